@@ -1,0 +1,10 @@
+use thiserror::Error;
+
+/// Errors building or running a world.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum EngineError {
+    /// A world description that cannot be built (a non-positive length, an odd lane count, an
+    /// actor off the road...). The message names the field and the offending value.
+    #[error("invalid world: {0}")]
+    InvalidWorld(String),
+}

@@ -1,0 +1,114 @@
+use rapier3d::prelude::*;
+use serde::Serialize;
+
+/// Capsule radius of a pedestrian, in metres.
+pub(crate) const PED_RADIUS_M: f32 = 0.3;
+/// Half-height of the capsule's cylinder, in metres (total height 1.8 m).
+pub(crate) const PED_HALF_HEIGHT_M: f32 = 0.6;
+
+/// Where a pedestrian is in its behaviour `tick.skipUntil(trigger).takeUntil(done).foreach(walk)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PedestrianPhase {
+    /// Standing at the start, waiting for the trigger.
+    Waiting,
+    /// Walking toward the target.
+    Walking,
+    /// At the target; stays there.
+    Arrived,
+}
+
+/// A pedestrian's observable state.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PedestrianState {
+    /// Ground position `[x, y, z]` in metres (feet).
+    pub pos_m: [f64; 3],
+    /// The behaviour's phase.
+    pub phase: PedestrianPhase,
+    /// Time the walk started, in seconds since the run began, `None` before the trigger.
+    pub triggered_at_s: Option<f64>,
+}
+
+/// A kinematic pedestrian: a sensor capsule moved by position, not by forces. It never pushes
+/// the car; contact is reported through collision events on the sensor.
+pub(crate) struct Pedestrian {
+    pub(crate) body: RigidBodyHandle,
+    pub(crate) collider: ColliderHandle,
+    start: [f64; 3],
+    target: [f64; 3],
+    trigger_distance_m: f64,
+    speed_mps: f64,
+    pos: [f64; 3],
+    phase: PedestrianPhase,
+    triggered_at_s: Option<f64>,
+}
+
+impl Pedestrian {
+    pub(crate) fn build(
+        physics: &mut PhysicsWorld,
+        start: [f64; 3],
+        target: [f64; 3],
+        trigger_distance_m: f64,
+        speed_mps: f64,
+    ) -> Self {
+        let body = RigidBodyBuilder::kinematic_position_based().translation(centre(start));
+        let collider = ColliderBuilder::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M)
+            .sensor(true)
+            .active_events(ActiveEvents::COLLISION_EVENTS);
+        let (body, collider) = physics.insert(body, collider);
+        Pedestrian {
+            body,
+            collider,
+            start,
+            target,
+            trigger_distance_m,
+            speed_mps,
+            pos: start,
+            phase: PedestrianPhase::Waiting,
+            triggered_at_s: None,
+        }
+    }
+
+    /// Advances the behaviour by one step of `dt_s` seconds, at time `t_s`, with the ego
+    /// vehicle's centre at `ego_pos` (m). Sets the kinematic target of the next physics step.
+    pub(crate) fn tick(&mut self, physics: &mut PhysicsWorld, t_s: f64, dt_s: f64, ego_pos: [f64; 3]) {
+        if self.phase == PedestrianPhase::Waiting {
+            let d = (ego_pos[0] - self.start[0]).hypot(ego_pos[2] - self.start[2]);
+            if d < self.trigger_distance_m {
+                self.phase = PedestrianPhase::Walking;
+                self.triggered_at_s = Some(t_s);
+            }
+        }
+        if self.phase == PedestrianPhase::Walking {
+            let delta = [0, 1, 2].map(|i| self.target[i] - self.pos[i]);
+            let remaining = delta.iter().map(|d| d * d).sum::<f64>().sqrt();
+            let step = self.speed_mps * dt_s;
+            if remaining <= step {
+                self.pos = self.target;
+                self.phase = PedestrianPhase::Arrived;
+            } else {
+                for (p, d) in self.pos.iter_mut().zip(delta) {
+                    *p += d / remaining * step;
+                }
+            }
+            physics.bodies[self.body].set_next_kinematic_translation(centre(self.pos));
+        }
+    }
+
+    pub(crate) fn state(&self) -> PedestrianState {
+        PedestrianState {
+            pos_m: self.pos,
+            phase: self.phase,
+            triggered_at_s: self.triggered_at_s,
+        }
+    }
+}
+
+/// The capsule's centre for feet at `feet` (m).
+fn centre(feet: [f64; 3]) -> Vector {
+    Vector::new(
+        feet[0] as f32,
+        feet[1] as f32 + PED_HALF_HEIGHT_M + PED_RADIUS_M,
+        feet[2] as f32,
+    )
+}

@@ -1,0 +1,147 @@
+use rapier3d::control::{DynamicRayCastVehicleController, WheelTuning};
+use rapier3d::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::Control;
+
+/// Mass, size and actuator limits of the ego vehicle. Defaults are a mid-size car.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VehicleParams {
+    /// Mass in kg. Default 1500.
+    pub mass_kg: f64,
+    /// Body length, width and height in metres. Default 4.5 × 1.8 × 1.0.
+    pub size_m: [f64; 3],
+    /// Wheel radius in metres. Default 0.35.
+    pub wheel_radius_m: f64,
+    /// Engine force at full throttle per driven (rear) wheel, in N. Default 2250 N, i.e.
+    /// 3 m/s² on a 1500 kg car.
+    pub max_engine_force_n: f64,
+    /// Brake force at full brake per wheel, in N. Default 3000 N, i.e. 8 m/s² on a 1500 kg
+    /// car; the tyres' friction limit (road friction) may cap it further.
+    pub max_brake_force_n: f64,
+    /// Front-wheel angle at full steering, in rad. Default 0.5 rad (about 29°).
+    pub max_steer_rad: f64,
+}
+
+impl Default for VehicleParams {
+    fn default() -> Self {
+        VehicleParams {
+            mass_kg: 1500.0,
+            size_m: [4.5, 1.8, 1.0],
+            wheel_radius_m: 0.35,
+            max_engine_force_n: 2250.0,
+            max_brake_force_n: 3000.0,
+            max_steer_rad: 0.5,
+        }
+    }
+}
+
+/// Suspension rest length in metres.
+const SUSPENSION_REST_M: f32 = 0.3;
+/// Height of the wheels' hard points below the chassis centre, in metres.
+const HARD_POINT_DROP_M: f32 = 0.3;
+
+/// The ego vehicle: a dynamic box chassis carried by rapier's
+/// `DynamicRayCastVehicleController` on four ray-cast wheels (front steered, rear driven,
+/// all braked). Forward is the chassis' local `+x`, up its `+y`.
+pub(crate) struct EgoVehicle {
+    pub(crate) body: RigidBodyHandle,
+    pub(crate) collider: ColliderHandle,
+    controller: DynamicRayCastVehicleController,
+    params: VehicleParams,
+}
+
+impl EgoVehicle {
+    /// Builds the vehicle with its wheels on the ground at `pos` (surface point, metres),
+    /// heading `heading_rad`, moving forward at `speed_mps`.
+    pub(crate) fn build(
+        physics: &mut PhysicsWorld,
+        params: &VehicleParams,
+        pos: [f64; 3],
+        heading_rad: f64,
+        speed_mps: f64,
+        friction: f64,
+    ) -> Self {
+        let [len, wid, hei] = params.size_m.map(|v| v as f32);
+        let radius = params.wheel_radius_m as f32;
+        // Chassis centre so that the wheels rest with a little compression at the start.
+        let y = pos[1] as f32 + radius + SUSPENSION_REST_M + HARD_POINT_DROP_M - 0.05;
+        let rotation = Rotation::from_rotation_y(heading_rad as f32);
+        let forward = rotation * Vector::X;
+        let body = RigidBodyBuilder::dynamic()
+            .pose(Pose::from_parts(
+                Vector::new(pos[0] as f32, y, pos[2] as f32),
+                rotation,
+            ))
+            .linvel(forward * speed_mps as f32)
+            .linear_damping(0.02)
+            .can_sleep(false);
+        let collider = ColliderBuilder::cuboid(len / 2.0, hei / 2.0, wid / 2.0)
+            .mass(params.mass_kg as f32)
+            .active_events(ActiveEvents::COLLISION_EVENTS);
+        let (body, collider) = physics.insert(body, collider);
+
+        // Suspension stiffness and damping are per unit of chassis mass in rapier's model
+        // (force = mass · (k · compression - c · velocity)): k = 30 gives ~8 cm static
+        // compression, c ≈ 2.5–3 about half critical damping.
+        let tuning = WheelTuning {
+            suspension_stiffness: 30.0,
+            suspension_compression: 2.5,
+            suspension_damping: 3.0,
+            max_suspension_travel: 0.25,
+            side_friction_stiffness: 1.0,
+            friction_slip: friction as f32,
+            max_suspension_force: (params.mass_kg * 9.81 * 2.0) as f32,
+        };
+        let mut controller = DynamicRayCastVehicleController::new(body);
+        let (ax, az) = (len / 2.0 - 0.8, wid / 2.0 - 0.1);
+        for (x, z) in [(ax, az), (ax, -az), (-ax, az), (-ax, -az)] {
+            controller.add_wheel(
+                Vector::new(x, -HARD_POINT_DROP_M, z),
+                -Vector::Y,
+                Vector::Z,
+                SUSPENSION_REST_M,
+                radius,
+                &tuning,
+            );
+        }
+        EgoVehicle {
+            body,
+            collider,
+            controller,
+            params: params.clone(),
+        }
+    }
+
+    /// Sets engine, brake and steering from `control` (clamped), as documented on [`Control`].
+    /// rapier's `brake` is an impulse per step, hence the factor `dt`.
+    pub(crate) fn apply(&mut self, control: Control, dt_s: f64) {
+        let c = control.clamped();
+        let engine = (c.throttle.max(0.0) * self.params.max_engine_force_n) as f32;
+        let brake = ((-c.throttle).max(0.0) * self.params.max_brake_force_n * dt_s) as f32;
+        let steer = (c.steering * self.params.max_steer_rad) as f32;
+        for (i, wheel) in self.controller.wheels_mut().iter_mut().enumerate() {
+            let front = i < 2;
+            wheel.steering = if front { steer } else { 0.0 };
+            wheel.engine_force = if front { 0.0 } else { engine };
+            wheel.brake = brake;
+        }
+    }
+
+    /// Runs the controller's suspension and tyre model for one step; call before the physics
+    /// step. The wheels' rays see only fixed colliders (the road), never actors or sensors.
+    pub(crate) fn update(&mut self, physics: &mut PhysicsWorld, dt_s: f64) {
+        let queries = physics.broad_phase.as_query_pipeline_mut(
+            physics.narrow_phase.query_dispatcher(),
+            &mut physics.bodies,
+            &mut physics.colliders,
+            QueryFilter::only_fixed().exclude_sensors(),
+        );
+        self.controller.update_vehicle(dt_s as f32, queries);
+    }
+
+    /// Length, width and height of the body, in metres.
+    pub(crate) fn size_m(&self) -> [f64; 3] {
+        self.params.size_m
+    }
+}

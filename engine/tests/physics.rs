@@ -1,0 +1,160 @@
+//! Closed-loop physics tests of the engine: the ego vehicle, a pedestrian and the built-in
+//! systems under test on a straight road.
+
+use paracosm_engine::sut::{Aeb, AebConfig, ConstantControl, Sut};
+use paracosm_engine::{
+    Control, EgoSpec, Lane, LidarSpec, PedestrianSpec, RoadSpec, Simulation, VehicleParams,
+    WorldSpec, DEFAULT_DT_S,
+};
+
+fn world(pedestrians: Vec<PedestrianSpec>, initial_speed_mps: f64) -> WorldSpec {
+    WorldSpec {
+        dt_s: DEFAULT_DT_S,
+        road: RoadSpec::default(),
+        ego: EgoSpec {
+            lane: Lane::Driving(1),
+            at_m: 10.0,
+            initial_speed_mps,
+            vehicle: VehicleParams::default(),
+        },
+        pedestrians,
+        lidar: LidarSpec::default(),
+    }
+}
+
+/// A pedestrian that stands still in lane 1 at `x` (its trigger never fires).
+fn standing_in_lane(x: f64) -> PedestrianSpec {
+    PedestrianSpec {
+        start: (Lane::Driving(1), x),
+        target: (Lane::Driving(1), x),
+        trigger_distance_m: 1e-6,
+        speed_mps: 1.0,
+    }
+}
+
+/// Runs `sut` for `seconds`; returns the time of the first contact, the smallest separation
+/// and the final state's x and speed.
+fn drive(spec: &WorldSpec, sut: &mut dyn Sut, seconds: f64) -> (Option<f64>, f64, f64, f64) {
+    let mut sim = Simulation::new(spec).unwrap();
+    sut.reset(0).unwrap();
+    let mut first_contact = None;
+    let mut min_sep = f64::INFINITY;
+    while sim.t_s() < seconds {
+        let control = sut.act(&sim.observation()).unwrap();
+        sim.step(control);
+        let snap = sim.snapshot();
+        min_sep = min_sep.min(snap.min_pedestrian_separation_m);
+        if snap.ego_pedestrian_contact && first_contact.is_none() {
+            first_contact = Some(snap.t_s);
+        }
+    }
+    let ego = sim.ego_state();
+    (first_contact, min_sep, ego.pos_m[0], ego.speed_mps)
+}
+
+#[test]
+fn constant_throttle_hits_a_pedestrian_standing_40_m_ahead() {
+    let spec = world(vec![standing_in_lane(50.0)], 0.0);
+    let mut sut = ConstantControl(Control {
+        throttle: 0.5,
+        steering: 0.0,
+    });
+    let (contact, min_sep, _, _) = drive(&spec, &mut sut, 15.0);
+    let t = contact.expect("the car should reach the pedestrian");
+    // 40 m from rest at ~1.5 m/s² (half throttle) less the bumper: roughly 6–8 s.
+    assert!((4.0..10.0).contains(&t), "contact at {t} s");
+    assert_eq!(min_sep, 0.0);
+}
+
+#[test]
+fn aeb_stops_before_a_pedestrian_standing_40_m_ahead() {
+    let spec = world(vec![standing_in_lane(50.0)], 12.0);
+    let mut sut = Aeb::new(AebConfig::default());
+    let (contact, min_sep, x, speed) = drive(&spec, &mut sut, 15.0);
+    assert_eq!(contact, None, "aeb must not touch the pedestrian");
+    assert!(min_sep > 0.5, "closest approach {min_sep} m");
+    assert!(x < 50.0 - 2.25, "stopped at x = {x} m");
+    assert!(speed.abs() < 0.2, "still moving at {speed} m/s");
+}
+
+#[test]
+fn aeb_cruises_at_its_target_speed_and_keeps_its_lane_on_an_empty_road() {
+    let spec = world(vec![], 0.0);
+    let mut sut = Aeb::new(AebConfig::default());
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut max_lateral_error: f64 = 0.0;
+    while sim.t_s() < 14.0 {
+        let c = sut.act(&sim.observation()).unwrap();
+        sim.step(c);
+        max_lateral_error = max_lateral_error.max((sim.ego_state().pos_m[2] - 1.75).abs());
+    }
+    let ego = sim.ego_state();
+    assert!((ego.speed_mps - 12.0).abs() < 0.3, "speed {}", ego.speed_mps);
+    assert!(max_lateral_error < 0.2, "lateral error {max_lateral_error} m");
+    assert!(ego.heading_rad.abs() < 0.02, "heading {}", ego.heading_rad);
+}
+
+#[test]
+fn full_brake_from_12_mps_stops_in_a_plausible_distance() {
+    let spec = world(vec![], 12.0);
+    let mut sut = ConstantControl(Control::FULL_BRAKE);
+    let (_, _, x, speed) = drive(&spec, &mut sut, 4.0);
+    let distance = x - 10.0;
+    // v² / (2 a) = 9 m at 8 m/s²; allow for the suspension settling.
+    assert!((7.0..13.0).contains(&distance), "stopping distance {distance} m");
+    assert!(speed.abs() < 0.1);
+}
+
+#[test]
+fn the_same_world_gives_the_same_bits_twice() {
+    let run = || {
+        let spec = world(vec![standing_in_lane(60.0)], 12.0);
+        let mut sim = Simulation::new(&spec).unwrap();
+        let mut sut = Aeb::new(AebConfig::default());
+        for _ in 0..600 {
+            let c = sut.act(&sim.observation()).unwrap();
+            sim.step(c);
+        }
+        let e = sim.ego_state();
+        [e.pos_m[0], e.pos_m[1], e.pos_m[2], e.heading_rad, e.speed_mps].map(f64::to_bits)
+    };
+    assert_eq!(run(), run());
+}
+
+#[test]
+fn a_walking_pedestrian_crosses_once_triggered() {
+    let spec = world(
+        vec![PedestrianSpec {
+            start: (Lane::SideWalk, 60.0),
+            target: (Lane::OppositeSideWalk, 60.0),
+            trigger_distance_m: 30.0,
+            speed_mps: 3.0,
+        }],
+        12.0,
+    );
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut sut = ConstantControl(Control::FULL_BRAKE);
+    // The car stops at ~x = 19 m, 41 m from the pedestrian: no trigger.
+    for _ in 0..300 {
+        let c = sut.act(&sim.observation()).unwrap();
+        sim.step(c);
+    }
+    let snap = sim.snapshot();
+    assert_eq!(snap.pedestrians[0].triggered_at_s, None);
+    assert_eq!(snap.pedestrians[0].pos_m, [60.0, 0.15, 4.5]);
+
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut sut = ConstantControl(Control::default());
+    let mut triggered = None;
+    while sim.t_s() < 10.0 {
+        let c = sut.act(&sim.observation()).unwrap();
+        sim.step(c);
+        triggered = triggered.or(sim.snapshot().pedestrians[0].triggered_at_s);
+    }
+    // Coasting at ~12 m/s from x = 10 m: within 30 m of x = 60 after about 1.7 s.
+    let t = triggered.expect("the trigger should fire");
+    assert!((1.3..2.2).contains(&t), "triggered at {t} s");
+    // 9 m across at 3 m/s: arrived 3 s later.
+    let p = sim.snapshot().pedestrians[0];
+    assert_eq!(p.pos_m, [60.0, 0.15, -4.5]);
+}

@@ -1,0 +1,21 @@
+//! Test oracles over sampled signal traces: monitors that turn a run into a verdict with a
+//! quantitative robustness (`> 0` satisfied, `<= 0` violated).
+//!
+//! Monitors see only named signals ([`Signals`]) at sample times ([`Frame`]); they know nothing
+//! of the simulator, so they work as well on a trace exported from another tool.
+//!
+//! - [`CollisionMonitor`]: no contact between the ego vehicle and another body (paper §2,
+//!   "Invariants and Monitors").
+//! - [`DistanceMonitor`]: the ego vehicle travelled at least `min_distance_m`, so it did not pass
+//!   by standing still (paper §2).
+#![warn(missing_docs)]
+
+mod collision;
+mod distance;
+mod monitor;
+mod signals;
+
+pub use collision::CollisionMonitor;
+pub use distance::DistanceMonitor;
+pub use monitor::{Monitor, Verdict};
+pub use signals::{Frame, SignalError, Signals};

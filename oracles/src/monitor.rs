@@ -1,0 +1,41 @@
+use std::ops::ControlFlow;
+
+use serde::Serialize;
+
+use crate::Frame;
+
+/// The outcome of a monitor over a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verdict {
+    /// Whether the property held over the whole run.
+    pub passed: bool,
+    /// Quantitative robustness in the monitor's unit (metres for the shipped monitors):
+    /// `> 0` satisfied with that margin, `<= 0` violated. `passed == (robustness > 0)` for
+    /// every shipped monitor.
+    pub robustness: f64,
+    /// Time of the first violation in seconds since the start, `None` if none.
+    pub first_violation_s: Option<f64>,
+    /// Extra measurements, e.g. `("min_distance_m", 0.4)`.
+    #[serde(skip)]
+    pub metrics: Vec<(&'static str, f64)>,
+}
+
+/// A test oracle fed one frame at a time.
+///
+/// `observe` may return `ControlFlow::Break(())` once the verdict can no longer change, so a
+/// simulator may stop the run early. `verdict` may be called at any time and reflects the
+/// frames seen so far.
+pub trait Monitor: Send {
+    /// A short name used as the key in results files, e.g. `collision`.
+    fn name(&self) -> &str;
+
+    /// Consumes one frame.
+    ///
+    /// Frames come in increasing time order. A frame lacking a signal the monitor needs is a
+    /// violation of the monitor's contract with the simulator; the shipped monitors treat it as
+    /// a failed verdict (robustness `-inf`) rather than panicking.
+    fn observe(&mut self, frame: &Frame<'_>) -> ControlFlow<()>;
+
+    /// The verdict over the frames seen so far.
+    fn verdict(&self) -> Verdict;
+}

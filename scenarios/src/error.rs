@@ -1,0 +1,29 @@
+use paracosm_engine::sut::SutError;
+use paracosm_engine::EngineError;
+use paracosm_generators::GeneratorError;
+use thiserror::Error;
+
+/// Errors loading, instantiating or running a scenario.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ScenarioError {
+    /// No built-in scenario has that name.
+    #[error("unknown scenario `{name}` (built-in scenarios: {known})")]
+    UnknownScenario {
+        /// The name asked for.
+        name: String,
+        /// The known names, comma-separated.
+        known: String,
+    },
+    /// The assignment lacks a parameter the world needs, or has it with a non-numeric value.
+    #[error("assignment has no numeric value for parameter `{0}`")]
+    MissingParam(String),
+    /// The parameter space or a point is invalid.
+    #[error(transparent)]
+    Space(#[from] GeneratorError),
+    /// The instantiated world cannot be built.
+    #[error(transparent)]
+    Engine(#[from] EngineError),
+    /// The system under test failed.
+    #[error(transparent)]
+    Sut(#[from] SutError),
+}

@@ -1,0 +1,172 @@
+use std::ops::ControlFlow;
+
+use paracosm_engine::{Simulation, Snapshot};
+use paracosm_generators::Assignment;
+use paracosm_oracles::{Frame, Monitor, Signals, Verdict};
+
+use crate::{Scenario, ScenarioError};
+
+/// Names of the signals the runner publishes to monitors each step.
+pub mod signal {
+    /// Ego vehicle centre, `x`, in metres.
+    pub const EGO_X_M: &str = "ego_x_m";
+    /// Ego vehicle centre, `z`, in metres.
+    pub const EGO_Z_M: &str = "ego_z_m";
+    /// Ego speed along its heading, m/s.
+    pub const EGO_SPEED_MPS: &str = "ego_speed_mps";
+    /// `1.0` while the ego vehicle touches a pedestrian, else `0.0`.
+    pub const EGO_PED_CONTACT: &str = "ego_ped_contact";
+    /// Smallest distance between the ego body and a pedestrian, metres (`0` touching).
+    pub const EGO_PED_SEPARATION_M: &str = "ego_ped_separation_m";
+}
+
+/// The result of one test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TestOutcome {
+    /// Each monitor's name and verdict, in the scenario's order.
+    pub monitors: Vec<(String, Verdict)>,
+    /// Measurements: the monitors' metrics (e.g. `min_distance_m`, `distance_travelled_m`),
+    /// then `time_to_failure_s` when a monitor failed and `simulated_s`.
+    pub metrics: Vec<(&'static str, f64)>,
+}
+
+impl TestOutcome {
+    /// Whether every monitor passed.
+    pub fn passed(&self) -> bool {
+        self.monitors.iter().all(|(_, v)| v.passed)
+    }
+
+    /// The smallest robustness over the monitors (`+inf` with none): the falsification cost.
+    pub fn robustness(&self) -> f64 {
+        self.monitors
+            .iter()
+            .map(|(_, v)| v.robustness)
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+fn publish(snap: &Snapshot, out: &mut Signals) {
+    out.set(signal::EGO_X_M, snap.ego.pos_m[0]);
+    out.set(signal::EGO_Z_M, snap.ego.pos_m[2]);
+    out.set(signal::EGO_SPEED_MPS, snap.ego.speed_mps);
+    out.set_bool(signal::EGO_PED_CONTACT, snap.ego_pedestrian_contact);
+    out.set(signal::EGO_PED_SEPARATION_M, snap.min_pedestrian_separation_m);
+}
+
+/// Feeds one snapshot to every monitor; `Break` when any monitor settled its verdict.
+fn observe(snap: &Snapshot, signals: &mut Signals, monitors: &mut [Box<dyn Monitor>]) -> bool {
+    publish(snap, signals);
+    let frame = Frame {
+        t_s: snap.t_s,
+        signals,
+    };
+    let mut stop = false;
+    for m in monitors.iter_mut() {
+        stop |= matches!(m.observe(&frame), ControlFlow::Break(()));
+    }
+    stop
+}
+
+impl Scenario {
+    /// Runs one test: instantiates the world for `assignment`, resets the system under test with
+    /// `seed`, and steps until the horizon or until a monitor settles its verdict.
+    ///
+    /// Deterministic: the same scenario, assignment and seed give bit-identical outcomes.
+    ///
+    /// # Errors
+    /// [`ScenarioError`] when the world cannot be built or the system under test fails.
+    pub fn run(&self, assignment: &Assignment, seed: u64) -> Result<TestOutcome, ScenarioError> {
+        let spec = self.instantiate(assignment)?;
+        let mut sim = Simulation::new(&spec)?;
+        let mut sut = self.sut.build();
+        sut.reset(seed)?;
+        let mut monitors: Vec<Box<dyn Monitor>> = self.monitors.iter().map(|m| m.build()).collect();
+        let mut signals = Signals::new();
+        let ticks = (self.horizon_s / spec.dt_s).round() as u64;
+        let mut stopped = observe(&sim.snapshot(), &mut signals, &mut monitors);
+        let mut tick = 0;
+        while !stopped && tick < ticks {
+            let control = sut.act(&sim.observation())?;
+            sim.step(control);
+            tick += 1;
+            stopped = observe(&sim.snapshot(), &mut signals, &mut monitors);
+        }
+
+        let monitors: Vec<(String, Verdict)> = monitors
+            .iter()
+            .map(|m| (m.name().to_owned(), m.verdict()))
+            .collect();
+        let mut metrics: Vec<(&'static str, f64)> = monitors
+            .iter()
+            .flat_map(|(_, v)| v.metrics.iter().copied())
+            .collect();
+        if let Some(ttf) = monitors
+            .iter()
+            .filter_map(|(_, v)| v.first_violation_s)
+            .reduce(f64::min)
+        {
+            metrics.push(("time_to_failure_s", ttf));
+        }
+        metrics.push(("simulated_s", sim.t_s()));
+        Ok(TestOutcome { monitors, metrics })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use paracosm_generators::Point;
+
+    use crate::pedestrian_crossing::{self, TRIGGER_DISTANCE, WALKING_SPEED};
+
+    fn run(speed: f64, trigger: f64) -> crate::TestOutcome {
+        let s = pedestrian_crossing::scenario();
+        let u = |v: f64, (lo, hi): (f64, f64)| (v - lo) / (hi - lo);
+        let a = s
+            .space
+            .decode(&Point {
+                discrete: vec![],
+                continuous: vec![
+                    u(speed, pedestrian_crossing::WALKING_SPEED_RANGE_MPS),
+                    u(trigger, pedestrian_crossing::TRIGGER_DISTANCE_RANGE_M),
+                ],
+            })
+            .unwrap();
+        assert_eq!(a.real(WALKING_SPEED).unwrap(), speed);
+        assert!((a.real(TRIGGER_DISTANCE).unwrap() - trigger).abs() < 1e-9);
+        s.run(&a, 1).unwrap()
+    }
+
+    #[test]
+    fn slow_pedestrian_far_trigger_is_safe() {
+        let o = run(1.0, 55.0);
+        assert!(o.passed(), "{o:?}");
+        assert!(o.robustness() > 0.0);
+    }
+
+    #[test]
+    fn fast_pedestrian_close_trigger_is_hit_and_stops_the_run_early() {
+        let o = run(6.0, 12.0);
+        assert!(!o.passed(), "{o:?}");
+        let (_, collision) = &o.monitors[0];
+        assert!(!collision.passed && collision.robustness <= 0.0);
+        let ttf = o.metrics.iter().find(|(n, _)| *n == "time_to_failure_s").unwrap().1;
+        let simulated = o.metrics.iter().find(|(n, _)| *n == "simulated_s").unwrap().1;
+        assert_eq!(ttf, simulated, "the run stops at the contact");
+        assert!(simulated < pedestrian_crossing::HORIZON_S);
+    }
+
+    #[test]
+    fn instantiate_uses_the_assignment() {
+        let s = pedestrian_crossing::scenario();
+        let a = s
+            .space
+            .decode(&Point {
+                discrete: vec![],
+                continuous: vec![0.0, 0.5],
+            })
+            .unwrap();
+        let w = s.instantiate(&a).unwrap();
+        assert_eq!(w.pedestrians[0].speed_mps, 0.5);
+        assert_eq!(w.pedestrians[0].trigger_distance_m, 32.5);
+    }
+}

@@ -1,0 +1,276 @@
+//! `paracosm-fuzz`: run a test campaign on a scenario and report the failures it finds.
+//!
+//! Exit codes: 0 no failure found, 1 a test failed, 2 bad input or usage, 3 internal error.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Parser, ValueEnum};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use tracing::info;
+
+use paracosm::campaign::{Campaign, CampaignError, RESULTS_FILE};
+use paracosm::record::Status;
+use paracosm::summary::Summary;
+use paracosm_generators::Strategy;
+
+/// Test-generation strategies on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum StrategyArg {
+    /// Uniform random points (ChaCha8, seeded by --seed).
+    Random,
+    /// The Halton low-dispersion sequence (paper §3.2); --seed is not used.
+    Halton,
+    /// Owen-scrambled Sobol points (at most 65536); --seed selects the scramble.
+    Sobol,
+}
+
+impl From<StrategyArg> for Strategy {
+    fn from(s: StrategyArg) -> Self {
+        match s {
+            StrategyArg::Random => Strategy::Random,
+            StrategyArg::Halton => Strategy::Halton,
+            StrategyArg::Sobol => Strategy::Sobol,
+        }
+    }
+}
+
+/// Run a test campaign on a scenario: sample its open parameters, simulate each test, and
+/// write results.jsonl, summary.json and a failure map.
+#[derive(Debug, Parser)]
+#[command(name = "paracosm-fuzz", version, about, long_about = None)]
+struct Cli {
+    /// Built-in scenario to test (available: pedestrian-crossing).
+    scenario: String,
+    /// How test points are chosen.
+    #[arg(long, value_enum, default_value = "halton")]
+    strategy: StrategyArg,
+    /// Number of tests to run (at least 1).
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..))]
+    budget: u64,
+    /// Campaign seed: seeds the generator and every test.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    jobs: Option<u64>,
+    /// Output folder for results.jsonl, summary.json and failure_map.{png,svg}.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// Replace the results of an earlier campaign in --out.
+    #[arg(long)]
+    force: bool,
+}
+
+/// An error caused by the user's input: exit code 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+struct BadInput(String);
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help and --version
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            let rendered = e.to_string();
+            let reason = rendered
+                .lines()
+                .find(|l| !l.trim().is_empty())
+                .unwrap_or("invalid arguments")
+                .trim_start_matches("error: ");
+            eprintln!("paracosm-fuzz: {reason} (see --help)");
+            return ExitCode::from(2);
+        }
+    };
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    match run(&cli) {
+        Ok(code) => code,
+        Err(e) => {
+            let code = if e.downcast_ref::<BadInput>().is_some() { 2 } else { 3 };
+            eprintln!("paracosm-fuzz: {e:#}");
+            ExitCode::from(code)
+        }
+    }
+}
+
+fn run(cli: &Cli) -> Result<ExitCode> {
+    let scenario =
+        paracosm_scenarios::builtin(&cli.scenario).map_err(|e| BadInput(e.to_string()))?;
+    let strategy = Strategy::from(cli.strategy);
+    if let Some(cap) = strategy.capacity().filter(|&cap| cli.budget > cap) {
+        return Err(BadInput(format!(
+            "--budget {} is more than the {} points {strategy} can produce",
+            cli.budget, cap
+        ))
+        .into());
+    }
+    let jobs = cli.jobs.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |j| j as usize,
+    );
+    prepare_out_dir(cli)?;
+
+    let campaign = Campaign {
+        scenario: &scenario,
+        strategy,
+        seed: cli.seed,
+        budget: cli.budget,
+        jobs,
+    };
+    let bar = if std::io::stderr().is_terminal() {
+        ProgressBar::with_draw_target(Some(cli.budget), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} tests, {msg} ({per_sec}, eta {eta})",
+        )
+        .context("progress bar template")?,
+    );
+    let mut failures = 0u64;
+    let report = campaign
+        .run(&cli.out, |r| {
+            failures += u64::from(r.status == Status::Fail);
+            bar.set_message(format!("{failures} failed"));
+            bar.inc(1);
+        })
+        .map_err(|e| match e {
+            CampaignError::Io { .. } | CampaignError::Generator(_) => {
+                anyhow::Error::new(BadInput(e.to_string()))
+            }
+            CampaignError::Pool { .. } => anyhow::Error::new(e),
+        })?;
+    bar.finish_and_clear();
+
+    let stem = cli.out.join("failure_map");
+    let title = format!(
+        "{}: {}, {} tests, {} failed",
+        scenario.name, strategy, cli.budget, report.counts.fail
+    );
+    let plots = paracosm::plot::failure_map(
+        &stem,
+        &scenario.space,
+        &scenario.map_axes,
+        &[(&title, &report.records)],
+    )
+    .map_err(|e| BadInput(e.to_string()))?;
+
+    let mut outputs = vec![RESULTS_FILE.to_owned(), "summary.json".to_owned()];
+    outputs.extend(plots.iter().filter_map(|p| {
+        p.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+    }));
+    let summary = Summary {
+        tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
+        scenario: scenario.name.clone(),
+        strategy: strategy.name().to_owned(),
+        seed: cli.seed,
+        budget: cli.budget,
+        jobs,
+        space: scenario.space.params().to_vec(),
+        counts: report.counts,
+        first_failure: report.first_failure.clone(),
+        wall_s: report.wall_s,
+        outputs,
+    };
+    let summary_path = cli.out.join("summary.json");
+    std::fs::write(&summary_path, serde_json::to_string_pretty(&summary)? + "\n")
+        .map_err(|e| BadInput(format!("cannot write `{}`: {e}", summary_path.display())))?;
+    info!(path = %summary_path.display(), "wrote summary");
+
+    let c = report.counts;
+    println!(
+        "{} tests of {} ({}, seed {}): {} passed, {} failed, {} errors in {:.1} s ({:.0} tests/s)",
+        cli.budget,
+        scenario.name,
+        strategy,
+        cli.seed,
+        c.pass,
+        c.fail,
+        c.error,
+        report.wall_s,
+        cli.budget as f64 / report.wall_s.max(1e-9)
+    );
+    if let Some(f) = &report.first_failure {
+        let values: Vec<String> = f
+            .params
+            .iter()
+            .map(|(n, v)| {
+                let unit = scenario
+                    .space
+                    .param(n)
+                    .and_then(|p| p.unit.clone())
+                    .unwrap_or_default();
+                match v.as_f64() {
+                    Some(x) => format!("{n} = {x:.3} {unit}"),
+                    None => format!("{n} = {v}"),
+                }
+            })
+            .collect();
+        println!(
+            "first failure: test {} ({}), monitors failed: {}",
+            f.id,
+            values.join(", "),
+            f.failed_monitors.join(", ")
+        );
+    }
+    println!(
+        "wrote {}, {}, {}",
+        cli.out.join(RESULTS_FILE).display(),
+        summary_path.display(),
+        plots
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok(if c.fail > 0 {
+        ExitCode::from(1)
+    } else if c.error > 0 {
+        ExitCode::from(3)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Creates `--out` and refuses to overwrite an earlier campaign's results without `--force`.
+fn prepare_out_dir(cli: &Cli) -> Result<()> {
+    let results = cli.out.join(RESULTS_FILE);
+    if results.exists() && !cli.force {
+        return Err(BadInput(format!(
+            "`{}` already holds a campaign's results; pass --force to replace them, or choose \
+             another --out",
+            cli.out.display()
+        ))
+        .into());
+    }
+    std::fs::create_dir_all(&cli.out).map_err(|e| {
+        BadInput(format!(
+            "cannot create output folder `{}`: {e}",
+            cli.out.display()
+        ))
+    })?;
+    // Probe writability now, before any test runs.
+    let probe = cli.out.join(".paracosm-write-probe");
+    std::fs::write(&probe, b"").map_err(|e| {
+        BadInput(format!(
+            "cannot write to output folder `{}`: {e}",
+            cli.out.display()
+        ))
+    })?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}

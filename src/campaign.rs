@@ -1,0 +1,244 @@
+//! The campaign runner: points from a generator, tests in parallel, results in order.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc;
+use std::time::Instant;
+
+use paracosm_generators::{GeneratorError, Point, Strategy};
+use paracosm_scenarios::Scenario;
+use thiserror::Error;
+
+use crate::record::{MonitorResult, RunRecord, Status};
+use crate::seed::test_seed;
+use crate::summary::{Counts, FirstFailure};
+
+/// File name of the per-test results in the output folder.
+pub const RESULTS_FILE: &str = "results.jsonl";
+
+/// Errors that stop a campaign (a single test's failure never does: it becomes an `error`
+/// record).
+#[derive(Debug, Error)]
+pub enum CampaignError {
+    /// The generator cannot serve the budget (e.g. Sobol past 2^16 points).
+    #[error(transparent)]
+    Generator(#[from] GeneratorError),
+    /// The output folder or a file in it cannot be written.
+    #[error("cannot write `{path}`: {source}")]
+    Io {
+        /// The path being written.
+        path: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// The worker pool could not be started.
+    #[error("cannot start {jobs} worker threads: {reason}")]
+    Pool {
+        /// Threads asked for.
+        jobs: usize,
+        /// rayon's reason.
+        reason: String,
+    },
+}
+
+/// A campaign's settings.
+#[derive(Debug, Clone)]
+pub struct Campaign<'a> {
+    /// The scenario under test.
+    pub scenario: &'a Scenario,
+    /// The test-generation strategy.
+    pub strategy: Strategy,
+    /// Campaign seed: seeds the generator and, with the test index, every test.
+    pub seed: u64,
+    /// Number of tests, `>= 1`.
+    pub budget: u64,
+    /// Worker threads, `>= 1`. Results do not depend on it.
+    pub jobs: usize,
+}
+
+/// What a finished campaign reports.
+#[derive(Debug, Clone)]
+pub struct CampaignReport {
+    /// Every record, by id.
+    pub records: Vec<RunRecord>,
+    /// Outcome counts.
+    pub counts: Counts,
+    /// The failing test with the smallest id.
+    pub first_failure: Option<FirstFailure>,
+    /// Wall-clock time in seconds.
+    pub wall_s: f64,
+}
+
+impl Campaign<'_> {
+    /// The campaign's points, in test order: `budget` points from the strategy's generator.
+    ///
+    /// # Errors
+    /// [`CampaignError::Generator`] when the strategy cannot produce them.
+    pub fn points(&self) -> Result<Vec<Point>, CampaignError> {
+        let mut generator = self.strategy.build(&self.scenario.space, self.seed)?;
+        Ok(generator.ask(self.budget as usize)?)
+    }
+
+    /// Runs test `id` at `point` alone: what a worker does, and what a replay does.
+    pub fn run_one(&self, id: u64, point: &Point) -> RunRecord {
+        let started = Instant::now();
+        let seed = test_seed(self.seed, id);
+        let scenario = self.scenario;
+        let decoded = scenario.space.decode(point);
+        let outcome = match &decoded {
+            Ok(assignment) => catch_unwind(AssertUnwindSafe(|| scenario.run(assignment, seed)))
+                .unwrap_or_else(|panic| {
+                    let msg = panic
+                        .downcast_ref::<&str>()
+                        .map(|s| s.to_string())
+                        .or_else(|| panic.downcast_ref::<String>().cloned())
+                        .unwrap_or_else(|| "unknown panic".into());
+                    Err(paracosm_scenarios::ScenarioError::Sut(
+                        paracosm_engine::sut::SutError::Failed(format!("internal panic: {msg}")),
+                    ))
+                })
+                .map_err(|e| e.to_string()),
+            Err(e) => Err(e.to_string()),
+        };
+        let (status, monitors, metrics, error) = match outcome {
+            Ok(o) => (
+                if o.passed() { Status::Pass } else { Status::Fail },
+                o.monitors
+                    .iter()
+                    .map(|(n, v)| (n.clone(), MonitorResult::from(v)))
+                    .collect(),
+                o.metrics,
+                None,
+            ),
+            Err(e) => (Status::Error, Vec::new(), Vec::new(), Some(e)),
+        };
+        RunRecord {
+            id,
+            seed,
+            strategy: self.strategy.name().to_owned(),
+            point: point.clone(),
+            params: decoded.ok(),
+            status,
+            monitors,
+            metrics,
+            error,
+            wall_ms: started.elapsed().as_secs_f64() * 1e3,
+        }
+    }
+
+    /// Runs the campaign, writing `results.jsonl` into `out_dir` (created if needed, the file
+    /// replaced). `on_done` is called in the calling thread as each test finishes (for progress
+    /// bars).
+    ///
+    /// Tests are handed to `jobs` rayon workers one index at a time, so tests finish roughly in
+    /// index order. Each record is appended and flushed as soon as every record before it is
+    /// written: the file is in id order and byte-identical for any `jobs`, and at most the
+    /// tests in flight are missing if the process dies.
+    ///
+    /// # Errors
+    /// [`CampaignError`] when the points cannot be generated, the pool cannot start, or the
+    /// results file cannot be written. Records already written stay on disk.
+    pub fn run(
+        &self,
+        out_dir: &Path,
+        mut on_done: impl FnMut(&RunRecord),
+    ) -> Result<CampaignReport, CampaignError> {
+        let started = Instant::now();
+        let points = self.points()?;
+        let path = out_dir.join(RESULTS_FILE);
+        let io_err = |source| CampaignError::Io {
+            path: path.clone(),
+            source,
+        };
+        std::fs::create_dir_all(out_dir).map_err(|source| CampaignError::Io {
+            path: out_dir.to_path_buf(),
+            source,
+        })?;
+        let mut out = BufWriter::new(File::create(&path).map_err(io_err)?);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(self.jobs)
+            .thread_name(|i| format!("paracosm-worker-{i}"))
+            .build()
+            .map_err(|e| CampaignError::Pool {
+                jobs: self.jobs,
+                reason: e.to_string(),
+            })?;
+
+        let next = AtomicUsize::new(0);
+        let (tx, rx) = mpsc::channel::<RunRecord>();
+        let mut records: Vec<RunRecord> = Vec::with_capacity(points.len());
+        let mut pending: BTreeMap<u64, RunRecord> = BTreeMap::new();
+        let mut write_result = Ok(());
+        std::thread::scope(|scope| {
+            let points = &points;
+            let next = &next;
+            scope.spawn(move || {
+                pool.scope(|s| {
+                    for _ in 0..self.jobs {
+                        let tx = tx.clone();
+                        s.spawn(move |_| loop {
+                            let i = next.fetch_add(1, Ordering::Relaxed);
+                            let Some(p) = points.get(i) else { break };
+                            if tx.send(self.run_one(i as u64, p)).is_err() {
+                                break; // the writer gave up; stop taking work
+                            }
+                        });
+                    }
+                });
+            });
+            for record in rx {
+                on_done(&record);
+                pending.insert(record.id, record);
+                while let Some(r) = pending.remove(&(records.len() as u64)) {
+                    if write_result.is_ok() {
+                        write_result = write_line(&mut out, &r);
+                        if write_result.is_err() {
+                            // Stop the workers: nothing more can be saved.
+                            next.store(usize::MAX / 2, Ordering::Relaxed);
+                        }
+                    }
+                    records.push(r);
+                }
+            }
+        });
+        write_result.map_err(io_err)?;
+
+        let mut counts = Counts::default();
+        for r in &records {
+            match r.status {
+                Status::Pass => counts.pass += 1,
+                Status::Fail => counts.fail += 1,
+                Status::Error => counts.error += 1,
+            }
+        }
+        let first_failure = records.iter().find_map(|r| match (&r.status, &r.params) {
+            (Status::Fail, Some(params)) => Some(FirstFailure {
+                id: r.id,
+                params: params.clone(),
+                failed_monitors: r
+                    .monitors
+                    .iter()
+                    .filter(|(_, m)| !m.passed)
+                    .map(|(n, _)| n.clone())
+                    .collect(),
+            }),
+            _ => None,
+        });
+        Ok(CampaignReport {
+            records,
+            counts,
+            first_failure,
+            wall_s: started.elapsed().as_secs_f64(),
+        })
+    }
+}
+
+fn write_line(out: &mut BufWriter<File>, record: &RunRecord) -> std::io::Result<()> {
+    serde_json::to_writer(&mut *out, record)?;
+    out.write_all(b"\n")?;
+    out.flush()
+}

@@ -1,0 +1,17 @@
+//! paracosm: coverage-driven testing and falsification of autonomous-driving systems.
+//!
+//! This root crate runs test campaigns: it asks a generator for points of a scenario's
+//! parameter space, runs one closed-loop simulation per point in parallel, appends every
+//! result to `results.jsonl` as soon as it is known, and writes `summary.json` and the failure
+//! map. The command-line tools `paracosm-fuzz` and `paracosm-cover` sit on top
+//! (`src/bin/`). See `ARCHITECTURE.md` for how the crates fit together.
+#![warn(missing_docs)]
+
+pub mod campaign;
+pub mod plot;
+pub mod record;
+pub mod seed;
+pub mod summary;
+
+pub use campaign::{Campaign, CampaignError, CampaignReport};
+pub use record::{RunRecord, Status};

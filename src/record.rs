@@ -1,0 +1,85 @@
+//! One line of `results.jsonl`.
+
+use serde::ser::SerializeMap;
+use serde::{Serialize, Serializer};
+
+use paracosm_generators::{Assignment, Point};
+use paracosm_oracles::Verdict;
+
+/// A test's outcome class.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// Every monitor passed.
+    Pass,
+    /// At least one monitor failed.
+    Fail,
+    /// The test could not be run to a verdict (invalid world, system under test failure,
+    /// internal error); `error` says why.
+    Error,
+}
+
+/// A monitor's verdict as written to the results file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MonitorResult {
+    /// Whether the monitor's property held.
+    pub passed: bool,
+    /// Robustness in the monitor's unit; `> 0` satisfied. Non-finite values are written as
+    /// `null` (JSON has no infinity).
+    pub robustness: f64,
+    /// Time of the first violation in seconds since the start, or `null`.
+    pub first_violation_s: Option<f64>,
+}
+
+impl From<&Verdict> for MonitorResult {
+    fn from(v: &Verdict) -> Self {
+        MonitorResult {
+            passed: v.passed,
+            robustness: v.robustness,
+            first_violation_s: v.first_violation_s,
+        }
+    }
+}
+
+/// One test's record: a line of `results.jsonl` (see DESIGN.md, "Files a run writes").
+///
+/// Field order is the line's key order. `wall_ms` is the only field that depends on the
+/// machine and the moment; it comes last so that tools can drop it to compare runs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunRecord {
+    /// Test index in the campaign, `0..budget`.
+    pub id: u64,
+    /// The test's own seed, derived from the campaign seed and `id` ([`crate::seed::test_seed`]).
+    pub seed: u64,
+    /// The strategy that proposed the point.
+    pub strategy: String,
+    /// The point in normalised coordinates (`continuous` in `[0, 1)`, `discrete` level indices).
+    pub point: Point,
+    /// The point's values by parameter name, in the parameters' units; `null` only when the
+    /// point does not decode (then `status` is `error`).
+    pub params: Option<Assignment>,
+    /// Pass, fail or error.
+    pub status: Status,
+    /// Each monitor's verdict, by monitor name, in the scenario's order.
+    #[serde(serialize_with = "ordered_map")]
+    pub monitors: Vec<(String, MonitorResult)>,
+    /// Measurements by name (units in the name: `_m`, `_s`), e.g. `min_distance_m`,
+    /// `distance_travelled_m`, `time_to_failure_s`.
+    #[serde(serialize_with = "ordered_map")]
+    pub metrics: Vec<(&'static str, f64)>,
+    /// Why the test ended in `error`, else `null`.
+    pub error: Option<String>,
+    /// Wall-clock time of the test in milliseconds. Machine-dependent.
+    pub wall_ms: f64,
+}
+
+fn ordered_map<K: Serialize, V: Serialize, S: Serializer>(
+    pairs: &[(K, V)],
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    let mut map = serializer.serialize_map(Some(pairs.len()))?;
+    for (k, v) in pairs {
+        map.serialize_entry(k, v)?;
+    }
+    map.end()
+}

@@ -1,0 +1,54 @@
+//! `summary.json`: a campaign's settings, counts and first failure.
+
+use serde::Serialize;
+
+use paracosm_generators::{Assignment, Param};
+
+/// Counts of test outcomes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct Counts {
+    /// Tests whose monitors all passed.
+    pub pass: u64,
+    /// Tests with at least one failed monitor.
+    pub fail: u64,
+    /// Tests that ended in an error.
+    pub error: u64,
+}
+
+/// The first failing test, by id.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FirstFailure {
+    /// Test id.
+    pub id: u64,
+    /// Its parameter values.
+    pub params: Assignment,
+    /// The monitors that failed.
+    pub failed_monitors: Vec<String>,
+}
+
+/// The contents of `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// `paracosm <version>`.
+    pub tool: String,
+    /// Scenario name.
+    pub scenario: String,
+    /// Strategy name.
+    pub strategy: String,
+    /// Campaign seed.
+    pub seed: u64,
+    /// Number of tests asked for.
+    pub budget: u64,
+    /// Worker threads used (does not change any result).
+    pub jobs: usize,
+    /// The scenario's open parameters.
+    pub space: Vec<Param>,
+    /// Outcome counts.
+    pub counts: Counts,
+    /// The failing test with the smallest id, if any.
+    pub first_failure: Option<FirstFailure>,
+    /// Wall-clock time of the whole campaign in seconds.
+    pub wall_s: f64,
+    /// Files written, relative to the output folder.
+    pub outputs: Vec<String>,
+}
