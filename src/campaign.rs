@@ -106,7 +106,11 @@ impl Campaign<'_> {
         };
         let (status, monitors, metrics, error) = match outcome {
             Ok(o) => (
-                if o.passed() { Status::Pass } else { Status::Fail },
+                if o.passed() {
+                    Status::Pass
+                } else {
+                    Status::Fail
+                },
                 o.monitors
                     .iter()
                     .map(|(n, v)| (n.clone(), MonitorResult::from(v)))

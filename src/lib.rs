@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod campaign;
+pub mod cli;
 pub mod plot;
 pub mod record;
 pub mod seed;

@@ -94,7 +94,10 @@ fn draw_panel<DB: DrawingBackend>(
     let blue = RGBColor(31, 119, 180);
     let red = RGBColor(214, 39, 40);
     chart
-        .draw_series(pass.iter().map(|&p| Circle::new(p, 3, blue.stroke_width(1))))
+        .draw_series(
+            pass.iter()
+                .map(|&p| Circle::new(p, 3, blue.stroke_width(1))),
+        )
         .map_err(|e| e.to_string())?
         .label(format!("pass ({})", pass.len()))
         .legend(move |p| Circle::new(p, 3, blue.stroke_width(1)));
@@ -105,7 +108,11 @@ fn draw_panel<DB: DrawingBackend>(
         .legend(move |p| Cross::new(p, 4, red.stroke_width(2)));
     if !error.is_empty() {
         chart
-            .draw_series(error.iter().map(|&p| TriangleMarker::new(p, 4, BLACK.mix(0.5))))
+            .draw_series(
+                error
+                    .iter()
+                    .map(|&p| TriangleMarker::new(p, 4, BLACK.mix(0.5))),
+            )
             .map_err(|e| e.to_string())?
             .label(format!("error ({})", error.len()))
             .legend(|p| TriangleMarker::new(p, 4, BLACK.mix(0.5)));
@@ -140,8 +147,20 @@ pub fn failure_map(
     let size = (760 * panels.len().max(1) as u32, 600);
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
-    render(BitMapBackend::new(&png, size).into_drawing_area(), &png, space, axes, panels)?;
-    render(SVGBackend::new(&svg, size).into_drawing_area(), &svg, space, axes, panels)?;
+    render(
+        BitMapBackend::new(&png, size).into_drawing_area(),
+        &png,
+        space,
+        axes,
+        panels,
+    )?;
+    render(
+        SVGBackend::new(&svg, size).into_drawing_area(),
+        &svg,
+        space,
+        axes,
+        panels,
+    )?;
     Ok([png, svg])
 }
 

@@ -7,7 +7,8 @@
 /// generators", OOPSLA 2014) applied to `campaign_seed + (index + 1) · γ` with
 /// `γ = 0x9E3779B97F4A7C15`: distinct indices give well-mixed, distinct seeds.
 pub fn test_seed(campaign_seed: u64, index: u64) -> u64 {
-    let mut z = campaign_seed.wrapping_add(index.wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    let mut z =
+        campaign_seed.wrapping_add(index.wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)

@@ -45,12 +45,24 @@ mod tests {
             steering: f64::NAN,
         }
         .clamped();
-        assert_eq!(c, Control { throttle: 1.0, steering: 0.0 });
+        assert_eq!(
+            c,
+            Control {
+                throttle: 1.0,
+                steering: 0.0
+            }
+        );
         let c = Control {
             throttle: -2.0,
             steering: -0.5,
         }
         .clamped();
-        assert_eq!(c, Control { throttle: -1.0, steering: -0.5 });
+        assert_eq!(
+            c,
+            Control {
+                throttle: -1.0,
+                steering: -0.5
+            }
+        );
     }
 }

@@ -71,7 +71,13 @@ impl Pedestrian {
 
     /// Advances the behaviour by one step of `dt_s` seconds, at time `t_s`, with the ego
     /// vehicle's centre at `ego_pos` (m). Sets the kinematic target of the next physics step.
-    pub(crate) fn tick(&mut self, physics: &mut PhysicsWorld, t_s: f64, dt_s: f64, ego_pos: [f64; 3]) {
+    pub(crate) fn tick(
+        &mut self,
+        physics: &mut PhysicsWorld,
+        t_s: f64,
+        dt_s: f64,
+        ego_pos: [f64; 3],
+    ) {
         if self.phase == PedestrianPhase::Waiting {
             let d = (ego_pos[0] - self.start[0]).hypot(ego_pos[2] - self.start[2]);
             if d < self.trigger_distance_m {

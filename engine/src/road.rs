@@ -39,11 +39,13 @@ impl RoadSegment {
             return bad(format!("road length {} m is not positive", spec.length_m));
         }
         if spec.lanes == 0 || spec.lanes % 2 == 1 {
-            return bad(format!("road has {} lanes; need an even number >= 2", spec.lanes));
+            return bad(format!(
+                "road has {} lanes; need an even number >= 2",
+                spec.lanes
+            ));
         }
-        if !(spec.lane_width_m.is_finite() && spec.lane_width_m > 0.0)
-            || !(spec.sidewalk_width_m.is_finite() && spec.sidewalk_width_m > 0.0)
-        {
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(spec.lane_width_m) || !positive(spec.sidewalk_width_m) {
             return bad("lane and sidewalk widths must be positive".into());
         }
         if !(spec.friction > 0.0 && spec.friction <= 2.0) {
@@ -127,9 +129,18 @@ mod tests {
     #[test]
     fn on_lane_places_lanes_and_sidewalks() {
         let r = RoadSegment::new(RoadSpec::default()).unwrap();
-        assert_eq!(r.on_lane(Lane::Driving(1), 10.0).unwrap(), [10.0, 0.0, 1.75]);
-        assert_eq!(r.on_lane(Lane::Driving(-1), 10.0).unwrap(), [10.0, 0.0, -1.75]);
-        assert_eq!(r.on_lane(Lane::SideWalk, 100.0).unwrap(), [100.0, 0.15, 4.5]);
+        assert_eq!(
+            r.on_lane(Lane::Driving(1), 10.0).unwrap(),
+            [10.0, 0.0, 1.75]
+        );
+        assert_eq!(
+            r.on_lane(Lane::Driving(-1), 10.0).unwrap(),
+            [10.0, 0.0, -1.75]
+        );
+        assert_eq!(
+            r.on_lane(Lane::SideWalk, 100.0).unwrap(),
+            [100.0, 0.15, 4.5]
+        );
         assert_eq!(
             r.on_lane(Lane::OppositeSideWalk, 100.0).unwrap(),
             [100.0, 0.15, -4.5]
@@ -149,10 +160,22 @@ mod tests {
         assert!(r.on_lane(Lane::Driving(2), 1.0).is_err());
         assert!(r.on_lane(Lane::Driving(1), 250.0).is_err());
         for spec in [
-            RoadSpec { lanes: 3, ..RoadSpec::default() },
-            RoadSpec { length_m: -1.0, ..RoadSpec::default() },
-            RoadSpec { friction: 0.0, ..RoadSpec::default() },
-            RoadSpec { lane_width_m: f64::NAN, ..RoadSpec::default() },
+            RoadSpec {
+                lanes: 3,
+                ..RoadSpec::default()
+            },
+            RoadSpec {
+                length_m: -1.0,
+                ..RoadSpec::default()
+            },
+            RoadSpec {
+                friction: 0.0,
+                ..RoadSpec::default()
+            },
+            RoadSpec {
+                lane_width_m: f64::NAN,
+                ..RoadSpec::default()
+            },
         ] {
             assert!(RoadSegment::new(spec).is_err());
         }

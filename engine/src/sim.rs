@@ -5,7 +5,9 @@ use serde::Serialize;
 
 use crate::pedestrian::Pedestrian;
 use crate::vehicle::EgoVehicle;
-use crate::{Control, EngineError, LidarReturn, LidarSpec, PedestrianState, RoadSegment, WorldSpec};
+use crate::{
+    Control, EngineError, LidarReturn, LidarSpec, PedestrianState, RoadSegment, WorldSpec,
+};
 
 /// The ego vehicle's state.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -74,12 +76,17 @@ impl Simulation {
     pub fn new(spec: &WorldSpec) -> Result<Self, EngineError> {
         let invalid = |m: String| EngineError::InvalidWorld(m);
         if !(spec.dt_s.is_finite() && spec.dt_s > 0.0) {
-            return Err(invalid(format!("time step {} s is not positive", spec.dt_s)));
+            return Err(invalid(format!(
+                "time step {} s is not positive",
+                spec.dt_s
+            )));
         }
         spec.lidar.validate().map_err(invalid)?;
         let road = RoadSegment::new(spec.road.clone())?;
         if !matches!(spec.ego.lane, crate::Lane::Driving(_)) {
-            return Err(invalid("the ego vehicle must start on a driving lane".into()));
+            return Err(invalid(
+                "the ego vehicle must start on a driving lane".into(),
+            ));
         }
         if !(spec.ego.initial_speed_mps.is_finite() && spec.ego.initial_speed_mps >= 0.0) {
             return Err(invalid(format!(

@@ -89,8 +89,15 @@ fn aeb_cruises_at_its_target_speed_and_keeps_its_lane_on_an_empty_road() {
         max_lateral_error = max_lateral_error.max((sim.ego_state().pos_m[2] - 1.75).abs());
     }
     let ego = sim.ego_state();
-    assert!((ego.speed_mps - 12.0).abs() < 0.3, "speed {}", ego.speed_mps);
-    assert!(max_lateral_error < 0.2, "lateral error {max_lateral_error} m");
+    assert!(
+        (ego.speed_mps - 12.0).abs() < 0.3,
+        "speed {}",
+        ego.speed_mps
+    );
+    assert!(
+        max_lateral_error < 0.2,
+        "lateral error {max_lateral_error} m"
+    );
     assert!(ego.heading_rad.abs() < 0.02, "heading {}", ego.heading_rad);
 }
 
@@ -101,7 +108,10 @@ fn full_brake_from_12_mps_stops_in_a_plausible_distance() {
     let (_, _, x, speed) = drive(&spec, &mut sut, 4.0);
     let distance = x - 10.0;
     // v² / (2 a) = 9 m at 8 m/s²; allow for the suspension settling.
-    assert!((7.0..13.0).contains(&distance), "stopping distance {distance} m");
+    assert!(
+        (7.0..13.0).contains(&distance),
+        "stopping distance {distance} m"
+    );
     assert!(speed.abs() < 0.1);
 }
 
@@ -116,7 +126,14 @@ fn the_same_world_gives_the_same_bits_twice() {
             sim.step(c);
         }
         let e = sim.ego_state();
-        [e.pos_m[0], e.pos_m[1], e.pos_m[2], e.heading_rad, e.speed_mps].map(f64::to_bits)
+        [
+            e.pos_m[0],
+            e.pos_m[1],
+            e.pos_m[2],
+            e.heading_rad,
+            e.speed_mps,
+        ]
+        .map(f64::to_bits)
     };
     assert_eq!(run(), run());
 }

@@ -39,7 +39,11 @@ impl Strategy {
     /// # Errors
     /// [`GeneratorError::CapacityExceeded`] when the space has more dimensions than the
     /// strategy supports.
-    pub fn build(self, space: &ParamSpace, seed: u64) -> Result<Box<dyn Generator>, GeneratorError> {
+    pub fn build(
+        self,
+        space: &ParamSpace,
+        seed: u64,
+    ) -> Result<Box<dyn Generator>, GeneratorError> {
         Ok(match self {
             Strategy::Random => Box::new(UniformRandom::new(space, seed)),
             Strategy::Halton => Box::new(Halton::new(space)),

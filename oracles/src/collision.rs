@@ -88,12 +88,11 @@ mod tests {
             s.set_bool("contact", c);
             s.set("sep", d);
             seen += 1;
-            if m
-                .observe(&Frame {
-                    t_s: t,
-                    signals: &s,
-                })
-                .is_break()
+            if m.observe(&Frame {
+                t_s: t,
+                signals: &s,
+            })
+            .is_break()
             {
                 break;
             }
@@ -124,7 +123,12 @@ mod tests {
     fn a_trace_without_the_signals_fails_instead_of_panicking() {
         let mut m = CollisionMonitor::new("collision", "contact", "sep");
         let s = Signals::new();
-        assert!(m.observe(&Frame { t_s: 0.0, signals: &s }).is_break());
+        assert!(m
+            .observe(&Frame {
+                t_s: 0.0,
+                signals: &s
+            })
+            .is_break());
         assert!(!m.verdict().passed);
         assert_eq!(m.verdict().robustness, f64::NEG_INFINITY);
     }

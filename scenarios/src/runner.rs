@@ -50,7 +50,10 @@ fn publish(snap: &Snapshot, out: &mut Signals) {
     out.set(signal::EGO_Z_M, snap.ego.pos_m[2]);
     out.set(signal::EGO_SPEED_MPS, snap.ego.speed_mps);
     out.set_bool(signal::EGO_PED_CONTACT, snap.ego_pedestrian_contact);
-    out.set(signal::EGO_PED_SEPARATION_M, snap.min_pedestrian_separation_m);
+    out.set(
+        signal::EGO_PED_SEPARATION_M,
+        snap.min_pedestrian_separation_m,
+    );
 }
 
 /// Feeds one snapshot to every monitor; `Break` when any monitor settled its verdict.
@@ -144,15 +147,37 @@ mod tests {
     }
 
     #[test]
-    fn fast_pedestrian_close_trigger_is_hit_and_stops_the_run_early() {
-        let o = run(6.0, 12.0);
+    fn pedestrian_triggered_10_m_ahead_at_3_mps_is_hit_and_the_run_stops_early() {
+        let o = run(3.0, 10.0);
         assert!(!o.passed(), "{o:?}");
         let (_, collision) = &o.monitors[0];
         assert!(!collision.passed && collision.robustness <= 0.0);
-        let ttf = o.metrics.iter().find(|(n, _)| *n == "time_to_failure_s").unwrap().1;
-        let simulated = o.metrics.iter().find(|(n, _)| *n == "simulated_s").unwrap().1;
+        let ttf = o
+            .metrics
+            .iter()
+            .find(|(n, _)| *n == "time_to_failure_s")
+            .unwrap()
+            .1;
+        let simulated = o
+            .metrics
+            .iter()
+            .find(|(n, _)| *n == "simulated_s")
+            .unwrap()
+            .1;
         assert_eq!(ttf, simulated, "the run stops at the contact");
         assert!(simulated < pedestrian_crossing::HORIZON_S);
+    }
+
+    /// Requirement: the failure boundary is not a straight line. Along the vertical line
+    /// walking_speed = 1 m/s the outcome goes safe -> collision -> safe; a single straight
+    /// boundary would split any line into at most two runs.
+    #[test]
+    fn outcome_changes_twice_along_one_line_so_the_boundary_is_not_straight() {
+        let outcomes: Vec<bool> = [6.0, 20.0, 50.0]
+            .iter()
+            .map(|&trigger| run(1.0, trigger).passed())
+            .collect();
+        assert_eq!(outcomes, [true, false, true]);
     }
 
     #[test]

@@ -27,7 +27,7 @@ enum StrategyArg {
 
 /// Test designs over a scenario's parameter space.
 #[derive(Debug, Parser)]
-#[command(name = "paracosm-cover", version, about, long_about = None)]
+#[command(name = "paracosm-cover", version)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -44,7 +44,7 @@ enum Command {
         #[arg(long, value_enum, default_value = "halton")]
         strategy: StrategyArg,
         /// Number of points (at least 1).
-        #[arg(short = 'n', long, value_parser = clap::value_parser!(u64).range(1..))]
+        #[arg(short = 'n', long, value_parser = paracosm::cli::positive)]
         count: u64,
         /// Seed of the random and Sobol strategies.
         #[arg(long, default_value_t = 0)]
@@ -67,12 +67,7 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
         Err(e) => {
-            let rendered = e.to_string();
-            let reason = rendered
-                .lines()
-                .find(|l| !l.trim().is_empty())
-                .unwrap_or("invalid arguments")
-                .trim_start_matches("error: ");
+            let reason = paracosm::cli::one_line(&e);
             eprintln!("paracosm-cover: {reason} (see --help)");
             return ExitCode::from(2);
         }
@@ -87,7 +82,11 @@ fn main() -> ExitCode {
             }) {
                 return ExitCode::SUCCESS;
             }
-            let code = if e.downcast_ref::<BadInput>().is_some() { 2 } else { 3 };
+            let code = if e.downcast_ref::<BadInput>().is_some() {
+                2
+            } else {
+                3
+            };
             eprintln!("paracosm-cover: {e:#}");
             ExitCode::from(code)
         }
@@ -115,9 +114,10 @@ fn run(cli: Cli) -> Result<()> {
                 .and_then(|mut g| g.ask(count as usize))
                 .map_err(|e| BadInput(e.to_string()))?;
             let sink: Box<dyn Write> = match &output {
-                Some(path) => Box::new(std::fs::File::create(path).map_err(|e| {
-                    BadInput(format!("cannot write `{}`: {e}", path.display()))
-                })?),
+                Some(path) => Box::new(
+                    std::fs::File::create(path)
+                        .map_err(|e| BadInput(format!("cannot write `{}`: {e}", path.display())))?,
+                ),
                 None => Box::new(std::io::stdout().lock()),
             };
             let mut w = csv::Writer::from_writer(sink);

@@ -40,7 +40,7 @@ impl From<StrategyArg> for Strategy {
 /// Run a test campaign on a scenario: sample its open parameters, simulate each test, and
 /// write results.jsonl, summary.json and a failure map.
 #[derive(Debug, Parser)]
-#[command(name = "paracosm-fuzz", version, about, long_about = None)]
+#[command(name = "paracosm-fuzz", version)]
 struct Cli {
     /// Built-in scenario to test (available: pedestrian-crossing).
     scenario: String,
@@ -48,7 +48,7 @@ struct Cli {
     #[arg(long, value_enum, default_value = "halton")]
     strategy: StrategyArg,
     /// Number of tests to run (at least 1).
-    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, default_value_t = 100, value_parser = paracosm::cli::positive)]
     budget: u64,
     /// Campaign seed: seeds the generator and every test.
     #[arg(long, default_value_t = 0)]
@@ -78,12 +78,7 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
         Err(e) => {
-            let rendered = e.to_string();
-            let reason = rendered
-                .lines()
-                .find(|l| !l.trim().is_empty())
-                .unwrap_or("invalid arguments")
-                .trim_start_matches("error: ");
+            let reason = paracosm::cli::one_line(&e);
             eprintln!("paracosm-fuzz: {reason} (see --help)");
             return ExitCode::from(2);
         }
@@ -98,7 +93,11 @@ fn main() -> ExitCode {
     match run(&cli) {
         Ok(code) => code,
         Err(e) => {
-            let code = if e.downcast_ref::<BadInput>().is_some() { 2 } else { 3 };
+            let code = if e.downcast_ref::<BadInput>().is_some() {
+                2
+            } else {
+                3
+            };
             eprintln!("paracosm-fuzz: {e:#}");
             ExitCode::from(code)
         }
@@ -169,10 +168,11 @@ fn run(cli: &Cli) -> Result<ExitCode> {
     .map_err(|e| BadInput(e.to_string()))?;
 
     let mut outputs = vec![RESULTS_FILE.to_owned(), "summary.json".to_owned()];
-    outputs.extend(plots.iter().filter_map(|p| {
-        p.file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-    }));
+    outputs.extend(
+        plots
+            .iter()
+            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned())),
+    );
     let summary = Summary {
         tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
         scenario: scenario.name.clone(),
@@ -187,8 +187,11 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         outputs,
     };
     let summary_path = cli.out.join("summary.json");
-    std::fs::write(&summary_path, serde_json::to_string_pretty(&summary)? + "\n")
-        .map_err(|e| BadInput(format!("cannot write `{}`: {e}", summary_path.display())))?;
+    std::fs::write(
+        &summary_path,
+        serde_json::to_string_pretty(&summary)? + "\n",
+    )
+    .map_err(|e| BadInput(format!("cannot write `{}`: {e}", summary_path.display())))?;
     info!(path = %summary_path.display(), "wrote summary");
 
     let c = report.counts;

@@ -1,0 +1,223 @@
+//! End-to-end tests of the real `paracosm-fuzz` and `paracosm-cover` binaries.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn fuzz(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .args(args)
+        .output()
+        .expect("paracosm-fuzz runs")
+}
+
+fn lines(path: &Path) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("each line is a JSON object"))
+        .collect()
+}
+
+/// `results.jsonl` without the `wall_ms` field, the only one allowed to differ between runs.
+fn without_wall_time(path: &Path) -> String {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let cut = l.rfind(",\"wall_ms\":").expect("wall_ms is the last field");
+            assert!(l[cut..].ends_with('}'));
+            l[..cut].to_owned()
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn budget_20_writes_results_summary_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let o = fuzz(&[
+        "pedestrian-crossing",
+        "--strategy",
+        "halton",
+        "--budget",
+        "20",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let records = lines(&out.join("results.jsonl"));
+    assert_eq!(records.len(), 20);
+    let failed = records.iter().filter(|r| r["status"] == "fail").count();
+    // Exit code 1 exactly when a test failed.
+    assert_eq!(
+        o.status.code(),
+        Some(if failed > 0 { 1 } else { 0 }),
+        "{stdout}"
+    );
+    for (i, r) in records.iter().enumerate() {
+        assert_eq!(r["id"], i as u64);
+        assert_eq!(r["strategy"], "halton");
+        let speed = r["params"]["walking_speed"].as_f64().unwrap();
+        let trigger = r["params"]["trigger_distance"].as_f64().unwrap();
+        assert!((0.5..10.0).contains(&speed) && (5.0..60.0).contains(&trigger));
+        assert!(["pass", "fail"].contains(&r["status"].as_str().unwrap()));
+        let collision = &r["monitors"]["collision"];
+        assert_eq!(
+            collision["passed"].as_bool().unwrap(),
+            collision["robustness"].as_f64().unwrap() > 0.0
+        );
+        assert!(r["metrics"]["distance_travelled_m"].as_f64().unwrap() >= 0.0);
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["budget"], 20);
+    assert_eq!(summary["counts"]["fail"], failed as u64);
+    assert_eq!(
+        summary["counts"]["pass"].as_u64().unwrap() + failed as u64,
+        20
+    );
+    for plot in ["failure_map.png", "failure_map.svg"] {
+        let len = std::fs::metadata(out.join(plot)).unwrap().len();
+        assert!(len > 5_000, "{plot} is only {len} bytes");
+    }
+    let png = std::fs::read(out.join("failure_map.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let svg = std::fs::read_to_string(out.join("failure_map.svg")).unwrap();
+    assert!(svg.contains("walking_speed [m/s]") && svg.contains("trigger_distance [m]"));
+    assert!(
+        stdout.contains("20 tests of pedestrian-crossing"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn results_are_identical_across_thread_counts_and_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, jobs: &str| {
+        let out = dir.path().join(name);
+        let o = fuzz(&[
+            "pedestrian-crossing",
+            "--strategy",
+            "random",
+            "--seed",
+            "11",
+            "--budget",
+            "40",
+            "--jobs",
+            jobs,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(matches!(o.status.code(), Some(0 | 1)));
+        without_wall_time(&out.join("results.jsonl"))
+    };
+    let one = run("j1", "1");
+    let two = run("j2", "2");
+    let again = run("j2-again", "2");
+    assert_eq!(one.lines().count(), 40);
+    assert_eq!(one, two);
+    assert_eq!(two, again);
+}
+
+#[test]
+fn bad_arguments_exit_2_with_a_one_line_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "not a folder").unwrap();
+    let under_file = file.join("out");
+    let out = dir.path().join("out");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["pedestrian-crossing", "--budget", "0"], "--budget"),
+        (
+            vec!["pedestrian-crossing", "--strategy", "annealing"],
+            "annealing",
+        ),
+        (
+            vec![
+                "pedestrian-crossing",
+                "--budget",
+                "2",
+                "--out",
+                under_file.to_str().unwrap(),
+            ],
+            "cannot create output folder",
+        ),
+        (
+            vec!["no-such-scenario", "--out", out.to_str().unwrap()],
+            "unknown scenario",
+        ),
+        (
+            vec![
+                "pedestrian-crossing",
+                "--strategy",
+                "sobol",
+                "--budget",
+                "70000",
+            ],
+            "65536",
+        ),
+        (vec![], "SCENARIO"),
+    ];
+    for (args, needle) in cases {
+        let o = fuzz(&args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+    assert!(!out.exists(), "nothing is written for bad input");
+}
+
+#[test]
+fn an_earlier_campaign_is_not_overwritten_without_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let first = fuzz(&["pedestrian-crossing", "--budget", "2", "--out", out]);
+    assert!(matches!(first.status.code(), Some(0 | 1)));
+    let before = std::fs::read_to_string(dir.path().join("results.jsonl")).unwrap();
+    let again = fuzz(&["pedestrian-crossing", "--budget", "3", "--out", out]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("results.jsonl")).unwrap(),
+        before
+    );
+    let forced = fuzz(&[
+        "pedestrian-crossing",
+        "--budget",
+        "3",
+        "--out",
+        out,
+        "--force",
+    ]);
+    assert!(matches!(forced.status.code(), Some(0 | 1)));
+    assert_eq!(lines(&dir.path().join("results.jsonl")).len(), 3);
+}
+
+#[test]
+fn cover_generate_writes_the_halton_design_as_csv() {
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-cover"))
+        .args([
+            "generate",
+            "pedestrian-crossing",
+            "--strategy",
+            "halton",
+            "-n",
+            "3",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    // Halton(2, 3) points 0, 1, 2 mapped onto [0.5, 10) × [5, 60).
+    assert_eq!(
+        String::from_utf8(o.stdout).unwrap(),
+        "id,walking_speed,trigger_distance\n0,0.5,5\n1,5.25,23.333333333333332\n2,2.875,41.666666666666664\n"
+    );
+    let bad = Command::new(env!("CARGO_BIN_EXE_paracosm-cover"))
+        .args(["generate", "pedestrian-crossing", "-n", "0"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+}
