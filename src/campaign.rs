@@ -246,3 +246,92 @@ fn write_line(out: &mut BufWriter<File>, record: &RunRecord) -> std::io::Result<
     out.write_all(b"\n")?;
     out.flush()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn campaign(scenario: &Scenario, jobs: usize) -> Campaign<'_> {
+        Campaign {
+            scenario,
+            strategy: Strategy::Random,
+            seed: 5,
+            budget: 12,
+            jobs,
+        }
+    }
+
+    fn strip_wall(mut r: RunRecord) -> RunRecord {
+        r.wall_ms = 0.0;
+        r
+    }
+
+    #[test]
+    fn records_are_in_id_order_and_independent_of_jobs() {
+        let s = paracosm_scenarios::pedestrian_crossing::scenario();
+        let dir = tempfile::tempdir().unwrap();
+        let mut seen = Vec::new();
+        let one = campaign(&s, 1)
+            .run(&dir.path().join("one"), |r| seen.push(r.id))
+            .unwrap();
+        let three = campaign(&s, 3)
+            .run(&dir.path().join("three"), |_| {})
+            .unwrap();
+        assert_eq!(seen.len(), 12);
+        let ids: Vec<u64> = one.records.iter().map(|r| r.id).collect();
+        assert_eq!(ids, (0..12).collect::<Vec<_>>());
+        let a: Vec<_> = one.records.into_iter().map(strip_wall).collect();
+        let b: Vec<_> = three.records.into_iter().map(strip_wall).collect();
+        assert_eq!(a, b);
+        assert_eq!(one.counts, three.counts);
+        assert_eq!(one.counts.pass + one.counts.fail + one.counts.error, 12);
+        let written = std::fs::read_to_string(dir.path().join("one").join(RESULTS_FILE)).unwrap();
+        assert_eq!(written.lines().count(), 12);
+        assert!(written.ends_with('\n'));
+    }
+
+    #[test]
+    fn any_test_can_be_replayed_alone() {
+        let s = paracosm_scenarios::pedestrian_crossing::scenario();
+        let c = campaign(&s, 2);
+        let dir = tempfile::tempdir().unwrap();
+        let report = c.run(dir.path(), |_| {}).unwrap();
+        let points = c.points().unwrap();
+        for id in [0u64, 7, 11] {
+            let replay = c.run_one(id, &points[id as usize]);
+            assert_eq!(
+                strip_wall(replay),
+                strip_wall(report.records[id as usize].clone())
+            );
+        }
+    }
+
+    #[test]
+    fn a_point_that_does_not_decode_becomes_an_error_record() {
+        let s = paracosm_scenarios::pedestrian_crossing::scenario();
+        let r = campaign(&s, 1).run_one(
+            0,
+            &Point {
+                discrete: vec![],
+                continuous: vec![1.5, 0.5],
+            },
+        );
+        assert_eq!(r.status, Status::Error);
+        assert_eq!(r.params, None);
+        assert!(r.error.unwrap().contains("outside [0, 1)"));
+    }
+
+    #[test]
+    fn sobol_past_its_capacity_is_refused_before_anything_runs() {
+        let s = paracosm_scenarios::pedestrian_crossing::scenario();
+        let c = Campaign {
+            strategy: Strategy::Sobol,
+            budget: 70_000,
+            ..campaign(&s, 1)
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let err = c.run(&dir.path().join("x"), |_| {}).unwrap_err();
+        assert!(matches!(err, CampaignError::Generator(_)));
+        assert!(!dir.path().join("x").exists());
+    }
+}

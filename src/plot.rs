@@ -183,3 +183,68 @@ fn render<DB: DrawingBackend>(
     }
     root.present().map_err(|e| fail(e.to_string()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use paracosm_generators::{Param, Point, Value};
+
+    fn record(id: u64, space: &ParamSpace, u: [f64; 2], status: Status) -> RunRecord {
+        let point = Point {
+            discrete: vec![0],
+            continuous: u.to_vec(),
+        };
+        RunRecord {
+            id,
+            seed: 0,
+            strategy: "random".into(),
+            params: space.decode(&point).ok(),
+            point,
+            status,
+            monitors: vec![],
+            metrics: vec![],
+            error: None,
+            wall_ms: 0.0,
+        }
+    }
+
+    fn space() -> ParamSpace {
+        ParamSpace::new(vec![
+            Param::interval("speed", 0.0, 10.0, "m/s"),
+            Param::levels("colour", vec![Value::Text("red".into())]),
+            Param::interval("dist", 5.0, 60.0, "m"),
+        ])
+        .unwrap()
+    }
+
+    #[test]
+    fn draws_png_and_svg_with_labelled_axes_and_counts() {
+        let s = space();
+        let records = vec![
+            record(0, &s, [0.1, 0.1], Status::Pass),
+            record(1, &s, [0.5, 0.5], Status::Fail),
+            record(2, &s, [0.9, 0.2], Status::Fail),
+        ];
+        let dir = tempfile::tempdir().unwrap();
+        let axes = ["speed".to_owned(), "dist".to_owned()];
+        let [png, svg] =
+            failure_map(&dir.path().join("map"), &s, &axes, &[("t", &records)]).unwrap();
+        assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
+        let svg = std::fs::read_to_string(svg).unwrap();
+        for text in ["speed [m/s]", "dist [m]", "pass (1)", "fail (2)"] {
+            assert!(svg.contains(text), "missing {text}");
+        }
+    }
+
+    #[test]
+    fn a_discrete_or_unknown_axis_is_an_error() {
+        let s = space();
+        let dir = tempfile::tempdir().unwrap();
+        for bad in ["colour", "nope"] {
+            let axes = ["speed".to_owned(), bad.to_owned()];
+            let err = failure_map(&dir.path().join("m"), &s, &axes, &[]).unwrap_err();
+            assert!(matches!(err, PlotError::NotAnAxis(ref n) if n == bad));
+        }
+        assert!(!dir.path().join("m.png").exists());
+    }
+}

@@ -83,3 +83,41 @@ fn ordered_map<K: Serialize, V: Serialize, S: Serializer>(
     }
     map.end()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use paracosm_generators::{Param, ParamSpace};
+
+    #[test]
+    fn serialises_with_the_documented_keys_in_order_and_wall_time_last() {
+        let space = ParamSpace::new(vec![Param::interval("v", 0.0, 2.0, "m/s")]).unwrap();
+        let point = Point {
+            discrete: vec![],
+            continuous: vec![0.25],
+        };
+        let r = RunRecord {
+            id: 3,
+            seed: 9,
+            strategy: "halton".into(),
+            params: space.decode(&point).ok(),
+            point,
+            status: Status::Fail,
+            monitors: vec![(
+                "collision".into(),
+                MonitorResult {
+                    passed: false,
+                    robustness: 0.0,
+                    first_violation_s: Some(1.5),
+                },
+            )],
+            metrics: vec![("min_distance_m", 0.0), ("time_to_failure_s", 1.5)],
+            error: None,
+            wall_ms: 2.5,
+        };
+        assert_eq!(
+            serde_json::to_string(&r).unwrap(),
+            r#"{"id":3,"seed":9,"strategy":"halton","point":{"discrete":[],"continuous":[0.25]},"params":{"v":0.5},"status":"fail","monitors":{"collision":{"passed":false,"robustness":0.0,"first_violation_s":1.5}},"metrics":{"min_distance_m":0.0,"time_to_failure_s":1.5},"error":null,"wall_ms":2.5}"#
+        );
+    }
+}

@@ -118,3 +118,38 @@ fn centre(feet: [f64; 3]) -> Vector {
         feet[2] as f32,
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn waits_until_triggered_then_walks_at_its_speed_and_stops_at_the_target() {
+        let mut physics = PhysicsWorld::new();
+        let mut p = Pedestrian::build(
+            &mut physics,
+            [100.0, 0.0, 4.0],
+            [100.0, 0.0, -4.0],
+            20.0,
+            2.0,
+        );
+        let dt = 0.1;
+        // Ego 30 m away: nothing happens.
+        p.tick(&mut physics, 0.0, dt, [70.0, 0.8, 1.75]);
+        assert_eq!(p.state().phase, PedestrianPhase::Waiting);
+        assert_eq!(p.state().pos_m, [100.0, 0.0, 4.0]);
+        // Ego 19.9 m away (planar): triggered, first step of 0.2 m.
+        p.tick(&mut physics, 0.1, dt, [80.1, 0.8, 4.0]);
+        let s = p.state();
+        assert_eq!(s.phase, PedestrianPhase::Walking);
+        assert_eq!(s.triggered_at_s, Some(0.1));
+        assert!((s.pos_m[2] - 3.8).abs() < 1e-12);
+        // 8 m at 0.2 m per step: arrives after 40 steps in all, and stays.
+        for i in 0..45 {
+            p.tick(&mut physics, 0.2 + 0.1 * i as f64, dt, [200.0, 0.8, 0.0]);
+        }
+        assert_eq!(p.state().phase, PedestrianPhase::Arrived);
+        assert_eq!(p.state().pos_m, [100.0, 0.0, -4.0]);
+        assert_eq!(p.state().triggered_at_s, Some(0.1));
+    }
+}

@@ -272,3 +272,123 @@ impl Simulation {
         );
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{EgoSpec, Lane, LidarSpec, PedestrianSpec, RoadSpec, VehicleParams};
+
+    fn spec() -> WorldSpec {
+        WorldSpec {
+            dt_s: crate::DEFAULT_DT_S,
+            road: RoadSpec::default(),
+            ego: EgoSpec {
+                lane: Lane::Driving(1),
+                at_m: 10.0,
+                initial_speed_mps: 5.0,
+                vehicle: VehicleParams::default(),
+            },
+            pedestrians: vec![PedestrianSpec {
+                start: (Lane::Driving(1), 40.0),
+                target: (Lane::Driving(1), 40.0),
+                trigger_distance_m: 1e-6,
+                speed_mps: 1.0,
+            }],
+            lidar: LidarSpec::default(),
+        }
+    }
+
+    #[test]
+    fn invalid_worlds_are_errors_naming_the_problem() {
+        let cases: Vec<(WorldSpec, &str)> = vec![
+            (
+                WorldSpec {
+                    dt_s: 0.0,
+                    ..spec()
+                },
+                "time step",
+            ),
+            (
+                WorldSpec {
+                    ego: EgoSpec {
+                        lane: Lane::SideWalk,
+                        ..spec().ego
+                    },
+                    ..spec()
+                },
+                "driving lane",
+            ),
+            (
+                WorldSpec {
+                    ego: EgoSpec {
+                        initial_speed_mps: -1.0,
+                        ..spec().ego
+                    },
+                    ..spec()
+                },
+                "initial speed",
+            ),
+            (
+                WorldSpec {
+                    pedestrians: vec![PedestrianSpec {
+                        speed_mps: 0.0,
+                        ..spec().pedestrians[0].clone()
+                    }],
+                    ..spec()
+                },
+                "pedestrian 0",
+            ),
+            (
+                WorldSpec {
+                    lidar: LidarSpec {
+                        beams: 0,
+                        ..LidarSpec::default()
+                    },
+                    ..spec()
+                },
+                "lidar",
+            ),
+        ];
+        for (s, needle) in cases {
+            let err = Simulation::new(&s)
+                .err()
+                .expect("invalid world")
+                .to_string();
+            assert!(err.contains(needle), "{err}");
+        }
+    }
+
+    #[test]
+    fn starts_at_its_lane_with_its_speed_and_the_lidar_sees_the_pedestrian() {
+        let sim = Simulation::new(&spec()).unwrap();
+        let ego = sim.ego_state();
+        assert_eq!(ego.pos_m[0], 10.0);
+        assert_eq!(ego.pos_m[2], 1.75);
+        assert!((ego.speed_mps - 5.0).abs() < 1e-5);
+        assert_eq!(ego.heading_rad, 0.0);
+        let obs = sim.observation();
+        let ahead = obs
+            .lidar
+            .iter()
+            .filter(|r| r.point_m[2].abs() < 0.5)
+            .map(|r| r.point_m[0])
+            .reduce(f64::min)
+            .expect("a return straight ahead");
+        // Pedestrian centre 30 m ahead of the chassis centre, capsule radius 0.3 m.
+        assert!((ahead - 29.7).abs() < 0.05, "nearest return at {ahead} m");
+        let snap = sim.snapshot();
+        assert!(!snap.ego_pedestrian_contact);
+        // 30 m between centres, less half the car (2.25 m) and the capsule radius (0.3 m).
+        assert!((snap.min_pedestrian_separation_m - 27.45).abs() < 0.05);
+    }
+
+    #[test]
+    fn time_advances_by_whole_steps() {
+        let mut sim = Simulation::new(&spec()).unwrap();
+        for _ in 0..60 {
+            sim.step(Control::default());
+        }
+        assert!((sim.t_s() - 1.0).abs() < 1e-12);
+        assert_eq!(sim.snapshot().t_s, sim.t_s());
+    }
+}

@@ -145,3 +145,42 @@ impl EgoVehicle {
         self.params.size_m
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn control_maps_to_engine_brake_and_steering_within_limits() {
+        let mut physics = PhysicsWorld::new();
+        let params = VehicleParams::default();
+        let mut v = EgoVehicle::build(&mut physics, &params, [0.0, 0.0, 0.0], 0.0, 0.0, 0.8);
+        let dt = 1.0 / 60.0;
+        v.apply(
+            Control {
+                throttle: 0.5,
+                steering: -2.0,
+            },
+            dt,
+        );
+        let w = v.controller.wheels();
+        assert_eq!(w.len(), 4);
+        assert_eq!(w[0].steering, -0.5); // clamped to -1, times 0.5 rad
+        assert_eq!(w[2].steering, 0.0);
+        assert_eq!(w[0].engine_force, 0.0); // front wheels are not driven
+        assert_eq!(w[2].engine_force, 1125.0);
+        assert!(w.iter().all(|w| w.brake == 0.0));
+
+        v.apply(
+            Control {
+                throttle: -1.0,
+                steering: 0.0,
+            },
+            dt,
+        );
+        let w = v.controller.wheels();
+        assert!(w.iter().all(|w| w.engine_force == 0.0));
+        // 3000 N for one step of 1/60 s is an impulse of 50 N·s per wheel.
+        assert!(w.iter().all(|w| (w.brake - 50.0).abs() < 1e-3));
+    }
+}
