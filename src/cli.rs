@@ -1,5 +1,52 @@
 //! Helpers shared by the command-line tools.
 
+use std::process::ExitCode;
+
+use clap::{Parser, ValueEnum};
+use paracosm_generators::Strategy;
+
+/// Test-generation strategies as command-line values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum StrategyArg {
+    /// Uniform random points (ChaCha8, seeded by --seed).
+    Random,
+    /// The Halton low-dispersion sequence from index 0 (paper §3.2); --seed is not used.
+    Halton,
+    /// Owen-scrambled Sobol points (at most 65536); --seed selects the scramble.
+    Sobol,
+}
+
+impl From<StrategyArg> for Strategy {
+    fn from(s: StrategyArg) -> Self {
+        match s {
+            StrategyArg::Random => Strategy::Random,
+            StrategyArg::Halton => Strategy::Halton,
+            StrategyArg::Sobol => Strategy::Sobol,
+        }
+    }
+}
+
+/// Parses the command line of `tool`. On `--help`/`--version` prints and returns
+/// `Err(ExitCode::SUCCESS)`; on bad usage prints `tool: <one-line reason> (see --help)` to
+/// stderr and returns `Err(2)`.
+pub fn parse_args<T: Parser>(tool: &str) -> Result<T, ExitCode> {
+    T::try_parse().map_err(|e| {
+        if e.use_stderr() {
+            eprintln!("{tool}: {} (see --help)", one_line(&e));
+            ExitCode::from(2)
+        } else {
+            let _ = e.print();
+            ExitCode::SUCCESS
+        }
+    })
+}
+
+/// An error caused by the user's input (arguments, files): the tools exit with code 2 for it
+/// and 3 for anything else.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadInput(pub String);
+
 /// Parses a count that must be at least 1 (`--budget`, `-n`).
 ///
 /// # Errors

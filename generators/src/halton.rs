@@ -55,14 +55,7 @@ pub struct Halton {
 impl Halton {
     /// A Halton generator over `space`, starting at index 0.
     pub fn new(space: &ParamSpace) -> Self {
-        let levels = space
-            .params()
-            .iter()
-            .map(|p| match &p.domain {
-                crate::Domain::Levels(l) => Some(l.len() as u32),
-                crate::Domain::Interval { .. } => None,
-            })
-            .collect::<Vec<_>>();
+        let levels = space.layout();
         Halton {
             primes: first_primes(levels.len()),
             levels,

@@ -1,7 +1,7 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::{Domain, Generator, GeneratorError, ParamSpace, Point};
+use crate::{Generator, GeneratorError, ParamSpace, Point};
 
 /// Independent uniform sampling: each continuous coordinate uniform on `[0, 1)`, each level
 /// uniform among its parameter's levels.
@@ -21,14 +21,7 @@ impl UniformRandom {
     pub fn new(space: &ParamSpace, seed: u64) -> Self {
         UniformRandom {
             rng: ChaCha8Rng::seed_from_u64(seed),
-            levels: space
-                .params()
-                .iter()
-                .map(|p| match &p.domain {
-                    Domain::Levels(l) => Some(l.len() as u32),
-                    Domain::Interval { .. } => None,
-                })
-                .collect(),
+            levels: space.layout(),
         }
     }
 }

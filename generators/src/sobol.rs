@@ -1,4 +1,4 @@
-use crate::{Domain, Generator, GeneratorError, ParamSpace, Point};
+use crate::{Generator, GeneratorError, ParamSpace, Point};
 
 /// Points available from `sobol_burley`: indices `0..2^16`.
 pub const SOBOL_MAX_POINTS: u64 = 1 << 16;
@@ -37,14 +37,7 @@ impl Sobol {
             });
         }
         Ok(Sobol {
-            levels: space
-                .params()
-                .iter()
-                .map(|p| match &p.domain {
-                    Domain::Levels(l) => Some(l.len() as u32),
-                    Domain::Interval { .. } => None,
-                })
-                .collect(),
+            levels: space.layout(),
             seed: (seed as u32) ^ ((seed >> 32) as u32),
             next: 0,
         })

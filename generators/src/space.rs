@@ -168,6 +168,18 @@ impl ParamSpace {
             .collect()
     }
 
+    /// Per parameter in declaration order: `None` for a continuous parameter, `Some(L)` for a
+    /// discrete one with `L` levels. Generators walk this to fill a [`Point`].
+    pub fn layout(&self) -> Vec<Option<u32>> {
+        self.params
+            .iter()
+            .map(|p| match &p.domain {
+                Domain::Levels(l) => Some(l.len() as u32),
+                Domain::Interval { .. } => None,
+            })
+            .collect()
+    }
+
     /// Maps a point to named values in the parameters' units, in declaration order.
     /// A continuous coordinate `u` becomes `lo + u (hi - lo)`; a level index selects its level.
     ///

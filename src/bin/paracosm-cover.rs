@@ -11,19 +11,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
+
+use paracosm::cli::{BadInput, StrategyArg};
 
 use paracosm_generators::Strategy;
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-enum StrategyArg {
-    /// Uniform random points (ChaCha8, seeded by --seed).
-    Random,
-    /// The Halton sequence from index 0 (paper §3.2).
-    Halton,
-    /// Owen-scrambled Sobol points (at most 65536).
-    Sobol,
-}
 
 /// Test designs over a scenario's parameter space.
 #[derive(Debug, Parser)]
@@ -55,22 +47,10 @@ enum Command {
     },
 }
 
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-struct BadInput(String);
-
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli = match paracosm::cli::parse_args::<Cli>("paracosm-cover") {
         Ok(cli) => cli,
-        Err(e) if !e.use_stderr() => {
-            let _ = e.print();
-            return ExitCode::SUCCESS;
-        }
-        Err(e) => {
-            let reason = paracosm::cli::one_line(&e);
-            eprintln!("paracosm-cover: {reason} (see --help)");
-            return ExitCode::from(2);
-        }
+        Err(code) => return code,
     };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -104,11 +84,7 @@ fn run(cli: Cli) -> Result<()> {
         } => {
             let scenario =
                 paracosm_scenarios::builtin(&scenario).map_err(|e| BadInput(e.to_string()))?;
-            let strategy = match strategy {
-                StrategyArg::Random => Strategy::Random,
-                StrategyArg::Halton => Strategy::Halton,
-                StrategyArg::Sobol => Strategy::Sobol,
-            };
+            let strategy = Strategy::from(strategy);
             let points = strategy
                 .build(&scenario.space, seed)
                 .and_then(|mut g| g.ask(count as usize))

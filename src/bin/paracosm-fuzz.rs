@@ -7,35 +7,16 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use clap::{Parser, ValueEnum};
+use clap::Parser;
+
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use paracosm::cli::{BadInput, StrategyArg};
 use tracing::info;
 
 use paracosm::campaign::{Campaign, CampaignError, RESULTS_FILE};
 use paracosm::record::Status;
 use paracosm::summary::Summary;
 use paracosm_generators::Strategy;
-
-/// Test-generation strategies on the command line.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-enum StrategyArg {
-    /// Uniform random points (ChaCha8, seeded by --seed).
-    Random,
-    /// The Halton low-dispersion sequence (paper §3.2); --seed is not used.
-    Halton,
-    /// Owen-scrambled Sobol points (at most 65536); --seed selects the scramble.
-    Sobol,
-}
-
-impl From<StrategyArg> for Strategy {
-    fn from(s: StrategyArg) -> Self {
-        match s {
-            StrategyArg::Random => Strategy::Random,
-            StrategyArg::Halton => Strategy::Halton,
-            StrategyArg::Sobol => Strategy::Sobol,
-        }
-    }
-}
 
 /// Run a test campaign on a scenario: sample its open parameters, simulate each test, and
 /// write results.jsonl, summary.json and a failure map.
@@ -64,24 +45,10 @@ struct Cli {
     force: bool,
 }
 
-/// An error caused by the user's input: exit code 2.
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-struct BadInput(String);
-
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli = match paracosm::cli::parse_args::<Cli>("paracosm-fuzz") {
         Ok(cli) => cli,
-        Err(e) if !e.use_stderr() => {
-            // --help and --version
-            let _ = e.print();
-            return ExitCode::SUCCESS;
-        }
-        Err(e) => {
-            let reason = paracosm::cli::one_line(&e);
-            eprintln!("paracosm-fuzz: {reason} (see --help)");
-            return ExitCode::from(2);
-        }
+        Err(code) => return code,
     };
     tracing_subscriber::fmt()
         .with_env_filter(
