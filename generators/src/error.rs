@@ -31,6 +31,6 @@ pub enum GeneratorError {
         requested: u64,
     },
     /// A strategy name that no generator answers to.
-    #[error("unknown strategy `{0}` (expected one of: random, halton, sobol)")]
+    #[error("unknown strategy `{0}` (expected one of: random, halton, halton-scrambled, sobol)")]
     UnknownStrategy(String),
 }

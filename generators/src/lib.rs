@@ -12,6 +12,7 @@
 //! This crate depends on nothing else of the workspace, so researchers can use it alone.
 #![warn(missing_docs)]
 
+pub mod coverage;
 mod error;
 mod generator;
 mod halton;

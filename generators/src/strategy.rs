@@ -9,19 +9,28 @@ pub enum Strategy {
     Random,
     /// [`Halton`]: the paper's low-dispersion sequence (§3.2); ignores the seed.
     Halton,
+    /// [`Halton::scrambled`]: the Halton sequence with random digit permutations (Owen 2017);
+    /// the seed draws the permutations.
+    ScrambledHalton,
     /// [`Sobol`]: Owen-scrambled Sobol points; the seed selects the scramble.
     Sobol,
 }
 
 impl Strategy {
     /// Every strategy, in the order the CLI lists them.
-    pub const ALL: [Strategy; 3] = [Strategy::Random, Strategy::Halton, Strategy::Sobol];
+    pub const ALL: [Strategy; 4] = [
+        Strategy::Random,
+        Strategy::Halton,
+        Strategy::ScrambledHalton,
+        Strategy::Sobol,
+    ];
 
     /// The name used on the command line and in results files.
     pub fn name(self) -> &'static str {
         match self {
             Strategy::Random => "random",
             Strategy::Halton => "halton",
+            Strategy::ScrambledHalton => "halton-scrambled",
             Strategy::Sobol => "sobol",
         }
     }
@@ -30,7 +39,7 @@ impl Strategy {
     pub fn capacity(self) -> Option<u64> {
         match self {
             Strategy::Sobol => Some(crate::SOBOL_MAX_POINTS),
-            Strategy::Random | Strategy::Halton => None,
+            Strategy::Random | Strategy::Halton | Strategy::ScrambledHalton => None,
         }
     }
 
@@ -47,6 +56,7 @@ impl Strategy {
         Ok(match self {
             Strategy::Random => Box::new(UniformRandom::new(space, seed)),
             Strategy::Halton => Box::new(Halton::new(space)),
+            Strategy::ScrambledHalton => Box::new(Halton::scrambled(space, seed)),
             Strategy::Sobol => Box::new(Sobol::new(space, seed)?),
         })
     }
@@ -80,7 +90,7 @@ mod tests {
         }
         assert_eq!(
             "annealing".parse::<Strategy>().unwrap_err().to_string(),
-            "unknown strategy `annealing` (expected one of: random, halton, sobol)"
+            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol)"
         );
     }
 }

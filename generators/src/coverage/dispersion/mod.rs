@@ -1,0 +1,216 @@
+//! Dispersion: the volume of the largest empty axis-parallel box (PARACOSM §3.1).
+
+mod bracket;
+mod plane;
+mod sweep;
+
+use serde::Serialize;
+
+use super::{check_unit_points, CoverageError};
+
+/// An axis-parallel box `(lo_1, hi_1) × ... × (lo_d, hi_d)` inside `[0, 1]^d`, open: a point
+/// on its boundary is not inside it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EmptyBox {
+    /// Lower corner, `d` values in `[0, 1]`.
+    pub lo: Vec<f64>,
+    /// Upper corner, `d` values in `[0, 1]`, `hi[i] >= lo[i]`.
+    pub hi: Vec<f64>,
+}
+
+impl EmptyBox {
+    /// The box's volume `Π (hi_i - lo_i)`.
+    pub fn volume(&self) -> f64 {
+        self.lo.iter().zip(&self.hi).map(|(l, h)| h - l).product()
+    }
+
+    /// Whether `p` (length `d`) lies strictly inside.
+    pub fn contains_strictly(&self, p: &[f64]) -> bool {
+        p.iter()
+            .zip(self.lo.iter().zip(&self.hi))
+            .all(|(x, (l, h))| l < x && x < h)
+    }
+
+    /// Checks emptiness against an `n × d` row-major point set in `O(n d)`: the way anyone can
+    /// verify a reported witness.
+    pub fn is_empty_of(&self, points: &[f64]) -> bool {
+        let d = self.lo.len();
+        !points.chunks_exact(d).any(|p| self.contains_strictly(p))
+    }
+
+    fn unit(d: usize) -> Self {
+        EmptyBox {
+            lo: vec![0.0; d],
+            hi: vec![1.0; d],
+        }
+    }
+}
+
+/// The dispersion of a point set: exact, or a certified bracket.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Dispersion {
+    /// A lower bound: the volume of `witness`, an empty box anyone can check.
+    pub lower: f64,
+    /// A proven upper bound (equal to `lower` when `exact`).
+    pub upper: f64,
+    /// Whether `lower == upper` is the exact dispersion, proven by exhaustive enumeration.
+    pub exact: bool,
+    /// The largest empty box found.
+    pub witness: EmptyBox,
+    /// How the numbers were obtained, and which bound the upper one is.
+    pub method: String,
+}
+
+/// Limits of [`dispersion`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct DispersionOptions {
+    /// For `d >= 3`, the largest `n` solved exactly, by dimension: index `d - 3` (`d = 3, 4,
+    /// 5, ...`); past the table's end the last entry applies. Default `[2000, 300, 120, 60]`:
+    /// each takes at most a few seconds on 2 cores for uniform random points.
+    pub exact_max_points: Vec<usize>,
+    /// Regions the branch and bound of the bracket may process. Default 200,000.
+    pub bracket_regions: usize,
+    /// Random starts of the greedy lower bound, per dimension. Default 64.
+    pub greedy_starts_per_dim: usize,
+    /// Seed of the greedy starts (ChaCha8). Default 0.
+    pub seed: u64,
+}
+
+impl Default for DispersionOptions {
+    fn default() -> Self {
+        DispersionOptions {
+            exact_max_points: vec![2000, 300, 120, 60],
+            bracket_regions: 200_000,
+            greedy_starts_per_dim: 64,
+            seed: 0,
+        }
+    }
+}
+
+/// Dispersion of `points` (`n × d`, row-major, values in `[0, 1]`): the largest volume of an
+/// open axis-parallel box inside `[0, 1]^d` that contains no point; boxes touching the cube's
+/// boundary count (PARACOSM §3.1; Niederreiter, "Random Number Generation and Quasi-Monte
+/// Carlo Methods", SIAM 1992, ch. 6, with axis-parallel boxes as the neighbourhoods).
+///
+/// - `d = 1`: exact, the largest gap between sorted values and the ends, `O(n log n)`.
+/// - `d = 2`: exact. Every maximal empty rectangle has its left side on a point, on `x = 0`,
+///   or spans `[0, 1]` in `x`. For each point `p` a sweep to the right finds the next point
+///   whose `y` lies in the current open band with a range-minimum segment tree over `y`, and
+///   shrinks the band (Naamad, Lee, Hsu, "On the maximum empty rectangle problem", Discrete
+///   Appl. Math. 8, 1984, with pruning by the best area so far). The mirrored sweep covers
+///   `x = 0`, the largest `y` gap the full-width strips. `O(n log n)` per visited point; about
+///   0.1 s for `n = 100,000` on uniform or quasi-random points.
+/// - `d >= 3`, `n` within [`DispersionOptions::exact_max_points`]: exact, by the same
+///   decomposition on the first axis, keeping the maximal empty `(d-1)`-boxes around each
+///   supporting point as the sweep adds points, pruned by the best volume so far; the boxes
+///   spanning the first axis recurse on the other `d - 1` axes.
+/// - Otherwise: a certified bracket. Lower: the largest of many greedily grown maximal empty
+///   boxes and the boxes met by the branch and bound. Upper: a branch and bound over the box
+///   corners (each region fixes an interval for every `lo_i` and `hi_i`; a region is dropped
+///   when a point lies strictly inside its smallest box, since then every box of the region
+///   contains it; the largest union box of the regions left bounds every empty box). The
+///   bound is proven by that partition argument, and tightens with
+///   [`DispersionOptions::bracket_regions`].
+///
+/// Points on the cube's boundary lie in no open box and never count. Deterministic: the same
+/// input and options give the same result and witness on any thread count.
+///
+/// # Errors
+/// [`CoverageError::Shape`] for `d = 0` or a length not a multiple of `d`;
+/// [`CoverageError::OutsideUnitCube`] for a value that is NaN or outside `[0, 1]`.
+pub fn dispersion(
+    points: &[f64],
+    d: usize,
+    options: &DispersionOptions,
+) -> Result<Dispersion, CoverageError> {
+    let n = check_unit_points(points, d)?;
+    // Points with a coordinate on the boundary are inside no open box.
+    let inner: Vec<f64> = points
+        .chunks_exact(d)
+        .filter(|p| p.iter().all(|&x| 0.0 < x && x < 1.0))
+        .flatten()
+        .copied()
+        .collect();
+    let m = inner.len() / d;
+    let limit = options
+        .exact_max_points
+        .get(d.saturating_sub(3))
+        .or(options.exact_max_points.last())
+        .copied()
+        .unwrap_or(0);
+    let (witness, method) = match d {
+        1 => (max_gap(&inner), "exact: largest gap (d = 1)".to_owned()),
+        2 => (
+            plane::largest_empty_rectangle(&inner),
+            "exact: maximal-empty-rectangle sweep (d = 2)".to_owned(),
+        ),
+        _ if m <= limit => (
+            sweep::largest_empty_box(&inner, d),
+            format!("exact: maximal-empty-box sweep (d = {d}, n = {n})"),
+        ),
+        _ => {
+            let b = bracket::bracket(&inner, d, options);
+            let method = format!(
+                "bracket (d = {d}, n = {n} is past the exact limit {limit}): lower = largest \
+                 empty box found (greedy maximal boxes), upper = branch and bound over box \
+                 corners after {} regions",
+                b.regions
+            );
+            let exact = b.upper <= b.witness.volume();
+            let lower = b.witness.volume();
+            return Ok(Dispersion {
+                lower,
+                upper: b.upper.max(lower),
+                exact,
+                witness: b.witness,
+                method,
+            });
+        }
+    };
+    let v = witness.volume();
+    Ok(Dispersion {
+        lower: v,
+        upper: v,
+        exact: true,
+        witness,
+        method,
+    })
+}
+
+/// `d = 1`: the largest gap between consecutive sorted values, `0` and `1`.
+fn max_gap(xs: &[f64]) -> EmptyBox {
+    let mut v: Vec<f64> = xs.to_vec();
+    v.sort_by(f64::total_cmp);
+    let mut best = (0.0, 0.0, 0.0);
+    let mut prev = 0.0;
+    for &x in v.iter().chain(std::iter::once(&1.0)) {
+        if x - prev > best.0 {
+            best = (x - prev, prev, x);
+        }
+        prev = x;
+    }
+    EmptyBox {
+        lo: vec![best.1],
+        hi: vec![best.2],
+    }
+}
+
+/// Deterministic choice between two candidate boxes: larger volume, then lexicographically
+/// smaller corners.
+pub(crate) fn better(a: &EmptyBox, av: f64, b: &EmptyBox, bv: f64) -> bool {
+    match av.total_cmp(&bv) {
+        std::cmp::Ordering::Greater => true,
+        std::cmp::Ordering::Less => false,
+        std::cmp::Ordering::Equal => {
+            let ka = a.lo.iter().chain(&a.hi);
+            let kb = b.lo.iter().chain(&b.hi);
+            ka.zip(kb)
+                .map(|(x, y)| x.total_cmp(y))
+                .find(|o| o.is_ne())
+                .is_some_and(|o| o.is_lt())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,167 @@
+use proptest::prelude::*;
+
+use super::*;
+
+/// O(n^(2d+1)) brute force: every box whose faces lie on point coordinates or the cube's
+/// boundary, checked against every point.
+fn brute(points: &[f64], d: usize) -> f64 {
+    let coords: Vec<Vec<f64>> = (0..d)
+        .map(|k| {
+            let mut c: Vec<f64> = points.chunks_exact(d).map(|p| p[k]).collect();
+            c.extend([0.0, 1.0]);
+            c.sort_by(f64::total_cmp);
+            c.dedup();
+            c
+        })
+        .collect();
+    let mut best: f64 = 0.0;
+    let mut b = EmptyBox {
+        lo: vec![0.0; d],
+        hi: vec![0.0; d],
+    };
+    fn rec(k: usize, d: usize, coords: &[Vec<f64>], b: &mut EmptyBox, pts: &[f64], best: &mut f64) {
+        if k == d {
+            if b.is_empty_of(pts) {
+                *best = best.max(b.volume());
+            }
+            return;
+        }
+        for (i, &lo) in coords[k].iter().enumerate() {
+            for &hi in &coords[k][i + 1..] {
+                b.lo[k] = lo;
+                b.hi[k] = hi;
+                rec(k + 1, d, coords, b, pts, best);
+            }
+        }
+    }
+    rec(0, d, &coords, &mut b, points, &mut best);
+    best
+}
+
+/// Points on a coarse grid so that ties and boundary values are frequent.
+fn grid_points(d: usize, max_n: usize) -> impl Strategy<Value = Vec<f64>> {
+    prop::collection::vec(0u8..=8, d..=d * max_n).prop_map(move |raw| {
+        let n = raw.len() / d;
+        raw[..n * d].iter().map(|&v| f64::from(v) / 8.0).collect()
+    })
+}
+
+fn check(points: &[f64], d: usize) -> Result<(), TestCaseError> {
+    let r = dispersion(points, d, &DispersionOptions::default()).unwrap();
+    let b = brute(points, d);
+    prop_assert!(r.exact);
+    prop_assert!(
+        (r.lower - b).abs() < 1e-12,
+        "d={} fast {} brute {}",
+        d,
+        r.lower,
+        b
+    );
+    prop_assert_eq!(r.lower, r.upper);
+    prop_assert!(r.witness.is_empty_of(points));
+    prop_assert!((r.witness.volume() - r.lower).abs() < 1e-15);
+    Ok(())
+}
+
+proptest! {
+    #[test]
+    fn exact_1d_matches_brute_force(points in grid_points(1, 12)) {
+        check(&points, 1)?;
+    }
+
+    #[test]
+    fn exact_2d_matches_brute_force(points in grid_points(2, 9)) {
+        check(&points, 2)?;
+    }
+
+    #[test]
+    fn exact_2d_matches_brute_force_on_fine_coordinates(
+        raw in prop::collection::vec(0.0f64..1.0, 2..24),
+    ) {
+        let n = raw.len() / 2;
+        check(&raw[..2 * n], 2)?;
+    }
+
+    #[test]
+    fn exact_3d_matches_brute_force(points in grid_points(3, 5)) {
+        check(&points, 3)?;
+    }
+
+    #[test]
+    fn the_bracket_contains_the_exact_value(
+        raw in prop::collection::vec(0.0f64..1.0, 9..60),
+    ) {
+        let d = 3;
+        let n = raw.len() / d;
+        let pts = &raw[..n * d];
+        let exact = dispersion(pts, d, &DispersionOptions::default()).unwrap();
+        let opts = DispersionOptions {
+            exact_max_points: vec![0],
+            bracket_regions: 2_000,
+            ..DispersionOptions::default()
+        };
+        let b = dispersion(pts, d, &opts).unwrap();
+        prop_assert!(b.witness.is_empty_of(pts));
+        prop_assert!(b.lower <= exact.lower + 1e-12 && exact.lower <= b.upper + 1e-12,
+            "{} <= {} <= {}", b.lower, exact.lower, b.upper);
+    }
+}
+
+#[test]
+fn empty_and_boundary_only_sets_leave_the_whole_cube() {
+    for d in 1..=4 {
+        let r = dispersion(&[], d, &DispersionOptions::default()).unwrap();
+        assert_eq!(r.lower, 1.0);
+        let corner: Vec<f64> = vec![0.0; d];
+        assert_eq!(
+            dispersion(&corner, d, &DispersionOptions::default())
+                .unwrap()
+                .upper,
+            1.0
+        );
+    }
+}
+
+#[test]
+fn a_centre_point_leaves_half_the_square() {
+    let r = dispersion(&[0.5, 0.5], 2, &DispersionOptions::default()).unwrap();
+    assert_eq!(r.lower, 0.5);
+    assert!(r.witness.is_empty_of(&[0.5, 0.5]));
+}
+
+#[test]
+fn halton_dispersion_shrinks_like_one_over_n() {
+    use crate::{Generator, Halton, Param, ParamSpace};
+    let space = ParamSpace::new(vec![
+        Param::interval("x", 0.0, 1.0, "1"),
+        Param::interval("y", 0.0, 1.0, "1"),
+    ])
+    .unwrap();
+    let pts: Vec<f64> = Halton::new(&space)
+        .ask(4096)
+        .unwrap()
+        .into_iter()
+        .flat_map(|p| p.continuous)
+        .collect();
+    let small = dispersion(&pts[..2 * 256], 2, &DispersionOptions::default()).unwrap();
+    let large = dispersion(&pts, 2, &DispersionOptions::default()).unwrap();
+    // n · dispersion stays bounded (paper Proposition 3.3): within [1, 8] here.
+    for (n, r) in [(256.0, &small), (4096.0, &large)] {
+        let c = n * r.lower;
+        assert!((1.0..8.0).contains(&c), "n·dispersion = {c} at n = {n}");
+    }
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    assert!(matches!(
+        dispersion(&[0.1, 1.5], 2, &DispersionOptions::default()),
+        Err(CoverageError::OutsideUnitCube {
+            row: 0,
+            column: 1,
+            ..
+        })
+    ));
+    assert!(dispersion(&[0.1, 0.2, 0.3], 2, &DispersionOptions::default()).is_err());
+    assert!(dispersion(&[0.1], 0, &DispersionOptions::default()).is_err());
+}

@@ -1,0 +1,390 @@
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::CoverageError;
+use crate::{Domain, ParamSpace, Point, Value};
+
+/// The largest strength `t` the estimators accept.
+pub const MAX_STRENGTH: usize = 6;
+
+/// One t-tuple that no test covers: `(parameter name, value)` pairs in declaration order.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MissingTuple {
+    /// The tuple's values, by parameter.
+    pub values: Vec<(String, Value)>,
+}
+
+/// k-wise (t-wise) combinatorial coverage of the discrete parameters at one strength
+/// (PARACOSM §3.1; Kuhn, Kacker, Lei, "Introduction to Combinatorial Testing", 2013).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct KWiseCoverage {
+    /// The strength `t`.
+    pub strength: usize,
+    /// t-tuples (a choice of `t` parameters and one level for each) that some test covers.
+    pub covered: u64,
+    /// All t-tuples: `Σ over t-subsets S of Π_{i∈S} v_i`, with `v_i` the level counts.
+    pub total: u64,
+    /// `covered / total` in `[0, 1]` (`1` when there are no tuples).
+    pub fraction: f64,
+    /// Up to the requested number of uncovered tuples, in lexicographic order of parameter
+    /// subsets, then of levels.
+    pub missing: Vec<MissingTuple>,
+}
+
+/// Counts of [`kwise_coverage_rows`]: missing tuples as `(column, level)` pairs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RawKWise {
+    /// Covered t-tuples.
+    pub covered: u64,
+    /// All t-tuples.
+    pub total: u64,
+    /// Up to `max_missing` uncovered tuples as `(column, level)` pairs, columns increasing.
+    pub missing: Vec<Vec<(usize, u32)>>,
+}
+
+/// t-wise coverage of the discrete parameters of `points` in `space` at strength `t`,
+/// reporting at most `max_missing` uncovered tuples by name and value.
+///
+/// Exact: every t-subset of parameters gets a bitset over its `Π v_i` level combinations,
+/// filled in one pass over the rows. Time `O(C(k, t) · n · t)`, memory one bitset per worker;
+/// parallel over subsets with rayon, and deterministic whatever the thread count.
+///
+/// # Errors
+/// [`CoverageError::Strength`] unless `1 <= t <= min(6, k)` with `k` discrete parameters;
+/// [`CoverageError::LevelOutOfRange`] / [`CoverageError::Shape`] for points that do not fit.
+pub fn kwise_coverage(
+    space: &ParamSpace,
+    points: &[Point],
+    t: usize,
+    max_missing: usize,
+) -> Result<KWiseCoverage, CoverageError> {
+    let discrete: Vec<_> = space.discrete().collect();
+    let levels: Vec<u32> = space.level_counts();
+    let k = levels.len();
+    let mut rows = Vec::with_capacity(points.len() * k);
+    for (r, p) in points.iter().enumerate() {
+        if p.discrete.len() != k {
+            return Err(CoverageError::Shape(format!(
+                "row {r} has {} level indices, the space has {k} discrete parameters",
+                p.discrete.len()
+            )));
+        }
+        rows.extend_from_slice(&p.discrete);
+    }
+    let raw = kwise_coverage_rows(&levels, &rows, t, max_missing)?;
+    let missing = raw
+        .missing
+        .into_iter()
+        .map(|tuple| MissingTuple {
+            values: tuple
+                .into_iter()
+                .map(|(c, l)| {
+                    let p = discrete[c];
+                    let v = match &p.domain {
+                        Domain::Levels(ls) => ls[l as usize].clone(),
+                        Domain::Interval { .. } => unreachable!("discrete() yields levels only"),
+                    };
+                    (p.name.clone(), v)
+                })
+                .collect(),
+        })
+        .collect();
+    Ok(KWiseCoverage {
+        strength: t,
+        covered: raw.covered,
+        total: raw.total,
+        fraction: if raw.total == 0 {
+            1.0
+        } else {
+            raw.covered as f64 / raw.total as f64
+        },
+        missing,
+    })
+}
+
+/// [`kwise_coverage`] on raw data: `levels` has the `k` level counts, `rows` is `n × k`
+/// row-major level indices.
+///
+/// # Errors
+/// As [`kwise_coverage`]; [`CoverageError::TooManyTuples`] if the count overflows 64 bits.
+pub fn kwise_coverage_rows(
+    levels: &[u32],
+    rows: &[u32],
+    t: usize,
+    max_missing: usize,
+) -> Result<RawKWise, CoverageError> {
+    let k = levels.len();
+    let max = MAX_STRENGTH.min(k);
+    if t == 0 || t > max {
+        return Err(CoverageError::Strength {
+            t,
+            max,
+            discrete: k,
+        });
+    }
+    if rows.len() % k != 0 {
+        return Err(CoverageError::Shape(format!(
+            "{} level indices do not form rows of {k}",
+            rows.len()
+        )));
+    }
+    let n = rows.len() / k;
+    // Column-major copy: the inner loop walks one column per subset member.
+    let mut columns = vec![Vec::with_capacity(n); k];
+    for (i, &l) in rows.iter().enumerate() {
+        let c = i % k;
+        if l >= levels[c] {
+            return Err(CoverageError::LevelOutOfRange {
+                row: i / k,
+                column: c,
+                level: l,
+                levels: levels[c],
+            });
+        }
+        columns[c].push(l);
+    }
+
+    let per_first: Vec<Result<RawKWise, CoverageError>> = (0..=k - t)
+        .into_par_iter()
+        .map(|first| {
+            let mut acc = RawKWise {
+                covered: 0,
+                total: 0,
+                missing: Vec::new(),
+            };
+            let mut subset: Vec<usize> = (first..first + t).collect();
+            let mut bits: Vec<u64> = Vec::new();
+            loop {
+                cover_subset(levels, &columns, &subset, max_missing, &mut bits, &mut acc)
+                    .ok_or(CoverageError::TooManyTuples { t })?;
+                if !next_subset(&mut subset, k) {
+                    break;
+                }
+            }
+            Ok(acc)
+        })
+        .collect();
+
+    let mut out = RawKWise {
+        covered: 0,
+        total: 0,
+        missing: Vec::new(),
+    };
+    for part in per_first {
+        let part = part?;
+        out.covered += part.covered;
+        out.total = out
+            .total
+            .checked_add(part.total)
+            .ok_or(CoverageError::TooManyTuples { t })?;
+        let room = max_missing - out.missing.len();
+        out.missing.extend(part.missing.into_iter().take(room));
+    }
+    Ok(out)
+}
+
+/// Advances `subset` (increasing indices below `k`) to the next subset with the same first
+/// element, in lexicographic order. Returns false when there is none.
+fn next_subset(subset: &mut [usize], k: usize) -> bool {
+    let t = subset.len();
+    let mut i = t;
+    while i > 1 {
+        i -= 1;
+        if subset[i] < k - (t - i) {
+            subset[i] += 1;
+            for j in i + 1..t {
+                subset[j] = subset[j - 1] + 1;
+            }
+            return true;
+        }
+    }
+    false
+}
+
+/// Marks the level combinations of `subset` seen in the rows; adds the counts and up to
+/// `max_missing` missing tuples to `acc`. `None` on overflow.
+fn cover_subset(
+    levels: &[u32],
+    columns: &[Vec<u32>],
+    subset: &[usize],
+    max_missing: usize,
+    bits: &mut Vec<u64>,
+    acc: &mut RawKWise,
+) -> Option<()> {
+    // Mixed radix: the last member varies fastest.
+    let mut strides = vec![0u64; subset.len()];
+    let mut size: u64 = 1;
+    for (i, &c) in subset.iter().enumerate().rev() {
+        strides[i] = size;
+        size = size.checked_mul(u64::from(levels[c]))?;
+    }
+    let words = usize::try_from(size.div_ceil(64)).ok()?;
+    bits.clear();
+    bits.resize(words, 0);
+    // Each row's combination index, one subset member at a time (a vectorisable loop).
+    let n = columns.first().map_or(0, Vec::len);
+    let mut index = vec![0u64; n];
+    for (i, &c) in subset.iter().enumerate() {
+        for (slot, &l) in index.iter_mut().zip(&columns[c]) {
+            *slot += u64::from(l) * strides[i];
+        }
+    }
+    for idx in index {
+        bits[(idx / 64) as usize] |= 1 << (idx % 64);
+    }
+    let covered: u64 = bits.iter().map(|w| u64::from(w.count_ones())).sum();
+    acc.covered += covered;
+    acc.total = acc.total.checked_add(size)?;
+    if acc.missing.len() < max_missing && covered < size {
+        for idx in 0..size {
+            if bits[(idx / 64) as usize] & (1 << (idx % 64)) == 0 {
+                let tuple = subset
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &c)| (c, ((idx / strides[i]) % u64::from(levels[c])) as u32))
+                    .collect();
+                acc.missing.push(tuple);
+                if acc.missing.len() == max_missing {
+                    break;
+                }
+            }
+        }
+    }
+    Some(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Param;
+    use proptest::prelude::*;
+
+    /// Brute force: enumerate every t-subset and every level combination, scan all rows.
+    fn brute(levels: &[u32], rows: &[Vec<u32>], t: usize) -> (u64, u64) {
+        let k = levels.len();
+        let mut covered = 0;
+        let mut total = 0;
+        let mut subset: Vec<usize> = (0..t).collect();
+        loop {
+            let combos: u64 = subset.iter().map(|&c| u64::from(levels[c])).product();
+            total += combos;
+            for idx in 0..combos {
+                let mut rest = idx;
+                let mut want = vec![0u32; t];
+                for i in (0..t).rev() {
+                    want[i] = (rest % u64::from(levels[subset[i]])) as u32;
+                    rest /= u64::from(levels[subset[i]]);
+                }
+                if rows
+                    .iter()
+                    .any(|r| subset.iter().zip(&want).all(|(&c, &w)| r[c] == w))
+                {
+                    covered += 1;
+                }
+            }
+            // next subset, any first element
+            let mut i = t;
+            loop {
+                if i == 0 {
+                    return (covered, total);
+                }
+                i -= 1;
+                if subset[i] < k - (t - i) {
+                    subset[i] += 1;
+                    for j in i + 1..t {
+                        subset[j] = subset[j - 1] + 1;
+                    }
+                    break;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_known_pairwise_array_covers_every_pair() {
+        // The L4(2^3) orthogonal array covers all 12 pairs of 3 binary factors.
+        let rows = [0, 0, 0, 0, 1, 1, 1, 0, 1, 1, 1, 0];
+        let c = kwise_coverage_rows(&[2, 2, 2], &rows, 2, 10).unwrap();
+        assert_eq!((c.covered, c.total), (12, 12));
+        assert!(c.missing.is_empty());
+        let c3 = kwise_coverage_rows(&[2, 2, 2], &rows, 3, 2).unwrap();
+        assert_eq!((c3.covered, c3.total), (4, 8));
+        // (0,0,1) is the first of the missing triples.
+        assert_eq!(c3.missing[0], vec![(0, 0), (1, 0), (2, 1)]);
+        assert_eq!(c3.missing.len(), 2);
+    }
+
+    #[test]
+    fn missing_tuples_are_named_by_parameter_and_value() {
+        let space = ParamSpace::new(vec![
+            Param::levels("lanes", vec![Value::Int(2), Value::Int(4)]),
+            Param::interval("fog", 0.0, 1.0, "1"),
+            Param::levels(
+                "colour",
+                vec![Value::Text("red".into()), Value::Text("white".into())],
+            ),
+        ])
+        .unwrap();
+        let pts = vec![
+            Point {
+                discrete: vec![0, 0],
+                continuous: vec![0.1],
+            },
+            Point {
+                discrete: vec![1, 1],
+                continuous: vec![0.2],
+            },
+        ];
+        let c = kwise_coverage(&space, &pts, 2, 5).unwrap();
+        assert_eq!((c.covered, c.total), (2, 4));
+        assert_eq!(c.fraction, 0.5);
+        assert_eq!(
+            c.missing[0].values,
+            vec![
+                ("lanes".to_owned(), Value::Int(2)),
+                ("colour".to_owned(), Value::Text("white".into()))
+            ]
+        );
+        let one = kwise_coverage(&space, &pts, 1, 5).unwrap();
+        assert_eq!((one.covered, one.total), (4, 4));
+    }
+
+    #[test]
+    fn bad_strengths_and_levels_are_errors() {
+        assert!(matches!(
+            kwise_coverage_rows(&[2, 2], &[0, 0], 3, 0),
+            Err(CoverageError::Strength { t: 3, max: 2, .. })
+        ));
+        assert!(kwise_coverage_rows(&[2, 2], &[0, 0], 0, 0).is_err());
+        assert_eq!(
+            kwise_coverage_rows(&[2, 2], &[0, 0, 1, 2], 1, 0),
+            Err(CoverageError::LevelOutOfRange {
+                row: 1,
+                column: 1,
+                level: 2,
+                levels: 2
+            })
+        );
+    }
+
+    proptest! {
+        #[test]
+        fn matches_brute_force(
+            levels in prop::collection::vec(1u32..4, 1..6),
+            seed_rows in prop::collection::vec(prop::collection::vec(0u32..100, 6), 0..12),
+            t in 1usize..4,
+        ) {
+            let k = levels.len();
+            prop_assume!(t <= k);
+            let rows: Vec<Vec<u32>> = seed_rows
+                .iter()
+                .map(|r| (0..k).map(|c| r[c] % levels[c]).collect())
+                .collect();
+            let flat: Vec<u32> = rows.concat();
+            let fast = kwise_coverage_rows(&levels, &flat, t, usize::MAX).unwrap();
+            let (covered, total) = brute(&levels, &rows, t);
+            prop_assert_eq!((fast.covered, fast.total), (covered, total));
+            prop_assert_eq!(fast.missing.len() as u64, total - covered);
+        }
+    }
+}

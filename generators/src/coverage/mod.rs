@@ -1,0 +1,46 @@
+//! Coverage of a test set (PARACOSM §3.1): k-wise combinatorial coverage for the discrete
+//! parameters, dispersion and discrepancies for the continuous ones, and the paper's
+//! (k, ε)-covering criterion that joins them.
+//!
+//! Point sets are passed as `n × d` row-major slices of `f64` with every value in `[0, 1]`
+//! (the unit cube), discrete rows as `n × k` row-major slices of level indices.
+
+mod discrepancy;
+mod dispersion;
+mod error;
+mod kwise;
+mod star;
+
+pub use discrepancy::{discrepancy, Discrepancy};
+pub use dispersion::{dispersion, Dispersion, DispersionOptions, EmptyBox};
+pub use error::CoverageError;
+pub use kwise::{
+    kwise_coverage, kwise_coverage_rows, KWiseCoverage, MissingTuple, RawKWise, MAX_STRENGTH,
+};
+pub use star::{star_discrepancy, StarDiscrepancy, StarOptions};
+
+/// Checks an `n × d` row-major point set: `d >= 1`, length a multiple of `d`, every value
+/// finite and in `[0, 1]`. Returns `n`.
+pub(crate) fn check_unit_points(points: &[f64], d: usize) -> Result<usize, CoverageError> {
+    if d == 0 {
+        return Err(CoverageError::Shape(
+            "dimension d must be at least 1".into(),
+        ));
+    }
+    if points.len() % d != 0 {
+        return Err(CoverageError::Shape(format!(
+            "{} values do not form rows of {d}",
+            points.len()
+        )));
+    }
+    for (k, &v) in points.iter().enumerate() {
+        if !(0.0..=1.0).contains(&v) {
+            return Err(CoverageError::OutsideUnitCube {
+                row: k / d,
+                column: k % d,
+                value: v,
+            });
+        }
+    }
+    Ok(points.len() / d)
+}
