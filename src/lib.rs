@@ -9,6 +9,7 @@
 
 pub mod campaign;
 pub mod cli;
+pub mod cover;
 pub mod plot;
 pub mod record;
 pub mod seed;

@@ -47,6 +47,9 @@ pub struct Summary {
     pub counts: Counts,
     /// The failing test with the smallest id, if any.
     pub first_failure: Option<FirstFailure>,
+    /// Coverage of the campaign's points: k-wise coverage of the discrete parameters,
+    /// dispersion, discrepancies and star discrepancy of the continuous ones (unit cube).
+    pub coverage: Option<crate::cover::Estimate>,
     /// Wall-clock time of the whole campaign in seconds.
     pub wall_s: f64,
     /// Files written, relative to the output folder.

@@ -196,28 +196,233 @@ fn an_earlier_campaign_is_not_overwritten_without_force() {
     assert_eq!(lines(&dir.path().join("results.jsonl")).len(), 3);
 }
 
+fn cover(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_paracosm-cover"))
+        .args(args)
+        .output()
+        .expect("paracosm-cover runs")
+}
+
 #[test]
 fn cover_generate_writes_the_halton_design_as_csv() {
-    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-cover"))
-        .args([
-            "generate",
-            "pedestrian-crossing",
-            "--strategy",
-            "halton",
-            "-n",
-            "3",
-        ])
-        .output()
-        .unwrap();
+    let o = cover(&[
+        "generate",
+        "--space",
+        "pedestrian-crossing",
+        "--strategy",
+        "halton",
+        "--budget",
+        "3",
+    ]);
     assert_eq!(o.status.code(), Some(0));
     // Halton(2, 3) points 0, 1, 2 mapped onto [0.5, 10) × [5, 60).
     assert_eq!(
         String::from_utf8(o.stdout).unwrap(),
         "id,walking_speed,trigger_distance\n0,0.5,5\n1,5.25,23.333333333333332\n2,2.875,41.666666666666664\n"
     );
-    let bad = Command::new(env!("CARGO_BIN_EXE_paracosm-cover"))
-        .args(["generate", "pedestrian-crossing", "-n", "0"])
-        .output()
-        .unwrap();
+    let scrambled = cover(&[
+        "generate",
+        "--space",
+        "pedestrian-crossing",
+        "--scramble",
+        "--budget",
+        "3",
+        "--seed",
+        "1",
+    ]);
+    assert_eq!(scrambled.status.code(), Some(0));
+    assert_eq!(
+        String::from_utf8(scrambled.stdout).unwrap().lines().count(),
+        4
+    );
+    let bad = cover(&[
+        "generate",
+        "--space",
+        "pedestrian-crossing",
+        "--budget",
+        "0",
+    ]);
     assert_eq!(bad.status.code(), Some(2));
+}
+
+#[test]
+fn cover_estimate_reads_fuzz_results_and_csv_and_decides_k_epsilon() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let f = fuzz(&[
+        "pedestrian-crossing",
+        "--budget",
+        "64",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(matches!(f.status.code(), Some(0 | 1)));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let d = summary["coverage"]["dispersion"]["lower"].as_f64().unwrap();
+    assert!(d > 0.0 && d < 0.2, "dispersion {d}");
+    assert_eq!(summary["coverage"]["dispersion"]["exact"], true);
+
+    let results = out.join("results.jsonl");
+    let o = cover(&[
+        "estimate",
+        results.to_str().unwrap(),
+        "--space",
+        "pedestrian-crossing",
+        "--json",
+        "--epsilon",
+        "0.2",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let est: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(est["tests"], 64);
+    assert_eq!(est["dispersion"]["lower"].as_f64().unwrap(), d);
+    assert_eq!(est["k_epsilon"]["covering"], true);
+    let table = cover(&[
+        "estimate",
+        results.to_str().unwrap(),
+        "--space",
+        "pedestrian-crossing",
+    ]);
+    let text = String::from_utf8(table.stdout).unwrap();
+    assert!(
+        text.contains("dispersion") && text.contains("exact") && text.contains("cd"),
+        "{text}"
+    );
+
+    let csv = dir.path().join("design.csv");
+    let g = cover(&[
+        "generate",
+        "--space",
+        "pedestrian-crossing",
+        "--budget",
+        "64",
+        "--output",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(g.status.code(), Some(0));
+    let e = cover(&[
+        "estimate",
+        csv.to_str().unwrap(),
+        "--space",
+        "pedestrian-crossing",
+        "--json",
+        "--metrics",
+        "dispersion",
+    ]);
+    let est2: serde_json::Value = serde_json::from_slice(&e.stdout).unwrap();
+    // The same 64 Halton points, read back in units: the same dispersion.
+    assert!((est2["dispersion"]["lower"].as_f64().unwrap() - d).abs() < 1e-12);
+}
+
+#[test]
+fn cover_bad_input_exits_2_naming_row_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_str().unwrap().to_owned()
+    };
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (vec!["estimate".into(), write("e.csv", "")], "empty"),
+        (
+            vec!["estimate".into(), write("r.csv", "x,y\n0.1,0.2\n0.3\n")],
+            ":3",
+        ),
+        (
+            vec!["estimate".into(), write("t.csv", "x,y\n0.1,zz\n")],
+            ":2: column 2 (`y`)",
+        ),
+        (
+            vec!["estimate".into(), write("n.csv", "x,y\n0.1,inf\n")],
+            ":2: column 2 (`y`)",
+        ),
+        (
+            vec!["estimate".into(), write("o.csv", "x,y\n0.1,2\n")],
+            "outside the domain",
+        ),
+        (
+            vec![
+                "estimate".into(),
+                write("m.csv", "x\n0.5\n"),
+                "--metrics".into(),
+                "dispersion,foo".into(),
+            ],
+            "unknown metric `foo`",
+        ),
+        (
+            vec![
+                "estimate".into(),
+                write("s.csv", "x\n0.5\n"),
+                "--strength".into(),
+                "2".into(),
+            ],
+            "strength t = 2",
+        ),
+        (
+            vec![
+                "plan".into(),
+                "--space".into(),
+                "nope".into(),
+                "--epsilon".into(),
+                "0.1".into(),
+            ],
+            "neither a built-in scenario",
+        ),
+    ];
+    for (args, needle) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = cover(&args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn cover_plan_prints_the_formulas_and_budgets() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("space.toml");
+    std::fs::write(
+        &spec,
+        "[[param]]\nname = \"a\"\nlevels = [0, 1]\n[[param]]\nname = \"b\"\nlevels = [0, 1]\n[[param]]\nname = \"c\"\nlevels = [0, 1]\n[[param]]\nname = \"x\"\ninterval = [0.0, 1.0]\n",
+    )
+    .unwrap();
+    let o = cover(&[
+        "plan",
+        "--space",
+        spec.to_str().unwrap(),
+        "--strength",
+        "2",
+        "--epsilon",
+        "0.05",
+        "--delta",
+        "0.01",
+        "--json",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let p: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // Prop. 3.2: 2^2 (2 ln 3 - ln 0.01) = 4 (2.197 + 4.605) = 27.2 -> 28.
+    assert_eq!(p["random_kwise_prop32"], 28);
+    // Union bound: T = 12 tuples, V = 4: ln(1200) / -ln(3/4) = 24.6 -> 25.
+    assert_eq!(p["random_kwise_union"], 25);
+    // x is the 4th parameter, so its Halton coordinate is base-7 van der Corput: the largest
+    // gap is below 7/n.
+    let c = p["halton_constant"].as_f64().unwrap();
+    assert!(c > 0.9 && c < 7.0, "{c}");
+    assert_eq!(
+        p["total"].as_u64().unwrap(),
+        p["random_kwise_exact_union"].as_u64().unwrap() * p["halton_per_group"].as_u64().unwrap()
+    );
 }

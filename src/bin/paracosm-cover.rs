@@ -1,23 +1,22 @@
-//! `paracosm-cover`: test designs over a scenario's parameter space.
-//!
-//! `paracosm-cover generate SCENARIO --strategy halton -n 50` writes the first 50 points of
-//! the design as CSV (one column per parameter, values in the parameters' units), so that a
-//! design can be inspected, plotted or run by another tool.
+//! `paracosm-cover`: coverage of test sets (estimate), test designs (generate), and test
+//! budgets (plan) over a scenario's parameter space.
 //!
 //! Exit codes: 0 success, 2 bad input or usage, 3 internal error.
 
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
 use paracosm::cli::{BadInput, StrategyArg};
+use paracosm::cover::{estimate, load_space, plan, read_tests, Metric};
+use paracosm_generators::coverage::{discrepancy, Discrepancy};
+use paracosm_generators::{Halton, Param, ParamSpace, Strategy};
 
-use paracosm_generators::Strategy;
-
-/// Test designs over a scenario's parameter space.
+/// Coverage of test sets, test designs and test budgets over a parameter space.
 #[derive(Debug, Parser)]
 #[command(name = "paracosm-cover", version)]
 struct Cli {
@@ -27,23 +26,81 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Write the first N points of a design as CSV: a header of parameter names, then one row
-    /// per test with its id and values in the parameters' units.
+    /// Estimate the coverage of a test set: k-wise coverage of the discrete parameters,
+    /// dispersion and discrepancies of the continuous ones, and optionally the (k, ε)-covering
+    /// verdict.
+    Estimate {
+        /// A CSV file with a header, or the results.jsonl of paracosm-fuzz.
+        file: PathBuf,
+        /// The parameters' domains: a built-in scenario name or a TOML file. Without it every
+        /// column must lie in [0, 1] and is continuous (a first column `id` is skipped).
+        #[arg(long)]
+        space: Option<String>,
+        /// Largest k-wise strength to report (default: 2, or the number of discrete
+        /// parameters if smaller).
+        #[arg(long)]
+        strength: Option<usize>,
+        /// Metrics of the continuous part, comma-separated: dispersion, cd, wd, md, l2star, star.
+        #[arg(
+            long,
+            default_value = "dispersion,cd,wd,md,l2star,star",
+            value_delimiter = ','
+        )]
+        metrics: Vec<String>,
+        /// Also decide (k, ε)-covering with k = --strength and this dispersion bound.
+        #[arg(long)]
+        epsilon: Option<f64>,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Write the first N points of a design as CSV in the parameters' units (header: id and
+    /// the parameter names).
     Generate {
-        /// Built-in scenario whose open parameters span the space (e.g. pedestrian-crossing).
-        scenario: String,
+        /// The parameters' domains: a built-in scenario name or a TOML file.
+        #[arg(long)]
+        space: String,
         /// How points are chosen.
         #[arg(long, value_enum, default_value = "halton")]
         strategy: StrategyArg,
+        /// With --strategy halton: randomise it by digit permutations (Owen 2017).
+        #[arg(long)]
+        scramble: bool,
         /// Number of points (at least 1).
-        #[arg(short = 'n', long, value_parser = paracosm::cli::positive)]
-        count: u64,
-        /// Seed of the random and Sobol strategies.
+        #[arg(long, value_parser = paracosm::cli::positive)]
+        budget: u64,
+        /// Seed of the random, scrambled Halton and Sobol strategies.
         #[arg(long, default_value_t = 0)]
         seed: u64,
         /// Write to this file instead of standard output.
         #[arg(long)]
         output: Option<PathBuf>,
+    },
+    /// Print how many tests a (k, ε)-covering set needs: random k-wise rows by Proposition 3.2
+    /// and its union bound, Halton points per row from the measured n·dispersion constant.
+    Plan {
+        /// The parameters' domains: a built-in scenario name or a TOML file.
+        #[arg(long)]
+        space: String,
+        /// Strength k of the discrete part.
+        #[arg(long, default_value_t = 2)]
+        strength: usize,
+        /// Target dispersion of each row's continuous part, in (0, 1].
+        #[arg(long)]
+        epsilon: f64,
+        /// Allowed failure probability of the random k-wise family, in (0, 1).
+        #[arg(long, default_value_t = 0.01)]
+        delta: f64,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Time the estimators and generators on fixed inputs (the paracosm side of
+    /// experiments/bench/compare_scipy.py).
+    Bench {
+        /// Print JSON (the format compare_scipy.py reads).
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -73,35 +130,73 @@ fn main() -> ExitCode {
     }
 }
 
+fn bad(e: impl ToString) -> anyhow::Error {
+    BadInput(e.to_string()).into()
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
+        Command::Estimate {
+            file,
+            space,
+            strength,
+            metrics,
+            epsilon,
+            json,
+        } => {
+            let metrics = metrics
+                .iter()
+                .map(|m| m.parse::<Metric>())
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(bad)?;
+            let space = space.map(|s| load_space(&s)).transpose().map_err(bad)?;
+            let set = read_tests(&file, space.as_ref()).map_err(bad)?;
+            let report = estimate(&set, &metrics, strength, epsilon).map_err(bad)?;
+            let mut out = std::io::stdout().lock();
+            if json {
+                serde_json::to_writer_pretty(&mut out, &report)?;
+                writeln!(out)?;
+            } else {
+                write!(out, "{report}")?;
+            }
+            Ok(())
+        }
         Command::Generate {
-            scenario,
+            space,
             strategy,
-            count,
+            scramble,
+            budget,
             seed,
             output,
         } => {
-            let scenario =
-                paracosm_scenarios::builtin(&scenario).map_err(|e| BadInput(e.to_string()))?;
-            let strategy = Strategy::from(strategy);
+            let space = load_space(&space).map_err(bad)?;
+            let strategy = match (Strategy::from(strategy), scramble) {
+                (Strategy::Halton, true) => Strategy::ScrambledHalton,
+                (_, true) => return Err(bad("--scramble applies to --strategy halton only")),
+                (s, false) => s,
+            };
+            if let Some(cap) = strategy.capacity().filter(|&c| budget > c) {
+                return Err(bad(format!(
+                    "--budget {budget} is more than the {cap} points {strategy} can produce"
+                )));
+            }
             let points = strategy
-                .build(&scenario.space, seed)
-                .and_then(|mut g| g.ask(count as usize))
-                .map_err(|e| BadInput(e.to_string()))?;
+                .build(&space, seed)
+                .and_then(|mut g| g.ask(budget as usize))
+                .map_err(bad)?;
             let sink: Box<dyn Write> = match &output {
                 Some(path) => Box::new(
                     std::fs::File::create(path)
-                        .map_err(|e| BadInput(format!("cannot write `{}`: {e}", path.display())))?,
+                        .map_err(|e| bad(format!("cannot write `{}`: {e}", path.display())))?,
                 ),
                 None => Box::new(std::io::stdout().lock()),
             };
             let mut w = csv::Writer::from_writer(sink);
             let mut header = vec!["id".to_owned()];
-            header.extend(scenario.space.params().iter().map(|p| p.name.clone()));
+            header.extend(space.params().iter().map(|p| p.name.clone()));
             w.write_record(&header)?;
             for (i, p) in points.iter().enumerate() {
-                let a = scenario.space.decode(p)?;
+                let a = space.decode(p)?;
                 let mut row = vec![i.to_string()];
                 row.extend(a.iter().map(|(_, v)| v.to_string()));
                 w.write_record(&row)?;
@@ -109,5 +204,93 @@ fn run(cli: Cli) -> Result<()> {
             w.flush().context("writing the design")?;
             Ok(())
         }
+        Command::Plan {
+            space,
+            strength,
+            epsilon,
+            delta,
+            json,
+        } => {
+            if !(epsilon > 0.0 && epsilon <= 1.0) {
+                return Err(bad(format!("--epsilon {epsilon} is not in (0, 1]")));
+            }
+            if !(delta > 0.0 && delta < 1.0) {
+                return Err(bad(format!("--delta {delta} is not in (0, 1)")));
+            }
+            let space = load_space(&space).map_err(bad)?;
+            let nd = space.level_counts().len();
+            if nd > 0 && (strength == 0 || strength > nd.min(6)) {
+                return Err(bad(format!(
+                    "--strength {strength} is not in 1..={} (the space has {nd} discrete parameters)",
+                    nd.min(6)
+                )));
+            }
+            let p = plan(&space, strength, epsilon, delta);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&p)?);
+            } else {
+                print!("{p}");
+            }
+            Ok(())
+        }
+        Command::Bench { json } => {
+            let r = bench();
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                for (k, v) in r.as_object().into_iter().flatten() {
+                    println!("{k:<30} {v}");
+                }
+            }
+            Ok(())
+        }
     }
+}
+
+/// Best of 7 runs after a warm-up, in milliseconds.
+fn best_ms(mut f: impl FnMut()) -> f64 {
+    f();
+    (0..7)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn bench() -> serde_json::Value {
+    let space = |d: usize| {
+        ParamSpace::new(
+            (0..d)
+                .map(|i| Param::interval(&format!("x{i}"), 0.0, 1.0, "1"))
+                .collect(),
+        )
+        .expect("valid space")
+    };
+    let s8 = space(8);
+    let halton = best_ms(|| {
+        let h = Halton::scrambled(&s8, 0);
+        std::hint::black_box(h.unit_points(0, 65_536));
+    });
+    let x: Vec<f64> = Strategy::Random
+        .build(&s8, 0)
+        .and_then(|mut g| g.ask(4000))
+        .expect("random points")
+        .into_iter()
+        .flat_map(|p| p.continuous)
+        .collect();
+    let disc = |k: Discrepancy| {
+        best_ms(|| {
+            std::hint::black_box(discrepancy(&x, 8, k).expect("valid points"));
+        })
+    };
+    serde_json::json!({
+        "halton_scrambled_65536x8_ms": halton,
+        "cd_4000x8_ms": disc(Discrepancy::Centered),
+        "wd_4000x8_ms": disc(Discrepancy::WrapAround),
+        "md_4000x8_ms": disc(Discrepancy::Mixture),
+        "l2star_4000x8_ms": disc(Discrepancy::L2Star),
+        "threads": rayon::current_num_threads(),
+    })
 }

@@ -140,6 +140,18 @@ fn run(cli: &Cli) -> Result<ExitCode> {
             .iter()
             .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned())),
     );
+    let coverage = {
+        let set = paracosm::cover::TestSet {
+            space: scenario.space.clone(),
+            points: report.records.iter().map(|r| r.point.clone()).collect(),
+        };
+        let metrics: Vec<paracosm::cover::Metric> =
+            ["dispersion", "cd", "wd", "md", "l2star", "star"]
+                .iter()
+                .filter_map(|m| m.parse().ok())
+                .collect();
+        paracosm::cover::estimate(&set, &metrics, None, None).ok()
+    };
     let summary = Summary {
         tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
         scenario: scenario.name.clone(),
@@ -150,6 +162,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         space: scenario.space.params().to_vec(),
         counts: report.counts,
         first_failure: report.first_failure.clone(),
+        coverage,
         wall_s: report.wall_s,
         outputs,
     };

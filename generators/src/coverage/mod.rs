@@ -5,12 +5,14 @@
 //! Point sets are passed as `n × d` row-major slices of `f64` with every value in `[0, 1]`
 //! (the unit cube), discrete rows as `n × k` row-major slices of level indices.
 
+mod covering;
 mod discrepancy;
 mod dispersion;
 mod error;
 mod kwise;
 mod star;
 
+pub use covering::{k_epsilon_covering, KEpsilonCovering};
 pub use discrepancy::{discrepancy, Discrepancy};
 pub use dispersion::{dispersion, Dispersion, DispersionOptions, EmptyBox};
 pub use error::CoverageError;

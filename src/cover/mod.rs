@@ -1,0 +1,12 @@
+//! The library side of `paracosm-cover`: parameter-space specs, reading test sets from CSV or
+//! `results.jsonl`, coverage reports and budget plans.
+
+mod input;
+mod plan;
+mod report;
+mod spec;
+
+pub use input::{read_tests, InputError, TestSet};
+pub use plan::{plan, Plan};
+pub use report::{estimate, Estimate, Metric};
+pub use spec::{load_space, SpecError};

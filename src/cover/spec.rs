@@ -1,0 +1,148 @@
+//! `--space SPEC`: a built-in scenario's space, or a small TOML file.
+
+use std::path::Path;
+
+use serde::Deserialize;
+use thiserror::Error;
+
+use paracosm_generators::{Domain, Param, ParamSpace, Value};
+
+/// Errors loading a space spec.
+#[derive(Debug, Error)]
+pub enum SpecError {
+    /// Neither a built-in scenario nor a readable file.
+    #[error("`{0}` is neither a built-in scenario ({1}) nor a readable file")]
+    NotFound(String, String),
+    /// The TOML file does not parse or describes an invalid space.
+    #[error("{file}: {reason}")]
+    Invalid {
+        /// The file.
+        file: String,
+        /// What is wrong, with the line and column where the TOML parser gives them.
+        reason: String,
+    },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpecFile {
+    param: Vec<SpecParam>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpecParam {
+    name: String,
+    interval: Option<[f64; 2]>,
+    levels: Option<Vec<toml::Value>>,
+    unit: Option<String>,
+}
+
+/// The space named by `spec`: a built-in scenario name (e.g. `pedestrian-crossing`), or a TOML
+/// file of `[[param]]` tables, each with a `name`, either `interval = [lo, hi]` or
+/// `levels = [...]` (integers, numbers or strings), and an optional `unit`:
+///
+/// ```toml
+/// [[param]]
+/// name = "walking_speed"
+/// interval = [0.5, 10.0]
+/// unit = "m/s"
+///
+/// [[param]]
+/// name = "lanes"
+/// levels = [2, 4, 6]
+/// ```
+///
+/// # Errors
+/// [`SpecError`] naming the file, and the line and column of a TOML error.
+pub fn load_space(spec: &str) -> Result<ParamSpace, SpecError> {
+    if let Ok(s) = paracosm_scenarios::builtin(spec) {
+        return Ok(s.space);
+    }
+    let path = Path::new(spec);
+    let text = std::fs::read_to_string(path).map_err(|_| {
+        SpecError::NotFound(
+            spec.to_owned(),
+            paracosm_scenarios::builtin_names().join(", "),
+        )
+    })?;
+    let invalid = |reason: String| SpecError::Invalid {
+        file: spec.to_owned(),
+        reason,
+    };
+    let file: SpecFile = toml::from_str(&text).map_err(|e| {
+        let at = e
+            .span()
+            .map(|s| {
+                let before = &text[..s.start.min(text.len())];
+                let line = before.matches('\n').count() + 1;
+                let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+                format!("line {line}, column {col}: ")
+            })
+            .unwrap_or_default();
+        invalid(format!("{at}{}", e.message()))
+    })?;
+    let mut params = Vec::new();
+    for p in file.param {
+        let domain = match (p.interval, p.levels) {
+            (Some([lo, hi]), None) => Domain::Interval { lo, hi },
+            (None, Some(levels)) => Domain::Levels(
+                levels
+                    .into_iter()
+                    .map(|v| match v {
+                        toml::Value::Integer(i) => Ok(Value::Int(i)),
+                        toml::Value::Float(x) => Ok(Value::Real(x)),
+                        toml::Value::String(s) => Ok(Value::Text(s)),
+                        other => Err(invalid(format!(
+                            "parameter `{}`: level {other} is not a number or a string",
+                            p.name
+                        ))),
+                    })
+                    .collect::<Result<_, _>>()?,
+            ),
+            _ => {
+                return Err(invalid(format!(
+                    "parameter `{}` needs exactly one of `interval` and `levels`",
+                    p.name
+                )))
+            }
+        };
+        params.push(Param {
+            name: p.name,
+            domain,
+            unit: p.unit,
+        });
+    }
+    ParamSpace::new(params).map_err(|e| invalid(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn loads_builtin_and_toml_spaces_and_reports_errors_with_position() {
+        assert_eq!(load_space("pedestrian-crossing").unwrap().params().len(), 2);
+        let dir = tempfile::tempdir().unwrap();
+        let good = dir.path().join("s.toml");
+        std::fs::write(
+            &good,
+            "[[param]]\nname = \"v\"\ninterval = [0.5, 10.0]\nunit = \"m/s\"\n\n[[param]]\nname = \"lanes\"\nlevels = [2, 4]\n",
+        )
+        .unwrap();
+        let s = load_space(good.to_str().unwrap()).unwrap();
+        assert_eq!(s.level_counts(), [2]);
+        assert_eq!(s.continuous_dims(), 1);
+        let bad = dir.path().join("b.toml");
+        std::fs::write(&bad, "[[param]]\nname = \"v\"\ninterval = [0.5, \n").unwrap();
+        let e = load_space(bad.to_str().unwrap()).unwrap_err().to_string();
+        assert!(e.contains("line 3"), "{e}");
+        let both = dir.path().join("c.toml");
+        std::fs::write(&both, "[[param]]\nname = \"v\"\n").unwrap();
+        assert!(load_space(both.to_str().unwrap())
+            .unwrap_err()
+            .to_string()
+            .contains("exactly one of"));
+        assert!(matches!(load_space("nope"), Err(SpecError::NotFound(..))));
+    }
+}
