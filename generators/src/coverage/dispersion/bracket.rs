@@ -24,7 +24,7 @@ struct Region {
     c: Vec<f64>,
     e: Vec<f64>,
     points: Vec<u32>,
-    /// `Π (e_i - a_i)`: no box of the region is larger.
+    /// No box of the region that is empty is larger: see [`region_bound`].
     bound: f64,
 }
 
@@ -57,6 +57,37 @@ fn cmp_slices(x: &[f64], y: &[f64]) -> Ordering {
         .map(|(p, q)| p.total_cmp(q))
         .find(|o| o.is_ne())
         .unwrap_or(Ordering::Equal)
+}
+
+/// An upper bound on the volume of every empty box of region `r`.
+///
+/// Every box `B` of the region lies inside the union box `U = (a, e)` and contains the
+/// smallest box `I = (b, c)`. To contain no point `p` of `U`, `B` must leave `p` out along some
+/// axis `j`: either `p_j <= lo_j <= b_j`, and then `B` lies in `U` with `a_j` raised to `p_j`,
+/// or `p_j >= hi_j >= c_j`, and then `B` lies in `U` with `e_j` lowered to `p_j`. So
+/// `vol(B) <= max_j vol(U clipped at p_j)` for every such `p`, and the bound is the least of
+/// these over the points (and `vol(U)` itself). Proof by this case split; `O(|points| · d)`.
+fn region_bound(r: &Region, points: &[f64], d: usize) -> f64 {
+    let widths: Vec<f64> = (0..d).map(|k| (r.e[k] - r.a[k]).max(0.0)).collect();
+    let vol_u: f64 = widths.iter().product();
+    if vol_u <= 0.0 {
+        return 0.0;
+    }
+    let mut bound = vol_u;
+    for &i in &r.points {
+        let p = &points[i as usize * d..(i as usize + 1) * d];
+        let mut best_clip: f64 = 0.0;
+        for k in 0..d {
+            if p[k] <= r.b[k] {
+                best_clip = best_clip.max(vol_u * (r.e[k] - p[k]) / widths[k]);
+            }
+            if p[k] >= r.c[k] {
+                best_clip = best_clip.max(vol_u * (p[k] - r.a[k]) / widths[k]);
+            }
+        }
+        bound = bound.min(best_clip);
+    }
+    bound
 }
 
 /// Grows the empty box `b` to a maximal empty box, axis by axis in `axes` order: on each axis
@@ -98,6 +129,15 @@ pub(super) fn bracket(points: &[f64], d: usize, options: &DispersionOptions) -> 
             hi: c,
         };
         let cand = grow(points, d, start, &axes);
+        let v = cand.volume();
+        if better(&cand, v, &best, best_v) {
+            best = cand;
+            best_v = v;
+        }
+    }
+
+    // The exact sweep, each walk cut short, usually finds the largest box or close to it.
+    if let Some(cand) = super::sweep::capped_lower_bound(points, d, 32) {
         let v = cand.volume();
         if better(&cand, v, &best, best_v) {
             best = cand;
@@ -182,10 +222,6 @@ pub(super) fn bracket(points: &[f64], d: usize, options: &DispersionOptions) -> 
                     child.a[axis] = mid;
                 }
             }
-            child.bound = (0..d).map(|k| (child.e[k] - child.a[k]).max(0.0)).product();
-            if child.bound <= best_v {
-                continue;
-            }
             child.points = r
                 .points
                 .iter()
@@ -195,6 +231,10 @@ pub(super) fn bracket(points: &[f64], d: usize, options: &DispersionOptions) -> 
                     (0..d).all(|k| child.a[k] < p[k] && p[k] < child.e[k])
                 })
                 .collect();
+            child.bound = region_bound(&child, points, d);
+            if child.bound <= best_v {
+                continue;
+            }
             heap.push(child);
         }
     }

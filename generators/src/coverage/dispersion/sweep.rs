@@ -33,8 +33,8 @@ pub(super) fn largest_empty_box(points: &[f64], d: usize) -> EmptyBox {
     };
     let floor = AtomicU64::new(span.volume().to_bits());
     // Mirror by negation (exact in floating point); the mirrored axis ends at 0.
-    let right = lower_supported(points, d, n, 1.0, &floor);
-    let left = lower_supported(&mirrored, d, n, 0.0, &floor);
+    let right = lower_supported(points, d, n, 1.0, &floor, usize::MAX);
+    let left = lower_supported(&mirrored, d, n, 0.0, &floor, usize::MAX);
     let left = left.map(|mut b| {
         let (lo, hi) = (-b.hi[0], -b.lo[0]);
         b.lo[0] = lo;
@@ -68,7 +68,14 @@ fn lower_supported(
     n: usize,
     x_end: f64,
     floor: &AtomicU64,
+    max_steps: usize,
 ) -> Option<EmptyBox> {
+    // A capped walk also keeps only the largest boxes, so that high dimensions stay cheap.
+    let max_boxes = if max_steps == usize::MAX {
+        usize::MAX
+    } else {
+        16
+    };
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&a, &b| points[a * d].total_cmp(&points[b * d]).then(a.cmp(&b)));
     let pt = |i: usize| &points[i * d..(i + 1) * d];
@@ -107,7 +114,9 @@ fn lower_supported(
             while j < n && pt(order[j])[0] == px {
                 j += 1;
             }
-            while j < n && !boxes.is_empty() {
+            let mut steps = 0;
+            while j < n && !boxes.is_empty() && steps < max_steps {
+                steps += 1;
                 let gx = pt(order[j])[0];
                 for b in &boxes {
                     consider(gx, b, &mut best);
@@ -119,10 +128,17 @@ fn lower_supported(
                 }
                 let f = f64::from_bits(floor.load(Ordering::Relaxed));
                 boxes.retain(|b| (x_end - px) * b.volume() >= f);
+                if boxes.len() > max_boxes {
+                    boxes.sort_by(|a, b| b.volume().total_cmp(&a.volume()));
+                    boxes.truncate(max_boxes);
+                }
                 j = end;
             }
-            for b in &boxes {
-                consider(x_end, b, &mut best);
+            // Boxes reach the end of the axis only if the walk was not cut short.
+            if j >= n {
+                for b in &boxes {
+                    consider(x_end, b, &mut best);
+                }
             }
             best
         })
@@ -177,4 +193,13 @@ fn split(boxes: &mut Vec<EmptyBox>, s: &[f64], p: &[f64]) {
     let mut k = keep.iter();
     out.retain(|_| *k.next().unwrap_or(&false));
     *boxes = out;
+}
+
+/// A lower bound for the bracket: the sweep of [`largest_empty_box`] with each supporting
+/// point's walk cut after `max_steps` point groups. Every box it reports is empty; the walk
+/// just stops looking.
+pub(super) fn capped_lower_bound(points: &[f64], d: usize, max_steps: usize) -> Option<EmptyBox> {
+    let n = points.len() / d;
+    let floor = AtomicU64::new(0f64.to_bits());
+    lower_supported(points, d, n, 1.0, &floor, max_steps)
 }
