@@ -26,6 +26,18 @@ impl From<StrategyArg> for Strategy {
     }
 }
 
+/// The strategy named by `--strategy` and `--scramble`.
+///
+/// # Errors
+/// A message when `--scramble` is given with a strategy other than `halton`.
+pub fn strategy(arg: StrategyArg, scramble: bool) -> Result<Strategy, String> {
+    match (Strategy::from(arg), scramble) {
+        (Strategy::Halton, true) => Ok(Strategy::ScrambledHalton),
+        (s, true) => Err(format!("--scramble applies to --strategy halton only, not {s}")),
+        (s, false) => Ok(s),
+    }
+}
+
 /// Parses the command line of `tool`. On `--help`/`--version` prints and returns
 /// `Err(ExitCode::SUCCESS)`; on bad usage prints `tool: <one-line reason> (see --help)` to
 /// stderr and returns `Err(2)`.
@@ -81,6 +93,13 @@ pub fn one_line(e: &clap::Error) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scramble_only_goes_with_halton() {
+        assert_eq!(strategy(StrategyArg::Halton, true), Ok(Strategy::ScrambledHalton));
+        assert_eq!(strategy(StrategyArg::Sobol, false), Ok(Strategy::Sobol));
+        assert!(strategy(StrategyArg::Random, true).is_err());
+    }
 
     #[test]
     fn positive_rejects_zero_and_garbage() {

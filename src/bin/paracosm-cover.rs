@@ -170,11 +170,7 @@ fn run(cli: Cli) -> Result<()> {
             output,
         } => {
             let space = load_space(&space).map_err(bad)?;
-            let strategy = match (Strategy::from(strategy), scramble) {
-                (Strategy::Halton, true) => Strategy::ScrambledHalton,
-                (_, true) => return Err(bad("--scramble applies to --strategy halton only")),
-                (s, false) => s,
-            };
+            let strategy = paracosm::cli::strategy(strategy, scramble).map_err(bad)?;
             if let Some(cap) = strategy.capacity().filter(|&c| budget > c) {
                 return Err(bad(format!(
                     "--budget {budget} is more than the {cap} points {strategy} can produce"

@@ -16,7 +16,6 @@ use tracing::info;
 use paracosm::campaign::{Campaign, CampaignError, RESULTS_FILE};
 use paracosm::record::Status;
 use paracosm::summary::Summary;
-use paracosm_generators::Strategy;
 
 /// Run a test campaign on a scenario: sample its open parameters, simulate each test, and
 /// write results.jsonl, summary.json and a failure map.
@@ -28,6 +27,10 @@ struct Cli {
     /// How test points are chosen.
     #[arg(long, value_enum, default_value = "halton")]
     strategy: StrategyArg,
+    /// With --strategy halton: randomise it by digit permutations (Owen 2017); --seed draws
+    /// the permutations.
+    #[arg(long)]
+    scramble: bool,
     /// Number of tests to run (at least 1).
     #[arg(long, default_value_t = 100, value_parser = paracosm::cli::positive)]
     budget: u64,
@@ -74,7 +77,7 @@ fn main() -> ExitCode {
 fn run(cli: &Cli) -> Result<ExitCode> {
     let scenario =
         paracosm_scenarios::builtin(&cli.scenario).map_err(|e| BadInput(e.to_string()))?;
-    let strategy = Strategy::from(cli.strategy);
+    let strategy = paracosm::cli::strategy(cli.strategy, cli.scramble).map_err(BadInput)?;
     if let Some(cap) = strategy.capacity().filter(|&cap| cli.budget > cap) {
         return Err(BadInput(format!(
             "--budget {} is more than the {} points {strategy} can produce",

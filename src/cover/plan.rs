@@ -128,10 +128,15 @@ pub fn plan(space: &ParamSpace, strength: usize, epsilon: f64, delta: f64) -> Pl
 
 impl fmt::Display for Plan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let k = if self.random_kwise_exact_union.is_some() {
+            self.strength.to_string()
+        } else {
+            "k".to_owned()
+        };
         writeln!(
             f,
-            "plan for a ({}, {})-covering set with failure probability δ = {}",
-            self.strength, self.epsilon, self.delta
+            "plan for a ({k}, {})-covering set with failure probability δ = {}",
+            self.epsilon, self.delta
         )?;
         match self.random_kwise_exact_union {
             None => writeln!(f, "discrete part: none")?,

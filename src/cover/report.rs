@@ -170,7 +170,7 @@ impl fmt::Display for Estimate {
             }
             writeln!(
                 f,
-                "    witness box: lo {:?}, hi {:?}",
+                "    witness box (unit cube): lo {:?}, hi {:?}",
                 d.witness.lo, d.witness.hi
             )?;
             writeln!(f, "    method: {}", d.method)?;
@@ -200,7 +200,15 @@ impl fmt::Display for Estimate {
                 Some(false) => "no",
                 None => "undecided (the dispersion bracket straddles ε)",
             };
-            writeln!(f, "({}, {})-covering: {verdict}", k.k, k.epsilon)?;
+            if k.kwise.is_some() {
+                writeln!(f, "({}, {})-covering: {verdict}", k.k, k.epsilon)?;
+            } else {
+                writeln!(
+                    f,
+                    "(k, {})-covering: {verdict} (no discrete parameters: only the dispersion condition applies)",
+                    k.epsilon
+                )?;
+            }
             if let Some((group, d)) = &k.worst_group {
                 writeln!(
                     f,
