@@ -33,7 +33,9 @@ impl From<StrategyArg> for Strategy {
 pub fn strategy(arg: StrategyArg, scramble: bool) -> Result<Strategy, String> {
     match (Strategy::from(arg), scramble) {
         (Strategy::Halton, true) => Ok(Strategy::ScrambledHalton),
-        (s, true) => Err(format!("--scramble applies to --strategy halton only, not {s}")),
+        (s, true) => Err(format!(
+            "--scramble applies to --strategy halton only, not {s}"
+        )),
         (s, false) => Ok(s),
     }
 }
@@ -96,7 +98,10 @@ mod tests {
 
     #[test]
     fn scramble_only_goes_with_halton() {
-        assert_eq!(strategy(StrategyArg::Halton, true), Ok(Strategy::ScrambledHalton));
+        assert_eq!(
+            strategy(StrategyArg::Halton, true),
+            Ok(Strategy::ScrambledHalton)
+        );
         assert_eq!(strategy(StrategyArg::Sobol, false), Ok(Strategy::Sobol));
         assert!(strategy(StrategyArg::Random, true).is_err());
     }

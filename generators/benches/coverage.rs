@@ -5,8 +5,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use paracosm_generators::coverage::{
-    discrepancy, dispersion, kwise_coverage_rows, star_discrepancy, Discrepancy,
-    DispersionOptions, StarOptions,
+    discrepancy, dispersion, kwise_coverage_rows, star_discrepancy, Discrepancy, DispersionOptions,
+    StarOptions,
 };
 use paracosm_generators::{Halton, Param, ParamSpace, Strategy};
 

@@ -47,6 +47,9 @@ enum Command {
             value_delimiter = ','
         )]
         metrics: Vec<String>,
+        /// Uncovered tuples to list per strength.
+        #[arg(long, default_value_t = 10)]
+        missing: usize,
         /// Also decide (k, ε)-covering with k = --strength and this dispersion bound.
         #[arg(long)]
         epsilon: Option<f64>,
@@ -141,6 +144,7 @@ fn run(cli: Cli) -> Result<()> {
             space,
             strength,
             metrics,
+            missing,
             epsilon,
             json,
         } => {
@@ -151,7 +155,7 @@ fn run(cli: Cli) -> Result<()> {
                 .map_err(bad)?;
             let space = space.map(|s| load_space(&s)).transpose().map_err(bad)?;
             let set = read_tests(&file, space.as_ref()).map_err(bad)?;
-            let report = estimate(&set, &metrics, strength, epsilon).map_err(bad)?;
+            let report = estimate(&set, &metrics, strength, epsilon, missing).map_err(bad)?;
             let mut out = std::io::stdout().lock();
             if json {
                 serde_json::to_writer_pretty(&mut out, &report)?;

@@ -153,7 +153,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
                 .iter()
                 .filter_map(|m| m.parse().ok())
                 .collect();
-        paracosm::cover::estimate(&set, &metrics, None, None).ok()
+        paracosm::cover::estimate(&set, &metrics, None, None, 10).ok()
     };
     let summary = Summary {
         tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),

@@ -66,8 +66,8 @@ pub struct Estimate {
 }
 
 /// Computes the requested metrics over the continuous coordinates of `set`, k-wise coverage
-/// for strengths `1..=strength` over its discrete ones, and the (k, ε) verdict with
-/// `k = strength` when `epsilon` is given.
+/// for strengths `1..=strength` over its discrete ones (listing up to `max_missing` uncovered
+/// tuples per strength), and the (k, ε) verdict with `k = strength` when `epsilon` is given.
 ///
 /// # Errors
 /// [`CoverageError`] for a strength larger than the number of discrete parameters (or above
@@ -77,6 +77,7 @@ pub fn estimate(
     metrics: &[Metric],
     strength: Option<usize>,
     epsilon: Option<f64>,
+    max_missing: usize,
 ) -> Result<Estimate, CoverageError> {
     let nd = set.space.level_counts().len();
     let nc = set.space.continuous_dims();
@@ -94,7 +95,7 @@ pub fn estimate(
         None => nd.min(2),
     };
     let kwise = (1..=strength)
-        .map(|t| kwise_coverage(&set.space, &set.points, t, 10))
+        .map(|t| kwise_coverage(&set.space, &set.points, t, max_missing))
         .collect::<Result<Vec<_>, _>>()?;
     let coords: Vec<f64> = set
         .points
@@ -212,7 +213,7 @@ impl fmt::Display for Estimate {
             if let Some((group, d)) = &k.worst_group {
                 writeln!(
                     f,
-                    "    largest dispersion in one discrete group {group:?}: [{:.6e}, {:.6e}] over {} groups",
+                    "    largest dispersion in one discrete group (level indices {group:?}): [{:.6e}, {:.6e}] over {} groups",
                     d.lower, d.upper, k.groups
                 )?;
             }
