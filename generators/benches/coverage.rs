@@ -8,15 +8,10 @@ use paracosm_generators::coverage::{
     discrepancy, dispersion, kwise_coverage_rows, star_discrepancy, Discrepancy, DispersionOptions,
     StarOptions,
 };
-use paracosm_generators::{Halton, Param, ParamSpace, Strategy};
+use paracosm_generators::{Halton, ParamSpace, Strategy};
 
 fn unit(d: usize) -> ParamSpace {
-    ParamSpace::new(
-        (0..d)
-            .map(|i| Param::interval(&format!("x{i}"), 0.0, 1.0, "1"))
-            .collect(),
-    )
-    .unwrap()
+    ParamSpace::unit_cube(d)
 }
 
 fn points(s: Strategy, n: usize, d: usize) -> Vec<f64> {

@@ -1,15 +1,10 @@
 //! Throughput of the generators: 10,000 points in 8 continuous dimensions.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use paracosm_generators::{Param, ParamSpace, Strategy};
+use paracosm_generators::{ParamSpace, Strategy};
 
 fn bench(c: &mut Criterion) {
-    let space = ParamSpace::new(
-        (0..8)
-            .map(|i| Param::interval(&format!("x{i}"), 0.0, 1.0, "1"))
-            .collect(),
-    )
-    .unwrap();
+    let space = ParamSpace::unit_cube(8);
     let mut group = c.benchmark_group("ask_10000x8");
     for s in Strategy::ALL {
         group.bench_function(s.name(), |b| {

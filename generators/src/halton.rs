@@ -314,12 +314,7 @@ mod tests {
     }
 
     fn unit_space(d: usize) -> ParamSpace {
-        ParamSpace::new(
-            (0..d)
-                .map(|i| Param::interval(&format!("x{i}"), 0.0, 1.0, "1"))
-                .collect(),
-        )
-        .unwrap()
+        ParamSpace::unit_cube(d)
     }
 
     /// Value stability of the scrambled sequence: seed 7, first three points in 2 dimensions.

@@ -84,15 +84,9 @@ impl Generator for Sobol {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Param;
 
     fn space(d: usize) -> ParamSpace {
-        ParamSpace::new(
-            (0..d)
-                .map(|i| Param::interval(&format!("x{i}"), 0.0, 1.0, "1"))
-                .collect(),
-        )
-        .unwrap()
+        ParamSpace::unit_cube(d)
     }
 
     /// Value stability: pins the first rows for seed 0 in two dimensions.

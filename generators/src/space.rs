@@ -128,6 +128,16 @@ impl ParamSpace {
         Ok(ParamSpace { params })
     }
 
+    /// The unit cube `[0, 1)^d` as a space: continuous parameters `x0 .. x{d-1}`, unit `1`.
+    /// Handy for using the generators and estimators on bare point sets.
+    pub fn unit_cube(d: usize) -> Self {
+        ParamSpace {
+            params: (0..d)
+                .map(|i| Param::interval(&format!("x{i}"), 0.0, 1.0, "1"))
+                .collect(),
+        }
+    }
+
     /// All parameters in declaration order.
     pub fn params(&self) -> &[Param] {
         &self.params
@@ -312,6 +322,13 @@ mod tests {
             continuous: vec![0.1, 0.1],
         };
         assert!(s.decode(&short).is_err());
+    }
+
+    #[test]
+    fn unit_cube_is_a_valid_continuous_space() {
+        let c = ParamSpace::unit_cube(3);
+        assert_eq!(c.continuous_dims(), 3);
+        assert_eq!(ParamSpace::new(c.params().to_vec()), Ok(c));
     }
 
     #[test]

@@ -14,7 +14,7 @@ use clap::{Parser, Subcommand};
 use paracosm::cli::{BadInput, StrategyArg};
 use paracosm::cover::{estimate, load_space, plan, read_tests, Metric};
 use paracosm_generators::coverage::{discrepancy, Discrepancy};
-use paracosm_generators::{Halton, Param, ParamSpace, Strategy};
+use paracosm_generators::{Halton, ParamSpace, Strategy};
 
 /// Coverage of test sets, test designs and test budgets over a parameter space.
 #[derive(Debug, Parser)]
@@ -260,15 +260,7 @@ fn best_ms(mut f: impl FnMut()) -> f64 {
 }
 
 fn bench() -> serde_json::Value {
-    let space = |d: usize| {
-        ParamSpace::new(
-            (0..d)
-                .map(|i| Param::interval(&format!("x{i}"), 0.0, 1.0, "1"))
-                .collect(),
-        )
-        .expect("valid space")
-    };
-    let s8 = space(8);
+    let s8 = ParamSpace::unit_cube(8);
     let halton = best_ms(|| {
         let h = Halton::scrambled(&s8, 0);
         std::hint::black_box(h.unit_points(0, 65_536));

@@ -4,7 +4,7 @@ use std::fmt;
 
 use serde::Serialize;
 
-use paracosm_generators::coverage::{dispersion, DispersionOptions};
+use paracosm_generators::coverage::{dispersion, subset_products, DispersionOptions};
 use paracosm_generators::{Halton, ParamSpace};
 
 /// A test budget plan for a space.
@@ -48,33 +48,7 @@ pub fn plan(space: &ParamSpace, strength: usize, epsilon: f64, delta: f64) -> Pl
             let m = 2f64.powi(k as i32) * (k as f64 * (nd as f64).ln() - delta.ln());
             prop32 = Some(m.ceil().max(1.0) as u64);
         }
-        // Products over all k-subsets.
-        let mut products = Vec::new();
-        let mut subset: Vec<usize> = (0..k).collect();
-        loop {
-            products.push(
-                subset
-                    .iter()
-                    .map(|&c| f64::from(levels[c]))
-                    .product::<f64>(),
-            );
-            let mut i = k;
-            let mut moved = false;
-            while i > 0 {
-                i -= 1;
-                if subset[i] < nd - (k - i) {
-                    subset[i] += 1;
-                    for j in i + 1..k {
-                        subset[j] = subset[j - 1] + 1;
-                    }
-                    moved = true;
-                    break;
-                }
-            }
-            if !moved {
-                break;
-            }
-        }
+        let products = subset_products(&levels, k);
         let tuples: f64 = products.iter().sum();
         let vmax = products.iter().copied().fold(1.0, f64::max);
         union = Some(if vmax <= 1.0 {

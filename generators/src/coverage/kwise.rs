@@ -31,6 +31,23 @@ pub struct KWiseCoverage {
     pub missing: Vec<MissingTuple>,
 }
 
+/// `Π_{i∈S} v_i` for every t-subset `S` of the parameters, in lexicographic order of subsets:
+/// the number of t-tuples each subset contributes. Empty unless `1 <= t <= levels.len()`.
+pub fn subset_products(levels: &[u32], t: usize) -> Vec<f64> {
+    let k = levels.len();
+    if t == 0 || t > k {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    let mut subset: Vec<usize> = (0..t).collect();
+    loop {
+        out.push(subset.iter().map(|&c| f64::from(levels[c])).product());
+        if !next_subset(&mut subset, k, 0) {
+            return out;
+        }
+    }
+}
+
 /// Counts of [`kwise_coverage_rows`]: missing tuples as `(column, level)` pairs.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct RawKWise {
@@ -157,7 +174,7 @@ pub fn kwise_coverage_rows(
             loop {
                 cover_subset(levels, &columns, &subset, max_missing, &mut bits, &mut acc)
                     .ok_or(CoverageError::TooManyTuples { t })?;
-                if !next_subset(&mut subset, k) {
+                if !next_subset(&mut subset, k, 1) {
                     break;
                 }
             }
@@ -183,12 +200,12 @@ pub fn kwise_coverage_rows(
     Ok(out)
 }
 
-/// Advances `subset` (increasing indices below `k`) to the next subset with the same first
-/// element, in lexicographic order. Returns false when there is none.
-fn next_subset(subset: &mut [usize], k: usize) -> bool {
+/// Advances `subset` (increasing indices below `k`) to the next subset in lexicographic order
+/// that keeps its first `fixed` elements. Returns false when there is none.
+fn next_subset(subset: &mut [usize], k: usize, fixed: usize) -> bool {
     let t = subset.len();
     let mut i = t;
-    while i > 1 {
+    while i > fixed {
         i -= 1;
         if subset[i] < k - (t - i) {
             subset[i] += 1;
@@ -347,6 +364,13 @@ mod tests {
         );
         let one = kwise_coverage(&space, &pts, 1, 5).unwrap();
         assert_eq!((one.covered, one.total), (4, 4));
+    }
+
+    #[test]
+    fn subset_products_list_every_subset() {
+        assert_eq!(subset_products(&[2, 3, 4], 2), [6.0, 8.0, 12.0]);
+        assert_eq!(subset_products(&[2, 3, 4], 3), [24.0]);
+        assert!(subset_products(&[2, 3], 3).is_empty());
     }
 
     #[test]

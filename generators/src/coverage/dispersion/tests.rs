@@ -131,12 +131,8 @@ fn a_centre_point_leaves_half_the_square() {
 
 #[test]
 fn halton_dispersion_shrinks_like_one_over_n() {
-    use crate::{Generator, Halton, Param, ParamSpace};
-    let space = ParamSpace::new(vec![
-        Param::interval("x", 0.0, 1.0, "1"),
-        Param::interval("y", 0.0, 1.0, "1"),
-    ])
-    .unwrap();
+    use crate::{Generator, Halton, ParamSpace};
+    let space = ParamSpace::unit_cube(2);
     let pts: Vec<f64> = Halton::new(&space)
         .ask(4096)
         .unwrap()
