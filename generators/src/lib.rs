@@ -13,6 +13,7 @@
 #![warn(missing_docs)]
 
 pub mod coverage;
+pub mod covering;
 mod error;
 mod generator;
 mod halton;

@@ -1,0 +1,196 @@
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+use super::{check, CoveringArray, CoveringError};
+use crate::coverage::subset_products;
+
+/// The size of a random t-wise covering family, by the formula that applies.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RandomKWiseSize {
+    /// Rows.
+    pub rows: u64,
+    /// Which formula gave them.
+    pub formula: &'static str,
+}
+
+/// Rows of a random t-wise covering family that covers every t-tuple with probability at least
+/// `1 − δ`.
+///
+/// - Binary parameters: PARACOSM Proposition 3.2, `m = ceil(2^t (t ln k − ln δ))`.
+/// - Mixed levels: the union bound over all t-tuples, `m = ceil(ln(T / δ) / −ln(1 − 1/V))`
+///   with `T = Σ_S Π_{i∈S} v_i` the number of t-tuples and `V` the largest product.
+///
+/// # Errors
+/// As [`random_kwise`].
+pub fn random_kwise_rows(
+    levels: &[u32],
+    t: usize,
+    delta: f64,
+) -> Result<RandomKWiseSize, CoveringError> {
+    check(levels, t)?;
+    let k = levels.len() as f64;
+    if levels.iter().all(|&v| v == 2) {
+        let m = 2f64.powi(t as i32) * (t as f64 * k.ln() - delta.ln());
+        return Ok(RandomKWiseSize {
+            rows: m.ceil().max(1.0) as u64,
+            formula: "2^t (t ln k - ln δ) (Proposition 3.2)",
+        });
+    }
+    let products = subset_products(levels, t);
+    let tuples: f64 = products.iter().sum();
+    let vmax = products.iter().copied().fold(1.0, f64::max);
+    let rows = if vmax <= 1.0 {
+        1
+    } else {
+        ((tuples / delta).ln() / -(1.0 - 1.0 / vmax).ln())
+            .ceil()
+            .max(1.0) as u64
+    };
+    Ok(RandomKWiseSize {
+        rows,
+        formula: "ln(T / δ) / -ln(1 - 1/V) (union bound)",
+    })
+}
+
+fn draw(levels: &[u32], rng: &mut ChaCha8Rng, out: &mut Vec<u32>) {
+    for &v in levels {
+        out.push(rng.random_range(0..v));
+    }
+}
+
+/// A random t-wise covering family of [`random_kwise_rows`] rows: each cell uniform over its
+/// levels, drawn row by row from `ChaCha8Rng::seed_from_u64(seed)`. Covers every t-tuple with
+/// probability at least `1 − δ`; check with [`crate::coverage::kwise_coverage_rows`].
+///
+/// # Errors
+/// [`CoveringError::Strength`] unless `1 <= t <= min(6, k)`; [`CoveringError::NoLevels`].
+pub fn random_kwise(
+    levels: &[u32],
+    t: usize,
+    delta: f64,
+    seed: u64,
+) -> Result<CoveringArray, CoveringError> {
+    let m = random_kwise_rows(levels, t, delta)?.rows as usize;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut rows = Vec::with_capacity(m * levels.len());
+    for _ in 0..m {
+        draw(levels, &mut rng, &mut rows);
+    }
+    Ok(CoveringArray {
+        levels: levels.to_vec(),
+        strength: t,
+        rows,
+    })
+}
+
+/// Random rows, drawn as in [`random_kwise`], until every t-tuple is covered (checked with
+/// one bitset per t-subset, updated row by row).
+///
+/// # Errors
+/// As [`random_kwise`]; [`CoveringError::NotCovered`] after `max_rows` rows.
+pub fn random_until_covered(
+    levels: &[u32],
+    t: usize,
+    seed: u64,
+    max_rows: usize,
+) -> Result<CoveringArray, CoveringError> {
+    check(levels, t)?;
+    let k = levels.len();
+    let mut subsets: Vec<(Vec<usize>, Vec<u64>, Vec<bool>)> = Vec::new();
+    let mut cur: Vec<usize> = (0..t).collect();
+    loop {
+        let mut strides = vec![0u64; t];
+        let mut size = 1u64;
+        for (s, &c) in strides.iter_mut().zip(&cur).rev() {
+            *s = size;
+            size *= u64::from(levels[c]);
+        }
+        subsets.push((cur.clone(), strides, vec![false; size as usize]));
+        let mut i = t;
+        let mut moved = false;
+        while i > 0 {
+            i -= 1;
+            if cur[i] < k - (t - i) {
+                cur[i] += 1;
+                for j in i + 1..t {
+                    cur[j] = cur[j - 1] + 1;
+                }
+                moved = true;
+                break;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    let mut missing: usize = subsets.iter().map(|s| s.2.len()).sum();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut rows = Vec::new();
+    let mut n = 0;
+    while missing > 0 {
+        if n == max_rows {
+            return Err(CoveringError::NotCovered { rows: n, t });
+        }
+        let start = rows.len();
+        draw(levels, &mut rng, &mut rows);
+        let row = &rows[start..];
+        for (cols, strides, seen) in &mut subsets {
+            let idx: u64 = cols
+                .iter()
+                .zip(strides.iter())
+                .map(|(&c, &s)| u64::from(row[c]) * s)
+                .sum();
+            if !seen[idx as usize] {
+                seen[idx as usize] = true;
+                missing -= 1;
+            }
+        }
+        n += 1;
+    }
+    Ok(CoveringArray {
+        levels: levels.to_vec(),
+        strength: t,
+        rows,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coverage::kwise_coverage_rows;
+
+    #[test]
+    fn sizes_follow_the_stated_formulas() {
+        // 2^2 (2 ln 10 - ln 0.01) = 4 (4.605 + 4.605) = 36.8 -> 37
+        let s = random_kwise_rows(&[2; 10], 2, 0.01).unwrap();
+        assert_eq!(s.rows, 37);
+        assert!(s.formula.contains("Proposition 3.2"));
+        // 3 binary + 1 ternary, t = 2: T = 3·4 + 3·6 = 30, V = 6: ln(3000) / -ln(5/6) = 43.9
+        let m = random_kwise_rows(&[2, 2, 2, 3], 2, 0.01).unwrap();
+        assert_eq!(m.rows, 44);
+        assert!(m.formula.contains("union bound"));
+    }
+
+    #[test]
+    fn until_covered_stops_as_soon_as_everything_is_covered() {
+        let a = random_until_covered(&[3, 2, 4, 2, 3], 2, 7, 10_000).unwrap();
+        let all = kwise_coverage_rows(&a.levels, &a.rows, 2, 0).unwrap();
+        assert_eq!(all.covered, all.total);
+        let one_less = &a.rows[..a.rows.len() - a.levels.len()];
+        let before = kwise_coverage_rows(&a.levels, one_less, 2, 0).unwrap();
+        assert!(before.covered < before.total);
+        assert!(matches!(
+            random_until_covered(&[5; 6], 3, 1, 10),
+            Err(CoveringError::NotCovered { rows: 10, t: 3 })
+        ));
+    }
+
+    #[test]
+    fn value_stability_first_rows() {
+        let a = random_kwise(&[2, 3, 4], 2, 0.1, 42).unwrap();
+        assert_eq!(&a.rows[..9], &PINNED);
+    }
+
+    const PINNED: [u32; 9] = [0, 2, 0, 1, 2, 1, 0, 1, 2];
+}
