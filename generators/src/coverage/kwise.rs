@@ -31,6 +31,21 @@ pub struct KWiseCoverage {
     pub missing: Vec<MissingTuple>,
 }
 
+/// Every `t`-subset of `0..k`, in lexicographic order (empty unless `1 <= t <= k`).
+pub fn subsets(k: usize, t: usize) -> Vec<Vec<usize>> {
+    if t == 0 || t > k {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    let mut subset: Vec<usize> = (0..t).collect();
+    loop {
+        out.push(subset.clone());
+        if !next_subset(&mut subset, k, 0) {
+            return out;
+        }
+    }
+}
+
 /// `Π_{i∈S} v_i` for every t-subset `S` of the parameters, in lexicographic order of subsets:
 /// the number of t-tuples each subset contributes. Empty unless `1 <= t <= levels.len()`.
 pub fn subset_products(levels: &[u32], t: usize) -> Vec<f64> {

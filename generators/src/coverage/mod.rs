@@ -17,8 +17,8 @@ pub use discrepancy::{discrepancy, Discrepancy};
 pub use dispersion::{dispersion, Dispersion, DispersionOptions, EmptyBox};
 pub use error::CoverageError;
 pub use kwise::{
-    kwise_coverage, kwise_coverage_rows, subset_products, KWiseCoverage, MissingTuple, RawKWise,
-    MAX_STRENGTH,
+    kwise_coverage, kwise_coverage_rows, subset_products, subsets, KWiseCoverage, MissingTuple,
+    RawKWise, MAX_STRENGTH,
 };
 pub use star::{star_discrepancy, StarDiscrepancy, StarOptions};
 

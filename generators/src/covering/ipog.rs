@@ -3,10 +3,9 @@ use std::collections::BinaryHeap;
 
 use rayon::prelude::*;
 
-use super::{check, CoveringArray, CoveringError};
-
-/// A cell left open ("don't care") during construction.
-const OPEN: u32 = u32::MAX;
+use super::constraints::OPEN;
+use super::{check, Constraints, CoveringArray, CoveringError};
+use crate::coverage::subsets;
 
 /// A t-way covering array by IPOG (Lei, Kacker, Kuhn, Okun, Lawrence, "IPOG: A General Strategy
 /// for T-Way Software Testing", ECBS 2007), with IPOG-F's horizontal growth (Forbes, Lawrence,
@@ -36,7 +35,30 @@ const OPEN: u32 = u32::MAX;
 /// [`CoveringError::Strength`] unless `1 <= t <= min(6, k)`; [`CoveringError::NoLevels`] for a
 /// column without levels.
 pub fn ipog(levels: &[u32], t: usize) -> Result<CoveringArray, CoveringError> {
+    ipog_with(levels, t, &Constraints::default(), &[])
+}
+
+/// [`ipog`] with forbidden combinations and seed rows.
+///
+/// - No row contains a forbidden combination, and only t-tuples that extend to an allowed
+///   full row are covered (the others cannot be). Every candidate cell is checked by
+///   completing the row ([`Constraints::complete`]), so rows stay completable and the final
+///   fill of open cells obeys the constraints.
+/// - Seed rows (PICT's `/e`) come first in the array, as given; `None` cells are filled by
+///   the construction. They are never dropped.
+///
+/// # Errors
+/// As [`ipog`]; [`CoveringError::Seed`] for a seed of the wrong length, a level out of range
+/// or a seed breaking a constraint; [`CoveringError::Constraint`] for a constraint naming a
+/// column or level that does not exist.
+pub fn ipog_with(
+    levels: &[u32],
+    t: usize,
+    constraints: &Constraints,
+    seeds: &[Vec<Option<u32>>],
+) -> Result<CoveringArray, CoveringError> {
     check(levels, t)?;
+    let seeds = super::check_seeds(levels, constraints, seeds)?;
     // Columns in decreasing level count (stable), as IPOG's authors order parameters: the
     // first t columns' full product is the floor on the size, so it should be the largest.
     let mut order: Vec<usize> = (0..levels.len()).collect();
@@ -45,9 +67,21 @@ pub fn ipog(levels: &[u32], t: usize) -> Result<CoveringArray, CoveringError> {
     // Several runs that break ties differently (run 0 is the plain deterministic order); the
     // smallest array wins, the lowest run on equal sizes.
     let runs = if t >= 4 { 8 } else { 1 };
+    let mut position = vec![0usize; levels.len()];
+    for (j, &c) in order.iter().enumerate() {
+        position[c] = j;
+    }
+    let cons = constraints.renamed(&position);
+    let sorted_seeds: Vec<Vec<u32>> = seeds
+        .iter()
+        .map(|s| order.iter().map(|&c| s[c]).collect())
+        .collect();
     let built = (0..runs as u64)
         .into_par_iter()
-        .map(|run| remove_redundant(&sorted, t, ipog_in_order(&sorted, t, run)))
+        .map(|run| {
+            let rows = ipog_in_order(&sorted, t, run, &cons, &sorted_seeds);
+            remove_redundant(&sorted, t, rows, sorted_seeds.len())
+        })
         .min_by(|a, b| a.len().cmp(&b.len()))
         .expect("at least one run");
     let k = levels.len();
@@ -65,26 +99,54 @@ pub fn ipog(levels: &[u32], t: usize) -> Result<CoveringArray, CoveringError> {
 }
 
 /// IPOG on columns in the given order; returns the `n × k` rows.
-fn ipog_in_order(levels: &[u32], t: usize, run: u64) -> Vec<u32> {
+fn ipog_in_order(
+    levels: &[u32],
+    t: usize,
+    run: u64,
+    cons: &Constraints,
+    seeds: &[Vec<u32>],
+) -> Vec<u32> {
     let k = levels.len();
     let first: usize = levels[..t].iter().map(|&v| v as usize).product();
-    let mut rows: Vec<Vec<u32>> = (0..first)
-        .map(|mut idx| {
-            let mut row = vec![0u32; t];
-            for j in (0..t).rev() {
-                row[j] = (idx % levels[j] as usize) as u32;
-                idx /= levels[j] as usize;
-            }
-            row.reserve(k - t);
-            row
-        })
-        .collect();
+    let mut rows: Vec<Vec<u32>> = seeds.iter().map(|s| s[..t].to_vec()).collect();
+    for mut idx in 0..first {
+        let mut row = vec![0u32; t];
+        for j in (0..t).rev() {
+            row[j] = (idx % levels[j] as usize) as u32;
+            idx /= levels[j] as usize;
+        }
+        let seeded = rows[..seeds.len()].iter().any(|s| *s == row);
+        let cells: Vec<(usize, u32)> = row.iter().copied().enumerate().collect();
+        if !seeded && cons.completable(levels, &cells) {
+            rows.push(row);
+        }
+    }
     for i in t..k {
-        extend(&mut rows, levels, t, i, run);
+        extend(&mut rows, levels, t, i, run, cons, seeds);
     }
     rows.into_iter()
-        .flat_map(|r| r.into_iter().map(|c| if c == OPEN { 0 } else { c }))
+        .flat_map(|r| {
+            let full = if r.contains(&OPEN) {
+                cons.complete(levels, &r).unwrap_or_else(|| {
+                    // Rows are kept completable, so this does not happen; fall back to 0s.
+                    r.iter().map(|&c| if c == OPEN { 0 } else { c }).collect()
+                })
+            } else {
+                r
+            };
+            full.into_iter()
+        })
         .collect()
+}
+
+/// Whether `row` (a prefix of the columns, open cells allowed) extends to an allowed full row.
+fn allowed(levels: &[u32], cons: &Constraints, row: &[u32]) -> bool {
+    if cons.is_empty() {
+        return true;
+    }
+    let mut full = row.to_vec();
+    full.resize(levels.len(), OPEN);
+    cons.complete(levels, &full).is_some()
 }
 
 /// The uncovered combinations of one `(t−1)`-subset `cols` of earlier parameters with the new
@@ -114,13 +176,33 @@ impl Block {
         self.uncovered[(bit / 64) as usize] & (1 << (bit % 64)) != 0
     }
 
+    /// The tuple of bit `bit`: `(column, level)` for the subset's columns, then column `i`.
+    fn cells(&self, bit: u64, vi: u64, i: usize) -> Vec<(usize, u32)> {
+        let (mut base, level) = (bit / vi, (bit % vi) as u32);
+        let mut want = Vec::with_capacity(self.cols.len() + 1);
+        for (&c, &s) in self.cols.iter().zip(&self.strides) {
+            want.push((c, (base / s) as u32));
+            base %= s;
+        }
+        want.push((i, level));
+        want
+    }
+
     fn cover(&mut self, bit: u64) {
         self.uncovered[(bit / 64) as usize] &= !(1 << (bit % 64));
     }
 }
 
 /// Adds column `i` to `rows` (each of length `i`): horizontal then vertical growth.
-fn extend(rows: &mut Vec<Vec<u32>>, levels: &[u32], t: usize, i: usize, run: u64) {
+fn extend(
+    rows: &mut Vec<Vec<u32>>,
+    levels: &[u32],
+    t: usize,
+    i: usize,
+    run: u64,
+    cons: &Constraints,
+    seeds: &[Vec<u32>],
+) {
     // Tie-break key: 0 for run 0 (lowest row and level win), a SplitMix64 hash otherwise.
     let key = |r: usize, v: u64| -> u64 {
         if run == 0 {
@@ -135,7 +217,13 @@ fn extend(rows: &mut Vec<Vec<u32>>, levels: &[u32], t: usize, i: usize, run: u64
         z ^ (z >> 31)
     };
     let vi = u64::from(levels[i]);
-    let mut blocks: Vec<Block> = subsets(i, t - 1)
+    // The (t−1)-subsets of the earlier columns (one empty subset when t = 1).
+    let earlier = if t == 1 {
+        vec![Vec::new()]
+    } else {
+        subsets(i, t - 1)
+    };
+    let mut blocks: Vec<Block> = earlier
         .into_iter()
         .map(|cols| {
             let mut strides = vec![0u64; cols.len()];
@@ -156,17 +244,44 @@ fn extend(rows: &mut Vec<Vec<u32>>, levels: &[u32], t: usize, i: usize, run: u64
             }
         })
         .collect();
-    for row in rows.iter_mut() {
-        row.push(OPEN);
+    for (r, row) in rows.iter_mut().enumerate() {
+        row.push(seeds.get(r).map_or(OPEN, |s| s[i]));
+    }
+    // Tuples no allowed row can hold are not to be covered; seeds' tuples are covered already.
+    for b in &mut blocks {
+        if !cons.is_empty() {
+            for bit in 0..(b.uncovered.len() as u64 * 64) {
+                if b.is_uncovered(bit) && !cons.completable(levels, &b.cells(bit, vi, i)) {
+                    b.cover(bit);
+                }
+            }
+        }
+        for row in &rows[..seeds.len()] {
+            if let (Some(base), true) = (b.base(row), row[i] != OPEN) {
+                b.cover(base * vi + u64::from(row[i]));
+            }
+        }
     }
 
     // Horizontal growth, IPOG-F: the globally best (row, level) first, by lazy greedy.
     let best = |r: usize, row: &[u32], blocks: &[Block]| -> (u64, u32) {
+        if row[i] != OPEN {
+            return (0, 0); // a seed's cell
+        }
         let mut gains = vec![0u64; vi as usize];
         for b in blocks {
             if let Some(base) = b.base(row) {
                 for (v, g) in gains.iter_mut().enumerate() {
                     *g += u64::from(b.is_uncovered(base * vi + v as u64));
+                }
+            }
+        }
+        if !cons.is_empty() {
+            let mut probe = row.to_vec();
+            for (v, g) in gains.iter_mut().enumerate() {
+                probe[i] = v as u32;
+                if *g > 0 && !allowed(levels, cons, &probe) {
+                    *g = 0;
                 }
             }
         }
@@ -223,14 +338,17 @@ fn extend(rows: &mut Vec<Vec<u32>>, levels: &[u32], t: usize, i: usize, run: u64
             if !b.is_uncovered(bit) {
                 continue;
             }
-            let (mut base, level) = (bit / vi, (bit % vi) as u32);
-            let mut want: Vec<(usize, u32)> = Vec::with_capacity(b.cols.len() + 1);
-            for (&c, &s) in b.cols.iter().zip(&b.strides) {
-                want.push((c, (base / s) as u32));
-                base %= s;
-            }
-            want.push((i, level));
-            let fits = |row: &[u32]| want.iter().all(|&(c, v)| row[c] == v || row[c] == OPEN);
+            let want = b.cells(bit, vi, i);
+            let fits = |row: &[u32]| {
+                want.iter().all(|&(c, v)| row[c] == v || row[c] == OPEN)
+                    && (cons.is_empty() || {
+                        let mut probe = row.to_vec();
+                        for &(c, v) in &want {
+                            probe[c] = v;
+                        }
+                        allowed(levels, cons, &probe)
+                    })
+            };
             match flexible.iter().copied().find(|&r| fits(&rows[r])) {
                 Some(r) => {
                     for &(c, v) in &want {
@@ -251,8 +369,9 @@ fn extend(rows: &mut Vec<Vec<u32>>, levels: &[u32], t: usize, i: usize, run: u64
 }
 
 /// Drops rows whose every t-tuple is covered by some other kept row, scanning from the last
-/// row (vertical growth adds the least useful rows last). `rows` is `n × k` row-major.
-fn remove_redundant(levels: &[u32], t: usize, rows: Vec<u32>) -> Vec<u32> {
+/// row (vertical growth adds the least useful rows last) and keeping the first `keep_first`
+/// rows (the seeds). `rows` is `n × k` row-major.
+fn remove_redundant(levels: &[u32], t: usize, rows: Vec<u32>, keep_first: usize) -> Vec<u32> {
     let k = levels.len();
     let n = rows.len() / k;
     let subsets = subsets(k, t);
@@ -271,7 +390,7 @@ fn remove_redundant(levels: &[u32], t: usize, rows: Vec<u32>) -> Vec<u32> {
         }
     }
     let mut keep = vec![true; n];
-    for r in (0..n).rev() {
+    for r in (keep_first..n).rev() {
         let row = &rows[r * k..(r + 1) * k];
         let redundant = subsets
             .iter()
@@ -291,36 +410,11 @@ fn remove_redundant(levels: &[u32], t: usize, rows: Vec<u32>) -> Vec<u32> {
         .collect()
 }
 
-/// All `s`-subsets of `0..n` in lexicographic order (one empty subset for `s = 0`).
-fn subsets(n: usize, s: usize) -> Vec<Vec<usize>> {
-    let mut out = Vec::new();
-    if s > n {
-        return out;
-    }
-    let mut cur: Vec<usize> = (0..s).collect();
-    loop {
-        out.push(cur.clone());
-        let mut i = s;
-        loop {
-            if i == 0 {
-                return out;
-            }
-            i -= 1;
-            if cur[i] < n - (s - i) {
-                cur[i] += 1;
-                for j in i + 1..s {
-                    cur[j] = cur[j - 1] + 1;
-                }
-                break;
-            }
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::coverage::kwise_coverage_rows;
+    use crate::covering::CoveringError;
     use proptest::prelude::*;
 
     fn covers(a: &CoveringArray) -> bool {
@@ -376,7 +470,61 @@ mod tests {
         assert!(covers(&a));
     }
 
+    #[test]
+    fn seeds_come_first_and_forbidden_pairs_never_appear() {
+        use crate::covering::coverage_with_constraints;
+        // A = 0 with B = 1 is forbidden; C = 2 with D = 0 too.
+        let cons = Constraints::new(vec![vec![(0, 0), (1, 1)], vec![(2, 2), (3, 0)]]);
+        let levels = [2, 2, 3, 3];
+        let seeds = vec![
+            vec![Some(1), Some(1), Some(2), Some(1)],
+            vec![Some(0), None, None, Some(2)],
+        ];
+        let a = ipog_with(&levels, 2, &cons, &seeds).unwrap();
+        assert_eq!(a.row(0), [1, 1, 2, 1]);
+        assert_eq!((a.row(1)[0], a.row(1)[3]), (0, 2));
+        for r in 0..a.len() {
+            assert!(!cons.violated_by(a.row(r)), "row {r}: {:?}", a.row(r));
+        }
+        let (covered, coverable) = coverage_with_constraints(&levels, &a.rows, 2, &cons);
+        assert_eq!(covered, coverable);
+        // 2·2 + 2·3·2 + 2·3·2 + 3·3 = 37 pairs; two are forbidden.
+        assert_eq!(coverable, 35);
+        assert!(matches!(
+            ipog_with(&levels, 2, &cons, &[vec![Some(0), Some(1), None, None]]),
+            Err(CoveringError::Seed { row: 0, .. })
+        ));
+        assert!(matches!(
+            ipog_with(&levels, 2, &Constraints::new(vec![vec![(0, 5)]]), &[]),
+            Err(CoveringError::Constraint { index: 0, .. })
+        ));
+    }
+
     proptest! {
+        #[test]
+        fn constrained_arrays_cover_every_coverable_tuple_and_break_no_constraint(
+            levels in prop::collection::vec(2u32..4, 3..7),
+            pairs in prop::collection::vec((0usize..7, 0u32..4, 0usize..7, 0u32..4), 0..4),
+            t in 2usize..4,
+        ) {
+            use crate::covering::coverage_with_constraints;
+            let k = levels.len();
+            prop_assume!(t <= k);
+            let forbidden: Vec<Vec<(usize, u32)>> = pairs
+                .iter()
+                .filter(|&&(a, _, b, _)| a % k != b % k)
+                .map(|&(a, va, b, vb)| vec![(a % k, va % levels[a % k]), (b % k, vb % levels[b % k])])
+                .collect();
+            let cons = Constraints::new(forbidden);
+            prop_assume!(cons.completable(&levels, &[]));
+            let a = ipog_with(&levels, t, &cons, &[]).unwrap();
+            for r in 0..a.len() {
+                prop_assert!(!cons.violated_by(a.row(r)));
+            }
+            let (covered, coverable) = coverage_with_constraints(&levels, &a.rows, t, &cons);
+            prop_assert_eq!(covered, coverable);
+        }
+
         #[test]
         fn every_t_tuple_is_covered(
             levels in prop::collection::vec(1u32..5, 2..8),

@@ -5,10 +5,12 @@
 //! - [`random_kwise`] and [`random_until_covered`]: random arrays sized by Proposition 3.2 and
 //!   its union bound, or grown until the coverage checker is satisfied.
 
+mod constraints;
 mod ipog;
 mod random;
 
-pub use ipog::ipog;
+pub use constraints::Constraints;
+pub use ipog::{ipog, ipog_with};
 pub use random::{random_kwise, random_kwise_rows, random_until_covered, RandomKWiseSize};
 
 use serde::Serialize;
@@ -30,6 +32,22 @@ pub enum CoveringError {
     /// A parameter has no level.
     #[error("parameter {0} has no levels")]
     NoLevels(usize),
+    /// A seed row does not fit the parameters or breaks a constraint.
+    #[error("seed row {row}: {reason}")]
+    Seed {
+        /// Seed index, from 0.
+        row: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A constraint names a column or level that does not exist.
+    #[error("constraint {index}: {reason}")]
+    Constraint {
+        /// Constraint index, from 0.
+        index: usize,
+        /// What is wrong.
+        reason: String,
+    },
     /// A random array hit its row limit before covering every tuple.
     #[error("{rows} random rows did not cover every {t}-tuple")]
     NotCovered {
@@ -84,4 +102,91 @@ pub(crate) fn check(levels: &[u32], t: usize) -> Result<(), CoveringError> {
         return Err(CoveringError::NoLevels(j));
     }
     Ok(())
+}
+
+/// Checks constraints and seeds against `levels`; returns the seeds with open cells as
+/// `OPEN`.
+pub(crate) fn check_seeds(
+    levels: &[u32],
+    constraints: &Constraints,
+    seeds: &[Vec<Option<u32>>],
+) -> Result<Vec<Vec<u32>>, CoveringError> {
+    let k = levels.len();
+    for (index, f) in constraints.forbidden().iter().enumerate() {
+        for &(c, v) in f {
+            if c >= k || v >= levels[c] {
+                return Err(CoveringError::Constraint {
+                    index,
+                    reason: format!("column {c} level {v} does not exist"),
+                });
+            }
+        }
+    }
+    seeds
+        .iter()
+        .enumerate()
+        .map(|(row, s)| {
+            if s.len() != k {
+                return Err(CoveringError::Seed {
+                    row,
+                    reason: format!("has {} cells, the array has {k} columns", s.len()),
+                });
+            }
+            let cells: Vec<u32> = s.iter().map(|c| c.unwrap_or(constraints::OPEN)).collect();
+            if let Some(c) =
+                (0..k).find(|&c| cells[c] != constraints::OPEN && cells[c] >= levels[c])
+            {
+                return Err(CoveringError::Seed {
+                    row,
+                    reason: format!(
+                        "level {} of column {c} is out of range 0..{}",
+                        cells[c], levels[c]
+                    ),
+                });
+            }
+            if constraints.complete(levels, &cells).is_none() {
+                return Err(CoveringError::Seed {
+                    row,
+                    reason: "breaks a constraint".into(),
+                });
+            }
+            Ok(cells)
+        })
+        .collect()
+}
+
+/// t-wise coverage of `rows` (`n × k` row-major) counting only the t-tuples that extend to a
+/// row allowed by `constraints` ("coverable"): `(covered, coverable)`.
+pub fn coverage_with_constraints(
+    levels: &[u32],
+    rows: &[u32],
+    t: usize,
+    constraints: &Constraints,
+) -> (u64, u64) {
+    let k = levels.len();
+    let (mut covered, mut total) = (0, 0);
+    for cols in crate::coverage::subsets(k, t) {
+        let size: usize = cols.iter().map(|&c| levels[c] as usize).product();
+        let index = |row: &[u32]| {
+            cols.iter()
+                .fold(0usize, |a, &c| a * levels[c] as usize + row[c] as usize)
+        };
+        let mut seen = vec![false; size];
+        for row in rows.chunks_exact(k) {
+            seen[index(row)] = true;
+        }
+        for (idx, &s) in seen.iter().enumerate() {
+            let mut rest = idx;
+            let mut cells = vec![(0usize, 0u32); t];
+            for (slot, &c) in cells.iter_mut().zip(&cols).rev() {
+                *slot = (c, (rest % levels[c] as usize) as u32);
+                rest /= levels[c] as usize;
+            }
+            if constraints.completable(levels, &cells) {
+                total += 1;
+                covered += u64::from(s);
+            }
+        }
+    }
+    (covered, total)
 }
