@@ -11,7 +11,10 @@ mod random;
 
 pub use constraints::Constraints;
 pub use ipog::{ipog, ipog_with};
-pub use random::{random_kwise, random_kwise_rows, random_until_covered, RandomKWiseSize};
+pub use random::{
+    random_kwise, random_kwise_rows, random_kwise_with, random_until_covered,
+    random_until_covered_with, RandomKWiseSize,
+};
 
 use serde::Serialize;
 use thiserror::Error;

@@ -2,7 +2,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-use super::{check, CoveringArray, CoveringError};
+use super::constraints::OPEN;
+use super::{check, check_seeds, Constraints, CoveringArray, CoveringError};
 use crate::coverage::subset_products;
 
 /// The size of a random t-wise covering family, by the formula that applies.
@@ -53,10 +54,33 @@ pub fn random_kwise_rows(
     })
 }
 
-fn draw(levels: &[u32], rng: &mut ChaCha8Rng, out: &mut Vec<u32>) {
-    for &v in levels {
-        out.push(rng.random_range(0..v));
+/// Appends one random row: each cell uniform over its levels, redrawn (up to 64 times) while it
+/// breaks a constraint, and otherwise the lowest-levels completion of a random prefix.
+fn draw(levels: &[u32], cons: &Constraints, rng: &mut ChaCha8Rng, out: &mut Vec<u32>) {
+    let mut row: Vec<u32> = levels.iter().map(|&v| rng.random_range(0..v)).collect();
+    let mut tries = 0;
+    while !cons.is_empty() && cons.violated_by(&row) && tries < 64 {
+        row = levels.iter().map(|&v| rng.random_range(0..v)).collect();
+        tries += 1;
     }
+    if !cons.is_empty() && cons.violated_by(&row) {
+        let open = vec![OPEN; levels.len()];
+        row = cons.complete(levels, &open).unwrap_or(row);
+    }
+    out.extend_from_slice(&row);
+}
+
+/// The seeds, completed deterministically, then room for more rows.
+fn seeded(
+    levels: &[u32],
+    cons: &Constraints,
+    seeds: &[Vec<Option<u32>>],
+) -> Result<Vec<u32>, CoveringError> {
+    let mut rows = Vec::new();
+    for s in check_seeds(levels, cons, seeds)? {
+        rows.extend(cons.complete(levels, &s).unwrap_or(s));
+    }
+    Ok(rows)
 }
 
 /// A random t-wise covering family of [`random_kwise_rows`] rows: each cell uniform over its
@@ -71,11 +95,28 @@ pub fn random_kwise(
     delta: f64,
     seed: u64,
 ) -> Result<CoveringArray, CoveringError> {
+    random_kwise_with(levels, t, delta, seed, &Constraints::default(), &[])
+}
+
+/// [`random_kwise`] after the seed rows (their open cells completed), with every row redrawn
+/// until it breaks no constraint.
+///
+/// # Errors
+/// As [`random_kwise`]; [`CoveringError::Seed`] and [`CoveringError::Constraint`] as in
+/// [`super::ipog_with`].
+pub fn random_kwise_with(
+    levels: &[u32],
+    t: usize,
+    delta: f64,
+    seed: u64,
+    constraints: &Constraints,
+    seeds: &[Vec<Option<u32>>],
+) -> Result<CoveringArray, CoveringError> {
     let m = random_kwise_rows(levels, t, delta)?.rows as usize;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut rows = Vec::with_capacity(m * levels.len());
+    let mut rows = seeded(levels, constraints, seeds)?;
     for _ in 0..m {
-        draw(levels, &mut rng, &mut rows);
+        draw(levels, constraints, &mut rng, &mut rows);
     }
     Ok(CoveringArray {
         levels: levels.to_vec(),
@@ -94,6 +135,22 @@ pub fn random_until_covered(
     t: usize,
     seed: u64,
     max_rows: usize,
+) -> Result<CoveringArray, CoveringError> {
+    random_until_covered_with(levels, t, seed, max_rows, &Constraints::default(), &[])
+}
+
+/// [`random_until_covered`] after the seed rows, drawing only rows that break no constraint and
+/// stopping when every coverable t-tuple is covered.
+///
+/// # Errors
+/// As [`random_until_covered`] and [`random_kwise_with`].
+pub fn random_until_covered_with(
+    levels: &[u32],
+    t: usize,
+    seed: u64,
+    max_rows: usize,
+    constraints: &Constraints,
+    seeds: &[Vec<Option<u32>>],
 ) -> Result<CoveringArray, CoveringError> {
     check(levels, t)?;
     let k = levels.len();
@@ -124,17 +181,25 @@ pub fn random_until_covered(
             break;
         }
     }
-    let mut missing: usize = subsets.iter().map(|s| s.2.len()).sum();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut rows = Vec::new();
-    let mut n = 0;
-    while missing > 0 {
-        if n == max_rows {
-            return Err(CoveringError::NotCovered { rows: n, t });
+    // Tuples that no allowed row holds count as seen from the start.
+    let mut missing: usize = 0;
+    for (cols, strides, seen) in &mut subsets {
+        for (idx, slot) in seen.iter_mut().enumerate() {
+            let cells: Vec<(usize, u32)> = cols
+                .iter()
+                .zip(strides.iter())
+                .map(|(&c, &s)| (c, ((idx as u64 / s) % u64::from(levels[c])) as u32))
+                .collect();
+            if constraints.completable(levels, &cells) {
+                missing += 1;
+            } else {
+                *slot = true;
+            }
         }
-        let start = rows.len();
-        draw(levels, &mut rng, &mut rows);
-        let row = &rows[start..];
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut rows = seeded(levels, constraints, seeds)?;
+    let mut mark = |row: &[u32], missing: &mut usize| {
         for (cols, strides, seen) in &mut subsets {
             let idx: u64 = cols
                 .iter()
@@ -143,9 +208,21 @@ pub fn random_until_covered(
                 .sum();
             if !seen[idx as usize] {
                 seen[idx as usize] = true;
-                missing -= 1;
+                *missing -= 1;
             }
         }
+    };
+    for row in rows.clone().chunks_exact(k) {
+        mark(row, &mut missing);
+    }
+    let mut n = 0;
+    while missing > 0 {
+        if n == max_rows {
+            return Err(CoveringError::NotCovered { rows: n, t });
+        }
+        let start = rows.len();
+        draw(levels, constraints, &mut rng, &mut rows);
+        mark(&rows[start..], &mut missing);
         n += 1;
     }
     Ok(CoveringArray {
@@ -184,6 +261,24 @@ mod tests {
             random_until_covered(&[5; 6], 3, 1, 10),
             Err(CoveringError::NotCovered { rows: 10, t: 3 })
         ));
+    }
+
+    #[test]
+    fn constrained_random_arrays_break_no_constraint_and_keep_their_seeds() {
+        use crate::covering::coverage_with_constraints;
+        let cons = Constraints::new(vec![vec![(0, 0), (1, 1)]]);
+        let levels = [2, 2, 3];
+        let seeds = vec![vec![Some(1), Some(1), None]];
+        let a = random_until_covered_with(&levels, 2, 3, 10_000, &cons, &seeds).unwrap();
+        assert_eq!(&a.rows[..2], &[1, 1]);
+        for row in a.rows.chunks_exact(3) {
+            assert!(!cons.violated_by(row));
+        }
+        let (covered, coverable) = coverage_with_constraints(&levels, &a.rows, 2, &cons);
+        assert_eq!((covered, coverable), (15, 15));
+        let b = random_kwise_with(&levels, 2, 0.01, 3, &cons, &seeds).unwrap();
+        assert!(b.rows.chunks_exact(3).all(|r| !cons.violated_by(r)));
+        assert_eq!(&b.rows[..2], &[1, 1]);
     }
 
     #[test]
