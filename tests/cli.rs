@@ -426,3 +426,67 @@ fn cover_plan_prints_the_formulas_and_budgets() {
         p["random_kwise_exact_union"].as_u64().unwrap() * p["halton_per_group"].as_u64().unwrap()
     );
 }
+
+#[test]
+fn cover_generate_model_writes_a_pairwise_array_that_respects_the_constraints() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("disks.txt");
+    std::fs::write(
+        &model,
+        "# disks\nType: Primary, Logical, Single\nSize: 10, 100, 500\nFormat: FAT, NTFS\nCompression: on, off\n\nIF [Type] = \"Single\" THEN [Format] <> \"FAT\";\n",
+    )
+    .unwrap();
+    for algorithm in ["ipog", "kwise", "random"] {
+        let o = cover(&[
+            "generate",
+            "--model",
+            model.to_str().unwrap(),
+            "--algorithm",
+            algorithm,
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let text = String::from_utf8(o.stdout).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some("Type,Size,Format,Compression"));
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert!(
+            rows.iter().all(|r| !(r[0] == "Single" && r[2] == "FAT")),
+            "{algorithm}"
+        );
+        // Every allowed pair of values appears.
+        let values = [
+            vec!["Primary", "Logical", "Single"],
+            vec!["10", "100", "500"],
+            vec!["FAT", "NTFS"],
+            vec!["on", "off"],
+        ];
+        for a in 0..4 {
+            for b in a + 1..4 {
+                for va in &values[a] {
+                    for vb in &values[b] {
+                        let forbidden = a == 0 && b == 2 && *va == "Single" && *vb == "FAT";
+                        let seen = rows.iter().any(|r| r[a] == *va && r[b] == *vb);
+                        assert_eq!(seen, !forbidden, "{algorithm}: {va} {vb}");
+                    }
+                }
+            }
+        }
+        if algorithm == "ipog" {
+            assert_eq!(rows.len(), 9, "IPOG reaches the 3 × 3 lower bound here");
+        }
+    }
+    let bad = dir.path().join("bad.txt");
+    std::fs::write(
+        &bad,
+        "A: x, y\nIF [A] = \"x\" OR [A] = \"y\" THEN [A] <> \"x\";\n",
+    )
+    .unwrap();
+    let o = cover(&["generate", "--model", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("bad.txt:2: unsupported constraint"));
+}

@@ -2,11 +2,13 @@
 //! `results.jsonl`, coverage reports and budget plans.
 
 mod input;
+mod pict;
 mod plan;
 mod report;
 mod spec;
 
 pub use input::{read_tests, InputError, TestSet};
+pub use pict::{parse_pict, PictError, PictModel};
 pub use plan::{plan, Plan};
 pub use report::{estimate, Estimate, Metric};
 pub use spec::{load_space, SpecError};

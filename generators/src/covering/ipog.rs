@@ -115,7 +115,7 @@ fn ipog_in_order(
             row[j] = (idx % levels[j] as usize) as u32;
             idx /= levels[j] as usize;
         }
-        let seeded = rows[..seeds.len()].iter().any(|s| *s == row);
+        let seeded = rows[..seeds.len()].contains(&row);
         let cells: Vec<(usize, u32)> = row.iter().copied().enumerate().collect();
         if !seeded && cons.completable(levels, &cells) {
             rows.push(row);

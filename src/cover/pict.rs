@@ -1,0 +1,171 @@
+//! PICT's plain-text parameter models (`paracosm-cover generate --model FILE`).
+//!
+//! Supported: `# comments`, blank lines, parameter lines `Name: v1, v2, v3`, and constraints of
+//! the form `IF [A] = "x" THEN [B] <> "y";` (values quoted, or bare numbers). Anything else in
+//! the constraint section is refused with the line number.
+
+use std::sync::LazyLock;
+
+use regex::Regex;
+use thiserror::Error;
+
+use paracosm_generators::covering::Constraints;
+
+/// A parsed model: parameters with their values as written, and forbidden combinations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PictModel {
+    /// `(name, values)` in file order.
+    pub params: Vec<(String, Vec<String>)>,
+    /// The constraints, as forbidden `(parameter index, value index)` pairs.
+    pub constraints: Constraints,
+}
+
+impl PictModel {
+    /// Level counts, one per parameter.
+    pub fn levels(&self) -> Vec<u32> {
+        self.params.iter().map(|(_, v)| v.len() as u32).collect()
+    }
+}
+
+/// A model error with its line (from 1).
+#[derive(Debug, Error, PartialEq)]
+#[error("{file}:{line}: {message}")]
+pub struct PictError {
+    /// The model file.
+    pub file: String,
+    /// The line, from 1.
+    pub line: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+static IF_THEN: LazyLock<Regex> = LazyLock::new(|| {
+    let value = r#"(?:"([^"]*)"|([0-9][^\s;]*))"#;
+    Regex::new(&format!(
+        r#"(?i)^\s*IF\s+\[([^\]]+)\]\s*=\s*{value}\s+THEN\s+\[([^\]]+)\]\s*<>\s*{value}\s*;\s*$"#
+    ))
+    .expect("the pattern is valid")
+});
+
+/// Parses a PICT model.
+///
+/// # Errors
+/// [`PictError`] with the line for a malformed parameter line, a duplicate parameter or value,
+/// a parameter without values, an unknown parameter or value in a constraint, or constraint
+/// syntax other than `IF [A] = "x" THEN [B] <> "y";`.
+pub fn parse_pict(file: &str, text: &str) -> Result<PictModel, PictError> {
+    let err = |line: usize, message: String| PictError {
+        file: file.to_owned(),
+        line,
+        message,
+    };
+    let mut params: Vec<(String, Vec<String>)> = Vec::new();
+    let mut forbidden = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let content = raw.split('#').next().unwrap_or("").trim();
+        if content.is_empty() {
+            continue;
+        }
+        if let Some(c) = IF_THEN.captures(content) {
+            let lookup = |name: &str, value: &str| -> Result<(usize, u32), PictError> {
+                let p = params
+                    .iter()
+                    .position(|(n, _)| n == name)
+                    .ok_or_else(|| err(line, format!("unknown parameter [{name}]")))?;
+                let v = params[p]
+                    .1
+                    .iter()
+                    .position(|x| x == value)
+                    .ok_or_else(|| err(line, format!("[{name}] has no value \"{value}\"")))?;
+                Ok((p, v as u32))
+            };
+            let value = |q: usize, b: usize| c.get(q).or(c.get(b)).map_or("", |m| m.as_str());
+            let a = lookup(c[1].trim(), value(2, 3))?;
+            let b = lookup(c[4].trim(), value(5, 6))?;
+            forbidden.push(vec![a, b]);
+            continue;
+        }
+        let upper = content.to_ascii_uppercase();
+        if upper.starts_with("IF ") || upper.starts_with('[') || content.ends_with(';') {
+            return Err(err(
+                line,
+                format!(
+                    "unsupported constraint `{content}`: only `IF [A] = \"x\" THEN [B] <> \"y\";` is supported"
+                ),
+            ));
+        }
+        let Some((name, values)) = content.split_once(':') else {
+            return Err(err(
+                line,
+                format!("expected `Name: v1, v2, ...`, found `{content}`"),
+            ));
+        };
+        let name = name.trim().to_owned();
+        let values: Vec<String> = values.split(',').map(|v| v.trim().to_owned()).collect();
+        if name.is_empty() || values.iter().any(String::is_empty) {
+            return Err(err(
+                line,
+                "a parameter needs a name and non-empty values".into(),
+            ));
+        }
+        if params.iter().any(|(n, _)| *n == name) {
+            return Err(err(line, format!("parameter `{name}` is declared twice")));
+        }
+        if let Some(d) = values
+            .iter()
+            .enumerate()
+            .find(|(j, v)| values[..*j].contains(v))
+        {
+            return Err(err(line, format!("value `{}` appears twice", d.1)));
+        }
+        params.push((name, values));
+    }
+    if params.is_empty() {
+        return Err(err(1, "the model declares no parameter".into()));
+    }
+    Ok(PictModel {
+        params,
+        constraints: Constraints::new(forbidden),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MODEL: &str = "# a PICT model\nType: Primary, Logical, Single\nSize: 10, 100, 500\nFormat: FAT, NTFS\n\nIF [Type] = \"Single\" THEN [Format] <> \"FAT\";\nif [Size] = 500 then [Format] <> \"NTFS\";\n";
+
+    #[test]
+    fn parses_parameters_and_if_then_constraints() {
+        let m = parse_pict("m.txt", MODEL).unwrap();
+        assert_eq!(m.levels(), [3, 3, 2]);
+        assert_eq!(m.params[1].1, ["10", "100", "500"]);
+        assert_eq!(
+            m.constraints.forbidden(),
+            [vec![(0, 2), (2, 0)], vec![(1, 2), (2, 1)]]
+        );
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let cases = [
+            (
+                "A: x, y\nIF [A] = \"x\" THEN [B] <> \"y\";\n",
+                "m:2: unknown parameter [B]",
+            ),
+            (
+                "A: x, y\nIF [A] = \"x\" OR [A] = \"y\" THEN [A] <> \"x\";\n",
+                "m:2: unsupported constraint",
+            ),
+            ("A: x, y\nB x, y\n", "m:2: expected `Name: v1, v2, ...`"),
+            ("A: x, x\n", "m:1: value `x` appears twice"),
+            ("A: x\nA: y\n", "m:2: parameter `A` is declared twice"),
+            ("# nothing\n", "m:1: the model declares no parameter"),
+        ];
+        for (text, want) in cases {
+            let e = parse_pict("m", text).unwrap_err().to_string();
+            assert!(e.starts_with(want), "{e}");
+        }
+    }
+}
