@@ -56,6 +56,8 @@ pub struct Campaign<'a> {
     pub seed: u64,
     /// Number of tests, `>= 1`.
     pub budget: u64,
+    /// Strength of the covering-suite strategies (`ipog`, `kwise`); ignored by the others.
+    pub strength: usize,
     /// Worker threads, `>= 1`. Results do not depend on it.
     pub jobs: usize,
 }
@@ -79,7 +81,12 @@ impl Campaign<'_> {
     /// # Errors
     /// [`CampaignError::Generator`] when the strategy cannot produce them.
     pub fn points(&self) -> Result<Vec<Point>, CampaignError> {
-        let mut generator = self.strategy.build(&self.scenario.space, self.seed)?;
+        let mut generator = self.strategy.build_sized(
+            &self.scenario.space,
+            self.seed,
+            self.budget,
+            self.strength,
+        )?;
         Ok(generator.ask(self.budget as usize)?)
     }
 
@@ -257,6 +264,7 @@ mod tests {
             strategy: Strategy::Random,
             seed: 5,
             budget: 12,
+            strength: 2,
             jobs,
         }
     }

@@ -14,6 +14,11 @@ pub enum StrategyArg {
     Halton,
     /// Owen-scrambled Sobol points (at most 65536); --seed selects the scramble.
     Sobol,
+    /// A (k, ε)-covering suite: an IPOG covering array of strength --strength over the discrete
+    /// parameters, and a block of Halton points per array row.
+    Ipog,
+    /// As ipog, with a random k-wise array sized by Proposition 3.2.
+    Kwise,
 }
 
 impl From<StrategyArg> for Strategy {
@@ -22,6 +27,8 @@ impl From<StrategyArg> for Strategy {
             StrategyArg::Random => Strategy::Random,
             StrategyArg::Halton => Strategy::Halton,
             StrategyArg::Sobol => Strategy::Sobol,
+            StrategyArg::Ipog => Strategy::Ipog,
+            StrategyArg::Kwise => Strategy::KWise,
         }
     }
 }

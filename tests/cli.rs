@@ -490,3 +490,29 @@ fn cover_generate_model_writes_a_pairwise_array_that_respects_the_constraints() 
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("bad.txt:2: unsupported constraint"));
 }
+
+#[test]
+fn ipog_suites_cover_every_pair_and_give_each_row_its_own_halton_block() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("mixed.toml");
+    std::fs::write(
+        &spec,
+        "[[param]]\nname = \"lanes\"\nlevels = [2, 4, 6]\n[[param]]\nname = \"colour\"\nlevels = [\"red\", \"white\"]\n[[param]]\nname = \"night\"\nlevels = [0, 1]\n[[param]]\nname = \"fog\"\ninterval = [0.0, 1.0]\n",
+    )
+    .unwrap();
+    let csv = dir.path().join("suite.csv");
+    let g = cover(&["generate", "--space", spec.to_str().unwrap(), "--strategy", "ipog", "--strength", "2", "--budget", "60", "--output", csv.to_str().unwrap()]);
+    assert_eq!(g.status.code(), Some(0), "{}", String::from_utf8_lossy(&g.stderr));
+    let e = cover(&["estimate", csv.to_str().unwrap(), "--space", spec.to_str().unwrap(), "--json", "--strength", "2"]);
+    let est: serde_json::Value = serde_json::from_slice(&e.stdout).unwrap();
+    assert_eq!(est["tests"], 60);
+    assert_eq!(est["kwise"][1]["fraction"], 1.0);
+    // No fog value repeats: each array row's block is its own range of the Halton sequence.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut fogs: Vec<&str> = text.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
+    fogs.sort();
+    fogs.dedup();
+    assert_eq!(fogs.len(), 60);
+    let too_strong = cover(&["generate", "--space", spec.to_str().unwrap(), "--strategy", "ipog", "--strength", "4", "--budget", "10"]);
+    assert_eq!(too_strong.status.code(), Some(2));
+}

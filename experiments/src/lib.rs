@@ -39,6 +39,7 @@ pub fn figure9(budget: u64, seed: u64, jobs: usize, out: &Path) -> Result<Figure
             strategy,
             seed,
             budget,
+            strength: 2,
             jobs,
         };
         let report = campaign

@@ -30,7 +30,13 @@ pub enum GeneratorError {
         /// What was asked for.
         requested: u64,
     },
+    /// A covering-suite strategy was built without a budget ([`crate::Strategy::build_sized`]).
+    #[error("strategy `{0}` needs a budget and a strength")]
+    NeedsBudget(&'static str),
+    /// The covering array of a suite cannot be built.
+    #[error("covering array: {0}")]
+    Covering(String),
     /// A strategy name that no generator answers to.
-    #[error("unknown strategy `{0}` (expected one of: random, halton, halton-scrambled, sobol)")]
+    #[error("unknown strategy `{0}` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise)")]
     UnknownStrategy(String),
 }

@@ -14,10 +14,18 @@ pub enum Strategy {
     ScrambledHalton,
     /// [`Sobol`]: Owen-scrambled Sobol points; the seed selects the scramble.
     Sobol,
+    /// [`crate::covering::CoveringSuite`] on an IPOG array: a (k, ε)-covering suite (§3.2).
+    Ipog,
+    /// [`crate::covering::CoveringSuite`] on a random k-wise array (Proposition 3.2).
+    KWise,
 }
 
 impl Strategy {
-    /// Every strategy, in the order the CLI lists them.
+    /// The covering-suite strategies, which need a budget and a strength
+    /// ([`Strategy::build_sized`]).
+    pub const SUITES: [Strategy; 2] = [Strategy::Ipog, Strategy::KWise];
+
+    /// Every point generator that needs no budget, in the order the CLI lists them.
     pub const ALL: [Strategy; 4] = [
         Strategy::Random,
         Strategy::Halton,
@@ -32,6 +40,8 @@ impl Strategy {
             Strategy::Halton => "halton",
             Strategy::ScrambledHalton => "halton-scrambled",
             Strategy::Sobol => "sobol",
+            Strategy::Ipog => "ipog",
+            Strategy::KWise => "kwise",
         }
     }
 
@@ -39,7 +49,11 @@ impl Strategy {
     pub fn capacity(self) -> Option<u64> {
         match self {
             Strategy::Sobol => Some(crate::SOBOL_MAX_POINTS),
-            Strategy::Random | Strategy::Halton | Strategy::ScrambledHalton => None,
+            Strategy::Random
+            | Strategy::Halton
+            | Strategy::ScrambledHalton
+            | Strategy::Ipog
+            | Strategy::KWise => None,
         }
     }
 
@@ -47,7 +61,8 @@ impl Strategy {
     ///
     /// # Errors
     /// [`GeneratorError::CapacityExceeded`] when the space has more dimensions than the
-    /// strategy supports.
+    /// strategy supports; [`GeneratorError::NeedsBudget`] for the covering suites, which are
+    /// built by [`Strategy::build_sized`].
     pub fn build(
         self,
         space: &ParamSpace,
@@ -58,7 +73,42 @@ impl Strategy {
             Strategy::Halton => Box::new(Halton::new(space)),
             Strategy::ScrambledHalton => Box::new(Halton::scrambled(space, seed)),
             Strategy::Sobol => Box::new(Sobol::new(space, seed)?),
+            Strategy::Ipog | Strategy::KWise => {
+                return Err(GeneratorError::NeedsBudget(self.name()))
+            }
         })
+    }
+}
+
+impl Strategy {
+    /// A generator of this strategy for a campaign of `budget` tests. The covering suites
+    /// ([`Strategy::SUITES`]) build a strength-`strength` array over the discrete parameters
+    /// and give each row `ceil(budget / rows)` Halton points; the others ignore `strength` and
+    /// are as [`Strategy::build`].
+    ///
+    /// # Errors
+    /// As [`Strategy::build`]; [`GeneratorError::Covering`] when the array cannot be built
+    /// (e.g. `strength` above the number of discrete parameters).
+    pub fn build_sized(
+        self,
+        space: &ParamSpace,
+        seed: u64,
+        budget: u64,
+        strength: usize,
+    ) -> Result<Box<dyn Generator>, GeneratorError> {
+        use crate::covering::{ArrayKind, CoveringSuite};
+        let kind = match self {
+            Strategy::Ipog => ArrayKind::Ipog,
+            Strategy::KWise => ArrayKind::RandomKWise,
+            _ => return self.build(space, seed),
+        };
+        let err = |e: crate::covering::CoveringError| GeneratorError::Covering(e.to_string());
+        // The array's size decides the block size: build once to count rows.
+        let probe = CoveringSuite::new(space, strength, kind, 1, seed).map_err(err)?;
+        let per_row = CoveringSuite::per_row_for_budget(probe.rows(), budget);
+        Ok(Box::new(
+            CoveringSuite::new(space, strength, kind, per_row, seed).map_err(err)?,
+        ))
     }
 }
 
@@ -68,6 +118,7 @@ impl FromStr for Strategy {
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         Strategy::ALL
             .into_iter()
+            .chain(Strategy::SUITES)
             .find(|st| st.name() == s)
             .ok_or_else(|| GeneratorError::UnknownStrategy(s.to_owned()))
     }
@@ -90,7 +141,7 @@ mod tests {
         }
         assert_eq!(
             "annealing".parse::<Strategy>().unwrap_err().to_string(),
-            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol)"
+            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise)"
         );
     }
 }

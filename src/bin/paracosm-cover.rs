@@ -67,7 +67,7 @@ enum Command {
         /// A PICT model: `Name: v1, v2` lines and `IF [A] = "x" THEN [B] <> "y";` constraints.
         #[arg(long)]
         model: Option<PathBuf>,
-        /// With --model: the strength t of the covering array.
+        /// The strength t of the covering array (--model, or --strategy ipog / kwise).
         #[arg(long, default_value_t = 2)]
         strength: usize,
         /// With --model: ipog (IPOG-F), kwise (random, sized by Proposition 3.2 / union bound
@@ -210,7 +210,7 @@ fn run(cli: Cli) -> Result<()> {
                 )));
             }
             let points = strategy
-                .build(&space, seed)
+                .build_sized(&space, seed, budget, strength)
                 .and_then(|mut g| g.ask(budget as usize))
                 .map_err(bad)?;
             let sink: Box<dyn Write> = match &output {

@@ -31,6 +31,9 @@ struct Cli {
     /// the permutations.
     #[arg(long)]
     scramble: bool,
+    /// Strength t of the covering array of --strategy ipog or kwise.
+    #[arg(long, default_value_t = 2)]
+    strength: usize,
     /// Number of tests to run (at least 1).
     #[arg(long, default_value_t = 100, value_parser = paracosm::cli::positive)]
     budget: u64,
@@ -96,6 +99,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         strategy,
         seed: cli.seed,
         budget: cli.budget,
+        strength: cli.strength,
         jobs,
     };
     let bar = if std::io::stderr().is_terminal() {

@@ -8,6 +8,7 @@
 mod constraints;
 mod ipog;
 mod random;
+mod suite;
 
 pub use constraints::Constraints;
 pub use ipog::{ipog, ipog_with};
@@ -15,6 +16,7 @@ pub use random::{
     random_kwise, random_kwise_rows, random_kwise_with, random_until_covered,
     random_until_covered_with, RandomKWiseSize,
 };
+pub use suite::{ArrayKind, CoveringSuite};
 
 use serde::Serialize;
 use thiserror::Error;

@@ -1,0 +1,180 @@
+use crate::{Generator, GeneratorError, Halton, ParamSpace, Point};
+
+use super::{ipog, random_kwise, CoveringError};
+
+/// How the discrete half of a [`CoveringSuite`] is built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ArrayKind {
+    /// [`super::ipog`].
+    Ipog,
+    /// [`super::random_kwise`] with δ = 0.01.
+    RandomKWise,
+}
+
+/// A (k, ε)-covering test suite for a mixed space (PARACOSM §3.2): a t-wise covering array
+/// over the discrete parameters and, for each of its rows, a block of Halton points over the
+/// continuous ones.
+///
+/// Row `r`'s block is Halton indices `r · m .. (r + 1) · m` (disjoint ranges, so no two blocks
+/// repeat each other) with `m` points per row. Points come out interleaved, block position
+/// major and row minor (row 0 point 0, row 1 point 0, ..., row 0 point 1, ...), so any prefix
+/// of at least `rows` points covers every t-tuple and spreads evenly over the rows.
+#[derive(Debug, Clone)]
+pub struct CoveringSuite {
+    rows: Vec<Vec<u32>>,
+    per_row: u64,
+    /// Halton over the continuous coordinates only.
+    halton: Halton,
+    next: u64,
+    name: &'static str,
+}
+
+impl CoveringSuite {
+    /// A suite of strength `t` over `space` with `per_row` continuous points for each array
+    /// row (use [`CoveringSuite::per_row_for_budget`] or a Halton budget for a target ε).
+    ///
+    /// # Errors
+    /// [`CoveringError::Strength`] for `t` outside `1..=min(6, N_D)` when the space has
+    /// discrete parameters.
+    pub fn new(
+        space: &ParamSpace,
+        t: usize,
+        kind: ArrayKind,
+        per_row: u64,
+        seed: u64,
+    ) -> Result<Self, CoveringError> {
+        let levels = space.level_counts();
+        let k = levels.len();
+        let rows: Vec<Vec<u32>> = if k == 0 {
+            vec![Vec::new()]
+        } else {
+            let a = match kind {
+                ArrayKind::Ipog => ipog(&levels, t)?,
+                ArrayKind::RandomKWise => random_kwise(&levels, t, 0.01, seed)?,
+            };
+            (0..a.len()).map(|r| a.row(r).to_vec()).collect()
+        };
+        let continuous = ParamSpace::unit_cube(space.continuous_dims());
+        Ok(CoveringSuite {
+            rows,
+            per_row: per_row.max(1),
+            halton: Halton::new(&continuous),
+            next: 0,
+            name: match kind {
+                ArrayKind::Ipog => "ipog",
+                ArrayKind::RandomKWise => "kwise",
+            },
+        })
+    }
+
+    /// Points per row so that `rows × m >= budget`: `m = ceil(budget / rows)`.
+    pub fn per_row_for_budget(rows: usize, budget: u64) -> u64 {
+        budget.div_ceil(rows.max(1) as u64).max(1)
+    }
+
+    /// Rows of the covering array (1 when the space has no discrete parameter).
+    pub fn rows(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Total points: `rows × per_row`.
+    pub fn len(&self) -> u64 {
+        self.rows.len() as u64 * self.per_row
+    }
+
+    /// Whether the suite has no point (never: at least one row and one point per row).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Point `j` in the interleaved order.
+    pub fn point(&self, j: u64) -> Point {
+        let rows = self.rows.len() as u64;
+        let (r, i) = ((j % rows) as usize, j / rows);
+        let h = self.halton.point(r as u64 * self.per_row + i);
+        Point {
+            discrete: self.rows[r].clone(),
+            continuous: h.continuous,
+        }
+    }
+}
+
+impl Generator for CoveringSuite {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn ask(&mut self, n: usize) -> Result<Vec<Point>, GeneratorError> {
+        let end = self.next + n as u64;
+        if end > self.len() {
+            return Err(GeneratorError::CapacityExceeded {
+                generator: self.name,
+                what: "points",
+                limit: self.len(),
+                requested: end,
+            });
+        }
+        let pts = (self.next..end).map(|j| self.point(j)).collect();
+        self.next = end;
+        Ok(pts)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coverage::kwise_coverage;
+    use crate::{Param, Value};
+
+    fn space() -> ParamSpace {
+        ParamSpace::new(vec![
+            Param::levels("a", vec![Value::Int(0), Value::Int(1), Value::Int(2)]),
+            Param::interval("x", 0.0, 1.0, "1"),
+            Param::levels("b", vec![Value::Int(0), Value::Int(1)]),
+            Param::levels("c", vec![Value::Int(0), Value::Int(1)]),
+            Param::interval("y", 0.0, 1.0, "1"),
+        ])
+        .unwrap()
+    }
+
+    #[test]
+    fn any_prefix_of_rows_points_covers_every_pair_and_blocks_differ() {
+        let s = space();
+        let mut suite = CoveringSuite::new(&s, 2, ArrayKind::Ipog, 16, 0).unwrap();
+        let rows = suite.rows();
+        let pts = suite.ask(rows * 16).unwrap();
+        let c = kwise_coverage(&s, &pts[..rows], 2, 0).unwrap();
+        assert_eq!(c.covered, c.total);
+        // Blocks use disjoint Halton ranges: no continuous part repeats across rows.
+        let mut seen: Vec<Vec<u64>> = pts
+            .iter()
+            .map(|p| p.continuous.iter().map(|x| x.to_bits()).collect())
+            .collect();
+        seen.sort();
+        seen.dedup();
+        assert_eq!(seen.len(), pts.len());
+        // Each row's block is the Halton points r·m .. (r+1)·m.
+        let h = Halton::new(&ParamSpace::unit_cube(2));
+        assert_eq!(pts[1].continuous, h.point(16).continuous);
+        assert!(suite.ask(1).is_err());
+    }
+
+    #[test]
+    fn value_stability_first_points() {
+        let mut suite = CoveringSuite::new(&space(), 2, ArrayKind::Ipog, 4, 0).unwrap();
+        let p = suite.ask(2).unwrap();
+        assert_eq!(p[0].discrete, [0, 0, 0]);
+        assert_eq!(p[0].continuous, [0.0, 0.0]);
+        // Row 1 starts at Halton index 4: (γ_2(4), γ_3(4)) = (1/8, 4/9).
+        assert_eq!(p[1].discrete, PINNED_ROW1);
+        assert_eq!(p[1].continuous, [1.0 / 8.0, 4.0 / 9.0]);
+    }
+
+    const PINNED_ROW1: [u32; 3] = [0, 1, 1];
+
+    #[test]
+    fn per_row_for_budget_rounds_up() {
+        assert_eq!(CoveringSuite::per_row_for_budget(9, 100), 12);
+        assert_eq!(CoveringSuite::per_row_for_budget(0, 5), 5);
+    }
+}
