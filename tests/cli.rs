@@ -501,18 +501,57 @@ fn ipog_suites_cover_every_pair_and_give_each_row_its_own_halton_block() {
     )
     .unwrap();
     let csv = dir.path().join("suite.csv");
-    let g = cover(&["generate", "--space", spec.to_str().unwrap(), "--strategy", "ipog", "--strength", "2", "--budget", "60", "--output", csv.to_str().unwrap()]);
-    assert_eq!(g.status.code(), Some(0), "{}", String::from_utf8_lossy(&g.stderr));
-    let e = cover(&["estimate", csv.to_str().unwrap(), "--space", spec.to_str().unwrap(), "--json", "--strength", "2"]);
+    let g = cover(&[
+        "generate",
+        "--space",
+        spec.to_str().unwrap(),
+        "--strategy",
+        "ipog",
+        "--strength",
+        "2",
+        "--budget",
+        "60",
+        "--output",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        g.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&g.stderr)
+    );
+    let e = cover(&[
+        "estimate",
+        csv.to_str().unwrap(),
+        "--space",
+        spec.to_str().unwrap(),
+        "--json",
+        "--strength",
+        "2",
+    ]);
     let est: serde_json::Value = serde_json::from_slice(&e.stdout).unwrap();
     assert_eq!(est["tests"], 60);
     assert_eq!(est["kwise"][1]["fraction"], 1.0);
     // No fog value repeats: each array row's block is its own range of the Halton sequence.
     let text = std::fs::read_to_string(&csv).unwrap();
-    let mut fogs: Vec<&str> = text.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
+    let mut fogs: Vec<&str> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap())
+        .collect();
     fogs.sort();
     fogs.dedup();
     assert_eq!(fogs.len(), 60);
-    let too_strong = cover(&["generate", "--space", spec.to_str().unwrap(), "--strategy", "ipog", "--strength", "4", "--budget", "10"]);
+    let too_strong = cover(&[
+        "generate",
+        "--space",
+        spec.to_str().unwrap(),
+        "--strategy",
+        "ipog",
+        "--strength",
+        "4",
+        "--budget",
+        "10",
+    ]);
     assert_eq!(too_strong.status.code(), Some(2));
 }

@@ -70,6 +70,10 @@ enum Command {
         /// The strength t of the covering array (--model, or --strategy ipog / kwise).
         #[arg(long, default_value_t = 2)]
         strength: usize,
+        /// With --model: rows that must appear first in the array (PICT's /e), as a CSV with a
+        /// header of parameter names and values as written in the model; blank cells are free.
+        #[arg(long, requires = "model")]
+        seeds: Option<PathBuf>,
         /// With --model: ipog (IPOG-F), kwise (random, sized by Proposition 3.2 / union bound
         /// for δ = 0.01), or random (random rows until every tuple is covered).
         #[arg(long, value_enum, default_value = "ipog")]
@@ -190,6 +194,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Generate {
             space,
             model,
+            seeds,
             strength,
             algorithm,
             strategy,
@@ -199,7 +204,14 @@ fn run(cli: Cli) -> Result<()> {
             output,
         } => {
             if let Some(model) = model {
-                return generate_array(&model, strength, algorithm, seed, output.as_deref());
+                return generate_array(
+                    &model,
+                    seeds.as_deref(),
+                    strength,
+                    algorithm,
+                    seed,
+                    output.as_deref(),
+                );
             }
             let space = load_space(space.as_deref().unwrap_or_default()).map_err(bad)?;
             let budget = budget.unwrap_or(1);
@@ -279,6 +291,7 @@ fn run(cli: Cli) -> Result<()> {
 /// `generate --model`: a covering array for a PICT model, written as CSV of value names.
 fn generate_array(
     model: &std::path::Path,
+    seeds: Option<&std::path::Path>,
     t: usize,
     algorithm: Algorithm,
     seed: u64,
@@ -289,11 +302,19 @@ fn generate_array(
         .map_err(|e| bad(format!("cannot read `{}`: {e}", model.display())))?;
     let m = paracosm::cover::parse_pict(&model.display().to_string(), &text).map_err(bad)?;
     let levels = m.levels();
+    let seed_rows = match seeds {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| bad(format!("cannot read `{}`: {e}", path.display())))?;
+            paracosm::cover::read_seeds(&m, &path.display().to_string(), &text).map_err(bad)?
+        }
+        None => Vec::new(),
+    };
     let array = match algorithm {
-        Algorithm::Ipog => ipog_with(&levels, t, &m.constraints, &[]),
-        Algorithm::Kwise => random_kwise_with(&levels, t, 0.01, seed, &m.constraints, &[]),
+        Algorithm::Ipog => ipog_with(&levels, t, &m.constraints, &seed_rows),
+        Algorithm::Kwise => random_kwise_with(&levels, t, 0.01, seed, &m.constraints, &seed_rows),
         Algorithm::Random => {
-            random_until_covered_with(&levels, t, seed, 10_000_000, &m.constraints, &[])
+            random_until_covered_with(&levels, t, seed, 10_000_000, &m.constraints, &seed_rows)
         }
     }
     .map_err(bad)?;

@@ -8,7 +8,7 @@ mod report;
 mod spec;
 
 pub use input::{read_tests, InputError, TestSet};
-pub use pict::{parse_pict, PictError, PictModel};
+pub use pict::{parse_pict, read_seeds, PictError, PictModel};
 pub use plan::{plan, Plan};
 pub use report::{estimate, Estimate, Metric};
 pub use spec::{load_space, SpecError};

@@ -130,6 +130,62 @@ pub fn parse_pict(file: &str, text: &str) -> Result<PictModel, PictError> {
     })
 }
 
+/// Seed rows for a model (PICT's `/e`): a CSV whose header names model parameters (any
+/// subset, any order) and whose cells are values as written in the model; an empty cell or a
+/// parameter without a column is left to the generator.
+///
+/// # Errors
+/// [`PictError`] with the line for an unknown parameter in the header, an unknown value, or a
+/// malformed row.
+pub fn read_seeds(
+    model: &PictModel,
+    file: &str,
+    text: &str,
+) -> Result<Vec<Vec<Option<u32>>>, PictError> {
+    let err = |line: usize, message: String| PictError {
+        file: file.to_owned(),
+        line,
+        message,
+    };
+    let mut reader = csv::ReaderBuilder::new().from_reader(text.as_bytes());
+    let header = reader.headers().map_err(|e| err(1, e.to_string()))?.clone();
+    let columns: Vec<usize> = header
+        .iter()
+        .map(|h| {
+            model
+                .params
+                .iter()
+                .position(|(n, _)| n == h.trim())
+                .ok_or_else(|| err(1, format!("`{h}` is not a parameter of the model")))
+        })
+        .collect::<Result<_, _>>()?;
+    let mut seeds = Vec::new();
+    for record in reader.records() {
+        let record = record.map_err(|e| {
+            err(
+                e.position().map_or(0, |p| p.line() as usize),
+                format!("malformed row: {e}"),
+            )
+        })?;
+        let line = record.position().map_or(0, |p| p.line() as usize);
+        let mut seed = vec![None; model.params.len()];
+        for (cell, &p) in record.iter().zip(&columns) {
+            let cell = cell.trim();
+            if cell.is_empty() {
+                continue;
+            }
+            let (name, values) = &model.params[p];
+            let v = values
+                .iter()
+                .position(|x| x == cell)
+                .ok_or_else(|| err(line, format!("`{cell}` is not a value of `{name}`")))?;
+            seed[p] = Some(v as u32);
+        }
+        seeds.push(seed);
+    }
+    Ok(seeds)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -145,6 +201,20 @@ mod tests {
             m.constraints.forbidden(),
             [vec![(0, 2), (2, 0)], vec![(1, 2), (2, 1)]]
         );
+    }
+
+    #[test]
+    fn seeds_map_names_to_levels_and_leave_blanks_open() {
+        let m = parse_pict("m.txt", MODEL).unwrap();
+        let seeds = read_seeds(&m, "s.csv", "Format,Type\nNTFS,Single\n,Logical\n").unwrap();
+        assert_eq!(
+            seeds,
+            [vec![Some(2), None, Some(1)], vec![Some(1), None, None]]
+        );
+        let e = read_seeds(&m, "s.csv", "Format\nexFAT\n")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "s.csv:2: `exFAT` is not a value of `Format`");
     }
 
     #[test]
