@@ -85,8 +85,17 @@ enum Command {
         #[arg(long)]
         scramble: bool,
         /// Number of points (at least 1).
-        #[arg(long, value_parser = paracosm::cli::positive, required_unless_present = "model")]
+        #[arg(
+            long,
+            value_parser = paracosm::cli::positive,
+            required_unless_present_any = ["model", "epsilon"]
+        )]
         budget: Option<u64>,
+        /// With --strategy ipog or kwise instead of --budget: size each array row's Halton block
+        /// for this target dispersion, ceil(C / ε) points with C the measured n·dispersion
+        /// constant of `plan`.
+        #[arg(long, conflicts_with = "budget")]
+        epsilon: Option<f64>,
         /// Seed of the random, scrambled Halton and Sobol strategies.
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -197,6 +206,7 @@ fn run(cli: Cli) -> Result<()> {
             seeds,
             strength,
             algorithm,
+            epsilon,
             strategy,
             scramble,
             budget,
@@ -214,8 +224,12 @@ fn run(cli: Cli) -> Result<()> {
                 );
             }
             let space = load_space(space.as_deref().unwrap_or_default()).map_err(bad)?;
-            let budget = budget.unwrap_or(1);
             let strategy = paracosm::cli::strategy(strategy, scramble).map_err(bad)?;
+            let budget = match (budget, epsilon) {
+                (Some(b), _) => b,
+                (None, Some(eps)) => suite_budget(&space, strategy, strength, eps, seed)?,
+                (None, None) => return Err(bad("give --budget or --epsilon")),
+            };
             if let Some(cap) = strategy.capacity().filter(|&c| budget > c) {
                 return Err(bad(format!(
                     "--budget {budget} is more than the {cap} points {strategy} can produce"
@@ -286,6 +300,36 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// The budget of a covering suite whose rows each get `ceil(C / ε)` Halton points.
+fn suite_budget(
+    space: &ParamSpace,
+    strategy: Strategy,
+    strength: usize,
+    epsilon: f64,
+    seed: u64,
+) -> Result<u64> {
+    use paracosm_generators::covering::{ArrayKind, CoveringSuite};
+    if !(epsilon > 0.0 && epsilon <= 1.0) {
+        return Err(bad(format!("--epsilon {epsilon} is not in (0, 1]")));
+    }
+    let kind = match strategy {
+        Strategy::Ipog => ArrayKind::Ipog,
+        Strategy::KWise => ArrayKind::RandomKWise,
+        other => {
+            return Err(bad(format!(
+                "--epsilon sizes the covering suites (ipog, kwise), not {other}; give --budget"
+            )))
+        }
+    };
+    let rows = CoveringSuite::new(space, strength, kind, 1, seed)
+        .map_err(bad)?
+        .rows() as u64;
+    let per_row = plan(space, strength, epsilon, 0.01)
+        .halton_per_group
+        .unwrap_or(1);
+    Ok(rows * per_row)
 }
 
 /// `generate --model`: a covering array for a PICT model, written as CSV of value names.
