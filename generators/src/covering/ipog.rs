@@ -23,8 +23,10 @@ use crate::coverage::subsets;
 ///    - Vertical growth: each tuple still uncovered goes into the first row whose cells are
 ///      equal or open on its parameters (filling them), or into a new row that is open
 ///      elsewhere.
-/// 3. Open cells left at the end take level 0.
-/// 4. Rows whose every t-tuple also appears in another row are dropped, last row first.
+/// 3. Repacking: for each row, last first, the t-tuples only it covers are moved into the open
+///    cells of other rows; when all of them fit, the row is deleted.
+/// 4. Open cells left at the end take level 0 (or the lowest levels the constraints allow),
+///    and rows whose every t-tuple also appears in another row are dropped, last row first.
 ///
 /// For t >= 4 the construction runs 8 times in parallel, run 0 breaking ties toward the lowest
 /// row and level and the others by a seeded hash, and keeps the smallest array. Deterministic:
@@ -124,6 +126,7 @@ fn ipog_in_order(
     for i in t..k {
         extend(&mut rows, levels, t, i, run, cons, seeds);
     }
+    let rows = repack(levels, t, rows, seeds.len(), cons);
     rows.into_iter()
         .flat_map(|r| {
             let full = if r.contains(&OPEN) {
@@ -136,6 +139,117 @@ fn ipog_in_order(
             };
             full.into_iter()
         })
+        .collect()
+}
+
+/// Deletes rows whose tuples can all live elsewhere: for each row, last first, every t-tuple
+/// that only it covers is moved into the open cells of another row (equal or open on the
+/// tuple's columns, and still allowed by the constraints); if all move, the row goes, else the
+/// moves are undone. Rows before `keep_first` (the seeds) stay.
+fn repack(
+    levels: &[u32],
+    t: usize,
+    mut rows: Vec<Vec<u32>>,
+    keep_first: usize,
+    cons: &Constraints,
+) -> Vec<Vec<u32>> {
+    let k = levels.len();
+    let n = rows.len();
+    let subsets = subsets(k, t);
+    let mut by_column: Vec<Vec<usize>> = vec![Vec::new(); k];
+    for (s, cols) in subsets.iter().enumerate() {
+        for &c in cols {
+            by_column[c].push(s);
+        }
+    }
+    let index = |cols: &[usize], row: &[u32]| -> Option<usize> {
+        cols.iter().try_fold(0usize, |acc, &c| {
+            (row[c] != OPEN).then(|| acc * levels[c] as usize + row[c] as usize)
+        })
+    };
+    let mut counts: Vec<Vec<u32>> = subsets
+        .iter()
+        .map(|cols| vec![0u32; cols.iter().map(|&c| levels[c] as usize).product()])
+        .collect();
+    for row in &rows {
+        for (cols, cnt) in subsets.iter().zip(&mut counts) {
+            if let Some(x) = index(cols, row) {
+                cnt[x] += 1;
+            }
+        }
+    }
+    let mut flexible: Vec<usize> = (0..n).filter(|&r| rows[r].contains(&OPEN)).collect();
+    let mut deleted = vec![false; n];
+    for r in (keep_first..n).rev() {
+        let unique: Vec<Vec<(usize, u32)>> = subsets
+            .iter()
+            .zip(&counts)
+            .filter_map(|(cols, cnt)| {
+                let x = index(cols, &rows[r])?;
+                (cnt[x] == 1).then(|| cols.iter().map(|&c| (c, rows[r][c])).collect())
+            })
+            .collect();
+        let mut log: Vec<(usize, usize)> = Vec::new();
+        let mut moved_all = true;
+        for u in &unique {
+            let cols: Vec<usize> = u.iter().map(|&(c, _)| c).collect();
+            let x = index(&cols, &rows[r]).expect("assigned");
+            let s = subsets.iter().position(|c| *c == cols).expect("a subset");
+            if counts[s][x] >= 2 {
+                continue; // an earlier move covered it too
+            }
+            let target = flexible.iter().copied().find(|&q| {
+                q != r
+                    && !deleted[q]
+                    && u.iter()
+                        .all(|&(c, v)| rows[q][c] == v || rows[q][c] == OPEN)
+                    && (cons.is_empty() || {
+                        let mut probe = rows[q].clone();
+                        for &(c, v) in u {
+                            probe[c] = v;
+                        }
+                        cons.complete(levels, &probe).is_some()
+                    })
+            });
+            let Some(q) = target else {
+                moved_all = false;
+                break;
+            };
+            for &(c, v) in u {
+                if rows[q][c] == OPEN {
+                    rows[q][c] = v;
+                    log.push((q, c));
+                    for &s in &by_column[c] {
+                        if let Some(x) = index(&subsets[s], &rows[q]) {
+                            counts[s][x] += 1;
+                        }
+                    }
+                }
+            }
+        }
+        if moved_all {
+            deleted[r] = true;
+            for (cols, cnt) in subsets.iter().zip(&mut counts) {
+                if let Some(x) = index(cols, &rows[r]) {
+                    cnt[x] -= 1;
+                }
+            }
+        } else {
+            for &(q, c) in log.iter().rev() {
+                for &s in &by_column[c] {
+                    if let Some(x) = index(&subsets[s], &rows[q]) {
+                        counts[s][x] -= 1;
+                    }
+                }
+                rows[q][c] = OPEN;
+            }
+        }
+        flexible.retain(|&q| !deleted[q] && rows[q].contains(&OPEN));
+    }
+    rows.into_iter()
+        .zip(deleted)
+        .filter(|(_, d)| !d)
+        .map(|(r, _)| r)
         .collect()
 }
 
@@ -430,7 +544,7 @@ mod tests {
         assert!(a.len() <= 6, "{} rows", a.len());
         let b = ipog(&[2; 10], 2).unwrap();
         assert!(covers(&b));
-        assert!(b.len() <= 9, "{} rows", b.len());
+        assert!(b.len() <= 7, "{} rows", b.len());
     }
 
     #[test]
@@ -452,6 +566,7 @@ mod tests {
             (&[5u32; 10][..], 2, 45),
             (&[5; 10][..], 3, 308),
             (&[5; 10][..], 4, 1811),
+            (&[5; 10][..], 5, 9722),
             (&tcas[..], 2, 100),
             (&tcas[..], 3, 400),
             (&tcas[..], 4, 1361),
