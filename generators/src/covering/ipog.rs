@@ -625,12 +625,7 @@ mod tests {
             use crate::covering::coverage_with_constraints;
             let k = levels.len();
             prop_assume!(t <= k);
-            let forbidden: Vec<Vec<(usize, u32)>> = pairs
-                .iter()
-                .filter(|&&(a, _, b, _)| a % k != b % k)
-                .map(|&(a, va, b, vb)| vec![(a % k, va % levels[a % k]), (b % k, vb % levels[b % k])])
-                .collect();
-            let cons = Constraints::new(forbidden);
+            let cons = crate::covering::forbidden_pairs(&levels, &pairs);
             prop_assume!(cons.completable(&levels, &[]));
             let a = ipog_with(&levels, t, &cons, &[]).unwrap();
             for r in 0..a.len() {

@@ -195,3 +195,17 @@ pub fn coverage_with_constraints(
     }
     (covered, total)
 }
+
+/// Test helper: constraints forbidding the pairs `(column, level, column, level)` drawn by a
+/// property test, folded into range (pairs on one column are dropped).
+#[cfg(test)]
+pub(crate) fn forbidden_pairs(levels: &[u32], pairs: &[(usize, u32, usize, u32)]) -> Constraints {
+    let k = levels.len();
+    Constraints::new(
+        pairs
+            .iter()
+            .filter(|&&(a, _, b, _)| a % k != b % k)
+            .map(|&(a, va, b, vb)| vec![(a % k, va % levels[a % k]), (b % k, vb % levels[b % k])])
+            .collect(),
+    )
+}

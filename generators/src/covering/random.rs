@@ -154,33 +154,19 @@ pub fn random_until_covered_with(
 ) -> Result<CoveringArray, CoveringError> {
     check(levels, t)?;
     let k = levels.len();
-    let mut subsets: Vec<(Vec<usize>, Vec<u64>, Vec<bool>)> = Vec::new();
-    let mut cur: Vec<usize> = (0..t).collect();
-    loop {
-        let mut strides = vec![0u64; t];
-        let mut size = 1u64;
-        for (s, &c) in strides.iter_mut().zip(&cur).rev() {
-            *s = size;
-            size *= u64::from(levels[c]);
-        }
-        subsets.push((cur.clone(), strides, vec![false; size as usize]));
-        let mut i = t;
-        let mut moved = false;
-        while i > 0 {
-            i -= 1;
-            if cur[i] < k - (t - i) {
-                cur[i] += 1;
-                for j in i + 1..t {
-                    cur[j] = cur[j - 1] + 1;
-                }
-                moved = true;
-                break;
+    // Per t-subset: its columns, mixed-radix strides, and which combinations were seen.
+    let mut subsets: Vec<(Vec<usize>, Vec<u64>, Vec<bool>)> = crate::coverage::subsets(k, t)
+        .into_iter()
+        .map(|cols| {
+            let mut strides = vec![0u64; t];
+            let mut size = 1u64;
+            for (s, &c) in strides.iter_mut().zip(&cols).rev() {
+                *s = size;
+                size *= u64::from(levels[c]);
             }
-        }
-        if !moved {
-            break;
-        }
-    }
+            (cols, strides, vec![false; size as usize])
+        })
+        .collect();
     // Tuples that no allowed row holds count as seen from the start.
     let mut missing: usize = 0;
     for (cols, strides, seen) in &mut subsets {
@@ -305,12 +291,7 @@ mod tests {
         ) {
             use crate::covering::coverage_with_constraints;
             let k = levels.len();
-            let forbidden: Vec<Vec<(usize, u32)>> = pairs
-                .iter()
-                .filter(|&&(a, _, b, _)| a % k != b % k)
-                .map(|&(a, va, b, vb)| vec![(a % k, va % levels[a % k]), (b % k, vb % levels[b % k])])
-                .collect();
-            let cons = Constraints::new(forbidden);
+            let cons = crate::covering::forbidden_pairs(&levels, &pairs);
             proptest::prop_assume!(cons.completable(&levels, &[]));
             let a = random_until_covered_with(&levels, 2, seed, 100_000, &cons, &[]).unwrap();
             for row in a.rows.chunks_exact(k) {
