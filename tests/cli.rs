@@ -196,6 +196,17 @@ fn an_earlier_campaign_is_not_overwritten_without_force() {
     assert_eq!(lines(&dir.path().join("results.jsonl")).len(), 3);
 }
 
+/// Asserts a zero exit (showing stderr otherwise) and parses standard output as JSON.
+fn success_json(o: &Output) -> serde_json::Value {
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_slice(&o.stdout).expect("standard output is JSON")
+}
+
 fn cover(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_paracosm-cover"))
         .args(args)
@@ -273,13 +284,7 @@ fn cover_estimate_reads_fuzz_results_and_csv_and_decides_k_epsilon() {
         "--epsilon",
         "0.2",
     ]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let est: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let est = success_json(&o);
     assert_eq!(est["tests"], 64);
     assert_eq!(est["dispersion"]["lower"].as_f64().unwrap(), d);
     assert_eq!(est["k_epsilon"]["covering"], true);
@@ -406,13 +411,7 @@ fn cover_plan_prints_the_formulas_and_budgets() {
         "0.01",
         "--json",
     ]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let p: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let p = success_json(&o);
     // Prop. 3.2: 2^2 (2 ln 3 - ln 0.01) = 4 (2.197 + 4.605) = 27.2 -> 28.
     assert_eq!(p["random_kwise_prop32"], 28);
     // Union bound: T = 12 tuples, V = 4: ln(1200) / -ln(3/4) = 24.6 -> 25.

@@ -23,12 +23,13 @@ import os
 import subprocess
 import sys
 import time
-import venv
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+from scipy_venv import ensure_venv  # noqa: E402
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 PARACOSM_BIN = REPO_ROOT / "target" / "release" / "paracosm-cover"
-VENV_DIR = Path(os.environ.get("VENV", "/tmp/paracosm-scipy-venv"))
 
 REPEATS = 7
 DISC_N, DISC_D = 4000, 8
@@ -41,18 +42,6 @@ TASKS = [
     ("MD discrepancy, n=4000, d=8", "md_4000x8_ms"),
     ("L2-star discrepancy, n=4000, d=8", "l2star_4000x8_ms"),
 ]
-
-
-def ensure_venv():
-    """Re-execute this script inside VENV_DIR (creating it if needed)."""
-    if Path(sys.prefix).resolve() == VENV_DIR.resolve():
-        return
-    python = VENV_DIR / "bin" / "python"
-    if not python.exists():
-        print(f"creating virtualenv at {VENV_DIR}", file=sys.stderr)
-        venv.create(VENV_DIR, with_pip=True)
-        subprocess.check_call([str(python), "-m", "pip", "install", "-q", "scipy", "numpy"])
-    os.execv(str(python), [str(python), str(Path(__file__).resolve()), *sys.argv[1:]])
 
 
 def best_ms(fn):
@@ -149,5 +138,5 @@ def main():
 
 
 if __name__ == "__main__":
-    ensure_venv()
+    ensure_venv(__file__)
     main()
