@@ -16,6 +16,7 @@ mod error;
 mod lidar;
 mod pedestrian;
 mod road;
+pub mod rx;
 mod sim;
 mod spec;
 pub mod sut;

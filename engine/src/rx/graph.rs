@@ -1,0 +1,209 @@
+use std::fmt;
+use std::sync::Arc;
+
+use super::{OpenStream, RxError, Value};
+
+/// Index of a stream in its [`Graph`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct StreamId(pub usize);
+
+/// A native function on stream values: arguments in, a value or an error message out.
+pub type NativeFn = Arc<dyn Fn(&[Value]) -> Result<Value, String> + Send + Sync>;
+
+/// A function a combinator applies.
+#[derive(Clone)]
+pub enum Func {
+    /// A Rust closure, with a name for messages.
+    Native(&'static str, NativeFn),
+    /// Host function number `n` (a Starlark lambda), called through [`super::Host`].
+    Host(u32),
+}
+
+impl Func {
+    /// A named native function.
+    pub fn native(
+        name: &'static str,
+        f: impl Fn(&[Value]) -> Result<Value, String> + Send + Sync + 'static,
+    ) -> Self {
+        Func::Native(name, Arc::new(f))
+    }
+}
+
+impl fmt::Debug for Func {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Func::Native(name, _) => write!(f, "Native({name})"),
+            Func::Host(n) => write!(f, "Host({n})"),
+        }
+    }
+}
+
+/// One stream of a graph. Combinators name their inputs by [`StreamId`].
+#[derive(Debug, Clone)]
+pub enum Node {
+    /// `Const(v)`: `v` at every step.
+    Const(Value),
+    /// `tick`: the time in seconds at every step.
+    Tick,
+    /// An open parameter slot, bound to a test case's values by [`Graph::bind`].
+    Param(usize),
+    /// A bound open input stream.
+    Open(OpenStream),
+    /// Physics output number `n` (a position, a velocity, a contact flag...), read through
+    /// [`super::Inputs`] at every step.
+    Probe(u32),
+    /// `src.map(f)`.
+    Map {
+        /// Source.
+        src: StreamId,
+        /// Function of one argument.
+        f: Func,
+    },
+    /// `src.filter(p)`.
+    Filter {
+        /// Source.
+        src: StreamId,
+        /// Predicate of one argument, returning a bool.
+        pred: Func,
+    },
+    /// `a.zip(b)`: pairs as [`Value::Tuple`].
+    Zip(StreamId, StreamId),
+    /// `src.take(n)`.
+    Take {
+        /// Source.
+        src: StreamId,
+        /// Number of events passed.
+        n: u64,
+    },
+    /// `src.skipUntil(trigger)`.
+    SkipUntil {
+        /// Source.
+        src: StreamId,
+        /// The stream whose first event opens the gate.
+        trigger: StreamId,
+    },
+    /// `src.takeUntil(stop)`.
+    TakeUntil {
+        /// Source.
+        src: StreamId,
+        /// The stream whose first event closes the gate.
+        stop: StreamId,
+    },
+    /// `a.concat(b)`.
+    Concat(StreamId, StreamId),
+    /// `src.sum()` (with `f: None`, adding numbers or vectors) or `src.sum(init, f)`.
+    Sum {
+        /// Source.
+        src: StreamId,
+        /// Initial accumulator: the first event emits `init + v` (or `f(init, v)`).
+        init: Value,
+        /// Fold `acc, v -> acc`; `None` adds.
+        f: Option<Func>,
+    },
+    /// `src.foreach(sink)`: each event goes to sink number `sink`, which acts on an object.
+    Foreach {
+        /// Source.
+        src: StreamId,
+        /// The sink's number, interpreted by the caller.
+        sink: u32,
+    },
+}
+
+impl Node {
+    /// The streams this node reads.
+    pub fn inputs(&self) -> Vec<StreamId> {
+        match self {
+            Node::Const(_) | Node::Tick | Node::Param(_) | Node::Open(_) | Node::Probe(_) => {
+                vec![]
+            }
+            Node::Map { src, .. }
+            | Node::Filter { src, .. }
+            | Node::Take { src, .. }
+            | Node::Sum { src, .. }
+            | Node::Foreach { src, .. } => vec![*src],
+            Node::Zip(a, b) | Node::Concat(a, b) => vec![*a, *b],
+            Node::SkipUntil { src, trigger: o } | Node::TakeUntil { src, stop: o } => {
+                vec![*src, *o]
+            }
+        }
+    }
+}
+
+/// A checked stream graph: nodes plus their evaluation order.
+#[derive(Debug, Clone)]
+pub struct Graph {
+    nodes: Vec<Node>,
+    order: Vec<usize>,
+}
+
+impl Graph {
+    /// Checks `nodes` and orders them topologically (Kahn's algorithm; ties in index order, so
+    /// the order is deterministic).
+    ///
+    /// # Errors
+    /// [`RxError::Dangling`] for a reference past the end, [`RxError::Cycle`] for a cycle.
+    pub fn new(nodes: Vec<Node>) -> Result<Self, RxError> {
+        let n = nodes.len();
+        let mut indegree = vec![0usize; n];
+        let mut readers = vec![Vec::new(); n];
+        for (i, node) in nodes.iter().enumerate() {
+            for StreamId(j) in node.inputs() {
+                if j >= n {
+                    return Err(RxError::Dangling {
+                        node: i,
+                        missing: j,
+                    });
+                }
+                indegree[i] += 1;
+                readers[j].push(i);
+            }
+        }
+        let mut ready: std::collections::BTreeSet<usize> =
+            (0..n).filter(|&i| indegree[i] == 0).collect();
+        let mut order = Vec::with_capacity(n);
+        while let Some(i) = ready.pop_first() {
+            order.push(i);
+            for &r in &readers[i] {
+                indegree[r] -= 1;
+                if indegree[r] == 0 {
+                    ready.insert(r);
+                }
+            }
+        }
+        if let Some(stuck) = (0..n).find(|&i| indegree[i] > 0) {
+            return Err(RxError::Cycle(stuck));
+        }
+        Ok(Graph { nodes, order })
+    }
+
+    /// The nodes, by [`StreamId`].
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The evaluation order (node indices).
+    pub fn order(&self) -> &[usize] {
+        &self.order
+    }
+
+    /// The graph with every [`Node::Param`]`(slot)` replaced by `Open(values[slot])`: a test
+    /// case closing the open streams.
+    ///
+    /// # Errors
+    /// [`RxError::Unbound`] for a slot past the end of `values`.
+    pub fn bind(&self, values: &[OpenStream]) -> Result<Graph, RxError> {
+        let mut nodes = self.nodes.clone();
+        for (i, node) in nodes.iter_mut().enumerate() {
+            if let Node::Param(slot) = *node {
+                let v = values
+                    .get(slot)
+                    .ok_or(RxError::Unbound { node: i, slot })?;
+                *node = Node::Open(v.clone());
+            }
+        }
+        Ok(Graph {
+            nodes,
+            order: self.order.clone(),
+        })
+    }
+}

@@ -1,0 +1,275 @@
+use std::collections::VecDeque;
+
+use super::{Func, Graph, Node, RxError, StreamId, Value};
+
+/// The physics outputs a graph's [`Node::Probe`]s read, supplied by the simulation each step.
+pub trait Inputs {
+    /// The current value of probe `id`.
+    fn probe(&self, id: u32) -> Value;
+}
+
+/// Calls host functions (Starlark lambdas) for [`Func::Host`].
+pub trait Host {
+    /// Calls host function `f` with `args`.
+    ///
+    /// # Errors
+    /// The function's own failure, as a message.
+    fn call(&mut self, f: u32, args: &[Value]) -> Result<Value, String>;
+}
+
+/// A [`Host`] without functions: every call is an error. For graphs built in Rust.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoHost;
+
+impl Host for NoHost {
+    fn call(&mut self, f: u32, _args: &[Value]) -> Result<Value, String> {
+        Err(format!("no host function {f} in this world"))
+    }
+}
+
+#[derive(Debug, Clone, Default)]
+struct State {
+    value: Option<Value>,
+    fired: bool,
+    done: bool,
+    count: u64,
+    open: bool,
+    queue_a: VecDeque<Value>,
+    queue_b: VecDeque<Value>,
+}
+
+/// A graph being run: each stream's current value, fired flag and internal state.
+#[derive(Debug, Clone)]
+pub struct Runtime {
+    graph: Graph,
+    states: Vec<State>,
+}
+
+impl Runtime {
+    /// A runtime at time zero, before the first step. The graph must be bound (no
+    /// [`Node::Param`] left).
+    pub fn new(graph: Graph) -> Self {
+        let states = vec![State::default(); graph.nodes().len()];
+        Runtime { graph, states }
+    }
+
+    /// The graph.
+    pub fn graph(&self) -> &Graph {
+        &self.graph
+    }
+
+    /// The last value of `id`, `None` before its first event.
+    pub fn current(&self, id: StreamId) -> Option<&Value> {
+        self.states.get(id.0).and_then(|s| s.value.as_ref())
+    }
+
+    /// Whether `id` fired in the last step.
+    pub fn fired(&self, id: StreamId) -> bool {
+        self.states.get(id.0).is_some_and(|s| s.fired)
+    }
+
+    /// Whether `id` has completed.
+    pub fn completed(&self, id: StreamId) -> bool {
+        self.states.get(id.0).is_some_and(|s| s.done)
+    }
+
+    /// Evaluates every stream once for the step at `t_s` seconds, in topological order.
+    /// Events reaching `foreach` sinks are appended to `sinks` as `(sink, value)`, in node
+    /// order.
+    ///
+    /// # Errors
+    /// [`RxError::Type`] for a value of the wrong kind, [`RxError::Host`] when a host function
+    /// fails, [`RxError::Unbound`] for an unbound parameter.
+    pub fn step(
+        &mut self,
+        t_s: f64,
+        inputs: &dyn Inputs,
+        host: &mut dyn Host,
+        sinks: &mut Vec<(u32, Value)>,
+    ) -> Result<(), RxError> {
+        for k in 0..self.graph.order().len() {
+            let i = self.graph.order()[k];
+            let out = self.eval(i, t_s, inputs, host, sinks)?;
+            let s = &mut self.states[i];
+            s.fired = out.is_some();
+            if let Some(v) = out {
+                s.value = Some(v);
+            }
+        }
+        Ok(())
+    }
+
+    fn event(&self, id: StreamId) -> Option<&Value> {
+        let s = &self.states[id.0];
+        if s.fired {
+            s.value.as_ref()
+        } else {
+            None
+        }
+    }
+
+    fn eval(
+        &mut self,
+        i: usize,
+        t_s: f64,
+        inputs: &dyn Inputs,
+        host: &mut dyn Host,
+        sinks: &mut Vec<(u32, Value)>,
+    ) -> Result<Option<Value>, RxError> {
+        if self.states[i].done {
+            return Ok(None);
+        }
+        let done = |s: &Self, id: StreamId| s.states[id.0].done;
+        let node = &self.graph.nodes()[i];
+        let out = match node {
+            Node::Const(v) => Some(v.clone()),
+            Node::Tick => Some(Value::Num(t_s)),
+            Node::Open(o) => Some(o.at(t_s)),
+            Node::Probe(p) => Some(inputs.probe(*p)),
+            Node::Param(slot) => return Err(RxError::Unbound { node: i, slot: *slot }),
+            Node::Map { src, f } => {
+                let f = f.clone();
+                let src = *src;
+                let out = match self.event(src).cloned() {
+                    Some(v) => Some(call(i, &f, &[v], host)?),
+                    None => None,
+                };
+                self.states[i].done = done(self, src);
+                out
+            }
+            Node::Filter { src, pred } => {
+                let (pred, src) = (pred.clone(), *src);
+                let out = match self.event(src).cloned() {
+                    Some(v) => {
+                        let keep = call(i, &pred, std::slice::from_ref(&v), host)?;
+                        match keep.as_bool() {
+                            Some(true) => Some(v),
+                            Some(false) => None,
+                            None => return Err(type_error(i, "filter predicate", "bool", &keep)),
+                        }
+                    }
+                    None => None,
+                };
+                self.states[i].done = done(self, src);
+                out
+            }
+            Node::Zip(a, b) => {
+                let (a, b) = (*a, *b);
+                let (ea, eb) = (self.event(a).cloned(), self.event(b).cloned());
+                let (da, db) = (done(self, a), done(self, b));
+                let s = &mut self.states[i];
+                s.queue_a.extend(ea);
+                s.queue_b.extend(eb);
+                let out = if !s.queue_a.is_empty() && !s.queue_b.is_empty() {
+                    let pair = vec![s.queue_a.pop_front(), s.queue_b.pop_front()];
+                    Some(Value::Tuple(pair.into_iter().flatten().collect()))
+                } else {
+                    None
+                };
+                s.done = (da && s.queue_a.is_empty()) || (db && s.queue_b.is_empty());
+                out
+            }
+            Node::Take { src, n } => {
+                let (src, n) = (*src, *n);
+                let e = self.event(src).cloned();
+                let d = done(self, src);
+                let s = &mut self.states[i];
+                let out = if s.count < n { e } else { None };
+                if out.is_some() {
+                    s.count += 1;
+                }
+                s.done = s.count >= n || d;
+                out
+            }
+            Node::SkipUntil { src, trigger } => {
+                let (src, trigger) = (*src, *trigger);
+                let opened = self.states[trigger.0].fired;
+                let e = self.event(src).cloned();
+                let d = done(self, src);
+                let s = &mut self.states[i];
+                s.open |= opened;
+                s.done = d;
+                if s.open {
+                    e
+                } else {
+                    None
+                }
+            }
+            Node::TakeUntil { src, stop } => {
+                let (src, stop) = (*src, *stop);
+                let closed = self.states[stop.0].fired;
+                let e = self.event(src).cloned();
+                let d = done(self, src);
+                let s = &mut self.states[i];
+                s.done = closed || d;
+                if closed {
+                    None
+                } else {
+                    e
+                }
+            }
+            Node::Concat(a, b) => {
+                let (a, b) = (*a, *b);
+                let a_done = done(self, a);
+                let ea = self.event(a).cloned();
+                let eb = self.event(b).cloned();
+                let b_done = done(self, b);
+                let s = &mut self.states[i];
+                // `a`'s own flag: `open` marks that `a` had completed before this step.
+                if !s.open {
+                    s.queue_a.extend(ea);
+                }
+                if a_done {
+                    s.open = true;
+                    s.queue_a.extend(eb);
+                }
+                let out = s.queue_a.pop_front();
+                s.done = a_done && b_done && s.queue_a.is_empty();
+                out
+            }
+            Node::Sum { src, init, f } => {
+                let (src, f) = (*src, f.clone());
+                let init = init.clone();
+                let out = match self.event(src).cloned() {
+                    Some(v) => {
+                        let acc = self.states[i].value.clone().unwrap_or(init);
+                        Some(match &f {
+                            Some(f) => call(i, f, &[acc, v], host)?,
+                            None => acc.add(&v).ok_or_else(|| {
+                                type_error(i, "sum", "numbers or vectors of one kind", &v)
+                            })?,
+                        })
+                    }
+                    None => None,
+                };
+                self.states[i].done = done(self, src);
+                out
+            }
+            Node::Foreach { src, sink } => {
+                let (src, sink) = (*src, *sink);
+                if let Some(v) = self.event(src) {
+                    sinks.push((sink, v.clone()));
+                }
+                self.states[i].done = done(self, src);
+                None
+            }
+        };
+        Ok(out)
+    }
+}
+
+fn call(node: usize, f: &Func, args: &[Value], host: &mut dyn Host) -> Result<Value, RxError> {
+    match f {
+        Func::Native(_, f) => f(args).map_err(|message| RxError::Type { node, message }),
+        Func::Host(n) => host
+            .call(*n, args)
+            .map_err(|message| RxError::Host { node, message }),
+    }
+}
+
+fn type_error(node: usize, what: &str, expected: &str, got: &Value) -> RxError {
+    RxError::Type {
+        node,
+        message: format!("{what} needs {expected}, got a {}", got.kind()),
+    }
+}
