@@ -7,4 +7,7 @@ pub enum EngineError {
     /// actor off the road...). The message names the field and the offending value.
     #[error("invalid world: {0}")]
     InvalidWorld(String),
+    /// The stream graph failed while running (a lambda raised, a value of the wrong kind).
+    #[error(transparent)]
+    Stream(#[from] crate::rx::RxError),
 }

@@ -1,6 +1,7 @@
-//! The simulation core of paracosm: a `rapier3d` world with a straight road, a physical ego
-//! vehicle (rapier's ray-cast vehicle controller), kinematic pedestrians, a ray-cast lidar, and
-//! the systems under test that drive the ego vehicle.
+//! The simulation core of paracosm: the reactive stream runtime, road networks, a `rapier3d`
+//! world with a physical ego vehicle (rapier's ray-cast vehicle controller), kinematic
+//! pedestrians and NPC cars, a ray-cast lidar, and the systems under test that drive the ego
+//! vehicle.
 //!
 //! Frame of reference (right-handed, SI units): `x` runs along the road in the driving direction
 //! of the positive lanes, `y` points up, `z` points to the right of a driver on a positive lane.
@@ -11,22 +12,30 @@
 //! bit-identically on every run, thread and CPU.
 #![warn(missing_docs)]
 
+pub mod behaviour;
+mod car;
 mod control;
+mod environment;
 mod error;
 mod lidar;
+pub mod network;
 mod pedestrian;
-mod road;
+pub mod placement;
 pub mod rx;
 mod sim;
 mod spec;
 pub mod sut;
 mod vehicle;
 
+pub use car::CarState;
 pub use control::Control;
+pub use environment::{visibility_m, FOG_EXTINCTION_PER_M};
 pub use error::EngineError;
 pub use lidar::{LidarReturn, LidarSpec};
+pub use network::{Lane, Location, Network, PieceId, PieceKind};
 pub use pedestrian::{PedestrianPhase, PedestrianState};
-pub use road::{Lane, RoadSegment};
 pub use sim::{EgoState, Observation, Simulation, Snapshot};
-pub use spec::{EgoSpec, PedestrianSpec, RoadSpec, WorldSpec, DEFAULT_DT_S};
+pub use spec::{
+    CarSpec, EgoSpec, EnvironmentSpec, PedestrianSpec, TriggeredPedestrian, WorldSpec, DEFAULT_DT_S,
+};
 pub use vehicle::VehicleParams;

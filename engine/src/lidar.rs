@@ -87,7 +87,7 @@ impl LidarSpec {
     }
 
     /// Casts every beam from the mount of the chassis at `chassis` (pose), ignoring the
-    /// vehicle's own body. Sees fixed geometry and actors, including sensor colliders
+    /// vehicle's own body, out to `range_m` metres (the spec's range, or less in fog). Sees fixed geometry and actors, including sensor colliders
     /// (pedestrians).
     pub(crate) fn scan(
         &self,
@@ -95,6 +95,7 @@ impl LidarSpec {
         chassis: &Pose,
         own_body: RigidBodyHandle,
         directions: &[(f64, f64)],
+        range_m: f64,
         out: &mut Vec<LidarReturn>,
     ) {
         out.clear();
@@ -114,7 +115,7 @@ impl LidarSpec {
                 -(el.cos() * az.sin()) as f32,
             );
             let ray = Ray::new(origin, chassis.rotation * local);
-            if let Some((_, toi)) = queries.cast_ray(&ray, self.range_m as f32, true) {
+            if let Some((_, toi)) = queries.cast_ray(&ray, range_m as f32, true) {
                 let p = mount_local + local * toi;
                 out.push(LidarReturn {
                     azimuth_rad: az,

@@ -30,27 +30,20 @@ pub struct PedestrianState {
 }
 
 /// A kinematic pedestrian: a sensor capsule moved by position, not by forces. It never pushes
-/// the car; contact is reported through collision events on the sensor.
+/// the car; contact is reported through collision events on the sensor. Its behaviour comes
+/// from the stream graph: each event on its `walk` sink moves it one step toward the target.
 pub(crate) struct Pedestrian {
     pub(crate) body: RigidBodyHandle,
     pub(crate) collider: ColliderHandle,
-    start: [f64; 3],
     target: [f64; 3],
-    trigger_distance_m: f64,
-    speed_mps: f64,
     pos: [f64; 3],
+    velocity: [f64; 3],
     phase: PedestrianPhase,
     triggered_at_s: Option<f64>,
 }
 
 impl Pedestrian {
-    pub(crate) fn build(
-        physics: &mut PhysicsWorld,
-        start: [f64; 3],
-        target: [f64; 3],
-        trigger_distance_m: f64,
-        speed_mps: f64,
-    ) -> Self {
+    pub(crate) fn build(physics: &mut PhysicsWorld, start: [f64; 3], target: [f64; 3]) -> Self {
         let body = RigidBodyBuilder::kinematic_position_based().translation(centre(start));
         let collider = ColliderBuilder::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M)
             .sensor(true)
@@ -59,46 +52,54 @@ impl Pedestrian {
         Pedestrian {
             body,
             collider,
-            start,
             target,
-            trigger_distance_m,
-            speed_mps,
             pos: start,
+            velocity: [0.0; 3],
             phase: PedestrianPhase::Waiting,
             triggered_at_s: None,
         }
     }
 
-    /// Advances the behaviour by one step of `dt_s` seconds, at time `t_s`, with the ego
-    /// vehicle's centre at `ego_pos` (m). Sets the kinematic target of the next physics step.
-    pub(crate) fn tick(
-        &mut self,
-        physics: &mut PhysicsWorld,
-        t_s: f64,
-        dt_s: f64,
-        ego_pos: [f64; 3],
-    ) {
+    /// One walking step at time `t_s`: `speed_mps · dt_s` metres toward the target, stopping
+    /// there. Sets the kinematic target of the next physics step. The first step marks the
+    /// trigger time.
+    pub(crate) fn walk(&mut self, physics: &mut PhysicsWorld, t_s: f64, dt_s: f64, speed_mps: f64) {
         if self.phase == PedestrianPhase::Waiting {
-            let d = (ego_pos[0] - self.start[0]).hypot(ego_pos[2] - self.start[2]);
-            if d < self.trigger_distance_m {
-                self.phase = PedestrianPhase::Walking;
-                self.triggered_at_s = Some(t_s);
+            self.phase = PedestrianPhase::Walking;
+            self.triggered_at_s = Some(t_s);
+        }
+        if self.phase != PedestrianPhase::Walking {
+            return;
+        }
+        let delta = [0, 1, 2].map(|i| self.target[i] - self.pos[i]);
+        let remaining = delta.iter().map(|d| d * d).sum::<f64>().sqrt();
+        let step = speed_mps.max(0.0) * dt_s;
+        let before = self.pos;
+        if remaining <= step {
+            self.pos = self.target;
+            self.phase = PedestrianPhase::Arrived;
+        } else {
+            for (p, d) in self.pos.iter_mut().zip(delta) {
+                *p += d / remaining * step;
             }
         }
-        if self.phase == PedestrianPhase::Walking {
-            let delta = [0, 1, 2].map(|i| self.target[i] - self.pos[i]);
-            let remaining = delta.iter().map(|d| d * d).sum::<f64>().sqrt();
-            let step = self.speed_mps * dt_s;
-            if remaining <= step {
-                self.pos = self.target;
-                self.phase = PedestrianPhase::Arrived;
-            } else {
-                for (p, d) in self.pos.iter_mut().zip(delta) {
-                    *p += d / remaining * step;
-                }
-            }
-            physics.bodies[self.body].set_next_kinematic_translation(centre(self.pos));
-        }
+        self.velocity = [0, 1, 2].map(|i| (self.pos[i] - before[i]) / dt_s);
+        physics.bodies[self.body].set_next_kinematic_translation(centre(self.pos));
+    }
+
+    /// Clears the velocity of a step without a walk event.
+    pub(crate) fn rest(&mut self) {
+        self.velocity = [0.0; 3];
+    }
+
+    /// Feet position `[x, y, z]` in metres.
+    pub(crate) fn pos(&self) -> [f64; 3] {
+        self.pos
+    }
+
+    /// Velocity `[x, y, z]` in m/s over the last step.
+    pub(crate) fn velocity(&self) -> [f64; 3] {
+        self.velocity
     }
 
     pub(crate) fn state(&self) -> PedestrianState {
@@ -124,29 +125,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn waits_until_triggered_then_walks_at_its_speed_and_stops_at_the_target() {
+    fn walks_at_its_speed_marks_the_trigger_time_and_stops_at_the_target() {
         let mut physics = PhysicsWorld::new();
-        let mut p = Pedestrian::build(
-            &mut physics,
-            [100.0, 0.0, 4.0],
-            [100.0, 0.0, -4.0],
-            20.0,
-            2.0,
-        );
+        let mut p = Pedestrian::build(&mut physics, [100.0, 0.0, 4.0], [100.0, 0.0, -4.0]);
         let dt = 0.1;
-        // Ego 30 m away: nothing happens.
-        p.tick(&mut physics, 0.0, dt, [70.0, 0.8, 1.75]);
         assert_eq!(p.state().phase, PedestrianPhase::Waiting);
-        assert_eq!(p.state().pos_m, [100.0, 0.0, 4.0]);
-        // Ego 19.9 m away (planar): triggered, first step of 0.2 m.
-        p.tick(&mut physics, 0.1, dt, [80.1, 0.8, 4.0]);
+        p.walk(&mut physics, 0.1, dt, 2.0);
         let s = p.state();
         assert_eq!(s.phase, PedestrianPhase::Walking);
         assert_eq!(s.triggered_at_s, Some(0.1));
         assert!((s.pos_m[2] - 3.8).abs() < 1e-12);
+        assert!((p.velocity()[2] + 2.0).abs() < 1e-9);
         // 8 m at 0.2 m per step: arrives after 40 steps in all, and stays.
         for i in 0..45 {
-            p.tick(&mut physics, 0.2 + 0.1 * i as f64, dt, [200.0, 0.8, 0.0]);
+            p.walk(&mut physics, 0.2 + 0.1 * i as f64, dt, 2.0);
         }
         assert_eq!(p.state().phase, PedestrianPhase::Arrived);
         assert_eq!(p.state().pos_m, [100.0, 0.0, -4.0]);

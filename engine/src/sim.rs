@@ -3,11 +3,14 @@ use std::sync::mpsc::{channel, Receiver};
 use rapier3d::prelude::*;
 use serde::Serialize;
 
+use crate::behaviour::{decode_probe, Actor, Output};
+use crate::car::{Car, CarState};
+use crate::network::{Lane, Network};
 use crate::pedestrian::Pedestrian;
+use crate::rx::{Host, Inputs, Runtime, StreamId, Value};
+use crate::spec::EnvironmentSpec;
 use crate::vehicle::EgoVehicle;
-use crate::{
-    Control, EngineError, LidarReturn, LidarSpec, PedestrianState, RoadSegment, WorldSpec,
-};
+use crate::{visibility_m, Control, EngineError, LidarReturn, LidarSpec, PedestrianState, WorldSpec};
 
 /// The ego vehicle's state.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -31,6 +34,8 @@ pub struct Observation<'a> {
     pub ego: EgoState,
     /// The latest lidar scan, in the vehicle frame.
     pub lidar: &'a [LidarReturn],
+    /// The route to follow, world `[x, z]` in metres (navigation); empty: keep the lane.
+    pub route: &'a [[f64; 2]],
 }
 
 /// The world's state after a step: what monitors are computed from.
@@ -42,20 +47,33 @@ pub struct Snapshot {
     pub ego: EgoState,
     /// Every pedestrian, in the order of [`WorldSpec::pedestrians`].
     pub pedestrians: Vec<PedestrianState>,
-    /// Whether the ego vehicle's body touches a pedestrian's sensor now (collision events).
-    pub ego_pedestrian_contact: bool,
-    /// The smallest distance between the ego vehicle's body and a pedestrian's capsule, in
-    /// metres; `0` when touching, `+inf` without pedestrians.
-    pub min_pedestrian_separation_m: f64,
+    /// Every NPC car, in the order of [`WorldSpec::cars`].
+    pub cars: Vec<CarState>,
+    /// Whether the ego vehicle's body touches a pedestrian or a car now (collision events).
+    pub ego_contact: bool,
+    /// The smallest distance between the ego vehicle's body and a pedestrian's capsule or a
+    /// car's body, in metres; `0` when touching, `+inf` without actors.
+    pub min_separation_m: f64,
+    /// Light intensity now, `[0, 1]`.
+    pub light: f64,
+    /// Fog density now, `[0, 1]`.
+    pub fog: f64,
 }
 
-/// A running world: the physics, the actors and the ego vehicle's sensors, advanced in fixed
-/// steps by [`Simulation::step`].
+/// A running world: the physics, the actors, the stream graph that drives them, and the ego
+/// vehicle's sensors, advanced in fixed steps by [`Simulation::step`].
 pub struct Simulation {
     physics: PhysicsWorld,
-    road: RoadSegment,
+    network: Network,
     ego: EgoVehicle,
+    route: Vec<[f64; 2]>,
     pedestrians: Vec<Pedestrian>,
+    cars: Vec<Car>,
+    speeds: (Vec<StreamId>, Vec<StreamId>),
+    environment: EnvironmentSpec,
+    light_fog: (f64, f64),
+    streams: Runtime,
+    sinks: Vec<(u32, Value)>,
     touching: Vec<bool>,
     lidar: LidarSpec,
     directions: Vec<(f64, f64)>,
@@ -71,8 +89,8 @@ impl Simulation {
     /// Builds the world described by `spec`.
     ///
     /// # Errors
-    /// [`EngineError::InvalidWorld`] when the road, a position, a speed, the lidar or the step
-    /// is invalid; the message says which.
+    /// [`EngineError::InvalidWorld`] when a position, a speed, the lidar, the step or a car's
+    /// path is invalid; the message says which.
     pub fn new(spec: &WorldSpec) -> Result<Self, EngineError> {
         let invalid = |m: String| EngineError::InvalidWorld(m);
         if !(spec.dt_s.is_finite() && spec.dt_s > 0.0) {
@@ -82,8 +100,7 @@ impl Simulation {
             )));
         }
         spec.lidar.validate().map_err(invalid)?;
-        let road = RoadSegment::new(spec.road.clone())?;
-        if !matches!(spec.ego.lane, crate::Lane::Driving(_)) {
+        if !matches!(spec.ego.start.lane, Lane::Driving(_)) {
             return Err(invalid(
                 "the ego vehicle must start on a driving lane".into(),
             ));
@@ -96,41 +113,43 @@ impl Simulation {
         }
         let mut physics = PhysicsWorld::new();
         physics.integration_parameters.dt = spec.dt_s as f32;
-        road.build(&mut physics);
+        spec.network.build(&mut physics);
 
-        let start = road.on_lane(spec.ego.lane, spec.ego.at_m)?;
-        // Positive lanes drive along +x, negative ones along -x.
-        let heading = match spec.ego.lane {
-            crate::Lane::Driving(k) if k < 0 => std::f64::consts::PI,
-            _ => 0.0,
-        };
+        let start = spec.ego.start;
+        // The tyres grip with the friction of the piece the ego vehicle starts on.
+        let friction = spec.network.piece(start.piece).kind.friction();
         let ego = EgoVehicle::build(
             &mut physics,
             &spec.ego.vehicle,
-            start,
-            heading,
+            start.pos_m,
+            start.heading_rad,
             spec.ego.initial_speed_mps,
-            spec.road.friction,
+            friction,
         );
 
-        let mut pedestrians = Vec::with_capacity(spec.pedestrians.len());
-        for (i, p) in spec.pedestrians.iter().enumerate() {
-            let ok = |v: f64| v.is_finite() && v > 0.0;
-            if !ok(p.speed_mps) || !ok(p.trigger_distance_m) {
-                return Err(invalid(format!(
-                    "pedestrian {i}: speed {} m/s and trigger distance {} m must be positive",
-                    p.speed_mps, p.trigger_distance_m
-                )));
+        let pedestrians: Vec<Pedestrian> = spec
+            .pedestrians
+            .iter()
+            .map(|p| Pedestrian::build(&mut physics, p.start, p.target))
+            .collect();
+        let mut cars = Vec::with_capacity(spec.cars.len());
+        for (i, c) in spec.cars.iter().enumerate() {
+            if c.path.len() < 2 || c.path.iter().flatten().any(|v| !v.is_finite()) {
+                return Err(invalid(format!("car {i} has no route of two or more points")));
             }
-            let s = road.on_lane(p.start.0, p.start.1)?;
-            let t = road.on_lane(p.target.0, p.target.1)?;
-            pedestrians.push(Pedestrian::build(
-                &mut physics,
-                s,
-                t,
-                p.trigger_distance_m,
-                p.speed_mps,
-            ));
+            cars.push(Car::build(&mut physics, c.path.clone(), c.size_m, c.enabled));
+        }
+        let n = spec.streams.nodes().len();
+        let ids = spec
+            .pedestrians
+            .iter()
+            .map(|p| p.speed)
+            .chain(spec.cars.iter().map(|c| c.speed))
+            .chain([spec.environment.light, spec.environment.fog]);
+        for id in ids {
+            if id.0 >= n {
+                return Err(invalid(format!("stream {} does not exist", id.0)));
+            }
         }
 
         let (collision_tx, events) = channel();
@@ -139,10 +158,20 @@ impl Simulation {
         let scan_every = ((1.0 / (spec.lidar.rate_hz * spec.dt_s)).round() as u64).max(1);
         let mut sim = Simulation {
             physics,
-            road,
-            touching: vec![false; pedestrians.len()],
+            network: spec.network.clone(),
+            route: spec.ego.route.clone(),
+            touching: vec![false; pedestrians.len() + cars.len()],
             ego,
             pedestrians,
+            cars,
+            speeds: (
+                spec.pedestrians.iter().map(|p| p.speed).collect(),
+                spec.cars.iter().map(|c| c.speed).collect(),
+            ),
+            environment: spec.environment,
+            light_fog: (1.0, 0.0),
+            streams: Runtime::new(spec.streams.clone()),
+            sinks: Vec::new(),
             directions: spec.lidar.directions(),
             lidar: spec.lidar.clone(),
             scan_every,
@@ -168,43 +197,70 @@ impl Simulation {
         self.dt_s
     }
 
-    /// The road.
-    pub fn road(&self) -> &RoadSegment {
-        &self.road
+    /// The road network.
+    pub fn network(&self) -> &Network {
+        &self.network
     }
 
     /// The ego vehicle's state now.
     pub fn ego_state(&self) -> EgoState {
-        let body = &self.physics.bodies[self.ego.body];
-        let p = body.translation();
-        let forward = *body.rotation() * Vector::X;
-        EgoState {
-            pos_m: [p.x, p.y, p.z].map(f64::from),
-            heading_rad: f64::from(-forward.z).atan2(f64::from(forward.x)),
-            speed_mps: f64::from(body.linvel().dot(forward)),
-        }
+        ego_state(&self.physics, &self.ego)
     }
 
-    /// What the system under test sees now: odometry and the latest lidar scan.
+    /// What the system under test sees now: odometry, the latest lidar scan and its route.
     pub fn observation(&self) -> Observation<'_> {
         Observation {
             t_s: self.t_s(),
             dt_s: self.dt_s,
             ego: self.ego_state(),
             lidar: &self.scan,
+            route: &self.route,
         }
     }
 
-    /// Advances the world by one step of `dt` under `control`: vehicle model, actor behaviours,
-    /// rapier step, contact events, and a lidar scan when one is due.
-    pub fn step(&mut self, control: Control) {
+    /// Advances the world by one step of `dt` under `control`: vehicle model, the stream graph
+    /// (actor behaviours, light and fog), NPC cars, rapier step, contact events, and a lidar
+    /// scan when one is due. `host` runs the graph's lambdas.
+    ///
+    /// # Errors
+    /// [`EngineError::Stream`] when the stream graph fails (a lambda raised, a value of the
+    /// wrong kind).
+    pub fn step(&mut self, control: Control, host: &mut dyn Host) -> Result<(), EngineError> {
         let dt = self.dt_s;
         self.ego.apply(control, dt);
         self.ego.update(&mut self.physics, dt);
         let t = self.t_s();
-        let ego_pos = self.ego_state().pos_m;
+        self.sinks.clear();
+        let inputs = WorldInputs {
+            physics: &self.physics,
+            ego: &self.ego,
+            pedestrians: &self.pedestrians,
+            cars: &self.cars,
+            touching: &self.touching,
+        };
+        self.streams.step(t, &inputs, host, &mut self.sinks)?;
+        let num = |rt: &Runtime, id: StreamId, default: f64| {
+            rt.current(id).and_then(Value::as_num).unwrap_or(default)
+        };
+        self.light_fog = (
+            num(&self.streams, self.environment.light, 1.0),
+            num(&self.streams, self.environment.fog, 0.0),
+        );
         for p in &mut self.pedestrians {
-            p.tick(&mut self.physics, t, dt, ego_pos);
+            p.rest();
+        }
+        for (sink, _) in &self.sinks {
+            let i = *sink as usize;
+            if let (Some(p), Some(&speed)) = (self.pedestrians.get_mut(i), self.speeds.0.get(i)) {
+                p.walk(&mut self.physics, t, dt, num(&self.streams, speed, 0.0));
+            }
+        }
+        for (car, &speed) in self.cars.iter_mut().zip(&self.speeds.1) {
+            car.advance(&mut self.physics, num(&self.streams, speed, 0.0), dt);
+        }
+        if self.tick == 0 {
+            // The first scan was taken before light and fog were known.
+            self.rescan();
         }
         self.physics.step_with_events(&(), &self.collector);
         while let Ok(event) = self.events.try_recv() {
@@ -219,7 +275,12 @@ impl Simulation {
             } else {
                 continue;
             };
-            if let Some(i) = self.pedestrians.iter().position(|p| p.collider == other) {
+            let actors = self
+                .pedestrians
+                .iter()
+                .map(|p| Some(p.collider))
+                .chain(self.cars.iter().map(|c| c.body.map(|(_, c)| c)));
+            if let Some(i) = actors.into_iter().position(|c| c == Some(other)) {
                 self.touching[i] = started;
             }
         }
@@ -227,16 +288,20 @@ impl Simulation {
         if self.tick % self.scan_every == 0 {
             self.rescan();
         }
+        Ok(())
     }
 
     /// The state monitors are computed from.
     pub fn snapshot(&self) -> Snapshot {
         let chassis = &self.physics.colliders[self.ego.collider];
-        let min_sep = self
+        let colliders = self
             .pedestrians
             .iter()
-            .filter_map(|p| {
-                let c = &self.physics.colliders[p.collider];
+            .map(|p| p.collider)
+            .chain(self.cars.iter().filter_map(|c| c.body.map(|(_, c)| c)));
+        let min_sep = colliders
+            .filter_map(|handle| {
+                let c = &self.physics.colliders[handle];
                 rapier3d::parry::query::distance(
                     chassis.position(),
                     chassis.shape(),
@@ -251,8 +316,11 @@ impl Simulation {
             t_s: self.t_s(),
             ego: self.ego_state(),
             pedestrians: self.pedestrians.iter().map(Pedestrian::state).collect(),
-            ego_pedestrian_contact: self.touching.iter().any(|&t| t),
-            min_pedestrian_separation_m: min_sep,
+            cars: self.cars.iter().map(Car::state).collect(),
+            ego_contact: self.touching.iter().any(|&t| t),
+            min_separation_m: min_sep,
+            light: self.light_fog.0,
+            fog: self.light_fog.1,
         }
     }
 
@@ -263,43 +331,113 @@ impl Simulation {
 
     fn rescan(&mut self) {
         let pose = *self.physics.bodies[self.ego.body].position();
+        let range_m = self.lidar.range_m.min(visibility_m(self.light_fog.1));
         self.lidar.scan(
             &self.physics,
             &pose,
             self.ego.body,
             &self.directions,
+            range_m,
             &mut self.scan,
         );
+    }
+}
+
+fn ego_state(physics: &PhysicsWorld, ego: &EgoVehicle) -> EgoState {
+    let body = &physics.bodies[ego.body];
+    let p = body.translation();
+    let forward = *body.rotation() * Vector::X;
+    EgoState {
+        pos_m: [p.x, p.y, p.z].map(f64::from),
+        heading_rad: f64::from(-forward.z).atan2(f64::from(forward.x)),
+        speed_mps: f64::from(body.linvel().dot(forward)),
+    }
+}
+
+/// The physics outputs the stream graph reads.
+struct WorldInputs<'a> {
+    physics: &'a PhysicsWorld,
+    ego: &'a EgoVehicle,
+    pedestrians: &'a [Pedestrian],
+    cars: &'a [Car],
+    touching: &'a [bool],
+}
+
+impl Inputs for WorldInputs<'_> {
+    fn probe(&self, id: u32) -> Value {
+        let (actor, output) = decode_probe(id);
+        match actor {
+            Actor::Ego => {
+                let s = ego_state(self.physics, self.ego);
+                match output {
+                    Output::Pos => Value::Vec3(s.pos_m),
+                    Output::Vel => {
+                        let v = self.physics.bodies[self.ego.body].linvel();
+                        Value::Vec3([v.x, v.y, v.z].map(f64::from))
+                    }
+                    Output::Heading => Value::Num(s.heading_rad),
+                    Output::Speed => Value::Num(s.speed_mps),
+                    Output::Collision => Value::Bool(self.touching.iter().any(|&t| t)),
+                }
+            }
+            Actor::Pedestrian(i) => match self.pedestrians.get(i as usize) {
+                None => Value::Unit,
+                Some(p) => {
+                    let v = p.velocity();
+                    match output {
+                        Output::Pos => Value::Vec3(p.pos()),
+                        Output::Vel => Value::Vec3(v),
+                        Output::Heading => Value::Num((-v[2]).atan2(v[0])),
+                        Output::Speed => Value::Num(v[0].hypot(v[2])),
+                        Output::Collision => Value::Bool(self.touching[i as usize]),
+                    }
+                }
+            },
+            Actor::Car(i) => match self.cars.get(i as usize) {
+                None => Value::Unit,
+                Some(c) => {
+                    let s = c.state();
+                    let d = crate::network::direction(s.heading_rad);
+                    match output {
+                        Output::Pos => Value::Vec3(s.pos_m),
+                        Output::Vel => Value::Vec3([d[0] * s.speed_mps, 0.0, d[1] * s.speed_mps]),
+                        Output::Heading => Value::Num(s.heading_rad),
+                        Output::Speed => Value::Num(s.speed_mps),
+                        Output::Collision => {
+                            Value::Bool(self.touching[self.pedestrians.len() + i as usize])
+                        }
+                    }
+                }
+            },
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{EgoSpec, Lane, LidarSpec, PedestrianSpec, RoadSpec, VehicleParams};
+    use crate::rx::NoHost;
+    use crate::{EgoSpec, Lane, TriggeredPedestrian};
 
     fn spec() -> WorldSpec {
-        WorldSpec {
-            dt_s: crate::DEFAULT_DT_S,
-            road: RoadSpec::default(),
-            ego: EgoSpec {
-                lane: Lane::Driving(1),
-                at_m: 10.0,
-                initial_speed_mps: 5.0,
-                vehicle: VehicleParams::default(),
-            },
-            pedestrians: vec![PedestrianSpec {
+        WorldSpec::straight_road(
+            200.0,
+            10.0,
+            5.0,
+            &[TriggeredPedestrian {
                 start: (Lane::Driving(1), 40.0),
                 target: (Lane::Driving(1), 40.0),
                 trigger_distance_m: 1e-6,
                 speed_mps: 1.0,
             }],
-            lidar: LidarSpec::default(),
-        }
+        )
+        .unwrap()
     }
 
     #[test]
     fn invalid_worlds_are_errors_naming_the_problem() {
+        let mut sidewalk = spec();
+        sidewalk.ego.start.lane = Lane::SideWalk;
         let cases: Vec<(WorldSpec, &str)> = vec![
             (
                 WorldSpec {
@@ -308,16 +446,7 @@ mod tests {
                 },
                 "time step",
             ),
-            (
-                WorldSpec {
-                    ego: EgoSpec {
-                        lane: Lane::SideWalk,
-                        ..spec().ego
-                    },
-                    ..spec()
-                },
-                "driving lane",
-            ),
+            (sidewalk, "driving lane"),
             (
                 WorldSpec {
                     ego: EgoSpec {
@@ -327,16 +456,6 @@ mod tests {
                     ..spec()
                 },
                 "initial speed",
-            ),
-            (
-                WorldSpec {
-                    pedestrians: vec![PedestrianSpec {
-                        speed_mps: 0.0,
-                        ..spec().pedestrians[0].clone()
-                    }],
-                    ..spec()
-                },
-                "pedestrian 0",
             ),
             (
                 WorldSpec {
@@ -356,6 +475,18 @@ mod tests {
                 .to_string();
             assert!(err.contains(needle), "{err}");
         }
+        let bad_ped = WorldSpec::straight_road(
+            200.0,
+            10.0,
+            5.0,
+            &[TriggeredPedestrian {
+                start: (Lane::SideWalk, 50.0),
+                target: (Lane::OppositeSideWalk, 50.0),
+                trigger_distance_m: 10.0,
+                speed_mps: 0.0,
+            }],
+        );
+        assert!(bad_ped.unwrap_err().to_string().contains("pedestrian 0"));
     }
 
     #[test]
@@ -377,18 +508,31 @@ mod tests {
         // Pedestrian centre 30 m ahead of the chassis centre, capsule radius 0.3 m.
         assert!((ahead - 29.7).abs() < 0.05, "nearest return at {ahead} m");
         let snap = sim.snapshot();
-        assert!(!snap.ego_pedestrian_contact);
+        assert!(!snap.ego_contact);
         // 30 m between centres, less half the car (2.25 m) and the capsule radius (0.3 m).
-        assert!((snap.min_pedestrian_separation_m - 27.45).abs() < 0.05);
+        assert!((snap.min_separation_m - 27.45).abs() < 0.05);
     }
 
     #[test]
     fn time_advances_by_whole_steps() {
         let mut sim = Simulation::new(&spec()).unwrap();
         for _ in 0..60 {
-            sim.step(Control::default());
+            sim.step(Control::default(), &mut NoHost).unwrap();
         }
         assert!((sim.t_s() - 1.0).abs() < 1e-12);
         assert_eq!(sim.snapshot().t_s, sim.t_s());
+    }
+
+    #[test]
+    fn fog_shortens_the_lidar_range() {
+        let mut s = spec();
+        let mut nodes = s.streams.nodes().to_vec();
+        // Fog 1: visibility 19.6 m, so the pedestrian 30 m ahead disappears from the scan.
+        nodes[s.environment.fog.0] = crate::rx::Node::Const(Value::Num(1.0));
+        s.streams = crate::rx::Graph::new(nodes).unwrap();
+        let mut sim = Simulation::new(&s).unwrap();
+        sim.step(Control::default(), &mut NoHost).unwrap();
+        assert_eq!(sim.snapshot().fog, 1.0);
+        assert!(sim.observation().lidar.iter().all(|r| r.range_m < 19.6));
     }
 }

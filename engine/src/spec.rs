@@ -1,58 +1,90 @@
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
-use crate::{Lane, LidarSpec, VehicleParams};
+use crate::behaviour::{probe, Actor, GraphBuilder, Output};
+use crate::network::{Lane, Location, Network, PieceId};
+use crate::rx::{Graph, Node, StreamId, Value};
+use crate::{EngineError, LidarSpec, VehicleParams};
 
 /// The default physics step: 1/60 s (rapier's own default).
 pub const DEFAULT_DT_S: f64 = 1.0 / 60.0;
 
-/// A straight road segment along `+x`, starting at `x = 0` (paper §2, `RoadSegment`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct RoadSpec {
-    /// Length along `x`, in metres, `> 0`. Default 200 m (the paper's example).
-    pub length_m: f64,
-    /// Number of driving lanes, even and `>= 2`: half drive along `+x` (lanes `1..=n/2`, right
-    /// of the centre line), half along `-x` (lanes `-1..=-n/2`). Default 2.
-    pub lanes: u32,
-    /// Width of one lane, in metres. Default 3.5 m.
-    pub lane_width_m: f64,
-    /// Width of each of the two sidewalks, in metres. Default 2.0 m.
-    pub sidewalk_width_m: f64,
-    /// Tyre–road friction coefficient, dimensionless, in `(0, 2]`. Default 0.8 (dry asphalt).
-    /// rapier's vehicle controller ignores collider friction, so this becomes each wheel's
-    /// `friction_slip`.
-    pub friction: f64,
-}
-
-impl Default for RoadSpec {
-    fn default() -> Self {
-        RoadSpec {
-            length_m: 200.0,
-            lanes: 2,
-            lane_width_m: 3.5,
-            sidewalk_width_m: 2.0,
-            friction: 0.8,
-        }
-    }
-}
-
-/// The ego vehicle: where it starts and how it is built.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// The ego vehicle (paper §2, `AutonomousVehicle`): where it starts and how it is built.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EgoSpec {
-    /// The lane it starts on (a driving lane).
-    pub lane: Lane,
-    /// Start position along the road, in metres from `x = 0`.
-    pub at_m: f64,
+    /// Start: a driving lane of a segment (`onLane`).
+    pub start: Location,
     /// Initial forward speed in m/s, `>= 0`.
     pub initial_speed_mps: f64,
     /// Mass, dimensions and actuator limits.
     pub vehicle: VehicleParams,
+    /// The route the system under test is asked to follow, world `[x, z]` in metres (a
+    /// navigation plan from the lane graph); empty: keep the start lane.
+    pub route: Vec<[f64; 2]>,
 }
 
-/// A pedestrian that waits at `start`, and walks in a straight line to `target` at `speed_mps`
-/// once the ego vehicle comes within `trigger_distance_m` of `start` (paper §2, "Reactive
-/// Behaviors": `tick.skipUntil(trigger).takeUntil(done).foreach(walk)`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// A pedestrian (paper §2, `Pedestrian`): a kinematic capsule that walks in a straight line
+/// from `start` to `target` on each event of its `walk` sink (see [`crate::behaviour`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PedestrianSpec {
+    /// Start, feet position `[x, y, z]` in metres.
+    pub start: [f64; 3],
+    /// Target, feet position `[x, y, z]` in metres.
+    pub target: [f64; 3],
+    /// Walking speed stream, m/s; read at each walking step, values `<= 0` stand still.
+    pub speed: StreamId,
+}
+
+/// An NPC car (paper §2, `Car`): a kinematic box that drives along `path` at the speed its
+/// stream gives, and stops at the path's end.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CarSpec {
+    /// The route, world `[x, z]` in metres, at least two points: from the lane graph.
+    pub path: Vec<[f64; 2]>,
+    /// Speed stream, m/s; negative values count as 0.
+    pub speed: StreamId,
+    /// Colour name (for the camera renderer), e.g. `red`.
+    pub color: String,
+    /// Length, width and height in metres.
+    pub size_m: [f64; 3],
+    /// Whether the car is in this test (a scenario may make its presence a parameter).
+    pub enabled: bool,
+}
+
+/// Global conditions (paper §2, `World(light, fog)`), as streams.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct EnvironmentSpec {
+    /// Light intensity, `[0, 1]`, nominal 1: the camera's exposure (the lidar ignores it).
+    pub light: StreamId,
+    /// Fog density in `[0, 1]`: see [`crate::visibility_m`].
+    pub fog: StreamId,
+}
+
+/// Everything needed to build a [`crate::Simulation`]: the road network, the actors, the
+/// stream graph (with every open parameter bound) that drives their behaviour, and sensors.
+#[derive(Debug, Clone)]
+pub struct WorldSpec {
+    /// Physics step in seconds, `> 0`. Default [`DEFAULT_DT_S`].
+    pub dt_s: f64,
+    /// The roads.
+    pub network: Network,
+    /// The ego vehicle.
+    pub ego: EgoSpec,
+    /// Pedestrians, in order; pedestrian `i` walks on sink [`crate::behaviour::walk_sink`]`(i)`.
+    pub pedestrians: Vec<PedestrianSpec>,
+    /// NPC cars, in order.
+    pub cars: Vec<CarSpec>,
+    /// Light and fog.
+    pub environment: EnvironmentSpec,
+    /// The reactive graph, bound (no open parameter slot left).
+    pub streams: Graph,
+    /// The ego vehicle's lidar.
+    pub lidar: LidarSpec,
+}
+
+/// A pedestrian of [`WorldSpec::straight_road`]: the paper's crossing pedestrian with constant
+/// trigger distance and speed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TriggeredPedestrian {
     /// Start lane (usually [`Lane::SideWalk`]) and position along the road in metres.
     pub start: (Lane, f64),
     /// Target lane (usually [`Lane::OppositeSideWalk`]) and position along the road in metres.
@@ -64,17 +96,62 @@ pub struct PedestrianSpec {
     pub speed_mps: f64,
 }
 
-/// Everything needed to build a [`crate::Simulation`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct WorldSpec {
-    /// Physics step in seconds, `> 0`. Default [`DEFAULT_DT_S`].
-    pub dt_s: f64,
-    /// The road.
-    pub road: RoadSpec,
-    /// The ego vehicle.
-    pub ego: EgoSpec,
-    /// The pedestrians, in order.
-    pub pedestrians: Vec<PedestrianSpec>,
-    /// The ego vehicle's lidar.
-    pub lidar: LidarSpec,
+impl WorldSpec {
+    /// The paper's first example (§2, "A Simple World") built in Rust: one straight road of
+    /// `length_m` metres with 2 lanes and friction 0.8, the ego vehicle on lane 1 at `ego_at_m`
+    /// metres moving at `initial_speed_mps`, and pedestrians with the paper's behaviour, under
+    /// clear daylight (light 1, fog 0) and the default lidar.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] for a position off the road or a non-positive speed or
+    /// trigger distance.
+    pub fn straight_road(
+        length_m: f64,
+        ego_at_m: f64,
+        initial_speed_mps: f64,
+        pedestrians: &[TriggeredPedestrian],
+    ) -> Result<WorldSpec, EngineError> {
+        let network = Network::single_segment(length_m, 2, 0.8)?;
+        let road = PieceId(0);
+        let start = network.on_lane(road, Lane::Driving(1), ego_at_m)?;
+        let mut g = GraphBuilder::new();
+        let ego_pos = g.push(Node::Probe(probe(Actor::Ego, Output::Pos)));
+        let light = g.push(Node::Const(Value::Num(1.0)));
+        let fog = g.push(Node::Const(Value::Num(0.0)));
+        let mut peds = Vec::with_capacity(pedestrians.len());
+        for (i, p) in pedestrians.iter().enumerate() {
+            let ok = |v: f64| v.is_finite() && v > 0.0;
+            if !ok(p.speed_mps) || !ok(p.trigger_distance_m) {
+                return Err(EngineError::InvalidWorld(format!(
+                    "pedestrian {i}: speed {} m/s and trigger distance {} m must be positive",
+                    p.speed_mps, p.trigger_distance_m
+                )));
+            }
+            let s = network.on_lane(road, p.start.0, p.start.1)?.pos_m;
+            let t = network.on_lane(road, p.target.0, p.target.1)?.pos_m;
+            let dist = g.push(Node::Const(Value::Num(p.trigger_distance_m)));
+            let speed = g.push(Node::Const(Value::Num(p.speed_mps)));
+            g.pedestrian(i as u32, s, t, ego_pos, dist);
+            peds.push(PedestrianSpec {
+                start: s,
+                target: t,
+                speed,
+            });
+        }
+        Ok(WorldSpec {
+            dt_s: DEFAULT_DT_S,
+            network,
+            ego: EgoSpec {
+                start,
+                initial_speed_mps,
+                vehicle: VehicleParams::default(),
+                route: vec![],
+            },
+            pedestrians: peds,
+            cars: vec![],
+            environment: EnvironmentSpec { light, fog },
+            streams: g.finish()?,
+            lidar: LidarSpec::default(),
+        })
+    }
 }

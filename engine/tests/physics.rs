@@ -2,29 +2,16 @@
 //! systems under test on a straight road.
 
 use paracosm_engine::sut::{Aeb, AebConfig, ConstantControl, Sut};
-use paracosm_engine::{
-    Control, EgoSpec, Lane, LidarSpec, PedestrianSpec, RoadSpec, Simulation, VehicleParams,
-    WorldSpec, DEFAULT_DT_S,
-};
+use paracosm_engine::rx::NoHost;
+use paracosm_engine::{Control, Lane, Simulation, TriggeredPedestrian, WorldSpec};
 
-fn world(pedestrians: Vec<PedestrianSpec>, initial_speed_mps: f64) -> WorldSpec {
-    WorldSpec {
-        dt_s: DEFAULT_DT_S,
-        road: RoadSpec::default(),
-        ego: EgoSpec {
-            lane: Lane::Driving(1),
-            at_m: 10.0,
-            initial_speed_mps,
-            vehicle: VehicleParams::default(),
-        },
-        pedestrians,
-        lidar: LidarSpec::default(),
-    }
+fn world(pedestrians: Vec<TriggeredPedestrian>, initial_speed_mps: f64) -> WorldSpec {
+    WorldSpec::straight_road(200.0, 10.0, initial_speed_mps, &pedestrians).unwrap()
 }
 
 /// A pedestrian that stands still in lane 1 at `x` (its trigger never fires).
-fn standing_in_lane(x: f64) -> PedestrianSpec {
-    PedestrianSpec {
+fn standing_in_lane(x: f64) -> TriggeredPedestrian {
+    TriggeredPedestrian {
         start: (Lane::Driving(1), x),
         target: (Lane::Driving(1), x),
         trigger_distance_m: 1e-6,
@@ -41,10 +28,10 @@ fn drive(spec: &WorldSpec, sut: &mut dyn Sut, seconds: f64) -> (Option<f64>, f64
     let mut min_sep = f64::INFINITY;
     while sim.t_s() < seconds {
         let control = sut.act(&sim.observation()).unwrap();
-        sim.step(control);
+        sim.step(control, &mut NoHost).unwrap();
         let snap = sim.snapshot();
-        min_sep = min_sep.min(snap.min_pedestrian_separation_m);
-        if snap.ego_pedestrian_contact && first_contact.is_none() {
+        min_sep = min_sep.min(snap.min_separation_m);
+        if snap.ego_contact && first_contact.is_none() {
             first_contact = Some(snap.t_s);
         }
     }
@@ -86,7 +73,7 @@ fn aeb_cruises_at_its_target_speed_and_keeps_its_lane_on_an_empty_road() {
     let mut max_lateral_error: f64 = 0.0;
     while sim.t_s() < 14.0 {
         let c = sut.act(&sim.observation()).unwrap();
-        sim.step(c);
+        sim.step(c, &mut NoHost).unwrap();
         max_lateral_error = max_lateral_error.max((sim.ego_state().pos_m[2] - 1.75).abs());
     }
     let ego = sim.ego_state();
@@ -124,7 +111,7 @@ fn the_same_world_gives_the_same_bits_twice() {
         let mut sut = Aeb::new(AebConfig::default());
         for _ in 0..600 {
             let c = sut.act(&sim.observation()).unwrap();
-            sim.step(c);
+            sim.step(c, &mut NoHost).unwrap();
         }
         let e = sim.ego_state();
         [
@@ -142,7 +129,7 @@ fn the_same_world_gives_the_same_bits_twice() {
 #[test]
 fn a_walking_pedestrian_crosses_once_triggered() {
     let spec = world(
-        vec![PedestrianSpec {
+        vec![TriggeredPedestrian {
             start: (Lane::SideWalk, 60.0),
             target: (Lane::OppositeSideWalk, 60.0),
             trigger_distance_m: 30.0,
@@ -155,7 +142,7 @@ fn a_walking_pedestrian_crosses_once_triggered() {
     // The car stops at ~x = 19 m, 41 m from the pedestrian: no trigger.
     for _ in 0..300 {
         let c = sut.act(&sim.observation()).unwrap();
-        sim.step(c);
+        sim.step(c, &mut NoHost).unwrap();
     }
     let snap = sim.snapshot();
     assert_eq!(snap.pedestrians[0].triggered_at_s, None);
@@ -166,7 +153,7 @@ fn a_walking_pedestrian_crosses_once_triggered() {
     let mut triggered = None;
     while sim.t_s() < 10.0 {
         let c = sut.act(&sim.observation()).unwrap();
-        sim.step(c);
+        sim.step(c, &mut NoHost).unwrap();
         triggered = triggered.or(sim.snapshot().pedestrians[0].triggered_at_s);
     }
     // Coasting at ~12 m/s from x = 10 m: within 30 m of x = 60 after about 1.7 s.

@@ -4,7 +4,7 @@ use std::sync::Arc;
 use super::{OpenStream, RxError, Value};
 
 /// Index of a stream in its [`Graph`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
 pub struct StreamId(pub usize);
 
 /// A native function on stream values: arguments in, a value or an error message out.

@@ -28,6 +28,18 @@ pub struct AebConfig {
     pub lateral_gain: f64,
     /// Lane keeping: steering per radian of heading error. Default 1.0.
     pub heading_gain: f64,
+    /// Route following (pure pursuit): wheelbase in metres. Default 2.9 m.
+    pub wheelbase_m: f64,
+    /// Route following: front-wheel angle at full steering, rad. Default 0.5 rad.
+    pub max_steer_rad: f64,
+    /// Route following: look-ahead time in seconds, times the speed. Default 0.6 s.
+    pub lookahead_s: f64,
+    /// Route following: shortest look-ahead distance in metres. Default 5 m.
+    pub min_lookahead_m: f64,
+    /// Route following: largest lateral acceleration in curves, m/s². Default 2.5 m/s².
+    pub lateral_accel_mps2: f64,
+    /// Route following: deceleration planned before curves, m/s². Default 2 m/s².
+    pub curve_decel_mps2: f64,
 }
 
 impl Default for AebConfig {
@@ -42,6 +54,12 @@ impl Default for AebConfig {
             min_height_m: -0.6,
             lateral_gain: 0.1,
             heading_gain: 1.0,
+            wheelbase_m: 2.9,
+            max_steer_rad: 0.5,
+            lookahead_s: 0.6,
+            min_lookahead_m: 5.0,
+            lateral_accel_mps2: 2.5,
+            curve_decel_mps2: 2.0,
         }
     }
 }
@@ -49,7 +67,9 @@ impl Default for AebConfig {
 /// `aeb`: a cruise controller with automatic emergency braking.
 ///
 /// Each step it keeps the lane it started in (proportional control on lateral offset and
-/// heading from odometry), and looks for lidar returns inside its corridor ahead. With `g` the
+/// heading from odometry) or, when the observation carries a route, follows the route by pure
+/// pursuit (Coulter 1992) and slows for its curves (lateral acceleration at most
+/// `lateral_accel_mps2`, planned with `curve_decel_mps2`). It looks for lidar returns inside its corridor ahead. With `g` the
 /// gap from the bumper to the nearest such return and `v` the speed, it brakes at full force
 /// when `g - standstill_gap_m < v · ttc_brake_s` (time to collision below `ttc_brake_s`, a
 /// static-obstacle assumption), and otherwise tracks `target_speed_mps`. It sees only what the
@@ -60,12 +80,18 @@ pub struct Aeb {
     config: AebConfig,
     /// Start pose `(x, z, heading)`, the line lane keeping follows.
     line: Option<(f64, f64, f64)>,
+    /// Index of the route vertex reached so far.
+    progress: usize,
 }
 
 impl Aeb {
     /// An `aeb` system with the given settings.
     pub fn new(config: AebConfig) -> Self {
-        Aeb { config, line: None }
+        Aeb {
+            config,
+            line: None,
+            progress: 0,
+        }
     }
 
     /// Gap in metres from the bumper to the nearest return in the corridor, if any.
@@ -86,10 +112,34 @@ impl Aeb {
 impl Sut for Aeb {
     fn reset(&mut self, _seed: u64) -> Result<(), SutError> {
         self.line = None;
+        self.progress = 0;
         Ok(())
     }
 
     fn act(&mut self, obs: &Observation<'_>) -> Result<Control, SutError> {
+        let (steering, target_speed) = if obs.route.len() >= 2 {
+            self.pursue(obs)
+        } else {
+            (self.keep_line(obs), self.config.target_speed_mps)
+        };
+        let c = &self.config;
+        let ego = obs.ego;
+        let v = ego.speed_mps.max(0.0);
+        let brake = self
+            .nearest_gap_m(obs)
+            .is_some_and(|gap| gap - c.standstill_gap_m < v * c.ttc_brake_s);
+        let throttle = if brake {
+            -1.0
+        } else {
+            c.speed_gain * (target_speed - ego.speed_mps)
+        };
+        Ok(Control { throttle, steering }.clamped())
+    }
+}
+
+impl Aeb {
+    /// Steering that holds the start line.
+    fn keep_line(&mut self, obs: &Observation<'_>) -> f64 {
         let c = &self.config;
         let ego = obs.ego;
         let (x0, z0, h0) = *self
@@ -101,19 +151,64 @@ impl Sut for Aeb {
         let heading_err = (ego.heading_rad - h0 + std::f64::consts::PI)
             .rem_euclid(std::f64::consts::TAU)
             - std::f64::consts::PI;
-        let steering = c.lateral_gain * right - c.heading_gain * heading_err;
-
-        let v = ego.speed_mps.max(0.0);
-        let brake = self
-            .nearest_gap_m(obs)
-            .is_some_and(|gap| gap - c.standstill_gap_m < v * c.ttc_brake_s);
-        let throttle = if brake {
-            -1.0
-        } else {
-            c.speed_gain * (c.target_speed_mps - ego.speed_mps)
-        };
-        Ok(Control { throttle, steering }.clamped())
+        c.lateral_gain * right - c.heading_gain * heading_err
     }
+
+    /// Pure-pursuit steering toward the route point one look-ahead distance ahead, and the
+    /// speed the curves ahead allow.
+    fn pursue(&mut self, obs: &Observation<'_>) -> (f64, f64) {
+        let c = &self.config;
+        let route = obs.route;
+        let (x, z) = (obs.ego.pos_m[0], obs.ego.pos_m[2]);
+        let d2 = |p: [f64; 2]| (p[0] - x).powi(2) + (p[1] - z).powi(2);
+        let window = self.progress..route.len().min(self.progress + 64);
+        self.progress = window
+            .min_by(|&a, &b| d2(route[a]).total_cmp(&d2(route[b])))
+            .unwrap_or(self.progress);
+        let v = obs.ego.speed_mps.max(0.0);
+        let lookahead = (v * c.lookahead_s).max(c.min_lookahead_m);
+        let mut target = *route.last().expect("two points");
+        let mut travelled = d2(route[self.progress]).sqrt();
+        for w in route[self.progress..].windows(2) {
+            let seg = ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt();
+            if travelled + seg >= lookahead {
+                let u = ((lookahead - travelled) / seg.max(1e-9)).clamp(0.0, 1.0);
+                target = [w[0][0] + u * (w[1][0] - w[0][0]), w[0][1] + u * (w[1][1] - w[0][1])];
+                break;
+            }
+            travelled += seg;
+        }
+        let bearing = (-(target[1] - z)).atan2(target[0] - x);
+        let alpha = wrap(bearing - obs.ego.heading_rad);
+        let ld = d2(target).sqrt().max(1e-3);
+        let steer = (2.0 * c.wheelbase_m * alpha.sin() / ld).atan() / c.max_steer_rad;
+
+        // Speed allowed by each curve ahead, less what braking at curve_decel covers.
+        let mut speed = c.target_speed_mps;
+        let mut ahead = 0.0;
+        let horizon = v * v / (2.0 * c.curve_decel_mps2) + 20.0;
+        let pts = &route[self.progress..];
+        for i in 1..pts.len().saturating_sub(1) {
+            let (a, b, d) = (pts[i - 1], pts[i], pts[i + 1]);
+            let l1 = (b[0] - a[0]).hypot(b[1] - a[1]);
+            let l2 = (d[0] - b[0]).hypot(d[1] - b[1]);
+            ahead += l1;
+            if ahead > horizon {
+                break;
+            }
+            let turn = wrap((-(d[1] - b[1])).atan2(d[0] - b[0]) - (-(b[1] - a[1])).atan2(b[0] - a[0]));
+            let kappa = turn.abs() / ((l1 + l2) / 2.0).max(1e-6);
+            if kappa > 1e-4 {
+                let v_curve = (c.lateral_accel_mps2 / kappa).sqrt();
+                speed = speed.min((v_curve * v_curve + 2.0 * c.curve_decel_mps2 * ahead).sqrt());
+            }
+        }
+        (steer, speed)
+    }
+}
+
+fn wrap(a: f64) -> f64 {
+    (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
 }
 
 #[cfg(test)]
@@ -147,6 +242,7 @@ mod tests {
             dt_s: 1.0 / 60.0,
             ego,
             lidar: &lidar,
+            route: &[],
         })
         .unwrap()
     }

@@ -1,0 +1,166 @@
+//! How the world and the stream graph meet: probes (physics outputs as streams), sinks
+//! (actions on actors), a graph builder, and the paper's pedestrian behaviour.
+
+use crate::rx::{Func, Graph, Node, RxError, StreamId, Value};
+
+/// An object whose outputs a probe reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Actor {
+    /// The ego vehicle.
+    Ego,
+    /// Pedestrian `i`, in [`crate::WorldSpec::pedestrians`] order.
+    Pedestrian(u32),
+    /// NPC car `i`, in [`crate::WorldSpec::cars`] order.
+    Car(u32),
+}
+
+/// What a probe reads from its actor, each step (paper §2: `rxout pos, vel, ...`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Output {
+    /// Position `[x, y, z]` in metres (the ego's chassis centre, a pedestrian's feet, a car's
+    /// ground point).
+    Pos,
+    /// Velocity `[x, y, z]` in m/s.
+    Vel,
+    /// Heading in rad.
+    Heading,
+    /// Speed in m/s (signed along the heading for the ego).
+    Speed,
+    /// Contact: `true` while the actor touches the ego vehicle (for the ego: touches any
+    /// actor).
+    Collision,
+}
+
+const OUTPUTS: [Output; 5] = [
+    Output::Pos,
+    Output::Vel,
+    Output::Heading,
+    Output::Speed,
+    Output::Collision,
+];
+
+/// The probe number of `output` of `actor`, for [`Node::Probe`].
+pub fn probe(actor: Actor, output: Output) -> u32 {
+    let o = OUTPUTS.iter().position(|&x| x == output).expect("listed") as u32;
+    let a = match actor {
+        Actor::Ego => 0,
+        Actor::Pedestrian(i) => 1 + 2 * i,
+        Actor::Car(i) => 2 + 2 * i,
+    };
+    a * 8 + o
+}
+
+/// The inverse of [`probe`].
+pub fn decode_probe(p: u32) -> (Actor, Output) {
+    let (a, o) = (p / 8, p % 8);
+    let actor = match a {
+        0 => Actor::Ego,
+        a if a % 2 == 1 => Actor::Pedestrian((a - 1) / 2),
+        a => Actor::Car((a - 2) / 2),
+    };
+    (actor, OUTPUTS[(o as usize).min(OUTPUTS.len() - 1)])
+}
+
+/// The sink that makes pedestrian `i` take one walking step per event.
+pub fn walk_sink(i: u32) -> u32 {
+    i
+}
+
+/// Collects nodes; each push returns the new stream's id.
+#[derive(Debug, Clone, Default)]
+pub struct GraphBuilder {
+    nodes: Vec<Node>,
+}
+
+impl GraphBuilder {
+    /// An empty builder.
+    pub fn new() -> Self {
+        GraphBuilder::default()
+    }
+
+    /// Adds `node`.
+    pub fn push(&mut self, node: Node) -> StreamId {
+        self.nodes.push(node);
+        StreamId(self.nodes.len() - 1)
+    }
+
+    /// The nodes so far.
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The checked graph.
+    ///
+    /// # Errors
+    /// As [`Graph::new`].
+    pub fn finish(self) -> Result<Graph, RxError> {
+        Graph::new(self.nodes)
+    }
+
+    /// The paper's pedestrian behaviour (§2, "Reactive Behaviors") for pedestrian `index`:
+    ///
+    /// ```text
+    /// trigger = car.zip(dist).filter(|car - start| < dist)   // planar distance, m
+    /// done    = pos.filter(_ == target)
+    /// tick.skipUntil(trigger).takeUntil(done).foreach(walk)
+    /// ```
+    ///
+    /// `car` is a position stream (m), `dist` the trigger distance stream (m). The distance is
+    /// measured in the ground plane (`x`, `z`), so the heights of a car's centre and a curb do
+    /// not count. Returns the trigger stream.
+    pub fn pedestrian(
+        &mut self,
+        index: u32,
+        start: [f64; 3],
+        target: [f64; 3],
+        car: StreamId,
+        dist: StreamId,
+    ) -> StreamId {
+        let pair = self.push(Node::Zip(car, dist));
+        let trigger = self.push(Node::Filter {
+            src: pair,
+            pred: Func::native("|car - start| < dist", move |a| match &a[0] {
+                Value::Tuple(p) => match (p[0].as_vec3(), p[1].as_num()) {
+                    (Some(c), Some(d)) => {
+                        Ok(Value::Bool((c[0] - start[0]).hypot(c[2] - start[2]) < d))
+                    }
+                    _ => Err("the car stream must carry positions and dist numbers".into()),
+                },
+                v => Err(format!("expected a (position, distance) pair, got a {}", v.kind())),
+            }),
+        });
+        self.pedestrian_with_trigger(index, target, trigger);
+        trigger
+    }
+
+    /// `tick.skipUntil(trigger).takeUntil(done).foreach(walk)` for pedestrian `index`, with
+    /// any trigger stream (e.g. one a scenario computes with lambdas).
+    pub fn pedestrian_with_trigger(&mut self, index: u32, target: [f64; 3], trigger: StreamId) {
+        let pos = self.push(Node::Probe(probe(Actor::Pedestrian(index), Output::Pos)));
+        let done = self.push(Node::Filter {
+            src: pos,
+            pred: Func::native("_ == target", move |a| Ok(Value::Bool(a[0] == Value::Vec3(target)))),
+        });
+        let tick = self.push(Node::Tick);
+        let skip = self.push(Node::SkipUntil { src: tick, trigger });
+        let take = self.push(Node::TakeUntil { src: skip, stop: done });
+        self.push(Node::Foreach {
+            src: take,
+            sink: walk_sink(index),
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn probes_round_trip() {
+        for actor in [Actor::Ego, Actor::Pedestrian(0), Actor::Pedestrian(7), Actor::Car(0), Actor::Car(3)] {
+            for output in OUTPUTS {
+                assert_eq!(decode_probe(probe(actor, output)), (actor, output));
+            }
+        }
+    }
+}

@@ -1,0 +1,68 @@
+use rapier3d::prelude::*;
+
+use super::{Network, PieceKind, CURB_HEIGHT_M, SIDEWALK_WIDTH_M};
+
+/// Thickness of the road slab under the surface `y = 0`, in metres.
+const SLAB_THICKNESS_M: f64 = 0.2;
+
+impl Network {
+    /// Inserts every piece as fixed colliders with its friction: a slab whose top is the
+    /// surface `y = 0`, raised sidewalks along segments, and a roundabout's raised island.
+    pub(crate) fn build(&self, physics: &mut PhysicsWorld) {
+        for p in &self.pieces {
+            let mu = p.kind.friction() as f32;
+            let rotation = Rotation::from_rotation_y(p.pose.heading_rad as f32);
+            // Heights in f32 as rapier stores them, so that a segment at the origin builds
+            // exactly the colliders of the single-road engine before networks.
+            let at = |local: [f64; 2], y: f32| {
+                let [x, z] = p.pose.apply(local);
+                Pose::from_parts(Vector::new(x as f32, y, z as f32), rotation)
+            };
+            let slab = SLAB_THICKNESS_M as f32;
+            let ([hx, hz], centre) = p.kind.footprint();
+            match p.kind {
+                PieceKind::Segment { length_m, .. } => {
+                    let hw = p.kind.half_road_m();
+                    physics.insert_collider(
+                        ColliderBuilder::cuboid(hx as f32, slab / 2.0, hw as f32)
+                            .position(at(centre, -slab / 2.0))
+                            .friction(mu),
+                        None,
+                    );
+                    let sw = SIDEWALK_WIDTH_M;
+                    let curb = CURB_HEIGHT_M as f32;
+                    let h = (slab + curb) / 2.0;
+                    for side in [1.0, -1.0] {
+                        physics.insert_collider(
+                            ColliderBuilder::cuboid(hx as f32, h, (sw / 2.0) as f32)
+                                .position(at(
+                                    [length_m / 2.0, side * (hw + sw / 2.0)],
+                                    curb - h,
+                                ))
+                                .friction(mu),
+                            None,
+                        );
+                    }
+                }
+                _ => {
+                    physics.insert_collider(
+                        ColliderBuilder::cuboid(hx as f32, slab / 2.0, hz as f32)
+                            .position(at(centre, -slab / 2.0))
+                            .friction(mu),
+                        None,
+                    );
+                    if let Some(r) = p.kind.island_radius_m() {
+                        let curb = CURB_HEIGHT_M as f32;
+                        let h = (slab + curb) / 2.0;
+                        physics.insert_collider(
+                            ColliderBuilder::cylinder(h, r as f32)
+                                .position(at(centre, curb - h))
+                                .friction(mu),
+                            None,
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

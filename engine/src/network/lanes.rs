@@ -1,0 +1,237 @@
+use serde::{Deserialize, Serialize};
+
+use super::geometry::{direction, wrap};
+use super::{Location, Network, PieceId, PieceKind, LANE_WIDTH_M};
+use crate::EngineError;
+
+/// A choice at a junction, relative to the direction of arrival.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Turn {
+    /// Leave on the opposite side.
+    Straight,
+    /// Leave a quarter turn to the left (counter-clockwise).
+    Left,
+    /// Leave a quarter turn to the right.
+    Right,
+}
+
+impl Turn {
+    /// Parses `"straight"`, `"left"` or `"right"`.
+    pub fn parse(s: &str) -> Option<Turn> {
+        match s {
+            "straight" => Some(Turn::Straight),
+            "left" => Some(Turn::Left),
+            "right" => Some(Turn::Right),
+            _ => None,
+        }
+    }
+}
+
+/// One lane's path across a piece: a polyline in world `[x, z]` metres, entering through a
+/// port's incoming lane `j` and leaving through a port's outgoing lane `j` (lanes counted
+/// from the centre line, `1..=n/2`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LanePath {
+    /// The piece.
+    pub piece: PieceId,
+    /// `(port, lane)` it enters through.
+    pub entry: (usize, u32),
+    /// `(port, lane)` it leaves through.
+    pub exit: (usize, u32),
+    /// The turn it makes.
+    pub turn: Turn,
+    /// The polyline, at least two points.
+    pub points: Vec<[f64; 2]>,
+}
+
+/// Points sampled along each turning path.
+const CURVE_POINTS: usize = 12;
+
+fn add(a: [f64; 2], b: [f64; 2], s: f64) -> [f64; 2] {
+    [a[0] + s * b[0], a[1] + s * b[1]]
+}
+
+impl Network {
+    /// Every lane path of `piece` in world coordinates.
+    pub fn lane_paths(&self, piece: PieceId) -> Vec<LanePath> {
+        let p = &self.pieces[piece.0];
+        let half = p.kind.lanes() / 2;
+        let offset = |j: u32| (f64::from(j) - 0.5) * LANE_WIDTH_M;
+        let mut out = Vec::new();
+        if let PieceKind::Segment { length_m, .. } = p.kind {
+            for j in 1..=half {
+                let z = offset(j);
+                let fwd = vec![p.pose.apply([0.0, z]), p.pose.apply([length_m, z])];
+                let back = vec![p.pose.apply([length_m, -z]), p.pose.apply([0.0, -z])];
+                out.push(LanePath {
+                    piece,
+                    entry: (0, j),
+                    exit: (1, j),
+                    turn: Turn::Straight,
+                    points: fwd,
+                });
+                out.push(LanePath {
+                    piece,
+                    entry: (1, j),
+                    exit: (0, j),
+                    turn: Turn::Straight,
+                    points: back,
+                });
+            }
+            return out;
+        }
+        let ports = p.kind.ports();
+        for (a, pa) in ports.iter().enumerate() {
+            for (b, pb) in ports.iter().enumerate() {
+                if a == b {
+                    continue;
+                }
+                let inward = wrap(pa.heading_rad + std::f64::consts::PI);
+                let delta = wrap(pb.heading_rad - inward);
+                let turn = if delta.abs() < 0.1 {
+                    Turn::Straight
+                } else if (delta - std::f64::consts::FRAC_PI_2).abs() < 0.1 {
+                    Turn::Left
+                } else if (delta + std::f64::consts::FRAC_PI_2).abs() < 0.1 {
+                    Turn::Right
+                } else {
+                    continue;
+                };
+                for j in 1..=half {
+                    // Incoming lanes lie left of the port's outward direction, outgoing right.
+                    let left = direction(pa.heading_rad + std::f64::consts::FRAC_PI_2);
+                    let right = direction(pb.heading_rad - std::f64::consts::FRAC_PI_2);
+                    let e = add(pa.pos, left, offset(j));
+                    let x = add(pb.pos, right, offset(j));
+                    let local = match p.kind.island_radius_m() {
+                        Some(island) => ring(e, x, island + p.kind.half_road_m() / 2.0 + 0.5),
+                        None => bend(e, direction(inward), x, direction(pb.heading_rad)),
+                    };
+                    out.push(LanePath {
+                        piece,
+                        entry: (a, j),
+                        exit: (b, j),
+                        turn,
+                        points: local.into_iter().map(|q| p.pose.apply(q)).collect(),
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// The path a vehicle drives from `start` (a driving lane of a segment): along its lane,
+    /// then across the connected pieces, taking at each junction with a choice the next turn
+    /// of `turns` (then `straight`, `right`, `left`, in that order of preference, when the
+    /// list is used up or the turn is not there), until the network ends or the path is
+    /// `max_len_m` metres long. World `[x, z]` points in metres.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] when `start` is not on a driving lane.
+    pub fn route(
+        &self,
+        start: &Location,
+        turns: &[Turn],
+        max_len_m: f64,
+    ) -> Result<Vec<[f64; 2]>, EngineError> {
+        let super::Lane::Driving(k) = start.lane else {
+            return Err(EngineError::InvalidWorld(
+                "a route must start on a driving lane".into(),
+            ));
+        };
+        let j = k.unsigned_abs();
+        let entry = if k > 0 { 0 } else { 1 };
+        let mut path = self
+            .lane_paths(start.piece)
+            .into_iter()
+            .find(|l| l.entry == (entry, j))
+            .expect("a segment has both directions of each lane");
+        let mut points = vec![[start.pos_m[0], start.pos_m[2]]];
+        points.push(*path.points.last().expect("two points"));
+        let mut length = dist(points[0], points[1]);
+        let mut turns = turns.iter();
+        while length < max_len_m {
+            let out = (path.piece, path.exit.0);
+            let Some(next) = self.links.iter().find_map(|l| {
+                if l.a == out {
+                    Some(l.b)
+                } else if l.b == out {
+                    Some(l.a)
+                } else {
+                    None
+                }
+            }) else {
+                break;
+            };
+            let candidates: Vec<LanePath> = self
+                .lane_paths(next.0)
+                .into_iter()
+                .filter(|l| l.entry == (next.1, path.exit.1))
+                .collect();
+            let pick = if candidates.len() > 1 {
+                let wanted = turns.next().copied();
+                wanted
+                    .into_iter()
+                    .chain([Turn::Straight, Turn::Right, Turn::Left])
+                    .find_map(|t| candidates.iter().find(|c| c.turn == t))
+            } else {
+                candidates.first()
+            };
+            let Some(pick) = pick.cloned() else { break };
+            for &q in &pick.points[1..] {
+                length += dist(*points.last().expect("non-empty"), q);
+                points.push(q);
+            }
+            path = pick;
+        }
+        Ok(points)
+    }
+}
+
+fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// A quadratic Bézier from `e` (heading `de`) to `x` (heading `dx`) through the crossing of
+/// the two lines; a straight line when they are parallel.
+fn bend(e: [f64; 2], de: [f64; 2], x: [f64; 2], dx: [f64; 2]) -> Vec<[f64; 2]> {
+    let cross = de[0] * dx[1] - de[1] * dx[0];
+    if cross.abs() < 1e-9 {
+        return vec![e, x];
+    }
+    // e + s·de = x - u·dx, solved for s.
+    let r = [x[0] - e[0], x[1] - e[1]];
+    let s = (r[0] * dx[1] - r[1] * dx[0]) / cross;
+    let c = add(e, de, s);
+    (0..=CURVE_POINTS)
+        .map(|i| {
+            let t = i as f64 / CURVE_POINTS as f64;
+            let (a, b, d) = ((1.0 - t) * (1.0 - t), 2.0 * t * (1.0 - t), t * t);
+            [
+                a * e[0] + b * c[0] + d * x[0],
+                a * e[1] + b * c[1] + d * x[1],
+            ]
+        })
+        .collect()
+}
+
+/// From `e` onto a counter-clockwise circle of radius `r` about the origin, around to the
+/// angle of `x`, and out to `x`.
+fn ring(e: [f64; 2], x: [f64; 2], r: f64) -> Vec<[f64; 2]> {
+    let angle = |p: [f64; 2]| (-p[1]).atan2(p[0]);
+    // Join the ring a little after the entry and leave it a little before the exit.
+    let a0 = angle(e) + 0.35;
+    let mut a1 = angle(x) - 0.35;
+    while a1 <= a0 {
+        a1 += std::f64::consts::TAU;
+    }
+    let n = ((a1 - a0) / 0.15).ceil().max(2.0) as usize;
+    let mut pts = vec![e];
+    pts.extend((0..=n).map(|i| {
+        let a = a0 + (a1 - a0) * i as f64 / n as f64;
+        [r * a.cos(), -r * a.sin()]
+    }));
+    pts.push(x);
+    pts
+}

@@ -1,0 +1,367 @@
+//! Road networks (paper §2, "More Complex Worlds"): road pieces, `connect`, the geometric and
+//! topological checks, the lane graph that NPC cars route on, and `onLane`.
+//!
+//! Pieces live in groups that move rigidly. A fresh piece is its own group at the origin.
+//! `connect(parent.port, child, child.port)` moves the child's whole group so that the two
+//! ports coincide and face each other, then checks that no two pieces overlap. Connecting two
+//! pieces of the same group (closing a loop) moves nothing and checks instead that the ports
+//! already coincide.
+
+mod build;
+mod geometry;
+mod lanes;
+mod piece;
+
+pub use geometry::{direction, wrap, Pose2};
+pub use lanes::{LanePath, Turn};
+pub use piece::{Piece, PieceKind, PortGeometry, LANE_WIDTH_M, PORT_NAMES, SIDEWALK_WIDTH_M};
+
+use rapier3d::parry::query::intersection_test;
+use rapier3d::parry::shape::Cuboid;
+use rapier3d::prelude::{Pose, Rotation, Vector};
+use serde::{Deserialize, Serialize};
+
+use crate::EngineError;
+
+/// Height of the sidewalks and of a roundabout's island above the road surface, in metres.
+pub const CURB_HEIGHT_M: f64 = 0.15;
+/// How far apart two ports may be and still count as coinciding, in metres.
+pub const PORT_TOLERANCE_M: f64 = 0.01;
+/// How far from opposite two coinciding ports may face, in rad.
+pub const PORT_TOLERANCE_RAD: f64 = 1e-3;
+/// Pieces are shrunk by this much, in metres, before the overlap test, so that pieces that
+/// merely touch along a shared edge do not count as overlapping.
+const TOUCH_MARGIN_M: f64 = 0.05;
+
+/// A place across a road segment (paper §2, `onLane`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Lane {
+    /// A driving lane: `1..=n/2` right of the centre line driving along the segment's `+x`,
+    /// `-1..=-n/2` left of it driving along `-x`. Lane `±1` is next to the centre line.
+    Driving(i32),
+    /// The sidewalk on the right (`+z`) side: the paper's `r.SideWalk`.
+    SideWalk,
+    /// The sidewalk on the left (`-z`) side: the paper's `-r.SideWalk`.
+    OppositeSideWalk,
+}
+
+/// Index of a piece in its [`Network`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct PieceId(pub usize);
+
+/// A resolved `onLane(lane, at)`: a world position and the direction of travel there.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Location {
+    /// Surface point `[x, y, z]` in metres (`y` is 0 on the road, the curb on a sidewalk).
+    pub pos_m: [f64; 3],
+    /// Direction of travel of the lane in rad (for sidewalks, the segment's heading).
+    pub heading_rad: f64,
+    /// The segment.
+    pub piece: PieceId,
+    /// The lane.
+    pub lane: Lane,
+    /// Distance along the segment from its port `ONE`, in metres.
+    pub at_m: f64,
+}
+
+/// Two connected ports: `(piece, port index)` each.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Link {
+    /// The parent side.
+    pub a: (PieceId, usize),
+    /// The child side.
+    pub b: (PieceId, usize),
+}
+
+/// A set of road pieces and their connections.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Network {
+    pieces: Vec<Piece>,
+    group: Vec<usize>,
+    links: Vec<Link>,
+}
+
+impl Network {
+    /// An empty network.
+    pub fn new() -> Self {
+        Network::default()
+    }
+
+    /// A network of one straight segment at the origin.
+    ///
+    /// # Errors
+    /// As [`Network::add`].
+    pub fn single_segment(length_m: f64, lanes: u32, friction: f64) -> Result<Self, EngineError> {
+        let mut n = Network::new();
+        n.add(
+            "RoadSegment",
+            PieceKind::Segment {
+                length_m,
+                lanes,
+                friction,
+            },
+        )?;
+        Ok(n)
+    }
+
+    /// Adds a piece at the origin, in a group of its own.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] when the piece's sizes are invalid.
+    pub fn add(&mut self, name: &str, kind: PieceKind) -> Result<PieceId, EngineError> {
+        kind.validate()?;
+        let id = self.pieces.len();
+        self.pieces.push(Piece {
+            name: name.to_owned(),
+            kind,
+            pose: Pose2::default(),
+        });
+        self.group.push(id);
+        Ok(PieceId(id))
+    }
+
+    /// The pieces, by [`PieceId`].
+    pub fn pieces(&self) -> &[Piece] {
+        &self.pieces
+    }
+
+    /// The connections.
+    pub fn links(&self) -> &[Link] {
+        &self.links
+    }
+
+    /// The piece `id`.
+    pub fn piece(&self, id: PieceId) -> &Piece {
+        &self.pieces[id.0]
+    }
+
+    /// The pieces of the group that `id` belongs to (`id` and everything connected to it).
+    pub fn group_of(&self, id: PieceId) -> Vec<PieceId> {
+        let g = self.group[id.0];
+        (0..self.pieces.len())
+            .filter(|&i| self.group[i] == g)
+            .map(PieceId)
+            .collect()
+    }
+
+    fn port_name(&self, (piece, port): (PieceId, usize)) -> String {
+        format!("{}.{}", self.pieces[piece.0].name, PORT_NAMES[port])
+    }
+
+    fn port(&self, piece: PieceId, port: usize) -> Result<PortGeometry, EngineError> {
+        let p = &self.pieces[piece.0];
+        p.port(port).ok_or_else(|| {
+            let names = PORT_NAMES[..p.kind.ports().len()].join(", ");
+            EngineError::InvalidWorld(format!(
+                "{} has ports {names}; it has no port {}",
+                p.name,
+                PORT_NAMES.get(port).copied().unwrap_or("?")
+            ))
+        })
+    }
+
+    /// `parent.connect((port, child, child_port))`: joins `child`'s port to `parent`'s.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] for a port the piece lacks or one already connected, a
+    /// lane-count mismatch, ports of one group that do not coincide, or pieces that would
+    /// overlap. Nothing moves when it fails.
+    pub fn connect(
+        &mut self,
+        parent: PieceId,
+        port: usize,
+        child: PieceId,
+        child_port: usize,
+    ) -> Result<(), EngineError> {
+        let bad = |m: String| Err(EngineError::InvalidWorld(m));
+        let pp = self.port(parent, port)?;
+        let cp = self.port(child, child_port)?;
+        let (a, b) = ((parent, port), (child, child_port));
+        if parent == child {
+            return bad(format!("{} cannot connect to itself", self.pieces[parent.0].name));
+        }
+        for end in [a, b] {
+            if self.links.iter().any(|l| l.a == end || l.b == end) {
+                return bad(format!("port {} is already connected", self.port_name(end)));
+            }
+        }
+        let (pk, ck) = (&self.pieces[parent.0].kind, &self.pieces[child.0].kind);
+        if pk.lanes() != ck.lanes() {
+            return bad(format!(
+                "lane-count mismatch: {} has {} lanes but {} has {}",
+                self.port_name(a),
+                pk.lanes(),
+                self.port_name(b),
+                ck.lanes()
+            ));
+        }
+        let target_heading = wrap(pp.heading_rad + std::f64::consts::PI);
+        if self.group[parent.0] == self.group[child.0] {
+            let gap = (pp.pos[0] - cp.pos[0]).hypot(pp.pos[1] - cp.pos[1]);
+            let turn = wrap(cp.heading_rad - target_heading).abs();
+            if gap > PORT_TOLERANCE_M || turn > PORT_TOLERANCE_RAD {
+                return bad(format!(
+                    "connection points do not coincide: {} is at ({:.2}, {:.2}) m facing {:.1}°, {} at ({:.2}, {:.2}) m facing {:.1}°",
+                    self.port_name(a),
+                    pp.pos[0],
+                    pp.pos[1],
+                    pp.heading_rad.to_degrees(),
+                    self.port_name(b),
+                    cp.pos[0],
+                    cp.pos[1],
+                    cp.heading_rad.to_degrees()
+                ));
+            }
+            self.links.push(Link { a, b });
+            return Ok(());
+        }
+        // Rotate the child's group about its port, then move that port onto the parent's.
+        let delta = wrap(target_heading - cp.heading_rad);
+        let rot = Pose2 {
+            x: 0.0,
+            z: 0.0,
+            heading_rad: delta,
+        };
+        let [rx, rz] = rot.apply(cp.pos);
+        let motion = Pose2 {
+            x: pp.pos[0] - rx,
+            z: pp.pos[1] - rz,
+            heading_rad: delta,
+        };
+        let moved = self.group_of(child);
+        let mut next = self.clone();
+        for &PieceId(i) in &moved {
+            next.pieces[i].pose = motion.compose(&self.pieces[i].pose);
+        }
+        let others = self.group_of(parent);
+        next.check_overlaps(&moved, &others)?;
+        let g = self.group[parent.0];
+        for &PieceId(i) in &moved {
+            next.group[i] = g;
+        }
+        next.links.push(Link { a, b });
+        *self = next;
+        Ok(())
+    }
+
+    /// Checks that no piece of `xs` overlaps a piece of `ys` (parry's intersection test on
+    /// the footprints, shrunk by a few centimetres so shared edges do not count).
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] naming the first overlapping pair.
+    pub fn check_overlaps(&self, xs: &[PieceId], ys: &[PieceId]) -> Result<(), EngineError> {
+        for &x in xs {
+            for &y in ys {
+                if x != y && self.overlap(x, y) {
+                    return Err(EngineError::InvalidWorld(format!(
+                        "road pieces overlap: {} and {}",
+                        self.pieces[x.0].name, self.pieces[y.0].name
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks every pair of pieces for overlap (see [`Network::check_overlaps`]).
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] naming the first overlapping pair.
+    pub fn check_all_overlaps(&self) -> Result<(), EngineError> {
+        for i in 0..self.pieces.len() {
+            let ys: Vec<PieceId> = (i + 1..self.pieces.len()).map(PieceId).collect();
+            self.check_overlaps(&[PieceId(i)], &ys)?;
+        }
+        Ok(())
+    }
+
+    fn footprint(&self, id: PieceId) -> (Pose, Cuboid) {
+        let p = &self.pieces[id.0];
+        let ([hx, hz], centre) = p.kind.footprint();
+        let [x, z] = p.pose.apply(centre);
+        let pose = Pose::from_parts(
+            Vector::new(x as f32, 0.0, z as f32),
+            Rotation::from_rotation_y(p.pose.heading_rad as f32),
+        );
+        let shrink = |h: f64| (h - TOUCH_MARGIN_M).max(0.001) as f32;
+        (pose, Cuboid::new(Vector::new(shrink(hx), 0.5, shrink(hz))))
+    }
+
+    fn overlap(&self, a: PieceId, b: PieceId) -> bool {
+        let (pa, sa) = self.footprint(a);
+        let (pb, sb) = self.footprint(b);
+        intersection_test(&pa, &sa, &pb, &sb).map_or(true, |i| i.intersecting)
+    }
+
+    /// `piece.onLane(lane, at)`: the point on `lane` of segment `piece`, `at_m` metres from its
+    /// port `ONE`.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] if the piece is not a segment, for lane 0 or a lane
+    /// beyond `±lanes/2`, or `at_m` outside `[0, len]`.
+    pub fn on_lane(&self, piece: PieceId, lane: Lane, at_m: f64) -> Result<Location, EngineError> {
+        let p = &self.pieces[piece.0];
+        let PieceKind::Segment {
+            length_m, lanes, ..
+        } = p.kind
+        else {
+            return Err(EngineError::InvalidWorld(format!(
+                "onLane needs a RoadSegment; {} is a {}",
+                p.name,
+                p.kind.type_name()
+            )));
+        };
+        if !(0.0..=length_m).contains(&at_m) {
+            return Err(EngineError::InvalidWorld(format!(
+                "position {at_m} m is outside {} [0, {length_m}] m",
+                p.name
+            )));
+        }
+        let sidewalk_z = p.kind.half_road_m() + SIDEWALK_WIDTH_M / 2.0;
+        let (z, y, reverse) = match lane {
+            Lane::Driving(k) => {
+                let half = (lanes / 2) as i32;
+                if k == 0 || k.abs() > half {
+                    return Err(EngineError::InvalidWorld(format!(
+                        "lane {k} does not exist on {} with {lanes} lanes (lanes ±1..=±{half})",
+                        p.name
+                    )));
+                }
+                let z = (k.abs() as f64 - 0.5) * LANE_WIDTH_M * f64::from(k.signum());
+                (z, 0.0, k < 0)
+            }
+            Lane::SideWalk => (sidewalk_z, CURB_HEIGHT_M, false),
+            Lane::OppositeSideWalk => (-sidewalk_z, CURB_HEIGHT_M, false),
+        };
+        let [x, wz] = p.pose.apply([at_m, z]);
+        let heading = if reverse {
+            wrap(p.pose.heading_rad + std::f64::consts::PI)
+        } else {
+            p.pose.heading_rad
+        };
+        Ok(Location {
+            pos_m: [x, y, wz],
+            heading_rad: heading,
+            piece,
+            lane,
+            at_m,
+        })
+    }
+
+    /// The piece whose driving surface contains the world point `[x, z]`, if any.
+    pub fn driving_surface_at(&self, p: [f64; 2]) -> Option<PieceId> {
+        self.pieces.iter().position(|piece| {
+            let inv = Pose2 {
+                x: 0.0,
+                z: 0.0,
+                heading_rad: -piece.pose.heading_rad,
+            };
+            let local = inv.apply([p[0] - piece.pose.x, p[1] - piece.pose.z]);
+            piece.kind.on_driving_surface(local)
+        })
+        .map(PieceId)
+    }
+}
+
+#[cfg(test)]
+mod tests;

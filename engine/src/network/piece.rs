@@ -1,0 +1,231 @@
+use serde::{Deserialize, Serialize};
+
+use super::geometry::{direction, Pose2};
+use crate::EngineError;
+
+/// Width of one driving lane, in metres, on every piece.
+pub const LANE_WIDTH_M: f64 = 3.5;
+/// Width of each sidewalk along a road segment, in metres.
+pub const SIDEWALK_WIDTH_M: f64 = 2.0;
+
+/// What a road piece is, in its own frame (paper §2, "More Complex Worlds").
+///
+/// Local frames: a segment runs along `+x` from port `ONE` at `x = 0` to port `TWO` at
+/// `x = len`. Junctions are centred on their origin with port `ONE` east (`+x`), `TWO` south
+/// (`+z`), `THREE` west (`-x`) and, for four-way pieces, `FOUR` north (`-z`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PieceKind {
+    /// `RoadSegment`: a straight road with sidewalks.
+    Segment {
+        /// Length in metres, `> 0`.
+        length_m: f64,
+        /// Driving lanes, even and `>= 2`: half each way.
+        lanes: u32,
+        /// Tyre–road friction, in `(0, 2]`.
+        friction: f64,
+    },
+    /// `TIntersection`: three ports `ONE`, `TWO`, `THREE` (the stem is `TWO`, south).
+    TIntersection {
+        /// Lanes of the roads it joins.
+        lanes: u32,
+        /// Friction.
+        friction: f64,
+    },
+    /// `CrossIntersection`: four ports.
+    CrossIntersection {
+        /// Lanes of the roads it joins.
+        lanes: u32,
+        /// Friction.
+        friction: f64,
+    },
+    /// `Roundabout`: four ports on a square plaza of side `2 · radius_m` around a raised
+    /// central island; traffic circles counter-clockwise.
+    Roundabout {
+        /// Lanes of the roads it joins.
+        lanes: u32,
+        /// Half the plaza's side, in metres.
+        radius_m: f64,
+        /// Friction.
+        friction: f64,
+    },
+}
+
+/// A connection point of a piece, in the piece's frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PortGeometry {
+    /// Centre of the road's end `[x, z]`, in metres.
+    pub pos: [f64; 2],
+    /// Outward heading, in rad: the direction a car leaving through it drives.
+    pub heading_rad: f64,
+}
+
+/// Names of ports by index.
+pub const PORT_NAMES: [&str; 4] = ["ONE", "TWO", "THREE", "FOUR"];
+
+impl PieceKind {
+    /// The paper's name of the piece type.
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            PieceKind::Segment { .. } => "RoadSegment",
+            PieceKind::TIntersection { .. } => "TIntersection",
+            PieceKind::CrossIntersection { .. } => "CrossIntersection",
+            PieceKind::Roundabout { .. } => "Roundabout",
+        }
+    }
+
+    /// Driving lanes of the roads at its ports.
+    pub fn lanes(&self) -> u32 {
+        match *self {
+            PieceKind::Segment { lanes, .. }
+            | PieceKind::TIntersection { lanes, .. }
+            | PieceKind::CrossIntersection { lanes, .. }
+            | PieceKind::Roundabout { lanes, .. } => lanes,
+        }
+    }
+
+    /// Friction coefficient of its surface.
+    pub fn friction(&self) -> f64 {
+        match *self {
+            PieceKind::Segment { friction, .. }
+            | PieceKind::TIntersection { friction, .. }
+            | PieceKind::CrossIntersection { friction, .. }
+            | PieceKind::Roundabout { friction, .. } => friction,
+        }
+    }
+
+    /// Half the width of the driving surface of its roads, in metres.
+    pub fn half_road_m(&self) -> f64 {
+        self.lanes() as f64 * LANE_WIDTH_M / 2.0
+    }
+
+    /// Half the width of a road including both sidewalks, in metres: half a junction's side.
+    pub fn half_width_m(&self) -> f64 {
+        self.half_road_m() + SIDEWALK_WIDTH_M
+    }
+
+    /// Checks the documented ranges.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] naming the value.
+    pub fn validate(&self) -> Result<(), EngineError> {
+        let bad = |m: String| Err(EngineError::InvalidWorld(m));
+        let name = self.type_name();
+        let lanes = self.lanes();
+        if lanes == 0 || lanes % 2 == 1 {
+            return bad(format!("{name} has {lanes} lanes; need an even number >= 2"));
+        }
+        let mu = self.friction();
+        if !(mu > 0.0 && mu <= 2.0) {
+            return bad(format!("{name} friction {mu} is outside (0, 2]"));
+        }
+        match *self {
+            PieceKind::Segment { length_m, .. } if !(length_m.is_finite() && length_m > 0.0) => {
+                bad(format!("RoadSegment length {length_m} m is not positive"))
+            }
+            PieceKind::Roundabout { radius_m, .. } => {
+                let min = self.half_width_m() + 3.0;
+                if !(radius_m.is_finite() && radius_m >= min) {
+                    bad(format!(
+                        "Roundabout radius {radius_m} m is too small for {lanes} lanes (at least {min} m)"
+                    ))
+                } else {
+                    Ok(())
+                }
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Half-extents `[along x, along z]` of the rectangular footprint, in metres, and its
+    /// centre in the local frame.
+    pub fn footprint(&self) -> ([f64; 2], [f64; 2]) {
+        match *self {
+            PieceKind::Segment { length_m, .. } => {
+                ([length_m / 2.0, self.half_width_m()], [length_m / 2.0, 0.0])
+            }
+            PieceKind::TIntersection { .. } | PieceKind::CrossIntersection { .. } => {
+                let h = self.half_width_m();
+                ([h, h], [0.0, 0.0])
+            }
+            PieceKind::Roundabout { radius_m, .. } => ([radius_m, radius_m], [0.0, 0.0]),
+        }
+    }
+
+    /// Radius of the raised central island of a roundabout, in metres.
+    pub fn island_radius_m(&self) -> Option<f64> {
+        match *self {
+            PieceKind::Roundabout { radius_m, .. } => {
+                Some(radius_m - self.half_road_m() - SIDEWALK_WIDTH_M)
+            }
+            _ => None,
+        }
+    }
+
+    /// Its ports, by index.
+    pub fn ports(&self) -> Vec<PortGeometry> {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let compass = |h: f64, n: usize| -> Vec<PortGeometry> {
+            [0.0, -FRAC_PI_2, PI, FRAC_PI_2][..n]
+                .iter()
+                .map(|&heading_rad| {
+                    let d = direction(heading_rad);
+                    PortGeometry {
+                        pos: [d[0] * h, d[1] * h],
+                        heading_rad,
+                    }
+                })
+                .collect()
+        };
+        match *self {
+            PieceKind::Segment { length_m, .. } => vec![
+                PortGeometry {
+                    pos: [0.0, 0.0],
+                    heading_rad: PI,
+                },
+                PortGeometry {
+                    pos: [length_m, 0.0],
+                    heading_rad: 0.0,
+                },
+            ],
+            PieceKind::TIntersection { .. } => compass(self.half_width_m(), 3),
+            PieceKind::CrossIntersection { .. } => compass(self.half_width_m(), 4),
+            PieceKind::Roundabout { radius_m, .. } => compass(radius_m, 4),
+        }
+    }
+
+    /// Whether the local point `[x, z]` is on the driving surface (not a sidewalk).
+    pub fn on_driving_surface(&self, p: [f64; 2]) -> bool {
+        match *self {
+            PieceKind::Segment { length_m, .. } => {
+                (0.0..=length_m).contains(&p[0]) && p[1].abs() <= self.half_road_m()
+            }
+            _ => {
+                let ([hx, hz], _) = self.footprint();
+                let r = p[0].hypot(p[1]);
+                p[0].abs() <= hx && p[1].abs() <= hz && self.island_radius_m().is_none_or(|i| r > i)
+            }
+        }
+    }
+}
+
+/// A piece placed in the world.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Piece {
+    /// A name for messages, e.g. `RoadSegment r (grid.star:4:5)`.
+    pub name: String,
+    /// What it is.
+    pub kind: PieceKind,
+    /// Where its local frame sits in the world.
+    pub pose: Pose2,
+}
+
+impl Piece {
+    /// Port `i` in world coordinates: centre `[x, z]` and outward heading.
+    pub fn port(&self, i: usize) -> Option<PortGeometry> {
+        self.kind.ports().get(i).map(|p| PortGeometry {
+            pos: self.pose.apply(p.pos),
+            heading_rad: super::geometry::wrap(self.pose.heading_rad + p.heading_rad),
+        })
+    }
+}
