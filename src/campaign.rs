@@ -276,7 +276,7 @@ mod tests {
 
     #[test]
     fn records_are_in_id_order_and_independent_of_jobs() {
-        let s = paracosm_scenarios::pedestrian_crossing::scenario();
+        let s = paracosm_scenarios::reference::scenario();
         let dir = tempfile::tempdir().unwrap();
         let mut seen = Vec::new();
         let one = campaign(&s, 1)
@@ -300,7 +300,7 @@ mod tests {
 
     #[test]
     fn any_test_can_be_replayed_alone() {
-        let s = paracosm_scenarios::pedestrian_crossing::scenario();
+        let s = paracosm_scenarios::reference::scenario();
         let c = campaign(&s, 2);
         let dir = tempfile::tempdir().unwrap();
         let report = c.run(dir.path(), |_| {}).unwrap();
@@ -316,7 +316,7 @@ mod tests {
 
     #[test]
     fn a_point_that_does_not_decode_becomes_an_error_record() {
-        let s = paracosm_scenarios::pedestrian_crossing::scenario();
+        let s = paracosm_scenarios::reference::scenario();
         let r = campaign(&s, 1).run_one(
             0,
             &Point {
@@ -331,7 +331,7 @@ mod tests {
 
     #[test]
     fn sobol_past_its_capacity_is_refused_before_anything_runs() {
-        let s = paracosm_scenarios::pedestrian_crossing::scenario();
+        let s = paracosm_scenarios::reference::scenario();
         let c = Campaign {
             strategy: Strategy::Sobol,
             budget: 70_000,

@@ -527,12 +527,12 @@ mod tests {
     fn fog_shortens_the_lidar_range() {
         let mut s = spec();
         let mut nodes = s.streams.nodes().to_vec();
-        // Fog 1: visibility 19.6 m, so the pedestrian 30 m ahead disappears from the scan.
+        // Fog 1: visibility 7.8 m, so the pedestrian 30 m ahead disappears from the scan.
         nodes[s.environment.fog.0] = crate::rx::Node::Const(Value::Num(1.0));
         s.streams = crate::rx::Graph::new(nodes).unwrap();
         let mut sim = Simulation::new(&s).unwrap();
         sim.step(Control::default(), &mut NoHost).unwrap();
         assert_eq!(sim.snapshot().fog, 1.0);
-        assert!(sim.observation().lidar.iter().all(|r| r.range_m < 19.6));
+        assert!(sim.observation().lidar.iter().all(|r| r.range_m < 7.9));
     }
 }

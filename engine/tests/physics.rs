@@ -163,3 +163,64 @@ fn a_walking_pedestrian_crosses_once_triggered() {
     let p = sim.snapshot().pedestrians[0];
     assert_eq!(p.pos_m, [60.0, 0.15, -4.5]);
 }
+
+/// aeb follows a route around a loop of T-intersections (the shape of `t_loop.star`):
+/// after 60 s it has gone round more than once and never left the driving surface.
+#[test]
+fn aeb_follows_a_route_around_a_loop_of_t_intersections() {
+    use paracosm_engine::network::{Network, PieceKind, Turn};
+    use paracosm_engine::PieceId;
+    let mut n = Network::new();
+    let t: Vec<PieceId> = (0..4)
+        .map(|i| {
+            n.add(&format!("t{i}"), PieceKind::TIntersection { lanes: 2, friction: 0.8 })
+                .unwrap()
+        })
+        .collect();
+    let r: Vec<PieceId> = (0..4)
+        .map(|i| {
+            n.add(
+                &format!("r{i}"),
+                PieceKind::Segment {
+                    length_m: 80.0,
+                    lanes: 2,
+                    friction: 0.8,
+                },
+            )
+            .unwrap()
+        })
+        .collect();
+    let (one, two, three) = (0, 1, 2);
+    n.connect(t[0], one, r[0], one).unwrap();
+    n.connect(r[0], two, t[1], three).unwrap();
+    n.connect(t[1], two, r[1], one).unwrap();
+    n.connect(r[1], two, t[2], three).unwrap();
+    n.connect(t[2], two, r[2], one).unwrap();
+    n.connect(r[2], two, t[3], two).unwrap();
+    n.connect(t[3], one, r[3], one).unwrap();
+    n.connect(r[3], two, t[0], two).unwrap();
+    let mut spec = WorldSpec::straight_road(200.0, 10.0, 0.0, &[]).unwrap();
+    spec.ego.start = n.on_lane(r[0], Lane::Driving(1), 10.0).unwrap();
+    spec.ego.route = n.route(&spec.ego.start, &[] as &[Turn], 2000.0).unwrap();
+    spec.network = n.clone();
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut sut = Aeb::new(AebConfig::default());
+    let mut travelled = 0.0;
+    let mut last = sim.ego_state().pos_m;
+    while sim.t_s() < 60.0 {
+        let c = sut.act(&sim.observation()).unwrap();
+        sim.step(c, &mut NoHost).unwrap();
+        let p = sim.ego_state().pos_m;
+        travelled += (p[0] - last[0]).hypot(p[2] - last[2]);
+        last = p;
+        assert!(
+            n.driving_surface_at([p[0], p[2]]).is_some(),
+            "left the road at t = {} s, ({}, {})",
+            sim.t_s(),
+            p[0],
+            p[2]
+        );
+    }
+    // One lap is about 4 · (80 + 11) m = 364 m.
+    assert!(travelled > 400.0, "travelled {travelled} m");
+}

@@ -10,7 +10,6 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use paracosm::{Campaign, RunRecord};
 use paracosm_generators::Strategy;
-use paracosm_scenarios::pedestrian_crossing;
 
 /// What [`figure9`] measured and wrote.
 #[derive(Debug, Clone)]
@@ -30,7 +29,7 @@ pub struct Figure9 {
 /// # Errors
 /// When a campaign or a plot cannot be written.
 pub fn figure9(budget: u64, seed: u64, jobs: usize, out: &Path) -> Result<Figure9> {
-    let scenario = pedestrian_crossing::scenario();
+    let scenario = paracosm_scenarios::builtin("pedestrian-crossing")?;
     let dir = out.join("fig9");
     let mut runs: Vec<(String, Vec<RunRecord>, u64)> = Vec::new();
     for strategy in [Strategy::Random, Strategy::Halton] {

@@ -8,14 +8,17 @@
 //!   "Invariants and Monitors").
 //! - [`DistanceMonitor`]: the ego vehicle travelled at least `min_distance_m`, so it did not pass
 //!   by standing still (paper §2).
+//! - [`TimeToFailureMonitor`]: a wrapped monitor first fails no earlier than a given time.
 #![warn(missing_docs)]
 
 mod collision;
 mod distance;
 mod monitor;
 mod signals;
+mod time_to_failure;
 
 pub use collision::CollisionMonitor;
 pub use distance::DistanceMonitor;
 pub use monitor::{Monitor, Verdict};
 pub use signals::{Frame, SignalError, Signals};
+pub use time_to_failure::TimeToFailureMonitor;

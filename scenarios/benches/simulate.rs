@@ -3,7 +3,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use paracosm_generators::Point;
-use paracosm_scenarios::pedestrian_crossing::scenario;
+use paracosm_scenarios::reference::scenario;
 
 fn bench(c: &mut Criterion) {
     let s = scenario();

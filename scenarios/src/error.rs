@@ -23,6 +23,18 @@ pub enum ScenarioError {
     /// The instantiated world cannot be built.
     #[error(transparent)]
     Engine(#[from] EngineError),
+    /// A scenario program is wrong: the message is a diagnostic naming the file, line and
+    /// column, with the source line and a caret.
+    #[error("{0}")]
+    Language(String),
+    /// A scenario file cannot be read.
+    #[error("cannot read {path}: {message}")]
+    Io {
+        /// The path.
+        path: String,
+        /// The system's message.
+        message: String,
+    },
     /// The system under test failed.
     #[error(transparent)]
     Sut(#[from] SutError),

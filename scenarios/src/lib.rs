@@ -4,38 +4,77 @@
 //! [`Assignment`] of them into a concrete world ([`Scenario::instantiate`]), and runs one test
 //! in closed loop with its system under test and monitors ([`Scenario::run`]).
 //!
-//! The built-in scenarios are listed by [`builtin_names`] and loaded by [`builtin`]. Until the
-//! Starlark front end lands they are defined in Rust; their names, ranges and units live in one
-//! place per scenario (e.g. [`pedestrian_crossing`]).
+//! Scenarios are Starlark programs in the paper's vocabulary ([`lang`], LANGUAGE.md). The
+//! shipped ones live in `scenarios/*.star`, are compiled into the binary, and are listed by
+//! [`builtin_names`] and loaded by [`builtin`]; [`load`] takes a path or a built-in name.
 #![warn(missing_docs)]
 
 mod error;
-pub mod pedestrian_crossing;
+pub mod lang;
+pub mod reference;
 mod runner;
 mod scenario;
 
+use std::path::Path;
+
 pub use error::ScenarioError;
 pub use runner::{signal, TestOutcome};
-pub use scenario::{MonitorSpec, Scenario};
+pub use scenario::{Lambdas, MonitorSpec, Scenario, Template};
 
 use paracosm_generators::Assignment;
 
-/// Names of the built-in scenarios, for `paracosm-fuzz NAME`.
-pub fn builtin_names() -> &'static [&'static str] {
-    &[pedestrian_crossing::NAME]
+/// The shipped scenario programs: `(file name, source)`.
+pub const BUILTIN_SOURCES: [(&str, &str); 5] = [
+    (
+        "pedestrian_crossing.star",
+        include_str!("../pedestrian_crossing.star"),
+    ),
+    (
+        "follow_lead_car.star",
+        include_str!("../follow_lead_car.star"),
+    ),
+    ("fog_light.star", include_str!("../fog_light.star")),
+    ("t_loop.star", include_str!("../t_loop.star")),
+    ("grid_world.star", include_str!("../grid_world.star")),
+];
+
+/// Names of the built-in scenarios: the file stems with hyphens (`pedestrian-crossing`, ...).
+pub fn builtin_names() -> Vec<String> {
+    BUILTIN_SOURCES
+        .iter()
+        .map(|(f, _)| f.trim_end_matches(".star").replace('_', "-"))
+        .collect()
 }
 
-/// The built-in scenario called `name`.
+/// The built-in scenario called `name` (hyphens or underscores).
 ///
 /// # Errors
 /// [`ScenarioError::UnknownScenario`] listing the known names.
 pub fn builtin(name: &str) -> Result<Scenario, ScenarioError> {
-    match name {
-        pedestrian_crossing::NAME => Ok(pedestrian_crossing::scenario()),
-        _ => Err(ScenarioError::UnknownScenario {
-            name: name.to_owned(),
-            known: builtin_names().join(", "),
-        }),
+    let wanted = name.replace('_', "-");
+    for (file, source) in BUILTIN_SOURCES {
+        let stem = file.trim_end_matches(".star").replace('_', "-");
+        if stem == wanted {
+            return lang::load_source(&format!("scenarios/{file}"), source, &stem);
+        }
+    }
+    Err(ScenarioError::UnknownScenario {
+        name: name.to_owned(),
+        known: builtin_names().join(", "),
+    })
+}
+
+/// A scenario by path (anything ending in `.star` or naming an existing file) or by built-in
+/// name.
+///
+/// # Errors
+/// As [`lang::load_file`] and [`builtin`].
+pub fn load(name_or_path: &str) -> Result<Scenario, ScenarioError> {
+    let path = Path::new(name_or_path);
+    if name_or_path.ends_with(".star") || path.exists() {
+        lang::load_file(path)
+    } else {
+        builtin(name_or_path)
     }
 }
 

@@ -1,6 +1,7 @@
 use std::ops::ControlFlow;
 
-use paracosm_engine::{Simulation, Snapshot};
+use paracosm_engine::rx::{Host, NoHost};
+use paracosm_engine::{Simulation, Snapshot, WorldSpec};
 use paracosm_generators::Assignment;
 use paracosm_oracles::{Frame, Monitor, Signals, Verdict};
 
@@ -14,10 +15,15 @@ pub mod signal {
     pub const EGO_Z_M: &str = "ego_z_m";
     /// Ego speed along its heading, m/s.
     pub const EGO_SPEED_MPS: &str = "ego_speed_mps";
-    /// `1.0` while the ego vehicle touches a pedestrian, else `0.0`.
-    pub const EGO_PED_CONTACT: &str = "ego_ped_contact";
-    /// Smallest distance between the ego body and a pedestrian, metres (`0` touching).
-    pub const EGO_PED_SEPARATION_M: &str = "ego_ped_separation_m";
+    /// `1.0` while the ego vehicle touches a pedestrian or a car, else `0.0`.
+    pub const EGO_CONTACT: &str = "ego_contact";
+    /// Smallest distance between the ego body and a pedestrian or a car, metres (`0`
+    /// touching).
+    pub const EGO_SEPARATION_M: &str = "ego_separation_m";
+    /// Fog density, `[0, 1]`.
+    pub const FOG: &str = "fog";
+    /// Light intensity, `[0, 1]`.
+    pub const LIGHT: &str = "light";
 }
 
 /// The result of one test.
@@ -49,11 +55,10 @@ fn publish(snap: &Snapshot, out: &mut Signals) {
     out.set(signal::EGO_X_M, snap.ego.pos_m[0]);
     out.set(signal::EGO_Z_M, snap.ego.pos_m[2]);
     out.set(signal::EGO_SPEED_MPS, snap.ego.speed_mps);
-    out.set_bool(signal::EGO_PED_CONTACT, snap.ego_pedestrian_contact);
-    out.set(
-        signal::EGO_PED_SEPARATION_M,
-        snap.min_pedestrian_separation_m,
-    );
+    out.set_bool(signal::EGO_CONTACT, snap.ego_contact);
+    out.set(signal::EGO_SEPARATION_M, snap.min_separation_m);
+    out.set(signal::FOG, snap.fog);
+    out.set(signal::LIGHT, snap.light);
 }
 
 /// Feeds one snapshot to every monitor; `Break` when any monitor settled its verdict.
@@ -80,7 +85,23 @@ impl Scenario {
     /// [`ScenarioError`] when the world cannot be built or the system under test fails.
     pub fn run(&self, assignment: &Assignment, seed: u64) -> Result<TestOutcome, ScenarioError> {
         let spec = self.instantiate(assignment)?;
-        let mut sim = Simulation::new(&spec)?;
+        match &self.lambdas {
+            None => self.run_world(&spec, seed, &mut NoHost),
+            Some(lambdas) => {
+                let mut out = None;
+                lambdas.with_host(&mut |host| out = Some(self.run_world(&spec, seed, host)));
+                out.expect("with_host calls its closure")
+            }
+        }
+    }
+
+    fn run_world(
+        &self,
+        spec: &WorldSpec,
+        seed: u64,
+        host: &mut dyn Host,
+    ) -> Result<TestOutcome, ScenarioError> {
+        let mut sim = Simulation::new(spec)?;
         let mut sut = self.sut.build();
         sut.reset(seed)?;
         let mut monitors: Vec<Box<dyn Monitor>> = self.monitors.iter().map(|m| m.build()).collect();
@@ -90,7 +111,7 @@ impl Scenario {
         let mut tick = 0;
         while !stopped && tick < ticks {
             let control = sut.act(&sim.observation())?;
-            sim.step(control);
+            sim.step(control, host)?;
             tick += 1;
             stopped = observe(&sim.snapshot(), &mut signals, &mut monitors);
         }
@@ -119,7 +140,7 @@ impl Scenario {
 mod tests {
     use paracosm_generators::Point;
 
-    use crate::pedestrian_crossing::{self, TRIGGER_DISTANCE, WALKING_SPEED};
+    use crate::reference::{self as pedestrian_crossing, TRIGGER_DISTANCE, WALKING_SPEED};
 
     fn run(speed: f64, trigger: f64) -> crate::TestOutcome {
         let s = pedestrian_crossing::scenario();
@@ -191,7 +212,16 @@ mod tests {
             })
             .unwrap();
         let w = s.instantiate(&a).unwrap();
-        assert_eq!(w.pedestrians[0].speed_mps, 0.5);
-        assert_eq!(w.pedestrians[0].trigger_distance_m, 32.5);
+        let value = |id: paracosm_engine::rx::StreamId| match &w.streams.nodes()[id.0] {
+            paracosm_engine::rx::Node::Const(v) => v.as_num().unwrap(),
+            n => panic!("{n:?}"),
+        };
+        assert_eq!(value(w.pedestrians[0].speed), 0.5);
+        // The trigger distance is the constant zipped with the car's position.
+        let dist = w.streams.nodes().iter().find_map(|n| match n {
+            paracosm_engine::rx::Node::Zip(_, d) => Some(*d),
+            _ => None,
+        });
+        assert_eq!(value(dist.unwrap()), 32.5);
     }
 }

@@ -22,8 +22,13 @@ use paracosm::summary::Summary;
 #[derive(Debug, Parser)]
 #[command(name = "paracosm-fuzz", version)]
 struct Cli {
-    /// Built-in scenario to test (available: pedestrian-crossing).
-    scenario: String,
+    /// Scenario to test: a path to a `.star` program, or a built-in name (see --list):
+    /// pedestrian-crossing, follow-lead-car, fog-light, t-loop, grid-world.
+    #[arg(required_unless_present = "list")]
+    scenario: Option<String>,
+    /// List the built-in scenarios and exit.
+    #[arg(long)]
+    list: bool,
     /// How test points are chosen.
     #[arg(long, value_enum, default_value = "halton")]
     strategy: StrategyArg,
@@ -78,8 +83,16 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: &Cli) -> Result<ExitCode> {
-    let scenario =
-        paracosm_scenarios::builtin(&cli.scenario).map_err(|e| BadInput(e.to_string()))?;
+    if cli.list {
+        for name in paracosm_scenarios::builtin_names() {
+            let s = paracosm_scenarios::builtin(&name).context("a built-in scenario fails to load")?;
+            let params: Vec<String> = s.space.params().iter().map(|p| p.label()).collect();
+            println!("{name}\n    {}\n    parameters: {}", s.description, params.join(", "));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let name = cli.scenario.as_deref().unwrap_or_default();
+    let scenario = paracosm_scenarios::load(name).map_err(|e| BadInput(e.to_string()))?;
     let strategy = paracosm::cli::strategy(cli.strategy, cli.scramble).map_err(BadInput)?;
     if let Some(cap) = strategy.capacity().filter(|&cap| cli.budget > cap) {
         return Err(BadInput(format!(

@@ -124,7 +124,8 @@ impl Network {
     /// The path a vehicle drives from `start` (a driving lane of a segment): along its lane,
     /// then across the connected pieces, taking at each junction with a choice the next turn
     /// of `turns` (then `straight`, `right`, `left`, in that order of preference, when the
-    /// list is used up or the turn is not there), until the network ends or the path is
+    /// list is used up or the turn is not there; exits into the network before dead ends),
+    /// until the network ends or the path is
     /// `max_len_m` metres long. World `[x, z]` points in metres.
     ///
     /// # Errors
@@ -164,11 +165,19 @@ impl Network {
             }) else {
                 break;
             };
-            let candidates: Vec<LanePath> = self
+            let mut candidates: Vec<LanePath> = self
                 .lane_paths(next.0)
                 .into_iter()
                 .filter(|l| l.entry == (next.1, path.exit.1))
                 .collect();
+            // Prefer exits that lead on into the network over dead ends.
+            let linked = |l: &LanePath| {
+                let end = (l.piece, l.exit.0);
+                self.links.iter().any(|k| k.a == end || k.b == end)
+            };
+            if candidates.iter().any(linked) {
+                candidates.retain(linked);
+            }
             let pick = if candidates.len() > 1 {
                 let wanted = turns.next().copied();
                 wanted
@@ -185,8 +194,28 @@ impl Network {
             }
             path = pick;
         }
-        Ok(points)
+        Ok(resample(&points, ROUTE_SPACING_M))
     }
+}
+
+/// Largest distance between consecutive points of a route, in metres, so that followers find
+/// their place on it by the nearest point.
+const ROUTE_SPACING_M: f64 = 1.0;
+
+/// `points` with points inserted so that no two consecutive ones are more than `max_m` apart.
+fn resample(points: &[[f64; 2]], max_m: f64) -> Vec<[f64; 2]> {
+    let mut out = vec![points[0]];
+    for w in points.windows(2) {
+        let n = (dist(w[0], w[1]) / max_m).ceil().max(1.0) as usize;
+        for i in 1..=n {
+            let t = i as f64 / n as f64;
+            out.push([
+                w[0][0] + t * (w[1][0] - w[0][0]),
+                w[0][1] + t * (w[1][1] - w[0][1]),
+            ]);
+        }
+    }
+    out
 }
 
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {

@@ -120,6 +120,23 @@ impl Network {
         Ok(PieceId(id))
     }
 
+    /// Sets the friction of piece `id` (a test case's value for an open friction stream).
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] for a friction outside `(0, 2]`.
+    pub fn set_friction(&mut self, id: PieceId, friction: f64) -> Result<(), EngineError> {
+        let mut kind = self.pieces[id.0].kind.clone();
+        match &mut kind {
+            PieceKind::Segment { friction: f, .. }
+            | PieceKind::TIntersection { friction: f, .. }
+            | PieceKind::CrossIntersection { friction: f, .. }
+            | PieceKind::Roundabout { friction: f, .. } => *f = friction,
+        }
+        kind.validate()?;
+        self.pieces[id.0].kind = kind;
+        Ok(())
+    }
+
     /// The pieces, by [`PieceId`].
     pub fn pieces(&self) -> &[Piece] {
         &self.pieces

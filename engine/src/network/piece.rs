@@ -7,6 +7,10 @@ use crate::EngineError;
 pub const LANE_WIDTH_M: f64 = 3.5;
 /// Width of each sidewalk along a road segment, in metres.
 pub const SIDEWALK_WIDTH_M: f64 = 2.0;
+/// Extra paved margin on each side of an intersection beyond the roads' width, in metres, so
+/// that turning paths have radii a car can steer (a right turn from lane 1 of a two-lane road
+/// has a 6.75 m radius, above the ego vehicle's 5.3 m minimum).
+pub const JUNCTION_APRON_M: f64 = 3.0;
 
 /// What a road piece is, in its own frame (paper §2, "More Complex Worlds").
 ///
@@ -99,9 +103,15 @@ impl PieceKind {
         self.lanes() as f64 * LANE_WIDTH_M / 2.0
     }
 
-    /// Half the width of a road including both sidewalks, in metres: half a junction's side.
+    /// Half the width of a road including both sidewalks, in metres.
     pub fn half_width_m(&self) -> f64 {
         self.half_road_m() + SIDEWALK_WIDTH_M
+    }
+
+    /// Half the side of a T- or cross-intersection, in metres: the roads' half width plus
+    /// [`JUNCTION_APRON_M`].
+    pub fn junction_half_m(&self) -> f64 {
+        self.half_width_m() + JUNCTION_APRON_M
     }
 
     /// Checks the documented ranges.
@@ -145,7 +155,7 @@ impl PieceKind {
                 ([length_m / 2.0, self.half_width_m()], [length_m / 2.0, 0.0])
             }
             PieceKind::TIntersection { .. } | PieceKind::CrossIntersection { .. } => {
-                let h = self.half_width_m();
+                let h = self.junction_half_m();
                 ([h, h], [0.0, 0.0])
             }
             PieceKind::Roundabout { radius_m, .. } => ([radius_m, radius_m], [0.0, 0.0]),
@@ -188,8 +198,8 @@ impl PieceKind {
                     heading_rad: 0.0,
                 },
             ],
-            PieceKind::TIntersection { .. } => compass(self.half_width_m(), 3),
-            PieceKind::CrossIntersection { .. } => compass(self.half_width_m(), 4),
+            PieceKind::TIntersection { .. } => compass(self.junction_half_m(), 3),
+            PieceKind::CrossIntersection { .. } => compass(self.junction_half_m(), 4),
             PieceKind::Roundabout { radius_m, .. } => compass(radius_m, 4),
         }
     }

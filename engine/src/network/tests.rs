@@ -39,18 +39,18 @@ fn the_papers_t_intersection_places_its_roads_at_its_ports() {
     n.connect(t, ONE, e, TWO).unwrap();
     n.connect(t, TWO, s, ONE).unwrap();
     n.connect(t, THREE, w, ONE).unwrap();
-    // Half the junction: 4 lanes · 3.5 m / 2 + 2 m sidewalk = 9 m.
+    // Half the junction: 4 lanes · 3.5 m / 2 + 2 m sidewalk + 3 m apron = 12 m.
     let port = |p: PieceId, i: usize| n.piece(p).port(i).unwrap();
-    assert!(close(port(e, TWO).pos, [9.0, 0.0]));
+    assert!(close(port(e, TWO).pos, [12.0, 0.0]));
     // e joins with its end TWO, so it runs back toward the junction: its ONE is 50 m east.
-    assert!(close(port(e, ONE).pos, [59.0, 0.0]));
-    assert!(close(port(s, TWO).pos, [0.0, 59.0]));
-    assert!(close(port(w, TWO).pos, [-29.0, 0.0]));
+    assert!(close(port(e, ONE).pos, [62.0, 0.0]));
+    assert!(close(port(s, TWO).pos, [0.0, 62.0]));
+    assert!(close(port(w, TWO).pos, [-32.0, 0.0]));
     assert_eq!(n.group_of(t).len(), 4);
     assert_eq!(n.links().len(), 3);
     // onLane on the rotated south road: lane 1 drives away from the junction (+z).
     let l = n.on_lane(s, Lane::Driving(1), 10.0).unwrap();
-    assert!(close([l.pos_m[0], l.pos_m[2]], [-1.75, 19.0]));
+    assert!(close([l.pos_m[0], l.pos_m[2]], [-1.75, 22.0]));
     assert!((wrap(l.heading_rad + std::f64::consts::FRAC_PI_2)).abs() < 1e-12);
 }
 
@@ -160,9 +160,9 @@ fn a_grid_of_cross_intersections_validates() {
     let xs = grid(&mut n, 3, 40.0);
     n.check_all_overlaps().unwrap();
     assert_eq!(n.group_of(xs[0][0]).len(), 9 + 12);
-    // 3 × 3 junctions 40 m apart plus their 11 m sides: x22 sits at (2 · 51, 2 · 51).
+    // 3 × 3 junctions 40 m apart plus their 17 m sides: x22 sits at (2 · 57, 2 · 57).
     let p = n.piece(xs[2][2]).pose;
-    assert!(close([p.x, p.z], [102.0, 102.0]), "{p:?}");
+    assert!(close([p.x, p.z], [114.0, 114.0]), "{p:?}");
 }
 
 #[test]
@@ -184,10 +184,10 @@ fn routes_follow_the_lane_graph_and_its_turns() {
     let x10 = n.piece(xs[1][0]).pose;
     // After two right turns it drives west along h11 and ends at x10, where the network
     // offers only north or south... and keeps going: it must pass x10's east port.
-    assert!(route.iter().any(|p| (p[0] - (x10.x + 5.5)).abs() < 1e-6), "{last:?}");
-    // Every step of the route is short and continuous.
+    assert!(route.iter().any(|p| (p[0] - (x10.x + 8.5)).abs() < 1e-6), "{last:?}");
+    // Every step of the route is short (resampled to 1 m) and continuous.
     for w in route.windows(2) {
-        assert!((w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) <= 40.0 + 1e-9);
+        assert!((w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) <= 1.0 + 1e-9);
     }
     // Driving lanes keep to the right: heading east on lane 1 means z > junction z.
     assert!(start.pos_m[2] > 0.0);

@@ -17,6 +17,8 @@ pub enum Value {
     Vec3([f64; 3]),
     /// A tuple, e.g. the pairs made by `zip`.
     Tuple(Vec<Value>),
+    /// A text level, e.g. a colour from `VarEnum(["red", "white"])`.
+    Text(String),
 }
 
 impl Value {
@@ -54,6 +56,7 @@ impl Value {
             Value::Bool(_) => "bool",
             Value::Vec3(_) => "vector",
             Value::Tuple(_) => "tuple",
+            Value::Text(_) => "string",
         }
     }
 

@@ -1,3 +1,8 @@
+//! The Rust reference of `pedestrian_crossing.star`: the same study written against the
+//! engine directly. The shipped scenario is the Starlark program; this module exists so tests
+//! can check that the program gives byte-identical results and benchmarks can measure what the
+//! language costs.
+//!
 //! `pedestrian-crossing`: the paper's "Dynamic Pedestrian Behavior" study (§4.2.2, Figure 9).
 //!
 //! The ego vehicle drives down a straight two-lane road at 12 m/s under the `aeb` system. A
@@ -7,9 +12,9 @@
 //! Monitors: no collision, and at least 60 m travelled in the 15 s horizon.
 
 use paracosm_engine::sut::{AebConfig, SutConfig};
-use paracosm_engine::{
-    EgoSpec, Lane, LidarSpec, PedestrianSpec, RoadSpec, VehicleParams, WorldSpec, DEFAULT_DT_S,
-};
+use std::sync::Arc;
+
+use paracosm_engine::{Lane, TriggeredPedestrian, WorldSpec};
 use paracosm_generators::{Assignment, Param, ParamSpace};
 
 use crate::{real, MonitorSpec, Scenario, ScenarioError};
@@ -59,32 +64,25 @@ pub fn scenario() -> Scenario {
         horizon_s: HORIZON_S,
         sut: SutConfig::Aeb(AebConfig::default()),
         monitors: vec![
-            MonitorSpec::Collision,
-            MonitorSpec::Distance {
-                min_distance_m: MIN_DISTANCE_M,
-            },
+            MonitorSpec::collision(),
+            MonitorSpec::distance(MIN_DISTANCE_M),
         ],
         map_axes: [WALKING_SPEED.to_owned(), TRIGGER_DISTANCE.to_owned()],
-        template: world,
+        template: Arc::new(world),
+        lambdas: None,
     }
 }
 
 fn world(a: &Assignment) -> Result<WorldSpec, ScenarioError> {
-    Ok(WorldSpec {
-        dt_s: DEFAULT_DT_S,
-        road: RoadSpec::default(),
-        ego: EgoSpec {
-            lane: Lane::Driving(1),
-            at_m: EGO_START_M,
-            initial_speed_mps: AebConfig::default().target_speed_mps,
-            vehicle: VehicleParams::default(),
-        },
-        pedestrians: vec![PedestrianSpec {
+    Ok(WorldSpec::straight_road(
+        200.0,
+        EGO_START_M,
+        AebConfig::default().target_speed_mps,
+        &[TriggeredPedestrian {
             start: (Lane::SideWalk, CROSSING_AT_M),
             target: (Lane::OppositeSideWalk, CROSSING_AT_M),
             trigger_distance_m: real(a, TRIGGER_DISTANCE)?,
             speed_mps: real(a, WALKING_SPEED)?,
         }],
-        lidar: LidarSpec::default(),
-    })
+    )?)
 }

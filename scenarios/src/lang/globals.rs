@@ -1,0 +1,517 @@
+#![allow(non_snake_case)] // The paper's keyword names: numLane, minD, minT.
+
+//! The global builtins of the scenario language (LANGUAGE.md documents each).
+
+use std::cell::RefCell;
+
+use anyhow::{anyhow, bail};
+use paracosm_engine::behaviour::{Actor, Output};
+use paracosm_engine::network::PieceKind;
+use paracosm_engine::rx::{Node, StreamId, Value as Rx};
+use paracosm_engine::sut::{AebConfig, SutConfig};
+use paracosm_generators::{Domain, Value as Level};
+use starlark::environment::GlobalsBuilder;
+use starlark::eval::Evaluator;
+use starlark::starlark_module;
+use starlark::values::list::UnpackList;
+use starlark::values::none::NoneType;
+use starlark::values::{ProvidesStaticType, UnpackValue, Value, ValueLike};
+
+use super::scene::{
+    turns, Fixed, ObjectDecl, OverTime, ParamDecl, Pending, PedTrigger, SceneBuilder,
+};
+use super::values::{ActorKind, ActorVal, LaneSide, Loc, MonitorVal, OverTimeVal, Road, Stream, WorldVal};
+use crate::MonitorSpec;
+
+/// The state a program's builtins write into, reached through `Evaluator::extra`.
+#[derive(ProvidesStaticType)]
+pub struct LoadState {
+    /// The declarations so far.
+    pub scene: RefCell<SceneBuilder>,
+}
+
+impl Default for LoadState {
+    fn default() -> Self {
+        LoadState {
+            scene: RefCell::new(SceneBuilder::new()),
+        }
+    }
+}
+
+/// The program's [`LoadState`].
+pub fn state<'a>(eval: &Evaluator<'_, 'a, '_>) -> anyhow::Result<&'a LoadState> {
+    eval.extra
+        .and_then(|e| e.downcast_ref::<LoadState>())
+        .ok_or_else(|| anyhow!("scenario builtins work only while a scenario program loads"))
+}
+
+fn here(eval: &Evaluator) -> String {
+    eval.call_stack_top_location()
+        .map(|l| l.resolve_span().begin.to_string())
+        .map(|pos| {
+            let file = eval.call_stack_top_location().map(|l| l.filename().to_owned()).unwrap_or_default();
+            format!("{file}:{pos}")
+        })
+        .unwrap_or_else(|| "?".into())
+}
+
+/// A number: an int, a float, or a `Const` stream of a number.
+pub fn number(v: Value, what: &str) -> anyhow::Result<f64> {
+    if let Some(i) = v.unpack_i32() {
+        return Ok(f64::from(i));
+    }
+    if let Some(f) = v.downcast_ref::<starlark::values::float::StarlarkFloat>() {
+        return Ok(f.0);
+    }
+    bail!("{what} must be a number, got a {}", v.get_type())
+}
+
+fn constant(v: Value) -> Option<Rx> {
+    if let Some(b) = v.unpack_bool() {
+        return Some(Rx::Bool(b));
+    }
+    if let Some(s) = v.unpack_str() {
+        return Some(Rx::Text(s.to_owned()));
+    }
+    number(v, "").ok().map(Rx::Num)
+}
+
+/// A stream argument: a stream, or a plain number, bool or string (a constant stream).
+pub fn stream_arg(v: Value, b: &mut SceneBuilder, what: &str) -> anyhow::Result<StreamId> {
+    if let Some(s) = v.downcast_ref::<Stream>() {
+        return Ok(StreamId(s.id));
+    }
+    match constant(v) {
+        Some(c) => Ok(b.graph.push(Node::Const(c))),
+        None => bail!("{what} must be a stream or a constant, got a {}", v.get_type()),
+    }
+}
+
+/// A value fixed for a test: a constant, `Const(...)`, or an open parameter constant over
+/// time.
+fn fixed_arg(v: Value, b: &SceneBuilder, what: &str) -> anyhow::Result<Fixed> {
+    if let Some(s) = v.downcast_ref::<Stream>() {
+        if let Some(p) = b.param_of(StreamId(s.id)) {
+            if b.params[p].over_time != OverTime::Constant {
+                bail!("{what} must be constant over a test; it cannot vary over_time");
+            }
+            return Ok(Fixed::Param(p));
+        }
+        if let Some(Node::Const(c)) = b.graph.nodes().get(s.id) {
+            return Ok(Fixed::Const(c.clone()));
+        }
+        bail!("{what} must be a constant or an open parameter (VarInterval/VarEnum), not a computed stream");
+    }
+    constant(v)
+        .map(Fixed::Const)
+        .ok_or_else(|| anyhow!("{what} must be a constant, got a {}", v.get_type()))
+}
+
+/// A number known when the program loads: a plain number or `Const(number)`.
+fn load_time_number(v: Value, b: &SceneBuilder, what: &str) -> anyhow::Result<f64> {
+    match fixed_arg(v, b, what)? {
+        Fixed::Const(Rx::Num(x)) => Ok(x),
+        Fixed::Const(c) => bail!("{what} must be a number, got a {}", c.kind()),
+        Fixed::Param(_) => bail!("{what} must be known when the program loads (a number or Const); open parameters cannot change the road geometry"),
+    }
+}
+
+fn lanes(v: Option<Value>, b: &SceneBuilder, default: u32) -> anyhow::Result<u32> {
+    let Some(v) = v else { return Ok(default) };
+    let x = load_time_number(v, b, "nlanes")?;
+    if x.fract() != 0.0 || !(2.0..=16.0).contains(&x) || (x as u32) % 2 == 1 {
+        bail!("nlanes must be an even whole number from 2 to 16, got {x}");
+    }
+    Ok(x as u32)
+}
+
+fn add_piece(eval: &Evaluator, what: &str, kind: PieceKind, friction: Option<Value>) -> anyhow::Result<Road> {
+    let st = state(eval)?;
+    let mut b = st.scene.borrow_mut();
+    let fixed = match friction {
+        Some(v) => fixed_arg(v, &b, "friction")?,
+        None => Fixed::Const(Rx::Num(kind.friction())),
+    };
+    let segment = matches!(kind, PieceKind::Segment { .. });
+    let ports = kind.ports().len();
+    let name = format!("{what} declared at {}", here(eval));
+    let id = b.roads.add(&name, kind).map_err(|e| anyhow!(super::scene::strip(e)))?;
+    b.frictions.push((id, fixed));
+    Ok(Road { piece: id.0, ports, segment, network: false })
+}
+
+fn friction_default(f: Option<Value>, b: &SceneBuilder) -> anyhow::Result<f64> {
+    // A placeholder inside (0, 2] for open frictions: each test sets its own value.
+    match f {
+        Some(v) => match fixed_arg(v, b, "friction")? {
+            Fixed::Const(Rx::Num(x)) => Ok(x),
+            Fixed::Param(p) => match &b.params[p].domain {
+                Domain::Interval { lo, .. } => Ok(*lo),
+                _ => bail!("friction must be a number or a VarInterval"),
+            },
+            Fixed::Const(c) => bail!("friction must be a number, got a {}", c.kind()),
+        },
+        None => Ok(0.8),
+    }
+}
+
+fn location(v: Value, what: &str) -> anyhow::Result<usize> {
+    v.downcast_ref::<Loc>()
+        .map(|l| l.index)
+        .ok_or_else(|| anyhow!("{what} must be a location from r.onLane(lane, at), got a {}", v.get_type()))
+}
+
+fn declare(eval: &Evaluator, b: &mut SceneBuilder, what: &str, kind: ActorKind, pending: Pending) -> ActorVal {
+    let actor = match kind {
+        ActorKind::Ego => Actor::Ego,
+        ActorKind::Pedestrian(i) => Actor::Pedestrian(i),
+        ActorKind::Car(i) => Actor::Car(i),
+    };
+    let outputs = [Output::Pos, Output::Vel, Output::Heading, Output::Speed, Output::Collision]
+        .map(|o| b.probe(actor, o).0);
+    b.objects.push(ObjectDecl {
+        name: format!("{what} declared at {}", here(eval)),
+        pending,
+        placed: false,
+    });
+    ActorVal { kind, outputs, object: b.objects.len() - 1 }
+}
+
+fn route_arg(v: Option<Value>) -> anyhow::Result<Option<Vec<paracosm_engine::network::Turn>>> {
+    match v {
+        None => Ok(None),
+        Some(v) if v.is_none() => Ok(None),
+        Some(v) => {
+            let list = UnpackList::<String>::unpack_value(v)
+                .ok()
+                .flatten()
+                .ok_or_else(|| anyhow!("route must be a list of turns such as [\"left\", \"straight\"], got a {}", v.get_type()))?;
+            turns(&list.items).map(Some).map_err(|e| anyhow!(e))
+        }
+    }
+}
+
+fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<MonitorVal> {
+    let st = state(eval)?;
+    let mut b = st.scene.borrow_mut();
+    b.monitors.push(spec);
+    Ok(MonitorVal { index: b.monitors.len() - 1 })
+}
+
+fn ego_arg(v: Value, what: &str) -> anyhow::Result<()> {
+    match v.downcast_ref::<ActorVal>() {
+        Some(a) if a.kind == ActorKind::Ego => Ok(()),
+        _ => bail!("{what} watches the AutonomousVehicle; got a {}", v.get_type()),
+    }
+}
+
+/// The builtins.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
+    const tick: Stream = Stream { id: super::scene::TICK.0 };
+    const SideWalk: LaneSide = LaneSide { opposite: false };
+
+    /// `Const(v)`: the constant stream of `v`.
+    fn Const<'v>(v: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
+        let c = constant(v).ok_or_else(|| anyhow!("Const takes a number, a bool or a string, got a {}", v.get_type()))?;
+        let st = state(eval)?;
+        let id = st.scene.borrow_mut().graph.push(Node::Const(c));
+        Ok(Stream { id: id.0 })
+    }
+
+    /// `VarInterval(lo, hi, unit=None, name=None, over_time=None)`: an open real stream.
+    fn VarInterval<'v>(
+        lo: Value<'v>,
+        hi: Value<'v>,
+        #[starlark(require = named)] unit: Option<&str>,
+        #[starlark(require = named)] name: Option<&str>,
+        #[starlark(require = named)] over_time: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Stream> {
+        let (lo, hi) = (number(lo, "VarInterval lo")?, number(hi, "VarInterval hi")?);
+        if !(lo.is_finite() && hi.is_finite()) || lo >= hi {
+            bail!("VarInterval({lo}, {hi}) is empty: lo must be below hi");
+        }
+        let over_time = match over_time {
+            None => OverTime::Constant,
+            Some(v) if v.is_none() => OverTime::Constant,
+            Some(v) => v.downcast_ref::<OverTimeVal>().map(|o| o.over_time).ok_or_else(|| anyhow!("over_time must be Piecewise(k) or Polynomial(deg), got a {}", v.get_type()))?,
+        };
+        let at = here(eval);
+        let st = state(eval)?;
+        let id = st.scene.borrow_mut().param(ParamDecl {
+            name: name.map(str::to_owned),
+            hint: None,
+            domain: Domain::Interval { lo, hi },
+            unit: unit.map(str::to_owned),
+            over_time,
+            at,
+        });
+        Ok(Stream { id: id.0 })
+    }
+
+    /// `VarEnum([levels...], name=None)`: an open discrete stream.
+    fn VarEnum<'v>(
+        levels: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Stream> {
+        let items: Vec<Value> = levels.iterate(eval.heap()).map_err(|_| anyhow!("VarEnum takes a list of levels, got a {}", levels.get_type()))?.collect();
+        if items.is_empty() {
+            bail!("VarEnum([]) has no levels");
+        }
+        let mut out = Vec::new();
+        for v in items {
+            let level = if let Some(b) = v.unpack_bool() {
+                Level::Text(b.to_string())
+            } else if let Some(i) = v.unpack_i32() {
+                Level::Int(i64::from(i))
+            } else if let Some(s) = v.unpack_str() {
+                Level::Text(s.to_owned())
+            } else {
+                Level::Real(number(v, "a VarEnum level")?)
+            };
+            if out.contains(&level) {
+                bail!("VarEnum lists the level {level} twice");
+            }
+            out.push(level);
+        }
+        let at = here(eval);
+        let st = state(eval)?;
+        let id = st.scene.borrow_mut().param(ParamDecl {
+            name: name.map(str::to_owned),
+            hint: None,
+            domain: Domain::Levels(out),
+            unit: None,
+            over_time: OverTime::Constant,
+            at,
+        });
+        Ok(Stream { id: id.0 })
+    }
+
+    /// `Piecewise(k)`: an open stream held constant on `k` equal parts of the test.
+    fn Piecewise(k: i32) -> anyhow::Result<OverTimeVal> {
+        if !(1..=64).contains(&k) {
+            bail!("Piecewise(k) needs 1 <= k <= 64, got {k}");
+        }
+        Ok(OverTimeVal { over_time: OverTime::Piecewise(k as usize) })
+    }
+
+    /// `Polynomial(deg)`: an open stream that is a Bernstein polynomial of degree `deg` in time.
+    fn Polynomial(deg: i32) -> anyhow::Result<OverTimeVal> {
+        if !(0..=16).contains(&deg) {
+            bail!("Polynomial(deg) needs 0 <= deg <= 16, got {deg}");
+        }
+        Ok(OverTimeVal { over_time: OverTime::Polynomial(deg as usize) })
+    }
+
+    /// `World(light=1.0, fog=0.0)`: global conditions as streams.
+    fn World<'v>(
+        #[starlark(require = named)] light: Option<Value<'v>>,
+        #[starlark(require = named)] fog: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<WorldVal> {
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        if b.world.is_some() {
+            bail!("a program has one World");
+        }
+        let heap = eval.heap();
+        let light = stream_arg(light.unwrap_or_else(|| heap.alloc(1.0)), &mut b, "light")?;
+        let fog = stream_arg(fog.unwrap_or_else(|| heap.alloc(0.0)), &mut b, "fog")?;
+        b.world = Some((light, fog));
+        Ok(WorldVal { light: light.0, fog: fog.0 })
+    }
+
+    /// `RoadSegment(len=200.0, nlanes=2, friction=0.8)`.
+    fn RoadSegment<'v>(
+        #[starlark(require = named)] len: Option<Value<'v>>,
+        #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        let kind = {
+            let st = state(eval)?;
+            let b = st.scene.borrow();
+            let length_m = match len { Some(v) => load_time_number(v, &b, "len")?, None => 200.0 };
+            PieceKind::Segment { length_m, lanes: lanes(nlanes, &b, 2)?, friction: friction_default(friction, &b)? }
+        };
+        add_piece(eval, "RoadSegment", kind, friction)
+    }
+
+    /// `TIntersection(nlanes=2, friction=0.8)`; `numLane=` is the paper's spelling.
+    fn TIntersection<'v>(
+        #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] numLane: Option<Value<'v>>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        let kind = {
+            let st = state(eval)?;
+            let b = st.scene.borrow();
+            PieceKind::TIntersection { lanes: lanes(nlanes.or(numLane), &b, 2)?, friction: friction_default(friction, &b)? }
+        };
+        add_piece(eval, "TIntersection", kind, friction)
+    }
+
+    /// `CrossIntersection(nlanes=2, friction=0.8)`.
+    fn CrossIntersection<'v>(
+        #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] numLane: Option<Value<'v>>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        let kind = {
+            let st = state(eval)?;
+            let b = st.scene.borrow();
+            PieceKind::CrossIntersection { lanes: lanes(nlanes.or(numLane), &b, 2)?, friction: friction_default(friction, &b)? }
+        };
+        add_piece(eval, "CrossIntersection", kind, friction)
+    }
+
+    /// `Roundabout(nlanes=2, radius=20.0, friction=0.8)`.
+    fn Roundabout<'v>(
+        #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] radius: Option<Value<'v>>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        let kind = {
+            let st = state(eval)?;
+            let b = st.scene.borrow();
+            let radius_m = match radius { Some(v) => load_time_number(v, &b, "radius")?, None => 20.0 };
+            PieceKind::Roundabout { lanes: lanes(nlanes, &b, 2)?, radius_m, friction: friction_default(friction, &b)? }
+        };
+        add_piece(eval, "Roundabout", kind, friction)
+    }
+
+    /// `AutonomousVehicle(loc=, sut="aeb", route=None, speed=None)`: the ego vehicle.
+    fn AutonomousVehicle<'v>(
+        #[starlark(require = named)] loc: Value<'v>,
+        #[starlark(require = named)] sut: Option<&str>,
+        #[starlark(require = named)] route: Option<Value<'v>>,
+        #[starlark(require = named)] speed: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<ActorVal> {
+        let loc = location(loc, "loc")?;
+        let sut = match sut.unwrap_or("aeb") {
+            "aeb" => SutConfig::Aeb(AebConfig::default()),
+            other => bail!("unknown system under test `{other}` (built in: aeb)"),
+        };
+        let initial_speed_mps = match speed {
+            Some(v) => number(v, "speed")?,
+            None => AebConfig::default().target_speed_mps,
+        };
+        if !(initial_speed_mps.is_finite() && initial_speed_mps >= 0.0) {
+            bail!("speed {initial_speed_mps} m/s must be >= 0");
+        }
+        let route = route_arg(route)?;
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        Ok(declare(eval, &mut b, "AutonomousVehicle", ActorKind::Ego, Pending::Ego { loc, route, initial_speed_mps, sut }))
+    }
+
+    /// `Car(loc=, speed=10.0, route=[], color="red", enabled=True)`: an NPC car that follows
+    /// the lane graph.
+    fn Car<'v>(
+        #[starlark(require = named)] loc: Value<'v>,
+        #[starlark(require = named)] speed: Option<Value<'v>>,
+        #[starlark(require = named)] route: Option<Value<'v>>,
+        #[starlark(require = named)] color: Option<Value<'v>>,
+        #[starlark(require = named)] enabled: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<ActorVal> {
+        let loc = location(loc, "loc")?;
+        let route = route_arg(route)?.unwrap_or_default();
+        let heap = eval.heap();
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        let speed = stream_arg(speed.unwrap_or_else(|| heap.alloc(10.0)), &mut b, "speed")?;
+        let color = fixed_arg(color.unwrap_or_else(|| heap.alloc("red")), &b, "color")?;
+        let enabled = fixed_arg(enabled.unwrap_or_else(|| Value::new_bool(true)), &b, "enabled")?;
+        let i = b.n_cars;
+        b.n_cars += 1;
+        Ok(declare(eval, &mut b, "Car", ActorKind::Car(i), Pending::Car { loc, route, speed, color, enabled }))
+    }
+
+    /// `Pedestrian(start=, target=, speed=, dist=None, car=None, trigger=None)`: walks from
+    /// `start` to `target` once `car` comes within `dist` metres of `start` (or once
+    /// `trigger` fires).
+    fn Pedestrian<'v>(
+        #[starlark(require = named)] start: Value<'v>,
+        #[starlark(require = named)] target: Value<'v>,
+        #[starlark(require = named)] speed: Value<'v>,
+        #[starlark(require = named)] dist: Option<Value<'v>>,
+        #[starlark(require = named)] car: Option<Value<'v>>,
+        #[starlark(require = named)] trigger: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<ActorVal> {
+        let (start, target) = (location(start, "start")?, location(target, "target")?);
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        let speed = stream_arg(speed, &mut b, "speed")?;
+        let trigger = match (dist, car, trigger) {
+            (Some(d), Some(c), None) => {
+                let car = match c.downcast_ref::<ActorVal>() {
+                    Some(a) => StreamId(a.outputs[0]),
+                    None => stream_arg(c, &mut b, "car")?,
+                };
+                PedTrigger::Near { car, dist: stream_arg(d, &mut b, "dist")? }
+            }
+            (None, None, Some(t)) => PedTrigger::Stream(stream_arg(t, &mut b, "trigger")?),
+            _ => bail!("Pedestrian needs either dist= and car=, or trigger="),
+        };
+        let i = b.n_pedestrians;
+        b.n_pedestrians += 1;
+        Ok(declare(eval, &mut b, "Pedestrian", ActorKind::Pedestrian(i), Pending::Pedestrian { start, target, speed, trigger }))
+    }
+
+    /// `CollisionMonitor(v, name="collision")`: fails when the ego vehicle touches a
+    /// pedestrian or a car; robustness is the smallest separation in metres.
+    fn CollisionMonitor<'v>(v: Value<'v>, #[starlark(require = named)] name: Option<&str>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<MonitorVal> {
+        ego_arg(v, "CollisionMonitor")?;
+        monitor(eval, MonitorSpec::Collision { name: name.unwrap_or("collision").to_owned() })
+    }
+
+    /// `DistanceMonitor(v, minD=, name="distance")`: fails unless the ego vehicle travels at
+    /// least `minD` metres; robustness `D - minD` in metres.
+    fn DistanceMonitor<'v>(v: Value<'v>, #[starlark(require = named)] minD: Value<'v>, #[starlark(require = named)] name: Option<&str>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<MonitorVal> {
+        ego_arg(v, "DistanceMonitor")?;
+        let min_distance_m = number(minD, "minD")?;
+        monitor(eval, MonitorSpec::Distance { name: name.unwrap_or("distance").to_owned(), min_distance_m })
+    }
+
+    /// `TimeToFailure(m, minT=0.0)`: wraps monitor `m`; reports the time of its first
+    /// violation and fails when it comes before `minT` seconds.
+    fn TimeToFailure<'v>(m: Value<'v>, #[starlark(require = named)] minT: Option<Value<'v>>, #[starlark(require = named)] name: Option<&str>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<MonitorVal> {
+        let inner = m.downcast_ref::<MonitorVal>().ok_or_else(|| anyhow!("TimeToFailure wraps a monitor, got a {}", m.get_type()))?.index;
+        let min_s = match minT { Some(v) => number(v, "minT")?, None => 0.0 };
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        let wrapped = b.monitors.get(inner).cloned().ok_or_else(|| anyhow!("that monitor is already wrapped"))?;
+        b.monitors[inner] = MonitorSpec::TimeToFailure { name: name.unwrap_or("time_to_failure").to_owned(), inner: Box::new(wrapped), min_s };
+        Ok(MonitorVal { index: inner })
+    }
+
+    /// `test(horizon=15.0, map=None)`: the test length in seconds and the failure map's axes.
+    fn test<'v>(
+        #[starlark(require = named)] horizon: Option<Value<'v>>,
+        #[starlark(require = named)] map: Option<(String, String)>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<NoneType> {
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        if let Some(h) = horizon {
+            let h = number(h, "horizon")?;
+            if !(h.is_finite() && h > 0.0 && h <= 3600.0) {
+                bail!("horizon {h} s must be in (0, 3600]");
+            }
+            b.horizon_s = Some(h);
+        }
+        if let Some((x, y)) = map {
+            b.map_axes = Some([x, y]);
+        }
+        Ok(NoneType)
+    }
+}

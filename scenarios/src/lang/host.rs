@@ -1,0 +1,107 @@
+//! Calling a frozen program's lambdas from the stream graph, one heap and evaluator per test.
+
+use paracosm_engine::rx::{Host, Value as Rx};
+use starlark::environment::Module;
+use starlark::eval::Evaluator;
+use starlark::values::float::StarlarkFloat;
+use starlark::values::tuple::{AllocTuple, TupleRef};
+use starlark::values::{Heap, OwnedFrozenValue, Value, ValueLike};
+
+use crate::Lambdas;
+
+/// The lambdas of a frozen program, by host function number.
+pub struct StarLambdas {
+    /// `lambda#n` of the frozen module.
+    pub values: Vec<OwnedFrozenValue>,
+}
+
+impl Lambdas for StarLambdas {
+    fn with_host(&self, f: &mut dyn FnMut(&mut dyn Host)) {
+        Module::with_temp_heap(|module| {
+            // The test's module keeps the program's frozen heap alive while it runs.
+            let functions: Vec<Value> = self
+                .values
+                .iter()
+                .map(|v| {
+                    module.frozen_heap().add_reference(v.owner());
+                    // SAFETY: the frozen heap that owns `v` is referenced by this module's
+                    // frozen heap (just above) and by `self.values`, both of which outlive
+                    // every use of the value inside this closure.
+                    unsafe { v.unchecked_frozen_value() }.to_value()
+                })
+                .collect();
+            let mut eval = Evaluator::new(&module);
+            let mut host = StarHost {
+                eval: &mut eval,
+                functions: &functions,
+            };
+            f(&mut host);
+        });
+    }
+}
+
+struct StarHost<'a, 'v, 'b, 'e> {
+    eval: &'a mut Evaluator<'v, 'b, 'e>,
+    functions: &'a [Value<'v>],
+}
+
+fn to_star<'v>(v: &Rx, heap: Heap<'v>) -> Value<'v> {
+    match v {
+        Rx::Unit => Value::new_none(),
+        Rx::Num(x) => heap.alloc(*x),
+        Rx::Bool(b) => Value::new_bool(*b),
+        Rx::Vec3(p) => heap.alloc(AllocTuple(p.iter().map(|&x| heap.alloc(x)))),
+        Rx::Tuple(items) => heap.alloc(AllocTuple(items.iter().map(|x| to_star(x, heap)))),
+        Rx::Text(s) => heap.alloc(s.as_str()),
+    }
+}
+
+fn from_star(v: Value) -> Result<Rx, String> {
+    if v.is_none() {
+        return Ok(Rx::Unit);
+    }
+    if let Some(b) = v.unpack_bool() {
+        return Ok(Rx::Bool(b));
+    }
+    if let Some(i) = v.unpack_i32() {
+        return Ok(Rx::Num(f64::from(i)));
+    }
+    if let Some(f) = v.downcast_ref::<StarlarkFloat>() {
+        return Ok(Rx::Num(f.0));
+    }
+    if let Some(s) = v.unpack_str() {
+        return Ok(Rx::Text(s.to_owned()));
+    }
+    if let Some(t) = TupleRef::from_value(v) {
+        let items = t
+            .content()
+            .iter()
+            .map(|&x| from_star(x))
+            .collect::<Result<Vec<_>, _>>()?;
+        // A triple of numbers is a position or a velocity.
+        if let [Rx::Num(a), Rx::Num(b), Rx::Num(c)] = items.as_slice() {
+            return Ok(Rx::Vec3([*a, *b, *c]));
+        }
+        return Ok(Rx::Tuple(items));
+    }
+    Err(format!(
+        "a lambda returned a {}; streams carry numbers, bools, strings and tuples",
+        v.get_type()
+    ))
+}
+
+impl Host for StarHost<'_, '_, '_, '_> {
+    fn call(&mut self, f: u32, args: &[Rx]) -> Result<Rx, String> {
+        let heap = self.eval.heap();
+        let args: Vec<Value> = args.iter().map(|a| to_star(a, heap)).collect();
+        let function = *self
+            .functions
+            .get(f as usize)
+            .ok_or_else(|| format!("no lambda {f}"))?;
+        let out = self
+            .eval
+            .eval_function(function, &args, &[])
+            .map_err(|e| format!("{e}"))?;
+        from_star(out)
+    }
+}

@@ -1,0 +1,141 @@
+//! The scenario language: Starlark programs (the `starlark` crate) that build a reactive world
+//! with the paper's vocabulary (§2). LANGUAGE.md is the reference.
+//!
+//! A program is evaluated once, hermetically (no `load`, no file, network or clock access) and
+//! within limits (a step count, a heap size, a call depth). Its declarations become a
+//! [`Scenario`](crate::Scenario): the open parameters form the space, the rest a world template.
+//! The module is then frozen; its lambdas are shared by all workers, each of which calls them
+//! through its own heap and evaluator, one per test.
+
+mod globals;
+mod host;
+mod methods;
+mod scene;
+mod values;
+
+use std::path::Path;
+use std::sync::Arc;
+
+use starlark::environment::{GlobalsBuilder, Module};
+use starlark::eval::Evaluator;
+use starlark::syntax::{AstModule, Dialect};
+use starlark::values::ValueLike;
+
+use crate::{Scenario, ScenarioError};
+
+pub use scene::OverTime;
+
+/// Most evaluation steps (function calls and loop iterations) a program may take to load.
+pub const MAX_LOAD_STEPS: u64 = 10_000_000;
+/// Most heap a program may use to load, in bytes.
+pub const MAX_LOAD_HEAP_BYTES: usize = 256 << 20;
+/// Deepest call stack a program may use.
+pub const MAX_CALL_DEPTH: usize = 200;
+
+fn lambda_name(n: u32) -> String {
+    // Not an identifier, so no program can read or overwrite it.
+    format!("lambda#{n}")
+}
+
+/// Loads the scenario program at `path`. The scenario's name is the file stem with `_`
+/// replaced by `-`; its description is the first paragraph of the file's header comment.
+///
+/// # Errors
+/// [`ScenarioError::Io`] when the file cannot be read; [`ScenarioError::Language`] with a
+/// diagnostic naming the file, line and column (and a caret under the source) for any error
+/// in the program.
+pub fn load_file(path: &Path) -> Result<Scenario, ScenarioError> {
+    let source = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().replace('_', "-"))
+        .unwrap_or_else(|| "scenario".into());
+    load_source(&path.display().to_string(), &source, &stem)
+}
+
+/// The first paragraph of the leading `#` comment, joined into one line.
+fn header(source: &str) -> String {
+    let mut out = Vec::new();
+    for line in source.lines() {
+        match line.strip_prefix('#') {
+            Some(text) if !text.trim().is_empty() => out.push(text.trim().to_owned()),
+            Some(_) if out.is_empty() => {}
+            _ => break,
+        }
+    }
+    out.join(" ")
+}
+
+/// The globals of a scenario program: Starlark's standard library plus the paracosm builtins.
+fn globals() -> starlark::environment::Globals {
+    GlobalsBuilder::standard()
+        .with(globals::paracosm_globals)
+        .build()
+}
+
+/// Loads a scenario program from `source`; `file` names it in diagnostics, `name` is the
+/// scenario's name.
+///
+/// # Errors
+/// [`ScenarioError::Language`] as for [`load_file`].
+pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, ScenarioError> {
+    let lang = |m: String| ScenarioError::Language(m);
+    let dialect = Dialect {
+        enable_load: false,
+        enable_top_level_stmt: true,
+        ..Dialect::Standard
+    };
+    let ast = AstModule::parse(file, source.to_owned(), &dialect)
+        .map_err(|e| lang(format!("{e}")))?;
+    let globals = globals();
+    let state = globals::LoadState::default();
+    let frozen = Module::with_temp_heap(|module| -> Result<_, ScenarioError> {
+        {
+            let mut eval = Evaluator::new(&module);
+            eval.extra = Some(&state);
+            let limits = [
+                eval.set_max_tick_count(MAX_LOAD_STEPS),
+                eval.set_max_heap_size(MAX_LOAD_HEAP_BYTES),
+                eval.set_max_callstack_size(MAX_CALL_DEPTH),
+            ];
+            for l in limits {
+                l.map_err(|e| lang(e.to_string()))?;
+            }
+            eval.eval_module(ast, &globals)
+                .map_err(|e| lang(format!("{e}")))?;
+        }
+        // Open parameters take the name of the global they are bound to.
+        let mut scene = state.scene.borrow_mut();
+        for n in module.names() {
+            let Some(v) = module.get(n.as_str()) else { continue };
+            if let Some(s) = v.downcast_ref::<values::Stream>() {
+                if let Some(p) = scene.param_of(paracosm_engine::rx::StreamId(s.id)) {
+                    scene.params[p].name.get_or_insert_with(|| n.as_str().to_owned());
+                }
+            }
+        }
+        drop(scene);
+        module.freeze().map_err(|e| lang(format!("{e:?}")))
+    })?;
+    let scene = state.scene.into_inner();
+    let lambdas: Option<Arc<dyn crate::Lambdas>> = if scene.lambdas == 0 {
+        None
+    } else {
+        let values = (0..scene.lambdas)
+            .map(|n| frozen.get(&lambda_name(n)))
+            .collect::<anyhow::Result<Vec<_>>>()
+            .map_err(|e| lang(e.to_string()))?;
+        Some(Arc::new(host::StarLambdas { values }))
+    };
+    let meta = scene::Meta {
+        name: name.to_owned(),
+        description: header(source),
+    };
+    scene::finish(scene, meta, lambdas).map_err(|m| lang(format!("error: {m}\n --> {file}")))
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,286 @@
+//! The Starlark values of the scenario language. Each holds indices into the program's
+//! [`super::scene::SceneBuilder`], never other Starlark values, so all are simple values.
+
+use std::fmt;
+
+use allocative::Allocative;
+use starlark::environment::Methods;
+use starlark::starlark_simple_value;
+use starlark::StarlarkPagablePanic;
+use starlark::values::{
+    starlark_value, Heap, NoSerialize, ProvidesStaticType, StarlarkValue, Value,
+};
+
+use super::scene::OverTime;
+
+macro_rules! simple {
+    ($t:ident, $ty:literal, $($body:tt)*) => {
+        starlark_simple_value!($t);
+        #[starlark_value(type = $ty)]
+        impl<'v> StarlarkValue<'v> for $t {
+            $($body)*
+        }
+    };
+}
+
+/// A stream (paper §2): `tick`, `Const(...)`, an open parameter, an output of an object, or a
+/// combinator over streams.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct Stream {
+    /// Node index in the graph.
+    pub id: usize,
+}
+
+impl fmt::Display for Stream {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Stream({})", self.id)
+    }
+}
+
+starlark::methods_static!(STREAM_METHODS = super::methods::stream_methods);
+
+simple!(Stream, "Stream",
+    fn get_methods() -> Option<&'static Methods> {
+        Some(STREAM_METHODS.methods())
+    }
+);
+
+/// A road piece, or a network of connected pieces represented by its first piece.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct Road {
+    /// Piece index in the network.
+    pub piece: usize,
+    /// Number of ports of the piece.
+    pub ports: usize,
+    /// Whether it is a segment (has `onLane` and sidewalks).
+    pub segment: bool,
+    /// Whether this value stands for a whole network (the result of `connect`).
+    pub network: bool,
+}
+
+impl fmt::Display for Road {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.network {
+            write!(f, "RoadNetwork(piece {})", self.piece)
+        } else {
+            write!(f, "Road(piece {})", self.piece)
+        }
+    }
+}
+
+starlark::methods_static!(ROAD_METHODS = super::methods::road_methods);
+
+const PORTS: [&str; 4] = ["ONE", "TWO", "THREE", "FOUR"];
+
+simple!(Road, "Road",
+    fn get_methods() -> Option<&'static Methods> {
+        Some(ROAD_METHODS.methods())
+    }
+
+    fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
+        if attribute == "SideWalk" && self.segment {
+            return Some(heap.alloc(LaneSide { opposite: false }));
+        }
+        let i = PORTS.iter().position(|p| *p == attribute)?;
+        (i < self.ports && !self.network).then(|| heap.alloc(Port { piece: self.piece, index: i }))
+    }
+
+    fn dir_attr(&self) -> Vec<String> {
+        let mut v: Vec<String> = PORTS[..self.ports].iter().map(|s| s.to_string()).collect();
+        if self.segment {
+            v.push("SideWalk".into());
+        }
+        v
+    }
+);
+
+/// A connection point of a road piece (`t.ONE`).
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct Port {
+    /// Piece index.
+    pub piece: usize,
+    /// Port index.
+    pub index: usize,
+}
+
+impl fmt::Display for Port {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Port({}.{})", self.piece, PORTS[self.index])
+    }
+}
+
+simple!(Port, "Port",);
+
+/// `r.SideWalk` (`opposite: false`) or `-r.SideWalk`.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct LaneSide {
+    /// The left (`-z`) sidewalk.
+    pub opposite: bool,
+}
+
+impl fmt::Display for LaneSide {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(if self.opposite { "-SideWalk" } else { "SideWalk" })
+    }
+}
+
+simple!(LaneSide, "SideWalk",
+    fn minus(&self, heap: Heap<'v>) -> starlark::Result<Value<'v>> {
+        Ok(heap.alloc(LaneSide { opposite: !self.opposite }))
+    }
+);
+
+/// A resolved `onLane(lane, at)`.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct Loc {
+    /// Index into the program's locations.
+    pub index: usize,
+}
+
+impl fmt::Display for Loc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Location({})", self.index)
+    }
+}
+
+simple!(Loc, "Location",);
+
+/// What kind of actor an [`ActorVal`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Allocative)]
+pub enum ActorKind {
+    /// `AutonomousVehicle`.
+    Ego,
+    /// `Pedestrian` number `i`.
+    Pedestrian(u32),
+    /// `Car` number `i`.
+    Car(u32),
+}
+
+/// An actor with its output streams (`pos`, `vel`, `heading`, `speed`, `collision`) and, for
+/// a pedestrian, its `walk` action.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct ActorVal {
+    /// Which actor.
+    pub kind: ActorKind,
+    /// Output streams: pos, vel, heading, speed, collision.
+    pub outputs: [usize; 5],
+    /// Index in the placement list.
+    pub object: usize,
+}
+
+const OUTPUT_NAMES: [&str; 5] = ["pos", "vel", "heading", "speed", "collision"];
+
+impl fmt::Display for ActorVal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.kind {
+            ActorKind::Ego => f.write_str("AutonomousVehicle"),
+            ActorKind::Pedestrian(i) => write!(f, "Pedestrian({i})"),
+            ActorKind::Car(i) => write!(f, "Car({i})"),
+        }
+    }
+}
+
+simple!(ActorVal, "Actor",
+    fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
+        if let ActorKind::Pedestrian(i) = self.kind {
+            if attribute == "walk" {
+                return Some(heap.alloc(Action { sink: i }));
+            }
+        }
+        let i = OUTPUT_NAMES.iter().position(|n| *n == attribute)?;
+        Some(heap.alloc(Stream { id: self.outputs[i] }))
+    }
+
+    fn dir_attr(&self) -> Vec<String> {
+        let mut v: Vec<String> = OUTPUT_NAMES.iter().map(|s| s.to_string()).collect();
+        if matches!(self.kind, ActorKind::Pedestrian(_)) {
+            v.push("walk".into());
+        }
+        v
+    }
+);
+
+/// An action for `foreach`: `p.walk` moves pedestrian `p` one step toward its target.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct Action {
+    /// The sink number.
+    pub sink: u32,
+}
+
+impl fmt::Display for Action {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "walk({})", self.sink)
+    }
+}
+
+simple!(Action, "Action",);
+
+/// `World(light=, fog=)`.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct WorldVal {
+    /// Light stream.
+    pub light: usize,
+    /// Fog stream.
+    pub fog: usize,
+}
+
+impl fmt::Display for WorldVal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("World")
+    }
+}
+
+starlark::methods_static!(WORLD_METHODS = super::methods::world_methods);
+
+simple!(WorldVal, "World",
+    fn get_methods() -> Option<&'static Methods> {
+        Some(WORLD_METHODS.methods())
+    }
+
+    fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
+        match attribute {
+            "light" => Some(heap.alloc(Stream { id: self.light })),
+            "fog" => Some(heap.alloc(Stream { id: self.fog })),
+            _ => None,
+        }
+    }
+
+    fn dir_attr(&self) -> Vec<String> {
+        vec!["light".into(), "fog".into()]
+    }
+);
+
+/// A monitor, registered when created.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct MonitorVal {
+    /// Index in the program's monitor list.
+    pub index: usize,
+}
+
+impl fmt::Display for MonitorVal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Monitor({})", self.index)
+    }
+}
+
+simple!(MonitorVal, "Monitor",);
+
+/// `Piecewise(k)` or `Polynomial(deg)`.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct OverTimeVal {
+    /// The profile.
+    #[allocative(skip)]
+    pub over_time: OverTime,
+}
+
+impl fmt::Display for OverTimeVal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.over_time {
+            OverTime::Constant => f.write_str("Constant"),
+            OverTime::Piecewise(k) => write!(f, "Piecewise({k})"),
+            OverTime::Polynomial(d) => write!(f, "Polynomial({d})"),
+        }
+    }
+}
+
+simple!(OverTimeVal, "OverTime",);
