@@ -554,3 +554,139 @@ fn ipog_suites_cover_every_pair_and_give_each_row_its_own_halton_block() {
     ]);
     assert_eq!(too_strong.status.code(), Some(2));
 }
+
+/// Issue 5, requirement 6: the Starlark `pedestrian_crossing.star` gives the results the Rust
+/// definition gave before the language existed (fixture written by that version), byte for
+/// byte apart from wall time; by path and by built-in name.
+#[test]
+fn pedestrian_crossing_star_reproduces_the_rust_study_byte_for_byte() {
+    let fixture = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/fixtures/pedestrian_crossing_halton_seed7_n60.jsonl"),
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let star = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/pedestrian_crossing.star");
+    for (name, scenario) in [
+        ("path", star.to_str().unwrap()),
+        ("builtin", "pedestrian_crossing"),
+    ] {
+        let out = dir.path().join(name);
+        let o = fuzz(&[
+            scenario,
+            "--strategy",
+            "halton",
+            "--budget",
+            "60",
+            "--seed",
+            "7",
+            "--jobs",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(1),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        // The fixture keeps each object's closing brace; without_wall_time cuts it with wall_ms.
+        let expected: Vec<&str> = fixture.lines().map(|l| &l[..l.len() - 1]).collect();
+        let got = without_wall_time(&out.join("results.jsonl"));
+        let got: Vec<&str> = got.lines().collect();
+        assert_eq!(got.len(), expected.len(), "{name}");
+        for (g, e) in got.iter().zip(&expected) {
+            assert_eq!(g, e, "{name}");
+        }
+    }
+}
+
+#[test]
+fn list_shows_every_built_in_with_its_parameters() {
+    let o = fuzz(&["--list"]);
+    assert_eq!(o.status.code(), Some(0));
+    let s = String::from_utf8_lossy(&o.stdout);
+    for name in [
+        "pedestrian-crossing",
+        "follow-lead-car",
+        "fog-light",
+        "t-loop",
+        "grid-world",
+    ] {
+        assert!(s.contains(name), "{name} missing from:\n{s}");
+    }
+    assert!(
+        s.contains("parameters: walking_speed [m/s], trigger_distance [m]"),
+        "{s}"
+    );
+}
+
+#[test]
+fn every_shipped_scenario_runs_and_fog_light_fails_in_dense_fog() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, budget) in [
+        ("follow-lead-car", "4"),
+        ("fog-light", "4"),
+        ("t-loop", "2"),
+        ("grid-world", "2"),
+    ] {
+        let out = dir.path().join(name);
+        let o = fuzz(&[name, "--budget", budget, "--out", out.to_str().unwrap()]);
+        assert!(
+            matches!(o.status.code(), Some(0 | 1)),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        for r in lines(&out.join("results.jsonl")) {
+            assert_ne!(r["status"], "error", "{name}: {r}");
+        }
+    }
+    // Fog 0.95 (visibility 8.2 m) hides the crawling car until too late; fog 0.1 does not.
+    let star = dir.path().join("fog.star");
+    let source = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/fog_light.star"),
+    )
+    .unwrap();
+    for (fog, code) in [("0.95", 1), ("0.1", 0)] {
+        let fixed = source
+            .replace("fog = VarInterval(0.0, 1.0)", &format!("fog = {fog}"))
+            .replace("map = (\"fog\", \"light\")", "map = (\"light\", \"light\")");
+        std::fs::write(&star, fixed).unwrap();
+        let out = dir.path().join(format!("fog{fog}"));
+        let o = fuzz(&[
+            star.to_str().unwrap(),
+            "--budget",
+            "3",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(code),
+            "fog {fog}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}
+
+#[test]
+fn a_scenario_error_exits_2_with_file_line_column_and_caret() {
+    let dir = tempfile::tempdir().unwrap();
+    let star = dir.path().join("bad.star");
+    std::fs::write(&star, "w = World()\nspeed = VarInterval(5, 1)\n").unwrap();
+    let out = dir.path().join("out");
+    let o = fuzz(&[star.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("VarInterval(5, 1) is empty"), "{stderr}");
+    assert!(
+        stderr.contains(&format!("{}:2:9", star.display())),
+        "{stderr}"
+    );
+    assert!(stderr.contains("^^^"), "{stderr}");
+    assert!(!out.exists(), "nothing is written for a bad scenario");
+    let missing = fuzz(&["no/such/file.star"]);
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("cannot read no/such/file.star"));
+}

@@ -126,7 +126,10 @@ impl GraphBuilder {
                     }
                     _ => Err("the car stream must carry positions and dist numbers".into()),
                 },
-                v => Err(format!("expected a (position, distance) pair, got a {}", v.kind())),
+                v => Err(format!(
+                    "expected a (position, distance) pair, got a {}",
+                    v.kind()
+                )),
             }),
         });
         self.pedestrian_with_trigger(index, target, trigger);
@@ -139,11 +142,16 @@ impl GraphBuilder {
         let pos = self.push(Node::Probe(probe(Actor::Pedestrian(index), Output::Pos)));
         let done = self.push(Node::Filter {
             src: pos,
-            pred: Func::native("_ == target", move |a| Ok(Value::Bool(a[0] == Value::Vec3(target)))),
+            pred: Func::native("_ == target", move |a| {
+                Ok(Value::Bool(a[0] == Value::Vec3(target)))
+            }),
         });
         let tick = self.push(Node::Tick);
         let skip = self.push(Node::SkipUntil { src: tick, trigger });
-        let take = self.push(Node::TakeUntil { src: skip, stop: done });
+        let take = self.push(Node::TakeUntil {
+            src: skip,
+            stop: done,
+        });
         self.push(Node::Foreach {
             src: take,
             sink: walk_sink(index),
@@ -157,7 +165,13 @@ mod tests {
 
     #[test]
     fn probes_round_trip() {
-        for actor in [Actor::Ego, Actor::Pedestrian(0), Actor::Pedestrian(7), Actor::Car(0), Actor::Car(3)] {
+        for actor in [
+            Actor::Ego,
+            Actor::Pedestrian(0),
+            Actor::Pedestrian(7),
+            Actor::Car(0),
+            Actor::Car(3),
+        ] {
             for output in OUTPUTS {
                 assert_eq!(decode_probe(probe(actor, output)), (actor, output));
             }

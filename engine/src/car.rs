@@ -73,7 +73,10 @@ impl Car {
             0.0
         };
         let heading = (-(b[1] - a[1])).atan2(b[0] - a[0]);
-        ([a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])], heading)
+        (
+            [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])],
+            heading,
+        )
     }
 
     fn pose(&self) -> Pose {

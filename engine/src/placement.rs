@@ -99,7 +99,8 @@ pub fn check(objects: &[Placed], network: &Network) -> Result<(), EngineError> {
     for i in 0..objects.len() {
         for j in i + 1..objects.len() {
             let ((pa, sa), (pb, sb)) = (&shapes[i], &shapes[j]);
-            if intersection_test(pa, sa.as_ref(), pb, sb.as_ref()).map_or(true, |i| i.intersecting) {
+            if intersection_test(pa, sa.as_ref(), pb, sb.as_ref()).map_or(true, |i| i.intersecting)
+            {
                 return Err(EngineError::InvalidWorld(format!(
                     "{} and {} start in collision",
                     objects[i].name, objects[j].name

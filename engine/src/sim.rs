@@ -10,7 +10,9 @@ use crate::pedestrian::Pedestrian;
 use crate::rx::{Host, Inputs, Runtime, StreamId, Value};
 use crate::spec::EnvironmentSpec;
 use crate::vehicle::EgoVehicle;
-use crate::{visibility_m, Control, EngineError, LidarReturn, LidarSpec, PedestrianState, WorldSpec};
+use crate::{
+    visibility_m, Control, EngineError, LidarReturn, LidarSpec, PedestrianState, WorldSpec,
+};
 
 /// The ego vehicle's state.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -135,9 +137,16 @@ impl Simulation {
         let mut cars = Vec::with_capacity(spec.cars.len());
         for (i, c) in spec.cars.iter().enumerate() {
             if c.path.len() < 2 || c.path.iter().flatten().any(|v| !v.is_finite()) {
-                return Err(invalid(format!("car {i} has no route of two or more points")));
+                return Err(invalid(format!(
+                    "car {i} has no route of two or more points"
+                )));
             }
-            cars.push(Car::build(&mut physics, c.path.clone(), c.size_m, c.enabled));
+            cars.push(Car::build(
+                &mut physics,
+                c.path.clone(),
+                c.size_m,
+                c.enabled,
+            ));
         }
         let n = spec.streams.nodes().len();
         let ids = spec

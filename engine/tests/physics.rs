@@ -1,8 +1,8 @@
 //! Closed-loop physics tests of the engine: the ego vehicle, a pedestrian and the built-in
 //! systems under test on a straight road.
 
-use paracosm_engine::sut::{Aeb, AebConfig, ConstantControl, Sut};
 use paracosm_engine::rx::NoHost;
+use paracosm_engine::sut::{Aeb, AebConfig, ConstantControl, Sut};
 use paracosm_engine::{Control, Lane, Simulation, TriggeredPedestrian, WorldSpec};
 
 fn world(pedestrians: Vec<TriggeredPedestrian>, initial_speed_mps: f64) -> WorldSpec {
@@ -173,8 +173,14 @@ fn aeb_follows_a_route_around_a_loop_of_t_intersections() {
     let mut n = Network::new();
     let t: Vec<PieceId> = (0..4)
         .map(|i| {
-            n.add(&format!("t{i}"), PieceKind::TIntersection { lanes: 2, friction: 0.8 })
-                .unwrap()
+            n.add(
+                &format!("t{i}"),
+                PieceKind::TIntersection {
+                    lanes: 2,
+                    friction: 0.8,
+                },
+            )
+            .unwrap()
         })
         .collect();
     let r: Vec<PieceId> = (0..4)

@@ -65,7 +65,12 @@ mod tests {
             let touching = contact_at.is_some_and(|c| t >= c);
             s.set_bool("contact", touching);
             s.set("sep", if touching { 0.0 } else { 1.0 });
-            if m.observe(&Frame { t_s: t, signals: &s }).is_break() {
+            if m.observe(&Frame {
+                t_s: t,
+                signals: &s,
+            })
+            .is_break()
+            {
                 break;
             }
         }

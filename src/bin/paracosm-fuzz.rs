@@ -85,9 +85,14 @@ fn main() -> ExitCode {
 fn run(cli: &Cli) -> Result<ExitCode> {
     if cli.list {
         for name in paracosm_scenarios::builtin_names() {
-            let s = paracosm_scenarios::builtin(&name).context("a built-in scenario fails to load")?;
+            let s =
+                paracosm_scenarios::builtin(&name).context("a built-in scenario fails to load")?;
             let params: Vec<String> = s.space.params().iter().map(|p| p.label()).collect();
-            println!("{name}\n    {}\n    parameters: {}", s.description, params.join(", "));
+            println!(
+                "{name}\n    {}\n    parameters: {}",
+                s.description,
+                params.join(", ")
+            );
         }
         return Ok(ExitCode::SUCCESS);
     }

@@ -35,10 +35,7 @@ impl Network {
                     for side in [1.0, -1.0] {
                         physics.insert_collider(
                             ColliderBuilder::cuboid(hx as f32, h, (sw / 2.0) as f32)
-                                .position(at(
-                                    [length_m / 2.0, side * (hw + sw / 2.0)],
-                                    curb - h,
-                                ))
+                                .position(at([length_m / 2.0, side * (hw + sw / 2.0)], curb - h))
                                 .friction(mu),
                             None,
                         );

@@ -17,10 +17,7 @@ impl Pose2 {
     /// rapier's `Rotation::from_rotation_y(heading)`).
     pub fn apply(&self, p: [f64; 2]) -> [f64; 2] {
         let (s, c) = self.heading_rad.sin_cos();
-        [
-            self.x + p[0] * c + p[1] * s,
-            self.z - p[0] * s + p[1] * c,
-        ]
+        [self.x + p[0] * c + p[1] * s, self.z - p[0] * s + p[1] * c]
     }
 
     /// The composition `self ∘ inner`: first `inner`, then `self`.

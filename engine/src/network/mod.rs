@@ -195,7 +195,10 @@ impl Network {
         let cp = self.port(child, child_port)?;
         let (a, b) = ((parent, port), (child, child_port));
         if parent == child {
-            return bad(format!("{} cannot connect to itself", self.pieces[parent.0].name));
+            return bad(format!(
+                "{} cannot connect to itself",
+                self.pieces[parent.0].name
+            ));
         }
         for end in [a, b] {
             if self.links.iter().any(|l| l.a == end || l.b == end) {
@@ -367,16 +370,18 @@ impl Network {
 
     /// The piece whose driving surface contains the world point `[x, z]`, if any.
     pub fn driving_surface_at(&self, p: [f64; 2]) -> Option<PieceId> {
-        self.pieces.iter().position(|piece| {
-            let inv = Pose2 {
-                x: 0.0,
-                z: 0.0,
-                heading_rad: -piece.pose.heading_rad,
-            };
-            let local = inv.apply([p[0] - piece.pose.x, p[1] - piece.pose.z]);
-            piece.kind.on_driving_surface(local)
-        })
-        .map(PieceId)
+        self.pieces
+            .iter()
+            .position(|piece| {
+                let inv = Pose2 {
+                    x: 0.0,
+                    z: 0.0,
+                    heading_rad: -piece.pose.heading_rad,
+                };
+                let local = inv.apply([p[0] - piece.pose.x, p[1] - piece.pose.z]);
+                piece.kind.on_driving_surface(local)
+            })
+            .map(PieceId)
     }
 }
 

@@ -123,7 +123,9 @@ impl PieceKind {
         let name = self.type_name();
         let lanes = self.lanes();
         if lanes == 0 || lanes % 2 == 1 {
-            return bad(format!("{name} has {lanes} lanes; need an even number >= 2"));
+            return bad(format!(
+                "{name} has {lanes} lanes; need an even number >= 2"
+            ));
         }
         let mu = self.friction();
         if !(mu > 0.0 && mu <= 2.0) {

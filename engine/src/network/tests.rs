@@ -13,8 +13,14 @@ fn seg(n: &mut Network, name: &str, len: f64, lanes: u32) -> PieceId {
 }
 
 fn cross(n: &mut Network, name: &str, lanes: u32) -> PieceId {
-    n.add(name, PieceKind::CrossIntersection { lanes, friction: 0.8 })
-        .unwrap()
+    n.add(
+        name,
+        PieceKind::CrossIntersection {
+            lanes,
+            friction: 0.8,
+        },
+    )
+    .unwrap()
 }
 
 const ONE: usize = 0;
@@ -31,7 +37,13 @@ fn close(a: [f64; 2], b: [f64; 2]) -> bool {
 fn the_papers_t_intersection_places_its_roads_at_its_ports() {
     let mut n = Network::new();
     let t = n
-        .add("t", PieceKind::TIntersection { lanes: 4, friction: 0.8 })
+        .add(
+            "t",
+            PieceKind::TIntersection {
+                lanes: 4,
+                friction: 0.8,
+            },
+        )
         .unwrap();
     let e = seg(&mut n, "e", 50.0, 4);
     let s = seg(&mut n, "s", 50.0, 4);
@@ -76,7 +88,10 @@ fn ports_that_do_not_coincide_are_refused_when_closing_a_loop() {
     n.connect(b, TWO, c, ONE).unwrap();
     // a, b, c lie in a straight line: a.ONE at x = 0, c.TWO at x = 110.
     let err = n.connect(c, TWO, a, ONE).unwrap_err().to_string();
-    assert!(err.contains("connection points do not coincide: c.TWO is at (110.00, 0.00) m"), "{err}");
+    assert!(
+        err.contains("connection points do not coincide: c.TWO is at (110.00, 0.00) m"),
+        "{err}"
+    );
     assert!(err.contains("a.ONE at (0.00, 0.00) m"), "{err}");
 }
 
@@ -99,7 +114,11 @@ fn overlapping_pieces_are_refused_and_nothing_moves() {
     let f = seg(&mut n, "f", 60.0, 2);
     let err = n.connect(e, ONE, f, ONE).unwrap_err().to_string();
     assert_eq!(err, "invalid world: road pieces overlap: f and long");
-    assert_eq!(n.piece(f).pose, Pose2::default(), "the failed connect moved nothing");
+    assert_eq!(
+        n.piece(f).pose,
+        Pose2::default(),
+        "the failed connect moved nothing"
+    );
     assert_eq!(n.links().len(), 5);
     // Two unconnected roads at the origin overlap too (what `place` checks).
     let mut m = Network::new();
@@ -121,7 +140,10 @@ fn ports_are_used_once_and_must_exist() {
     let err = n.connect(a, TWO, c, ONE).unwrap_err().to_string();
     assert!(err.contains("port a.TWO is already connected"), "{err}");
     let err = n.connect(a, FOUR, c, ONE).unwrap_err().to_string();
-    assert!(err.contains("a has ports ONE, TWO; it has no port FOUR"), "{err}");
+    assert!(
+        err.contains("a has ports ONE, TWO; it has no port FOUR"),
+        "{err}"
+    );
 }
 
 /// The paper's Figure 3: a grid of cross-intersections built by iteration; closing each
@@ -141,11 +163,8 @@ fn grid(n: &mut Network, size: usize, block_m: f64) -> Vec<Vec<PieceId>> {
                 let s = seg(n, &format!("v{i}{j}"), block_m, 2);
                 let above: &Vec<PieceId> = &xs[i - 1];
                 n.connect(above[j], TWO, s, ONE).unwrap();
-                if j == 0 {
-                    n.connect(s, TWO, c, FOUR).unwrap();
-                } else {
-                    n.connect(s, TWO, c, FOUR).unwrap();
-                }
+                // For j > 0, c is already placed: this closes a block and checks the ports.
+                n.connect(s, TWO, c, FOUR).unwrap();
             }
             row.push(c);
         }
@@ -184,7 +203,10 @@ fn routes_follow_the_lane_graph_and_its_turns() {
     let x10 = n.piece(xs[1][0]).pose;
     // After two right turns it drives west along h11 and ends at x10, where the network
     // offers only north or south... and keeps going: it must pass x10's east port.
-    assert!(route.iter().any(|p| (p[0] - (x10.x + 8.5)).abs() < 1e-6), "{last:?}");
+    assert!(
+        route.iter().any(|p| (p[0] - (x10.x + 8.5)).abs() < 1e-6),
+        "{last:?}"
+    );
     // Every step of the route is short (resampled to 1 m) and continuous.
     for w in route.windows(2) {
         assert!((w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) <= 1.0 + 1e-9);
@@ -215,7 +237,9 @@ fn driving_surfaces_exclude_sidewalks_and_the_roundabout_island() {
     let start = n.on_lane(r, Lane::Driving(1), 90.0).unwrap();
     let route = n.route(&start, &[Turn::Left], 200.0).unwrap();
     // Around the island counter-clockwise and out of the north port (-z).
-    assert!(route.iter().all(|p| (p[0] - 120.0).hypot(p[1]) > 15.0 - 1e-9));
+    assert!(route
+        .iter()
+        .all(|p| (p[0] - 120.0).hypot(p[1]) > 15.0 - 1e-9));
     let end = route.last().unwrap();
     assert!(end[1] < -19.0, "{end:?}");
 }

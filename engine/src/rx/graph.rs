@@ -4,7 +4,9 @@ use std::sync::Arc;
 use super::{OpenStream, RxError, Value};
 
 /// Index of a stream in its [`Graph`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 pub struct StreamId(pub usize);
 
 /// A native function on stream values: arguments in, a value or an error message out.
@@ -195,9 +197,7 @@ impl Graph {
         let mut nodes = self.nodes.clone();
         for (i, node) in nodes.iter_mut().enumerate() {
             if let Node::Param(slot) = *node {
-                let v = values
-                    .get(slot)
-                    .ok_or(RxError::Unbound { node: i, slot })?;
+                let v = values.get(slot).ok_or(RxError::Unbound { node: i, slot })?;
                 *node = Node::Open(v.clone());
             }
         }

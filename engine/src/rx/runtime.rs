@@ -126,7 +126,12 @@ impl Runtime {
             Node::Tick => Some(Value::Num(t_s)),
             Node::Open(o) => Some(o.at(t_s)),
             Node::Probe(p) => Some(inputs.probe(*p)),
-            Node::Param(slot) => return Err(RxError::Unbound { node: i, slot: *slot }),
+            Node::Param(slot) => {
+                return Err(RxError::Unbound {
+                    node: i,
+                    slot: *slot,
+                })
+            }
             Node::Map { src, f } => {
                 let f = f.clone();
                 let src = *src;

@@ -17,7 +17,11 @@ thread_local! {
 
 /// Runs `nodes` for `steps` steps and returns what the last node emitted at each step (`None`
 /// when it did not fire), plus the sink events.
-fn run(nodes: Vec<Node>, script: Vec<Vec<Value>>, steps: usize) -> (Vec<Option<Value>>, Vec<(u32, Value)>) {
+fn run(
+    nodes: Vec<Node>,
+    script: Vec<Vec<Value>>,
+    steps: usize,
+) -> (Vec<Option<Value>>, Vec<(u32, Value)>) {
     let last = StreamId(nodes.len() - 1);
     let mut rt = Runtime::new(Graph::new(nodes).unwrap());
     let inputs = Script(script);
@@ -85,7 +89,10 @@ fn take_passes_the_first_n_events_then_completes() {
         },
     ];
     let script = vec![nums(&[-1.0, 5.0, -2.0, 6.0, 7.0])];
-    assert_eq!(run(nodes, script, 5).0, vec![None, n(5.0), None, n(6.0), None]);
+    assert_eq!(
+        run(nodes, script, 5).0,
+        vec![None, n(5.0), None, n(6.0), None]
+    );
 }
 
 #[test]
@@ -100,7 +107,10 @@ fn skip_until_opens_at_the_first_trigger_inclusive_and_stays_open() {
         },
     ];
     let script = vec![nums(&[0.0, 0.0, 1.0, 0.0, 0.0])];
-    assert_eq!(run(nodes, script, 5).0, vec![None, None, n(2.0), n(3.0), n(4.0)]);
+    assert_eq!(
+        run(nodes, script, 5).0,
+        vec![None, None, n(2.0), n(3.0), n(4.0)]
+    );
 }
 
 #[test]
@@ -115,7 +125,10 @@ fn take_until_closes_at_the_first_stop_exclusive_and_completes() {
         },
     ];
     let script = vec![nums(&[0.0, 0.0, 1.0, 0.0, 0.0])];
-    assert_eq!(run(nodes, script, 5).0, vec![n(0.0), n(1.0), None, None, None]);
+    assert_eq!(
+        run(nodes, script, 5).0,
+        vec![n(0.0), n(1.0), None, None, None]
+    );
 }
 
 #[test]
@@ -166,18 +179,26 @@ fn sum_is_a_running_total_and_a_fold_with_a_function() {
         },
     ];
     let script = vec![nums(&[1.0, -5.0, 2.0, 3.0])];
-    assert_eq!(run(nodes, script.clone(), 4).0, vec![n(1.0), None, n(3.0), n(6.0)]);
+    assert_eq!(
+        run(nodes, script.clone(), 4).0,
+        vec![n(1.0), None, n(3.0), n(6.0)]
+    );
     let nodes = vec![
         Node::Probe(0),
         Node::Sum {
             src: StreamId(0),
             init: Value::Num(1.0),
             f: Some(Func::native("max", |a| {
-                Ok(Value::Num(a[0].as_num().unwrap().max(a[1].as_num().unwrap())))
+                Ok(Value::Num(
+                    a[0].as_num().unwrap().max(a[1].as_num().unwrap()),
+                ))
             })),
         },
     ];
-    assert_eq!(run(nodes, script, 4).0, vec![n(1.0), n(1.0), n(2.0), n(3.0)]);
+    assert_eq!(
+        run(nodes, script, 4).0,
+        vec![n(1.0), n(1.0), n(2.0), n(3.0)]
+    );
 }
 
 #[test]
@@ -241,7 +262,9 @@ fn the_papers_distance_monitor_sums_step_lengths() {
     let norm = Func::native("|a - b|", |a| match &a[0] {
         Value::Tuple(p) => {
             let (x, y) = (p[0].as_vec3().unwrap(), p[1].as_vec3().unwrap());
-            Ok(Value::Num((0..3).map(|i| (x[i] - y[i]).powi(2)).sum::<f64>().sqrt()))
+            Ok(Value::Num(
+                (0..3).map(|i| (x[i] - y[i]).powi(2)).sum::<f64>().sqrt(),
+            ))
         }
         v => Err(format!("got {v:?}")),
     });
@@ -263,7 +286,12 @@ fn the_papers_distance_monitor_sums_step_lengths() {
             f: None,
         },
     ];
-    let path = [[0.0, 0.0, 0.0], [3.0, 0.0, 4.0], [3.0, 0.0, 5.0], [3.0, 0.0, 5.0]];
+    let path = [
+        [0.0, 0.0, 0.0],
+        [3.0, 0.0, 4.0],
+        [3.0, 0.0, 5.0],
+        [3.0, 0.0, 5.0],
+    ];
     let script = vec![path.iter().map(|&p| Value::Vec3(p)).collect()];
     let (out, _) = run(nodes, script, 4);
     assert_eq!(out, vec![n(0.0), n(5.0), n(6.0), n(6.0)]);
@@ -285,7 +313,10 @@ fn cycles_and_dangling_references_are_errors() {
     let dangling = vec![Node::Zip(StreamId(0), StreamId(9))];
     assert!(matches!(
         Graph::new(dangling).unwrap_err(),
-        RxError::Dangling { node: 0, missing: 9 }
+        RxError::Dangling {
+            node: 0,
+            missing: 9
+        }
     ));
 }
 
@@ -301,7 +332,8 @@ fn topological_order_lets_a_node_read_a_later_index() {
     let g = Graph::new(nodes).unwrap();
     assert_eq!(g.order(), &[1, 0]);
     let mut rt = Runtime::new(g);
-    rt.step(3.0, &Script(vec![]), &mut NoHost, &mut Vec::new()).unwrap();
+    rt.step(3.0, &Script(vec![]), &mut NoHost, &mut Vec::new())
+        .unwrap();
     assert_eq!(rt.current(StreamId(0)), Some(&Value::Num(-3.0)));
 }
 
@@ -315,7 +347,8 @@ fn open_streams_bind_and_vary_over_time() {
     let (mut rt, mut sinks) = (Runtime::new(g.bind(&[piecewise]).unwrap()), Vec::new());
     let mut seen = vec![];
     for t in [0.0, 0.99, 1.0, 2.5, 7.0] {
-        rt.step(t, &Script(vec![]), &mut NoHost, &mut sinks).unwrap();
+        rt.step(t, &Script(vec![]), &mut NoHost, &mut sinks)
+            .unwrap();
         seen.push(rt.current(StreamId(0)).unwrap().as_num().unwrap());
     }
     assert_eq!(seen, vec![0.1, 0.1, 0.5, 0.9, 0.9]);

@@ -173,7 +173,10 @@ impl Aeb {
             let seg = ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt();
             if travelled + seg >= lookahead {
                 let u = ((lookahead - travelled) / seg.max(1e-9)).clamp(0.0, 1.0);
-                target = [w[0][0] + u * (w[1][0] - w[0][0]), w[0][1] + u * (w[1][1] - w[0][1])];
+                target = [
+                    w[0][0] + u * (w[1][0] - w[0][0]),
+                    w[0][1] + u * (w[1][1] - w[0][1]),
+                ];
                 break;
             }
             travelled += seg;
@@ -196,7 +199,8 @@ impl Aeb {
             if ahead > horizon {
                 break;
             }
-            let turn = wrap((-(d[1] - b[1])).atan2(d[0] - b[0]) - (-(b[1] - a[1])).atan2(b[0] - a[0]));
+            let turn =
+                wrap((-(d[1] - b[1])).atan2(d[0] - b[0]) - (-(b[1] - a[1])).atan2(b[0] - a[0]));
             let kappa = turn.abs() / ((l1 + l2) / 2.0).max(1e-6);
             if kappa > 1e-4 {
                 let v_curve = (c.lateral_accel_mps2 / kappa).sqrt();

@@ -18,9 +18,11 @@ use starlark::values::none::NoneType;
 use starlark::values::{ProvidesStaticType, UnpackValue, Value, ValueLike};
 
 use super::scene::{
-    turns, Fixed, ObjectDecl, OverTime, ParamDecl, Pending, PedTrigger, SceneBuilder,
+    turns, Fixed, ObjectDecl, OverTime, ParamDecl, PedTrigger, Pending, SceneBuilder,
 };
-use super::values::{ActorKind, ActorVal, LaneSide, Loc, MonitorVal, OverTimeVal, Road, Stream, WorldVal};
+use super::values::{
+    ActorKind, ActorVal, LaneSide, Loc, MonitorVal, OverTimeVal, Road, Stream, WorldVal,
+};
 use crate::MonitorSpec;
 
 /// The state a program's builtins write into, reached through `Evaluator::extra`.
@@ -49,7 +51,10 @@ fn here(eval: &Evaluator) -> String {
     eval.call_stack_top_location()
         .map(|l| l.resolve_span().begin.to_string())
         .map(|pos| {
-            let file = eval.call_stack_top_location().map(|l| l.filename().to_owned()).unwrap_or_default();
+            let file = eval
+                .call_stack_top_location()
+                .map(|l| l.filename().to_owned())
+                .unwrap_or_default();
             format!("{file}:{pos}")
         })
         .unwrap_or_else(|| "?".into())
@@ -83,7 +88,10 @@ pub fn stream_arg(v: Value, b: &mut SceneBuilder, what: &str) -> anyhow::Result<
     }
     match constant(v) {
         Some(c) => Ok(b.graph.push(Node::Const(c))),
-        None => bail!("{what} must be a stream or a constant, got a {}", v.get_type()),
+        None => bail!(
+            "{what} must be a stream or a constant, got a {}",
+            v.get_type()
+        ),
     }
 }
 
@@ -125,7 +133,12 @@ fn lanes(v: Option<Value>, b: &SceneBuilder, default: u32) -> anyhow::Result<u32
     Ok(x as u32)
 }
 
-fn add_piece(eval: &Evaluator, what: &str, kind: PieceKind, friction: Option<Value>) -> anyhow::Result<Road> {
+fn add_piece(
+    eval: &Evaluator,
+    what: &str,
+    kind: PieceKind,
+    friction: Option<Value>,
+) -> anyhow::Result<Road> {
     let st = state(eval)?;
     let mut b = st.scene.borrow_mut();
     let fixed = match friction {
@@ -135,9 +148,17 @@ fn add_piece(eval: &Evaluator, what: &str, kind: PieceKind, friction: Option<Val
     let segment = matches!(kind, PieceKind::Segment { .. });
     let ports = kind.ports().len();
     let name = format!("{what} declared at {}", here(eval));
-    let id = b.roads.add(&name, kind).map_err(|e| anyhow!(super::scene::strip(e)))?;
+    let id = b
+        .roads
+        .add(&name, kind)
+        .map_err(|e| anyhow!(super::scene::strip(e)))?;
     b.frictions.push((id, fixed));
-    Ok(Road { piece: id.0, ports, segment, network: false })
+    Ok(Road {
+        piece: id.0,
+        ports,
+        segment,
+        network: false,
+    })
 }
 
 fn friction_default(f: Option<Value>, b: &SceneBuilder) -> anyhow::Result<f64> {
@@ -156,25 +177,44 @@ fn friction_default(f: Option<Value>, b: &SceneBuilder) -> anyhow::Result<f64> {
 }
 
 fn location(v: Value, what: &str) -> anyhow::Result<usize> {
-    v.downcast_ref::<Loc>()
-        .map(|l| l.index)
-        .ok_or_else(|| anyhow!("{what} must be a location from r.onLane(lane, at), got a {}", v.get_type()))
+    v.downcast_ref::<Loc>().map(|l| l.index).ok_or_else(|| {
+        anyhow!(
+            "{what} must be a location from r.onLane(lane, at), got a {}",
+            v.get_type()
+        )
+    })
 }
 
-fn declare(eval: &Evaluator, b: &mut SceneBuilder, what: &str, kind: ActorKind, pending: Pending) -> ActorVal {
+fn declare(
+    eval: &Evaluator,
+    b: &mut SceneBuilder,
+    what: &str,
+    kind: ActorKind,
+    pending: Pending,
+) -> ActorVal {
     let actor = match kind {
         ActorKind::Ego => Actor::Ego,
         ActorKind::Pedestrian(i) => Actor::Pedestrian(i),
         ActorKind::Car(i) => Actor::Car(i),
     };
-    let outputs = [Output::Pos, Output::Vel, Output::Heading, Output::Speed, Output::Collision]
-        .map(|o| b.probe(actor, o).0);
+    let outputs = [
+        Output::Pos,
+        Output::Vel,
+        Output::Heading,
+        Output::Speed,
+        Output::Collision,
+    ]
+    .map(|o| b.probe(actor, o).0);
     b.objects.push(ObjectDecl {
         name: format!("{what} declared at {}", here(eval)),
         pending,
         placed: false,
     });
-    ActorVal { kind, outputs, object: b.objects.len() - 1 }
+    ActorVal {
+        kind,
+        outputs,
+        object: b.objects.len() - 1,
+    }
 }
 
 fn route_arg(v: Option<Value>) -> anyhow::Result<Option<Vec<paracosm_engine::network::Turn>>> {
@@ -185,7 +225,12 @@ fn route_arg(v: Option<Value>) -> anyhow::Result<Option<Vec<paracosm_engine::net
             let list = UnpackList::<String>::unpack_value(v)
                 .ok()
                 .flatten()
-                .ok_or_else(|| anyhow!("route must be a list of turns such as [\"left\", \"straight\"], got a {}", v.get_type()))?;
+                .ok_or_else(|| {
+                    anyhow!(
+                        "route must be a list of turns such as [\"left\", \"straight\"], got a {}",
+                        v.get_type()
+                    )
+                })?;
             turns(&list.items).map(Some).map_err(|e| anyhow!(e))
         }
     }
@@ -195,13 +240,18 @@ fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<MonitorVal> {
     let st = state(eval)?;
     let mut b = st.scene.borrow_mut();
     b.monitors.push(spec);
-    Ok(MonitorVal { index: b.monitors.len() - 1 })
+    Ok(MonitorVal {
+        index: b.monitors.len() - 1,
+    })
 }
 
 fn ego_arg(v: Value, what: &str) -> anyhow::Result<()> {
     match v.downcast_ref::<ActorVal>() {
         Some(a) if a.kind == ActorKind::Ego => Ok(()),
-        _ => bail!("{what} watches the AutonomousVehicle; got a {}", v.get_type()),
+        _ => bail!(
+            "{what} watches the AutonomousVehicle; got a {}",
+            v.get_type()
+        ),
     }
 }
 
@@ -209,12 +259,19 @@ fn ego_arg(v: Value, what: &str) -> anyhow::Result<()> {
 #[starlark_module]
 #[allow(non_snake_case)]
 pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
-    const tick: Stream = Stream { id: super::scene::TICK.0 };
+    const tick: Stream = Stream {
+        id: super::scene::TICK.0,
+    };
     const SideWalk: LaneSide = LaneSide { opposite: false };
 
     /// `Const(v)`: the constant stream of `v`.
     fn Const<'v>(v: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
-        let c = constant(v).ok_or_else(|| anyhow!("Const takes a number, a bool or a string, got a {}", v.get_type()))?;
+        let c = constant(v).ok_or_else(|| {
+            anyhow!(
+                "Const takes a number, a bool or a string, got a {}",
+                v.get_type()
+            )
+        })?;
         let st = state(eval)?;
         let id = st.scene.borrow_mut().graph.push(Node::Const(c));
         Ok(Stream { id: id.0 })
@@ -236,7 +293,15 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let over_time = match over_time {
             None => OverTime::Constant,
             Some(v) if v.is_none() => OverTime::Constant,
-            Some(v) => v.downcast_ref::<OverTimeVal>().map(|o| o.over_time).ok_or_else(|| anyhow!("over_time must be Piecewise(k) or Polynomial(deg), got a {}", v.get_type()))?,
+            Some(v) => v
+                .downcast_ref::<OverTimeVal>()
+                .map(|o| o.over_time)
+                .ok_or_else(|| {
+                    anyhow!(
+                        "over_time must be Piecewise(k) or Polynomial(deg), got a {}",
+                        v.get_type()
+                    )
+                })?,
         };
         let at = here(eval);
         let st = state(eval)?;
@@ -257,7 +322,15 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] name: Option<&str>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Stream> {
-        let items: Vec<Value> = levels.iterate(eval.heap()).map_err(|_| anyhow!("VarEnum takes a list of levels, got a {}", levels.get_type()))?.collect();
+        let items: Vec<Value> = levels
+            .iterate(eval.heap())
+            .map_err(|_| {
+                anyhow!(
+                    "VarEnum takes a list of levels, got a {}",
+                    levels.get_type()
+                )
+            })?
+            .collect();
         if items.is_empty() {
             bail!("VarEnum([]) has no levels");
         }
@@ -295,7 +368,9 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         if !(1..=64).contains(&k) {
             bail!("Piecewise(k) needs 1 <= k <= 64, got {k}");
         }
-        Ok(OverTimeVal { over_time: OverTime::Piecewise(k as usize) })
+        Ok(OverTimeVal {
+            over_time: OverTime::Piecewise(k as usize),
+        })
     }
 
     /// `Polynomial(deg)`: an open stream that is a Bernstein polynomial of degree `deg` in time.
@@ -303,7 +378,9 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         if !(0..=16).contains(&deg) {
             bail!("Polynomial(deg) needs 0 <= deg <= 16, got {deg}");
         }
-        Ok(OverTimeVal { over_time: OverTime::Polynomial(deg as usize) })
+        Ok(OverTimeVal {
+            over_time: OverTime::Polynomial(deg as usize),
+        })
     }
 
     /// `World(light=1.0, fog=0.0)`: global conditions as streams.
@@ -321,7 +398,10 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let light = stream_arg(light.unwrap_or_else(|| heap.alloc(1.0)), &mut b, "light")?;
         let fog = stream_arg(fog.unwrap_or_else(|| heap.alloc(0.0)), &mut b, "fog")?;
         b.world = Some((light, fog));
-        Ok(WorldVal { light: light.0, fog: fog.0 })
+        Ok(WorldVal {
+            light: light.0,
+            fog: fog.0,
+        })
     }
 
     /// `RoadSegment(len=200.0, nlanes=2, friction=0.8)`.
@@ -334,8 +414,15 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let kind = {
             let st = state(eval)?;
             let b = st.scene.borrow();
-            let length_m = match len { Some(v) => load_time_number(v, &b, "len")?, None => 200.0 };
-            PieceKind::Segment { length_m, lanes: lanes(nlanes, &b, 2)?, friction: friction_default(friction, &b)? }
+            let length_m = match len {
+                Some(v) => load_time_number(v, &b, "len")?,
+                None => 200.0,
+            };
+            PieceKind::Segment {
+                length_m,
+                lanes: lanes(nlanes, &b, 2)?,
+                friction: friction_default(friction, &b)?,
+            }
         };
         add_piece(eval, "RoadSegment", kind, friction)
     }
@@ -350,7 +437,10 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let kind = {
             let st = state(eval)?;
             let b = st.scene.borrow();
-            PieceKind::TIntersection { lanes: lanes(nlanes.or(numLane), &b, 2)?, friction: friction_default(friction, &b)? }
+            PieceKind::TIntersection {
+                lanes: lanes(nlanes.or(numLane), &b, 2)?,
+                friction: friction_default(friction, &b)?,
+            }
         };
         add_piece(eval, "TIntersection", kind, friction)
     }
@@ -365,7 +455,10 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let kind = {
             let st = state(eval)?;
             let b = st.scene.borrow();
-            PieceKind::CrossIntersection { lanes: lanes(nlanes.or(numLane), &b, 2)?, friction: friction_default(friction, &b)? }
+            PieceKind::CrossIntersection {
+                lanes: lanes(nlanes.or(numLane), &b, 2)?,
+                friction: friction_default(friction, &b)?,
+            }
         };
         add_piece(eval, "CrossIntersection", kind, friction)
     }
@@ -380,8 +473,15 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let kind = {
             let st = state(eval)?;
             let b = st.scene.borrow();
-            let radius_m = match radius { Some(v) => load_time_number(v, &b, "radius")?, None => 20.0 };
-            PieceKind::Roundabout { lanes: lanes(nlanes, &b, 2)?, radius_m, friction: friction_default(friction, &b)? }
+            let radius_m = match radius {
+                Some(v) => load_time_number(v, &b, "radius")?,
+                None => 20.0,
+            };
+            PieceKind::Roundabout {
+                lanes: lanes(nlanes, &b, 2)?,
+                radius_m,
+                friction: friction_default(friction, &b)?,
+            }
         };
         add_piece(eval, "Roundabout", kind, friction)
     }
@@ -409,7 +509,18 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let route = route_arg(route)?;
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
-        Ok(declare(eval, &mut b, "AutonomousVehicle", ActorKind::Ego, Pending::Ego { loc, route, initial_speed_mps, sut }))
+        Ok(declare(
+            eval,
+            &mut b,
+            "AutonomousVehicle",
+            ActorKind::Ego,
+            Pending::Ego {
+                loc,
+                route,
+                initial_speed_mps,
+                sut,
+            },
+        ))
     }
 
     /// `Car(loc=, speed=10.0, route=[], color="red", enabled=True)`: an NPC car that follows
@@ -429,10 +540,26 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let mut b = st.scene.borrow_mut();
         let speed = stream_arg(speed.unwrap_or_else(|| heap.alloc(10.0)), &mut b, "speed")?;
         let color = fixed_arg(color.unwrap_or_else(|| heap.alloc("red")), &b, "color")?;
-        let enabled = fixed_arg(enabled.unwrap_or_else(|| Value::new_bool(true)), &b, "enabled")?;
+        let enabled = fixed_arg(
+            enabled.unwrap_or_else(|| Value::new_bool(true)),
+            &b,
+            "enabled",
+        )?;
         let i = b.n_cars;
         b.n_cars += 1;
-        Ok(declare(eval, &mut b, "Car", ActorKind::Car(i), Pending::Car { loc, route, speed, color, enabled }))
+        Ok(declare(
+            eval,
+            &mut b,
+            "Car",
+            ActorKind::Car(i),
+            Pending::Car {
+                loc,
+                route,
+                speed,
+                color,
+                enabled,
+            },
+        ))
     }
 
     /// `Pedestrian(start=, target=, speed=, dist=None, car=None, trigger=None)`: walks from
@@ -457,40 +584,93 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
                     Some(a) => StreamId(a.outputs[0]),
                     None => stream_arg(c, &mut b, "car")?,
                 };
-                PedTrigger::Near { car, dist: stream_arg(d, &mut b, "dist")? }
+                PedTrigger::Near {
+                    car,
+                    dist: stream_arg(d, &mut b, "dist")?,
+                }
             }
             (None, None, Some(t)) => PedTrigger::Stream(stream_arg(t, &mut b, "trigger")?),
             _ => bail!("Pedestrian needs either dist= and car=, or trigger="),
         };
         let i = b.n_pedestrians;
         b.n_pedestrians += 1;
-        Ok(declare(eval, &mut b, "Pedestrian", ActorKind::Pedestrian(i), Pending::Pedestrian { start, target, speed, trigger }))
+        Ok(declare(
+            eval,
+            &mut b,
+            "Pedestrian",
+            ActorKind::Pedestrian(i),
+            Pending::Pedestrian {
+                start,
+                target,
+                speed,
+                trigger,
+            },
+        ))
     }
 
     /// `CollisionMonitor(v, name="collision")`: fails when the ego vehicle touches a
     /// pedestrian or a car; robustness is the smallest separation in metres.
-    fn CollisionMonitor<'v>(v: Value<'v>, #[starlark(require = named)] name: Option<&str>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<MonitorVal> {
+    fn CollisionMonitor<'v>(
+        v: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
         ego_arg(v, "CollisionMonitor")?;
-        monitor(eval, MonitorSpec::Collision { name: name.unwrap_or("collision").to_owned() })
+        monitor(
+            eval,
+            MonitorSpec::Collision {
+                name: name.unwrap_or("collision").to_owned(),
+            },
+        )
     }
 
     /// `DistanceMonitor(v, minD=, name="distance")`: fails unless the ego vehicle travels at
     /// least `minD` metres; robustness `D - minD` in metres.
-    fn DistanceMonitor<'v>(v: Value<'v>, #[starlark(require = named)] minD: Value<'v>, #[starlark(require = named)] name: Option<&str>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<MonitorVal> {
+    fn DistanceMonitor<'v>(
+        v: Value<'v>,
+        #[starlark(require = named)] minD: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
         ego_arg(v, "DistanceMonitor")?;
         let min_distance_m = number(minD, "minD")?;
-        monitor(eval, MonitorSpec::Distance { name: name.unwrap_or("distance").to_owned(), min_distance_m })
+        monitor(
+            eval,
+            MonitorSpec::Distance {
+                name: name.unwrap_or("distance").to_owned(),
+                min_distance_m,
+            },
+        )
     }
 
     /// `TimeToFailure(m, minT=0.0)`: wraps monitor `m`; reports the time of its first
     /// violation and fails when it comes before `minT` seconds.
-    fn TimeToFailure<'v>(m: Value<'v>, #[starlark(require = named)] minT: Option<Value<'v>>, #[starlark(require = named)] name: Option<&str>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<MonitorVal> {
-        let inner = m.downcast_ref::<MonitorVal>().ok_or_else(|| anyhow!("TimeToFailure wraps a monitor, got a {}", m.get_type()))?.index;
-        let min_s = match minT { Some(v) => number(v, "minT")?, None => 0.0 };
+    fn TimeToFailure<'v>(
+        m: Value<'v>,
+        #[starlark(require = named)] minT: Option<Value<'v>>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        let inner = m
+            .downcast_ref::<MonitorVal>()
+            .ok_or_else(|| anyhow!("TimeToFailure wraps a monitor, got a {}", m.get_type()))?
+            .index;
+        let min_s = match minT {
+            Some(v) => number(v, "minT")?,
+            None => 0.0,
+        };
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
-        let wrapped = b.monitors.get(inner).cloned().ok_or_else(|| anyhow!("that monitor is already wrapped"))?;
-        b.monitors[inner] = MonitorSpec::TimeToFailure { name: name.unwrap_or("time_to_failure").to_owned(), inner: Box::new(wrapped), min_s };
+        let wrapped = b
+            .monitors
+            .get(inner)
+            .cloned()
+            .ok_or_else(|| anyhow!("that monitor is already wrapped"))?;
+        b.monitors[inner] = MonitorSpec::TimeToFailure {
+            name: name.unwrap_or("time_to_failure").to_owned(),
+            inner: Box::new(wrapped),
+            min_s,
+        };
         Ok(MonitorVal { index: inner })
     }
 

@@ -16,7 +16,10 @@ use super::values::{Action, ActorVal, LaneSide, Loc, Port, Road, Stream};
 /// Stores `f` as host function `n` and returns `Func::Host(n)`.
 fn lambda<'v>(f: Value<'v>, what: &str, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Func> {
     if f.get_type() != "function" {
-        bail!("{what} needs a function (a lambda or a def), got a {}", f.get_type());
+        bail!(
+            "{what} needs a function (a lambda or a def), got a {}",
+            f.get_type()
+        );
     }
     let st = state(eval)?;
     let n = {
@@ -34,7 +37,11 @@ fn push(eval: &Evaluator<'_, '_, '_>, node: Node) -> anyhow::Result<Stream> {
     Ok(Stream { id: id.0 })
 }
 
-fn other<'v>(v: Value<'v>, what: &str, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<StreamId> {
+fn other<'v>(
+    v: Value<'v>,
+    what: &str,
+    eval: &mut Evaluator<'v, '_, '_>,
+) -> anyhow::Result<StreamId> {
     let st = state(eval)?;
     let mut b = st.scene.borrow_mut();
     stream_arg(v, &mut b, what)
@@ -44,19 +51,43 @@ fn other<'v>(v: Value<'v>, what: &str, eval: &mut Evaluator<'v, '_, '_>) -> anyh
 #[starlark_module]
 pub(crate) fn stream_methods(builder: &mut MethodsBuilder) {
     /// `s.map(f)`: `f(v)` for each event `v`.
-    fn map<'v>(this: &Stream, f: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
+    fn map<'v>(
+        this: &Stream,
+        f: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Stream> {
         let f = lambda(f, "map", eval)?;
-        push(eval, Node::Map { src: StreamId(this.id), f })
+        push(
+            eval,
+            Node::Map {
+                src: StreamId(this.id),
+                f,
+            },
+        )
     }
 
     /// `s.filter(p)`: the events for which `p(v)` is true.
-    fn filter<'v>(this: &Stream, p: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
+    fn filter<'v>(
+        this: &Stream,
+        p: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Stream> {
         let pred = lambda(p, "filter", eval)?;
-        push(eval, Node::Filter { src: StreamId(this.id), pred })
+        push(
+            eval,
+            Node::Filter {
+                src: StreamId(this.id),
+                pred,
+            },
+        )
     }
 
     /// `a.zip(b)`: pairs `(a_i, b_i)`.
-    fn zip<'v>(this: &Stream, other_stream: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
+    fn zip<'v>(
+        this: &Stream,
+        other_stream: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Stream> {
         let b = other(other_stream, "zip", eval)?;
         push(eval, Node::Zip(StreamId(this.id), b))
     }
@@ -66,23 +97,53 @@ pub(crate) fn stream_methods(builder: &mut MethodsBuilder) {
         if n < 0 {
             bail!("take needs n >= 0, got {n}");
         }
-        push(eval, Node::Take { src: StreamId(this.id), n: n as u64 })
+        push(
+            eval,
+            Node::Take {
+                src: StreamId(this.id),
+                n: n as u64,
+            },
+        )
     }
 
     /// `s.skipUntil(t)`: events from the first event of `t` on.
-    fn skipUntil<'v>(this: &Stream, trigger: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
+    fn skipUntil<'v>(
+        this: &Stream,
+        trigger: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Stream> {
         let t = other(trigger, "skipUntil", eval)?;
-        push(eval, Node::SkipUntil { src: StreamId(this.id), trigger: t })
+        push(
+            eval,
+            Node::SkipUntil {
+                src: StreamId(this.id),
+                trigger: t,
+            },
+        )
     }
 
     /// `s.takeUntil(t)`: events until the first event of `t`.
-    fn takeUntil<'v>(this: &Stream, stop: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
+    fn takeUntil<'v>(
+        this: &Stream,
+        stop: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Stream> {
         let t = other(stop, "takeUntil", eval)?;
-        push(eval, Node::TakeUntil { src: StreamId(this.id), stop: t })
+        push(
+            eval,
+            Node::TakeUntil {
+                src: StreamId(this.id),
+                stop: t,
+            },
+        )
     }
 
     /// `a.concat(b)`: `a`'s events, then `b`'s.
-    fn concat<'v>(this: &Stream, second: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
+    fn concat<'v>(
+        this: &Stream,
+        second: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Stream> {
         let b = other(second, "concat", eval)?;
         push(eval, Node::Concat(StreamId(this.id), b))
     }
@@ -94,28 +155,63 @@ pub(crate) fn stream_methods(builder: &mut MethodsBuilder) {
         #[starlark(default = NoneType)] f: Value<'v>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Stream> {
-        let init = if init.is_none() { Rx::Num(0.0) } else { Rx::Num(number(init, "sum(init=)")?) };
-        let f = if f.is_none() { None } else { Some(lambda(f, "sum", eval)?) };
-        push(eval, Node::Sum { src: StreamId(this.id), init, f })
+        let init = if init.is_none() {
+            Rx::Num(0.0)
+        } else {
+            Rx::Num(number(init, "sum(init=)")?)
+        };
+        let f = if f.is_none() {
+            None
+        } else {
+            Some(lambda(f, "sum", eval)?)
+        };
+        push(
+            eval,
+            Node::Sum {
+                src: StreamId(this.id),
+                init,
+                f,
+            },
+        )
     }
 
     /// `s.foreach(action)`: each event performs `action` (e.g. `p.walk`).
-    fn foreach<'v>(this: &Stream, action: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<NoneType> {
-        let a = action
-            .downcast_ref::<Action>()
-            .ok_or_else(|| anyhow!("foreach needs an action such as `p.walk`, got a {}", action.get_type()))?;
-        push(eval, Node::Foreach { src: StreamId(this.id), sink: a.sink })?;
+    fn foreach<'v>(
+        this: &Stream,
+        action: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<NoneType> {
+        let a = action.downcast_ref::<Action>().ok_or_else(|| {
+            anyhow!(
+                "foreach needs an action such as `p.walk`, got a {}",
+                action.get_type()
+            )
+        })?;
+        push(
+            eval,
+            Node::Foreach {
+                src: StreamId(this.id),
+                sink: a.sink,
+            },
+        )?;
         Ok(NoneType)
     }
 }
 
 fn lane_of(v: Value) -> anyhow::Result<Lane> {
     if let Some(s) = v.downcast_ref::<LaneSide>() {
-        return Ok(if s.opposite { Lane::OppositeSideWalk } else { Lane::SideWalk });
+        return Ok(if s.opposite {
+            Lane::OppositeSideWalk
+        } else {
+            Lane::SideWalk
+        });
     }
     match v.unpack_i32() {
         Some(k) => Ok(Lane::Driving(k)),
-        None => bail!("a lane is a lane number or r.SideWalk / -r.SideWalk, got a {}", v.get_type()),
+        None => bail!(
+            "a lane is a lane number or r.SideWalk / -r.SideWalk, got a {}",
+            v.get_type()
+        ),
     }
 }
 
@@ -124,7 +220,12 @@ fn lane_of(v: Value) -> anyhow::Result<Lane> {
 pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
     /// `r.onLane(lane, at)`: the point `at` metres along lane `lane` (a number, negative for
     /// the opposite direction, or `r.SideWalk` / `-r.SideWalk`).
-    fn onLane<'v>(this: &Road, lane: Value<'v>, at: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Loc> {
+    fn onLane<'v>(
+        this: &Road,
+        lane: Value<'v>,
+        at: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Loc> {
         if this.network || !this.segment {
             bail!("onLane needs a RoadSegment");
         }
@@ -133,14 +234,22 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
         let piece = PieceId(this.piece);
-        b.roads.on_lane(piece, lane, at_m).map_err(|e| anyhow!(super::scene::strip(e)))?;
+        b.roads
+            .on_lane(piece, lane, at_m)
+            .map_err(|e| anyhow!(super::scene::strip(e)))?;
         b.locs.push(LaneRef { piece, lane, at_m });
-        Ok(Loc { index: b.locs.len() - 1 })
+        Ok(Loc {
+            index: b.locs.len() - 1,
+        })
     }
 
     /// `parent.connect((parent.PORT, child, child.PORT), ...)`: joins each child to a port of
     /// this road or network, positioning it; returns the composite network.
-    fn connect<'v>(this: &Road, #[starlark(args)] links: UnpackTuple<Value<'v>>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Road> {
+    fn connect<'v>(
+        this: &Road,
+        #[starlark(args)] links: UnpackTuple<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
         if b.placed {
@@ -149,22 +258,40 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
         for link in links.items {
             let t = TupleRef::from_value(link)
                 .filter(|t| t.len() == 3)
-                .ok_or_else(|| anyhow!("connect takes tuples (port, child, child_port), got {link}"))?;
+                .ok_or_else(|| {
+                    anyhow!("connect takes tuples (port, child, child_port), got {link}")
+                })?;
             let items = t.content();
-            let port = |v: Value<'v>| v.downcast_ref::<Port>().copied().ok_or_else(|| anyhow!("expected a port such as t.ONE, got {v}"));
+            let port = |v: Value<'v>| {
+                v.downcast_ref::<Port>()
+                    .copied()
+                    .ok_or_else(|| anyhow!("expected a port such as t.ONE, got {v}"))
+            };
             let (p, c) = (port(items[0])?, port(items[2])?);
-            let child = items[1].downcast_ref::<Road>().ok_or_else(|| anyhow!("expected a road piece, got {}", items[1]))?;
+            let child = items[1]
+                .downcast_ref::<Road>()
+                .ok_or_else(|| anyhow!("expected a road piece, got {}", items[1]))?;
             if c.piece != child.piece {
-                bail!("the child port {} does not belong to the child road {}", items[2], items[1]);
+                bail!(
+                    "the child port {} does not belong to the child road {}",
+                    items[2],
+                    items[1]
+                );
             }
             if b.roads.group_of(PieceId(p.piece)) != b.roads.group_of(PieceId(this.piece)) {
-                bail!("port {} belongs to neither this road nor its network", items[0]);
+                bail!(
+                    "port {} belongs to neither this road nor its network",
+                    items[0]
+                );
             }
             b.roads
                 .connect(PieceId(p.piece), p.index, PieceId(c.piece), c.index)
                 .map_err(|e| anyhow!(super::scene::strip(e)))?;
         }
-        Ok(Road { network: true, ..*this })
+        Ok(Road {
+            network: true,
+            ..*this
+        })
     }
 }
 
@@ -172,7 +299,11 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
 #[starlark_module]
 pub(crate) fn world_methods(builder: &mut MethodsBuilder) {
     /// `w.place(objects...)`: adds roads and actors to the scene and checks the placement.
-    fn place<'v>(#[allow(unused_variables)] this: &super::values::WorldVal, #[starlark(args)] objects: UnpackTuple<Value<'v>>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<NoneType> {
+    fn place<'v>(
+        #[allow(unused_variables)] this: &super::values::WorldVal,
+        #[starlark(args)] objects: UnpackTuple<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<NoneType> {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
         let mut actors = Vec::new();

@@ -88,8 +88,8 @@ pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, Sce
         enable_top_level_stmt: true,
         ..Dialect::Standard
     };
-    let ast = AstModule::parse(file, source.to_owned(), &dialect)
-        .map_err(|e| lang(format!("{e}")))?;
+    let ast =
+        AstModule::parse(file, source.to_owned(), &dialect).map_err(|e| lang(format!("{e}")))?;
     let globals = globals();
     let state = globals::LoadState::default();
     let frozen = Module::with_temp_heap(|module| -> Result<_, ScenarioError> {
@@ -110,10 +110,14 @@ pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, Sce
         // Open parameters take the name of the global they are bound to.
         let mut scene = state.scene.borrow_mut();
         for n in module.names() {
-            let Some(v) = module.get(n.as_str()) else { continue };
+            let Some(v) = module.get(n.as_str()) else {
+                continue;
+            };
             if let Some(s) = v.downcast_ref::<values::Stream>() {
                 if let Some(p) = scene.param_of(paracosm_engine::rx::StreamId(s.id)) {
-                    scene.params[p].name.get_or_insert_with(|| n.as_str().to_owned());
+                    scene.params[p]
+                        .name
+                        .get_or_insert_with(|| n.as_str().to_owned());
                 }
             }
         }

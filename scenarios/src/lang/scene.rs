@@ -318,7 +318,9 @@ pub fn finish(
         Some(axes) => {
             for a in &axes {
                 if space.param(a).is_none() {
-                    return Err(format!("test(map=...) names `{a}`, which is not a parameter"));
+                    return Err(format!(
+                        "test(map=...) names `{a}`, which is not a parameter"
+                    ));
                 }
             }
             axes
@@ -380,7 +382,11 @@ impl Frozen {
                 let reals = |names: Vec<String>| -> Result<Vec<f64>, ScenarioError> {
                     names
                         .iter()
-                        .map(|n| get(n)?.as_f64().ok_or(ScenarioError::MissingParam(n.clone())))
+                        .map(|n| {
+                            get(n)?
+                                .as_f64()
+                                .ok_or(ScenarioError::MissingParam(n.clone()))
+                        })
                         .collect()
                 };
                 Ok(match p.over_time {

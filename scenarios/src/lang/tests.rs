@@ -17,7 +17,10 @@ fn err(src: &str) -> String {
 fn assert_diag(src: &str, message: &str, at: &str) {
     let m = err(src);
     assert!(m.contains(message), "message {message:?} not in:\n{m}");
-    assert!(m.contains(&format!("bad.star:{at}")), "location {at} not in:\n{m}");
+    assert!(
+        m.contains(&format!("bad.star:{at}")),
+        "location {at} not in:\n{m}"
+    );
     assert!(m.contains('^'), "no caret in:\n{m}");
 }
 
@@ -28,16 +31,16 @@ fn a_syntax_error_points_at_the_token() {
 
 #[test]
 fn a_typo_suggests_the_right_name() {
-    assert_diag("x = VarIntervall(0, 1)\n", "Variable `VarIntervall` not found, did you mean `VarInterval`?", "1:5");
+    assert_diag(
+        "x = VarIntervall(0, 1)\n",
+        "Variable `VarIntervall` not found, did you mean `VarInterval`?",
+        "1:5",
+    );
 }
 
 #[test]
 fn an_unknown_keyword_is_refused() {
-    assert_diag(
-        "r = RoadSegment(lenght = 10.0)\n",
-        "lenght",
-        "1:5",
-    );
+    assert_diag("r = RoadSegment(lenght = 10.0)\n", "lenght", "1:5");
 }
 
 #[test]
@@ -70,9 +73,7 @@ fn an_invalid_connection_is_refused() {
 
 #[test]
 fn objects_starting_in_collision_are_both_named() {
-    let src = format!(
-        "{HEADER}c = Car(loc = r.onLane(1, 12))\nw.place(r, v, c)\n"
-    );
+    let src = format!("{HEADER}c = Car(loc = r.onLane(1, 12))\nw.place(r, v, c)\n");
     assert_diag(
         &src,
         "AutonomousVehicle declared at bad.star:3:5 and Car declared at bad.star:4:5 start in collision",

@@ -6,22 +6,12 @@ use std::fmt;
 use allocative::Allocative;
 use starlark::environment::Methods;
 use starlark::starlark_simple_value;
-use starlark::StarlarkPagablePanic;
 use starlark::values::{
     starlark_value, Heap, NoSerialize, ProvidesStaticType, StarlarkValue, Value,
 };
+use starlark::StarlarkPagablePanic;
 
 use super::scene::OverTime;
-
-macro_rules! simple {
-    ($t:ident, $ty:literal, $($body:tt)*) => {
-        starlark_simple_value!($t);
-        #[starlark_value(type = $ty)]
-        impl<'v> StarlarkValue<'v> for $t {
-            $($body)*
-        }
-    };
-}
 
 /// A stream (paper §2): `tick`, `Const(...)`, an open parameter, an output of an object, or a
 /// combinator over streams.
@@ -39,11 +29,14 @@ impl fmt::Display for Stream {
 
 starlark::methods_static!(STREAM_METHODS = super::methods::stream_methods);
 
-simple!(Stream, "Stream",
+starlark_simple_value!(Stream);
+
+#[starlark_value(type = "Stream")]
+impl<'v> StarlarkValue<'v> for Stream {
     fn get_methods() -> Option<&'static Methods> {
         Some(STREAM_METHODS.methods())
     }
-);
+}
 
 /// A road piece, or a network of connected pieces represented by its first piece.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -72,7 +65,10 @@ starlark::methods_static!(ROAD_METHODS = super::methods::road_methods);
 
 const PORTS: [&str; 4] = ["ONE", "TWO", "THREE", "FOUR"];
 
-simple!(Road, "Road",
+starlark_simple_value!(Road);
+
+#[starlark_value(type = "Road")]
+impl<'v> StarlarkValue<'v> for Road {
     fn get_methods() -> Option<&'static Methods> {
         Some(ROAD_METHODS.methods())
     }
@@ -82,7 +78,12 @@ simple!(Road, "Road",
             return Some(heap.alloc(LaneSide { opposite: false }));
         }
         let i = PORTS.iter().position(|p| *p == attribute)?;
-        (i < self.ports && !self.network).then(|| heap.alloc(Port { piece: self.piece, index: i }))
+        (i < self.ports && !self.network).then(|| {
+            heap.alloc(Port {
+                piece: self.piece,
+                index: i,
+            })
+        })
     }
 
     fn dir_attr(&self) -> Vec<String> {
@@ -92,7 +93,7 @@ simple!(Road, "Road",
         }
         v
     }
-);
+}
 
 /// A connection point of a road piece (`t.ONE`).
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -109,7 +110,10 @@ impl fmt::Display for Port {
     }
 }
 
-simple!(Port, "Port",);
+starlark_simple_value!(Port);
+
+#[starlark_value(type = "Port")]
+impl<'v> StarlarkValue<'v> for Port {}
 
 /// `r.SideWalk` (`opposite: false`) or `-r.SideWalk`.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -120,15 +124,24 @@ pub struct LaneSide {
 
 impl fmt::Display for LaneSide {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(if self.opposite { "-SideWalk" } else { "SideWalk" })
+        f.write_str(if self.opposite {
+            "-SideWalk"
+        } else {
+            "SideWalk"
+        })
     }
 }
 
-simple!(LaneSide, "SideWalk",
+starlark_simple_value!(LaneSide);
+
+#[starlark_value(type = "SideWalk")]
+impl<'v> StarlarkValue<'v> for LaneSide {
     fn minus(&self, heap: Heap<'v>) -> starlark::Result<Value<'v>> {
-        Ok(heap.alloc(LaneSide { opposite: !self.opposite }))
+        Ok(heap.alloc(LaneSide {
+            opposite: !self.opposite,
+        }))
     }
-);
+}
 
 /// A resolved `onLane(lane, at)`.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -143,7 +156,10 @@ impl fmt::Display for Loc {
     }
 }
 
-simple!(Loc, "Location",);
+starlark_simple_value!(Loc);
+
+#[starlark_value(type = "Location")]
+impl<'v> StarlarkValue<'v> for Loc {}
 
 /// What kind of actor an [`ActorVal`] is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Allocative)]
@@ -180,7 +196,10 @@ impl fmt::Display for ActorVal {
     }
 }
 
-simple!(ActorVal, "Actor",
+starlark_simple_value!(ActorVal);
+
+#[starlark_value(type = "Actor")]
+impl<'v> StarlarkValue<'v> for ActorVal {
     fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
         if let ActorKind::Pedestrian(i) = self.kind {
             if attribute == "walk" {
@@ -188,7 +207,9 @@ simple!(ActorVal, "Actor",
             }
         }
         let i = OUTPUT_NAMES.iter().position(|n| *n == attribute)?;
-        Some(heap.alloc(Stream { id: self.outputs[i] }))
+        Some(heap.alloc(Stream {
+            id: self.outputs[i],
+        }))
     }
 
     fn dir_attr(&self) -> Vec<String> {
@@ -198,7 +219,7 @@ simple!(ActorVal, "Actor",
         }
         v
     }
-);
+}
 
 /// An action for `foreach`: `p.walk` moves pedestrian `p` one step toward its target.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -213,7 +234,10 @@ impl fmt::Display for Action {
     }
 }
 
-simple!(Action, "Action",);
+starlark_simple_value!(Action);
+
+#[starlark_value(type = "Action")]
+impl<'v> StarlarkValue<'v> for Action {}
 
 /// `World(light=, fog=)`.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -232,7 +256,10 @@ impl fmt::Display for WorldVal {
 
 starlark::methods_static!(WORLD_METHODS = super::methods::world_methods);
 
-simple!(WorldVal, "World",
+starlark_simple_value!(WorldVal);
+
+#[starlark_value(type = "World")]
+impl<'v> StarlarkValue<'v> for WorldVal {
     fn get_methods() -> Option<&'static Methods> {
         Some(WORLD_METHODS.methods())
     }
@@ -248,7 +275,7 @@ simple!(WorldVal, "World",
     fn dir_attr(&self) -> Vec<String> {
         vec!["light".into(), "fog".into()]
     }
-);
+}
 
 /// A monitor, registered when created.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -263,7 +290,10 @@ impl fmt::Display for MonitorVal {
     }
 }
 
-simple!(MonitorVal, "Monitor",);
+starlark_simple_value!(MonitorVal);
+
+#[starlark_value(type = "Monitor")]
+impl<'v> StarlarkValue<'v> for MonitorVal {}
 
 /// `Piecewise(k)` or `Polynomial(deg)`.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -283,4 +313,7 @@ impl fmt::Display for OverTimeVal {
     }
 }
 
-simple!(OverTimeVal, "OverTime",);
+starlark_simple_value!(OverTimeVal);
+
+#[starlark_value(type = "OverTime")]
+impl<'v> StarlarkValue<'v> for OverTimeVal {}
