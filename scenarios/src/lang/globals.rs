@@ -161,6 +161,22 @@ fn add_piece(
     })
 }
 
+/// A T- or cross-intersection from its keyword arguments.
+fn junction(
+    eval: &Evaluator,
+    what: &str,
+    nlanes: Option<Value>,
+    friction: Option<Value>,
+    make: fn(u32, f64) -> PieceKind,
+) -> anyhow::Result<Road> {
+    let kind = {
+        let st = state(eval)?;
+        let b = st.scene.borrow();
+        make(lanes(nlanes, &b, 2)?, friction_default(friction, &b)?)
+    };
+    add_piece(eval, what, kind, friction)
+}
+
 fn friction_default(f: Option<Value>, b: &SceneBuilder) -> anyhow::Result<f64> {
     // A placeholder inside (0, 2] for open frictions: each test sets its own value.
     match f {
@@ -434,33 +450,29 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] friction: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Road> {
-        let kind = {
-            let st = state(eval)?;
-            let b = st.scene.borrow();
-            PieceKind::TIntersection {
-                lanes: lanes(nlanes.or(numLane), &b, 2)?,
-                friction: friction_default(friction, &b)?,
-            }
-        };
-        add_piece(eval, "TIntersection", kind, friction)
+        junction(
+            eval,
+            "TIntersection",
+            nlanes.or(numLane),
+            friction,
+            |lanes, friction| PieceKind::TIntersection { lanes, friction },
+        )
     }
 
-    /// `CrossIntersection(nlanes=2, friction=0.8)`.
+    /// `CrossIntersection(nlanes=2, friction=0.8)`; `numLane=` too.
     fn CrossIntersection<'v>(
         #[starlark(require = named)] nlanes: Option<Value<'v>>,
         #[starlark(require = named)] numLane: Option<Value<'v>>,
         #[starlark(require = named)] friction: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Road> {
-        let kind = {
-            let st = state(eval)?;
-            let b = st.scene.borrow();
-            PieceKind::CrossIntersection {
-                lanes: lanes(nlanes.or(numLane), &b, 2)?,
-                friction: friction_default(friction, &b)?,
-            }
-        };
-        add_piece(eval, "CrossIntersection", kind, friction)
+        junction(
+            eval,
+            "CrossIntersection",
+            nlanes.or(numLane),
+            friction,
+            |lanes, friction| PieceKind::CrossIntersection { lanes, friction },
+        )
     }
 
     /// `Roundabout(nlanes=2, radius=20.0, friction=0.8)`.

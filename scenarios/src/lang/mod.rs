@@ -56,6 +56,61 @@ pub fn load_file(path: &Path) -> Result<Scenario, ScenarioError> {
     load_source(&path.display().to_string(), &source, &stem)
 }
 
+/// The keyword arguments of each builtin, for "did you mean" on a misspelled keyword
+/// (starlark reports the unknown keyword but suggests nothing).
+const KEYWORDS: &[(&str, &[&str])] = &[
+    ("World", &["light", "fog"]),
+    ("RoadSegment", &["len", "nlanes", "friction"]),
+    ("TIntersection", &["nlanes", "numLane", "friction"]),
+    ("CrossIntersection", &["nlanes", "numLane", "friction"]),
+    ("Roundabout", &["nlanes", "radius", "friction"]),
+    ("AutonomousVehicle", &["loc", "sut", "route", "speed"]),
+    ("Car", &["loc", "speed", "route", "color", "enabled"]),
+    (
+        "Pedestrian",
+        &["start", "target", "speed", "dist", "car", "trigger"],
+    ),
+    ("VarInterval", &["unit", "name", "over_time"]),
+    ("VarEnum", &["name"]),
+    ("CollisionMonitor", &["name"]),
+    ("DistanceMonitor", &["minD", "name"]),
+    ("TimeToFailure", &["minT", "name"]),
+    ("test", &["horizon", "map"]),
+];
+
+/// Adds "did you mean `x`?" to starlark's "Found `y` extra named parameter(s) for call to F".
+fn suggest_keyword(message: &str) -> String {
+    let Some(rest) = message.split("Found `").nth(1) else {
+        return message.to_owned();
+    };
+    let Some((wrong, tail)) = rest.split_once('`') else {
+        return message.to_owned();
+    };
+    let Some(function) = tail.split("for call to ").nth(1).and_then(|f| {
+        f.split(|c: char| !c.is_alphanumeric() && c != '_')
+            .find(|w| !w.is_empty())
+    }) else {
+        return message.to_owned();
+    };
+    let best = KEYWORDS
+        .iter()
+        .find(|(f, _)| *f == function)
+        .and_then(|(_, keys)| {
+            keys.iter()
+                .map(|k| (strsim::levenshtein(k, wrong), *k))
+                .filter(|(d, _)| *d <= 3)
+                .min()
+        });
+    match best {
+        Some((_, key)) => message.replacen(
+            &format!("call to {function}"),
+            &format!("call to {function}, did you mean `{key}`?"),
+            1,
+        ),
+        None => message.to_owned(),
+    }
+}
+
 /// The first paragraph of the leading `#` comment, joined into one line.
 fn header(source: &str) -> String {
     let mut out = Vec::new();
@@ -105,7 +160,7 @@ pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, Sce
                 l.map_err(|e| lang(e.to_string()))?;
             }
             eval.eval_module(ast, &globals)
-                .map_err(|e| lang(format!("{e}")))?;
+                .map_err(|e| lang(suggest_keyword(&format!("{e}"))))?;
         }
         // Open parameters take the name of the global they are bound to.
         let mut scene = state.scene.borrow_mut();

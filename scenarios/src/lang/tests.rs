@@ -40,7 +40,11 @@ fn a_typo_suggests_the_right_name() {
 
 #[test]
 fn an_unknown_keyword_is_refused() {
-    assert_diag("r = RoadSegment(lenght = 10.0)\n", "lenght", "1:5");
+    assert_diag(
+        "r = RoadSegment(lenght = 10.0)\n",
+        "Found `lenght` extra named parameter(s) for call to RoadSegment, did you mean `len`?",
+        "1:5",
+    );
 }
 
 #[test]
