@@ -10,6 +10,16 @@ fn fuzz(args: &[&str]) -> Output {
         .expect("paracosm-fuzz runs")
 }
 
+/// Asserts the exit code, showing stderr when it differs.
+fn expect_code(o: &Output, code: i32) {
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
 fn lines(path: &Path) -> Vec<serde_json::Value> {
     std::fs::read_to_string(path)
         .unwrap()
@@ -198,12 +208,7 @@ fn an_earlier_campaign_is_not_overwritten_without_force() {
 
 /// Asserts a zero exit (showing stderr otherwise) and parses standard output as JSON.
 fn success_json(o: &Output) -> serde_json::Value {
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    expect_code(o, 0);
     serde_json::from_slice(&o.stdout).expect("standard output is JSON")
 }
 
@@ -443,12 +448,7 @@ fn cover_generate_model_writes_a_pairwise_array_that_respects_the_constraints() 
             "--algorithm",
             algorithm,
         ]);
-        assert_eq!(
-            o.status.code(),
-            Some(0),
-            "{}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        expect_code(&o, 0);
         let text = String::from_utf8(o.stdout).unwrap();
         let mut lines = text.lines();
         assert_eq!(lines.next(), Some("Type,Size,Format,Compression"));
@@ -513,12 +513,7 @@ fn ipog_suites_cover_every_pair_and_give_each_row_its_own_halton_block() {
         "--output",
         csv.to_str().unwrap(),
     ]);
-    assert_eq!(
-        g.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&g.stderr)
-    );
+    expect_code(&g, 0);
     let e = cover(&[
         "estimate",
         csv.to_str().unwrap(),
@@ -585,12 +580,7 @@ fn pedestrian_crossing_star_reproduces_the_rust_study_byte_for_byte() {
             "--out",
             out.to_str().unwrap(),
         ]);
-        assert_eq!(
-            o.status.code(),
-            Some(1),
-            "{}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        expect_code(&o, 1);
         // The fixture keeps each object's closing brace; without_wall_time cuts it with wall_ms.
         let expected: Vec<&str> = fixture.lines().map(|l| &l[..l.len() - 1]).collect();
         let got = without_wall_time(&out.join("results.jsonl"));

@@ -48,16 +48,10 @@ pub fn state<'a>(eval: &Evaluator<'_, 'a, '_>) -> anyhow::Result<&'a LoadState> 
 }
 
 fn here(eval: &Evaluator) -> String {
-    eval.call_stack_top_location()
-        .map(|l| l.resolve_span().begin.to_string())
-        .map(|pos| {
-            let file = eval
-                .call_stack_top_location()
-                .map(|l| l.filename().to_owned())
-                .unwrap_or_default();
-            format!("{file}:{pos}")
-        })
-        .unwrap_or_else(|| "?".into())
+    match eval.call_stack_top_location() {
+        Some(l) => format!("{}:{}", l.filename(), l.resolve_span().begin),
+        None => "?".into(),
+    }
 }
 
 /// A number: an int, a float, or a `Const` stream of a number.
@@ -161,18 +155,21 @@ fn add_piece(
     })
 }
 
-/// A T- or cross-intersection from its keyword arguments.
-fn junction(
+/// A road piece from its keyword arguments: `make` gets the program's declarations, the lane
+/// count (default 2) and the friction (default 0.8, or an open friction's lower bound as a
+/// placeholder) and reads any further load-time arguments.
+fn road_piece(
     eval: &Evaluator,
     what: &str,
     nlanes: Option<Value>,
     friction: Option<Value>,
-    make: fn(u32, f64) -> PieceKind,
+    make: impl FnOnce(&SceneBuilder, u32, f64) -> anyhow::Result<PieceKind>,
 ) -> anyhow::Result<Road> {
     let kind = {
         let st = state(eval)?;
         let b = st.scene.borrow();
-        make(lanes(nlanes, &b, 2)?, friction_default(friction, &b)?)
+        let (lanes, mu) = (lanes(nlanes, &b, 2)?, friction_default(friction, &b)?);
+        make(&b, lanes, mu)?
     };
     add_piece(eval, what, kind, friction)
 }
@@ -323,7 +320,6 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let st = state(eval)?;
         let id = st.scene.borrow_mut().param(ParamDecl {
             name: name.map(str::to_owned),
-            hint: None,
             domain: Domain::Interval { lo, hi },
             unit: unit.map(str::to_owned),
             over_time,
@@ -370,7 +366,6 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let st = state(eval)?;
         let id = st.scene.borrow_mut().param(ParamDecl {
             name: name.map(str::to_owned),
-            hint: None,
             domain: Domain::Levels(out),
             unit: None,
             over_time: OverTime::Constant,
@@ -427,20 +422,23 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] friction: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Road> {
-        let kind = {
-            let st = state(eval)?;
-            let b = st.scene.borrow();
-            let length_m = match len {
-                Some(v) => load_time_number(v, &b, "len")?,
-                None => 200.0,
-            };
-            PieceKind::Segment {
-                length_m,
-                lanes: lanes(nlanes, &b, 2)?,
-                friction: friction_default(friction, &b)?,
-            }
-        };
-        add_piece(eval, "RoadSegment", kind, friction)
+        road_piece(
+            eval,
+            "RoadSegment",
+            nlanes,
+            friction,
+            |b, lanes, friction| {
+                let length_m = match len {
+                    Some(v) => load_time_number(v, b, "len")?,
+                    None => 200.0,
+                };
+                Ok(PieceKind::Segment {
+                    length_m,
+                    lanes,
+                    friction,
+                })
+            },
+        )
     }
 
     /// `TIntersection(nlanes=2, friction=0.8)`; `numLane=` is the paper's spelling.
@@ -450,12 +448,12 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] friction: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Road> {
-        junction(
+        road_piece(
             eval,
             "TIntersection",
             nlanes.or(numLane),
             friction,
-            |lanes, friction| PieceKind::TIntersection { lanes, friction },
+            |_, lanes, friction| Ok(PieceKind::TIntersection { lanes, friction }),
         )
     }
 
@@ -466,12 +464,12 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] friction: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Road> {
-        junction(
+        road_piece(
             eval,
             "CrossIntersection",
             nlanes.or(numLane),
             friction,
-            |lanes, friction| PieceKind::CrossIntersection { lanes, friction },
+            |_, lanes, friction| Ok(PieceKind::CrossIntersection { lanes, friction }),
         )
     }
 
@@ -482,20 +480,23 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] friction: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Road> {
-        let kind = {
-            let st = state(eval)?;
-            let b = st.scene.borrow();
-            let radius_m = match radius {
-                Some(v) => load_time_number(v, &b, "radius")?,
-                None => 20.0,
-            };
-            PieceKind::Roundabout {
-                lanes: lanes(nlanes, &b, 2)?,
-                radius_m,
-                friction: friction_default(friction, &b)?,
-            }
-        };
-        add_piece(eval, "Roundabout", kind, friction)
+        road_piece(
+            eval,
+            "Roundabout",
+            nlanes,
+            friction,
+            |b, lanes, friction| {
+                let radius_m = match radius {
+                    Some(v) => load_time_number(v, b, "radius")?,
+                    None => 20.0,
+                };
+                Ok(PieceKind::Roundabout {
+                    lanes,
+                    radius_m,
+                    friction,
+                })
+            },
+        )
     }
 
     /// `AutonomousVehicle(loc=, sut="aeb", route=None, speed=None)`: the ego vehicle.

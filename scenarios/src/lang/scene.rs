@@ -32,10 +32,8 @@ pub const TICK: StreamId = StreamId(0);
 /// A `VarInterval` or `VarEnum` as declared.
 #[derive(Debug, Clone)]
 pub struct ParamDecl {
-    /// `name=`, or the global variable it was assigned to, or a name from its first use.
+    /// `name=`, or the global variable it was assigned to; `None` gives `param<i>`.
     pub name: Option<String>,
-    /// A fallback name from its first use, e.g. `pedestrian0_speed`.
-    pub hint: Option<String>,
     /// Range or levels.
     pub domain: Domain,
     /// `unit=`.
@@ -269,8 +267,8 @@ pub struct Meta {
 /// Turns a finished program's declarations into a [`Scenario`].
 ///
 /// # Errors
-/// [`ScenarioError::Language`] when something required is missing (no `place`, no ego
-/// vehicle) or the parameters clash.
+/// A message (the caller makes it a [`ScenarioError::Language`]) when something required is
+/// missing (no `place`, no ego vehicle, an actor never placed) or the parameters clash.
 pub fn finish(
     b: SceneBuilder,
     meta: Meta,
@@ -293,11 +291,7 @@ pub fn finish(
     let mut params: Vec<(String, ParamDecl)> = Vec::new();
     let mut space = Vec::new();
     for (i, p) in b.params.into_iter().enumerate() {
-        let name = p
-            .name
-            .clone()
-            .or_else(|| p.hint.clone())
-            .unwrap_or_else(|| format!("param{i}"));
+        let name = p.name.clone().unwrap_or_else(|| format!("param{i}"));
         if let Some((_, first)) = params.iter().find(|(n, _)| *n == name) {
             return Err(format!(
                 "two open parameters are named `{name}` (declared at {} and {}); give one another name=",
@@ -432,7 +426,7 @@ impl Frozen {
                     Value::Text(t) => t,
                     v => format!("{v:?}"),
                 },
-                size_m: [4.5, 1.8, 1.5],
+                size_m: CAR_SIZE_M,
                 enabled: self.fixed(&c.enabled, &open).as_bool().unwrap_or(true),
             })
             .collect();
