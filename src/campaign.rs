@@ -10,7 +10,7 @@ use std::sync::mpsc;
 use std::time::Instant;
 
 use paracosm_generators::{GeneratorError, Point, Strategy};
-use paracosm_scenarios::Scenario;
+use paracosm_scenarios::{RunOptions, Scenario};
 use thiserror::Error;
 
 use crate::record::{MonitorResult, RunRecord, Status};
@@ -90,25 +90,33 @@ impl Campaign<'_> {
         Ok(generator.ask(self.budget as usize)?)
     }
 
-    /// Runs test `id` at `point` alone: what a worker does, and what a replay does.
+    /// Runs test `id` at `point` alone: what a worker does.
     pub fn run_one(&self, id: u64, point: &Point) -> RunRecord {
+        self.run_one_with(id, point, &mut RunOptions::default())
+    }
+
+    /// As [`Campaign::run_one`], with a viewing camera and a frame callback: what a replay
+    /// does.
+    pub fn run_one_with(&self, id: u64, point: &Point, options: &mut RunOptions<'_>) -> RunRecord {
         let started = Instant::now();
         let seed = test_seed(self.seed, id);
         let scenario = self.scenario;
         let decoded = scenario.space.decode(point);
         let outcome = match &decoded {
-            Ok(assignment) => catch_unwind(AssertUnwindSafe(|| scenario.run(assignment, seed)))
-                .unwrap_or_else(|panic| {
-                    let msg = panic
-                        .downcast_ref::<&str>()
-                        .map(|s| s.to_string())
-                        .or_else(|| panic.downcast_ref::<String>().cloned())
-                        .unwrap_or_else(|| "unknown panic".into());
-                    Err(paracosm_scenarios::ScenarioError::Sut(
-                        paracosm_engine::sut::SutError::Failed(format!("internal panic: {msg}")),
-                    ))
-                })
-                .map_err(|e| e.to_string()),
+            Ok(assignment) => catch_unwind(AssertUnwindSafe(|| {
+                scenario.run_with(assignment, seed, options)
+            }))
+            .unwrap_or_else(|panic| {
+                let msg = panic
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "unknown panic".into());
+                Err(paracosm_scenarios::ScenarioError::Sut(
+                    paracosm_engine::sut::SutError::Failed(format!("internal panic: {msg}")),
+                ))
+            })
+            .map_err(|e| e.to_string()),
             Err(e) => Err(e.to_string()),
         };
         let (status, monitors, metrics, error) = match outcome {

@@ -3,6 +3,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, ValueEnum};
+use paracosm_engine::sut::{ExternalConfig, SutConfig};
 use paracosm_generators::Strategy;
 
 /// Test-generation strategies as command-line values.
@@ -67,6 +68,39 @@ pub fn parse_args<T: Parser>(tool: &str) -> Result<T, ExitCode> {
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
 pub struct BadInput(pub String);
+
+/// The system under test chosen on the command line (`--sut NAME` or `--sut-cmd COMMAND`),
+/// or `None` to keep the scenario's.
+///
+/// # Errors
+/// A message for an unknown name, a command that does not split (an unclosed quote) or is
+/// empty, or a timeout that is not a positive number of seconds.
+pub fn sut_override(
+    name: Option<&str>,
+    command: Option<&str>,
+    timeout_s: f64,
+    reuse: bool,
+) -> Result<Option<SutConfig>, String> {
+    if !(timeout_s.is_finite() && timeout_s > 0.0) {
+        return Err(format!(
+            "--sut-timeout {timeout_s} must be a positive number of seconds"
+        ));
+    }
+    match (name, command) {
+        (Some(n), _) => SutConfig::builtin(n)
+            .map(Some)
+            .map_err(|e| format!("--sut: {e}")),
+        (None, Some(c)) => {
+            let words = shlex::split(c)
+                .filter(|w| !w.is_empty())
+                .ok_or_else(|| format!("--sut-cmd {c:?} is empty or has an unclosed quote"))?;
+            Ok(Some(SutConfig::External(ExternalConfig::new(
+                words, timeout_s, reuse,
+            ))))
+        }
+        (None, None) => Ok(None),
+    }
+}
 
 /// Parses a count that must be at least 1 (`--budget`, `-n`).
 ///

@@ -12,6 +12,7 @@ pub mod cli;
 pub mod cover;
 pub mod plot;
 pub mod record;
+pub mod replay;
 pub mod seed;
 pub mod summary;
 

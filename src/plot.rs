@@ -184,6 +184,191 @@ fn render<DB: DrawingBackend>(
     root.present().map_err(|e| fail(e.to_string()))
 }
 
+/// Width of one tile of a contact sheet, in pixels.
+const TILE_W: u32 = 240;
+
+/// Draws a contact sheet of camera frames: at most 36 of `frames` (`(time s, image)`,
+/// evenly spaced, always the last), 6 per row, each scaled to 240 pixels wide with its time
+/// under it, and `title` on top. Writes PNG to `path`.
+///
+/// # Errors
+/// The backend's message when the file cannot be written.
+pub fn contact_sheet(
+    path: &Path,
+    frames: &[(f64, image::RgbImage)],
+    title: &str,
+) -> Result<(), String> {
+    register_font();
+    const COLS: usize = 6;
+    const MAX: usize = 36;
+    let Some((_, first)) = frames.first() else {
+        return Ok(());
+    };
+    let step = frames.len().div_ceil(MAX).max(1);
+    let mut picked: Vec<usize> = (0..frames.len()).step_by(step).collect();
+    if picked.last() != Some(&(frames.len() - 1)) {
+        if picked.len() == MAX {
+            picked.pop();
+        }
+        picked.push(frames.len() - 1);
+    }
+    let tile_h = (f64::from(TILE_W) * f64::from(first.height()) / f64::from(first.width()))
+        .round()
+        .max(1.0) as u32;
+    let rows = picked.len().div_ceil(COLS) as u32;
+    let (label, top) = (20u32, 36u32);
+    let size = (COLS as u32 * TILE_W, top + rows * (tile_h + label));
+    let root = BitMapBackend::new(path, size).into_drawing_area();
+    let fail = |e: &dyn std::fmt::Display| format!("cannot draw `{}`: {e}", path.display());
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    root.draw(&Text::new(title, (8, 8), (FAMILY, 18).into_font()))
+        .map_err(|e| fail(&e))?;
+    for (k, &i) in picked.iter().enumerate() {
+        let (t, img) = &frames[i];
+        let tile =
+            image::imageops::resize(img, TILE_W, tile_h, image::imageops::FilterType::Triangle);
+        let x = (k % COLS) as i32 * TILE_W as i32;
+        let y = (top + (k / COLS) as u32 * (tile_h + label)) as i32;
+        let element = plotters::element::BitMapElement::with_owned_buffer(
+            (x, y),
+            (TILE_W, tile_h),
+            tile.into_raw(),
+        )
+        .ok_or_else(|| fail(&"tile buffer size"))?;
+        root.draw(&element).map_err(|e| fail(&e))?;
+        root.draw(&Text::new(
+            format!("t = {t:.2} s"),
+            (x + 6, y + tile_h as i32 + 3),
+            (FAMILY, 13).into_font(),
+        ))
+        .map_err(|e| fail(&e))?;
+    }
+    root.present().map_err(|e| fail(&e))
+}
+
+/// Failure rate per cell of a `bins × bins` grid over `axes`: `(failed, tests)` per cell,
+/// row-major from the lowest `y` bin, `x` fastest. Errors count as tests, not failures.
+pub fn failure_rates(
+    records: &[RunRecord],
+    space: &ParamSpace,
+    axes: &[String; 2],
+    bins: usize,
+) -> Result<Vec<(u32, u32)>, PlotError> {
+    let (x_lo, x_hi, _) = axis(space, &axes[0])?;
+    let (y_lo, y_hi, _) = axis(space, &axes[1])?;
+    let cell = |v: f64, lo: f64, hi: f64| {
+        (((v - lo) / (hi - lo) * bins as f64).floor() as usize).min(bins - 1)
+    };
+    let mut cells = vec![(0u32, 0u32); bins * bins];
+    for r in records {
+        let Some(p) = r.params.as_ref() else { continue };
+        let (Some(x), Some(y)) = (p.real(&axes[0]), p.real(&axes[1])) else {
+            continue;
+        };
+        let c = &mut cells[cell(y, y_lo, y_hi) * bins + cell(x, x_lo, x_hi)];
+        c.0 += u32::from(r.status == Status::Fail);
+        c.1 += 1;
+    }
+    Ok(cells)
+}
+
+/// The failure-rate heat map (paper Figure 10a): the share of failed tests in each cell of a
+/// `bins × bins` grid over `axes`, white (0 %) to red (100 %), with each cell's `failed/tests`
+/// written in it; empty cells are grey. Writes `stem.png` and `stem.svg` (760 × 600 pixels)
+/// and returns their paths.
+///
+/// # Errors
+/// As [`failure_map`].
+pub fn failure_rate_map(
+    stem: &Path,
+    space: &ParamSpace,
+    axes: &[String; 2],
+    title: &str,
+    records: &[RunRecord],
+    bins: usize,
+) -> Result<[PathBuf; 2], PlotError> {
+    register_font();
+    let bins = bins.max(1);
+    let cells = failure_rates(records, space, axes, bins)?;
+    let png = stem.with_extension("png");
+    let svg = stem.with_extension("svg");
+    let size = (760, 600);
+    let drawn = |path: &Path, r: Result<(), String>| {
+        r.map_err(|reason| PlotError::Draw {
+            path: path.to_path_buf(),
+            reason,
+        })
+    };
+    let root = BitMapBackend::new(&png, size).into_drawing_area();
+    drawn(&png, draw_rates(root, space, axes, title, &cells, bins))?;
+    let root = SVGBackend::new(&svg, size).into_drawing_area();
+    drawn(&svg, draw_rates(root, space, axes, title, &cells, bins))?;
+    Ok([png, svg])
+}
+
+fn draw_rates<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    space: &ParamSpace,
+    axes: &[String; 2],
+    title: &str,
+    cells: &[(u32, u32)],
+    bins: usize,
+) -> Result<(), String> {
+    let (x_lo, x_hi, x_label) = axis(space, &axes[0]).map_err(|e| e.to_string())?;
+    let (y_lo, y_hi, y_label) = axis(space, &axes[1]).map_err(|e| e.to_string())?;
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, (FAMILY, 20))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(55)
+        .build_cartesian_2d(x_lo..x_hi, y_lo..y_hi)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .label_style((FAMILY, 14))
+        .axis_desc_style((FAMILY, 16))
+        .disable_mesh()
+        .draw()
+        .map_err(|e| e.to_string())?;
+    let (dx, dy) = ((x_hi - x_lo) / bins as f64, (y_hi - y_lo) / bins as f64);
+    let rects = cells.iter().enumerate().map(|(i, &(failed, n))| {
+        let (cx, cy) = ((i % bins) as f64, (i / bins) as f64);
+        let color = if n == 0 {
+            RGBColor(220, 220, 220)
+        } else {
+            // White at 0 % to the failure red (214, 39, 40) at 100 %.
+            let rate = f64::from(failed) / f64::from(n);
+            let mix = |to: f64| (255.0 + rate * (to - 255.0)).round() as u8;
+            RGBColor(mix(214.0), mix(39.0), mix(40.0))
+        };
+        Rectangle::new(
+            [
+                (x_lo + cx * dx, y_lo + cy * dy),
+                (x_lo + (cx + 1.0) * dx, y_lo + (cy + 1.0) * dy),
+            ],
+            color.filled(),
+        )
+    });
+    chart.draw_series(rects).map_err(|e| e.to_string())?;
+    let labels = cells
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.1 > 0)
+        .map(|(i, &(failed, n))| {
+            let (cx, cy) = ((i % bins) as f64, (i / bins) as f64);
+            Text::new(
+                format!("{failed}/{n}"),
+                (x_lo + (cx + 0.3) * dx, y_lo + (cy + 0.6) * dy),
+                (FAMILY, 13).into_font().color(&BLACK),
+            )
+        });
+    chart.draw_series(labels).map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -234,6 +419,27 @@ mod tests {
         for text in ["speed [m/s]", "dist [m]", "pass (1)", "fail (2)"] {
             assert!(svg.contains(text), "missing {text}");
         }
+    }
+
+    #[test]
+    fn failure_rates_bin_the_tests_and_the_heat_map_draws() {
+        let s = space();
+        let records = vec![
+            record(0, &s, [0.1, 0.1], Status::Pass),
+            record(1, &s, [0.2, 0.2], Status::Fail),
+            record(2, &s, [0.9, 0.9], Status::Fail),
+            record(3, &s, [0.9, 0.1], Status::Error),
+        ];
+        let axes = ["speed".to_owned(), "dist".to_owned()];
+        let cells = failure_rates(&records, &s, &axes, 2).unwrap();
+        // Row 0 (low dist): x low has 1 fail of 2, x high has 1 error; row 1: 1 fail of 1.
+        assert_eq!(cells, vec![(1, 2), (0, 1), (0, 0), (1, 1)]);
+        let dir = tempfile::tempdir().unwrap();
+        let [png, svg] =
+            failure_rate_map(&dir.path().join("rate"), &s, &axes, "t", &records, 2).unwrap();
+        assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
+        let svg = std::fs::read_to_string(svg).unwrap();
+        assert!(svg.contains("1/2") && svg.contains("dist [m]"));
     }
 
     #[test]

@@ -2,7 +2,7 @@ use rapier3d::prelude::*;
 use serde::Serialize;
 
 /// Height of an NPC car's body above the road, in metres.
-const CLEARANCE_M: f64 = 0.2;
+pub(crate) const CLEARANCE_M: f64 = 0.2;
 
 /// An NPC car's observable state.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -1,3 +1,9 @@
+/// The light intensity of nominal daylight, at which a camera's fixed exposure is calibrated:
+/// a surface of albedo `a` facing the sun reads `255 · a · light / NOMINAL_LIGHT` (clipped at
+/// 255). Light is in `[0, 1]`: 0 is night, 1 twice nominal (glare: bright surfaces saturate).
+/// The lidar ignores light.
+pub const NOMINAL_LIGHT: f64 = 0.5;
+
 /// Extinction coefficient at fog density 1, in 1/m.
 pub const FOG_EXTINCTION_PER_M: f64 = 0.5;
 

@@ -10,4 +10,8 @@ pub enum EngineError {
     /// The stream graph failed while running (a lambda raised, a value of the wrong kind).
     #[error(transparent)]
     Stream(#[from] crate::rx::RxError),
+    /// A sensor cannot be set up or read (no GPU adapter for the camera, a camera setting out
+    /// of range, a lost device).
+    #[error("sensor: {0}")]
+    Sensor(String),
 }

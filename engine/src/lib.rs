@@ -1,9 +1,9 @@
 //! The simulation core of paracosm: the reactive stream runtime, road networks, a `rapier3d`
 //! world with a physical ego vehicle (rapier's ray-cast vehicle controller), kinematic
-//! pedestrians and NPC cars, a ray-cast lidar, and the systems under test that drive the ego
-//! vehicle.
+//! pedestrians and NPC cars, a ray-cast lidar, a `wgpu` camera (RGB and depth, feature
+//! `render`, on by default), and the systems under test that drive the ego vehicle.
 //!
-//! Frame of reference (right-handed, SI units): `x` runs along the road in the driving direction
+//! CameraFrame of reference (right-handed, SI units): `x` runs along the road in the driving direction
 //! of the positive lanes, `y` points up, `z` points to the right of a driver on a positive lane.
 //! Headings are in radians, counter-clockwise seen from above, `0` along `+x`.
 //!
@@ -13,6 +13,7 @@
 #![warn(missing_docs)]
 
 pub mod behaviour;
+mod camera;
 mod car;
 mod control;
 mod environment;
@@ -21,15 +22,18 @@ mod lidar;
 pub mod network;
 mod pedestrian;
 pub mod placement;
+#[cfg(feature = "render")]
+pub mod render;
 pub mod rx;
 mod sim;
 mod spec;
 pub mod sut;
 mod vehicle;
 
+pub use camera::{CameraFrame, CameraSpec, SENSOR_HEIGHT_MM, SENSOR_WIDTH_MM};
 pub use car::CarState;
 pub use control::Control;
-pub use environment::{visibility_m, FOG_EXTINCTION_PER_M};
+pub use environment::{visibility_m, FOG_EXTINCTION_PER_M, NOMINAL_LIGHT};
 pub use error::EngineError;
 pub use lidar::{LidarReturn, LidarSpec};
 pub use network::{Lane, Location, Network, PieceId, PieceKind};

@@ -11,7 +11,8 @@ use crate::rx::{Host, Inputs, Runtime, StreamId, Value};
 use crate::spec::EnvironmentSpec;
 use crate::vehicle::EgoVehicle;
 use crate::{
-    visibility_m, Control, EngineError, LidarReturn, LidarSpec, PedestrianState, WorldSpec,
+    visibility_m, CameraFrame, CameraSpec, Control, EngineError, LidarReturn, LidarSpec,
+    PedestrianState, WorldSpec,
 };
 
 /// The ego vehicle's state.
@@ -38,6 +39,9 @@ pub struct Observation<'a> {
     pub lidar: &'a [LidarReturn],
     /// The route to follow, world `[x, z]` in metres (navigation); empty: keep the lane.
     pub route: &'a [[f64; 2]],
+    /// The latest camera frame (RGB and depth), when a camera is attached
+    /// ([`Simulation::attach_camera`]) and has captured one.
+    pub camera: Option<&'a CameraFrame>,
 }
 
 /// The world's state after a step: what monitors are computed from.
@@ -85,6 +89,11 @@ pub struct Simulation {
     collector: ChannelEventCollector,
     dt_s: f64,
     tick: u64,
+    /// Size `[length, width, height]` (m) and colour name of each NPC car, for the camera.
+    car_looks: Vec<([f64; 3], String)>,
+    #[cfg(feature = "render")]
+    camera: Option<crate::render::CameraRig>,
+    frame: Option<CameraFrame>,
 }
 
 impl Simulation {
@@ -178,7 +187,12 @@ impl Simulation {
                 spec.cars.iter().map(|c| c.speed).collect(),
             ),
             environment: spec.environment,
-            light_fog: (1.0, 0.0),
+            // Known before the first step when they are constants (a camera frame at t = 0
+            // needs them); time-varying ones are set by the first step.
+            light_fog: (
+                constant(&spec.streams, spec.environment.light).unwrap_or(crate::NOMINAL_LIGHT),
+                constant(&spec.streams, spec.environment.fog).unwrap_or(0.0),
+            ),
             streams: Runtime::new(spec.streams.clone()),
             sinks: Vec::new(),
             directions: spec.lidar.directions(),
@@ -189,6 +203,14 @@ impl Simulation {
             collector: ChannelEventCollector::new(collision_tx, force_tx, tear_tx),
             dt_s: spec.dt_s,
             tick: 0,
+            car_looks: spec
+                .cars
+                .iter()
+                .map(|c| (c.size_m, c.color.clone()))
+                .collect(),
+            #[cfg(feature = "render")]
+            camera: None,
+            frame: None,
         };
         // Contacts and ray casts need the broad phase filled before the first step.
         sim.physics.detect_collisions(&(), &());
@@ -224,7 +246,108 @@ impl Simulation {
             ego: self.ego_state(),
             lidar: &self.scan,
             route: &self.route,
+            camera: self.frame.as_ref(),
         }
+    }
+
+    /// Mounts `camera` on the ego vehicle, rendering through the process's shared
+    /// [`crate::render::Renderer`]; `seed` drives the camera's pixel noise. Frames are taken
+    /// by [`Simulation::capture`].
+    ///
+    /// # Errors
+    /// [`EngineError::Sensor`] when the camera's values are out of range, no GPU adapter is
+    /// found, or this build lacks the `render` feature.
+    pub fn attach_camera(&mut self, camera: &CameraSpec, seed: u64) -> Result<(), EngineError> {
+        camera.validate().map_err(EngineError::Sensor)?;
+        #[cfg(feature = "render")]
+        {
+            let renderer = crate::render::Renderer::shared()
+                .map_err(|e| EngineError::Sensor(e.to_string()))?;
+            self.camera = Some(crate::render::CameraRig::new(
+                renderer,
+                &self.network,
+                camera,
+                seed,
+            )?);
+            Ok(())
+        }
+        #[cfg(not(feature = "render"))]
+        {
+            let _ = seed;
+            Err(EngineError::Sensor(
+                "this build has no camera: paracosm-engine was built without its `render` \
+                 feature"
+                    .into(),
+            ))
+        }
+    }
+
+    /// The attached camera, if any.
+    pub fn camera(&self) -> Option<&CameraSpec> {
+        #[cfg(feature = "render")]
+        {
+            self.camera.as_ref().map(|c| c.camera())
+        }
+        #[cfg(not(feature = "render"))]
+        {
+            None
+        }
+    }
+
+    /// Renders the attached camera now; the frame is kept for [`Simulation::observation`]
+    /// until the next capture.
+    ///
+    /// # Errors
+    /// [`EngineError::Sensor`] without an attached camera, or when the GPU fails.
+    pub fn capture(&mut self) -> Result<&CameraFrame, EngineError> {
+        #[cfg(feature = "render")]
+        {
+            let objects = self.render_objects();
+            let ego = self.ego_state();
+            let pose = crate::render::CameraPose {
+                chassis_m: ego.pos_m,
+                heading_rad: ego.heading_rad,
+            };
+            let t_s = self.t_s();
+            let light_fog = self.light_fog;
+            let rig = self
+                .camera
+                .as_mut()
+                .ok_or_else(|| EngineError::Sensor("no camera is attached".into()))?;
+            let frame = rig.capture(pose, &objects, light_fog, t_s)?;
+            Ok(self.frame.insert(frame))
+        }
+        #[cfg(not(feature = "render"))]
+        {
+            Err(EngineError::Sensor("no camera is attached".into()))
+        }
+    }
+
+    /// The boxes the camera draws: every enabled NPC car (its colour, from the ground to its
+    /// roof) and every pedestrian (0.5 × 1.8 × 0.5 m, red).
+    #[cfg(feature = "render")]
+    pub fn render_objects(&self) -> Vec<crate::render::RenderObject> {
+        let mut out = Vec::with_capacity(self.cars.len() + self.pedestrians.len());
+        for (car, (size, color)) in self.cars.iter().zip(&self.car_looks) {
+            let s = car.state();
+            if s.enabled {
+                out.push(crate::render::RenderObject {
+                    base_m: s.pos_m,
+                    size_m: [size[0], size[2] + crate::car::CLEARANCE_M, size[1]],
+                    heading_rad: s.heading_rad,
+                    albedo: crate::render::color_albedo(color),
+                });
+            }
+        }
+        for p in &self.pedestrians {
+            out.push(crate::render::RenderObject {
+                base_m: p.state().pos_m,
+                size_m: [0.5, 1.8, 0.5],
+                heading_rad: 0.0,
+                albedo: [0.75, 0.22, 0.18],
+            });
+        }
+        out
     }
 
     /// Advances the world by one step of `dt` under `control`: vehicle model, the stream graph
@@ -349,6 +472,15 @@ impl Simulation {
             range_m,
             &mut self.scan,
         );
+    }
+}
+
+/// The value of stream `id` at t = 0 when it is a constant or a bound open stream.
+fn constant(graph: &crate::rx::Graph, id: StreamId) -> Option<f64> {
+    match graph.nodes().get(id.0)? {
+        crate::rx::Node::Const(v) => v.as_num(),
+        crate::rx::Node::Open(open) => open.at(0.0).as_num(),
+        _ => None,
     }
 }
 

@@ -18,7 +18,7 @@ mod scenario;
 use std::path::Path;
 
 pub use error::ScenarioError;
-pub use runner::{signal, TestOutcome};
+pub use runner::{signal, RunOptions, TestOutcome};
 pub use scenario::{Lambdas, MonitorSpec, Scenario, Template};
 
 use paracosm_generators::Assignment;

@@ -1,7 +1,7 @@
 use std::ops::ControlFlow;
 
 use paracosm_engine::rx::{Host, NoHost};
-use paracosm_engine::{Simulation, Snapshot, WorldSpec};
+use paracosm_engine::{CameraFrame, CameraSpec, Control, Simulation, Snapshot, WorldSpec};
 use paracosm_generators::Assignment;
 use paracosm_oracles::{Frame, Monitor, Signals, Verdict};
 
@@ -75,6 +75,22 @@ fn observe(snap: &Snapshot, signals: &mut Signals, monitors: &mut [Box<dyn Monit
     stop
 }
 
+/// Extras for one run: a camera to watch it with, and a callback for every camera frame
+/// (what `paracosm-fuzz replay --frames` uses).
+#[derive(Default)]
+pub struct RunOptions<'a> {
+    /// A camera to mount when the system under test has none (frames for looking at; the
+    /// system does not see them). Ignored when the system has its own camera.
+    pub camera: Option<CameraSpec>,
+    /// Called with every frame the camera takes.
+    pub on_frame: Option<&'a mut dyn FnMut(&CameraFrame)>,
+}
+
+/// Every how many physics steps something at `hz` happens (at least every step).
+fn period_ticks(hz: Option<f64>, dt_s: f64) -> u64 {
+    hz.map_or(1, |hz| ((1.0 / (hz * dt_s)).round() as u64).max(1))
+}
+
 impl Scenario {
     /// Runs one test: instantiates the world for `assignment`, resets the system under test with
     /// `seed`, and steps until the horizon or until a monitor settles its verdict.
@@ -84,12 +100,27 @@ impl Scenario {
     /// # Errors
     /// [`ScenarioError`] when the world cannot be built or the system under test fails.
     pub fn run(&self, assignment: &Assignment, seed: u64) -> Result<TestOutcome, ScenarioError> {
+        self.run_with(assignment, seed, &mut RunOptions::default())
+    }
+
+    /// As [`Scenario::run`], with a viewing camera and a frame callback.
+    ///
+    /// # Errors
+    /// As [`Scenario::run`].
+    pub fn run_with(
+        &self,
+        assignment: &Assignment,
+        seed: u64,
+        options: &mut RunOptions<'_>,
+    ) -> Result<TestOutcome, ScenarioError> {
         let spec = self.instantiate(assignment)?;
         match &self.lambdas {
-            None => self.run_world(&spec, seed, &mut NoHost),
+            None => self.run_world(&spec, seed, &mut NoHost, options),
             Some(lambdas) => {
                 let mut out = None;
-                lambdas.with_host(&mut |host| out = Some(self.run_world(&spec, seed, host)));
+                lambdas.with_host(&mut |host| {
+                    out = Some(self.run_world(&spec, seed, host, options));
+                });
                 out.expect("with_host calls its closure")
             }
         }
@@ -100,17 +131,45 @@ impl Scenario {
         spec: &WorldSpec,
         seed: u64,
         host: &mut dyn Host,
+        options: &mut RunOptions<'_>,
     ) -> Result<TestOutcome, ScenarioError> {
         let mut sim = Simulation::new(spec)?;
         let mut sut = self.sut.build();
         sut.reset(seed)?;
+        let sensors = sut.sensors();
+        // The system's own camera, or else the viewing camera, whose frames it never sees.
+        let (camera, sut_sees) = match (sensors.camera, options.camera.clone()) {
+            (Some(c), _) => (Some(c), true),
+            (None, viewer) => (viewer, false),
+        };
+        let frame_every = match &camera {
+            Some(c) => {
+                sim.attach_camera(c, seed)?;
+                period_ticks(Some(c.rate_hz), spec.dt_s)
+            }
+            None => 0,
+        };
+        let control_every = period_ticks(sensors.control_hz, spec.dt_s);
         let mut monitors: Vec<Box<dyn Monitor>> = self.monitors.iter().map(|m| m.build()).collect();
         let mut signals = Signals::new();
         let ticks = (self.horizon_s / spec.dt_s).round() as u64;
         let mut stopped = observe(&sim.snapshot(), &mut signals, &mut monitors);
         let mut tick = 0;
+        let mut control = Control::default();
         while !stopped && tick < ticks {
-            let control = sut.act(&sim.observation())?;
+            if frame_every > 0 && tick % frame_every == 0 {
+                let frame = sim.capture()?;
+                if let Some(f) = options.on_frame.as_mut() {
+                    f(frame);
+                }
+            }
+            if tick % control_every == 0 {
+                let mut obs = sim.observation();
+                if !sut_sees {
+                    obs.camera = None;
+                }
+                control = sut.act(&obs)?;
+            }
             sim.step(control, host)?;
             tick += 1;
             stopped = observe(&sim.snapshot(), &mut signals, &mut monitors);

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use clap::Parser;
+use clap::{Parser, Subcommand};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use paracosm::cli::{BadInput, StrategyArg};
@@ -20,8 +20,15 @@ use paracosm::summary::Summary;
 /// Run a test campaign on a scenario: sample its open parameters, simulate each test, and
 /// write results.jsonl, summary.json and a failure map.
 #[derive(Debug, Parser)]
-#[command(name = "paracosm-fuzz", version)]
+#[command(
+    name = "paracosm-fuzz",
+    version,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 struct Cli {
+    #[command(subcommand)]
+    command: Option<Sub>,
     /// Scenario to test: a path to a `.star` program, or a built-in name (see --list):
     /// pedestrian-crossing, follow-lead-car, fog-light, t-loop, grid-world.
     #[arg(required_unless_present = "list")]
@@ -54,6 +61,51 @@ struct Cli {
     /// Replace the results of an earlier campaign in --out.
     #[arg(long)]
     force: bool,
+    /// Built-in system under test, instead of the scenario's default: aeb (lidar) or vision
+    /// (camera).
+    #[arg(long, value_name = "NAME", conflicts_with = "sut_cmd")]
+    sut: Option<String>,
+    /// Run the system under test as a program speaking SUT_PROTOCOL.md over stdin/stdout,
+    /// e.g. "python3 my_controller.py" (split like a shell would, without expansion).
+    #[arg(long, value_name = "COMMAND")]
+    sut_cmd: Option<String>,
+    /// With --sut-cmd: longest wait for any answer of the program, in seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+    sut_timeout: f64,
+    /// With --sut-cmd: start a fresh process for every test, instead of keeping one alive
+    /// per worker and sending it a reset message.
+    #[arg(long)]
+    sut_fresh: bool,
+}
+
+#[derive(Debug, Subcommand)]
+enum Sub {
+    /// Re-run one recorded test from its parameters and seed (campaign.json beside the
+    /// results), write its camera frames as PNG and a contact sheet, and check that the
+    /// verdict equals the recorded one. Exit 0 when it does, 3 when it does not.
+    Replay(ReplayArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct ReplayArgs {
+    /// A campaign's results.jsonl.
+    results: PathBuf,
+    /// Id of the test to re-run.
+    #[arg(long)]
+    id: u64,
+    /// Folder for frame_NNNNN.png and contact_sheet.png (a 320 x 240 camera at 20 Hz is
+    /// mounted when the system under test has none).
+    #[arg(long, value_name = "DIR")]
+    frames: Option<PathBuf>,
+    /// Replay with this built-in system under test instead of the recorded one.
+    #[arg(long, value_name = "NAME", conflicts_with = "sut_cmd")]
+    sut: Option<String>,
+    /// Replay with this external system under test instead of the recorded one.
+    #[arg(long, value_name = "COMMAND")]
+    sut_cmd: Option<String>,
+    /// With --sut-cmd: longest wait for an answer, in seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+    sut_timeout: f64,
 }
 
 fn main() -> ExitCode {
@@ -68,7 +120,11 @@ fn main() -> ExitCode {
         )
         .with_writer(std::io::stderr)
         .init();
-    match run(&cli) {
+    let result = match &cli.command {
+        Some(Sub::Replay(args)) => replay(args),
+        None => run(&cli),
+    };
+    match result {
         Ok(code) => code,
         Err(e) => {
             let code = if e.downcast_ref::<BadInput>().is_some() {
@@ -97,7 +153,17 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let name = cli.scenario.as_deref().unwrap_or_default();
-    let scenario = paracosm_scenarios::load(name).map_err(|e| BadInput(e.to_string()))?;
+    let mut scenario = paracosm_scenarios::load(name).map_err(|e| BadInput(e.to_string()))?;
+    if let Some(sut) = paracosm::cli::sut_override(
+        cli.sut.as_deref(),
+        cli.sut_cmd.as_deref(),
+        cli.sut_timeout,
+        !cli.sut_fresh,
+    )
+    .map_err(BadInput)?
+    {
+        scenario.sut = sut;
+    }
     let strategy = paracosm::cli::strategy(cli.strategy, cli.scramble).map_err(BadInput)?;
     if let Some(cap) = strategy.capacity().filter(|&cap| cli.budget > cap) {
         return Err(BadInput(format!(
@@ -111,6 +177,37 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         |j| j as usize,
     );
     prepare_out_dir(cli)?;
+    let campaign_file = paracosm::replay::CampaignFile {
+        tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
+        scenario: match std::fs::canonicalize(name) {
+            Ok(path) if std::path::Path::new(name).is_file() => path.display().to_string(),
+            _ => name.to_owned(),
+        },
+        sut: match (&cli.sut, &cli.sut_cmd) {
+            (Some(n), _) => paracosm::replay::SutChoice::Builtin { name: n.clone() },
+            (None, Some(_)) => match &scenario.sut {
+                paracosm_engine::sut::SutConfig::External(e) => {
+                    paracosm::replay::SutChoice::Command {
+                        command: e.command.clone(),
+                        timeout_s: e.timeout_s,
+                        reuse: e.reuse,
+                    }
+                }
+                _ => paracosm::replay::SutChoice::Scenario,
+            },
+            (None, None) => paracosm::replay::SutChoice::Scenario,
+        },
+        strategy: strategy.name().to_owned(),
+        seed: cli.seed,
+        budget: cli.budget,
+        strength: cli.strength,
+    };
+    let campaign_path = cli.out.join(paracosm::replay::CAMPAIGN_FILE);
+    std::fs::write(
+        &campaign_path,
+        serde_json::to_string_pretty(&campaign_file)? + "\n",
+    )
+    .map_err(|e| BadInput(format!("cannot write `{}`: {e}", campaign_path.display())))?;
 
     let campaign = Campaign {
         scenario: &scenario,
@@ -159,6 +256,16 @@ fn run(cli: &Cli) -> Result<ExitCode> {
     )
     .map_err(|e| BadInput(e.to_string()))?;
 
+    let rates = paracosm::plot::failure_rate_map(
+        &cli.out.join("failure_rate"),
+        &scenario.space,
+        &scenario.map_axes,
+        &format!("{}: failure rate ({} tests)", scenario.name, cli.budget),
+        &report.records,
+        8,
+    )
+    .map_err(|e| BadInput(e.to_string()))?;
+    let plots: Vec<std::path::PathBuf> = plots.into_iter().chain(rates).collect();
     let mut outputs = vec![RESULTS_FILE.to_owned(), "summary.json".to_owned()];
     outputs.extend(
         plots
@@ -252,6 +359,63 @@ fn run(cli: &Cli) -> Result<ExitCode> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+fn replay(args: &ReplayArgs) -> Result<ExitCode> {
+    let sut = paracosm::cli::sut_override(
+        args.sut.as_deref(),
+        args.sut_cmd.as_deref(),
+        args.sut_timeout,
+        false,
+    )
+    .map_err(BadInput)?;
+    let r = paracosm::replay::replay(&args.results, args.id, args.frames.as_deref(), sut)
+        .map_err(|e| BadInput(e.to_string()))?;
+    let recorded = r.recorded["status"].as_str().unwrap_or("?");
+    let replayed = paracosm::replay::status_name(r.replayed.status);
+    let verdicts: Vec<String> = r
+        .replayed
+        .monitors
+        .iter()
+        .map(|(n, m)| {
+            format!(
+                "{n} {} (robustness {:.3})",
+                if m.passed { "passed" } else { "failed" },
+                m.robustness
+            )
+        })
+        .collect();
+    println!(
+        "test {}: recorded {recorded}, replayed {replayed}: {}{}",
+        args.id,
+        verdicts.join(", "),
+        r.replayed
+            .error
+            .as_deref()
+            .map(|e| format!(" ({e})"))
+            .unwrap_or_default()
+    );
+    if let Some(sheet) = &r.contact_sheet {
+        println!(
+            "wrote {} frames to {} and {}",
+            r.frames.len(),
+            args.frames
+                .as_deref()
+                .unwrap_or(std::path::Path::new("."))
+                .display(),
+            sheet.display()
+        );
+    }
+    if r.matches {
+        println!("the replayed verdict equals the recorded one");
+        Ok(ExitCode::SUCCESS)
+    } else {
+        println!(
+            "the replayed verdict DIFFERS from the recorded one: recorded monitors {}",
+            r.recorded["monitors"]
+        );
+        Ok(ExitCode::from(3))
+    }
 }
 
 /// Creates `--out` and refuses to overwrite an earlier campaign's results without `--force`.

@@ -14,7 +14,9 @@ mod piece;
 
 pub use geometry::{direction, wrap, Pose2};
 pub use lanes::{LanePath, Turn};
-pub use piece::{Piece, PieceKind, PortGeometry, LANE_WIDTH_M, PORT_NAMES, SIDEWALK_WIDTH_M};
+pub use piece::{
+    Piece, PieceKind, PortGeometry, JUNCTION_APRON_M, LANE_WIDTH_M, PORT_NAMES, SIDEWALK_WIDTH_M,
+};
 
 use rapier3d::parry::query::intersection_test;
 use rapier3d::parry::shape::Cuboid;

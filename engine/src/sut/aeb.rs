@@ -247,6 +247,7 @@ mod tests {
             ego,
             lidar: &lidar,
             route: &[],
+            camera: None,
         })
         .unwrap()
     }

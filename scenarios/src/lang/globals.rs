@@ -9,6 +9,7 @@ use paracosm_engine::behaviour::{Actor, Output};
 use paracosm_engine::network::PieceKind;
 use paracosm_engine::rx::{Node, StreamId, Value as Rx};
 use paracosm_engine::sut::{AebConfig, SutConfig};
+use paracosm_engine::NOMINAL_LIGHT;
 use paracosm_generators::{Domain, Value as Level};
 use starlark::environment::GlobalsBuilder;
 use starlark::eval::Evaluator;
@@ -394,7 +395,8 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         })
     }
 
-    /// `World(light=1.0, fog=0.0)`: global conditions as streams.
+    /// `World(light=0.5, fog=0.0)`: global conditions as streams (light 0.5 is the nominal
+    /// daylight a camera's exposure is calibrated for).
     fn World<'v>(
         #[starlark(require = named)] light: Option<Value<'v>>,
         #[starlark(require = named)] fog: Option<Value<'v>>,
@@ -406,7 +408,11 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             bail!("a program has one World");
         }
         let heap = eval.heap();
-        let light = stream_arg(light.unwrap_or_else(|| heap.alloc(1.0)), &mut b, "light")?;
+        let light = stream_arg(
+            light.unwrap_or_else(|| heap.alloc(NOMINAL_LIGHT)),
+            &mut b,
+            "light",
+        )?;
         let fog = stream_arg(fog.unwrap_or_else(|| heap.alloc(0.0)), &mut b, "fog")?;
         b.world = Some((light, fog));
         Ok(WorldVal {
@@ -499,7 +505,8 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         )
     }
 
-    /// `AutonomousVehicle(loc=, sut="aeb", route=None, speed=None)`: the ego vehicle.
+    /// `AutonomousVehicle(loc=, sut="aeb", route=None, speed=None)`: the ego vehicle and its
+    /// default system under test (`aeb` or `vision`; `--sut`/`--sut-cmd` override it).
     fn AutonomousVehicle<'v>(
         #[starlark(require = named)] loc: Value<'v>,
         #[starlark(require = named)] sut: Option<&str>,
@@ -508,10 +515,7 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<ActorVal> {
         let loc = location(loc, "loc")?;
-        let sut = match sut.unwrap_or("aeb") {
-            "aeb" => SutConfig::Aeb(AebConfig::default()),
-            other => bail!("unknown system under test `{other}` (built in: aeb)"),
-        };
+        let sut = SutConfig::builtin(sut.unwrap_or("aeb")).map_err(anyhow::Error::msg)?;
         let initial_speed_mps = match speed {
             Some(v) => number(v, "speed")?,
             None => AebConfig::default().target_speed_mps,

@@ -1,0 +1,263 @@
+//! The pinhole camera model and the frames it produces.
+
+use serde::{Deserialize, Serialize};
+
+/// Width of the camera's sensor in millimetres (a full-frame 36 × 24 mm sensor).
+pub const SENSOR_WIDTH_MM: f64 = 36.0;
+/// Height of the camera's sensor in millimetres.
+pub const SENSOR_HEIGHT_MM: f64 = 24.0;
+
+/// A camera mounted on the ego vehicle (paper §2, "Sensors"; §4.2 varies the focal length
+/// 10–50 mm).
+///
+/// Intrinsics: square pixels, principal point at the image centre, and the sensor's 36 mm
+/// width spread over the image width, so `fx = fy = focal_mm · width / 36` pixels (horizontal
+/// sensor fit, as Blender's "sensor fit: horizontal"; at 4:3 the image shows 27 of the
+/// sensor's 24 mm of height). The horizontal field of view is `2 · atan(18 / focal_mm)`:
+/// 73.7° at 24 mm, 121.9° at 10 mm, 39.6° at 50 mm.
+///
+/// Mount: `mount_m` is `[forward, up, right]` from the ego chassis centre in metres; the camera
+/// looks along the vehicle's heading, tilted down by `pitch_rad`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CameraSpec {
+    /// Image width in pixels, `1..=4096`. Default 320.
+    pub width: u32,
+    /// Image height in pixels, `1..=4096`. Default 240.
+    pub height: u32,
+    /// Focal length in millimetres, `(0, 1000]`. Default 24 mm.
+    pub focal_mm: f64,
+    /// Mount point `[forward, up, right]` from the chassis centre, metres. Default
+    /// `[0.5, 0.9, 0]` (behind the windscreen, 1.4 m above the road).
+    pub mount_m: [f64; 3],
+    /// Downward tilt in rad, `[-π/2, π/2]`. Default 0.05 rad (2.9°).
+    pub pitch_rad: f64,
+    /// Frames per second of simulated time, `> 0`. Default 20 Hz.
+    pub rate_hz: f64,
+    /// Standard deviation of additive Gaussian pixel noise, in 8-bit levels (`0` off). Default 0.
+    pub noise_sigma: f64,
+    /// Standard deviation of a Gaussian blur, in pixels (`0` off). Default 0.
+    pub blur_sigma_px: f64,
+    /// Far clipping distance in metres: farther surfaces show sky and depth `+inf`. Default 500 m.
+    pub far_m: f64,
+}
+
+impl Default for CameraSpec {
+    fn default() -> Self {
+        CameraSpec {
+            width: 320,
+            height: 240,
+            focal_mm: 24.0,
+            mount_m: [0.5, 0.9, 0.0],
+            pitch_rad: 0.05,
+            rate_hz: 20.0,
+            noise_sigma: 0.0,
+            blur_sigma_px: 0.0,
+            far_m: 500.0,
+        }
+    }
+}
+
+impl CameraSpec {
+    /// Checks the documented ranges.
+    ///
+    /// # Errors
+    /// A message naming the first value out of range.
+    pub fn validate(&self) -> Result<(), String> {
+        let range = |name: &str, v: f64, ok: bool| {
+            if ok && v.is_finite() {
+                Ok(())
+            } else {
+                Err(format!("camera {name} {v} is out of range"))
+            }
+        };
+        if !(1..=4096).contains(&self.width) || !(1..=4096).contains(&self.height) {
+            return Err(format!(
+                "camera resolution {}x{} is outside 1..=4096",
+                self.width, self.height
+            ));
+        }
+        range(
+            "focal_mm",
+            self.focal_mm,
+            self.focal_mm > 0.0 && self.focal_mm <= 1000.0,
+        )?;
+        range(
+            "pitch_rad",
+            self.pitch_rad,
+            self.pitch_rad.abs() <= std::f64::consts::FRAC_PI_2,
+        )?;
+        range("rate_hz", self.rate_hz, self.rate_hz > 0.0)?;
+        range("noise_sigma", self.noise_sigma, self.noise_sigma >= 0.0)?;
+        range(
+            "blur_sigma_px",
+            self.blur_sigma_px,
+            self.blur_sigma_px >= 0.0,
+        )?;
+        range("far_m", self.far_m, self.far_m > 1.0)?;
+        for v in self.mount_m {
+            range("mount_m", v, true)?;
+        }
+        Ok(())
+    }
+
+    /// Focal length in pixels, `fx = fy = focal_mm · width / 36`.
+    pub fn focal_px(&self) -> f64 {
+        self.focal_mm * f64::from(self.width) / SENSOR_WIDTH_MM
+    }
+
+    /// Horizontal field of view in rad.
+    pub fn hfov_rad(&self) -> f64 {
+        2.0 * (SENSOR_WIDTH_MM / 2.0 / self.focal_mm).atan()
+    }
+
+    /// Vertical field of view in rad.
+    pub fn vfov_rad(&self) -> f64 {
+        2.0 * (f64::from(self.height) / 2.0 / self.focal_px()).atan()
+    }
+
+    /// The point seen at pixel `(u, v)` (column, row; pixel centres at `+0.5`) with z-depth
+    /// `depth_m`, in the camera frame `[right, up, forward]` metres (the inverse of the
+    /// projection the renderer uses).
+    pub fn back_project(&self, u: f64, v: f64, depth_m: f64) -> [f64; 3] {
+        let f = self.focal_px();
+        let cx = f64::from(self.width) / 2.0;
+        let cy = f64::from(self.height) / 2.0;
+        [(u - cx) / f * depth_m, (cy - v) / f * depth_m, depth_m]
+    }
+
+    /// A camera-frame point `[right, up, forward]` in the vehicle frame `[forward, up,
+    /// right]` relative to the chassis centre, metres: undoes the pitch and adds the mount.
+    pub fn camera_to_vehicle(&self, p: [f64; 3]) -> [f64; 3] {
+        let (s, c) = self.pitch_rad.sin_cos();
+        // The optical axis is (cos, -sin) in (forward, up); the camera's up is (sin, cos).
+        let forward = c * p[2] + s * p[1];
+        let up = -s * p[2] + c * p[1];
+        [
+            self.mount_m[0] + forward,
+            self.mount_m[1] + up,
+            self.mount_m[2] + p[0],
+        ]
+    }
+}
+
+/// One camera frame: an RGB image and the matching depth map.
+///
+/// Conventions: images are row-major, origin at the top-left pixel, rows top to bottom;
+/// pixel `(u, v)` (column, row) is at index `v · width + u`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CameraFrame {
+    /// Simulated time of the frame, seconds.
+    pub t_s: f64,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// RGB8, `height × width × 3` bytes, row-major, top-left origin, sRGB-like 8-bit levels.
+    pub rgb: Vec<u8>,
+    /// Depth in metres along the optical axis (z-depth, not range), `height × width`,
+    /// row-major; `+inf` where the ray meets only sky (nothing within `far_m`).
+    pub depth_m: Vec<f32>,
+}
+
+impl CameraFrame {
+    /// The `[r, g, b]` of pixel `(u, v)`.
+    ///
+    /// # Panics
+    /// If `(u, v)` is outside the image.
+    pub fn rgb_at(&self, u: u32, v: u32) -> [u8; 3] {
+        let i = 3 * (v * self.width + u) as usize;
+        [self.rgb[i], self.rgb[i + 1], self.rgb[i + 2]]
+    }
+
+    /// The depth of pixel `(u, v)` in metres.
+    ///
+    /// # Panics
+    /// If `(u, v)` is outside the image.
+    pub fn depth_at(&self, u: u32, v: u32) -> f32 {
+        self.depth_m[(v * self.width + u) as usize]
+    }
+
+    /// The image as an `image` crate buffer (for PNG output and image processing).
+    pub fn to_image(&self) -> image::RgbImage {
+        image::RgbImage::from_raw(self.width, self.height, self.rgb.clone())
+            .expect("rgb holds width × height × 3 bytes")
+    }
+
+    /// The depth map as an 8-bit grey image: `255` at 0 m falling linearly to `0` at
+    /// `max_m` and beyond (sky black), for looking at.
+    pub fn depth_image(&self, max_m: f32) -> image::GrayImage {
+        let px = self
+            .depth_m
+            .iter()
+            .map(|&d| {
+                if d.is_finite() {
+                    (255.0 * (1.0 - (d / max_m).clamp(0.0, 1.0))).round() as u8
+                } else {
+                    0
+                }
+            })
+            .collect();
+        image::GrayImage::from_raw(self.width, self.height, px)
+            .expect("depth holds width × height values")
+    }
+
+    /// Writes the RGB image as PNG.
+    ///
+    /// # Errors
+    /// The encoder's or the file system's message.
+    pub fn save_png(&self, path: &std::path::Path) -> Result<(), String> {
+        self.to_image()
+            .save_with_format(path, image::ImageFormat::Png)
+            .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn intrinsics_follow_the_36_mm_sensor() {
+        let c = CameraSpec::default();
+        assert!((c.focal_px() - 24.0 * 320.0 / 36.0).abs() < 1e-12);
+        assert!((c.hfov_rad().to_degrees() - 73.74).abs() < 0.01);
+        let wide = CameraSpec {
+            focal_mm: 10.0,
+            ..c.clone()
+        };
+        assert!(wide.hfov_rad() > c.hfov_rad());
+        // The centre pixel looks straight ahead.
+        let p = c.back_project(160.0, 120.0, 10.0);
+        assert_eq!(p, [0.0, 0.0, 10.0]);
+        assert!(c.validate().is_ok());
+        assert!(CameraSpec {
+            width: 0,
+            ..c.clone()
+        }
+        .validate()
+        .is_err());
+        assert!(CameraSpec {
+            focal_mm: f64::NAN,
+            ..c
+        }
+        .validate()
+        .is_err());
+    }
+
+    #[test]
+    fn back_projection_with_pitch_lands_on_the_ground() {
+        // A camera 1.4 m above the road, pitched down: the centre ray meets the road at
+        // 1.4 / tan(pitch) ahead.
+        let c = CameraSpec {
+            mount_m: [0.0, 1.4, 0.0],
+            pitch_rad: 0.1,
+            ..CameraSpec::default()
+        };
+        let ground = 1.4 / 0.1f64.tan();
+        let depth = ground * 0.1f64.cos() + 1.4 * 0.1f64.sin();
+        let p = c.camera_to_vehicle(c.back_project(160.0, 120.0, depth));
+        assert!(p[1].abs() < 1e-9, "{p:?}");
+        assert!((p[0] - ground).abs() < 1e-9, "{p:?}");
+    }
+}

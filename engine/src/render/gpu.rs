@@ -1,0 +1,628 @@
+//! The wgpu device, the pipeline, and render-and-readback of batches of camera views.
+
+use std::sync::{Arc, Mutex, OnceLock};
+
+use wgpu::util::DeviceExt;
+
+use super::mesh::{albedo, Mesh, Vertex};
+use super::post;
+use super::RenderError;
+use crate::camera::{CameraFrame, CameraSpec};
+use crate::network::Network;
+
+use crate::NOMINAL_LIGHT;
+
+/// Direction toward the sun (world, unit after normalising): high, ahead-left of a car driving
+/// along `+x`, so faces turned toward an approaching ego vehicle are lit.
+const SUN: [f32; 3] = [-0.45, 1.0, -0.3];
+
+const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+const DEPTH_OUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+const ZBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Near clipping plane, in metres.
+const NEAR_M: f32 = 0.05;
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Globals {
+    view_proj: [[f32; 4]; 4],
+    eye: [f32; 4],
+    forward: [f32; 4],
+    sun: [f32; 4],
+    sky: [f32; 4],
+    params: [f32; 4],
+}
+
+/// A box in the world for the camera: a car or a pedestrian.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderObject {
+    /// Centre of the box's base (the ground point under it) `[x, y, z]`, metres.
+    pub base_m: [f64; 3],
+    /// Length (along the heading), height and width, metres.
+    pub size_m: [f64; 3],
+    /// Heading in rad (counter-clockwise seen from above, `0` along `+x`).
+    pub heading_rad: f64,
+    /// Albedo, linear RGB in `[0, 1]`.
+    pub albedo: [f32; 3],
+}
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Instance {
+    model: [[f32; 4]; 4],
+    tint: [f32; 4],
+}
+
+impl Instance {
+    fn identity() -> Self {
+        Instance {
+            model: glam::Mat4::IDENTITY.to_cols_array_2d(),
+            tint: [1.0; 4],
+        }
+    }
+
+    fn of(o: &RenderObject) -> Self {
+        let [l, h, w] = o.size_m.map(|v| v as f32);
+        let model = glam::Mat4::from_scale_rotation_translation(
+            glam::Vec3::new(l, h, w),
+            glam::Quat::from_rotation_y(o.heading_rad as f32),
+            glam::Vec3::new(
+                o.base_m[0] as f32,
+                o.base_m[1] as f32 + h / 2.0,
+                o.base_m[2] as f32,
+            ),
+        );
+        Instance {
+            model: model.to_cols_array_2d(),
+            tint: [o.albedo[0], o.albedo[1], o.albedo[2], 1.0],
+        }
+    }
+}
+
+/// Where the camera's vehicle is: chassis centre `[x, y, z]` in metres and heading in rad.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraPose {
+    /// Chassis centre, world metres.
+    pub chassis_m: [f64; 3],
+    /// Vehicle heading, rad.
+    pub heading_rad: f64,
+}
+
+/// The static geometry of one road network, uploaded to the GPU once per world.
+pub struct SceneGeometry {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+}
+
+/// One camera's render targets and readback buffer. Each view renders one frame at a time;
+/// many views render together through [`Renderer::render`].
+pub struct View {
+    camera: CameraSpec,
+    color: wgpu::TextureView,
+    color_texture: wgpu::Texture,
+    depth_out: wgpu::TextureView,
+    depth_texture: wgpu::Texture,
+    zbuffer: wgpu::TextureView,
+    readback: wgpu::Buffer,
+    padded_row: u32,
+    globals: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    instances: wgpu::Buffer,
+    instance_capacity: usize,
+}
+
+impl View {
+    /// The camera this view renders.
+    pub fn camera(&self) -> &CameraSpec {
+        &self.camera
+    }
+}
+
+/// One frame to render: a view of a scene from a pose, with the actors, the light and the fog.
+pub struct RenderJob<'a> {
+    /// The static world.
+    pub scene: &'a SceneGeometry,
+    /// The camera's targets.
+    pub view: &'a mut View,
+    /// The vehicle carrying the camera.
+    pub pose: CameraPose,
+    /// Cars and pedestrians.
+    pub objects: &'a [RenderObject],
+    /// Light intensity, `[0, 1]` (see [`NOMINAL_LIGHT`]).
+    pub light: f64,
+    /// Fog density, `[0, 1]`: extinction `fog · FOG_EXTINCTION_PER_M` per metre, as the lidar
+    /// ([`crate::visibility_m`]).
+    pub fog: f64,
+    /// Simulated time, seconds (stamped on the frame).
+    pub t_s: f64,
+    /// Seeds the frame's pixel noise (ChaCha8), so noisy frames are reproducible.
+    pub noise_seed: u64,
+}
+
+/// The offscreen renderer: one wgpu device and pipeline shared by every camera of the
+/// process (creating a device costs 55–140 ms; a frame well under 2 ms).
+pub struct Renderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    cube: SceneGeometry,
+    identity: wgpu::Buffer,
+    adapter: String,
+}
+
+static SHARED: OnceLock<Result<Arc<Renderer>, RenderError>> = OnceLock::new();
+
+impl Renderer {
+    /// Creates a device on the first adapter found: Vulkan (lavapipe on a CPU-only machine),
+    /// then GL (llvmpipe). `WGPU_BACKEND` (e.g. `gl`) narrows the choice.
+    ///
+    /// # Errors
+    /// [`RenderError::NoAdapter`] when no adapter exists (install Mesa's
+    /// `mesa-vulkan-drivers`), [`RenderError::Device`] when the device cannot be created.
+    pub fn new() -> Result<Self, RenderError> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL;
+        let desc = desc.with_env();
+        let instance = wgpu::Instance::new(desc);
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("paracosm"),
+            required_limits: wgpu::Limits::downlevel_defaults(),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::Device(e.to_string()))?;
+
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("paracosm camera"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("shader.wgsl").into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("globals"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("paracosm camera"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let vertex_attributes =
+            wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
+        let instance_attributes = wgpu::vertex_attr_array![
+            3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4
+        ];
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("paracosm camera"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &shader,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[
+                    Some(wgpu::VertexBufferLayout {
+                        array_stride: std::mem::size_of::<Vertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &vertex_attributes,
+                    }),
+                    Some(wgpu::VertexBufferLayout {
+                        array_stride: std::mem::size_of::<Instance>() as u64,
+                        step_mode: wgpu::VertexStepMode::Instance,
+                        attributes: &instance_attributes,
+                    }),
+                ],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: ZBUFFER_FORMAT,
+                depth_write_enabled: Some(true),
+                // Reversed Z: near is 1, infinitely far is 0.
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &shader,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[
+                    Some(wgpu::ColorTargetState {
+                        format: COLOR_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    }),
+                    Some(wgpu::ColorTargetState {
+                        format: DEPTH_OUT_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    }),
+                ],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let cube = upload(&device, &Mesh::unit_cube());
+        let identity = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("identity instance"),
+            contents: bytemuck::bytes_of(&Instance::identity()),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        Ok(Renderer {
+            device,
+            queue,
+            pipeline,
+            layout,
+            cube,
+            identity,
+            adapter: format!("{} ({:?}, {})", info.name, info.backend, info.driver),
+        })
+    }
+
+    /// The process-wide renderer, created on first use and shared by every simulation and
+    /// thread.
+    ///
+    /// # Errors
+    /// As [`Renderer::new`]; a failure is remembered and returned to every later caller.
+    pub fn shared() -> Result<Arc<Renderer>, RenderError> {
+        SHARED.get_or_init(|| Renderer::new().map(Arc::new)).clone()
+    }
+
+    /// The adapter in use, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, llvmpipe)`.
+    pub fn adapter(&self) -> &str {
+        &self.adapter
+    }
+
+    /// Uploads the static world of `network`.
+    pub fn scene(&self, network: &Network) -> SceneGeometry {
+        upload(&self.device, &Mesh::world(network))
+    }
+
+    /// Creates the render targets of `camera`.
+    ///
+    /// # Errors
+    /// [`RenderError::Camera`] when the camera's values are out of range.
+    pub fn view(&self, camera: &CameraSpec) -> Result<View, RenderError> {
+        camera.validate().map_err(RenderError::Camera)?;
+        let size = wgpu::Extent3d {
+            width: camera.width,
+            height: camera.height,
+            depth_or_array_layers: 1,
+        };
+        let texture = |label, format, usage| {
+            self.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let target = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let color_texture = texture("color", COLOR_FORMAT, target);
+        let depth_texture = texture("depth", DEPTH_OUT_FORMAT, target);
+        let zbuffer = texture(
+            "z-buffer",
+            ZBUFFER_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        // Both targets have 4 bytes per pixel; rows are padded to 256 bytes for the copy.
+        let padded_row = (4 * camera.width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: 2 * u64::from(padded_row) * u64::from(camera.height),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let globals = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("globals"),
+            size: std::mem::size_of::<Globals>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("globals"),
+            layout: &self.layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: globals.as_entire_binding(),
+            }],
+        });
+        let instance_capacity = 16;
+        Ok(View {
+            camera: camera.clone(),
+            color: color_texture.create_view(&Default::default()),
+            color_texture,
+            depth_out: depth_texture.create_view(&Default::default()),
+            depth_texture,
+            zbuffer: zbuffer.create_view(&Default::default()),
+            readback,
+            padded_row,
+            globals,
+            bind_group,
+            instances: self.instance_buffer(instance_capacity),
+            instance_capacity,
+        })
+    }
+
+    fn instance_buffer(&self, capacity: usize) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("instances"),
+            size: (capacity * std::mem::size_of::<Instance>()) as u64,
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// Renders every job in one submission and reads the frames back, in the jobs' order.
+    /// Batching many cameras amortises the submission and the wait.
+    ///
+    /// # Errors
+    /// [`RenderError::Readback`] when the device fails or is lost.
+    pub fn render(&self, jobs: &mut [RenderJob<'_>]) -> Result<Vec<CameraFrame>, RenderError> {
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frames"),
+            });
+        for job in jobs.iter_mut() {
+            self.encode(&mut encoder, job);
+        }
+        let index = self.queue.submit([encoder.finish()]);
+        let failed = Arc::new(Mutex::new(None::<String>));
+        for job in jobs.iter() {
+            let failed = Arc::clone(&failed);
+            job.view
+                .readback
+                .slice(..)
+                .map_async(wgpu::MapMode::Read, move |r| {
+                    if let Err(e) = r {
+                        *failed.lock().unwrap_or_else(|p| p.into_inner()) = Some(e.to_string());
+                    }
+                });
+        }
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(index),
+                timeout: None,
+            })
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        if let Some(e) = failed.lock().unwrap_or_else(|p| p.into_inner()).take() {
+            return Err(RenderError::Readback(e));
+        }
+        let mut frames = Vec::with_capacity(jobs.len());
+        for job in jobs.iter() {
+            let frame = read_frame(job)?;
+            job.view.readback.unmap();
+            frames.push(post::apply(frame, &job.view.camera, job.noise_seed));
+        }
+        Ok(frames)
+    }
+
+    /// Renders one frame (a batch of one).
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn render_one(&self, job: RenderJob<'_>) -> Result<CameraFrame, RenderError> {
+        let mut jobs = [job];
+        Ok(self.render(&mut jobs)?.remove(0))
+    }
+
+    fn encode(&self, encoder: &mut wgpu::CommandEncoder, job: &mut RenderJob<'_>) {
+        let camera = &job.view.camera;
+        let globals = globals(camera, job);
+        self.queue
+            .write_buffer(&job.view.globals, 0, bytemuck::bytes_of(&globals));
+        let instances: Vec<Instance> = job.objects.iter().map(Instance::of).collect();
+        if instances.len() > job.view.instance_capacity {
+            job.view.instance_capacity = instances.len().next_power_of_two();
+            job.view.instances = self.instance_buffer(job.view.instance_capacity);
+        }
+        if !instances.is_empty() {
+            self.queue
+                .write_buffer(&job.view.instances, 0, bytemuck::cast_slice(&instances));
+        }
+        let view = &*job.view;
+        let sky = sky_color(job.light);
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("camera"),
+                color_attachments: &[
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &view.color,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color {
+                                r: sky[0],
+                                g: sky[1],
+                                b: sky[2],
+                                a: 1.0,
+                            }),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &view.depth_out,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            // The bits of f32 +inf: sky.
+                            load: wgpu::LoadOp::Clear(wgpu::Color {
+                                r: f64::from(f32::INFINITY.to_bits()),
+                                g: 0.0,
+                                b: 0.0,
+                                a: 0.0,
+                            }),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
+                ],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &view.zbuffer,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &view.bind_group, &[]);
+            pass.set_vertex_buffer(0, job.scene.vertices.slice(..));
+            pass.set_vertex_buffer(1, self.identity.slice(..));
+            pass.set_index_buffer(job.scene.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..job.scene.index_count, 0, 0..1);
+            if !instances.is_empty() {
+                pass.set_vertex_buffer(0, self.cube.vertices.slice(..));
+                pass.set_vertex_buffer(1, view.instances.slice(..));
+                pass.set_index_buffer(self.cube.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..self.cube.index_count, 0, 0..instances.len() as u32);
+            }
+        }
+        let size = wgpu::Extent3d {
+            width: camera.width,
+            height: camera.height,
+            depth_or_array_layers: 1,
+        };
+        let plane = u64::from(view.padded_row) * u64::from(camera.height);
+        for (texture, offset) in [(&view.color_texture, 0), (&view.depth_texture, plane)] {
+            encoder.copy_texture_to_buffer(
+                wgpu::TexelCopyTextureInfo {
+                    texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &view.readback,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset,
+                        bytes_per_row: Some(view.padded_row),
+                        rows_per_image: Some(camera.height),
+                    },
+                },
+                size,
+            );
+        }
+    }
+}
+
+fn upload(device: &wgpu::Device, mesh: &Mesh) -> SceneGeometry {
+    let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("vertices"),
+        contents: bytemuck::cast_slice(&mesh.vertices),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("indices"),
+        contents: bytemuck::cast_slice(&mesh.indices),
+        usage: wgpu::BufferUsages::INDEX,
+    });
+    SceneGeometry {
+        vertices,
+        indices,
+        index_count: mesh.indices.len() as u32,
+    }
+}
+
+/// Exposure gain for a light intensity: `light / NOMINAL_LIGHT`, at least 0.
+fn exposure(light: f64) -> f64 {
+    light.max(0.0) / NOMINAL_LIGHT
+}
+
+fn sky_color(light: f64) -> [f64; 3] {
+    albedo::SKY.map(|c| (f64::from(c) * exposure(light)).min(1.0))
+}
+
+fn globals(camera: &CameraSpec, job: &RenderJob<'_>) -> Globals {
+    let (s, c) = job.pose.heading_rad.sin_cos();
+    // Vehicle axes in the world: forward (cos, 0, -sin), up (0, 1, 0), right (sin, 0, cos).
+    let fwd = glam::DVec3::new(c, 0.0, -s);
+    let right = glam::DVec3::new(s, 0.0, c);
+    let up = glam::DVec3::Y;
+    let [mf, mu, mr] = camera.mount_m;
+    let chassis = glam::DVec3::from(job.pose.chassis_m);
+    let eye = chassis + fwd * mf + up * mu + right * mr;
+    let (ps, pc) = camera.pitch_rad.sin_cos();
+    let axis = fwd * pc - up * ps;
+    let cam_up = fwd * ps + up * pc;
+    let view = glam::dcamera::rh::view::look_to_mat4(eye, axis, cam_up);
+    let proj = glam::dcamera::rh::proj::directx::perspective_infinite_reverse(
+        camera.vfov_rad(),
+        f64::from(camera.width) / f64::from(camera.height),
+        f64::from(NEAR_M),
+    );
+    let sun = glam::Vec3::from(SUN).normalize();
+    let v4 = |v: glam::DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
+    Globals {
+        view_proj: (proj * view).as_mat4().to_cols_array_2d(),
+        eye: v4(eye),
+        forward: v4(axis),
+        sun: [sun.x, sun.y, sun.z, 0.0],
+        sky: [albedo::SKY[0], albedo::SKY[1], albedo::SKY[2], 0.0],
+        params: [
+            exposure(job.light) as f32,
+            (job.fog.clamp(0.0, 1.0) * crate::FOG_EXTINCTION_PER_M) as f32,
+            camera.far_m as f32,
+            0.0,
+        ],
+    }
+}
+
+fn read_frame(job: &RenderJob<'_>) -> Result<CameraFrame, RenderError> {
+    let view = &*job.view;
+    let (w, h) = (view.camera.width as usize, view.camera.height as usize);
+    let row = view.padded_row as usize;
+    let data = view
+        .readback
+        .slice(..)
+        .get_mapped_range()
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    let mut rgb = Vec::with_capacity(w * h * 3);
+    let mut depth_m = Vec::with_capacity(w * h);
+    for y in 0..h {
+        let line = &data[y * row..y * row + 4 * w];
+        for px in line.chunks_exact(4) {
+            rgb.extend_from_slice(&px[..3]);
+        }
+        let line = &data[(h + y) * row..(h + y) * row + 4 * w];
+        depth_m.extend(
+            line.chunks_exact(4)
+                .map(|b| f32::from_bits(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))),
+        );
+    }
+    Ok(CameraFrame {
+        t_s: job.t_s,
+        width: view.camera.width,
+        height: view.camera.height,
+        rgb,
+        depth_m,
+    })
+}

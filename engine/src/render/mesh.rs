@@ -1,0 +1,290 @@
+//! Triangle meshes of the static world (ground, roads, markings, sidewalks, islands) and of
+//! the box that stands for every car and pedestrian.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::network::{Network, Piece, PieceKind, CURB_HEIGHT_M, JUNCTION_APRON_M, LANE_WIDTH_M};
+
+/// One vertex: position in world metres, unit normal, albedo (linear, `[0, 1]`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub(crate) struct Vertex {
+    pub pos: [f32; 3],
+    pub normal: [f32; 3],
+    pub color: [f32; 3],
+}
+
+/// Albedos of the world's materials.
+pub(crate) mod albedo {
+    pub const GRASS: [f32; 3] = [0.22, 0.36, 0.16];
+    pub const ASPHALT: [f32; 3] = [0.21, 0.21, 0.22];
+    pub const CONCRETE: [f32; 3] = [0.56, 0.55, 0.52];
+    pub const PAINT_WHITE: [f32; 3] = [0.92, 0.92, 0.90];
+    pub const PAINT_YELLOW: [f32; 3] = [0.88, 0.70, 0.12];
+    pub const ISLAND: [f32; 3] = [0.26, 0.46, 0.20];
+    /// The sky, and the colour fog fades toward.
+    pub const SKY: [f32; 3] = [0.62, 0.74, 0.90];
+}
+
+/// Height of lane markings above the asphalt, in metres (enough to never z-fight with the
+/// reversed-Z depth buffer).
+const PAINT_LIFT_M: f64 = 0.01;
+/// Width of painted lines, in metres.
+const LINE_WIDTH_M: f64 = 0.15;
+/// Dashed lane dividers: dash length and period, in metres.
+const DASH_M: (f64, f64) = (3.0, 9.0);
+/// How far the ground plane reaches beyond the network, in metres.
+const GROUND_MARGIN_M: f64 = 2000.0;
+
+/// An indexed triangle list.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct Mesh {
+    pub vertices: Vec<Vertex>,
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    fn quad(&mut self, corners: [[f64; 3]; 4], normal: [f32; 3], color: [f32; 3]) {
+        let base = self.vertices.len() as u32;
+        for c in corners {
+            self.vertices.push(Vertex {
+                pos: [c[0] as f32, c[1] as f32, c[2] as f32],
+                normal,
+                color,
+            });
+        }
+        self.indices
+            .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+    }
+
+    /// A horizontal rectangle `[x0, x1] × [z0, z1]` of the piece's local frame at height `y`.
+    fn flat(&mut self, piece: &Piece, x: (f64, f64), z: (f64, f64), y: f64, color: [f32; 3]) {
+        let w = |lx: f64, lz: f64| {
+            let [wx, wz] = piece.pose.apply([lx, lz]);
+            [wx, y, wz]
+        };
+        self.quad(
+            [w(x.0, z.0), w(x.1, z.0), w(x.1, z.1), w(x.0, z.1)],
+            [0.0, 1.0, 0.0],
+            color,
+        );
+    }
+
+    /// A vertical curb face along local `z = z0` from `x0` to `x1`, facing `side` (`±1` in z).
+    fn curb(&mut self, piece: &Piece, x: (f64, f64), z0: f64, side: f64) {
+        let w = |lx: f64, y: f64| {
+            let [wx, wz] = piece.pose.apply([lx, z0]);
+            [wx, y, wz]
+        };
+        let [nx, nz] = piece.pose.apply([0.0, side]);
+        let normal = [(nx - piece.pose.x) as f32, 0.0, (nz - piece.pose.z) as f32];
+        self.quad(
+            [
+                w(x.0, 0.0),
+                w(x.1, 0.0),
+                w(x.1, CURB_HEIGHT_M),
+                w(x.0, CURB_HEIGHT_M),
+            ],
+            normal,
+            albedo::CONCRETE,
+        );
+    }
+
+    /// A horizontal disc of radius `r` at height `y`, centred on the piece's origin.
+    fn disc(&mut self, piece: &Piece, r: f64, y: f64, color: [f32; 3]) {
+        const SIDES: u32 = 48;
+        let base = self.vertices.len() as u32;
+        let [cx, cz] = piece.pose.apply([0.0, 0.0]);
+        self.vertices.push(Vertex {
+            pos: [cx as f32, y as f32, cz as f32],
+            normal: [0.0, 1.0, 0.0],
+            color,
+        });
+        for i in 0..SIDES {
+            let a = f64::from(i) / f64::from(SIDES) * std::f64::consts::TAU;
+            let [x, z] = piece.pose.apply([r * a.cos(), r * a.sin()]);
+            self.vertices.push(Vertex {
+                pos: [x as f32, y as f32, z as f32],
+                normal: [0.0, 1.0, 0.0],
+                color,
+            });
+        }
+        for i in 0..SIDES {
+            self.indices
+                .extend_from_slice(&[base, base + 1 + i, base + 1 + (i + 1) % SIDES]);
+        }
+    }
+
+    /// A painted line along local `x` from `x0` to `x1`, centred on `z`.
+    fn line(&mut self, piece: &Piece, x: (f64, f64), z: f64, color: [f32; 3]) {
+        let h = LINE_WIDTH_M / 2.0;
+        self.flat(piece, x, (z - h, z + h), PAINT_LIFT_M, color);
+    }
+
+    fn dashed(&mut self, piece: &Piece, length_m: f64, z: f64) {
+        let mut x = DASH_M.1 / 2.0;
+        while x < length_m {
+            self.line(
+                piece,
+                (x, (x + DASH_M.0).min(length_m)),
+                z,
+                albedo::PAINT_WHITE,
+            );
+            x += DASH_M.1;
+        }
+    }
+
+    fn segment(&mut self, piece: &Piece, length_m: f64) {
+        let kind = &piece.kind;
+        let road = kind.half_road_m();
+        let outer = kind.half_width_m();
+        let along = (0.0, length_m);
+        self.flat(piece, along, (-road, road), 0.0, albedo::ASPHALT);
+        for side in [-1.0, 1.0] {
+            let (a, b) = (side * road, side * outer);
+            self.flat(
+                piece,
+                along,
+                (a.min(b), a.max(b)),
+                CURB_HEIGHT_M,
+                albedo::CONCRETE,
+            );
+            self.curb(piece, along, side * road, -side);
+            // Edge line.
+            self.line(piece, along, side * (road - 0.3), albedo::PAINT_WHITE);
+            // Lane dividers between lanes of one direction.
+            for k in 1..kind.lanes() / 2 {
+                self.dashed(piece, length_m, side * f64::from(k) * LANE_WIDTH_M);
+            }
+            // Double yellow centre line.
+            self.line(piece, along, side * 0.12, albedo::PAINT_YELLOW);
+        }
+    }
+
+    fn junction(&mut self, piece: &Piece) {
+        let ([hx, hz], _) = piece.kind.footprint();
+        self.flat(piece, (-hx, hx), (-hz, hz), 0.0, albedo::ASPHALT);
+        if let Some(island) = piece.kind.island_radius_m() {
+            self.disc(piece, island, CURB_HEIGHT_M, albedo::ISLAND);
+        } else {
+            // Stop lines where the roads enter, across the incoming lanes.
+            let road = piece.kind.half_road_m();
+            let edge = piece.kind.junction_half_m() - JUNCTION_APRON_M / 2.0;
+            for port in piece.kind.ports() {
+                let rot = crate::network::Pose2 {
+                    x: piece.pose.x,
+                    z: piece.pose.z,
+                    heading_rad: piece.pose.heading_rad + port.heading_rad,
+                };
+                let rotated = Piece {
+                    name: String::new(),
+                    kind: piece.kind.clone(),
+                    pose: rot,
+                };
+                // Incoming lanes lie on local -z of a frame whose x points out of the port.
+                self.flat(
+                    &rotated,
+                    (edge - 0.25, edge + 0.25),
+                    (-road, 0.0),
+                    PAINT_LIFT_M,
+                    albedo::PAINT_WHITE,
+                );
+            }
+        }
+    }
+
+    /// The static world of `network`: a ground plane and every road piece.
+    pub(crate) fn world(network: &Network) -> Mesh {
+        let mut mesh = Mesh::default();
+        let (mut lo, mut hi) = ([0.0f64; 2], [0.0f64; 2]);
+        for piece in network.pieces() {
+            let ([hx, hz], [cx, cz]) = piece.kind.footprint();
+            for (sx, sz) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                let [x, z] = piece.pose.apply([cx + sx * hx, cz + sz * hz]);
+                lo = [lo[0].min(x), lo[1].min(z)];
+                hi = [hi[0].max(x), hi[1].max(z)];
+            }
+            match piece.kind {
+                PieceKind::Segment { length_m, .. } => mesh.segment(piece, length_m),
+                _ => mesh.junction(piece),
+            }
+        }
+        let m = GROUND_MARGIN_M;
+        mesh.quad(
+            [
+                [lo[0] - m, -0.02, lo[1] - m],
+                [hi[0] + m, -0.02, lo[1] - m],
+                [hi[0] + m, -0.02, hi[1] + m],
+                [lo[0] - m, -0.02, hi[1] + m],
+            ],
+            [0.0, 1.0, 0.0],
+            albedo::GRASS,
+        );
+        mesh
+    }
+
+    /// The unit cube `[-0.5, 0.5]³` with flat normals, white: scaled, turned and tinted per
+    /// instance into cars and pedestrians.
+    pub(crate) fn unit_cube() -> Mesh {
+        let mut mesh = Mesh::default();
+        let h = 0.5;
+        let white = [1.0, 1.0, 1.0];
+        for axis in 0..3 {
+            for sign in [-1.0f64, 1.0] {
+                let mut normal = [0.0f32; 3];
+                normal[axis] = sign as f32;
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let corner = |a: f64, b: f64| {
+                    let mut p = [0.0; 3];
+                    p[axis] = sign * h;
+                    p[u] = a;
+                    p[v] = b;
+                    p
+                };
+                mesh.quad(
+                    [corner(-h, -h), corner(h, -h), corner(h, h), corner(-h, h)],
+                    normal,
+                    white,
+                );
+            }
+        }
+        mesh
+    }
+}
+
+/// The albedo of a colour name used by scenarios (`Car(color=...)`); unknown names are
+/// mid grey.
+pub fn color_albedo(name: &str) -> [f32; 3] {
+    match name.to_ascii_lowercase().as_str() {
+        "red" => [0.75, 0.08, 0.07],
+        "white" => [0.92, 0.92, 0.92],
+        "black" => [0.04, 0.04, 0.05],
+        "blue" => [0.08, 0.18, 0.70],
+        "green" => [0.10, 0.55, 0.15],
+        "yellow" => [0.90, 0.78, 0.10],
+        "orange" => [0.92, 0.45, 0.08],
+        "silver" => [0.70, 0.71, 0.73],
+        _ => [0.45, 0.45, 0.45],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_segment_has_asphalt_sidewalks_and_markings() {
+        let n = Network::single_segment(100.0, 4, 1.0).unwrap();
+        let m = Mesh::world(&n);
+        assert_eq!(m.indices.len() % 3, 0);
+        assert!(m.indices.iter().all(|&i| (i as usize) < m.vertices.len()));
+        let count = |c: [f32; 3]| m.vertices.iter().filter(|v| v.color == c).count();
+        assert_eq!(count(albedo::ASPHALT), 4);
+        assert!(
+            count(albedo::PAINT_WHITE) > 4 * 20,
+            "dashes of two dividers"
+        );
+        assert_eq!(count(albedo::PAINT_YELLOW), 8);
+        assert_eq!(Mesh::unit_cube().indices.len(), 36);
+    }
+}

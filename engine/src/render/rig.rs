@@ -1,0 +1,65 @@
+//! A camera mounted on one simulation's ego vehicle.
+
+use std::sync::Arc;
+
+use super::gpu::{CameraPose, RenderJob, RenderObject, Renderer, SceneGeometry, View};
+use crate::camera::{CameraFrame, CameraSpec};
+use crate::network::Network;
+use crate::EngineError;
+
+/// The renderer, the world's uploaded geometry and the camera's targets, for one simulation.
+pub(crate) struct CameraRig {
+    renderer: Arc<Renderer>,
+    scene: SceneGeometry,
+    view: View,
+    seed: u64,
+    frames: u64,
+}
+
+impl CameraRig {
+    pub(crate) fn new(
+        renderer: Arc<Renderer>,
+        network: &Network,
+        camera: &CameraSpec,
+        seed: u64,
+    ) -> Result<Self, EngineError> {
+        let view = renderer
+            .view(camera)
+            .map_err(|e| EngineError::Sensor(e.to_string()))?;
+        Ok(CameraRig {
+            scene: renderer.scene(network),
+            renderer,
+            view,
+            seed,
+            frames: 0,
+        })
+    }
+
+    pub(crate) fn camera(&self) -> &CameraSpec {
+        self.view.camera()
+    }
+
+    pub(crate) fn capture(
+        &mut self,
+        pose: CameraPose,
+        objects: &[RenderObject],
+        light_fog: (f64, f64),
+        t_s: f64,
+    ) -> Result<CameraFrame, EngineError> {
+        // Each frame's noise has its own stream: (test seed, frame number).
+        let noise_seed = self.seed ^ self.frames.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        self.frames += 1;
+        self.renderer
+            .render_one(RenderJob {
+                scene: &self.scene,
+                view: &mut self.view,
+                pose,
+                objects,
+                light: light_fog.0,
+                fog: light_fog.1,
+                t_s,
+                noise_seed,
+            })
+            .map_err(|e| EngineError::Sensor(e.to_string()))
+    }
+}

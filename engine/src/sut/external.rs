@@ -1,0 +1,460 @@
+//! Systems under test in another process, over stdin/stdout (SUT_PROTOCOL.md).
+//!
+//! Every message in either direction is one frame: a 4-byte little-endian length `H`, `H`
+//! bytes of a UTF-8 JSON object (the header), then the raw bytes of each binary buffer the
+//! header lists under `buffers` (`name`, `dtype`, `shape`, `nbytes`), in that order.
+
+use std::io::{BufReader, Read, Write};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use serde_json::{json, Value as Json};
+
+use super::{Sensors, Sut, SutError};
+use crate::{CameraSpec, Control, Observation};
+
+/// The protocol version sent in the `hello` message.
+pub const PROTOCOL_VERSION: u32 = 1;
+/// The largest header accepted from a system under test, in bytes.
+const MAX_HEADER_BYTES: u32 = 1 << 20;
+
+/// How to run an external system under test.
+#[derive(Debug, Clone)]
+pub struct ExternalConfig {
+    /// Program and arguments, e.g. `["python3", "controller.py"]`.
+    pub command: Vec<String>,
+    /// Longest wait for any answer (handshake, reset, control), seconds, `> 0`.
+    pub timeout_s: f64,
+    /// Keep processes alive between tests (reset by a `reset` message) instead of starting a
+    /// fresh one per test. A process that failed is never reused.
+    pub reuse: bool,
+    /// Idle processes kept for reuse, shared by the campaign's workers.
+    pub pool: Arc<ProcessPool>,
+}
+
+impl ExternalConfig {
+    /// A configuration with a fresh, empty pool.
+    pub fn new(command: Vec<String>, timeout_s: f64, reuse: bool) -> Self {
+        ExternalConfig {
+            command,
+            timeout_s,
+            reuse,
+            pool: Arc::new(ProcessPool::default()),
+        }
+    }
+}
+
+impl PartialEq for ExternalConfig {
+    fn eq(&self, other: &Self) -> bool {
+        self.command == other.command
+            && self.timeout_s == other.timeout_s
+            && self.reuse == other.reuse
+    }
+}
+
+/// Idle external processes, handed to the next test that needs one (at most one per worker is
+/// ever alive at a time).
+#[derive(Debug, Default)]
+pub struct ProcessPool {
+    idle: Mutex<Vec<Process>>,
+}
+
+/// A message from the system under test: its JSON header (any buffers it sent are read and
+/// dropped, to stay in step).
+#[derive(Debug)]
+struct Message {
+    header: Json,
+}
+
+/// A running system-under-test process.
+#[derive(Debug)]
+struct Process {
+    child: Child,
+    stdin: ChildStdin,
+    replies: Receiver<Result<Message, String>>,
+    stderr: Arc<Mutex<String>>,
+    sensors: Sensors,
+    wants_depth: bool,
+    wants_lidar: bool,
+}
+
+impl Drop for Process {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn read_message(r: &mut impl Read) -> Result<Option<Message>, String> {
+    let mut len = [0u8; 4];
+    match r.read_exact(&mut len) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => return Ok(None),
+        Err(e) => return Err(format!("cannot read its output: {e}")),
+    }
+    let len = u32::from_le_bytes(len);
+    if len > MAX_HEADER_BYTES {
+        return Err(format!(
+            "sent a malformed frame: header length {len} bytes is over the {MAX_HEADER_BYTES}-byte \
+             limit (bytes {:02x?}; is it printing to stdout?)",
+            len.to_le_bytes()
+        ));
+    }
+    let mut header = vec![0u8; len as usize];
+    r.read_exact(&mut header)
+        .map_err(|e| format!("sent a truncated frame: {e}"))?;
+    let header: Json = serde_json::from_slice(&header).map_err(|e| {
+        let text = String::from_utf8_lossy(&header[..header.len().min(80)]);
+        let hint = if text.contains("NaN") || text.contains("Infinity") {
+            " (NaN and Infinity are not JSON numbers: controls must be finite, in [-1, 1])"
+        } else {
+            ""
+        };
+        format!("sent a malformed frame: the header is not JSON ({e}){hint}: {text:?}")
+    })?;
+    if let Some(list) = header.get("buffers").and_then(Json::as_array) {
+        for b in list {
+            let n = b
+                .get("nbytes")
+                .and_then(Json::as_u64)
+                .ok_or_else(|| "sent a malformed frame: a buffer has no `nbytes`".to_string())?;
+            if n > 1 << 30 {
+                return Err(format!("sent a malformed frame: buffer of {n} bytes"));
+            }
+            let mut data = vec![0u8; n as usize];
+            r.read_exact(&mut data)
+                .map_err(|e| format!("sent a truncated buffer: {e}"))?;
+        }
+    }
+    Ok(Some(Message { header }))
+}
+
+fn write_message(w: &mut impl Write, header: &Json, buffers: &[&[u8]]) -> std::io::Result<()> {
+    let text = serde_json::to_vec(header).expect("JSON values serialise");
+    w.write_all(&(text.len() as u32).to_le_bytes())?;
+    w.write_all(&text)?;
+    for b in buffers {
+        w.write_all(b)?;
+    }
+    w.flush()
+}
+
+impl Process {
+    fn spawn(config: &ExternalConfig, dt_s: f64) -> Result<Process, String> {
+        let (program, args) = config
+            .command
+            .split_first()
+            .ok_or_else(|| "the command is empty".to_string())?;
+        let mut child = Command::new(program)
+            .args(args)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .map_err(|e| format!("cannot start `{program}`: {e}"))?;
+        let stdin = child.stdin.take().expect("piped");
+        let stdout = child.stdout.take().expect("piped");
+        let mut err_pipe = child.stderr.take().expect("piped");
+        let (tx, replies) = mpsc::channel();
+        std::thread::spawn(move || {
+            let mut r = BufReader::new(stdout);
+            loop {
+                let m = read_message(&mut r);
+                let stop = !matches!(m, Ok(Some(_)));
+                let m = m.and_then(|m| m.ok_or_else(|| "closed its output".to_string()));
+                if tx.send(m).is_err() || stop {
+                    break;
+                }
+            }
+        });
+        let stderr = Arc::new(Mutex::new(String::new()));
+        let tail = Arc::clone(&stderr);
+        std::thread::spawn(move || {
+            let mut buf = [0u8; 4096];
+            while let Ok(n) = err_pipe.read(&mut buf) {
+                if n == 0 {
+                    break;
+                }
+                let mut t = tail.lock().unwrap_or_else(|p| p.into_inner());
+                t.push_str(&String::from_utf8_lossy(&buf[..n]));
+                // Keep the last 4 KiB: where the traceback is.
+                if t.len() > 8192 {
+                    let cut = t.len() - 4096;
+                    let cut = (cut..t.len()).find(|&i| t.is_char_boundary(i)).unwrap_or(0);
+                    t.drain(..cut);
+                }
+            }
+        });
+        let mut p = Process {
+            child,
+            stdin,
+            replies,
+            stderr,
+            sensors: Sensors::default(),
+            wants_depth: false,
+            wants_lidar: false,
+        };
+        let hello = p.request(
+            &json!({"type": "hello", "protocol": PROTOCOL_VERSION, "dt_s": dt_s}),
+            &[],
+            config.timeout_s,
+        )?;
+        p.accept_hello(&hello.header)?;
+        Ok(p)
+    }
+
+    fn accept_hello(&mut self, h: &Json) -> Result<(), String> {
+        if h.get("type").and_then(Json::as_str) != Some("hello") {
+            return Err(format!("answered the hello with {h} instead of a hello"));
+        }
+        let sensors = h.get("sensors").cloned().unwrap_or(Json::Null);
+        let flag = |k: &str| sensors.get(k).and_then(Json::as_bool).unwrap_or(false);
+        self.wants_depth = flag("depth");
+        self.wants_lidar = flag("lidar");
+        let camera = match sensors.get("camera") {
+            None | Some(Json::Null) | Some(Json::Bool(false)) => None,
+            Some(Json::Bool(true)) => Some(CameraSpec::default()),
+            Some(spec) => {
+                let c: CameraSpec = serde_json::from_value(spec.clone())
+                    .map_err(|e| format!("declared an invalid camera {spec}: {e}"))?;
+                c.validate()
+                    .map_err(|e| format!("declared an invalid camera: {e}"))?;
+                Some(c)
+            }
+        };
+        let camera = match (camera, self.wants_depth) {
+            (None, true) => Some(CameraSpec::default()),
+            (c, _) => c,
+        };
+        let control_hz = match h.get("control_hz") {
+            None | Some(Json::Null) => None,
+            Some(v) => match v.as_f64() {
+                Some(hz) if hz.is_finite() && hz > 0.0 => Some(hz),
+                _ => return Err(format!("declared control_hz {v}; need a positive number")),
+            },
+        };
+        self.sensors = Sensors { camera, control_hz };
+        Ok(())
+    }
+
+    /// Sends one message and waits for the answer.
+    fn request(
+        &mut self,
+        header: &Json,
+        buffers: &[&[u8]],
+        timeout_s: f64,
+    ) -> Result<Message, String> {
+        if let Err(e) = write_message(&mut self.stdin, header, buffers) {
+            return Err(self.died(&format!("stopped reading its input ({e})")));
+        }
+        match self
+            .replies
+            .recv_timeout(Duration::from_secs_f64(timeout_s))
+        {
+            Ok(Ok(m)) => Ok(m),
+            Ok(Err(e)) => Err(self.died(&e)),
+            Err(RecvTimeoutError::Timeout) => {
+                let _ = self.child.kill();
+                Err(format!(
+                    "did not answer within {timeout_s} s (--sut-timeout); killed it{}",
+                    self.stderr_tail()
+                ))
+            }
+            Err(RecvTimeoutError::Disconnected) => Err(self.died("closed its output")),
+        }
+    }
+
+    fn died(&mut self, what: &str) -> String {
+        // Give a crashing process a moment to finish writing its traceback and exit.
+        let mut status = None;
+        for _ in 0..50 {
+            if let Ok(Some(s)) = self.child.try_wait() {
+                status = Some(s);
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+        let status = status.map_or_else(
+            || "the process was still running (killed)".to_string(),
+            |s| format!("process {s}"),
+        );
+        format!("{what}; {status}{}", self.stderr_tail())
+    }
+
+    fn stderr_tail(&self) -> String {
+        let t = self.stderr.lock().unwrap_or_else(|p| p.into_inner());
+        let lines: Vec<&str> = t.trim_end().lines().collect();
+        if lines.is_empty() {
+            String::new()
+        } else {
+            let from = lines.len().saturating_sub(5);
+            format!("; its stderr ends with: {}", lines[from..].join(" | "))
+        }
+    }
+}
+
+/// A system under test in another process, speaking the protocol of SUT_PROTOCOL.md over its
+/// stdin and stdout. Any failure of the process (it crashes, hangs past the timeout, writes
+/// garbage, answers NaN or controls outside `[-1, 1]`) becomes a [`SutError`]: the test is
+/// recorded as an `error` and the process is killed, never reused.
+#[derive(Debug)]
+pub struct ExternalSut {
+    config: ExternalConfig,
+    process: Option<Process>,
+    healthy: bool,
+}
+
+impl ExternalSut {
+    /// A system that will start (or take from the pool) its process at the first reset.
+    pub fn new(config: ExternalConfig) -> Self {
+        ExternalSut {
+            config,
+            process: None,
+            healthy: false,
+        }
+    }
+
+    fn fail(&mut self, message: String) -> SutError {
+        self.healthy = false;
+        self.process = None; // kills it
+        SutError::Failed(format!(
+            "external system under test `{}` {message}",
+            self.config.command.join(" ")
+        ))
+    }
+}
+
+impl Drop for ExternalSut {
+    fn drop(&mut self) {
+        if let (true, true, Some(p)) = (self.config.reuse, self.healthy, self.process.take()) {
+            self.config
+                .pool
+                .idle
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .push(p);
+        }
+    }
+}
+
+impl Sut for ExternalSut {
+    fn sensors(&self) -> Sensors {
+        self.process
+            .as_ref()
+            .map(|p| p.sensors.clone())
+            .unwrap_or_default()
+    }
+
+    fn reset(&mut self, seed: u64) -> Result<(), SutError> {
+        // The physics step is not known here; the hello carries the default step.
+        let dt_s = crate::DEFAULT_DT_S;
+        if self.process.is_none() {
+            let pooled = if self.config.reuse {
+                self.config
+                    .pool
+                    .idle
+                    .lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .pop()
+            } else {
+                None
+            };
+            self.process = Some(match pooled {
+                Some(p) => p,
+                None => Process::spawn(&self.config, dt_s).map_err(|e| self.fail(e))?,
+            });
+        }
+        let timeout = self.config.timeout_s;
+        let p = self.process.as_mut().expect("set above");
+        let reply = p.request(&json!({"type": "reset", "seed": seed}), &[], timeout);
+        match reply {
+            Ok(m) if m.header.get("type").and_then(Json::as_str) == Some("ready") => {
+                self.healthy = true;
+                Ok(())
+            }
+            Ok(m) => Err(self.fail(format!(
+                "answered the reset with {} instead of {{\"type\": \"ready\"}}",
+                m.header
+            ))),
+            Err(e) => Err(self.fail(e)),
+        }
+    }
+
+    fn act(&mut self, obs: &Observation<'_>) -> Result<Control, SutError> {
+        let timeout = self.config.timeout_s;
+        let Some(p) = self.process.as_mut() else {
+            return Err(self.fail("was not started (no reset)".into()));
+        };
+        let mut header = json!({
+            "type": "observation",
+            "t_s": obs.t_s,
+            "ego": {
+                "pos_m": obs.ego.pos_m,
+                "heading_rad": obs.ego.heading_rad,
+                "speed_mps": obs.ego.speed_mps,
+            },
+        });
+        let mut descriptors = Vec::new();
+        let mut depth_bytes = Vec::new();
+        let mut lidar_bytes = Vec::new();
+        let mut payloads: Vec<&[u8]> = Vec::new();
+        if let (Some(frame), true) = (obs.camera, p.sensors.camera.is_some()) {
+            let (h, w) = (frame.height, frame.width);
+            descriptors.push(
+                json!({"name": "camera", "dtype": "uint8", "shape": [h, w, 3],
+                "nbytes": frame.rgb.len(), "t_s": frame.t_s}),
+            );
+            if p.wants_depth {
+                depth_bytes = frame.depth_m.iter().flat_map(|d| d.to_le_bytes()).collect();
+                descriptors.push(json!({"name": "depth", "dtype": "float32", "shape": [h, w],
+                    "nbytes": depth_bytes.len()}));
+            }
+        }
+        if p.wants_lidar {
+            lidar_bytes = obs
+                .lidar
+                .iter()
+                .flat_map(|r| r.point_m.map(|v| (v as f32).to_le_bytes()))
+                .flatten()
+                .collect();
+            descriptors.push(json!({"name": "lidar", "dtype": "float32",
+                "shape": [obs.lidar.len(), 3], "nbytes": lidar_bytes.len()}));
+        }
+        if let Some(frame) = obs.camera.filter(|_| p.sensors.camera.is_some()) {
+            payloads.push(&frame.rgb);
+            if p.wants_depth {
+                payloads.push(&depth_bytes);
+            }
+        }
+        if p.wants_lidar {
+            payloads.push(&lidar_bytes);
+        }
+        header["buffers"] = Json::Array(descriptors);
+        let reply = match p.request(&header, &payloads, timeout) {
+            Ok(m) => m,
+            Err(e) => return Err(self.fail(e)),
+        };
+        let value = |k: &str| -> Result<f64, String> {
+            let v = reply
+                .header
+                .get(k)
+                .ok_or_else(|| format!("answered {} without `{k}`", reply.header))?;
+            // JSON has no NaN: clients that write `NaN` send a string or a bare token the
+            // parser rejects; both end here or in the frame reader.
+            let x = v
+                .as_f64()
+                .ok_or_else(|| format!("answered {k} = {v}; controls must be numbers"))?;
+            if !x.is_finite() || !(-1.0..=1.0).contains(&x) {
+                return Err(format!("answered {k} = {x}, outside [-1, 1]"));
+            }
+            Ok(x)
+        };
+        match (value("throttle"), value("steering")) {
+            (Ok(throttle), Ok(steering)) => Ok(Control { throttle, steering }),
+            (Err(e), _) | (_, Err(e)) => Err(self.fail(e)),
+        }
+    }
+}

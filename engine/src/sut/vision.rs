@@ -1,0 +1,310 @@
+use serde::{Deserialize, Serialize};
+
+use super::{Sensors, Sut, SutError};
+use crate::{CameraFrame, CameraSpec, Control, Observation};
+
+/// Settings of the built-in [`Vision`] system.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct VisionConfig {
+    /// The camera it reads. Default: 160 × 120 px, 24 mm, 20 Hz, pixel noise σ = 2 levels.
+    pub camera: CameraSpec,
+    /// Cruise speed in m/s. Default 12 m/s.
+    pub target_speed_mps: f64,
+    /// Throttle per m/s of speed error. Default 0.5.
+    pub speed_gain: f64,
+    /// Half-width of the corridor ahead in which obstacles count, metres. Default 1.3 m.
+    pub corridor_half_width_m: f64,
+    /// Brake at full force when the gap less `standstill_gap_m` is shorter than
+    /// `speed · ttc_brake_s` (seconds). Default 1.4 s.
+    pub ttc_brake_s: f64,
+    /// Gap kept when stopped, metres. Default 2 m.
+    pub standstill_gap_m: f64,
+    /// Chassis centre to front bumper, metres. Default 2.25 m.
+    pub front_offset_m: f64,
+    /// Points at least this high above the road (m) are obstacles; lower ones are road.
+    /// Default 0.3 m.
+    pub obstacle_height_m: f64,
+    /// Smallest colour difference (sum of |ΔR| + |ΔG| + |ΔB| in 8-bit levels) between a
+    /// pixel and both the sky and the road for it to count as an object: about twice the pixel
+    /// noise of the default camera. Default 10.
+    pub contrast_threshold: f64,
+    /// Object pixels needed in the corridor before braking. Default 6.
+    pub min_obstacle_pixels: usize,
+    /// Lane keeping: the look-ahead distance at which the lane centre is aimed for, metres.
+    /// Default 10 m.
+    pub lookahead_m: f64,
+    /// Wheelbase for the pure-pursuit steering, metres. Default 2.9 m.
+    pub wheelbase_m: f64,
+    /// Front-wheel angle at full steering, rad. Default 0.5 rad.
+    pub max_steer_rad: f64,
+}
+
+impl Default for VisionConfig {
+    fn default() -> Self {
+        VisionConfig {
+            camera: CameraSpec {
+                width: 160,
+                height: 120,
+                noise_sigma: 2.0,
+                ..CameraSpec::default()
+            },
+            target_speed_mps: 12.0,
+            speed_gain: 0.5,
+            corridor_half_width_m: 1.3,
+            ttc_brake_s: 1.4,
+            standstill_gap_m: 2.0,
+            front_offset_m: 2.25,
+            obstacle_height_m: 0.3,
+            contrast_threshold: 10.0,
+            min_obstacle_pixels: 6,
+            lookahead_m: 10.0,
+            wheelbase_m: 2.9,
+            max_steer_rad: 0.5,
+        }
+    }
+}
+
+/// `vision`: lane keeping and emergency braking from the camera alone (image and depth map,
+/// no lidar, no ground truth).
+///
+/// Each camera frame (20 Hz) it back-projects every pixel through the depth map into the
+/// vehicle frame ([`CameraSpec::back_project`], [`CameraSpec::camera_to_vehicle`]), using the
+/// chassis height from odometry to place the road plane, and then:
+/// - **Objects.** A pixel is part of an object when it stands at least `obstacle_height_m`
+///   above the road and its colour differs by at least `contrast_threshold` from both the sky
+///   (the mean of the frame's sky pixels) and the road (the mean of the road just ahead). So it
+///   sees what a camera shows: in fog an object fades toward the sky colour (Koschmieder) and
+///   is found only when near; in the dark every difference shrinks with the exposure; in glare
+///   bright surfaces and the sky both clip at 255. The gap to the nearest object in the
+///   corridor (`min_obstacle_pixels` pixels at least) drives the same braking rule as `aeb`.
+/// - **Lane.** Road pixels brighter than the road by `contrast_threshold` and by half the
+///   road's own level (paint) between 4 and 16 m ahead are lane markings; the nearest marking on each side bounds the lane, and pure pursuit
+///   (Coulter 1992) steers toward the lane centre `lookahead_m` ahead. With no marking seen it
+///   holds the wheel straight.
+///
+/// Its exposure-dependent failures are the point: on `fog_light.star` it fails more the denser
+/// the fog and the farther the light is from the 0.5 its camera is calibrated for.
+#[derive(Debug, Clone)]
+pub struct Vision {
+    config: VisionConfig,
+    last_frame_t: Option<f64>,
+    decision: Control,
+}
+
+/// What one frame shows: the gap to the nearest object in the corridor, and the lane centre's
+/// lateral offset (m, right positive) at the look-ahead distance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Perception {
+    /// Distance from the chassis centre to the nearest object in the corridor, metres.
+    pub obstacle_m: Option<f64>,
+    /// Lane centre, metres to the right of the vehicle's axis.
+    pub lane_centre_m: Option<f64>,
+}
+
+impl Vision {
+    /// A `vision` system with the given settings.
+    pub fn new(config: VisionConfig) -> Self {
+        Vision {
+            config,
+            last_frame_t: None,
+            decision: Control::default(),
+        }
+    }
+
+    /// Reads one frame. `chassis_height_m` is the chassis centre's height above the road.
+    pub fn perceive(&self, frame: &CameraFrame, chassis_height_m: f64) -> Perception {
+        let c = &self.config;
+        let cam = &c.camera;
+        let (w, h) = (frame.width, frame.height);
+        let diff = |a: [f64; 3], b: [f64; 3]| -> f64 { (0..3).map(|i| (a[i] - b[i]).abs()).sum() };
+        // Sky: the mean of pixels with no depth; road: the mean of road pixels near the bottom
+        // centre of the image.
+        let mut sky = ([0.0; 3], 0usize);
+        let mut road = ([0.0; 3], 0usize);
+        let mut points = Vec::with_capacity((w * h) as usize);
+        for v in 0..h {
+            for u in 0..w {
+                let d = frame.depth_at(u, v);
+                let rgb = frame.rgb_at(u, v);
+                if !d.is_finite() {
+                    for i in 0..3 {
+                        sky.0[i] += f64::from(rgb[i]);
+                    }
+                    sky.1 += 1;
+                    continue;
+                }
+                let p = cam.camera_to_vehicle(cam.back_project(
+                    f64::from(u) + 0.5,
+                    f64::from(v) + 0.5,
+                    f64::from(d),
+                ));
+                let height = p[1] + chassis_height_m;
+                if height.abs() < 0.1 && p[2].abs() < 1.0 && (3.0..8.0).contains(&p[0]) {
+                    for i in 0..3 {
+                        road.0[i] += f64::from(rgb[i]);
+                    }
+                    road.1 += 1;
+                }
+                points.push((p, height, rgb));
+            }
+        }
+        let mean = |(s, n): ([f64; 3], usize), fallback: [f64; 3]| {
+            if n == 0 {
+                fallback
+            } else {
+                s.map(|v| v / n as f64)
+            }
+        };
+        let sky = mean(sky, [255.0; 3]);
+        let road = mean(road, [60.0; 3]);
+        let road_luma = road.iter().sum::<f64>() / 3.0;
+
+        let mut candidates = Vec::new();
+        let (mut left, mut right) = (Vec::new(), Vec::new());
+        for (p, height, rgb) in points {
+            if p[0] <= 0.0 {
+                continue;
+            }
+            if height >= c.obstacle_height_m {
+                if p[2].abs() <= c.corridor_half_width_m {
+                    candidates.push((p[0], rgb));
+                }
+            } else if height.abs() < 0.1 && (4.0..16.0).contains(&p[0]) {
+                let luma = rgb.iter().map(|&v| f64::from(v)).sum::<f64>() / 3.0;
+                if luma >= road_luma + c.contrast_threshold.max(0.5 * road_luma) {
+                    if (-3.0..-0.3).contains(&p[2]) {
+                        left.push(p[2]);
+                    } else if (0.3..3.0).contains(&p[2]) {
+                        right.push(p[2]);
+                    }
+                }
+            }
+        }
+        let obstacle_m = nearest_visible_object(candidates, c.min_obstacle_pixels.max(1), |mean| {
+            diff(mean, sky) >= c.contrast_threshold && diff(mean, road) >= c.contrast_threshold
+        });
+        // The nearest line on each side: the median of the markings within 0.6 m of the
+        // innermost one.
+        let nearest = |xs: &mut Vec<f64>, inner_first: bool| -> Option<f64> {
+            if xs.len() < MIN_MARKING_PIXELS {
+                return None;
+            }
+            xs.sort_by(f64::total_cmp);
+            if !inner_first {
+                xs.reverse();
+            }
+            let edge = *xs.first()?;
+            let band: Vec<f64> = xs
+                .iter()
+                .copied()
+                .filter(|x| (x - edge).abs() < 0.6)
+                .collect();
+            Some(band[band.len() / 2])
+        };
+        let half_lane = crate::network::LANE_WIDTH_M / 2.0;
+        let lane_centre_m = match (nearest(&mut left, false), nearest(&mut right, true)) {
+            (Some(l), Some(r)) => Some((l + r) / 2.0),
+            (Some(l), None) => Some(l + half_lane),
+            (None, Some(r)) => Some(r - half_lane),
+            (None, None) => None,
+        };
+        Perception {
+            obstacle_m,
+            lane_centre_m,
+        }
+    }
+
+    fn decide(&self, frame: &CameraFrame, obs: &Observation<'_>) -> Control {
+        let c = &self.config;
+        let seen = self.perceive(frame, obs.ego.pos_m[1]);
+        let v = obs.ego.speed_mps.max(0.0);
+        let brake = seen.obstacle_m.is_some_and(|d| {
+            let gap = d - c.front_offset_m;
+            gap - c.standstill_gap_m < v * c.ttc_brake_s
+        });
+        let throttle = if brake {
+            -1.0
+        } else {
+            c.speed_gain * (c.target_speed_mps - obs.ego.speed_mps)
+        };
+        let steering = seen.lane_centre_m.map_or(0.0, |y| {
+            // Pure pursuit: curvature 2y / L² toward the point (L, y); z (y) points right,
+            // and positive steering turns left.
+            let curvature = 2.0 * y / c.lookahead_m.powi(2);
+            -(c.wheelbase_m * curvature).atan() / c.max_steer_rad
+        });
+        Control { throttle, steering }.clamped()
+    }
+}
+
+/// Paint pixels needed on one side before a lane line counts as seen.
+const MIN_MARKING_PIXELS: usize = 8;
+
+/// Depth of an object cluster along the view, metres: candidates within this of the
+/// cluster's nearest point belong to it.
+const CLUSTER_DEPTH_M: f64 = 1.5;
+
+/// The distance of the nearest object whose mean colour `visible` accepts. `candidates` are
+/// `(forward distance m, rgb)` of pixels standing above the road in the corridor; they are
+/// grouped front to back into clusters [`CLUSTER_DEPTH_M`] deep, and a cluster of at least
+/// `min_pixels` pixels is an object. Averaging over the cluster keeps pixel noise from making
+/// an invisible object visible.
+fn nearest_visible_object(
+    mut candidates: Vec<(f64, [u8; 3])>,
+    min_pixels: usize,
+    visible: impl Fn([f64; 3]) -> bool,
+) -> Option<f64> {
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut start = 0;
+    while start < candidates.len() {
+        let near = candidates[start].0;
+        let end = start
+            + candidates[start..]
+                .iter()
+                .take_while(|(d, _)| *d < near + CLUSTER_DEPTH_M)
+                .count();
+        let cluster = &candidates[start..end];
+        if cluster.len() >= min_pixels {
+            let mut mean = [0.0; 3];
+            for (_, rgb) in cluster {
+                for i in 0..3 {
+                    mean[i] += f64::from(rgb[i]) / cluster.len() as f64;
+                }
+            }
+            if visible(mean) {
+                // The min_pixels-th nearest point: robust to a stray pixel.
+                return Some(cluster[min_pixels - 1].0);
+            }
+        }
+        start = end;
+    }
+    None
+}
+
+impl Sut for Vision {
+    fn sensors(&self) -> Sensors {
+        Sensors {
+            camera: Some(self.config.camera.clone()),
+            control_hz: None,
+        }
+    }
+
+    fn reset(&mut self, _seed: u64) -> Result<(), SutError> {
+        self.last_frame_t = None;
+        self.decision = Control::default();
+        Ok(())
+    }
+
+    fn act(&mut self, obs: &Observation<'_>) -> Result<Control, SutError> {
+        let frame = obs.camera.ok_or_else(|| {
+            SutError::Failed("vision needs camera frames but the observation has none".into())
+        })?;
+        // Decide once per frame; hold the decision between frames.
+        if self.last_frame_t != Some(frame.t_s) {
+            self.last_frame_t = Some(frame.t_s);
+            self.decision = self.decide(frame, obs);
+        }
+        Ok(self.decision)
+    }
+}

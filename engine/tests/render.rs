@@ -1,0 +1,304 @@
+//! The camera renderer on fixed scenes: golden images with tolerances, depth against
+//! geometry, fog and light. These tests need a GPU adapter; on a machine without a GPU, Mesa's
+//! lavapipe (Debian `mesa-vulkan-drivers`, installed by `scripts/test`) provides one. They
+//! never skip: without an adapter they fail.
+#![cfg(feature = "render")]
+
+use std::path::{Path, PathBuf};
+
+use paracosm_engine::network::{Network, PieceKind};
+use paracosm_engine::render::{CameraPose, RenderJob, RenderObject, Renderer, NOMINAL_LIGHT};
+use paracosm_engine::{CameraFrame, CameraSpec};
+
+fn renderer() -> std::sync::Arc<Renderer> {
+    Renderer::shared().expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe)")
+}
+
+const WHITE: [f32; 3] = [0.92, 0.92, 0.92];
+const RED: [f32; 3] = [0.75, 0.08, 0.07];
+
+fn car_at(x: f64, z: f64, albedo: [f32; 3]) -> RenderObject {
+    RenderObject {
+        base_m: [x, 0.0, z],
+        size_m: [4.5, 1.7, 1.9],
+        heading_rad: 0.0,
+        albedo,
+    }
+}
+
+/// The ego camera at the start of lane 1 of a straight 4-lane road, 10 m in.
+fn pose() -> CameraPose {
+    CameraPose {
+        chassis_m: [10.0, 0.5, 1.75],
+        heading_rad: 0.0,
+    }
+}
+
+fn render(
+    network: &Network,
+    camera: &CameraSpec,
+    pose: CameraPose,
+    objects: &[RenderObject],
+    light: f64,
+    fog: f64,
+) -> CameraFrame {
+    let r = renderer();
+    let scene = r.scene(network);
+    let mut view = r.view(camera).unwrap();
+    r.render_one(RenderJob {
+        scene: &scene,
+        view: &mut view,
+        pose,
+        objects,
+        light,
+        fog,
+        t_s: 0.0,
+        noise_seed: 0,
+    })
+    .unwrap()
+}
+
+fn road() -> Network {
+    Network::single_segment(200.0, 4, 1.0).unwrap()
+}
+
+fn golden_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
+}
+
+/// Compares `frame` with `tests/golden/NAME.png`: the mean absolute difference over all
+/// channels must be at most 1.5 levels and the 99th percentile at most 24 levels (renderers
+/// differ in rasterisation rules at edges, not in colour). On failure writes
+/// `NAME-actual.png` and `NAME-difference.png` beside the reference. `PARACOSM_BLESS=1`
+/// (re)writes the reference.
+fn assert_golden(name: &str, frame: &CameraFrame) {
+    let reference = golden_dir().join(format!("{name}.png"));
+    if std::env::var_os("PARACOSM_BLESS").is_some() {
+        frame.save_png(&reference).unwrap();
+        return;
+    }
+    let expected = image::open(&reference)
+        .unwrap_or_else(|e| panic!("{}: {e} (PARACOSM_BLESS=1 writes it)", reference.display()))
+        .to_rgb8();
+    assert_eq!(
+        (expected.width(), expected.height()),
+        (frame.width, frame.height),
+        "{name}: size"
+    );
+    let mut diffs: Vec<u8> = expected
+        .as_raw()
+        .iter()
+        .zip(&frame.rgb)
+        .map(|(a, b)| a.abs_diff(*b))
+        .collect();
+    let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;
+    let difference: Vec<u8> = diffs.iter().map(|&d| d.saturating_mul(4)).collect();
+    diffs.sort_unstable();
+    let p99 = diffs[diffs.len() * 99 / 100];
+    if mean > 1.5 || p99 > 24 {
+        let actual = golden_dir().join(format!("{name}-actual.png"));
+        let diff_path = golden_dir().join(format!("{name}-difference.png"));
+        frame.save_png(&actual).unwrap();
+        image::RgbImage::from_raw(frame.width, frame.height, difference)
+            .unwrap()
+            .save(&diff_path)
+            .unwrap();
+        panic!(
+            "{name}: mean difference {mean:.2} levels (at most 1.5), 99th percentile {p99} (at \
+             most 24); wrote {} and {}",
+            actual.display(),
+            diff_path.display()
+        );
+    }
+}
+
+#[test]
+fn an_adapter_is_found() {
+    let r = Renderer::new().expect("no GPU adapter: these tests must not skip");
+    eprintln!("adapter: {}", r.adapter());
+    assert!(!r.adapter().is_empty());
+}
+
+#[test]
+fn golden_straight_road_with_a_white_car_ahead() {
+    let frame = render(
+        &road(),
+        &CameraSpec::default(),
+        pose(),
+        &[car_at(35.0, 1.75, WHITE)],
+        NOMINAL_LIGHT,
+        0.0,
+    );
+    assert_golden("straight_road_car", &frame);
+}
+
+#[test]
+fn golden_straight_road_in_fog() {
+    let frame = render(
+        &road(),
+        &CameraSpec::default(),
+        pose(),
+        &[car_at(35.0, 1.75, WHITE)],
+        NOMINAL_LIGHT,
+        0.8,
+    );
+    assert_golden("straight_road_car_fog_0.8", &frame);
+}
+
+#[test]
+fn golden_cross_intersection_at_dusk() {
+    let mut n = Network::new();
+    let a = n
+        .add(
+            "a",
+            PieceKind::Segment {
+                length_m: 60.0,
+                lanes: 2,
+                friction: 1.0,
+            },
+        )
+        .unwrap();
+    let x = n
+        .add(
+            "x",
+            PieceKind::CrossIntersection {
+                lanes: 2,
+                friction: 1.0,
+            },
+        )
+        .unwrap();
+    n.connect(a, 1, x, 2).unwrap();
+    let frame = render(
+        &n,
+        &CameraSpec {
+            focal_mm: 18.0,
+            ..CameraSpec::default()
+        },
+        CameraPose {
+            chassis_m: [40.0, 0.5, 1.75],
+            heading_rad: 0.0,
+        },
+        &[
+            car_at(70.0, -1.75, RED),
+            RenderObject {
+                base_m: [55.0, 0.15, 5.0],
+                size_m: [0.5, 1.8, 0.5],
+                heading_rad: 0.0,
+                albedo: [0.75, 0.22, 0.18],
+            },
+        ],
+        0.3,
+        0.0,
+    );
+    assert_golden("cross_intersection_dusk", &frame);
+}
+
+#[test]
+fn depth_is_the_distance_along_the_optical_axis() {
+    let camera = CameraSpec {
+        pitch_rad: 0.0,
+        ..CameraSpec::default()
+    };
+    let frame = render(
+        &road(),
+        &camera,
+        pose(),
+        &[car_at(35.0, 1.75, WHITE)],
+        0.6,
+        0.0,
+    );
+    // The camera sits 0.5 m ahead of the chassis at x = 10, so the car's rear face (x = 32.75)
+    // is 22.25 m away, straight ahead at the image centre.
+    let d = frame.depth_at(160, 118);
+    assert!((d - 22.25).abs() < 0.05, "depth {d}");
+    // The sky has no depth.
+    assert_eq!(frame.depth_at(160, 2), f32::INFINITY);
+    // A road pixel below the centre lies on the ground, 0.5 m below the chassis centre.
+    let (u, v) = (160.0, 200.0);
+    let depth = f64::from(frame.depth_at(160, 200));
+    let p = camera.camera_to_vehicle(camera.back_project(u + 0.5, v + 0.5, depth));
+    assert!((p[1] + 0.5).abs() < 0.02, "vehicle-frame point {p:?}");
+}
+
+fn contrast(frame: &CameraFrame, car: (u32, u32), background: (u32, u32)) -> f64 {
+    let a = frame.rgb_at(car.0, car.1);
+    let b = frame.rgb_at(background.0, background.1);
+    a.iter()
+        .zip(&b)
+        .map(|(x, y)| f64::from(x.abs_diff(*y)))
+        .sum::<f64>()
+}
+
+#[test]
+fn fog_fades_the_car_into_the_sky_and_light_scales_the_image() {
+    let objects = [car_at(35.0, 1.75, RED)];
+    let at = |fog: f64, light: f64| {
+        render(
+            &road(),
+            &CameraSpec::default(),
+            pose(),
+            &objects,
+            light,
+            fog,
+        )
+    };
+    let car_px = (160, 112);
+    let sky_px = (160, 5);
+    let clear = contrast(&at(0.0, 0.6), car_px, sky_px);
+    let misty = contrast(&at(0.2, 0.6), car_px, sky_px);
+    let dense = contrast(&at(0.8, 0.6), car_px, sky_px);
+    assert!(clear > misty && misty > dense, "{clear} {misty} {dense}");
+    assert!(
+        dense < 10.0,
+        "22 m in fog 0.8 is beyond the 9.8 m visibility: {dense}"
+    );
+    let mean =
+        |f: &CameraFrame| f.rgb.iter().map(|&v| f64::from(v)).sum::<f64>() / f.rgb.len() as f64;
+    let dark = mean(&at(0.0, 0.15));
+    let nominal = mean(&at(0.0, 0.6));
+    assert!((dark / nominal - 0.25).abs() < 0.03, "{dark} {nominal}");
+}
+
+#[test]
+fn many_views_render_in_one_batch_like_one_at_a_time() {
+    let r = renderer();
+    let network = road();
+    let scene = r.scene(&network);
+    let camera = CameraSpec::default();
+    let objects = [car_at(35.0, 1.75, WHITE)];
+    let mut views: Vec<_> = (0..4).map(|_| r.view(&camera).unwrap()).collect();
+    let mut jobs: Vec<RenderJob<'_>> = views
+        .iter_mut()
+        .enumerate()
+        .map(|(i, view)| RenderJob {
+            scene: &scene,
+            view,
+            pose: CameraPose {
+                chassis_m: [10.0 + i as f64, 0.5, 1.75],
+                heading_rad: 0.0,
+            },
+            objects: &objects,
+            light: 0.6,
+            fog: 0.0,
+            t_s: 0.0,
+            noise_seed: 0,
+        })
+        .collect();
+    let batch = r.render(&mut jobs).unwrap();
+    for (i, frame) in batch.iter().enumerate() {
+        let single = render(
+            &network,
+            &camera,
+            CameraPose {
+                chassis_m: [10.0 + i as f64, 0.5, 1.75],
+                heading_rad: 0.0,
+            },
+            &objects,
+            0.6,
+            0.0,
+        );
+        assert_eq!(frame.rgb, single.rgb, "view {i}");
+        assert_eq!(frame.depth_m, single.depth_m, "view {i}");
+    }
+    assert_ne!(batch[0].rgb, batch[3].rgb, "the views moved");
+}

@@ -1,0 +1,269 @@
+//! `campaign.json` (how a campaign was run) and the replay of one recorded test.
+
+use std::path::{Path, PathBuf};
+
+use paracosm_engine::sut::{ExternalConfig, SutConfig};
+use paracosm_engine::{CameraFrame, CameraSpec};
+use paracosm_generators::{Point, Strategy};
+use paracosm_scenarios::RunOptions;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::campaign::Campaign;
+use crate::record::{RunRecord, Status};
+
+/// File name of the campaign's settings in the output folder, written before any test runs.
+pub const CAMPAIGN_FILE: &str = "campaign.json";
+
+/// Which system under test a campaign ran.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SutChoice {
+    /// The scenario's own default (`AutonomousVehicle(sut=...)`).
+    Scenario,
+    /// A built-in system chosen with `--sut`.
+    Builtin {
+        /// `aeb` or `vision`.
+        name: String,
+    },
+    /// A program chosen with `--sut-cmd`.
+    Command {
+        /// Program and arguments.
+        command: Vec<String>,
+        /// `--sut-timeout`, seconds.
+        timeout_s: f64,
+        /// Whether processes were kept alive between tests.
+        reuse: bool,
+    },
+}
+
+impl SutChoice {
+    /// The configuration to run, or `None` for the scenario's default.
+    ///
+    /// # Errors
+    /// A message for an unknown built-in name.
+    pub fn config(&self) -> Result<Option<SutConfig>, String> {
+        match self {
+            SutChoice::Scenario => Ok(None),
+            SutChoice::Builtin { name } => SutConfig::builtin(name).map(Some),
+            SutChoice::Command {
+                command,
+                timeout_s,
+                reuse,
+            } => Ok(Some(SutConfig::External(ExternalConfig::new(
+                command.clone(),
+                *timeout_s,
+                *reuse,
+            )))),
+        }
+    }
+}
+
+/// The contents of `campaign.json`: everything needed to rebuild any test of the campaign.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CampaignFile {
+    /// `paracosm <version>`.
+    pub tool: String,
+    /// The scenario as given: a built-in name, or the absolute path of a `.star` file.
+    pub scenario: String,
+    /// The system under test.
+    pub sut: SutChoice,
+    /// Strategy name (`halton`, `random`, ...).
+    pub strategy: String,
+    /// Campaign seed.
+    pub seed: u64,
+    /// Number of tests.
+    pub budget: u64,
+    /// Strength of covering-array strategies.
+    pub strength: usize,
+}
+
+/// Why a replay cannot run.
+#[derive(Debug, Error)]
+pub enum ReplayError {
+    /// A file cannot be read or written, or does not parse.
+    #[error("{0}")]
+    Input(String),
+}
+
+/// The outcome of a replay.
+#[derive(Debug)]
+pub struct Replay {
+    /// The record as written by the campaign (a JSON object).
+    pub recorded: serde_json::Value,
+    /// The record of the replayed run.
+    pub replayed: RunRecord,
+    /// Whether status and every monitor's verdict and robustness equal the recorded ones.
+    pub matches: bool,
+    /// Frames written, in time order.
+    pub frames: Vec<PathBuf>,
+    /// The contact sheet, when frames were written.
+    pub contact_sheet: Option<PathBuf>,
+}
+
+fn input(e: impl std::fmt::Display) -> ReplayError {
+    ReplayError::Input(e.to_string())
+}
+
+/// Reads `campaign.json` from `dir`.
+///
+/// # Errors
+/// [`ReplayError::Input`] naming the file when it is missing or malformed.
+pub fn read_campaign_file(dir: &Path) -> Result<CampaignFile, ReplayError> {
+    let path = dir.join(CAMPAIGN_FILE);
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| input(format!("cannot read `{}`: {e}", path.display())))?;
+    serde_json::from_str(&text).map_err(|e| {
+        input(format!(
+            "`{}` is not a campaign file: {e} (line {}, column {})",
+            path.display(),
+            e.line(),
+            e.column()
+        ))
+    })
+}
+
+/// The line of `results` whose `id` is `id`.
+fn find_record(results: &Path, id: u64) -> Result<serde_json::Value, ReplayError> {
+    let text = std::fs::read_to_string(results)
+        .map_err(|e| input(format!("cannot read `{}`: {e}", results.display())))?;
+    let mut ids = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let v: serde_json::Value = match serde_json::from_str(line) {
+            Ok(v) => v,
+            // A half-written last line (the campaign was killed) is not a record.
+            Err(_) if n + 1 == text.lines().count() => continue,
+            Err(e) => {
+                return Err(input(format!(
+                    "{}:{}:{}: not a results line: {e}",
+                    results.display(),
+                    n + 1,
+                    e.column()
+                )))
+            }
+        };
+        match v.get("id").and_then(serde_json::Value::as_u64) {
+            Some(i) if i == id => return Ok(v),
+            Some(i) => ids.push(i),
+            None => {
+                return Err(input(format!(
+                    "{}:{}: a results line without an `id`",
+                    results.display(),
+                    n + 1
+                )))
+            }
+        }
+    }
+    let range = match (ids.iter().min(), ids.iter().max()) {
+        (Some(lo), Some(hi)) => format!("ids {lo}..={hi}"),
+        _ => "no records".into(),
+    };
+    Err(input(format!(
+        "no test with id {id} in `{}` ({range})",
+        results.display()
+    )))
+}
+
+/// Re-runs test `id` of the campaign whose results are `results` (with `campaign.json` beside
+/// it), from its recorded point and seed. With `frames`, writes every camera frame as
+/// `frame_NNNNN.png` there (the system's own camera, or a default 320 × 240 camera at 20 Hz
+/// for systems without one), and `contact_sheet.png`. `sut` replaces the recorded system.
+///
+/// # Errors
+/// [`ReplayError::Input`] when a file is missing or malformed, the id is not in the results,
+/// the scenario does not load, or a frame cannot be written.
+pub fn replay(
+    results: &Path,
+    id: u64,
+    frames: Option<&Path>,
+    sut: Option<SutConfig>,
+) -> Result<Replay, ReplayError> {
+    let dir = results.parent().unwrap_or(Path::new("."));
+    let campaign_file = read_campaign_file(dir)?;
+    let recorded = find_record(results, id)?;
+    let point: Point = serde_json::from_value(recorded["point"].clone())
+        .map_err(|e| input(format!("test {id}: its `point` does not parse: {e}")))?;
+    let mut scenario = paracosm_scenarios::load(&campaign_file.scenario).map_err(input)?;
+    if let Some(s) = sut.or(campaign_file.sut.config().map_err(input)?) {
+        scenario.sut = s;
+    }
+    let strategy: Strategy = campaign_file.strategy.parse().map_err(input)?;
+    let campaign = Campaign {
+        scenario: &scenario,
+        strategy,
+        seed: campaign_file.seed,
+        budget: campaign_file.budget,
+        strength: campaign_file.strength,
+        jobs: 1,
+    };
+    if let Some(dir) = frames {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| input(format!("cannot create `{}`: {e}", dir.display())))?;
+    }
+    let mut written = Vec::new();
+    let mut thumbnails = Vec::new();
+    let mut write_error = None;
+    let mut on_frame = |f: &CameraFrame| {
+        let Some(dir) = frames else { return };
+        let path = dir.join(format!("frame_{:05}.png", written.len()));
+        match f.save_png(&path) {
+            Ok(()) => {
+                written.push(path);
+                thumbnails.push((f.t_s, f.to_image()));
+            }
+            Err(e) => {
+                write_error.get_or_insert(e);
+            }
+        }
+    };
+    let mut options = RunOptions {
+        camera: frames.map(|_| CameraSpec::default()),
+        on_frame: Some(&mut on_frame),
+    };
+    let replayed = campaign.run_one_with(id, &point, &mut options);
+    drop(options);
+    if let Some(e) = write_error {
+        return Err(input(e));
+    }
+    if recorded["seed"].as_u64() != Some(replayed.seed) {
+        return Err(input(format!(
+            "test {id} was recorded with seed {} but campaign.json gives {}: the results and \
+             campaign.json are from different campaigns",
+            recorded["seed"], replayed.seed
+        )));
+    }
+    let contact_sheet = match frames {
+        Some(dir) if !thumbnails.is_empty() => {
+            let path = dir.join("contact_sheet.png");
+            crate::plot::contact_sheet(&path, &thumbnails, &format!("test {id}")).map_err(input)?;
+            Some(path)
+        }
+        _ => None,
+    };
+    let matches = verdicts_match(&recorded, &replayed);
+    Ok(Replay {
+        recorded,
+        replayed,
+        matches,
+        frames: written,
+        contact_sheet,
+    })
+}
+
+/// Status, and each monitor's `passed`, `robustness` and `first_violation_s`, equal between a
+/// recorded line and a replayed record (compared through their JSON form, as written).
+fn verdicts_match(recorded: &serde_json::Value, replayed: &RunRecord) -> bool {
+    let Ok(replayed) = serde_json::to_value(replayed) else {
+        return false;
+    };
+    recorded["status"] == replayed["status"] && recorded["monitors"] == replayed["monitors"]
+}
+
+/// `pass`, `fail` or `error`.
+pub fn status_name(s: Status) -> &'static str {
+    match s {
+        Status::Pass => "pass",
+        Status::Fail => "fail",
+        Status::Error => "error",
+    }
+}
