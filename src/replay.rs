@@ -216,12 +216,14 @@ pub fn replay(
             }
         }
     };
-    let mut options = RunOptions {
-        camera: frames.map(|_| CameraSpec::default()),
-        on_frame: Some(&mut on_frame),
-    };
-    let replayed = campaign.run_one_with(id, &point, &mut options);
-    drop(options);
+    let replayed = campaign.run_one_with(
+        id,
+        &point,
+        &mut RunOptions {
+            camera: frames.map(|_| CameraSpec::default()),
+            on_frame: Some(&mut on_frame),
+        },
+    );
     if let Some(e) = write_error {
         return Err(input(e));
     }

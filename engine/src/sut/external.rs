@@ -72,7 +72,8 @@ struct Message {
 #[derive(Debug)]
 struct Process {
     child: Child,
-    stdin: ChildStdin,
+    /// `None` once closed (when the process is dropped).
+    stdin: Option<ChildStdin>,
     replies: Receiver<Result<Message, String>>,
     stderr: Arc<Mutex<String>>,
     sensors: Sensors,
@@ -82,6 +83,14 @@ struct Process {
 
 impl Drop for Process {
     fn drop(&mut self) {
+        // Closing stdin asks the program to exit; give it 100 ms, then kill it.
+        self.stdin = None;
+        for _ in 0..10 {
+            if let Ok(Some(_)) = self.child.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
@@ -189,7 +198,7 @@ impl Process {
         });
         let mut p = Process {
             child,
-            stdin,
+            stdin: Some(stdin),
             replies,
             stderr,
             sensors: Sensors::default(),
@@ -246,7 +255,11 @@ impl Process {
         buffers: &[&[u8]],
         timeout_s: f64,
     ) -> Result<Message, String> {
-        if let Err(e) = write_message(&mut self.stdin, header, buffers) {
+        let written = match self.stdin.as_mut() {
+            Some(stdin) => write_message(stdin, header, buffers),
+            None => Err(std::io::Error::other("stdin closed")),
+        };
+        if let Err(e) = written {
             return Err(self.died(&format!("stopped reading its input ({e})")));
         }
         match self

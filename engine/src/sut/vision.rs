@@ -128,10 +128,7 @@ impl Vision {
                 let d = frame.depth_at(u, v);
                 let rgb = frame.rgb_at(u, v);
                 if !d.is_finite() {
-                    for i in 0..3 {
-                        sky.0[i] += f64::from(rgb[i]);
-                    }
-                    sky.1 += 1;
+                    accumulate(&mut sky, rgb);
                     continue;
                 }
                 let p = cam.camera_to_vehicle(cam.back_project(
@@ -141,10 +138,7 @@ impl Vision {
                 ));
                 let height = p[1] + chassis_height_m;
                 if height.abs() < 0.1 && p[2].abs() < 1.0 && (3.0..8.0).contains(&p[0]) {
-                    for i in 0..3 {
-                        road.0[i] += f64::from(rgb[i]);
-                    }
-                    road.1 += 1;
+                    accumulate(&mut road, rgb);
                 }
                 points.push((p, height, rgb));
             }
@@ -236,6 +230,14 @@ impl Vision {
         });
         Control { throttle, steering }.clamped()
     }
+}
+
+/// Adds a pixel to a running `(sum, count)` of colours.
+fn accumulate(acc: &mut ([f64; 3], usize), rgb: [u8; 3]) {
+    for (sum, v) in acc.0.iter_mut().zip(rgb) {
+        *sum += f64::from(v);
+    }
+    acc.1 += 1;
 }
 
 /// Paint pixels needed on one side before a lane line counts as seen.

@@ -1,0 +1,250 @@
+//! Systems under test end to end: the Python client library, misbehaving external programs,
+//! the camera-based `vision`, and `replay`.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn fuzz(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("paracosm-fuzz runs")
+}
+
+fn expect_code(o: &Output, code: i32) {
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "stdout: {}\nstderr: {}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn records(dir: &Path) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(dir.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+fn statuses(dir: &Path) -> Vec<String> {
+    records(dir)
+        .iter()
+        .map(|r| r["status"].as_str().unwrap().to_owned())
+        .collect()
+}
+
+fn script(name: &str) -> String {
+    format!(
+        "python3 {}",
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(name).display()
+    )
+}
+
+#[test]
+fn the_python_example_runs_the_pedestrian_study_with_the_verdicts_of_aeb() {
+    let dir = tempfile::tempdir().unwrap();
+    let (py, aeb) = (dir.path().join("py"), dir.path().join("aeb"));
+    let common = [
+        "pedestrian-crossing",
+        "--budget",
+        "12",
+        "--jobs",
+        "2",
+        "--out",
+    ];
+    let cmd = script("examples/python/paracosm_sut.py");
+    let mut args = common.to_vec();
+    args.extend([py.to_str().unwrap(), "--sut-cmd", &cmd]);
+    let o = fuzz(&args);
+    let mut args = common.to_vec();
+    args.push(aeb.to_str().unwrap());
+    fuzz(&args);
+    let (a, b) = (statuses(&py), statuses(&aeb));
+    assert_eq!(a.len(), 12);
+    assert!(!a.contains(&"error".to_owned()), "{a:?}");
+    assert!(
+        a.contains(&"fail".to_owned()),
+        "test 9 is a collision: {a:?}"
+    );
+    // The example brakes by the same rule as aeb; on the straight road they agree.
+    assert_eq!(a, b);
+    expect_code(&o, 1);
+    let campaign: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(py.join("campaign.json")).unwrap()).unwrap();
+    assert_eq!(campaign["sut"]["kind"], "command");
+}
+
+#[test]
+fn every_misbehaving_program_becomes_an_error_record_and_the_campaign_goes_on() {
+    let cases = [
+        ("crash.py", "RuntimeError: controller exploded"),
+        ("hang.py", "did not answer within 1 s"),
+        ("garbage.py", "is it printing to stdout?"),
+        ("nan.py", "NaN and Infinity are not JSON numbers"),
+        ("out_of_range.py", "answered throttle = 3, outside [-1, 1]"),
+    ];
+    for (file, message) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let cmd = script(&format!("tests/sut_faults/{file}"));
+        let o = fuzz(&[
+            "pedestrian-crossing",
+            "--budget",
+            "2",
+            "--jobs",
+            "1",
+            "--sut-timeout",
+            "1",
+            "--out",
+            dir.path().to_str().unwrap(),
+            "--sut-cmd",
+            &cmd,
+        ]);
+        expect_code(&o, 3);
+        let rs = records(dir.path());
+        assert_eq!(rs.len(), 2, "{file}: both tests are recorded");
+        for r in rs {
+            assert_eq!(r["status"], "error", "{file}");
+            let error = r["error"].as_str().unwrap();
+            assert!(error.contains(message), "{file}: {error}");
+        }
+        assert!(dir.path().join("summary.json").exists(), "{file}");
+    }
+}
+
+#[test]
+fn after_a_crash_the_next_test_gets_a_fresh_process() {
+    let dir = tempfile::tempdir().unwrap();
+    let marker = dir.path().join("crashed-once");
+    let out = dir.path().join("out");
+    let cmd = script("tests/sut_faults/crash_first_test.py");
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .args([
+            "pedestrian-crossing",
+            "--budget",
+            "4",
+            "--jobs",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+            "--sut-cmd",
+            &cmd,
+        ])
+        .env("CRASH_MARKER", &marker)
+        .output()
+        .unwrap();
+    assert!(o.status.code() == Some(0) || o.status.code() == Some(3));
+    let s = statuses(&out);
+    assert_eq!(s[0], "error");
+    assert!(records(&out)[0]["error"]
+        .as_str()
+        .unwrap()
+        .contains("exit status: 7"));
+    assert!(s[1..].iter().all(|s| s != "error"), "{s:?}");
+}
+
+#[test]
+fn a_program_gets_the_camera_and_depth_it_asks_for_fresh_or_reused() {
+    for fresh in [false, true] {
+        let dir = tempfile::tempdir().unwrap();
+        let cmd = script("tests/sut_faults/camera.py");
+        let mut args = vec![
+            "pedestrian-crossing",
+            "--budget",
+            "2",
+            "--jobs",
+            "1",
+            "--out",
+            dir.path().to_str().unwrap(),
+            "--sut-cmd",
+            &cmd,
+        ];
+        if fresh {
+            args.push("--sut-fresh");
+        }
+        let o = fuzz(&args);
+        expect_code(&o, 0);
+        assert_eq!(statuses(dir.path()), ["pass", "pass"]);
+    }
+}
+
+#[test]
+fn replay_writes_frames_and_a_contact_sheet_and_confirms_the_verdict() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    fuzz(&[
+        "pedestrian-crossing",
+        "--budget",
+        "12",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(statuses(&out)[9], "fail");
+    let frames = dir.path().join("frames");
+    let results = out.join("results.jsonl");
+    let o = fuzz(&[
+        "replay",
+        results.to_str().unwrap(),
+        "--id",
+        "9",
+        "--frames",
+        frames.to_str().unwrap(),
+    ]);
+    expect_code(&o, 0);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("recorded fail, replayed fail"), "{stdout}");
+    assert!(stdout.contains("equals the recorded one"), "{stdout}");
+    let pngs = std::fs::read_dir(&frames)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .starts_with("frame_")
+        })
+        .count();
+    // The collision is at about 7.35 s; a 20 Hz camera takes a frame every 50 ms.
+    assert!((100..200).contains(&pngs), "{pngs} frames");
+    let sheet = std::fs::read(frames.join("contact_sheet.png")).unwrap();
+    assert_eq!(&sheet[..4], b"\x89PNG");
+    let first = image::open(frames.join("frame_00000.png")).unwrap();
+    assert_eq!((first.width(), first.height()), (320, 240));
+
+    // An id that is not there is bad input.
+    let o = fuzz(&["replay", results.to_str().unwrap(), "--id", "77"]);
+    expect_code(&o, 2);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no test with id 77"));
+}
+
+#[test]
+fn vision_fails_in_fog_dark_and_glare_but_not_in_clear_nominal_light() {
+    let mut s = paracosm_scenarios::builtin("fog-light").unwrap();
+    s.sut = paracosm_engine::sut::SutConfig::builtin("vision").unwrap();
+    let run = |light: f64, fog: f64| {
+        // Both parameters span [0, 1], light first: the unit point is the value.
+        let a = s
+            .space
+            .decode(&paracosm_generators::Point {
+                discrete: vec![],
+                continuous: vec![light, fog],
+            })
+            .unwrap();
+        assert_eq!(a.real("fog"), Some(fog));
+        s.run(&a, 1).unwrap().passed()
+    };
+    assert!(run(0.5, 0.0), "clear, nominal light");
+    assert!(run(0.4, 0.15), "light mist");
+    assert!(
+        !run(0.5, 0.7),
+        "dense fog hides the white car until too late"
+    );
+    assert!(!run(0.03, 0.0), "too dark to see");
+    assert!(
+        !run(0.97, 0.0),
+        "glare: the white car and the sky both clip at 255"
+    );
+}
