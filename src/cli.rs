@@ -69,36 +69,56 @@ pub fn parse_args<T: Parser>(tool: &str) -> Result<T, ExitCode> {
 #[error("{0}")]
 pub struct BadInput(pub String);
 
-/// The system under test chosen on the command line (`--sut NAME` or `--sut-cmd COMMAND`),
-/// or `None` to keep the scenario's.
-///
-/// # Errors
-/// A message for an unknown name, a command that does not split (an unclosed quote) or is
-/// empty, or a timeout that is not a positive number of seconds.
-pub fn sut_override(
-    name: Option<&str>,
-    command: Option<&str>,
-    timeout_s: f64,
-    reuse: bool,
-) -> Result<Option<SutConfig>, String> {
-    if !(timeout_s.is_finite() && timeout_s > 0.0) {
-        return Err(format!(
-            "--sut-timeout {timeout_s} must be a positive number of seconds"
-        ));
-    }
-    match (name, command) {
-        (Some(n), _) => SutConfig::builtin(n)
-            .map(Some)
-            .map_err(|e| format!("--sut: {e}")),
-        (None, Some(c)) => {
-            let words = shlex::split(c)
-                .filter(|w| !w.is_empty())
-                .ok_or_else(|| format!("--sut-cmd {c:?} is empty or has an unclosed quote"))?;
-            Ok(Some(SutConfig::External(ExternalConfig::new(
-                words, timeout_s, reuse,
-            ))))
+/// The options that choose a system under test (`paracosm-fuzz` and its `replay`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SutArgs {
+    /// Built-in system under test, instead of the scenario's default: aeb (lidar) or vision
+    /// (camera).
+    #[arg(long, value_name = "NAME", conflicts_with = "sut_cmd")]
+    pub sut: Option<String>,
+    /// Run the system under test as a program speaking SUT_PROTOCOL.md over stdin/stdout,
+    /// e.g. "python3 my_controller.py" (split like a shell would, without expansion).
+    #[arg(long, value_name = "COMMAND")]
+    pub sut_cmd: Option<String>,
+    /// With --sut-cmd: longest wait for any answer of the program, in seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+    pub sut_timeout: f64,
+    /// With --sut-cmd: start a fresh process for every test, instead of keeping one alive
+    /// per worker and sending it a reset message.
+    #[arg(long)]
+    pub sut_fresh: bool,
+}
+
+impl SutArgs {
+    /// The system under test chosen (`--sut NAME` or `--sut-cmd COMMAND`), or `None` to keep
+    /// the scenario's.
+    ///
+    /// # Errors
+    /// A message for an unknown name, a command that does not split (an unclosed quote) or is
+    /// empty, or a timeout that is not a positive number of seconds.
+    pub fn config(&self) -> Result<Option<SutConfig>, String> {
+        let timeout_s = self.sut_timeout;
+        if !(timeout_s.is_finite() && timeout_s > 0.0) {
+            return Err(format!(
+                "--sut-timeout {timeout_s} must be a positive number of seconds"
+            ));
         }
-        (None, None) => Ok(None),
+        match (&self.sut, &self.sut_cmd) {
+            (Some(n), _) => SutConfig::builtin(n)
+                .map(Some)
+                .map_err(|e| format!("--sut: {e}")),
+            (None, Some(c)) => {
+                let words = shlex::split(c)
+                    .filter(|w| !w.is_empty())
+                    .ok_or_else(|| format!("--sut-cmd {c:?} is empty or has an unclosed quote"))?;
+                Ok(Some(SutConfig::External(ExternalConfig::new(
+                    words,
+                    timeout_s,
+                    !self.sut_fresh,
+                ))))
+            }
+            (None, None) => Ok(None),
+        }
     }
 }
 
@@ -145,6 +165,37 @@ mod tests {
         );
         assert_eq!(strategy(StrategyArg::Sobol, false), Ok(Strategy::Sobol));
         assert!(strategy(StrategyArg::Random, true).is_err());
+    }
+
+    #[test]
+    fn sut_options_choose_a_builtin_or_a_command_or_nothing() {
+        let args = |sut: Option<&str>, cmd: Option<&str>, timeout: f64| SutArgs {
+            sut: sut.map(str::to_owned),
+            sut_cmd: cmd.map(str::to_owned),
+            sut_timeout: timeout,
+            sut_fresh: false,
+        };
+        assert_eq!(args(None, None, 10.0).config(), Ok(None));
+        assert_eq!(
+            args(Some("vision"), None, 10.0)
+                .config()
+                .unwrap()
+                .unwrap()
+                .name(),
+            "vision"
+        );
+        let cmd = args(None, Some("python3 'my ctl.py' --fast"), 2.0)
+            .config()
+            .unwrap()
+            .unwrap();
+        assert_eq!(cmd.name(), "python3 my ctl.py --fast");
+        assert!(args(Some("lidar"), None, 10.0)
+            .config()
+            .unwrap_err()
+            .contains("aeb, vision"));
+        assert!(args(None, Some("python3 'oops"), 10.0).config().is_err());
+        assert!(args(None, Some("   "), 10.0).config().is_err());
+        assert!(args(None, Some("x"), 0.0).config().is_err());
     }
 
     #[test]

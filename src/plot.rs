@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use thiserror::Error;
@@ -52,15 +53,15 @@ fn axis(space: &ParamSpace, name: &str) -> Result<(f64, f64, String), PlotError>
     }
 }
 
-/// One panel: `title` on top, a red cross per failed test, a blue circle per passed test and
-/// a grey triangle per error, at the tests' values of `axes = [x, y]`.
-fn draw_panel<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    records: &[RunRecord],
+/// A chart over the continuous parameters `axes = [x, y]` with `title`, axis labels with
+/// units, and light grid lines when `grid`.
+fn chart_on<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
     space: &ParamSpace,
     axes: &[String; 2],
     title: &str,
-) -> Result<(), String> {
+    grid: bool,
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
     let (x_lo, x_hi, x_label) = axis(space, &axes[0]).map_err(|e| e.to_string())?;
     let (y_lo, y_hi, y_label) = axis(space, &axes[1]).map_err(|e| e.to_string())?;
     let mut chart = ChartBuilder::on(area)
@@ -70,15 +71,29 @@ fn draw_panel<DB: DrawingBackend>(
         .y_label_area_size(55)
         .build_cartesian_2d(x_lo..x_hi, y_lo..y_hi)
         .map_err(|e| e.to_string())?;
-    chart
-        .configure_mesh()
-        .x_desc(x_label)
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(x_label)
         .y_desc(y_label)
         .label_style((FAMILY, 14))
         .axis_desc_style((FAMILY, 16))
-        .light_line_style(WHITE.mix(0.0))
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .light_line_style(WHITE.mix(0.0));
+    if !grid {
+        mesh.disable_mesh();
+    }
+    mesh.draw().map_err(|e| e.to_string())?;
+    Ok(chart)
+}
+
+/// One panel: `title` on top, a red cross per failed test, a blue circle per passed test and
+/// a grey triangle per error, at the tests' values of `axes = [x, y]`.
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    records: &[RunRecord],
+    space: &ParamSpace,
+    axes: &[String; 2],
+    title: &str,
+) -> Result<(), String> {
+    let mut chart = chart_on(area, space, axes, title, true)?;
     let at = |r: &RunRecord| -> Option<(f64, f64)> {
         let p = r.params.as_ref()?;
         Some((p.real(&axes[0])?, p.real(&axes[1])?))
@@ -314,25 +329,10 @@ fn draw_rates<DB: DrawingBackend>(
     cells: &[(u32, u32)],
     bins: usize,
 ) -> Result<(), String> {
-    let (x_lo, x_hi, x_label) = axis(space, &axes[0]).map_err(|e| e.to_string())?;
-    let (y_lo, y_hi, y_label) = axis(space, &axes[1]).map_err(|e| e.to_string())?;
+    let (x_lo, x_hi, _) = axis(space, &axes[0]).map_err(|e| e.to_string())?;
+    let (y_lo, y_hi, _) = axis(space, &axes[1]).map_err(|e| e.to_string())?;
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, (FAMILY, 20))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(55)
-        .build_cartesian_2d(x_lo..x_hi, y_lo..y_hi)
-        .map_err(|e| e.to_string())?;
-    chart
-        .configure_mesh()
-        .x_desc(x_label)
-        .y_desc(y_label)
-        .label_style((FAMILY, 14))
-        .axis_desc_style((FAMILY, 16))
-        .disable_mesh()
-        .draw()
-        .map_err(|e| e.to_string())?;
+    let mut chart = chart_on(&root, space, axes, title, false)?;
     let (dx, dy) = ((x_hi - x_lo) / bins as f64, (y_hi - y_lo) / bins as f64);
     let rects = cells.iter().enumerate().map(|(i, &(failed, n))| {
         let (cx, cy) = ((i % bins) as f64, (i / bins) as f64);

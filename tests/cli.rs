@@ -3,22 +3,8 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn fuzz(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
-        .args(args)
-        .output()
-        .expect("paracosm-fuzz runs")
-}
-
-/// Asserts the exit code, showing stderr when it differs.
-fn expect_code(o: &Output, code: i32) {
-    assert_eq!(
-        o.status.code(),
-        Some(code),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
+mod common;
+use common::{expect_code, fuzz};
 
 fn lines(path: &Path) -> Vec<serde_json::Value> {
     std::fs::read_to_string(path)

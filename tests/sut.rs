@@ -2,25 +2,10 @@
 //! the camera-based `vision`, and `replay`.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn fuzz(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
-        .args(args)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .expect("paracosm-fuzz runs")
-}
-
-fn expect_code(o: &Output, code: i32) {
-    assert_eq!(
-        o.status.code(),
-        Some(code),
-        "stdout: {}\nstderr: {}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
+mod common;
+use common::{expect_code, fuzz};
 
 fn records(dir: &Path) -> Vec<serde_json::Value> {
     std::fs::read_to_string(dir.join("results.jsonl"))

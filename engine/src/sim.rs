@@ -90,6 +90,7 @@ pub struct Simulation {
     dt_s: f64,
     tick: u64,
     /// Size `[length, width, height]` (m) and colour name of each NPC car, for the camera.
+    #[cfg(feature = "render")]
     car_looks: Vec<([f64; 3], String)>,
     #[cfg(feature = "render")]
     camera: Option<crate::render::CameraRig>,
@@ -203,6 +204,7 @@ impl Simulation {
             collector: ChannelEventCollector::new(collision_tx, force_tx, tear_tx),
             dt_s: spec.dt_s,
             tick: 0,
+            #[cfg(feature = "render")]
             car_looks: spec
                 .cars
                 .iter()

@@ -120,6 +120,51 @@ fn an_adapter_is_found() {
 }
 
 #[test]
+fn the_gl_backend_renders_what_vulkan_renders() {
+    // llvmpipe's OpenGL (through EGL) has no depth-buffer copies and cannot render R32Float:
+    // depth goes through the R32Uint colour target on both backends.
+    let gl = Renderer::with_backends(paracosm_engine::render::Backends::GL)
+        .expect("a GL adapter (Mesa's llvmpipe through EGL)");
+    let vk = Renderer::with_backends(paracosm_engine::render::Backends::VULKAN)
+        .expect("a Vulkan adapter (lavapipe)");
+    let frame = |r: &Renderer| {
+        let scene = r.scene(&road());
+        let mut view = r.view(&CameraSpec::default()).unwrap();
+        r.render_one(RenderJob {
+            scene: &scene,
+            view: &mut view,
+            pose: pose(),
+            objects: &[car_at(35.0, 1.75, RED)],
+            light: 0.5,
+            fog: 0.1,
+            t_s: 0.0,
+            noise_seed: 0,
+        })
+        .unwrap()
+    };
+    let (a, b) = (frame(&gl), frame(&vk));
+    let mean = a
+        .rgb
+        .iter()
+        .zip(&b.rgb)
+        .map(|(x, y)| f64::from(x.abs_diff(*y)))
+        .sum::<f64>()
+        / a.rgb.len() as f64;
+    assert!(mean < 1.5, "mean difference {mean} levels");
+    let same_depth = a
+        .depth_m
+        .iter()
+        .zip(&b.depth_m)
+        .filter(|(x, y)| x == y || (x.is_finite() && (*x - *y).abs() < 1e-3 * x.abs()))
+        .count();
+    assert!(
+        same_depth as f64 > 0.99 * a.depth_m.len() as f64,
+        "{same_depth} of {} depths agree",
+        a.depth_m.len()
+    );
+}
+
+#[test]
 fn golden_straight_road_with_a_white_car_ahead() {
     let frame = render(
         &road(),

@@ -77,7 +77,7 @@ fn world(a: &Assignment) -> Result<WorldSpec, ScenarioError> {
     Ok(WorldSpec::straight_road(
         200.0,
         EGO_START_M,
-        AebConfig::default().target_speed_mps,
+        AebConfig::default().cruise.target_speed_mps,
         &[TriggeredPedestrian {
             start: (Lane::SideWalk, CROSSING_AT_M),
             target: (Lane::OppositeSideWalk, CROSSING_AT_M),

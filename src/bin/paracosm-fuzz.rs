@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use paracosm::cli::{BadInput, StrategyArg};
+use paracosm::cli::{BadInput, StrategyArg, SutArgs};
 use tracing::info;
 
 use paracosm::campaign::{Campaign, CampaignError, RESULTS_FILE};
@@ -61,21 +61,8 @@ struct Cli {
     /// Replace the results of an earlier campaign in --out.
     #[arg(long)]
     force: bool,
-    /// Built-in system under test, instead of the scenario's default: aeb (lidar) or vision
-    /// (camera).
-    #[arg(long, value_name = "NAME", conflicts_with = "sut_cmd")]
-    sut: Option<String>,
-    /// Run the system under test as a program speaking SUT_PROTOCOL.md over stdin/stdout,
-    /// e.g. "python3 my_controller.py" (split like a shell would, without expansion).
-    #[arg(long, value_name = "COMMAND")]
-    sut_cmd: Option<String>,
-    /// With --sut-cmd: longest wait for any answer of the program, in seconds.
-    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
-    sut_timeout: f64,
-    /// With --sut-cmd: start a fresh process for every test, instead of keeping one alive
-    /// per worker and sending it a reset message.
-    #[arg(long)]
-    sut_fresh: bool,
+    #[command(flatten)]
+    sut: SutArgs,
 }
 
 #[derive(Debug, Subcommand)]
@@ -97,15 +84,9 @@ struct ReplayArgs {
     /// mounted when the system under test has none).
     #[arg(long, value_name = "DIR")]
     frames: Option<PathBuf>,
-    /// Replay with this built-in system under test instead of the recorded one.
-    #[arg(long, value_name = "NAME", conflicts_with = "sut_cmd")]
-    sut: Option<String>,
-    /// Replay with this external system under test instead of the recorded one.
-    #[arg(long, value_name = "COMMAND")]
-    sut_cmd: Option<String>,
-    /// With --sut-cmd: longest wait for an answer, in seconds.
-    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
-    sut_timeout: f64,
+    /// A system under test to replay with instead of the recorded one.
+    #[command(flatten)]
+    sut: SutArgs,
 }
 
 fn main() -> ExitCode {
@@ -154,14 +135,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
     }
     let name = cli.scenario.as_deref().unwrap_or_default();
     let mut scenario = paracosm_scenarios::load(name).map_err(|e| BadInput(e.to_string()))?;
-    if let Some(sut) = paracosm::cli::sut_override(
-        cli.sut.as_deref(),
-        cli.sut_cmd.as_deref(),
-        cli.sut_timeout,
-        !cli.sut_fresh,
-    )
-    .map_err(BadInput)?
-    {
+    if let Some(sut) = cli.sut.config().map_err(BadInput)? {
         scenario.sut = sut;
     }
     let strategy = paracosm::cli::strategy(cli.strategy, cli.scramble).map_err(BadInput)?;
@@ -183,7 +157,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
             Ok(path) if std::path::Path::new(name).is_file() => path.display().to_string(),
             _ => name.to_owned(),
         },
-        sut: match (&cli.sut, &cli.sut_cmd) {
+        sut: match (&cli.sut.sut, &cli.sut.sut_cmd) {
             (Some(n), _) => paracosm::replay::SutChoice::Builtin { name: n.clone() },
             (None, Some(_)) => match &scenario.sut {
                 paracosm_engine::sut::SutConfig::External(e) => {
@@ -362,13 +336,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
 }
 
 fn replay(args: &ReplayArgs) -> Result<ExitCode> {
-    let sut = paracosm::cli::sut_override(
-        args.sut.as_deref(),
-        args.sut_cmd.as_deref(),
-        args.sut_timeout,
-        false,
-    )
-    .map_err(BadInput)?;
+    let sut = args.sut.config().map_err(BadInput)?;
     let r = paracosm::replay::replay(&args.results, args.id, args.frames.as_deref(), sut)
         .map_err(|e| BadInput(e.to_string()))?;
     let recorded = r.recorded["status"].as_str().unwrap_or("?");

@@ -164,7 +164,21 @@ impl Renderer {
     pub fn new() -> Result<Self, RenderError> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL;
-        let desc = desc.with_env();
+        Self::with_instance(desc.with_env())
+    }
+
+    /// Creates a device on the first adapter of `backends` only, ignoring `WGPU_BACKEND`
+    /// (e.g. `wgpu::Backends::GL` for llvmpipe's OpenGL).
+    ///
+    /// # Errors
+    /// As [`Renderer::new`].
+    pub fn with_backends(backends: wgpu::Backends) -> Result<Self, RenderError> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = backends;
+        Self::with_instance(desc)
+    }
+
+    fn with_instance(desc: wgpu::InstanceDescriptor) -> Result<Self, RenderError> {
         let instance = wgpu::Instance::new(desc);
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,

@@ -31,6 +31,7 @@ pub use crate::camera::{CameraFrame, CameraSpec};
 pub use crate::NOMINAL_LIGHT;
 pub use gpu::{CameraPose, RenderJob, RenderObject, Renderer, SceneGeometry, View};
 pub use mesh::color_albedo;
+pub use wgpu::Backends;
 
 use thiserror::Error;
 

@@ -1,26 +1,14 @@
 use serde::{Deserialize, Serialize};
 
-use super::{Sut, SutError};
+use super::{Cruise, Sut, SutError};
 use crate::{Control, Observation};
 
 /// Settings of the built-in [`Aeb`] system.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AebConfig {
-    /// Cruise speed in m/s. Default 12 m/s (43 km/h).
-    pub target_speed_mps: f64,
-    /// Cruise control gain: throttle per m/s of speed error. Default 0.5.
-    pub speed_gain: f64,
-    /// Half-width of the corridor ahead in which lidar returns count as obstacles, in metres,
-    /// measured from the vehicle's axis. Default 1.3 m (half the car's width plus 0.4 m).
-    pub corridor_half_width_m: f64,
-    /// Time headway that triggers braking, in seconds: brake at full force when the gap to the
-    /// nearest obstacle, less `standstill_gap_m`, is shorter than `speed · ttc_brake_s`, i.e.
-    /// when the time to collision at the current speed drops below it. Default 1.4 s.
-    pub ttc_brake_s: f64,
-    /// Gap kept to an obstacle when stopped, in metres. Default 2 m.
-    pub standstill_gap_m: f64,
-    /// Distance from the chassis centre to the front bumper, in metres. Default 2.25 m.
-    pub front_offset_m: f64,
+    /// Cruise control and the braking rule.
+    #[serde(flatten)]
+    pub cruise: Cruise,
     /// Returns lower than this, in metres relative to the chassis centre (`y` of the vehicle
     /// frame), are ground clutter and ignored. Default -0.6 m (about 0.25 m above the road).
     pub min_height_m: f64,
@@ -45,12 +33,7 @@ pub struct AebConfig {
 impl Default for AebConfig {
     fn default() -> Self {
         AebConfig {
-            target_speed_mps: 12.0,
-            speed_gain: 0.5,
-            corridor_half_width_m: 1.3,
-            ttc_brake_s: 1.4,
-            standstill_gap_m: 2.0,
-            front_offset_m: 2.25,
+            cruise: Cruise::default(),
             min_height_m: -0.6,
             lateral_gain: 0.1,
             heading_gain: 1.0,
@@ -94,18 +77,25 @@ impl Aeb {
         }
     }
 
-    /// Gap in metres from the bumper to the nearest return in the corridor, if any.
-    pub fn nearest_gap_m(&self, obs: &Observation<'_>) -> Option<f64> {
+    /// Distance in metres from the chassis centre to the nearest lidar return in the
+    /// corridor ahead, if any.
+    pub fn nearest_obstacle_m(&self, obs: &Observation<'_>) -> Option<f64> {
         let c = &self.config;
         obs.lidar
             .iter()
             .filter(|r| {
                 r.point_m[0] > 0.0
-                    && r.point_m[2].abs() <= c.corridor_half_width_m
+                    && r.point_m[2].abs() <= c.cruise.corridor_half_width_m
                     && r.point_m[1] >= c.min_height_m
             })
-            .map(|r| r.point_m[0] - c.front_offset_m)
+            .map(|r| r.point_m[0])
             .reduce(f64::min)
+    }
+
+    /// Gap in metres from the bumper to the nearest return in the corridor, if any.
+    pub fn nearest_gap_m(&self, obs: &Observation<'_>) -> Option<f64> {
+        self.nearest_obstacle_m(obs)
+            .map(|d| d - self.config.cruise.front_offset_m)
     }
 }
 
@@ -120,19 +110,13 @@ impl Sut for Aeb {
         let (steering, target_speed) = if obs.route.len() >= 2 {
             self.pursue(obs)
         } else {
-            (self.keep_line(obs), self.config.target_speed_mps)
+            (self.keep_line(obs), self.config.cruise.target_speed_mps)
         };
-        let c = &self.config;
-        let ego = obs.ego;
-        let v = ego.speed_mps.max(0.0);
-        let brake = self
-            .nearest_gap_m(obs)
-            .is_some_and(|gap| gap - c.standstill_gap_m < v * c.ttc_brake_s);
-        let throttle = if brake {
-            -1.0
-        } else {
-            c.speed_gain * (target_speed - ego.speed_mps)
-        };
+        let throttle = self.config.cruise.throttle(
+            obs.ego.speed_mps,
+            target_speed,
+            self.nearest_obstacle_m(obs),
+        );
         Ok(Control { throttle, steering }.clamped())
     }
 }
@@ -187,7 +171,7 @@ impl Aeb {
         let steer = (2.0 * c.wheelbase_m * alpha.sin() / ld).atan() / c.max_steer_rad;
 
         // Speed allowed by each curve ahead, less what braking at curve_decel covers.
-        let mut speed = c.target_speed_mps;
+        let mut speed = c.cruise.target_speed_mps;
         let mut ahead = 0.0;
         let horizon = v * v / (2.0 * c.curve_decel_mps2) + 20.0;
         let pts = &route[self.progress..];

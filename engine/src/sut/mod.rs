@@ -8,11 +8,13 @@
 
 mod aeb;
 mod constant;
+mod cruise;
 mod external;
 mod vision;
 
 pub use aeb::{Aeb, AebConfig};
 pub use constant::ConstantControl;
+pub use cruise::Cruise;
 pub use external::{ExternalConfig, ExternalSut, ProcessPool, PROTOCOL_VERSION};
 pub use vision::{Perception, Vision, VisionConfig};
 

@@ -1,6 +1,6 @@
 use serde::{Deserialize, Serialize};
 
-use super::{Sensors, Sut, SutError};
+use super::{Cruise, Sensors, Sut, SutError};
 use crate::{CameraFrame, CameraSpec, Control, Observation};
 
 /// Settings of the built-in [`Vision`] system.
@@ -9,19 +9,9 @@ use crate::{CameraFrame, CameraSpec, Control, Observation};
 pub struct VisionConfig {
     /// The camera it reads. Default: 160 × 120 px, 24 mm, 20 Hz, pixel noise σ = 2 levels.
     pub camera: CameraSpec,
-    /// Cruise speed in m/s. Default 12 m/s.
-    pub target_speed_mps: f64,
-    /// Throttle per m/s of speed error. Default 0.5.
-    pub speed_gain: f64,
-    /// Half-width of the corridor ahead in which obstacles count, metres. Default 1.3 m.
-    pub corridor_half_width_m: f64,
-    /// Brake at full force when the gap less `standstill_gap_m` is shorter than
-    /// `speed · ttc_brake_s` (seconds). Default 1.4 s.
-    pub ttc_brake_s: f64,
-    /// Gap kept when stopped, metres. Default 2 m.
-    pub standstill_gap_m: f64,
-    /// Chassis centre to front bumper, metres. Default 2.25 m.
-    pub front_offset_m: f64,
+    /// Cruise control and the braking rule (as `aeb`'s).
+    #[serde(flatten)]
+    pub cruise: Cruise,
     /// Points at least this high above the road (m) are obstacles; lower ones are road.
     /// Default 0.3 m.
     pub obstacle_height_m: f64,
@@ -49,12 +39,7 @@ impl Default for VisionConfig {
                 noise_sigma: 2.0,
                 ..CameraSpec::default()
             },
-            target_speed_mps: 12.0,
-            speed_gain: 0.5,
-            corridor_half_width_m: 1.3,
-            ttc_brake_s: 1.4,
-            standstill_gap_m: 2.0,
-            front_offset_m: 2.25,
+            cruise: Cruise::default(),
             obstacle_height_m: 0.3,
             contrast_threshold: 10.0,
             min_obstacle_pixels: 6,
@@ -161,7 +146,7 @@ impl Vision {
                 continue;
             }
             if height >= c.obstacle_height_m {
-                if p[2].abs() <= c.corridor_half_width_m {
+                if p[2].abs() <= c.cruise.corridor_half_width_m {
                     candidates.push((p[0], rgb));
                 }
             } else if height.abs() < 0.1 && (4.0..16.0).contains(&p[0]) {
@@ -212,16 +197,11 @@ impl Vision {
     fn decide(&self, frame: &CameraFrame, obs: &Observation<'_>) -> Control {
         let c = &self.config;
         let seen = self.perceive(frame, obs.ego.pos_m[1]);
-        let v = obs.ego.speed_mps.max(0.0);
-        let brake = seen.obstacle_m.is_some_and(|d| {
-            let gap = d - c.front_offset_m;
-            gap - c.standstill_gap_m < v * c.ttc_brake_s
-        });
-        let throttle = if brake {
-            -1.0
-        } else {
-            c.speed_gain * (c.target_speed_mps - obs.ego.speed_mps)
-        };
+        let throttle = c.cruise.throttle(
+            obs.ego.speed_mps,
+            c.cruise.target_speed_mps,
+            seen.obstacle_m,
+        );
         let steering = seen.lane_centre_m.map_or(0.0, |y| {
             // Pure pursuit: curvature 2y / L² toward the point (L, y); z (y) points right,
             // and positive steering turns left.

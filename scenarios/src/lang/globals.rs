@@ -518,7 +518,7 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let sut = SutConfig::builtin(sut.unwrap_or("aeb")).map_err(anyhow::Error::msg)?;
         let initial_speed_mps = match speed {
             Some(v) => number(v, "speed")?,
-            None => AebConfig::default().target_speed_mps,
+            None => AebConfig::default().cruise.target_speed_mps,
         };
         if !(initial_speed_mps.is_finite() && initial_speed_mps >= 0.0) {
             bail!("speed {initial_speed_mps} m/s must be >= 0");
