@@ -1,11 +1,12 @@
 //! The campaign runner: points from a generator, tests in parallel, results in order.
 
 use std::collections::BTreeMap;
-use std::fs::File;
+use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, Write};
+use std::ops::Range;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
@@ -65,8 +66,10 @@ pub struct Campaign<'a> {
 /// What a finished campaign reports.
 #[derive(Debug, Clone)]
 pub struct CampaignReport {
-    /// Every record, by id.
+    /// Every record this run wrote, by id.
     pub records: Vec<RunRecord>,
+    /// Whether the stop flag ended the run before every asked id ran.
+    pub interrupted: bool,
     /// Outcome counts.
     pub counts: Counts,
     /// The failing test with the smallest id.
@@ -130,7 +133,10 @@ impl Campaign<'_> {
                     .iter()
                     .map(|(n, v)| (n.clone(), MonitorResult::from(v)))
                     .collect(),
-                o.metrics,
+                o.metrics
+                    .into_iter()
+                    .map(|(n, v)| (n.to_owned(), v))
+                    .collect(),
                 None,
             ),
             Err(e) => (Status::Error, Vec::new(), Vec::new(), Some(e)),
@@ -164,10 +170,31 @@ impl Campaign<'_> {
     pub fn run(
         &self,
         out_dir: &Path,
+        on_done: impl FnMut(&RunRecord),
+    ) -> Result<CampaignReport, CampaignError> {
+        self.run_ids(out_dir, 0..self.budget, false, None, on_done)
+    }
+
+    /// Runs the tests with ids in `ids` (a sub-range of `0..budget`: a shard, or what a
+    /// resumed run has left), writing their records to `results.jsonl` in `out_dir`: appended
+    /// to the file when `append` (which must end with a complete line), else replacing it.
+    /// When `stop` becomes true no new test starts; the tests in flight finish, the records
+    /// that follow without a gap are written, and the report says `interrupted`.
+    ///
+    /// # Errors
+    /// As [`Campaign::run`].
+    pub fn run_ids(
+        &self,
+        out_dir: &Path,
+        ids: Range<u64>,
+        append: bool,
+        stop: Option<&AtomicBool>,
         mut on_done: impl FnMut(&RunRecord),
     ) -> Result<CampaignReport, CampaignError> {
         let started = Instant::now();
-        let points = self.points()?;
+        let all = self.points()?;
+        let first = ids.start.min(all.len() as u64);
+        let points = &all[first as usize..ids.end.min(all.len() as u64) as usize];
         let path = out_dir.join(RESULTS_FILE);
         let io_err = |source| CampaignError::Io {
             path: path.clone(),
@@ -177,7 +204,13 @@ impl Campaign<'_> {
             path: out_dir.to_path_buf(),
             source,
         })?;
-        let mut out = BufWriter::new(File::create(&path).map_err(io_err)?);
+        let file = if append {
+            OpenOptions::new().append(true).create(true).open(&path)
+        } else {
+            File::create(&path)
+        };
+        let mut out = BufWriter::new(file.map_err(io_err)?);
+        let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.jobs)
             .thread_name(|i| format!("paracosm-worker-{i}"))
@@ -199,10 +232,14 @@ impl Campaign<'_> {
                 pool.scope(|s| {
                     for _ in 0..self.jobs {
                         let tx = tx.clone();
+                        let stopped = &stopped;
                         s.spawn(move |_| loop {
+                            if stopped() {
+                                break;
+                            }
                             let i = next.fetch_add(1, Ordering::Relaxed);
                             let Some(p) = points.get(i) else { break };
-                            if tx.send(self.run_one(i as u64, p)).is_err() {
+                            if tx.send(self.run_one(first + i as u64, p)).is_err() {
                                 break; // the writer gave up; stop taking work
                             }
                         });
@@ -212,7 +249,7 @@ impl Campaign<'_> {
             for record in rx {
                 on_done(&record);
                 pending.insert(record.id, record);
-                while let Some(r) = pending.remove(&(records.len() as u64)) {
+                while let Some(r) = pending.remove(&(first + records.len() as u64)) {
                     if write_result.is_ok() {
                         write_result = write_line(&mut out, &r);
                         if write_result.is_err() {
@@ -248,6 +285,7 @@ impl Campaign<'_> {
             _ => None,
         });
         Ok(CampaignReport {
+            interrupted: records.len() < points.len(),
             records,
             counts,
             first_failure,

@@ -7,12 +7,18 @@
 //! (`src/bin/`). See `ARCHITECTURE.md` for how the crates fit together.
 #![warn(missing_docs)]
 
+pub mod atomic;
 pub mod campaign;
+pub mod campaign_file;
 pub mod cli;
 pub mod cover;
+pub mod junit;
+pub mod merge;
 pub mod plot;
 pub mod record;
 pub mod replay;
+pub mod report;
+pub mod results;
 pub mod seed;
 pub mod summary;
 

@@ -162,20 +162,31 @@ pub fn failure_map(
     let size = (760 * panels.len().max(1) as u32, 600);
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
-    render(
-        BitMapBackend::new(&png, size).into_drawing_area(),
-        &png,
-        space,
-        axes,
-        panels,
-    )?;
-    render(
-        SVGBackend::new(&svg, size).into_drawing_area(),
-        &svg,
-        space,
-        axes,
-        panels,
-    )?;
+    // Through a temporary file and a rename: a failed write leaves any earlier plot whole.
+    let atomic = |path: &Path, draw: &dyn Fn(&Path) -> Result<(), PlotError>| {
+        crate::atomic::with_temp(path, draw).map_err(|reason| PlotError::Draw {
+            path: path.to_path_buf(),
+            reason,
+        })
+    };
+    atomic(&png, &|tmp| {
+        render(
+            BitMapBackend::new(tmp, size).into_drawing_area(),
+            tmp,
+            space,
+            axes,
+            panels,
+        )
+    })?;
+    atomic(&svg, &|tmp| {
+        render(
+            SVGBackend::new(tmp, size).into_drawing_area(),
+            tmp,
+            space,
+            axes,
+            panels,
+        )
+    })?;
     Ok([png, svg])
 }
 
@@ -314,10 +325,20 @@ pub fn failure_rate_map(
             reason,
         })
     };
-    let root = BitMapBackend::new(&png, size).into_drawing_area();
-    drawn(&png, draw_rates(root, space, axes, title, &cells, bins))?;
-    let root = SVGBackend::new(&svg, size).into_drawing_area();
-    drawn(&svg, draw_rates(root, space, axes, title, &cells, bins))?;
+    let atomic = |path: &Path, draw: &dyn Fn(&Path) -> Result<(), PlotError>| {
+        crate::atomic::with_temp(path, draw).map_err(|reason| PlotError::Draw {
+            path: path.to_path_buf(),
+            reason,
+        })
+    };
+    atomic(&png, &|tmp| {
+        let root = BitMapBackend::new(tmp, size).into_drawing_area();
+        drawn(&png, draw_rates(root, space, axes, title, &cells, bins))
+    })?;
+    atomic(&svg, &|tmp| {
+        let root = SVGBackend::new(tmp, size).into_drawing_area();
+        drawn(&svg, draw_rates(root, space, axes, title, &cells, bins))
+    })?;
     Ok([png, svg])
 }
 

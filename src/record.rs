@@ -1,13 +1,14 @@
 //! One line of `results.jsonl`.
 
+use serde::de::{MapAccess, Visitor};
 use serde::ser::SerializeMap;
-use serde::{Serialize, Serializer};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use paracosm_generators::{Assignment, Point};
+use paracosm_generators::{Assignment, ParamSpace, Point};
 use paracosm_oracles::Verdict;
 
 /// A test's outcome class.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
     /// Every monitor passed.
@@ -20,12 +21,13 @@ pub enum Status {
 }
 
 /// A monitor's verdict as written to the results file.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MonitorResult {
     /// Whether the monitor's property held.
     pub passed: bool,
     /// Robustness in the monitor's unit; `> 0` satisfied. Non-finite values are written as
-    /// `null` (JSON has no infinity).
+    /// `null` (JSON has no infinity) and read back as NaN.
+    #[serde(deserialize_with = "f64_or_null")]
     pub robustness: f64,
     /// Time of the first violation in seconds since the start, or `null`.
     pub first_violation_s: Option<f64>,
@@ -66,11 +68,89 @@ pub struct RunRecord {
     /// Measurements by name (units in the name: `_m`, `_s`), e.g. `min_distance_m`,
     /// `distance_travelled_m`, `time_to_failure_s`.
     #[serde(serialize_with = "ordered_map")]
-    pub metrics: Vec<(&'static str, f64)>,
+    pub metrics: Vec<(String, f64)>,
     /// Why the test ended in `error`, else `null`.
     pub error: Option<String>,
     /// Wall-clock time of the test in milliseconds. Machine-dependent.
     pub wall_ms: f64,
+}
+
+/// The fields of a results line, as read back (`params` is rebuilt from `point`).
+#[derive(Deserialize)]
+struct Line {
+    id: u64,
+    seed: u64,
+    strategy: String,
+    point: Point,
+    status: Status,
+    #[serde(deserialize_with = "pairs")]
+    monitors: Vec<(String, MonitorResult)>,
+    #[serde(deserialize_with = "metric_pairs")]
+    metrics: Vec<(String, f64)>,
+    error: Option<String>,
+    #[serde(deserialize_with = "f64_or_null")]
+    wall_ms: f64,
+}
+
+impl RunRecord {
+    /// Reads one line of `results.jsonl` written for a scenario with parameter space `space`
+    /// (`params` is decoded again from `point`; robustness and metrics written as `null` come
+    /// back as NaN).
+    ///
+    /// # Errors
+    /// serde_json's error (with its column) when the line is not a results record.
+    pub fn from_line(line: &str, space: &ParamSpace) -> Result<RunRecord, serde_json::Error> {
+        let l: Line = serde_json::from_str(line)?;
+        Ok(RunRecord {
+            id: l.id,
+            seed: l.seed,
+            strategy: l.strategy,
+            params: space.decode(&l.point).ok(),
+            point: l.point,
+            status: l.status,
+            monitors: l.monitors,
+            metrics: l.metrics,
+            error: l.error,
+            wall_ms: l.wall_ms,
+        })
+    }
+}
+
+fn f64_or_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// A JSON object read as `(key, value)` pairs in file order.
+struct Pairs<V>(std::marker::PhantomData<V>);
+
+impl<'de, V: Deserialize<'de>> Visitor<'de> for Pairs<V> {
+    type Value = Vec<(String, V)>;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a JSON object")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+        let mut out = Vec::new();
+        while let Some(entry) = map.next_entry()? {
+            out.push(entry);
+        }
+        Ok(out)
+    }
+}
+
+fn pairs<'de, D: Deserializer<'de>, V: Deserialize<'de>>(
+    d: D,
+) -> Result<Vec<(String, V)>, D::Error> {
+    d.deserialize_map(Pairs(std::marker::PhantomData))
+}
+
+fn metric_pairs<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<(String, f64)>, D::Error> {
+    let raw: Vec<(String, Option<f64>)> = pairs(d)?;
+    Ok(raw
+        .into_iter()
+        .map(|(k, v)| (k, v.unwrap_or(f64::NAN)))
+        .collect())
 }
 
 fn ordered_map<K: Serialize, V: Serialize, S: Serializer>(
@@ -111,12 +191,17 @@ mod tests {
                     first_violation_s: Some(1.5),
                 },
             )],
-            metrics: vec![("min_distance_m", 0.0), ("time_to_failure_s", 1.5)],
+            metrics: vec![
+                ("min_distance_m".into(), 0.0),
+                ("time_to_failure_s".into(), 1.5),
+            ],
             error: None,
             wall_ms: 2.5,
         };
+        let line = serde_json::to_string(&r).unwrap();
+        assert_eq!(RunRecord::from_line(&line, &space).unwrap(), r);
         assert_eq!(
-            serde_json::to_string(&r).unwrap(),
+            line,
             r#"{"id":3,"seed":9,"strategy":"halton","point":{"discrete":[],"continuous":[0.25]},"params":{"v":0.5},"status":"fail","monitors":{"collision":{"passed":false,"robustness":0.0,"first_violation_s":1.5}},"metrics":{"min_distance_m":0.0,"time_to_failure_s":1.5},"error":null,"wall_ms":2.5}"#
         );
     }

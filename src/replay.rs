@@ -1,82 +1,16 @@
-//! `campaign.json` (how a campaign was run) and the replay of one recorded test.
+//! The replay of one recorded test, from `campaign.json` and its line of `results.jsonl`.
 
 use std::path::{Path, PathBuf};
 
-use paracosm_engine::sut::{ExternalConfig, SutConfig};
+use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{CameraFrame, CameraSpec};
 use paracosm_generators::{Point, Strategy};
 use paracosm_scenarios::RunOptions;
-use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::campaign::Campaign;
+use crate::campaign_file::CampaignFile;
 use crate::record::{RunRecord, Status};
-
-/// File name of the campaign's settings in the output folder, written before any test runs.
-pub const CAMPAIGN_FILE: &str = "campaign.json";
-
-/// Which system under test a campaign ran.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum SutChoice {
-    /// The scenario's own default (`AutonomousVehicle(sut=...)`).
-    Scenario,
-    /// A built-in system chosen with `--sut`.
-    Builtin {
-        /// `aeb` or `vision`.
-        name: String,
-    },
-    /// A program chosen with `--sut-cmd`.
-    Command {
-        /// Program and arguments.
-        command: Vec<String>,
-        /// `--sut-timeout`, seconds.
-        timeout_s: f64,
-        /// Whether processes were kept alive between tests.
-        reuse: bool,
-    },
-}
-
-impl SutChoice {
-    /// The configuration to run, or `None` for the scenario's default.
-    ///
-    /// # Errors
-    /// A message for an unknown built-in name.
-    pub fn config(&self) -> Result<Option<SutConfig>, String> {
-        match self {
-            SutChoice::Scenario => Ok(None),
-            SutChoice::Builtin { name } => SutConfig::builtin(name).map(Some),
-            SutChoice::Command {
-                command,
-                timeout_s,
-                reuse,
-            } => Ok(Some(SutConfig::External(ExternalConfig::new(
-                command.clone(),
-                *timeout_s,
-                *reuse,
-            )))),
-        }
-    }
-}
-
-/// The contents of `campaign.json`: everything needed to rebuild any test of the campaign.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CampaignFile {
-    /// `paracosm <version>`.
-    pub tool: String,
-    /// The scenario as given: a built-in name, or the absolute path of a `.star` file.
-    pub scenario: String,
-    /// The system under test.
-    pub sut: SutChoice,
-    /// Strategy name (`halton`, `random`, ...).
-    pub strategy: String,
-    /// Campaign seed.
-    pub seed: u64,
-    /// Number of tests.
-    pub budget: u64,
-    /// Strength of covering-array strategies.
-    pub strength: usize,
-}
 
 /// Why a replay cannot run.
 #[derive(Debug, Error)]
@@ -103,24 +37,6 @@ pub struct Replay {
 
 fn input(e: impl std::fmt::Display) -> ReplayError {
     ReplayError::Input(e.to_string())
-}
-
-/// Reads `campaign.json` from `dir`.
-///
-/// # Errors
-/// [`ReplayError::Input`] naming the file when it is missing or malformed.
-pub fn read_campaign_file(dir: &Path) -> Result<CampaignFile, ReplayError> {
-    let path = dir.join(CAMPAIGN_FILE);
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| input(format!("cannot read `{}`: {e}", path.display())))?;
-    serde_json::from_str(&text).map_err(|e| {
-        input(format!(
-            "`{}` is not a campaign file: {e} (line {}, column {})",
-            path.display(),
-            e.line(),
-            e.column()
-        ))
-    })
 }
 
 /// The line of `results` whose `id` is `id`.
@@ -179,7 +95,7 @@ pub fn replay(
     sut: Option<SutConfig>,
 ) -> Result<Replay, ReplayError> {
     let dir = results.parent().unwrap_or(Path::new("."));
-    let campaign_file = read_campaign_file(dir)?;
+    let campaign_file = CampaignFile::read(dir).map_err(input)?;
     let recorded = find_record(results, id)?;
     let point: Point = serde_json::from_value(recorded["point"].clone())
         .map_err(|e| input(format!("test {id}: its `point` does not parse: {e}")))?;

@@ -26,9 +26,28 @@ pub struct FirstFailure {
     pub failed_monitors: Vec<String>,
 }
 
+/// A failed test as `summary.json` lists it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FailureEntry {
+    /// Test id.
+    pub id: u64,
+    /// The smallest robustness over its monitors (the most violated); `null` when not a
+    /// number.
+    pub robustness: f64,
+    /// The monitors that failed.
+    pub failed_monitors: Vec<String>,
+    /// Its parameter values.
+    pub params: Option<Assignment>,
+    /// The command that re-runs it and writes its camera frames.
+    pub replay: String,
+}
+
 /// The contents of `summary.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
+    /// Every failed test, most violated (smallest robustness) first, each with the command
+    /// that replays it.
+    pub failures: Vec<FailureEntry>,
     /// `paracosm <version>`.
     pub tool: String,
     /// Scenario name.
@@ -37,8 +56,12 @@ pub struct Summary {
     pub strategy: String,
     /// Campaign seed.
     pub seed: u64,
-    /// Number of tests asked for.
+    /// Number of tests of the whole campaign.
     pub budget: u64,
+    /// The shard this folder holds (`null`: the whole campaign).
+    pub shard: Option<crate::campaign_file::Shard>,
+    /// Tests with a record in `results.jsonl`.
+    pub tests_run: u64,
     /// Worker threads used (does not change any result).
     pub jobs: usize,
     /// The scenario's open parameters.

@@ -70,6 +70,7 @@ pub fn scenario() -> Scenario {
         map_axes: [WALKING_SPEED.to_owned(), TRIGGER_DISTANCE.to_owned()],
         template: Arc::new(world),
         lambdas: None,
+        source: Arc::from(""),
     }
 }
 

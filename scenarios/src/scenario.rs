@@ -96,6 +96,9 @@ pub struct Scenario {
     pub monitors: Vec<MonitorSpec>,
     /// The two parameters of the failure map, `[x axis, y axis]`.
     pub map_axes: [String; 2],
+    /// The program text it was loaded from (empty for scenarios written in Rust): part of a
+    /// campaign's fingerprint, so a resumed campaign runs the same program.
+    pub source: Arc<str>,
     /// Builds the world for an assignment of the open parameters.
     pub(crate) template: Template,
     /// Runs the lambdas of the world's stream graph (Starlark scenarios); `None`: native only.

@@ -5,6 +5,7 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
@@ -13,9 +14,10 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use paracosm::cli::{BadInput, StrategyArg, SutArgs};
 use tracing::info;
 
-use paracosm::campaign::{Campaign, CampaignError, RESULTS_FILE};
+use paracosm::campaign::{Campaign, CampaignError};
+use paracosm::campaign_file::{CampaignFile, Shard, SutChoice, CAMPAIGN_FILE};
 use paracosm::record::Status;
-use paracosm::summary::Summary;
+use paracosm::report::Finished;
 
 /// Run a test campaign on a scenario: sample its open parameters, simulate each test, and
 /// write results.jsonl, summary.json and a failure map.
@@ -30,37 +32,53 @@ struct Cli {
     #[command(subcommand)]
     command: Option<Sub>,
     /// Scenario to test: a path to a `.star` program, or a built-in name (see --list):
-    /// pedestrian-crossing, follow-lead-car, fog-light, t-loop, grid-world.
-    #[arg(required_unless_present = "list")]
+    /// pedestrian-crossing, follow-lead-car, fog-light, t-loop, grid-world. Optional with
+    /// --resume (taken from the folder's campaign.json).
+    #[arg(required_unless_present_any = ["list", "resume"])]
     scenario: Option<String>,
     /// List the built-in scenarios and exit.
     #[arg(long)]
     list: bool,
-    /// How test points are chosen.
-    #[arg(long, value_enum, default_value = "halton")]
-    strategy: StrategyArg,
+    /// How test points are chosen [default: halton].
+    #[arg(long, value_enum)]
+    strategy: Option<StrategyArg>,
     /// With --strategy halton: randomise it by digit permutations (Owen 2017); --seed draws
     /// the permutations.
     #[arg(long)]
     scramble: bool,
-    /// Strength t of the covering array of --strategy ipog or kwise.
-    #[arg(long, default_value_t = 2)]
-    strength: usize,
-    /// Number of tests to run (at least 1).
-    #[arg(long, default_value_t = 100, value_parser = paracosm::cli::positive)]
-    budget: u64,
-    /// Campaign seed: seeds the generator and every test.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
+    /// Strength t of the covering array of --strategy ipog or kwise [default: 2].
+    #[arg(long)]
+    strength: Option<usize>,
+    /// Number of tests of the campaign, at least 1 [default: 100]. With --shard, of the
+    /// whole campaign, not of the shard.
+    #[arg(long, value_parser = paracosm::cli::positive)]
+    budget: Option<u64>,
+    /// Campaign seed: seeds the generator and every test [default: 0].
+    #[arg(long)]
+    seed: Option<u64>,
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     jobs: Option<u64>,
     /// Output folder for results.jsonl, summary.json and failure_map.{png,svg}.
     #[arg(long, default_value = "out")]
     out: PathBuf,
-    /// Replace the results of an earlier campaign in --out.
-    #[arg(long)]
+    /// Replace what --out holds (otherwise a non-empty folder is refused).
+    #[arg(long, conflicts_with = "resume")]
     force: bool,
+    /// Finish the campaign in --out after a crash, a kill or Ctrl-C: keep its records, cut a
+    /// half-written last line, and run the tests that are missing. Refused when the given
+    /// arguments differ from the campaign's (campaign.json). Starts the campaign when --out
+    /// holds none yet.
+    #[arg(long)]
+    resume: bool,
+    /// Run only shard I of N (0 <= I < N): the tests with ids in [I·budget/N,
+    /// (I+1)·budget/N). Merge the shard folders with `paracosm-fuzz merge`.
+    #[arg(long, value_name = "I/N", value_parser = Shard::parse)]
+    shard: Option<Shard>,
+    /// Also write JUnit XML: one test case per generated test, failures with their monitor
+    /// verdicts, parameters and replay command.
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
     #[command(flatten)]
     sut: SutArgs,
 }
@@ -71,6 +89,35 @@ enum Sub {
     /// results), write its camera frames as PNG and a contact sheet, and check that the
     /// verdict equals the recorded one. Exit 0 when it does, 3 when it does not.
     Replay(ReplayArgs),
+    /// Combine the shard folders of one campaign (--shard I/N) into one campaign folder:
+    /// results, summary, coverage and plots. Checks that the shards share the campaign's
+    /// fingerprint and that none is missing, given twice or incomplete.
+    Merge(MergeArgs),
+    /// Reprint the summary of a finished or partial campaign folder: counts, first failure,
+    /// coverage and plot paths.
+    Report(ReportArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct MergeArgs {
+    /// The shard folders.
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Folder for the merged campaign.
+    #[arg(long)]
+    out: PathBuf,
+    /// Replace what --out holds.
+    #[arg(long)]
+    force: bool,
+    /// Also write JUnit XML.
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
+}
+
+#[derive(Debug, clap::Args)]
+struct ReportArgs {
+    /// A campaign (or shard) folder.
+    dir: PathBuf,
 }
 
 #[derive(Debug, clap::Args)]
@@ -103,6 +150,8 @@ fn main() -> ExitCode {
         .init();
     let result = match &cli.command {
         Some(Sub::Replay(args)) => replay(args),
+        Some(Sub::Merge(args)) => merge(args),
+        Some(Sub::Report(args)) => report(args),
         None => run(&cli),
     };
     match result {
@@ -119,6 +168,9 @@ fn main() -> ExitCode {
     }
 }
 
+/// Set by Ctrl-C: no new test starts.
+static STOP: AtomicBool = AtomicBool::new(false);
+
 fn run(cli: &Cli) -> Result<ExitCode> {
     if cli.list {
         for name in paracosm_scenarios::builtin_names() {
@@ -133,16 +185,20 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         }
         return Ok(ExitCode::SUCCESS);
     }
-    let name = cli.scenario.as_deref().unwrap_or_default();
-    let mut scenario = paracosm_scenarios::load(name).map_err(|e| BadInput(e.to_string()))?;
-    if let Some(sut) = cli.sut.config().map_err(BadInput)? {
-        scenario.sut = sut;
-    }
-    let strategy = paracosm::cli::strategy(cli.strategy, cli.scramble).map_err(BadInput)?;
-    if let Some(cap) = strategy.capacity().filter(|&cap| cli.budget > cap) {
+    let stored = if cli.resume && cli.out.join(CAMPAIGN_FILE).exists() {
+        Some(CampaignFile::read(&cli.out).map_err(BadInput)?)
+    } else {
+        None
+    };
+    let (file, scenario) = settings(cli, stored.as_ref())?;
+    let strategy: paracosm_generators::Strategy = file
+        .strategy
+        .parse()
+        .map_err(|e: paracosm_generators::GeneratorError| BadInput(e.to_string()))?;
+    if let Some(cap) = strategy.capacity().filter(|&cap| file.budget > cap) {
         return Err(BadInput(format!(
             "--budget {} is more than the {} points {strategy} can produce",
-            cli.budget, cap
+            file.budget, cap
         ))
         .into());
     }
@@ -150,49 +206,52 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         || std::thread::available_parallelism().map_or(1, |n| n.get()),
         |j| j as usize,
     );
-    prepare_out_dir(cli)?;
-    let campaign_file = paracosm::replay::CampaignFile {
-        tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
-        scenario: match std::fs::canonicalize(name) {
-            Ok(path) if std::path::Path::new(name).is_file() => path.display().to_string(),
-            _ => name.to_owned(),
-        },
-        sut: match (&cli.sut.sut, &cli.sut.sut_cmd) {
-            (Some(n), _) => paracosm::replay::SutChoice::Builtin { name: n.clone() },
-            (None, Some(_)) => match &scenario.sut {
-                paracosm_engine::sut::SutConfig::External(e) => {
-                    paracosm::replay::SutChoice::Command {
-                        command: e.command.clone(),
-                        timeout_s: e.timeout_s,
-                        reuse: e.reuse,
-                    }
-                }
-                _ => paracosm::replay::SutChoice::Scenario,
-            },
-            (None, None) => paracosm::replay::SutChoice::Scenario,
-        },
-        strategy: strategy.name().to_owned(),
-        seed: cli.seed,
-        budget: cli.budget,
-        strength: cli.strength,
+    prepare_out_dir(&cli.out, cli.force, cli.resume)?;
+    if stored.is_none() {
+        file.write(&cli.out).map_err(BadInput)?;
+    }
+    let ids = file.ids();
+    let existing = if stored.is_some() {
+        paracosm::results::load(&cli.out, &scenario.space, ids.clone(), true).map_err(BadInput)?
+    } else {
+        paracosm::results::Existing {
+            records: Vec::new(),
+            repaired_bytes: 0,
+        }
     };
-    let campaign_path = cli.out.join(paracosm::replay::CAMPAIGN_FILE);
-    std::fs::write(
-        &campaign_path,
-        serde_json::to_string_pretty(&campaign_file)? + "\n",
-    )
-    .map_err(|e| BadInput(format!("cannot write `{}`: {e}", campaign_path.display())))?;
+    if existing.repaired_bytes > 0 {
+        eprintln!(
+            "paracosm-fuzz: cut a half-written last line ({} bytes) off {}; that test runs again",
+            existing.repaired_bytes,
+            cli.out.join(paracosm::campaign::RESULTS_FILE).display()
+        );
+    }
+    let start = ids.start + existing.records.len() as u64;
+    if stored.is_some() {
+        eprintln!(
+            "paracosm-fuzz: resuming: {} of {} tests already done",
+            existing.records.len(),
+            ids.end - ids.start
+        );
+    }
+    // Ctrl-C: finish the tests in flight, write them, and say how to resume. A second
+    // Ctrl-C exits at once.
+    let _ = ctrlc::set_handler(|| {
+        if STOP.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
 
     let campaign = Campaign {
         scenario: &scenario,
         strategy,
-        seed: cli.seed,
-        budget: cli.budget,
-        strength: cli.strength,
+        seed: file.seed,
+        budget: file.budget,
+        strength: file.strength,
         jobs,
     };
     let bar = if std::io::stderr().is_terminal() {
-        ProgressBar::with_draw_target(Some(cli.budget), ProgressDrawTarget::stderr())
+        ProgressBar::with_draw_target(Some(ids.end - start), ProgressDrawTarget::stderr())
     } else {
         ProgressBar::hidden()
     };
@@ -204,11 +263,17 @@ fn run(cli: &Cli) -> Result<ExitCode> {
     );
     let mut failures = 0u64;
     let report = campaign
-        .run(&cli.out, |r| {
-            failures += u64::from(r.status == Status::Fail);
-            bar.set_message(format!("{failures} failed"));
-            bar.inc(1);
-        })
+        .run_ids(
+            &cli.out,
+            start..ids.end,
+            stored.is_some(),
+            Some(&STOP),
+            |r| {
+                failures += u64::from(r.status == Status::Fail);
+                bar.set_message(format!("{failures} failed"));
+                bar.inc(1);
+            },
+        )
         .map_err(|e| match e {
             CampaignError::Io { .. } | CampaignError::Generator(_) => {
                 anyhow::Error::new(BadInput(e.to_string()))
@@ -216,123 +281,153 @@ fn run(cli: &Cli) -> Result<ExitCode> {
             CampaignError::Pool { .. } => anyhow::Error::new(e),
         })?;
     bar.finish_and_clear();
-
-    let stem = cli.out.join("failure_map");
-    let title = format!(
-        "{}: {}, {} tests, {} failed",
-        scenario.name, strategy, cli.budget, report.counts.fail
-    );
-    let plots = paracosm::plot::failure_map(
-        &stem,
-        &scenario.space,
-        &scenario.map_axes,
-        &[(&title, &report.records)],
-    )
-    .map_err(|e| BadInput(e.to_string()))?;
-
-    let rates = paracosm::plot::failure_rate_map(
-        &cli.out.join("failure_rate"),
-        &scenario.space,
-        &scenario.map_axes,
-        &format!("{}: failure rate ({} tests)", scenario.name, cli.budget),
-        &report.records,
-        8,
-    )
-    .map_err(|e| BadInput(e.to_string()))?;
-    let plots: Vec<std::path::PathBuf> = plots.into_iter().chain(rates).collect();
-    let mut outputs = vec![RESULTS_FILE.to_owned(), "summary.json".to_owned()];
-    outputs.extend(
-        plots
-            .iter()
-            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned())),
-    );
-    let coverage = {
-        let set = paracosm::cover::TestSet {
-            space: scenario.space.clone(),
-            points: report.records.iter().map(|r| r.point.clone()).collect(),
-        };
-        let metrics: Vec<paracosm::cover::Metric> =
-            ["dispersion", "cd", "wd", "md", "l2star", "star"]
-                .iter()
-                .filter_map(|m| m.parse().ok())
-                .collect();
-        paracosm::cover::estimate(&set, &metrics, None, None, 10).ok()
-    };
-    let summary = Summary {
-        tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
-        scenario: scenario.name.clone(),
-        strategy: strategy.name().to_owned(),
-        seed: cli.seed,
-        budget: cli.budget,
-        jobs,
-        space: scenario.space.params().to_vec(),
-        counts: report.counts,
-        first_failure: report.first_failure.clone(),
-        coverage,
-        wall_s: report.wall_s,
-        outputs,
-    };
-    let summary_path = cli.out.join("summary.json");
-    std::fs::write(
-        &summary_path,
-        serde_json::to_string_pretty(&summary)? + "\n",
-    )
-    .map_err(|e| BadInput(format!("cannot write `{}`: {e}", summary_path.display())))?;
-    info!(path = %summary_path.display(), "wrote summary");
-
-    let c = report.counts;
-    println!(
-        "{} tests of {} ({}, seed {}): {} passed, {} failed, {} errors in {:.1} s ({:.0} tests/s)",
-        cli.budget,
-        scenario.name,
-        strategy,
-        cli.seed,
-        c.pass,
-        c.fail,
-        c.error,
-        report.wall_s,
-        cli.budget as f64 / report.wall_s.max(1e-9)
-    );
-    if let Some(f) = &report.first_failure {
-        let values: Vec<String> = f
-            .params
-            .iter()
-            .map(|(n, v)| {
-                let unit = scenario
-                    .space
-                    .param(n)
-                    .and_then(|p| p.unit.clone())
-                    .unwrap_or_default();
-                match v.as_f64() {
-                    Some(x) => format!("{n} = {x:.3} {unit}"),
-                    None => format!("{n} = {v}"),
-                }
-            })
-            .collect();
-        println!(
-            "first failure: test {} ({}), monitors failed: {}",
-            f.id,
-            values.join(", "),
-            f.failed_monitors.join(", ")
+    let done = existing.records.len() + report.records.len();
+    if report.interrupted {
+        eprintln!(
+            "paracosm-fuzz: interrupted: {done} of {} tests are in {}; finish the campaign \
+             with:\n    paracosm-fuzz --resume --out {}",
+            ids.end - ids.start,
+            cli.out.join(paracosm::campaign::RESULTS_FILE).display(),
+            cli.out.display()
         );
+        return Ok(ExitCode::from(130));
     }
+    let mut records = existing.records;
+    records.extend(report.records);
+    let summary = paracosm::report::write_outputs(&Finished {
+        out: &cli.out,
+        scenario: &scenario,
+        file: &file,
+        records: &records,
+        jobs,
+        wall_s: report.wall_s,
+        junit: cli.junit.as_deref(),
+    })
+    .map_err(BadInput)?;
+    info!(path = %cli.out.display(), "wrote summary");
     println!(
-        "wrote {}, {}, {}",
-        cli.out.join(RESULTS_FILE).display(),
-        summary_path.display(),
-        plots
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
+        "{}",
+        paracosm::report::human(&summary, &scenario, &cli.out, ids.end - ids.start)
     );
-    Ok(if c.fail > 0 {
+    Ok(exit_code(&summary.counts))
+}
+
+fn exit_code(c: &paracosm::summary::Counts) -> ExitCode {
+    if c.fail > 0 {
         ExitCode::from(1)
     } else if c.error > 0 {
         ExitCode::from(3)
     } else {
         ExitCode::SUCCESS
-    })
+    }
+}
+
+/// The campaign's settings and scenario: from the arguments (checked against the folder's
+/// campaign when resuming), or from the folder's campaign alone (`--resume` without SCENARIO).
+fn settings(
+    cli: &Cli,
+    stored: Option<&CampaignFile>,
+) -> Result<(CampaignFile, paracosm_scenarios::Scenario)> {
+    let refuse = |diffs: Vec<String>| -> anyhow::Error {
+        BadInput(format!(
+            "refusing to resume: `{}` holds a campaign with other settings ({}); resume without \
+             those arguments, or start a new campaign with --force or another --out",
+            cli.out.display(),
+            diffs.join("; ")
+        ))
+        .into()
+    };
+    let sut = cli.sut.config().map_err(BadInput)?;
+    match (&cli.scenario, stored) {
+        (Some(name), _) => {
+            let mut scenario =
+                paracosm_scenarios::load(name).map_err(|e| BadInput(e.to_string()))?;
+            if let Some(s) = &sut {
+                scenario.sut = s.clone();
+            }
+            let strategy =
+                paracosm::cli::strategy(cli.strategy.unwrap_or(StrategyArg::Halton), cli.scramble)
+                    .map_err(BadInput)?;
+            let file = CampaignFile::new(
+                name,
+                &scenario,
+                SutChoice::of(sut.as_ref()),
+                strategy.name(),
+                cli.seed.unwrap_or(0),
+                cli.budget.unwrap_or(100),
+                cli.strength.unwrap_or(2),
+                cli.shard,
+            );
+            if let Some(st) = stored {
+                let diffs = st.differences(&file);
+                if !diffs.is_empty() {
+                    return Err(refuse(diffs));
+                }
+            }
+            Ok((file, scenario))
+        }
+        (None, Some(st)) => {
+            // Arguments given with a bare --resume must agree with the stored campaign.
+            let mut diffs = Vec::new();
+            let mut check = |name: &str, given: Option<String>, stored: String| {
+                if let Some(g) = given.filter(|g| *g != stored) {
+                    diffs.push(format!("{name}: {stored} vs {g}"));
+                }
+            };
+            check("seed", cli.seed.map(|v| v.to_string()), st.seed.to_string());
+            check(
+                "budget",
+                cli.budget.map(|v| v.to_string()),
+                st.budget.to_string(),
+            );
+            check(
+                "strength",
+                cli.strength.map(|v| v.to_string()),
+                st.strength.to_string(),
+            );
+            let strategy = cli
+                .strategy
+                .map(|s| paracosm::cli::strategy(s, cli.scramble).map(|s| s.name().to_owned()))
+                .transpose()
+                .map_err(BadInput)?;
+            check("strategy", strategy, st.strategy.clone());
+            let shard = |s: Option<Shard>| s.map_or("none".to_owned(), |s| s.to_string());
+            check("shard", cli.shard.map(|s| shard(Some(s))), shard(st.shard));
+            if sut.is_some() && SutChoice::of(sut.as_ref()) != st.sut {
+                diffs.push("system under test differs".into());
+            }
+            if !diffs.is_empty() {
+                return Err(refuse(diffs));
+            }
+            let mut scenario =
+                paracosm_scenarios::load(&st.scenario).map_err(|e| BadInput(e.to_string()))?;
+            if let Some(s) = st.sut.config().map_err(BadInput)? {
+                scenario.sut = s;
+            }
+            let again = CampaignFile::new(
+                &st.scenario,
+                &scenario,
+                st.sut.clone(),
+                &st.strategy,
+                st.seed,
+                st.budget,
+                st.strength,
+                st.shard,
+            );
+            if again.fingerprint != st.fingerprint {
+                return Err(refuse(vec![format!(
+                    "the scenario `{}` changed since the campaign started",
+                    st.scenario
+                )]));
+            }
+            Ok((st.clone(), scenario))
+        }
+        (None, None) => Err(BadInput(format!(
+            "--resume without SCENARIO needs a campaign in `{}`, which has no {CAMPAIGN_FILE}",
+            cli.out.display()
+        ))
+        .into()),
+    }
 }
 
 fn replay(args: &ReplayArgs) -> Result<ExitCode> {
@@ -386,29 +481,127 @@ fn replay(args: &ReplayArgs) -> Result<ExitCode> {
     }
 }
 
-/// Creates `--out` and refuses to overwrite an earlier campaign's results without `--force`.
-fn prepare_out_dir(cli: &Cli) -> Result<()> {
-    let results = cli.out.join(RESULTS_FILE);
-    if results.exists() && !cli.force {
+fn merge(args: &MergeArgs) -> Result<ExitCode> {
+    prepare_out_dir(&args.out, args.force, false)?;
+    let m = paracosm::merge::merge(&args.dirs, &args.out).map_err(BadInput)?;
+    // The campaign's wall time: the shards' own, added up (they may have run in parallel).
+    let wall_s: f64 = args
+        .dirs
+        .iter()
+        .filter_map(|d| std::fs::read_to_string(d.join(paracosm::report::SUMMARY_FILE)).ok())
+        .filter_map(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .filter_map(|s| s["wall_s"].as_f64())
+        .sum();
+    let summary = paracosm::report::write_outputs(&Finished {
+        out: &args.out,
+        scenario: &m.scenario,
+        file: &m.file,
+        records: &m.records,
+        jobs: 1,
+        wall_s,
+        junit: args.junit.as_deref(),
+    })
+    .map_err(BadInput)?;
+    println!(
+        "merged {} shards into {}",
+        args.dirs.len(),
+        args.out.display()
+    );
+    println!(
+        "{}",
+        paracosm::report::human(&summary, &m.scenario, &args.out, m.file.budget)
+    );
+    Ok(exit_code(&summary.counts))
+}
+
+fn report(args: &ReportArgs) -> Result<ExitCode> {
+    let file = CampaignFile::read(&args.dir).map_err(BadInput)?;
+    let mut scenario =
+        paracosm_scenarios::load(&file.scenario).map_err(|e| BadInput(e.to_string()))?;
+    if let Some(s) = file.sut.config().map_err(BadInput)? {
+        scenario.sut = s;
+    }
+    let ids = file.ids();
+    let existing = paracosm::results::load(&args.dir, &scenario.space, ids.clone(), false)
+        .map_err(BadInput)?;
+    let stored: Option<serde_json::Value> =
+        std::fs::read_to_string(args.dir.join(paracosm::report::SUMMARY_FILE))
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok());
+    let wall_s = stored
+        .as_ref()
+        .and_then(|s| s["wall_s"].as_f64())
+        .unwrap_or_else(|| existing.records.iter().map(|r| r.wall_ms).sum::<f64>() / 1e3);
+    let outputs: Vec<String> = [
+        paracosm::campaign::RESULTS_FILE,
+        paracosm::report::SUMMARY_FILE,
+        "failure_map.png",
+        "failure_map.svg",
+        "failure_rate.png",
+        "failure_rate.svg",
+    ]
+    .iter()
+    .filter(|f| args.dir.join(f).exists())
+    .map(|f| f.to_string())
+    .collect();
+    let summary = paracosm::report::summarise(
+        &Finished {
+            out: &args.dir,
+            scenario: &scenario,
+            file: &file,
+            records: &existing.records,
+            jobs: stored
+                .as_ref()
+                .and_then(|s| s["jobs"].as_u64())
+                .unwrap_or(1) as usize,
+            wall_s,
+            junit: None,
+        },
+        outputs,
+    );
+    let expected = ids.end - ids.start;
+    println!(
+        "{}",
+        paracosm::report::human(&summary, &scenario, &args.dir, expected)
+    );
+    if (existing.records.len() as u64) < expected {
+        println!(
+            "partial: {} of {expected} tests; finish it with `paracosm-fuzz --resume --out {}`",
+            existing.records.len(),
+            args.dir.display()
+        );
+    }
+    Ok(exit_code(&summary.counts))
+}
+
+/// Creates `out`; refuses a non-empty folder unless `force` (replace) or `resume`.
+fn prepare_out_dir(out: &std::path::Path, force: bool, resume: bool) -> Result<()> {
+    let non_empty = std::fs::read_dir(out)
+        .map(|mut d| d.next().is_some())
+        .unwrap_or(false);
+    if out.exists() && !out.is_dir() {
+        return Err(BadInput(format!("--out `{}` is not a folder", out.display())).into());
+    }
+    if non_empty && !force && !resume {
         return Err(BadInput(format!(
-            "`{}` already holds a campaign's results; pass --force to replace them, or choose \
-             another --out",
-            cli.out.display()
+            "`{}` is not empty; pass --resume to finish the campaign in it, --force to replace \
+             it, or choose another --out",
+            out.display()
         ))
         .into());
     }
-    std::fs::create_dir_all(&cli.out).map_err(|e| {
+    std::fs::create_dir_all(out).map_err(|e| {
         BadInput(format!(
             "cannot create output folder `{}`: {e}",
-            cli.out.display()
+            out.display()
         ))
     })?;
     // Probe writability now, before any test runs.
-    let probe = cli.out.join(".paracosm-write-probe");
+    let probe = out.join(".paracosm-write-probe");
     std::fs::write(&probe, b"").map_err(|e| {
         BadInput(format!(
             "cannot write to output folder `{}`: {e}",
-            cli.out.display()
+            out.display()
         ))
     })?;
     let _ = std::fs::remove_file(&probe);

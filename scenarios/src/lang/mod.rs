@@ -193,7 +193,12 @@ pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, Sce
         name: name.to_owned(),
         description: header(source),
     };
-    scene::finish(scene, meta, lambdas).map_err(|m| lang(format!("error: {m}\n --> {file}")))
+    scene::finish(scene, meta, lambdas)
+        .map(|mut s| {
+            s.source = Arc::from(source);
+            s
+        })
+        .map_err(|m| lang(format!("error: {m}\n --> {file}")))
 }
 
 #[cfg(test)]

@@ -351,6 +351,7 @@ pub fn finish(
         map_axes,
         template: Arc::new(move |a: &Assignment| frozen.instantiate(a)),
         lambdas,
+        source: Arc::from(""),
     })
 }
 

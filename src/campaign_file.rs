@@ -1,0 +1,334 @@
+//! `campaign.json`: how a campaign was run, its fingerprint, and its shard.
+//!
+//! Written (atomically) before the first test. `--resume` compares the fingerprint of its
+//! arguments with the stored one; `merge` checks that every shard has the same; `replay`
+//! rebuilds any test from it.
+
+use std::path::Path;
+
+use paracosm_engine::sut::{ExternalConfig, SutConfig};
+use paracosm_generators::Param;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+/// File name of the campaign's settings in the output folder.
+pub const CAMPAIGN_FILE: &str = "campaign.json";
+
+/// Which system under test a campaign ran.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SutChoice {
+    /// The scenario's own default (`AutonomousVehicle(sut=...)`).
+    Scenario,
+    /// A built-in system chosen with `--sut`.
+    Builtin {
+        /// `aeb` or `vision`.
+        name: String,
+    },
+    /// A program chosen with `--sut-cmd`.
+    Command {
+        /// Program and arguments.
+        command: Vec<String>,
+        /// `--sut-timeout`, seconds.
+        timeout_s: f64,
+        /// Whether processes were kept alive between tests.
+        reuse: bool,
+    },
+}
+
+impl SutChoice {
+    /// What `--sut`/`--sut-cmd` chose (`config`, from [`crate::cli::SutArgs::config`]).
+    pub fn of(config: Option<&SutConfig>) -> SutChoice {
+        match config {
+            None => SutChoice::Scenario,
+            Some(SutConfig::External(e)) => SutChoice::Command {
+                command: e.command.clone(),
+                timeout_s: e.timeout_s,
+                reuse: e.reuse,
+            },
+            Some(other) => SutChoice::Builtin { name: other.name() },
+        }
+    }
+
+    /// The configuration to run, or `None` for the scenario's default.
+    ///
+    /// # Errors
+    /// A message for an unknown built-in name.
+    pub fn config(&self) -> Result<Option<SutConfig>, String> {
+        match self {
+            SutChoice::Scenario => Ok(None),
+            SutChoice::Builtin { name } => SutConfig::builtin(name).map(Some),
+            SutChoice::Command {
+                command,
+                timeout_s,
+                reuse,
+            } => Ok(Some(SutConfig::External(ExternalConfig::new(
+                command.clone(),
+                *timeout_s,
+                *reuse,
+            )))),
+        }
+    }
+}
+
+/// Shard `index` of `count` (`--shard I/N`, `I` in `0..N`): the tests with ids in
+/// [`Shard::range`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// Which shard, `0..count`.
+    pub index: u64,
+    /// How many shards, `>= 1`.
+    pub count: u64,
+}
+
+impl Shard {
+    /// Parses `I/N`.
+    ///
+    /// # Errors
+    /// A message when it is not two whole numbers with `N >= 1` and `I < N`.
+    pub fn parse(s: &str) -> Result<Shard, String> {
+        let bad = || format!("`{s}` is not a shard I/N with 0 <= I < N (e.g. 0/4)");
+        let (i, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count) = (
+            i.trim().parse::<u64>().map_err(|_| bad())?,
+            n.trim().parse::<u64>().map_err(|_| bad())?,
+        );
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// The ids of this shard of a campaign of `budget` tests: the contiguous block
+    /// `[index · budget / count, (index + 1) · budget / count)`, so the shards of a campaign
+    /// cover `0..budget` exactly once, in order, and differ in size by at most one.
+    pub fn range(&self, budget: u64) -> std::ops::Range<u64> {
+        let at = |k: u64| (u128::from(k) * u128::from(budget) / u128::from(self.count)) as u64;
+        at(self.index)..at(self.index + 1)
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// The contents of `campaign.json`: everything needed to rebuild any test of the campaign.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CampaignFile {
+    /// `paracosm <version>`.
+    pub tool: String,
+    /// SHA-256 (hex) of the settings that decide every result: the scenario's program text
+    /// and name, parameter space, system under test, strategy, seed, budget and strength.
+    /// Shards of one campaign share it.
+    pub fingerprint: String,
+    /// The scenario as given: a built-in name, or the absolute path of a `.star` file.
+    pub scenario: String,
+    /// The system under test.
+    pub sut: SutChoice,
+    /// Strategy name (`halton`, `random`, ...).
+    pub strategy: String,
+    /// Campaign seed.
+    pub seed: u64,
+    /// Number of tests of the whole campaign.
+    pub budget: u64,
+    /// Strength of covering-array strategies.
+    pub strength: usize,
+    /// This folder's shard, or `null` for a whole campaign.
+    pub shard: Option<Shard>,
+    /// The scenario's open parameters.
+    pub space: Vec<Param>,
+}
+
+/// What decides a campaign's results, hashed into its fingerprint.
+#[derive(Serialize)]
+struct Fingerprinted<'a> {
+    scenario_name: &'a str,
+    scenario_source_sha256: String,
+    space: &'a [Param],
+    sut: &'a SutChoice,
+    strategy: &'a str,
+    seed: u64,
+    budget: u64,
+    strength: usize,
+}
+
+fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+impl CampaignFile {
+    /// The settings of a campaign of `scenario` (loaded from `scenario_arg`), with its
+    /// fingerprint.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        scenario_arg: &str,
+        scenario: &paracosm_scenarios::Scenario,
+        sut: SutChoice,
+        strategy: &str,
+        seed: u64,
+        budget: u64,
+        strength: usize,
+        shard: Option<Shard>,
+    ) -> CampaignFile {
+        let space = scenario.space.params().to_vec();
+        let fingerprint = {
+            let f = Fingerprinted {
+                scenario_name: &scenario.name,
+                scenario_source_sha256: sha256_hex(scenario.source.as_bytes()),
+                space: &space,
+                sut: &sut,
+                strategy,
+                seed,
+                budget,
+                strength,
+            };
+            sha256_hex(&serde_json::to_vec(&f).expect("settings serialise"))
+        };
+        let path = Path::new(scenario_arg);
+        CampaignFile {
+            tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
+            fingerprint,
+            scenario: match std::fs::canonicalize(path) {
+                Ok(p) if path.is_file() => p.display().to_string(),
+                _ => scenario_arg.to_owned(),
+            },
+            sut,
+            strategy: strategy.to_owned(),
+            seed,
+            budget,
+            strength,
+            shard,
+            space,
+        }
+    }
+
+    /// The ids this folder runs: its shard's, or all.
+    pub fn ids(&self) -> std::ops::Range<u64> {
+        self.shard.map_or(0..self.budget, |s| s.range(self.budget))
+    }
+
+    /// How `other` differs from `self` in what the fingerprint covers and the shard, as
+    /// `name: ours vs theirs` items (empty: same campaign and shard).
+    pub fn differences(&self, other: &CampaignFile) -> Vec<String> {
+        let mut out = Vec::new();
+        let mut cmp = |name: &str, a: String, b: String| {
+            if a != b {
+                out.push(format!("{name}: {a} vs {b}"));
+            }
+        };
+        cmp("scenario", self.scenario.clone(), other.scenario.clone());
+        cmp("strategy", self.strategy.clone(), other.strategy.clone());
+        cmp("seed", self.seed.to_string(), other.seed.to_string());
+        cmp("budget", self.budget.to_string(), other.budget.to_string());
+        cmp(
+            "strength",
+            self.strength.to_string(),
+            other.strength.to_string(),
+        );
+        cmp(
+            "system under test",
+            format!("{:?}", self.sut),
+            format!("{:?}", other.sut),
+        );
+        let shard = |s: &Option<Shard>| s.map_or("none".to_owned(), |s| s.to_string());
+        cmp("shard", shard(&self.shard), shard(&other.shard));
+        if self.space != other.space {
+            out.push("parameter space differs".into());
+        }
+        if out.is_empty() && self.fingerprint != other.fingerprint {
+            out.push("the scenario program's text differs".into());
+        }
+        out
+    }
+
+    /// Reads `campaign.json` from `dir`.
+    ///
+    /// # Errors
+    /// A message naming the file when it is missing or malformed (with line and column).
+    pub fn read(dir: &Path) -> Result<CampaignFile, String> {
+        let path = dir.join(CAMPAIGN_FILE);
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+        serde_json::from_str(&text).map_err(|e| {
+            format!(
+                "{}:{}:{}: not a campaign file: {e}",
+                path.display(),
+                e.line(),
+                e.column()
+            )
+        })
+    }
+
+    /// Writes `campaign.json` into `dir` (through a temporary file and a rename).
+    ///
+    /// # Errors
+    /// The file system's message.
+    pub fn write(&self, dir: &Path) -> Result<(), String> {
+        let text = serde_json::to_string_pretty(self).expect("serialises") + "\n";
+        crate::atomic::write(&dir.join(CAMPAIGN_FILE), text.as_bytes())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_cover_the_budget_once_in_order() {
+        for (budget, count) in [(10u64, 3u64), (7, 7), (5, 8), (1_000_003, 16)] {
+            let mut next = 0;
+            for index in 0..count {
+                let r = Shard { index, count }.range(budget);
+                assert_eq!(r.start, next);
+                assert!(r.end - r.start <= budget / count + 1);
+                next = r.end;
+            }
+            assert_eq!(next, budget);
+        }
+        assert_eq!(Shard::parse("2/4"), Ok(Shard { index: 2, count: 4 }));
+        for bad in ["4/4", "1/0", "x/2", "1", "-1/2", ""] {
+            assert!(Shard::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn the_fingerprint_covers_the_settings_and_the_program_text() {
+        let s = paracosm_scenarios::builtin("pedestrian-crossing").unwrap();
+        let make = |seed, shard| {
+            CampaignFile::new(
+                "pedestrian-crossing",
+                &s,
+                SutChoice::Scenario,
+                "halton",
+                seed,
+                100,
+                2,
+                shard,
+            )
+        };
+        let a = make(0, None);
+        assert_eq!(a.fingerprint, make(0, None).fingerprint);
+        assert_ne!(a.fingerprint, make(1, None).fingerprint);
+        let sharded = make(0, Some(Shard { index: 1, count: 2 }));
+        assert_eq!(a.fingerprint, sharded.fingerprint, "shards share it");
+        assert_eq!(a.differences(&make(1, None)), ["seed: 0 vs 1"]);
+        let mut edited = s.clone();
+        edited.source = "# edited\n".into();
+        let b = CampaignFile::new(
+            "pedestrian-crossing",
+            &edited,
+            SutChoice::Scenario,
+            "halton",
+            0,
+            100,
+            2,
+            None,
+        );
+        assert_eq!(a.differences(&b), ["the scenario program's text differs"]);
+    }
+}

@@ -1,0 +1,126 @@
+//! `paracosm-fuzz merge`: shard folders into one campaign folder.
+
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::campaign::RESULTS_FILE;
+use crate::campaign_file::CampaignFile;
+use crate::record::RunRecord;
+
+/// A merged campaign, written to its folder (results and `campaign.json`; the caller writes
+/// the summary and plots with [`crate::report::write_outputs`]).
+#[derive(Debug)]
+pub struct Merged {
+    /// The whole campaign's settings (no shard).
+    pub file: CampaignFile,
+    /// Every record, by id.
+    pub records: Vec<RunRecord>,
+    /// The scenario.
+    pub scenario: paracosm_scenarios::Scenario,
+}
+
+/// Checks that `dirs` are the complete, non-overlapping shards of one campaign and writes
+/// their records, in id order, to `out/results.jsonl` with the whole campaign's
+/// `campaign.json`.
+///
+/// # Errors
+/// A message when a folder is not a shard, the shards belong to different campaigns
+/// (fingerprints), one is missing, given twice or incomplete, or a file cannot be read or
+/// written.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, String> {
+    let mut shards: BTreeMap<u64, (PathBuf, CampaignFile)> = BTreeMap::new();
+    let mut first: Option<(PathBuf, CampaignFile)> = None;
+    for dir in dirs {
+        let file = CampaignFile::read(dir)?;
+        let Some(shard) = file.shard else {
+            return Err(format!(
+                "`{}` holds a whole campaign, not a shard (run shards with --shard I/N)",
+                dir.display()
+            ));
+        };
+        if let Some((first_dir, f)) = &first {
+            let their_count = f.shard.map_or(1, |s| s.count);
+            if f.fingerprint != file.fingerprint || their_count != shard.count {
+                let mut diff = f.differences(&file);
+                diff.retain(|d| !d.starts_with("shard: "));
+                if their_count != shard.count {
+                    diff.push(format!("shard counts: {their_count} vs {}", shard.count));
+                }
+                return Err(format!(
+                    "`{}` and `{}` are shards of different campaigns ({})",
+                    first_dir.display(),
+                    dir.display(),
+                    diff.join("; ")
+                ));
+            }
+        } else {
+            first = Some((dir.clone(), file.clone()));
+        }
+        if let Some((other, _)) = shards.get(&shard.index) {
+            return Err(format!(
+                "shard {shard} is given twice: `{}` and `{}`",
+                other.display(),
+                dir.display()
+            ));
+        }
+        shards.insert(shard.index, (dir.clone(), file));
+    }
+    let Some((_, template)) = first else {
+        return Err("no shard folders given".into());
+    };
+    let count = template.shard.map_or(1, |s| s.count);
+    let missing: Vec<String> = (0..count)
+        .filter(|i| !shards.contains_key(i))
+        .map(|i| format!("{i}/{count}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(format!(
+            "shard {} of the campaign {} missing",
+            missing.join(", "),
+            if missing.len() == 1 { "is" } else { "are" }
+        ));
+    }
+    let mut scenario = paracosm_scenarios::load(&template.scenario).map_err(|e| e.to_string())?;
+    if let Some(sut) = template.sut.config()? {
+        scenario.sut = sut;
+    }
+    let mut records = Vec::with_capacity(template.budget as usize);
+    for (dir, file) in shards.values() {
+        let ids = file.ids();
+        let existing = crate::results::load(dir, &scenario.space, ids.clone(), false)?;
+        let done = existing.records.len() as u64;
+        if done != ids.end - ids.start {
+            return Err(format!(
+                "shard {} in `{}` is incomplete: {} of {} tests; finish it with \
+                 `paracosm-fuzz --resume --out {}`",
+                file.shard.expect("checked"),
+                dir.display(),
+                done,
+                ids.end - ids.start,
+                dir.display()
+            ));
+        }
+        records.extend(existing.records);
+    }
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create `{}`: {e}", out.display()))?;
+    let mut whole = CampaignFile {
+        shard: None,
+        ..template
+    };
+    whole.tool = format!("paracosm {}", env!("CARGO_PKG_VERSION"));
+    let results = out.join(RESULTS_FILE);
+    crate::atomic::with_temp(&results, |tmp| -> Result<(), String> {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(tmp).map_err(|e| e.to_string())?);
+        for (dir, _) in shards.values() {
+            crate::results::append_file(&mut f, dir)?;
+        }
+        f.flush().map_err(|e| e.to_string())
+    })?;
+    whole.write(out)?;
+    Ok(Merged {
+        file: whole,
+        records,
+        scenario,
+    })
+}

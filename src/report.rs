@@ -1,0 +1,271 @@
+//! What a campaign leaves besides `results.jsonl`: `summary.json`, the plots, JUnit XML, and
+//! the human summary printed by `paracosm-fuzz`, `merge` and `report`.
+
+use std::path::{Path, PathBuf};
+
+use paracosm_scenarios::Scenario;
+
+use crate::campaign::RESULTS_FILE;
+use crate::campaign_file::CampaignFile;
+use crate::record::{RunRecord, Status};
+use crate::summary::{Counts, FailureEntry, FirstFailure, Summary};
+
+/// File name of the summary in the output folder.
+pub const SUMMARY_FILE: &str = "summary.json";
+
+/// Outcome counts of `records`.
+pub fn counts(records: &[RunRecord]) -> Counts {
+    let mut c = Counts::default();
+    for r in records {
+        match r.status {
+            Status::Pass => c.pass += 1,
+            Status::Fail => c.fail += 1,
+            Status::Error => c.error += 1,
+        }
+    }
+    c
+}
+
+fn failed_monitors(r: &RunRecord) -> Vec<String> {
+    r.monitors
+        .iter()
+        .filter(|(_, m)| !m.passed)
+        .map(|(n, _)| n.clone())
+        .collect()
+}
+
+/// The failing test with the smallest id.
+pub fn first_failure(records: &[RunRecord]) -> Option<FirstFailure> {
+    records.iter().find_map(|r| match (&r.status, &r.params) {
+        (Status::Fail, Some(params)) => Some(FirstFailure {
+            id: r.id,
+            params: params.clone(),
+            failed_monitors: failed_monitors(r),
+        }),
+        _ => None,
+    })
+}
+
+/// The command that replays test `id` of the campaign in `out`.
+pub fn replay_command(out: &Path, id: u64) -> String {
+    format!(
+        "paracosm-fuzz replay {} --id {id} --frames {}",
+        out.join(RESULTS_FILE).display(),
+        out.join(format!("frames-{id}")).display()
+    )
+}
+
+/// Every failed test, smallest robustness first (ties by id; NaN last).
+pub fn failures(records: &[RunRecord], out: &Path) -> Vec<FailureEntry> {
+    let mut list: Vec<FailureEntry> = records
+        .iter()
+        .filter(|r| r.status == Status::Fail)
+        .map(|r| FailureEntry {
+            id: r.id,
+            robustness: r
+                .monitors
+                .iter()
+                .map(|(_, m)| m.robustness)
+                .fold(f64::INFINITY, f64::min),
+            failed_monitors: failed_monitors(r),
+            params: r.params.clone(),
+            replay: replay_command(out, r.id),
+        })
+        .collect();
+    list.sort_by(|a, b| {
+        let key = |x: f64| if x.is_nan() { f64::INFINITY } else { x };
+        key(a.robustness)
+            .total_cmp(&key(b.robustness))
+            .then(a.id.cmp(&b.id))
+    });
+    list
+}
+
+/// Settings of [`write_outputs`].
+pub struct Finished<'a> {
+    /// The output folder.
+    pub out: &'a Path,
+    /// The scenario.
+    pub scenario: &'a Scenario,
+    /// The campaign's settings.
+    pub file: &'a CampaignFile,
+    /// Every record of the folder, by id.
+    pub records: &'a [RunRecord],
+    /// Worker threads used.
+    pub jobs: usize,
+    /// Wall time in seconds.
+    pub wall_s: f64,
+    /// Where to write JUnit XML, if asked.
+    pub junit: Option<&'a Path>,
+}
+
+/// Writes the plots (`failure_map`, `failure_rate`), JUnit XML when asked, and
+/// `summary.json`, each through a temporary file and a rename, and returns the summary.
+///
+/// # Errors
+/// A message naming the file that cannot be written.
+pub fn write_outputs(f: &Finished<'_>) -> Result<Summary, String> {
+    let scenario = f.scenario;
+    let counts = counts(f.records);
+    let title = format!(
+        "{}: {}, {} tests, {} failed",
+        scenario.name,
+        f.file.strategy,
+        f.records.len(),
+        counts.fail
+    );
+    let mut plots: Vec<PathBuf> = crate::plot::failure_map(
+        &f.out.join("failure_map"),
+        &scenario.space,
+        &scenario.map_axes,
+        &[(&title, f.records)],
+    )
+    .map_err(|e| e.to_string())?
+    .into();
+    plots.extend(
+        crate::plot::failure_rate_map(
+            &f.out.join("failure_rate"),
+            &scenario.space,
+            &scenario.map_axes,
+            &format!(
+                "{}: failure rate ({} tests)",
+                scenario.name,
+                f.records.len()
+            ),
+            f.records,
+            8,
+        )
+        .map_err(|e| e.to_string())?,
+    );
+    if let Some(path) = f.junit {
+        crate::junit::write(path, &scenario.name, f.records, f.out)?;
+    }
+    let mut outputs = vec![
+        RESULTS_FILE.to_owned(),
+        SUMMARY_FILE.to_owned(),
+        crate::campaign_file::CAMPAIGN_FILE.to_owned(),
+    ];
+    outputs.extend(
+        plots
+            .iter()
+            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned())),
+    );
+    if let Some(j) = f.junit {
+        outputs.push(j.display().to_string());
+    }
+    let summary = summarise(f, outputs);
+    let text = serde_json::to_string_pretty(&summary).expect("summaries serialise") + "\n";
+    crate::atomic::write(&f.out.join(SUMMARY_FILE), text.as_bytes())?;
+    Ok(summary)
+}
+
+/// The summary of a folder's records, listing `outputs` as the files written.
+pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
+    let scenario = f.scenario;
+    let coverage = {
+        let set = crate::cover::TestSet {
+            space: scenario.space.clone(),
+            points: f.records.iter().map(|r| r.point.clone()).collect(),
+        };
+        let metrics: Vec<crate::cover::Metric> = ["dispersion", "cd", "wd", "md", "l2star", "star"]
+            .iter()
+            .filter_map(|m| m.parse().ok())
+            .collect();
+        crate::cover::estimate(&set, &metrics, None, None, 10).ok()
+    };
+    Summary {
+        failures: failures(f.records, f.out),
+        tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
+        scenario: scenario.name.clone(),
+        strategy: f.file.strategy.clone(),
+        seed: f.file.seed,
+        budget: f.file.budget,
+        shard: f.file.shard,
+        tests_run: f.records.len() as u64,
+        jobs: f.jobs,
+        space: scenario.space.params().to_vec(),
+        counts: counts(f.records),
+        first_failure: first_failure(f.records),
+        coverage,
+        wall_s: f.wall_s,
+        outputs,
+    }
+}
+
+/// The human summary: counts and speed, the first failure, coverage, and the files.
+pub fn human(summary: &Summary, scenario: &Scenario, out: &Path, expected: u64) -> String {
+    let c = summary.counts;
+    let mut lines = vec![format!(
+        "{} of {} tests of {} ({}, seed {}{}): {} passed, {} failed, {} errors in {:.1} s ({:.0} tests/s)",
+        summary.tests_run,
+        expected,
+        scenario.name,
+        summary.strategy,
+        summary.seed,
+        summary
+            .shard
+            .map(|s| format!(", shard {s}"))
+            .unwrap_or_default(),
+        c.pass,
+        c.fail,
+        c.error,
+        summary.wall_s,
+        summary.tests_run as f64 / summary.wall_s.max(1e-9)
+    )];
+    if let Some(f) = &summary.first_failure {
+        let values: Vec<String> = f
+            .params
+            .iter()
+            .map(|(n, v)| {
+                let unit = scenario
+                    .space
+                    .param(n)
+                    .and_then(|p| p.unit.clone())
+                    .unwrap_or_default();
+                match v.as_f64() {
+                    Some(x) => format!("{n} = {x:.3} {unit}"),
+                    None => format!("{n} = {v}"),
+                }
+            })
+            .collect();
+        lines.push(format!(
+            "first failure: test {} ({}), monitors failed: {}",
+            f.id,
+            values.join(", "),
+            f.failed_monitors.join(", ")
+        ));
+        lines.push(format!("replay it: {}", replay_command(out, f.id)));
+    }
+    if let Some(cov) = &summary.coverage {
+        let mut parts = Vec::new();
+        if let Some(d) = &cov.dispersion {
+            parts.push(if d.exact {
+                format!("dispersion {:.4}", d.lower)
+            } else {
+                format!("dispersion in [{:.4}, {:.4}]", d.lower, d.upper)
+            });
+        }
+        if let Some(star) = &cov.star {
+            parts.push(format!("star discrepancy {:.4}", star.upper));
+        }
+        for k in &cov.kwise {
+            parts.push(format!(
+                "{}-wise coverage {}/{}",
+                k.strength, k.covered, k.total
+            ));
+        }
+        if !parts.is_empty() {
+            lines.push(format!("coverage: {}", parts.join(", ")));
+        }
+    }
+    lines.push(format!(
+        "files: {}",
+        summary
+            .outputs
+            .iter()
+            .map(|o| out.join(o).display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
+    lines.join("\n")
+}

@@ -1,0 +1,137 @@
+//! Reading a folder's `results.jsonl` back: for `--resume`, `merge` and `report`.
+
+use std::io::Write;
+use std::ops::Range;
+use std::path::Path;
+
+use paracosm_generators::ParamSpace;
+
+use crate::campaign::RESULTS_FILE;
+use crate::record::RunRecord;
+
+/// The records found in a folder.
+#[derive(Debug)]
+pub struct Existing {
+    /// The records, in id order.
+    pub records: Vec<RunRecord>,
+    /// Bytes of a half-written last line that were cut off (0 when the file was whole).
+    pub repaired_bytes: usize,
+}
+
+/// Reads `results.jsonl` in `dir`, written for a campaign whose folder runs `ids` with
+/// parameter space `space`. A last line without its newline (the process was killed while
+/// writing it) is cut off the file when `repair`, and ignored otherwise. Every other line must
+/// be a record, and the records must be `ids.start, ids.start + 1, ...` in order, since the
+/// runner writes them so. A missing file reads as no records.
+///
+/// # Errors
+/// A message with `file:line:column` for a line that is not a record, or naming the first id
+/// out of sequence; or the file system's message.
+pub fn load(
+    dir: &Path,
+    space: &ParamSpace,
+    ids: Range<u64>,
+    repair: bool,
+) -> Result<Existing, String> {
+    let path = dir.join(RESULTS_FILE);
+    let bytes = match std::fs::read(&path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+        Err(e) => return Err(format!("cannot read `{}`: {e}", path.display())),
+    };
+    let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let repaired_bytes = bytes.len() - whole;
+    if repaired_bytes > 0 && repair {
+        let f = std::fs::OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .map_err(|e| format!("cannot repair `{}`: {e}", path.display()))?;
+        f.set_len(whole as u64)
+            .and_then(|()| f.sync_all())
+            .map_err(|e| format!("cannot repair `{}`: {e}", path.display()))?;
+    }
+    let text = std::str::from_utf8(&bytes[..whole]).map_err(|e| {
+        format!(
+            "{}: not UTF-8 text (byte {}); is it a results file?",
+            path.display(),
+            e.valid_up_to()
+        )
+    })?;
+    let mut records = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let r = RunRecord::from_line(line, space).map_err(|e| {
+            format!(
+                "{}:{}:{}: not a results record: {e}",
+                path.display(),
+                n + 1,
+                e.column()
+            )
+        })?;
+        let expected = ids.start + records.len() as u64;
+        if r.id != expected || !ids.contains(&r.id) {
+            return Err(format!(
+                "{}:{}: test id {} where {} was expected (this folder runs ids {}..{}); the file \
+                 was not written by this campaign",
+                path.display(),
+                n + 1,
+                r.id,
+                expected,
+                ids.start,
+                ids.end
+            ));
+        }
+        records.push(r);
+    }
+    Ok(Existing {
+        records,
+        repaired_bytes,
+    })
+}
+
+/// Appends `src`'s `results.jsonl` bytes to `out` (whole lines only).
+///
+/// # Errors
+/// The file system's message.
+pub fn append_file(out: &mut impl Write, src: &Path) -> Result<(), String> {
+    let path = src.join(RESULTS_FILE);
+    let bytes =
+        std::fs::read(&path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+    let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    out.write_all(&bytes[..whole])
+        .map_err(|e| format!("cannot write the merged results: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_half_written_last_line_is_cut_off_and_ids_must_follow_in_order() {
+        let s = paracosm_scenarios::reference::scenario();
+        let dir = tempfile::tempdir().unwrap();
+        let c = crate::Campaign {
+            scenario: &s,
+            strategy: paracosm_generators::Strategy::Halton,
+            seed: 0,
+            budget: 4,
+            strength: 2,
+            jobs: 1,
+        };
+        c.run(dir.path(), |_| {}).unwrap();
+        let path = dir.path().join(RESULTS_FILE);
+        let full = std::fs::read_to_string(&path).unwrap();
+        let cut = full.len() - 20;
+        std::fs::write(&path, &full[..cut]).unwrap();
+        let e = load(dir.path(), &s.space, 0..4, true).unwrap();
+        assert_eq!(e.records.len(), 3);
+        assert!(e.repaired_bytes > 0);
+        let repaired = std::fs::read_to_string(&path).unwrap();
+        assert!(repaired.ends_with('\n') && full.starts_with(&repaired));
+        // A shard that should start at id 2 does not accept ids 0..3.
+        let err = load(dir.path(), &s.space, 2..4, false).unwrap_err();
+        assert!(err.contains(":1: test id 0 where 2 was expected"), "{err}");
+        std::fs::write(&path, "{\"id\": 0, oops\n").unwrap();
+        let err = load(dir.path(), &s.space, 0..4, false).unwrap_err();
+        assert!(err.contains("results.jsonl:1:"), "{err}");
+    }
+}
