@@ -75,13 +75,16 @@ pub struct RunRecord {
     pub wall_ms: f64,
 }
 
-/// The fields of a results line, as read back (`params` is rebuilt from `point`).
+/// The fields of a results line, as read back (`params` is rebuilt from `point`). Unknown
+/// keys are refused: a line with them was not written by paracosm.
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct Line {
     id: u64,
     seed: u64,
     strategy: String,
     point: Point,
+    params: serde_json::Value,
     status: Status,
     #[serde(deserialize_with = "pairs")]
     monitors: Vec<(String, MonitorResult)>,
@@ -101,11 +104,21 @@ impl RunRecord {
     /// serde_json's error (with its column) when the line is not a results record.
     pub fn from_line(line: &str, space: &ParamSpace) -> Result<RunRecord, serde_json::Error> {
         let l: Line = serde_json::from_str(line)?;
+        let params = space.decode(&l.point).ok();
+        // `params` must be what `point` decodes to: otherwise the line was edited or belongs
+        // to another scenario.
+        if serde_json::to_value(&params)? != l.params {
+            return Err(serde::de::Error::custom(format!(
+                "`params` {} do not match `point` decoded in this scenario's space ({})",
+                l.params,
+                serde_json::to_value(&params)?
+            )));
+        }
         Ok(RunRecord {
             id: l.id,
             seed: l.seed,
             strategy: l.strategy,
-            params: space.decode(&l.point).ok(),
+            params,
             point: l.point,
             status: l.status,
             monitors: l.monitors,

@@ -40,7 +40,7 @@ fn input(e: impl std::fmt::Display) -> ReplayError {
 }
 
 /// The line of `results` whose `id` is `id`.
-fn find_record(results: &Path, id: u64) -> Result<serde_json::Value, ReplayError> {
+fn find_record(results: &Path, id: u64) -> Result<(usize, String), ReplayError> {
     let text = std::fs::read_to_string(results)
         .map_err(|e| input(format!("cannot read `{}`: {e}", results.display())))?;
     let mut ids = Vec::new();
@@ -59,7 +59,7 @@ fn find_record(results: &Path, id: u64) -> Result<serde_json::Value, ReplayError
             }
         };
         match v.get("id").and_then(serde_json::Value::as_u64) {
-            Some(i) if i == id => return Ok(v),
+            Some(i) if i == id => return Ok((n + 1, line.to_owned())),
             Some(i) => ids.push(i),
             None => {
                 return Err(input(format!(
@@ -95,11 +95,19 @@ pub fn replay(
     sut: Option<SutConfig>,
 ) -> Result<Replay, ReplayError> {
     let dir = results.parent().unwrap_or(Path::new("."));
+    let (line_no, line) = find_record(results, id)?;
     let campaign_file = CampaignFile::read(dir).map_err(input)?;
-    let recorded = find_record(results, id)?;
-    let point: Point = serde_json::from_value(recorded["point"].clone())
-        .map_err(|e| input(format!("test {id}: its `point` does not parse: {e}")))?;
     let mut scenario = paracosm_scenarios::load(&campaign_file.scenario).map_err(input)?;
+    let record = RunRecord::from_line(&line, &scenario.space).map_err(|e| {
+        input(format!(
+            "{}:{line_no}:{}: not a results record of this campaign: {e}",
+            results.display(),
+            e.column()
+        ))
+    })?;
+    let recorded: serde_json::Value =
+        serde_json::from_str(&line).expect("from_line parsed it as JSON");
+    let point: Point = record.point;
     if let Some(s) = sut.or(campaign_file.sut.config().map_err(input)?) {
         scenario.sut = s;
     }
@@ -143,11 +151,13 @@ pub fn replay(
     if let Some(e) = write_error {
         return Err(input(e));
     }
-    if recorded["seed"].as_u64() != Some(replayed.seed) {
+    if record.seed != replayed.seed {
         return Err(input(format!(
-            "test {id} was recorded with seed {} but campaign.json gives {}: the results and \
-             campaign.json are from different campaigns",
-            recorded["seed"], replayed.seed
+            "{}:{line_no}: test {id} was recorded with seed {} but campaign.json gives {}: the \
+             results and campaign.json are from different campaigns",
+            results.display(),
+            record.seed,
+            replayed.seed
         )));
     }
     let contact_sheet = match frames {

@@ -50,14 +50,34 @@ pub fn read_tests(path: &Path, space: Option<&ParamSpace>) -> Result<TestSet, In
     };
     let text =
         std::fs::read_to_string(path).map_err(|e| err(None, None, format!("cannot read: {e}")))?;
+    let is_jsonl = path.extension().is_some_and(|e| e == "jsonl");
+    parse_tests(&file, &text, is_jsonl, space)
+}
+
+/// Reads a test set from `text`, the contents of the file named `file`: `paracosm-fuzz`
+/// results when `is_jsonl`, else CSV with a header (see [`read_tests`]).
+///
+/// # Errors
+/// As [`read_tests`].
+pub fn parse_tests(
+    file: &str,
+    text: &str,
+    is_jsonl: bool,
+    space: Option<&ParamSpace>,
+) -> Result<TestSet, InputError> {
+    let err = |line: Option<u64>, column: Option<(usize, String)>, message: String| InputError {
+        file: file.to_owned(),
+        line,
+        column,
+        message,
+    };
     if text.trim().is_empty() {
         return Err(err(None, None, "the file is empty".into()));
     }
-    let is_jsonl = path.extension().is_some_and(|e| e == "jsonl");
     let (names, rows) = if is_jsonl {
-        jsonl_rows(&text, space, &err)?
+        jsonl_rows(text, space, &err)?
     } else {
-        csv_rows(&text, space, &err)?
+        csv_rows(text, space, &err)?
     };
     let space = match space {
         Some(s) => s.clone(),
@@ -197,6 +217,12 @@ fn csv_rows(
     Ok((names, rows))
 }
 
+/// The keys of a `results.jsonl` line.
+const RESULT_KEYS: [&str; 10] = [
+    "id", "seed", "strategy", "point", "params", "status", "monitors", "metrics", "error",
+    "wall_ms",
+];
+
 fn jsonl_rows(
     text: &str,
     space: Option<&ParamSpace>,
@@ -216,6 +242,19 @@ fn jsonl_rows(
                 format!("not JSON (column {}): {e}", e.column()),
             )
         })?;
+        // A line with other keys was not written by paracosm-fuzz.
+        if let Some(obj) = v.as_object() {
+            if let Some(k) = obj.keys().find(|k| !RESULT_KEYS.contains(&k.as_str())) {
+                return Err(err(
+                    Some(ln),
+                    None,
+                    format!(
+                        "unknown key `{k}`: not a paracosm-fuzz results line (keys: {})",
+                        RESULT_KEYS.join(", ")
+                    ),
+                ));
+            }
+        }
         let cells: Vec<Cell> = match space {
             Some(s) => s
                 .params()

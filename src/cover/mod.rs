@@ -7,8 +7,8 @@ mod plan;
 mod report;
 mod spec;
 
-pub use input::{read_tests, InputError, TestSet};
+pub use input::{parse_tests, read_tests, InputError, TestSet};
 pub use pict::{parse_pict, read_seeds, PictError, PictModel};
 pub use plan::{plan, Plan};
 pub use report::{estimate, Estimate, Metric};
-pub use spec::{load_space, SpecError};
+pub use spec::{load_space, parse_space, SpecError};

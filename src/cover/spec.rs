@@ -66,11 +66,19 @@ pub fn load_space(spec: &str) -> Result<ParamSpace, SpecError> {
             paracosm_scenarios::builtin_names().join(", "),
         )
     })?;
+    parse_space(spec, &text)
+}
+
+/// The space described by the TOML `text` of the file named `file` (see [`load_space`]).
+///
+/// # Errors
+/// [`SpecError::Invalid`] naming the file, with the line and column of a TOML error.
+pub fn parse_space(file: &str, text: &str) -> Result<ParamSpace, SpecError> {
     let invalid = |reason: String| SpecError::Invalid {
-        file: spec.to_owned(),
+        file: file.to_owned(),
         reason,
     };
-    let file: SpecFile = toml::from_str(&text).map_err(|e| {
+    let parsed: SpecFile = toml::from_str(text).map_err(|e| {
         let at = e
             .span()
             .map(|s| {
@@ -83,7 +91,7 @@ pub fn load_space(spec: &str) -> Result<ParamSpace, SpecError> {
         invalid(format!("{at}{}", e.message()))
     })?;
     let mut params = Vec::new();
-    for p in file.param {
+    for p in parsed.param {
         let domain = match (p.interval, p.levels) {
             (Some([lo, hi]), None) => Domain::Interval { lo, hi },
             (None, Some(levels)) => Domain::Levels(

@@ -63,6 +63,12 @@ pub fn number(v: Value, what: &str) -> anyhow::Result<f64> {
     if let Some(f) = v.downcast_ref::<starlark::values::float::StarlarkFloat>() {
         return Ok(f.0);
     }
+    if v.get_type() == "int" {
+        // An integer beyond 32 bits: its value as a float, so that range checks name it.
+        if let Ok(x) = v.to_str().parse::<f64>() {
+            return Ok(x);
+        }
+    }
     bail!("{what} must be a number, got a {}", v.get_type())
 }
 

@@ -31,6 +31,9 @@ pub const MAX_LOAD_STEPS: u64 = 10_000_000;
 pub const MAX_LOAD_HEAP_BYTES: usize = 256 << 20;
 /// Deepest call stack a program may use.
 pub const MAX_CALL_DEPTH: usize = 200;
+/// Deepest nesting of brackets (`(`, `[`, `{`) a program may have. starlark's parser recurses
+/// once per level and would overflow the stack (an abort, not an error) near 10,000 levels.
+pub const MAX_NESTING: usize = 100;
 
 fn lambda_name(n: u32) -> String {
     // Not an identifier, so no program can read or overwrite it.
@@ -131,6 +134,70 @@ fn globals() -> starlark::environment::Globals {
         .build()
 }
 
+/// Where (line, column, from 1) brackets first nest deeper than [`MAX_NESTING`], skipping
+/// strings and comments; `Ok` when they never do.
+fn check_nesting(source: &str) -> Result<(), (usize, usize)> {
+    let (mut depth, mut line, mut column) = (0usize, 1usize, 0usize);
+    let mut quote: Option<(char, bool)> = None; // (quote char, triple)
+    let mut chars = source.chars().peekable();
+    let mut comment = false;
+    while let Some(c) = chars.next() {
+        column += 1;
+        if c == '\n' {
+            line += 1;
+            column = 0;
+            comment = false;
+            continue;
+        }
+        if comment {
+            continue;
+        }
+        match quote {
+            Some((q, triple)) => {
+                if c == '\\' {
+                    chars.next();
+                    column += 1;
+                } else if c == q {
+                    if !triple {
+                        quote = None;
+                    } else if chars.peek() == Some(&q) {
+                        chars.next();
+                        if chars.peek() == Some(&q) {
+                            chars.next();
+                            quote = None;
+                        }
+                    }
+                }
+            }
+            None => match c {
+                '#' => comment = true,
+                '"' | '\'' => {
+                    let triple = chars.peek() == Some(&c) && {
+                        let mut ahead = chars.clone();
+                        ahead.next();
+                        ahead.peek() == Some(&c)
+                    };
+                    if triple {
+                        chars.next();
+                        chars.next();
+                        column += 2;
+                    }
+                    quote = Some((c, triple));
+                }
+                '(' | '[' | '{' => {
+                    depth += 1;
+                    if depth > MAX_NESTING {
+                        return Err((line, column));
+                    }
+                }
+                ')' | ']' | '}' => depth = depth.saturating_sub(1),
+                _ => {}
+            },
+        }
+    }
+    Ok(())
+}
+
 /// Loads a scenario program from `source`; `file` names it in diagnostics, `name` is the
 /// scenario's name.
 ///
@@ -143,6 +210,11 @@ pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, Sce
         enable_top_level_stmt: true,
         ..Dialect::Standard
     };
+    check_nesting(source).map_err(|(line, column)| {
+        lang(format!(
+            "error: brackets nest deeper than {MAX_NESTING} levels\n --> {file}:{line}:{column}"
+        ))
+    })?;
     let ast =
         AstModule::parse(file, source.to_owned(), &dialect).map_err(|e| lang(format!("{e}")))?;
     let globals = globals();
@@ -159,8 +231,15 @@ pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, Sce
             for l in limits {
                 l.map_err(|e| lang(e.to_string()))?;
             }
-            eval.eval_module(ast, &globals)
-                .map_err(|e| lang(suggest_keyword(&format!("{e}"))))?;
+            eval.eval_module(ast, &globals).map_err(|e| {
+                let message = suggest_keyword(&format!("{e}"));
+                // Limit errors (steps, heap) carry no span: say which program hit them.
+                if message.contains(file) {
+                    lang(message)
+                } else {
+                    lang(format!("{message}\n --> {file}"))
+                }
+            })?;
         }
         // Open parameters take the name of the global they are bound to.
         let mut scene = state.scene.borrow_mut();

@@ -125,3 +125,24 @@ fn parameters_take_their_global_names_and_over_time_adds_coordinates() {
     let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["fog.c0", "fog.c1", "fog.c2", "levels"]);
 }
+
+#[test]
+fn brackets_nested_too_deep_are_an_error_not_a_stack_overflow() {
+    let deep = format!("x = {}{}\n", "[".repeat(20_000), "]".repeat(20_000));
+    let e = super::load_source("deep.star", &deep, "deep")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("nest deeper than 100 levels") && e.contains("deep.star:1:105"),
+        "{e}"
+    );
+    // Brackets inside strings and comments do not count.
+    let fine = format!(
+        "# {}\ns = \"{}\"\nt = \"\"\"{}\"\"\"\n",
+        "[".repeat(500),
+        "(".repeat(500),
+        "{".repeat(500)
+    );
+    assert!(super::check_nesting(&fine).is_ok());
+    assert_eq!(super::check_nesting("a = [[1]]\nb = ((2))"), Ok(()));
+}

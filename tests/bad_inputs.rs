@@ -1,0 +1,195 @@
+//! The hostile-input corpus (`tests/bad_inputs/`): every malformed scenario, space, CSV,
+//! results file and command line ends with exit code 2, a message that names the problem and
+//! the file, and no panic.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn run(tool: &str, args: &[String]) -> Output {
+    let exe = match tool {
+        "fuzz" => env!("CARGO_BIN_EXE_paracosm-fuzz"),
+        "cover" => env!("CARGO_BIN_EXE_paracosm-cover"),
+        other => panic!("unknown tool {other}"),
+    };
+    Command::new(exe)
+        .args(args)
+        .current_dir(root())
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap()
+}
+
+/// Asserts exit code 2, no panic, and each of `phrases` in stderr.
+fn assert_refused(what: &str, o: &Output, phrases: &[&str]) {
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{what}: exit {:?}\n{stderr}",
+        o.status
+    );
+    assert!(!stderr.contains("panicked"), "{what}: {stderr}");
+    for p in phrases {
+        assert!(stderr.contains(p), "{what}: `{p}` not in\n{stderr}");
+    }
+}
+
+fn files(kind: &str) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("tests/bad_inputs").join(kind))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    v.sort();
+    assert!(!v.is_empty());
+    v
+}
+
+fn rel(p: &Path) -> String {
+    p.strip_prefix(root()).unwrap().display().to_string()
+}
+
+fn name(p: &Path) -> String {
+    p.file_name().unwrap().to_string_lossy().into_owned()
+}
+
+#[test]
+fn bad_scenario_programs() {
+    let tmp = tempfile::tempdir().unwrap();
+    for f in files("scenarios") {
+        let out = tmp.path().join(name(&f));
+        let o = run(
+            "fuzz",
+            &[
+                rel(&f),
+                "--budget".into(),
+                "1".into(),
+                "--out".into(),
+                out.display().to_string(),
+            ],
+        );
+        assert_refused(&rel(&f), &o, &[&name(&f)]);
+        assert!(
+            !out.join("results.jsonl").exists(),
+            "{}: nothing runs",
+            rel(&f)
+        );
+    }
+    // A folder given as the scenario.
+    let o = run("fuzz", &["tests/bad_inputs/scenarios".into()]);
+    assert_refused("a folder", &o, &["Is a directory"]);
+}
+
+#[test]
+fn bad_space_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let csv = tmp.path().join("tests.csv");
+    std::fs::write(&csv, "v\n0.5\n").unwrap();
+    let mut cases = files("spaces");
+    cases.push(root().join("tests/bad_inputs/spaces"));
+    for f in cases {
+        let o = run(
+            "cover",
+            &[
+                "estimate".into(),
+                "--space".into(),
+                rel(&f),
+                csv.display().to_string(),
+            ],
+        );
+        assert_refused(&rel(&f), &o, &[&name(&f)]);
+    }
+}
+
+#[test]
+fn bad_csv_files() {
+    let mut cases = files("csv");
+    cases.push(root().join("tests/bad_inputs/csv"));
+    for f in cases {
+        let o = run("cover", &["estimate".into(), rel(&f)]);
+        assert_refused(&rel(&f), &o, &[&name(&f)]);
+    }
+}
+
+#[test]
+fn bad_results_files_for_every_reader() {
+    let tmp = tempfile::tempdir().unwrap();
+    // A real campaign's campaign.json, beside which each bad results file is put.
+    let base = tmp.path().join("base");
+    let o = run(
+        "fuzz",
+        &[
+            "pedestrian-crossing".into(),
+            "--budget".into(),
+            "2".into(),
+            "--out".into(),
+            base.display().to_string(),
+        ],
+    );
+    assert!(o.status.code() == Some(0) || o.status.code() == Some(1));
+    for f in files("results") {
+        let what = rel(&f);
+        let o = run(
+            "cover",
+            &[
+                "estimate".into(),
+                "--space".into(),
+                "pedestrian-crossing".into(),
+                what.clone(),
+            ],
+        );
+        assert_refused(&what, &o, &[&name(&f)]);
+        if name(&f) == "empty.jsonl" {
+            continue; // an empty results file is a campaign that has not started
+        }
+        let dir = tmp.path().join(name(&f));
+        std::fs::create_dir(&dir).unwrap();
+        std::fs::copy(base.join("campaign.json"), dir.join("campaign.json")).unwrap();
+        std::fs::copy(&f, dir.join("results.jsonl")).unwrap();
+        let before = std::fs::read(dir.join("results.jsonl")).unwrap();
+        let d = dir.display().to_string();
+        let results = dir.join("results.jsonl").display().to_string();
+        for args in [
+            vec!["report".to_owned(), d.clone()],
+            vec!["--resume".to_owned(), "--out".to_owned(), d.clone()],
+            vec![
+                "replay".to_owned(),
+                results.clone(),
+                "--id".to_owned(),
+                "0".to_owned(),
+            ],
+        ] {
+            let o = run("fuzz", &args);
+            assert_refused(&format!("{what} with {}", args[0]), &o, &["results.jsonl"]);
+        }
+        // A refused resume loses nothing.
+        if name(&f) != "binary_garbage.jsonl" {
+            let after = std::fs::read(dir.join("results.jsonl")).unwrap();
+            let whole = |b: &[u8]| b.iter().rposition(|&c| c == b'\n').map_or(0, |i| i + 1);
+            assert_eq!(&after[..whole(&after)], &before[..whole(&before)], "{what}");
+        }
+    }
+}
+
+#[test]
+fn bad_command_lines() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::create_dir(tmp.path().join("empty")).unwrap();
+    let text = std::fs::read_to_string(root().join("tests/bad_inputs/args.txt")).unwrap();
+    let mut n = 0;
+    for line in text
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
+    {
+        let (cmd, expect) = line.split_once(" => ").expect("TOOL ARGS => phrase");
+        let words = shlex::split(&cmd.replace("{TMP}", &tmp.path().display().to_string()))
+            .expect("a shell-like line");
+        let o = run(&words[0], &words[1..]);
+        assert_refused(line, &o, &[expect]);
+        n += 1;
+    }
+    assert!(n >= 30, "{n} cases");
+}
