@@ -213,6 +213,25 @@ mod tests {
         };
         let line = serde_json::to_string(&r).unwrap();
         assert_eq!(RunRecord::from_line(&line, &space).unwrap(), r);
+        // Floats read back bit for bit (serde_json's float_roundtrip): a resumed campaign and
+        // a replay rebuild exactly the recorded point.
+        let awkward = RunRecord {
+            point: Point {
+                discrete: vec![],
+                continuous: vec![1.0 / 3.0 + 1e-17 * 7.0],
+            },
+            params: None,
+            ..r.clone()
+        };
+        let awkward = RunRecord {
+            params: space.decode(&awkward.point).ok(),
+            ..awkward
+        };
+        let back = RunRecord::from_line(&serde_json::to_string(&awkward).unwrap(), &space).unwrap();
+        assert_eq!(
+            back.point.continuous[0].to_bits(),
+            awkward.point.continuous[0].to_bits()
+        );
         assert_eq!(
             line,
             r#"{"id":3,"seed":9,"strategy":"halton","point":{"discrete":[],"continuous":[0.25]},"params":{"v":0.5},"status":"fail","monitors":{"collision":{"passed":false,"robustness":0.0,"first_violation_s":1.5}},"metrics":{"min_distance_m":0.0,"time_to_failure_s":1.5},"error":null,"wall_ms":2.5}"#

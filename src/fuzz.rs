@@ -1,0 +1,40 @@
+//! Entry points of the fuzz targets (`fuzz/`, run by `cargo fuzz`) and of their regression
+//! test (`tests/fuzz_regressions.rs`, which replays the inputs kept in `fuzz/regressions/`).
+//! Each feeds arbitrary bytes to a reader of user input; a panic or a stack overflow is a bug.
+
+use std::sync::OnceLock;
+
+use paracosm_generators::ParamSpace;
+
+fn text(data: &[u8]) -> Option<&str> {
+    std::str::from_utf8(data).ok()
+}
+
+fn study_space() -> &'static ParamSpace {
+    static SPACE: OnceLock<ParamSpace> = OnceLock::new();
+    SPACE.get_or_init(|| paracosm_scenarios::reference::scenario().space)
+}
+
+/// A space file (TOML) and a CSV test set, with and without a space.
+pub fn inputs(data: &[u8]) {
+    let Some(s) = text(data) else { return };
+    let _ = crate::cover::parse_space("fuzz.toml", s);
+    let _ = crate::cover::parse_tests("fuzz.csv", s, false, None);
+    let _ = crate::cover::parse_tests("fuzz.csv", s, false, Some(study_space()));
+}
+
+/// Lines of `results.jsonl`, as `--resume`/`report` and `paracosm-cover` read them.
+pub fn results(data: &[u8]) {
+    let Some(s) = text(data) else { return };
+    for line in s.lines() {
+        let _ = crate::record::RunRecord::from_line(line, study_space());
+    }
+    let _ = crate::cover::parse_tests("fuzz.jsonl", s, true, None);
+    let _ = crate::cover::parse_tests("fuzz.jsonl", s, true, Some(study_space()));
+}
+
+/// A scenario program.
+pub fn scenario(data: &[u8]) {
+    let Some(s) = text(data) else { return };
+    let _ = paracosm_scenarios::lang::load_source("fuzz.star", s, "fuzz");
+}
