@@ -9,12 +9,14 @@
 //! - [`DistanceMonitor`]: the ego vehicle travelled at least `min_distance_m`, so it did not pass
 //!   by standing still (paper §2).
 //! - [`TimeToFailureMonitor`]: a wrapped monitor first fails no earlier than a given time.
+//! - [`stl`]: signal temporal logic formulas and their quantitative robustness.
 #![warn(missing_docs)]
 
 mod collision;
 mod distance;
 mod monitor;
 mod signals;
+pub mod stl;
 mod time_to_failure;
 
 pub use collision::CollisionMonitor;

@@ -1,0 +1,198 @@
+//! Offline robustness over a whole trace.
+
+use std::collections::BTreeMap;
+
+use super::window::{sliding_max, sliding_min};
+use super::{Cmp, Formula, StlError};
+
+/// A uniformly sampled trace: named signals, each `n` samples, `dt_s` seconds apart, the
+/// first at time 0.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Trace {
+    /// Sampling period in seconds, `> 0`.
+    pub dt_s: f64,
+    /// Samples by signal name, all of the same length.
+    pub signals: BTreeMap<String, Vec<f64>>,
+}
+
+impl Trace {
+    /// Number of samples (0 without signals).
+    pub fn len(&self) -> usize {
+        self.signals.values().next().map_or(0, Vec::len)
+    }
+
+    /// Whether the trace has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn check(&self) -> Result<(), StlError> {
+        if !(self.dt_s.is_finite() && self.dt_s > 0.0) {
+            return Err(StlError::Trace(format!(
+                "step {} s is not positive",
+                self.dt_s
+            )));
+        }
+        let n = self.len();
+        if let Some((name, v)) = self.signals.iter().find(|(_, v)| v.len() != n) {
+            return Err(StlError::Trace(format!(
+                "signal `{name}` has {} samples, others {n}",
+                v.len()
+            )));
+        }
+        Ok(())
+    }
+
+    /// The sample offsets `[a/dt, b/dt]` of a time interval `[a, b]` in seconds (a bound that
+    /// falls between samples rounds inward, within 1e-9 of a sample it counts as on it).
+    fn steps(&self, a: f64, b: f64) -> (usize, usize) {
+        let lo = (a / self.dt_s - 1e-9).ceil().max(0.0) as usize;
+        let hi = (b / self.dt_s + 1e-9).floor().max(0.0) as usize;
+        (lo, hi.max(lo))
+    }
+}
+
+/// The robustness of `f` at every sample of `trace`: `out[i]` is ρ(f, trace, i) (module docs).
+///
+/// # Errors
+/// [`StlError::MissingSignal`] for a signal the trace lacks; [`StlError::Trace`] for a
+/// malformed trace.
+pub fn robustness(f: &Formula, trace: &Trace) -> Result<Vec<f64>, StlError> {
+    trace.check()?;
+    eval(f, trace)
+}
+
+fn eval(f: &Formula, t: &Trace) -> Result<Vec<f64>, StlError> {
+    let n = t.len();
+    Ok(match f {
+        Formula::True => vec![f64::INFINITY; n],
+        Formula::False => vec![f64::NEG_INFINITY; n],
+        Formula::Pred { signal, op, value } => {
+            let x = t
+                .signals
+                .get(signal)
+                .ok_or_else(|| StlError::MissingSignal(signal.clone()))?;
+            match op {
+                Cmp::Gt | Cmp::Ge => x.iter().map(|v| v - value).collect(),
+                Cmp::Lt | Cmp::Le => x.iter().map(|v| value - v).collect(),
+            }
+        }
+        Formula::Not(g) => eval(g, t)?.into_iter().map(|r| -r).collect(),
+        Formula::And(a, b) => zip(eval(a, t)?, eval(b, t)?, f64::min),
+        Formula::Or(a, b) => zip(eval(a, t)?, eval(b, t)?, f64::max),
+        Formula::Implies(a, b) => zip(eval(a, t)?, eval(b, t)?, |x, y| (-x).max(y)),
+        Formula::Globally(a, b, g) => {
+            let (lo, hi) = t.steps(*a, *b);
+            sliding_min(&eval(g, t)?, lo, hi)
+        }
+        Formula::Eventually(a, b, g) => {
+            let (lo, hi) = t.steps(*a, *b);
+            sliding_max(&eval(g, t)?, lo, hi)
+        }
+        Formula::Until(a, b, left, right) => {
+            let (lo, hi) = t.steps(*a, *b);
+            until(&eval(left, t)?, &eval(right, t)?, lo, hi)
+        }
+    })
+}
+
+fn zip(a: Vec<f64>, b: Vec<f64>, op: impl Fn(f64, f64) -> f64) -> Vec<f64> {
+    a.into_iter().zip(b).map(|(x, y)| op(x, y)).collect()
+}
+
+/// `out[i] = max_{j ∈ [i+lo, i+hi], j < n} min(ψ(j), min_{k ∈ [i, j)} φ(k))`.
+///
+/// For each `i` the inner minimum over `[i, j)` grows one sample at a time as `j` advances,
+/// so one pass over the window suffices: O(n · (hi − lo + 1) + n · lo).
+fn until(phi: &[f64], psi: &[f64], lo: usize, hi: usize) -> Vec<f64> {
+    let n = phi.len();
+    let mut out = vec![f64::NEG_INFINITY; n];
+    for (i, slot) in out.iter_mut().enumerate() {
+        let mut prefix = f64::INFINITY; // min of φ over [i, j)
+        let mut best = f64::NEG_INFINITY;
+        for j in i..n.min(i.saturating_add(hi).saturating_add(1)) {
+            if j >= i + lo {
+                best = best.max(psi[j].min(prefix));
+            }
+            prefix = prefix.min(phi[j]);
+        }
+        *slot = best;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::parse;
+    use super::*;
+    use proptest::prelude::*;
+
+    fn trace(a: &[f64], b: &[f64]) -> Trace {
+        let mut signals = BTreeMap::new();
+        signals.insert("a".to_owned(), a.to_vec());
+        signals.insert("b".to_owned(), b.to_vec());
+        Trace { dt_s: 1.0, signals }
+    }
+
+    fn rho(text: &str, t: &Trace) -> Vec<f64> {
+        robustness(&parse(text).unwrap(), t).unwrap()
+    }
+
+    #[test]
+    fn hand_computed_values() {
+        let t = trace(&[1.0, -2.0, 3.0, 0.5], &[0.0, 2.0, 0.0, 5.0]);
+        assert_eq!(rho("a > 0", &t), [1.0, -2.0, 3.0, 0.5]);
+        assert_eq!(rho("b < 1", &t), [1.0, -1.0, 1.0, -4.0]);
+        assert_eq!(rho("G[0,1] a > 0", &t), [-2.0, -2.0, 0.5, 0.5]);
+        assert_eq!(
+            rho("F[1,2] (a > 0)", &t),
+            [3.0, 3.0, 0.5, f64::NEG_INFINITY]
+        );
+        assert_eq!(rho("a > 0 & b < 1", &t), [1.0, -2.0, 1.0, -4.0]);
+        assert_eq!(rho("a > 0 -> b < 1", &t), [1.0, 2.0, 1.0, -0.5]);
+        // a U[1,2] (b > 1): at 0, j = 1: min(ψ(1) = 1, φ(0) = 1) = 1; j = 2: min(-1, -2).
+        assert_eq!(rho("a > 0 U[1,2] b > 1", &t)[0], 1.0);
+        assert_eq!(rho("true", &t), [f64::INFINITY; 4]);
+        assert_eq!(
+            parse("G[0,10](a > 0 -> F[0,2](b < 1))").unwrap().signals(),
+            ["a", "b"]
+        );
+    }
+
+    #[test]
+    fn errors_show_the_column_and_name_the_problem() {
+        let e = parse("G[0,1] (a > )").unwrap_err().to_string();
+        assert!(
+            e.contains("1:13") && e.contains('^') && e.contains("expected number"),
+            "{e}"
+        );
+        assert_eq!(parse("F[2,1] a > 0"), Err(StlError::Interval(2.0, 1.0)));
+        let t = trace(&[1.0], &[1.0]);
+        assert_eq!(
+            robustness(&parse("c > 0").unwrap(), &t),
+            Err(StlError::MissingSignal("c".into()))
+        );
+    }
+
+    fn values() -> impl Strategy<Value = Vec<f64>> {
+        prop::collection::vec(-10.0f64..10.0, 1..40)
+    }
+
+    proptest! {
+        #[test]
+        fn textbook_identities(a in values(), lo in 0u32..5, w in 0u32..5) {
+            let b: Vec<f64> = a.iter().rev().copied().collect();
+            let t = trace(&a, &b);
+            let hi = lo + w;
+            let eq = |x: &str, y: &str| -> Result<(), TestCaseError> {
+                prop_assert_eq!(rho(x, &t), rho(y, &t), "{} vs {}", x, y);
+                Ok(())
+            };
+            eq(&format!("F[{lo},{hi}] a > 1"), &format!("!G[{lo},{hi}] !(a > 1)"))?;
+            eq(&format!("G[{lo},{hi}] (a > 1 & b < 2)"),
+               &format!("G[{lo},{hi}] a > 1 & G[{lo},{hi}] b < 2"))?;
+            eq(&format!("F[{lo},{hi}] a > 1"), &format!("true U[{lo},{hi}] a > 1"))?;
+            eq("a > 1 -> b < 2", "!(a > 1) | b < 2")?;
+        }
+    }
+}

@@ -1,0 +1,118 @@
+//! Signal temporal logic (STL) with quantitative robustness (space robustness of Fainekos &
+//! Pappas 2009; Donzé & Maler 2010), in discrete time over uniformly sampled traces.
+//!
+//! Syntax ([`parse`], a `pest` grammar): predicates `signal < c`, `<=`, `>`, `>=`; `true`,
+//! `false`; `!φ` (or `not`), `φ & ψ` (`and`), `φ | ψ` (`or`), `φ -> ψ`; `G[a,b] φ`,
+//! `F[a,b] φ` and `φ U[a,b] ψ` with bounds in seconds. Example:
+//! `G[0,10](a > 0 -> F[0,2](b < 1))`.
+//!
+//! Robustness ρ at sample `i` (positive: satisfied with that margin):
+//! - `x > c`, `x >= c`: `x(i) - c`; `x < c`, `x <= c`: `c - x(i)`;
+//! - `!φ`: `-ρφ`; `φ & ψ`: `min`; `φ | ψ`: `max`; `φ -> ψ`: `max(-ρφ, ρψ)`;
+//! - `G[a,b] φ`: `min` of `ρφ(j)` over `j ∈ [i + a/dt, i + b/dt]` within the trace (`+inf`
+//!   when the window is past the end); `F[a,b] φ`: `max` (`-inf` when empty);
+//! - `φ U[a,b] ψ`: `max` over `j ∈ [i + a/dt, i + b/dt]` of `min(ρψ(j), min_{k ∈ [i, j)} ρφ(k))`.
+//!
+//! Window minima and maxima use Lemire's streaming algorithm (a monotone deque, "Streaming
+//! maximum-minimum filter using no more than three comparisons per element", 2006): O(n) per
+//! operator, whatever the window.
+
+mod eval;
+mod parse;
+mod window;
+
+pub use eval::{robustness, Trace};
+pub use parse::parse;
+pub use window::{sliding_max, sliding_min};
+
+use thiserror::Error;
+
+/// A comparison in a predicate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cmp {
+    /// `<`
+    Lt,
+    /// `<=`
+    Le,
+    /// `>`
+    Gt,
+    /// `>=`
+    Ge,
+}
+
+/// An STL formula. Time bounds are in seconds, `0 <= lo <= hi`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Formula {
+    /// `true`: robustness `+inf`.
+    True,
+    /// `false`: robustness `-inf`.
+    False,
+    /// `signal op value`.
+    Pred {
+        /// The signal's name.
+        signal: String,
+        /// The comparison.
+        op: Cmp,
+        /// The threshold, in the signal's unit.
+        value: f64,
+    },
+    /// `!φ`.
+    Not(Box<Formula>),
+    /// `φ & ψ`.
+    And(Box<Formula>, Box<Formula>),
+    /// `φ | ψ`.
+    Or(Box<Formula>, Box<Formula>),
+    /// `φ -> ψ`.
+    Implies(Box<Formula>, Box<Formula>),
+    /// `G[lo,hi] φ`.
+    Globally(f64, f64, Box<Formula>),
+    /// `F[lo,hi] φ`.
+    Eventually(f64, f64, Box<Formula>),
+    /// `φ U[lo,hi] ψ`.
+    Until(f64, f64, Box<Formula>, Box<Formula>),
+}
+
+impl Formula {
+    /// The names of the signals it reads, sorted, without repeats.
+    pub fn signals(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        self.collect(&mut out);
+        out.sort();
+        out.dedup();
+        out
+    }
+
+    fn collect(&self, out: &mut Vec<String>) {
+        match self {
+            Formula::True | Formula::False => {}
+            Formula::Pred { signal, .. } => out.push(signal.clone()),
+            Formula::Not(f) | Formula::Globally(_, _, f) | Formula::Eventually(_, _, f) => {
+                f.collect(out)
+            }
+            Formula::And(a, b)
+            | Formula::Or(a, b)
+            | Formula::Implies(a, b)
+            | Formula::Until(_, _, a, b) => {
+                a.collect(out);
+                b.collect(out);
+            }
+        }
+    }
+}
+
+/// Errors of the STL front end and evaluator.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum StlError {
+    /// The text does not parse; the message shows the line with a caret at the column.
+    #[error("STL syntax error:\n{0}")]
+    Parse(String),
+    /// A time interval is empty, negative or not finite.
+    #[error("STL interval [{0}, {1}] must satisfy 0 <= a <= b and be finite")]
+    Interval(f64, f64),
+    /// The trace lacks a signal the formula reads.
+    #[error("the trace has no signal `{0}`")]
+    MissingSignal(String),
+    /// The trace is malformed (signals of different lengths, a non-positive step).
+    #[error("invalid trace: {0}")]
+    Trace(String),
+}
