@@ -24,6 +24,16 @@ pub mod signal {
     pub const FOG: &str = "fog";
     /// Light intensity, `[0, 1]`.
     pub const LIGHT: &str = "light";
+    /// Every signal, for `Stl` formulas.
+    pub const ALL: [&str; 7] = [
+        EGO_X_M,
+        EGO_Z_M,
+        EGO_SPEED_MPS,
+        EGO_CONTACT,
+        EGO_SEPARATION_M,
+        FOG,
+        LIGHT,
+    ];
 }
 
 /// The result of one test.

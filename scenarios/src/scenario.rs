@@ -26,6 +26,14 @@ pub enum MonitorSpec {
         /// `minD`, in metres.
         min_distance_m: f64,
     },
+    /// `Stl(formula)`: a signal temporal logic property of the runner's signals
+    /// ([`paracosm_oracles::stl`]), judged at time 0 and settled online.
+    Stl {
+        /// Key in results files, default `stl`.
+        name: String,
+        /// The formula's text (parsed when the program loads).
+        formula: String,
+    },
     /// `TimeToFailure(m, minT)`: `m` first fails no earlier than `min_s` seconds.
     /// Robustness in seconds (see [`TimeToFailureMonitor`]).
     TimeToFailure {
@@ -70,6 +78,10 @@ impl MonitorSpec {
                 signal::EGO_X_M,
                 signal::EGO_Z_M,
                 *min_distance_m,
+            )),
+            MonitorSpec::Stl { name, formula } => Box::new(paracosm_oracles::stl::StlMonitor::new(
+                name,
+                paracosm_oracles::stl::parse(formula).expect("checked when the program loaded"),
             )),
             MonitorSpec::TimeToFailure { name, inner, min_s } => {
                 Box::new(TimeToFailureMonitor::new(name, inner.build(), *min_s))

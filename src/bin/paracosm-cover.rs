@@ -122,6 +122,20 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Evaluate the robustness of a signal temporal logic formula on a trace (a CSV with a
+    /// header, one column per signal, one row per sample), as the `Stl` monitor does.
+    Stl {
+        /// The formula, e.g. "G[0,10](a > 0 -> F[0,2](b < 1))"; bounds in seconds.
+        formula: String,
+        /// The trace.
+        trace: PathBuf,
+        /// Sampling period in seconds.
+        #[arg(long, default_value_t = 1.0)]
+        dt: f64,
+        /// Print JSON: robustness at time 0, the samples, the evaluation time in seconds.
+        #[arg(long)]
+        json: bool,
+    },
     /// Time the estimators and generators on fixed inputs (the paracosm side of
     /// experiments/bench/compare_scipy.py).
     Bench {
@@ -166,6 +180,37 @@ fn main() -> ExitCode {
             ExitCode::from(code)
         }
     }
+}
+
+/// A CSV trace: a header of signal names, one row of numbers per sample.
+fn read_trace(path: &std::path::Path, dt_s: f64) -> Result<paracosm_oracles::stl::Trace> {
+    let file = path.display().to_string();
+    let mut reader = csv::Reader::from_path(path).map_err(|e| bad(format!("{file}: {e}")))?;
+    let names: Vec<String> = reader
+        .headers()
+        .map_err(|e| bad(format!("{file}: {e}")))?
+        .iter()
+        .map(str::to_owned)
+        .collect();
+    let mut columns = vec![Vec::new(); names.len()];
+    for (row, record) in reader.records().enumerate() {
+        let record = record.map_err(|e| bad(format!("{file}:{}: {e}", row + 2)))?;
+        for (j, cell) in record.iter().enumerate() {
+            let v: f64 = cell.trim().parse().map_err(|_| {
+                bad(format!(
+                    "{file}:{}: column {} (`{}`): `{cell}` is not a number",
+                    row + 2,
+                    j + 1,
+                    names[j]
+                ))
+            })?;
+            columns[j].push(v);
+        }
+    }
+    Ok(paracosm_oracles::stl::Trace {
+        dt_s,
+        signals: names.into_iter().zip(columns).collect(),
+    })
 }
 
 fn bad(e: impl ToString) -> anyhow::Error {
@@ -285,6 +330,33 @@ fn run(cli: Cli) -> Result<()> {
                 println!("{}", serde_json::to_string_pretty(&p)?);
             } else {
                 print!("{p}");
+            }
+            Ok(())
+        }
+        Command::Stl {
+            formula,
+            trace,
+            dt,
+            json,
+        } => {
+            let f = paracosm_oracles::stl::parse(&formula).map_err(bad)?;
+            let t = read_trace(&trace, dt)?;
+            let started = std::time::Instant::now();
+            let r = paracosm_oracles::stl::robustness(&f, &t).map_err(bad)?;
+            let eval_s = started.elapsed().as_secs_f64();
+            let r0 = r.first().copied().unwrap_or(f64::INFINITY);
+            if json {
+                println!(
+                    "{}",
+                    serde_json::json!({"robustness": r0, "samples": r.len(), "eval_s": eval_s})
+                );
+            } else {
+                println!(
+                    "robustness {r0} ({}) over {} samples, evaluated in {:.3} ms",
+                    if r0 > 0.0 { "satisfied" } else { "violated" },
+                    r.len(),
+                    eval_s * 1e3
+                );
             }
             Ok(())
         }

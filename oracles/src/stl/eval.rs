@@ -96,6 +96,95 @@ fn eval(f: &Formula, t: &Trace) -> Result<Vec<f64>, StlError> {
     })
 }
 
+/// Bounds `(lower, upper)` of the robustness at sample 0 over every continuation of `trace`:
+/// the trace is extended by the formula's horizon with unknown samples, which count as `-inf`
+/// in the lower bound and `+inf` in the upper (robustness is monotone in every predicate
+/// value, negation swapping the two).
+///
+/// # Errors
+/// As [`robustness`].
+pub fn eval_bounds(f: &Formula, trace: &Trace) -> Result<(f64, f64), StlError> {
+    trace.check()?;
+    let known = trace.len();
+    let horizon = trace.steps(0.0, horizon_s(f)).1;
+    let (lo, hi) = bounds(f, trace, known, known + horizon)?;
+    Ok((
+        lo.first().copied().unwrap_or(f64::NEG_INFINITY),
+        hi.first().copied().unwrap_or(f64::INFINITY),
+    ))
+}
+
+/// How far ahead of a sample `f` looks, in seconds.
+fn horizon_s(f: &Formula) -> f64 {
+    match f {
+        Formula::True | Formula::False | Formula::Pred { .. } => 0.0,
+        Formula::Not(g) => horizon_s(g),
+        Formula::And(a, b) | Formula::Or(a, b) | Formula::Implies(a, b) => {
+            horizon_s(a).max(horizon_s(b))
+        }
+        Formula::Globally(_, hi, g) | Formula::Eventually(_, hi, g) => hi + horizon_s(g),
+        Formula::Until(_, hi, a, b) => hi + horizon_s(a).max(horizon_s(b)),
+    }
+}
+
+type Bounds = (Vec<f64>, Vec<f64>);
+
+fn bounds(f: &Formula, t: &Trace, known: usize, len: usize) -> Result<Bounds, StlError> {
+    let both = |v: f64| (vec![v; len], vec![v; len]);
+    Ok(match f {
+        Formula::True => both(f64::INFINITY),
+        Formula::False => both(f64::NEG_INFINITY),
+        Formula::Pred { .. } => {
+            let mut known_values = eval(f, t)?;
+            known_values.truncate(known);
+            let pad = |v: f64| {
+                let mut out = known_values.clone();
+                out.resize(len, v);
+                out
+            };
+            (pad(f64::NEG_INFINITY), pad(f64::INFINITY))
+        }
+        Formula::Not(g) => {
+            let (lo, hi) = bounds(g, t, known, len)?;
+            (
+                hi.into_iter().map(|r| -r).collect(),
+                lo.into_iter().map(|r| -r).collect(),
+            )
+        }
+        Formula::And(a, b) | Formula::Or(a, b) => {
+            let ((alo, ahi), (blo, bhi)) = (bounds(a, t, known, len)?, bounds(b, t, known, len)?);
+            let op = if matches!(f, Formula::And(..)) {
+                f64::min
+            } else {
+                f64::max
+            };
+            (zip(alo, blo, op), zip(ahi, bhi, op))
+        }
+        Formula::Implies(a, b) => {
+            let ((alo, ahi), (blo, bhi)) = (bounds(a, t, known, len)?, bounds(b, t, known, len)?);
+            (
+                zip(ahi, blo, |x, y| (-x).max(y)),
+                zip(alo, bhi, |x, y| (-x).max(y)),
+            )
+        }
+        Formula::Globally(a, b, g) | Formula::Eventually(a, b, g) => {
+            let (lo_w, hi_w) = t.steps(*a, *b);
+            let (glo, ghi) = bounds(g, t, known, len)?;
+            if matches!(f, Formula::Globally(..)) {
+                (sliding_min(&glo, lo_w, hi_w), sliding_min(&ghi, lo_w, hi_w))
+            } else {
+                (sliding_max(&glo, lo_w, hi_w), sliding_max(&ghi, lo_w, hi_w))
+            }
+        }
+        Formula::Until(a, b, left, right) => {
+            let (lo_w, hi_w) = t.steps(*a, *b);
+            let ((llo, lhi), (rlo, rhi)) =
+                (bounds(left, t, known, len)?, bounds(right, t, known, len)?);
+            (until(&llo, &rlo, lo_w, hi_w), until(&lhi, &rhi, lo_w, hi_w))
+        }
+    })
+}
+
 fn zip(a: Vec<f64>, b: Vec<f64>, op: impl Fn(f64, f64) -> f64) -> Vec<f64> {
     a.into_iter().zip(b).map(|(x, y)| op(x, y)).collect()
 }
@@ -157,6 +246,24 @@ mod tests {
             parse("G[0,10](a > 0 -> F[0,2](b < 1))").unwrap().signals(),
             ["a", "b"]
         );
+    }
+
+    #[test]
+    fn bounds_contain_the_final_value_and_tighten_as_samples_come() {
+        let full = trace(&[1.0, 2.0, -1.0, 3.0, 4.0], &[0.0; 5]);
+        let f = parse("G[0,4] a > 0").unwrap();
+        let last = robustness(&f, &full).unwrap()[0];
+        for k in 1..=5 {
+            let mut part = full.clone();
+            for v in part.signals.values_mut() {
+                v.truncate(k);
+            }
+            let (lo, hi) = eval_bounds(&f, &part).unwrap();
+            assert!(lo <= last && last <= hi, "{k}: {lo} {last} {hi}");
+            if k >= 3 {
+                assert_eq!(hi, -1.0, "the violation at sample 2 settles it");
+            }
+        }
     }
 
     #[test]

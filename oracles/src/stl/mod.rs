@@ -18,10 +18,12 @@
 //! operator, whatever the window.
 
 mod eval;
+mod online;
 mod parse;
 mod window;
 
-pub use eval::{robustness, Trace};
+pub use eval::{eval_bounds, robustness, Trace};
+pub use online::StlMonitor;
 pub use parse::parse;
 pub use window::{sliding_max, sliding_min};
 

@@ -666,6 +666,33 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         )
     }
 
+    /// `Stl(formula, name="stl")`: a signal temporal logic property over the runner's
+    /// signals (`ego_x_m`, `ego_z_m`, `ego_speed_mps`, `ego_contact`, `ego_separation_m`,
+    /// `fog`, `light`), judged at the start of the test; robustness in the formula's units.
+    /// The formula is parsed when the program loads: a syntax error shows a caret.
+    fn Stl<'v>(
+        #[starlark(require = pos)] formula: &str,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        let parsed = paracosm_oracles::stl::parse(formula).map_err(anyhow::Error::msg)?;
+        for s in parsed.signals() {
+            if !crate::runner::signal::ALL.contains(&s.as_str()) {
+                bail!(
+                    "Stl: unknown signal `{s}`; the runner publishes {}",
+                    crate::runner::signal::ALL.join(", ")
+                );
+            }
+        }
+        monitor(
+            eval,
+            MonitorSpec::Stl {
+                name: name.unwrap_or("stl").to_owned(),
+                formula: formula.to_owned(),
+            },
+        )
+    }
+
     /// `TimeToFailure(m, minT=0.0)`: wraps monitor `m`; reports the time of its first
     /// violation and fails when it comes before `minT` seconds.
     fn TimeToFailure<'v>(

@@ -78,6 +78,7 @@ const KEYWORDS: &[(&str, &[&str])] = &[
     ("CollisionMonitor", &["name"]),
     ("DistanceMonitor", &["minD", "name"]),
     ("TimeToFailure", &["minT", "name"]),
+    ("Stl", &["name"]),
     ("test", &["horizon", "map"]),
 ];
 

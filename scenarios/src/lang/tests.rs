@@ -146,3 +146,50 @@ fn brackets_nested_too_deep_are_an_error_not_a_stack_overflow() {
     assert!(super::check_nesting(&fine).is_ok());
     assert_eq!(super::check_nesting("a = [[1]]\nb = ((2))"), Ok(()));
 }
+
+#[test]
+fn stl_monitors_judge_tests_and_settle_early() {
+    let program = include_str!("../../pedestrian_crossing.star").replace(
+        "CollisionMonitor(v)",
+        "CollisionMonitor(v)\nStl(\"G[0,15] (ego_separation_m > 0.5)\", name = \"keep_clear\")",
+    );
+    let s = load_source("stl.star", &program, "stl").unwrap();
+    let run = |speed: f64, trigger: f64| {
+        let a = s
+            .space
+            .decode(&paracosm_generators::Point {
+                discrete: vec![],
+                continuous: vec![(speed - 0.5) / 9.5, (trigger - 5.0) / 55.0],
+            })
+            .unwrap();
+        s.run(&a, 1).unwrap()
+    };
+    let hit = run(3.0, 10.0);
+    let (name, stl) = &hit.monitors[1];
+    assert_eq!(name, "keep_clear");
+    assert!(!stl.passed && stl.robustness <= 0.0, "{stl:?}");
+    let simulated = hit
+        .metrics
+        .iter()
+        .find(|(n, _)| *n == "simulated_s")
+        .unwrap()
+        .1;
+    assert!(simulated < 15.0, "the run stops early: {simulated}");
+    let safe = run(1.0, 55.0);
+    assert!(safe.monitors[1].1.passed && safe.monitors[1].1.robustness > 0.5);
+
+    let bad = |f: &str| {
+        let p = program.replace("G[0,15] (ego_separation_m > 0.5)", f);
+        load_source("stl.star", &p, "stl").unwrap_err().to_string()
+    };
+    let e = bad("G[0,15] (ego_separation_m > )");
+    assert!(
+        e.contains("expected number") && e.contains('^') && e.contains("stl.star:"),
+        "{e}"
+    );
+    let e = bad("G[0,15] (dist_ped > 0.5)");
+    assert!(
+        e.contains("unknown signal `dist_ped`") && e.contains("ego_separation_m"),
+        "{e}"
+    );
+}
