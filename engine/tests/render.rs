@@ -164,30 +164,26 @@ fn the_gl_backend_renders_what_vulkan_renders() {
     );
 }
 
-#[test]
-fn golden_straight_road_with_a_white_car_ahead() {
-    let frame = render(
+/// The white car 22 m ahead on the straight road, at nominal light and `fog`.
+fn straight_road_car(fog: f64) -> CameraFrame {
+    render(
         &road(),
         &CameraSpec::default(),
         pose(),
         &[car_at(35.0, 1.75, WHITE)],
         NOMINAL_LIGHT,
-        0.0,
-    );
-    assert_golden("straight_road_car", &frame);
+        fog,
+    )
+}
+
+#[test]
+fn golden_straight_road_with_a_white_car_ahead() {
+    assert_golden("straight_road_car", &straight_road_car(0.0));
 }
 
 #[test]
 fn golden_straight_road_in_fog() {
-    let frame = render(
-        &road(),
-        &CameraSpec::default(),
-        pose(),
-        &[car_at(35.0, 1.75, WHITE)],
-        NOMINAL_LIGHT,
-        0.8,
-    );
-    assert_golden("straight_road_car_fog_0.8", &frame);
+    assert_golden("straight_road_car_fog_0.8", &straight_road_car(0.8));
 }
 
 #[test]

@@ -1,7 +1,6 @@
 //! Online monitoring: an STL formula as a [`Monitor`] that settles its verdict as soon as the
 //! samples seen decide it.
 
-use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 
 use super::eval::{eval_bounds, robustness, Trace};
@@ -28,7 +27,8 @@ pub struct StlMonitor {
     formula: Formula,
     signals: Vec<String>,
     times: Vec<f64>,
-    trace: BTreeMap<String, Vec<f64>>,
+    /// The samples so far; `dt_s` is set from the first two frames.
+    trace: Trace,
     settled: Option<Verdict>,
     missing: Option<(String, f64)>,
 }
@@ -39,23 +39,15 @@ impl StlMonitor {
         let signals = formula.signals();
         StlMonitor {
             name: name.to_owned(),
-            trace: signals.iter().map(|s| (s.clone(), Vec::new())).collect(),
+            trace: Trace {
+                dt_s: 1.0,
+                signals: signals.iter().map(|s| (s.clone(), Vec::new())).collect(),
+            },
             signals,
             formula,
             times: Vec::new(),
             settled: None,
             missing: None,
-        }
-    }
-
-    fn trace(&self) -> Trace {
-        let dt_s = match self.times.as_slice() {
-            [t0, t1, ..] if t1 > t0 => t1 - t0,
-            _ => 1.0,
-        };
-        Trace {
-            dt_s,
-            signals: self.trace.clone(),
         }
     }
 }
@@ -71,7 +63,12 @@ impl Monitor for StlMonitor {
         }
         for s in &self.signals {
             match frame.signals.get(s) {
-                Ok(v) => self.trace.get_mut(s).expect("one per signal").push(v),
+                Ok(v) => self
+                    .trace
+                    .signals
+                    .get_mut(s)
+                    .expect("one per signal")
+                    .push(v),
                 Err(_) => {
                     self.missing = Some((s.clone(), frame.t_s));
                     return ControlFlow::Break(());
@@ -79,10 +76,15 @@ impl Monitor for StlMonitor {
             }
         }
         self.times.push(frame.t_s);
+        if let [t0, t1] = self.times[..] {
+            if t1 > t0 {
+                self.trace.dt_s = t1 - t0;
+            }
+        }
         if self.times.len() % CHECK_EVERY != 0 || self.times.len() < 2 {
             return ControlFlow::Continue(());
         }
-        let (lo, hi) = match eval_bounds(&self.formula, &self.trace()) {
+        let (lo, hi) = match eval_bounds(&self.formula, &self.trace) {
             Ok(b) => b,
             Err(_) => return ControlFlow::Continue(()),
         };
@@ -119,7 +121,7 @@ impl Monitor for StlMonitor {
         if let Some(v) = &self.settled {
             return v.clone();
         }
-        let r = robustness(&self.formula, &self.trace())
+        let r = robustness(&self.formula, &self.trace)
             .ok()
             .and_then(|r| r.first().copied())
             .unwrap_or(f64::INFINITY);
