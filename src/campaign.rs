@@ -36,6 +36,9 @@ pub enum CampaignError {
         /// The operating system's reason.
         source: std::io::Error,
     },
+    /// An adaptive strategy cannot run as asked: a shard, or results it did not propose.
+    #[error("{0}")]
+    Adaptive(String),
     /// The worker pool could not be started.
     #[error("cannot start {jobs} worker threads: {reason}")]
     Pool {
@@ -61,6 +64,9 @@ pub struct Campaign<'a> {
     pub strength: usize,
     /// Worker threads, `>= 1`. Results do not depend on it.
     pub jobs: usize,
+    /// End the campaign at the first failed test (robustness `<= 0`): no new test starts, the
+    /// tests in flight finish and are written.
+    pub stop_at_first_failure: bool,
 }
 
 /// What a finished campaign reports.
@@ -70,6 +76,8 @@ pub struct CampaignReport {
     pub records: Vec<RunRecord>,
     /// Whether the stop flag ended the run before every asked id ran.
     pub interrupted: bool,
+    /// Whether [`Campaign::stop_at_first_failure`] ended the run before every asked id ran.
+    pub stopped_at_failure: bool,
     /// Outcome counts.
     pub counts: Counts,
     /// The failing test with the smallest id.
@@ -82,7 +90,9 @@ impl Campaign<'_> {
     /// The campaign's points, in test order: `budget` points from the strategy's generator.
     ///
     /// # Errors
-    /// [`CampaignError::Generator`] when the strategy cannot produce them.
+    /// [`CampaignError::Generator`] when the strategy cannot produce them;
+    /// [`CampaignError::Adaptive`] for an adaptive strategy, whose points exist only as the
+    /// campaign runs.
     pub fn points(&self) -> Result<Vec<Point>, CampaignError> {
         let mut generator = self.strategy.build_sized(
             &self.scenario.space,
@@ -90,6 +100,13 @@ impl Campaign<'_> {
             self.budget,
             self.strength,
         )?;
+        if generator.batch().is_some() {
+            return Err(CampaignError::Adaptive(format!(
+                "{} chooses each batch from the robustness of the last: its points exist only \
+                 as a campaign runs",
+                self.strategy
+            )));
+        }
         Ok(generator.ask(self.budget as usize)?)
     }
 
@@ -164,6 +181,10 @@ impl Campaign<'_> {
     /// written: the file is in id order and byte-identical for any `jobs`, and at most the
     /// tests in flight are missing if the process dies.
     ///
+    /// An adaptive strategy ([`Strategy::FALSIFIERS`]) runs in batches of its
+    /// `Generator::batch` size: ask, simulate the batch in parallel, tell the robustness of
+    /// every test in id order, ask again.
+    ///
     /// # Errors
     /// [`CampaignError`] when the points cannot be generated, the pool cannot start, or the
     /// results file cannot be written. Records already written stay on disk.
@@ -172,97 +193,91 @@ impl Campaign<'_> {
         out_dir: &Path,
         on_done: impl FnMut(&RunRecord),
     ) -> Result<CampaignReport, CampaignError> {
-        self.run_ids(out_dir, 0..self.budget, false, None, on_done)
+        self.run_ids(out_dir, 0..self.budget, None, None, on_done)
     }
 
     /// Runs the tests with ids in `ids` (a sub-range of `0..budget`: a shard, or what a
-    /// resumed run has left), writing their records to `results.jsonl` in `out_dir`: appended
-    /// to the file when `append` (which must end with a complete line), else replacing it.
-    /// When `stop` becomes true no new test starts; the tests in flight finish, the records
-    /// that follow without a gap are written, and the report says `interrupted`.
+    /// resumed run has left), writing their records to `results.jsonl` in `out_dir`. With
+    /// `prior = Some(records)` the file already holds `records` (the ids just before
+    /// `ids.start`, in order) and the new records are appended to it (it must end with a
+    /// complete line); with `None` the file is replaced. When `stop` becomes true no new test
+    /// starts; the tests in flight finish, the records that follow without a gap are written,
+    /// and the report says `interrupted`. With [`Campaign::stop_at_first_failure`] the first
+    /// failed test stops the campaign the same way, but it is not `interrupted`.
+    ///
+    /// An adaptive strategy replays `prior` into its searches (their robustness, without
+    /// simulating them again) before it runs the rest, so a resumed campaign equals an
+    /// uninterrupted one. It cannot run a shard: its tests depend on all earlier ones.
     ///
     /// # Errors
-    /// As [`Campaign::run`].
+    /// As [`Campaign::run`]; [`CampaignError::Adaptive`] for a shard of an adaptive campaign
+    /// or prior records that the strategy would not have proposed.
     pub fn run_ids(
         &self,
         out_dir: &Path,
         ids: Range<u64>,
-        append: bool,
+        prior: Option<&[RunRecord]>,
         stop: Option<&AtomicBool>,
         mut on_done: impl FnMut(&RunRecord),
     ) -> Result<CampaignReport, CampaignError> {
         let started = Instant::now();
-        let all = self.points()?;
-        let first = ids.start.min(all.len() as u64);
-        let points = &all[first as usize..ids.end.min(all.len() as u64) as usize];
-        let path = out_dir.join(RESULTS_FILE);
-        let io_err = |source| CampaignError::Io {
-            path: path.clone(),
-            source,
-        };
-        std::fs::create_dir_all(out_dir).map_err(|source| CampaignError::Io {
-            path: out_dir.to_path_buf(),
-            source,
-        })?;
-        let file = if append {
-            OpenOptions::new().append(true).create(true).open(&path)
-        } else {
-            File::create(&path)
-        };
-        let mut out = BufWriter::new(file.map_err(io_err)?);
-        let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(self.jobs)
-            .thread_name(|i| format!("paracosm-worker-{i}"))
-            .build()
-            .map_err(|e| CampaignError::Pool {
-                jobs: self.jobs,
-                reason: e.to_string(),
-            })?;
-
-        let next = AtomicUsize::new(0);
-        let (tx, rx) = mpsc::channel::<RunRecord>();
-        let mut records: Vec<RunRecord> = Vec::with_capacity(points.len());
-        let mut pending: BTreeMap<u64, RunRecord> = BTreeMap::new();
-        let mut write_result = Ok(());
-        std::thread::scope(|scope| {
-            let points = &points;
-            let next = &next;
-            scope.spawn(move || {
-                pool.scope(|s| {
-                    for _ in 0..self.jobs {
-                        let tx = tx.clone();
-                        let stopped = &stopped;
-                        s.spawn(move |_| loop {
-                            if stopped() {
-                                break;
-                            }
-                            let i = next.fetch_add(1, Ordering::Relaxed);
-                            let Some(p) = points.get(i) else { break };
-                            if tx.send(self.run_one(first + i as u64, p)).is_err() {
-                                break; // the writer gave up; stop taking work
-                            }
-                        });
+        let mut generator = self.strategy.build_sized(
+            &self.scenario.space,
+            self.seed,
+            self.budget,
+            self.strength,
+        )?;
+        let ids = ids.start.min(self.budget)..ids.end.min(self.budget);
+        let mut run = Run::open(self, out_dir, prior.is_some(), stop)?;
+        match generator.batch() {
+            None => {
+                let all = generator.ask(ids.end as usize)?;
+                let points = &all[ids.start as usize..];
+                run.execute(ids.start, points, &mut on_done)?;
+            }
+            Some(batch) => {
+                let prior = prior.unwrap_or(&[]);
+                let first = ids.start - prior.len() as u64;
+                if first != 0 || ids.end != self.budget {
+                    return Err(CampaignError::Adaptive(format!(
+                        "{} adapts each test to all earlier ones, so it runs whole campaigns \
+                         only, not a shard",
+                        self.strategy
+                    )));
+                }
+                let mut next = 0u64;
+                while next < ids.end && !run.halted() {
+                    let n = (batch as u64).min(ids.end - next) as usize;
+                    let points = generator.ask(n)?;
+                    if points.is_empty() {
+                        return Err(CampaignError::Adaptive(format!(
+                            "{} proposed no point at test {next}",
+                            self.strategy
+                        )));
                     }
-                });
-            });
-            for record in rx {
-                on_done(&record);
-                pending.insert(record.id, record);
-                while let Some(r) = pending.remove(&(first + records.len() as u64)) {
-                    if write_result.is_ok() {
-                        write_result = write_line(&mut out, &r);
-                        if write_result.is_err() {
-                            // Stop the workers: nothing more can be saved.
-                            next.store(usize::MAX / 2, Ordering::Relaxed);
+                    // The part of the batch that an earlier run already simulated.
+                    let known = ((ids.start - next.min(ids.start)) as usize).min(points.len());
+                    let mut told: Vec<(Point, f64)> = Vec::with_capacity(points.len());
+                    for (j, p) in points[..known].iter().enumerate() {
+                        let r = &prior[next as usize + j];
+                        if &r.point != p {
+                            return Err(CampaignError::Adaptive(format!(
+                                "test {} in the results is not the point {} proposes; the \
+                                 results were not written by this campaign",
+                                r.id, self.strategy
+                            )));
                         }
+                        told.push((p.clone(), r.robustness()));
                     }
-                    records.push(r);
+                    let fresh = run.execute(next + known as u64, &points[known..], &mut on_done)?;
+                    told.extend(fresh.iter().map(|r| (r.point.clone(), r.robustness())));
+                    generator.tell(&told);
+                    next += points.len() as u64;
                 }
             }
-        });
-        write_result.map_err(io_err)?;
-
+        }
+        let records = run.records;
+        let asked = ids.end - ids.start;
         let mut counts = Counts::default();
         for r in &records {
             match r.status {
@@ -285,12 +300,142 @@ impl Campaign<'_> {
             _ => None,
         });
         Ok(CampaignReport {
-            interrupted: records.len() < points.len(),
+            interrupted: (records.len() as u64) < asked && run.stopped_by_user,
+            stopped_at_failure: (records.len() as u64) < asked && !run.stopped_by_user,
             records,
             counts,
             first_failure,
             wall_s: started.elapsed().as_secs_f64(),
         })
+    }
+}
+
+/// The state of a running campaign: the open results file, the worker pool, the stop flags
+/// and the records written so far.
+struct Run<'c, 'a> {
+    campaign: &'c Campaign<'a>,
+    path: PathBuf,
+    out: BufWriter<File>,
+    pool: rayon::ThreadPool,
+    stop: Option<&'c AtomicBool>,
+    /// Set by the first failed test when the campaign stops at its first failure.
+    failed: AtomicBool,
+    stopped_by_user: bool,
+    records: Vec<RunRecord>,
+}
+
+impl<'c, 'a> Run<'c, 'a> {
+    fn open(
+        campaign: &'c Campaign<'a>,
+        out_dir: &Path,
+        append: bool,
+        stop: Option<&'c AtomicBool>,
+    ) -> Result<Self, CampaignError> {
+        let path = out_dir.join(RESULTS_FILE);
+        std::fs::create_dir_all(out_dir).map_err(|source| CampaignError::Io {
+            path: out_dir.to_path_buf(),
+            source,
+        })?;
+        let file = if append {
+            OpenOptions::new().append(true).create(true).open(&path)
+        } else {
+            File::create(&path)
+        };
+        let out = BufWriter::new(file.map_err(|source| CampaignError::Io {
+            path: path.clone(),
+            source,
+        })?);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(campaign.jobs)
+            .thread_name(|i| format!("paracosm-worker-{i}"))
+            .build()
+            .map_err(|e| CampaignError::Pool {
+                jobs: campaign.jobs,
+                reason: e.to_string(),
+            })?;
+        Ok(Run {
+            campaign,
+            path,
+            out,
+            pool,
+            stop,
+            failed: AtomicBool::new(false),
+            stopped_by_user: false,
+            records: Vec::new(),
+        })
+    }
+
+    /// Whether no new test may start: the user's stop, or the first failure.
+    fn halted(&self) -> bool {
+        // (`execute` repeats this on split borrows of the fields.)
+        self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) || self.failed.load(Ordering::Relaxed)
+    }
+
+    /// Runs `points` as tests `first..`, in parallel, writing each record once every record
+    /// before it is written. Returns this call's records (fewer than `points` when halted).
+    fn execute(
+        &mut self,
+        first: u64,
+        points: &[Point],
+        on_done: &mut impl FnMut(&RunRecord),
+    ) -> Result<Vec<RunRecord>, CampaignError> {
+        let campaign = self.campaign;
+        let jobs = campaign.jobs;
+        let next = AtomicUsize::new(0);
+        let (tx, rx) = mpsc::channel::<RunRecord>();
+        let mut done: Vec<RunRecord> = Vec::with_capacity(points.len());
+        let mut pending: BTreeMap<u64, RunRecord> = BTreeMap::new();
+        let mut write_result = Ok(());
+        let (pool, stop, failed, out) = (&self.pool, self.stop, &self.failed, &mut self.out);
+        let halted =
+            || stop.is_some_and(|s| s.load(Ordering::Relaxed)) || failed.load(Ordering::Relaxed);
+        std::thread::scope(|scope| {
+            let next = &next;
+            let halted = &halted;
+            scope.spawn(move || {
+                pool.scope(|s| {
+                    for _ in 0..jobs {
+                        let tx = tx.clone();
+                        s.spawn(move |_| loop {
+                            if halted() {
+                                break;
+                            }
+                            let i = next.fetch_add(1, Ordering::Relaxed);
+                            let Some(p) = points.get(i) else { break };
+                            if tx.send(campaign.run_one(first + i as u64, p)).is_err() {
+                                break; // the writer gave up; stop taking work
+                            }
+                        });
+                    }
+                });
+            });
+            for record in rx {
+                on_done(&record);
+                if campaign.stop_at_first_failure && record.status == Status::Fail {
+                    failed.store(true, Ordering::Relaxed);
+                }
+                pending.insert(record.id, record);
+                while let Some(r) = pending.remove(&(first + done.len() as u64)) {
+                    if write_result.is_ok() {
+                        write_result = write_line(out, &r);
+                        if write_result.is_err() {
+                            // Stop the workers: nothing more can be saved.
+                            next.store(usize::MAX / 2, Ordering::Relaxed);
+                        }
+                    }
+                    done.push(r);
+                }
+            }
+        });
+        write_result.map_err(|source| CampaignError::Io {
+            path: self.path.clone(),
+            source,
+        })?;
+        if done.len() < points.len() && self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            self.stopped_by_user = true;
+        }
+        self.records.extend(done.iter().cloned());
+        Ok(done)
     }
 }
 
@@ -312,6 +457,7 @@ mod tests {
             budget: 12,
             strength: 2,
             jobs,
+            stop_at_first_failure: false,
         }
     }
 

@@ -20,6 +20,15 @@ pub enum StrategyArg {
     Ipog,
     /// As ipog, with a random k-wise array sized by Proposition 3.2.
     Kwise,
+    /// Falsification: Nelder–Mead with random restarts minimising robustness (argmin);
+    /// discrete parameters fixed per search by a pairwise covering array.
+    FalsifyNm,
+    /// Falsification: particle swarms minimising robustness (argmin).
+    FalsifyPso,
+    /// Falsification: simulated annealing minimising robustness (argmin).
+    FalsifySa,
+    /// Falsification: the cross-entropy method minimising robustness.
+    FalsifyCe,
 }
 
 impl From<StrategyArg> for Strategy {
@@ -30,6 +39,10 @@ impl From<StrategyArg> for Strategy {
             StrategyArg::Sobol => Strategy::Sobol,
             StrategyArg::Ipog => Strategy::Ipog,
             StrategyArg::Kwise => Strategy::KWise,
+            StrategyArg::FalsifyNm => Strategy::FalsifyNm,
+            StrategyArg::FalsifyPso => Strategy::FalsifyPso,
+            StrategyArg::FalsifySa => Strategy::FalsifySa,
+            StrategyArg::FalsifyCe => Strategy::FalsifyCe,
         }
     }
 }

@@ -96,6 +96,18 @@ struct Line {
 }
 
 impl RunRecord {
+    /// The falsification cost of the test: the smallest robustness over its monitors
+    /// (`<= 0`: it failed; `+inf` without monitors), NaN for a test that ended in `error`.
+    pub fn robustness(&self) -> f64 {
+        if self.status == Status::Error {
+            return f64::NAN;
+        }
+        self.monitors
+            .iter()
+            .map(|(_, m)| m.robustness)
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Reads one line of `results.jsonl` written for a scenario with parameter space `space`
     /// (`params` is decoded again from `point`; robustness and metrics written as `null` come
     /// back as NaN).

@@ -119,6 +119,7 @@ pub fn replay(
         budget: campaign_file.budget,
         strength: campaign_file.strength,
         jobs: 1,
+        stop_at_first_failure: false,
     };
     if let Some(dir) = frames {
         std::fs::create_dir_all(dir)

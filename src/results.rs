@@ -116,6 +116,7 @@ mod tests {
             budget: 4,
             strength: 2,
             jobs: 1,
+            stop_at_first_failure: false,
         };
         c.run(dir.path(), |_| {}).unwrap();
         let path = dir.path().join(RESULTS_FILE);

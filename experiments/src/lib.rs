@@ -40,6 +40,7 @@ pub fn figure9(budget: u64, seed: u64, jobs: usize, out: &Path) -> Result<Figure
             budget,
             strength: 2,
             jobs,
+            stop_at_first_failure: false,
         };
         let report = campaign
             .run(&dir.join(strategy.name()), |_| {})

@@ -21,4 +21,13 @@ pub trait Generator: Send {
     /// Reports evaluated points with their robustness (`> 0` satisfied, `< 0` violated).
     /// Adaptive strategies use it; the default ignores it.
     fn tell(&mut self, _evaluated: &[(Point, f64)]) {}
+
+    /// `None` for a non-adaptive generator: its points do not depend on what it is told, so
+    /// a campaign asks for its whole budget at once. `Some(b)` for an adaptive one: the
+    /// campaign asks `b` points (fewer at the end of the budget), runs them, tells their
+    /// robustness in the order asked, and asks again. `b` never depends on the number of
+    /// worker threads.
+    fn batch(&self) -> Option<usize> {
+        None
+    }
 }

@@ -7,7 +7,9 @@
 //! in the parameters' units.
 //!
 //! Generators here: uniform random ([`UniformRandom`], ChaCha8), Halton ([`Halton`], the paper's
-//! radical-inverse construction, §3.2) and Owen-scrambled Sobol ([`Sobol`], via `sobol_burley`).
+//! radical-inverse construction, §3.2), Owen-scrambled Sobol ([`Sobol`], via `sobol_burley`),
+//! covering suites ([`covering`]) and adaptive falsifiers that minimise robustness
+//! ([`falsify::Falsifier`], on argmin).
 //!
 //! This crate depends on nothing else of the workspace, so researchers can use it alone.
 #![warn(missing_docs)]
@@ -15,6 +17,7 @@
 pub mod coverage;
 pub mod covering;
 mod error;
+pub mod falsify;
 mod generator;
 mod halton;
 mod point;

@@ -1,5 +1,6 @@
 use std::str::FromStr;
 
+use crate::falsify::{Falsifier, Method};
 use crate::{Generator, GeneratorError, Halton, ParamSpace, Sobol, UniformRandom};
 
 /// The test-generation strategies by name.
@@ -18,12 +19,29 @@ pub enum Strategy {
     Ipog,
     /// [`crate::covering::CoveringSuite`] on a random k-wise array (Proposition 3.2).
     KWise,
+    /// [`Falsifier`] with Nelder–Mead and random restarts (argmin).
+    FalsifyNm,
+    /// [`Falsifier`] with particle swarms (argmin).
+    FalsifyPso,
+    /// [`Falsifier`] with simulated annealing (argmin).
+    FalsifySa,
+    /// [`Falsifier`] with the cross-entropy method.
+    FalsifyCe,
 }
 
 impl Strategy {
     /// The covering-suite strategies, which need a budget and a strength
     /// ([`Strategy::build_sized`]).
     pub const SUITES: [Strategy; 2] = [Strategy::Ipog, Strategy::KWise];
+
+    /// The adaptive falsifiers ([`Falsifier`]): their points depend on the robustness they
+    /// are told, so they run only inside a campaign.
+    pub const FALSIFIERS: [Strategy; 4] = [
+        Strategy::FalsifyNm,
+        Strategy::FalsifyPso,
+        Strategy::FalsifySa,
+        Strategy::FalsifyCe,
+    ];
 
     /// Every point generator that needs no budget, in the order the CLI lists them.
     pub const ALL: [Strategy; 4] = [
@@ -42,6 +60,21 @@ impl Strategy {
             Strategy::Sobol => "sobol",
             Strategy::Ipog => "ipog",
             Strategy::KWise => "kwise",
+            Strategy::FalsifyNm => "falsify-nm",
+            Strategy::FalsifyPso => "falsify-pso",
+            Strategy::FalsifySa => "falsify-sa",
+            Strategy::FalsifyCe => "falsify-ce",
+        }
+    }
+
+    /// The search method of an adaptive strategy, `None` for the others.
+    pub fn method(self) -> Option<Method> {
+        match self {
+            Strategy::FalsifyNm => Some(Method::NelderMead),
+            Strategy::FalsifyPso => Some(Method::ParticleSwarm),
+            Strategy::FalsifySa => Some(Method::Annealing),
+            Strategy::FalsifyCe => Some(Method::CrossEntropy),
+            _ => None,
         }
     }
 
@@ -53,7 +86,11 @@ impl Strategy {
             | Strategy::Halton
             | Strategy::ScrambledHalton
             | Strategy::Ipog
-            | Strategy::KWise => None,
+            | Strategy::KWise
+            | Strategy::FalsifyNm
+            | Strategy::FalsifyPso
+            | Strategy::FalsifySa
+            | Strategy::FalsifyCe => None,
         }
     }
 
@@ -61,7 +98,8 @@ impl Strategy {
     ///
     /// # Errors
     /// [`GeneratorError::CapacityExceeded`] when the space has more dimensions than the
-    /// strategy supports; [`GeneratorError::NeedsBudget`] for the covering suites, which are
+    /// strategy supports; [`GeneratorError::Covering`] for a falsifier over a space without
+    /// continuous parameters; [`GeneratorError::NeedsBudget`] for the covering suites, which are
     /// built by [`Strategy::build_sized`].
     pub fn build(
         self,
@@ -75,6 +113,13 @@ impl Strategy {
             Strategy::Sobol => Box::new(Sobol::new(space, seed)?),
             Strategy::Ipog | Strategy::KWise => {
                 return Err(GeneratorError::NeedsBudget(self.name()))
+            }
+            Strategy::FalsifyNm
+            | Strategy::FalsifyPso
+            | Strategy::FalsifySa
+            | Strategy::FalsifyCe => {
+                let method = self.method().expect("a falsifier has a method");
+                Box::new(Falsifier::new(space, method, seed)?)
             }
         })
     }
@@ -119,6 +164,7 @@ impl FromStr for Strategy {
         Strategy::ALL
             .into_iter()
             .chain(Strategy::SUITES)
+            .chain(Strategy::FALSIFIERS)
             .find(|st| st.name() == s)
             .ok_or_else(|| GeneratorError::UnknownStrategy(s.to_owned()))
     }
@@ -136,12 +182,16 @@ mod tests {
 
     #[test]
     fn names_round_trip_and_unknown_names_are_errors() {
-        for s in Strategy::ALL {
+        for s in Strategy::ALL
+            .into_iter()
+            .chain(Strategy::SUITES)
+            .chain(Strategy::FALSIFIERS)
+        {
             assert_eq!(s.name().parse::<Strategy>().unwrap(), s);
         }
         assert_eq!(
             "annealing".parse::<Strategy>().unwrap_err().to_string(),
-            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise)"
+            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise, falsify-nm, falsify-pso, falsify-sa, falsify-ce)"
         );
     }
 }

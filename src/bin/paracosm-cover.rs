@@ -270,6 +270,12 @@ fn run(cli: Cli) -> Result<()> {
             }
             let space = load_space(space.as_deref().unwrap_or_default()).map_err(bad)?;
             let strategy = paracosm::cli::strategy(strategy, scramble).map_err(bad)?;
+            if strategy.method().is_some() {
+                return Err(bad(format!(
+                    "{strategy} chooses each test from the robustness of earlier ones, so it \
+                     needs a simulator: run it with paracosm-fuzz --strategy {strategy}"
+                )));
+            }
             let budget = match (budget, epsilon) {
                 (Some(b), _) => b,
                 (None, Some(eps)) => suite_budget(&space, strategy, strength, eps, seed)?,

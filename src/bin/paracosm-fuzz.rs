@@ -56,6 +56,11 @@ struct Cli {
     /// Campaign seed: seeds the generator and every test [default: 0].
     #[arg(long)]
     seed: Option<u64>,
+    /// End the campaign at the first failed test (robustness <= 0): the tests in flight
+    /// finish and are written, no new one starts. For falsification, e.g. with
+    /// --strategy falsify-nm.
+    #[arg(long)]
+    stop_at_first_failure: bool,
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     jobs: Option<u64>,
@@ -202,6 +207,13 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         ))
         .into());
     }
+    if file.shard.is_some() && strategy.method().is_some() {
+        return Err(BadInput(format!(
+            "--shard cannot split a {strategy} campaign: each of its tests depends on all \
+             earlier ones. Run it whole (it is parallel inside: --jobs)"
+        ))
+        .into());
+    }
     let jobs = cli.jobs.map_or_else(
         || std::thread::available_parallelism().map_or(1, |n| n.get()),
         |j| j as usize,
@@ -226,7 +238,10 @@ fn run(cli: &Cli) -> Result<ExitCode> {
             cli.out.join(paracosm::campaign::RESULTS_FILE).display()
         );
     }
-    let start = ids.start + existing.records.len() as u64;
+    let mut start = ids.start + existing.records.len() as u64;
+    if cli.stop_at_first_failure && existing.records.iter().any(|r| r.status == Status::Fail) {
+        start = ids.end; // the resumed campaign had already found its failure
+    }
     if stored.is_some() {
         eprintln!(
             "paracosm-fuzz: resuming: {} of {} tests already done",
@@ -249,6 +264,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         budget: file.budget,
         strength: file.strength,
         jobs,
+        stop_at_first_failure: cli.stop_at_first_failure,
     };
     let bar = if std::io::stderr().is_terminal() {
         ProgressBar::with_draw_target(Some(ids.end - start), ProgressDrawTarget::stderr())
@@ -266,7 +282,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         .run_ids(
             &cli.out,
             start..ids.end,
-            stored.is_some(),
+            stored.is_some().then_some(existing.records.as_slice()),
             Some(&STOP),
             |r| {
                 failures += u64::from(r.status == Status::Fail);
@@ -275,7 +291,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
             },
         )
         .map_err(|e| match e {
-            CampaignError::Io { .. } | CampaignError::Generator(_) => {
+            CampaignError::Io { .. } | CampaignError::Generator(_) | CampaignError::Adaptive(_) => {
                 anyhow::Error::new(BadInput(e.to_string()))
             }
             CampaignError::Pool { .. } => anyhow::Error::new(e),
