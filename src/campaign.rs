@@ -228,52 +228,53 @@ impl Campaign<'_> {
             self.strength,
         )?;
         let ids = ids.start.min(self.budget)..ids.end.min(self.budget);
-        let mut run = Run::open(self, out_dir, prior.is_some(), stop)?;
-        match generator.batch() {
-            None => {
-                let all = generator.ask(ids.end as usize)?;
-                let points = &all[ids.start as usize..];
-                run.execute(ids.start, points, &mut on_done)?;
+        let prior_len = prior.map_or(0, <[RunRecord]>::len) as u64;
+        // Everything that can be refused is refused before the output folder is touched.
+        let upfront = match generator.batch() {
+            None => Some(generator.ask(ids.end as usize)?),
+            Some(_) if ids.start != prior_len || ids.end != self.budget => {
+                return Err(CampaignError::Adaptive(format!(
+                    "{} adapts each test to all earlier ones, so it runs whole campaigns \
+                     only, not a shard",
+                    self.strategy
+                )));
             }
-            Some(batch) => {
-                let prior = prior.unwrap_or(&[]);
-                let first = ids.start - prior.len() as u64;
-                if first != 0 || ids.end != self.budget {
+            Some(_) => None,
+        };
+        let mut run = Run::open(self, out_dir, prior.is_some(), stop)?;
+        if let Some(all) = upfront {
+            run.execute(ids.start, &all[ids.start as usize..], &mut on_done)?;
+        } else {
+            let prior = prior.unwrap_or(&[]);
+            let batch = generator.batch().unwrap_or(1);
+            let mut next = 0u64;
+            while next < ids.end && !run.halted() {
+                let n = (batch as u64).min(ids.end - next) as usize;
+                let points = generator.ask(n)?;
+                if points.is_empty() {
                     return Err(CampaignError::Adaptive(format!(
-                        "{} adapts each test to all earlier ones, so it runs whole campaigns \
-                         only, not a shard",
+                        "{} proposed no point at test {next}",
                         self.strategy
                     )));
                 }
-                let mut next = 0u64;
-                while next < ids.end && !run.halted() {
-                    let n = (batch as u64).min(ids.end - next) as usize;
-                    let points = generator.ask(n)?;
-                    if points.is_empty() {
+                // The part of the batch that an earlier run already simulated.
+                let known = ((ids.start - next.min(ids.start)) as usize).min(points.len());
+                let mut told: Vec<(Point, f64)> = Vec::with_capacity(points.len());
+                for (j, p) in points[..known].iter().enumerate() {
+                    let r = &prior[next as usize + j];
+                    if &r.point != p {
                         return Err(CampaignError::Adaptive(format!(
-                            "{} proposed no point at test {next}",
-                            self.strategy
+                            "test {} in the results is not the point {} proposes; the \
+                             results were not written by this campaign",
+                            r.id, self.strategy
                         )));
                     }
-                    // The part of the batch that an earlier run already simulated.
-                    let known = ((ids.start - next.min(ids.start)) as usize).min(points.len());
-                    let mut told: Vec<(Point, f64)> = Vec::with_capacity(points.len());
-                    for (j, p) in points[..known].iter().enumerate() {
-                        let r = &prior[next as usize + j];
-                        if &r.point != p {
-                            return Err(CampaignError::Adaptive(format!(
-                                "test {} in the results is not the point {} proposes; the \
-                                 results were not written by this campaign",
-                                r.id, self.strategy
-                            )));
-                        }
-                        told.push((p.clone(), r.robustness()));
-                    }
-                    let fresh = run.execute(next + known as u64, &points[known..], &mut on_done)?;
-                    told.extend(fresh.iter().map(|r| (r.point.clone(), r.robustness())));
-                    generator.tell(&told);
-                    next += points.len() as u64;
+                    told.push((p.clone(), r.robustness()));
                 }
+                let fresh = run.execute(next + known as u64, &points[known..], &mut on_done)?;
+                told.extend(fresh.iter().map(|r| (r.point.clone(), r.robustness())));
+                generator.tell(&told);
+                next += points.len() as u64;
             }
         }
         let records = run.records;

@@ -26,6 +26,8 @@ pub(crate) struct Car {
     s: f64,
     speed: f64,
     half_height: f64,
+    /// Half length and half width, metres.
+    pub(crate) half_size_m: [f64; 2],
 }
 
 impl Car {
@@ -47,6 +49,7 @@ impl Car {
             s: 0.0,
             speed: 0.0,
             half_height: size_m[1] / 2.0,
+            half_size_m: [size_m[0] / 2.0, size_m[2] / 2.0],
         };
         if enabled {
             let pose = car.pose();
@@ -97,6 +100,21 @@ impl Car {
             let pose = self.pose();
             physics.bodies[body].set_next_kinematic_position(pose);
         }
+    }
+
+    /// The car as the time-to-collision test sees it, `None` when it is not in this test.
+    pub(crate) fn mover(&self) -> Option<crate::ttc::Mover> {
+        self.body?;
+        let ([x, z], heading_rad) = self.at(self.s);
+        Some(crate::ttc::Mover {
+            pos_m: [x, z],
+            velocity_mps: [
+                self.speed * heading_rad.cos(),
+                -self.speed * heading_rad.sin(),
+            ],
+            heading_rad,
+            half_size_m: self.half_size_m,
+        })
     }
 
     pub(crate) fn state(&self) -> CarState {

@@ -28,6 +28,7 @@ pub mod rx;
 mod sim;
 mod spec;
 pub mod sut;
+pub mod ttc;
 mod vehicle;
 
 pub use camera::{CameraFrame, CameraSpec, SENSOR_HEIGHT_MM, SENSOR_WIDTH_MM};

@@ -102,6 +102,17 @@ impl Pedestrian {
         self.velocity
     }
 
+    /// The pedestrian as the time-to-collision test sees it.
+    pub(crate) fn mover(&self) -> crate::ttc::Mover {
+        let r = f64::from(PED_RADIUS_M);
+        crate::ttc::Mover {
+            pos_m: [self.pos[0], self.pos[2]],
+            velocity_mps: [self.velocity[0], self.velocity[2]],
+            heading_rad: 0.0,
+            half_size_m: [r, r],
+        }
+    }
+
     pub(crate) fn state(&self) -> PedestrianState {
         PedestrianState {
             pos_m: self.pos,

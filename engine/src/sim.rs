@@ -60,6 +60,9 @@ pub struct Snapshot {
     /// The smallest distance between the ego vehicle's body and a pedestrian's capsule or a
     /// car's body, in metres; `0` when touching, `+inf` without actors.
     pub min_separation_m: f64,
+    /// Path time to collision of the ego vehicle in seconds ([`crate::ttc::time_to_collision_s`]):
+    /// `+inf` when nothing in its path is closing in, `0` when touching.
+    pub ttc_s: f64,
     /// Light intensity now, `[0, 1]`.
     pub light: f64,
     /// Fog density now, `[0, 1]`.
@@ -446,9 +449,27 @@ impl Simulation {
                 .map(|d| f64::from(d.distance))
             })
             .fold(f64::INFINITY, f64::min);
+        let ego = self.ego_state();
+        let size = self.ego.size_m();
+        let ego_mover = crate::ttc::Mover {
+            pos_m: [ego.pos_m[0], ego.pos_m[2]],
+            velocity_mps: [
+                ego.speed_mps * ego.heading_rad.cos(),
+                -ego.speed_mps * ego.heading_rad.sin(),
+            ],
+            heading_rad: ego.heading_rad,
+            half_size_m: [size[0] / 2.0, size[1] / 2.0],
+        };
+        let movers: Vec<crate::ttc::Mover> = self
+            .pedestrians
+            .iter()
+            .map(Pedestrian::mover)
+            .chain(self.cars.iter().filter_map(Car::mover))
+            .collect();
         Snapshot {
             t_s: self.t_s(),
-            ego: self.ego_state(),
+            ego,
+            ttc_s: crate::ttc::time_to_collision_s(&ego_mover, &movers),
             pedestrians: self.pedestrians.iter().map(Pedestrian::state).collect(),
             cars: self.cars.iter().map(Car::state).collect(),
             ego_contact: self.touching.iter().any(|&t| t),

@@ -3,7 +3,11 @@
 //!
 //! - [`figure9`]: the pedestrian-crossing failure map under random and Halton sampling, side
 //!   by side (paper §4.2.2, Figure 9).
+//! - [`falsification::falsification_study`]: simulations until the first failure, random and
+//!   quasi-random sampling against the adaptive falsifiers.
 #![warn(missing_docs)]
+
+pub mod falsification;
 
 use std::path::{Path, PathBuf};
 

@@ -20,17 +20,21 @@ pub mod signal {
     /// Smallest distance between the ego body and a pedestrian or a car, metres (`0`
     /// touching).
     pub const EGO_SEPARATION_M: &str = "ego_separation_m";
+    /// Path time to collision of the ego vehicle, seconds (`+inf` when nothing in its path
+    /// closes in; `paracosm_engine::ttc`).
+    pub const EGO_TTC_S: &str = "ego_ttc_s";
     /// Fog density, `[0, 1]`.
     pub const FOG: &str = "fog";
     /// Light intensity, `[0, 1]`.
     pub const LIGHT: &str = "light";
     /// Every signal, for `Stl` formulas.
-    pub const ALL: [&str; 7] = [
+    pub const ALL: [&str; 8] = [
         EGO_X_M,
         EGO_Z_M,
         EGO_SPEED_MPS,
         EGO_CONTACT,
         EGO_SEPARATION_M,
+        EGO_TTC_S,
         FOG,
         LIGHT,
     ];
@@ -67,6 +71,7 @@ fn publish(snap: &Snapshot, out: &mut Signals) {
     out.set(signal::EGO_SPEED_MPS, snap.ego.speed_mps);
     out.set_bool(signal::EGO_CONTACT, snap.ego_contact);
     out.set(signal::EGO_SEPARATION_M, snap.min_separation_m);
+    out.set(signal::EGO_TTC_S, snap.ttc_s);
     out.set(signal::FOG, snap.fog);
     out.set(signal::LIGHT, snap.light);
 }

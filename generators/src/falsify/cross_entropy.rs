@@ -10,7 +10,7 @@ use super::lane::reflect;
 
 /// Cross-entropy search over `[0, 1]^d` with an axis-aligned Gaussian sampling density.
 ///
-/// The first population is uniform over the cube. After each, the `elite` lowest-cost points
+/// The first population is uniform over the cube (or given). After each, the `elite` lowest-cost points
 /// give the new mean and standard deviation per coordinate, smoothed as
 /// `θ ← α θ_elite + (1 − α) θ` with `α = 0.7` (de Boer et al. 2005, §3.1). Samples are
 /// reflected into the cube.
@@ -22,6 +22,8 @@ pub struct CrossEntropy {
     mean: Option<Vec<f64>>,
     sigma: Vec<f64>,
     asked: Vec<Vec<f64>>,
+    /// Points of the first population, when given ([`CrossEntropy::with_first_population`]).
+    first: Option<Vec<Vec<f64>>>,
     rng: ChaCha8Rng,
 }
 
@@ -42,13 +44,26 @@ impl CrossEntropy {
             mean: None,
             sigma: vec![0.5; d],
             asked: Vec::new(),
+            first: None,
             rng,
         }
+    }
+
+    /// Uses `points` (each of length `d`, in `[0, 1]`) as the first population instead of
+    /// uniform random points, e.g. a space-filling design. Ignored when empty.
+    pub fn with_first_population(mut self, points: Vec<Vec<f64>>) -> Self {
+        if !points.is_empty() {
+            self.population = points.len();
+            self.elite = self.elite.min(self.population);
+            self.first = Some(points);
+        }
+        self
     }
 
     /// The next population: `population` points of `[0, 1]^d`.
     pub fn ask(&mut self) -> Vec<Vec<f64>> {
         let pts: Vec<Vec<f64>> = match &self.mean {
+            None if self.first.is_some() => self.first.take().expect("checked"),
             None => (0..self.population)
                 .map(|_| (0..self.d).map(|_| self.rng.random::<f64>()).collect())
                 .collect(),

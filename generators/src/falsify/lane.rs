@@ -13,7 +13,7 @@ use std::sync::mpsc::{Receiver, Sender};
 
 use argmin::core::{CostFunction, Error, Executor};
 use argmin::solver::neldermead::NelderMead;
-use argmin::solver::particleswarm::ParticleSwarm;
+use argmin::solver::particleswarm::{Particle, ParticleSwarm};
 use argmin::solver::simulatedannealing::{Anneal, SimulatedAnnealing};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -95,10 +95,21 @@ pub(super) fn reflect(x: f64) -> f64 {
     }
 }
 
-/// Runs one search of `method` in `d` dimensions from `start` to its end (convergence, its
-/// iteration limit, or the generator going away). Errors of argmin end the search early; the
-/// generator then starts the next one, so they are not reported.
-pub(super) fn search(method: Method, tuning: &Tuning, d: usize, start: Vec<f64>, bridge: Bridge) {
+/// Runs one search of `method` in `d` dimensions to its end (convergence, its iteration
+/// limit, or the generator going away). `starts` holds its start point (Nelder–Mead,
+/// annealing) or its initial swarm or population (at least one point). Errors of argmin end
+/// the search early; the generator then starts the next one, so they are not reported.
+pub(super) fn search(
+    method: Method,
+    tuning: &Tuning,
+    d: usize,
+    mut starts: Vec<Vec<f64>>,
+    bridge: Bridge,
+) {
+    if starts.is_empty() {
+        starts.push(vec![0.5; d]);
+    }
+    let start = starts[0].clone();
     match method {
         Method::NelderMead => {
             // A right-angled initial simplex of edge `simplex_edge`, pointing into the cube.
@@ -121,11 +132,25 @@ pub(super) fn search(method: Method, tuning: &Tuning, d: usize, start: Vec<f64>,
             }
         }
         Method::ParticleSwarm => {
+            // The initial swarm at the given points, with random velocities in ±range as
+            // argmin would draw them.
+            let costs = bridge.evaluate(starts.clone());
+            let particles: Vec<Particle<Vec<f64>, f64>> = {
+                let mut rng = bridge.rng.borrow_mut();
+                starts
+                    .iter()
+                    .zip(costs)
+                    .map(|(p, c)| {
+                        let v = (0..d).map(|_| rng.random_range(-1.0..1.0)).collect();
+                        Particle::new(p.clone(), c, v)
+                    })
+                    .collect()
+            };
             let seed = bridge.rng.borrow_mut().random::<u64>();
-            let solver = ParticleSwarm::new((vec![0.0; d], vec![1.0; d]), tuning.swarm_size)
+            let solver = ParticleSwarm::new((vec![0.0; d], vec![1.0; d]), particles.len())
                 .with_rng_generator(ChaCha8Rng::seed_from_u64(seed));
             let _ = Executor::new(bridge, solver)
-                .configure(|s| s.max_iters(tuning.pso_max_iters))
+                .configure(|s| s.population(particles).max_iters(tuning.pso_max_iters))
                 .timer(false)
                 .run();
         }
@@ -152,7 +177,8 @@ pub(super) fn search(method: Method, tuning: &Tuning, d: usize, start: Vec<f64>,
                 tuning.ce_population,
                 tuning.ce_elite,
                 ChaCha8Rng::seed_from_u64(seed),
-            );
+            )
+            .with_first_population(starts);
             for _ in 0..tuning.ce_max_iters {
                 let population = ce.ask();
                 let costs = bridge.evaluate(population);

@@ -13,9 +13,15 @@
 //!   request of each (a point for Nelder–Mead and annealing, a whole swarm or population for
 //!   the others). The batch does not depend on the number of worker threads, so results do
 //!   not either.
+//! - **Space-filling starts.** Every search starts from the next unused points of one
+//!   scrambled Halton sequence over the continuous parameters (Owen 2017, seeded by the
+//!   campaign seed): a point for Nelder–Mead and annealing, the whole initial swarm or first
+//!   population for the others. So the first batch is as spread out as `halton-scrambled`'s
+//!   first points, and restarts keep filling the space instead of landing where earlier
+//!   searches have been (the global phase of Breach's falsification works alike).
 //! - **Restarts.** When a search ends (converged, or at its iteration limit) its lane starts
-//!   the next one from a uniformly random point (search `k` draws from ChaCha8 stream `k` of
-//!   the campaign seed).
+//!   the next one. Each search's own random choices (annealing moves, swarm velocities,
+//!   cross-entropy samples) come from ChaCha8 stream `k` of the campaign seed for search `k`.
 //! - **Discrete parameters.** Searches run over the continuous coordinates only. The discrete
 //!   ones are fixed per search, to the rows of a strength-2 covering array (IPOG) over them,
 //!   taken in turn: search `k` uses row `k mod rows`. So every pair of discrete levels gets
@@ -34,12 +40,12 @@ use std::collections::VecDeque;
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::thread::JoinHandle;
 
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 pub use cross_entropy::CrossEntropy;
 
-use crate::{Generator, GeneratorError, ParamSpace, Point};
+use crate::{Generator, GeneratorError, Halton, ParamSpace, Point};
 
 /// The search method of a [`Falsifier`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -64,7 +70,8 @@ pub struct Tuning {
     /// Nelder–Mead: edge of the initial simplex, in unit-cube coordinates. Default 0.15.
     pub simplex_edge: f64,
     /// Nelder–Mead: converged when the costs of the simplex have this standard deviation.
-    /// Default 0.05 (cost units: the monitors', metres for the shipped ones).
+    /// Default 1e-3 (cost units: the monitors', metres for the shipped ones). Larger values
+    /// restart searches just as they close in on a small failure region.
     pub nm_sd_tolerance: f64,
     /// Nelder–Mead: iterations before a restart. Default 30.
     pub nm_max_iters: u64,
@@ -93,7 +100,7 @@ impl Default for Tuning {
         Tuning {
             lanes: 4,
             simplex_edge: 0.15,
-            nm_sd_tolerance: 0.05,
+            nm_sd_tolerance: 1e-3,
             nm_max_iters: 30,
             swarm_size: 8,
             pso_max_iters: 12,
@@ -146,6 +153,8 @@ pub struct Falsifier {
     rows: Vec<Vec<u32>>,
     lanes: Vec<Lane>,
     searches_started: u64,
+    /// The start points of the searches, consumed in order.
+    starts: Halton,
     /// Points requested by the lanes and not yet asked for.
     queue: VecDeque<Pending>,
     /// Points asked for and not yet told, in the order they were handed out.
@@ -200,6 +209,7 @@ impl Falsifier {
             rows,
             lanes: Vec::new(),
             searches_started: 0,
+            starts: Halton::scrambled(&ParamSpace::unit_cube(d), seed),
             queue: VecDeque::new(),
             handed: VecDeque::new(),
         };
@@ -222,7 +232,18 @@ impl Falsifier {
         self.searches_started += 1;
         let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
         rng.set_stream(k);
-        let start: Vec<f64> = (0..self.d).map(|_| rng.random::<f64>()).collect();
+        let starts_needed = match self.method {
+            Method::NelderMead | Method::Annealing => 1,
+            Method::ParticleSwarm => self.tuning.swarm_size,
+            Method::CrossEntropy => self.tuning.ce_population,
+        };
+        let starts: Vec<Vec<f64>> = self
+            .starts
+            .ask(starts_needed)
+            .unwrap_or_default()
+            .into_iter()
+            .map(|p| p.continuous)
+            .collect();
         let (req_tx, req_rx) = channel();
         let (ans_tx, ans_rx) = channel();
         let bridge = lane::Bridge {
@@ -235,7 +256,7 @@ impl Falsifier {
         let (method, tuning, d) = (self.method, self.tuning.clone(), self.d);
         let thread = std::thread::Builder::new()
             .name(format!("paracosm-search-{k}"))
-            .spawn(move || lane::search(method, &tuning, d, start, bridge))
+            .spawn(move || lane::search(method, &tuning, d, starts, bridge))
             .ok();
         Lane {
             requests: req_rx,
