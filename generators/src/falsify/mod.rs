@@ -459,6 +459,32 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+        #[test]
+        fn any_tuning_spends_the_budget_exactly_inside_the_bounds(
+            seed in 0u64..1000,
+            budget in 1usize..150,
+            method in 0usize..4,
+            lanes in 1usize..6,
+            w in proptest::collection::vec(-3.0f64..3.0, 2),
+            errors in proptest::bool::ANY,
+        ) {
+            let tuning = Tuning { lanes, ..Tuning::default() };
+            let mut g = Falsifier::with_tuning(&space(), ALL[method], seed, tuning).unwrap();
+            // A slope the searches chase out of the cube, and tests that error (NaN).
+            let pts = drive(&mut g, budget, |p| {
+                let r = w[0] * p.continuous[0] + w[1] * p.continuous[1];
+                if errors && p.continuous[0] > 0.7 { f64::NAN } else { r }
+            });
+            proptest::prop_assert_eq!(pts.len(), budget);
+            for p in &pts {
+                proptest::prop_assert!(p.continuous.iter().all(|x| (0.0..1.0).contains(x)));
+                proptest::prop_assert!(p.discrete[0] < 3);
+            }
+        }
+    }
+
     #[test]
     fn searches_take_the_covering_rows_in_turn() {
         let mut g = Falsifier::new(&space(), Method::NelderMead, 1).unwrap();
