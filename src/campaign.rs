@@ -173,8 +173,8 @@ impl Campaign<'_> {
     }
 
     /// Runs the campaign, writing `results.jsonl` into `out_dir` (created if needed, the file
-    /// replaced). `on_done` is called in the calling thread as each test finishes (for progress
-    /// bars).
+    /// replaced). `on_done` is called in the calling thread as each record is written (for
+    /// progress bars).
     ///
     /// Tests are handed to `jobs` rayon workers one index at a time, so tests finish roughly in
     /// index order. Each record is appended and flushed as soon as every record before it is
@@ -203,7 +203,10 @@ impl Campaign<'_> {
     /// complete line); with `None` the file is replaced. When `stop` becomes true no new test
     /// starts; the tests in flight finish, the records that follow without a gap are written,
     /// and the report says `interrupted`. With [`Campaign::stop_at_first_failure`] the first
-    /// failed test stops the campaign the same way, but it is not `interrupted`.
+    /// failed test stops the campaign: no new test starts, and the file ends with the first
+    /// failure in id order (records of tests that were in flight after it are dropped, so the
+    /// file does not depend on `jobs`); the report is not `interrupted`. When `prior` already
+    /// holds a failure, nothing runs.
     ///
     /// An adaptive strategy replays `prior` into its searches (their robustness, without
     /// simulating them again) before it runs the rest, so a resumed campaign equals an
@@ -229,6 +232,18 @@ impl Campaign<'_> {
         )?;
         let ids = ids.start.min(self.budget)..ids.end.min(self.budget);
         let prior_len = prior.map_or(0, <[RunRecord]>::len) as u64;
+        let prior_failed = prior.is_some_and(|p| p.iter().any(|r| r.status == Status::Fail));
+        if self.stop_at_first_failure && prior_failed {
+            // A resumed campaign that had already found its failure is finished.
+            return Ok(CampaignReport {
+                records: Vec::new(),
+                interrupted: false,
+                stopped_at_failure: true,
+                counts: Counts::default(),
+                first_failure: None,
+                wall_s: started.elapsed().as_secs_f64(),
+            });
+        }
         // Everything that can be refused is refused before the output folder is touched.
         let upfront = match generator.batch() {
             None => Some(generator.ask(ids.end as usize)?),
@@ -410,13 +425,20 @@ impl<'c, 'a> Run<'c, 'a> {
                     }
                 });
             });
+            // With stop_at_first_failure, records after the first failure (in id order) are
+            // tests that were in flight: dropped, so the file does not depend on timing.
+            let mut closed = false;
             for record in rx {
-                on_done(&record);
                 if campaign.stop_at_first_failure && record.status == Status::Fail {
                     failed.store(true, Ordering::Relaxed);
                 }
                 pending.insert(record.id, record);
                 while let Some(r) = pending.remove(&(first + done.len() as u64)) {
+                    if closed {
+                        break;
+                    }
+                    on_done(&r);
+                    closed = campaign.stop_at_first_failure && r.status == Status::Fail;
                     if write_result.is_ok() {
                         write_result = write_line(out, &r);
                         if write_result.is_err() {

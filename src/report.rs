@@ -220,10 +220,11 @@ pub fn human(summary: &Summary, scenario: &Scenario, out: &Path, expected: u64) 
                 let unit = scenario
                     .space
                     .param(n)
-                    .and_then(|p| p.unit.clone())
+                    .and_then(|p| p.unit.as_ref())
+                    .map(|u| format!(" {u}"))
                     .unwrap_or_default();
                 match v.as_f64() {
-                    Some(x) => format!("{n} = {x:.3} {unit}"),
+                    Some(x) => format!("{n} = {x:.3}{unit}"),
                     None => format!("{n} = {v}"),
                 }
             })

@@ -16,6 +16,10 @@ fn lines(dir: &Path) -> Vec<String> {
 }
 
 fn run(out: &Path, strategy: &str, extra: &[&str]) -> std::process::Output {
+    run_seeded(out, strategy, "3", extra)
+}
+
+fn run_seeded(out: &Path, strategy: &str, seed: &str, extra: &[&str]) -> std::process::Output {
     let mut args = vec![
         "pedestrian-crossing",
         "--strategy",
@@ -23,7 +27,7 @@ fn run(out: &Path, strategy: &str, extra: &[&str]) -> std::process::Output {
         "--budget",
         "40",
         "--seed",
-        "3",
+        seed,
         "--out",
         out.to_str().unwrap(),
     ];
@@ -77,31 +81,49 @@ fn a_resumed_adaptive_campaign_equals_an_uninterrupted_one() {
 }
 
 #[test]
-fn stop_at_first_failure_ends_the_campaign_at_the_failing_batch() {
+fn stop_at_first_failure_ends_the_file_at_the_first_failure_for_any_jobs() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("stop");
-    let o = run(
+    // Seed 6 fails in its second batch, while other tests of it are in flight.
+    let o = run_seeded(
         &out,
         "falsify-sa",
+        "6",
         &["--stop-at-first-failure", "--jobs", "1"],
     );
     expect_code(&o, 1);
     let records = lines(&out);
+    let three = dir.path().join("three");
+    run_seeded(
+        &three,
+        "falsify-sa",
+        "6",
+        &["--stop-at-first-failure", "--jobs", "3"],
+    );
+    assert_eq!(lines(&three), records, "the stopped file depends on --jobs");
     let failed: Vec<usize> = records
         .iter()
         .enumerate()
         .filter(|(_, l)| l.contains("\"status\":\"fail\""))
         .map(|(i, _)| i)
         .collect();
-    // With one worker, at most the test it had already taken runs after the first failure.
-    let first = failed[0];
-    assert!(records.len() <= first + 2, "{records:#?}");
-    assert!(records.len() < 40);
+    // The file ends with the first failure.
+    assert_eq!(failed, vec![records.len() - 1], "{records:#?}");
+    assert_eq!(records.len(), 6);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
         stdout.contains(&format!("{} of 40 tests", records.len())),
         "{stdout}"
     );
+    // Resuming it with the same flag finds the failure already there and runs nothing.
+    let again = fuzz(&[
+        "--resume",
+        "--stop-at-first-failure",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&again, 1);
+    assert_eq!(lines(&out), records);
 }
 
 #[test]

@@ -238,10 +238,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
             cli.out.join(paracosm::campaign::RESULTS_FILE).display()
         );
     }
-    let mut start = ids.start + existing.records.len() as u64;
-    if cli.stop_at_first_failure && existing.records.iter().any(|r| r.status == Status::Fail) {
-        start = ids.end; // the resumed campaign had already found its failure
-    }
+    let start = ids.start + existing.records.len() as u64;
     if stored.is_some() {
         eprintln!(
             "paracosm-fuzz: resuming: {} of {} tests already done",
@@ -307,6 +304,12 @@ fn run(cli: &Cli) -> Result<ExitCode> {
             cli.out.display()
         );
         return Ok(ExitCode::from(130));
+    }
+    if report.stopped_at_failure {
+        eprintln!(
+            "paracosm-fuzz: --stop-at-first-failure: stopped after {done} of {} tests",
+            ids.end - ids.start
+        );
     }
     let mut records = existing.records;
     records.extend(report.records);
