@@ -94,12 +94,7 @@ impl Campaign<'_> {
     /// [`CampaignError::Adaptive`] for an adaptive strategy, whose points exist only as the
     /// campaign runs.
     pub fn points(&self) -> Result<Vec<Point>, CampaignError> {
-        let mut generator = self.strategy.build_sized(
-            &self.scenario.space,
-            self.seed,
-            self.budget,
-            self.strength,
-        )?;
+        let mut generator = self.generator()?;
         if generator.batch().is_some() {
             return Err(CampaignError::Adaptive(format!(
                 "{} chooses each batch from the robustness of the last: its points exist only \
@@ -108,6 +103,16 @@ impl Campaign<'_> {
             )));
         }
         Ok(generator.ask(self.budget as usize)?)
+    }
+
+    /// The campaign's generator, fresh.
+    fn generator(&self) -> Result<Box<dyn paracosm_generators::Generator>, CampaignError> {
+        Ok(self.strategy.build_sized(
+            &self.scenario.space,
+            self.seed,
+            self.budget,
+            self.strength,
+        )?)
     }
 
     /// Runs test `id` at `point` alone: what a worker does.
@@ -224,12 +229,7 @@ impl Campaign<'_> {
         mut on_done: impl FnMut(&RunRecord),
     ) -> Result<CampaignReport, CampaignError> {
         let started = Instant::now();
-        let mut generator = self.strategy.build_sized(
-            &self.scenario.space,
-            self.seed,
-            self.budget,
-            self.strength,
-        )?;
+        let mut generator = self.generator()?;
         let ids = ids.start.min(self.budget)..ids.end.min(self.budget);
         let prior_len = prior.map_or(0, <[RunRecord]>::len) as u64;
         let prior_failed = prior.is_some_and(|p| p.iter().any(|r| r.status == Status::Fail));

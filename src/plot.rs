@@ -160,54 +160,52 @@ pub fn failure_map(
         axis(space, a)?;
     }
     let size = (760 * panels.len().max(1) as u32, 600);
-    let png = stem.with_extension("png");
-    let svg = stem.with_extension("svg");
-    // Through a temporary file and a rename: a failed write leaves any earlier plot whole.
-    let atomic = |path: &Path, draw: &dyn Fn(&Path) -> Result<(), PlotError>| {
-        crate::atomic::with_temp(path, draw).map_err(|reason| PlotError::Draw {
-            path: path.to_path_buf(),
-            reason,
-        })
+    png_and_svg(
+        stem,
+        size,
+        |root| render(root, space, axes, panels),
+        |root| render(root, space, axes, panels),
+    )
+}
+
+/// Draws one figure of `size` pixels into `stem.png` and `stem.svg`, each through a temporary
+/// file and a rename, so a failed write leaves any earlier plot whole. `png` and `svg` are the
+/// same drawing code on the two backends. Returns the two paths.
+fn png_and_svg(
+    stem: &Path,
+    size: (u32, u32),
+    png: impl Fn(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
+    svg: impl Fn(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
+) -> Result<[PathBuf; 2], PlotError> {
+    let (png_path, svg_path) = (stem.with_extension("png"), stem.with_extension("svg"));
+    let failed = |path: &Path| {
+        let path = path.to_path_buf();
+        move |reason| PlotError::Draw { path, reason }
     };
-    atomic(&png, &|tmp| {
-        render(
-            BitMapBackend::new(tmp, size).into_drawing_area(),
-            tmp,
-            space,
-            axes,
-            panels,
-        )
-    })?;
-    atomic(&svg, &|tmp| {
-        render(
-            SVGBackend::new(tmp, size).into_drawing_area(),
-            tmp,
-            space,
-            axes,
-            panels,
-        )
-    })?;
-    Ok([png, svg])
+    crate::atomic::with_temp(&png_path, |tmp| {
+        png(BitMapBackend::new(tmp, size).into_drawing_area())
+    })
+    .map_err(failed(&png_path))?;
+    crate::atomic::with_temp(&svg_path, |tmp| {
+        svg(SVGBackend::new(tmp, size).into_drawing_area())
+    })
+    .map_err(failed(&svg_path))?;
+    Ok([png_path, svg_path])
 }
 
 /// Fills `root` with the panels side by side and writes it out.
 fn render<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
-    path: &Path,
     space: &ParamSpace,
     axes: &[String; 2],
     panels: &[(&str, &[RunRecord])],
-) -> Result<(), PlotError> {
-    let fail = |reason: String| PlotError::Draw {
-        path: path.to_path_buf(),
-        reason,
-    };
-    root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
     let areas = root.split_evenly((1, panels.len().max(1)));
     for (area, (title, records)) in areas.iter().zip(panels) {
-        draw_panel(area, records, space, axes, title).map_err(fail)?;
+        draw_panel(area, records, space, axes, title)?;
     }
-    root.present().map_err(|e| fail(e.to_string()))
+    root.present().map_err(|e| e.to_string())
 }
 
 /// Width of one tile of a contact sheet, in pixels.
@@ -316,30 +314,12 @@ pub fn failure_rate_map(
     register_font();
     let bins = bins.max(1);
     let cells = failure_rates(records, space, axes, bins)?;
-    let png = stem.with_extension("png");
-    let svg = stem.with_extension("svg");
-    let size = (760, 600);
-    let drawn = |path: &Path, r: Result<(), String>| {
-        r.map_err(|reason| PlotError::Draw {
-            path: path.to_path_buf(),
-            reason,
-        })
-    };
-    let atomic = |path: &Path, draw: &dyn Fn(&Path) -> Result<(), PlotError>| {
-        crate::atomic::with_temp(path, draw).map_err(|reason| PlotError::Draw {
-            path: path.to_path_buf(),
-            reason,
-        })
-    };
-    atomic(&png, &|tmp| {
-        let root = BitMapBackend::new(tmp, size).into_drawing_area();
-        drawn(&png, draw_rates(root, space, axes, title, &cells, bins))
-    })?;
-    atomic(&svg, &|tmp| {
-        let root = SVGBackend::new(tmp, size).into_drawing_area();
-        drawn(&svg, draw_rates(root, space, axes, title, &cells, bins))
-    })?;
-    Ok([png, svg])
+    png_and_svg(
+        stem,
+        (760, 600),
+        |root| draw_rates(root, space, axes, title, &cells, bins),
+        |root| draw_rates(root, space, axes, title, &cells, bins),
+    )
 }
 
 fn draw_rates<DB: DrawingBackend>(
@@ -406,30 +386,12 @@ pub fn box_plot(
     panels: &[BoxPanel],
 ) -> Result<[PathBuf; 2], PlotError> {
     register_font();
-    let png = stem.with_extension("png");
-    let svg = stem.with_extension("svg");
-    let size = (760 * panels.len().max(1) as u32, 600);
-    let drawn = |path: &Path, r: Result<(), String>| {
-        r.map_err(|reason| PlotError::Draw {
-            path: path.to_path_buf(),
-            reason,
-        })
-    };
-    let atomic = |path: &Path, draw: &dyn Fn(&Path) -> Result<(), PlotError>| {
-        crate::atomic::with_temp(path, draw).map_err(|reason| PlotError::Draw {
-            path: path.to_path_buf(),
-            reason,
-        })
-    };
-    atomic(&png, &|tmp| {
-        let root = BitMapBackend::new(tmp, size).into_drawing_area();
-        drawn(&png, draw_boxes(root, y_label, panels))
-    })?;
-    atomic(&svg, &|tmp| {
-        let root = SVGBackend::new(tmp, size).into_drawing_area();
-        drawn(&svg, draw_boxes(root, y_label, panels))
-    })?;
-    Ok([png, svg])
+    png_and_svg(
+        stem,
+        (760 * panels.len().max(1) as u32, 600),
+        |root| draw_boxes(root, y_label, panels),
+        |root| draw_boxes(root, y_label, panels),
+    )
 }
 
 fn draw_boxes<DB: DrawingBackend>(

@@ -15,6 +15,12 @@ use anyhow::{Context, Result};
 use paracosm::{Campaign, RunRecord};
 use paracosm_generators::Strategy;
 
+/// Worker threads: `jobs`, or every core when `None`; at least 1.
+pub fn jobs_or_all_cores(jobs: Option<usize>) -> usize {
+    jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .max(1)
+}
+
 /// What [`figure9`] measured and wrote.
 #[derive(Debug, Clone)]
 pub struct Figure9 {

@@ -30,10 +30,7 @@ struct Cli {
 
 fn main() -> Result<()> {
     let cli = Cli::parse();
-    let jobs = cli
-        .jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .max(1);
+    let jobs = paracosm_experiments::jobs_or_all_cores(cli.jobs);
     let strategies = [
         Strategy::Random,
         Strategy::Halton,
