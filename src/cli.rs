@@ -20,8 +20,8 @@ pub enum StrategyArg {
     Ipog,
     /// As ipog, with a random k-wise array sized by Proposition 3.2.
     Kwise,
-    /// Falsification: Nelder–Mead with random restarts minimising robustness (argmin);
-    /// discrete parameters fixed per search by a pairwise covering array.
+    /// Falsification: Nelder–Mead with restarts minimising robustness (argmin); discrete
+    /// parameters fixed per search by a pairwise covering array.
     FalsifyNm,
     /// Falsification: particle swarms minimising robustness (argmin).
     FalsifyPso,

@@ -19,7 +19,7 @@ pub enum Strategy {
     Ipog,
     /// [`crate::covering::CoveringSuite`] on a random k-wise array (Proposition 3.2).
     KWise,
-    /// [`Falsifier`] with Nelder–Mead and random restarts (argmin).
+    /// [`Falsifier`] with Nelder–Mead and restarts (argmin).
     FalsifyNm,
     /// [`Falsifier`] with particle swarms (argmin).
     FalsifyPso,

@@ -56,9 +56,9 @@ struct Cli {
     /// Campaign seed: seeds the generator and every test [default: 0].
     #[arg(long)]
     seed: Option<u64>,
-    /// End the campaign at the first failed test (robustness <= 0): the tests in flight
-    /// finish and are written, no new one starts. For falsification, e.g. with
-    /// --strategy falsify-nm.
+    /// End the campaign at the first failed test (robustness <= 0): no new test starts, and
+    /// results.jsonl ends with that test (tests in flight after it are dropped, so the file
+    /// does not depend on --jobs). For falsification, e.g. with --strategy falsify-nm.
     #[arg(long)]
     stop_at_first_failure: bool,
     /// Worker threads (default: all cores). Results do not depend on it.

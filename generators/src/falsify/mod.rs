@@ -50,8 +50,8 @@ use crate::{Generator, GeneratorError, Halton, ParamSpace, Point};
 /// The search method of a [`Falsifier`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Method {
-    /// Nelder–Mead simplex search (Nelder and Mead 1965) with random restarts: argmin's
-    /// `NelderMead`.
+    /// Nelder–Mead simplex search (Nelder and Mead 1965) with restarts from space-filling
+    /// points: argmin's `NelderMead`.
     NelderMead,
     /// Particle swarm optimisation (Kennedy and Eberhart 1995): argmin's `ParticleSwarm`.
     ParticleSwarm,
