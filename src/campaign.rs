@@ -287,7 +287,11 @@ impl Campaign<'_> {
                     told.push((p.clone(), r.robustness()));
                 }
                 let fresh = run.execute(next + known as u64, &points[known..], &mut on_done)?;
-                told.extend(fresh.iter().map(|r| (r.point.clone(), r.robustness())));
+                told.extend(
+                    run.records[fresh]
+                        .iter()
+                        .map(|r| (r.point.clone(), r.robustness())),
+                );
                 generator.tell(&told);
                 next += points.len() as u64;
             }
@@ -388,13 +392,14 @@ impl<'c, 'a> Run<'c, 'a> {
     }
 
     /// Runs `points` as tests `first..`, in parallel, writing each record once every record
-    /// before it is written. Returns this call's records (fewer than `points` when halted).
+    /// before it is written. Returns where this call's records are in `self.records` (fewer than
+    /// `points` when halted).
     fn execute(
         &mut self,
         first: u64,
         points: &[Point],
         on_done: &mut impl FnMut(&RunRecord),
-    ) -> Result<Vec<RunRecord>, CampaignError> {
+    ) -> Result<Range<usize>, CampaignError> {
         let campaign = self.campaign;
         let jobs = campaign.jobs;
         let next = AtomicUsize::new(0);
@@ -457,8 +462,9 @@ impl<'c, 'a> Run<'c, 'a> {
         if done.len() < points.len() && self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
             self.stopped_by_user = true;
         }
-        self.records.extend(done.iter().cloned());
-        Ok(done)
+        let start = self.records.len();
+        self.records.append(&mut done);
+        Ok(start..self.records.len())
     }
 }
 

@@ -20,6 +20,24 @@ fn params(r: &RunRecord) -> String {
     }
 }
 
+/// Writes `case` with one child `<tag message=.. type=..>text</tag>`: a failure or an error.
+fn outcome<W: std::io::Write>(
+    case: quick_xml::writer::ElementWriter<'_, W>,
+    tag: &str,
+    kind: &str,
+    message: &str,
+    text: &str,
+) -> std::io::Result<()> {
+    case.write_inner_content(|w| {
+        w.create_element(tag)
+            .with_attribute(("message", message))
+            .with_attribute(("type", kind))
+            .write_text_content(BytesText::new(text))?;
+        Ok(())
+    })?;
+    Ok(())
+}
+
 fn verdicts(r: &RunRecord) -> String {
     r.monitors
         .iter()
@@ -82,23 +100,11 @@ pub fn render(scenario: &str, records: &[RunRecord], out: &Path) -> String {
                                             r.seed,
                                             replay_command(out, r.id)
                                         );
-                                        case.write_inner_content(|w| {
-                                            w.create_element("failure")
-                                                .with_attribute(("message", message.as_str()))
-                                                .with_attribute(("type", "falsified"))
-                                                .write_text_content(BytesText::new(&body))?;
-                                            Ok(())
-                                        })?;
+                                        outcome(case, "failure", "falsified", &message, &body)?;
                                     }
                                     Status::Error => {
                                         let message = r.error.clone().unwrap_or_default();
-                                        case.write_inner_content(|w| {
-                                            w.create_element("error")
-                                                .with_attribute(("message", message.as_str()))
-                                                .with_attribute(("type", "error"))
-                                                .write_text_content(BytesText::new(&message))?;
-                                            Ok(())
-                                        })?;
+                                        outcome(case, "error", "error", &message, &message)?;
                                     }
                                 }
                             }

@@ -270,42 +270,25 @@ fn three_shards_merge_into_the_single_machine_run() {
     assert!(rob.windows(2).all(|w| w[0] <= w[1]));
     assert!(list[0]["replay"].as_str().unwrap().contains("--id"));
 
-    // A missing shard, a shard given twice, and an incomplete one are refused.
+    // A missing shard, a shard given twice, and an incomplete one are refused (exit 2,
+    // with the reason on stderr).
     let m2 = dir.path().join("m2");
-    let o = fuzz(&["merge", s0, s2, "--out", m2.to_str().unwrap()]);
-    expect_code(&o, 2);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("shard 1/3 of the campaign is missing"));
-    let o = fuzz(&[
-        "merge",
-        s0,
-        s1,
-        s1,
-        s2,
-        "--out",
-        m2.to_str().unwrap(),
-        "--force",
-    ]);
-    expect_code(&o, 2);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("shard 1/3 is given twice"));
+    let refused = |shards: &[&str], reason: &str| {
+        let mut args = vec!["merge"];
+        args.extend(shards);
+        args.extend(["--out", m2.to_str().unwrap(), "--force"]);
+        let o = fuzz(&args);
+        expect_code(&o, 2);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(stderr.contains(reason), "{stderr}");
+    };
+    refused(&[s0, s2], "shard 1/3 of the campaign is missing");
+    refused(&[s0, s1, s1, s2], "shard 1/3 is given twice");
     let results = shard(1).join("results.jsonl");
     let text = std::fs::read_to_string(&results).unwrap();
     let keep: String = text.lines().take(10).map(|l| format!("{l}\n")).collect();
     std::fs::write(&results, keep).unwrap();
-    let o = fuzz(&[
-        "merge",
-        s0,
-        s1,
-        s2,
-        "--out",
-        m2.to_str().unwrap(),
-        "--force",
-    ]);
-    expect_code(&o, 2);
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        stderr.contains("is incomplete: 10 of 133 tests"),
-        "{stderr}"
-    );
+    refused(&[s0, s1, s2], "is incomplete: 10 of 133 tests");
     // `report` on the partial shard says so.
     let o = fuzz(&["report", s1]);
     let stdout = String::from_utf8_lossy(&o.stdout);
