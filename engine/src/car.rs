@@ -17,14 +17,26 @@ pub struct CarState {
     pub enabled: bool,
 }
 
+/// Gravitational acceleration in m/s², for the tyres' friction limit `μ·g`.
+pub(crate) const GRAVITY_MPS2: f64 = 9.81;
+
 /// A kinematic NPC car following a polyline at a commanded speed. Solid: the ego vehicle
 /// collides with it physically, and the lidar sees it.
+///
+/// It enters the test at its commanded speed; from then on its speed follows the command no
+/// faster than its tyres allow: by at most `μ·g` m/s² (the friction circle's longitudinal
+/// limit), where `μ` is the friction of the road piece under the car that step (or the
+/// ground's off the network).
 pub(crate) struct Car {
     pub(crate) body: Option<(RigidBodyHandle, ColliderHandle)>,
     path: Vec<[f64; 2]>,
     cumulative: Vec<f64>,
     s: f64,
+    /// Speed along the path in the last step, m/s.
     speed: f64,
+    /// Speed the tyres hold (the command, limited to `μ·g` of change per second), m/s;
+    /// `None` before the first step.
+    rolling: Option<f64>,
     half_height: f64,
     /// Half length and half width, metres.
     pub(crate) half_size_m: [f64; 2],
@@ -48,6 +60,7 @@ impl Car {
             cumulative,
             s: 0.0,
             speed: 0.0,
+            rolling: None,
             half_height: size_m[1] / 2.0,
             half_size_m: [size_m[0] / 2.0, size_m[2] / 2.0],
         };
@@ -90,11 +103,34 @@ impl Car {
         )
     }
 
-    /// Drives `speed_mps · dt_s` metres further (not past the path's end).
-    pub(crate) fn advance(&mut self, physics: &mut PhysicsWorld, speed_mps: f64, dt_s: f64) {
+    /// The ground point `[x, z]` under the car now, metres.
+    pub(crate) fn ground_m(&self) -> [f64; 2] {
+        self.at(self.s).0
+    }
+
+    /// Drives one step of `dt_s` toward the commanded `speed_mps` (negative counts as 0) on a
+    /// surface of friction `friction`: the speed changes by at most `friction · g · dt_s`
+    /// (except in the first step, which sets it), and the car does not pass its path's end.
+    pub(crate) fn advance(
+        &mut self,
+        physics: &mut PhysicsWorld,
+        speed_mps: f64,
+        friction: f64,
+        dt_s: f64,
+    ) {
         let end = *self.cumulative.last().expect("non-empty");
         let before = self.s;
-        self.s = (self.s + speed_mps.max(0.0) * dt_s).min(end);
+        let wanted = speed_mps.max(0.0);
+        let rolling = match self.rolling {
+            None => wanted,
+            Some(v) => {
+                let dv = friction * GRAVITY_MPS2 * dt_s;
+                wanted.clamp(v - dv, v + dv)
+            }
+        };
+        self.s = (self.s + rolling * dt_s).min(end);
+        // At the end of its path the car has stopped.
+        self.rolling = Some(if self.s >= end { 0.0 } else { rolling });
         self.speed = (self.s - before) / dt_s;
         if let Some((body, _)) = self.body {
             let pose = self.pose();

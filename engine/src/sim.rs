@@ -5,14 +5,14 @@ use serde::Serialize;
 
 use crate::behaviour::{decode_probe, Actor, Output};
 use crate::car::{Car, CarState};
-use crate::network::{Lane, Network};
+use crate::network::{Lane, Network, Surface};
 use crate::pedestrian::Pedestrian;
 use crate::rx::{Host, Inputs, Runtime, StreamId, Value};
 use crate::spec::EnvironmentSpec;
 use crate::vehicle::EgoVehicle;
 use crate::{
     visibility_m, CameraFrame, CameraSpec, Control, EngineError, LidarReturn, LidarSpec,
-    PedestrianState, WorldSpec,
+    PedestrianState, WorldSpec, NOMINAL_LIGHT,
 };
 
 /// The ego vehicle's state.
@@ -67,6 +67,16 @@ pub struct Snapshot {
     pub light: f64,
     /// Fog density now, `[0, 1]`.
     pub fog: f64,
+    /// Whether the centre of the ego vehicle's footprint is on no driving surface of the
+    /// network (a sidewalk, an island, the ground beside the road or beyond a dead end).
+    pub ego_off_road: bool,
+    /// Signed distance from the centre of the ego vehicle's footprint to the edge of the
+    /// driving surface, in metres: `> 0` on it, `<= 0` off it ([`Surface::edge_distance_m`]).
+    pub ego_road_edge_m: f64,
+    /// Lateral offset of the ego vehicle's centre from the centre line of the nearest lane
+    /// in its direction of travel, in metres, positive to the right
+    /// ([`Surface::lane_offset_m`]).
+    pub ego_lane_offset_m: f64,
 }
 
 /// A running world: the physics, the actors, the stream graph that drives them, and the ego
@@ -74,6 +84,7 @@ pub struct Snapshot {
 pub struct Simulation {
     physics: PhysicsWorld,
     network: Network,
+    surface: Surface,
     ego: EgoVehicle,
     route: Vec<[f64; 2]>,
     pedestrians: Vec<Pedestrian>,
@@ -131,8 +142,9 @@ impl Simulation {
         spec.network.build(&mut physics);
 
         let start = spec.ego.start;
-        // The tyres grip with the friction of the piece the ego vehicle starts on.
-        let friction = spec.network.piece(start.piece).kind.friction();
+        let surface = Surface::new(&spec.network);
+        // Each step sets every wheel's friction from the piece under it (EgoVehicle::grip).
+        let friction = surface.friction_at([start.pos_m[0], start.pos_m[2]]);
         let ego = EgoVehicle::build(
             &mut physics,
             &spec.ego.vehicle,
@@ -181,6 +193,7 @@ impl Simulation {
         let mut sim = Simulation {
             physics,
             network: spec.network.clone(),
+            surface,
             route: spec.ego.route.clone(),
             touching: vec![false; pedestrians.len() + cars.len()],
             ego,
@@ -365,6 +378,7 @@ impl Simulation {
     pub fn step(&mut self, control: Control, host: &mut dyn Host) -> Result<(), EngineError> {
         let dt = self.dt_s;
         self.ego.apply(control, dt);
+        self.ego.grip(&self.physics, &self.surface);
         self.ego.update(&mut self.physics, dt);
         let t = self.t_s();
         self.sinks.clear();
@@ -376,12 +390,15 @@ impl Simulation {
             touching: &self.touching,
         };
         self.streams.step(t, &inputs, host, &mut self.sinks)?;
-        let num = |rt: &Runtime, id: StreamId, default: f64| {
-            rt.current(id).and_then(Value::as_num).unwrap_or(default)
-        };
         self.light_fog = (
-            num(&self.streams, self.environment.light, 1.0),
-            num(&self.streams, self.environment.fog, 0.0),
+            number(
+                &self.streams,
+                self.environment.light,
+                NOMINAL_LIGHT,
+                t,
+                "the light",
+            )?,
+            number(&self.streams, self.environment.fog, 0.0, t, "the fog")?,
         );
         for p in &mut self.pedestrians {
             p.rest();
@@ -389,11 +406,21 @@ impl Simulation {
         for (sink, _) in &self.sinks {
             let i = *sink as usize;
             if let (Some(p), Some(&speed)) = (self.pedestrians.get_mut(i), self.speeds.0.get(i)) {
-                p.walk(&mut self.physics, t, dt, num(&self.streams, speed, 0.0));
+                let what = format!("the speed of pedestrian {i}");
+                let v = number(&self.streams, speed, 0.0, t, &what)?;
+                p.walk(&mut self.physics, t, dt, v);
             }
         }
-        for (car, &speed) in self.cars.iter_mut().zip(&self.speeds.1) {
-            car.advance(&mut self.physics, num(&self.streams, speed, 0.0), dt);
+        for (i, (car, &speed)) in self.cars.iter_mut().zip(&self.speeds.1).enumerate() {
+            let v = number(
+                &self.streams,
+                speed,
+                0.0,
+                t,
+                &format!("the speed of car {i}"),
+            )?;
+            let friction = self.surface.friction_at(car.ground_m());
+            car.advance(&mut self.physics, v, friction, dt);
         }
         if self.tick == 0 {
             // The first scan was taken before light and fog were known.
@@ -450,6 +477,8 @@ impl Simulation {
             })
             .fold(f64::INFINITY, f64::min);
         let ego = self.ego_state();
+        let centre = [ego.pos_m[0], ego.pos_m[2]];
+        let edge = self.surface.edge_distance_m(centre);
         let size = self.ego.size_m();
         let ego_mover = crate::ttc::Mover {
             pos_m: [ego.pos_m[0], ego.pos_m[2]],
@@ -476,7 +505,22 @@ impl Simulation {
             min_separation_m: min_sep,
             light: self.light_fog.0,
             fog: self.light_fog.1,
+            ego_off_road: edge < 0.0,
+            ego_road_edge_m: edge,
+            ego_lane_offset_m: self.surface.lane_offset_m(centre, ego.heading_rad),
         }
+    }
+
+    /// The road surface's point queries (friction, edges, lanes) for this world.
+    pub fn surface(&self) -> &Surface {
+        &self.surface
+    }
+
+    /// The tyre friction coefficient each wheel of the ego vehicle gripped with in the last
+    /// step (set from the piece under the wheel at the start of the step), in the order front
+    /// right, front left, rear right, rear left; before the first step, the start piece's.
+    pub fn ego_wheel_frictions(&self) -> Vec<f64> {
+        self.ego.wheel_frictions()
     }
 
     /// Length, width and height of the ego vehicle's body, in metres.
@@ -495,6 +539,31 @@ impl Simulation {
             range_m,
             &mut self.scan,
         );
+    }
+}
+
+/// The number stream `id` holds now (its latest event), `default` before its first event.
+///
+/// # Errors
+/// [`crate::rx::RxError::Input`] naming `what` when the latest value is not a finite number:
+/// an input is never read as 0 in its place.
+fn number(
+    rt: &Runtime,
+    id: StreamId,
+    default: f64,
+    t_s: f64,
+    what: &str,
+) -> Result<f64, EngineError> {
+    match rt.current(id) {
+        None => Ok(default),
+        Some(Value::Num(x)) if x.is_finite() => Ok(*x),
+        Some(v) => Err(crate::rx::RxError::Input {
+            name: what.to_owned(),
+            t_s,
+            value: crate::rx::describe(v),
+            expected: "a finite number".into(),
+        }
+        .into()),
     }
 }
 

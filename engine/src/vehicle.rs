@@ -128,6 +128,29 @@ impl EgoVehicle {
         }
     }
 
+    /// Sets each wheel's tyre friction (rapier's per-wheel `friction_slip`) to the friction of
+    /// the surface under its hard point now: the road piece there, or the ground
+    /// ([`crate::network::GROUND_FRICTION`]) off the network. Called at the start of every
+    /// step, so a wheel that crossed onto another piece grips with that piece's friction in
+    /// the very next step.
+    pub(crate) fn grip(&mut self, physics: &PhysicsWorld, surface: &crate::network::Surface) {
+        let chassis = *physics.bodies[self.body].position();
+        for wheel in self.controller.wheels_mut() {
+            let p = chassis.transform_point(wheel.chassis_connection_point_cs);
+            wheel.friction_slip = surface.friction_at([f64::from(p.x), f64::from(p.z)]) as f32;
+        }
+    }
+
+    /// Each wheel's tyre friction coefficient as set by the last [`EgoVehicle::grip`], in the
+    /// order front right, front left, rear right, rear left (`+z` is right of the driver).
+    pub(crate) fn wheel_frictions(&self) -> Vec<f64> {
+        self.controller
+            .wheels()
+            .iter()
+            .map(|w| f64::from(w.friction_slip))
+            .collect()
+    }
+
     /// Runs the controller's suspension and tyre model for one step; call before the physics
     /// step. The wheels' rays see only fixed colliders (the road), never actors or sensors.
     pub(crate) fn update(&mut self, physics: &mut PhysicsWorld, dt_s: f64) {

@@ -1,14 +1,42 @@
 use rapier3d::prelude::*;
 
-use super::{Network, PieceKind, CURB_HEIGHT_M, SIDEWALK_WIDTH_M};
+use super::{
+    Network, PieceKind, CURB_HEIGHT_M, GROUND_FRICTION, GROUND_MARGIN_M, GROUND_TOP_M,
+    SIDEWALK_WIDTH_M,
+};
 
 /// Thickness of the road slab under the surface `y = 0`, in metres.
 const SLAB_THICKNESS_M: f64 = 0.2;
 
 impl Network {
     /// Inserts every piece as fixed colliders with its friction: a slab whose top is the
-    /// surface `y = 0`, raised sidewalks along segments, and a roundabout's raised island.
+    /// surface `y = 0`, raised sidewalks along segments, and a roundabout's raised island;
+    /// then the ground (grass, top [`GROUND_TOP_M`], friction [`GROUND_FRICTION`]) reaching
+    /// [`GROUND_MARGIN_M`] beyond the network, so a vehicle that leaves the road drives on
+    /// instead of falling. The ground goes in last, so the pieces' collider handles do not
+    /// depend on it.
     pub(crate) fn build(&self, physics: &mut PhysicsWorld) {
+        self.build_pieces(physics);
+        let (lo, hi) = self.bounds_m();
+        let m = GROUND_MARGIN_M;
+        let half = [(hi[0] - lo[0]) / 2.0 + m, (hi[1] - lo[1]) / 2.0 + m];
+        let thickness = 1.0f32;
+        physics.insert_collider(
+            ColliderBuilder::cuboid(half[0] as f32, thickness / 2.0, half[1] as f32)
+                .position(Pose::from_parts(
+                    Vector::new(
+                        ((lo[0] + hi[0]) / 2.0) as f32,
+                        GROUND_TOP_M as f32 - thickness / 2.0,
+                        ((lo[1] + hi[1]) / 2.0) as f32,
+                    ),
+                    Rotation::from_rotation_y(0.0),
+                ))
+                .friction(GROUND_FRICTION as f32),
+            None,
+        );
+    }
+
+    fn build_pieces(&self, physics: &mut PhysicsWorld) {
         for p in &self.pieces {
             let mu = p.kind.friction() as f32;
             let rotation = Rotation::from_rotation_y(p.pose.heading_rad as f32);

@@ -11,12 +11,14 @@ mod build;
 mod geometry;
 mod lanes;
 mod piece;
+mod surface;
 
 pub use geometry::{direction, wrap, Pose2};
 pub use lanes::{LanePath, Turn};
 pub use piece::{
     Piece, PieceKind, PortGeometry, JUNCTION_APRON_M, LANE_WIDTH_M, PORT_NAMES, SIDEWALK_WIDTH_M,
 };
+pub use surface::{Surface, GROUND_FRICTION, GROUND_MARGIN_M, GROUND_TOP_M};
 
 use rapier3d::parry::query::intersection_test;
 use rapier3d::parry::shape::Cuboid;
@@ -368,6 +370,21 @@ impl Network {
             lane,
             at_m,
         })
+    }
+
+    /// The bounding box of every piece's footprint, world `([x_min, z_min], [x_max, z_max])`
+    /// in metres (`([0, 0], [0, 0])` for an empty network; the origin is always inside).
+    pub fn bounds_m(&self) -> ([f64; 2], [f64; 2]) {
+        let (mut lo, mut hi) = ([0.0f64; 2], [0.0f64; 2]);
+        for piece in &self.pieces {
+            let ([hx, hz], [cx, cz]) = piece.kind.footprint();
+            for (sx, sz) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                let [x, z] = piece.pose.apply([cx + sx * hx, cz + sz * hz]);
+                lo = [lo[0].min(x), lo[1].min(z)];
+                hi = [hi[0].max(x), hi[1].max(z)];
+            }
+        }
+        (lo, hi)
     }
 
     /// The piece whose driving surface contains the world point `[x, z]`, if any.

@@ -3,7 +3,10 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::network::{Network, Piece, PieceKind, CURB_HEIGHT_M, JUNCTION_APRON_M, LANE_WIDTH_M};
+use crate::network::{
+    Network, Piece, PieceKind, CURB_HEIGHT_M, GROUND_MARGIN_M, GROUND_TOP_M, JUNCTION_APRON_M,
+    LANE_WIDTH_M,
+};
 
 /// One vertex: position in world metres, unit normal, albedo (linear, `[0, 1]`).
 #[repr(C)]
@@ -33,8 +36,6 @@ const PAINT_LIFT_M: f64 = 0.01;
 const LINE_WIDTH_M: f64 = 0.15;
 /// Dashed lane dividers: dash length and period, in metres.
 const DASH_M: (f64, f64) = (3.0, 9.0);
-/// How far the ground plane reaches beyond the network, in metres.
-const GROUND_MARGIN_M: f64 = 2000.0;
 
 /// An indexed triangle list.
 #[derive(Debug, Default, Clone)]
@@ -196,26 +197,20 @@ impl Mesh {
     /// The static world of `network`: a ground plane and every road piece.
     pub(crate) fn world(network: &Network) -> Mesh {
         let mut mesh = Mesh::default();
-        let (mut lo, mut hi) = ([0.0f64; 2], [0.0f64; 2]);
         for piece in network.pieces() {
-            let ([hx, hz], [cx, cz]) = piece.kind.footprint();
-            for (sx, sz) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                let [x, z] = piece.pose.apply([cx + sx * hx, cz + sz * hz]);
-                lo = [lo[0].min(x), lo[1].min(z)];
-                hi = [hi[0].max(x), hi[1].max(z)];
-            }
             match piece.kind {
                 PieceKind::Segment { length_m, .. } => mesh.segment(piece, length_m),
                 _ => mesh.junction(piece),
             }
         }
-        let m = GROUND_MARGIN_M;
+        let (lo, hi) = network.bounds_m();
+        let (m, y) = (GROUND_MARGIN_M, GROUND_TOP_M);
         mesh.quad(
             [
-                [lo[0] - m, -0.02, lo[1] - m],
-                [hi[0] + m, -0.02, lo[1] - m],
-                [hi[0] + m, -0.02, hi[1] + m],
-                [lo[0] - m, -0.02, hi[1] + m],
+                [lo[0] - m, y, lo[1] - m],
+                [hi[0] + m, y, lo[1] - m],
+                [hi[0] + m, y, hi[1] + m],
+                [lo[0] - m, y, hi[1] + m],
             ],
             [0.0, 1.0, 0.0],
             albedo::GRASS,

@@ -109,6 +109,17 @@ pub enum Node {
         /// The sink's number, interpreted by the caller.
         sink: u32,
     },
+    /// `src`'s events, each checked against `expect` before anything reads it: an input of the
+    /// world fed by a stream whose values are known only while the test runs (a lambda's).
+    /// A value it does not accept is [`RxError::Input`] naming `name`.
+    Check {
+        /// Source.
+        src: StreamId,
+        /// What the input accepts.
+        expect: super::Expect,
+        /// The input, for messages: e.g. `the speed of Car lead (follow.star:12:8)`.
+        name: Arc<str>,
+    },
 }
 
 impl Node {
@@ -122,7 +133,8 @@ impl Node {
             | Node::Filter { src, .. }
             | Node::Take { src, .. }
             | Node::Sum { src, .. }
-            | Node::Foreach { src, .. } => vec![*src],
+            | Node::Foreach { src, .. }
+            | Node::Check { src, .. } => vec![*src],
             Node::Zip(a, b) | Node::Concat(a, b) => vec![*a, *b],
             Node::SkipUntil { src, trigger: o } | Node::TakeUntil { src, stop: o } => {
                 vec![*src, *o]

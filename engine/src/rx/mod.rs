@@ -21,10 +21,14 @@
 //!   `pos.take(1).concat(pos)` is `pos` delayed by one step.
 //! - `sum()` emits the running total (numbers or vectors); `sum(init, f)` the running fold
 //!   `acc = f(acc, v)`.
+//! - `Check` passes its source's events after checking each against what an input of the
+//!   world accepts ([`Expect`]); the first value it refuses ends the step with
+//!   [`RxError::Input`].
 //!
 //! Functions are native Rust closures or host functions (Starlark lambdas), called through the
 //! [`Host`] trait so this crate does not depend on the language front end.
 
+mod expect;
 mod graph;
 mod open;
 mod runtime;
@@ -32,6 +36,7 @@ mod runtime;
 mod tests;
 mod value;
 
+pub use expect::{describe, Expect};
 pub use graph::{Func, Graph, NativeFn, Node, StreamId};
 pub use open::OpenStream;
 pub use runtime::{Host, Inputs, NoHost, Runtime};
@@ -68,6 +73,18 @@ pub enum RxError {
         node: usize,
         /// What was expected and what came.
         message: String,
+    },
+    /// An input of the world received a value it does not accept (see [`Node::Check`]).
+    #[error("at t = {t_s:.3} s, {name} was {value}; it must be {expected}")]
+    Input {
+        /// The input, e.g. `the speed of Car lead (follow.star:12:8)`.
+        name: String,
+        /// Simulated time of the event, s.
+        t_s: f64,
+        /// The value, with its kind (see [`describe`]).
+        value: String,
+        /// What it accepts (see [`Expect`]).
+        expected: String,
     },
     /// A host function (a Starlark lambda) failed.
     #[error("stream {node}: {message}")]

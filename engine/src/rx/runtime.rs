@@ -250,6 +250,22 @@ impl Runtime {
                 self.states[i].done = done(self, src);
                 out
             }
+            Node::Check { src, expect, name } => {
+                let src = *src;
+                let out = self.event(src).cloned();
+                if let Some(v) = &out {
+                    if !expect.accepts(v) {
+                        return Err(RxError::Input {
+                            name: name.to_string(),
+                            t_s,
+                            value: super::describe(v),
+                            expected: expect.to_string(),
+                        });
+                    }
+                }
+                self.states[i].done = done(self, src);
+                out
+            }
             Node::Foreach { src, sink } => {
                 let (src, sink) = (*src, *sink);
                 if let Some(v) = self.event(src) {

@@ -1,0 +1,225 @@
+//! The road surface under the vehicles (issue 14): each wheel of the ego vehicle and each NPC
+//! car grips with the friction of the piece under it, and leaving the road is seen.
+
+use paracosm_engine::behaviour::GraphBuilder;
+use paracosm_engine::network::{PieceKind, GROUND_FRICTION};
+use paracosm_engine::rx::{Func, NoHost, Node, Value};
+use paracosm_engine::sut::ConstantControl;
+use paracosm_engine::sut::Sut;
+use paracosm_engine::{
+    CarSpec, Control, EgoSpec, EnvironmentSpec, Lane, LidarSpec, Network, PieceId, Simulation,
+    VehicleParams, WorldSpec, DEFAULT_DT_S,
+};
+
+fn segment(length_m: f64, friction: f64) -> PieceKind {
+    PieceKind::Segment {
+        length_m,
+        lanes: 2,
+        friction,
+    }
+}
+
+/// Segments end to end with the given `(length m, friction)`, connected ONE to TWO.
+fn road(pieces: &[(f64, f64)]) -> Network {
+    let mut n = Network::new();
+    let mut last: Option<PieceId> = None;
+    for (i, &(len, mu)) in pieces.iter().enumerate() {
+        let id = n.add(&format!("piece {i}"), segment(len, mu)).unwrap();
+        if let Some(prev) = last {
+            n.connect(prev, 1, id, 0).unwrap();
+        }
+        last = Some(id);
+    }
+    n
+}
+
+/// The ego on lane 1 of piece 0 at `at_m`, moving at `speed_mps`; `cars` NPC cars with their
+/// speed as a function of time (s -> m/s) and their start on lane 1.
+fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[(f64, fn(f64) -> f64)]) -> WorldSpec {
+    let start = network.on_lane(PieceId(0), Lane::Driving(1), at_m).unwrap();
+    let mut g = GraphBuilder::new();
+    let light = g.push(Node::Const(Value::Num(0.5)));
+    let fog = g.push(Node::Const(Value::Num(0.0)));
+    let tick = g.push(Node::Tick);
+    let mut specs = Vec::new();
+    for &(car_at, profile) in cars {
+        let speed = g.push(Node::Map {
+            src: tick,
+            f: Func::native("profile", move |a| {
+                Ok(Value::Num(profile(a[0].as_num().unwrap())))
+            }),
+        });
+        let loc = network
+            .on_lane(PieceId(0), Lane::Driving(1), car_at)
+            .unwrap();
+        specs.push(CarSpec {
+            path: network.route(&loc, &[], 5000.0).unwrap(),
+            speed,
+            color: "red".into(),
+            size_m: [4.5, 1.8, 1.5],
+            enabled: true,
+        });
+    }
+    WorldSpec {
+        dt_s: DEFAULT_DT_S,
+        network,
+        ego: EgoSpec {
+            start,
+            initial_speed_mps: speed_mps,
+            vehicle: VehicleParams::default(),
+            route: vec![],
+        },
+        pedestrians: vec![],
+        cars: specs,
+        environment: EnvironmentSpec { light, fog },
+        streams: g.finish().unwrap(),
+        lidar: LidarSpec::default(),
+    }
+}
+
+/// Front wheels' hard points are 1.45 m ahead of the chassis centre (4.5 m body, axle 0.8 m
+/// in from each end), the rear ones 1.45 m behind.
+const AXLE_M: f64 = 4.5 / 2.0 - 0.8;
+
+#[test]
+fn a_wheel_crossing_onto_the_next_piece_grips_with_its_friction_within_one_step() {
+    let spec = world(road(&[(60.0, 0.9), (200.0, 0.2)]), 50.0, 12.0, &[]);
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut sut = ConstantControl(Control::default());
+    let (mut front_wet, mut rear_wet) = (false, false);
+    while sim.t_s() < 2.0 {
+        let x = sim.ego_state().pos_m[0];
+        let control = sut.act(&sim.observation()).unwrap();
+        sim.step(control, &mut NoHost).unwrap();
+        let mu = sim.ego_wheel_frictions();
+        assert_eq!(mu.len(), 4);
+        // The friction used in this step is the one under the wheel when the step began.
+        for (wheel, ahead) in [(0, AXLE_M), (1, AXLE_M), (2, -AXLE_M), (3, -AXLE_M)] {
+            let x_wheel = x + ahead;
+            if (x_wheel - 60.0).abs() < 0.01 {
+                continue;
+            }
+            let expected = if x_wheel > 60.0 { 0.2 } else { 0.9 };
+            assert!(
+                (mu[wheel] - expected).abs() < 1e-6,
+                "wheel {wheel} at x = {x_wheel:.3} m gripped with {} (expected {expected})",
+                mu[wheel]
+            );
+        }
+        front_wet |= mu[0] < 0.5 && mu[2] > 0.5;
+        rear_wet |= mu[2] < 0.5;
+    }
+    assert!(
+        front_wet,
+        "a step with the front wheels on the wet piece and the rear on the dry"
+    );
+    assert!(rear_wet, "the rear wheels reached the wet piece");
+}
+
+/// Full braking from 12 m/s; returns the distance to a stop, m.
+fn stopping_distance(network: Network) -> f64 {
+    let spec = world(network, 50.0, 12.0, &[]);
+    let mut sim = Simulation::new(&spec).unwrap();
+    let start = sim.ego_state().pos_m[0];
+    let mut brake = ConstantControl(Control {
+        throttle: -1.0,
+        steering: 0.0,
+    });
+    while sim.t_s() < 30.0 && sim.ego_state().speed_mps > 0.05 {
+        let c = brake.act(&sim.observation()).unwrap();
+        sim.step(c, &mut NoHost).unwrap();
+    }
+    sim.ego_state().pos_m[0] - start
+}
+
+#[test]
+fn braking_on_a_wet_piece_ahead_takes_longer_than_on_a_dry_one() {
+    let dry = stopping_distance(road(&[(55.0, 0.9), (200.0, 0.9)]));
+    let wet = stopping_distance(road(&[(55.0, 0.9), (200.0, 0.1)]));
+    // Dry: about 12² / (2 · 8) = 9 m. On the wet piece (from 5 m on) the tyres slide.
+    assert!(dry < 12.0, "dry stopping distance {dry:.1} m");
+    assert!(wet > 2.0 * dry, "wet {wet:.1} m vs dry {dry:.1} m");
+}
+
+/// An NPC car told to stop dead at t = 1 s: its deceleration, m/s², measured over the step
+/// after the command.
+fn npc_deceleration(friction: f64) -> f64 {
+    let stop_at_1 = |t: f64| if t < 1.0 { 10.0 } else { 0.0 };
+    let spec = world(road(&[(300.0, friction)]), 10.0, 0.0, &[(40.0, stop_at_1)]);
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut speeds = Vec::new();
+    while sim.t_s() < 1.5 {
+        sim.step(Control::default(), &mut NoHost).unwrap();
+        speeds.push((sim.t_s(), sim.snapshot().cars[0].speed_mps));
+    }
+    let at = |t: f64| speeds.iter().find(|(s, _)| *s >= t).unwrap().1;
+    assert!(
+        (at(0.5) - 10.0).abs() < 1e-9,
+        "cruising at 10 m/s: {}",
+        at(0.5)
+    );
+    (at(1.1) - at(1.3)) / 0.2
+}
+
+#[test]
+fn an_npc_car_brakes_no_harder_than_the_friction_under_it_allows() {
+    let g = 9.81;
+    let dry = npc_deceleration(0.9);
+    let wet = npc_deceleration(0.1);
+    assert!((dry - 0.9 * g).abs() < 0.05 * g, "dry: {dry:.2} m/s²");
+    assert!((wet - 0.1 * g).abs() < 0.01 * g, "wet: {wet:.2} m/s²");
+}
+
+#[test]
+fn driving_past_a_dead_end_is_off_road_on_the_ground_beyond() {
+    // A 100 m road ending in a dead end; the ego rolls off it at 12 m/s.
+    let spec = world(road(&[(100.0, 0.8)]), 60.0, 12.0, &[]);
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut coast = ConstantControl(Control::default());
+    let snap = sim.snapshot();
+    assert!(!snap.ego_off_road);
+    assert!(
+        (snap.ego_road_edge_m - 1.75).abs() < 0.01,
+        "{}",
+        snap.ego_road_edge_m
+    );
+    assert!(
+        snap.ego_lane_offset_m.abs() < 0.01,
+        "{}",
+        snap.ego_lane_offset_m
+    );
+    let mut left_at = None;
+    while sim.t_s() < 6.0 {
+        let c = coast.act(&sim.observation()).unwrap();
+        sim.step(c, &mut NoHost).unwrap();
+        let s = sim.snapshot();
+        if s.ego_off_road && left_at.is_none() {
+            left_at = Some(s.ego.pos_m[0]);
+        }
+        assert_eq!(
+            s.ego_off_road,
+            s.ego.pos_m[0] > 100.0,
+            "at x = {}",
+            s.ego.pos_m[0]
+        );
+    }
+    let x = left_at.expect("the ego left the road");
+    assert!((x - 100.0).abs() < 0.5, "left the road at x = {x}");
+    let end = sim.snapshot();
+    assert!(
+        end.ego.pos_m[0] > 120.0,
+        "it drove on: x = {}",
+        end.ego.pos_m[0]
+    );
+    assert!(end.ego_road_edge_m < -20.0, "{}", end.ego_road_edge_m);
+    // On the grass: its wheels grip with the ground's friction and it has not fallen.
+    assert!(
+        end.ego.pos_m[1] > 0.0,
+        "chassis height {}",
+        end.ego.pos_m[1]
+    );
+    assert!(sim
+        .ego_wheel_frictions()
+        .iter()
+        .all(|&mu| (mu - GROUND_FRICTION).abs() < 1e-6));
+}
