@@ -153,7 +153,7 @@ impl Campaign<'_> {
                 },
                 o.monitors
                     .iter()
-                    .map(|(n, v)| (n.clone(), MonitorResult::from(v)))
+                    .map(|(n, v)| (n.clone(), MonitorResult::new(v, o.cut_short.contains(n))))
                     .collect(),
                 o.metrics
                     .into_iter()
@@ -261,6 +261,7 @@ impl Campaign<'_> {
             run.execute(ids.start, &all[ids.start as usize..], &mut on_done)?;
         } else {
             let prior = prior.unwrap_or(&[]);
+            let passive = self.scenario.passive_monitors();
             let batch = generator.batch().unwrap_or(1);
             let mut next = 0u64;
             while next < ids.end && !run.halted() {
@@ -284,13 +285,13 @@ impl Campaign<'_> {
                             r.id, self.strategy
                         )));
                     }
-                    told.push((p.clone(), r.robustness()));
+                    told.push((p.clone(), r.cost(&passive)));
                 }
                 let fresh = run.execute(next + known as u64, &points[known..], &mut on_done)?;
                 told.extend(
                     run.records[fresh]
                         .iter()
-                        .map(|r| (r.point.clone(), r.robustness())),
+                        .map(|r| (r.point.clone(), r.cost(&passive))),
                 );
                 generator.tell(&told);
                 next += points.len() as u64;

@@ -31,15 +31,27 @@ pub struct MonitorResult {
     pub robustness: f64,
     /// Time of the first violation in seconds since the start, or `null`.
     pub first_violation_s: Option<f64>,
+    /// `true` when the test stopped early (another monitor failed) before this monitor had
+    /// settled: its verdict covers the run up to the stop only. Written only when true.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub cut_short: bool,
 }
 
-impl From<&Verdict> for MonitorResult {
-    fn from(v: &Verdict) -> Self {
+impl MonitorResult {
+    /// The verdict as written, with `cut_short` as given.
+    pub fn new(v: &Verdict, cut_short: bool) -> Self {
         MonitorResult {
             passed: v.passed,
             robustness: v.robustness,
             first_violation_s: v.first_violation_s,
+            cut_short,
         }
+    }
+}
+
+impl From<&Verdict> for MonitorResult {
+    fn from(v: &Verdict) -> Self {
+        MonitorResult::new(v, false)
     }
 }
 
@@ -96,14 +108,23 @@ struct Line {
 }
 
 impl RunRecord {
-    /// The falsification cost of the test: the smallest robustness over its monitors
-    /// (`<= 0`: it failed; `+inf` without monitors), NaN for a test that ended in `error`.
+    /// The smallest robustness over the test's monitors (`<= 0`: it failed; `+inf` without
+    /// monitors), NaN for a test that ended in `error`.
     pub fn robustness(&self) -> f64 {
+        self.cost(&[])
+    }
+
+    /// The falsification cost of the test: the smallest robustness over its monitors, where
+    /// the `passive` ones (see `Scenario::passive_monitors`) count only when `<= 0`; `+inf`
+    /// when nothing counts, NaN for a test that ended in `error`. `<= 0` exactly when the test
+    /// failed.
+    pub fn cost(&self, passive: &[String]) -> f64 {
         if self.status == Status::Error {
             return f64::NAN;
         }
         self.monitors
             .iter()
+            .filter(|(n, m)| m.robustness <= 0.0 || !passive.contains(n))
             .map(|(_, m)| m.robustness)
             .fold(f64::INFINITY, f64::min)
     }
@@ -214,6 +235,7 @@ mod tests {
                     passed: false,
                     robustness: 0.0,
                     first_violation_s: Some(1.5),
+                    cut_short: false,
                 },
             )],
             metrics: vec![

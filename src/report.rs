@@ -1,8 +1,9 @@
 //! What a campaign leaves besides `results.jsonl`: `summary.json`, the plots, JUnit XML, and
 //! the human summary printed by `paracosm-fuzz`, `merge` and `report`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use paracosm_generators::{Domain, Param, ParamSpace, Point};
 use paracosm_scenarios::Scenario;
 
 use crate::campaign::RESULTS_FILE;
@@ -97,81 +98,184 @@ pub struct Finished<'a> {
     pub wall_s: f64,
     /// Where to write JUnit XML, if asked.
     pub junit: Option<&'a Path>,
+    /// The warnings the scenario loaded with for this campaign's system under test
+    /// ([`Scenario::warnings_for`]), recorded in the summary.
+    pub warnings: Vec<String>,
 }
 
-/// Writes the plots (`failure_map`, `failure_rate`), JUnit XML when asked, and
-/// `summary.json`, each through a temporary file and a rename, and returns the summary.
+/// What [`write_outputs`] wrote.
+#[derive(Debug, Clone)]
+pub struct Written {
+    /// The summary as written (its `outputs` list the plots that were drawn).
+    pub summary: Summary,
+    /// One line per plot that could not be drawn (also in the summary's `warnings`).
+    pub plot_warnings: Vec<String>,
+}
+
+/// The plots of a campaign: `(file stem, what)` for the failure map and the failure-rate heat
+/// map, none for a scenario without open parameters.
+fn plan_plots(scenario: &Scenario) -> Vec<&'static str> {
+    if scenario.map_axes.is_empty() {
+        Vec::new()
+    } else {
+        vec!["failure_map", "failure_rate"]
+    }
+}
+
+/// Writes `summary.json`, then JUnit XML when asked, then the plots (`failure_map`,
+/// `failure_rate`: none without open parameters, a strip plot with one, categorical columns for
+/// discrete ones), each file through a temporary file and a rename. The summary comes first so
+/// that no plotting problem can cost it: a plot that cannot be drawn is a warning, and the
+/// summary is written again without it and with the warning.
 ///
 /// # Errors
-/// A message naming the file that cannot be written.
-pub fn write_outputs(f: &Finished<'_>) -> Result<Summary, String> {
+/// A message naming the file when `summary.json` or the JUnit file cannot be written.
+pub fn write_outputs(f: &Finished<'_>) -> Result<Written, String> {
     let scenario = f.scenario;
-    let counts = counts(f.records);
-    let title = format!(
-        "{}: {}, {} tests, {} failed",
-        scenario.name,
-        f.file.strategy,
-        f.records.len(),
-        counts.fail
-    );
-    let mut plots: Vec<PathBuf> = crate::plot::failure_map(
-        &f.out.join("failure_map"),
-        &scenario.space,
-        &scenario.map_axes,
-        &[(&title, f.records)],
-    )
-    .map_err(|e| e.to_string())?
-    .into();
-    plots.extend(
-        crate::plot::failure_rate_map(
-            &f.out.join("failure_rate"),
-            &scenario.space,
-            &scenario.map_axes,
-            &format!(
-                "{}: failure rate ({} tests)",
-                scenario.name,
-                f.records.len()
-            ),
-            f.records,
-            8,
-        )
-        .map_err(|e| e.to_string())?,
-    );
-    if let Some(path) = f.junit {
-        crate::junit::write(path, &scenario.name, f.records, f.out)?;
-    }
+    let planned = plan_plots(scenario);
+    let plot_files = |stems: &[&str]| -> Vec<String> {
+        stems
+            .iter()
+            .flat_map(|s| [format!("{s}.png"), format!("{s}.svg")])
+            .collect()
+    };
     let mut outputs = vec![
         RESULTS_FILE.to_owned(),
         SUMMARY_FILE.to_owned(),
         crate::campaign_file::CAMPAIGN_FILE.to_owned(),
     ];
-    outputs.extend(
-        plots
-            .iter()
-            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned())),
-    );
     if let Some(j) = f.junit {
         outputs.push(j.display().to_string());
     }
-    let summary = summarise(f, outputs);
-    let text = serde_json::to_string_pretty(&summary).expect("summaries serialise") + "\n";
-    crate::atomic::write(&f.out.join(SUMMARY_FILE), text.as_bytes())?;
-    Ok(summary)
+    let base = outputs.clone();
+    outputs.extend(plot_files(&planned));
+    let mut summary = summarise(f, outputs);
+    write_summary(f.out, &summary)?;
+    if let Some(path) = f.junit {
+        crate::junit::write(path, &scenario.name, f.records, f.out)?;
+    }
+
+    let counts = summary.counts;
+    let mut drawn = Vec::new();
+    let mut plot_warnings = Vec::new();
+    for stem in planned {
+        let path = f.out.join(stem);
+        let result = match stem {
+            "failure_map" => {
+                let title = format!(
+                    "{}: {}, {} tests, {} failed",
+                    scenario.name,
+                    f.file.strategy,
+                    f.records.len(),
+                    counts.fail
+                );
+                crate::plot::failure_map(
+                    &path,
+                    &scenario.space,
+                    &scenario.map_axes,
+                    &[(&title, f.records)],
+                )
+            }
+            _ => crate::plot::failure_rate_map(
+                &path,
+                &scenario.space,
+                &scenario.map_axes,
+                &format!(
+                    "{}: failure rate ({} tests)",
+                    scenario.name,
+                    f.records.len()
+                ),
+                f.records,
+                8,
+            ),
+        };
+        match result {
+            Ok(_) => drawn.push(stem),
+            Err(e) => plot_warnings.push(format!("the plot {stem} was not drawn: {e}")),
+        }
+    }
+    if !plot_warnings.is_empty() {
+        let mut outputs = base;
+        outputs.extend(plot_files(&drawn));
+        summary.outputs = outputs;
+        summary.warnings.extend(plot_warnings.iter().cloned());
+        write_summary(f.out, &summary)?;
+    }
+    Ok(Written {
+        summary,
+        plot_warnings,
+    })
 }
 
-/// The summary of a folder's records, listing `outputs` as the files written.
+fn write_summary(out: &Path, summary: &Summary) -> Result<(), String> {
+    let text = serde_json::to_string_pretty(summary).expect("summaries serialise") + "\n";
+    crate::atomic::write(&out.join(SUMMARY_FILE), text.as_bytes())
+}
+
+/// `space` and `points` without the parameters named in `unused` (coordinates by name).
+fn used_only(space: &ParamSpace, points: &[Point], unused: &[String]) -> (ParamSpace, Vec<Point>) {
+    // For each parameter: whether it is kept, and its index among the continuous or the
+    // discrete coordinates of a point.
+    let mut keep = Vec::new();
+    let (mut c, mut d) = (0usize, 0usize);
+    for p in space.params() {
+        let used = !unused.contains(&p.name);
+        match p.domain {
+            Domain::Interval { .. } => {
+                keep.push((used, true, c));
+                c += 1;
+            }
+            Domain::Levels(_) => {
+                keep.push((used, false, d));
+                d += 1;
+            }
+        }
+    }
+    let params: Vec<Param> = space
+        .params()
+        .iter()
+        .zip(&keep)
+        .filter(|(_, k)| k.0)
+        .map(|(p, _)| p.clone())
+        .collect();
+    let sub = ParamSpace::new(params).expect("a subset of a valid space is valid");
+    let points = points
+        .iter()
+        .map(|pt| {
+            let mut out = Point {
+                discrete: Vec::new(),
+                continuous: Vec::new(),
+            };
+            for &(used, continuous, i) in &keep {
+                match (used, continuous) {
+                    (true, true) => out.continuous.extend(pt.continuous.get(i)),
+                    (true, false) => out.discrete.extend(pt.discrete.get(i)),
+                    _ => {}
+                }
+            }
+            out
+        })
+        .collect();
+    (sub, points)
+}
+
+/// The summary of a folder's records, listing `outputs` as the files written. Coverage is
+/// computed over the parameters that objects read; the others are listed as `unused_params`.
 pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
     let scenario = f.scenario;
     let coverage = {
-        let set = crate::cover::TestSet {
-            space: scenario.space.clone(),
-            points: f.records.iter().map(|r| r.point.clone()).collect(),
-        };
+        let points: Vec<Point> = f.records.iter().map(|r| r.point.clone()).collect();
+        let (space, points) = used_only(&scenario.space, &points, &scenario.unused_params);
+        let set = crate::cover::TestSet { space, points };
         let metrics: Vec<crate::cover::Metric> = ["dispersion", "cd", "wd", "md", "l2star", "star"]
             .iter()
             .filter_map(|m| m.parse().ok())
             .collect();
-        crate::cover::estimate(&set, &metrics, None, None, 10).ok()
+        if set.space.params().is_empty() {
+            None
+        } else {
+            crate::cover::estimate(&set, &metrics, None, None, 10).ok()
+        }
     };
     Summary {
         failures: failures(f.records, f.out),
@@ -184,9 +288,11 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
         tests_run: f.records.len() as u64,
         jobs: f.jobs,
         space: scenario.space.params().to_vec(),
+        unused_params: scenario.unused_params.clone(),
         counts: counts(f.records),
         first_failure: first_failure(f.records),
         coverage,
+        warnings: f.warnings.clone(),
         wall_s: f.wall_s,
         outputs,
     }

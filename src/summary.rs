@@ -66,13 +66,20 @@ pub struct Summary {
     pub jobs: usize,
     /// The scenario's open parameters.
     pub space: Vec<Param>,
+    /// The parameters (coordinates of `space`) that no object of the scenario reads: sampled
+    /// and recorded, but left out of `coverage`.
+    pub unused_params: Vec<String>,
     /// Outcome counts.
     pub counts: Counts,
     /// The failing test with the smallest id, if any.
     pub first_failure: Option<FirstFailure>,
-    /// Coverage of the campaign's points: k-wise coverage of the discrete parameters,
-    /// dispersion, discrepancies and star discrepancy of the continuous ones (unit cube).
+    /// Coverage of the campaign's points over the parameters that objects read: k-wise
+    /// coverage of the discrete parameters, dispersion, discrepancies and star discrepancy of
+    /// the continuous ones (unit cube); `null` without such parameters.
     pub coverage: Option<crate::cover::Estimate>,
+    /// The scenario's warnings for this campaign (LANGUAGE.md, "Warnings") and any plot that
+    /// could not be drawn.
+    pub warnings: Vec<String>,
     /// Wall-clock time of the whole campaign in seconds.
     pub wall_s: f64,
     /// Files written, relative to the output folder.

@@ -15,6 +15,7 @@
 pub mod behaviour;
 mod camera;
 mod car;
+pub mod colour;
 mod control;
 mod environment;
 mod error;

@@ -33,9 +33,12 @@ fn road(pieces: &[(f64, f64)]) -> Network {
     n
 }
 
-/// The ego on lane 1 of piece 0 at `at_m`, moving at `speed_mps`; `cars` NPC cars with their
-/// speed as a function of time (s -> m/s) and their start on lane 1.
-fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[(f64, fn(f64) -> f64)]) -> WorldSpec {
+/// An NPC car: where it starts on lane 1 of piece 0 (m), and its speed (m/s) as a function of
+/// time (s).
+type Npc = (f64, fn(f64) -> f64);
+
+/// The ego on lane 1 of piece 0 at `at_m`, moving at `speed_mps`, and `cars`.
+fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec {
     let start = network.on_lane(PieceId(0), Lane::Driving(1), at_m).unwrap();
     let mut g = GraphBuilder::new();
     let light = g.push(Node::Const(Value::Num(0.5)));

@@ -8,6 +8,7 @@
 //!   "Invariants and Monitors").
 //! - [`DistanceMonitor`]: the ego vehicle travelled at least `min_distance_m`, so it did not pass
 //!   by standing still (paper §2).
+//! - [`OffRoadMonitor`]: the ego vehicle stays on the drivable surface.
 //! - [`TimeToFailureMonitor`]: a wrapped monitor first fails no earlier than a given time.
 //! - [`stl`]: signal temporal logic formulas and their quantitative robustness.
 #![warn(missing_docs)]
@@ -15,6 +16,7 @@
 mod collision;
 mod distance;
 mod monitor;
+mod off_road;
 mod signals;
 pub mod stl;
 mod time_to_failure;
@@ -22,5 +24,6 @@ mod time_to_failure;
 pub use collision::CollisionMonitor;
 pub use distance::DistanceMonitor;
 pub use monitor::{Monitor, Verdict};
+pub use off_road::OffRoadMonitor;
 pub use signals::{Frame, SignalError, Signals};
 pub use time_to_failure::TimeToFailureMonitor;

@@ -22,9 +22,13 @@ pub struct Verdict {
 
 /// A test oracle fed one frame at a time.
 ///
-/// `observe` may return `ControlFlow::Break(())` once the verdict can no longer change, so a
-/// simulator may stop the run early. `verdict` may be called at any time and reflects the
-/// frames seen so far.
+/// `observe` returns `ControlFlow::Break(())` once the verdict is settled: no later frame can
+/// change it, whether it passed or failed. A runner then stops feeding that monitor (its
+/// verdict stays as it was when it settled) and may stop the run early: a run with several
+/// monitors stops when every monitor has settled, or when one has settled as failed
+/// (`verdict().passed` false); until then the others keep observing, so one monitor's early
+/// verdict never cuts another's observation short while the run could still pass. `verdict`
+/// may be called at any time and reflects the frames seen so far.
 pub trait Monitor: Send {
     /// A short name used as the key in results files, e.g. `collision`.
     fn name(&self) -> &str;

@@ -66,8 +66,12 @@ pub fn scenario() -> Scenario {
         monitors: vec![
             MonitorSpec::collision(),
             MonitorSpec::distance(MIN_DISTANCE_M),
+            MonitorSpec::implicit_off_road(),
         ],
-        map_axes: [WALKING_SPEED.to_owned(), TRIGGER_DISTANCE.to_owned()],
+        map_axes: vec![WALKING_SPEED.to_owned(), TRIGGER_DISTANCE.to_owned()],
+        warnings: vec![],
+        unused_params: vec![],
+        camera_only: vec![],
         template: Arc::new(world),
         lambdas: None,
         source: Arc::from(""),

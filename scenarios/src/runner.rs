@@ -23,18 +23,31 @@ pub mod signal {
     /// Path time to collision of the ego vehicle, seconds (`+inf` when nothing in its path
     /// closes in; `paracosm_engine::ttc`).
     pub const EGO_TTC_S: &str = "ego_ttc_s";
+    /// `1.0` while the centre of the ego vehicle's footprint is on no driving surface of the
+    /// network (a sidewalk, an island, the ground beside the road or past a dead end), else
+    /// `0.0`.
+    pub const EGO_OFFROAD: &str = "ego_offroad";
+    /// Signed distance from the ego's footprint centre to the edge of the driving surface,
+    /// metres: `> 0` on it, `<= 0` off it.
+    pub const EGO_ROAD_EDGE_M: &str = "ego_road_edge_m";
+    /// Lateral offset of the ego's centre from the centre line of the nearest lane in its
+    /// direction of travel, metres, positive to the right.
+    pub const EGO_LANE_OFFSET_M: &str = "ego_lane_offset_m";
     /// Fog density, `[0, 1]`.
     pub const FOG: &str = "fog";
     /// Light intensity, `[0, 1]`.
     pub const LIGHT: &str = "light";
     /// Every signal, for `Stl` formulas.
-    pub const ALL: [&str; 8] = [
+    pub const ALL: [&str; 11] = [
         EGO_X_M,
         EGO_Z_M,
         EGO_SPEED_MPS,
         EGO_CONTACT,
         EGO_SEPARATION_M,
         EGO_TTC_S,
+        EGO_OFFROAD,
+        EGO_ROAD_EDGE_M,
+        EGO_LANE_OFFSET_M,
         FOG,
         LIGHT,
     ];
@@ -45,6 +58,10 @@ pub mod signal {
 pub struct TestOutcome {
     /// Each monitor's name and verdict, in the scenario's order.
     pub monitors: Vec<(String, Verdict)>,
+    /// The monitors whose observation was cut short: the test stopped early because another
+    /// monitor failed while these had not settled, so their verdicts cover the run up to
+    /// then only. Empty when the test ran to its horizon or every monitor had settled.
+    pub cut_short: Vec<String>,
     /// Measurements: the monitors' metrics (e.g. `min_distance_m`, `distance_travelled_m`),
     /// then `time_to_failure_s` when a monitor failed and `simulated_s`.
     pub metrics: Vec<(&'static str, f64)>,
@@ -56,7 +73,7 @@ impl TestOutcome {
         self.monitors.iter().all(|(_, v)| v.passed)
     }
 
-    /// The smallest robustness over the monitors (`+inf` with none): the falsification cost.
+    /// The smallest robustness over the monitors (`+inf` with none).
     pub fn robustness(&self) -> f64 {
         self.monitors
             .iter()
@@ -72,22 +89,42 @@ fn publish(snap: &Snapshot, out: &mut Signals) {
     out.set_bool(signal::EGO_CONTACT, snap.ego_contact);
     out.set(signal::EGO_SEPARATION_M, snap.min_separation_m);
     out.set(signal::EGO_TTC_S, snap.ttc_s);
+    out.set_bool(signal::EGO_OFFROAD, snap.ego_off_road);
+    out.set(signal::EGO_ROAD_EDGE_M, snap.ego_road_edge_m);
+    out.set(signal::EGO_LANE_OFFSET_M, snap.ego_lane_offset_m);
     out.set(signal::FOG, snap.fog);
     out.set(signal::LIGHT, snap.light);
 }
 
-/// Feeds one snapshot to every monitor; `Break` when any monitor settled its verdict.
-fn observe(snap: &Snapshot, signals: &mut Signals, monitors: &mut [Box<dyn Monitor>]) -> bool {
-    publish(snap, signals);
-    let frame = Frame {
-        t_s: snap.t_s,
-        signals,
-    };
-    let mut stop = false;
-    for m in monitors.iter_mut() {
-        stop |= matches!(m.observe(&frame), ControlFlow::Break(()));
+/// The monitors of one test and which of them have settled their verdict.
+struct Watch {
+    monitors: Vec<Box<dyn Monitor>>,
+    settled: Vec<bool>,
+    signals: Signals,
+}
+
+impl Watch {
+    /// Feeds one snapshot to every monitor that has not settled yet. Returns whether the test
+    /// may stop: every monitor has settled, or one has settled as failed. Monitors are
+    /// independent: one settling (passed) never stops the others observing.
+    fn observe(&mut self, snap: &Snapshot) -> bool {
+        publish(snap, &mut self.signals);
+        let frame = Frame {
+            t_s: snap.t_s,
+            signals: &self.signals,
+        };
+        let mut failed = false;
+        for (m, settled) in self.monitors.iter_mut().zip(&mut self.settled) {
+            if *settled {
+                continue;
+            }
+            if let ControlFlow::Break(()) = m.observe(&frame) {
+                *settled = true;
+                failed |= !m.verdict().passed;
+            }
+        }
+        failed || self.settled.iter().all(|&s| s)
     }
-    stop
 }
 
 /// Extras for one run: a camera to watch it with, and a callback for every camera frame
@@ -165,10 +202,14 @@ impl Scenario {
             None => 0,
         };
         let control_every = period_ticks(sensors.control_hz, spec.dt_s);
-        let mut monitors: Vec<Box<dyn Monitor>> = self.monitors.iter().map(|m| m.build()).collect();
-        let mut signals = Signals::new();
+        let monitors: Vec<Box<dyn Monitor>> = self.monitors.iter().map(|m| m.build()).collect();
+        let mut watch = Watch {
+            settled: vec![false; monitors.len()],
+            monitors,
+            signals: Signals::new(),
+        };
         let ticks = (self.horizon_s / spec.dt_s).round() as u64;
-        let mut stopped = observe(&sim.snapshot(), &mut signals, &mut monitors);
+        let mut stopped = watch.observe(&sim.snapshot());
         let mut tick = 0;
         let mut control = Control::default();
         while !stopped && tick < ticks {
@@ -187,10 +228,22 @@ impl Scenario {
             }
             sim.step(control, host)?;
             tick += 1;
-            stopped = observe(&sim.snapshot(), &mut signals, &mut monitors);
+            stopped = watch.observe(&sim.snapshot());
         }
 
-        let monitors: Vec<(String, Verdict)> = monitors
+        let cut_short: Vec<String> = if tick < ticks {
+            watch
+                .monitors
+                .iter()
+                .zip(&watch.settled)
+                .filter(|(_, &settled)| !settled)
+                .map(|(m, _)| m.name().to_owned())
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let monitors: Vec<(String, Verdict)> = watch
+            .monitors
             .iter()
             .map(|m| (m.name().to_owned(), m.verdict()))
             .collect();
@@ -206,7 +259,11 @@ impl Scenario {
             metrics.push(("time_to_failure_s", ttf));
         }
         metrics.push(("simulated_s", sim.t_s()));
-        Ok(TestOutcome { monitors, metrics })
+        Ok(TestOutcome {
+            monitors,
+            cut_short,
+            metrics,
+        })
     }
 }
 

@@ -4,7 +4,9 @@ use std::sync::Arc;
 use paracosm_engine::rx::Host;
 use paracosm_engine::WorldSpec;
 use paracosm_generators::{Assignment, ParamSpace};
-use paracosm_oracles::{CollisionMonitor, DistanceMonitor, Monitor, TimeToFailureMonitor};
+use paracosm_oracles::{
+    CollisionMonitor, DistanceMonitor, Monitor, OffRoadMonitor, TimeToFailureMonitor,
+};
 
 use crate::runner::signal;
 use crate::ScenarioError;
@@ -25,6 +27,16 @@ pub enum MonitorSpec {
         name: String,
         /// `minD`, in metres.
         min_distance_m: f64,
+    },
+    /// `OffRoadMonitor(v)`: the ego vehicle's footprint centre stays on the driving surface.
+    /// Robustness: the smallest signed distance to the surface's edge, in metres.
+    OffRoad {
+        /// Key in results files, default `offroad`.
+        name: String,
+        /// Added by default to a program that declares none (LANGUAGE.md, "Monitors"): it
+        /// judges every test, but steers a falsifier only once it fails (see
+        /// [`Scenario::passive_monitors`]).
+        implicit: bool,
     },
     /// `Stl(formula)`: a signal temporal logic property of the runner's signals
     /// ([`paracosm_oracles::stl`]), judged at time 0 and settled online.
@@ -62,6 +74,44 @@ impl MonitorSpec {
         }
     }
 
+    /// The default `OffRoadMonitor` every program gets unless it declares one or opts out.
+    pub fn implicit_off_road() -> Self {
+        MonitorSpec::OffRoad {
+            name: "offroad".into(),
+            implicit: true,
+        }
+    }
+
+    /// Whether it judges leaving the road (an `OffRoadMonitor`, wrapped or not).
+    pub fn judges_off_road(&self) -> bool {
+        match self {
+            MonitorSpec::OffRoad { .. } => true,
+            MonitorSpec::TimeToFailure { inner, .. } => inner.judges_off_road(),
+            _ => false,
+        }
+    }
+
+    /// Whether it reads the runner's signal `name` (an `Stl` formula naming it).
+    pub fn reads_signal(&self, name: &str) -> bool {
+        match self {
+            MonitorSpec::Stl { formula, .. } => paracosm_oracles::stl::parse(formula)
+                .is_ok_and(|f| f.signals().iter().any(|s| s == name)),
+            MonitorSpec::TimeToFailure { inner, .. } => inner.reads_signal(name),
+            _ => false,
+        }
+    }
+
+    /// Its key in results files.
+    pub fn name(&self) -> &str {
+        match self {
+            MonitorSpec::Collision { name }
+            | MonitorSpec::Distance { name, .. }
+            | MonitorSpec::OffRoad { name, .. }
+            | MonitorSpec::Stl { name, .. }
+            | MonitorSpec::TimeToFailure { name, .. } => name,
+        }
+    }
+
     /// A fresh monitor reading the runner's signals (see [`signal`]).
     pub fn build(&self) -> Box<dyn Monitor> {
         match self {
@@ -79,6 +129,11 @@ impl MonitorSpec {
                 signal::EGO_Z_M,
                 *min_distance_m,
             )),
+            MonitorSpec::OffRoad { name, .. } => Box::new(OffRoadMonitor::new(
+                name,
+                signal::EGO_OFFROAD,
+                signal::EGO_ROAD_EDGE_M,
+            )),
             MonitorSpec::Stl { name, formula } => Box::new(paracosm_oracles::stl::StlMonitor::new(
                 name,
                 paracosm_oracles::stl::parse(formula).expect("checked when the program loaded"),
@@ -88,6 +143,35 @@ impl MonitorSpec {
             }
         }
     }
+}
+
+/// Something in a program that runs but checks or varies less than it seems to (a program
+/// with no monitor, an open parameter no object reads...): printed once per campaign, and an
+/// error with `paracosm-fuzz --deny-warnings`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Warning {
+    /// Where, `file:line:col`.
+    pub at: String,
+    /// What, in one sentence.
+    pub message: String,
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "warning: {}\n --> {}", self.message, self.at)
+    }
+}
+
+/// An open parameter that only a camera can see (the light, a colour): it affects the ego
+/// only when the system under test has a camera.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CameraOnly {
+    /// The parameter's name.
+    pub param: String,
+    /// Where it was declared, `file:line:col`.
+    pub at: String,
+    /// What it sets, e.g. `the light` or `the colour of Car declared at f.star:9:8`.
+    pub sets: String,
 }
 
 /// A parameterised family of tests (paper §3.1, "test configuration"): open parameters, a
@@ -106,8 +190,17 @@ pub struct Scenario {
     pub sut: SutConfig,
     /// The monitors, evaluated on every test.
     pub monitors: Vec<MonitorSpec>,
-    /// The two parameters of the failure map, `[x axis, y axis]`.
-    pub map_axes: [String; 2],
+    /// The parameters of the failure map: none (a scenario without open parameters gets no
+    /// map), one (a strip plot), or two (`[x axis, y axis]`). Continuous or discrete.
+    pub map_axes: Vec<String>,
+    /// What the program loads with but checks or varies less than it seems to, whatever the
+    /// system under test (see [`Scenario::warnings_for`] for the rest).
+    pub warnings: Vec<Warning>,
+    /// The coordinates of the space that no object reads (by name, as in
+    /// [`ParamSpace::params`]): sampled and recorded, but left out of coverage.
+    pub unused_params: Vec<String>,
+    /// The open parameters that only a camera sees.
+    pub camera_only: Vec<CameraOnly>,
     /// The program text it was loaded from (empty for scenarios written in Rust): part of a
     /// campaign's fingerprint, so a resumed campaign runs the same program.
     pub source: Arc<str>,
@@ -128,6 +221,41 @@ pub trait Lambdas: Send + Sync {
 }
 
 impl Scenario {
+    /// The warnings of this scenario when it tests `sut`: [`Scenario::warnings`], and for a
+    /// system without a camera every parameter that only a camera sees.
+    pub fn warnings_for(&self, sut: &SutConfig) -> Vec<Warning> {
+        let mut out = self.warnings.clone();
+        if sut.has_camera() == Some(false) {
+            for c in &self.camera_only {
+                out.push(Warning {
+                    at: c.at.clone(),
+                    message: format!(
+                        "`{}` sets {}, which only a camera sees, and the system under test `{}` \
+                         has none: it is sampled and counted in coverage but cannot affect the \
+                         ego",
+                        c.param,
+                        c.sets,
+                        sut.name()
+                    ),
+                });
+            }
+        }
+        out
+    }
+
+    /// The monitors that judge every test but do not steer a falsifier until they fail: the
+    /// default `OffRoadMonitor` (its margin to the road's edge, about 1.75 m in the middle of
+    /// a lane, would otherwise flatten the cost that falsifiers descend). A record's
+    /// falsification cost is the smallest robustness over the other monitors, and over these
+    /// only where they are `<= 0`.
+    pub fn passive_monitors(&self) -> Vec<String> {
+        self.monitors
+            .iter()
+            .filter(|m| matches!(m, MonitorSpec::OffRoad { implicit: true, .. }))
+            .map(|m| m.name().to_owned())
+            .collect()
+    }
+
     /// The concrete world for `assignment` (paper §3.1: a test case closes every open stream).
     ///
     /// # Errors

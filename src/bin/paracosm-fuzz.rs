@@ -84,6 +84,11 @@ struct Cli {
     /// verdicts, parameters and replay command.
     #[arg(long, value_name = "FILE")]
     junit: Option<PathBuf>,
+    /// Refuse to run (exit 2) when the scenario loads with warnings: no monitor, an open
+    /// parameter no object reads or that cannot affect the ego (LANGUAGE.md, "Warnings").
+    /// For CI.
+    #[arg(long)]
+    deny_warnings: bool,
     #[command(flatten)]
     sut: SutArgs,
 }
@@ -196,6 +201,19 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         None
     };
     let (file, scenario) = settings(cli, stored.as_ref())?;
+    // Warnings once per campaign, before anything runs; with --deny-warnings they refuse it.
+    let warnings = warnings_of(&scenario);
+    for w in &warnings {
+        eprintln!("paracosm-fuzz: {w}");
+    }
+    if cli.deny_warnings && !warnings.is_empty() {
+        return Err(BadInput(format!(
+            "--deny-warnings: the scenario loads with {} warning{} (above)",
+            warnings.len(),
+            if warnings.len() == 1 { "" } else { "s" }
+        ))
+        .into());
+    }
     let strategy: paracosm_generators::Strategy = file
         .strategy
         .parse()
@@ -313,7 +331,7 @@ fn run(cli: &Cli) -> Result<ExitCode> {
     }
     let mut records = existing.records;
     records.extend(report.records);
-    let summary = paracosm::report::write_outputs(&Finished {
+    let written = paracosm::report::write_outputs(&Finished {
         out: &cli.out,
         scenario: &scenario,
         file: &file,
@@ -321,8 +339,13 @@ fn run(cli: &Cli) -> Result<ExitCode> {
         jobs,
         wall_s: report.wall_s,
         junit: cli.junit.as_deref(),
+        warnings,
     })
     .map_err(BadInput)?;
+    for w in &written.plot_warnings {
+        eprintln!("paracosm-fuzz: warning: {w}");
+    }
+    let summary = written.summary;
     info!(path = %cli.out.display(), "wrote summary");
     println!(
         "{}",
@@ -511,7 +534,7 @@ fn merge(args: &MergeArgs) -> Result<ExitCode> {
         .filter_map(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
         .filter_map(|s| s["wall_s"].as_f64())
         .sum();
-    let summary = paracosm::report::write_outputs(&Finished {
+    let written = paracosm::report::write_outputs(&Finished {
         out: &args.out,
         scenario: &m.scenario,
         file: &m.file,
@@ -519,8 +542,13 @@ fn merge(args: &MergeArgs) -> Result<ExitCode> {
         jobs: 1,
         wall_s,
         junit: args.junit.as_deref(),
+        warnings: warnings_of(&m.scenario),
     })
     .map_err(BadInput)?;
+    for w in &written.plot_warnings {
+        eprintln!("paracosm-fuzz: warning: {w}");
+    }
+    let summary = written.summary;
     println!(
         "merged {} shards into {}",
         args.dirs.len(),
@@ -575,6 +603,7 @@ fn report(args: &ReportArgs) -> Result<ExitCode> {
                 .unwrap_or(1) as usize,
             wall_s,
             junit: None,
+            warnings: warnings_of(&scenario),
         },
         outputs,
     );
@@ -591,6 +620,15 @@ fn report(args: &ReportArgs) -> Result<ExitCode> {
         );
     }
     Ok(exit_code(&summary.counts))
+}
+
+/// The scenario's warnings for its system under test, as text.
+fn warnings_of(scenario: &paracosm_scenarios::Scenario) -> Vec<String> {
+    scenario
+        .warnings_for(&scenario.sut)
+        .iter()
+        .map(ToString::to_string)
+        .collect()
 }
 
 /// Creates `out`; refuses a non-empty folder unless `force` (replace) or `resume`.

@@ -247,20 +247,11 @@ impl Mesh {
     }
 }
 
-/// The albedo of a colour name used by scenarios (`Car(color=...)`); unknown names are
-/// mid grey.
+/// The albedo of a colour name used by scenarios (`Car(color=...)`, see
+/// [`crate::colour::COLOURS`]); a name not in the list (which the scenario language refuses
+/// when the program loads) is mid grey.
 pub fn color_albedo(name: &str) -> [f32; 3] {
-    match name.to_ascii_lowercase().as_str() {
-        "red" => [0.75, 0.08, 0.07],
-        "white" => [0.92, 0.92, 0.92],
-        "black" => [0.04, 0.04, 0.05],
-        "blue" => [0.08, 0.18, 0.70],
-        "green" => [0.10, 0.55, 0.15],
-        "yellow" => [0.90, 0.78, 0.10],
-        "orange" => [0.92, 0.45, 0.08],
-        "silver" => [0.70, 0.71, 0.73],
-        _ => [0.45, 0.45, 0.45],
-    }
+    crate::colour::albedo(name).unwrap_or([0.45, 0.45, 0.45])
 }
 
 #[cfg(test)]

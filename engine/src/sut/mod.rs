@@ -104,6 +104,17 @@ impl SutConfig {
         }
     }
 
+    /// Whether the system reads a camera: `Some(false)` for `aeb` and constant control,
+    /// `Some(true)` for `vision`, `None` for an external program (it declares its sensors in
+    /// its handshake, when a test starts).
+    pub fn has_camera(&self) -> Option<bool> {
+        match self {
+            SutConfig::Aeb(_) | SutConfig::Constant(_) => Some(false),
+            SutConfig::Vision(_) => Some(true),
+            SutConfig::External(_) => None,
+        }
+    }
+
     /// A fresh instance of the configured system.
     pub fn build(&self) -> Box<dyn Sut> {
         match self {

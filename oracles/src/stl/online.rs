@@ -103,7 +103,7 @@ impl Monitor for StlMonitor {
                 first_violation_s: None,
                 metrics: vec![],
             });
-            ControlFlow::Continue(())
+            ControlFlow::Break(())
         } else {
             ControlFlow::Continue(())
         }

@@ -21,6 +21,7 @@ use starlark::values::{ProvidesStaticType, UnpackValue, Value, ValueLike};
 use super::scene::{
     turns, Fixed, ObjectDecl, OverTime, ParamDecl, PedTrigger, Pending, SceneBuilder,
 };
+use super::types;
 use super::values::{
     ActorKind, ActorVal, LaneSide, Loc, MonitorVal, OverTimeVal, Road, Stream, WorldVal,
 };
@@ -48,7 +49,8 @@ pub fn state<'a>(eval: &Evaluator<'_, 'a, '_>) -> anyhow::Result<&'a LoadState> 
         .ok_or_else(|| anyhow!("scenario builtins work only while a scenario program loads"))
 }
 
-fn here(eval: &Evaluator) -> String {
+/// Where the builtin being evaluated was called, `file:line:col`.
+pub(crate) fn here(eval: &Evaluator) -> String {
     match eval.call_stack_top_location() {
         Some(l) => format!("{}:{}", l.filename(), l.resolve_span().begin),
         None => "?".into(),
@@ -96,6 +98,35 @@ pub fn stream_arg(v: Value, b: &mut SceneBuilder, what: &str) -> anyhow::Result<
     }
 }
 
+/// A stream argument for `input` of `owner` (declared `at`), with its type checked: now where
+/// its values are known, as the test runs where a lambda computes them
+/// ([`super::types::typed_stream`]).
+fn typed_arg(
+    v: Value,
+    b: &mut SceneBuilder,
+    input: &types::Input,
+    owner: &str,
+    at: &str,
+) -> anyhow::Result<StreamId> {
+    let id = stream_arg(v, b, input.keyword)?;
+    types::typed_stream(b, id, input, owner, at)
+}
+
+/// A value fixed for a test for `input` of `owner`, with every value it can take checked.
+fn fixed_typed(
+    v: Value,
+    b: &mut SceneBuilder,
+    input: &types::Input,
+    owner: &str,
+) -> anyhow::Result<Fixed> {
+    let f = fixed_arg(v, b, input.keyword)?;
+    match &f {
+        Fixed::Const(c) => types::check_const(c, input, owner)?,
+        Fixed::Param(p) => types::check_param(b, *p, input, owner)?,
+    }
+    Ok(f)
+}
+
 /// A value fixed for a test: a constant, `Const(...)`, or an open parameter constant over
 /// time.
 fn fixed_arg(v: Value, b: &SceneBuilder, what: &str) -> anyhow::Result<Fixed> {
@@ -138,14 +169,10 @@ fn add_piece(
     eval: &Evaluator,
     what: &str,
     kind: PieceKind,
-    friction: Option<Value>,
+    friction: Fixed,
 ) -> anyhow::Result<Road> {
     let st = state(eval)?;
     let mut b = st.scene.borrow_mut();
-    let fixed = match friction {
-        Some(v) => fixed_arg(v, &b, "friction")?,
-        None => Fixed::Const(Rx::Num(kind.friction())),
-    };
     let segment = matches!(kind, PieceKind::Segment { .. });
     let ports = kind.ports().len();
     let name = format!("{what} declared at {}", here(eval));
@@ -153,7 +180,7 @@ fn add_piece(
         .roads
         .add(&name, kind)
         .map_err(|e| anyhow!(super::scene::strip(e)))?;
-    b.frictions.push((id, fixed));
+    b.frictions.push((id, friction));
     Ok(Road {
         piece: id.0,
         ports,
@@ -163,8 +190,8 @@ fn add_piece(
 }
 
 /// A road piece from its keyword arguments: `make` gets the program's declarations, the lane
-/// count (default 2) and the friction (default 0.8, or an open friction's lower bound as a
-/// placeholder) and reads any further load-time arguments.
+/// count (default 2) and the friction (default 0.8, or for an open friction a value it can
+/// take, as a placeholder that each test replaces) and reads any further load-time arguments.
 fn road_piece(
     eval: &Evaluator,
     what: &str,
@@ -172,28 +199,24 @@ fn road_piece(
     friction: Option<Value>,
     make: impl FnOnce(&SceneBuilder, u32, f64) -> anyhow::Result<PieceKind>,
 ) -> anyhow::Result<Road> {
-    let kind = {
+    let (kind, fixed) = {
         let st = state(eval)?;
-        let b = st.scene.borrow();
-        let (lanes, mu) = (lanes(nlanes, &b, 2)?, friction_default(friction, &b)?);
-        make(&b, lanes, mu)?
-    };
-    add_piece(eval, what, kind, friction)
-}
-
-fn friction_default(f: Option<Value>, b: &SceneBuilder) -> anyhow::Result<f64> {
-    // A placeholder inside (0, 2] for open frictions: each test sets its own value.
-    match f {
-        Some(v) => match fixed_arg(v, b, "friction")? {
-            Fixed::Const(Rx::Num(x)) => Ok(x),
-            Fixed::Param(p) => match &b.params[p].domain {
-                Domain::Interval { lo, .. } => Ok(*lo),
-                _ => bail!("friction must be a number or a VarInterval"),
+        let mut b = st.scene.borrow_mut();
+        let fixed = match friction {
+            Some(v) => fixed_typed(v, &mut b, &types::FRICTION, what)?,
+            None => Fixed::Const(Rx::Num(0.8)),
+        };
+        let mu = match &fixed {
+            Fixed::Const(c) => c.as_num().unwrap_or(0.8),
+            Fixed::Param(p) => match &b.params[*p].domain {
+                Domain::Interval { lo, .. } => *lo,
+                Domain::Levels(levels) => types::level_value(&levels[0]).as_num().unwrap_or(0.8),
             },
-            Fixed::Const(c) => bail!("friction must be a number, got a {}", c.kind()),
-        },
-        None => Ok(0.8),
-    }
+        };
+        let lanes = lanes(nlanes, &b, 2)?;
+        (make(&b, lanes, mu)?, fixed)
+    };
+    add_piece(eval, what, kind, fixed)
 }
 
 fn location(v: Value, what: &str) -> anyhow::Result<usize> {
@@ -256,9 +279,20 @@ fn route_arg(v: Option<Value>) -> anyhow::Result<Option<Vec<paracosm_engine::net
     }
 }
 
+fn unique_monitor_name(b: &SceneBuilder, name: &str) -> anyhow::Result<()> {
+    if b.monitors.iter().any(|m| m.name() == name) {
+        bail!(
+            "two monitors are named `{name}`: results are keyed by monitor name, so give one \
+             another name="
+        );
+    }
+    Ok(())
+}
+
 fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<MonitorVal> {
     let st = state(eval)?;
     let mut b = st.scene.borrow_mut();
+    unique_monitor_name(&b, spec.name())?;
     b.monitors.push(spec);
     Ok(MonitorVal {
         index: b.monitors.len() - 1,
@@ -414,12 +448,21 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             bail!("a program has one World");
         }
         let heap = eval.heap();
-        let light = stream_arg(
+        let at = format!("declared at {}", here(eval));
+        let light = typed_arg(
             light.unwrap_or_else(|| heap.alloc(NOMINAL_LIGHT)),
             &mut b,
-            "light",
+            &types::LIGHT,
+            "World",
+            &at,
         )?;
-        let fog = stream_arg(fog.unwrap_or_else(|| heap.alloc(0.0)), &mut b, "fog")?;
+        let fog = typed_arg(
+            fog.unwrap_or_else(|| heap.alloc(0.0)),
+            &mut b,
+            &types::FOG,
+            "World",
+            &at,
+        )?;
         b.world = Some((light, fog));
         Ok(WorldVal {
             light: light.0,
@@ -561,12 +604,25 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let heap = eval.heap();
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
-        let speed = stream_arg(speed.unwrap_or_else(|| heap.alloc(10.0)), &mut b, "speed")?;
-        let color = fixed_arg(color.unwrap_or_else(|| heap.alloc("red")), &b, "color")?;
-        let enabled = fixed_arg(
+        let at = format!("declared at {}", here(eval));
+        let speed = typed_arg(
+            speed.unwrap_or_else(|| heap.alloc(10.0)),
+            &mut b,
+            &types::CAR_SPEED,
+            "Car",
+            &at,
+        )?;
+        let color = fixed_typed(
+            color.unwrap_or_else(|| heap.alloc("red")),
+            &mut b,
+            &types::COLOR,
+            "Car",
+        )?;
+        let enabled = fixed_typed(
             enabled.unwrap_or_else(|| Value::new_bool(true)),
-            &b,
-            "enabled",
+            &mut b,
+            &types::ENABLED,
+            "Car",
         )?;
         let i = b.n_cars;
         b.n_cars += 1;
@@ -598,21 +654,25 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<ActorVal> {
         let (start, target) = (location(start, "start")?, location(target, "target")?);
+        let at = format!("declared at {}", here(eval));
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
-        let speed = stream_arg(speed, &mut b, "speed")?;
+        let owner = "Pedestrian";
+        let speed = typed_arg(speed, &mut b, &types::PEDESTRIAN_SPEED, owner, &at)?;
         let trigger = match (dist, car, trigger) {
             (Some(d), Some(c), None) => {
                 let car = match c.downcast_ref::<ActorVal>() {
                     Some(a) => StreamId(a.outputs[0]),
-                    None => stream_arg(c, &mut b, "car")?,
+                    None => typed_arg(c, &mut b, &types::WATCHED_POSITION, owner, &at)?,
                 };
                 PedTrigger::Near {
                     car,
-                    dist: stream_arg(d, &mut b, "dist")?,
+                    dist: typed_arg(d, &mut b, &types::TRIGGER_DISTANCE, owner, &at)?,
                 }
             }
-            (None, None, Some(t)) => PedTrigger::Stream(stream_arg(t, &mut b, "trigger")?),
+            (None, None, Some(t)) => {
+                PedTrigger::Stream(typed_arg(t, &mut b, &types::TRIGGER, owner, &at)?)
+            }
             _ => bail!("Pedestrian needs either dist= and car=, or trigger="),
         };
         let i = b.n_pedestrians;
@@ -643,6 +703,25 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             eval,
             MonitorSpec::Collision {
                 name: name.unwrap_or("collision").to_owned(),
+            },
+        )
+    }
+
+    /// `OffRoadMonitor(v, name="offroad")`: fails when the centre of the ego vehicle's
+    /// footprint leaves the driving surface (a sidewalk, an island, the ground beside the road
+    /// or past a dead end); robustness is the smallest signed distance to the surface's edge
+    /// in metres.
+    fn OffRoadMonitor<'v>(
+        v: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        ego_arg(v, "OffRoadMonitor")?;
+        monitor(
+            eval,
+            MonitorSpec::OffRoad {
+                name: name.unwrap_or("offroad").to_owned(),
+                implicit: false,
             },
         )
     }
@@ -716,18 +795,25 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             .get(inner)
             .cloned()
             .ok_or_else(|| anyhow!("that monitor is already wrapped"))?;
+        let name = name.unwrap_or("time_to_failure");
+        if wrapped.name() != name {
+            unique_monitor_name(&b, name)?;
+        }
         b.monitors[inner] = MonitorSpec::TimeToFailure {
-            name: name.unwrap_or("time_to_failure").to_owned(),
+            name: name.to_owned(),
             inner: Box::new(wrapped),
             min_s,
         };
         Ok(MonitorVal { index: inner })
     }
 
-    /// `test(horizon=15.0, map=None)`: the test length in seconds and the failure map's axes.
+    /// `test(horizon=15.0, map=None, offroad=True)`: the test length in seconds, the failure
+    /// map's axes (one or two parameter names), and whether the default `OffRoadMonitor` is
+    /// added to a program that declares none.
     fn test<'v>(
         #[starlark(require = named)] horizon: Option<Value<'v>>,
-        #[starlark(require = named)] map: Option<(String, String)>,
+        #[starlark(require = named)] map: Option<Value<'v>>,
+        #[starlark(require = named)] offroad: Option<bool>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<NoneType> {
         let st = state(eval)?;
@@ -739,8 +825,34 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             }
             b.horizon_s = Some(h);
         }
-        if let Some((x, y)) = map {
-            b.map_axes = Some([x, y]);
+        if let Some(m) = map {
+            let axes: Vec<String> = if let Some(one) = m.unpack_str() {
+                vec![one.to_owned()]
+            } else {
+                let items = UnpackList::<String>::unpack_value(m)
+                    .ok()
+                    .flatten()
+                    .map(|l| l.items)
+                    .or_else(|| {
+                        starlark::values::tuple::TupleRef::from_value(m).and_then(|t| {
+                            t.content()
+                                .iter()
+                                .map(|v| v.unpack_str().map(str::to_owned))
+                                .collect::<Option<Vec<String>>>()
+                        })
+                    });
+                match items {
+                    Some(items) if (1..=2).contains(&items.len()) => items,
+                    _ => bail!(
+                        "test(map=) takes one or two parameter names, such as \"speed\" or \
+                         (\"speed\", \"dist\"), got {m}"
+                    ),
+                }
+            };
+            b.map_axes = Some(axes);
+        }
+        if let Some(o) = offroad {
+            b.offroad = Some(o);
         }
         Ok(NoneType)
     }

@@ -304,8 +304,10 @@ pub(crate) fn world_methods(builder: &mut MethodsBuilder) {
         #[starlark(args)] objects: UnpackTuple<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<NoneType> {
+        let at = super::globals::here(eval);
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
+        b.placed_at = Some(at);
         let mut actors = Vec::new();
         for o in objects.items {
             if let Some(a) = o.downcast_ref::<ActorVal>() {

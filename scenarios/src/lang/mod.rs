@@ -11,6 +11,8 @@ mod globals;
 mod host;
 mod methods;
 mod scene;
+mod types;
+mod usage;
 mod values;
 
 use std::path::Path;
@@ -76,10 +78,11 @@ const KEYWORDS: &[(&str, &[&str])] = &[
     ("VarInterval", &["unit", "name", "over_time"]),
     ("VarEnum", &["name"]),
     ("CollisionMonitor", &["name"]),
+    ("OffRoadMonitor", &["name"]),
     ("DistanceMonitor", &["minD", "name"]),
     ("TimeToFailure", &["minT", "name"]),
     ("Stl", &["name"]),
-    ("test", &["horizon", "map"]),
+    ("test", &["horizon", "map", "offroad"]),
 ];
 
 /// Adds "did you mean `x`?" to starlark's "Found `y` extra named parameter(s) for call to F".

@@ -191,8 +191,16 @@ pub struct SceneBuilder {
     pub monitors: Vec<MonitorSpec>,
     /// `test(horizon=)`, seconds.
     pub horizon_s: Option<f64>,
-    /// `test(map=)`.
-    pub map_axes: Option<[String; 2]>,
+    /// `test(map=)`: one or two parameter names.
+    pub map_axes: Option<Vec<String>>,
+    /// `test(offroad=)`: whether the default `OffRoadMonitor` is added (default true).
+    pub offroad: Option<bool>,
+    /// Where `place(...)` was called, `file:line:col`.
+    pub placed_at: Option<String>,
+    /// Warnings so far.
+    pub warnings: Vec<crate::scenario::Warning>,
+    /// The cars' names for messages, in the order of [`SceneBuilder::cars`].
+    pub car_names: Vec<String>,
     /// Number of lambdas stored so far.
     pub lambdas: u32,
     /// `onLane` results, by index.
@@ -223,6 +231,14 @@ impl SceneBuilder {
     /// A probe stream.
     pub fn probe(&mut self, actor: Actor, output: Output) -> StreamId {
         self.graph.push(Node::Probe(probe(actor, output)))
+    }
+
+    /// Records a warning about what the program declared at `at` (`file:line:col`).
+    pub fn warn(&mut self, at: &str, message: String) {
+        self.warnings.push(crate::scenario::Warning {
+            at: at.to_owned(),
+            message,
+        });
     }
 
     /// The stream's node, if it is an open parameter's, its parameter number.
@@ -282,6 +298,7 @@ pub fn finish(
     }
     let ego = b
         .ego
+        .clone()
         .ok_or("the program places no AutonomousVehicle: nothing to test")?;
     let horizon_s = b.horizon_s.unwrap_or(15.0);
     let world = match b.world {
@@ -290,7 +307,7 @@ pub fn finish(
     };
     let mut params: Vec<(String, ParamDecl)> = Vec::new();
     let mut space = Vec::new();
-    for (i, p) in b.params.into_iter().enumerate() {
+    for (i, p) in b.params.iter().enumerate() {
         let name = p.name.clone().unwrap_or_else(|| format!("param{i}"));
         if let Some((_, first)) = params.iter().find(|(n, _)| *n == name) {
             return Err(format!(
@@ -305,29 +322,75 @@ pub fn finish(
                 unit: p.unit.clone(),
             });
         }
-        params.push((name, p));
+        params.push((name, p.clone()));
     }
     let space = ParamSpace::new(space).map_err(|e| e.to_string())?;
-    let map_axes = match b.map_axes {
-        Some(axes) => {
-            for a in &axes {
-                if space.param(a).is_none() {
-                    return Err(format!(
-                        "test(map=...) names `{a}`, which is not a parameter"
+    let map_axes =
+        match &b.map_axes {
+            Some(axes) => {
+                for a in axes {
+                    if space.param(a).is_none() {
+                        let known: Vec<&str> =
+                            space.params().iter().map(|p| p.name.as_str()).collect();
+                        return Err(format!(
+                        "test(map=...) names `{a}`, which is not a parameter (the parameters: {})",
+                        if known.is_empty() { "none".to_owned() } else { known.join(", ") }
                     ));
+                    }
                 }
+                axes.clone()
             }
-            axes
+            None => space
+                .params()
+                .iter()
+                .take(2)
+                .map(|p| p.name.clone())
+                .collect(),
+        };
+
+    // Monitors: the default OffRoadMonitor unless the program has one or opts out.
+    let mut monitors = b.monitors.clone();
+    let declared = monitors.len();
+    let has_off_road = monitors.iter().any(MonitorSpec::judges_off_road);
+    if b.offroad.unwrap_or(true) && !has_off_road {
+        let implicit = MonitorSpec::implicit_off_road();
+        if monitors.iter().any(|m| m.name() == implicit.name()) {
+            return Err(format!(
+                "a monitor is named `{}`, the name of the default OffRoadMonitor: rename it, \
+                 declare OffRoadMonitor(v) yourself, or opt out with test(offroad = False)",
+                implicit.name()
+            ));
         }
-        None => {
-            let names: Vec<String> = space.params().iter().map(|p| p.name.clone()).collect();
-            match names.as_slice() {
-                [] => ["t".to_owned(), "t".to_owned()],
-                [a] => [a.clone(), a.clone()],
-                [a, b, ..] => [a.clone(), b.clone()],
-            }
-        }
-    };
+        monitors.push(implicit);
+    }
+    let mut warnings = b.warnings.clone();
+    let place_at = b.placed_at.clone().unwrap_or_default();
+    if declared == 0 {
+        warnings.push(crate::scenario::Warning {
+            at: place_at.clone(),
+            message: if monitors.is_empty() {
+                "the program declares no monitor and opts out of the default OffRoadMonitor: \
+                 every test passes whatever happens"
+                    .to_owned()
+            } else {
+                "the program declares no monitor: only the default OffRoadMonitor judges its \
+                 tests, so a test passes whatever else happens (add CollisionMonitor(v), \
+                 DistanceMonitor(v, minD = ...) or Stl(...))"
+                    .to_owned()
+            },
+        });
+    }
+    let stl_reads_light = monitors
+        .iter()
+        .any(|m| m.reads_signal(crate::signal::LIGHT));
+    let names: Vec<String> = params.iter().map(|(n, _)| n.clone()).collect();
+    let usage = super::usage::analyse(&b, &names, stl_reads_light);
+    warnings.extend(usage.warnings);
+    let unused_params: Vec<String> = usage
+        .unused
+        .iter()
+        .flat_map(|&p| coordinate_names(&names[p], params[p].1.over_time))
+        .collect();
     let graph = b.graph.finish().map_err(|e| e.to_string())?;
     let sut = ego.sut.clone();
     let frozen = Arc::new(Frozen {
@@ -347,8 +410,11 @@ pub fn finish(
         space,
         horizon_s,
         sut,
-        monitors: b.monitors,
+        monitors,
         map_axes,
+        warnings,
+        unused_params,
+        camera_only: usage.camera_only,
         template: Arc::new(move |a: &Assignment| frozen.instantiate(a)),
         lambdas,
         source: Arc::from(""),
@@ -356,13 +422,7 @@ pub fn finish(
 }
 
 fn to_rx(v: &paracosm_generators::Value) -> Value {
-    match v {
-        paracosm_generators::Value::Int(i) => Value::Num(*i as f64),
-        paracosm_generators::Value::Real(x) => Value::Num(*x),
-        paracosm_generators::Value::Text(t) if t == "true" => Value::Bool(true),
-        paracosm_generators::Value::Text(t) if t == "false" => Value::Bool(false),
-        paracosm_generators::Value::Text(t) => Value::Text(t.clone()),
-    }
+    super::types::level_value(v)
 }
 
 impl Frozen {
@@ -591,6 +651,7 @@ impl SceneBuilder {
                         color,
                         enabled,
                     });
+                    self.car_names.push(o.name.clone());
                 }
             }
         }

@@ -1,0 +1,77 @@
+//! Plots, as PNG and SVG, drawn with `plotters` and a bundled font so that they render on
+//! machines without system fonts: the failure map and the failure-rate heat map over any one
+//! or two parameters, continuous or discrete ([`map`]), contact sheets of camera frames
+//! ([`sheet`]) and box plots ([`boxes`]).
+
+mod axis;
+mod boxes;
+mod map;
+mod sheet;
+
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use thiserror::Error;
+
+pub use boxes::{box_plot, BoxPanel};
+pub use map::{failure_map, failure_rate_map, failure_rates, RateGrid};
+pub use sheet::contact_sheet;
+
+/// DejaVu Sans (Bitstream Vera license, see `assets/fonts/LICENSE`), bundled so plots draw on
+/// a machine with no fonts installed.
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+const FAMILY: &str = "sans-serif";
+
+/// Errors drawing a plot.
+#[derive(Debug, Error)]
+pub enum PlotError {
+    /// An axis names no parameter of the space.
+    #[error("cannot plot `{0}`: it is not a parameter of the scenario")]
+    NotAnAxis(String),
+    /// A map over no parameter, or over more than two.
+    #[error("a failure map has one or two axes, got {0}")]
+    Axes(usize),
+    /// The drawing backend failed (usually: the file cannot be written).
+    #[error("cannot draw `{path}`: {reason}")]
+    Draw {
+        /// The file being drawn.
+        path: PathBuf,
+        /// The backend's reason.
+        reason: String,
+    },
+}
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The bundled file is a valid TrueType font; a failure would only lose the labels.
+        let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
+    });
+}
+
+/// Draws one figure of `size` pixels into `stem.png` and `stem.svg`, each through a temporary
+/// file and a rename, so a failed write leaves any earlier plot whole. `png` and `svg` are the
+/// same drawing code on the two backends. Returns the two paths.
+fn png_and_svg(
+    stem: &Path,
+    size: (u32, u32),
+    png: impl Fn(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
+    svg: impl Fn(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
+) -> Result<[PathBuf; 2], PlotError> {
+    let (png_path, svg_path) = (stem.with_extension("png"), stem.with_extension("svg"));
+    let failed = |path: &Path| {
+        let path = path.to_path_buf();
+        move |reason| PlotError::Draw { path, reason }
+    };
+    crate::atomic::with_temp(&png_path, |tmp| {
+        png(BitMapBackend::new(tmp, size).into_drawing_area())
+    })
+    .map_err(failed(&png_path))?;
+    crate::atomic::with_temp(&svg_path, |tmp| {
+        svg(SVGBackend::new(tmp, size).into_drawing_area())
+    })
+    .map_err(failed(&svg_path))?;
+    Ok([png_path, svg_path])
+}
