@@ -335,10 +335,14 @@ pub fn human(summary: &Summary, scenario: &Scenario, out: &Path, expected: u64) 
                 }
             })
             .collect();
+        let values = if values.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", values.join(", "))
+        };
         lines.push(format!(
-            "first failure: test {} ({}), monitors failed: {}",
+            "first failure: test {}{values}, monitors failed: {}",
             f.id,
-            values.join(", "),
             f.failed_monitors.join(", ")
         ));
         lines.push(format!("replay it: {}", replay_command(out, f.id)));

@@ -106,7 +106,8 @@ struct Watch {
 impl Watch {
     /// Feeds one snapshot to every monitor that has not settled yet. Returns whether the test
     /// may stop: every monitor has settled, or one has settled as failed. Monitors are
-    /// independent: one settling (passed) never stops the others observing.
+    /// independent: one settling (passed) never stops the others observing. A test without
+    /// monitors runs to its horizon.
     fn observe(&mut self, snap: &Snapshot) -> bool {
         publish(snap, &mut self.signals);
         let frame = Frame {
@@ -123,7 +124,7 @@ impl Watch {
                 failed |= !m.verdict().passed;
             }
         }
-        failed || self.settled.iter().all(|&s| s)
+        failed || (!self.settled.is_empty() && self.settled.iter().all(|&s| s))
     }
 }
 

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use paracosm_generators::ParamSpace;
 
@@ -279,6 +280,12 @@ fn draw_rates<DB: DrawingBackend>(
         Rectangle::new([(x0, y0), (x1, y1)], color.filled())
     });
     chart.draw_series(rects).map_err(|e| e.to_string())?;
+    // White lines between the cells, so neighbours of one colour stay apart.
+    let borders = (0..g.cells.len()).map(|i| {
+        let (x0, x1, y0, y1) = span(i);
+        Rectangle::new([(x0, y0), (x1, y1)], WHITE.stroke_width(2))
+    });
+    chart.draw_series(borders).map_err(|e| e.to_string())?;
     let labels = g
         .cells
         .iter()
@@ -286,10 +293,11 @@ fn draw_rates<DB: DrawingBackend>(
         .filter(|(_, c)| c.1 > 0)
         .map(|(i, &(failed, n))| {
             let (x0, x1, y0, y1) = span(i);
+            let centred = Pos::new(HPos::Center, VPos::Center);
             Text::new(
                 format!("{failed}/{n}"),
-                (x0 + 0.3 * (x1 - x0), y0 + 0.6 * (y1 - y0)),
-                (FAMILY, 13).into_font().color(&BLACK),
+                ((x0 + x1) / 2.0, (y0 + y1) / 2.0),
+                (FAMILY, 13).into_font().color(&BLACK).pos(centred),
             )
         });
     chart.draw_series(labels).map_err(|e| e.to_string())?;

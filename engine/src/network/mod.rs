@@ -387,6 +387,22 @@ impl Network {
         (lo, hi)
     }
 
+    /// Distance in metres from the world point `[x, z]` to the footprint of piece `id`
+    /// (carriageway, sidewalks or plaza); `0` inside it.
+    pub fn distance_to_piece_m(&self, id: PieceId, p: [f64; 2]) -> f64 {
+        let piece = &self.pieces[id.0];
+        let inv = Pose2 {
+            x: 0.0,
+            z: 0.0,
+            heading_rad: -piece.pose.heading_rad,
+        };
+        let q = inv.apply([p[0] - piece.pose.x, p[1] - piece.pose.z]);
+        let ([hx, hz], [cx, cz]) = piece.kind.footprint();
+        let dx = ((q[0] - cx).abs() - hx).max(0.0);
+        let dz = ((q[1] - cz).abs() - hz).max(0.0);
+        dx.hypot(dz)
+    }
+
     /// The piece whose driving surface contains the world point `[x, z]`, if any.
     pub fn driving_surface_at(&self, p: [f64; 2]) -> Option<PieceId> {
         self.pieces

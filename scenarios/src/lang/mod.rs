@@ -27,6 +27,8 @@ use crate::{Scenario, ScenarioError};
 
 pub use scene::OverTime;
 
+/// The length of a test when the program does not set one with `test(horizon=)`, seconds.
+pub const DEFAULT_HORIZON_S: f64 = 15.0;
 /// Most evaluation steps (function calls and loop iterations) a program may take to load.
 pub const MAX_LOAD_STEPS: u64 = 10_000_000;
 /// Most heap a program may use to load, in bytes.

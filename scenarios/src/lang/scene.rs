@@ -300,7 +300,7 @@ pub fn finish(
         .ego
         .clone()
         .ok_or("the program places no AutonomousVehicle: nothing to test")?;
-    let horizon_s = b.horizon_s.unwrap_or(15.0);
+    let horizon_s = b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
     let world = match b.world {
         Some(w) => w,
         None => return Err("the program has no World(...)".into()),

@@ -193,3 +193,219 @@ fn stl_monitors_judge_tests_and_settle_early() {
         "{e}"
     );
 }
+
+/// A world with a road `r`, the ego `v` and a car `c` built from `car` (the keyword arguments
+/// after `loc`), `extra` lines before `place`.
+fn with_car(car: &str, extra: &str) -> String {
+    format!("{HEADER}c = Car(loc = r.onLane(1, 60){car})\n{extra}w.place(r, v, c)\nCollisionMonitor(v)\n")
+}
+
+/// Issue 14, requirement 4: every input declares its type, unit and range; what is known when
+/// the program loads is checked then, in forms beyond the shipped programs.
+#[test]
+fn inputs_of_the_wrong_kind_or_out_of_range_are_refused_at_load() {
+    let world = |args: &str| {
+        format!("w = World({args})\nr = RoadSegment(len = 200.0)\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, v)\n")
+    };
+    let walker = |args: &str| {
+        format!("{HEADER}p = Pedestrian(start = r.onLane(r.SideWalk, 100), target = r.onLane(-r.SideWalk, 100), {args})\nw.place(r, v, p)\n")
+    };
+    let cases: Vec<(String, &str, &str)> = vec![
+        (world("light = 1.5"), "World(light=) takes a number in [0, 1], got 1.5 (a number)", "1:5"),
+        (world("fog = Const(-0.1)"), "World(fog=) takes a number in [0, 1], got -0.1", "1:5"),
+        (world("fog = True"), "World(fog=) takes a number in [0, 1], got True (a bool)", "1:5"),
+        (world("fog = VarEnum([0.2, 1.5])"), "has the level 1.5 (a number)", "1:5"),
+        (
+            world("fog = VarInterval(0.2, 0.5, over_time = Piecewise(3)), light = VarInterval(-1, 1)"),
+            "World(light=) takes a number in [0, 1], but the VarInterval at bad.star:1:74 ranges over [-1, 1)",
+            "1:5",
+        ),
+        ("r = RoadSegment(friction = 0)\n".into(), "RoadSegment(friction=) takes a number in (0, 2], got 0", "1:5"),
+        (
+            "r = RoadSegment(friction = VarInterval(0, 0.5))\n".into(),
+            "takes a number in (0, 2], but the VarInterval at bad.star:1:28 ranges over [0, 0.5)",
+            "1:5",
+        ),
+        ("r = RoadSegment(friction = VarEnum([0.3, 2.5]))\n".into(), "has the level 2.5", "1:5"),
+        (with_car(", color = \"purple\"", ""), "Car(color=) takes a colour name (red, white", "4:5"),
+        (with_car(", color = VarEnum([\"red\", \"plaid\"])", ""), "has the level \"plaid\" (a string)", "4:5"),
+        (with_car(", enabled = 1", ""), "Car(enabled=) takes a bool, got 1 (a number)", "4:5"),
+        (with_car(", enabled = VarEnum([1, 0])", ""), "Car(enabled=) takes a bool", "4:5"),
+        (with_car(", speed = -3", ""), "Car(speed=) takes a number in m/s, >= 0, got -3", "4:5"),
+        (with_car(", speed = v.pos", ""), "Car(speed=) takes a number in m/s, >= 0, but this stream carries positions", "4:5"),
+        (with_car(", speed = tick.zip(tick)", ""), "but this stream carries tuples", "4:5"),
+        (walker("speed = \"slow\", trigger = tick"), "Pedestrian(speed=) takes a number in m/s, >= 0, got \"slow\"", "4:5"),
+        (walker("speed = 1.0, dist = VarInterval(-5, 5), car = v"), "Pedestrian(dist=) takes a number in m, >= 0, but", "4:5"),
+        (walker("speed = 1.0, dist = 10.0, car = 3.0"), "Pedestrian(car=) takes a position (x, y, z) in m, got 3 (a number)", "4:5"),
+        (walker("speed = 1.0, dist = 10.0, car = v.speed"), "but this stream carries numbers", "4:5"),
+    ];
+    for (src, message, at) in cases {
+        let m = err(&src);
+        assert!(m.contains(message), "{message:?} not in:\n{m}\nfor:\n{src}");
+        assert!(m.contains(&format!("bad.star:{at}")), "{at} not in:\n{m}");
+    }
+}
+
+#[test]
+fn inputs_of_the_right_kind_load_whatever_their_form() {
+    for (car, extra) in [
+        (", speed = v.speed", ""),
+        (", speed = tick.map(lambda t: 2.0)", ""),
+        (", speed = VarEnum([2, 4.5])", ""),
+        (", color = VarEnum([\"red\", \"White\"])", ""),
+        (", enabled = VarEnum([True, False])", ""),
+        (", speed = w.fog.map(lambda f: 10 * (1 - f))", ""),
+    ] {
+        let src = with_car(car, extra);
+        if let Err(e) = load_source("ok.star", &src, "ok") {
+            panic!("{car}: {e}");
+        }
+    }
+    let src = format!("{HEADER}r2 = RoadSegment(len = 50.0, friction = VarEnum([0.3, 0.9]))\nnet = r.connect((r.TWO, r2, r2.ONE))\np = Pedestrian(start = r.onLane(r.SideWalk, 100), target = r.onLane(-r.SideWalk, 100), speed = 1.0, dist = 10.0, car = v.pos.map(lambda p: p))\nw.place(r, r2, v, p)\nCollisionMonitor(v)\n");
+    load_source("ok.star", &src, "ok").unwrap();
+}
+
+/// Runs the one test of a program without open parameters.
+fn run_once(src: &str) -> Result<crate::TestOutcome, crate::ScenarioError> {
+    let s = load_source("run.star", src, "run").unwrap();
+    let a = s
+        .space
+        .decode(&paracosm_generators::Point {
+            discrete: vec![],
+            continuous: vec![],
+        })
+        .unwrap();
+    s.run(&a, 0)
+}
+
+/// Issue 14, requirement 4: a computed stream that leaves its input's type or range ends the
+/// test with an error naming the stream, the time and the value.
+#[test]
+fn computed_values_are_checked_as_the_test_runs() {
+    let fog = "w = World(fog = tick.map(lambda t: t / 2))\nr = RoadSegment(len = 200.0)\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, v)\nCollisionMonitor(v)\n";
+    let e = run_once(fog).unwrap_err().to_string();
+    // The first step past 2 s: t = 121/60 s, fog 1.0083.
+    assert!(
+        e.starts_with("at t = 2.017 s, the fog of World declared at run.star:1:5 was 1.0083333333333333 (a number); it must be a number in [0, 1]"),
+        "{e}"
+    );
+    for (speed, value) in [
+        (
+            "tick.map(lambda t: -1.0 if t > 1 else 3.0)",
+            "was -1 (a number)",
+        ),
+        ("tick.map(lambda t: t > 1)", "was False (a bool)"),
+        ("tick.map(lambda t: (t, t))", "(a tuple)"),
+    ] {
+        let e = run_once(&with_car(&format!(", speed = {speed}"), ""))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("the speed of Car declared at run.star:4:5") && e.contains(value),
+            "{speed}: {e}"
+        );
+    }
+    // Within range all along: no error.
+    run_once(&with_car(
+        ", speed = tick.map(lambda t: max(0.0, 5 - t))",
+        "",
+    ))
+    .unwrap();
+}
+
+#[test]
+fn a_parameter_in_another_unit_than_its_input_is_a_warning() {
+    let src = with_car(", speed = kmh", "").replace(
+        "w = World",
+        "kmh = VarInterval(10, 50, unit = \"km/h\")\nw = World",
+    );
+    let s = load_source("unit.star", &src, "unit").unwrap();
+    let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(
+        w.iter().any(
+            |w| w.contains("declared in km/h but feeds Car(speed=), which is in m/s")
+                && w.contains("unit.star:1:7")
+        ),
+        "{w:?}"
+    );
+}
+
+#[test]
+fn monitors_have_unique_names_and_the_default_offroad_monitor_yields_to_a_declared_one() {
+    let m = err(&format!(
+        "{HEADER}w.place(r, v)\nCollisionMonitor(v)\nCollisionMonitor(v)\n"
+    ));
+    assert!(m.contains("two monitors are named `collision`"), "{m}");
+    assert!(m.contains("bad.star:6:1"), "{m}");
+    let m = err(&format!(
+        "{HEADER}w.place(r, v)\nStl(\"ego_speed_mps > 1\", name = \"offroad\")\n"
+    ));
+    assert!(m.contains("the name of the default OffRoadMonitor"), "{m}");
+
+    let names = |src: &str| -> Vec<String> {
+        let s = load_source("m.star", src, "m").unwrap();
+        s.monitors.iter().map(|m| m.name().to_owned()).collect()
+    };
+    let base = format!("{HEADER}w.place(r, v)\nCollisionMonitor(v)\n");
+    assert_eq!(names(&base), ["collision", "offroad"]);
+    assert_eq!(
+        names(&format!(
+            "{base}TimeToFailure(OffRoadMonitor(v, name = \"lane\"), minT = 5)\n"
+        )),
+        ["collision", "time_to_failure"]
+    );
+    assert_eq!(
+        names(&format!("{base}test(offroad = False)\n")),
+        ["collision"]
+    );
+    let s = load_source("m.star", &base, "m").unwrap();
+    assert_eq!(s.passive_monitors(), ["offroad"]);
+}
+
+#[test]
+fn the_map_names_one_or_two_parameters_of_any_kind() {
+    let base = format!(
+        "c = VarEnum([\"red\", \"white\"], name = \"c\")\nf = VarInterval(0.0, 1.0)\n{}",
+        with_car(", color = c", "").replace(
+            "w = World(light = 1.0, fog = 0.0)",
+            "w = World(light = 1.0, fog = f)"
+        )
+    );
+    let axes = |map: &str| -> Result<Vec<String>, String> {
+        load_source("map.star", &format!("{base}test(map = {map})\n"), "map")
+            .map(|s| s.map_axes)
+            .map_err(|e| e.to_string())
+    };
+    assert_eq!(axes("\"c\"").unwrap(), ["c"]);
+    assert_eq!(axes("(\"c\", \"f\")").unwrap(), ["c", "f"]);
+    assert_eq!(axes("[\"f\", \"c\"]").unwrap(), ["f", "c"]);
+    let e = axes("\"nope\"").unwrap_err();
+    assert!(
+        e.contains("names `nope`, which is not a parameter (the parameters: c, f)"),
+        "{e}"
+    );
+    let e = axes("(\"c\", \"f\", \"c\")").unwrap_err();
+    assert!(e.contains("one or two parameter names"), "{e}");
+    // Without test(map=), the first two parameters, whatever their kind.
+    let s = load_source("map.star", &base, "map").unwrap();
+    assert_eq!(s.map_axes, ["c", "f"]);
+}
+
+#[test]
+fn a_test_without_monitors_runs_to_its_horizon() {
+    let src = format!("{HEADER}w.place(r, v)\ntest(horizon = 3.0, offroad = False)\n");
+    let s = load_source("none.star", &src, "none").unwrap();
+    assert!(s.monitors.is_empty());
+    assert!(s
+        .warnings
+        .iter()
+        .any(|w| w.message.contains("every test passes")));
+    let o = run_once(&src).unwrap();
+    let simulated = o
+        .metrics
+        .iter()
+        .find(|(n, _)| *n == "simulated_s")
+        .unwrap()
+        .1;
+    assert!((simulated - 3.0).abs() < 1e-9, "{simulated}");
+}

@@ -97,11 +97,22 @@ pub fn analyse(b: &SceneBuilder, names: &[String], stl_reads_light: bool) -> Usa
         }
     }
 
-    // Pieces a vehicle can be on: the ego's whole network, and every piece an NPC car's
-    // route crosses.
+    // Pieces a vehicle can be on: every piece the ego can reach within the horizon (on or off
+    // the road, at full throttle all the way: the engine bounds any system's acceleration),
+    // and every piece an NPC car's route crosses.
     let mut driven: HashSet<PieceId> = HashSet::new();
     if let Some(ego) = &b.ego {
-        driven.extend(b.roads.group_of(ego.start.piece));
+        let t = b.horizon_s.unwrap_or(crate::lang::DEFAULT_HORIZON_S);
+        let vehicle = paracosm_engine::VehicleParams::default();
+        // Two driven wheels (rear-wheel drive).
+        let a = 2.0 * vehicle.max_engine_force_n / vehicle.mass_kg;
+        let reach_m = ego.initial_speed_mps * t + 0.5 * a * t * t;
+        let start = [ego.start.pos_m[0], ego.start.pos_m[2]];
+        driven.extend(
+            (0..b.roads.pieces().len())
+                .map(PieceId)
+                .filter(|&id| b.roads.distance_to_piece_m(id, start) <= reach_m),
+        );
     }
     let surface = Surface::new(&b.roads);
     for c in &b.cars {
@@ -142,9 +153,9 @@ pub fn analyse(b: &SceneBuilder, names: &[String], stl_reads_light: bool) -> Usa
             usage.warnings.push(Warning {
                 at: decl.at.clone(),
                 message: format!(
-                    "`{name}` sets the friction of {}, where no vehicle ever drives (it is not \
-                     connected to the ego's road and no car's route crosses it): it cannot \
-                     affect the ego",
+                    "`{name}` sets the friction of {}, where no vehicle can be during a test (the \
+                     ego cannot get there within the horizon even at full throttle, and no car's \
+                     route crosses it): it cannot affect the ego",
                     pieces.into_iter().collect::<Vec<_>>().join(", ")
                 ),
             });
