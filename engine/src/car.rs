@@ -37,6 +37,8 @@ pub(crate) struct Car {
     /// Speed the tyres hold (the command, limited to `μ·g` of change per second), m/s;
     /// `None` before the first step.
     rolling: Option<f64>,
+    /// Ground point `[x, z]` (m) and heading (rad) at `s`, kept from the last move.
+    here: ([f64; 2], f64),
     half_height: f64,
     /// Half length and half width, metres.
     pub(crate) half_size_m: [f64; 2],
@@ -61,9 +63,11 @@ impl Car {
             s: 0.0,
             speed: 0.0,
             rolling: None,
+            here: ([0.0; 2], 0.0),
             half_height: size_m[1] / 2.0,
             half_size_m: [size_m[0] / 2.0, size_m[2] / 2.0],
         };
+        car.here = car.at(0.0);
         if enabled {
             let pose = car.pose();
             let body = RigidBodyBuilder::kinematic_position_based().pose(pose);
@@ -96,7 +100,7 @@ impl Car {
     }
 
     fn pose(&self) -> Pose {
-        let ([x, z], h) = self.at(self.s);
+        let ([x, z], h) = self.here;
         Pose::from_parts(
             Vector::new(x as f32, (CLEARANCE_M + self.half_height) as f32, z as f32),
             Rotation::from_rotation_y(h as f32),
@@ -105,7 +109,7 @@ impl Car {
 
     /// The ground point `[x, z]` under the car now, metres.
     pub(crate) fn ground_m(&self) -> [f64; 2] {
-        self.at(self.s).0
+        self.here.0
     }
 
     /// Drives one step of `dt_s` toward the commanded `speed_mps` (negative counts as 0) on a
@@ -132,6 +136,7 @@ impl Car {
         // At the end of its path the car has stopped.
         self.rolling = Some(if self.s >= end { 0.0 } else { rolling });
         self.speed = (self.s - before) / dt_s;
+        self.here = self.at(self.s);
         if let Some((body, _)) = self.body {
             let pose = self.pose();
             physics.bodies[body].set_next_kinematic_position(pose);
@@ -141,7 +146,7 @@ impl Car {
     /// The car as the time-to-collision test sees it, `None` when it is not in this test.
     pub(crate) fn mover(&self) -> Option<crate::ttc::Mover> {
         self.body?;
-        let ([x, z], heading_rad) = self.at(self.s);
+        let ([x, z], heading_rad) = self.here;
         Some(crate::ttc::Mover {
             pos_m: [x, z],
             velocity_mps: [
@@ -154,7 +159,7 @@ impl Car {
     }
 
     pub(crate) fn state(&self) -> CarState {
-        let ([x, z], heading_rad) = self.at(self.s);
+        let ([x, z], heading_rad) = self.here;
         CarState {
             pos_m: [x, 0.0, z],
             heading_rad,

@@ -1,6 +1,4 @@
-use std::ops::ControlFlow;
-
-use crate::{Frame, Monitor, Verdict};
+use crate::flag::{flag_monitor, FlagMonitor};
 
 /// Fails on any contact between the ego vehicle and another body (paper §2,
 /// `CollisionMonitor`: "assert(v.collider.isEmpty())").
@@ -8,16 +6,10 @@ use crate::{Frame, Monitor, Verdict};
 /// Reads two signals: a boolean contact flag and the separation between the two bodies in
 /// metres (`0` when touching). Robustness is the minimum separation over the run, and `<= 0`
 /// whenever a contact was seen even if the separation signal lagged. The verdict is settled
-/// at the first contact, so `observe` returns `Break` there.
+/// at the first contact, so `observe` returns `Break` there. Metric `min_distance_m`: the
+/// minimum separation.
 #[derive(Debug, Clone)]
-pub struct CollisionMonitor {
-    name: String,
-    contact_signal: &'static str,
-    separation_signal: &'static str,
-    min_separation_m: f64,
-    first_contact_s: Option<f64>,
-    broken_trace: bool,
-}
+pub struct CollisionMonitor(FlagMonitor);
 
 impl CollisionMonitor {
     /// A collision monitor reading `contact_signal` (boolean) and `separation_signal` (m).
@@ -26,78 +18,27 @@ impl CollisionMonitor {
         contact_signal: &'static str,
         separation_signal: &'static str,
     ) -> Self {
-        CollisionMonitor {
-            name: name.into(),
+        CollisionMonitor(FlagMonitor::new(
+            name.into(),
             contact_signal,
             separation_signal,
-            min_separation_m: f64::INFINITY,
-            first_contact_s: None,
-            broken_trace: false,
-        }
+            "min_distance_m",
+        ))
     }
 }
 
-impl Monitor for CollisionMonitor {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn observe(&mut self, frame: &Frame<'_>) -> ControlFlow<()> {
-        let (Ok(contact), Ok(sep)) = (
-            frame.signals.get_bool(self.contact_signal),
-            frame.signals.get(self.separation_signal),
-        ) else {
-            self.broken_trace = true;
-            self.first_contact_s.get_or_insert(frame.t_s);
-            return ControlFlow::Break(());
-        };
-        self.min_separation_m = self.min_separation_m.min(sep);
-        if contact {
-            self.min_separation_m = self.min_separation_m.min(0.0);
-            self.first_contact_s.get_or_insert(frame.t_s);
-            return ControlFlow::Break(());
-        }
-        ControlFlow::Continue(())
-    }
-
-    fn verdict(&self) -> Verdict {
-        let robustness = if self.broken_trace {
-            f64::NEG_INFINITY
-        } else {
-            self.min_separation_m
-        };
-        Verdict {
-            passed: self.first_contact_s.is_none() && robustness > 0.0,
-            robustness,
-            first_violation_s: self.first_contact_s,
-            metrics: vec![("min_distance_m", self.min_separation_m)],
-        }
-    }
-}
+flag_monitor!(CollisionMonitor);
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Signals;
+    use crate::{Frame, Monitor, Signals, Verdict};
 
     fn run(trace: &[(f64, bool, f64)]) -> (Verdict, usize) {
-        let mut m = CollisionMonitor::new("collision", "contact", "sep");
-        let mut seen = 0;
-        for &(t, c, d) in trace {
-            let mut s = Signals::new();
-            s.set_bool("contact", c);
-            s.set("sep", d);
-            seen += 1;
-            if m.observe(&Frame {
-                t_s: t,
-                signals: &s,
-            })
-            .is_break()
-            {
-                break;
-            }
-        }
-        (m.verdict(), seen)
+        crate::flag::feed(
+            &mut CollisionMonitor::new("collision", "flag", "margin"),
+            trace,
+        )
     }
 
     #[test]
@@ -121,7 +62,7 @@ mod tests {
 
     #[test]
     fn a_trace_without_the_signals_fails_instead_of_panicking() {
-        let mut m = CollisionMonitor::new("collision", "contact", "sep");
+        let mut m = CollisionMonitor::new("collision", "flag", "margin");
         let s = Signals::new();
         assert!(m
             .observe(&Frame {

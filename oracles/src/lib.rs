@@ -15,6 +15,7 @@
 
 mod collision;
 mod distance;
+mod flag;
 mod monitor;
 mod off_road;
 mod signals;

@@ -1,6 +1,4 @@
-use std::ops::ControlFlow;
-
-use crate::{Frame, Monitor, Verdict};
+use crate::flag::{flag_monitor, FlagMonitor};
 
 /// Fails when the ego vehicle leaves the drivable surface: a sidewalk, an island, the ground
 /// beside the road or beyond a dead end (issue 14; the paper's §2 lists monitors as user code,
@@ -12,14 +10,7 @@ use crate::{Frame, Monitor, Verdict};
 /// how far off it went when it did not. The verdict is settled at the first frame off the road,
 /// so `observe` returns `Break` there. Metric `min_road_edge_m`: that same smallest distance.
 #[derive(Debug, Clone)]
-pub struct OffRoadMonitor {
-    name: String,
-    off_road_signal: &'static str,
-    edge_signal: &'static str,
-    min_edge_m: f64,
-    first_off_s: Option<f64>,
-    broken_trace: bool,
-}
+pub struct OffRoadMonitor(FlagMonitor);
 
 impl OffRoadMonitor {
     /// A monitor reading `off_road_signal` (boolean) and `edge_signal` (signed distance, m).
@@ -28,78 +19,24 @@ impl OffRoadMonitor {
         off_road_signal: &'static str,
         edge_signal: &'static str,
     ) -> Self {
-        OffRoadMonitor {
-            name: name.into(),
+        OffRoadMonitor(FlagMonitor::new(
+            name.into(),
             off_road_signal,
             edge_signal,
-            min_edge_m: f64::INFINITY,
-            first_off_s: None,
-            broken_trace: false,
-        }
+            "min_road_edge_m",
+        ))
     }
 }
 
-impl Monitor for OffRoadMonitor {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn observe(&mut self, frame: &Frame<'_>) -> ControlFlow<()> {
-        let (Ok(off), Ok(edge)) = (
-            frame.signals.get_bool(self.off_road_signal),
-            frame.signals.get(self.edge_signal),
-        ) else {
-            self.broken_trace = true;
-            self.first_off_s.get_or_insert(frame.t_s);
-            return ControlFlow::Break(());
-        };
-        self.min_edge_m = self.min_edge_m.min(edge);
-        if off {
-            self.min_edge_m = self.min_edge_m.min(0.0);
-            self.first_off_s.get_or_insert(frame.t_s);
-            return ControlFlow::Break(());
-        }
-        ControlFlow::Continue(())
-    }
-
-    fn verdict(&self) -> Verdict {
-        let robustness = if self.broken_trace {
-            f64::NEG_INFINITY
-        } else {
-            self.min_edge_m
-        };
-        Verdict {
-            passed: self.first_off_s.is_none() && robustness > 0.0,
-            robustness,
-            first_violation_s: self.first_off_s,
-            metrics: vec![("min_road_edge_m", self.min_edge_m)],
-        }
-    }
-}
+flag_monitor!(OffRoadMonitor);
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Signals;
+    use crate::{Frame, Monitor, Signals, Verdict};
 
     fn run(trace: &[(f64, bool, f64)]) -> (Verdict, usize) {
-        let mut m = OffRoadMonitor::new("offroad", "off", "edge");
-        let mut seen = 0;
-        for &(t, off, edge) in trace {
-            let mut s = Signals::new();
-            s.set_bool("off", off);
-            s.set("edge", edge);
-            seen += 1;
-            if m.observe(&Frame {
-                t_s: t,
-                signals: &s,
-            })
-            .is_break()
-            {
-                break;
-            }
-        }
-        (m.verdict(), seen)
+        crate::flag::feed(&mut OffRoadMonitor::new("offroad", "flag", "margin"), trace)
     }
 
     #[test]
@@ -107,6 +44,7 @@ mod tests {
         let (v, seen) = run(&[(0.0, false, 1.75), (0.1, false, 0.4), (0.2, false, 1.0)]);
         assert!(v.passed);
         assert_eq!(v.robustness, 0.4);
+        assert_eq!(v.metrics, vec![("min_road_edge_m", 0.4)]);
         assert_eq!(seen, 3);
     }
 
@@ -121,7 +59,7 @@ mod tests {
 
     #[test]
     fn a_trace_without_the_signals_fails() {
-        let mut m = OffRoadMonitor::new("offroad", "off", "edge");
+        let mut m = OffRoadMonitor::new("offroad", "flag", "margin");
         let s = Signals::new();
         assert!(m
             .observe(&Frame {

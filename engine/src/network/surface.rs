@@ -39,6 +39,8 @@ enum Shape {
 #[derive(Debug, Clone)]
 struct PieceShape {
     pose: Pose2,
+    /// `(sin, cos)` of the pose's heading, so a query needs no trigonometry.
+    sin_cos: (f64, f64),
     shape: Shape,
     /// Half extents `[x, z]` and centre of the whole footprint (sidewalks included).
     footprint: ([f64; 2], [f64; 2]),
@@ -47,24 +49,19 @@ struct PieceShape {
     connected: [bool; 4],
 }
 
-/// A lane's centre line: a polyline in world `[x, z]` metres, in its direction of travel.
-#[derive(Debug, Clone)]
-struct LaneLine {
-    piece: usize,
-    points: Vec<[f64; 2]>,
-}
-
 /// Point queries on a [`Network`]'s surface, precomputed once per world.
 #[derive(Debug, Clone)]
 pub struct Surface {
     pieces: Vec<PieceShape>,
-    lanes: Vec<LaneLine>,
+    /// Each piece's lane centre lines: polylines in world `[x, z]` metres, in their direction
+    /// of travel.
+    lanes: Vec<Vec<Vec<[f64; 2]>>>,
 }
 
 impl PieceShape {
     /// `p` in the piece's own frame.
     fn local(&self, p: [f64; 2]) -> [f64; 2] {
-        let (s, c) = self.pose.heading_rad.sin_cos();
+        let (s, c) = self.sin_cos;
         let (dx, dz) = (p[0] - self.pose.x, p[1] - self.pose.z);
         [dx * c - dz * s, dx * s + dz * c]
     }
@@ -140,23 +137,22 @@ impl PieceShape {
     }
 }
 
-/// The distance from `p` to segment `a b` and the signed lateral offset of `p` from the line
-/// through them (positive to the right of the direction `a → b`), metres.
+/// The squared distance from `p` to segment `a b` (m²), the signed lateral offset of `p` from
+/// the line through them (m, positive to the right of the direction `a → b`), and that
+/// direction, not normalised.
 fn segment_offset(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64, [f64; 2]) {
     let d = [b[0] - a[0], b[1] - a[1]];
-    let len = d[0].hypot(d[1]);
-    if len == 0.0 {
-        let dist = (p[0] - a[0]).hypot(p[1] - a[1]);
-        return (dist, dist, [1.0, 0.0]);
-    }
-    let u = [d[0] / len, d[1] / len];
     let rel = [p[0] - a[0], p[1] - a[1]];
-    let t = (rel[0] * u[0] + rel[1] * u[1]).clamp(0.0, len);
-    let q = [a[0] + t * u[0], a[1] + t * u[1]];
-    let dist = (p[0] - q[0]).hypot(p[1] - q[1]);
-    // Right of a driver heading along u: (-u_z, u_x) in the (x, z) plane.
-    let lateral = rel[0] * -u[1] + rel[1] * u[0];
-    (dist, lateral, u)
+    let len2 = d[0] * d[0] + d[1] * d[1];
+    if len2 == 0.0 {
+        let dist2 = rel[0] * rel[0] + rel[1] * rel[1];
+        return (dist2, dist2.sqrt(), d);
+    }
+    let t = ((rel[0] * d[0] + rel[1] * d[1]) / len2).clamp(0.0, 1.0);
+    let (ex, ez) = (rel[0] - t * d[0], rel[1] - t * d[1]);
+    // Right of a driver heading along d: (-d_z, d_x) in the (x, z) plane.
+    let lateral = (rel[1] * d[0] - rel[0] * d[1]) / len2.sqrt();
+    (ex * ex + ez * ez, lateral, d)
 }
 
 impl Surface {
@@ -174,6 +170,7 @@ impl Surface {
             .zip(&connected)
             .map(|(p, &connected)| PieceShape {
                 pose: p.pose,
+                sin_cos: p.pose.heading_rad.sin_cos(),
                 shape: match p.kind {
                     PieceKind::Segment { length_m, .. } => Shape::Segment {
                         length_m,
@@ -191,10 +188,12 @@ impl Surface {
             })
             .collect();
         let lanes = (0..network.pieces().len())
-            .flat_map(|i| network.lane_paths(PieceId(i)))
-            .map(|l| LaneLine {
-                piece: l.piece.0,
-                points: l.points,
+            .map(|i| {
+                network
+                    .lane_paths(PieceId(i))
+                    .into_iter()
+                    .map(|l| l.points)
+                    .collect()
             })
             .collect();
         debug_assert!(PORT_NAMES.len() == 4);
@@ -222,21 +221,23 @@ impl Surface {
     /// distance to the nearest driving surface). Sidewalks, islands and the ground beyond a
     /// dead end are off the surface.
     pub fn edge_distance_m(&self, p: [f64; 2]) -> f64 {
+        // On the road: the largest inside distance over the pieces whose footprint holds the
+        // point (the others' would be negative). Off it: the distance to the nearest piece.
         let mut inside = f64::NEG_INFINITY;
-        let mut outside = f64::INFINITY;
         for s in &self.pieces {
-            let d = s.signed_edge_m(s.local(p));
-            if d >= 0.0 {
-                inside = inside.max(d);
-            } else {
-                outside = outside.min(-d);
+            let q = s.local(p);
+            if s.in_footprint(q, 0.0) {
+                inside = inside.max(s.signed_edge_m(q));
             }
         }
         if inside >= 0.0 {
-            inside
-        } else {
-            -outside
+            return inside;
         }
+        -self
+            .pieces
+            .iter()
+            .map(|s| -s.signed_edge_m(s.local(p)))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Whether the world point `[x, z]` is on no driving surface of the network.
@@ -249,22 +250,24 @@ impl Surface {
     /// right of that direction (the nearest lane of any direction when none agrees; NaN for a
     /// network without lanes). Lanes inside junctions are their turning paths.
     pub fn lane_offset_m(&self, p: [f64; 2], heading_rad: f64) -> f64 {
-        let near: Vec<bool> = self
-            .pieces
-            .iter()
-            .map(|s| s.in_footprint(s.local(p), 2.0))
-            .collect();
-        let any_near = near.iter().any(|&n| n);
+        // The lanes of the pieces around the point, or of every piece when it is off them all.
+        let near = |i: &usize| {
+            let s = &self.pieces[*i];
+            s.in_footprint(s.local(p), 2.0)
+        };
+        let any_near = (0..self.pieces.len()).any(|i| near(&i));
         let h = direction(heading_rad);
         let (mut agreeing, mut any) = ((f64::INFINITY, f64::NAN), (f64::INFINITY, f64::NAN));
-        for lane in self.lanes.iter().filter(|l| !any_near || near[l.piece]) {
-            for w in lane.points.windows(2) {
-                let (dist, lateral, u) = segment_offset(p, w[0], w[1]);
-                if dist < any.0 {
-                    any = (dist, lateral);
-                }
-                if u[0] * h[0] + u[1] * h[1] > 0.0 && dist < agreeing.0 {
-                    agreeing = (dist, lateral);
+        for i in (0..self.pieces.len()).filter(|i| !any_near || near(i)) {
+            for line in &self.lanes[i] {
+                for w in line.windows(2) {
+                    let (dist2, lateral, u) = segment_offset(p, w[0], w[1]);
+                    if dist2 < any.0 {
+                        any = (dist2, lateral);
+                    }
+                    if u[0] * h[0] + u[1] * h[1] > 0.0 && dist2 < agreeing.0 {
+                        agreeing = (dist2, lateral);
+                    }
                 }
             }
         }

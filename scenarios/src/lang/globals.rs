@@ -746,9 +746,9 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
     }
 
     /// `Stl(formula, name="stl")`: a signal temporal logic property over the runner's
-    /// signals (`ego_x_m`, `ego_z_m`, `ego_speed_mps`, `ego_contact`, `ego_separation_m`,
-    /// `ego_ttc_s`, `fog`, `light`), judged at the start of the test; robustness in the formula's units.
-    /// The formula is parsed when the program loads: a syntax error shows a caret.
+    /// signals ([`crate::signal::ALL`]), judged at the start of the test; robustness in the
+    /// formula's units. The formula is parsed when the program loads: a syntax error shows a
+    /// caret, an unknown signal is named.
     fn Stl<'v>(
         #[starlark(require = pos)] formula: &str,
         #[starlark(require = named)] name: Option<&str>,

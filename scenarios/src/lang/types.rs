@@ -46,42 +46,36 @@ pub struct Input {
     pub kind: Kind,
 }
 
-const fn number(keyword: &'static str, unit: &'static str, min: f64, max: f64) -> Input {
+const fn number(
+    keyword: &'static str,
+    unit: &'static str,
+    min: f64,
+    max: f64,
+    min_open: bool,
+) -> Input {
     Input {
         keyword,
         kind: Kind::Number {
             unit,
             min,
             max,
-            min_open: false,
-        },
-    }
-}
-
-const fn positive(keyword: &'static str, unit: &'static str, max: f64) -> Input {
-    Input {
-        keyword,
-        kind: Kind::Number {
-            unit,
-            min: 0.0,
-            max,
-            min_open: true,
+            min_open,
         },
     }
 }
 
 /// `World(light=)`: `[0, 1]`, 0.5 nominal daylight.
-pub const LIGHT: Input = number("light", "", 0.0, 1.0);
+pub const LIGHT: Input = number("light", "", 0.0, 1.0, false);
 /// `World(fog=)`: `[0, 1]`.
-pub const FOG: Input = number("fog", "", 0.0, 1.0);
+pub const FOG: Input = number("fog", "", 0.0, 1.0, false);
 /// `friction=` of every road piece: `(0, 2]`.
-pub const FRICTION: Input = positive("friction", "", 2.0);
+pub const FRICTION: Input = number("friction", "", 0.0, 2.0, true);
 /// `Car(speed=)`, m/s, `>= 0`.
-pub const CAR_SPEED: Input = number("speed", "m/s", 0.0, f64::INFINITY);
+pub const CAR_SPEED: Input = number("speed", "m/s", 0.0, f64::INFINITY, false);
 /// `Pedestrian(speed=)`, m/s, `>= 0`.
-pub const PEDESTRIAN_SPEED: Input = number("speed", "m/s", 0.0, f64::INFINITY);
+pub const PEDESTRIAN_SPEED: Input = number("speed", "m/s", 0.0, f64::INFINITY, false);
 /// `Pedestrian(dist=)`, m, `>= 0`.
-pub const TRIGGER_DISTANCE: Input = number("dist", "m", 0.0, f64::INFINITY);
+pub const TRIGGER_DISTANCE: Input = number("dist", "m", 0.0, f64::INFINITY, false);
 /// `Pedestrian(car=)`: a position stream (or an actor, whose `pos` it reads).
 pub const WATCHED_POSITION: Input = Input {
     keyword: "car",
