@@ -120,3 +120,22 @@ pub(crate) fn feed(m: &mut dyn Monitor, trace: &[(f64, bool, f64)]) -> (Verdict,
     }
     (m.verdict(), seen)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_trace_without_the_signals_fails_instead_of_panicking() {
+        let mut m = FlagMonitor::new("m".into(), "flag", "margin", "min_m");
+        let s = crate::Signals::new();
+        let frame = Frame {
+            t_s: 0.0,
+            signals: &s,
+        };
+        assert!(m.observe(&frame).is_break());
+        assert!(!m.verdict().passed);
+        assert_eq!(m.verdict().robustness, f64::NEG_INFINITY);
+        assert_eq!(m.verdict().first_violation_s, Some(0.0));
+    }
+}
