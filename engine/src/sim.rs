@@ -92,6 +92,8 @@ pub struct Simulation {
     speeds: (Vec<StreamId>, Vec<StreamId>),
     environment: EnvironmentSpec,
     light_fog: (f64, f64),
+    /// Pieces whose friction varies over the test, and their streams.
+    frictions: Vec<(crate::network::PieceId, StreamId)>,
     streams: Runtime,
     sinks: Vec<(u32, Value)>,
     touching: Vec<bool>,
@@ -179,6 +181,7 @@ impl Simulation {
             .iter()
             .map(|p| p.speed)
             .chain(spec.cars.iter().map(|c| c.speed))
+            .chain(spec.frictions.iter().map(|f| f.1))
             .chain([spec.environment.light, spec.environment.fog]);
         for id in ids {
             if id.0 >= n {
@@ -204,6 +207,7 @@ impl Simulation {
                 spec.cars.iter().map(|c| c.speed).collect(),
             ),
             environment: spec.environment,
+            frictions: spec.frictions.clone(),
             // Known before the first step when they are constants (a camera frame at t = 0
             // needs them); time-varying ones are set by the first step.
             light_fog: (
@@ -377,10 +381,9 @@ impl Simulation {
     /// wrong kind).
     pub fn step(&mut self, control: Control, host: &mut dyn Host) -> Result<(), EngineError> {
         let dt = self.dt_s;
-        self.ego.apply(control, dt);
-        self.ego.grip(&self.physics, &self.surface);
-        self.ego.update(&mut self.physics, dt);
         let t = self.t_s();
+        // The streams first, from the world as it is at the start of the step: light, fog
+        // and frictions then hold for the whole step.
         self.sinks.clear();
         let inputs = WorldInputs {
             physics: &self.physics,
@@ -391,15 +394,18 @@ impl Simulation {
         };
         self.streams.step(t, &inputs, host, &mut self.sinks)?;
         self.light_fog = (
-            number(
-                &self.streams,
-                self.environment.light,
-                NOMINAL_LIGHT,
-                t,
-                "the light",
-            )?,
+            number(&self.streams, self.environment.light, NOMINAL_LIGHT, t, "the light")?,
             number(&self.streams, self.environment.fog, 0.0, t, "the fog")?,
         );
+        for &(piece, stream) in &self.frictions {
+            let mu = self.network.piece(piece).kind.friction();
+            let what = format!("the friction of {}", self.network.piece(piece).name);
+            let mu = number(&self.streams, stream, mu, t, &what)?;
+            self.surface.set_friction(piece, mu);
+        }
+        self.ego.apply(control, dt);
+        self.ego.grip(&self.physics, &self.surface);
+        self.ego.update(&mut self.physics, dt);
         for p in &mut self.pedestrians {
             p.rest();
         }

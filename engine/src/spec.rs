@@ -65,8 +65,11 @@ pub struct EnvironmentSpec {
 pub struct WorldSpec {
     /// Physics step in seconds, `> 0`. Default [`DEFAULT_DT_S`].
     pub dt_s: f64,
-    /// The roads.
+    /// The roads, with the friction each piece has at the start.
     pub network: Network,
+    /// Pieces whose friction varies over the test: each piece and its friction stream (in
+    /// `(0, 2]`), read every step; the other pieces keep their friction.
+    pub frictions: Vec<(PieceId, StreamId)>,
     /// The ego vehicle.
     pub ego: EgoSpec,
     /// Pedestrians, in order; pedestrian `i` walks on sink [`crate::behaviour::walk_sink`]`(i)`.
@@ -141,6 +144,7 @@ impl WorldSpec {
         Ok(WorldSpec {
             dt_s: DEFAULT_DT_S,
             network,
+            frictions: vec![],
             ego: EgoSpec {
                 start,
                 initial_speed_mps,

@@ -66,6 +66,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
     WorldSpec {
         dt_s: DEFAULT_DT_S,
         network,
+        frictions: vec![],
         ego: EgoSpec {
             start,
             initial_speed_mps: speed_mps,

@@ -19,7 +19,7 @@ use std::path::Path;
 
 pub use error::ScenarioError;
 pub use runner::{signal, RunOptions, TestOutcome};
-pub use scenario::{Lambdas, MonitorSpec, Scenario, Template};
+pub use scenario::{CameraOnly, MonitorSpec, RustWorlds, Scenario, Warning, Worlds};
 
 use paracosm_generators::Assignment;
 

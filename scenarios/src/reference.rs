@@ -72,8 +72,7 @@ pub fn scenario() -> Scenario {
         warnings: vec![],
         unused_params: vec![],
         camera_only: vec![],
-        template: Arc::new(world),
-        lambdas: None,
+        worlds: Arc::new(crate::scenario::RustWorlds(world)),
         source: Arc::from(""),
     }
 }

@@ -1,6 +1,6 @@
 use std::ops::ControlFlow;
 
-use paracosm_engine::rx::{Host, NoHost};
+use paracosm_engine::rx::Host;
 use paracosm_engine::{CameraFrame, CameraSpec, Control, Simulation, Snapshot, WorldSpec};
 use paracosm_generators::Assignment;
 use paracosm_oracles::{Frame, Monitor, Signals, Verdict};
@@ -166,17 +166,11 @@ impl Scenario {
         seed: u64,
         options: &mut RunOptions<'_>,
     ) -> Result<TestOutcome, ScenarioError> {
-        let spec = self.instantiate(assignment)?;
-        match &self.lambdas {
-            None => self.run_world(&spec, seed, &mut NoHost, options),
-            Some(lambdas) => {
-                let mut out = None;
-                lambdas.with_host(&mut |host| {
-                    out = Some(self.run_world(&spec, seed, host, options));
-                });
-                out.expect("with_host calls its closure")
-            }
-        }
+        let mut out = None;
+        self.worlds.with_world(assignment, &mut |spec, host| {
+            out = Some(self.run_world(spec, seed, host, options));
+        })?;
+        out.ok_or_else(|| ScenarioError::Language("no world was built".into()))?
     }
 
     fn run_world(

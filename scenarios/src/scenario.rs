@@ -204,20 +204,40 @@ pub struct Scenario {
     /// The program text it was loaded from (empty for scenarios written in Rust): part of a
     /// campaign's fingerprint, so a resumed campaign runs the same program.
     pub source: Arc<str>,
-    /// Builds the world for an assignment of the open parameters.
-    pub(crate) template: Template,
-    /// Runs the lambdas of the world's stream graph (Starlark scenarios); `None`: native only.
-    pub(crate) lambdas: Option<Arc<dyn Lambdas>>,
+    /// Builds each test's world.
+    pub(crate) worlds: Arc<dyn Worlds>,
 }
 
-/// A world template: assignment in, world out.
-pub type Template = Arc<dyn Fn(&Assignment) -> Result<WorldSpec, ScenarioError> + Send + Sync>;
+/// Builds the world of each test (paper §3.1: a test case closes every open stream).
+pub trait Worlds: Send + Sync {
+    /// Builds the world for `assignment` and calls `run` with it and a host for its lambdas
+    /// (a Starlark program's: each test gets its own evaluation of the program, heap and
+    /// evaluator), for the duration of the test.
+    ///
+    /// # Errors
+    /// [`ScenarioError::MissingParam`] for an assignment that lacks a parameter;
+    /// [`ScenarioError::Language`] or [`ScenarioError::Engine`] when these values give an
+    /// impossible world.
+    fn with_world(
+        &self,
+        assignment: &Assignment,
+        run: &mut dyn FnMut(&WorldSpec, &mut dyn Host),
+    ) -> Result<(), ScenarioError>;
+}
 
-/// A source of [`Host`]s for a world's lambdas: each test gets a fresh one (its own heap and
-/// evaluator), handed to `f` for the duration of the test.
-pub trait Lambdas: Send + Sync {
-    /// Calls `f` with a host for one test.
-    fn with_host(&self, f: &mut dyn FnMut(&mut dyn Host));
+/// Worlds built by a Rust function, whose streams call no lambda.
+pub struct RustWorlds(pub fn(&Assignment) -> Result<WorldSpec, ScenarioError>);
+
+impl Worlds for RustWorlds {
+    fn with_world(
+        &self,
+        assignment: &Assignment,
+        run: &mut dyn FnMut(&WorldSpec, &mut dyn Host),
+    ) -> Result<(), ScenarioError> {
+        let spec = (self.0)(assignment)?;
+        run(&spec, &mut paracosm_engine::rx::NoHost);
+        Ok(())
+    }
 }
 
 impl Scenario {
@@ -262,7 +282,10 @@ impl Scenario {
     /// [`ScenarioError::MissingParam`] for an assignment that lacks a parameter, and
     /// [`ScenarioError::Engine`] when the values give an impossible world.
     pub fn instantiate(&self, assignment: &Assignment) -> Result<WorldSpec, ScenarioError> {
-        (self.template)(assignment)
+        let mut out = None;
+        self.worlds
+            .with_world(assignment, &mut |spec, _| out = Some(spec.clone()))?;
+        out.ok_or_else(|| ScenarioError::Language("no world was built".into()))
     }
 }
 

@@ -129,13 +129,7 @@ impl Network {
     /// # Errors
     /// [`EngineError::InvalidWorld`] for a friction outside `(0, 2]`.
     pub fn set_friction(&mut self, id: PieceId, friction: f64) -> Result<(), EngineError> {
-        let mut kind = self.pieces[id.0].kind.clone();
-        match &mut kind {
-            PieceKind::Segment { friction: f, .. }
-            | PieceKind::TIntersection { friction: f, .. }
-            | PieceKind::CrossIntersection { friction: f, .. }
-            | PieceKind::Roundabout { friction: f, .. } => *f = friction,
-        }
+        let kind = self.pieces[id.0].kind.with_friction(friction);
         kind.validate()?;
         self.pieces[id.0].kind = kind;
         Ok(())

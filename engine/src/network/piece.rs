@@ -98,6 +98,18 @@ impl PieceKind {
         }
     }
 
+    /// The same piece with friction `mu` (not checked; see [`PieceKind::validate`]).
+    pub fn with_friction(&self, mu: f64) -> PieceKind {
+        let mut k = self.clone();
+        match &mut k {
+            PieceKind::Segment { friction, .. }
+            | PieceKind::TIntersection { friction, .. }
+            | PieceKind::CrossIntersection { friction, .. }
+            | PieceKind::Roundabout { friction, .. } => *friction = mu,
+        }
+        k
+    }
+
     /// Half the width of the driving surface of its roads, in metres.
     pub fn half_road_m(&self) -> f64 {
         self.lanes() as f64 * LANE_WIDTH_M / 2.0

@@ -200,6 +200,14 @@ impl Surface {
         Surface { pieces, lanes }
     }
 
+    /// Sets the friction of piece `id` (a friction that varies over the test); an id not of
+    /// this network is ignored.
+    pub fn set_friction(&mut self, id: PieceId, friction: f64) {
+        if let Some(p) = self.pieces.get_mut(id.0) {
+            p.friction = friction;
+        }
+    }
+
     /// The piece whose footprint (carriageway, sidewalks, plaza) contains the world point
     /// `[x, z]` (m), if any; the first in network order where two touch.
     pub fn piece_under(&self, p: [f64; 2]) -> Option<PieceId> {

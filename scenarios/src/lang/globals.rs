@@ -18,9 +18,7 @@ use starlark::values::list::UnpackList;
 use starlark::values::none::NoneType;
 use starlark::values::{ProvidesStaticType, UnpackValue, Value, ValueLike};
 
-use super::scene::{
-    turns, Fixed, ObjectDecl, OverTime, ParamDecl, PedTrigger, Pending, SceneBuilder,
-};
+use super::scene::{turns, ObjectDecl, OverTime, ParamDecl, PedTrigger, Pending, SceneBuilder};
 use super::types;
 use super::values::{
     ActorKind, ActorVal, LaneSide, Loc, MonitorVal, OverTimeVal, Road, Stream, WorldVal,
@@ -34,10 +32,12 @@ pub struct LoadState {
     pub scene: RefCell<SceneBuilder>,
 }
 
-impl Default for LoadState {
-    fn default() -> Self {
+impl LoadState {
+    /// The state of an evaluation that gives the open parameters `values` (by declaration
+    /// index; `None`: their representative values).
+    pub fn new(values: Option<Vec<super::scene::ParamValue>>) -> Self {
         LoadState {
-            scene: RefCell::new(SceneBuilder::new()),
+            scene: RefCell::new(SceneBuilder::new(values)),
         }
     }
 }
@@ -70,6 +70,12 @@ pub fn number(v: Value, what: &str) -> anyhow::Result<f64> {
         if let Ok(x) = v.to_str().parse::<f64>() {
             return Ok(x);
         }
+    }
+    if v.downcast_ref::<Stream>().is_some() {
+        bail!(
+            "{what} takes one number for the whole test, but got a stream, which has no single \
+             value (an open parameter that varies over time is one)"
+        );
     }
     bail!("{what} must be a number, got a {}", v.get_type())
 }
@@ -112,48 +118,46 @@ fn typed_arg(
     types::typed_stream(b, id, input, owner, at)
 }
 
-/// A value fixed for a test for `input` of `owner`, with every value it can take checked.
-fn fixed_typed(
-    v: Value,
-    b: &mut SceneBuilder,
-    input: &types::Input,
-    owner: &str,
-) -> anyhow::Result<Fixed> {
-    let f = fixed_arg(v, b, input.keyword)?;
-    match &f {
-        Fixed::Const(c) => types::check_const(c, input, owner)?,
-        Fixed::Param(p) => types::check_param(b, *p, input, owner)?,
-    }
-    Ok(f)
+/// A value fixed for a test for `input` of `owner`: a constant (a plain value, `Const(...)`,
+/// or an open parameter constant over time, which the program sees as its value), checked.
+///
+/// # Errors
+/// A message for a stream (it has no single value) or a value of the wrong kind or range.
+fn fixed_typed(v: Value, b: &SceneBuilder, input: &types::Input, owner: &str) -> anyhow::Result<Rx> {
+    let c = match v.downcast_ref::<Stream>() {
+        Some(s) => match b.graph.nodes().get(s.id) {
+            Some(Node::Const(c)) => c.clone(),
+            _ => bail!(
+                "{owner}({}=) is fixed for a test: give it a constant or an open parameter that \
+                 does not vary over time, not a stream",
+                input.keyword
+            ),
+        },
+        None => constant(v).ok_or_else(|| {
+            anyhow!(
+                "{owner}({}=) takes {}, got a {}",
+                input.keyword,
+                input.kind,
+                v.get_type()
+            )
+        })?,
+    };
+    types::check_const(&c, input, owner)?;
+    Ok(c)
 }
 
-/// A value fixed for a test: a constant, `Const(...)`, or an open parameter constant over
-/// time.
-fn fixed_arg(v: Value, b: &SceneBuilder, what: &str) -> anyhow::Result<Fixed> {
-    if let Some(s) = v.downcast_ref::<Stream>() {
-        if let Some(p) = b.param_of(StreamId(s.id)) {
-            if b.params[p].over_time != OverTime::Constant {
-                bail!("{what} must be constant over a test; it cannot vary over_time");
-            }
-            return Ok(Fixed::Param(p));
-        }
-        if let Some(Node::Const(c)) = b.graph.nodes().get(s.id) {
-            return Ok(Fixed::Const(c.clone()));
-        }
-        bail!("{what} must be a constant or an open parameter (VarInterval/VarEnum), not a computed stream");
-    }
-    constant(v)
-        .map(Fixed::Const)
-        .ok_or_else(|| anyhow!("{what} must be a constant, got a {}", v.get_type()))
-}
-
-/// A number known when the program loads: a plain number or `Const(number)`.
+/// A number known when the world is built: a plain number, `Const(number)`, or an open
+/// parameter constant over time (its value in this test).
 fn load_time_number(v: Value, b: &SceneBuilder, what: &str) -> anyhow::Result<f64> {
-    match fixed_arg(v, b, what)? {
-        Fixed::Const(Rx::Num(x)) => Ok(x),
-        Fixed::Const(c) => bail!("{what} must be a number, got a {}", c.kind()),
-        Fixed::Param(_) => bail!("{what} must be known when the program loads (a number or Const); open parameters cannot change the road geometry"),
+    if let Some(s) = v.downcast_ref::<Stream>() {
+        if let Some(Node::Const(c)) = b.graph.nodes().get(s.id) {
+            return c
+                .as_num()
+                .filter(|_| matches!(c, Rx::Num(_)))
+                .ok_or_else(|| anyhow!("{what} must be a number, got a {}", c.kind()));
+        }
     }
+    number(v, what)
 }
 
 fn lanes(v: Option<Value>, b: &SceneBuilder, default: u32) -> anyhow::Result<u32> {
@@ -169,7 +173,7 @@ fn add_piece(
     eval: &Evaluator,
     what: &str,
     kind: PieceKind,
-    friction: Fixed,
+    friction: StreamId,
 ) -> anyhow::Result<Road> {
     let st = state(eval)?;
     let mut b = st.scene.borrow_mut();
@@ -190,8 +194,9 @@ fn add_piece(
 }
 
 /// A road piece from its keyword arguments: `make` gets the program's declarations, the lane
-/// count (default 2) and the friction (default 0.8, or for an open friction a value it can
-/// take, as a placeholder that each test replaces) and reads any further load-time arguments.
+/// count (default 2) and the friction at the start (default 0.8; for a friction that varies
+/// over the test, its value is set from its stream every step) and reads any further
+/// arguments.
 fn road_piece(
     eval: &Evaluator,
     what: &str,
@@ -199,24 +204,22 @@ fn road_piece(
     friction: Option<Value>,
     make: impl FnOnce(&SceneBuilder, u32, f64) -> anyhow::Result<PieceKind>,
 ) -> anyhow::Result<Road> {
-    let (kind, fixed) = {
+    let at = format!("declared at {}", here(eval));
+    let (kind, stream) = {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
-        let fixed = match friction {
-            Some(v) => fixed_typed(v, &mut b, &types::FRICTION, what)?,
-            None => Fixed::Const(Rx::Num(0.8)),
+        let stream = match friction {
+            Some(v) => typed_arg(v, &mut b, &types::FRICTION, what, &at)?,
+            None => b.graph.push(Node::Const(Rx::Num(0.8))),
         };
-        let mu = match &fixed {
-            Fixed::Const(c) => c.as_num().unwrap_or(0.8),
-            Fixed::Param(p) => match &b.params[*p].domain {
-                Domain::Interval { lo, .. } => *lo,
-                Domain::Levels(levels) => types::level_value(&levels[0]).as_num().unwrap_or(0.8),
-            },
+        let mu = match b.graph.nodes().get(stream.0) {
+            Some(Node::Const(Rx::Num(mu))) => *mu,
+            _ => 0.8,
         };
         let lanes = lanes(nlanes, &b, 2)?;
-        (make(&b, lanes, mu)?, fixed)
+        (make(&b, lanes, mu)?, stream)
     };
-    add_piece(eval, what, kind, fixed)
+    add_piece(eval, what, kind, stream)
 }
 
 fn location(v: Value, what: &str) -> anyhow::Result<usize> {
@@ -264,6 +267,10 @@ fn route_arg(v: Option<Value>) -> anyhow::Result<Option<Vec<paracosm_engine::net
     match v {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
+        // One turn, e.g. an open parameter `VarEnum(["left", "straight", "right"])`.
+        Some(v) if v.unpack_str().is_some() => turns(&[v.unpack_str().unwrap_or_default().to_owned()])
+            .map(Some)
+            .map_err(|e| anyhow!(e)),
         Some(v) => {
             let list = UnpackList::<String>::unpack_value(v)
                 .ok()
@@ -309,6 +316,30 @@ fn ego_arg(v: Value, what: &str) -> anyhow::Result<()> {
     }
 }
 
+/// Declares an open parameter; returns what the program sees: the test's value as a plain
+/// Starlark value (a float for an interval; an int, float, string or bool for a level), or,
+/// for one that varies over time, its stream.
+fn declare_param<'v>(
+    eval: &mut Evaluator<'v, '_, '_>,
+    decl: ParamDecl,
+) -> anyhow::Result<Value<'v>> {
+    let heap = eval.heap();
+    let st = state(eval)?;
+    let got = st
+        .scene
+        .borrow_mut()
+        .param(decl)
+        .map_err(anyhow::Error::msg)?;
+    Ok(match got {
+        Ok(Level::Int(i)) => heap.alloc(i),
+        Ok(Level::Real(x)) => heap.alloc(x),
+        Ok(Level::Text(t)) if t == "true" => Value::new_bool(true),
+        Ok(Level::Text(t)) if t == "false" => Value::new_bool(false),
+        Ok(Level::Text(t)) => heap.alloc(t.as_str()),
+        Err(id) => heap.alloc(Stream { id: id.0 }),
+    })
+}
+
 /// The builtins.
 #[starlark_module]
 #[allow(non_snake_case)]
@@ -331,7 +362,8 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         Ok(Stream { id: id.0 })
     }
 
-    /// `VarInterval(lo, hi, unit=None, name=None, over_time=None)`: an open real stream.
+    /// `VarInterval(lo, hi, unit=None, name=None, over_time=None)`: an open real parameter:
+    /// the test's value in `[lo, hi)`, or with `over_time=` a stream of values in `[lo, hi]`.
     fn VarInterval<'v>(
         lo: Value<'v>,
         hi: Value<'v>,
@@ -339,7 +371,7 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] name: Option<&str>,
         #[starlark(require = named)] over_time: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
-    ) -> anyhow::Result<Stream> {
+    ) -> anyhow::Result<Value<'v>> {
         let (lo, hi) = (number(lo, "VarInterval lo")?, number(hi, "VarInterval hi")?);
         if !(lo.is_finite() && hi.is_finite()) || lo >= hi {
             bail!("VarInterval({lo}, {hi}) is empty: lo must be below hi");
@@ -358,23 +390,24 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
                 })?,
         };
         let at = here(eval);
-        let st = state(eval)?;
-        let id = st.scene.borrow_mut().param(ParamDecl {
-            name: name.map(str::to_owned),
-            domain: Domain::Interval { lo, hi },
-            unit: unit.map(str::to_owned),
-            over_time,
-            at,
-        });
-        Ok(Stream { id: id.0 })
+        declare_param(
+            eval,
+            ParamDecl {
+                name: name.map(str::to_owned),
+                domain: Domain::Interval { lo, hi },
+                unit: unit.map(str::to_owned),
+                over_time,
+                at,
+            },
+        )
     }
 
-    /// `VarEnum([levels...], name=None)`: an open discrete stream.
+    /// `VarEnum([levels...], name=None)`: an open discrete parameter: the test's level.
     fn VarEnum<'v>(
         levels: Value<'v>,
         #[starlark(require = named)] name: Option<&str>,
         eval: &mut Evaluator<'v, '_, '_>,
-    ) -> anyhow::Result<Stream> {
+    ) -> anyhow::Result<Value<'v>> {
         let items: Vec<Value> = levels
             .iterate(eval.heap())
             .map_err(|_| {
@@ -404,15 +437,16 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             out.push(level);
         }
         let at = here(eval);
-        let st = state(eval)?;
-        let id = st.scene.borrow_mut().param(ParamDecl {
-            name: name.map(str::to_owned),
-            domain: Domain::Levels(out),
-            unit: None,
-            over_time: OverTime::Constant,
-            at,
-        });
-        Ok(Stream { id: id.0 })
+        declare_param(
+            eval,
+            ParamDecl {
+                name: name.map(str::to_owned),
+                domain: Domain::Levels(out),
+                unit: None,
+                over_time: OverTime::Constant,
+                at,
+            },
+        )
     }
 
     /// `Piecewise(k)`: an open stream held constant on `k` equal parts of the test.
@@ -612,18 +646,23 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             "Car",
             &at,
         )?;
-        let color = fixed_typed(
+        let color = match fixed_typed(
             color.unwrap_or_else(|| heap.alloc("red")),
-            &mut b,
+            &b,
             &types::COLOR,
             "Car",
-        )?;
+        )? {
+            Rx::Text(t) => t.to_ascii_lowercase(),
+            c => bail!("Car(color=) takes a colour name, got a {}", c.kind()),
+        };
         let enabled = fixed_typed(
             enabled.unwrap_or_else(|| Value::new_bool(true)),
-            &mut b,
+            &b,
             &types::ENABLED,
             "Car",
-        )?;
+        )?
+        .as_bool()
+        .unwrap_or(true);
         let i = b.n_cars;
         b.n_cars += 1;
         Ok(declare(

@@ -1,48 +1,23 @@
-//! Calling a frozen program's lambdas from the stream graph, one heap and evaluator per test.
+//! Calling a program's lambdas from the stream graph during a test, with the evaluator of the
+//! test's own evaluation of the program.
 
 use paracosm_engine::rx::{Host, Value as Rx};
-use starlark::environment::Module;
 use starlark::eval::Evaluator;
 use starlark::values::float::StarlarkFloat;
 use starlark::values::tuple::{AllocTuple, TupleRef};
-use starlark::values::{Heap, OwnedFrozenValue, Value, ValueLike};
+use starlark::values::{Heap, Value, ValueLike};
 
-use crate::Lambdas;
-
-/// The lambdas of a frozen program, by host function number.
-pub struct StarLambdas {
-    /// `lambda#n` of the frozen module.
-    pub values: Vec<OwnedFrozenValue>,
-}
-
-impl Lambdas for StarLambdas {
-    fn with_host(&self, f: &mut dyn FnMut(&mut dyn Host)) {
-        Module::with_temp_heap(|module| {
-            // The test's module keeps the program's frozen heap alive while it runs.
-            let functions: Vec<Value> = self
-                .values
-                .iter()
-                .map(|v| {
-                    module.frozen_heap().add_reference(v.owner());
-                    // SAFETY: the frozen heap that owns `v` is referenced by this module's
-                    // frozen heap (just above) and by `self.values`, both of which outlive
-                    // every use of the value inside this closure.
-                    unsafe { v.unchecked_frozen_value() }.to_value()
-                })
-                .collect();
-            let mut eval = Evaluator::new(&module);
-            let mut host = StarHost {
-                eval: &mut eval,
-                functions: &functions,
-            };
-            f(&mut host);
-        });
-    }
-}
-
-struct StarHost<'a, 'v, 'b, 'e> {
+/// The lambdas of one evaluation of a program, called through its evaluator.
+pub struct StarHost<'a, 'v, 'b, 'e> {
     eval: &'a mut Evaluator<'v, 'b, 'e>,
     functions: &'a [Value<'v>],
+}
+
+impl<'a, 'v, 'b, 'e> StarHost<'a, 'v, 'b, 'e> {
+    /// A host calling `functions` (host function `n` is `functions[n]`) with `eval`.
+    pub fn new(eval: &'a mut Evaluator<'v, 'b, 'e>, functions: &'a [Value<'v>]) -> Self {
+        StarHost { eval, functions }
+    }
 }
 
 fn to_star<'v>(v: &Rx, heap: Heap<'v>) -> Value<'v> {

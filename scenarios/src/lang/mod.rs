@@ -1,30 +1,31 @@
 //! The scenario language: Starlark programs (the `starlark` crate) that build a reactive world
 //! with the paper's vocabulary (§2). LANGUAGE.md is the reference.
 //!
-//! A program is evaluated once, hermetically (no `load`, no file, network or clock access) and
-//! within limits (a step count, a heap size, a call depth). Its declarations become a
-//! [`Scenario`](crate::Scenario): the open parameters form the space, the rest a world template.
-//! The module is then frozen; its lambdas are shared by all workers, each of which calls them
-//! through its own heap and evaluator, one per test.
+//! A program is evaluated hermetically (no `load`, no file, network or clock access) and within
+//! limits (a step count, a heap size, a call depth): when it loads, to learn its open parameters
+//! and check its worlds, and once per test with that test's values, in a heap and evaluator of
+//! the test's own ([`program`]). An open parameter that is constant over a test is a plain
+//! value in the program (a number, string or bool), so every Starlark operation works on it
+//! and the program may branch on it.
 
 mod globals;
 mod host;
 mod methods;
+mod names;
+mod program;
 mod scene;
 mod types;
 mod usage;
 mod values;
 
 use std::path::Path;
-use std::sync::Arc;
 
-use starlark::environment::{GlobalsBuilder, Module};
-use starlark::eval::Evaluator;
+use starlark::environment::GlobalsBuilder;
 use starlark::syntax::{AstModule, Dialect};
-use starlark::values::ValueLike;
 
 use crate::{Scenario, ScenarioError};
 
+pub use program::MAX_CHECKED_WORLDS;
 pub use scene::OverTime;
 
 /// The length of a test when the program does not set one with `test(horizon=)`, seconds.
@@ -88,7 +89,7 @@ const KEYWORDS: &[(&str, &[&str])] = &[
 ];
 
 /// Adds "did you mean `x`?" to starlark's "Found `y` extra named parameter(s) for call to F".
-fn suggest_keyword(message: &str) -> String {
+pub(crate) fn suggest_keyword(message: &str) -> String {
     let Some(rest) = message.split("Found `").nth(1) else {
         return message.to_owned();
     };
@@ -121,7 +122,7 @@ fn suggest_keyword(message: &str) -> String {
 }
 
 /// The first paragraph of the leading `#` comment, joined into one line.
-fn header(source: &str) -> String {
+pub(crate) fn header(source: &str) -> String {
     let mut out = Vec::new();
     for line in source.lines() {
         match line.strip_prefix('#') {
@@ -205,10 +206,14 @@ fn check_nesting(source: &str) -> Result<(), (usize, usize)> {
 }
 
 /// Loads a scenario program from `source`; `file` names it in diagnostics, `name` is the
-/// scenario's name.
+/// scenario's name. The program is evaluated once to learn its open parameters, then once per
+/// combination of its parameters' levels and interval ends (at most [`MAX_CHECKED_WORLDS`],
+/// else a pairwise covering array of them), each of which must build a valid world; each test
+/// evaluates it again with its own values.
 ///
 /// # Errors
-/// [`ScenarioError::Language`] as for [`load_file`].
+/// [`ScenarioError::Language`] as for [`load_file`]; an error that only some values cause
+/// names them.
 pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, ScenarioError> {
     let lang = |m: String| ScenarioError::Language(m);
     let dialect = Dialect {
@@ -223,67 +228,7 @@ pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, Sce
     })?;
     let ast =
         AstModule::parse(file, source.to_owned(), &dialect).map_err(|e| lang(format!("{e}")))?;
-    let globals = globals();
-    let state = globals::LoadState::default();
-    let frozen = Module::with_temp_heap(|module| -> Result<_, ScenarioError> {
-        {
-            let mut eval = Evaluator::new(&module);
-            eval.extra = Some(&state);
-            let limits = [
-                eval.set_max_tick_count(MAX_LOAD_STEPS),
-                eval.set_max_heap_size(MAX_LOAD_HEAP_BYTES),
-                eval.set_max_callstack_size(MAX_CALL_DEPTH),
-            ];
-            for l in limits {
-                l.map_err(|e| lang(e.to_string()))?;
-            }
-            eval.eval_module(ast, &globals).map_err(|e| {
-                let message = suggest_keyword(&format!("{e}"));
-                // Limit errors (steps, heap) carry no span: say which program hit them.
-                if message.contains(file) {
-                    lang(message)
-                } else {
-                    lang(format!("{message}\n --> {file}"))
-                }
-            })?;
-        }
-        // Open parameters take the name of the global they are bound to.
-        let mut scene = state.scene.borrow_mut();
-        for n in module.names() {
-            let Some(v) = module.get(n.as_str()) else {
-                continue;
-            };
-            if let Some(s) = v.downcast_ref::<values::Stream>() {
-                if let Some(p) = scene.param_of(paracosm_engine::rx::StreamId(s.id)) {
-                    scene.params[p]
-                        .name
-                        .get_or_insert_with(|| n.as_str().to_owned());
-                }
-            }
-        }
-        drop(scene);
-        module.freeze().map_err(|e| lang(format!("{e:?}")))
-    })?;
-    let scene = state.scene.into_inner();
-    let lambdas: Option<Arc<dyn crate::Lambdas>> = if scene.lambdas == 0 {
-        None
-    } else {
-        let values = (0..scene.lambdas)
-            .map(|n| frozen.get(&lambda_name(n)))
-            .collect::<anyhow::Result<Vec<_>>>()
-            .map_err(|e| lang(e.to_string()))?;
-        Some(Arc::new(host::StarLambdas { values }))
-    };
-    let meta = scene::Meta {
-        name: name.to_owned(),
-        description: header(source),
-    };
-    scene::finish(scene, meta, lambdas)
-        .map(|mut s| {
-            s.source = Arc::from(source);
-            s
-        })
-        .map_err(|m| lang(format!("error: {m}\n --> {file}")))
+    program::load(file, source, name, ast, globals())
 }
 
 #[cfg(test)]

@@ -1,19 +1,20 @@
-//! What a scenario program builds while it runs: plain Rust data (no Starlark values), turned
-//! into a [`Scenario`] once the program has finished.
-
-use std::sync::Arc;
+//! What one evaluation of a scenario program builds: plain Rust data (no Starlark values),
+//! turned into the test's [`WorldSpec`] once the program has finished. A program is evaluated
+//! once per test, with that test's values of its open parameters (LANGUAGE.md, "A family of
+//! worlds"), and a few times when it loads, to learn its parameters and check its worlds.
 
 use paracosm_engine::behaviour::{probe, Actor, GraphBuilder, Output};
 use paracosm_engine::network::{Location, Network, PieceId, Turn};
-use paracosm_engine::rx::{Graph, Node, OpenStream, StreamId, Value};
+use paracosm_engine::rx::{Node, OpenStream, StreamId, Value};
 use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{
     CarSpec, EgoSpec, EnvironmentSpec, LidarSpec, PedestrianSpec, VehicleParams, WorldSpec,
     DEFAULT_DT_S,
 };
-use paracosm_generators::{Assignment, Domain, Param, ParamSpace};
+use paracosm_generators::{Domain, Value as Level};
 
-use crate::{Lambdas, MonitorSpec, Scenario, ScenarioError};
+use crate::scenario::Warning;
+use crate::MonitorSpec;
 
 /// How an open stream varies over a test (paper §3.3).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,9 +31,9 @@ pub enum OverTime {
 pub const TICK: StreamId = StreamId(0);
 
 /// A `VarInterval` or `VarEnum` as declared.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ParamDecl {
-    /// `name=`, or the global variable it was assigned to; `None` gives `param<i>`.
+    /// `name=`, if given.
     pub name: Option<String>,
     /// Range or levels.
     pub domain: Domain,
@@ -44,13 +45,14 @@ pub struct ParamDecl {
     pub at: String,
 }
 
-/// A scalar input of an object that is fixed for a test: a constant, or an open parameter.
+/// What an open parameter is in one evaluation of the program.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Fixed {
-    /// A value known when the program loads.
-    Const(Value),
-    /// Open parameter number `n` (constant over time).
-    Param(usize),
+pub enum ParamValue {
+    /// A parameter constant over the test: its value, which the program sees as a plain
+    /// number, string or bool.
+    Level(Level),
+    /// A parameter that varies over the test: the stream of its values.
+    Over(OpenStream),
 }
 
 /// What starts a pedestrian walking.
@@ -111,10 +113,10 @@ pub enum Pending {
         route: Vec<Turn>,
         /// Speed stream.
         speed: StreamId,
-        /// Colour.
-        color: Fixed,
+        /// Colour name.
+        color: String,
         /// Presence.
-        enabled: Fixed,
+        enabled: bool,
     },
 }
 
@@ -140,20 +142,20 @@ pub struct PedestrianDecl {
     pub speed: StreamId,
 }
 
-/// A car as declared.
+/// A car as resolved.
 #[derive(Debug, Clone)]
 pub struct CarDecl {
     /// Its route, world `[x, z]` metres.
     pub path: Vec<[f64; 2]>,
     /// Speed stream, m/s.
     pub speed: StreamId,
-    /// Colour.
-    pub color: Fixed,
+    /// Colour name.
+    pub color: String,
     /// Presence.
-    pub enabled: Fixed,
+    pub enabled: bool,
 }
 
-/// The ego vehicle as declared.
+/// The ego vehicle as resolved.
 #[derive(Debug, Clone)]
 pub struct EgoDecl {
     /// Start.
@@ -166,18 +168,21 @@ pub struct EgoDecl {
     pub sut: SutConfig,
 }
 
-/// Everything a program declares.
-#[derive(Debug, Default)]
+/// Everything one evaluation of a program declares.
+#[derive(Debug)]
 pub struct SceneBuilder {
     /// The stream graph.
     pub graph: GraphBuilder,
     /// Open parameters, in declaration order.
     pub params: Vec<ParamDecl>,
+    /// The values this evaluation gives the parameters, by declaration index; `None`: each
+    /// parameter's representative value (an interval's lower bound, the first level).
+    pub values: Option<Vec<ParamValue>>,
     /// The road pieces.
     pub roads: Network,
-    /// Frictions of pieces, per piece.
-    pub frictions: Vec<(PieceId, Fixed)>,
-    /// The ego vehicle, once declared.
+    /// Each piece's friction stream.
+    pub frictions: Vec<(PieceId, StreamId)>,
+    /// The ego vehicle, once placed.
     pub ego: Option<EgoDecl>,
     /// Pedestrians.
     pub pedestrians: Vec<PedestrianDecl>,
@@ -198,7 +203,7 @@ pub struct SceneBuilder {
     /// Where `place(...)` was called, `file:line:col`.
     pub placed_at: Option<String>,
     /// Warnings so far.
-    pub warnings: Vec<crate::scenario::Warning>,
+    pub warnings: Vec<Warning>,
     /// The cars' names for messages, in the order of [`SceneBuilder::cars`].
     pub car_names: Vec<String>,
     /// Number of lambdas stored so far.
@@ -213,45 +218,98 @@ pub struct SceneBuilder {
     pub n_cars: u32,
 }
 
+/// The value a parameter takes when an evaluation gives it none: an interval's lower bound,
+/// the first level (constant over time, or the same as coefficients over time).
+pub fn representative(decl: &ParamDecl, horizon_s: f64) -> ParamValue {
+    let lowest = match &decl.domain {
+        Domain::Interval { lo, .. } => Level::Real(*lo),
+        Domain::Levels(levels) => levels[0].clone(),
+    };
+    match decl.over_time {
+        OverTime::Constant => ParamValue::Level(lowest),
+        over => {
+            let lo = lowest.as_f64().unwrap_or(0.0);
+            let n = coordinate_names("p", over).len();
+            ParamValue::Over(match over {
+                OverTime::Piecewise(_) => OpenStream::Piecewise {
+                    values: vec![lo; n],
+                    horizon_s,
+                },
+                _ => OpenStream::Polynomial {
+                    coefficients: vec![lo; n],
+                    horizon_s,
+                },
+            })
+        }
+    }
+}
+
 impl SceneBuilder {
-    /// A builder with the `tick` stream as stream [`TICK`].
-    pub fn new() -> Self {
-        let mut b = SceneBuilder::default();
-        let tick = b.graph.push(Node::Tick);
+    /// A builder with the `tick` stream as stream [`TICK`], for an evaluation that gives the
+    /// parameters `values` (by declaration index; `None`: representative values).
+    pub fn new(values: Option<Vec<ParamValue>>) -> Self {
+        let mut graph = GraphBuilder::new();
+        let tick = graph.push(Node::Tick);
         debug_assert_eq!(tick, TICK);
-        b
+        SceneBuilder {
+            graph,
+            params: Vec::new(),
+            values,
+            roads: Network::new(),
+            frictions: Vec::new(),
+            ego: None,
+            pedestrians: Vec::new(),
+            cars: Vec::new(),
+            world: None,
+            placed: false,
+            monitors: Vec::new(),
+            horizon_s: None,
+            map_axes: None,
+            offroad: None,
+            placed_at: None,
+            warnings: Vec::new(),
+            car_names: Vec::new(),
+            lambdas: 0,
+            locs: Vec::new(),
+            objects: Vec::new(),
+            n_pedestrians: 0,
+            n_cars: 0,
+        }
     }
 
-    /// A new open parameter and its stream.
-    pub fn param(&mut self, decl: ParamDecl) -> StreamId {
+    /// Declares an open parameter; returns what the program sees: its value, or for one
+    /// that varies over time, its stream.
+    ///
+    /// # Errors
+    /// A message when this evaluation has no value for it (the program declared more
+    /// parameters than with other values).
+    pub fn param(&mut self, decl: ParamDecl) -> Result<Result<Level, StreamId>, String> {
+        let k = self.params.len();
+        let value = match &self.values {
+            None => representative(&decl, self.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S)),
+            Some(values) => values.get(k).cloned().ok_or_else(|| {
+                format!(
+                    "the open parameter declared at {} exists only for some values of the others: \
+                     the set of open parameters may not depend on their values",
+                    decl.at
+                )
+            })?,
+        };
         self.params.push(decl);
-        self.graph.push(Node::Param(self.params.len() - 1))
+        Ok(match value {
+            ParamValue::Level(l) => Ok(l),
+            ParamValue::Over(_) => Err(self.graph.push(Node::Param(k))),
+        })
     }
 
     /// A probe stream.
     pub fn probe(&mut self, actor: Actor, output: Output) -> StreamId {
         self.graph.push(Node::Probe(probe(actor, output)))
     }
-
-    /// Records a warning about what the program declared at `at` (`file:line:col`).
-    pub fn warn(&mut self, at: &str, message: String) {
-        self.warnings.push(crate::scenario::Warning {
-            at: at.to_owned(),
-            message,
-        });
-    }
-
-    /// The stream's node, if it is an open parameter's, its parameter number.
-    pub fn param_of(&self, s: StreamId) -> Option<usize> {
-        match self.graph.nodes().get(s.0) {
-            Some(Node::Param(p)) => Some(*p),
-            _ => None,
-        }
-    }
 }
 
 /// The names of the coordinates a parameter adds to the space.
-fn coordinate_names(name: &str, over_time: OverTime) -> Vec<String> {
+pub fn coordinate_names(name: &str, over_time: OverTime) -> Vec<String> {
     match over_time {
         OverTime::Constant => vec![name.to_owned()],
         OverTime::Piecewise(k) => (0..k).map(|i| format!("{name}[{i}]")).collect(),
@@ -259,265 +317,84 @@ fn coordinate_names(name: &str, over_time: OverTime) -> Vec<String> {
     }
 }
 
-/// A loaded program, frozen: everything needed to instantiate worlds, shared by workers.
-pub struct Frozen {
-    params: Vec<(String, ParamDecl)>,
-    graph: Graph,
-    roads: Network,
-    frictions: Vec<(PieceId, Fixed)>,
-    ego: EgoDecl,
-    pedestrians: Vec<PedestrianDecl>,
-    cars: Vec<CarDecl>,
-    world: (StreamId, StreamId),
-    horizon_s: f64,
+/// The streams of the parameters that vary over time, by declaration index, for
+/// [`paracosm_engine::rx::Graph::bind`]; constant ones get an unused placeholder.
+fn over_time_streams(b: &SceneBuilder, horizon_s: f64) -> Vec<OpenStream> {
+    b.params
+        .iter()
+        .enumerate()
+        .map(|(k, decl)| {
+            let v = match &b.values {
+                Some(values) => values[k].clone(),
+                None => representative(decl, horizon_s),
+            };
+            match v {
+                ParamValue::Over(s) => s,
+                ParamValue::Level(l) => OpenStream::Constant(super::types::level_value(&l)),
+            }
+        })
+        .collect()
 }
 
-/// Settings of [`finish`] that come from outside the program.
-pub struct Meta {
-    /// Scenario name.
-    pub name: String,
-    /// Description.
-    pub description: String,
-}
-
-/// Turns a finished program's declarations into a [`Scenario`].
+/// The test's world from a finished, placed evaluation.
 ///
 /// # Errors
-/// A message (the caller makes it a [`ScenarioError::Language`]) when something required is
-/// missing (no `place`, no ego vehicle, an actor never placed) or the parameters clash.
-pub fn finish(
-    b: SceneBuilder,
-    meta: Meta,
-    lambdas: Option<Arc<dyn Lambdas>>,
-) -> Result<Scenario, String> {
-    if !b.placed {
-        return Err("the program never calls place(...): nothing to test".into());
-    }
-    if let Some(o) = b.objects.iter().find(|o| !o.placed) {
-        return Err(format!("{} is never placed: pass it to place(...)", o.name));
-    }
+/// A message when the program placed nothing or no ego vehicle, or its graph is invalid.
+pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
     let ego = b
         .ego
-        .clone()
+        .as_ref()
         .ok_or("the program places no AutonomousVehicle: nothing to test")?;
-    let horizon_s = b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
-    let world = match b.world {
-        Some(w) => w,
-        None => return Err("the program has no World(...)".into()),
-    };
-    let mut params: Vec<(String, ParamDecl)> = Vec::new();
-    let mut space = Vec::new();
-    for (i, p) in b.params.iter().enumerate() {
-        let name = p.name.clone().unwrap_or_else(|| format!("param{i}"));
-        if let Some((_, first)) = params.iter().find(|(n, _)| *n == name) {
-            return Err(format!(
-                "two open parameters are named `{name}` (declared at {} and {}); give one another name=",
-                first.at, p.at
-            ));
+    let (light, fog) = b.world.ok_or("the program has no World(...)")?;
+    let graph = b.graph.clone().finish().map_err(|e| e.to_string())?;
+    let streams = graph
+        .bind(&over_time_streams(b, horizon_s))
+        .map_err(|e| e.to_string())?;
+    // Pieces whose friction is constant carry it; the others get it from their stream each
+    // step.
+    let mut network = b.roads.clone();
+    let mut friction_streams = Vec::new();
+    for &(piece, stream) in &b.frictions {
+        match streams.nodes().get(stream.0) {
+            Some(Node::Const(Value::Num(mu))) => network.set_friction(piece, *mu).map_err(strip)?,
+            _ => friction_streams.push((piece, stream)),
         }
-        for coordinate in coordinate_names(&name, p.over_time) {
-            space.push(Param {
-                name: coordinate,
-                domain: p.domain.clone(),
-                unit: p.unit.clone(),
-            });
-        }
-        params.push((name, p.clone()));
     }
-    let space = ParamSpace::new(space).map_err(|e| e.to_string())?;
-    let map_axes =
-        match &b.map_axes {
-            Some(axes) => {
-                for a in axes {
-                    if space.param(a).is_none() {
-                        let known: Vec<&str> =
-                            space.params().iter().map(|p| p.name.as_str()).collect();
-                        return Err(format!(
-                        "test(map=...) names `{a}`, which is not a parameter (the parameters: {})",
-                        if known.is_empty() { "none".to_owned() } else { known.join(", ") }
-                    ));
-                    }
-                }
-                axes.clone()
-            }
-            None => space
-                .params()
-                .iter()
-                .take(2)
-                .map(|p| p.name.clone())
-                .collect(),
-        };
-
-    // Monitors: the default OffRoadMonitor unless the program has one or opts out.
-    let mut monitors = b.monitors.clone();
-    let declared = monitors.len();
-    let has_off_road = monitors.iter().any(MonitorSpec::judges_off_road);
-    if b.offroad.unwrap_or(true) && !has_off_road {
-        let implicit = MonitorSpec::implicit_off_road();
-        if monitors.iter().any(|m| m.name() == implicit.name()) {
-            return Err(format!(
-                "a monitor is named `{}`, the name of the default OffRoadMonitor: rename it, \
-                 declare OffRoadMonitor(v) yourself, or opt out with test(offroad = False)",
-                implicit.name()
-            ));
-        }
-        monitors.push(implicit);
-    }
-    let mut warnings = b.warnings.clone();
-    let place_at = b.placed_at.clone().unwrap_or_default();
-    if declared == 0 {
-        warnings.push(crate::scenario::Warning {
-            at: place_at.clone(),
-            message: if monitors.is_empty() {
-                "the program declares no monitor and opts out of the default OffRoadMonitor: \
-                 every test passes whatever happens"
-                    .to_owned()
-            } else {
-                "the program declares no monitor: only the default OffRoadMonitor judges its \
-                 tests, so a test passes whatever else happens (add CollisionMonitor(v), \
-                 DistanceMonitor(v, minD = ...) or Stl(...))"
-                    .to_owned()
-            },
-        });
-    }
-    let stl_reads_light = monitors
+    let cars = b
+        .cars
         .iter()
-        .any(|m| m.reads_signal(crate::signal::LIGHT));
-    let names: Vec<String> = params.iter().map(|(n, _)| n.clone()).collect();
-    let usage = super::usage::analyse(&b, &names, stl_reads_light);
-    warnings.extend(usage.warnings);
-    let unused_params: Vec<String> = usage
-        .unused
-        .iter()
-        .flat_map(|&p| coordinate_names(&names[p], params[p].1.over_time))
-        .collect();
-    let graph = b.graph.finish().map_err(|e| e.to_string())?;
-    let sut = ego.sut.clone();
-    let frozen = Arc::new(Frozen {
-        params,
-        graph,
-        roads: b.roads,
-        frictions: b.frictions,
-        ego,
-        pedestrians: b.pedestrians,
-        cars: b.cars,
-        world,
-        horizon_s,
-    });
-    Ok(Scenario {
-        name: meta.name,
-        description: meta.description,
-        space,
-        horizon_s,
-        sut,
-        monitors,
-        map_axes,
-        warnings,
-        unused_params,
-        camera_only: usage.camera_only,
-        template: Arc::new(move |a: &Assignment| frozen.instantiate(a)),
-        lambdas,
-        source: Arc::from(""),
-    })
-}
-
-fn to_rx(v: &paracosm_generators::Value) -> Value {
-    super::types::level_value(v)
-}
-
-impl Frozen {
-    fn open(&self, a: &Assignment) -> Result<Vec<OpenStream>, ScenarioError> {
-        self.params
-            .iter()
-            .map(|(name, p)| {
-                let get = |n: &str| {
-                    a.get(n)
-                        .ok_or_else(|| ScenarioError::MissingParam(n.to_owned()))
-                };
-                let reals = |names: Vec<String>| -> Result<Vec<f64>, ScenarioError> {
-                    names
-                        .iter()
-                        .map(|n| {
-                            get(n)?
-                                .as_f64()
-                                .ok_or(ScenarioError::MissingParam(n.clone()))
-                        })
-                        .collect()
-                };
-                Ok(match p.over_time {
-                    OverTime::Constant => OpenStream::Constant(to_rx(get(name)?)),
-                    OverTime::Piecewise(_) => OpenStream::Piecewise {
-                        values: reals(coordinate_names(name, p.over_time))?,
-                        horizon_s: self.horizon_s,
-                    },
-                    OverTime::Polynomial(_) => OpenStream::Polynomial {
-                        coefficients: reals(coordinate_names(name, p.over_time))?,
-                        horizon_s: self.horizon_s,
-                    },
-                })
-            })
-            .collect()
-    }
-
-    fn fixed(&self, f: &Fixed, open: &[OpenStream]) -> Value {
-        match f {
-            Fixed::Const(v) => v.clone(),
-            Fixed::Param(p) => open[*p].at(0.0),
-        }
-    }
-
-    fn instantiate(&self, a: &Assignment) -> Result<WorldSpec, ScenarioError> {
-        let open = self.open(a)?;
-        let streams = self
-            .graph
-            .bind(&open)
-            .map_err(paracosm_engine::EngineError::from)?;
-        let mut network = self.roads.clone();
-        for (piece, f) in &self.frictions {
-            let mu = self.fixed(f, &open).as_num().unwrap_or(f64::NAN);
-            network.set_friction(*piece, mu)?;
-        }
-        let cars = self
-            .cars
-            .iter()
-            .map(|c| CarSpec {
-                path: c.path.clone(),
-                speed: c.speed,
-                color: match self.fixed(&c.color, &open) {
-                    Value::Text(t) => t,
-                    v => format!("{v:?}"),
-                },
-                size_m: CAR_SIZE_M,
-                enabled: self.fixed(&c.enabled, &open).as_bool().unwrap_or(true),
-            })
-            .collect();
-        Ok(WorldSpec {
-            dt_s: DEFAULT_DT_S,
-            network,
-            ego: EgoSpec {
-                start: self.ego.start,
-                initial_speed_mps: self.ego.initial_speed_mps,
-                vehicle: VehicleParams::default(),
-                route: self.ego.route.clone(),
-            },
-            pedestrians: self
-                .pedestrians
-                .iter()
-                .map(|p| PedestrianSpec {
-                    start: p.start,
-                    target: p.target,
-                    speed: p.speed,
-                })
-                .collect(),
-            cars,
-            environment: EnvironmentSpec {
-                light: self.world.0,
-                fog: self.world.1,
-            },
-            streams,
-            lidar: LidarSpec::default(),
+        .map(|c| CarSpec {
+            path: c.path.clone(),
+            speed: c.speed,
+            color: c.color.clone(),
+            size_m: CAR_SIZE_M,
+            enabled: c.enabled,
         })
-    }
+        .collect();
+    Ok(WorldSpec {
+        dt_s: DEFAULT_DT_S,
+        network,
+        frictions: friction_streams,
+        ego: EgoSpec {
+            start: ego.start,
+            initial_speed_mps: ego.initial_speed_mps,
+            vehicle: VehicleParams::default(),
+            route: ego.route.clone(),
+        },
+        pedestrians: b
+            .pedestrians
+            .iter()
+            .map(|p| PedestrianSpec {
+                start: p.start,
+                target: p.target,
+                speed: p.speed,
+            })
+            .collect(),
+        cars,
+        environment: EnvironmentSpec { light, fog },
+        streams,
+        lidar: LidarSpec::default(),
+    })
 }
 
 /// Parses a route list of turns.
@@ -554,6 +431,9 @@ impl SceneBuilder {
         for &o in objects {
             self.objects[o].placed = true;
         }
+        if let Some(o) = self.objects.iter().find(|o| !o.placed) {
+            return Err(format!("{} is never placed: pass it to place(...)", o.name));
+        }
         let resolve = |b: &SceneBuilder, i: usize| {
             let l = b.locs[i];
             b.roads.on_lane(l.piece, l.lane, l.at_m).map_err(strip)
@@ -581,8 +461,6 @@ impl SceneBuilder {
             });
         }
         check(&placed, &self.roads).map_err(strip)?;
-        let mut pedestrians = Vec::new();
-        let mut cars = Vec::new();
         let mut ped_index = 0u32;
         for o in self.objects.clone() {
             match o.pending {
@@ -627,7 +505,7 @@ impl SceneBuilder {
                         }
                     }
                     ped_index += 1;
-                    pedestrians.push(PedestrianDecl {
+                    self.pedestrians.push(PedestrianDecl {
                         start: s,
                         target: t,
                         speed,
@@ -645,7 +523,7 @@ impl SceneBuilder {
                         .roads
                         .route(&start, &route, MAX_ROUTE_M)
                         .map_err(strip)?;
-                    cars.push(CarDecl {
+                    self.cars.push(CarDecl {
                         path,
                         speed,
                         color,
@@ -655,8 +533,6 @@ impl SceneBuilder {
                 }
             }
         }
-        self.pedestrians = pedestrians;
-        self.cars = cars;
         self.placed = true;
         Ok(())
     }

@@ -207,6 +207,9 @@ fn inputs_of_the_wrong_kind_or_out_of_range_are_refused_at_load() {
     let world = |args: &str| {
         format!("w = World({args})\nr = RoadSegment(len = 200.0)\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, v)\n")
     };
+    let road = |args: &str| {
+        format!("w = World()\nr = RoadSegment(len = 200.0, {args})\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, v)\n")
+    };
     let walker = |args: &str| {
         format!("{HEADER}p = Pedestrian(start = r.onLane(r.SideWalk, 100), target = r.onLane(-r.SideWalk, 100), {args})\nw.place(r, v, p)\n")
     };
@@ -214,28 +217,30 @@ fn inputs_of_the_wrong_kind_or_out_of_range_are_refused_at_load() {
         (world("light = 1.5"), "World(light=) takes a number in [0, 1], got 1.5 (a number)", "1:5"),
         (world("fog = Const(-0.1)"), "World(fog=) takes a number in [0, 1], got -0.1", "1:5"),
         (world("fog = True"), "World(fog=) takes a number in [0, 1], got True (a bool)", "1:5"),
-        (world("fog = VarEnum([0.2, 1.5])"), "has the level 1.5 (a number)", "1:5"),
+        (world("fog = VarEnum([0.2, 1.5])"), "World(fog=) takes a number in [0, 1], got 1.5 (a number)", "1:5"),
+        (world("fog = VarEnum([0.2, 1.5])"), "(the world fails for the test values w.fog = 1.5)", "1:5"),
         (
             world("fog = VarInterval(0.2, 0.5, over_time = Piecewise(3)), light = VarInterval(-1, 1)"),
-            "World(light=) takes a number in [0, 1], but the VarInterval at bad.star:1:74 ranges over [-1, 1)",
+            "World(light=) takes a number in [0, 1], got -1 (a number)",
             "1:5",
         ),
-        ("r = RoadSegment(friction = 0)\n".into(), "RoadSegment(friction=) takes a number in (0, 2], got 0", "1:5"),
+        (road("friction = 0"), "RoadSegment(friction=) takes a number in (0, 2], got 0", "2:5"),
         (
-            "r = RoadSegment(friction = VarInterval(0, 0.5))\n".into(),
-            "takes a number in (0, 2], but the VarInterval at bad.star:1:28 ranges over [0, 0.5)",
-            "1:5",
+            road("friction = VarInterval(0, 0.5)"),
+            "RoadSegment(friction=) takes a number in (0, 2], got 0 (a number)",
+            "2:5",
         ),
-        ("r = RoadSegment(friction = VarEnum([0.3, 2.5]))\n".into(), "has the level 2.5", "1:5"),
+        (road("friction = VarEnum([0.3, 2.5])"), "got 2.5 (a number)\n", "2:5"),
+        (road("friction = VarEnum([0.3, 2.5])"), "for the test values r.friction = 2.5", "2:5"),
         (with_car(", color = \"purple\"", ""), "Car(color=) takes a colour name (red, white", "4:5"),
-        (with_car(", color = VarEnum([\"red\", \"plaid\"])", ""), "has the level \"plaid\" (a string)", "4:5"),
+        (with_car(", color = VarEnum([\"red\", \"plaid\"])", ""), "Car(color=) takes a colour name (red, white, black, blue, green, yellow, orange, silver, grey), got \"plaid\" (a string)", "4:5"),
         (with_car(", enabled = 1", ""), "Car(enabled=) takes a bool, got 1 (a number)", "4:5"),
-        (with_car(", enabled = VarEnum([1, 0])", ""), "Car(enabled=) takes a bool", "4:5"),
+        (with_car(", enabled = VarEnum([1, 0])", ""), "Car(enabled=) takes a bool, got 1 (a number)", "4:5"),
         (with_car(", speed = -3", ""), "Car(speed=) takes a number in m/s, >= 0, got -3", "4:5"),
         (with_car(", speed = v.pos", ""), "Car(speed=) takes a number in m/s, >= 0, but this stream carries positions", "4:5"),
         (with_car(", speed = tick.zip(tick)", ""), "but this stream carries tuples", "4:5"),
         (walker("speed = \"slow\", trigger = tick"), "Pedestrian(speed=) takes a number in m/s, >= 0, got \"slow\"", "4:5"),
-        (walker("speed = 1.0, dist = VarInterval(-5, 5), car = v"), "Pedestrian(dist=) takes a number in m, >= 0, but", "4:5"),
+        (walker("speed = 1.0, dist = VarInterval(-5, 5), car = v"), "Pedestrian(dist=) takes a number in m, >= 0, got -5 (a number)", "4:5"),
         (walker("speed = 1.0, dist = 10.0, car = 3.0"), "Pedestrian(car=) takes a position (x, y, z) in m, got 3 (a number)", "4:5"),
         (walker("speed = 1.0, dist = 10.0, car = v.speed"), "but this stream carries numbers", "4:5"),
     ];

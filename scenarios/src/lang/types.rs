@@ -97,6 +97,25 @@ pub const ENABLED: Input = Input {
     kind: Kind::Bool,
 };
 
+/// `Builtin(keyword=)`'s input, for the builtins whose inputs take numbers with a unit or a
+/// range (used to check the unit a parameter declares).
+pub fn input_of(builtin: &str, keyword: &str) -> Option<Input> {
+    Some(match (builtin, keyword) {
+        ("World", "light") => LIGHT,
+        ("World", "fog") => FOG,
+        ("RoadSegment" | "TIntersection" | "CrossIntersection" | "Roundabout", "friction") => {
+            FRICTION
+        }
+        ("RoadSegment", "len") => number("len", "m", 0.0, f64::INFINITY, true),
+        ("Roundabout", "radius") => number("radius", "m", 0.0, f64::INFINITY, true),
+        ("AutonomousVehicle", "speed") => number("speed", "m/s", 0.0, f64::INFINITY, false),
+        ("Car", "speed") => CAR_SPEED,
+        ("Pedestrian", "speed") => PEDESTRIAN_SPEED,
+        ("Pedestrian", "dist") => TRIGGER_DISTANCE,
+        _ => return None,
+    })
+}
+
 impl Kind {
     /// The run-time check of a number stream; `None` for kinds that are not numbers.
     pub fn expect(&self) -> Option<Expect> {
@@ -277,8 +296,8 @@ fn param_label(b: &SceneBuilder, p: usize) -> String {
     }
 }
 
-/// Checks that every value open parameter `p` can take is accepted by `input` of `owner`
-/// (e.g. `World`). A parameter that declares a unit other than the input's gets a warning.
+/// Checks that every value open parameter `p` (one that varies over time, the only kind that
+/// stays a stream) can take is accepted by `input` of `owner` (e.g. `World`).
 ///
 /// # Errors
 /// A message naming the input, what it accepts, and the parameter's range or level.
@@ -322,18 +341,6 @@ pub fn check_param(
                     );
                 }
             }
-        }
-    }
-    if let (Kind::Number { unit, .. }, Some(declared)) = (kind, &d.unit) {
-        let norm = |u: &str| u.split_whitespace().collect::<String>();
-        if !unit.is_empty() && norm(declared) != norm(unit) {
-            b.warn(
-                &d.at,
-                format!(
-                    "{label} is declared in {declared} but feeds {owner}({}=), which is in {unit}",
-                    input.keyword
-                ),
-            );
         }
     }
     Ok(())

@@ -1,112 +1,161 @@
-//! Which object reads each open parameter, found when the program loads: a parameter no
-//! object reads is left out of coverage, and one that cannot affect the ego is named in a
-//! warning (LANGUAGE.md, "Warnings").
+//! Which inputs each open parameter changes, found when the program loads by building the
+//! world with each of the parameter's other values and comparing it with the first: a
+//! parameter that changes nothing and that no code reads is left out of coverage, and one that
+//! cannot affect the ego is named in a warning (LANGUAGE.md, "Warnings").
 
 use std::collections::{BTreeSet, HashSet};
 
 use paracosm_engine::network::{PieceId, Surface};
-use paracosm_engine::rx::{Node, StreamId};
+use paracosm_engine::WorldSpec;
 
-use super::scene::{Fixed, SceneBuilder};
+use super::names::Syntax;
+use super::scene::{ParamDecl, SceneBuilder};
+use super::types;
 use crate::scenario::{CameraOnly, Warning};
 
-/// What reads a parameter.
+/// What changed between two worlds of one program.
 #[derive(Debug, Clone, PartialEq)]
-enum Reader {
-    /// Something that moves or judges the world (a speed, a trigger, the fog, presence...).
-    World,
-    /// The light: only cameras see it (the lidar does not).
+pub enum Change {
+    /// The light (a stream no other stream reads).
     Light,
-    /// The colour of an object: only cameras see it.
-    Colour(String),
+    /// The colour of car `i`.
+    Colour(usize),
     /// The friction of a road piece.
     Friction(PieceId),
+    /// Anything else: geometry, an actor, a speed, the fog, a stream's value...
+    Other,
 }
 
-/// The findings: warnings, the parameters no object reads (by name), and those only a camera
+fn debug<T: std::fmt::Debug>(x: &T) -> String {
+    format!("{x:?}")
+}
+
+/// The streams some node reads.
+fn read_streams(w: &WorldSpec) -> HashSet<usize> {
+    w.streams
+        .nodes()
+        .iter()
+        .flat_map(|n| n.inputs())
+        .map(|s| s.0)
+        .collect()
+}
+
+/// What differs between `a` and `b`, two worlds of one program.
+pub fn changes(a: &WorldSpec, b: &WorldSpec) -> Vec<Change> {
+    let mut out = Vec::new();
+    let other = |c: bool, out: &mut Vec<Change>| {
+        if c {
+            out.push(Change::Other);
+        }
+    };
+    // Road pieces: a friction, or geometry.
+    let (pa, pb) = (a.network.pieces(), b.network.pieces());
+    if pa.len() != pb.len() || debug(&a.network.links()) != debug(&b.network.links()) {
+        out.push(Change::Other);
+    } else {
+        for (i, (x, y)) in pa.iter().zip(pb).enumerate() {
+            if x == y {
+                continue;
+            }
+            let mut y2 = y.clone();
+            y2.kind = y.kind.with_friction(x.kind.friction());
+            if *x == y2 {
+                out.push(Change::Friction(PieceId(i)));
+            } else {
+                out.push(Change::Other);
+            }
+        }
+    }
+    other(debug(&a.ego) != debug(&b.ego), &mut out);
+    other(debug(&a.pedestrians) != debug(&b.pedestrians), &mut out);
+    other(
+        debug(&a.environment) != debug(&b.environment) || a.dt_s != b.dt_s,
+        &mut out,
+    );
+    other(debug(&a.lidar) != debug(&b.lidar), &mut out);
+    other(debug(&a.frictions) != debug(&b.frictions), &mut out);
+    if a.cars.len() != b.cars.len() {
+        out.push(Change::Other);
+    } else {
+        for (i, (x, y)) in a.cars.iter().zip(&b.cars).enumerate() {
+            if x.color != y.color {
+                out.push(Change::Colour(i));
+            }
+            let mut y2 = y.clone();
+            y2.color = x.color.clone();
+            other(debug(x) != debug(&y2), &mut out);
+        }
+    }
+    // Streams: the light, a piece's friction, or anything else.
+    let (na, nb) = (a.streams.nodes(), b.streams.nodes());
+    if na.len() != nb.len() {
+        out.push(Change::Other);
+    } else {
+        let read = read_streams(a);
+        let inputs: HashSet<usize> = a
+            .cars
+            .iter()
+            .map(|c| c.speed.0)
+            .chain(a.pedestrians.iter().map(|p| p.speed.0))
+            .chain([a.environment.fog.0])
+            .collect();
+        for (i, (x, y)) in na.iter().zip(nb).enumerate() {
+            if debug(x) == debug(y) {
+                continue;
+            }
+            let piece = a.frictions.iter().find(|(_, s)| s.0 == i).map(|(p, _)| *p);
+            if read.contains(&i) || inputs.contains(&i) {
+                out.push(Change::Other);
+            } else if i == a.environment.light.0 {
+                out.push(Change::Light);
+            } else if let Some(p) = piece {
+                out.push(Change::Friction(p));
+            }
+            // Any other stream is read by nothing: a constant friction, which the network
+            // carries and the comparison of the pieces has seen.
+        }
+    }
+    out
+}
+
+/// What [`analyse`] needs.
+pub struct Inputs<'a> {
+    /// Each parameter's final name and declaration.
+    pub params: &'a [(String, ParamDecl)],
+    /// What each parameter's other values changed, by parameter.
+    pub changes: &'a [Vec<Change>],
+    /// Whether code of the program (a lambda, a `def`, an expression) reads the parameter's
+    /// variable, by parameter.
+    pub read_in_code: &'a [bool],
+    /// Whether an `Stl` formula reads the `light` signal.
+    pub stl_reads_light: bool,
+    /// The program's first evaluation.
+    pub world: &'a SceneBuilder,
+    /// The test length, seconds.
+    pub horizon_s: f64,
+}
+
+/// The findings: warnings, the parameters no object reads (by index), and those only a camera
 /// sees.
 pub struct Usage {
     /// Warnings, in parameter order.
     pub warnings: Vec<Warning>,
-    /// Indices of the parameters no object reads.
+    /// Indices of the parameters that change nothing.
     pub unused: Vec<usize>,
     /// Parameters only a camera sees.
     pub camera_only: Vec<CameraOnly>,
 }
 
-/// The open parameters a stream depends on (through every combinator), by index.
-fn params_behind(b: &SceneBuilder, root: StreamId, out: &mut BTreeSet<usize>, seen: &mut [bool]) {
-    let mut stack = vec![root];
-    while let Some(id) = stack.pop() {
-        if std::mem::replace(&mut seen[id.0], true) {
-            continue;
-        }
-        let node = &b.graph.nodes()[id.0];
-        if let Node::Param(p) = node {
-            out.insert(*p);
-        }
-        stack.extend(node.inputs());
-    }
-}
-
-/// Analyses a placed program; `names` are the parameters' final names, `stl_reads_light`
-/// whether an `Stl` formula reads the `light` signal (a monitor then reads the light).
-pub fn analyse(b: &SceneBuilder, names: &[String], stl_reads_light: bool) -> Usage {
-    let n = b.params.len();
-    let mut readers: Vec<Vec<Reader>> = vec![Vec::new(); n];
-    let reach = |root: StreamId, reader: Reader, readers: &mut Vec<Vec<Reader>>| {
-        let mut ps = BTreeSet::new();
-        let mut seen = vec![false; b.graph.nodes().len()];
-        params_behind(b, root, &mut ps, &mut seen);
-        for p in ps {
-            readers[p].push(reader.clone());
-        }
-    };
-    if let Some((light, fog)) = b.world {
-        let light_reader = if stl_reads_light {
-            Reader::World
-        } else {
-            Reader::Light
-        };
-        reach(light, light_reader, &mut readers);
-        reach(fog, Reader::World, &mut readers);
-    }
-    for c in &b.cars {
-        reach(c.speed, Reader::World, &mut readers);
-    }
-    for p in &b.pedestrians {
-        reach(p.speed, Reader::World, &mut readers);
-    }
-    // Every `foreach` acts on the world: the pedestrians' behaviours and the program's own.
-    for (i, node) in b.graph.nodes().iter().enumerate() {
-        if matches!(node, Node::Foreach { .. }) {
-            reach(StreamId(i), Reader::World, &mut readers);
-        }
-    }
-    for (piece, f) in &b.frictions {
-        if let Fixed::Param(p) = f {
-            readers[*p].push(Reader::Friction(*piece));
-        }
-    }
-    for (c, owner) in b.cars.iter().zip(&b.car_names) {
-        if let Fixed::Param(p) = c.color {
-            readers[p].push(Reader::Colour(owner.clone()));
-        }
-        if let Fixed::Param(p) = c.enabled {
-            readers[p].push(Reader::World);
-        }
-    }
-
-    // Pieces a vehicle can be on: every piece the ego can reach within the horizon (on or off
-    // the road, at full throttle all the way: the engine bounds any system's acceleration),
-    // and every piece an NPC car's route crosses.
-    let mut driven: HashSet<PieceId> = HashSet::new();
+/// Pieces a vehicle can be on during a test: every piece the ego can reach within the
+/// horizon (on or off the road, at full throttle all the way: the engine bounds any system's
+/// acceleration), and every piece an NPC car's route crosses.
+fn driven(b: &SceneBuilder, horizon_s: f64) -> HashSet<PieceId> {
+    let mut driven = HashSet::new();
     if let Some(ego) = &b.ego {
-        let t = b.horizon_s.unwrap_or(crate::lang::DEFAULT_HORIZON_S);
         let vehicle = paracosm_engine::VehicleParams::default();
         // Two driven wheels (rear-wheel drive).
         let a = 2.0 * vehicle.max_engine_force_n / vehicle.mass_kg;
-        let reach_m = ego.initial_speed_mps * t + 0.5 * a * t * t;
+        let reach_m = ego.initial_speed_mps * horizon_s + 0.5 * a * horizon_s * horizon_s;
         let start = [ego.start.pos_m[0], ego.start.pos_m[2]];
         driven.extend(
             (0..b.roads.pieces().len())
@@ -118,35 +167,42 @@ pub fn analyse(b: &SceneBuilder, names: &[String], stl_reads_light: bool) -> Usa
     for c in &b.cars {
         driven.extend(c.path.iter().filter_map(|&p| surface.piece_under(p)));
     }
+    driven
+}
 
+/// Classifies every parameter by what it changes.
+pub fn analyse(i: Inputs<'_>) -> Usage {
+    let driven = driven(i.world, i.horizon_s);
     let mut usage = Usage {
         warnings: Vec::new(),
         unused: Vec::new(),
         camera_only: Vec::new(),
     };
-    for (p, rs) in readers.iter().enumerate() {
-        let decl = &b.params[p];
-        let name = &names[p];
-        if rs.is_empty() {
-            usage.unused.push(p);
+    for (k, (name, decl)) in i.params.iter().enumerate() {
+        let changes = &i.changes[k];
+        if i.read_in_code[k] {
+            continue;
+        }
+        if changes.is_empty() {
+            usage.unused.push(k);
             usage.warnings.push(Warning {
                 at: decl.at.clone(),
                 message: format!(
-                    "`{name}` is sampled but no object uses it: it changes nothing in a test, so \
-                     coverage leaves it out (summary.json lists it under unused_params)"
+                    "`{name}` is sampled but no object uses it: every value builds the same \
+                     world, so coverage leaves it out (summary.json lists it under unused_params)"
                 ),
             });
             continue;
         }
-        let undriven = |r: &Reader| matches!(r, Reader::Friction(piece) if !driven.contains(piece));
-        if rs.contains(&Reader::World) {
-            continue;
-        }
-        if rs.iter().all(undriven) {
-            let pieces: BTreeSet<String> = rs
+        let undriven = |c: &Change| matches!(c, Change::Friction(p) if !driven.contains(p));
+        let visual = |c: &Change| {
+            matches!(c, Change::Colour(_)) || (*c == Change::Light && !i.stl_reads_light)
+        };
+        if changes.iter().all(undriven) {
+            let pieces: BTreeSet<String> = changes
                 .iter()
-                .filter_map(|r| match r {
-                    Reader::Friction(piece) => Some(b.roads.piece(*piece).name.clone()),
+                .filter_map(|c| match c {
+                    Change::Friction(p) => Some(i.world.roads.piece(*p).name.clone()),
                     _ => None,
                 })
                 .collect();
@@ -161,18 +217,21 @@ pub fn analyse(b: &SceneBuilder, names: &[String], stl_reads_light: bool) -> Usa
             });
             continue;
         }
-        if rs
-            .iter()
-            .all(|r| undriven(r) || matches!(r, Reader::Light | Reader::Colour(_)))
-        {
-            let sets: Vec<String> = rs
-                .iter()
-                .filter_map(|r| match r {
-                    Reader::Light => Some("the light".to_owned()),
-                    Reader::Colour(owner) => Some(format!("the colour of {owner}")),
-                    _ => None,
-                })
-                .collect();
+        if changes.iter().all(|c| undriven(c) || visual(c)) {
+            let mut sets: Vec<String> = Vec::new();
+            for c in changes {
+                let s = match c {
+                    Change::Light => "the light".to_owned(),
+                    Change::Colour(car) => format!(
+                        "the colour of {}",
+                        i.world.car_names.get(*car).map_or("a car", String::as_str)
+                    ),
+                    _ => continue,
+                };
+                if !sets.contains(&s) {
+                    sets.push(s);
+                }
+            }
             usage.camera_only.push(CameraOnly {
                 param: name.clone(),
                 at: decl.at.clone(),
@@ -181,4 +240,35 @@ pub fn analyse(b: &SceneBuilder, names: &[String], stl_reads_light: bool) -> Usa
         }
     }
     usage
+}
+
+/// A warning for each parameter declared with a `unit=` that is passed whole to an input in
+/// another unit (`unit = "km/h"` feeding `Car(speed=)`, in m/s).
+pub fn unit_warnings(params: &[(String, ParamDecl)], syntax: &Syntax) -> Vec<Warning> {
+    let norm = |u: &str| u.split_whitespace().collect::<String>();
+    let mut out = Vec::new();
+    for (name, decl) in params {
+        let (Some(unit), Some(variable)) = (
+            &decl.unit,
+            syntax.site(&decl.at).and_then(|s| s.variable.clone()),
+        ) else {
+            continue;
+        };
+        for (builtin, keyword) in syntax.passed_to(&variable) {
+            if let Some(input) = types::input_of(builtin, keyword) {
+                if let types::Kind::Number { unit: theirs, .. } = input.kind {
+                    if !theirs.is_empty() && norm(theirs) != norm(unit) {
+                        out.push(Warning {
+                            at: decl.at.clone(),
+                            message: format!(
+                                "`{name}` is declared in {unit} but feeds {builtin}({keyword}=), \
+                                 which is in {theirs}"
+                            ),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
 }

@@ -1,0 +1,286 @@
+//! What the program's syntax tells about its open parameters: the name each gets from where
+//! it stands (LANGUAGE.md, "Names of parameters"), and where a variable holding one is read
+//! other than as a whole argument of a builtin (then code of the program may depend on it in
+//! ways the world does not show, so usage analysis counts it as used).
+
+use std::collections::HashMap;
+
+use starlark::syntax::AstModule;
+use starlark_syntax::syntax::ast::{ArgumentP, AssignTargetP, AstExpr, AstStmt, ExprP, StmtP};
+use starlark_syntax::syntax::uniplate::Visit;
+
+/// The builtins that declare open parameters.
+const DECLARERS: [&str; 2] = ["VarInterval", "VarEnum"];
+
+/// What the syntax says about one `VarInterval`/`VarEnum` call site.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Site {
+    /// The name it gets from where it stands: the variable it is assigned to (`speed`), else
+    /// `<variable>.<keyword>` of the call whose argument it is (`w.fog`), else
+    /// `<Callee>.<keyword>` (`World.fog`); `None` elsewhere.
+    pub name: Option<String>,
+    /// The variable it is assigned to, if it is.
+    pub variable: Option<String>,
+}
+
+/// What the syntax of a program says, by call site (`"line:col"`, from 1).
+#[derive(Debug, Default)]
+pub struct Syntax {
+    sites: HashMap<String, Site>,
+    /// Identifiers read other than as a whole argument of a paracosm builtin: inside a lambda
+    /// or a `def`, in an expression, as an argument of a user function.
+    used_in_code: HashMap<String, usize>,
+    /// `(builtin, keyword, variable)` for every `Builtin(keyword = variable)`.
+    passed: Vec<(String, String, String)>,
+}
+
+fn callee(e: &AstExpr) -> Option<String> {
+    match &e.node {
+        ExprP::Identifier(id) => Some(id.node.ident.clone()),
+        ExprP::Dot(_, attr) => Some(attr.node.clone()),
+        _ => None,
+    }
+}
+
+fn is_declarer(e: &AstExpr) -> bool {
+    matches!(&e.node, ExprP::Call(f, _) if callee(f).is_some_and(|c| DECLARERS.contains(&c.as_str())))
+}
+
+struct Walker<'a> {
+    ast: &'a AstModule,
+    builtins: &'a [&'a str],
+    out: Syntax,
+}
+
+impl Walker<'_> {
+    fn pos(&self, e: &AstExpr) -> String {
+        format!("{}", self.ast.file_span(e.span).resolve_span().begin)
+    }
+
+    fn site(&mut self, e: &AstExpr, name: Option<String>, variable: Option<String>) {
+        let key = self.pos(e);
+        self.out.sites.entry(key).or_insert(Site { name, variable });
+    }
+
+    fn stmt(&mut self, s: &AstStmt, in_code: bool) {
+        match &s.node {
+            StmtP::Assign(a) => {
+                let target = match &a.lhs.node {
+                    AssignTargetP::Identifier(id) => Some(id.node.ident.clone()),
+                    _ => None,
+                };
+                self.expr(&a.rhs, target.as_deref(), in_code);
+                a.lhs.visit_expr(|e| self.expr(e, None, true));
+            }
+            // Everything a function does is code.
+            StmtP::Def(_) => s.visit_children(|v| match v {
+                Visit::Stmt(s) => self.stmt(s, true),
+                Visit::Expr(e) => self.expr(e, None, true),
+            }),
+            StmtP::For(f) => {
+                self.expr(&f.over, None, true);
+                self.stmt(&f.body, in_code);
+            }
+            StmtP::If(c, body) => {
+                self.expr(c, None, true);
+                self.stmt(body, in_code);
+            }
+            StmtP::IfElse(c, bodies) => {
+                self.expr(c, None, true);
+                self.stmt(&bodies.0, in_code);
+                self.stmt(&bodies.1, in_code);
+            }
+            _ => s.visit_children(|v| match v {
+                Visit::Stmt(s) => self.stmt(s, in_code),
+                Visit::Expr(e) => self.expr(e, None, in_code),
+            }),
+        }
+    }
+
+    /// Walks `e`, the direct right-hand side of an assignment to `target` if any; `in_code`:
+    /// identifiers here are read by code rather than passed whole to a builtin.
+    fn expr(&mut self, e: &AstExpr, target: Option<&str>, in_code: bool) {
+        match &e.node {
+            ExprP::Call(f, args) => {
+                let name = callee(f);
+                if is_declarer(e) {
+                    let given = target.map(str::to_owned);
+                    self.site(e, given.clone(), given);
+                }
+                let builtin = name
+                    .as_deref()
+                    .is_some_and(|n| self.builtins.contains(&n) && !DECLARERS.contains(&n));
+                for a in &args.args {
+                    let value = a.node.expr();
+                    if let (ArgumentP::Named(kw, _), true) = (&a.node, is_declarer(value)) {
+                        let owner = target.map(str::to_owned).or_else(|| name.clone());
+                        let n = owner.map(|o| format!("{o}.{}", kw.node));
+                        self.site(value, n, None);
+                    }
+                    match (&value.node, builtin) {
+                        // A variable passed whole to a builtin: the world shows its effect.
+                        (ExprP::Identifier(id), true) => {
+                            if let ArgumentP::Named(kw, _) = &a.node {
+                                if let Some(n) = &name {
+                                    self.out.passed.push((
+                                        n.clone(),
+                                        kw.node.clone(),
+                                        id.node.ident.clone(),
+                                    ));
+                                }
+                            }
+                            if in_code {
+                                *self
+                                    .out
+                                    .used_in_code
+                                    .entry(id.node.ident.clone())
+                                    .or_default() += 1;
+                            }
+                        }
+                        _ => self.expr(value, None, in_code || !builtin),
+                    }
+                }
+                self.expr(f, None, in_code);
+            }
+            ExprP::Identifier(id) => {
+                if in_code {
+                    *self
+                        .out
+                        .used_in_code
+                        .entry(id.node.ident.clone())
+                        .or_default() += 1;
+                }
+            }
+            ExprP::Lambda(_) => e.visit_expr(|x| self.expr(x, None, true)),
+            // Tuples and lists of arguments (`connect((a.ONE, b, b.TWO))`, `route = [x]`)
+            // pass their items on as they are.
+            ExprP::Tuple(items) | ExprP::List(items) => {
+                for x in items {
+                    match &x.node {
+                        ExprP::Identifier(_) if !in_code => {}
+                        _ => self.expr(x, None, in_code),
+                    }
+                }
+            }
+            _ => e.visit_expr(|x| self.expr(x, None, true)),
+        }
+    }
+}
+
+impl Syntax {
+    /// Analyses `ast`; `builtins` are the names of paracosm's builtins and methods (a variable
+    /// passed whole to one of them is not "read by code").
+    pub fn of(ast: &AstModule, builtins: &[&str]) -> Syntax {
+        let mut w = Walker {
+            ast,
+            builtins,
+            out: Syntax::default(),
+        };
+        w.stmt(ast.statement(), false);
+        w.out
+    }
+
+    /// The site at `at` (`file:line:col`, the position of the call).
+    pub fn site(&self, at: &str) -> Option<&Site> {
+        let mut parts = at.rsplitn(3, ':');
+        let col = parts.next()?;
+        let line = parts.next()?;
+        self.sites.get(&format!("{line}:{col}"))
+    }
+
+    /// Whether the program reads `variable` in code (a lambda, a `def`, an expression, a user
+    /// function's argument) rather than only passing it whole to builtins.
+    pub fn read_in_code(&self, variable: &str) -> bool {
+        self.used_in_code.get(variable).copied().unwrap_or(0) > 0
+    }
+
+    /// The `(builtin, keyword)` pairs that `variable` is passed to whole.
+    pub fn passed_to(&self, variable: &str) -> Vec<(&str, &str)> {
+        self.passed
+            .iter()
+            .filter(|(_, _, v)| v == variable)
+            .map(|(b, k, _)| (b.as_str(), k.as_str()))
+            .collect()
+    }
+}
+
+/// Gives each parameter its final name: `explicit[k]` when given, else the site's name, else
+/// `param<k>`; names that two parameters derive alike (one call site in a loop, or the same
+/// keyword of two calls) get `_1`, `_2`, ... in declaration order.
+///
+/// # Errors
+/// A message when two explicit names clash.
+pub fn final_names(explicit: &[Option<String>], derived: &[Option<String>]) -> Vec<String> {
+    let base: Vec<String> = explicit
+        .iter()
+        .zip(derived)
+        .enumerate()
+        .map(|(k, (e, d))| {
+            e.clone()
+                .or_else(|| d.clone())
+                .unwrap_or_else(|| format!("param{k}"))
+        })
+        .collect();
+    let mut out = base.clone();
+    for (k, name) in base.iter().enumerate() {
+        if explicit[k].is_some() {
+            continue;
+        }
+        let same: Vec<usize> = (0..base.len())
+            .filter(|&j| base[j] == *name && explicit[j].is_none())
+            .collect();
+        let taken_explicitly = (0..base.len()).any(|j| explicit[j].as_deref() == Some(name));
+        if same.len() > 1 || taken_explicitly {
+            let i = same.iter().position(|&j| j == k).unwrap_or(0) + 1;
+            out[k] = format!("{name}_{i}");
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use starlark::syntax::Dialect;
+
+    fn syntax(src: &str) -> Syntax {
+        let dialect = Dialect {
+            enable_top_level_stmt: true,
+            ..Dialect::Standard
+        };
+        let ast = AstModule::parse("t.star", src.to_owned(), &dialect).unwrap();
+        Syntax::of(&ast, &["World", "Car", "RoadSegment", "onLane", "map"])
+    }
+
+    #[test]
+    fn names_come_from_where_the_parameter_stands() {
+        let s = syntax(
+            "speed = VarInterval(0, 1)\nw = World(fog = VarInterval(0, 1))\nWorld(light = VarEnum([0.1, 0.2]))\nx = [VarInterval(0, 1)]\n",
+        );
+        assert_eq!(s.site("t.star:1:9").unwrap().name.as_deref(), Some("speed"));
+        assert_eq!(s.site("t.star:1:9").unwrap().variable.as_deref(), Some("speed"));
+        assert_eq!(s.site("t.star:2:17").unwrap().name.as_deref(), Some("w.fog"));
+        assert_eq!(s.site("t.star:3:15").unwrap().name.as_deref(), Some("World.light"));
+        assert_eq!(s.site("t.star:4:6").unwrap().name, None);
+    }
+
+    #[test]
+    fn reading_a_variable_in_code_is_told_apart_from_passing_it_to_a_builtin() {
+        let s = syntax(
+            "c = VarEnum(['red', 'white'])\nk = VarEnum([1, 2])\nd = VarInterval(0, 1)\ncar = Car(color = c, speed = tick.map(lambda t: k * t))\nif d > 0.5:\n    pass\n",
+        );
+        assert!(!s.read_in_code("c"));
+        assert_eq!(s.passed_to("c"), [("Car", "color")]);
+        assert!(s.read_in_code("k"), "inside a lambda");
+        assert!(s.read_in_code("d"), "in a condition");
+    }
+
+    #[test]
+    fn alike_names_are_numbered_and_explicit_ones_win() {
+        let names = final_names(
+            &[None, None, Some("x".into()), None],
+            &[Some("Car.speed".into()), Some("Car.speed".into()), None, Some("x".into())],
+        );
+        assert_eq!(names, ["Car.speed_1", "Car.speed_2", "x", "x_1"]);
+    }
+}

@@ -1,0 +1,530 @@
+//! A loaded scenario program: evaluated once per test with that test's values of its open
+//! parameters (paper §2, "A Family of Worlds": a test case closes every open stream, so every
+//! input, road geometry included, may be open), and a few times when it loads, to learn its
+//! parameters, to check its worlds over the levels and corners of its parameters, and to find
+//! which inputs each parameter changes.
+
+use std::sync::Arc;
+
+use paracosm_engine::rx::{Host, OpenStream};
+use paracosm_engine::sut::SutConfig;
+use paracosm_engine::WorldSpec;
+use paracosm_generators::{Assignment, Domain, Param, ParamSpace, Value as Level};
+use starlark::environment::{Globals, Module};
+use starlark::eval::Evaluator;
+use starlark::syntax::AstModule;
+use starlark::values::Value;
+
+use super::globals::LoadState;
+use super::host::StarHost;
+use super::names::{final_names, Syntax};
+use super::scene::{self, coordinate_names, OverTime, ParamDecl, ParamValue, SceneBuilder};
+use super::usage;
+use crate::scenario::Warning;
+use crate::{MonitorSpec, Scenario, ScenarioError};
+
+/// Most combinations of parameter values checked when a program loads; beyond it, the rows
+/// of a pairwise covering array over them.
+pub const MAX_CHECKED_WORLDS: usize = 4096;
+
+/// The names of paracosm's builtins and methods: a variable passed whole to one of them acts
+/// through the world, which the usage analysis sees.
+const BUILTINS: &[&str] = &[
+    "World",
+    "RoadSegment",
+    "TIntersection",
+    "CrossIntersection",
+    "Roundabout",
+    "AutonomousVehicle",
+    "Car",
+    "Pedestrian",
+    "Const",
+    "CollisionMonitor",
+    "DistanceMonitor",
+    "OffRoadMonitor",
+    "TimeToFailure",
+    "Stl",
+    "test",
+    "onLane",
+    "connect",
+    "place",
+    "zip",
+    "skipUntil",
+    "takeUntil",
+    "concat",
+];
+
+/// A program and what its first evaluation told about it.
+pub struct Program {
+    file: String,
+    ast: AstModule,
+    globals: Globals,
+    /// Final name and declaration of each open parameter, in declaration order.
+    params: Vec<(String, ParamDecl)>,
+    /// The monitors the program declares (without the default `OffRoadMonitor`).
+    monitors: Vec<MonitorSpec>,
+    horizon_s: f64,
+    sut: SutConfig,
+}
+
+fn lambda_values<'v>(b: &SceneBuilder, module: &Module<'v>) -> Result<Vec<Value<'v>>, String> {
+    (0..b.lambdas)
+        .map(|n| {
+            module
+                .get(&super::lambda_name(n))
+                .ok_or_else(|| format!("lambda {n} is missing from the program's module"))
+        })
+        .collect()
+}
+
+/// Checks what every evaluation must have declared once the program has run.
+fn finished(b: &SceneBuilder) -> Result<(), String> {
+    if !b.placed {
+        return Err("the program never calls place(...): nothing to test".into());
+    }
+    if let Some(o) = b.objects.iter().find(|o| !o.placed) {
+        return Err(format!("{} is never placed: pass it to place(...)", o.name));
+    }
+    if b.ego.is_none() {
+        return Err("the program places no AutonomousVehicle: nothing to test".into());
+    }
+    if b.world.is_none() {
+        return Err("the program has no World(...)".into());
+    }
+    Ok(())
+}
+
+impl Program {
+    /// Evaluates the program with `values` (by declaration index; `None`: representative
+    /// values) within the loading limits, checks that it finished, and calls `then` with what
+    /// it declared and its module (whose lambdas the test calls).
+    fn evaluate<R>(
+        &self,
+        values: Option<Vec<ParamValue>>,
+        then: impl FnOnce(SceneBuilder, &Module) -> Result<R, String>,
+    ) -> Result<R, String> {
+        Module::with_temp_heap(|module| {
+            let state = LoadState::new(values);
+            {
+                let mut eval = Evaluator::new(&module);
+                eval.extra = Some(&state);
+                let limits = [
+                    eval.set_max_tick_count(super::MAX_LOAD_STEPS),
+                    eval.set_max_heap_size(super::MAX_LOAD_HEAP_BYTES),
+                    eval.set_max_callstack_size(super::MAX_CALL_DEPTH),
+                ];
+                for l in limits {
+                    l.map_err(|e| e.to_string())?;
+                }
+                eval.eval_module(self.ast.clone(), &self.globals)
+                    .map_err(|e| {
+                        let message = super::suggest_keyword(&format!("{e}"));
+                        // Limit errors (steps, heap) carry no span: say which program hit them.
+                        if message.contains(&self.file) {
+                            message
+                        } else {
+                            format!("{message}\n --> {}", self.file)
+                        }
+                    })?;
+            }
+            let b = state.scene.into_inner();
+            finished(&b).map_err(|m| format!("error: {m}\n --> {}", self.file))?;
+            then(b, &module)
+        })
+    }
+
+    /// Checks that an evaluation declared what the first one did: the same open parameters,
+    /// monitors, horizon and system under test.
+    fn consistent(&self, b: &SceneBuilder) -> Result<(), String> {
+        for (k, (name, decl)) in self.params.iter().enumerate() {
+            match b.params.get(k) {
+                Some(d) if d == decl => {}
+                Some(d) => {
+                    return Err(format!(
+                        "the open parameters depend on their values: parameter {k} is `{name}` \
+                         (declared at {}) for some values and the one declared at {} for others",
+                        decl.at, d.at
+                    ))
+                }
+                None => {
+                    return Err(format!(
+                        "the open parameters depend on their values: `{name}` (declared at {}) \
+                         is not declared for these values",
+                        decl.at
+                    ))
+                }
+            }
+        }
+        if let Some(extra) = b.params.get(self.params.len()) {
+            return Err(format!(
+                "the open parameters depend on their values: the one declared at {} exists only \
+                 for these values",
+                extra.at
+            ));
+        }
+        if b.monitors != self.monitors {
+            return Err(
+                "the monitors depend on the open parameters' values: declare the same monitors \
+                 for every test"
+                    .into(),
+            );
+        }
+        if b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S) != self.horizon_s {
+            return Err("test(horizon=) depends on the open parameters' values".into());
+        }
+        if b.ego.as_ref().map(|e| &e.sut) != Some(&self.sut) {
+            return Err(
+                "AutonomousVehicle(sut=) depends on the open parameters' values".into(),
+            );
+        }
+        Ok(())
+    }
+
+    /// The values of an assignment, by declaration index.
+    ///
+    /// # Errors
+    /// [`ScenarioError::MissingParam`] for a parameter (or coordinate) it lacks.
+    fn values(&self, a: &Assignment) -> Result<Vec<ParamValue>, ScenarioError> {
+        self.params
+            .iter()
+            .map(|(name, p)| {
+                let get = |n: &str| {
+                    a.get(n)
+                        .ok_or_else(|| ScenarioError::MissingParam(n.to_owned()))
+                };
+                let reals = || -> Result<Vec<f64>, ScenarioError> {
+                    coordinate_names(name, p.over_time)
+                        .iter()
+                        .map(|n| {
+                            get(n)?
+                                .as_f64()
+                                .ok_or(ScenarioError::MissingParam(n.clone()))
+                        })
+                        .collect()
+                };
+                Ok(match p.over_time {
+                    OverTime::Constant => ParamValue::Level(get(name)?.clone()),
+                    OverTime::Piecewise(_) => ParamValue::Over(OpenStream::Piecewise {
+                        values: reals()?,
+                        horizon_s: self.horizon_s,
+                    }),
+                    OverTime::Polynomial(_) => ParamValue::Over(OpenStream::Polynomial {
+                        coefficients: reals()?,
+                        horizon_s: self.horizon_s,
+                    }),
+                })
+            })
+            .collect()
+    }
+
+    /// The test values a parameter is checked at when the program loads: every level; an
+    /// interval's two ends (over time: all coefficients at one end, then at the other).
+    fn checked_values(&self, k: usize) -> Vec<(ParamValue, String)> {
+        let (name, p) = &self.params[k];
+        let n = coordinate_names(name, p.over_time).len();
+        let over = |x: f64| match p.over_time {
+            OverTime::Constant => ParamValue::Level(Level::Real(x)),
+            OverTime::Piecewise(_) => ParamValue::Over(OpenStream::Piecewise {
+                values: vec![x; n],
+                horizon_s: self.horizon_s,
+            }),
+            OverTime::Polynomial(_) => ParamValue::Over(OpenStream::Polynomial {
+                coefficients: vec![x; n],
+                horizon_s: self.horizon_s,
+            }),
+        };
+        match &p.domain {
+            Domain::Interval { lo, hi } => vec![
+                (over(*lo), format!("{name} = {lo}")),
+                (over(*hi), format!("{name} = {hi}")),
+            ],
+            Domain::Levels(levels) => levels
+                .iter()
+                .map(|l| (ParamValue::Level(l.clone()), format!("{name} = {l}")))
+                .collect(),
+        }
+    }
+
+    /// Every combination of [`Program::checked_values`] when there are at most
+    /// [`MAX_CHECKED_WORLDS`], else the rows of a pairwise covering array over them.
+    fn combinations(&self) -> Vec<(Vec<ParamValue>, String)> {
+        let options: Vec<Vec<(ParamValue, String)>> =
+            (0..self.params.len()).map(|k| self.checked_values(k)).collect();
+        let count = options
+            .iter()
+            .try_fold(1usize, |n, o| n.checked_mul(o.len()))
+            .unwrap_or(usize::MAX);
+        let rows: Vec<Vec<usize>> = if count <= MAX_CHECKED_WORLDS {
+            let mut rows = vec![Vec::new()];
+            for o in &options {
+                rows = rows
+                    .into_iter()
+                    .flat_map(|r| {
+                        (0..o.len()).map(move |i| {
+                            let mut r = r.clone();
+                            r.push(i);
+                            r
+                        })
+                    })
+                    .collect();
+            }
+            rows
+        } else {
+            let levels: Vec<u32> = options.iter().map(|o| o.len() as u32).collect();
+            match paracosm_generators::covering::ipog(&levels, 2) {
+                Ok(array) => (0..array.len())
+                    .map(|r| array.row(r).iter().map(|&i| i as usize).collect())
+                    .collect(),
+                Err(_) => vec![vec![0; options.len()]],
+            }
+        };
+        rows.into_iter()
+            .map(|r| {
+                let values = r.iter().zip(&options).map(|(&i, o)| o[i].0.clone()).collect();
+                let label = r
+                    .iter()
+                    .zip(&options)
+                    .map(|(&i, o)| o[i].1.clone())
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                (values, label)
+            })
+            .collect()
+    }
+
+    /// The world of one evaluation with `values`, checked for consistency.
+    fn world_for(&self, values: Vec<ParamValue>) -> Result<WorldSpec, String> {
+        self.evaluate(Some(values), |b, _| {
+            self.consistent(&b)?;
+            scene::world(&b, self.horizon_s)
+        })
+    }
+}
+
+impl crate::Worlds for Program {
+    fn with_world(
+        &self,
+        assignment: &Assignment,
+        run: &mut dyn FnMut(&WorldSpec, &mut dyn Host),
+    ) -> Result<(), ScenarioError> {
+        let values = self.values(assignment)?;
+        self.evaluate(Some(values), |b, module| {
+            self.consistent(&b)?;
+            let spec = scene::world(&b, self.horizon_s)?;
+            let functions = lambda_values(&b, module)?;
+            let mut eval = Evaluator::new(module);
+            let mut host = StarHost::new(&mut eval, &functions);
+            run(&spec, &mut host);
+            Ok(())
+        })
+        .map_err(|m| {
+            ScenarioError::Language(format!("the program failed for this test's values: {m}"))
+        })
+    }
+}
+
+/// Loads a program: the first evaluation (representative values) declares the parameters,
+/// monitors and settings; then every combination of the parameters' levels and interval ends
+/// is evaluated and must build a valid world with the same declarations; then each
+/// parameter's other values show which inputs it changes (for warnings and coverage).
+///
+/// # Errors
+/// A diagnostic naming the file, line and column, and for a world that fails only for some
+/// values, those values.
+pub fn load(
+    file: &str,
+    source: &str,
+    name: &str,
+    ast: AstModule,
+    globals: Globals,
+) -> Result<Scenario, ScenarioError> {
+    let lang = ScenarioError::Language;
+    let syntax = Syntax::of(&ast, BUILTINS);
+    let mut program = Program {
+        file: file.to_owned(),
+        ast,
+        globals,
+        params: Vec::new(),
+        monitors: Vec::new(),
+        horizon_s: super::DEFAULT_HORIZON_S,
+        sut: SutConfig::builtin("aeb").map_err(lang)?,
+    };
+    let first = program.evaluate(None, |b, _| Ok(b)).map_err(lang)?;
+
+    // Names: explicit, else from where the parameter stands, else by position.
+    let explicit: Vec<Option<String>> = first.params.iter().map(|p| p.name.clone()).collect();
+    let derived: Vec<Option<String>> = first
+        .params
+        .iter()
+        .map(|p| syntax.site(&p.at).and_then(|s| s.name.clone()))
+        .collect();
+    for (i, a) in explicit.iter().enumerate() {
+        if let Some(a) = a {
+            if let Some(j) = (0..i).find(|&j| explicit[j].as_deref() == Some(a)) {
+                return Err(lang(format!(
+                    "error: two open parameters are named `{a}` (declared at {} and {}); give \
+                     one another name=\n --> {file}",
+                    first.params[j].at, first.params[i].at
+                )));
+            }
+        }
+    }
+    let names = final_names(&explicit, &derived);
+    program.params = names.iter().cloned().zip(first.params.clone()).collect();
+    program.monitors = first.monitors.clone();
+    program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
+    program.sut = first
+        .ego
+        .as_ref()
+        .map(|e| e.sut.clone())
+        .ok_or_else(|| lang("the program places no AutonomousVehicle".into()))?;
+
+    let mut space = Vec::new();
+    for (name, p) in &program.params {
+        for coordinate in coordinate_names(name, p.over_time) {
+            space.push(Param {
+                name: coordinate,
+                domain: p.domain.clone(),
+                unit: p.unit.clone(),
+            });
+        }
+    }
+    let space = ParamSpace::new(space).map_err(|e| lang(e.to_string()))?;
+
+    // Every combination of levels and interval ends builds a valid world.
+    let with = |label: &str, m: String| {
+        if label.is_empty() {
+            lang(m)
+        } else {
+            lang(format!("{m}\n(the world fails for the test values {label})"))
+        }
+    };
+    if !program.params.is_empty() {
+        for (values, label) in program.combinations() {
+            program
+                .world_for(values)
+                .map_err(|m| with(&label, m))?;
+        }
+    }
+
+    // What each parameter changes: its other checked values against the first evaluation.
+    let base = scene::world(&first, program.horizon_s).map_err(lang)?;
+    let base_values: Vec<ParamValue> = program
+        .params
+        .iter()
+        .map(|(_, d)| scene::representative(d, program.horizon_s))
+        .collect();
+    let mut changes = Vec::with_capacity(program.params.len());
+    for k in 0..program.params.len() {
+        let mut seen = Vec::new();
+        for (v, label) in program.checked_values(k) {
+            if v == base_values[k] {
+                continue;
+            }
+            let mut values = base_values.clone();
+            values[k] = v;
+            let other = program.world_for(values).map_err(|m| with(&label, m))?;
+            seen.extend(usage::changes(&base, &other));
+        }
+        changes.push(seen);
+    }
+
+    let mut monitors = program.monitors.clone();
+    let declared = monitors.len();
+    let has_off_road = monitors.iter().any(MonitorSpec::judges_off_road);
+    if first.offroad.unwrap_or(true) && !has_off_road {
+        let implicit = MonitorSpec::implicit_off_road();
+        if monitors.iter().any(|m| m.name() == implicit.name()) {
+            return Err(lang(format!(
+                "error: a monitor is named `{}`, the name of the default OffRoadMonitor: rename \
+                 it, declare OffRoadMonitor(v) yourself, or opt out with test(offroad = False)\n \
+                 --> {file}",
+                implicit.name()
+            )));
+        }
+        monitors.push(implicit);
+    }
+    let map_axes = match &first.map_axes {
+        Some(axes) => {
+            for a in axes {
+                if space.param(a).is_none() {
+                    let known: Vec<&str> = space.params().iter().map(|p| p.name.as_str()).collect();
+                    return Err(lang(format!(
+                        "error: test(map=...) names `{a}`, which is not a parameter (the \
+                         parameters: {})\n --> {file}",
+                        if known.is_empty() {
+                            "none".to_owned()
+                        } else {
+                            known.join(", ")
+                        }
+                    )));
+                }
+            }
+            axes.clone()
+        }
+        None => space.params().iter().take(2).map(|p| p.name.clone()).collect(),
+    };
+
+    let mut warnings = first.warnings.clone();
+    let place_at = first.placed_at.clone().unwrap_or_default();
+    if declared == 0 {
+        warnings.push(Warning {
+            at: place_at,
+            message: if monitors.is_empty() {
+                "the program declares no monitor and opts out of the default OffRoadMonitor: \
+                 every test passes whatever happens"
+                    .to_owned()
+            } else {
+                "the program declares no monitor: only the default OffRoadMonitor judges its \
+                 tests, so a test passes whatever else happens (add CollisionMonitor(v), \
+                 DistanceMonitor(v, minD = ...) or Stl(...))"
+                    .to_owned()
+            },
+        });
+    }
+    let stl_reads_light = monitors
+        .iter()
+        .any(|m| m.reads_signal(crate::signal::LIGHT));
+    let read_in_code: Vec<bool> = program
+        .params
+        .iter()
+        .map(|(_, d)| {
+            syntax
+                .site(&d.at)
+                .and_then(|s| s.variable.as_deref())
+                .is_some_and(|v| syntax.read_in_code(v))
+        })
+        .collect();
+    let found = usage::analyse(usage::Inputs {
+        params: &program.params,
+        changes: &changes,
+        read_in_code: &read_in_code,
+        stl_reads_light,
+        world: &first,
+        horizon_s: program.horizon_s,
+    });
+    warnings.extend(found.warnings);
+    warnings.extend(usage::unit_warnings(&program.params, &syntax));
+    let unused_params: Vec<String> = found
+        .unused
+        .iter()
+        .flat_map(|&k| coordinate_names(&program.params[k].0, program.params[k].1.over_time))
+        .collect();
+
+    let horizon_s = program.horizon_s;
+    let sut = program.sut.clone();
+    Ok(Scenario {
+        name: name.to_owned(),
+        description: super::header(source),
+        space,
+        horizon_s,
+        sut,
+        monitors,
+        map_axes,
+        warnings,
+        unused_params,
+        camera_only: found.camera_only,
+        source: Arc::from(source),
+        worlds: Arc::new(program),
+    })
+}
