@@ -216,12 +216,12 @@ fn mistyped_inputs_are_refused_at_load_with_file_line_col() {
         (
             "fog_out_of_range.star",
             "World(fog=) takes a number in [0, 1], got 3 (a number)",
-            "fog_out_of_range.star:5:5",
+            "fog_out_of_range.star:6:5",
         ),
         (
             "fog_out_of_range.star",
             "(the world fails for the test values fog = 3)",
-            "fog_out_of_range.star:5:5",
+            "fog_out_of_range.star:6:5",
         ),
     ] {
         let out = dir.path().join(file);

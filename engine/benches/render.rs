@@ -10,18 +10,27 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use paracosm_engine::network::Network;
 use paracosm_engine::render::{CameraPose, RenderJob, RenderObject, Renderer, SceneGeometry, View};
 use paracosm_engine::CameraSpec;
+use paracosm_engine::Size;
 
 fn objects() -> Vec<RenderObject> {
     vec![
         RenderObject {
             base_m: [40.0, 0.0, 1.75],
-            size_m: [4.5, 1.7, 1.9],
+            size: Size {
+                length_m: 4.5,
+                width_m: 1.9,
+                height_m: 1.7,
+            },
             heading_rad: 0.0,
             albedo: [0.92, 0.92, 0.92],
         },
         RenderObject {
             base_m: [30.0, 0.15, 5.0],
-            size_m: [0.5, 1.8, 0.5],
+            size: Size {
+                length_m: 0.5,
+                width_m: 0.5,
+                height_m: 1.8,
+            },
             heading_rad: 0.0,
             albedo: [0.75, 0.22, 0.18],
         },

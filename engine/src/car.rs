@@ -1,6 +1,9 @@
 use rapier3d::prelude::*;
 use serde::Serialize;
 
+use crate::actor::{Size, VisibleBox};
+use crate::rx::StreamId;
+
 /// Height of an NPC car's body above the road, in metres.
 pub(crate) const CLEARANCE_M: f64 = 0.2;
 
@@ -39,17 +42,26 @@ pub(crate) struct Car {
     rolling: Option<f64>,
     /// Ground point `[x, z]` (m) and heading (rad) at `s`, kept from the last move.
     here: ([f64; 2], f64),
-    half_height: f64,
-    /// Half length and half width, metres.
-    pub(crate) half_size_m: [f64; 2],
+    /// Its body; the collider spans `[CLEARANCE_M, CLEARANCE_M + height]` above the road.
+    pub(crate) size: Size,
+    /// How the camera draws it.
+    pub(crate) albedo: [f32; 3],
+    /// Its speed stream, m/s.
+    pub(crate) speed_stream: StreamId,
+    /// Whether it touches the ego vehicle now.
+    pub(crate) touching: bool,
 }
 
 impl Car {
+    /// A car on `path` (world `[x, z]` metres, two points or more), in the physics world when
+    /// `enabled`, driven by `speed_stream`.
     pub(crate) fn build(
         physics: &mut PhysicsWorld,
         path: Vec<[f64; 2]>,
-        size_m: [f64; 3],
+        size: Size,
         enabled: bool,
+        albedo: [f32; 3],
+        speed_stream: StreamId,
     ) -> Self {
         let mut cumulative = vec![0.0];
         for w in path.windows(2) {
@@ -64,16 +76,22 @@ impl Car {
             speed: 0.0,
             rolling: None,
             here: ([0.0; 2], 0.0),
-            half_height: size_m[1] / 2.0,
-            half_size_m: [size_m[0] / 2.0, size_m[2] / 2.0],
+            size,
+            albedo,
+            speed_stream,
+            touching: false,
         };
         car.here = car.at(0.0);
         if enabled {
             let pose = car.pose();
             let body = RigidBodyBuilder::kinematic_position_based().pose(pose);
-            let [l, h, w] = size_m.map(|v| (v / 2.0) as f32);
-            let collider =
-                ColliderBuilder::cuboid(l, h, w).active_events(ActiveEvents::COLLISION_EVENTS);
+            // Half extents along the body's x (length), y (height) and z (width).
+            let collider = ColliderBuilder::cuboid(
+                (size.length_m / 2.0) as f32,
+                (size.height_m / 2.0) as f32,
+                (size.width_m / 2.0) as f32,
+            )
+            .active_events(ActiveEvents::COLLISION_EVENTS);
             car.body = Some(physics.insert(body, collider));
         }
         car
@@ -102,7 +120,11 @@ impl Car {
     fn pose(&self) -> Pose {
         let ([x, z], h) = self.here;
         Pose::from_parts(
-            Vector::new(x as f32, (CLEARANCE_M + self.half_height) as f32, z as f32),
+            Vector::new(
+                x as f32,
+                (CLEARANCE_M + self.size.height_m / 2.0) as f32,
+                z as f32,
+            ),
             Rotation::from_rotation_y(h as f32),
         )
     }
@@ -154,7 +176,23 @@ impl Car {
                 -self.speed * heading_rad.sin(),
             ],
             heading_rad,
-            half_size_m: self.half_size_m,
+            half_size_m: [self.size.length_m / 2.0, self.size.width_m / 2.0],
+        })
+    }
+
+    /// The box the camera draws: from the road to its roof, so it covers the wheels under
+    /// the collider's clearance.
+    pub(crate) fn visible(&self) -> Option<VisibleBox> {
+        self.body?;
+        let ([x, z], heading_rad) = self.here;
+        Some(VisibleBox {
+            base_m: [x, 0.0, z],
+            size: Size {
+                height_m: self.size.height_m + CLEARANCE_M,
+                ..self.size
+            },
+            heading_rad,
+            albedo: self.albedo,
         })
     }
 

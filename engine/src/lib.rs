@@ -12,6 +12,7 @@
 //! bit-identically on every run, thread and CPU.
 #![warn(missing_docs)]
 
+pub mod actor;
 pub mod behaviour;
 mod camera;
 mod car;
@@ -21,17 +22,20 @@ mod environment;
 mod error;
 mod lidar;
 pub mod network;
+mod obstacle;
 mod pedestrian;
 pub mod placement;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod rx;
+pub mod sensor;
 mod sim;
 mod spec;
 pub mod sut;
 pub mod ttc;
 mod vehicle;
 
+pub use actor::{Handle, Set, Size, VisibleBox};
 pub use camera::{CameraFrame, CameraSpec, SENSOR_HEIGHT_MM, SENSOR_WIDTH_MM};
 pub use car::CarState;
 pub use control::Control;
@@ -39,9 +43,11 @@ pub use environment::{visibility_m, FOG_EXTINCTION_PER_M, NOMINAL_LIGHT};
 pub use error::EngineError;
 pub use lidar::{LidarReturn, LidarSpec};
 pub use network::{Lane, Location, Network, PieceId, PieceKind};
+pub use obstacle::ObstacleState;
 pub use pedestrian::{PedestrianPhase, PedestrianState};
 pub use sim::{EgoState, Observation, Simulation, Snapshot};
 pub use spec::{
-    CarSpec, EgoSpec, EnvironmentSpec, PedestrianSpec, TriggeredPedestrian, WorldSpec, DEFAULT_DT_S,
+    CarSpec, EgoSpec, EnvironmentSpec, ObstacleSpec, PedestrianSpec, TriggeredPedestrian,
+    WorldSpec, DEFAULT_DT_S,
 };
 pub use vehicle::VehicleParams;

@@ -128,6 +128,55 @@ impl LidarSpec {
     }
 }
 
+/// The lidar as a [`crate::sensor::Sensor`]: scans at its rate, its range capped by the fog's
+/// visibility ([`crate::visibility_m`]); light does not affect it.
+pub(crate) struct Lidar {
+    spec: LidarSpec,
+    directions: Vec<(f64, f64)>,
+    period: u64,
+    scan: Vec<LidarReturn>,
+}
+
+impl Lidar {
+    /// A lidar of `spec` on a simulation stepping `dt_s` seconds.
+    pub(crate) fn new(spec: &LidarSpec, dt_s: f64) -> Self {
+        Lidar {
+            directions: spec.directions(),
+            period: ((1.0 / (spec.rate_hz * dt_s)).round() as u64).max(1),
+            spec: spec.clone(),
+            scan: Vec::new(),
+        }
+    }
+}
+
+impl crate::sensor::Sensor for Lidar {
+    fn name(&self) -> &'static str {
+        "lidar"
+    }
+
+    fn period_ticks(&self) -> u64 {
+        self.period
+    }
+
+    fn capture(&mut self, scene: &crate::sensor::Scene<'_>) -> Result<(), crate::EngineError> {
+        let pose = *scene.physics.bodies[scene.ego_body].position();
+        let range_m = self.spec.range_m.min(crate::visibility_m(scene.fog));
+        self.spec.scan(
+            scene.physics,
+            &pose,
+            scene.ego_body,
+            &self.directions,
+            range_m,
+            &mut self.scan,
+        );
+        Ok(())
+    }
+
+    fn reading(&self) -> Option<crate::sensor::Reading<'_>> {
+        Some(crate::sensor::Reading::Lidar(&self.scan))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -35,6 +35,10 @@ pub struct PedestrianState {
 pub(crate) struct Pedestrian {
     pub(crate) body: RigidBodyHandle,
     pub(crate) collider: ColliderHandle,
+    /// Its walking speed stream, m/s.
+    pub(crate) speed_stream: crate::rx::StreamId,
+    /// Whether it touches the ego vehicle now.
+    pub(crate) touching: bool,
     target: [f64; 3],
     pos: [f64; 3],
     velocity: [f64; 3],
@@ -43,7 +47,12 @@ pub(crate) struct Pedestrian {
 }
 
 impl Pedestrian {
-    pub(crate) fn build(physics: &mut PhysicsWorld, start: [f64; 3], target: [f64; 3]) -> Self {
+    pub(crate) fn build(
+        physics: &mut PhysicsWorld,
+        start: [f64; 3],
+        target: [f64; 3],
+        speed_stream: crate::rx::StreamId,
+    ) -> Self {
         let body = RigidBodyBuilder::kinematic_position_based().translation(centre(start));
         let collider = ColliderBuilder::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M)
             .sensor(true)
@@ -52,6 +61,8 @@ impl Pedestrian {
         Pedestrian {
             body,
             collider,
+            speed_stream,
+            touching: false,
             target,
             pos: start,
             velocity: [0.0; 3],
@@ -113,6 +124,16 @@ impl Pedestrian {
         }
     }
 
+    /// The box the camera draws: the capsule's bounding box, [`crate::Size::PEDESTRIAN`].
+    pub(crate) fn visible(&self) -> crate::actor::VisibleBox {
+        crate::actor::VisibleBox {
+            base_m: self.pos,
+            size: crate::Size::PEDESTRIAN,
+            heading_rad: 0.0,
+            albedo: [0.75, 0.22, 0.18],
+        }
+    }
+
     pub(crate) fn state(&self) -> PedestrianState {
         PedestrianState {
             pos_m: self.pos,
@@ -138,7 +159,12 @@ mod tests {
     #[test]
     fn walks_at_its_speed_marks_the_trigger_time_and_stops_at_the_target() {
         let mut physics = PhysicsWorld::new();
-        let mut p = Pedestrian::build(&mut physics, [100.0, 0.0, 4.0], [100.0, 0.0, -4.0]);
+        let mut p = Pedestrian::build(
+            &mut physics,
+            [100.0, 0.0, 4.0],
+            [100.0, 0.0, -4.0],
+            crate::rx::StreamId(0),
+        );
         let dt = 0.1;
         assert_eq!(p.state().phase, PedestrianPhase::Waiting);
         p.walk(&mut physics, 0.1, dt, 2.0);

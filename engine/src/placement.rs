@@ -13,15 +13,15 @@ use crate::EngineError;
 /// The space an object occupies at the start.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Footprint {
-    /// A box on the ground: centre of its base `pos_m` (metres), heading (rad), and length,
-    /// width, height `size_m` (metres).
+    /// A box on the ground (a vehicle, an obstacle): centre of its base `pos_m` (metres),
+    /// heading (rad), and its size.
     Vehicle {
         /// Ground point under the centre, metres.
         pos_m: [f64; 3],
         /// Heading, rad.
         heading_rad: f64,
-        /// Length, width, height in metres.
-        size_m: [f64; 3],
+        /// Its size.
+        size: crate::Size,
     },
     /// A standing pedestrian's capsule, feet at `pos_m` (metres).
     Pedestrian {
@@ -47,20 +47,21 @@ fn shape(f: &Footprint) -> (Pose, Box<dyn Shape>) {
         Footprint::Vehicle {
             pos_m,
             heading_rad,
-            size_m,
+            size,
         } => (
             Pose::from_parts(
                 Vector::new(
                     pos_m[0] as f32,
-                    (pos_m[1] + size_m[1] / 2.0) as f32,
+                    (pos_m[1] + size.height_m / 2.0) as f32,
                     pos_m[2] as f32,
                 ),
                 Rotation::from_rotation_y(heading_rad as f32),
             ),
+            // Half extents along x (length), y (height), z (width).
             Box::new(Cuboid::new(Vector::new(
-                (size_m[0] / 2.0) as f32,
-                (size_m[1] / 2.0) as f32,
-                (size_m[2] / 2.0) as f32,
+                (size.length_m / 2.0) as f32,
+                (size.height_m / 2.0) as f32,
+                (size.width_m / 2.0) as f32,
             ))),
         ),
         Footprint::Pedestrian { pos_m } => (

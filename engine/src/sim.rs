@@ -1,18 +1,22 @@
+use std::collections::HashMap;
 use std::sync::mpsc::{channel, Receiver};
 
 use rapier3d::prelude::*;
 use serde::Serialize;
 
+use crate::actor::{Handle, Set, Size, VisibleBox};
 use crate::behaviour::{decode_probe, Actor, Output};
 use crate::car::{Car, CarState};
-use crate::network::{Lane, Network, Surface};
+use crate::network::{Lane, Network, PieceId, Surface};
+use crate::obstacle::{Obstacle, ObstacleState};
 use crate::pedestrian::Pedestrian;
 use crate::rx::{Host, Inputs, Runtime, StreamId, Value};
+use crate::sensor::{Reading, Scene, Sensor, Sensors};
 use crate::spec::EnvironmentSpec;
 use crate::vehicle::EgoVehicle;
 use crate::{
-    visibility_m, CameraFrame, CameraSpec, Control, EngineError, LidarReturn, LidarSpec,
-    PedestrianState, WorldSpec, NOMINAL_LIGHT,
+    CameraFrame, CameraSpec, Control, EngineError, LidarReturn, PedestrianState, WorldSpec,
+    NOMINAL_LIGHT,
 };
 
 /// The ego vehicle's state.
@@ -27,7 +31,7 @@ pub struct EgoState {
 }
 
 /// What a system under test sees at one instant.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Observation<'a> {
     /// Time since the start, in seconds.
     pub t_s: f64,
@@ -35,13 +39,16 @@ pub struct Observation<'a> {
     pub dt_s: f64,
     /// The ego vehicle's own state (odometry).
     pub ego: EgoState,
-    /// The latest lidar scan, in the vehicle frame.
+    /// The latest lidar scan, in the vehicle frame (empty without a lidar).
     pub lidar: &'a [LidarReturn],
     /// The route to follow, world `[x, z]` in metres (navigation); empty: keep the lane.
     pub route: &'a [[f64; 2]],
     /// The latest camera frame (RGB and depth), when a camera is attached
     /// ([`Simulation::attach_camera`]) and has captured one.
     pub camera: Option<&'a CameraFrame>,
+    /// Every sensor's latest reading, by the sensor's name, in the order the sensors were
+    /// mounted (what an external system receives, SUT_PROTOCOL.md).
+    pub readings: Vec<(&'static str, Reading<'a>)>,
 }
 
 /// The world's state after a step: what monitors are computed from.
@@ -55,10 +62,13 @@ pub struct Snapshot {
     pub pedestrians: Vec<PedestrianState>,
     /// Every NPC car, in the order of [`WorldSpec::cars`].
     pub cars: Vec<CarState>,
-    /// Whether the ego vehicle's body touches a pedestrian or a car now (collision events).
+    /// Every static obstacle, in the order of [`WorldSpec::obstacles`].
+    pub obstacles: Vec<ObstacleState>,
+    /// Whether the ego vehicle's body touches a pedestrian, a car or an obstacle now
+    /// (collision events).
     pub ego_contact: bool,
-    /// The smallest distance between the ego vehicle's body and a pedestrian's capsule or a
-    /// car's body, in metres; `0` when touching, `+inf` without actors.
+    /// The smallest distance between the ego vehicle's body and a pedestrian's capsule, a
+    /// car's or an obstacle's body, in metres; `0` when touching, `+inf` without actors.
     pub min_separation_m: f64,
     /// Path time to collision of the ego vehicle in seconds ([`crate::ttc::time_to_collision_s`]):
     /// `+inf` when nothing in its path is closing in, `0` when touching.
@@ -79,46 +89,46 @@ pub struct Snapshot {
     pub ego_lane_offset_m: f64,
 }
 
-/// A running world: the physics, the actors, the stream graph that drives them, and the ego
-/// vehicle's sensors, advanced in fixed steps by [`Simulation::step`].
+/// Which actor a collider belongs to.
+#[derive(Debug, Clone, Copy)]
+enum Owner {
+    Pedestrian(Handle<Pedestrian>),
+    Car(Handle<Car>),
+    Obstacle(Handle<Obstacle>),
+}
+
+/// A running world: the physics, the actors in their sets, the stream graph that drives
+/// them, and the ego vehicle's sensors, advanced in fixed steps by [`Simulation::step`].
 pub struct Simulation {
     physics: PhysicsWorld,
     network: Network,
     surface: Surface,
     ego: EgoVehicle,
     route: Vec<[f64; 2]>,
-    pedestrians: Vec<Pedestrian>,
-    cars: Vec<Car>,
-    speeds: (Vec<StreamId>, Vec<StreamId>),
+    pedestrians: Set<Pedestrian>,
+    cars: Set<Car>,
+    obstacles: Set<Obstacle>,
+    /// The actor each actor collider belongs to.
+    owners: HashMap<ColliderHandle, Owner>,
     environment: EnvironmentSpec,
     light_fog: (f64, f64),
     /// Pieces whose friction varies over the test, and their streams.
-    frictions: Vec<(crate::network::PieceId, StreamId)>,
+    frictions: Vec<(PieceId, StreamId)>,
     streams: Runtime,
     sinks: Vec<(u32, Value)>,
-    touching: Vec<bool>,
-    lidar: LidarSpec,
-    directions: Vec<(f64, f64)>,
-    scan_every: u64,
-    scan: Vec<LidarReturn>,
+    sensors: Sensors,
     events: Receiver<CollisionEvent>,
     collector: ChannelEventCollector,
     dt_s: f64,
     tick: u64,
-    /// Size `[length, width, height]` (m) and colour name of each NPC car, for the camera.
-    #[cfg(feature = "render")]
-    car_looks: Vec<([f64; 3], String)>,
-    #[cfg(feature = "render")]
-    camera: Option<crate::render::CameraRig>,
-    frame: Option<CameraFrame>,
 }
 
 impl Simulation {
-    /// Builds the world described by `spec`.
+    /// Builds the world described by `spec`, with its lidar mounted.
     ///
     /// # Errors
-    /// [`EngineError::InvalidWorld`] when a position, a speed, the lidar, the step or a car's
-    /// path is invalid; the message says which.
+    /// [`EngineError::InvalidWorld`] when a position, a speed, a size, the lidar, the step or
+    /// a car's path is invalid; the message says which.
     pub fn new(spec: &WorldSpec) -> Result<Self, EngineError> {
         let invalid = |m: String| EngineError::InvalidWorld(m);
         if !(spec.dt_s.is_finite() && spec.dt_s > 0.0) {
@@ -156,25 +166,6 @@ impl Simulation {
             friction,
         );
 
-        let pedestrians: Vec<Pedestrian> = spec
-            .pedestrians
-            .iter()
-            .map(|p| Pedestrian::build(&mut physics, p.start, p.target))
-            .collect();
-        let mut cars = Vec::with_capacity(spec.cars.len());
-        for (i, c) in spec.cars.iter().enumerate() {
-            if c.path.len() < 2 || c.path.iter().flatten().any(|v| !v.is_finite()) {
-                return Err(invalid(format!(
-                    "car {i} has no route of two or more points"
-                )));
-            }
-            cars.push(Car::build(
-                &mut physics,
-                c.path.clone(),
-                c.size_m,
-                c.enabled,
-            ));
-        }
         let n = spec.streams.nodes().len();
         let ids = spec
             .pedestrians
@@ -188,55 +179,90 @@ impl Simulation {
                 return Err(invalid(format!("stream {} does not exist", id.0)));
             }
         }
+        let mut owners = HashMap::new();
+        let mut pedestrians = Set::default();
+        for p in &spec.pedestrians {
+            let ped = Pedestrian::build(&mut physics, p.start, p.target, p.speed);
+            let collider = ped.collider;
+            owners.insert(collider, Owner::Pedestrian(pedestrians.insert(ped)));
+        }
+        let mut cars = Set::default();
+        for (i, c) in spec.cars.iter().enumerate() {
+            if c.path.len() < 2 || c.path.iter().flatten().any(|v| !v.is_finite()) {
+                return Err(invalid(format!(
+                    "car {i} has no route of two or more points"
+                )));
+            }
+            if !c.size.is_valid() {
+                return Err(invalid(format!("car {i} has the size {:?}", c.size)));
+            }
+            let car = Car::build(
+                &mut physics,
+                c.path.clone(),
+                c.size,
+                c.enabled,
+                crate::colour::albedo(&c.color).unwrap_or([0.45, 0.45, 0.45]),
+                c.speed,
+            );
+            let collider = car.body.map(|(_, c)| c);
+            let h = cars.insert(car);
+            if let Some(collider) = collider {
+                owners.insert(collider, Owner::Car(h));
+            }
+        }
+        let mut obstacles = Set::default();
+        for (i, o) in spec.obstacles.iter().enumerate() {
+            if !o.size.is_valid() || o.base_m.iter().any(|v| !v.is_finite()) {
+                return Err(invalid(format!(
+                    "obstacle {i} has the size {:?} at {:?}",
+                    o.size, o.base_m
+                )));
+            }
+            let obstacle = Obstacle::build(
+                &mut physics,
+                o.base_m,
+                o.heading_rad,
+                o.size,
+                crate::colour::albedo(&o.color).unwrap_or([0.45, 0.45, 0.45]),
+            );
+            let collider = obstacle.collider;
+            owners.insert(collider, Owner::Obstacle(obstacles.insert(obstacle)));
+        }
 
         let (collision_tx, events) = channel();
         let (force_tx, _) = channel();
         let (tear_tx, _) = channel();
-        let scan_every = ((1.0 / (spec.lidar.rate_hz * spec.dt_s)).round() as u64).max(1);
+        let mut sensors = Sensors::default();
+        sensors.insert(Box::new(crate::lidar::Lidar::new(&spec.lidar, spec.dt_s)));
         let mut sim = Simulation {
             physics,
             network: spec.network.clone(),
             surface,
             route: spec.ego.route.clone(),
-            touching: vec![false; pedestrians.len() + cars.len()],
             ego,
             pedestrians,
             cars,
-            speeds: (
-                spec.pedestrians.iter().map(|p| p.speed).collect(),
-                spec.cars.iter().map(|c| c.speed).collect(),
-            ),
+            obstacles,
+            owners,
             environment: spec.environment,
             frictions: spec.frictions.clone(),
             // Known before the first step when they are constants (a camera frame at t = 0
             // needs them); time-varying ones are set by the first step.
             light_fog: (
-                constant(&spec.streams, spec.environment.light).unwrap_or(crate::NOMINAL_LIGHT),
+                constant(&spec.streams, spec.environment.light).unwrap_or(NOMINAL_LIGHT),
                 constant(&spec.streams, spec.environment.fog).unwrap_or(0.0),
             ),
             streams: Runtime::new(spec.streams.clone()),
             sinks: Vec::new(),
-            directions: spec.lidar.directions(),
-            lidar: spec.lidar.clone(),
-            scan_every,
-            scan: Vec::new(),
+            sensors,
             events,
             collector: ChannelEventCollector::new(collision_tx, force_tx, tear_tx),
             dt_s: spec.dt_s,
             tick: 0,
-            #[cfg(feature = "render")]
-            car_looks: spec
-                .cars
-                .iter()
-                .map(|c| (c.size_m, c.color.clone()))
-                .collect(),
-            #[cfg(feature = "render")]
-            camera: None,
-            frame: None,
         };
         // Contacts and ray casts need the broad phase filled before the first step.
         sim.physics.detect_collisions(&(), &());
-        sim.rescan();
+        sim.capture_all(|_| true)?;
         Ok(sim)
     }
 
@@ -260,21 +286,39 @@ impl Simulation {
         ego_state(&self.physics, &self.ego)
     }
 
-    /// What the system under test sees now: odometry, the latest lidar scan and its route.
+    /// What the system under test sees now: odometry, its route, and every sensor's latest
+    /// reading.
     pub fn observation(&self) -> Observation<'_> {
+        let readings: Vec<(&'static str, Reading<'_>)> = self
+            .sensors
+            .values()
+            .filter_map(|s| s.reading().map(|r| (s.name(), r)))
+            .collect();
+        let lidar = readings
+            .iter()
+            .find_map(|(_, r)| match r {
+                Reading::Lidar(l) => Some(*l),
+                _ => None,
+            })
+            .unwrap_or(&[]);
+        let camera = readings.iter().find_map(|(_, r)| match r {
+            Reading::Camera(f) => Some(*f),
+            _ => None,
+        });
         Observation {
             t_s: self.t_s(),
             dt_s: self.dt_s,
             ego: self.ego_state(),
-            lidar: &self.scan,
+            lidar,
             route: &self.route,
-            camera: self.frame.as_ref(),
+            camera,
+            readings,
         }
     }
 
     /// Mounts `camera` on the ego vehicle, rendering through the process's shared
-    /// [`crate::render::Renderer`]; `seed` drives the camera's pixel noise. Frames are taken
-    /// by [`Simulation::capture`].
+    /// [`crate::render::Renderer`] at the camera's rate; `seed` drives the camera's pixel
+    /// noise. It takes its first frame now.
     ///
     /// # Errors
     /// [`EngineError::Sensor`] when the camera's values are out of range, no GPU adapter is
@@ -285,13 +329,10 @@ impl Simulation {
         {
             let renderer = crate::render::Renderer::shared()
                 .map_err(|e| EngineError::Sensor(e.to_string()))?;
-            self.camera = Some(crate::render::CameraRig::new(
-                renderer,
-                &self.network,
-                camera,
-                seed,
-            )?);
-            Ok(())
+            let rig =
+                crate::render::CameraRig::new(renderer, &self.network, camera, seed, self.dt_s)?;
+            let h = self.sensors.insert(Box::new(rig));
+            self.capture_all(|handle| handle == h)
         }
         #[cfg(not(feature = "render"))]
         {
@@ -304,97 +345,86 @@ impl Simulation {
         }
     }
 
-    /// The attached camera, if any.
-    pub fn camera(&self) -> Option<&CameraSpec> {
-        #[cfg(feature = "render")]
-        {
-            self.camera.as_ref().map(|c| c.camera())
-        }
-        #[cfg(not(feature = "render"))]
-        {
-            None
-        }
-    }
-
-    /// Renders the attached camera now; the frame is kept for [`Simulation::observation`]
-    /// until the next capture.
-    ///
-    /// # Errors
-    /// [`EngineError::Sensor`] without an attached camera, or when the GPU fails.
-    pub fn capture(&mut self) -> Result<&CameraFrame, EngineError> {
-        #[cfg(feature = "render")]
-        {
-            let objects = self.render_objects();
-            let ego = self.ego_state();
-            let pose = crate::render::CameraPose {
-                chassis_m: ego.pos_m,
-                heading_rad: ego.heading_rad,
-            };
-            let t_s = self.t_s();
-            let light_fog = self.light_fog;
-            let rig = self
-                .camera
-                .as_mut()
-                .ok_or_else(|| EngineError::Sensor("no camera is attached".into()))?;
-            let frame = rig.capture(pose, &objects, light_fog, t_s)?;
-            Ok(self.frame.insert(frame))
-        }
-        #[cfg(not(feature = "render"))]
-        {
-            Err(EngineError::Sensor("no camera is attached".into()))
-        }
+    /// The latest frame of the attached camera, if any.
+    pub fn camera_frame(&self) -> Option<&CameraFrame> {
+        self.sensors.values().find_map(|s| match s.reading() {
+            Some(Reading::Camera(f)) => Some(f),
+            _ => None,
+        })
     }
 
     /// The boxes the camera draws: every enabled NPC car (its colour, from the ground to its
-    /// roof) and every pedestrian (0.5 × 1.8 × 0.5 m, red).
-    #[cfg(feature = "render")]
-    pub fn render_objects(&self) -> Vec<crate::render::RenderObject> {
-        let mut out = Vec::with_capacity(self.cars.len() + self.pedestrians.len());
-        for (car, (size, color)) in self.cars.iter().zip(&self.car_looks) {
-            let s = car.state();
-            if s.enabled {
-                out.push(crate::render::RenderObject {
-                    base_m: s.pos_m,
-                    size_m: [size[0], size[2] + crate::car::CLEARANCE_M, size[1]],
-                    heading_rad: s.heading_rad,
-                    albedo: crate::render::color_albedo(color),
-                });
-            }
-        }
-        for p in &self.pedestrians {
-            out.push(crate::render::RenderObject {
-                base_m: p.state().pos_m,
-                size_m: [0.5, 1.8, 0.5],
-                heading_rad: 0.0,
-                albedo: [0.75, 0.22, 0.18],
-            });
-        }
-        out
+    /// roof), every pedestrian and every obstacle.
+    pub fn visible_boxes(&self) -> Vec<VisibleBox> {
+        self.cars
+            .values()
+            .filter_map(Car::visible)
+            .chain(self.pedestrians.values().map(Pedestrian::visible))
+            .chain(self.obstacles.values().map(Obstacle::visible))
+            .collect()
     }
 
-    /// Advances the world by one step of `dt` under `control`: vehicle model, the stream graph
-    /// (actor behaviours, light and fog), NPC cars, rapier step, contact events, and a lidar
-    /// scan when one is due. `host` runs the graph's lambdas.
+    /// Captures every sensor that `due` selects.
+    fn capture_all(
+        &mut self,
+        due: impl Fn(Handle<Box<dyn Sensor>>) -> bool,
+    ) -> Result<(), EngineError> {
+        let handles: Vec<_> = self.sensors.iter().map(|(h, _)| h).collect();
+        let draws = handles
+            .iter()
+            .any(|&h| due(h) && self.sensors.get(h).is_some_and(|s| s.draws()));
+        let boxes = if draws {
+            self.visible_boxes()
+        } else {
+            Vec::new()
+        };
+        let scene = Scene {
+            physics: &self.physics,
+            ego_body: self.ego.body,
+            ego: ego_state(&self.physics, &self.ego),
+            light: self.light_fog.0,
+            fog: self.light_fog.1,
+            t_s: self.t_s(),
+            boxes: &boxes,
+        };
+        for h in handles {
+            if due(h) {
+                if let Some(s) = self.sensors.get_mut(h) {
+                    s.capture(&scene)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Advances the world by one step of `dt` under `control`: the stream graph first (actor
+    /// behaviours, light, fog, frictions, from the world as it is at the start of the step),
+    /// then the vehicle model, pedestrians, NPC cars, the rapier step, contact events, and
+    /// every sensor that is due. `host` runs the graph's lambdas.
     ///
     /// # Errors
     /// [`EngineError::Stream`] when the stream graph fails (a lambda raised, a value of the
-    /// wrong kind).
+    /// wrong kind); [`EngineError::Sensor`] when a sensor fails.
     pub fn step(&mut self, control: Control, host: &mut dyn Host) -> Result<(), EngineError> {
         let dt = self.dt_s;
         let t = self.t_s();
-        // The streams first, from the world as it is at the start of the step: light, fog
-        // and frictions then hold for the whole step.
         self.sinks.clear();
         let inputs = WorldInputs {
             physics: &self.physics,
             ego: &self.ego,
+            ego_touching: self.ego_contact(),
             pedestrians: &self.pedestrians,
             cars: &self.cars,
-            touching: &self.touching,
         };
         self.streams.step(t, &inputs, host, &mut self.sinks)?;
         self.light_fog = (
-            number(&self.streams, self.environment.light, NOMINAL_LIGHT, t, "the light")?,
+            number(
+                &self.streams,
+                self.environment.light,
+                NOMINAL_LIGHT,
+                t,
+                "the light",
+            )?,
             number(&self.streams, self.environment.fog, 0.0, t, "the fog")?,
         );
         for &(piece, stream) in &self.frictions {
@@ -406,31 +436,26 @@ impl Simulation {
         self.ego.apply(control, dt);
         self.ego.grip(&self.physics, &self.surface);
         self.ego.update(&mut self.physics, dt);
-        for p in &mut self.pedestrians {
+        for p in self.pedestrians.iter_mut() {
             p.rest();
         }
         for (sink, _) in &self.sinks {
-            let i = *sink as usize;
-            if let (Some(p), Some(&speed)) = (self.pedestrians.get_mut(i), self.speeds.0.get(i)) {
-                let what = format!("the speed of pedestrian {i}");
-                let v = number(&self.streams, speed, 0.0, t, &what)?;
+            let h = Handle::<Pedestrian>::from_index(*sink as usize);
+            if let Some(p) = self.pedestrians.get_mut(h) {
+                let what = format!("the speed of pedestrian {sink}");
+                let v = number(&self.streams, p.speed_stream, 0.0, t, &what)?;
                 p.walk(&mut self.physics, t, dt, v);
             }
         }
-        for (i, (car, &speed)) in self.cars.iter_mut().zip(&self.speeds.1).enumerate() {
-            let v = number(
-                &self.streams,
-                speed,
-                0.0,
-                t,
-                &format!("the speed of car {i}"),
-            )?;
+        for (i, car) in self.cars.iter_mut().enumerate() {
+            let what = format!("the speed of car {i}");
+            let v = number(&self.streams, car.speed_stream, 0.0, t, &what)?;
             let friction = self.surface.friction_at(car.ground_m());
             car.advance(&mut self.physics, v, friction, dt);
         }
         if self.tick == 0 {
-            // The first scan was taken before light and fog were known.
-            self.rescan();
+            // The first lidar scan was taken before light and fog were known.
+            self.capture_all_named("lidar")?;
         }
         self.physics.step_with_events(&(), &self.collector);
         while let Ok(event) = self.events.try_recv() {
@@ -445,20 +470,45 @@ impl Simulation {
             } else {
                 continue;
             };
-            let actors = self
-                .pedestrians
-                .iter()
-                .map(|p| Some(p.collider))
-                .chain(self.cars.iter().map(|c| c.body.map(|(_, c)| c)));
-            if let Some(i) = actors.into_iter().position(|c| c == Some(other)) {
-                self.touching[i] = started;
+            match self.owners.get(&other) {
+                Some(Owner::Pedestrian(h)) => {
+                    if let Some(p) = self.pedestrians.get_mut(*h) {
+                        p.touching = started;
+                    }
+                }
+                Some(Owner::Car(h)) => {
+                    if let Some(c) = self.cars.get_mut(*h) {
+                        c.touching = started;
+                    }
+                }
+                Some(Owner::Obstacle(h)) => {
+                    if let Some(o) = self.obstacles.get_mut(*h) {
+                        o.touching = started;
+                    }
+                }
+                None => {}
             }
         }
         self.tick += 1;
-        if self.tick % self.scan_every == 0 {
-            self.rescan();
-        }
-        Ok(())
+        let tick = self.tick;
+        let due: Vec<bool> = self
+            .sensors
+            .values()
+            .map(|s| tick % s.period_ticks() == 0)
+            .collect();
+        self.capture_all(|h| due[h.index()])
+    }
+
+    fn capture_all_named(&mut self, name: &str) -> Result<(), EngineError> {
+        let named: Vec<bool> = self.sensors.values().map(|s| s.name() == name).collect();
+        self.capture_all(|h| named[h.index()])
+    }
+
+    /// Whether the ego vehicle touches any actor now.
+    fn ego_contact(&self) -> bool {
+        self.pedestrians.values().any(|p| p.touching)
+            || self.cars.values().any(|c| c.touching)
+            || self.obstacles.values().any(|o| o.touching)
     }
 
     /// The state monitors are computed from.
@@ -466,9 +516,10 @@ impl Simulation {
         let chassis = &self.physics.colliders[self.ego.collider];
         let colliders = self
             .pedestrians
-            .iter()
+            .values()
             .map(|p| p.collider)
-            .chain(self.cars.iter().filter_map(|c| c.body.map(|(_, c)| c)));
+            .chain(self.cars.values().filter_map(|c| c.body.map(|(_, c)| c)))
+            .chain(self.obstacles.values().map(|o| o.collider));
         let min_sep = colliders
             .filter_map(|handle| {
                 let c = &self.physics.colliders[handle];
@@ -485,7 +536,7 @@ impl Simulation {
         let ego = self.ego_state();
         let centre = [ego.pos_m[0], ego.pos_m[2]];
         let edge = self.surface.edge_distance_m(centre);
-        let size = self.ego.size_m();
+        let size = self.ego.size();
         let ego_mover = crate::ttc::Mover {
             pos_m: [ego.pos_m[0], ego.pos_m[2]],
             velocity_mps: [
@@ -493,21 +544,23 @@ impl Simulation {
                 -ego.speed_mps * ego.heading_rad.sin(),
             ],
             heading_rad: ego.heading_rad,
-            half_size_m: [size[0] / 2.0, size[1] / 2.0],
+            half_size_m: [size.length_m / 2.0, size.width_m / 2.0],
         };
         let movers: Vec<crate::ttc::Mover> = self
             .pedestrians
-            .iter()
+            .values()
             .map(Pedestrian::mover)
-            .chain(self.cars.iter().filter_map(Car::mover))
+            .chain(self.cars.values().filter_map(Car::mover))
+            .chain(self.obstacles.values().map(Obstacle::mover))
             .collect();
         Snapshot {
             t_s: self.t_s(),
             ego,
             ttc_s: crate::ttc::time_to_collision_s(&ego_mover, &movers),
-            pedestrians: self.pedestrians.iter().map(Pedestrian::state).collect(),
-            cars: self.cars.iter().map(Car::state).collect(),
-            ego_contact: self.touching.iter().any(|&t| t),
+            pedestrians: self.pedestrians.values().map(Pedestrian::state).collect(),
+            cars: self.cars.values().map(Car::state).collect(),
+            obstacles: self.obstacles.values().map(Obstacle::state).collect(),
+            ego_contact: self.ego_contact(),
             min_separation_m: min_sep,
             light: self.light_fog.0,
             fog: self.light_fog.1,
@@ -529,22 +582,20 @@ impl Simulation {
         self.ego.wheel_frictions()
     }
 
-    /// Length, width and height of the ego vehicle's body, in metres.
-    pub fn ego_size_m(&self) -> [f64; 3] {
-        self.ego.size_m()
+    /// The size of the ego vehicle's body.
+    pub fn ego_size(&self) -> Size {
+        self.ego.size()
     }
 
-    fn rescan(&mut self) {
-        let pose = *self.physics.bodies[self.ego.body].position();
-        let range_m = self.lidar.range_m.min(visibility_m(self.light_fog.1));
-        self.lidar.scan(
-            &self.physics,
-            &pose,
-            self.ego.body,
-            &self.directions,
-            range_m,
-            &mut self.scan,
-        );
+    /// The half extents of a car's collider along its length, height and width, metres, or
+    /// `None` for a car not in this test (for checking that the drawing and the collider
+    /// agree).
+    pub fn car_collider_half_extents_m(&self, car: usize) -> Option<[f64; 3]> {
+        let c = self.cars.get(Handle::from_index(car))?;
+        let (_, collider) = c.body?;
+        let cuboid = self.physics.colliders[collider].shape().as_cuboid()?;
+        let h = cuboid.half_extents;
+        Some([f64::from(h.x), f64::from(h.y), f64::from(h.z)])
     }
 }
 
@@ -597,9 +648,10 @@ fn ego_state(physics: &PhysicsWorld, ego: &EgoVehicle) -> EgoState {
 struct WorldInputs<'a> {
     physics: &'a PhysicsWorld,
     ego: &'a EgoVehicle,
-    pedestrians: &'a [Pedestrian],
-    cars: &'a [Car],
-    touching: &'a [bool],
+    /// Whether the ego vehicle touches any actor.
+    ego_touching: bool,
+    pedestrians: &'a Set<Pedestrian>,
+    cars: &'a Set<Car>,
 }
 
 impl Inputs for WorldInputs<'_> {
@@ -616,10 +668,10 @@ impl Inputs for WorldInputs<'_> {
                     }
                     Output::Heading => Value::Num(s.heading_rad),
                     Output::Speed => Value::Num(s.speed_mps),
-                    Output::Collision => Value::Bool(self.touching.iter().any(|&t| t)),
+                    Output::Collision => Value::Bool(self.ego_touching),
                 }
             }
-            Actor::Pedestrian(i) => match self.pedestrians.get(i as usize) {
+            Actor::Pedestrian(i) => match self.pedestrians.get(Handle::from_index(i as usize)) {
                 None => Value::Unit,
                 Some(p) => {
                     let v = p.velocity();
@@ -628,11 +680,11 @@ impl Inputs for WorldInputs<'_> {
                         Output::Vel => Value::Vec3(v),
                         Output::Heading => Value::Num((-v[2]).atan2(v[0])),
                         Output::Speed => Value::Num(v[0].hypot(v[2])),
-                        Output::Collision => Value::Bool(self.touching[i as usize]),
+                        Output::Collision => Value::Bool(p.touching),
                     }
                 }
             },
-            Actor::Car(i) => match self.cars.get(i as usize) {
+            Actor::Car(i) => match self.cars.get(Handle::from_index(i as usize)) {
                 None => Value::Unit,
                 Some(c) => {
                     let s = c.state();
@@ -642,9 +694,7 @@ impl Inputs for WorldInputs<'_> {
                         Output::Vel => Value::Vec3([d[0] * s.speed_mps, 0.0, d[1] * s.speed_mps]),
                         Output::Heading => Value::Num(s.heading_rad),
                         Output::Speed => Value::Num(s.speed_mps),
-                        Output::Collision => {
-                            Value::Bool(self.touching[self.pedestrians.len() + i as usize])
-                        }
+                        Output::Collision => Value::Bool(c.touching),
                     }
                 }
             },
@@ -656,7 +706,7 @@ impl Inputs for WorldInputs<'_> {
 mod tests {
     use super::*;
     use crate::rx::NoHost;
-    use crate::{EgoSpec, Lane, TriggeredPedestrian};
+    use crate::{EgoSpec, Lane, LidarSpec, TriggeredPedestrian};
 
     fn spec() -> WorldSpec {
         WorldSpec::straight_road(
@@ -737,6 +787,7 @@ mod tests {
         assert!((ego.speed_mps - 5.0).abs() < 1e-5);
         assert_eq!(ego.heading_rad, 0.0);
         let obs = sim.observation();
+        assert_eq!(obs.readings.len(), 1, "the lidar alone");
         let ahead = obs
             .lidar
             .iter()

@@ -42,12 +42,25 @@ pub struct CarSpec {
     pub path: Vec<[f64; 2]>,
     /// Speed stream, m/s; negative values count as 0.
     pub speed: StreamId,
-    /// Colour name (for the camera renderer), e.g. `red`.
+    /// Colour name (for the camera renderer), e.g. `red` ([`crate::colour::COLOURS`]).
     pub color: String,
-    /// Length, width and height in metres.
-    pub size_m: [f64; 3],
+    /// Its body.
+    pub size: crate::Size,
     /// Whether the car is in this test (a scenario may make its presence a parameter).
     pub enabled: bool,
+}
+
+/// A static obstacle (`Obstacle(loc=, size=, color=)`): a box that never moves.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ObstacleSpec {
+    /// Centre of its base `[x, y, z]`, metres.
+    pub base_m: [f64; 3],
+    /// Heading in rad.
+    pub heading_rad: f64,
+    /// Its size.
+    pub size: crate::Size,
+    /// Colour name ([`crate::colour::COLOURS`]).
+    pub color: String,
 }
 
 /// Global conditions (paper §2, `World(light, fog)`), as streams.
@@ -76,6 +89,8 @@ pub struct WorldSpec {
     pub pedestrians: Vec<PedestrianSpec>,
     /// NPC cars, in order.
     pub cars: Vec<CarSpec>,
+    /// Static obstacles, in order.
+    pub obstacles: Vec<ObstacleSpec>,
     /// Light and fog.
     pub environment: EnvironmentSpec,
     /// The reactive graph, bound (no open parameter slot left).
@@ -153,6 +168,7 @@ impl WorldSpec {
             },
             pedestrians: peds,
             cars: vec![],
+            obstacles: vec![],
             environment: EnvironmentSpec { light, fog },
             streams: g.finish()?,
             lidar: LidarSpec::default(),

@@ -9,8 +9,8 @@ use crate::Control;
 pub struct VehicleParams {
     /// Mass in kg. Default 1500.
     pub mass_kg: f64,
-    /// Body length, width and height in metres. Default 4.5 × 1.8 × 1.0.
-    pub size_m: [f64; 3],
+    /// Body size. Default 4.5 × 1.8 × 1.0 m.
+    pub size: crate::Size,
     /// Wheel radius in metres. Default 0.35.
     pub wheel_radius_m: f64,
     /// Engine force at full throttle per driven (rear) wheel, in N. Default 2250 N, i.e.
@@ -27,7 +27,11 @@ impl Default for VehicleParams {
     fn default() -> Self {
         VehicleParams {
             mass_kg: 1500.0,
-            size_m: [4.5, 1.8, 1.0],
+            size: crate::Size {
+                length_m: 4.5,
+                width_m: 1.8,
+                height_m: 1.0,
+            },
             wheel_radius_m: 0.35,
             max_engine_force_n: 2250.0,
             max_brake_force_n: 3000.0,
@@ -62,7 +66,11 @@ impl EgoVehicle {
         speed_mps: f64,
         friction: f64,
     ) -> Self {
-        let [len, wid, hei] = params.size_m.map(|v| v as f32);
+        let (len, wid, hei) = (
+            params.size.length_m as f32,
+            params.size.width_m as f32,
+            params.size.height_m as f32,
+        );
         let radius = params.wheel_radius_m as f32;
         // Chassis centre so that the wheels rest with a little compression at the start.
         let y = pos[1] as f32 + radius + SUSPENSION_REST_M + HARD_POINT_DROP_M - 0.05;
@@ -163,9 +171,9 @@ impl EgoVehicle {
         self.controller.update_vehicle(dt_s as f32, queries);
     }
 
-    /// Length, width and height of the body, in metres.
-    pub(crate) fn size_m(&self) -> [f64; 3] {
-        self.params.size_m
+    /// The size of the body.
+    pub(crate) fn size(&self) -> crate::Size {
+        self.params.size
     }
 }
 

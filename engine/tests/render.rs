@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use paracosm_engine::network::{Network, PieceKind};
 use paracosm_engine::render::{CameraPose, RenderJob, RenderObject, Renderer, NOMINAL_LIGHT};
+use paracosm_engine::Size;
 use paracosm_engine::{CameraFrame, CameraSpec};
 
 fn renderer() -> std::sync::Arc<Renderer> {
@@ -20,7 +21,11 @@ const RED: [f32; 3] = [0.75, 0.08, 0.07];
 fn car_at(x: f64, z: f64, albedo: [f32; 3]) -> RenderObject {
     RenderObject {
         base_m: [x, 0.0, z],
-        size_m: [4.5, 1.7, 1.9],
+        size: Size {
+            length_m: 4.5,
+            width_m: 1.9,
+            height_m: 1.7,
+        },
         heading_rad: 0.0,
         albedo,
     }
@@ -223,7 +228,11 @@ fn golden_cross_intersection_at_dusk() {
             car_at(70.0, -1.75, RED),
             RenderObject {
                 base_m: [55.0, 0.15, 5.0],
-                size_m: [0.5, 1.8, 0.5],
+                size: Size {
+                    length_m: 0.5,
+                    width_m: 0.5,
+                    height_m: 1.8,
+                },
                 heading_rad: 0.0,
                 albedo: [0.75, 0.22, 0.18],
             },
@@ -342,4 +351,104 @@ fn many_views_render_in_one_batch_like_one_at_a_time() {
         assert_eq!(frame.depth_m, single.depth_m, "view {i}");
     }
     assert_ne!(batch[0].rgb, batch[3].rgb, "the views moved");
+}
+
+/// Issue 15: an NPC car's collider and its drawing have one size (length, width, height, in
+/// one axis order). Seen from behind, the car's rear face in the image is as wide and as high
+/// as the collider's rear face, projected through the camera's intrinsics; and the drawn box
+/// matches the collider's extents.
+#[test]
+fn an_npc_cars_collider_and_its_drawing_agree() {
+    use paracosm_engine::behaviour::GraphBuilder;
+    use paracosm_engine::rx::{Node, Value};
+    use paracosm_engine::{
+        CarSpec, EgoSpec, EnvironmentSpec, Lane, LidarSpec, PieceId, Simulation, VehicleParams,
+        WorldSpec, DEFAULT_DT_S,
+    };
+    let network = road();
+    let start = network.on_lane(PieceId(0), Lane::Driving(1), 10.0).unwrap();
+    let car_at = network.on_lane(PieceId(0), Lane::Driving(1), 40.0).unwrap();
+    let mut g = GraphBuilder::new();
+    let light = g.push(Node::Const(Value::Num(NOMINAL_LIGHT)));
+    let fog = g.push(Node::Const(Value::Num(0.0)));
+    let still = g.push(Node::Const(Value::Num(0.0)));
+    let spec = WorldSpec {
+        dt_s: DEFAULT_DT_S,
+        frictions: vec![],
+        ego: EgoSpec {
+            start,
+            initial_speed_mps: 0.0,
+            vehicle: VehicleParams::default(),
+            route: vec![],
+        },
+        pedestrians: vec![],
+        cars: vec![CarSpec {
+            path: network.route(&car_at, &[], 100.0).unwrap(),
+            speed: still,
+            color: "white".into(),
+            size: Size::CAR,
+            enabled: true,
+        }],
+        obstacles: vec![],
+        environment: EnvironmentSpec { light, fog },
+        streams: g.finish().unwrap(),
+        lidar: LidarSpec::default(),
+        network,
+    };
+    let mut sim = Simulation::new(&spec).unwrap();
+    let camera = CameraSpec {
+        width: 640,
+        height: 480,
+        pitch_rad: 0.0,
+        ..CameraSpec::default()
+    };
+    sim.attach_camera(&camera, 0).unwrap();
+
+    // The collider: half extents along length, height, width.
+    let [hl, hh, hw] = sim.car_collider_half_extents_m(0).unwrap();
+    assert!(
+        (2.0 * hl - Size::CAR.length_m).abs() < 1e-6,
+        "length {}",
+        2.0 * hl
+    );
+    assert!(
+        (2.0 * hw - Size::CAR.width_m).abs() < 1e-6,
+        "width {}",
+        2.0 * hw
+    );
+    assert!(
+        (2.0 * hh - Size::CAR.height_m).abs() < 1e-6,
+        "height {}",
+        2.0 * hh
+    );
+    let drawn = sim.visible_boxes()[0];
+    assert_eq!(drawn.size.length_m, Size::CAR.length_m);
+    assert_eq!(drawn.size.width_m, Size::CAR.width_m);
+
+    // The image: the rear face stands 40 - 2.25 m from the start, the camera 0.5 m ahead of
+    // the chassis centre.
+    let frame = sim.camera_frame().unwrap();
+    let ego = sim.ego_state();
+    let depth = 40.0 - Size::CAR.length_m / 2.0 - (ego.pos_m[0] + camera.mount_m[0]);
+    let fx = camera.focal_mm * f64::from(camera.width) / 36.0;
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let on_car = |u: usize, v: usize| (f64::from(frame.depth_m[v * w + u]) - depth).abs() < 0.05;
+    let rows: Vec<usize> = (0..h).filter(|&v| (0..w).any(|u| on_car(u, v))).collect();
+    let (row, last) = (rows[0], *rows.last().expect("the car is in the image"));
+    let middle = (row + last) / 2;
+    let columns = (0..w).filter(|&u| on_car(u, middle)).count() as f64;
+    let expected_width = fx * Size::CAR.width_m / depth;
+    assert!(
+        (columns - expected_width).abs() <= 2.0,
+        "rear face {columns} px wide, the collider {expected_width:.1} px"
+    );
+    // The roof: the top row of the rear face is the collider's top, projected.
+    let camera_y = ego.pos_m[1] + camera.mount_m[1];
+    let top = 0.2 + Size::CAR.height_m;
+    let cy = f64::from(camera.height) / 2.0;
+    let expected_row = cy - fx * (top - camera_y) / depth;
+    assert!(
+        (row as f64 - expected_row).abs() <= 2.0,
+        "roof at row {row}, the collider's at {expected_row:.1}"
+    );
 }

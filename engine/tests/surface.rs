@@ -8,7 +8,7 @@ use paracosm_engine::sut::ConstantControl;
 use paracosm_engine::sut::Sut;
 use paracosm_engine::{
     CarSpec, Control, EgoSpec, EnvironmentSpec, Lane, LidarSpec, Network, PieceId, Simulation,
-    VehicleParams, WorldSpec, DEFAULT_DT_S,
+    Size, VehicleParams, WorldSpec, DEFAULT_DT_S,
 };
 
 fn segment(length_m: f64, friction: f64) -> PieceKind {
@@ -59,7 +59,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
             path: network.route(&loc, &[], 5000.0).unwrap(),
             speed,
             color: "red".into(),
-            size_m: [4.5, 1.8, 1.5],
+            size: Size::CAR,
             enabled: true,
         });
     }
@@ -75,6 +75,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
         },
         pedestrians: vec![],
         cars: specs,
+        obstacles: vec![],
         environment: EnvironmentSpec { light, fog },
         streams: g.finish().unwrap(),
         lidar: LidarSpec::default(),

@@ -209,15 +209,16 @@ impl Scenario {
         let mut control = Control::default();
         while !stopped && tick < ticks {
             if frame_every > 0 && tick % frame_every == 0 {
-                let frame = sim.capture()?;
-                if let Some(f) = options.on_frame.as_mut() {
+                if let (Some(f), Some(frame)) = (options.on_frame.as_mut(), sim.camera_frame()) {
                     f(frame);
                 }
             }
             if tick % control_every == 0 {
                 let mut obs = sim.observation();
                 if !sut_sees {
+                    // A viewing camera's frames are for people, not for the system.
                     obs.camera = None;
+                    obs.readings.retain(|(name, _)| *name != "camera");
                 }
                 control = sut.act(&obs)?;
             }

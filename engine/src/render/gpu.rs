@@ -33,18 +33,8 @@ struct Globals {
     params: [f32; 4],
 }
 
-/// A box in the world for the camera: a car or a pedestrian.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RenderObject {
-    /// Centre of the box's base (the ground point under it) `[x, y, z]`, metres.
-    pub base_m: [f64; 3],
-    /// Length (along the heading), height and width, metres.
-    pub size_m: [f64; 3],
-    /// Heading in rad (counter-clockwise seen from above, `0` along `+x`).
-    pub heading_rad: f64,
-    /// Albedo, linear RGB in `[0, 1]`.
-    pub albedo: [f32; 3],
-}
+/// A box in the world for the camera: a car, a pedestrian, an obstacle.
+pub type RenderObject = crate::actor::VisibleBox;
 
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -62,7 +52,12 @@ impl Instance {
     }
 
     fn of(o: &RenderObject) -> Self {
-        let [l, h, w] = o.size_m.map(|v| v as f32);
+        // The unit cube scaled to the box: x along the heading, y up, z across.
+        let (l, h, w) = (
+            o.size.length_m as f32,
+            o.size.height_m as f32,
+            o.size.width_m as f32,
+        );
         let model = glam::Mat4::from_scale_rotation_translation(
             glam::Vec3::new(l, h, w),
             glam::Quat::from_rotation_y(o.heading_rad as f32),

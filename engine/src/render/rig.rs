@@ -4,16 +4,48 @@ use std::sync::Arc;
 
 use super::gpu::{CameraPose, RenderJob, RenderObject, Renderer, SceneGeometry, View};
 use crate::camera::{CameraFrame, CameraSpec};
+
 use crate::network::Network;
 use crate::EngineError;
 
-/// The renderer, the world's uploaded geometry and the camera's targets, for one simulation.
+/// The renderer, the world's uploaded geometry and the camera's targets, for one simulation:
+/// the camera as a [`crate::sensor::Sensor`].
 pub(crate) struct CameraRig {
     renderer: Arc<Renderer>,
     scene: SceneGeometry,
     view: View,
     seed: u64,
     frames: u64,
+    period: u64,
+    frame: Option<CameraFrame>,
+}
+
+impl crate::sensor::Sensor for CameraRig {
+    fn name(&self) -> &'static str {
+        "camera"
+    }
+
+    fn period_ticks(&self) -> u64 {
+        self.period
+    }
+
+    fn draws(&self) -> bool {
+        true
+    }
+
+    fn capture(&mut self, scene: &crate::sensor::Scene<'_>) -> Result<(), EngineError> {
+        let pose = CameraPose {
+            chassis_m: scene.ego.pos_m,
+            heading_rad: scene.ego.heading_rad,
+        };
+        let frame = self.render(pose, scene.boxes, (scene.light, scene.fog), scene.t_s)?;
+        self.frame = Some(frame);
+        Ok(())
+    }
+
+    fn reading(&self) -> Option<crate::sensor::Reading<'_>> {
+        self.frame.as_ref().map(crate::sensor::Reading::Camera)
+    }
 }
 
 impl CameraRig {
@@ -22,6 +54,7 @@ impl CameraRig {
         network: &Network,
         camera: &CameraSpec,
         seed: u64,
+        dt_s: f64,
     ) -> Result<Self, EngineError> {
         let view = renderer
             .view(camera)
@@ -32,14 +65,12 @@ impl CameraRig {
             view,
             seed,
             frames: 0,
+            period: ((1.0 / (camera.rate_hz * dt_s)).round() as u64).max(1),
+            frame: None,
         })
     }
 
-    pub(crate) fn camera(&self) -> &CameraSpec {
-        self.view.camera()
-    }
-
-    pub(crate) fn capture(
+    fn render(
         &mut self,
         pose: CameraPose,
         objects: &[RenderObject],

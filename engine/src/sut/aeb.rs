@@ -232,6 +232,7 @@ mod tests {
             lidar: &lidar,
             route: &[],
             camera: None,
+            readings: vec![("lidar", crate::sensor::Reading::Lidar(&lidar))],
         })
         .unwrap()
     }

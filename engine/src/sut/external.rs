@@ -78,7 +78,8 @@ struct Process {
     stderr: Arc<Mutex<String>>,
     sensors: Sensors,
     wants_depth: bool,
-    wants_lidar: bool,
+    /// The sensors the program asked for by name with `true` in its hello (`lidar`...).
+    wanted: Vec<String>,
 }
 
 impl Drop for Process {
@@ -203,7 +204,7 @@ impl Process {
             stderr,
             sensors: Sensors::default(),
             wants_depth: false,
-            wants_lidar: false,
+            wanted: Vec::new(),
         };
         let hello = p.request(
             &json!({"type": "hello", "protocol": PROTOCOL_VERSION, "dt_s": dt_s}),
@@ -219,9 +220,19 @@ impl Process {
             return Err(format!("answered the hello with {h} instead of a hello"));
         }
         let sensors = h.get("sensors").cloned().unwrap_or(Json::Null);
-        let flag = |k: &str| sensors.get(k).and_then(Json::as_bool).unwrap_or(false);
-        self.wants_depth = flag("depth");
-        self.wants_lidar = flag("lidar");
+        self.wants_depth = sensors
+            .get("depth")
+            .and_then(Json::as_bool)
+            .unwrap_or(false);
+        self.wanted = sensors
+            .as_object()
+            .map(|m| {
+                m.iter()
+                    .filter(|(_, v)| v.as_bool() == Some(true))
+                    .map(|(k, _)| k.clone())
+                    .collect()
+            })
+            .unwrap_or_default();
         let camera = match sensors.get("camera") {
             None | Some(Json::Null) | Some(Json::Bool(false)) => None,
             Some(Json::Bool(true)) => Some(CameraSpec::default()),
@@ -410,41 +421,32 @@ impl Sut for ExternalSut {
                 "speed_mps": obs.ego.speed_mps,
             },
         });
-        let mut descriptors = Vec::new();
-        let mut depth_bytes = Vec::new();
-        let mut lidar_bytes = Vec::new();
-        let mut payloads: Vec<&[u8]> = Vec::new();
-        if let (Some(frame), true) = (obs.camera, p.sensors.camera.is_some()) {
-            let (h, w) = (frame.height, frame.width);
-            descriptors.push(
-                json!({"name": "camera", "dtype": "uint8", "shape": [h, w, 3],
-                "nbytes": frame.rgb.len(), "t_s": frame.t_s}),
-            );
-            if p.wants_depth {
-                depth_bytes = frame.depth_m.iter().flat_map(|d| d.to_le_bytes()).collect();
-                descriptors.push(json!({"name": "depth", "dtype": "float32", "shape": [h, w],
-                    "nbytes": depth_bytes.len()}));
+        // Every reading the program declared, as named arrays (SUT_PROTOCOL.md), in the
+        // order of their names.
+        let mut readings: Vec<_> = obs.readings.iter().collect();
+        readings.sort_by_key(|(name, _)| *name);
+        let mut sent = Vec::new();
+        for (name, reading) in readings {
+            let wanted = match *name {
+                "camera" => p.sensors.camera.is_some(),
+                other => p.wanted.iter().any(|w| w == other),
+            };
+            if wanted {
+                sent.extend(reading.payloads(p.wants_depth));
             }
         }
-        if p.wants_lidar {
-            lidar_bytes = obs
-                .lidar
-                .iter()
-                .flat_map(|r| r.point_m.map(|v| (v as f32).to_le_bytes()))
-                .flatten()
-                .collect();
-            descriptors.push(json!({"name": "lidar", "dtype": "float32",
-                "shape": [obs.lidar.len(), 3], "nbytes": lidar_bytes.len()}));
-        }
-        if let Some(frame) = obs.camera.filter(|_| p.sensors.camera.is_some()) {
-            payloads.push(&frame.rgb);
-            if p.wants_depth {
-                payloads.push(&depth_bytes);
-            }
-        }
-        if p.wants_lidar {
-            payloads.push(&lidar_bytes);
-        }
+        let descriptors: Vec<Json> = sent
+            .iter()
+            .map(|b| {
+                let mut d = json!({"name": b.name, "dtype": b.dtype, "shape": b.shape,
+                    "nbytes": b.bytes.len()});
+                if let Some(t) = b.t_s {
+                    d["t_s"] = json!(t);
+                }
+                d
+            })
+            .collect();
+        let payloads: Vec<&[u8]> = sent.iter().map(|b| b.bytes.as_slice()).collect();
         header["buffers"] = Json::Array(descriptors);
         let reply = match p.request(&header, &payloads, timeout) {
             Ok(m) => m,

@@ -123,7 +123,12 @@ fn typed_arg(
 ///
 /// # Errors
 /// A message for a stream (it has no single value) or a value of the wrong kind or range.
-fn fixed_typed(v: Value, b: &SceneBuilder, input: &types::Input, owner: &str) -> anyhow::Result<Rx> {
+fn fixed_typed(
+    v: Value,
+    b: &SceneBuilder,
+    input: &types::Input,
+    owner: &str,
+) -> anyhow::Result<Rx> {
     let c = match v.downcast_ref::<Stream>() {
         Some(s) => match b.graph.nodes().get(s.id) {
             Some(Node::Const(c)) => c.clone(),
@@ -268,9 +273,11 @@ fn route_arg(v: Option<Value>) -> anyhow::Result<Option<Vec<paracosm_engine::net
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
         // One turn, e.g. an open parameter `VarEnum(["left", "straight", "right"])`.
-        Some(v) if v.unpack_str().is_some() => turns(&[v.unpack_str().unwrap_or_default().to_owned()])
-            .map(Some)
-            .map_err(|e| anyhow!(e)),
+        Some(v) if v.unpack_str().is_some() => {
+            turns(&[v.unpack_str().unwrap_or_default().to_owned()])
+                .map(Some)
+                .map_err(|e| anyhow!(e))
+        }
         Some(v) => {
             let list = UnpackList::<String>::unpack_value(v)
                 .ok()

@@ -258,9 +258,18 @@ mod tests {
             "speed = VarInterval(0, 1)\nw = World(fog = VarInterval(0, 1))\nWorld(light = VarEnum([0.1, 0.2]))\nx = [VarInterval(0, 1)]\n",
         );
         assert_eq!(s.site("t.star:1:9").unwrap().name.as_deref(), Some("speed"));
-        assert_eq!(s.site("t.star:1:9").unwrap().variable.as_deref(), Some("speed"));
-        assert_eq!(s.site("t.star:2:17").unwrap().name.as_deref(), Some("w.fog"));
-        assert_eq!(s.site("t.star:3:15").unwrap().name.as_deref(), Some("World.light"));
+        assert_eq!(
+            s.site("t.star:1:9").unwrap().variable.as_deref(),
+            Some("speed")
+        );
+        assert_eq!(
+            s.site("t.star:2:17").unwrap().name.as_deref(),
+            Some("w.fog")
+        );
+        assert_eq!(
+            s.site("t.star:3:15").unwrap().name.as_deref(),
+            Some("World.light")
+        );
         assert_eq!(s.site("t.star:4:6").unwrap().name, None);
     }
 
@@ -279,7 +288,12 @@ mod tests {
     fn alike_names_are_numbered_and_explicit_ones_win() {
         let names = final_names(
             &[None, None, Some("x".into()), None],
-            &[Some("Car.speed".into()), Some("Car.speed".into()), None, Some("x".into())],
+            &[
+                Some("Car.speed".into()),
+                Some("Car.speed".into()),
+                None,
+                Some("x".into()),
+            ],
         );
         assert_eq!(names, ["Car.speed_1", "Car.speed_2", "x", "x_1"]);
     }

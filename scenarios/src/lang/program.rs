@@ -173,9 +173,7 @@ impl Program {
             return Err("test(horizon=) depends on the open parameters' values".into());
         }
         if b.ego.as_ref().map(|e| &e.sut) != Some(&self.sut) {
-            return Err(
-                "AutonomousVehicle(sut=) depends on the open parameters' values".into(),
-            );
+            return Err("AutonomousVehicle(sut=) depends on the open parameters' values".into());
         }
         Ok(())
     }
@@ -248,8 +246,9 @@ impl Program {
     /// Every combination of [`Program::checked_values`] when there are at most
     /// [`MAX_CHECKED_WORLDS`], else the rows of a pairwise covering array over them.
     fn combinations(&self) -> Vec<(Vec<ParamValue>, String)> {
-        let options: Vec<Vec<(ParamValue, String)>> =
-            (0..self.params.len()).map(|k| self.checked_values(k)).collect();
+        let options: Vec<Vec<(ParamValue, String)>> = (0..self.params.len())
+            .map(|k| self.checked_values(k))
+            .collect();
         let count = options
             .iter()
             .try_fold(1usize, |n, o| n.checked_mul(o.len()))
@@ -280,7 +279,11 @@ impl Program {
         };
         rows.into_iter()
             .map(|r| {
-                let values = r.iter().zip(&options).map(|(&i, o)| o[i].0.clone()).collect();
+                let values = r
+                    .iter()
+                    .zip(&options)
+                    .map(|(&i, o)| o[i].0.clone())
+                    .collect();
                 let label = r
                     .iter()
                     .zip(&options)
@@ -396,14 +399,14 @@ pub fn load(
         if label.is_empty() {
             lang(m)
         } else {
-            lang(format!("{m}\n(the world fails for the test values {label})"))
+            lang(format!(
+                "{m}\n(the world fails for the test values {label})"
+            ))
         }
     };
     if !program.params.is_empty() {
         for (values, label) in program.combinations() {
-            program
-                .world_for(values)
-                .map_err(|m| with(&label, m))?;
+            program.world_for(values).map_err(|m| with(&label, m))?;
         }
     }
 
@@ -462,7 +465,12 @@ pub fn load(
             }
             axes.clone()
         }
-        None => space.params().iter().take(2).map(|p| p.name.clone()).collect(),
+        None => space
+            .params()
+            .iter()
+            .take(2)
+            .map(|p| p.name.clone())
+            .collect(),
     };
 
     let mut warnings = first.warnings.clone();

@@ -8,7 +8,7 @@ use paracosm_engine::network::{Location, Network, PieceId, Turn};
 use paracosm_engine::rx::{Node, OpenStream, StreamId, Value};
 use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{
-    CarSpec, EgoSpec, EnvironmentSpec, LidarSpec, PedestrianSpec, VehicleParams, WorldSpec,
+    CarSpec, EgoSpec, EnvironmentSpec, LidarSpec, PedestrianSpec, Size, VehicleParams, WorldSpec,
     DEFAULT_DT_S,
 };
 use paracosm_generators::{Domain, Value as Level};
@@ -367,7 +367,7 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
             path: c.path.clone(),
             speed: c.speed,
             color: c.color.clone(),
-            size_m: CAR_SIZE_M,
+            size: Size::CAR,
             enabled: c.enabled,
         })
         .collect();
@@ -391,6 +391,7 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
             })
             .collect(),
         cars,
+        obstacles: vec![],
         environment: EnvironmentSpec { light, fog },
         streams,
         lidar: LidarSpec::default(),
@@ -411,9 +412,6 @@ pub fn turns(names: &[String]) -> Result<Vec<Turn>, String> {
 
 /// Longest route computed for an actor, in metres.
 const MAX_ROUTE_M: f64 = 5000.0;
-/// Body size of the ego vehicle and NPC cars for the placement check, metres.
-const EGO_SIZE_M: [f64; 3] = [4.5, 1.8, 1.0];
-const CAR_SIZE_M: [f64; 3] = [4.5, 1.8, 1.5];
 
 impl SceneBuilder {
     /// `w.place(...)`: marks `objects` placed, resolves every actor's location and route on
@@ -442,18 +440,18 @@ impl SceneBuilder {
         let mut placed = Vec::new();
         for o in &self.objects {
             let (loc, footprint) = match &o.pending {
-                Pending::Ego { loc, .. } => (*loc, Some(EGO_SIZE_M)),
-                Pending::Car { loc, .. } => (*loc, Some(CAR_SIZE_M)),
+                Pending::Ego { loc, .. } => (*loc, Some(VehicleParams::default().size)),
+                Pending::Car { loc, .. } => (*loc, Some(Size::CAR)),
                 Pending::Pedestrian { start, .. } => (*start, None),
             };
             let at = resolve(self, loc)?;
             placed.push(Placed {
                 name: o.name.clone(),
                 footprint: match footprint {
-                    Some(size_m) => Footprint::Vehicle {
+                    Some(size) => Footprint::Vehicle {
                         pos_m: at.pos_m,
                         heading_rad: at.heading_rad,
-                        size_m,
+                        size,
                     },
                     None => Footprint::Pedestrian { pos_m: at.pos_m },
                 },

@@ -1,0 +1,179 @@
+//! Actors as sets with typed handles, the way rapier keeps bodies and colliders: each kind of
+//! actor (NPC cars, pedestrians, static obstacles) lives in its own [`Set`], and each actor
+//! carries its own [`Size`], look, speed source and contact state.
+
+use std::fmt;
+use std::marker::PhantomData;
+
+use serde::{Deserialize, Serialize};
+
+/// The size of a box-shaped body, metres: one struct and one axis order everywhere (the
+/// collider, the camera's drawing, the placement check, time to collision).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Size {
+    /// Along the heading, m, `> 0`.
+    pub length_m: f64,
+    /// Across the heading, m, `> 0`.
+    pub width_m: f64,
+    /// Up, m, `> 0`.
+    pub height_m: f64,
+}
+
+impl Size {
+    /// An NPC car: 4.5 × 1.8 × 1.5 m.
+    pub const CAR: Size = Size {
+        length_m: 4.5,
+        width_m: 1.8,
+        height_m: 1.5,
+    };
+    /// A pedestrian's bounding box: 0.6 × 0.6 × 1.8 m (a capsule of radius 0.3 m).
+    pub const PEDESTRIAN: Size = Size {
+        length_m: 0.6,
+        width_m: 0.6,
+        height_m: 1.8,
+    };
+
+    /// Whether every extent is finite and positive.
+    pub fn is_valid(&self) -> bool {
+        [self.length_m, self.width_m, self.height_m]
+            .iter()
+            .all(|v| v.is_finite() && *v > 0.0)
+    }
+}
+
+/// A box the camera draws: a car, a pedestrian, an obstacle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VisibleBox {
+    /// Centre of the box's base (the ground point under it) `[x, y, z]`, metres.
+    pub base_m: [f64; 3],
+    /// Its size; the drawn box reaches from the base to `height_m` above it.
+    pub size: Size,
+    /// Heading in rad (counter-clockwise seen from above, `0` along `+x`).
+    pub heading_rad: f64,
+    /// Albedo, linear RGB in `[0, 1]`.
+    pub albedo: [f32; 3],
+}
+
+/// A handle to an actor of type `T` in its [`Set`]: its index, typed so that a car's handle
+/// cannot name a pedestrian.
+pub struct Handle<T> {
+    index: u32,
+    kind: PhantomData<fn() -> T>,
+}
+
+impl<T> Handle<T> {
+    /// The handle of the `index`-th actor inserted.
+    pub fn from_index(index: usize) -> Self {
+        Handle {
+            index: index as u32,
+            kind: PhantomData,
+        }
+    }
+
+    /// Its index, in insertion order.
+    pub fn index(self) -> usize {
+        self.index as usize
+    }
+}
+
+impl<T> Clone for Handle<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for Handle<T> {}
+impl<T> PartialEq for Handle<T> {
+    fn eq(&self, other: &Self) -> bool {
+        self.index == other.index
+    }
+}
+impl<T> Eq for Handle<T> {}
+impl<T> std::hash::Hash for Handle<T> {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.index.hash(state);
+    }
+}
+impl<T> fmt::Debug for Handle<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Handle({})", self.index)
+    }
+}
+
+/// A set of actors of one kind, in insertion order.
+pub struct Set<T> {
+    items: Vec<T>,
+}
+
+impl<T> Default for Set<T> {
+    fn default() -> Self {
+        Set { items: Vec::new() }
+    }
+}
+
+impl<T> Set<T> {
+    /// Adds `item`; returns its handle.
+    pub fn insert(&mut self, item: T) -> Handle<T> {
+        self.items.push(item);
+        Handle::from_index(self.items.len() - 1)
+    }
+
+    /// The actor of handle `h`, if it is in the set.
+    pub fn get(&self, h: Handle<T>) -> Option<&T> {
+        self.items.get(h.index())
+    }
+
+    /// The actor of handle `h`, mutably.
+    pub fn get_mut(&mut self, h: Handle<T>) -> Option<&mut T> {
+        self.items.get_mut(h.index())
+    }
+
+    /// Every actor with its handle, in insertion order.
+    pub fn iter(&self) -> impl Iterator<Item = (Handle<T>, &T)> {
+        self.items
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (Handle::from_index(i), t))
+    }
+
+    /// Every actor, mutably, in insertion order.
+    pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut T> {
+        self.items.iter_mut()
+    }
+
+    /// Every actor, in insertion order.
+    pub fn values(&self) -> impl Iterator<Item = &T> {
+        self.items.iter()
+    }
+
+    /// How many actors it holds.
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// Whether it holds none.
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn handles_are_typed_indices_in_insertion_order() {
+        let mut s: Set<&str> = Set::default();
+        let a = s.insert("a");
+        let b = s.insert("b");
+        assert_eq!((a.index(), b.index()), (0, 1));
+        assert_eq!(s.get(b), Some(&"b"));
+        assert_eq!(s.iter().map(|(h, _)| h).collect::<Vec<_>>(), [a, b]);
+        assert!(Size::CAR.is_valid());
+        assert!(!Size {
+            length_m: 1.0,
+            width_m: 0.0,
+            height_m: 1.0
+        }
+        .is_valid());
+    }
+}

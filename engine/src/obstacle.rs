@@ -1,0 +1,89 @@
+use rapier3d::prelude::*;
+use serde::Serialize;
+
+use crate::actor::{Size, VisibleBox};
+
+/// A static obstacle's state, for snapshots.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ObstacleState {
+    /// Centre of its base `[x, y, z]`, metres.
+    pub base_m: [f64; 3],
+    /// Heading in rad.
+    pub heading_rad: f64,
+    /// Its size.
+    pub size: Size,
+}
+
+/// A static box (a parked car, a cone, a barrier): it never moves, collides with the ego
+/// vehicle, stops lidar beams and is drawn by the camera. A kinematic body that is never
+/// moved, so the ego's wheel rays (which see only fixed colliders, the road) pass under it.
+pub(crate) struct Obstacle {
+    pub(crate) collider: ColliderHandle,
+    state: ObstacleState,
+    pub(crate) albedo: [f32; 3],
+    /// Whether it touches the ego vehicle now.
+    pub(crate) touching: bool,
+}
+
+impl Obstacle {
+    /// An obstacle standing on `base_m` (its base's centre, metres), turned `heading_rad`.
+    pub(crate) fn build(
+        physics: &mut PhysicsWorld,
+        base_m: [f64; 3],
+        heading_rad: f64,
+        size: Size,
+        albedo: [f32; 3],
+    ) -> Self {
+        let body = RigidBodyBuilder::kinematic_position_based().pose(Pose::from_parts(
+            Vector::new(
+                base_m[0] as f32,
+                (base_m[1] + size.height_m / 2.0) as f32,
+                base_m[2] as f32,
+            ),
+            Rotation::from_rotation_y(heading_rad as f32),
+        ));
+        let collider = ColliderBuilder::cuboid(
+            (size.length_m / 2.0) as f32,
+            (size.height_m / 2.0) as f32,
+            (size.width_m / 2.0) as f32,
+        )
+        .active_events(ActiveEvents::COLLISION_EVENTS);
+        let (_, collider) = physics.insert(body, collider);
+        Obstacle {
+            collider,
+            state: ObstacleState {
+                base_m,
+                heading_rad,
+                size,
+            },
+            albedo,
+            touching: false,
+        }
+    }
+
+    pub(crate) fn state(&self) -> ObstacleState {
+        self.state
+    }
+
+    pub(crate) fn visible(&self) -> VisibleBox {
+        VisibleBox {
+            base_m: self.state.base_m,
+            size: self.state.size,
+            heading_rad: self.state.heading_rad,
+            albedo: self.albedo,
+        }
+    }
+
+    /// It as the time-to-collision test sees it: standing still.
+    pub(crate) fn mover(&self) -> crate::ttc::Mover {
+        crate::ttc::Mover {
+            pos_m: [self.state.base_m[0], self.state.base_m[2]],
+            velocity_mps: [0.0, 0.0],
+            heading_rad: self.state.heading_rad,
+            half_size_m: [
+                self.state.size.length_m / 2.0,
+                self.state.size.width_m / 2.0,
+            ],
+        }
+    }
+}
