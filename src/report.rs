@@ -329,9 +329,9 @@ pub fn human(summary: &Summary, scenario: &Scenario, out: &Path, expected: u64) 
                     .and_then(|p| p.unit.as_ref())
                     .map(|u| format!(" {u}"))
                     .unwrap_or_default();
-                match v.as_f64() {
-                    Some(x) => format!("{n} = {x:.3}{unit}"),
-                    None => format!("{n} = {v}"),
+                match v {
+                    paracosm_generators::Value::Real(x) => format!("{n} = {x:.3}{unit}"),
+                    _ => format!("{n} = {v}{unit}"),
                 }
             })
             .collect();

@@ -599,18 +599,20 @@ fn pedestrian_crossing_star_reproduces_the_rust_study_byte_for_byte() {
 }
 
 #[test]
-fn list_shows_every_built_in_with_its_parameters() {
+fn list_and_help_show_every_built_in_with_its_parameters() {
     let o = fuzz(&["--list"]);
     assert_eq!(o.status.code(), Some(0));
     let s = String::from_utf8_lossy(&o.stdout);
-    for name in [
-        "pedestrian-crossing",
-        "follow-lead-car",
-        "fog-light",
-        "t-loop",
-        "grid-world",
-    ] {
-        assert!(s.contains(name), "{name} missing from:\n{s}");
+    let help = fuzz(&["--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    let names = paracosm_scenarios::builtin_names();
+    assert_eq!(names.len(), 9, "{names:?}");
+    for name in &names {
+        assert!(s.contains(name.as_str()), "{name} missing from:\n{s}");
+        assert!(
+            help.contains(name.as_str()),
+            "{name} missing from --help:\n{help}"
+        );
     }
     assert!(
         s.contains("parameters: walking_speed [m/s], trigger_distance [m]"),

@@ -20,6 +20,39 @@ pub struct CarState {
     pub enabled: bool,
 }
 
+/// When a lane change starts.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub enum LaneChangeStart {
+    /// At this time since the start of the test, s.
+    At(f64),
+    /// At the first event of this stream.
+    When(StreamId),
+}
+
+/// A lane change (`Car(lane_change = ChangeLane(...))`): the car moves sideways by
+/// `offset_m` (to its right; negative: to its left) over `duration_s`, along the
+/// minimum-jerk profile `10τ³ − 15τ⁴ + 6τ⁵` of `τ = (t − t₀) / duration_s` (Flash & Hogan
+/// 1985), turning with its sideways speed; then it keeps the offset for the rest of its route.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LaneChangeSpec {
+    /// Sideways distance, m, positive to the right of the direction of travel.
+    pub offset_m: f64,
+    /// When it starts.
+    pub start: LaneChangeStart,
+    /// How long it takes, s, `> 0`.
+    pub duration_s: f64,
+}
+
+impl LaneChangeSpec {
+    /// The share of the offset done at `tau` in `[0, 1]`, and its rate `d/dτ`.
+    fn profile(tau: f64) -> (f64, f64) {
+        let t = tau.clamp(0.0, 1.0);
+        let p = t * t * t * (10.0 - 15.0 * t + 6.0 * t * t);
+        let dp = 30.0 * t * t * (1.0 - t) * (1.0 - t);
+        (p, dp)
+    }
+}
+
 /// Gravitational acceleration in m/s², for the tyres' friction limit `μ·g`.
 pub(crate) const GRAVITY_MPS2: f64 = 9.81;
 
@@ -50,6 +83,10 @@ pub(crate) struct Car {
     pub(crate) speed_stream: StreamId,
     /// Whether it touches the ego vehicle now.
     pub(crate) touching: bool,
+    /// Its lane change, if it has one.
+    pub(crate) lane_change: Option<LaneChangeSpec>,
+    /// When its lane change started, s.
+    pub(crate) change_started_s: Option<f64>,
 }
 
 impl Car {
@@ -80,6 +117,8 @@ impl Car {
             albedo,
             speed_stream,
             touching: false,
+            lane_change: None,
+            change_started_s: None,
         };
         car.here = car.at(0.0);
         if enabled {
@@ -134,14 +173,44 @@ impl Car {
         self.here.0
     }
 
-    /// Drives one step of `dt_s` toward the commanded `speed_mps` (negative counts as 0) on a
-    /// surface of friction `friction`: the speed changes by at most `friction · g · dt_s`
-    /// (except in the first step, which sets it), and the car does not pass its path's end.
+    /// The ground point and heading at arc length `s` and time `t_s`, with the lane change's
+    /// sideways offset and the turn of its sideways speed.
+    fn place_at(&self, s: f64, t_s: f64) -> ([f64; 2], f64) {
+        let (p, heading) = self.at(s);
+        let (Some(change), Some(t0)) = (self.lane_change, self.change_started_s) else {
+            return (p, heading);
+        };
+        let tau = (t_s - t0) / change.duration_s;
+        let (share, rate) = LaneChangeSpec::profile(tau);
+        let d = change.offset_m * share;
+        // Right of a driver heading along `heading`, in the (x, z) plane.
+        let right = [heading.sin(), heading.cos()];
+        let sideways_mps = if (0.0..1.0).contains(&tau) {
+            change.offset_m * rate / change.duration_s
+        } else {
+            0.0
+        };
+        let turn = sideways_mps.atan2(self.speed.max(0.1));
+        ([p[0] + d * right[0], p[1] + d * right[1]], heading - turn)
+    }
+
+    /// Starts its lane change at `t_s` if it has one that has not started.
+    pub(crate) fn start_lane_change(&mut self, t_s: f64) {
+        if self.lane_change.is_some() && self.change_started_s.is_none() {
+            self.change_started_s = Some(t_s);
+        }
+    }
+
+    /// Drives one step of `dt_s` at time `t_s` toward the commanded `speed_mps` (negative
+    /// counts as 0) on a surface of friction `friction`: the speed changes by at most
+    /// `friction · g · dt_s` (except in the first step, which sets it), and the car does not
+    /// pass its path's end.
     pub(crate) fn advance(
         &mut self,
         physics: &mut PhysicsWorld,
         speed_mps: f64,
         friction: f64,
+        t_s: f64,
         dt_s: f64,
     ) {
         let end = *self.cumulative.last().expect("non-empty");
@@ -158,7 +227,7 @@ impl Car {
         // At the end of its path the car has stopped.
         self.rolling = Some(if self.s >= end { 0.0 } else { rolling });
         self.speed = (self.s - before) / dt_s;
-        self.here = self.at(self.s);
+        self.here = self.place_at(self.s, t_s + dt_s);
         if let Some((body, _)) = self.body {
             let pose = self.pose();
             physics.bodies[body].set_next_kinematic_position(pose);

@@ -37,7 +37,7 @@ mod vehicle;
 
 pub use actor::{Handle, Set, Size, VisibleBox};
 pub use camera::{CameraFrame, CameraSpec, SENSOR_HEIGHT_MM, SENSOR_WIDTH_MM};
-pub use car::CarState;
+pub use car::{CarState, LaneChangeSpec, LaneChangeStart};
 pub use control::Control;
 pub use environment::{visibility_m, FOG_EXTINCTION_PER_M, NOMINAL_LIGHT};
 pub use error::EngineError;

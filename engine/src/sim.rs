@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use crate::actor::{Handle, Set, Size, VisibleBox};
 use crate::behaviour::{decode_probe, Actor, Output};
-use crate::car::{Car, CarState};
+use crate::car::{Car, CarState, LaneChangeStart};
 use crate::network::{Lane, Network, PieceId, Surface};
 use crate::obstacle::{Obstacle, ObstacleState};
 use crate::pedestrian::Pedestrian;
@@ -196,7 +196,20 @@ impl Simulation {
             if !c.size.is_valid() {
                 return Err(invalid(format!("car {i} has the size {:?}", c.size)));
             }
-            let car = Car::build(
+            if let Some(change) = c.lane_change {
+                let starts_ok = match change.start {
+                    LaneChangeStart::At(t0) => t0.is_finite() && t0 >= 0.0,
+                    LaneChangeStart::When(s) => s.0 < n,
+                };
+                if !(change.offset_m.is_finite()
+                    && change.duration_s.is_finite()
+                    && change.duration_s > 0.0
+                    && starts_ok)
+                {
+                    return Err(invalid(format!("car {i} has the lane change {change:?}")));
+                }
+            }
+            let mut car = Car::build(
                 &mut physics,
                 c.path.clone(),
                 c.size,
@@ -204,6 +217,7 @@ impl Simulation {
                 crate::colour::albedo(&c.color).unwrap_or([0.45, 0.45, 0.45]),
                 c.speed,
             );
+            car.lane_change = c.lane_change;
             let collider = car.body.map(|(_, c)| c);
             let h = cars.insert(car);
             if let Some(collider) = collider {
@@ -450,8 +464,13 @@ impl Simulation {
         for (i, car) in self.cars.iter_mut().enumerate() {
             let what = format!("the speed of car {i}");
             let v = number(&self.streams, car.speed_stream, 0.0, t, &what)?;
+            match car.lane_change.map(|c| c.start) {
+                Some(LaneChangeStart::At(t0)) if t >= t0 => car.start_lane_change(t0),
+                Some(LaneChangeStart::When(s)) if self.streams.fired(s) => car.start_lane_change(t),
+                _ => {}
+            }
             let friction = self.surface.friction_at(car.ground_m());
-            car.advance(&mut self.physics, v, friction, dt);
+            car.advance(&mut self.physics, v, friction, t, dt);
         }
         if self.tick == 0 {
             // The first lidar scan was taken before light and fog were known.

@@ -48,6 +48,8 @@ pub struct CarSpec {
     pub size: crate::Size,
     /// Whether the car is in this test (a scenario may make its presence a parameter).
     pub enabled: bool,
+    /// A lane change it makes, if any (a cut-in).
+    pub lane_change: Option<crate::LaneChangeSpec>,
 }
 
 /// A static obstacle (`Obstacle(loc=, size=, color=)`): a box that never moves.

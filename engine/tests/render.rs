@@ -388,6 +388,7 @@ fn an_npc_cars_collider_and_its_drawing_agree() {
             color: "white".into(),
             size: Size::CAR,
             enabled: true,
+            lane_change: None,
         }],
         obstacles: vec![],
         environment: EnvironmentSpec { light, fog },

@@ -61,6 +61,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
             color: "red".into(),
             size: Size::CAR,
             enabled: true,
+            lane_change: None,
         });
     }
     WorldSpec {

@@ -24,7 +24,7 @@ pub use scenario::{CameraOnly, MonitorSpec, RustWorlds, Scenario, Warning, World
 use paracosm_generators::Assignment;
 
 /// The shipped scenario programs: `(file name, source)`.
-pub const BUILTIN_SOURCES: [(&str, &str); 5] = [
+pub const BUILTIN_SOURCES: [(&str, &str); 9] = [
     (
         "pedestrian_crossing.star",
         include_str!("../pedestrian_crossing.star"),
@@ -36,6 +36,13 @@ pub const BUILTIN_SOURCES: [(&str, &str); 5] = [
     ("fog_light.star", include_str!("../fog_light.star")),
     ("t_loop.star", include_str!("../t_loop.star")),
     ("grid_world.star", include_str!("../grid_world.star")),
+    ("cut_in.star", include_str!("../cut_in.star")),
+    ("roundabout.star", include_str!("../roundabout.star")),
+    (
+        "family_of_worlds.star",
+        include_str!("../family_of_worlds.star"),
+    ),
+    ("example_3_1.star", include_str!("../example_3_1.star")),
 ];
 
 /// Names of the built-in scenarios: the file stems with hyphens (`pedestrian-crossing`, ...).

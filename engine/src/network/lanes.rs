@@ -142,15 +142,44 @@ impl Network {
             ));
         };
         let j = k.unsigned_abs();
-        let entry = if k > 0 { 0 } else { 1 };
-        let mut path = self
-            .lane_paths(start.piece)
-            .into_iter()
-            .find(|l| l.entry == (entry, j))
-            .expect("a segment has both directions of each lane");
-        let mut points = vec![[start.pos_m[0], start.pos_m[2]]];
-        points.push(*path.points.last().expect("two points"));
-        let mut length = dist(points[0], points[1]);
+        let (mut path, mut points) = match start.through {
+            // Inside a junction: the rest of the lane path it is on.
+            Some((entry, exit)) => {
+                let path = self
+                    .lane_paths(start.piece)
+                    .into_iter()
+                    .find(|l| l.entry == (entry, j) && l.exit.0 == exit)
+                    .ok_or_else(|| {
+                        EngineError::InvalidWorld("a junction location off its lane path".into())
+                    })?;
+                let mut points = vec![[start.pos_m[0], start.pos_m[2]]];
+                let mut walked = 0.0;
+                for w in path.points.windows(2) {
+                    walked += dist(w[0], w[1]);
+                    if walked > start.at_m {
+                        points.push(w[1]);
+                    }
+                }
+                if points.len() < 2 {
+                    points.push(*path.points.last().expect("two points"));
+                }
+                (path, points)
+            }
+            None => {
+                let entry = if k > 0 { 0 } else { 1 };
+                let path = self
+                    .lane_paths(start.piece)
+                    .into_iter()
+                    .find(|l| l.entry == (entry, j))
+                    .expect("a segment has both directions of each lane");
+                let points = vec![
+                    [start.pos_m[0], start.pos_m[2]],
+                    *path.points.last().expect("two points"),
+                ];
+                (path, points)
+            }
+        };
+        let mut length = points.windows(2).map(|w| dist(w[0], w[1])).sum::<f64>();
         let mut turns = turns.iter();
         while length < max_len_m {
             let out = (path.piece, path.exit.0);
@@ -196,6 +225,32 @@ impl Network {
         }
         Ok(resample(&points, ROUTE_SPACING_M))
     }
+}
+
+/// The point `at_m` metres along the polyline `points` (clamped to its ends), the heading of
+/// the piece it is on, and the polyline's length, metres.
+pub(crate) fn along(points: &[[f64; 2]], at_m: f64) -> ([f64; 2], f64, f64) {
+    let length: f64 = points.windows(2).map(|w| dist(w[0], w[1])).sum();
+    let mut left = at_m.clamp(0.0, length);
+    for w in points.windows(2) {
+        let d = dist(w[0], w[1]);
+        let heading = (-(w[1][1] - w[0][1])).atan2(w[1][0] - w[0][0]);
+        if left <= d || d == 0.0 && left == 0.0 {
+            let u = if d > 0.0 { left / d } else { 0.0 };
+            return (
+                [
+                    w[0][0] + u * (w[1][0] - w[0][0]),
+                    w[0][1] + u * (w[1][1] - w[0][1]),
+                ],
+                heading,
+                length,
+            );
+        }
+        left -= d;
+    }
+    let n = points.len();
+    let (a, b) = (points[n - 2], points[n - 1]);
+    (b, (-(b[1] - a[1])).atan2(b[0] - a[0]), length)
 }
 
 /// Largest distance between consecutive points of a route, in metres, so that followers find

@@ -64,8 +64,12 @@ pub struct Location {
     pub piece: PieceId,
     /// The lane.
     pub lane: Lane,
-    /// Distance along the segment from its port `ONE`, in metres.
+    /// Distance along the segment from its port `ONE`, in metres; in a junction, along the
+    /// lane path from where it enters.
     pub at_m: f64,
+    /// In a junction or roundabout: the lane path it is on, `(entry port, exit port)`;
+    /// `None` on a segment.
+    pub through: Option<(usize, usize)>,
 }
 
 /// Two connected ports: `(piece, port index)` each.
@@ -363,6 +367,67 @@ impl Network {
             piece,
             lane,
             at_m,
+            through: None,
+        })
+    }
+
+    /// `j.onLane(port, turn, at, lane=1)` for a junction or roundabout: the point `at_m` metres
+    /// along the lane path that enters through port `entry` in lane `lane` (`1..=nlanes/2`,
+    /// counted from the centre line) and makes `turn`.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] for a segment (use [`Network::on_lane`]), a port the piece
+    /// lacks, a turn it has no path for, a lane beyond `nlanes/2`, or `at_m` outside
+    /// `[0, path length]`.
+    pub fn on_junction_lane(
+        &self,
+        piece: PieceId,
+        entry: usize,
+        turn: Turn,
+        lane: u32,
+        at_m: f64,
+    ) -> Result<Location, EngineError> {
+        let p = &self.pieces[piece.0];
+        let bad = |m: String| Err(EngineError::InvalidWorld(m));
+        if matches!(p.kind, PieceKind::Segment { .. }) {
+            return bad(format!(
+                "{} is a RoadSegment: give onLane a lane number and a distance",
+                p.name
+            ));
+        }
+        let half = p.kind.lanes() / 2;
+        if lane == 0 || lane > half {
+            return bad(format!(
+                "lane {lane} does not exist in {} with {} lanes (lanes 1..={half})",
+                p.name,
+                p.kind.lanes()
+            ));
+        }
+        let Some(path) = self
+            .lane_paths(piece)
+            .into_iter()
+            .find(|l| l.entry == (entry, lane) && l.turn == turn)
+        else {
+            return bad(format!(
+                "{} has no {turn:?} turn from port {}",
+                p.name,
+                PORT_NAMES.get(entry).copied().unwrap_or("?")
+            ));
+        };
+        let (point, heading, length) = lanes::along(&path.points, at_m);
+        if !(0.0..=length).contains(&at_m) {
+            return bad(format!(
+                "position {at_m} m is outside the {length:.1} m path through {}",
+                p.name
+            ));
+        }
+        Ok(Location {
+            pos_m: [point[0], 0.0, point[1]],
+            heading_rad: heading,
+            piece,
+            lane: Lane::Driving(lane as i32),
+            at_m,
+            through: Some((path.entry.0, path.exit.0)),
         })
     }
 

@@ -21,7 +21,8 @@ use starlark::values::{ProvidesStaticType, UnpackValue, Value, ValueLike};
 use super::scene::{turns, ObjectDecl, OverTime, ParamDecl, PedTrigger, Pending, SceneBuilder};
 use super::types;
 use super::values::{
-    ActorKind, ActorVal, LaneSide, Loc, MonitorVal, OverTimeVal, Road, Stream, WorldVal,
+    ActorKind, ActorVal, ChangeStart, LaneChangeVal, LaneSide, Loc, MonitorVal, ObstacleVal,
+    OverTimeVal, Road, Stream, WorldVal,
 };
 use crate::MonitorSpec;
 
@@ -630,17 +631,28 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         ))
     }
 
-    /// `Car(loc=, speed=10.0, route=[], color="red", enabled=True)`: an NPC car that follows
-    /// the lane graph.
+    /// `Car(loc=, speed=10.0, route=[], color="red", enabled=True, lane_change=None)`: an
+    /// NPC car that follows the lane graph, and may change lanes once (`ChangeLane`).
     fn Car<'v>(
         #[starlark(require = named)] loc: Value<'v>,
         #[starlark(require = named)] speed: Option<Value<'v>>,
         #[starlark(require = named)] route: Option<Value<'v>>,
         #[starlark(require = named)] color: Option<Value<'v>>,
         #[starlark(require = named)] enabled: Option<Value<'v>>,
+        #[starlark(require = named)] lane_change: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<ActorVal> {
         let loc = location(loc, "loc")?;
+        let lane_change = match lane_change {
+            None => None,
+            Some(v) if v.is_none() => None,
+            Some(v) => Some(*v.downcast_ref::<LaneChangeVal>().ok_or_else(|| {
+                anyhow!(
+                    "Car(lane_change=) takes ChangeLane(to = lane, at = seconds or when = stream, duration = seconds), got a {}",
+                    v.get_type()
+                )
+            })?),
+        };
         let route = route_arg(route)?.unwrap_or_default();
         let heap = eval.heap();
         let st = state(eval)?;
@@ -683,8 +695,114 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
                 speed,
                 color,
                 enabled,
+                lane_change,
             },
         ))
+    }
+
+    /// `ChangeLane(to=, at=None, when=None, duration=3.0)`: a lane change for
+    /// `Car(lane_change=)`: to lane `to` of the car's segment, starting `at` seconds into the
+    /// test or at the first event of the stream `when`, over `duration` seconds.
+    fn ChangeLane<'v>(
+        #[starlark(require = named)] to: Value<'v>,
+        #[starlark(require = named)] at: Option<Value<'v>>,
+        #[starlark(require = named)] when: Option<Value<'v>>,
+        #[starlark(require = named)] duration: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<LaneChangeVal> {
+        let to = number(to, "ChangeLane(to=)")?;
+        if to.fract() != 0.0 || to == 0.0 {
+            bail!("ChangeLane(to=) is a lane number (1, 2, ... or -1, -2, ...), got {to}");
+        }
+        let duration_s = match duration {
+            Some(v) => number(v, "ChangeLane(duration=)")?,
+            None => 3.0,
+        };
+        if !(duration_s.is_finite() && duration_s > 0.0) {
+            bail!("ChangeLane(duration=) takes a number in s, > 0, got {duration_s}");
+        }
+        let start = match (at, when) {
+            (Some(t), None) => {
+                let t = number(t, "ChangeLane(at=)")?;
+                if !(t.is_finite() && t >= 0.0) {
+                    bail!("ChangeLane(at=) takes a number in s, >= 0, got {t}");
+                }
+                ChangeStart::At(t)
+            }
+            (None, Some(w)) => {
+                let st = state(eval)?;
+                let mut b = st.scene.borrow_mut();
+                ChangeStart::When(stream_arg(w, &mut b, "ChangeLane(when=)")?.0)
+            }
+            _ => bail!("ChangeLane needs either at = seconds or when = a stream"),
+        };
+        Ok(LaneChangeVal {
+            to: to as i32,
+            start,
+            duration_s,
+        })
+    }
+
+    /// `Obstacle(loc=, size=(4.5, 1.8, 1.5), color="grey")`: a static box (a parked car, a
+    /// cone, a barrier) standing at `loc`, turned along its lane; `size` is its length, width
+    /// and height in metres. It collides with the ego vehicle, stops lidar beams and is drawn
+    /// by the camera.
+    fn Obstacle<'v>(
+        #[starlark(require = named)] loc: Value<'v>,
+        #[starlark(require = named)] size: Option<Value<'v>>,
+        #[starlark(require = named)] color: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<ObstacleVal> {
+        let loc = location(loc, "loc")?;
+        let size = match size {
+            None => paracosm_engine::Size::CAR,
+            Some(v) => {
+                let items: Vec<Value> = v
+                    .iterate(eval.heap())
+                    .map_err(|_| {
+                        anyhow!(
+                            "Obstacle(size=) takes (length, width, height) in m, got a {}",
+                            v.get_type()
+                        )
+                    })?
+                    .collect();
+                let [l, w, h] = items.as_slice() else {
+                    bail!(
+                        "Obstacle(size=) takes three numbers (length, width, height) in m, got {}",
+                        items.len()
+                    );
+                };
+                let size = paracosm_engine::Size {
+                    length_m: number(*l, "Obstacle(size=) length")?,
+                    width_m: number(*w, "Obstacle(size=) width")?,
+                    height_m: number(*h, "Obstacle(size=) height")?,
+                };
+                if !size.is_valid() {
+                    bail!("Obstacle(size=) needs three positive lengths in m, got {size:?}");
+                }
+                size
+            }
+        };
+        let heap = eval.heap();
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        let color = match fixed_typed(
+            color.unwrap_or_else(|| heap.alloc("grey")),
+            &b,
+            &types::COLOR,
+            "Obstacle",
+        )? {
+            Rx::Text(t) => t.to_ascii_lowercase(),
+            c => bail!("Obstacle(color=) takes a colour name, got a {}", c.kind()),
+        };
+        b.objects.push(ObjectDecl {
+            name: format!("Obstacle declared at {}", here(eval)),
+            pending: Pending::Obstacle { loc, size, color },
+            placed: false,
+        });
+        Ok(ObstacleVal {
+            object: b.objects.len() - 1,
+        })
     }
 
     /// `Pedestrian(start=, target=, speed=, dist=None, car=None, trigger=None)`: walks from

@@ -1,7 +1,7 @@
 //! Methods of streams, roads and the world.
 
 use anyhow::{anyhow, bail};
-use paracosm_engine::network::{Lane, PieceId};
+use paracosm_engine::network::{Lane, PieceId, Turn};
 use paracosm_engine::rx::{Func, Node, StreamId, Value as Rx};
 use starlark::environment::MethodsBuilder;
 use starlark::eval::Evaluator;
@@ -218,26 +218,70 @@ fn lane_of(v: Value) -> anyhow::Result<Lane> {
 /// Road methods: `onLane` and `connect`.
 #[starlark_module]
 pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
-    /// `r.onLane(lane, at)`: the point `at` metres along lane `lane` (a number, negative for
-    /// the opposite direction, or `r.SideWalk` / `-r.SideWalk`).
+    /// `r.onLane(lane, at)` on a segment: the point `at` metres along lane `lane` (a number,
+    /// negative for the opposite direction, or `r.SideWalk` / `-r.SideWalk`).
+    /// `j.onLane(port, turn, at, lane=1)` in a junction or roundabout: the point `at` metres
+    /// along the lane path that enters through `port` in lane `lane` and makes `turn`
+    /// (`"straight"`, `"left"`, `"right"`).
     fn onLane<'v>(
         this: &Road,
-        lane: Value<'v>,
-        at: Value<'v>,
+        #[starlark(require = pos)] first: Value<'v>,
+        #[starlark(require = pos)] second: Value<'v>,
+        #[starlark(require = pos)] at: Option<Value<'v>>,
+        #[starlark(require = named)] lane: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Loc> {
-        if this.network || !this.segment {
-            bail!("onLane needs a RoadSegment");
+        if this.network {
+            bail!("onLane needs a road piece, not the network connect returns: call it on one of the pieces");
         }
-        let lane = lane_of(lane)?;
-        let at_m = number(at, "onLane(at=)")?;
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
         let piece = PieceId(this.piece);
-        b.roads
-            .on_lane(piece, lane, at_m)
-            .map_err(|e| anyhow!(super::scene::strip(e)))?;
-        b.locs.push(LaneRef { piece, lane, at_m });
+        let r = if this.segment {
+            if at.is_some() || lane.is_some() {
+                bail!("a RoadSegment's onLane takes (lane, at); onLane(port, turn, at, lane=) is for junctions");
+            }
+            LaneRef::Segment {
+                piece,
+                lane: lane_of(first)?,
+                at_m: number(second, "onLane(at=)")?,
+            }
+        } else {
+            let port = first
+                .downcast_ref::<Port>()
+                .filter(|p| p.piece == this.piece)
+                .ok_or_else(|| {
+                    anyhow!("a junction's onLane takes one of its ports first (such as j.ONE), got {first}")
+                })?
+                .index;
+            let turn = second
+                .unpack_str()
+                .and_then(Turn::parse)
+                .ok_or_else(|| {
+                    anyhow!("a junction's onLane takes a turn second: \"straight\", \"left\" or \"right\", got {second}")
+                })?;
+            let at =
+                at.ok_or_else(|| anyhow!("a junction's onLane needs how far along its path, at="))?;
+            let lane = match lane {
+                Some(v) => {
+                    let x = number(v, "onLane(lane=)")?;
+                    if x.fract() != 0.0 || x < 1.0 {
+                        bail!("onLane(lane=) is a lane number from 1, got {x}");
+                    }
+                    x as u32
+                }
+                None => 1,
+            };
+            LaneRef::Junction {
+                piece,
+                entry: port,
+                turn,
+                lane,
+                at_m: number(at, "onLane(at=)")?,
+            }
+        };
+        r.resolve(&b.roads).map_err(|e| anyhow!(e))?;
+        b.locs.push(r);
         Ok(Loc {
             index: b.locs.len() - 1,
         })
@@ -312,8 +356,13 @@ pub(crate) fn world_methods(builder: &mut MethodsBuilder) {
         for o in objects.items {
             if let Some(a) = o.downcast_ref::<ActorVal>() {
                 actors.push(a.object);
+            } else if let Some(x) = o.downcast_ref::<super::values::ObstacleVal>() {
+                actors.push(x.object);
             } else if o.downcast_ref::<Road>().is_none() {
-                bail!("place takes roads and actors, got a {}", o.get_type());
+                bail!(
+                    "place takes roads, actors and obstacles, got a {}",
+                    o.get_type()
+                );
             }
         }
         b.place(&actors).map_err(|e| anyhow!(e))?;

@@ -25,7 +25,7 @@ use starlark::syntax::{AstModule, Dialect};
 
 use crate::{Scenario, ScenarioError};
 
-pub use program::MAX_CHECKED_WORLDS;
+pub use program::{MAX_CHECKED_WORLDS, MAX_CHECK_STEPS};
 pub use scene::OverTime;
 
 /// The length of a test when the program does not set one with `test(horizon=)`, seconds.
@@ -73,7 +73,12 @@ const KEYWORDS: &[(&str, &[&str])] = &[
     ("CrossIntersection", &["nlanes", "numLane", "friction"]),
     ("Roundabout", &["nlanes", "radius", "friction"]),
     ("AutonomousVehicle", &["loc", "sut", "route", "speed"]),
-    ("Car", &["loc", "speed", "route", "color", "enabled"]),
+    (
+        "Car",
+        &["loc", "speed", "route", "color", "enabled", "lane_change"],
+    ),
+    ("ChangeLane", &["to", "at", "when", "duration"]),
+    ("Obstacle", &["loc", "size", "color"]),
     (
         "Pedestrian",
         &["start", "target", "speed", "dist", "car", "trigger"],

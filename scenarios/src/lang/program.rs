@@ -27,6 +27,13 @@ use crate::{MonitorSpec, Scenario, ScenarioError};
 /// of a pairwise covering array over them.
 pub const MAX_CHECKED_WORLDS: usize = 4096;
 
+/// Most evaluation steps (function calls and loop iterations, as starlark counts them) that
+/// checking the combinations at load may take in all. A program whose every evaluation is
+/// long would otherwise take up to [`MAX_CHECKED_WORLDS`] × [`super::MAX_LOAD_STEPS`] steps;
+/// past this budget, the combinations left are checked by the tests that reach them, and a
+/// warning says how many were checked.
+pub const MAX_CHECK_STEPS: u64 = 50_000_000;
+
 /// The names of paracosm's builtins and methods: a variable passed whole to one of them acts
 /// through the world, which the usage analysis sees.
 const BUILTINS: &[&str] = &[
@@ -38,6 +45,8 @@ const BUILTINS: &[&str] = &[
     "AutonomousVehicle",
     "Car",
     "Pedestrian",
+    "Obstacle",
+    "ChangeLane",
     "Const",
     "CollisionMonitor",
     "DistanceMonitor",
@@ -65,6 +74,7 @@ pub struct Program {
     monitors: Vec<MonitorSpec>,
     horizon_s: f64,
     sut: SutConfig,
+    syntax: Syntax,
 }
 
 fn lambda_values<'v>(b: &SceneBuilder, module: &Module<'v>) -> Result<Vec<Value<'v>>, String> {
@@ -103,8 +113,18 @@ impl Program {
         values: Option<Vec<ParamValue>>,
         then: impl FnOnce(SceneBuilder, &Module) -> Result<R, String>,
     ) -> Result<R, String> {
+        self.evaluate_counted(values, then).map(|(r, _)| r)
+    }
+
+    /// [`Program::evaluate`], also returning the evaluation's step count.
+    fn evaluate_counted<R>(
+        &self,
+        values: Option<Vec<ParamValue>>,
+        then: impl FnOnce(SceneBuilder, &Module) -> Result<R, String>,
+    ) -> Result<(R, u64), String> {
         Module::with_temp_heap(|module| {
             let state = LoadState::new(values);
+            let steps;
             {
                 let mut eval = Evaluator::new(&module);
                 eval.extra = Some(&state);
@@ -126,10 +146,11 @@ impl Program {
                             format!("{message}\n --> {}", self.file)
                         }
                     })?;
+                steps = eval.get_total_tick_count();
             }
             let b = state.scene.into_inner();
             finished(&b).map_err(|m| format!("error: {m}\n --> {}", self.file))?;
-            then(b, &module)
+            Ok((then(b, &module)?, steps))
         })
     }
 
@@ -156,9 +177,15 @@ impl Program {
             }
         }
         if let Some(extra) = b.params.get(self.params.len()) {
+            let name = extra
+                .name
+                .clone()
+                .or_else(|| self.syntax.site(&extra.at).and_then(|s| s.name.clone()))
+                .map(|n| format!("`{n}` "))
+                .unwrap_or_default();
             return Err(format!(
-                "the open parameters depend on their values: the one declared at {} exists only \
-                 for these values",
+                "the open parameters depend on their values: {name}(declared at {}) exists only \
+                 for some values",
                 extra.at
             ));
         }
@@ -297,7 +324,12 @@ impl Program {
 
     /// The world of one evaluation with `values`, checked for consistency.
     fn world_for(&self, values: Vec<ParamValue>) -> Result<WorldSpec, String> {
-        self.evaluate(Some(values), |b, _| {
+        self.world_counted(values).map(|(w, _)| w)
+    }
+
+    /// [`Program::world_for`], also returning the evaluation's step count.
+    fn world_counted(&self, values: Vec<ParamValue>) -> Result<(WorldSpec, u64), String> {
+        self.evaluate_counted(Some(values), |b, _| {
             self.consistent(&b)?;
             scene::world(&b, self.horizon_s)
         })
@@ -342,8 +374,8 @@ pub fn load(
     globals: Globals,
 ) -> Result<Scenario, ScenarioError> {
     let lang = ScenarioError::Language;
-    let syntax = Syntax::of(&ast, BUILTINS);
     let mut program = Program {
+        syntax: Syntax::of(&ast, BUILTINS),
         file: file.to_owned(),
         ast,
         globals,
@@ -353,6 +385,7 @@ pub fn load(
         sut: SutConfig::builtin("aeb").map_err(lang)?,
     };
     let first = program.evaluate(None, |b, _| Ok(b)).map_err(lang)?;
+    let syntax = &program.syntax;
 
     // Names: explicit, else from where the parameter stands, else by position.
     let explicit: Vec<Option<String>> = first.params.iter().map(|p| p.name.clone()).collect();
@@ -404,9 +437,18 @@ pub fn load(
             ))
         }
     };
+    let mut checked = None;
     if !program.params.is_empty() {
-        for (values, label) in program.combinations() {
-            program.world_for(values).map_err(|m| with(&label, m))?;
+        let combinations = program.combinations();
+        let total = combinations.len();
+        let mut steps = 0u64;
+        for (done, (values, label)) in combinations.into_iter().enumerate() {
+            if steps > MAX_CHECK_STEPS {
+                checked = Some((done, total, steps));
+                break;
+            }
+            let (_, s) = program.world_counted(values).map_err(|m| with(&label, m))?;
+            steps += s;
         }
     }
 
@@ -475,6 +517,16 @@ pub fn load(
 
     let mut warnings = first.warnings.clone();
     let place_at = first.placed_at.clone().unwrap_or_default();
+    if let Some((done, total, steps)) = checked {
+        warnings.push(Warning {
+            at: format!("{file}:1:1"),
+            message: format!(
+                "loading checked {done} of the {total} combinations of levels and interval ends \
+                 ({steps} evaluation steps, over the budget of {MAX_CHECK_STEPS}); a test whose \
+                 values break the world among the others ends with status `error`"
+            ),
+        });
+    }
     if declared == 0 {
         warnings.push(Warning {
             at: place_at,
@@ -512,7 +564,7 @@ pub fn load(
         horizon_s: program.horizon_s,
     });
     warnings.extend(found.warnings);
-    warnings.extend(usage::unit_warnings(&program.params, &syntax));
+    warnings.extend(usage::unit_warnings(&program.params, syntax));
     let unused_params: Vec<String> = found
         .unused
         .iter()

@@ -8,8 +8,8 @@ use paracosm_engine::network::{Location, Network, PieceId, Turn};
 use paracosm_engine::rx::{Node, OpenStream, StreamId, Value};
 use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{
-    CarSpec, EgoSpec, EnvironmentSpec, LidarSpec, PedestrianSpec, Size, VehicleParams, WorldSpec,
-    DEFAULT_DT_S,
+    CarSpec, EgoSpec, EnvironmentSpec, LidarSpec, ObstacleSpec, PedestrianSpec, Size,
+    VehicleParams, WorldSpec, DEFAULT_DT_S,
 };
 use paracosm_generators::{Domain, Value as Level};
 
@@ -69,15 +69,51 @@ pub enum PedTrigger {
     Stream(StreamId),
 }
 
-/// An `onLane(lane, at)` not yet resolved (pieces may still move).
+/// An `onLane(...)` not yet resolved (pieces may still move).
 #[derive(Debug, Clone, Copy)]
-pub struct LaneRef {
-    /// The segment.
-    pub piece: PieceId,
-    /// The lane.
-    pub lane: paracosm_engine::Lane,
-    /// Distance from the segment's port ONE, m.
-    pub at_m: f64,
+pub enum LaneRef {
+    /// `r.onLane(lane, at)` on a segment.
+    Segment {
+        /// The segment.
+        piece: PieceId,
+        /// The lane.
+        lane: paracosm_engine::Lane,
+        /// Distance from the segment's port ONE, m.
+        at_m: f64,
+    },
+    /// `j.onLane(port, turn, at, lane=)` in a junction or roundabout.
+    Junction {
+        /// The junction.
+        piece: PieceId,
+        /// The port it enters through.
+        entry: usize,
+        /// The turn its path makes.
+        turn: Turn,
+        /// Its lane, from the centre line.
+        lane: u32,
+        /// Distance along the path, m.
+        at_m: f64,
+    },
+}
+
+impl LaneRef {
+    /// The location on `roads` as they stand.
+    ///
+    /// # Errors
+    /// The network's message when the location does not exist.
+    pub fn resolve(&self, roads: &Network) -> Result<Location, String> {
+        match *self {
+            LaneRef::Segment { piece, lane, at_m } => roads.on_lane(piece, lane, at_m),
+            LaneRef::Junction {
+                piece,
+                entry,
+                turn,
+                lane,
+                at_m,
+            } => roads.on_junction_lane(piece, entry, turn, lane, at_m),
+        }
+        .map_err(strip)
+    }
 }
 
 /// An actor declared but not yet placed.
@@ -117,6 +153,17 @@ pub enum Pending {
         color: String,
         /// Presence.
         enabled: bool,
+        /// Its lane change, if any.
+        lane_change: Option<super::values::LaneChangeVal>,
+    },
+    /// `Obstacle`.
+    Obstacle {
+        /// Where its base's centre stands.
+        loc: usize,
+        /// Its size.
+        size: Size,
+        /// Colour name.
+        color: String,
     },
 }
 
@@ -153,6 +200,8 @@ pub struct CarDecl {
     pub color: String,
     /// Presence.
     pub enabled: bool,
+    /// Its lane change, if any.
+    pub lane_change: Option<paracosm_engine::LaneChangeSpec>,
 }
 
 /// The ego vehicle as resolved.
@@ -188,6 +237,8 @@ pub struct SceneBuilder {
     pub pedestrians: Vec<PedestrianDecl>,
     /// Cars.
     pub cars: Vec<CarDecl>,
+    /// Static obstacles.
+    pub obstacles: Vec<ObstacleSpec>,
     /// `World(light=, fog=)`.
     pub world: Option<(StreamId, StreamId)>,
     /// Whether `place` ran.
@@ -260,6 +311,7 @@ impl SceneBuilder {
             ego: None,
             pedestrians: Vec::new(),
             cars: Vec::new(),
+            obstacles: Vec::new(),
             world: None,
             placed: false,
             monitors: Vec::new(),
@@ -288,9 +340,14 @@ impl SceneBuilder {
         let value = match &self.values {
             None => representative(&decl, self.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S)),
             Some(values) => values.get(k).cloned().ok_or_else(|| {
+                let name = decl
+                    .name
+                    .as_ref()
+                    .map(|n| format!("`{n}`, "))
+                    .unwrap_or_default();
                 format!(
-                    "the open parameter declared at {} exists only for some values of the others: \
-                     the set of open parameters may not depend on their values",
+                    "the open parameter {name}declared at {}, exists only for some values of the \
+                     others: the set of open parameters may not depend on their values",
                     decl.at
                 )
             })?,
@@ -369,6 +426,7 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
             color: c.color.clone(),
             size: Size::CAR,
             enabled: c.enabled,
+            lane_change: c.lane_change,
         })
         .collect();
     Ok(WorldSpec {
@@ -391,7 +449,7 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
             })
             .collect(),
         cars,
-        obstacles: vec![],
+        obstacles: b.obstacles.clone(),
         environment: EnvironmentSpec { light, fog },
         streams,
         lidar: LidarSpec::default(),
@@ -432,17 +490,15 @@ impl SceneBuilder {
         if let Some(o) = self.objects.iter().find(|o| !o.placed) {
             return Err(format!("{} is never placed: pass it to place(...)", o.name));
         }
-        let resolve = |b: &SceneBuilder, i: usize| {
-            let l = b.locs[i];
-            b.roads.on_lane(l.piece, l.lane, l.at_m).map_err(strip)
-        };
+        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(&b.roads);
         // Check the starting positions before anything depends on them (routes, behaviours).
         let mut placed = Vec::new();
         for o in &self.objects {
-            let (loc, footprint) = match &o.pending {
-                Pending::Ego { loc, .. } => (*loc, Some(VehicleParams::default().size)),
-                Pending::Car { loc, .. } => (*loc, Some(Size::CAR)),
-                Pending::Pedestrian { start, .. } => (*start, None),
+            let (loc, footprint, on_road) = match &o.pending {
+                Pending::Ego { loc, .. } => (*loc, Some(VehicleParams::default().size), true),
+                Pending::Car { loc, .. } => (*loc, Some(Size::CAR), true),
+                Pending::Obstacle { loc, size, .. } => (*loc, Some(*size), false),
+                Pending::Pedestrian { start, .. } => (*start, None, false),
             };
             let at = resolve(self, loc)?;
             placed.push(Placed {
@@ -455,7 +511,7 @@ impl SceneBuilder {
                     },
                     None => Footprint::Pedestrian { pos_m: at.pos_m },
                 },
-                on_road: footprint.is_some(),
+                on_road,
             });
         }
         check(&placed, &self.roads).map_err(strip)?;
@@ -515,24 +571,91 @@ impl SceneBuilder {
                     speed,
                     color,
                     enabled,
+                    lane_change,
                 } => {
                     let start = resolve(self, loc)?;
                     let path = self
                         .roads
                         .route(&start, &route, MAX_ROUTE_M)
                         .map_err(strip)?;
+                    let lane_change = match lane_change {
+                        Some(c) => Some(self.lane_change(&o.name, &start, c)?),
+                        None => None,
+                    };
                     self.cars.push(CarDecl {
                         path,
                         speed,
                         color,
                         enabled,
+                        lane_change,
                     });
                     self.car_names.push(o.name.clone());
+                }
+                Pending::Obstacle { loc, size, color } => {
+                    let at = resolve(self, loc)?;
+                    self.obstacles.push(ObstacleSpec {
+                        base_m: at.pos_m,
+                        heading_rad: at.heading_rad,
+                        size,
+                        color,
+                    });
                 }
             }
         }
         self.placed = true;
         Ok(())
+    }
+}
+
+impl SceneBuilder {
+    /// The engine's lane change of car `name` starting at `start`: the sideways offset to lane
+    /// `c.to` of the same segment, measured to the right of the car's direction.
+    ///
+    /// # Errors
+    /// A message when the car does not start on a segment's driving lane or the target lane
+    /// does not exist there.
+    fn lane_change(
+        &self,
+        name: &str,
+        start: &Location,
+        c: super::values::LaneChangeVal,
+    ) -> Result<paracosm_engine::LaneChangeSpec, String> {
+        if start.through.is_some() {
+            return Err(format!(
+                "{name}: a lane change starts on a RoadSegment's lane, not inside a junction"
+            ));
+        }
+        let target = self
+            .roads
+            .on_lane(
+                start.piece,
+                paracosm_engine::Lane::Driving(c.to),
+                start.at_m,
+            )
+            .map_err(|e| format!("{name}: ChangeLane(to = {}): {}", c.to, strip(e)))?;
+        let h = start.heading_rad;
+        let right = [h.sin(), h.cos()];
+        let d = [
+            target.pos_m[0] - start.pos_m[0],
+            target.pos_m[2] - start.pos_m[2],
+        ];
+        let offset_m = d[0] * right[0] + d[1] * right[1];
+        if offset_m.abs() < 1e-6 {
+            return Err(format!(
+                "{name}: ChangeLane(to = {}) is the lane it starts on",
+                c.to
+            ));
+        }
+        Ok(paracosm_engine::LaneChangeSpec {
+            offset_m,
+            start: match c.start {
+                super::values::ChangeStart::At(t) => paracosm_engine::LaneChangeStart::At(t),
+                super::values::ChangeStart::When(s) => {
+                    paracosm_engine::LaneChangeStart::When(StreamId(s))
+                }
+            },
+            duration_s: c.duration_s,
+        })
     }
 }
 

@@ -68,6 +68,7 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec) -> Vec<Change> {
     }
     other(debug(&a.ego) != debug(&b.ego), &mut out);
     other(debug(&a.pedestrians) != debug(&b.pedestrians), &mut out);
+    other(debug(&a.obstacles) != debug(&b.obstacles), &mut out);
     other(
         debug(&a.environment) != debug(&b.environment) || a.dt_s != b.dt_s,
         &mut out,

@@ -317,3 +317,56 @@ starlark_simple_value!(OverTimeVal);
 
 #[starlark_value(type = "OverTime")]
 impl<'v> StarlarkValue<'v> for OverTimeVal {}
+
+/// When a `ChangeLane` starts.
+#[derive(Debug, Clone, Copy, PartialEq, Allocative)]
+pub enum ChangeStart {
+    /// At this time, s.
+    At(f64),
+    /// At the first event of this stream.
+    When(usize),
+}
+
+/// `ChangeLane(to=, at=, when=, duration=)`: a lane change for `Car(lane_change=)`.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct LaneChangeVal {
+    /// The lane it moves to, on the car's segment.
+    pub to: i32,
+    /// When it starts.
+    pub start: ChangeStart,
+    /// How long it takes, s.
+    pub duration_s: f64,
+}
+
+impl fmt::Display for LaneChangeVal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "ChangeLane(to = {}, duration = {})",
+            self.to, self.duration_s
+        )
+    }
+}
+
+starlark_simple_value!(LaneChangeVal);
+
+#[starlark_value(type = "ChangeLane")]
+impl<'v> StarlarkValue<'v> for LaneChangeVal {}
+
+/// `Obstacle(...)`: a static box, for `place`.
+#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+pub struct ObstacleVal {
+    /// Index in the program's declared objects.
+    pub object: usize,
+}
+
+impl fmt::Display for ObstacleVal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Obstacle({})", self.object)
+    }
+}
+
+starlark_simple_value!(ObstacleVal);
+
+#[starlark_value(type = "Obstacle")]
+impl<'v> StarlarkValue<'v> for ObstacleVal {}

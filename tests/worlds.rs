@@ -1,0 +1,450 @@
+//! Issue 15: a family of worlds. Every input may be open, road geometry included; each test
+//! builds its own world; load checks every level and interval end; new vocabulary (lane
+//! changes, locations in junctions, obstacles). The scenario files are in `tests/scenarios/`
+//! and `scenarios/`, each saying what it shows.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{expect_code, fuzz};
+use paracosm_engine::rx::NoHost;
+use paracosm_engine::sut::{ConstantControl, Sut};
+use paracosm_engine::{Control, Simulation};
+use paracosm_generators::{Assignment, ParamSpace, Point, Value};
+use paracosm_scenarios::Scenario;
+use serde_json::Value as Json;
+
+fn path(dir: &str, name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(dir).join(name)
+}
+
+fn load(dir: &str, name: &str) -> Scenario {
+    paracosm_scenarios::load(path(dir, name).to_str().unwrap()).unwrap()
+}
+
+/// The assignment with the given values by name (levels by value, intervals by value), the
+/// others at their lowest.
+fn assign(space: &ParamSpace, values: &[(&str, Value)]) -> Assignment {
+    let mut point = Point {
+        discrete: Vec::new(),
+        continuous: Vec::new(),
+    };
+    for p in space.params() {
+        let given = values.iter().find(|(n, _)| *n == p.name).map(|(_, v)| v);
+        match &p.domain {
+            paracosm_generators::Domain::Interval { lo, hi } => {
+                let x = given.and_then(Value::as_f64).unwrap_or(*lo);
+                point.continuous.push((x - lo) / (hi - lo));
+            }
+            paracosm_generators::Domain::Levels(levels) => {
+                let i = given.map_or(0, |v| levels.iter().position(|l| l == v).unwrap());
+                point.discrete.push(i as u32);
+            }
+        }
+    }
+    space.decode(&point).unwrap()
+}
+
+fn stderr(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn worlds_with_2_4_and_6_lanes_really_differ() {
+    let s = load("tests/scenarios", "lanes_family.star");
+    let mut lateral = Vec::new();
+    let mut bearings = Vec::new();
+    for n in [2, 4, 6] {
+        // The cone ~37 m ahead: within the lidar's ±30° even across six lanes.
+        let a = assign(
+            &s.space,
+            &[("nlanes", Value::Int(n)), ("gap", Value::Real(39.5))],
+        );
+        let world = s.instantiate(&a).unwrap();
+        let sim = Simulation::new(&world).unwrap();
+        // The outermost lane's centre: (n/2 - 1/2) · 3.5 m right of the centre line.
+        let z = sim.ego_state().pos_m[2];
+        assert!(
+            (z - (n as f64 / 2.0 - 0.5) * 3.5).abs() < 1e-6,
+            "{n} lanes: z = {z}"
+        );
+        lateral.push(z);
+        // The cone on the left sidewalk: the nearest lidar return to the left.
+        let obs = sim.observation();
+        let cone = obs
+            .lidar
+            .iter()
+            .filter(|r| r.point_m[2] < -0.5)
+            .min_by(|a, b| a.range_m.total_cmp(&b.range_m))
+            .expect("the lidar sees the cone");
+        bearings.push(cone.azimuth_rad);
+        // The road itself: 2·n/2 lanes of 3.5 m, so the edge is n·1.75 m from the centre.
+        assert!((world.network.pieces()[0].kind.half_road_m() - n as f64 * 1.75).abs() < 1e-9);
+    }
+    assert!(lateral.windows(2).all(|w| w[1] > w[0] + 3.0), "{lateral:?}");
+    // The wider the road, the farther to the left the cone appears.
+    assert!(
+        bearings.windows(2).all(|w| w[1] > w[0] + 0.02),
+        "the cone's bearing must differ by level: {bearings:?}"
+    );
+
+    // A campaign counts the three levels in its k-wise coverage.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = fuzz(&[
+        path("tests/scenarios", "lanes_family.star")
+            .to_str()
+            .unwrap(),
+        "--budget",
+        "12",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 0);
+    let summary: Json =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let kwise = &summary["coverage"]["kwise"][0];
+    assert_eq!(
+        (kwise["covered"].as_u64(), kwise["total"].as_u64()),
+        (Some(3), Some(3))
+    );
+}
+
+#[test]
+fn an_open_place_on_a_lane_moves_the_car_to_the_sampled_gap() {
+    let s = load("scenarios", "cut_in.star");
+    for gap in [2.0, 11.5, 29.0] {
+        let a = assign(&s.space, &[("gap", Value::Real(gap))]);
+        let sim = Simulation::new(&s.instantiate(&a).unwrap()).unwrap();
+        let snap = sim.snapshot();
+        let ego_x = snap.ego.pos_m[0];
+        let car_x = snap.cars[0].pos_m[0];
+        // Bumper to bumper: the car's centre is 4.5 m plus the gap ahead of the ego's.
+        assert!(
+            (car_x - ego_x - 4.5 - gap).abs() < 1e-6,
+            "gap {gap}: {car_x} - {ego_x}"
+        );
+    }
+}
+
+/// Full brake from 25 m/s for the whole test; where the ego stops, m from its start.
+fn braking_distance(s: &Scenario, first: f64, second: f64) -> f64 {
+    let a = assign(
+        &s.space,
+        &[
+            ("friction[0]", Value::Real(first)),
+            ("friction[1]", Value::Real(second)),
+        ],
+    );
+    let mut sim = Simulation::new(&s.instantiate(&a).unwrap()).unwrap();
+    let start = sim.ego_state().pos_m[0];
+    let mut brake = ConstantControl(Control {
+        throttle: -1.0,
+        steering: 0.0,
+    });
+    while sim.t_s() < s.horizon_s {
+        let c = brake.act(&sim.observation()).unwrap();
+        sim.step(c, &mut NoHost).unwrap();
+    }
+    sim.ego_state().pos_m[0] - start
+}
+
+#[test]
+fn a_friction_that_drops_halfway_lengthens_the_braking_distance() {
+    let s = load("tests/scenarios", "friction_drops.star");
+    let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["friction[0]", "friction[1]"]);
+    let dry = braking_distance(&s, 0.85, 0.85);
+    let drops = braking_distance(&s, 0.85, 0.1);
+    // 25 m/s at about 8 m/s² stops in about 3.1 s and 39 m; after 2 s on ice (0.1) it slides
+    // on at about 1 m/s² for the rest of the test.
+    assert!((30.0..45.0).contains(&dry), "dry: {dry:.1} m");
+    assert!(
+        drops > dry + 3.0,
+        "drops at 2 s: {drops:.1} m vs dry {dry:.1} m"
+    );
+    assert_eq!(braking_distance(&s, 0.85, 0.85), dry, "deterministic");
+}
+
+#[test]
+fn a_cut_in_fails_some_tests_and_passes_others_and_both_replay_with_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = fuzz(&[
+        path("scenarios", "cut_in.star").to_str().unwrap(),
+        "--budget",
+        "50",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 1);
+    let records: Vec<Json> = std::fs::read_to_string(out.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let collided = records
+        .iter()
+        .find(|r| r["monitors"]["collision"]["passed"] == false)
+        .expect("a collision");
+    let passed = records
+        .iter()
+        .find(|r| r["status"] == "pass")
+        .expect("a pass");
+    for r in [collided, passed] {
+        let id = r["id"].to_string();
+        let frames = dir.path().join(format!("frames-{id}"));
+        let o = fuzz(&[
+            "replay",
+            out.join("results.jsonl").to_str().unwrap(),
+            "--id",
+            &id,
+            "--frames",
+            frames.to_str().unwrap(),
+        ]);
+        expect_code(&o, 0);
+        assert!(frames.join("contact_sheet.png").exists());
+        assert!(std::fs::read_dir(&frames).unwrap().count() > 10);
+    }
+}
+
+#[test]
+fn a_network_that_breaks_only_for_six_lanes_is_refused_at_load_naming_the_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = fuzz(&[
+        path("tests/scenarios", "breaks_for_six.star")
+            .to_str()
+            .unwrap(),
+        "--budget",
+        "3",
+        "--out",
+        dir.path().join("out").to_str().unwrap(),
+    ]);
+    expect_code(&o, 2);
+    let e = stderr(&o);
+    assert!(e.contains("lane-count mismatch"), "{e}");
+    assert!(
+        e.contains("the world fails for the test values nlanes = 6"),
+        "{e}"
+    );
+    assert!(e.contains("breaks_for_six.star:9:7"), "{e}");
+}
+
+#[test]
+fn the_set_of_open_parameters_may_not_depend_on_their_values() {
+    let e = paracosm_scenarios::load(
+        path("tests/scenarios", "params_depend_on_values.star")
+            .to_str()
+            .unwrap(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("`extra`"), "{e}");
+    assert!(e.contains("may not depend on their values"), "{e}");
+    assert!(e.contains("lanes = 4"), "{e}");
+}
+
+#[test]
+fn a_world_invalid_only_inside_an_interval_is_an_error_for_those_tests_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = fuzz(&[
+        path("tests/scenarios", "interior_collision.star")
+            .to_str()
+            .unwrap(),
+        "--budget",
+        "40",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 3);
+    let records: Vec<Json> = std::fs::read_to_string(out.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(records.len(), 40);
+    let errors: Vec<&Json> = records.iter().filter(|r| r["status"] == "error").collect();
+    assert!(
+        !errors.is_empty() && errors.len() < 10,
+        "{} errors",
+        errors.len()
+    );
+    for r in &errors {
+        let at = r["params"]["at"].as_f64().unwrap();
+        // The cars (4.5 m long) overlap when their centres are closer than 4.5 m.
+        assert!((at + 20.0 - 60.0).abs() < 4.6, "at = {at}");
+        assert!(r["error"].as_str().unwrap().contains("start in collision"));
+    }
+    assert!(records.iter().any(|r| r["status"] == "pass"));
+}
+
+#[test]
+fn branching_on_a_value_a_junction_location_an_obstacle_and_an_open_ego_speed() {
+    let src = r#"
+lanes = VarEnum([2, 4])
+start_speed = VarInterval(4.0, 10.0, unit = "m/s")
+rb = Roundabout(nlanes = 2, radius = 20.0)
+west = RoadSegment(len = 100.0)
+net = rb.connect((rb.THREE, west, west.ONE))
+if lanes == 4:
+    road = RoadSegment(len = 10.0 * lanes, nlanes = 2)
+    net = net.connect((west.TWO, road, road.ONE))
+w = World()
+v = AutonomousVehicle(loc = west.onLane(-1, 60), speed = start_speed)
+ring = Car(loc = rb.onLane(rb.TWO, "left", 12), speed = 5.0, route = [])
+box = Obstacle(loc = west.onLane(-1, 20), size = (1.0, 2.0, 1.5), color = "yellow")
+w.place(net, v, ring, box)
+CollisionMonitor(v)
+"#;
+    let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
+    for (lanes, pieces) in [(2, 2), (4, 3)] {
+        let a = assign(
+            &s.space,
+            &[
+                ("lanes", Value::Int(lanes)),
+                ("start_speed", Value::Real(7.5)),
+            ],
+        );
+        let world = s.instantiate(&a).unwrap();
+        assert_eq!(world.network.pieces().len(), pieces, "lanes = {lanes}");
+        let sim = Simulation::new(&world).unwrap();
+        assert!((sim.ego_state().speed_mps - 7.5).abs() < 0.01);
+        let snap = sim.snapshot();
+        // The ring car is on the roundabout's ring, between the island and the plaza's edge.
+        let r = snap.cars[0].pos_m[0].hypot(snap.cars[0].pos_m[2]);
+        assert!((12.0..20.0).contains(&r), "ring car at radius {r}");
+        assert_eq!(snap.obstacles.len(), 1);
+        assert_eq!(snap.obstacles[0].size.width_m, 2.0);
+        // The obstacle stands in the ego's lane 40 m ahead; the lidar sees it.
+        let ahead = sim
+            .observation()
+            .lidar
+            .iter()
+            .filter(|r| r.point_m[2].abs() < 0.3)
+            .map(|r| r.range_m)
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            (ahead - 37.5).abs() < 1.0,
+            "nearest return straight ahead at {ahead} m"
+        );
+    }
+}
+
+#[test]
+fn driving_into_an_obstacle_is_a_collision() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 200.0)
+v = AutonomousVehicle(loc = r.onLane(1, 10), sut = "aeb")
+wall = Obstacle(loc = r.onLane(1, 60), size = (0.5, 3.0, 1.0))
+w.place(r, v, wall)
+CollisionMonitor(v)
+"#;
+    let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
+    let a = assign(&s.space, &[]);
+    // aeb sees it with its lidar and stops.
+    let o = s.run(&a, 0).unwrap();
+    assert!(o.passed(), "{o:?}");
+    // Full throttle into it: a collision.
+    let mut hits = s.clone();
+    hits.sut = paracosm_engine::sut::SutConfig::Constant(Control {
+        throttle: 0.5,
+        steering: 0.0,
+    });
+    let o = hits.run(&a, 0).unwrap();
+    let (_, collision) = o.monitors.iter().find(|(n, _)| n == "collision").unwrap();
+    assert!(!collision.passed, "{o:?}");
+    assert!(collision.first_violation_s.unwrap() < 5.0);
+}
+
+#[test]
+fn parameters_are_values_the_program_computes_with() {
+    // range(), int(), indexing and arithmetic on both sides of an operator all work.
+    let src = r#"
+n = VarEnum([2, 4])
+gap = VarInterval(10.0, 20.0)
+w = World()
+r = RoadSegment(len = 200.0, nlanes = n)
+v = AutonomousVehicle(loc = r.onLane(1, 10))
+cars = [Car(loc = r.onLane(lane, 100 - gap + 5 * lane), speed = 2.0) for lane in range(1, n // 2 + 1)]
+names = ["one", "two"][int(n / 2) - 1]
+w.place(r, v, *cars)
+CollisionMonitor(v, name = "collision_" + names)
+"#;
+    let e = paracosm_scenarios::lang::load_source("t.star", src, "t")
+        .unwrap_err()
+        .to_string();
+    // The monitor's name depends on n: refused, and said so.
+    assert!(
+        e.contains("the monitors depend on the open parameters' values"),
+        "{e}"
+    );
+    let fixed = src.replace("name = \"collision_\" + names", "name = \"collision\"");
+    let s = paracosm_scenarios::lang::load_source("t.star", &fixed, "t").unwrap();
+    let a = assign(
+        &s.space,
+        &[("n", Value::Int(4)), ("gap", Value::Real(12.0))],
+    );
+    let world = s.instantiate(&a).unwrap();
+    assert_eq!(world.cars.len(), 2);
+    let sim = Simulation::new(&world).unwrap();
+    let xs: Vec<f64> = sim.snapshot().cars.iter().map(|c| c.pos_m[0]).collect();
+    assert_eq!(xs, [93.0, 98.0]);
+}
+
+/// Bit-identical results for any thread count, on every shipped scenario (the new ones with a
+/// per-test evaluation of the program and worlds of different shapes included).
+#[test]
+fn every_shipped_scenario_gives_the_same_results_for_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in paracosm_scenarios::builtin_names() {
+        let run = |jobs: &str| {
+            let out = dir.path().join(format!("{name}-{jobs}"));
+            let o = fuzz(&[
+                &name,
+                "--budget",
+                "6",
+                "--seed",
+                "5",
+                "--strategy",
+                "random",
+                "--jobs",
+                jobs,
+                "--out",
+                out.to_str().unwrap(),
+            ]);
+            assert!(
+                matches!(o.status.code(), Some(0 | 1)),
+                "{name}: {}",
+                stderr(&o)
+            );
+            std::fs::read_to_string(out.join("results.jsonl"))
+                .unwrap()
+                .lines()
+                .map(|l| l[..l.rfind(",\"wall_ms\":").unwrap()].to_owned())
+                .collect::<Vec<_>>()
+        };
+        let (one, two) = (run("1"), run("2"));
+        assert_eq!(one.len(), 6, "{name}");
+        assert_eq!(one, two, "{name}");
+    }
+}
+
+#[test]
+fn checking_a_slow_program_stops_at_the_load_budget_and_says_so() {
+    let s = load("tests/scenarios", "slow_to_evaluate.star");
+    let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    let budget = paracosm_scenarios::lang::MAX_CHECK_STEPS;
+    let found = w
+        .iter()
+        .find(|m| m.contains("loading checked"))
+        .unwrap_or_else(|| panic!("no budget warning in {w:?}"));
+    // 3 million steps an evaluation: the budget of 50 million is passed after 17 of 32.
+    assert!(
+        found.contains("checked 17 of the 32 combinations"),
+        "{found}"
+    );
+    assert!(found.contains(&budget.to_string()), "{found}");
+}
