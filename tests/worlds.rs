@@ -448,3 +448,434 @@ fn checking_a_slow_program_stops_at_the_load_budget_and_says_so() {
     );
     assert!(found.contains(&budget.to_string()), "{found}");
 }
+
+/// One input of the program in [`EVERY_INPUT`]: its placeholder, its value as a plain
+/// constant, an open form (named `x`, two or more values that must give different worlds),
+/// and whether LANGUAGE.md's table says it accepts a stream that varies over time
+/// (`over_time=`, where the input is a number) and a computed stream.
+struct Slot {
+    key: &'static str,
+    plain: &'static str,
+    open: &'static str,
+    over_time: Option<bool>,
+    computed: bool,
+}
+
+const fn slot(
+    key: &'static str,
+    plain: &'static str,
+    open: &'static str,
+    over_time: Option<bool>,
+    computed: bool,
+) -> Slot {
+    Slot {
+        key,
+        plain,
+        open,
+        over_time,
+        computed,
+    }
+}
+
+/// A program that uses every input LANGUAGE.md lists, each a placeholder `{key}`.
+const EVERY_INPUT: &str = r#"n = {n}
+w = World(light = {light}, fog = {fog})
+r = RoadSegment(len = {len}, nlanes = n, friction = {friction})
+j = CrossIntersection(nlanes = n, friction = {jfriction})
+x = RoadSegment(len = 60.0, nlanes = n)
+k = Roundabout(nlanes = n, radius = {radius})
+net = r.connect((r.TWO, j, j.THREE))
+net = j.connect((j.ONE, x, x.ONE))
+net = x.connect((x.TWO, k, k.THREE))
+v = AutonomousVehicle(loc = r.onLane({ego_lane}, {ego_at}), speed = {ego_speed}, route = {ego_route})
+c = Car(loc = r.onLane({car_lane}, {car_at}), speed = {car_speed}, color = {color}, enabled = {enabled}, route = {car_route}, lane_change = ChangeLane(to = {lc_to}, at = {lc_at}, duration = {lc_duration}))
+d = Car(loc = k.onLane(k.ONE, {j_turn}, {j_at}, lane = {j_lane}), speed = 5.0)
+o = Obstacle(loc = r.onLane(-r.SideWalk, {obs_at}), size = ({obs_len}, 0.5, {obs_h}), color = {obs_color})
+pa = {ped_at}
+p = Pedestrian(start = r.onLane(r.SideWalk, pa), target = r.onLane(-r.SideWalk, pa), speed = {ped_speed}, dist = {ped_dist}, car = v)
+w.place(net, v, c, d, o, p)
+CollisionMonitor(v)
+DistanceMonitor(v, minD = {minD})
+test(horizon = {horizon})
+"#;
+
+const SLOTS: &[Slot] = &[
+    slot(
+        "light",
+        "0.5",
+        "VarInterval(0.3, 0.7, name = \"x\")",
+        Some(true),
+        true,
+    ),
+    slot(
+        "fog",
+        "0.1",
+        "VarInterval(0.0, 0.5, name = \"x\")",
+        Some(true),
+        true,
+    ),
+    slot(
+        "len",
+        "200.0",
+        "VarInterval(180.0, 250.0, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "n",
+        "4",
+        "VarEnum([4, 6], name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "radius",
+        "20.0",
+        "VarInterval(20.0, 30.0, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "friction",
+        "0.8",
+        "VarInterval(0.2, 0.9, name = \"x\")",
+        Some(true),
+        true,
+    ),
+    slot(
+        "jfriction",
+        "0.8",
+        "VarEnum([0.3, 0.9], name = \"x\")",
+        Some(true),
+        true,
+    ),
+    slot(
+        "ego_lane",
+        "1",
+        "VarEnum([1, 2], name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "ego_at",
+        "10.0",
+        "VarInterval(5.0, 15.0, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "ego_speed",
+        "12.0",
+        "VarInterval(5.0, 15.0, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "ego_route",
+        "\"straight\"",
+        "VarEnum([\"left\", \"straight\"], name = \"x\")",
+        None,
+        false,
+    ),
+    slot(
+        "car_lane",
+        "2",
+        "VarEnum([2, -1], name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "car_at",
+        "40.0",
+        "VarInterval(30.0, 60.0, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "car_speed",
+        "8.0",
+        "VarInterval(5.0, 10.0, name = \"x\")",
+        Some(true),
+        true,
+    ),
+    slot(
+        "color",
+        "\"red\"",
+        "VarEnum([\"red\", \"blue\"], name = \"x\")",
+        None,
+        false,
+    ),
+    slot(
+        "enabled",
+        "True",
+        "VarEnum([True, False], name = \"x\")",
+        None,
+        false,
+    ),
+    slot(
+        "car_route",
+        "\"straight\"",
+        "VarEnum([\"left\", \"right\"], name = \"x\")",
+        None,
+        false,
+    ),
+    slot(
+        "lc_to",
+        "1",
+        "VarEnum([1, -1], name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "lc_at",
+        "2.0",
+        "VarInterval(1.0, 3.0, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "lc_duration",
+        "3.0",
+        "VarInterval(2.0, 4.0, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "j_turn",
+        "\"right\"",
+        "VarEnum([\"right\", \"straight\"], name = \"x\")",
+        None,
+        false,
+    ),
+    slot(
+        "j_at",
+        "5.0",
+        "VarInterval(2.0, 8.0, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "j_lane",
+        "1",
+        "VarEnum([1, 2], name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "obs_at",
+        "150.0",
+        "VarInterval(120.0, 140.0, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "obs_len",
+        "0.5",
+        "VarInterval(0.3, 0.6, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "obs_h",
+        "1.2",
+        "VarInterval(0.5, 1.5, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "obs_color",
+        "\"orange\"",
+        "VarEnum([\"orange\", \"grey\"], name = \"x\")",
+        None,
+        false,
+    ),
+    slot(
+        "ped_at",
+        "100.0",
+        "VarInterval(90.0, 110.0, name = \"x\")",
+        Some(false),
+        false,
+    ),
+    slot(
+        "ped_speed",
+        "1.5",
+        "VarInterval(1.0, 2.0, name = \"x\")",
+        Some(true),
+        true,
+    ),
+    slot(
+        "ped_dist",
+        "30.0",
+        "VarInterval(20.0, 40.0, name = \"x\")",
+        Some(true),
+        true,
+    ),
+];
+
+/// Inputs that are the same for every test of a campaign: constants only.
+const CAMPAIGN_CONSTANTS: &[(&str, &str, &str)] = &[
+    ("minD", "10.0", "VarInterval(5.0, 15.0, name = \"x\")"),
+    ("horizon", "3.0", "VarInterval(2.0, 4.0, name = \"x\")"),
+];
+
+fn every_input(with: &[(&str, &str)]) -> String {
+    let mut src = EVERY_INPUT.to_owned();
+    for (k, v) in with {
+        src = src.replace(&format!("{{{k}}}"), v);
+    }
+    for s in SLOTS {
+        src = src.replace(&format!("{{{}}}", s.key), s.plain);
+    }
+    for (k, plain, _) in CAMPAIGN_CONSTANTS {
+        src = src.replace(&format!("{{{k}}}"), plain);
+    }
+    src
+}
+
+/// The parameter `x` at the start (`0.1` of the interval, first level) or the end.
+fn x_at(space: &ParamSpace, end: bool) -> Assignment {
+    let mut point = Point {
+        discrete: Vec::new(),
+        continuous: Vec::new(),
+    };
+    for p in space.params() {
+        match &p.domain {
+            paracosm_generators::Domain::Interval { .. } => {
+                point.continuous.push(if end { 0.9 } else { 0.1 })
+            }
+            paracosm_generators::Domain::Levels(levels) => {
+                point
+                    .discrete
+                    .push(if end { levels.len() as u32 - 1 } else { 0 })
+            }
+        }
+    }
+    space.decode(&point).unwrap()
+}
+
+/// The line of `key`'s placeholder in [`EVERY_INPUT`], from 1.
+fn line_of(key: &str) -> usize {
+    // `n` and `pa` are assigned on lines of their own, and used on the next line but one.
+    let key = match key {
+        "n" => "len",
+        "ped_at" => "ped_speed",
+        k => k,
+    };
+    EVERY_INPUT
+        .lines()
+        .position(|l| l.contains(&format!("{{{key}}}")))
+        .unwrap()
+        + 1
+}
+
+#[test]
+fn every_input_takes_a_constant_const_an_open_value_and_what_the_reference_says() {
+    let load = |src: &str| paracosm_scenarios::lang::load_source("every.star", src, "every");
+    let base = load(&every_input(&[])).unwrap_or_else(|e| panic!("{e}"));
+    let empty = base.space.decode(&Point {
+        discrete: vec![],
+        continuous: vec![],
+    });
+    let base_run = format!("{:?}", base.run(&empty.unwrap(), 0).unwrap());
+    for s in SLOTS {
+        // Const(v) is v: the same test, verdicts, robustness and metrics.
+        let c = format!("Const({})", s.plain);
+        let with_const =
+            load(&every_input(&[(s.key, &c)])).unwrap_or_else(|e| panic!("{}: Const: {e}", s.key));
+        let run = with_const.run(&empty_assignment(&with_const), 0).unwrap();
+        assert_eq!(
+            format!("{run:?}"),
+            base_run,
+            "{}: Const({}) is not {}",
+            s.key,
+            s.plain,
+            s.plain
+        );
+
+        // Open per test: the two ends give different worlds, and both run.
+        let open = load(&every_input(&[(s.key, s.open)]))
+            .unwrap_or_else(|e| panic!("{}: open: {e}", s.key));
+        assert_eq!(open.space.params().len(), 1, "{}", s.key);
+        let (a, b) = (x_at(&open.space, false), x_at(&open.space, true));
+        let (wa, wb) = (open.instantiate(&a).unwrap(), open.instantiate(&b).unwrap());
+        assert_ne!(
+            format!("{wa:?}"),
+            format!("{wb:?}"),
+            "{}: the open value changes nothing",
+            s.key
+        );
+        for x in [&a, &b] {
+            open.run(x, 0)
+                .unwrap_or_else(|e| panic!("{}: open: {x:?}: {e}", s.key));
+        }
+
+        // Over time and computed: accepted and run, or refused at load naming the line.
+        let lo_hi = s.open.trim_start_matches("VarInterval(");
+        let mut forms = Vec::new();
+        if let Some(ok) = s.over_time {
+            let varying = if s.open.starts_with("VarInterval") {
+                format!(
+                    "VarInterval({}",
+                    lo_hi.replace("name = \"x\"", "name = \"x\", over_time = Piecewise(2)")
+                )
+            } else {
+                format!(
+                    "VarInterval({0}, {0} + 1, name = \"x\", over_time = Piecewise(2))",
+                    s.plain
+                )
+            };
+            forms.push(("over time", varying, ok));
+        }
+        forms.push((
+            "computed",
+            format!("tick.map(lambda t: {})", s.plain),
+            s.computed,
+        ));
+        for (what, form, ok) in forms {
+            let got = load(&every_input(&[(s.key, &form)]));
+            match (got, ok) {
+                (Ok(sc), true) => {
+                    let a = x_at(&sc.space, true);
+                    sc.run(&a, 0)
+                        .unwrap_or_else(|e| panic!("{} {what}: {e}", s.key));
+                }
+                (Err(e), false) => {
+                    let e = e.to_string();
+                    let at = format!("every.star:{}:", line_of(s.key));
+                    assert!(e.contains(&at), "{} {what}: {at} missing from\n{e}", s.key);
+                    assert!(
+                        e.contains("stream"),
+                        "{} {what}: the refusal must say a stream is not taken here:\n{e}",
+                        s.key
+                    );
+                }
+                (Ok(_), false) => panic!("{} {what}: accepted, but LANGUAGE.md says no", s.key),
+                (Err(e), true) => {
+                    panic!("{} {what}: refused, but LANGUAGE.md says yes: {e}", s.key)
+                }
+            }
+        }
+    }
+    // Inputs fixed for the whole campaign: a constant or Const, never open.
+    for (key, plain, open) in CAMPAIGN_CONSTANTS {
+        let c = format!("Const({plain})");
+        load(&every_input(&[(key, &c)])).unwrap_or_else(|e| panic!("{key}: Const: {e}"));
+        let e = load(&every_input(&[(key, open)])).unwrap_err().to_string();
+        assert!(
+            e.contains("depends on the open parameters")
+                || e.contains("depend on the open parameters"),
+            "{key}: {e}"
+        );
+        let at = format!("every.star:{}:", line_of(key));
+        assert!(e.contains(&at), "{key}: {at} missing from\n{e}");
+    }
+}
+
+fn empty_assignment(s: &Scenario) -> Assignment {
+    s.space
+        .decode(&Point {
+            discrete: vec![],
+            continuous: vec![],
+        })
+        .unwrap()
+}

@@ -72,7 +72,10 @@ pub fn number(v: Value, what: &str) -> anyhow::Result<f64> {
             return Ok(x);
         }
     }
-    if v.downcast_ref::<Stream>().is_some() {
+    if let Some(s) = v.downcast_ref::<Stream>() {
+        if let Some(x) = s.number {
+            return Ok(x);
+        }
         bail!(
             "{what} takes one number for the whole test, but got a stream, which has no single \
              value (an open parameter that varies over time is one)"
@@ -168,7 +171,7 @@ fn load_time_number(v: Value, b: &SceneBuilder, what: &str) -> anyhow::Result<f6
 
 fn lanes(v: Option<Value>, b: &SceneBuilder, default: u32) -> anyhow::Result<u32> {
     let Some(v) = v else { return Ok(default) };
-    let x = load_time_number(v, b, "nlanes")?;
+    let x = load_time_number(v, b, "nlanes=")?;
     if x.fract() != 0.0 || !(2.0..=16.0).contains(&x) || (x as u32) % 2 == 1 {
         bail!("nlanes must be an even whole number from 2 to 16, got {x}");
     }
@@ -269,27 +272,56 @@ fn declare(
     }
 }
 
-fn route_arg(v: Option<Value>) -> anyhow::Result<Option<Vec<paracosm_engine::network::Turn>>> {
+/// A string fixed for a test: a plain string, `Const("...")` or an open `VarEnum` level.
+pub(crate) fn text_value(v: Value, b: &SceneBuilder) -> Option<String> {
+    if let Some(t) = v.unpack_str() {
+        return Some(t.to_owned());
+    }
+    match v
+        .downcast_ref::<Stream>()
+        .map(|s| b.graph.nodes().get(s.id))
+    {
+        Some(Some(Node::Const(Rx::Text(t)))) => Some(t.clone()),
+        _ => None,
+    }
+}
+
+/// A route: `None`, one turn (a string, `Const("left")`, or an open `VarEnum` of turns) or a
+/// list of turns.
+fn route_arg(
+    v: Option<Value>,
+    b: &SceneBuilder,
+) -> anyhow::Result<Option<Vec<paracosm_engine::network::Turn>>> {
+    let one = |v: Value| text_value(v, b);
     match v {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
         // One turn, e.g. an open parameter `VarEnum(["left", "straight", "right"])`.
-        Some(v) if v.unpack_str().is_some() => {
-            turns(&[v.unpack_str().unwrap_or_default().to_owned()])
-                .map(Some)
-                .map_err(|e| anyhow!(e))
-        }
+        Some(v) if one(v).is_some() => turns(&[one(v).unwrap_or_default()])
+            .map(Some)
+            .map_err(|e| anyhow!(e)),
+        Some(v) if v.downcast_ref::<Stream>().is_some() => bail!(
+            "route is fixed for a test, since the path is planned when the world is built: give \
+             a turn, a list of turns or an open VarEnum of turns, not a stream"
+        ),
         Some(v) => {
-            let list = UnpackList::<String>::unpack_value(v)
+            let wrong = || {
+                anyhow!(
+                    "route must be a turn or a list of turns such as [\"left\", \"straight\"], \
+                     got a {}",
+                    v.get_type()
+                )
+            };
+            let items = UnpackList::<Value>::unpack_value(v)
                 .ok()
                 .flatten()
-                .ok_or_else(|| {
-                    anyhow!(
-                        "route must be a list of turns such as [\"left\", \"straight\"], got a {}",
-                        v.get_type()
-                    )
-                })?;
-            turns(&list.items).map(Some).map_err(|e| anyhow!(e))
+                .ok_or_else(wrong)?;
+            let list = items
+                .items
+                .into_iter()
+                .map(|t| one(t).ok_or_else(wrong))
+                .collect::<anyhow::Result<Vec<String>>>()?;
+            turns(&list).map(Some).map_err(|e| anyhow!(e))
         }
     }
 }
@@ -309,6 +341,7 @@ fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<MonitorVal> {
     let mut b = st.scene.borrow_mut();
     unique_monitor_name(&b, spec.name())?;
     b.monitors.push(spec);
+    b.monitors_at.push(here(eval));
     Ok(MonitorVal {
         index: b.monitors.len() - 1,
     })
@@ -344,7 +377,7 @@ fn declare_param<'v>(
         Ok(Level::Text(t)) if t == "true" => Value::new_bool(true),
         Ok(Level::Text(t)) if t == "false" => Value::new_bool(false),
         Ok(Level::Text(t)) => heap.alloc(t.as_str()),
-        Err(id) => heap.alloc(Stream { id: id.0 }),
+        Err(id) => heap.alloc(Stream::of(id.0)),
     })
 }
 
@@ -354,6 +387,7 @@ fn declare_param<'v>(
 pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
     const tick: Stream = Stream {
         id: super::scene::TICK.0,
+        number: None,
     };
     const SideWalk: LaneSide = LaneSide { opposite: false };
 
@@ -365,9 +399,13 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
                 v.get_type()
             )
         })?;
+        let number = match c {
+            Rx::Num(x) => Some(x),
+            _ => None,
+        };
         let st = state(eval)?;
         let id = st.scene.borrow_mut().graph.push(Node::Const(c));
-        Ok(Stream { id: id.0 })
+        Ok(Stream { id: id.0, number })
     }
 
     /// `VarInterval(lo, hi, unit=None, name=None, over_time=None)`: an open real parameter:
@@ -526,7 +564,7 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             friction,
             |b, lanes, friction| {
                 let length_m = match len {
-                    Some(v) => load_time_number(v, b, "len")?,
+                    Some(v) => load_time_number(v, b, "RoadSegment(len=)")?,
                     None => 200.0,
                 };
                 Ok(PieceKind::Segment {
@@ -584,7 +622,7 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             friction,
             |b, lanes, friction| {
                 let radius_m = match radius {
-                    Some(v) => load_time_number(v, b, "radius")?,
+                    Some(v) => load_time_number(v, b, "Roundabout(radius=)")?,
                     None => 20.0,
                 };
                 Ok(PieceKind::Roundabout {
@@ -608,15 +646,15 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let loc = location(loc, "loc")?;
         let sut = SutConfig::builtin(sut.unwrap_or("aeb")).map_err(anyhow::Error::msg)?;
         let initial_speed_mps = match speed {
-            Some(v) => number(v, "speed")?,
+            Some(v) => number(v, "AutonomousVehicle(speed=), the initial speed,")?,
             None => AebConfig::default().cruise.target_speed_mps,
         };
         if !(initial_speed_mps.is_finite() && initial_speed_mps >= 0.0) {
             bail!("speed {initial_speed_mps} m/s must be >= 0");
         }
-        let route = route_arg(route)?;
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
+        let route = route_arg(route, &b)?;
         Ok(declare(
             eval,
             &mut b,
@@ -653,10 +691,10 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
                 )
             })?),
         };
-        let route = route_arg(route)?.unwrap_or_default();
         let heap = eval.heap();
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
+        let route = route_arg(route, &b)?.unwrap_or_default();
         let at = format!("declared at {}", here(eval));
         let speed = typed_arg(
             speed.unwrap_or_else(|| heap.alloc(10.0)),
@@ -963,6 +1001,7 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         if wrapped.name() != name {
             unique_monitor_name(&b, name)?;
         }
+        b.monitors_at[inner] = here(eval);
         b.monitors[inner] = MonitorSpec::TimeToFailure {
             name: name.to_owned(),
             inner: Box::new(wrapped),
@@ -982,6 +1021,7 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
     ) -> anyhow::Result<NoneType> {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
+        b.test_at = Some(here(eval));
         if let Some(h) = horizon {
             let h = number(h, "horizon")?;
             if !(h.is_finite() && h > 0.0 && h <= 3600.0) {

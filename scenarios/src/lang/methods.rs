@@ -34,7 +34,7 @@ fn lambda<'v>(f: Value<'v>, what: &str, eval: &mut Evaluator<'v, '_, '_>) -> any
 fn push(eval: &Evaluator<'_, '_, '_>, node: Node) -> anyhow::Result<Stream> {
     let st = state(eval)?;
     let id = st.scene.borrow_mut().graph.push(node);
-    Ok(Stream { id: id.0 })
+    Ok(Stream::of(id.0))
 }
 
 fn other<'v>(
@@ -206,9 +206,12 @@ fn lane_of(v: Value) -> anyhow::Result<Lane> {
             Lane::SideWalk
         });
     }
-    match v.unpack_i32() {
-        Some(k) => Ok(Lane::Driving(k)),
-        None => bail!(
+    // A whole number, also as a float (`nlanes / 2`) or `Const(2)`.
+    match number(v, "onLane(lane=)") {
+        Ok(x) if x.fract() == 0.0 && x.abs() <= f64::from(i32::MAX) => Ok(Lane::Driving(x as i32)),
+        Ok(x) => bail!("a lane is a whole number, got {x}"),
+        Err(e) if v.downcast_ref::<Stream>().is_some() => Err(e),
+        Err(_) => bail!(
             "a lane is a lane number or r.SideWalk / -r.SideWalk, got a {}",
             v.get_type()
         ),
@@ -254,11 +257,15 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
                     anyhow!("a junction's onLane takes one of its ports first (such as j.ONE), got {first}")
                 })?
                 .index;
-            let turn = second
-                .unpack_str()
+            let turn = super::globals::text_value(second, &b)
+                .as_deref()
                 .and_then(Turn::parse)
                 .ok_or_else(|| {
-                    anyhow!("a junction's onLane takes a turn second: \"straight\", \"left\" or \"right\", got {second}")
+                    if second.downcast_ref::<Stream>().is_some() {
+                        anyhow!("a junction's onLane takes one turn for the whole test (the start is placed when the world is built): \"straight\", \"left\", \"right\" or an open VarEnum of them, not a stream")
+                    } else {
+                        anyhow!("a junction's onLane takes a turn second: \"straight\", \"left\" or \"right\", got {second}")
+                    }
                 })?;
             let at =
                 at.ok_or_else(|| anyhow!("a junction's onLane needs how far along its path, at="))?;

@@ -190,17 +190,39 @@ impl Program {
             ));
         }
         if b.monitors != self.monitors {
-            return Err(
-                "the monitors depend on the open parameters' values: declare the same monitors \
-                 for every test"
-                    .into(),
-            );
+            // The first monitor that differs, or the first one missing or extra.
+            let k = (0..b.monitors.len().max(self.monitors.len()))
+                .find(|&k| b.monitors.get(k) != self.monitors.get(k))
+                .unwrap_or(0);
+            let at = b
+                .monitors_at
+                .get(k)
+                .map(|a| format!("\n --> {a}"))
+                .unwrap_or_else(|| format!("\n --> {}", self.file));
+            return Err(format!(
+                "the monitors depend on the open parameters' values: declare the same monitors, \
+                 with the same settings, for every test (a verdict must mean the same in every \
+                 test of a campaign){at}"
+            ));
         }
         if b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S) != self.horizon_s {
-            return Err("test(horizon=) depends on the open parameters' values".into());
+            return Err(format!(
+                "test(horizon=) depends on the open parameters' values: every test of a \
+                 campaign has one length\n --> {}",
+                b.test_at.as_deref().unwrap_or(&self.file)
+            ));
         }
         if b.ego.as_ref().map(|e| &e.sut) != Some(&self.sut) {
-            return Err("AutonomousVehicle(sut=) depends on the open parameters' values".into());
+            let at = b
+                .objects
+                .iter()
+                .find(|o| matches!(o.pending, super::scene::Pending::Ego { .. }))
+                .and_then(|o| o.name.rsplit("declared at ").next().map(str::to_owned))
+                .unwrap_or_else(|| self.file.clone());
+            return Err(format!(
+                "AutonomousVehicle(sut=) depends on the open parameters' values: one system is \
+                 under test in a campaign\n --> {at}"
+            ));
         }
         Ok(())
     }

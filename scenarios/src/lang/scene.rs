@@ -245,6 +245,11 @@ pub struct SceneBuilder {
     pub placed: bool,
     /// Monitors.
     pub monitors: Vec<MonitorSpec>,
+    /// Where each monitor was declared (or last wrapped), `file:line:col`, in the order of
+    /// [`SceneBuilder::monitors`].
+    pub monitors_at: Vec<String>,
+    /// Where `test(...)` was called, `file:line:col`.
+    pub test_at: Option<String>,
     /// `test(horizon=)`, seconds.
     pub horizon_s: Option<f64>,
     /// `test(map=)`: one or two parameter names.
@@ -319,6 +324,8 @@ impl SceneBuilder {
             map_axes: None,
             offroad: None,
             placed_at: None,
+            monitors_at: Vec::new(),
+            test_at: None,
             warnings: Vec::new(),
             car_names: Vec::new(),
             lambdas: 0,

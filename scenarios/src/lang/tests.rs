@@ -51,7 +51,7 @@ fn an_unknown_keyword_is_refused() {
 fn a_wrong_argument_type_names_the_parameter() {
     assert_diag(
         "r = RoadSegment(len = \"long\")\n",
-        "len must be a number, got a string",
+        "RoadSegment(len=) must be a number, got a string",
         "1:5",
     );
 }

@@ -19,6 +19,15 @@ use super::scene::OverTime;
 pub struct Stream {
     /// Node index in the graph.
     pub id: usize,
+    /// The number of a `Const(number)`, which inputs fixed for a test read as that number.
+    pub number: Option<f64>,
+}
+
+impl Stream {
+    /// The stream of graph node `id`, not known to be a constant number.
+    pub fn of(id: usize) -> Self {
+        Self { id, number: None }
+    }
 }
 
 impl fmt::Display for Stream {
@@ -207,9 +216,7 @@ impl<'v> StarlarkValue<'v> for ActorVal {
             }
         }
         let i = OUTPUT_NAMES.iter().position(|n| *n == attribute)?;
-        Some(heap.alloc(Stream {
-            id: self.outputs[i],
-        }))
+        Some(heap.alloc(Stream::of(self.outputs[i])))
     }
 
     fn dir_attr(&self) -> Vec<String> {
@@ -266,8 +273,8 @@ impl<'v> StarlarkValue<'v> for WorldVal {
 
     fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
         match attribute {
-            "light" => Some(heap.alloc(Stream { id: self.light })),
-            "fog" => Some(heap.alloc(Stream { id: self.fog })),
+            "light" => Some(heap.alloc(Stream::of(self.light))),
+            "fog" => Some(heap.alloc(Stream::of(self.fog))),
             _ => None,
         }
     }
