@@ -241,7 +241,12 @@ fn the_set_of_open_parameters_may_not_depend_on_their_values() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("`extra`"), "{e}");
-    assert!(e.contains("may not depend on their values"), "{e}");
+    assert!(
+        e.contains("the open parameters depend on their values"),
+        "{e}"
+    );
+    assert!(e.contains("exists only for some values"), "{e}");
+    assert!(e.contains("params_depend_on_values.star:8:13"), "{e}");
     assert!(e.contains("lanes = 4"), "{e}");
 }
 
@@ -878,4 +883,55 @@ fn empty_assignment(s: &Scenario) -> Assignment {
             continuous: vec![],
         })
         .unwrap()
+}
+
+#[test]
+fn a_lambda_reads_the_tests_value_of_an_open_parameter() {
+    // A car's speed computed by a lambda that reads `cruise` gives the same test as the
+    // speed `cruise` itself, for every value; and different values give different tests.
+    let src = |speed: &str| {
+        format!(
+            r#"
+cruise = VarInterval(2.0, 10.0, unit = "m/s")
+w = World()
+r = RoadSegment(len = 300.0, nlanes = 2)
+v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 12.0)
+c = Car(loc = r.onLane(1, 60), speed = {speed})
+w.place(r, v, c)
+CollisionMonitor(v)
+test(horizon = 6.0)
+"#
+        )
+    };
+    let direct = paracosm_scenarios::lang::load_source("d.star", &src("cruise"), "d").unwrap();
+    let lambda =
+        paracosm_scenarios::lang::load_source("l.star", &src("tick.map(lambda t: cruise)"), "l")
+            .unwrap();
+    let mut seen = Vec::new();
+    for x in [2.5, 6.0, 9.5] {
+        let a = assign(&direct.space, &[("cruise", Value::Real(x))]);
+        let (d, l) = (direct.run(&a, 0).unwrap(), lambda.run(&a, 0).unwrap());
+        assert_eq!(format!("{d:?}"), format!("{l:?}"), "cruise = {x}");
+        let (_, collision) = d.monitors.iter().find(|(n, _)| n == "collision").unwrap();
+        seen.push(collision.robustness);
+    }
+    assert!(
+        seen.windows(2).all(|w| w[0] != w[1]),
+        "the value changes nothing: {seen:?}"
+    );
+}
+
+#[test]
+fn the_reference_example_places_a_truck_only_on_six_lanes() {
+    let s = load("tests/scenarios", "truck_on_six_lanes.star");
+    for (n, trucks) in [(2, 0), (4, 0), (6, 1)] {
+        let a = assign(
+            &s.space,
+            &[("nlanes", Value::Int(n)), ("gap", Value::Real(30.0))],
+        );
+        let world = s.instantiate(&a).unwrap();
+        assert_eq!(world.obstacles.len(), trucks, "{n} lanes");
+        assert_eq!(world.cars.len(), 1);
+        s.run(&a, 0).unwrap();
+    }
 }

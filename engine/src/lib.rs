@@ -20,7 +20,6 @@ pub mod colour;
 mod control;
 mod environment;
 mod error;
-mod lidar;
 pub mod network;
 mod obstacle;
 mod pedestrian;
@@ -41,10 +40,10 @@ pub use car::{CarState, LaneChangeSpec, LaneChangeStart};
 pub use control::Control;
 pub use environment::{visibility_m, FOG_EXTINCTION_PER_M, NOMINAL_LIGHT};
 pub use error::EngineError;
-pub use lidar::{LidarReturn, LidarSpec};
 pub use network::{Lane, Location, Network, PieceId, PieceKind};
 pub use obstacle::ObstacleState;
 pub use pedestrian::{PedestrianPhase, PedestrianState};
+pub use sensor::lidar::{LidarReturn, LidarSpec};
 pub use sim::{EgoState, Observation, Simulation, Snapshot};
 pub use spec::{
     CarSpec, EgoSpec, EnvironmentSpec, ObstacleSpec, PedestrianSpec, TriggeredPedestrian,

@@ -246,8 +246,7 @@ impl Simulation {
         let (collision_tx, events) = channel();
         let (force_tx, _) = channel();
         let (tear_tx, _) = channel();
-        let mut sensors = Sensors::default();
-        sensors.insert(Box::new(crate::lidar::Lidar::new(&spec.lidar, spec.dt_s)));
+        let sensors = crate::sensor::mounted(spec);
         let mut sim = Simulation {
             physics,
             network: spec.network.clone(),
@@ -345,8 +344,7 @@ impl Simulation {
                 .map_err(|e| EngineError::Sensor(e.to_string()))?;
             let rig =
                 crate::render::CameraRig::new(renderer, &self.network, camera, seed, self.dt_s)?;
-            let h = self.sensors.insert(Box::new(rig));
-            self.capture_all(|handle| handle == h)
+            self.mount(Box::new(rig))
         }
         #[cfg(not(feature = "render"))]
         {
@@ -357,6 +355,17 @@ impl Simulation {
                     .into(),
             ))
         }
+    }
+
+    /// Mounts `sensor` on the ego vehicle beside those [`crate::sensor::mounted`] registers;
+    /// it takes its first reading now, then one every [`Sensor::period_ticks`] steps, and its
+    /// readings appear in [`Simulation::observation`] under its name.
+    ///
+    /// # Errors
+    /// [`EngineError::Sensor`] when its first capture fails.
+    pub fn mount(&mut self, sensor: Box<dyn Sensor>) -> Result<(), EngineError> {
+        let h = self.sensors.insert(sensor);
+        self.capture_all(|handle| handle == h)
     }
 
     /// The latest frame of the attached camera, if any.

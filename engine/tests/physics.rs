@@ -230,3 +230,67 @@ fn aeb_follows_a_route_around_a_loop_of_t_intersections() {
     // One lap is about 4 · (80 + 11) m = 364 m.
     assert!(travelled > 400.0, "travelled {travelled} m");
 }
+
+/// A sensor written outside the engine: the ego's speed, every 6 steps, as one named array.
+struct Speedometer {
+    arrays: Vec<paracosm_engine::sensor::Payload>,
+    captures: usize,
+}
+
+impl paracosm_engine::sensor::Sensor for Speedometer {
+    fn name(&self) -> &'static str {
+        "speedometer"
+    }
+    fn period_ticks(&self) -> u64 {
+        6
+    }
+    fn capture(
+        &mut self,
+        scene: &paracosm_engine::sensor::Scene<'_>,
+    ) -> Result<(), paracosm_engine::EngineError> {
+        self.captures += 1;
+        self.arrays = vec![paracosm_engine::sensor::Payload {
+            name: "speed",
+            dtype: "float32",
+            shape: vec![1],
+            bytes: (scene.ego.speed_mps as f32).to_le_bytes().to_vec(),
+            t_s: Some(scene.t_s),
+        }];
+        Ok(())
+    }
+    fn reading(&self) -> Option<paracosm_engine::sensor::Reading<'_>> {
+        Some(paracosm_engine::sensor::Reading::Arrays(&self.arrays))
+    }
+}
+
+#[test]
+fn a_sensor_written_outside_the_engine_mounts_and_its_readings_reach_the_observation() {
+    use paracosm_engine::sensor::Reading;
+    let spec = world(vec![], 12.0);
+    let mut sim = Simulation::new(&spec).unwrap();
+    sim.mount(Box::new(Speedometer {
+        arrays: Vec::new(),
+        captures: 0,
+    }))
+    .unwrap();
+    let coast = Control {
+        throttle: 0.0,
+        steering: 0.0,
+    };
+    for _ in 0..13 {
+        sim.step(coast, &mut NoHost).unwrap();
+    }
+    let obs = sim.observation();
+    let names: Vec<&str> = obs.readings.iter().map(|(n, _)| *n).collect();
+    assert_eq!(names, ["lidar", "speedometer"]);
+    let (_, reading) = obs.readings[1];
+    let Reading::Arrays(arrays) = reading else {
+        panic!("{reading:?}")
+    };
+    // Mounted at t = 0, then captured at steps 6 and 12: the last reading is from t = 0.2 s.
+    assert_eq!(arrays[0].t_s, Some(12.0 / 60.0));
+    let speed = f32::from_le_bytes(arrays[0].bytes[..4].try_into().unwrap());
+    assert!((11.0..12.5).contains(&speed), "{speed}");
+    // What SUT_PROTOCOL.md would send for it: its arrays as they are.
+    assert_eq!(reading.payloads(false), arrays.to_vec());
+}

@@ -136,16 +136,48 @@ impl Program {
                 for l in limits {
                     l.map_err(|e| e.to_string())?;
                 }
-                eval.eval_module(self.ast.clone(), &self.globals)
-                    .map_err(|e| {
-                        let message = super::suggest_keyword(&format!("{e}"));
-                        // Limit errors (steps, heap) carry no span: say which program hit them.
-                        if message.contains(&self.file) {
-                            message
-                        } else {
-                            format!("{message}\n --> {}", self.file)
-                        }
-                    })?;
+                let result = eval.eval_module(self.ast.clone(), &self.globals);
+                if result.is_err() && state.scene.borrow().values.is_some() {
+                    // A parameter that only these values declare explains the failure first.
+                    self.same_params_so_far(&state.scene.borrow())?;
+                }
+                result.map_err(|e| {
+                    let message = super::suggest_keyword(&format!("{e}"));
+                    // Limit errors (steps, heap) carry no span: say which program hit them.
+                    let message = if message.contains(&self.file) {
+                        message
+                    } else {
+                        format!("{message}\n --> {}", self.file)
+                    };
+                    // The first evaluation: say which values it ran with.
+                    let b = state.scene.borrow();
+                    if b.values.is_none() && !b.params.is_empty() {
+                        let values: Vec<String> = b
+                            .params
+                            .iter()
+                            .enumerate()
+                            .map(|(k, d)| {
+                                let name = d
+                                    .name
+                                    .clone()
+                                    .or_else(|| {
+                                        self.syntax.site(&d.at).and_then(|s| s.name.clone())
+                                    })
+                                    .unwrap_or_else(|| format!("param{k}"));
+                                match &d.domain {
+                                    Domain::Interval { lo, .. } => format!("{name} = {lo}"),
+                                    Domain::Levels(l) => format!("{name} = {}", l[0]),
+                                }
+                            })
+                            .collect();
+                        format!(
+                            "{message}\n(evaluated with the first values: {})",
+                            values.join(", ")
+                        )
+                    } else {
+                        message
+                    }
+                })?;
                 steps = eval.get_total_tick_count();
             }
             let b = state.scene.into_inner();
@@ -154,26 +186,21 @@ impl Program {
         })
     }
 
-    /// Checks that an evaluation declared what the first one did: the same open parameters,
-    /// monitors, horizon and system under test.
-    fn consistent(&self, b: &SceneBuilder) -> Result<(), String> {
-        for (k, (name, decl)) in self.params.iter().enumerate() {
-            match b.params.get(k) {
-                Some(d) if d == decl => {}
-                Some(d) => {
+    /// Checks that the parameters an evaluation declared so far are the first ones the first
+    /// evaluation declared, and no more.
+    fn same_params_so_far(&self, b: &SceneBuilder) -> Result<(), String> {
+        for (k, d) in b.params.iter().enumerate() {
+            match self.params.get(k) {
+                Some((_, decl)) if d == decl => {}
+                Some((name, decl)) => {
                     return Err(format!(
-                        "the open parameters depend on their values: parameter {k} is `{name}` \
-                         (declared at {}) for some values and the one declared at {} for others",
-                        decl.at, d.at
-                    ))
+                    "error: the open parameters depend on their values: parameter {k} is `{name}` \
+                         (declared at {}) for some values and the one declared at {} for \
+                         others\n --> {}",
+                    decl.at, d.at, d.at
+                ))
                 }
-                None => {
-                    return Err(format!(
-                        "the open parameters depend on their values: `{name}` (declared at {}) \
-                         is not declared for these values",
-                        decl.at
-                    ))
-                }
+                None => break,
             }
         }
         if let Some(extra) = b.params.get(self.params.len()) {
@@ -184,9 +211,23 @@ impl Program {
                 .map(|n| format!("`{n}` "))
                 .unwrap_or_default();
             return Err(format!(
-                "the open parameters depend on their values: {name}(declared at {}) exists only \
-                 for some values",
-                extra.at
+                "error: the open parameters depend on their values: {name}(declared at {}) exists only \
+                 for some values\n --> {}",
+                extra.at, extra.at
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks that an evaluation declared what the first one did: the same open parameters,
+    /// monitors, horizon and system under test.
+    fn consistent(&self, b: &SceneBuilder) -> Result<(), String> {
+        self.same_params_so_far(b)?;
+        if let Some((name, decl)) = self.params.get(b.params.len()) {
+            return Err(format!(
+                "error: the open parameters depend on their values: `{name}` (declared at {}) is not \
+                 declared for these values\n --> {}",
+                decl.at, decl.at
             ));
         }
         if b.monitors != self.monitors {
@@ -200,14 +241,14 @@ impl Program {
                 .map(|a| format!("\n --> {a}"))
                 .unwrap_or_else(|| format!("\n --> {}", self.file));
             return Err(format!(
-                "the monitors depend on the open parameters' values: declare the same monitors, \
+                "error: the monitors depend on the open parameters' values: declare the same monitors, \
                  with the same settings, for every test (a verdict must mean the same in every \
                  test of a campaign){at}"
             ));
         }
         if b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S) != self.horizon_s {
             return Err(format!(
-                "test(horizon=) depends on the open parameters' values: every test of a \
+                "error: test(horizon=) depends on the open parameters' values: every test of a \
                  campaign has one length\n --> {}",
                 b.test_at.as_deref().unwrap_or(&self.file)
             ));
@@ -220,7 +261,7 @@ impl Program {
                 .and_then(|o| o.name.rsplit("declared at ").next().map(str::to_owned))
                 .unwrap_or_else(|| self.file.clone());
             return Err(format!(
-                "AutonomousVehicle(sut=) depends on the open parameters' values: one system is \
+                "error: AutonomousVehicle(sut=) depends on the open parameters' values: one system is \
                  under test in a campaign\n --> {at}"
             ));
         }

@@ -346,18 +346,11 @@ impl SceneBuilder {
         let k = self.params.len();
         let value = match &self.values {
             None => representative(&decl, self.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S)),
-            Some(values) => values.get(k).cloned().ok_or_else(|| {
-                let name = decl
-                    .name
-                    .as_ref()
-                    .map(|n| format!("`{n}`, "))
-                    .unwrap_or_default();
-                format!(
-                    "the open parameter {name}declared at {}, exists only for some values of the \
-                     others: the set of open parameters may not depend on their values",
-                    decl.at
-                )
-            })?,
+            // A parameter only these values declare: its representative value, so that the
+            // run goes on and the program reports it, naming it.
+            Some(values) => values.get(k).cloned().unwrap_or_else(|| {
+                representative(&decl, self.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S))
+            }),
         };
         self.params.push(decl);
         Ok(match value {

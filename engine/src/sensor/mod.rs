@@ -4,9 +4,11 @@
 //! [`crate::Observation`], and an external one receives each as named arrays
 //! (SUT_PROTOCOL.md).
 //!
-//! A new sensor is its own file implementing [`Sensor`], a [`Reading`] variant with its
-//! payloads (this file), its registration in [`crate::Simulation`], and a paragraph in
-//! SUT_PROTOCOL.md.
+//! A new sensor is its own file in this folder implementing [`Sensor`] (its reading is
+//! [`Reading::Arrays`], the named arrays SUT_PROTOCOL.md sends), a `mod` line and its
+//! registration in [`mounted`] (this file), and a paragraph in SUT_PROTOCOL.md: three files.
+
+pub(crate) mod lidar;
 
 use rapier3d::prelude::*;
 
@@ -38,6 +40,9 @@ pub enum Reading<'a> {
     Lidar(&'a [LidarReturn]),
     /// A camera frame: RGB and depth.
     Camera(&'a CameraFrame),
+    /// Named arrays: the reading of a sensor with no variant of its own, as the protocol
+    /// sends it; systems in process read them by name.
+    Arrays(&'a [Payload]),
 }
 
 /// One named array of a reading, as SUT_PROTOCOL.md sends it.
@@ -92,6 +97,7 @@ impl Reading<'_> {
                     .collect(),
                 t_s: None,
             }],
+            Reading::Arrays(arrays) => arrays.to_vec(),
         }
     }
 }
@@ -118,3 +124,12 @@ pub trait Sensor: Send {
 
 /// The sensors of one simulation.
 pub type Sensors = Set<Box<dyn Sensor>>;
+
+/// The sensors every simulation of `spec` mounts: the lidar. (A camera is mounted when a
+/// system under test asks for one, [`crate::Simulation::attach_camera`].) A new sensor is
+/// registered here.
+pub fn mounted(spec: &crate::WorldSpec) -> Sensors {
+    let mut sensors = Sensors::default();
+    sensors.insert(Box::new(lidar::Lidar::new(&spec.lidar, spec.dt_s)));
+    sensors
+}
