@@ -453,3 +453,93 @@ fn an_npc_cars_collider_and_its_drawing_agree() {
         "roof at row {row}, the collider's at {expected_row:.1}"
     );
 }
+
+/// Issue 15: an `Obstacle` is drawn by the camera. A yellow box 3 m wide and 1 m high stands in
+/// the ego's lane 30 m ahead; the camera sees a yellow face at the box's distance, as wide as
+/// the box projected through the intrinsics; without the box, nothing stands at that depth.
+#[test]
+fn an_obstacle_is_drawn_by_the_camera_at_its_place_and_size() {
+    use paracosm_engine::behaviour::GraphBuilder;
+    use paracosm_engine::rx::{Node, Value};
+    use paracosm_engine::{
+        EgoSpec, EnvironmentSpec, Lane, LidarSpec, ObstacleSpec, PieceId, Simulation,
+        VehicleParams, WorldSpec, DEFAULT_DT_S,
+    };
+    let network = road();
+    let start = network.on_lane(PieceId(0), Lane::Driving(1), 10.0).unwrap();
+    let at = network.on_lane(PieceId(0), Lane::Driving(1), 40.0).unwrap();
+    let size = Size {
+        length_m: 0.5,
+        width_m: 3.0,
+        height_m: 1.0,
+    };
+    let camera = CameraSpec {
+        width: 640,
+        height: 480,
+        pitch_rad: 0.0,
+        ..CameraSpec::default()
+    };
+    let frame_with = |obstacles: Vec<ObstacleSpec>| {
+        let mut g = GraphBuilder::new();
+        let light = g.push(Node::Const(Value::Num(NOMINAL_LIGHT)));
+        let fog = g.push(Node::Const(Value::Num(0.0)));
+        let spec = WorldSpec {
+            dt_s: DEFAULT_DT_S,
+            frictions: vec![],
+            ego: EgoSpec {
+                start: start.clone(),
+                initial_speed_mps: 0.0,
+                vehicle: VehicleParams::default(),
+                route: vec![],
+            },
+            pedestrians: vec![],
+            cars: vec![],
+            obstacles,
+            environment: EnvironmentSpec { light, fog },
+            streams: g.finish().unwrap(),
+            lidar: LidarSpec::default(),
+            network: network.clone(),
+        };
+        let mut sim = Simulation::new(&spec).unwrap();
+        sim.attach_camera(&camera, 0).unwrap();
+        let ego_x = sim.ego_state().pos_m[0];
+        (sim.camera_frame().unwrap().clone(), ego_x)
+    };
+    let (frame, ego_x) = frame_with(vec![ObstacleSpec {
+        base_m: at.pos_m,
+        heading_rad: at.heading_rad,
+        size,
+        color: "yellow".into(),
+    }]);
+    let (empty, _) = frame_with(vec![]);
+
+    let depth = at.pos_m[0] - size.length_m / 2.0 - (ego_x + camera.mount_m[0]);
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let at_box = |f: &CameraFrame, u: usize, v: usize| {
+        (f64::from(f.depth_m[v * w + u]) - depth).abs() < 0.05
+    };
+    let rows: Vec<usize> = (0..h)
+        .filter(|&v| (0..w).any(|u| at_box(&frame, u, v)))
+        .collect();
+    assert!(!rows.is_empty(), "the obstacle is in the image");
+    let middle = (rows[0] + rows[rows.len() - 1]) / 2;
+    let columns: Vec<usize> = (0..w).filter(|&u| at_box(&frame, u, middle)).collect();
+    let fx = camera.focal_mm * f64::from(camera.width) / 36.0;
+    let expected = fx * size.width_m / depth;
+    assert!(
+        (columns.len() as f64 - expected).abs() <= 2.0,
+        "face {} px wide, the box {expected:.1} px",
+        columns.len()
+    );
+    // Yellow: red and green well above blue.
+    let u = columns[columns.len() / 2];
+    let px = &frame.rgb[(middle * w + u) * 3..(middle * w + u) * 3 + 3];
+    assert!(
+        px[0] > px[2].saturating_add(40) && px[1] > px[2].saturating_add(40),
+        "pixel {px:?} is not yellow"
+    );
+    assert!(
+        !(0..w).any(|u| at_box(&empty, u, middle)),
+        "without the obstacle nothing stands at its distance"
+    );
+}
