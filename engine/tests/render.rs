@@ -487,7 +487,7 @@ fn an_obstacle_is_drawn_by_the_camera_at_its_place_and_size() {
             dt_s: DEFAULT_DT_S,
             frictions: vec![],
             ego: EgoSpec {
-                start: start.clone(),
+                start,
                 initial_speed_mps: 0.0,
                 vehicle: VehicleParams::default(),
                 route: vec![],
