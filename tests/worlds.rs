@@ -935,3 +935,42 @@ fn the_reference_example_places_a_truck_only_on_six_lanes() {
         s.run(&a, 0).unwrap();
     }
 }
+
+/// A campaign has one length and one system under test: a `test(horizon=)` or an
+/// `AutonomousVehicle(sut=)` computed from an open parameter is refused at load, naming the
+/// line that declares it; the same program with them fixed loads.
+#[test]
+fn a_horizon_or_a_system_under_test_that_depends_on_values_is_refused_naming_its_line() {
+    let base = r#"
+n = VarEnum([2, 4])
+w = World()
+r = RoadSegment(len = 200.0, nlanes = n)
+v = AutonomousVehicle(loc = r.onLane(1, 10), sut = SUT)
+w.place(r, v)
+CollisionMonitor(v)
+test(horizon = HORIZON)
+"#;
+    let with = |sut: &str, horizon: &str| base.replace("SUT", sut).replace("HORIZON", horizon);
+    let e = paracosm_scenarios::lang::load_source("t.star", &with("\"aeb\"", "5.0 * n"), "t")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("test(horizon=) depends on the open parameters' values"),
+        "{e}"
+    );
+    assert!(e.contains("t.star:8:1"), "{e}");
+    let e = paracosm_scenarios::lang::load_source(
+        "t.star",
+        &with("\"aeb\" if n == 2 else \"vision\"", "10.0"),
+        "t",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("AutonomousVehicle(sut=) depends on the open parameters' values"),
+        "{e}"
+    );
+    assert!(e.contains("t.star:5:5"), "{e}");
+    let s = paracosm_scenarios::lang::load_source("t.star", &with("\"aeb\"", "10.0"), "t").unwrap();
+    assert_eq!(s.horizon_s, 10.0);
+}
