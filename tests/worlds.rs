@@ -7,7 +7,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{expect_code, fuzz};
+use common::{assign, expect_code, fuzz};
 use paracosm_engine::rx::NoHost;
 use paracosm_engine::sut::{ConstantControl, Sut};
 use paracosm_engine::{Control, Simulation};
@@ -21,29 +21,6 @@ fn path(dir: &str, name: &str) -> PathBuf {
 
 fn load(dir: &str, name: &str) -> Scenario {
     paracosm_scenarios::load(path(dir, name).to_str().unwrap()).unwrap()
-}
-
-/// The assignment with the given values by name (levels by value, intervals by value), the
-/// others at their lowest.
-fn assign(space: &ParamSpace, values: &[(&str, Value)]) -> Assignment {
-    let mut point = Point {
-        discrete: Vec::new(),
-        continuous: Vec::new(),
-    };
-    for p in space.params() {
-        let given = values.iter().find(|(n, _)| *n == p.name).map(|(_, v)| v);
-        match &p.domain {
-            paracosm_generators::Domain::Interval { lo, hi } => {
-                let x = given.and_then(Value::as_f64).unwrap_or(*lo);
-                point.continuous.push((x - lo) / (hi - lo));
-            }
-            paracosm_generators::Domain::Levels(levels) => {
-                let i = given.map_or(0, |v| levels.iter().position(|l| l == v).unwrap());
-                point.discrete.push(i as u32);
-            }
-        }
-    }
-    space.decode(&point).unwrap()
 }
 
 fn stderr(o: &std::process::Output) -> String {

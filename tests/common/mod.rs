@@ -3,6 +3,8 @@
 
 use std::process::{Command, Output};
 
+use paracosm_generators::{Assignment, Domain, ParamSpace, Point, Value};
+
 /// Runs `paracosm-fuzz` with `args` (with a runtime folder for Mesa, which wants one).
 pub fn fuzz(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
@@ -21,4 +23,27 @@ pub fn expect_code(o: &Output, code: i32) {
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
     );
+}
+
+/// The assignment with the given values by name (levels by value, intervals by value), the
+/// others at their lowest.
+pub fn assign(space: &ParamSpace, values: &[(&str, Value)]) -> Assignment {
+    let mut point = Point {
+        discrete: Vec::new(),
+        continuous: Vec::new(),
+    };
+    for p in space.params() {
+        let given = values.iter().find(|(n, _)| *n == p.name).map(|(_, v)| v);
+        match &p.domain {
+            Domain::Interval { lo, hi } => {
+                let x = given.and_then(Value::as_f64).unwrap_or(*lo);
+                point.continuous.push((x - lo) / (hi - lo));
+            }
+            Domain::Levels(levels) => {
+                let i = given.map_or(0, |v| levels.iter().position(|l| l == v).unwrap());
+                point.discrete.push(i as u32);
+            }
+        }
+    }
+    space.decode(&point).unwrap()
 }

@@ -10,11 +10,12 @@ pub trait Inputs {
 
 /// Calls host functions (Starlark lambdas) for [`Func::Host`].
 pub trait Host {
-    /// Calls host function `f` with `args`.
+    /// Calls host function `f` with `args`. `streams` gives the latest value of every stream
+    /// of the graph (see [`Runtime::current`]), for functions that read streams they captured.
     ///
     /// # Errors
     /// The function's own failure, as a message.
-    fn call(&mut self, f: u32, args: &[Value]) -> Result<Value, String>;
+    fn call(&mut self, f: u32, args: &[Value], streams: &Runtime) -> Result<Value, String>;
 }
 
 /// A [`Host`] without functions: every call is an error. For graphs built in Rust.
@@ -22,7 +23,7 @@ pub trait Host {
 pub struct NoHost;
 
 impl Host for NoHost {
-    fn call(&mut self, f: u32, _args: &[Value]) -> Result<Value, String> {
+    fn call(&mut self, f: u32, _args: &[Value], _streams: &Runtime) -> Result<Value, String> {
         Err(format!("no host function {f} in this world"))
     }
 }
@@ -136,7 +137,7 @@ impl Runtime {
                 let f = f.clone();
                 let src = *src;
                 let out = match self.event(src).cloned() {
-                    Some(v) => Some(call(i, &f, &[v], host)?),
+                    Some(v) => Some(call(i, &f, &[v], host, self)?),
                     None => None,
                 };
                 self.states[i].done = done(self, src);
@@ -146,7 +147,7 @@ impl Runtime {
                 let (pred, src) = (pred.clone(), *src);
                 let out = match self.event(src).cloned() {
                     Some(v) => {
-                        let keep = call(i, &pred, std::slice::from_ref(&v), host)?;
+                        let keep = call(i, &pred, std::slice::from_ref(&v), host, self)?;
                         match keep.as_bool() {
                             Some(true) => Some(v),
                             Some(false) => None,
@@ -239,7 +240,7 @@ impl Runtime {
                     Some(v) => {
                         let acc = self.states[i].value.clone().unwrap_or(init);
                         Some(match &f {
-                            Some(f) => call(i, f, &[acc, v], host)?,
+                            Some(f) => call(i, f, &[acc, v], host, self)?,
                             None => acc.add(&v).ok_or_else(|| {
                                 type_error(i, "sum", "numbers or vectors of one kind", &v)
                             })?,
@@ -279,11 +280,17 @@ impl Runtime {
     }
 }
 
-fn call(node: usize, f: &Func, args: &[Value], host: &mut dyn Host) -> Result<Value, RxError> {
+fn call(
+    node: usize,
+    f: &Func,
+    args: &[Value],
+    host: &mut dyn Host,
+    streams: &Runtime,
+) -> Result<Value, RxError> {
     match f {
         Func::Native(_, f) => f(args).map_err(|message| RxError::Type { node, message }),
         Func::Host(n) => host
-            .call(*n, args)
+            .call(*n, args, streams)
             .map_err(|message| RxError::Host { node, message }),
     }
 }

@@ -169,6 +169,27 @@ fn load_time_number(v: Value, b: &SceneBuilder, what: &str) -> anyhow::Result<f6
     number(v, what)
 }
 
+/// A hint for a stream passed where a value is needed, empty for anything else.
+pub(crate) fn stream_hint(v: Value) -> &'static str {
+    if v.downcast_ref::<Stream>().is_some() {
+        " (a stream has a value only while a test runs: apply the function inside a lambda, \
+         e.g. s.map(lambda x: sqrt(x)))"
+    } else {
+        ""
+    }
+}
+
+/// A number argument of a math builtin.
+fn math_number(v: Value, what: &str) -> anyhow::Result<f64> {
+    super::position::num(v).ok_or_else(|| {
+        anyhow!(
+            "{what} takes numbers, got a {}{}",
+            v.get_type(),
+            stream_hint(v)
+        )
+    })
+}
+
 fn lanes(v: Option<Value>, b: &SceneBuilder, default: u32) -> anyhow::Result<u32> {
     let Some(v) = v else { return Ok(default) };
     let x = load_time_number(v, b, "nlanes=")?;
@@ -493,6 +514,73 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
                 at,
             },
         )
+    }
+
+    /// `abs(x)`: the absolute value of a number, or the length of a `Vector` (a difference of
+    /// positions: m). Replaces Starlark's `abs`, which takes numbers only.
+    ///
+    /// # Errors
+    /// A location (subtract another position first), a stream or any other value.
+    fn abs<'v>(
+        #[starlark(require = pos)] x: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Value<'v>> {
+        super::position::abs_of(x, eval.heap())
+    }
+
+    /// `dist(a, b)`: the distance between two positions (locations or vectors), m; in the
+    /// ground plane (`x`, `z`) when either is a location.
+    ///
+    /// # Errors
+    /// An argument that is not a position.
+    fn dist<'v>(
+        #[starlark(require = pos)] a: Value<'v>,
+        #[starlark(require = pos)] b: Value<'v>,
+    ) -> anyhow::Result<f64> {
+        super::position::dist_of(a, b)
+    }
+
+    /// `sqrt(x)`: the square root of a number `>= 0`.
+    ///
+    /// # Errors
+    /// A negative number or a value that is not a number.
+    fn sqrt<'v>(#[starlark(require = pos)] x: Value<'v>) -> anyhow::Result<f64> {
+        let v = math_number(x, "sqrt")?;
+        if v < 0.0 {
+            bail!("sqrt of a negative number, {v}");
+        }
+        Ok(v.sqrt())
+    }
+
+    /// `hypot(x, y)`: `sqrt(x² + y²)` without overflow.
+    ///
+    /// # Errors
+    /// An argument that is not a number.
+    fn hypot<'v>(
+        #[starlark(require = pos)] x: Value<'v>,
+        #[starlark(require = pos)] y: Value<'v>,
+    ) -> anyhow::Result<f64> {
+        Ok(math_number(x, "hypot")?.hypot(math_number(y, "hypot")?))
+    }
+
+    /// `clamp(x, lo, hi)`: `x` limited to `[lo, hi]`.
+    ///
+    /// # Errors
+    /// An argument that is not a number, or `lo > hi`.
+    fn clamp<'v>(
+        #[starlark(require = pos)] x: Value<'v>,
+        #[starlark(require = pos)] lo: Value<'v>,
+        #[starlark(require = pos)] hi: Value<'v>,
+    ) -> anyhow::Result<f64> {
+        let (x, lo, hi) = (
+            math_number(x, "clamp")?,
+            math_number(lo, "clamp")?,
+            math_number(hi, "clamp")?,
+        );
+        if lo > hi || lo.is_nan() || hi.is_nan() {
+            bail!("clamp(x, lo, hi) needs lo <= hi, got lo = {lo}, hi = {hi}");
+        }
+        Ok(x.clamp(lo, hi))
     }
 
     /// `Piecewise(k)`: an open stream held constant on `k` equal parts of the test.

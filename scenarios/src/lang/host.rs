@@ -1,22 +1,46 @@
 //! Calling a program's lambdas from the stream graph during a test, with the evaluator of the
 //! test's own evaluation of the program.
 
-use paracosm_engine::rx::{Host, Value as Rx};
+use paracosm_engine::rx::{Host, Runtime, StreamId, Value as Rx};
+
+use super::values::Stream;
 use starlark::eval::Evaluator;
 use starlark::values::float::StarlarkFloat;
 use starlark::values::tuple::{AllocTuple, TupleRef};
 use starlark::values::{Heap, Value, ValueLike};
 
 /// The lambdas of one evaluation of a program, called through its evaluator.
+///
+/// Lambdas see current values: before each call, every module-level variable that holds a
+/// stream is set to that stream's latest value ([`paracosm_engine::rx::Runtime::current`]:
+/// this step's event when the stream comes earlier in the graph's order, else the last one;
+/// `None` before its first event), so `lambda c: c < limit` with `limit` a stream compares
+/// numbers. The cost is one variable write per such variable and call.
 pub struct StarHost<'a, 'v, 'b, 'e> {
     eval: &'a mut Evaluator<'v, 'b, 'e>,
     functions: &'a [Value<'v>],
+    /// Module-level variables holding streams, with the stream each holds.
+    captured: Vec<(String, StreamId)>,
 }
 
 impl<'a, 'v, 'b, 'e> StarHost<'a, 'v, 'b, 'e> {
     /// A host calling `functions` (host function `n` is `functions[n]`) with `eval`.
     pub fn new(eval: &'a mut Evaluator<'v, 'b, 'e>, functions: &'a [Value<'v>]) -> Self {
-        StarHost { eval, functions }
+        let module = eval.module();
+        let mut captured: Vec<(String, StreamId)> = module
+            .names()
+            .filter_map(|name| {
+                let v = module.get(name.as_str())?;
+                let s = v.downcast_ref::<Stream>()?;
+                Some((name.as_str().to_owned(), StreamId(s.id)))
+            })
+            .collect();
+        captured.sort();
+        StarHost {
+            eval,
+            functions,
+            captured,
+        }
     }
 }
 
@@ -25,7 +49,7 @@ fn to_star<'v>(v: &Rx, heap: Heap<'v>) -> Value<'v> {
         Rx::Unit => Value::new_none(),
         Rx::Num(x) => heap.alloc(*x),
         Rx::Bool(b) => Value::new_bool(*b),
-        Rx::Vec3(p) => heap.alloc(AllocTuple(p.iter().map(|&x| heap.alloc(x)))),
+        Rx::Vec3(p) => heap.alloc(super::position::Vector(*p)),
         Rx::Tuple(items) => heap.alloc(AllocTuple(items.iter().map(|x| to_star(x, heap)))),
         Rx::Text(s) => heap.alloc(s.as_str()),
     }
@@ -43,6 +67,14 @@ fn from_star(v: Value) -> Result<Rx, String> {
     }
     if let Some(f) = v.downcast_ref::<StarlarkFloat>() {
         return Ok(Rx::Num(f.0));
+    }
+    if let Some(p) = v.downcast_ref::<super::position::Vector>() {
+        return Ok(Rx::Vec3(p.0));
+    }
+    if let Some(l) = v.downcast_ref::<super::position::Loc>() {
+        if let Some(at) = l.resolved() {
+            return Ok(Rx::Vec3(at.pos_m));
+        }
     }
     if let Some(s) = v.unpack_str() {
         return Ok(Rx::Text(s.to_owned()));
@@ -66,8 +98,15 @@ fn from_star(v: Value) -> Result<Rx, String> {
 }
 
 impl Host for StarHost<'_, '_, '_, '_> {
-    fn call(&mut self, f: u32, args: &[Rx]) -> Result<Rx, String> {
+    fn call(&mut self, f: u32, args: &[Rx], streams: &Runtime) -> Result<Rx, String> {
         let heap = self.eval.heap();
+        for (name, id) in &self.captured {
+            let now = match streams.current(*id) {
+                Some(v) => to_star(v, heap),
+                None => Value::new_none(),
+            };
+            self.eval.module().set(name, now);
+        }
         let args: Vec<Value> = args.iter().map(|a| to_star(a, heap)).collect();
         let function = *self
             .functions

@@ -287,10 +287,14 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
                 at_m: number(at, "onLane(at=)")?,
             }
         };
-        r.resolve(&b.roads).map_err(|e| anyhow!(e))?;
+        let at = r.resolve(&b.roads).map_err(|e| anyhow!(e))?;
         b.locs.push(r);
+        if let Ok(mut t) = b.loc_table.write() {
+            t.push(Some(at));
+        }
         Ok(Loc {
             index: b.locs.len() - 1,
+            table: b.loc_table.clone(),
         })
     }
 
@@ -339,6 +343,8 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
                 .connect(PieceId(p.piece), p.index, PieceId(c.piece), c.index)
                 .map_err(|e| anyhow!(super::scene::strip(e)))?;
         }
+        // Pieces moved: every location stands where the network now puts it.
+        b.resolve_locations();
         Ok(Road {
             network: true,
             ..*this

@@ -12,6 +12,7 @@ mod globals;
 mod host;
 mod methods;
 mod names;
+mod position;
 mod program;
 mod scene;
 mod types;

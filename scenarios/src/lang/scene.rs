@@ -266,6 +266,9 @@ pub struct SceneBuilder {
     pub lambdas: u32,
     /// `onLane` results, by index.
     pub locs: Vec<LaneRef>,
+    /// Where each of `locs` stands on the network as it is now, shared with the `Location`
+    /// values of the program.
+    pub loc_table: super::position::LocTable,
     /// Declared actors, in declaration order.
     pub objects: Vec<ObjectDecl>,
     /// Pedestrians declared so far (their index in the world).
@@ -330,6 +333,7 @@ impl SceneBuilder {
             car_names: Vec::new(),
             lambdas: 0,
             locs: Vec::new(),
+            loc_table: Default::default(),
             objects: Vec::new(),
             n_pedestrians: 0,
             n_cars: 0,
@@ -472,6 +476,19 @@ pub fn turns(names: &[String]) -> Result<Vec<Turn>, String> {
 const MAX_ROUTE_M: f64 = 5000.0;
 
 impl SceneBuilder {
+    /// Resolves every location again on the network as it stands (after `connect` moved
+    /// pieces); a location that no longer resolves is `None` until it does.
+    pub fn resolve_locations(&mut self) {
+        let now: Vec<_> = self
+            .locs
+            .iter()
+            .map(|l| l.resolve(&self.roads).ok())
+            .collect();
+        if let Ok(mut t) = self.loc_table.write() {
+            *t = now;
+        }
+    }
+
     /// `w.place(...)`: marks `objects` placed, resolves every actor's location and route on
     /// the final road network, builds the pedestrians' behaviour, and runs the checks: no
     /// overlapping road pieces, no objects starting in collision, vehicles on the road.

@@ -152,23 +152,7 @@ impl<'v> StarlarkValue<'v> for LaneSide {
     }
 }
 
-/// A resolved `onLane(lane, at)`.
-#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
-pub struct Loc {
-    /// Index into the program's locations.
-    pub index: usize,
-}
-
-impl fmt::Display for Loc {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "Location({})", self.index)
-    }
-}
-
-starlark_simple_value!(Loc);
-
-#[starlark_value(type = "Location")]
-impl<'v> StarlarkValue<'v> for Loc {}
+pub use super::position::Loc;
 
 /// What kind of actor an [`ActorVal`] is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Allocative)]
