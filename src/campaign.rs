@@ -144,7 +144,7 @@ impl Campaign<'_> {
             .map_err(|e| e.to_string()),
             Err(e) => Err(e.to_string()),
         };
-        let (status, monitors, metrics, error) = match outcome {
+        let (status, monitors, metrics, error, log) = match outcome {
             Ok(o) => (
                 if o.passed() {
                     Status::Pass
@@ -160,8 +160,9 @@ impl Campaign<'_> {
                     .map(|(n, v)| (n.to_owned(), v))
                     .collect(),
                 None,
+                o.log,
             ),
-            Err(e) => (Status::Error, Vec::new(), Vec::new(), Some(e)),
+            Err(e) => (Status::Error, Vec::new(), Vec::new(), Some(e), Vec::new()),
         };
         RunRecord {
             id,
@@ -173,6 +174,7 @@ impl Campaign<'_> {
             monitors,
             metrics,
             error,
+            log,
             wall_ms: started.elapsed().as_secs_f64() * 1e3,
         }
     }

@@ -83,6 +83,10 @@ pub struct RunRecord {
     pub metrics: Vec<(String, f64)>,
     /// Why the test ended in `error`, else `null`.
     pub error: Option<String>,
+    /// What the program printed during the test (`print`), in order; the key is left out
+    /// when it printed nothing.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub log: Vec<String>,
     /// Wall-clock time of the test in milliseconds. Machine-dependent.
     pub wall_ms: f64,
 }
@@ -103,6 +107,8 @@ struct Line {
     #[serde(deserialize_with = "metric_pairs")]
     metrics: Vec<(String, f64)>,
     error: Option<String>,
+    #[serde(default)]
+    log: Vec<String>,
     #[serde(deserialize_with = "f64_or_null")]
     wall_ms: f64,
 }
@@ -157,6 +163,7 @@ impl RunRecord {
             monitors: l.monitors,
             metrics: l.metrics,
             error: l.error,
+            log: l.log,
             wall_ms: l.wall_ms,
         })
     }
@@ -243,6 +250,7 @@ mod tests {
                 ("time_to_failure_s".into(), 1.5),
             ],
             error: None,
+            log: Vec::new(),
             wall_ms: 2.5,
         };
         let line = serde_json::to_string(&r).unwrap();

@@ -257,7 +257,7 @@ fn a_computed_stream_of_the_wrong_type_ends_its_test_as_an_error_and_the_campaig
             "{t} vs {switch}: {e}"
         );
         for part in [
-            "the speed of Car declared at",
+            "the speed of Car c (",
             "speed_lambda_string.star:14:5",
             "was \"fast\" (a string)",
             "must be a number in m/s, >= 0",
@@ -324,7 +324,7 @@ fn inputs_that_cannot_affect_the_ego_are_named() {
     );
     let e = stderr(&o);
     assert!(
-        e.contains("`wet` sets the friction of RoadSegment declared at"),
+        e.contains("`wet` sets the friction of RoadSegment far"),
         "{e}"
     );
     assert!(e.contains("it cannot affect the ego"), "{e}");
@@ -337,7 +337,7 @@ fn inputs_that_cannot_affect_the_ego_are_named() {
         &[],
     );
     assert!(
-        stderr(&o).contains("`lead_color` sets the colour of Car declared at"),
+        stderr(&o).contains("`lead_color` sets the colour of Car "),
         "{}",
         stderr(&o)
     );

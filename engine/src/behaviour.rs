@@ -61,9 +61,49 @@ pub fn decode_probe(p: u32) -> (Actor, Output) {
     (actor, OUTPUTS[(o as usize).min(OUTPUTS.len() - 1)])
 }
 
+/// What a `foreach` sink does with each event (paper §2: `foreach(walk)`). The event's value
+/// is the action's argument.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    /// Pedestrian `i` takes one walking step toward its target (the value is ignored).
+    Walk(u32),
+    /// Car `i` drives at the value, m/s (a number `>= 0`), from now on.
+    SetSpeed(u32),
+    /// Car `i` slows by the value times the step, m/s² (a number `> 0`), and keeps the
+    /// lower speed.
+    Brake(u32),
+    /// Car `i` changes to the lane the value names (a lane number of its start segment, or a
+    /// `(lane, duration_s)` tuple; 3 s by default).
+    ChangeLane(u32),
+}
+
+const SINK_KIND_SHIFT: u32 = 24;
+
+/// The sink number of `action`, for [`Node::Foreach`]; [`walk_sink`]`(i)` is `i`.
+pub fn action_sink(action: Action) -> u32 {
+    let (kind, i) = match action {
+        Action::Walk(i) => (0, i),
+        Action::SetSpeed(i) => (1, i),
+        Action::Brake(i) => (2, i),
+        Action::ChangeLane(i) => (3, i),
+    };
+    (kind << SINK_KIND_SHIFT) | (i & ((1 << SINK_KIND_SHIFT) - 1))
+}
+
+/// The inverse of [`action_sink`].
+pub fn decode_sink(sink: u32) -> Action {
+    let i = sink & ((1 << SINK_KIND_SHIFT) - 1);
+    match sink >> SINK_KIND_SHIFT {
+        1 => Action::SetSpeed(i),
+        2 => Action::Brake(i),
+        3 => Action::ChangeLane(i),
+        _ => Action::Walk(i),
+    }
+}
+
 /// The sink that makes pedestrian `i` take one walking step per event.
 pub fn walk_sink(i: u32) -> u32 {
-    i
+    action_sink(Action::Walk(i))
 }
 
 /// Collects nodes; each push returns the new stream's id.
@@ -162,6 +202,20 @@ impl GraphBuilder {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sinks_round_trip() {
+        for a in [
+            Action::Walk(0),
+            Action::Walk(9),
+            Action::SetSpeed(0),
+            Action::Brake(3),
+            Action::ChangeLane(12),
+        ] {
+            assert_eq!(decode_sink(action_sink(a)), a);
+        }
+        assert_eq!(walk_sink(4), 4);
+    }
 
     #[test]
     fn probes_round_trip() {

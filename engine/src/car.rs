@@ -87,6 +87,11 @@ pub(crate) struct Car {
     pub(crate) lane_change: Option<LaneChangeSpec>,
     /// When its lane change started, s.
     pub(crate) change_started_s: Option<f64>,
+    /// The sideways offset its current lane change starts from, m (0 for the first).
+    change_from_m: f64,
+    /// The speed an action set (`setSpeed`, `brake`), m/s: it then drives at this instead of
+    /// its speed stream's value.
+    pub(crate) speed_override: Option<f64>,
 }
 
 impl Car {
@@ -119,6 +124,8 @@ impl Car {
             touching: false,
             lane_change: None,
             change_started_s: None,
+            change_from_m: 0.0,
+            speed_override: None,
         };
         car.here = car.at(0.0);
         if enabled {
@@ -182,11 +189,12 @@ impl Car {
         };
         let tau = (t_s - t0) / change.duration_s;
         let (share, rate) = LaneChangeSpec::profile(tau);
-        let d = change.offset_m * share;
+        let from = self.change_from_m;
+        let d = from + (change.offset_m - from) * share;
         // Right of a driver heading along `heading`, in the (x, z) plane.
         let right = [heading.sin(), heading.cos()];
         let sideways_mps = if (0.0..1.0).contains(&tau) {
-            change.offset_m * rate / change.duration_s
+            (change.offset_m - from) * rate / change.duration_s
         } else {
             0.0
         };
@@ -199,6 +207,44 @@ impl Car {
         if self.lane_change.is_some() && self.change_started_s.is_none() {
             self.change_started_s = Some(t_s);
         }
+    }
+
+    /// The sideways offset from its start lane now, m (positive to the right).
+    fn offset_now_m(&self, t_s: f64) -> f64 {
+        match (self.lane_change, self.change_started_s) {
+            (Some(c), Some(t0)) => {
+                let (share, _) = LaneChangeSpec::profile((t_s - t0) / c.duration_s);
+                self.change_from_m + (c.offset_m - self.change_from_m) * share
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Starts moving sideways at `t_s` to `offset_m` from its start lane (m, positive to the
+    /// right) over `duration_s`, from wherever it is now (a `changeLane` action). Changing
+    /// to the offset it is already moving to does nothing, so an action repeated every step
+    /// makes one lane change.
+    pub(crate) fn change_lane_to(&mut self, offset_m: f64, duration_s: f64, t_s: f64) {
+        if self.change_started_s.is_some()
+            && self.lane_change.is_some_and(|c| c.offset_m == offset_m)
+        {
+            return;
+        }
+        if self.change_started_s.is_none() && offset_m == 0.0 {
+            return;
+        }
+        self.change_from_m = self.offset_now_m(t_s);
+        self.lane_change = Some(LaneChangeSpec {
+            offset_m,
+            start: LaneChangeStart::At(t_s),
+            duration_s,
+        });
+        self.change_started_s = Some(t_s);
+    }
+
+    /// Its speed along the path in the last step, m/s.
+    pub(crate) fn speed_mps(&self) -> f64 {
+        self.speed
     }
 
     /// Drives one step of `dt_s` at time `t_s` toward the commanded `speed_mps` (negative

@@ -5,7 +5,7 @@ use rapier3d::prelude::*;
 use serde::Serialize;
 
 use crate::actor::{Handle, Set, Size, VisibleBox};
-use crate::behaviour::{decode_probe, Actor, Output};
+use crate::behaviour::{decode_probe, decode_sink, Action, Actor, Output};
 use crate::car::{Car, CarState, LaneChangeStart};
 use crate::network::{Lane, Network, PieceId, Surface};
 use crate::obstacle::{Obstacle, ObstacleState};
@@ -115,7 +115,11 @@ pub struct Simulation {
     /// Pieces whose friction varies over the test, and their streams.
     frictions: Vec<(PieceId, StreamId)>,
     streams: Runtime,
+    /// The step whose streams [`Simulation::evaluate`] has computed, if it has.
+    evaluated: Option<u64>,
     sinks: Vec<(u32, Value)>,
+    /// Each car's lanes for `changeLane` ([`crate::CarSpec::lane_offsets_m`]).
+    car_lanes: Vec<Vec<(i32, f64)>>,
     sensors: Sensors,
     events: Receiver<CollisionEvent>,
     collector: ChannelEventCollector,
@@ -173,6 +177,7 @@ impl Simulation {
             .map(|p| p.speed)
             .chain(spec.cars.iter().map(|c| c.speed))
             .chain(spec.frictions.iter().map(|f| f.1))
+            .chain(spec.published.iter().map(|p| p.1))
             .chain([spec.environment.light, spec.environment.fog]);
         for id in ids {
             if id.0 >= n {
@@ -266,7 +271,9 @@ impl Simulation {
                 constant(&spec.streams, spec.environment.fog).unwrap_or(0.0),
             ),
             streams: Runtime::new(spec.streams.clone()),
+            evaluated: None,
             sinks: Vec::new(),
+            car_lanes: spec.cars.iter().map(|c| c.lane_offsets_m.clone()).collect(),
             sensors,
             events,
             collector: ChannelEventCollector::new(collision_tx, force_tx, tear_tx),
@@ -431,15 +438,7 @@ impl Simulation {
     pub fn step(&mut self, control: Control, host: &mut dyn Host) -> Result<(), EngineError> {
         let dt = self.dt_s;
         let t = self.t_s();
-        self.sinks.clear();
-        let inputs = WorldInputs {
-            physics: &self.physics,
-            ego: &self.ego,
-            ego_touching: self.ego_contact(),
-            pedestrians: &self.pedestrians,
-            cars: &self.cars,
-        };
-        self.streams.step(t, &inputs, host, &mut self.sinks)?;
+        self.evaluate(host)?;
         self.light_fog = (
             number(
                 &self.streams,
@@ -462,17 +461,15 @@ impl Simulation {
         for p in self.pedestrians.iter_mut() {
             p.rest();
         }
-        for (sink, _) in &self.sinks {
-            let h = Handle::<Pedestrian>::from_index(*sink as usize);
-            if let Some(p) = self.pedestrians.get_mut(h) {
-                let what = format!("the speed of pedestrian {sink}");
-                let v = number(&self.streams, p.speed_stream, 0.0, t, &what)?;
-                p.walk(&mut self.physics, t, dt, v);
-            }
-        }
+        self.act(t)?;
         for (i, car) in self.cars.iter_mut().enumerate() {
-            let what = format!("the speed of car {i}");
-            let v = number(&self.streams, car.speed_stream, 0.0, t, &what)?;
+            let v = match car.speed_override {
+                Some(v) => v,
+                None => {
+                    let what = format!("the speed of car {i}");
+                    number(&self.streams, car.speed_stream, 0.0, t, &what)?
+                }
+            };
             match car.lane_change.map(|c| c.start) {
                 Some(LaneChangeStart::At(t0)) if t >= t0 => car.start_lane_change(t0),
                 Some(LaneChangeStart::When(s)) if self.streams.fired(s) => car.start_lane_change(t),
@@ -525,6 +522,156 @@ impl Simulation {
             .map(|s| tick % s.period_ticks() == 0)
             .collect();
         self.capture_all(|h| due[h.index()])
+    }
+
+    /// Evaluates the stream graph for the current step, once: [`Simulation::step`] calls it,
+    /// and a runner calls it before reading [`Simulation::current`] so that published
+    /// streams hold this step's values (those of the state a [`Simulation::snapshot`] shows
+    /// now). Evaluating again in the same step does nothing.
+    ///
+    /// # Errors
+    /// [`EngineError::Stream`] when the graph fails (a lambda raised, a value of the wrong
+    /// kind).
+    pub fn evaluate(&mut self, host: &mut dyn Host) -> Result<(), EngineError> {
+        if self.evaluated == Some(self.tick) {
+            return Ok(());
+        }
+        let t = self.t_s();
+        self.sinks.clear();
+        let inputs = WorldInputs {
+            physics: &self.physics,
+            ego: &self.ego,
+            ego_touching: self.ego_contact(),
+            pedestrians: &self.pedestrians,
+            cars: &self.cars,
+        };
+        self.streams.step(t, &inputs, host, &mut self.sinks)?;
+        self.evaluated = Some(self.tick);
+        Ok(())
+    }
+
+    /// The latest value of stream `id` (after [`Simulation::evaluate`] for this step), `None`
+    /// before its first event or for an id past the graph.
+    pub fn current(&self, id: StreamId) -> Option<&Value> {
+        self.streams.current(id)
+    }
+
+    /// Calls every function of the stream graph once on sample values of this world at its
+    /// current time ([`crate::rx::Runtime::check`]), on a copy: the simulation is unchanged.
+    ///
+    /// # Errors
+    /// [`EngineError::Stream`] with the first failure.
+    pub fn check_streams(&self, host: &mut dyn Host) -> Result<(), EngineError> {
+        let inputs = WorldInputs {
+            physics: &self.physics,
+            ego: &self.ego,
+            ego_touching: self.ego_contact(),
+            pedestrians: &self.pedestrians,
+            cars: &self.cars,
+        };
+        let mut copy = Runtime::new(self.streams.graph().clone());
+        copy.check(self.t_s(), &inputs, host)?;
+        Ok(())
+    }
+
+    /// Performs this step's `foreach` events, in order: walking steps, car speeds, brakes and
+    /// lane changes.
+    ///
+    /// # Errors
+    /// [`crate::rx::RxError::Input`] for an argument the action cannot take (a speed that is
+    /// not a number, a lane the car's segment lacks).
+    fn act(&mut self, t: f64) -> Result<(), EngineError> {
+        let dt = self.dt_s;
+        let sinks = std::mem::take(&mut self.sinks);
+        let bad = |name: String, v: &Value, expected: &str| -> EngineError {
+            crate::rx::RxError::Input {
+                name,
+                t_s: t,
+                value: crate::rx::describe(v),
+                expected: expected.into(),
+            }
+            .into()
+        };
+        for (sink, value) in &sinks {
+            match decode_sink(*sink) {
+                Action::Walk(i) => {
+                    if let Some(p) = self.pedestrians.get_mut(Handle::from_index(i as usize)) {
+                        let what = format!("the speed of pedestrian {i}");
+                        let v = number(&self.streams, p.speed_stream, 0.0, t, &what)?;
+                        p.walk(&mut self.physics, t, dt, v);
+                    }
+                }
+                Action::SetSpeed(i) => {
+                    let Some(car) = self.cars.get_mut(Handle::from_index(i as usize)) else {
+                        continue;
+                    };
+                    match value.as_num() {
+                        Some(v)
+                            if v.is_finite() && v >= 0.0 && !matches!(value, Value::Bool(_)) =>
+                        {
+                            car.speed_override = Some(v)
+                        }
+                        _ => {
+                            return Err(bad(
+                                format!("the speed given to car {i}'s setSpeed"),
+                                value,
+                                "a finite number >= 0 (m/s)",
+                            ))
+                        }
+                    }
+                }
+                Action::Brake(i) => {
+                    let Some(car) = self.cars.get_mut(Handle::from_index(i as usize)) else {
+                        continue;
+                    };
+                    match value {
+                        Value::Num(d) if d.is_finite() && *d > 0.0 => {
+                            car.speed_override = Some((car.speed_mps() - d * dt).max(0.0))
+                        }
+                        _ => {
+                            return Err(bad(
+                                format!("the deceleration given to car {i}'s brake"),
+                                value,
+                                "a finite number > 0 (m/s²)",
+                            ))
+                        }
+                    }
+                }
+                Action::ChangeLane(i) => {
+                    let (lane, duration) = match value {
+                        Value::Num(l) => (*l, 3.0),
+                        Value::Tuple(v) if v.len() == 2 => match (&v[0], &v[1]) {
+                            (Value::Num(l), Value::Num(d)) => (*l, *d),
+                            _ => (f64::NAN, f64::NAN),
+                        },
+                        _ => (f64::NAN, f64::NAN),
+                    };
+                    let lanes = self.car_lanes.get(i as usize).cloned().unwrap_or_default();
+                    let offset = lanes
+                        .iter()
+                        .find(|(l, _)| f64::from(*l) == lane)
+                        .map(|(_, o)| *o);
+                    let Some(offset) = offset.filter(|_| duration.is_finite() && duration > 0.0)
+                    else {
+                        let known: Vec<String> = lanes.iter().map(|(l, _)| l.to_string()).collect();
+                        return Err(bad(
+                            format!("the lane given to car {i}'s changeLane"),
+                            value,
+                            &if known.is_empty() {
+                                "a lane of the segment the car starts on; it starts inside a junction, where there is none".to_owned()
+                            } else {
+                                format!("a lane of the segment the car starts on ({}), or (lane, duration > 0 s)", known.join(", "))
+                            },
+                        ));
+                    };
+                    if let Some(car) = self.cars.get_mut(Handle::from_index(i as usize)) {
+                        car.change_lane_to(offset, duration, t);
+                    }
+                }
+            }
+        }
+        self.sinks = sinks;
+        Ok(())
     }
 
     fn capture_all_named(&mut self, name: &str) -> Result<(), EngineError> {

@@ -50,6 +50,10 @@ pub struct CarSpec {
     pub enabled: bool,
     /// A lane change it makes, if any (a cut-in).
     pub lane_change: Option<crate::LaneChangeSpec>,
+    /// The lanes a `changeLane` action may take it to: each driving lane of the segment it
+    /// starts on and that lane's sideways offset from its start lane, m, positive to the
+    /// right of its direction. Empty when it starts inside a junction.
+    pub lane_offsets_m: Vec<(i32, f64)>,
 }
 
 /// A static obstacle (`Obstacle(loc=, size=, color=)`): a box that never moves.
@@ -97,6 +101,9 @@ pub struct WorldSpec {
     pub environment: EnvironmentSpec,
     /// The reactive graph, bound (no open parameter slot left).
     pub streams: Graph,
+    /// Streams published by name for monitors and `Stl` formulas (`Monitor`, `Signal`, an
+    /// actor's `lead.speed`): [`crate::Simulation::current`] reads each one's latest value.
+    pub published: Vec<(String, StreamId)>,
     /// The ego vehicle's lidar.
     pub lidar: LidarSpec,
 }
@@ -173,6 +180,7 @@ impl WorldSpec {
             obstacles: vec![],
             environment: EnvironmentSpec { light, fog },
             streams: g.finish()?,
+            published: vec![],
             lidar: LidarSpec::default(),
         })
     }

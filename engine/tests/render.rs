@@ -389,10 +389,12 @@ fn an_npc_cars_collider_and_its_drawing_agree() {
             size: Size::CAR,
             enabled: true,
             lane_change: None,
+            lane_offsets_m: vec![],
         }],
         obstacles: vec![],
         environment: EnvironmentSpec { light, fog },
         streams: g.finish().unwrap(),
+        published: vec![],
         lidar: LidarSpec::default(),
         network,
     };
@@ -497,6 +499,7 @@ fn an_obstacle_is_drawn_by_the_camera_at_its_place_and_size() {
             obstacles,
             environment: EnvironmentSpec { light, fog },
             streams: g.finish().unwrap(),
+            published: vec![],
             lidar: LidarSpec::default(),
             network: network.clone(),
         };

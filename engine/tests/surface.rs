@@ -62,6 +62,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
             size: Size::CAR,
             enabled: true,
             lane_change: None,
+            lane_offsets_m: vec![],
         });
     }
     WorldSpec {
@@ -79,6 +80,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
         obstacles: vec![],
         environment: EnvironmentSpec { light, fog },
         streams: g.finish().unwrap(),
+        published: vec![],
         lidar: LidarSpec::default(),
     }
 }

@@ -10,6 +10,8 @@
 //!   by standing still (paper §2).
 //! - [`OffRoadMonitor`]: the ego vehicle stays on the drivable surface.
 //! - [`TimeToFailureMonitor`]: a wrapped monitor first fails no earlier than a given time.
+//! - [`StreamMonitor`]: a user-written monitor, one signal's value taken over the test
+//!   (always, at the end, eventually), or a Boolean assertion.
 //! - [`stl`]: signal temporal logic formulas and their quantitative robustness.
 #![warn(missing_docs)]
 
@@ -20,6 +22,7 @@ mod monitor;
 mod off_road;
 mod signals;
 pub mod stl;
+mod stream;
 mod time_to_failure;
 
 pub use collision::CollisionMonitor;
@@ -27,4 +30,5 @@ pub use distance::DistanceMonitor;
 pub use monitor::{Monitor, Verdict};
 pub use off_road::OffRoadMonitor;
 pub use signals::{Frame, SignalError, Signals};
+pub use stream::{Over, StreamMonitor};
 pub use time_to_failure::TimeToFailureMonitor;

@@ -1,3 +1,5 @@
+use std::borrow::Cow;
+
 use thiserror::Error;
 
 /// Errors reading a trace.
@@ -14,7 +16,7 @@ pub enum SignalError {
 /// simplest and the fastest representation.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Signals {
-    values: Vec<(&'static str, f64)>,
+    values: Vec<(Cow<'static, str>, f64)>,
 }
 
 impl Signals {
@@ -25,10 +27,24 @@ impl Signals {
 
     /// Sets `name` to `value`, adding the signal if it is new.
     pub fn set(&mut self, name: &'static str, value: f64) {
-        match self.values.iter_mut().find(|(n, _)| *n == name) {
+        match self.values.iter_mut().find(|(n, _)| n == name) {
             Some(slot) => slot.1 = value,
-            None => self.values.push((name, value)),
+            None => self.values.push((Cow::Borrowed(name), value)),
         }
+    }
+
+    /// Sets `name` to `value`, for a name made at run time (a signal a scenario publishes,
+    /// `lead.speed`); the name is copied only when the signal is new.
+    pub fn set_named(&mut self, name: &str, value: f64) {
+        match self.values.iter_mut().find(|(n, _)| n == name) {
+            Some(slot) => slot.1 = value,
+            None => self.values.push((Cow::Owned(name.to_owned()), value)),
+        }
+    }
+
+    /// Removes `name` (a stream with no value yet), if it is set.
+    pub fn unset(&mut self, name: &str) {
+        self.values.retain(|(n, _)| n != name);
     }
 
     /// Sets a boolean signal (`1.0` or `0.0`).
@@ -43,7 +59,7 @@ impl Signals {
     pub fn get(&self, name: &str) -> Result<f64, SignalError> {
         self.values
             .iter()
-            .find(|(n, _)| *n == name)
+            .find(|(n, _)| n == name)
             .map(|(_, v)| *v)
             .ok_or_else(|| SignalError::Missing(name.to_owned()))
     }
@@ -57,8 +73,8 @@ impl Signals {
     }
 
     /// `(name, value)` pairs in insertion order.
-    pub fn iter(&self) -> impl Iterator<Item = (&'static str, f64)> + '_ {
-        self.values.iter().copied()
+    pub fn iter(&self) -> impl Iterator<Item = (&str, f64)> + '_ {
+        self.values.iter().map(|(n, v)| (n.as_ref(), *v))
     }
 }
 

@@ -65,6 +65,9 @@ pub struct TestOutcome {
     /// Measurements: the monitors' metrics (e.g. `min_distance_m`, `distance_travelled_m`),
     /// then `time_to_failure_s` when a monitor failed and `simulated_s`.
     pub metrics: Vec<(&'static str, f64)>,
+    /// What the program printed during the test (Starlark's `print`, in the program and in
+    /// its lambdas), in order; never written to stdout during a campaign.
+    pub log: Vec<String>,
 }
 
 impl TestOutcome {
@@ -96,11 +99,58 @@ fn publish(snap: &Snapshot, out: &mut Signals) {
     out.set(signal::LIGHT, snap.light);
 }
 
+/// A stream the world publishes by name, with the names of its components when it carries
+/// vectors (made once per test, not per step).
+struct Published {
+    name: String,
+    components: [String; 3],
+    id: paracosm_engine::rx::StreamId,
+}
+
+/// Sets each published stream's latest value as a signal: a number as is, a bool as 0 or 1,
+/// a vector as `name.x`, `name.y`, `name.z`; a stream with no event yet is left unset.
+///
+/// # Errors
+/// [`ScenarioError::Language`] for a stream carrying something else (a string, a tuple).
+fn publish_streams(
+    sim: &Simulation,
+    published: &[Published],
+    out: &mut Signals,
+) -> Result<(), ScenarioError> {
+    use paracosm_engine::rx::Value as Rx;
+    for p in published {
+        match sim.current(p.id) {
+            None => out.unset(&p.name),
+            Some(Rx::Num(x)) => out.set_named(&p.name, *x),
+            Some(Rx::Bool(b)) => out.set_named(&p.name, f64::from(u8::from(*b))),
+            Some(Rx::Vec3(v)) => {
+                for (c, x) in p.components.iter().zip(v) {
+                    out.set_named(c, *x);
+                }
+            }
+            Some(other) => {
+                let what = match p.name.strip_prefix("monitor:") {
+                    Some(m) => format!("the stream of monitor `{m}`"),
+                    None => format!("signal `{}`", p.name),
+                };
+                return Err(ScenarioError::Language(format!(
+                    "at t = {:.3} s, {what} carried {}; monitors and signals read numbers, \
+                     bools and vectors",
+                    sim.t_s(),
+                    paracosm_engine::rx::describe(other)
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The monitors of one test and which of them have settled their verdict.
 struct Watch {
     monitors: Vec<Box<dyn Monitor>>,
     settled: Vec<bool>,
     signals: Signals,
+    published: Vec<Published>,
 }
 
 impl Watch {
@@ -108,8 +158,10 @@ impl Watch {
     /// may stop: every monitor has settled, or one has settled as failed. Monitors are
     /// independent: one settling (passed) never stops the others observing. A test without
     /// monitors runs to its horizon.
-    fn observe(&mut self, snap: &Snapshot) -> bool {
-        publish(snap, &mut self.signals);
+    fn observe(&mut self, sim: &Simulation) -> Result<bool, ScenarioError> {
+        let snap = sim.snapshot();
+        publish(&snap, &mut self.signals);
+        publish_streams(sim, &self.published, &mut self.signals)?;
         let frame = Frame {
             t_s: snap.t_s,
             signals: &self.signals,
@@ -124,7 +176,7 @@ impl Watch {
                 failed |= !m.verdict().passed;
             }
         }
-        failed || (!self.settled.is_empty() && self.settled.iter().all(|&s| s))
+        Ok(failed || (!self.settled.is_empty() && self.settled.iter().all(|&s| s)))
     }
 }
 
@@ -202,9 +254,21 @@ impl Scenario {
             settled: vec![false; monitors.len()],
             monitors,
             signals: Signals::new(),
+            published: spec
+                .published
+                .iter()
+                .map(|(name, id)| Published {
+                    components: [".x", ".y", ".z"].map(|c| format!("{name}{c}")),
+                    name: name.clone(),
+                    id: *id,
+                })
+                .collect(),
         };
         let ticks = (self.horizon_s / spec.dt_s).round() as u64;
-        let mut stopped = watch.observe(&sim.snapshot());
+        // Streams are evaluated for the state a snapshot shows, so a published stream's value
+        // and the runner's own signals describe the same moment.
+        sim.evaluate(host)?;
+        let mut stopped = watch.observe(&sim)?;
         let mut tick = 0;
         let mut control = Control::default();
         while !stopped && tick < ticks {
@@ -224,7 +288,8 @@ impl Scenario {
             }
             sim.step(control, host)?;
             tick += 1;
-            stopped = watch.observe(&sim.snapshot());
+            sim.evaluate(host)?;
+            stopped = watch.observe(&sim)?;
         }
 
         let cut_short: Vec<String> = if tick < ticks {
@@ -259,6 +324,7 @@ impl Scenario {
             monitors,
             cut_short,
             metrics,
+            log: host.log(),
         })
     }
 }

@@ -5,7 +5,8 @@ use paracosm_engine::rx::Host;
 use paracosm_engine::WorldSpec;
 use paracosm_generators::{Assignment, ParamSpace};
 use paracosm_oracles::{
-    CollisionMonitor, DistanceMonitor, Monitor, OffRoadMonitor, TimeToFailureMonitor,
+    CollisionMonitor, DistanceMonitor, Monitor, OffRoadMonitor, Over, StreamMonitor,
+    TimeToFailureMonitor,
 };
 
 use crate::runner::signal;
@@ -45,6 +46,27 @@ pub enum MonitorSpec {
         name: String,
         /// The formula's text (parsed when the program loads).
         formula: String,
+    },
+    /// `Monitor(stream, name=, unit=, over=)`: a user-written monitor whose robustness is the
+    /// stream's value taken `over` the test ([`paracosm_oracles::StreamMonitor`]).
+    Stream {
+        /// Key in results files.
+        name: String,
+        /// The runner's signal carrying the stream's values
+        /// ([`paracosm_engine::WorldSpec::published`]).
+        signal: String,
+        /// The values' unit, as the program gave it (for reports).
+        unit: Option<String>,
+        /// How the values become one robustness.
+        over: Over,
+    },
+    /// `Assert(stream_of_bool, name=)`: the stream's truth value must hold at every event;
+    /// robustness `±1`.
+    Assert {
+        /// Key in results files.
+        name: String,
+        /// The runner's signal carrying the stream's values.
+        signal: String,
     },
     /// `TimeToFailure(m, minT)`: `m` first fails no earlier than `min_s` seconds.
     /// Robustness in seconds (see [`TimeToFailureMonitor`]).
@@ -93,11 +115,20 @@ impl MonitorSpec {
 
     /// Whether it reads the runner's signal `name` (an `Stl` formula naming it).
     pub fn reads_signal(&self, name: &str) -> bool {
+        self.signals().iter().any(|s| s == name)
+    }
+
+    /// The runner's signals it reads, by name: an `Stl` formula's, a user monitor's stream.
+    pub fn signals(&self) -> Vec<String> {
         match self {
             MonitorSpec::Stl { formula, .. } => paracosm_oracles::stl::parse(formula)
-                .is_ok_and(|f| f.signals().iter().any(|s| s == name)),
-            MonitorSpec::TimeToFailure { inner, .. } => inner.reads_signal(name),
-            _ => false,
+                .map(|f| f.signals())
+                .unwrap_or_default(),
+            MonitorSpec::Stream { signal, .. } | MonitorSpec::Assert { signal, .. } => {
+                vec![signal.clone()]
+            }
+            MonitorSpec::TimeToFailure { inner, .. } => inner.signals(),
+            _ => Vec::new(),
         }
     }
 
@@ -108,6 +139,8 @@ impl MonitorSpec {
             | MonitorSpec::Distance { name, .. }
             | MonitorSpec::OffRoad { name, .. }
             | MonitorSpec::Stl { name, .. }
+            | MonitorSpec::Stream { name, .. }
+            | MonitorSpec::Assert { name, .. }
             | MonitorSpec::TimeToFailure { name, .. } => name,
         }
     }
@@ -138,6 +171,12 @@ impl MonitorSpec {
                 name,
                 paracosm_oracles::stl::parse(formula).expect("checked when the program loaded"),
             )),
+            MonitorSpec::Stream {
+                name, signal, over, ..
+            } => Box::new(StreamMonitor::new(name, signal, *over)),
+            MonitorSpec::Assert { name, signal } => {
+                Box::new(StreamMonitor::assertion(name, signal))
+            }
             MonitorSpec::TimeToFailure { name, inner, min_s } => {
                 Box::new(TimeToFailureMonitor::new(name, inner.build(), *min_s))
             }

@@ -89,6 +89,10 @@ struct Cli {
     /// For CI.
     #[arg(long)]
     deny_warnings: bool,
+    /// Print each test's log (what the program's `print` wrote during it) on stderr, as
+    /// `test ID: LINE`, as the test finishes. Without it the log is only in results.jsonl.
+    #[arg(long)]
+    verbose: bool,
     #[command(flatten)]
     sut: SutArgs,
 }
@@ -301,6 +305,13 @@ fn run(cli: &Cli) -> Result<ExitCode> {
             Some(&STOP),
             |r| {
                 failures += u64::from(r.status == Status::Fail);
+                if cli.verbose {
+                    bar.suspend(|| {
+                        for line in &r.log {
+                            eprintln!("test {}: {line}", r.id);
+                        }
+                    });
+                }
                 bar.set_message(format!("{failures} failed"));
                 bar.inc(1);
             },
@@ -500,6 +511,9 @@ fn replay(args: &ReplayArgs) -> Result<ExitCode> {
             .map(|e| format!(" ({e})"))
             .unwrap_or_default()
     );
+    for line in &r.replayed.log {
+        println!("print: {line}");
+    }
     if let Some(sheet) = &r.contact_sheet {
         println!(
             "wrote {} frames to {} and {}",

@@ -324,6 +324,7 @@ mod tests {
             monitors: vec![],
             metrics: vec![],
             error: None,
+            log: Vec::new(),
             wall_ms: 0.0,
         }
     }

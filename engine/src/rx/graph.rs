@@ -109,6 +109,14 @@ pub enum Node {
         /// The sink's number, interpreted by the caller.
         sink: u32,
     },
+    /// `src.foreach(f)` with a host function: `f(v)` for each event, for the actions it
+    /// performs ([`super::Host::performed`]); what it returns is dropped.
+    Perform {
+        /// Source.
+        src: StreamId,
+        /// The function, of one argument.
+        f: Func,
+    },
     /// `src`'s events, each checked against `expect` before anything reads it: an input of the
     /// world fed by a stream whose values are known only while the test runs (a lambda's).
     /// A value it does not accept is [`RxError::Input`] naming `name`.
@@ -134,6 +142,7 @@ impl Node {
             | Node::Take { src, .. }
             | Node::Sum { src, .. }
             | Node::Foreach { src, .. }
+            | Node::Perform { src, .. }
             | Node::Check { src, .. } => vec![*src],
             Node::Zip(a, b) | Node::Concat(a, b) => vec![*a, *b],
             Node::SkipUntil { src, trigger: o } | Node::TakeUntil { src, stop: o } => {

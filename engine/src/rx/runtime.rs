@@ -16,6 +16,19 @@ pub trait Host {
     /// # Errors
     /// The function's own failure, as a message.
     fn call(&mut self, f: u32, args: &[Value], streams: &Runtime) -> Result<Value, String>;
+
+    /// The actions host functions performed since the last call of this method, as
+    /// `(sink, value)` pairs in the order they were performed (a Starlark `def` given to
+    /// `foreach` that calls `car.brake(6)`). The default host performs none.
+    fn performed(&mut self) -> Vec<(u32, Value)> {
+        Vec::new()
+    }
+
+    /// The lines host functions printed since the last call of this method (Starlark's
+    /// `print`), for the test's log. The default host prints none.
+    fn log(&mut self) -> Vec<String> {
+        Vec::new()
+    }
 }
 
 /// A [`Host`] without functions: every call is an error. For graphs built in Rust.
@@ -96,6 +109,84 @@ impl Runtime {
             if let Some(v) = out {
                 s.value = Some(v);
             }
+        }
+        Ok(())
+    }
+
+    /// Calls every function of the graph once, in topological order, on a sample value of
+    /// each stream at `t_s`: sources give their value now, and every combinator passes its
+    /// source's sample on whatever its gate (a `filter` whose predicate is false, a
+    /// `skipUntil` not yet opened) would do, so each function sees a value of the type it
+    /// will see during a test. Each stream's sample becomes its current value, so functions
+    /// reading captured streams see values too. Actions performed are discarded. Used to find
+    /// type errors in lambdas when a program loads rather than in every test.
+    ///
+    /// # Errors
+    /// The first [`RxError::Host`] or [`RxError::Type`] a function raised: a filter predicate
+    /// that returns no bool, a `sum` of values that do not add.
+    pub fn check(
+        &mut self,
+        t_s: f64,
+        inputs: &dyn Inputs,
+        host: &mut dyn Host,
+    ) -> Result<(), RxError> {
+        for k in 0..self.graph.order().len() {
+            let i = self.graph.order()[k];
+            let sample = |s: &Self, id: &StreamId| s.states[id.0].value.clone();
+            let node = self.graph.nodes()[i].clone();
+            let out = match &node {
+                Node::Const(v) => Some(v.clone()),
+                Node::Tick => Some(Value::Num(t_s)),
+                Node::Open(o) => Some(o.at(t_s)),
+                Node::Probe(p) => Some(inputs.probe(*p)),
+                Node::Param(slot) => {
+                    return Err(RxError::Unbound {
+                        node: i,
+                        slot: *slot,
+                    })
+                }
+                Node::Map { src, f } => match sample(self, src) {
+                    Some(v) => Some(call(i, f, &[v], host, self)?),
+                    None => None,
+                },
+                Node::Filter { src, pred } => match sample(self, src) {
+                    Some(v) => {
+                        let keep = call(i, pred, std::slice::from_ref(&v), host, self)?;
+                        if keep.as_bool().is_none() {
+                            return Err(type_error(i, "filter predicate", "bool", &keep));
+                        }
+                        Some(v)
+                    }
+                    None => None,
+                },
+                Node::Zip(a, b) => match (sample(self, a), sample(self, b)) {
+                    (Some(a), Some(b)) => Some(Value::Tuple(vec![a, b])),
+                    _ => None,
+                },
+                Node::Take { src, .. }
+                | Node::SkipUntil { src, .. }
+                | Node::TakeUntil { src, .. }
+                | Node::Check { src, .. } => sample(self, src),
+                Node::Concat(a, b) => sample(self, a).or_else(|| sample(self, b)),
+                Node::Sum { src, init, f } => match sample(self, src) {
+                    Some(v) => Some(match f {
+                        Some(f) => call(i, f, &[init.clone(), v], host, self)?,
+                        None => init.add(&v).ok_or_else(|| {
+                            type_error(i, "sum", "numbers or vectors of one kind", &v)
+                        })?,
+                    }),
+                    None => None,
+                },
+                Node::Perform { src, f } => {
+                    if let Some(v) = sample(self, src) {
+                        call(i, f, &[v], host, self)?;
+                        host.performed();
+                    }
+                    None
+                }
+                Node::Foreach { .. } => None,
+            };
+            self.states[i].value = out;
         }
         Ok(())
     }
@@ -266,6 +357,15 @@ impl Runtime {
                 }
                 self.states[i].done = done(self, src);
                 out
+            }
+            Node::Perform { src, f } => {
+                let (src, f) = (*src, f.clone());
+                if let Some(v) = self.event(src).cloned() {
+                    call(i, &f, &[v], host, self)?;
+                    sinks.extend(host.performed());
+                }
+                self.states[i].done = done(self, src);
+                None
             }
             Node::Foreach { src, sink } => {
                 let (src, sink) = (*src, *sink);

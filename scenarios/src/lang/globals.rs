@@ -31,15 +31,77 @@ use crate::MonitorSpec;
 pub struct LoadState {
     /// The declarations so far.
     pub scene: RefCell<SceneBuilder>,
+    /// The variable each once-run call is assigned to, by `"line:col"` (objects are named
+    /// after it in messages and `Stl` signals).
+    pub objects: std::sync::Arc<std::collections::HashMap<String, String>>,
+    /// What the program printed while evaluating.
+    pub log: RefCell<Vec<String>>,
+}
+
+impl starlark::PrintHandler for LoadState {
+    fn println(&self, text: &str) -> starlark::Result<()> {
+        self.log.borrow_mut().push(text.to_owned());
+        Ok(())
+    }
 }
 
 impl LoadState {
     /// The state of an evaluation that gives the open parameters `values` (by declaration
     /// index; `None`: their representative values).
-    pub fn new(values: Option<Vec<super::scene::ParamValue>>) -> Self {
+    pub fn new(
+        values: Option<Vec<super::scene::ParamValue>>,
+        objects: std::sync::Arc<std::collections::HashMap<String, String>>,
+    ) -> Self {
         LoadState {
             scene: RefCell::new(SceneBuilder::new(values)),
+            objects,
+            log: RefCell::new(Vec::new()),
         }
+    }
+}
+
+/// The variable the builtin call being evaluated is assigned to, when it runs once per
+/// evaluation (`lead = Car(...)` at the top level).
+pub(crate) fn variable_here(eval: &Evaluator) -> Option<String> {
+    let at = here(eval);
+    let mut parts = at.rsplitn(3, ':');
+    let (col, line) = (parts.next()?, parts.next()?);
+    state(eval)
+        .ok()?
+        .objects
+        .get(&format!("{line}:{col}"))
+        .cloned()
+}
+
+/// Where the builtin call being evaluated stands, with the top-level call it runs under when
+/// it is inside a function: `f.star:3:9 (called from f.star:12:1)`.
+fn site_here(eval: &Evaluator) -> String {
+    let at = here(eval);
+    let outer = (0..eval.call_stack_count())
+        .filter_map(|n| eval.call_stack_nth_location(n))
+        .last()
+        .map(|l| format!("{}:{}", l.filename(), l.resolve_span().begin));
+    match outer {
+        Some(o) if o != at => format!("{at} (called from {o})"),
+        _ => at,
+    }
+}
+
+/// How messages name the object a builtin call declares: by the variable it is assigned to
+/// (`Car lead`), else `Car at file:line:col`, adding where a function was called from.
+pub(crate) fn object_name(eval: &Evaluator, what: &str) -> String {
+    match variable_here(eval) {
+        Some(v) => format!("{what} {v}"),
+        None => format!("{what} at {}", site_here(eval)),
+    }
+}
+
+/// The words after `<What>` naming the object in messages about its inputs: `lead
+/// (f.star:4:5)`, or `at f.star:4:5` for an object without a variable.
+pub(crate) fn object_at(eval: &Evaluator) -> String {
+    match variable_here(eval) {
+        Some(v) => format!("{v} ({})", here(eval)),
+        None => format!("at {}", site_here(eval)),
     }
 }
 
@@ -209,7 +271,7 @@ fn add_piece(
     let mut b = st.scene.borrow_mut();
     let segment = matches!(kind, PieceKind::Segment { .. });
     let ports = kind.ports().len();
-    let name = format!("{what} declared at {}", here(eval));
+    let name = object_name(eval, what);
     let id = b
         .roads
         .add(&name, kind)
@@ -234,7 +296,7 @@ fn road_piece(
     friction: Option<Value>,
     make: impl FnOnce(&SceneBuilder, u32, f64) -> anyhow::Result<PieceKind>,
 ) -> anyhow::Result<Road> {
-    let at = format!("declared at {}", here(eval));
+    let at = object_at(eval);
     let (kind, stream) = {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
@@ -282,7 +344,10 @@ fn declare(
     ]
     .map(|o| b.probe(actor, o).0);
     b.objects.push(ObjectDecl {
-        name: format!("{what} declared at {}", here(eval)),
+        name: object_name(eval, what),
+        at: here(eval),
+        variable: variable_here(eval),
+        actor: Some(actor),
         pending,
         placed: false,
     });
@@ -355,6 +420,42 @@ fn unique_monitor_name(b: &SceneBuilder, name: &str) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// Publishes the stream a `Monitor` or `Assert` named `name` judges, checking that it carries
+/// `want` (numbers or bools) when that is known; returns the signal's name.
+fn publish_monitored(
+    eval: &Evaluator,
+    stream: Value,
+    name: &str,
+    what: &str,
+    want: types::SType,
+) -> anyhow::Result<String> {
+    let st = state(eval)?;
+    let mut b = st.scene.borrow_mut();
+    if stream.downcast_ref::<Stream>().is_none() {
+        bail!(
+            "{what} judges a stream (such as `v.speed.map(lambda s: 20 - s)`), got a {}",
+            stream.get_type()
+        );
+    }
+    let id = stream_arg(stream, &mut b, what)?;
+    let kind = types::stream_types(&b)[id.0];
+    if kind != want && kind != types::SType::Any {
+        bail!(
+            "{what} needs a stream of {}, and this one carries {}{}",
+            want.name(),
+            kind.name(),
+            if want == types::SType::Num {
+                " (for a stream of bools, use Assert)"
+            } else {
+                ""
+            }
+        );
+    }
+    let signal = format!("monitor:{name}");
+    b.published.push((signal.clone(), id));
+    Ok(signal)
 }
 
 fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<MonitorVal> {
@@ -616,7 +717,7 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             bail!("a program has one World");
         }
         let heap = eval.heap();
-        let at = format!("declared at {}", here(eval));
+        let at = object_at(eval);
         let light = typed_arg(
             light.unwrap_or_else(|| heap.alloc(NOMINAL_LIGHT)),
             &mut b,
@@ -783,7 +884,7 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
         let route = route_arg(route, &b)?.unwrap_or_default();
-        let at = format!("declared at {}", here(eval));
+        let at = object_at(eval);
         let speed = typed_arg(
             speed.unwrap_or_else(|| heap.alloc(10.0)),
             &mut b,
@@ -922,7 +1023,10 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             c => bail!("Obstacle(color=) takes a colour name, got a {}", c.kind()),
         };
         b.objects.push(ObjectDecl {
-            name: format!("Obstacle declared at {}", here(eval)),
+            name: object_name(eval, "Obstacle"),
+            at: here(eval),
+            variable: variable_here(eval),
+            actor: None,
             pending: Pending::Obstacle { loc, size, color },
             placed: false,
         });
@@ -944,7 +1048,7 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<ActorVal> {
         let (start, target) = (location(start, "start")?, location(target, "target")?);
-        let at = format!("declared at {}", here(eval));
+        let at = object_at(eval);
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
         let owner = "Pedestrian";
@@ -963,7 +1067,11 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
             (None, None, Some(t)) => {
                 PedTrigger::Stream(typed_arg(t, &mut b, &types::TRIGGER, owner, &at)?)
             }
-            _ => bail!("Pedestrian needs either dist= and car=, or trigger="),
+            (None, None, None) => PedTrigger::Never,
+            _ => bail!(
+                "Pedestrian takes dist= and car= together, or trigger=, or neither (then it \
+                 walks only when an action moves it: stream.foreach(p.walk))"
+            ),
         };
         let i = b.n_pedestrians;
         b.n_pedestrians += 1;
@@ -1044,15 +1152,9 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] name: Option<&str>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<MonitorVal> {
-        let parsed = paracosm_oracles::stl::parse(formula).map_err(anyhow::Error::msg)?;
-        for s in parsed.signals() {
-            if !crate::runner::signal::ALL.contains(&s.as_str()) {
-                bail!(
-                    "Stl: unknown signal `{s}`; the runner publishes {}",
-                    crate::runner::signal::ALL.join(", ")
-                );
-            }
-        }
+        // Signal names are checked once the program has run (a Signal(...) or an actor may
+        // come later in the program).
+        paracosm_oracles::stl::parse(formula).map_err(anyhow::Error::msg)?;
         monitor(
             eval,
             MonitorSpec::Stl {
@@ -1060,6 +1162,93 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
                 formula: formula.to_owned(),
             },
         )
+    }
+
+    /// `Monitor(stream, name=<variable> or "monitor", unit=None, over="always")`: a monitor
+    /// written by the program; its robustness is the stream's value taken `over` the test
+    /// (`"always"`: the minimum, failing at the first value `<= 0`; `"end"`: the last value;
+    /// `"eventually"`: the maximum), in `unit`.
+    fn Monitor<'v>(
+        #[starlark(require = pos)] stream: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        #[starlark(require = named)] unit: Option<&str>,
+        #[starlark(require = named)] over: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        let word = over.unwrap_or("always");
+        let over = paracosm_oracles::Over::parse(word).ok_or_else(|| {
+            anyhow!("Monitor(over=) is \"always\", \"end\" or \"eventually\", got {word:?}")
+        })?;
+        let name = name
+            .map(str::to_owned)
+            .or_else(|| variable_here(eval))
+            .unwrap_or_else(|| "monitor".to_owned());
+        let signal = publish_monitored(eval, stream, &name, "Monitor", types::SType::Num)?;
+        monitor(
+            eval,
+            MonitorSpec::Stream {
+                name,
+                signal,
+                unit: unit.map(str::to_owned),
+                over,
+            },
+        )
+    }
+
+    /// `Assert(stream, name=<variable> or "assert")`: fails at the first event of the stream
+    /// (of bools) that is false; robustness `+1` or `-1`.
+    fn Assert<'v>(
+        #[starlark(require = pos)] stream: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        let name = name
+            .map(str::to_owned)
+            .or_else(|| variable_here(eval))
+            .unwrap_or_else(|| "assert".to_owned());
+        let signal = publish_monitored(eval, stream, &name, "Assert", types::SType::Bool)?;
+        monitor(eval, MonitorSpec::Assert { name, signal })
+    }
+
+    /// `Signal(name, stream)`: publishes a stream of numbers, bools or vectors under `name`
+    /// for `Stl` formulas (a vector as `name.x`, `name.y`, `name.z`).
+    fn Signal<'v>(
+        #[starlark(require = pos)] name: &str,
+        #[starlark(require = pos)] stream: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<NoneType> {
+        let valid = name.split('.').all(|part| {
+            part.chars()
+                .next()
+                .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+                && part.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        });
+        if !valid {
+            bail!(
+                "Signal: `{name}` is not a signal name (letters, digits and _, parts joined by .)"
+            );
+        }
+        if crate::runner::signal::ALL.contains(&name) {
+            bail!("Signal: `{name}` is one of the runner's own signals; choose another name");
+        }
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        if b.published.iter().any(|(n, _)| n == name) {
+            bail!("Signal: `{name}` is published twice");
+        }
+        let id = stream_arg(stream, &mut b, "Signal")?;
+        let kind = types::stream_types(&b)[id.0];
+        if matches!(
+            kind,
+            types::SType::Text | types::SType::Tuple | types::SType::Unit
+        ) {
+            bail!(
+                "Signal `{name}` carries {}; a signal is a number, a bool or a vector",
+                kind.name()
+            );
+        }
+        b.published.push((name.to_owned(), id));
+        Ok(NoneType)
     }
 
     /// `TimeToFailure(m, minT=0.0)`: wraps monitor `m`; reports the time of its first

@@ -116,6 +116,35 @@ impl Host for StarHost<'_, '_, '_, '_> {
             .eval
             .eval_function(function, &args, &[])
             .map_err(|e| format!("{e}"))?;
+        // A function given to foreach may return the action to perform.
+        if let Some(a) = out.downcast_ref::<super::values::Action>() {
+            if let Some(test) = self.test() {
+                let value = a.bound_value().unwrap_or(Rx::Unit);
+                test.performed.borrow_mut().push((a.sink, value));
+            }
+            return Ok(Rx::Unit);
+        }
         from_star(out)
+    }
+
+    fn performed(&mut self) -> Vec<(u32, Rx)> {
+        self.test()
+            .map(|t| std::mem::take(&mut *t.performed.borrow_mut()))
+            .unwrap_or_default()
+    }
+
+    fn log(&mut self) -> Vec<String> {
+        self.test()
+            .map(|t| std::mem::take(&mut *t.log.borrow_mut()))
+            .unwrap_or_default()
+    }
+}
+
+impl StarHost<'_, '_, '_, '_> {
+    /// The test's state the evaluator carries, if it carries one.
+    fn test(&self) -> Option<&super::values::TestState> {
+        self.eval
+            .extra
+            .and_then(|e| e.downcast_ref::<super::values::TestState>())
     }
 }

@@ -175,27 +175,119 @@ pub(crate) fn stream_methods(builder: &mut MethodsBuilder) {
         )
     }
 
-    /// `s.foreach(action)`: each event performs `action` (e.g. `p.walk`).
+    /// `s.min()`: the running minimum of a number stream (an event per event of `s`).
+    fn min<'v>(this: &Stream, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
+        extreme(this, eval, "min", f64::INFINITY, f64::min)
+    }
+
+    /// `s.max()`: the running maximum of a number stream.
+    fn max<'v>(this: &Stream, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
+        extreme(this, eval, "max", f64::NEG_INFINITY, f64::max)
+    }
+
+    /// `s.foreach(action)`: each event performs `action`: `p.walk`, `car.setSpeed`,
+    /// `car.brake(decel)`, `car.changeLane(lane)` (unbound: the event's value is the
+    /// argument), or a function of the event that calls actions.
     fn foreach<'v>(
         this: &Stream,
         action: Value<'v>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<NoneType> {
-        let a = action.downcast_ref::<Action>().ok_or_else(|| {
-            anyhow!(
-                "foreach needs an action such as `p.walk`, got a {}",
+        let src = StreamId(this.id);
+        if let Some(a) = action.downcast_ref::<Action>() {
+            let src = match a.bound_value() {
+                Some(v) => {
+                    if a.method == "changeLane" {
+                        check_lane(a, eval)?;
+                    }
+                    let f = Func::native("the action's argument", move |_| Ok(v.clone()));
+                    push(eval, Node::Map { src, f })?.id
+                }
+                None => src.0,
+            };
+            push(
+                eval,
+                Node::Foreach {
+                    src: StreamId(src),
+                    sink: a.sink,
+                },
+            )?;
+            return Ok(NoneType);
+        }
+        if action.get_type() != "function" {
+            bail!(
+                "foreach needs an action (`p.walk`, `car.brake(6)`, `car.setSpeed`, \
+                 `car.changeLane(2)`) or a function that performs actions, got a {}",
                 action.get_type()
-            )
-        })?;
-        push(
-            eval,
-            Node::Foreach {
-                src: StreamId(this.id),
-                sink: a.sink,
-            },
-        )?;
+            );
+        }
+        let f = lambda(action, "foreach", eval)?;
+        push(eval, Node::Perform { src, f })?;
         Ok(NoneType)
     }
+}
+
+/// A running minimum or maximum: `sum(init, f)` with a native fold.
+fn extreme(
+    this: &Stream,
+    eval: &Evaluator<'_, '_, '_>,
+    name: &'static str,
+    init: f64,
+    pick: fn(f64, f64) -> f64,
+) -> anyhow::Result<Stream> {
+    let f = Func::native(name, move |a| match (&a[0], &a[1]) {
+        (Rx::Num(acc), Rx::Num(v)) => Ok(Rx::Num(pick(*acc, *v))),
+        (_, v) => Err(format!(
+            "{name}() needs a stream of numbers, got a {}",
+            v.kind()
+        )),
+    });
+    push(
+        eval,
+        Node::Sum {
+            src: StreamId(this.id),
+            init: Rx::Num(init),
+            f: Some(f),
+        },
+    )
+}
+
+/// Checks at load that a bound `car.changeLane(lane)` names a lane of the segment the car
+/// starts on.
+fn check_lane(a: &Action, eval: &Evaluator<'_, '_, '_>) -> anyhow::Result<()> {
+    use paracosm_engine::behaviour::{decode_sink, Action as Act};
+    let (Act::ChangeLane(car), Some((lane, _))) = (decode_sink(a.sink), a.bound) else {
+        return Ok(());
+    };
+    let st = state(eval)?;
+    let b = st.scene.borrow();
+    let Some(object) = b
+        .objects
+        .iter()
+        .find(|o| o.actor == Some(paracosm_engine::behaviour::Actor::Car(car)))
+    else {
+        return Ok(());
+    };
+    let super::scene::Pending::Car { loc, .. } = &object.pending else {
+        return Ok(());
+    };
+    let Some(start) = b.locs.get(*loc).and_then(|r| r.resolve(&b.roads).ok()) else {
+        return Ok(());
+    };
+    let lanes = b.lane_offsets(&start);
+    if !lanes.iter().any(|(l, _)| f64::from(*l) == lane) {
+        let known: Vec<String> = lanes.iter().map(|(l, _)| l.to_string()).collect();
+        bail!(
+            "{}.changeLane({lane}): the segment it starts on has {}",
+            object.name,
+            if known.is_empty() {
+                "no lanes to change to (it starts inside a junction)".to_owned()
+            } else {
+                format!("the lanes {}", known.join(", "))
+            }
+        );
+    }
+    Ok(())
 }
 
 fn lane_of(v: Value) -> anyhow::Result<Lane> {

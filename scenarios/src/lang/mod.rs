@@ -140,9 +140,10 @@ pub(crate) fn header(source: &str) -> String {
     out.join(" ")
 }
 
-/// The globals of a scenario program: Starlark's standard library plus the paracosm builtins.
+/// The globals of a scenario program: Starlark's standard library, `print` (to the test's
+/// log), plus the paracosm builtins.
 fn globals() -> starlark::environment::Globals {
-    GlobalsBuilder::standard()
+    GlobalsBuilder::extended_by(&[starlark::environment::LibraryExtension::Print])
         .with(globals::paracosm_globals)
         .build()
 }

@@ -32,6 +32,29 @@ pub struct Syntax {
     used_in_code: HashMap<String, usize>,
     /// `(builtin, keyword, variable)` for every `Builtin(keyword = variable)`.
     passed: Vec<(String, String, String)>,
+    /// The variable each call is assigned to, by call site (`"line:col"`), for calls that run
+    /// once per evaluation: `x = Builtin(...)` at the top level of the module or under an
+    /// `if` there, not in a loop or a `def`.
+    assigned_once: HashMap<String, String>,
+}
+
+/// Records `x = f(...)` statements that run at most once per evaluation.
+fn assigned_once(ast: &AstModule, s: &AstStmt, out: &mut HashMap<String, String>) {
+    match &s.node {
+        StmtP::Statements(list) => list.iter().for_each(|s| assigned_once(ast, s, out)),
+        StmtP::If(_, body) => assigned_once(ast, body, out),
+        StmtP::IfElse(_, bodies) => {
+            assigned_once(ast, &bodies.0, out);
+            assigned_once(ast, &bodies.1, out);
+        }
+        StmtP::Assign(a) => {
+            if let (AssignTargetP::Identifier(id), ExprP::Call(..)) = (&a.lhs.node, &a.rhs.node) {
+                let at = format!("{}", ast.file_span(a.rhs.span).resolve_span().begin);
+                out.insert(at, id.node.ident.clone());
+            }
+        }
+        _ => {}
+    }
 }
 
 fn callee(e: &AstExpr) -> Option<String> {
@@ -69,7 +92,10 @@ impl Walker<'_> {
                     AssignTargetP::Identifier(id) => Some(id.node.ident.clone()),
                     _ => None,
                 };
-                self.expr(&a.rhs, target.as_deref(), in_code);
+                // `dist = trigger_distance`: an alias may be read anywhere, so the value is
+                // read by code.
+                let alias = matches!(a.rhs.node, ExprP::Identifier(_));
+                self.expr(&a.rhs, target.as_deref(), in_code || alias);
                 a.lhs.visit_expr(|e| self.expr(e, None, true));
             }
             // Everything a function does is code.
@@ -177,7 +203,13 @@ impl Syntax {
             out: Syntax::default(),
         };
         w.stmt(ast.statement(), false);
+        assigned_once(ast, ast.statement(), &mut w.out.assigned_once);
         w.out
+    }
+
+    /// Every call assigned once to a variable: `"line:col"` of the call → the variable.
+    pub fn objects(&self) -> HashMap<String, String> {
+        self.assigned_once.clone()
     }
 
     /// The site at `at` (`file:line:col`, the position of the call).

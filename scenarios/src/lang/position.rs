@@ -21,8 +21,11 @@ use starlark::values::{
 use starlark::StarlarkPagablePanic;
 
 /// How close two positions must be to be `==`, in metres (in the ground plane when a location
-/// is involved, in 3-D between two vectors).
-pub const POSITION_TOLERANCE_M: f64 = 0.01;
+/// is involved, in 3-D between two vectors): one micrometre, enough for the rounding of
+/// coordinates computed two ways, far below any step an actor takes (a pedestrian at
+/// 0.5 m/s moves 8 mm per step), so `pos == target` holds when an actor has arrived and not a
+/// step before (the paper's `done = pos.filter(_ == target)`).
+pub const POSITION_TOLERANCE_M: f64 = 1e-6;
 
 /// The resolved locations of one evaluation of a program, by location index; shared by every
 /// [`Loc`] value and updated by the scene builder when `connect` moves pieces.

@@ -75,6 +75,8 @@ pub struct Program {
     horizon_s: f64,
     sut: SutConfig,
     syntax: Syntax,
+    /// [`Syntax::objects`], shared with every evaluation.
+    objects: Arc<std::collections::HashMap<String, String>>,
 }
 
 fn lambda_values<'v>(b: &SceneBuilder, module: &Module<'v>) -> Result<Vec<Value<'v>>, String> {
@@ -123,11 +125,12 @@ impl Program {
         then: impl FnOnce(SceneBuilder, &Module) -> Result<R, String>,
     ) -> Result<(R, u64), String> {
         Module::with_temp_heap(|module| {
-            let state = LoadState::new(values);
+            let state = LoadState::new(values, self.objects.clone());
             let steps;
             {
                 let mut eval = Evaluator::new(&module);
                 eval.extra = Some(&state);
+                eval.set_print_handler(&state);
                 let limits = [
                     eval.set_max_tick_count(super::MAX_LOAD_STEPS),
                     eval.set_max_heap_size(super::MAX_LOAD_HEAP_BYTES),
@@ -180,7 +183,15 @@ impl Program {
                 })?;
                 steps = eval.get_total_tick_count();
             }
-            let b = state.scene.into_inner();
+            let printed = std::mem::take(&mut *state.log.borrow_mut());
+            let mut b = state.scene.into_inner();
+            if b.values.is_none() {
+                // The evaluation at load: what the program prints is shown once, on stderr.
+                for line in &printed {
+                    eprintln!("{}: print: {line}", self.file);
+                }
+            }
+            b.log = printed;
             finished(&b).map_err(|m| format!("error: {m}\n --> {}", self.file))?;
             Ok((then(b, &module)?, steps))
         })
@@ -258,7 +269,7 @@ impl Program {
                 .objects
                 .iter()
                 .find(|o| matches!(o.pending, super::scene::Pending::Ego { .. }))
-                .and_then(|o| o.name.rsplit("declared at ").next().map(str::to_owned))
+                .map(|o| o.at.clone())
                 .unwrap_or_else(|| self.file.clone());
             return Err(format!(
                 "error: AutonomousVehicle(sut=) depends on the open parameters' values: one system is \
@@ -399,6 +410,61 @@ impl Program {
     }
 }
 
+/// Errors of a lambda that depend on the values it is given rather than on their types: a
+/// sample value may cause them where no test would (a division by a distance that is 0 only
+/// at t = 0), so the check at load lets them through to the tests.
+const VALUE_ERRORS: [&str; 4] = [
+    "division by zero",
+    "sqrt of a negative",
+    "out of bound",
+    "fail:",
+];
+
+impl Program {
+    /// Calls every lambda of the world the first evaluation built once, on sample values of
+    /// its streams at t = 0 ([`paracosm_engine::Simulation::check_streams`]), so that a type
+    /// error in a lambda is one error at load rather than one per test.
+    ///
+    /// # Errors
+    /// The lambda's error with its `file:line:col`, unless it is one of [`VALUE_ERRORS`].
+    fn check_lambdas(&self) -> Result<(), String> {
+        self.evaluate(None, |b, module| {
+            if b.lambdas == 0 {
+                return Ok(());
+            }
+            let spec = scene::world(&b, self.horizon_s)?;
+            // A world that does not build is reported elsewhere, by the test that builds it.
+            let Ok(sim) = paracosm_engine::Simulation::new(&spec) else {
+                return Ok(());
+            };
+            let functions = lambda_values(&b, module)?;
+            let test = super::values::TestState::default();
+            let mut eval = Evaluator::new(module);
+            eval.extra = Some(&test);
+            eval.set_print_handler(&test);
+            let mut host = StarHost::new(&mut eval, &functions);
+            match sim.check_streams(&mut host) {
+                Ok(()) => Ok(()),
+                Err(e) => {
+                    let message = e.to_string();
+                    let lower = message.to_ascii_lowercase();
+                    if VALUE_ERRORS.iter().any(|v| lower.contains(v)) {
+                        return Ok(());
+                    }
+                    let message = message
+                        .split_once(": ")
+                        .filter(|(head, _)| head.starts_with("stream "))
+                        .map_or(message.as_str(), |(_, rest)| rest);
+                    Err(format!(
+                        "{message}\n(found when loading: every lambda is called once on sample \
+                         values of its stream's type, those of the first test's world at t = 0)"
+                    ))
+                }
+            }
+        })
+    }
+}
+
 impl crate::Worlds for Program {
     fn with_world(
         &self,
@@ -410,7 +476,11 @@ impl crate::Worlds for Program {
             self.consistent(&b)?;
             let spec = scene::world(&b, self.horizon_s)?;
             let functions = lambda_values(&b, module)?;
+            let test = super::values::TestState::default();
+            test.log.borrow_mut().extend(b.log.iter().cloned());
             let mut eval = Evaluator::new(module);
+            eval.extra = Some(&test);
+            eval.set_print_handler(&test);
             let mut host = StarHost::new(&mut eval, &functions);
             run(&spec, &mut host);
             Ok(())
@@ -437,8 +507,10 @@ pub fn load(
     globals: Globals,
 ) -> Result<Scenario, ScenarioError> {
     let lang = ScenarioError::Language;
+    let syntax = Syntax::of(&ast, BUILTINS);
     let mut program = Program {
-        syntax: Syntax::of(&ast, BUILTINS),
+        objects: Arc::new(syntax.objects()),
+        syntax,
         file: file.to_owned(),
         ast,
         globals,
@@ -448,6 +520,10 @@ pub fn load(
         sut: SutConfig::builtin("aeb").map_err(lang)?,
     };
     let first = program.evaluate(None, |b, _| Ok(b)).map_err(lang)?;
+    program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
+    // Signals the monitors read exist (checked when the world is built).
+    scene::check_signals(&first).map_err(lang)?;
+    program.check_lambdas().map_err(lang)?;
     let syntax = &program.syntax;
 
     // Names: explicit, else from where the parameter stands, else by position.

@@ -67,6 +67,8 @@ pub enum PedTrigger {
     },
     /// Any stream: its first event starts the walk.
     Stream(StreamId),
+    /// None: it walks only when an action moves it (`stream.foreach(p.walk)`).
+    Never,
 }
 
 /// An `onLane(...)` not yet resolved (pieces may still move).
@@ -170,8 +172,15 @@ pub enum Pending {
 /// A declared actor: what it is, where it was declared, and whether `place` saw it.
 #[derive(Debug, Clone)]
 pub struct ObjectDecl {
-    /// E.g. `Car declared at follow.star:12:7`.
+    /// How messages name it: its variable (`lead`), else `Car at follow.star:12:7`.
     pub name: String,
+    /// Where it was declared, `file:line:col`.
+    pub at: String,
+    /// The variable it is assigned to, when its declaration runs once (`lead = Car(...)` at
+    /// the top level): its outputs are `Stl` signals `lead.speed`, `lead.pos.x`, ...
+    pub variable: Option<String>,
+    /// The actor it is (`None` for an obstacle).
+    pub actor: Option<Actor>,
     /// The declaration.
     pub pending: Pending,
     /// Whether `place` included it.
@@ -202,6 +211,8 @@ pub struct CarDecl {
     pub enabled: bool,
     /// Its lane change, if any.
     pub lane_change: Option<paracosm_engine::LaneChangeSpec>,
+    /// Lanes for `changeLane` ([`paracosm_engine::CarSpec::lane_offsets_m`]).
+    pub lane_offsets_m: Vec<(i32, f64)>,
 }
 
 /// The ego vehicle as resolved.
@@ -264,6 +275,10 @@ pub struct SceneBuilder {
     pub car_names: Vec<String>,
     /// Number of lambdas stored so far.
     pub lambdas: u32,
+    /// Streams published by name to monitors (`Monitor`, `Assert`, `Signal`).
+    pub published: Vec<(String, StreamId)>,
+    /// What the program printed while this evaluation ran (the start of a test's log).
+    pub log: Vec<String>,
     /// `onLane` results, by index.
     pub locs: Vec<LaneRef>,
     /// Where each of `locs` stands on the network as it is now, shared with the `Location`
@@ -332,6 +347,8 @@ impl SceneBuilder {
             warnings: Vec::new(),
             car_names: Vec::new(),
             lambdas: 0,
+            published: Vec::new(),
+            log: Vec::new(),
             locs: Vec::new(),
             loc_table: Default::default(),
             objects: Vec::new(),
@@ -407,7 +424,9 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
         .as_ref()
         .ok_or("the program places no AutonomousVehicle: nothing to test")?;
     let (light, fog) = b.world.ok_or("the program has no World(...)")?;
-    let graph = b.graph.clone().finish().map_err(|e| e.to_string())?;
+    let mut nodes = b.graph.clone();
+    let published = published(b, &mut nodes)?;
+    let graph = nodes.finish().map_err(|e| e.to_string())?;
     let streams = graph
         .bind(&over_time_streams(b, horizon_s))
         .map_err(|e| e.to_string())?;
@@ -431,6 +450,7 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
             size: Size::CAR,
             enabled: c.enabled,
             lane_change: c.lane_change,
+            lane_offsets_m: c.lane_offsets_m.clone(),
         })
         .collect();
     Ok(WorldSpec {
@@ -456,8 +476,121 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
         obstacles: b.obstacles.clone(),
         environment: EnvironmentSpec { light, fog },
         streams,
+        published,
         lidar: LidarSpec::default(),
     })
+}
+
+/// Checks that every signal a monitor reads is published by the runner, the program or an
+/// actor (see [`world`]).
+///
+/// # Errors
+/// A message naming the signal, what is published, and the monitor's `file:line:col`.
+pub fn check_signals(b: &SceneBuilder) -> Result<(), String> {
+    published(b, &mut b.graph.clone()).map(|_| ())
+}
+
+/// The outputs of an actor that `Stl` formulas may read as `<variable>.<output>`.
+const ACTOR_SIGNALS: [(&str, Output); 5] = [
+    ("pos", Output::Pos),
+    ("vel", Output::Vel),
+    ("speed", Output::Speed),
+    ("heading", Output::Heading),
+    ("collision", Output::Collision),
+];
+
+/// The streams published to the monitors: those the program published (`Monitor`, `Assert`,
+/// `Signal`), then each actor output a monitor reads by name (`lead.speed`, `p.pos.x`), as a
+/// probe added to `graph`.
+///
+/// # Errors
+/// A message naming a signal a monitor reads that is neither the runner's, the program's nor
+/// an actor's.
+fn published(
+    b: &SceneBuilder,
+    graph: &mut GraphBuilder,
+) -> Result<Vec<(String, StreamId)>, String> {
+    let mut out = b.published.clone();
+    let known = |out: &[(String, StreamId)], s: &str| {
+        crate::runner::signal::ALL.contains(&s)
+            || out.iter().any(|(n, _)| {
+                n == s
+                    || s.strip_prefix(n.as_str())
+                        .is_some_and(|c| [".x", ".y", ".z"].contains(&c))
+            })
+    };
+    for (k, m) in b.monitors.iter().enumerate() {
+        let at = b.monitors_at.get(k).map(String::as_str).unwrap_or("");
+        for s in m.signals() {
+            if known(&out, &s) {
+                continue;
+            }
+            let found = s.split_once('.').and_then(|(var, rest)| {
+                let object = b
+                    .objects
+                    .iter()
+                    .find(|o| o.variable.as_deref() == Some(var))?;
+                let actor = object.actor?;
+                let field = rest.split('.').next()?;
+                let (_, output) = ACTOR_SIGNALS.iter().find(|(n, _)| *n == field)?;
+                Some((format!("{var}.{field}"), actor, *output))
+            });
+            match found {
+                Some((name, actor, output)) => {
+                    let id = graph.push(Node::Probe(probe(actor, output)));
+                    out.push((name, id));
+                    if !known(&out, &s) {
+                        return Err(format!(
+                            "{} reads the signal `{s}`: `{}` is a {}, so write `{}` or, for a \
+                             position or velocity, `{}.x`, `.y` or `.z`",
+                            m.name(),
+                            out.last().map_or("", |(n, _)| n.as_str()),
+                            if matches!(output, Output::Pos | Output::Vel) {
+                                "vector"
+                            } else {
+                                "number"
+                            },
+                            out.last().map_or("", |(n, _)| n.as_str()),
+                            out.last().map_or("", |(n, _)| n.as_str()),
+                        ));
+                    }
+                }
+                None => {
+                    let actors: Vec<&str> = b
+                        .objects
+                        .iter()
+                        .filter(|o| o.actor.is_some())
+                        .filter_map(|o| o.variable.as_deref())
+                        .collect();
+                    let mine: Vec<&str> = b
+                        .published
+                        .iter()
+                        .map(|(n, _)| n.as_str())
+                        .filter(|n| !n.starts_with("monitor:"))
+                        .collect();
+                    return Err(format!(
+                        "monitor `{}` reads the signal `{s}`, which nothing publishes. The runner \
+                         publishes {}; the program's Signal(...)s: {}; each actor assigned to a \
+                         variable at the top level publishes <variable>.pos.x/.y/.z, .vel.x/.y/.z, \
+                         .speed, .heading and .collision (actors: {})\n --> {at}",
+                        m.name(),
+                        crate::runner::signal::ALL.join(", "),
+                        if mine.is_empty() {
+                            "none".to_owned()
+                        } else {
+                            mine.join(", ")
+                        },
+                        if actors.is_empty() {
+                            "none".to_owned()
+                        } else {
+                            actors.join(", ")
+                        },
+                    ));
+                }
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// Parses a route list of turns.
@@ -574,6 +707,7 @@ impl SceneBuilder {
                         PedTrigger::Stream(trigger) => {
                             self.graph.pedestrian_with_trigger(ped_index, t, trigger);
                         }
+                        PedTrigger::Never => {}
                     }
                     ped_index += 1;
                     self.pedestrians.push(PedestrianDecl {
@@ -599,12 +733,14 @@ impl SceneBuilder {
                         Some(c) => Some(self.lane_change(&o.name, &start, c)?),
                         None => None,
                     };
+                    let lane_offsets_m = self.lane_offsets(&start);
                     self.cars.push(CarDecl {
                         path,
                         speed,
                         color,
                         enabled,
                         lane_change,
+                        lane_offsets_m,
                     });
                     self.car_names.push(o.name.clone());
                 }
@@ -625,6 +761,29 @@ impl SceneBuilder {
 }
 
 impl SceneBuilder {
+    /// Each driving lane of the segment `start` is on, with its sideways offset from
+    /// `start`'s lane (m, positive to the right of the direction of travel); empty inside a
+    /// junction.
+    pub fn lane_offsets(&self, start: &Location) -> Vec<(i32, f64)> {
+        if start.through.is_some() {
+            return Vec::new();
+        }
+        let h = start.heading_rad;
+        let right = [h.sin(), h.cos()];
+        let half = (self.roads.piece(start.piece).kind.lanes() / 2) as i32;
+        (-half..=half)
+            .filter(|&l| l != 0)
+            .filter_map(|l| {
+                let at = self
+                    .roads
+                    .on_lane(start.piece, paracosm_engine::Lane::Driving(l), start.at_m)
+                    .ok()?;
+                let d = [at.pos_m[0] - start.pos_m[0], at.pos_m[2] - start.pos_m[2]];
+                Some((l, d[0] * right[0] + d[1] * right[1]))
+            })
+            .collect()
+    }
+
     /// The engine's lane change of car `name` starting at `start`: the sideways offset to lane
     /// `c.to` of the same segment, measured to the right of the car's direction.
     ///

@@ -70,7 +70,7 @@ fn an_invalid_connection_is_refused() {
     let src = "a = RoadSegment(len = 50.0, nlanes = 2)\nb = RoadSegment(len = 50.0, nlanes = 6)\na.connect((a.TWO, b, b.ONE))\n";
     assert_diag(
         src,
-        "lane-count mismatch: RoadSegment declared at bad.star:1:5.TWO has 2 lanes but RoadSegment declared at bad.star:2:5.ONE has 6",
+        "lane-count mismatch: RoadSegment a.TWO has 2 lanes but RoadSegment b.ONE has 6",
         "3:1",
     );
 }
@@ -80,7 +80,7 @@ fn objects_starting_in_collision_are_both_named() {
     let src = format!("{HEADER}c = Car(loc = r.onLane(1, 12))\nw.place(r, v, c)\n");
     assert_diag(
         &src,
-        "AutonomousVehicle declared at bad.star:3:5 and Car declared at bad.star:4:5 start in collision",
+        "AutonomousVehicle v and Car c start in collision",
         "5:1",
     );
 }
@@ -88,7 +88,7 @@ fn objects_starting_in_collision_are_both_named() {
 #[test]
 fn a_vehicle_off_the_road_is_refused() {
     let src = format!("{HEADER}c = Car(loc = r.onLane(r.SideWalk, 50))\nw.place(r, v, c)\n");
-    assert_diag(&src, "Car declared at bad.star:4:5 is off the road", "5:1");
+    assert_diag(&src, "Car c is off the road", "5:1");
 }
 
 #[test]
@@ -189,7 +189,9 @@ fn stl_monitors_judge_tests_and_settle_early() {
     );
     let e = bad("G[0,15] (dist_ped > 0.5)");
     assert!(
-        e.contains("unknown signal `dist_ped`") && e.contains("ego_separation_m"),
+        e.contains("reads the signal `dist_ped`, which nothing publishes")
+            && e.contains("ego_separation_m")
+            && e.contains("stl.star:"),
         "{e}"
     );
 }
@@ -291,7 +293,7 @@ fn computed_values_are_checked_as_the_test_runs() {
     let e = run_once(fog).unwrap_err().to_string();
     // The first step past 2 s: t = 121/60 s, fog 1.0083.
     assert!(
-        e.starts_with("at t = 2.017 s, the fog of World declared at run.star:1:5 was 1.0083333333333333 (a number); it must be a number in [0, 1]"),
+        e.starts_with("at t = 2.017 s, the fog of World w (run.star:1:5) was 1.0083333333333333 (a number); it must be a number in [0, 1]"),
         "{e}"
     );
     for (speed, value) in [
@@ -306,7 +308,7 @@ fn computed_values_are_checked_as_the_test_runs() {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("the speed of Car declared at run.star:4:5") && e.contains(value),
+            e.contains("the speed of Car c (run.star:4:5)") && e.contains(value),
             "{speed}: {e}"
         );
     }

@@ -193,7 +193,8 @@ pub enum SType {
 }
 
 impl SType {
-    fn name(self) -> &'static str {
+    /// The kind in words, for messages: `numbers`, `bools`...
+    pub fn name(self) -> &'static str {
         match self {
             SType::Num => "numbers",
             SType::Bool => "bools",
@@ -276,7 +277,7 @@ pub fn stream_types(b: &SceneBuilder) -> Vec<SType> {
                 None => of(src),
                 Some(_) => SType::Any,
             },
-            Node::Foreach { .. } => SType::Unit,
+            Node::Foreach { .. } | Node::Perform { .. } => SType::Unit,
         };
         out.push(t);
     }

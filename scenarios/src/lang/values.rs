@@ -194,10 +194,20 @@ starlark_simple_value!(ActorVal);
 #[starlark_value(type = "Actor")]
 impl<'v> StarlarkValue<'v> for ActorVal {
     fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
-        if let ActorKind::Pedestrian(i) = self.kind {
-            if attribute == "walk" {
-                return Some(heap.alloc(Action { sink: i }));
-            }
+        use paracosm_engine::behaviour::{action_sink, Action as Act};
+        let action = match (self.kind, attribute) {
+            (ActorKind::Pedestrian(i), "walk") => Some((Act::Walk(i), "walk")),
+            (ActorKind::Car(i), "setSpeed") => Some((Act::SetSpeed(i), "setSpeed")),
+            (ActorKind::Car(i), "brake") => Some((Act::Brake(i), "brake")),
+            (ActorKind::Car(i), "changeLane") => Some((Act::ChangeLane(i), "changeLane")),
+            _ => None,
+        };
+        if let Some((a, method)) = action {
+            return Some(heap.alloc(Action {
+                sink: action_sink(a),
+                method,
+                bound: None,
+            }));
         }
         let i = OUTPUT_NAMES.iter().position(|n| *n == attribute)?;
         Some(heap.alloc(Stream::of(self.outputs[i])))
@@ -205,30 +215,183 @@ impl<'v> StarlarkValue<'v> for ActorVal {
 
     fn dir_attr(&self) -> Vec<String> {
         let mut v: Vec<String> = OUTPUT_NAMES.iter().map(|s| s.to_string()).collect();
-        if matches!(self.kind, ActorKind::Pedestrian(_)) {
-            v.push("walk".into());
+        match self.kind {
+            ActorKind::Pedestrian(_) => v.push("walk".into()),
+            ActorKind::Car(_) => v.extend(["setSpeed", "brake", "changeLane"].map(String::from)),
+            ActorKind::Ego => {}
         }
         v
     }
 }
 
-/// An action for `foreach`: `p.walk` moves pedestrian `p` one step toward its target.
-#[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
+/// An action (paper §2, `foreach(walk)`): `p.walk`, `car.setSpeed`, `car.brake`,
+/// `car.changeLane`, with its argument when a call bound one (`car.brake(6)`).
+///
+/// Given to `foreach`, it is performed at each event: a bound action with its argument, an
+/// unbound one with the event's value as its argument. Called during a test (inside a `def`
+/// given to `foreach`), it is performed at once.
+#[derive(Debug, Clone, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
 pub struct Action {
-    /// The sink number.
+    /// The engine's sink number ([`paracosm_engine::behaviour::action_sink`]).
     pub sink: u32,
+    /// The method's name, for messages.
+    pub method: &'static str,
+    /// The arguments a call bound: a number (m/s, m/s², a lane), and for `changeLane` a
+    /// duration (s); `None` before a call.
+    #[allocative(skip)]
+    pub bound: Option<(f64, Option<f64>)>,
+}
+
+impl Action {
+    /// The event value the engine's sink reads for the bound arguments.
+    pub fn bound_value(&self) -> Option<paracosm_engine::rx::Value> {
+        use paracosm_engine::rx::Value as Rx;
+        self.bound.map(|(a, b)| match b {
+            Some(d) => Rx::Tuple(vec![Rx::Num(a), Rx::Num(d)]),
+            None => Rx::Num(a),
+        })
+    }
+
+    /// Whether the action needs an argument (all but `walk`).
+    pub fn takes_argument(&self) -> bool {
+        self.method != "walk"
+    }
 }
 
 impl fmt::Display for Action {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "walk({})", self.sink)
+        match self.bound {
+            None => write!(f, "{}", self.method),
+            Some((a, None)) => write!(f, "{}({a})", self.method),
+            Some((a, Some(d))) => write!(f, "{}({a}, duration = {d})", self.method),
+        }
     }
 }
 
 starlark_simple_value!(Action);
 
+/// What a test's evaluator carries: the actions performed by host functions, and the lines
+/// the program printed (the test's log).
+#[derive(Debug, Default, ProvidesStaticType)]
+pub struct TestState {
+    /// Actions performed since the host last drained them, `(sink, value)`.
+    pub performed: std::cell::RefCell<Vec<(u32, paracosm_engine::rx::Value)>>,
+    /// Lines printed, in order.
+    pub log: std::cell::RefCell<Vec<String>>,
+}
+
+impl starlark::PrintHandler for TestState {
+    fn println(&self, text: &str) -> starlark::Result<()> {
+        self.log.borrow_mut().push(text.to_owned());
+        Ok(())
+    }
+}
+
 #[starlark_value(type = "Action")]
-impl<'v> StarlarkValue<'v> for Action {}
+impl<'v> StarlarkValue<'v> for Action {
+    fn invoke(
+        &self,
+        _me: Value<'v>,
+        args: &starlark::eval::Arguments<'v, '_>,
+        eval: &mut starlark::eval::Evaluator<'v, '_, '_>,
+    ) -> starlark::Result<Value<'v>> {
+        let fail = |m: String| starlark::Error::new_other(anyhow::anyhow!(m));
+        if self.bound.is_some() {
+            return Err(fail(format!(
+                "{self} is already an action with its argument; pass it to foreach"
+            )));
+        }
+        let heap = eval.heap();
+        let number = |v: Value<'v>, what: &str| -> starlark::Result<f64> {
+            v.unpack_i32()
+                .map(f64::from)
+                .or_else(|| {
+                    starlark::values::ValueLike::downcast_ref::<
+                        starlark::values::float::StarlarkFloat,
+                    >(v)
+                    .map(|f| f.0)
+                })
+                .ok_or_else(|| {
+                    fail(format!(
+                        "{}: {what} is a number, got a {}",
+                        self.method,
+                        v.get_type()
+                    ))
+                })
+        };
+        let bound = match self.method {
+            "walk" => {
+                args.no_named_args()?;
+                let [] = args.positional(heap)?;
+                None
+            }
+            "changeLane" => {
+                let [lane] = args.positional(heap)?;
+                let mut duration = None;
+                for (k, v) in args.names_map()?.iter() {
+                    if k.as_str() != "duration" {
+                        return Err(fail(format!(
+                            "changeLane takes (lane, duration = s), not `{}`",
+                            k.as_str()
+                        )));
+                    }
+                    duration = Some(number(*v, "duration (s)")?);
+                }
+                let lane = number(lane, "the lane")?;
+                if lane.fract() != 0.0 || lane == 0.0 {
+                    return Err(fail(format!(
+                        "changeLane: a lane is a whole number other than 0, got {lane}"
+                    )));
+                }
+                if duration.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
+                    return Err(fail("changeLane(duration=) is a time > 0 in s".into()));
+                }
+                Some((lane, duration))
+            }
+            method => {
+                args.no_named_args()?;
+                let [v] = args.positional(heap)?;
+                let v = number(
+                    v,
+                    if method == "brake" {
+                        "the deceleration (m/s²)"
+                    } else {
+                        "the speed (m/s)"
+                    },
+                )?;
+                let ok = if method == "brake" {
+                    v.is_finite() && v > 0.0
+                } else {
+                    v.is_finite() && v >= 0.0
+                };
+                if !ok {
+                    return Err(fail(format!(
+                        "{method} needs {}, got {v}",
+                        if method == "brake" {
+                            "a deceleration > 0 m/s²"
+                        } else {
+                            "a speed >= 0 m/s"
+                        }
+                    )));
+                }
+                Some((v, None))
+            }
+        };
+        let action = Action {
+            bound,
+            ..self.clone()
+        };
+        // During a test, calling an action performs it.
+        if let Some(test) = eval.extra.and_then(|e| e.downcast_ref::<TestState>()) {
+            let value = action
+                .bound_value()
+                .unwrap_or(paracosm_engine::rx::Value::Unit);
+            test.performed.borrow_mut().push((action.sink, value));
+            return Ok(Value::new_none());
+        }
+        Ok(heap.alloc(action))
+    }
+}
 
 /// `World(light=, fog=)`.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
