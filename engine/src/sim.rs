@@ -538,6 +538,7 @@ impl Simulation {
         }
         let t = self.t_s();
         self.sinks.clear();
+        // Field by field, not `self.inputs()`: the graph's step borrows `self.streams`.
         let inputs = WorldInputs {
             physics: &self.physics,
             ego: &self.ego,
@@ -562,15 +563,8 @@ impl Simulation {
     /// # Errors
     /// [`EngineError::Stream`] with the first failure.
     pub fn check_streams(&self, host: &mut dyn Host) -> Result<(), EngineError> {
-        let inputs = WorldInputs {
-            physics: &self.physics,
-            ego: &self.ego,
-            ego_touching: self.ego_contact(),
-            pedestrians: &self.pedestrians,
-            cars: &self.cars,
-        };
         let mut copy = Runtime::new(self.streams.graph().clone());
-        copy.check(self.t_s(), &inputs, host)?;
+        copy.check(self.t_s(), &self.inputs(), host)?;
         Ok(())
     }
 
@@ -677,6 +671,17 @@ impl Simulation {
     fn capture_all_named(&mut self, name: &str) -> Result<(), EngineError> {
         let named: Vec<bool> = self.sensors.values().map(|s| s.name() == name).collect();
         self.capture_all(|h| named[h.index()])
+    }
+
+    /// The physics outputs the stream graph reads now.
+    fn inputs(&self) -> WorldInputs<'_> {
+        WorldInputs {
+            physics: &self.physics,
+            ego: &self.ego,
+            ego_touching: self.ego_contact(),
+            pedestrians: &self.pedestrians,
+            cars: &self.cars,
+        }
     }
 
     /// Whether the ego vehicle touches any actor now.

@@ -361,43 +361,22 @@ fn many_views_render_in_one_batch_like_one_at_a_time() {
 fn an_npc_cars_collider_and_its_drawing_agree() {
     use paracosm_engine::behaviour::GraphBuilder;
     use paracosm_engine::rx::{Node, Value};
-    use paracosm_engine::{
-        CarSpec, EgoSpec, EnvironmentSpec, Lane, LidarSpec, PieceId, Simulation, VehicleParams,
-        WorldSpec, DEFAULT_DT_S,
-    };
+    use paracosm_engine::{CarSpec, Lane, PieceId, Simulation};
     let network = road();
     let start = network.on_lane(PieceId(0), Lane::Driving(1), 10.0).unwrap();
     let car_at = network.on_lane(PieceId(0), Lane::Driving(1), 40.0).unwrap();
     let mut g = GraphBuilder::new();
-    let light = g.push(Node::Const(Value::Num(NOMINAL_LIGHT)));
-    let fog = g.push(Node::Const(Value::Num(0.0)));
     let still = g.push(Node::Const(Value::Num(0.0)));
-    let spec = WorldSpec {
-        dt_s: DEFAULT_DT_S,
-        frictions: vec![],
-        ego: EgoSpec {
-            start,
-            initial_speed_mps: 0.0,
-            vehicle: VehicleParams::default(),
-            route: vec![],
-        },
-        pedestrians: vec![],
-        cars: vec![CarSpec {
-            path: network.route(&car_at, &[], 100.0).unwrap(),
-            speed: still,
-            color: "white".into(),
-            size: Size::CAR,
-            enabled: true,
-            lane_change: None,
-            lane_offsets_m: vec![],
-        }],
-        obstacles: vec![],
-        environment: EnvironmentSpec { light, fog },
-        streams: g.finish().unwrap(),
-        published: vec![],
-        lidar: LidarSpec::default(),
-        network,
-    };
+    let cars = vec![CarSpec {
+        path: network.route(&car_at, &[], 100.0).unwrap(),
+        speed: still,
+        color: "white".into(),
+        size: Size::CAR,
+        enabled: true,
+        lane_change: None,
+        lane_offsets_m: vec![],
+    }];
+    let spec = standing_world(network, start, g, cars, vec![]);
     let mut sim = Simulation::new(&spec).unwrap();
     let camera = CameraSpec {
         width: 640,
@@ -462,11 +441,7 @@ fn an_npc_cars_collider_and_its_drawing_agree() {
 #[test]
 fn an_obstacle_is_drawn_by_the_camera_at_its_place_and_size() {
     use paracosm_engine::behaviour::GraphBuilder;
-    use paracosm_engine::rx::{Node, Value};
-    use paracosm_engine::{
-        EgoSpec, EnvironmentSpec, Lane, LidarSpec, ObstacleSpec, PieceId, Simulation,
-        VehicleParams, WorldSpec, DEFAULT_DT_S,
-    };
+    use paracosm_engine::{Lane, ObstacleSpec, PieceId, Simulation};
     let network = road();
     let start = network.on_lane(PieceId(0), Lane::Driving(1), 10.0).unwrap();
     let at = network.on_lane(PieceId(0), Lane::Driving(1), 40.0).unwrap();
@@ -482,27 +457,13 @@ fn an_obstacle_is_drawn_by_the_camera_at_its_place_and_size() {
         ..CameraSpec::default()
     };
     let frame_with = |obstacles: Vec<ObstacleSpec>| {
-        let mut g = GraphBuilder::new();
-        let light = g.push(Node::Const(Value::Num(NOMINAL_LIGHT)));
-        let fog = g.push(Node::Const(Value::Num(0.0)));
-        let spec = WorldSpec {
-            dt_s: DEFAULT_DT_S,
-            frictions: vec![],
-            ego: EgoSpec {
-                start,
-                initial_speed_mps: 0.0,
-                vehicle: VehicleParams::default(),
-                route: vec![],
-            },
-            pedestrians: vec![],
-            cars: vec![],
+        let spec = standing_world(
+            network.clone(),
+            start,
+            GraphBuilder::new(),
+            vec![],
             obstacles,
-            environment: EnvironmentSpec { light, fog },
-            streams: g.finish().unwrap(),
-            published: vec![],
-            lidar: LidarSpec::default(),
-            network: network.clone(),
-        };
+        );
         let mut sim = Simulation::new(&spec).unwrap();
         sim.attach_camera(&camera, 0).unwrap();
         let ego_x = sim.ego_state().pos_m[0];
@@ -545,4 +506,36 @@ fn an_obstacle_is_drawn_by_the_camera_at_its_place_and_size() {
         !(0..w).any(|u| at_box(&empty, u, middle)),
         "without the obstacle nothing stands at its distance"
     );
+}
+
+/// A world on `network` in nominal daylight without fog, the ego vehicle standing at `start`,
+/// with `cars` (whose streams `g` holds) and `obstacles`.
+fn standing_world(
+    network: paracosm_engine::Network,
+    start: paracosm_engine::Location,
+    mut g: paracosm_engine::behaviour::GraphBuilder,
+    cars: Vec<paracosm_engine::CarSpec>,
+    obstacles: Vec<paracosm_engine::ObstacleSpec>,
+) -> paracosm_engine::WorldSpec {
+    use paracosm_engine::rx::{Node, Value};
+    let light = g.push(Node::Const(Value::Num(paracosm_engine::NOMINAL_LIGHT)));
+    let fog = g.push(Node::Const(Value::Num(0.0)));
+    paracosm_engine::WorldSpec {
+        dt_s: paracosm_engine::DEFAULT_DT_S,
+        frictions: vec![],
+        ego: paracosm_engine::EgoSpec {
+            start,
+            initial_speed_mps: 0.0,
+            vehicle: paracosm_engine::VehicleParams::default(),
+            route: vec![],
+        },
+        pedestrians: vec![],
+        cars,
+        obstacles,
+        environment: paracosm_engine::EnvironmentSpec { light, fog },
+        streams: g.finish().unwrap(),
+        published: vec![],
+        lidar: paracosm_engine::LidarSpec::default(),
+        network,
+    }
 }

@@ -135,15 +135,8 @@ impl Runtime {
             let sample = |s: &Self, id: &StreamId| s.states[id.0].value.clone();
             let node = self.graph.nodes()[i].clone();
             let out = match &node {
-                Node::Const(v) => Some(v.clone()),
-                Node::Tick => Some(Value::Num(t_s)),
-                Node::Open(o) => Some(o.at(t_s)),
-                Node::Probe(p) => Some(inputs.probe(*p)),
-                Node::Param(slot) => {
-                    return Err(RxError::Unbound {
-                        node: i,
-                        slot: *slot,
-                    })
+                Node::Const(_) | Node::Tick | Node::Open(_) | Node::Probe(_) | Node::Param(_) => {
+                    Some(source(i, &node, t_s, inputs)?)
                 }
                 Node::Map { src, f } => match sample(self, src) {
                     Some(v) => Some(call(i, f, &[v], host, self)?),
@@ -214,15 +207,8 @@ impl Runtime {
         let done = |s: &Self, id: StreamId| s.states[id.0].done;
         let node = &self.graph.nodes()[i];
         let out = match node {
-            Node::Const(v) => Some(v.clone()),
-            Node::Tick => Some(Value::Num(t_s)),
-            Node::Open(o) => Some(o.at(t_s)),
-            Node::Probe(p) => Some(inputs.probe(*p)),
-            Node::Param(slot) => {
-                return Err(RxError::Unbound {
-                    node: i,
-                    slot: *slot,
-                })
+            Node::Const(_) | Node::Tick | Node::Open(_) | Node::Probe(_) | Node::Param(_) => {
+                Some(source(i, node, t_s, inputs)?)
             }
             Node::Map { src, f } => {
                 let f = f.clone();
@@ -377,6 +363,29 @@ impl Runtime {
             }
         };
         Ok(out)
+    }
+}
+
+/// The value of source node `node` (number `i`) at `t_s`: a constant, the time, a bound open
+/// stream or a probe.
+///
+/// # Errors
+/// [`RxError::Unbound`] for an open parameter slot; [`RxError::Type`] for a node that is not
+/// a source.
+fn source(i: usize, node: &Node, t_s: f64, inputs: &dyn Inputs) -> Result<Value, RxError> {
+    match node {
+        Node::Const(v) => Ok(v.clone()),
+        Node::Tick => Ok(Value::Num(t_s)),
+        Node::Open(o) => Ok(o.at(t_s)),
+        Node::Probe(p) => Ok(inputs.probe(*p)),
+        Node::Param(slot) => Err(RxError::Unbound {
+            node: i,
+            slot: *slot,
+        }),
+        _ => Err(RxError::Type {
+            node: i,
+            message: "not a source stream".into(),
+        }),
     }
 }
 

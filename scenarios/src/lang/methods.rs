@@ -200,8 +200,19 @@ pub(crate) fn stream_methods(builder: &mut MethodsBuilder) {
                     if a.method == "changeLane" {
                         check_lane(a, eval)?;
                     }
-                    let f = Func::native("the action's argument", move |_| Ok(v.clone()));
-                    push(eval, Node::Map { src, f })?.id
+                    // The argument rides in the graph as a fold's initial value, kept at every
+                    // event, so that a world whose argument differs differs in its graph (the
+                    // usage analysis sees which parameters an action reads).
+                    let keep = Func::native("the action's argument", |a| Ok(a[0].clone()));
+                    push(
+                        eval,
+                        Node::Sum {
+                            src,
+                            init: v,
+                            f: Some(keep),
+                        },
+                    )?
+                    .id
                 }
                 None => src.0,
             };

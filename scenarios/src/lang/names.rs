@@ -143,6 +143,16 @@ impl Walker<'_> {
                         let n = owner.map(|o| format!("{o}.{}", kw.node));
                         self.site(value, n, None);
                     }
+                    // A positional argument of a method: `lead.brake(VarEnum(...))` is
+                    // `lead.brake`.
+                    if let (ArgumentP::Positional(_), true, ExprP::Dot(obj, method)) =
+                        (&a.node, is_declarer(value), &f.node)
+                    {
+                        if let ExprP::Identifier(o) = &obj.node {
+                            let n = format!("{}.{}", o.node.ident, method.node);
+                            self.site(value, Some(n), None);
+                        }
+                    }
                     match (&value.node, builtin) {
                         // A variable passed whole to a builtin: the world shows its effect.
                         (ExprP::Identifier(id), true) => {
