@@ -30,10 +30,26 @@ pub enum SutChoice {
         /// Program and arguments.
         command: Vec<String>,
         /// `--sut-timeout`, seconds.
+        #[serde(deserialize_with = "buffered_f64")]
         timeout_s: f64,
         /// Whether processes were kept alive between tests.
         reuse: bool,
     },
+}
+
+/// A number inside an internally tagged enum. serde buffers such an enum before it picks the
+/// variant, and under serde_json's `arbitrary_precision` (which starlark turns on) a buffered
+/// number is a map that only `serde_json::Value` reads back as a number
+/// (`tests/read_back.rs`).
+fn buffered_f64<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    match serde_json::Value::deserialize(d)? {
+        serde_json::Value::Number(n) => n
+            .as_f64()
+            .ok_or_else(|| serde::de::Error::custom(format!("{n} is not a number"))),
+        other => Err(serde::de::Error::custom(format!(
+            "expected a number, found `{other}`"
+        ))),
+    }
 }
 
 impl SutChoice {

@@ -460,6 +460,20 @@ fn a_type_error_in_a_lambda_is_found_at_load() {
     ));
 }
 
+/// A builtin that builds the world, called inside a lambda, is refused at load with the
+/// lambda's place and the way out; the same value computed outside the lambda works.
+#[test]
+fn a_world_builtin_inside_a_lambda_is_refused_with_a_hint() {
+    let e = load_err(&format!(
+        "{ROAD}w.place(r, v)\nfar = v.pos.filter(lambda c: dist(c, r.onLane(1, 200)) < 5)\nAssert(far.map(lambda c: False))\n"
+    ));
+    assert!(e.contains("cannot run inside a lambda"), "{e}");
+    assert!(e.contains("t.star:6:38"), "{e}");
+    loads(&format!(
+        "{ROAD}w.place(r, v)\nend = r.onLane(1, 200)\nfar = v.pos.filter(lambda c: dist(c, end) < 5)\nAssert(far.map(lambda c: False))\n"
+    ));
+}
+
 /// Objects are named by their variable in messages, else by builtin and line, with the call
 /// that made them when a function did.
 #[test]
@@ -491,4 +505,43 @@ fn an_open_action_argument_is_named_and_used() {
     assert_eq!(names, ["lead.brake"]);
     assert!(sc.unused_params.is_empty(), "{:?}", sc.unused_params);
     assert!(sc.warnings.is_empty(), "{:?}", sc.warnings);
+}
+
+/// A passing `Stl` formula reports the whole trace's robustness: `F[0,15] where.x > 60` over
+/// a published vector equals the user monitor `max(x) - 60` (`over = "eventually"`), test for
+/// test, and is far from 0 for a car that drives 100 m past the threshold.
+#[test]
+fn a_passing_stl_formula_reports_the_traces_robustness_as_a_user_monitor_does() {
+    let src = "w = World()\nr = RoadSegment(len = 200, nlanes = 2)\nv = AutonomousVehicle(loc = r.onLane(1, 10), speed = VarInterval(4.0, 12.0))\nw.place(r, v)\nSignal(\"where\", v.pos)\nfar = Monitor(v.pos.map(lambda p: p.x - 60), over = \"eventually\")\nStl(\"F[0,15] (where.x > 60)\", name = \"gets_going\")\ntest(horizon = 15.0)\n";
+    let (records, _, _) = run_src(src, "6", &[], 0);
+    assert_eq!(records.len(), 6);
+    for r in &records {
+        let stl = r["monitors"]["gets_going"]["robustness"].as_f64().unwrap();
+        let user = r["monitors"]["far"]["robustness"].as_f64().unwrap();
+        assert!((stl - user).abs() < 1e-9, "{stl} vs {user}");
+        assert!(stl > 50.0, "{stl}");
+    }
+}
+
+/// A combinator given values of the wrong kind is named by where the program made it: at
+/// load when the sample values show it (`v.pos.min()`), in the test's error when only a later
+/// value does.
+#[test]
+fn a_combinator_of_the_wrong_kind_is_named_by_its_place() {
+    let e = load_err(&format!(
+        "{ROAD}w.place(r, v)\nlow = Monitor(v.pos.min(), name = \"m\")\n"
+    ));
+    assert!(
+        e.contains("t.star:6:15: min() needs a stream of numbers, got a vector"),
+        "{e}"
+    );
+    let src = format!(
+        "{ROAD}w.place(r, v)\nodd = tick.map(lambda t: 1.0 if t < 1 else \"x\").max()\nMonitor(odd, name = \"m\")\n"
+    );
+    let (records, _, _) = run_src(&src, "1", &[], 3);
+    let error = records[0]["error"].as_str().unwrap();
+    assert!(
+        error.contains("t.star:6:7: max() needs a stream of numbers, got a string"),
+        "{error}"
+    );
 }

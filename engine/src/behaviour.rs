@@ -110,6 +110,7 @@ pub fn walk_sink(i: u32) -> u32 {
 #[derive(Debug, Clone, Default)]
 pub struct GraphBuilder {
     nodes: Vec<Node>,
+    sites: Vec<Option<String>>,
 }
 
 impl GraphBuilder {
@@ -121,7 +122,16 @@ impl GraphBuilder {
     /// Adds `node`.
     pub fn push(&mut self, node: Node) -> StreamId {
         self.nodes.push(node);
+        self.sites.push(None);
         StreamId(self.nodes.len() - 1)
+    }
+
+    /// Adds `node` made at `site` (a program's `file:line:col`), which errors of the node
+    /// name instead of `stream N` (see [`Graph::site`]).
+    pub fn push_at(&mut self, node: Node, site: String) -> StreamId {
+        let id = self.push(node);
+        self.sites[id.0] = Some(site);
+        id
     }
 
     /// The nodes so far.
@@ -134,7 +144,7 @@ impl GraphBuilder {
     /// # Errors
     /// As [`Graph::new`].
     pub fn finish(self) -> Result<Graph, RxError> {
-        Graph::new(self.nodes)
+        Ok(Graph::new(self.nodes)?.with_sites(self.sites))
     }
 
     /// The paper's pedestrian behaviour (§2, "Reactive Behaviors") for pedestrian `index`:

@@ -4,7 +4,11 @@ use serde::{Deserialize, Serialize, Serializer};
 use crate::{GeneratorError, Point};
 
 /// A value of a parameter, in the parameter's unit.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+///
+/// In JSON an integer (`3`), a real (`0.4`, `3.0`) or a text (`"red"`); a number written
+/// with a fraction or an exponent reads back as [`Value::Real`], one without as
+/// [`Value::Int`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Value {
     /// An integer level, e.g. a lane count.
@@ -13,6 +17,26 @@ pub enum Value {
     Real(f64),
     /// A named level, e.g. a colour.
     Text(String),
+}
+
+/// Read through `serde_json::Value`, not derived: the workspace's serde_json has
+/// `arbitrary_precision` (starlark turns it on), under which a derived untagged enum sees a
+/// number as a map and matches no variant (`tests/read_back.rs`).
+impl<'de> Deserialize<'de> for Value {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        match serde_json::Value::deserialize(d)? {
+            serde_json::Value::Number(n) => match (n.as_i64(), n.as_f64()) {
+                (Some(i), _) => Ok(Value::Int(i)),
+                (None, Some(x)) => Ok(Value::Real(x)),
+                (None, None) => Err(D::Error::custom(format!("{n} is not a finite number"))),
+            },
+            serde_json::Value::String(s) => Ok(Value::Text(s)),
+            other => Err(D::Error::custom(format!(
+                "a parameter's value is a number or a text, not `{other}`"
+            ))),
+        }
+    }
 }
 
 impl Value {

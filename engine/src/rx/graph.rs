@@ -157,6 +157,8 @@ impl Node {
 pub struct Graph {
     nodes: Vec<Node>,
     order: Vec<usize>,
+    /// Where each node was made, when known (see [`Graph::site`]).
+    sites: Vec<Option<String>>,
 }
 
 impl Graph {
@@ -196,7 +198,27 @@ impl Graph {
         if let Some(stuck) = (0..n).find(|&i| indegree[i] > 0) {
             return Err(RxError::Cycle(stuck));
         }
-        Ok(Graph { nodes, order })
+        Ok(Graph {
+            sites: vec![None; nodes.len()],
+            nodes,
+            order,
+        })
+    }
+
+    /// The graph with node `i` made at `sites[i]` (a program's `file:line:col`); missing or
+    /// `None` entries stay unknown.
+    pub fn with_sites(mut self, mut sites: Vec<Option<String>>) -> Self {
+        sites.resize(self.nodes.len(), None);
+        self.sites = sites;
+        self
+    }
+
+    /// How messages name node `node`: where it was made (`f.star:5:15`), else `stream N`.
+    pub fn site(&self, node: usize) -> String {
+        match self.sites.get(node) {
+            Some(Some(site)) => site.clone(),
+            _ => format!("stream {node}"),
+        }
     }
 
     /// The nodes, by [`StreamId`].
@@ -225,6 +247,7 @@ impl Graph {
         Ok(Graph {
             nodes,
             order: self.order.clone(),
+            sites: self.sites.clone(),
         })
     }
 }

@@ -67,10 +67,12 @@ pub enum RxError {
         slot: usize,
     },
     /// A value of the wrong kind reached a combinator or a function.
-    #[error("stream {node}: {message}")]
+    #[error("{at}: {message}")]
     Type {
         /// The node.
         node: usize,
+        /// Where the node was made (`f.star:5:15`), else `stream N` ([`Graph::site`]).
+        at: String,
         /// What was expected and what came.
         message: String,
     },
@@ -87,10 +89,12 @@ pub enum RxError {
         expected: String,
     },
     /// A host function (a Starlark lambda) failed.
-    #[error("stream {node}: {message}")]
+    #[error("{at}: {message}")]
     Host {
         /// The node that called it.
         node: usize,
+        /// Where the node was made (`f.star:5:15`), else `stream N` ([`Graph::site`]).
+        at: String,
         /// The host's message.
         message: String,
     },

@@ -146,7 +146,13 @@ impl Runtime {
                     Some(v) => {
                         let keep = call(i, pred, std::slice::from_ref(&v), host, self)?;
                         if keep.as_bool().is_none() {
-                            return Err(type_error(i, "filter predicate", "bool", &keep));
+                            return Err(type_error(
+                                &self.graph,
+                                i,
+                                "filter predicate",
+                                "bool",
+                                &keep,
+                            ));
                         }
                         Some(v)
                     }
@@ -165,7 +171,7 @@ impl Runtime {
                     Some(v) => Some(match f {
                         Some(f) => call(i, f, &[init.clone(), v], host, self)?,
                         None => init.add(&v).ok_or_else(|| {
-                            type_error(i, "sum", "numbers or vectors of one kind", &v)
+                            type_error(&self.graph, i, "sum", "numbers or vectors of one kind", &v)
                         })?,
                     }),
                     None => None,
@@ -228,7 +234,15 @@ impl Runtime {
                         match keep.as_bool() {
                             Some(true) => Some(v),
                             Some(false) => None,
-                            None => return Err(type_error(i, "filter predicate", "bool", &keep)),
+                            None => {
+                                return Err(type_error(
+                                    &self.graph,
+                                    i,
+                                    "filter predicate",
+                                    "bool",
+                                    &keep,
+                                ))
+                            }
                         }
                     }
                     None => None,
@@ -319,7 +333,13 @@ impl Runtime {
                         Some(match &f {
                             Some(f) => call(i, f, &[acc, v], host, self)?,
                             None => acc.add(&v).ok_or_else(|| {
-                                type_error(i, "sum", "numbers or vectors of one kind", &v)
+                                type_error(
+                                    &self.graph,
+                                    i,
+                                    "sum",
+                                    "numbers or vectors of one kind",
+                                    &v,
+                                )
                             })?,
                         })
                     }
@@ -384,6 +404,7 @@ fn source(i: usize, node: &Node, t_s: f64, inputs: &dyn Inputs) -> Result<Value,
         }),
         _ => Err(RxError::Type {
             node: i,
+            at: format!("stream {i}"),
             message: "not a source stream".into(),
         }),
     }
@@ -397,16 +418,25 @@ fn call(
     streams: &Runtime,
 ) -> Result<Value, RxError> {
     match f {
-        Func::Native(_, f) => f(args).map_err(|message| RxError::Type { node, message }),
+        Func::Native(_, f) => f(args).map_err(|message| RxError::Type {
+            node,
+            at: streams.graph.site(node),
+            message,
+        }),
         Func::Host(n) => host
             .call(*n, args, streams)
-            .map_err(|message| RxError::Host { node, message }),
+            .map_err(|message| RxError::Host {
+                node,
+                at: streams.graph.site(node),
+                message,
+            }),
     }
 }
 
-fn type_error(node: usize, what: &str, expected: &str, got: &Value) -> RxError {
+fn type_error(graph: &Graph, node: usize, what: &str, expected: &str, got: &Value) -> RxError {
     RxError::Type {
         node,
+        at: graph.site(node),
         message: format!("{what} needs {expected}, got a {}", got.kind()),
     }
 }

@@ -1,10 +1,14 @@
 use serde::{Deserialize, Serialize};
+use serde_json::Value as Json;
 
 /// A value carried by a stream event.
 ///
 /// `tick` carries the time in seconds as [`Value::Num`]; positions and velocities are
 /// [`Value::Vec3`] `[x, y, z]` in metres or m/s; `zip` makes [`Value::Tuple`]s.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+///
+/// In JSON: `null`, a number, a bool, an array of three numbers (a vector), any other array
+/// (a tuple), a string.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Value {
     /// The unit value (an event with no payload).
@@ -71,6 +75,32 @@ impl Value {
             _ => None,
         }
     }
+}
+
+/// Read through `serde_json::Value`, not derived: the workspace's serde_json has
+/// `arbitrary_precision` (starlark turns it on), under which a derived untagged enum sees a
+/// number as a map and matches no variant.
+impl<'de> Deserialize<'de> for Value {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        from_json(Json::deserialize(d)?).map_err(serde::de::Error::custom)
+    }
+}
+
+fn from_json(j: Json) -> Result<Value, String> {
+    let number = |n: &serde_json::Number| n.as_f64().ok_or(format!("{n} is not a number"));
+    Ok(match j {
+        Json::Null => Value::Unit,
+        Json::Bool(b) => Value::Bool(b),
+        Json::Number(n) => Value::Num(number(&n)?),
+        Json::String(s) => Value::Text(s),
+        Json::Array(a) => match a.as_slice() {
+            [Json::Number(x), Json::Number(y), Json::Number(z)] => {
+                Value::Vec3([number(x)?, number(y)?, number(z)?])
+            }
+            _ => Value::Tuple(a.into_iter().map(from_json).collect::<Result<_, _>>()?),
+        },
+        Json::Object(_) => return Err("a stream value is not an object".into()),
+    })
 }
 
 impl From<f64> for Value {

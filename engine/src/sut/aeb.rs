@@ -7,7 +7,6 @@ use crate::{Control, Observation};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AebConfig {
     /// Cruise control and the braking rule.
-    #[serde(flatten)]
     pub cruise: Cruise,
     /// Returns lower than this, in metres relative to the chassis centre (`y` of the vehicle
     /// frame), are ground clutter and ignored. Default -0.6 m (about 0.25 m above the road).

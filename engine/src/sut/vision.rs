@@ -10,7 +10,6 @@ pub struct VisionConfig {
     /// The camera it reads. Default: 160 × 120 px, 24 mm, 20 Hz, pixel noise σ = 2 levels.
     pub camera: CameraSpec,
     /// Cruise control and the braking rule (as `aeb`'s).
-    #[serde(flatten)]
     pub cruise: Cruise,
     /// Points at least this high above the road (m) are obstacles; lower ones are road.
     /// Default 0.3 m.

@@ -16,11 +16,14 @@ const CHECK_EVERY: usize = 15;
 ///
 /// Samples are taken at the frames' times, assumed uniform (the step is the gap between the
 /// first two frames). Every [`CHECK_EVERY`] samples it bounds the robustness over every
-/// possible continuation: unknown future samples count as `-inf` for the lower bound and
-/// `+inf` for the upper. When the upper bound is `<= 0` the formula is violated whatever
-/// comes next: the verdict settles (robustness: that upper bound, a sound over-estimate) and
-/// the run may stop; when the lower bound is `> 0` it is satisfied. At the end of the run the
-/// verdict is the offline robustness of the trace seen (windows cut at its end).
+/// possible continuation: unknown future samples count as `+inf` for the upper bound. When
+/// that bound is `<= 0` the formula is violated whatever comes next: the verdict settles
+/// (robustness: that upper bound, a sound over-estimate) and the run may stop. A formula
+/// already satisfied does not settle: it keeps observing, so that its robustness is the
+/// trace's and not the lower bound at the moment it was decided (for `F[0,15] x > 60` that
+/// bound is the first sample's margin over 60, not the largest), which would tell a
+/// falsifier that every passing test was near failure. At the end of the run the verdict
+/// is the offline robustness of the trace seen (windows cut at its end).
 #[derive(Debug, Clone)]
 pub struct StlMonitor {
     name: String,
@@ -84,8 +87,8 @@ impl Monitor for StlMonitor {
         if self.times.len() % CHECK_EVERY != 0 || self.times.len() < 2 {
             return ControlFlow::Continue(());
         }
-        let (lo, hi) = match eval_bounds(&self.formula, &self.trace) {
-            Ok(b) => b,
+        let hi = match eval_bounds(&self.formula, &self.trace) {
+            Ok((_, hi)) => hi,
             Err(_) => return ControlFlow::Continue(()),
         };
         if hi <= 0.0 {
@@ -93,14 +96,6 @@ impl Monitor for StlMonitor {
                 passed: false,
                 robustness: hi,
                 first_violation_s: Some(frame.t_s),
-                metrics: vec![],
-            });
-            ControlFlow::Break(())
-        } else if lo > 0.0 {
-            self.settled = Some(Verdict {
-                passed: true,
-                robustness: lo,
-                first_violation_s: None,
                 metrics: vec![],
             });
             ControlFlow::Break(())
@@ -131,5 +126,49 @@ impl Monitor for StlMonitor {
             first_violation_s: (r <= 0.0).then(|| self.times.last().copied().unwrap_or(0.0)),
             metrics: vec![],
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Signals;
+
+    /// Feeds `x` at 60 Hz until the monitor settles; its verdict and how many samples it took.
+    fn run(formula: &str, x: impl Fn(usize) -> f64, n: usize) -> (Verdict, usize) {
+        let mut m = StlMonitor::new("stl", super::super::parse(formula).unwrap());
+        let mut fed = 0;
+        for i in 0..n {
+            let mut s = Signals::new();
+            s.set("x", x(i));
+            fed += 1;
+            if m.observe(&Frame {
+                t_s: i as f64 / 60.0,
+                signals: &s,
+            })
+            .is_break()
+            {
+                break;
+            }
+        }
+        (m.verdict(), fed)
+    }
+
+    #[test]
+    fn a_satisfied_formula_keeps_observing_and_reports_the_traces_robustness() {
+        // x rises 1 per sample: F[0,10] x > 60 holds from sample 61 on, and its robustness
+        // over 600 samples is the largest margin, 599 - 60, not the margin when it was decided.
+        let (v, fed) = run("F[0,10] (x > 60)", |i| i as f64, 600);
+        assert_eq!(fed, 600);
+        assert!(v.passed);
+        assert_eq!(v.robustness, 539.0);
+    }
+
+    #[test]
+    fn a_violated_formula_settles_at_once() {
+        let (v, fed) = run("G[0,10] (x < 30)", |i| i as f64, 600);
+        assert!(!v.passed);
+        assert!(fed < 60, "{fed}");
+        assert!(v.robustness <= 0.0);
     }
 }

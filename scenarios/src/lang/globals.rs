@@ -109,7 +109,13 @@ pub(crate) fn object_at(eval: &Evaluator) -> String {
 pub fn state<'a>(eval: &Evaluator<'_, 'a, '_>) -> anyhow::Result<&'a LoadState> {
     eval.extra
         .and_then(|e| e.downcast_ref::<LoadState>())
-        .ok_or_else(|| anyhow!("scenario builtins work only while a scenario program loads"))
+        .ok_or_else(|| {
+            anyhow!(
+                "scenario builtins (objects, `onLane`, streams, monitors) build the world, so \
+                 they cannot run inside a lambda during a test: compute the value outside the \
+                 lambda (`target = r.onLane(-2, 120)`) and use that variable in it"
+            )
+        })
 }
 
 /// Where the builtin being evaluated was called, `file:line:col`.

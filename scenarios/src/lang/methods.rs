@@ -9,7 +9,7 @@ use starlark::starlark_module;
 use starlark::values::tuple::{TupleRef, UnpackTuple};
 use starlark::values::{none::NoneType, Value, ValueLike};
 
-use super::globals::{number, state, stream_arg};
+use super::globals::{here, number, state, stream_arg};
 use super::scene::LaneRef;
 use super::values::{Action, ActorVal, LaneSide, Loc, Port, Road, Stream};
 
@@ -33,7 +33,7 @@ fn lambda<'v>(f: Value<'v>, what: &str, eval: &mut Evaluator<'v, '_, '_>) -> any
 
 fn push(eval: &Evaluator<'_, '_, '_>, node: Node) -> anyhow::Result<Stream> {
     let st = state(eval)?;
-    let id = st.scene.borrow_mut().graph.push(node);
+    let id = st.scene.borrow_mut().graph.push_at(node, here(eval));
     Ok(Stream::of(id.0))
 }
 

@@ -6,9 +6,9 @@
 
 use std::sync::Arc;
 
-use paracosm_engine::rx::{Host, OpenStream};
+use paracosm_engine::rx::{Host, OpenStream, RxError};
 use paracosm_engine::sut::SutConfig;
-use paracosm_engine::WorldSpec;
+use paracosm_engine::{EngineError, WorldSpec};
 use paracosm_generators::{Assignment, Domain, Param, ParamSpace, Value as Level};
 use starlark::environment::{Globals, Module};
 use starlark::eval::Evaluator;
@@ -429,9 +429,6 @@ impl Program {
     /// The lambda's error with its `file:line:col`, unless it is one of [`VALUE_ERRORS`].
     fn check_lambdas(&self) -> Result<(), String> {
         self.evaluate(None, |b, module| {
-            if b.lambdas == 0 {
-                return Ok(());
-            }
             let spec = scene::world(&b, self.horizon_s)?;
             // A world that does not build is reported elsewhere, by the test that builds it.
             let Ok(sim) = paracosm_engine::Simulation::new(&spec) else {
@@ -446,18 +443,19 @@ impl Program {
             match sim.check_streams(&mut host) {
                 Ok(()) => Ok(()),
                 Err(e) => {
-                    let message = e.to_string();
+                    // A lambda's message has its own traceback and location.
+                    let message = match e {
+                        EngineError::Stream(RxError::Host { message, .. }) => message,
+                        e => e.to_string(),
+                    };
                     let lower = message.to_ascii_lowercase();
                     if VALUE_ERRORS.iter().any(|v| lower.contains(v)) {
                         return Ok(());
                     }
-                    let message = message
-                        .split_once(": ")
-                        .filter(|(head, _)| head.starts_with("stream "))
-                        .map_or(message.as_str(), |(_, rest)| rest);
                     Err(format!(
-                        "{message}\n(found when loading: every lambda is called once on sample \
-                         values of its stream's type, those of the first test's world at t = 0)"
+                        "{message}\n(found when loading: every lambda and combinator is called \
+                         once on sample values of its stream's type, those of the first test's \
+                         world at t = 0)"
                     ))
                 }
             }
