@@ -4,12 +4,14 @@
 use std::io::Write;
 use std::path::Path;
 
+use crate::Error;
+
 /// Writes `bytes` to `path` through a temporary file and a rename.
 ///
 /// # Errors
-/// A message naming `path` with the file system's reason (e.g. no space left on device); the
-/// previous contents of `path`, if any, are then untouched.
-pub fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
+/// [`Error::Write`] naming `path` with the file system's reason (e.g. no space left on
+/// device); the previous contents of `path`, if any, are then untouched.
+pub fn write(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     with_temp(path, |tmp| {
         let mut f = std::fs::File::create(tmp)?;
         f.write_all(bytes)?;
@@ -21,11 +23,12 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
 /// over `path`. For writers that want a path, such as plotters' backends.
 ///
 /// # Errors
-/// A message naming `path` when `fill` or the rename fails; the temporary file is removed.
+/// [`Error::Write`] naming `path` when `fill` or the rename fails; the temporary file is
+/// removed.
 pub fn with_temp<E: std::fmt::Display>(
     path: &Path,
     fill: impl FnOnce(&Path) -> Result<(), E>,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
     let dir = dir.unwrap_or(Path::new("."));
     let suffix = path
@@ -36,12 +39,10 @@ pub fn with_temp<E: std::fmt::Display>(
         .prefix(".paracosm-")
         .suffix(&suffix)
         .tempfile_in(dir)
-        .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+        .map_err(|e| Error::write(path, e))?;
     let tmp_path = tmp.into_temp_path();
-    fill(&tmp_path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
-    tmp_path
-        .persist(path)
-        .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+    fill(&tmp_path).map_err(|e| Error::write(path, e))?;
+    tmp_path.persist(path).map_err(|e| Error::write(path, e))
 }
 
 #[cfg(test)]
@@ -53,7 +54,9 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("summary.json");
         write(&target, b"old").unwrap();
-        let err = with_temp(&target, |_| Err::<(), _>("disk full")).unwrap_err();
+        let err = with_temp(&target, |_| Err::<(), _>("disk full"))
+            .unwrap_err()
+            .to_string();
         assert!(
             err.contains("summary.json") && err.contains("disk full"),
             "{err}"

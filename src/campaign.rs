@@ -10,44 +10,16 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
-use paracosm_generators::{GeneratorError, Point, Strategy};
+use paracosm_generators::{Point, Strategy};
 use paracosm_scenarios::{RunOptions, Scenario};
-use thiserror::Error;
 
 use crate::record::{MonitorResult, RunRecord, Status};
 use crate::seed::test_seed;
 use crate::summary::{Counts, FirstFailure};
+use crate::Error;
 
 /// File name of the per-test results in the output folder.
 pub const RESULTS_FILE: &str = "results.jsonl";
-
-/// Errors that stop a campaign (a single test's failure never does: it becomes an `error`
-/// record).
-#[derive(Debug, Error)]
-pub enum CampaignError {
-    /// The generator cannot serve the budget (e.g. Sobol past 2^16 points).
-    #[error(transparent)]
-    Generator(#[from] GeneratorError),
-    /// The output folder or a file in it cannot be written.
-    #[error("cannot write `{path}`: {source}")]
-    Io {
-        /// The path being written.
-        path: PathBuf,
-        /// The operating system's reason.
-        source: std::io::Error,
-    },
-    /// An adaptive strategy cannot run as asked: a shard, or results it did not propose.
-    #[error("{0}")]
-    Adaptive(String),
-    /// The worker pool could not be started.
-    #[error("cannot start {jobs} worker threads: {reason}")]
-    Pool {
-        /// Threads asked for.
-        jobs: usize,
-        /// rayon's reason.
-        reason: String,
-    },
-}
 
 /// A campaign's settings.
 #[derive(Debug, Clone)]
@@ -90,13 +62,12 @@ impl Campaign<'_> {
     /// The campaign's points, in test order: `budget` points from the strategy's generator.
     ///
     /// # Errors
-    /// [`CampaignError::Generator`] when the strategy cannot produce them;
-    /// [`CampaignError::Adaptive`] for an adaptive strategy, whose points exist only as the
-    /// campaign runs.
-    pub fn points(&self) -> Result<Vec<Point>, CampaignError> {
+    /// [`Error::Generator`] when the strategy cannot produce them; [`Error::BadInput`] for an
+    /// adaptive strategy, whose points exist only as the campaign runs.
+    pub fn points(&self) -> Result<Vec<Point>, Error> {
         let mut generator = self.generator()?;
         if generator.batch().is_some() {
-            return Err(CampaignError::Adaptive(format!(
+            return Err(Error::BadInput(format!(
                 "{} chooses each batch from the robustness of the last: its points exist only \
                  as a campaign runs",
                 self.strategy
@@ -106,7 +77,7 @@ impl Campaign<'_> {
     }
 
     /// The campaign's generator, fresh.
-    fn generator(&self) -> Result<Box<dyn paracosm_generators::Generator>, CampaignError> {
+    fn generator(&self) -> Result<Box<dyn paracosm_generators::Generator>, Error> {
         Ok(self.strategy.build_sized(
             &self.scenario.space,
             self.seed,
@@ -131,17 +102,17 @@ impl Campaign<'_> {
             Ok(assignment) => catch_unwind(AssertUnwindSafe(|| {
                 scenario.run_with(assignment, seed, options)
             }))
-            .unwrap_or_else(|panic| {
+            .map_err(|panic| {
+                // A defect of paracosm (or of a library it calls), not of the system under
+                // test: recorded as such, and the campaign goes on.
                 let msg = panic
                     .downcast_ref::<&str>()
                     .map(|s| s.to_string())
                     .or_else(|| panic.downcast_ref::<String>().cloned())
-                    .unwrap_or_else(|| "unknown panic".into());
-                Err(paracosm_scenarios::ScenarioError::Sut(
-                    paracosm_engine::sut::SutError::Failed(format!("internal panic: {msg}")),
-                ))
+                    .unwrap_or_else(|| "a panic without a message".into());
+                Error::Internal(format!("the simulation panicked: {msg}")).to_string()
             })
-            .map_err(|e| e.to_string()),
+            .and_then(|run| run.map_err(|e| e.to_string())),
             Err(e) => Err(e.to_string()),
         };
         let (status, monitors, metrics, error, log) = match outcome {
@@ -181,7 +152,7 @@ impl Campaign<'_> {
 
     /// Runs the campaign, writing `results.jsonl` into `out_dir` (created if needed, the file
     /// replaced). `on_done` is called in the calling thread as each record is written (for
-    /// progress bars).
+    /// progress bars). [`Campaign::run_ids`] with a [`ResultsFile`] and `on_done` as observers.
     ///
     /// Tests are handed to `jobs` rayon workers one index at a time, so tests finish roughly in
     /// index order. Each record is appended and flushed as soon as every record before it is
@@ -193,23 +164,27 @@ impl Campaign<'_> {
     /// every test in id order, ask again.
     ///
     /// # Errors
-    /// [`CampaignError`] when the points cannot be generated, the pool cannot start, or the
-    /// results file cannot be written. Records already written stay on disk.
+    /// [`Error::Generator`] when the points cannot be generated, [`Error::Internal`] when the
+    /// pool cannot start, [`Error::Write`] when the results file cannot be written. Records
+    /// already written stay on disk.
     pub fn run(
         &self,
         out_dir: &Path,
         on_done: impl FnMut(&RunRecord),
-    ) -> Result<CampaignReport, CampaignError> {
-        self.run_ids(out_dir, 0..self.budget, None, None, on_done)
+    ) -> Result<CampaignReport, Error> {
+        let mut file = ResultsFile::new(out_dir, false);
+        let mut each = OnRecord(on_done);
+        self.run_ids(0..self.budget, None, None, &mut [&mut file, &mut each])
     }
 
     /// Runs the tests with ids in `ids` (a sub-range of `0..budget`: a shard, or what a
-    /// resumed run has left), writing their records to `results.jsonl` in `out_dir`. With
-    /// `prior = Some(records)` the file already holds `records` (the ids just before
-    /// `ids.start`, in order) and the new records are appended to it (it must end with a
-    /// complete line); with `None` the file is replaced. When `stop` becomes true no new test
-    /// starts; the tests in flight finish, the records that follow without a gap are written,
-    /// and the report says `interrupted`. With [`Campaign::stop_at_first_failure`] the first
+    /// resumed run has left) and reports to `observers`, in this order: each one's
+    /// [`Observer::started`] once the campaign is accepted (nothing is touched before), its
+    /// [`Observer::record`] for each record in id order, its [`Observer::finished`] at the
+    /// end. A [`ResultsFile`] among them writes `results.jsonl`. `prior = Some(records)` are
+    /// the records of an earlier run of this campaign (the ids just before `ids.start`, in
+    /// order). When `stop` becomes true no new test starts; the tests in flight finish, the
+    /// records that follow without a gap are reported, and the report says `interrupted`. With [`Campaign::stop_at_first_failure`] the first
     /// failed test stops the campaign: no new test starts, and the file ends with the first
     /// failure in id order (records of tests that were in flight after it are dropped, so the
     /// file does not depend on `jobs`); the report is not `interrupted`. When `prior` already
@@ -220,16 +195,16 @@ impl Campaign<'_> {
     /// uninterrupted one. It cannot run a shard: its tests depend on all earlier ones.
     ///
     /// # Errors
-    /// As [`Campaign::run`]; [`CampaignError::Adaptive`] for a shard of an adaptive campaign
-    /// or prior records that the strategy would not have proposed.
+    /// As [`Campaign::run`]; [`Error::BadInput`] for a shard of an adaptive campaign or prior
+    /// records that the strategy would not have proposed; the first error an observer
+    /// returns (no new test starts after it).
     pub fn run_ids(
         &self,
-        out_dir: &Path,
         ids: Range<u64>,
         prior: Option<&[RunRecord]>,
         stop: Option<&AtomicBool>,
-        mut on_done: impl FnMut(&RunRecord),
-    ) -> Result<CampaignReport, CampaignError> {
+        observers: &mut [&mut dyn Observer],
+    ) -> Result<CampaignReport, Error> {
         let started = Instant::now();
         let mut generator = self.generator()?;
         let ids = ids.start.min(self.budget)..ids.end.min(self.budget);
@@ -237,20 +212,24 @@ impl Campaign<'_> {
         let prior_failed = prior.is_some_and(|p| p.iter().any(|r| r.status == Status::Fail));
         if self.stop_at_first_failure && prior_failed {
             // A resumed campaign that had already found its failure is finished.
-            return Ok(CampaignReport {
+            let report = CampaignReport {
                 records: Vec::new(),
                 interrupted: false,
                 stopped_at_failure: true,
                 counts: Counts::default(),
                 first_failure: None,
                 wall_s: started.elapsed().as_secs_f64(),
-            });
+            };
+            for o in observers.iter_mut() {
+                o.finished(&report)?;
+            }
+            return Ok(report);
         }
         // Everything that can be refused is refused before the output folder is touched.
         let upfront = match generator.batch() {
             None => Some(generator.ask(ids.end as usize)?),
             Some(_) if ids.start != prior_len || ids.end != self.budget => {
-                return Err(CampaignError::Adaptive(format!(
+                return Err(Error::BadInput(format!(
                     "{} adapts each test to all earlier ones, so it runs whole campaigns \
                      only, not a shard",
                     self.strategy
@@ -258,9 +237,12 @@ impl Campaign<'_> {
             }
             Some(_) => None,
         };
-        let mut run = Run::open(self, out_dir, prior.is_some(), stop)?;
+        for o in observers.iter_mut() {
+            o.started(prior.unwrap_or(&[]))?;
+        }
+        let mut run = Run::open(self, stop)?;
         if let Some(all) = upfront {
-            run.execute(ids.start, &all[ids.start as usize..], &mut on_done)?;
+            run.execute(ids.start, &all[ids.start as usize..], observers)?;
         } else {
             let prior = prior.unwrap_or(&[]);
             let passive = self.scenario.passive_monitors();
@@ -270,7 +252,7 @@ impl Campaign<'_> {
                 let n = (batch as u64).min(ids.end - next) as usize;
                 let points = generator.ask(n)?;
                 if points.is_empty() {
-                    return Err(CampaignError::Adaptive(format!(
+                    return Err(Error::BadInput(format!(
                         "{} proposed no point at test {next}",
                         self.strategy
                     )));
@@ -281,7 +263,7 @@ impl Campaign<'_> {
                 for (j, p) in points[..known].iter().enumerate() {
                     let r = &prior[next as usize + j];
                     if &r.point != p {
-                        return Err(CampaignError::Adaptive(format!(
+                        return Err(Error::BadInput(format!(
                             "test {} in the results is not the point {} proposes; the \
                              results were not written by this campaign",
                             r.id, self.strategy
@@ -289,7 +271,7 @@ impl Campaign<'_> {
                     }
                     told.push((p.clone(), r.cost(&passive)));
                 }
-                let fresh = run.execute(next + known as u64, &points[known..], &mut on_done)?;
+                let fresh = run.execute(next + known as u64, &points[known..], observers)?;
                 told.extend(
                     run.records[fresh]
                         .iter()
@@ -301,44 +283,27 @@ impl Campaign<'_> {
         }
         let records = run.records;
         let asked = ids.end - ids.start;
-        let mut counts = Counts::default();
-        for r in &records {
-            match r.status {
-                Status::Pass => counts.pass += 1,
-                Status::Fail => counts.fail += 1,
-                Status::Error => counts.error += 1,
-            }
-        }
-        let first_failure = records.iter().find_map(|r| match (&r.status, &r.params) {
-            (Status::Fail, Some(params)) => Some(FirstFailure {
-                id: r.id,
-                params: params.clone(),
-                failed_monitors: r
-                    .monitors
-                    .iter()
-                    .filter(|(_, m)| !m.passed)
-                    .map(|(n, _)| n.clone())
-                    .collect(),
-            }),
-            _ => None,
-        });
-        Ok(CampaignReport {
+        let counts = Counts::of(&records);
+        let first_failure = FirstFailure::of(&records);
+        let report = CampaignReport {
             interrupted: (records.len() as u64) < asked && run.stopped_by_user,
             stopped_at_failure: (records.len() as u64) < asked && !run.stopped_by_user,
             records,
             counts,
             first_failure,
             wall_s: started.elapsed().as_secs_f64(),
-        })
+        };
+        for o in observers.iter_mut() {
+            o.finished(&report)?;
+        }
+        Ok(report)
     }
 }
 
-/// The state of a running campaign: the open results file, the worker pool, the stop flags
-/// and the records written so far.
+/// The state of a running campaign: the worker pool, the stop flags and the records reported
+/// so far.
 struct Run<'c, 'a> {
     campaign: &'c Campaign<'a>,
-    path: PathBuf,
-    out: BufWriter<File>,
     pool: rayon::ThreadPool,
     stop: Option<&'c AtomicBool>,
     /// Set by the first failed test when the campaign stops at its first failure.
@@ -348,38 +313,19 @@ struct Run<'c, 'a> {
 }
 
 impl<'c, 'a> Run<'c, 'a> {
-    fn open(
-        campaign: &'c Campaign<'a>,
-        out_dir: &Path,
-        append: bool,
-        stop: Option<&'c AtomicBool>,
-    ) -> Result<Self, CampaignError> {
-        let path = out_dir.join(RESULTS_FILE);
-        std::fs::create_dir_all(out_dir).map_err(|source| CampaignError::Io {
-            path: out_dir.to_path_buf(),
-            source,
-        })?;
-        let file = if append {
-            OpenOptions::new().append(true).create(true).open(&path)
-        } else {
-            File::create(&path)
-        };
-        let out = BufWriter::new(file.map_err(|source| CampaignError::Io {
-            path: path.clone(),
-            source,
-        })?);
+    fn open(campaign: &'c Campaign<'a>, stop: Option<&'c AtomicBool>) -> Result<Self, Error> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(campaign.jobs)
             .thread_name(|i| format!("paracosm-worker-{i}"))
             .build()
-            .map_err(|e| CampaignError::Pool {
-                jobs: campaign.jobs,
-                reason: e.to_string(),
+            .map_err(|e| {
+                Error::Internal(format!(
+                    "cannot start {} worker threads: {e}",
+                    campaign.jobs
+                ))
             })?;
         Ok(Run {
             campaign,
-            path,
-            out,
             pool,
             stop,
             failed: AtomicBool::new(false),
@@ -394,23 +340,23 @@ impl<'c, 'a> Run<'c, 'a> {
         self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) || self.failed.load(Ordering::Relaxed)
     }
 
-    /// Runs `points` as tests `first..`, in parallel, writing each record once every record
-    /// before it is written. Returns where this call's records are in `self.records` (fewer than
-    /// `points` when halted).
+    /// Runs `points` as tests `first..`, in parallel, reporting each record to the observers
+    /// once every record before it is reported. Returns where this call's records are in
+    /// `self.records` (fewer than `points` when halted).
     fn execute(
         &mut self,
         first: u64,
         points: &[Point],
-        on_done: &mut impl FnMut(&RunRecord),
-    ) -> Result<Range<usize>, CampaignError> {
+        observers: &mut [&mut dyn Observer],
+    ) -> Result<Range<usize>, Error> {
         let campaign = self.campaign;
         let jobs = campaign.jobs;
         let next = AtomicUsize::new(0);
         let (tx, rx) = mpsc::channel::<RunRecord>();
         let mut done: Vec<RunRecord> = Vec::with_capacity(points.len());
         let mut pending: BTreeMap<u64, RunRecord> = BTreeMap::new();
-        let mut write_result = Ok(());
-        let (pool, stop, failed, out) = (&self.pool, self.stop, &self.failed, &mut self.out);
+        let mut observed = Ok(());
+        let (pool, stop, failed) = (&self.pool, self.stop, &self.failed);
         let halted =
             || stop.is_some_and(|s| s.load(Ordering::Relaxed)) || failed.load(Ordering::Relaxed);
         std::thread::scope(|scope| {
@@ -445,11 +391,10 @@ impl<'c, 'a> Run<'c, 'a> {
                     if closed {
                         break;
                     }
-                    on_done(&r);
                     closed = campaign.stop_at_first_failure && r.status == Status::Fail;
-                    if write_result.is_ok() {
-                        write_result = write_line(out, &r);
-                        if write_result.is_err() {
+                    if observed.is_ok() {
+                        observed = observers.iter_mut().try_for_each(|o| o.record(&r));
+                        if observed.is_err() {
                             // Stop the workers: nothing more can be saved.
                             next.store(usize::MAX / 2, Ordering::Relaxed);
                         }
@@ -458,10 +403,7 @@ impl<'c, 'a> Run<'c, 'a> {
                 }
             }
         });
-        write_result.map_err(|source| CampaignError::Io {
-            path: self.path.clone(),
-            source,
-        })?;
+        observed?;
         if done.len() < points.len() && self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
             self.stopped_by_user = true;
         }
@@ -471,10 +413,98 @@ impl<'c, 'a> Run<'c, 'a> {
     }
 }
 
-fn write_line(out: &mut BufWriter<File>, record: &RunRecord) -> std::io::Result<()> {
-    serde_json::to_writer(&mut *out, record)?;
-    out.write_all(b"\n")?;
-    out.flush()
+/// What a campaign reports to, as it runs (in the style of argmin's observers): the results
+/// file, a progress bar, JUnit, a test's own checks. All calls come from the thread that runs
+/// the campaign, in id order. An error stops the campaign: no new test starts, and
+/// [`Campaign::run_ids`] returns it.
+pub trait Observer {
+    /// Once the campaign is accepted, before any test runs; `prior` are the records of an
+    /// earlier run of it (a resume), which are not reported again.
+    ///
+    /// # Errors
+    /// Whatever stops the observer (e.g. [`Error::Write`]).
+    fn started(&mut self, _prior: &[RunRecord]) -> Result<(), Error> {
+        Ok(())
+    }
+
+    /// Each new record, in id order.
+    ///
+    /// # Errors
+    /// As [`Observer::started`].
+    fn record(&mut self, _record: &RunRecord) -> Result<(), Error> {
+        Ok(())
+    }
+
+    /// Once, when no more tests will run (also after an interruption: see
+    /// [`CampaignReport::interrupted`]).
+    ///
+    /// # Errors
+    /// As [`Observer::started`].
+    fn finished(&mut self, _report: &CampaignReport) -> Result<(), Error> {
+        Ok(())
+    }
+}
+
+/// An [`Observer`] that calls a closure with each record.
+pub struct OnRecord<F>(pub F);
+
+impl<F: FnMut(&RunRecord)> Observer for OnRecord<F> {
+    fn record(&mut self, record: &RunRecord) -> Result<(), Error> {
+        (self.0)(record);
+        Ok(())
+    }
+}
+
+/// The [`Observer`] that writes `results.jsonl`: one line per record, flushed at once, so at
+/// most the tests in flight are missing if the process dies.
+pub struct ResultsFile {
+    path: PathBuf,
+    append: bool,
+    out: Option<BufWriter<File>>,
+}
+
+impl ResultsFile {
+    /// `results.jsonl` in `dir` (created when the campaign starts): replaced, or appended to
+    /// when `append` (a resumed campaign; the file must then end with a whole line).
+    pub fn new(dir: &Path, append: bool) -> Self {
+        ResultsFile {
+            path: dir.join(RESULTS_FILE),
+            append,
+            out: None,
+        }
+    }
+}
+
+impl Observer for ResultsFile {
+    fn started(&mut self, _prior: &[RunRecord]) -> Result<(), Error> {
+        if let Some(dir) = self.path.parent() {
+            std::fs::create_dir_all(dir).map_err(|e| Error::write(dir, e))?;
+        }
+        let file = if self.append {
+            OpenOptions::new()
+                .append(true)
+                .create(true)
+                .open(&self.path)
+        } else {
+            File::create(&self.path)
+        };
+        self.out = Some(BufWriter::new(
+            file.map_err(|e| Error::write(&self.path, e))?,
+        ));
+        Ok(())
+    }
+
+    fn record(&mut self, record: &RunRecord) -> Result<(), Error> {
+        let out = self
+            .out
+            .as_mut()
+            .ok_or_else(|| Error::Internal("a record before the campaign started".into()))?;
+        serde_json::to_writer(&mut *out, record)
+            .map_err(std::io::Error::from)
+            .and_then(|()| out.write_all(b"\n"))
+            .and_then(|()| out.flush())
+            .map_err(|e| Error::write(&self.path, e))
+    }
 }
 
 #[cfg(test)]
@@ -563,7 +593,7 @@ mod tests {
         };
         let dir = tempfile::tempdir().unwrap();
         let err = c.run(&dir.path().join("x"), |_| {}).unwrap_err();
-        assert!(matches!(err, CampaignError::Generator(_)));
+        assert!(matches!(err, Error::Generator(_)));
         assert!(!dir.path().join("x").exists());
     }
 }

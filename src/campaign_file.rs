@@ -69,11 +69,13 @@ impl SutChoice {
     /// The configuration to run, or `None` for the scenario's default.
     ///
     /// # Errors
-    /// A message for an unknown built-in name.
-    pub fn config(&self) -> Result<Option<SutConfig>, String> {
+    /// [`crate::Error::BadInput`] for an unknown built-in name.
+    pub fn config(&self) -> Result<Option<SutConfig>, crate::Error> {
         match self {
             SutChoice::Scenario => Ok(None),
-            SutChoice::Builtin { name } => SutConfig::builtin(name).map(Some),
+            SutChoice::Builtin { name } => SutConfig::builtin(name)
+                .map(Some)
+                .map_err(crate::Error::BadInput),
             SutChoice::Command {
                 command,
                 timeout_s,
@@ -265,26 +267,27 @@ impl CampaignFile {
     /// Reads `campaign.json` from `dir`.
     ///
     /// # Errors
-    /// A message naming the file when it is missing or malformed (with line and column).
-    pub fn read(dir: &Path) -> Result<CampaignFile, String> {
+    /// [`crate::Error::Input`] naming the file when it is missing or malformed (with line
+    /// and column).
+    pub fn read(dir: &Path) -> Result<CampaignFile, crate::Error> {
         let path = dir.join(CAMPAIGN_FILE);
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+        let text = std::fs::read_to_string(&path).map_err(|e| crate::Error::input(&path, e))?;
         serde_json::from_str(&text).map_err(|e| {
-            format!(
+            let message = format!(
                 "{}:{}:{}: not a campaign file: {e}",
                 path.display(),
                 e.line(),
                 e.column()
-            )
+            );
+            crate::Error::malformed(&path, message)
         })
     }
 
     /// Writes `campaign.json` into `dir` (through a temporary file and a rename).
     ///
     /// # Errors
-    /// The file system's message.
-    pub fn write(&self, dir: &Path) -> Result<(), String> {
+    /// [`crate::Error::Write`] with the file system's reason.
+    pub fn write(&self, dir: &Path) -> Result<(), crate::Error> {
         let text = serde_json::to_string_pretty(self).expect("serialises") + "\n";
         crate::atomic::write(&dir.join(CAMPAIGN_FILE), text.as_bytes())
     }

@@ -2,58 +2,25 @@
 
 use std::process::ExitCode;
 
-use clap::{Parser, ValueEnum};
+use clap::Parser;
 use paracosm_engine::sut::{ExternalConfig, SutConfig};
 use paracosm_generators::Strategy;
 
-/// Test-generation strategies as command-line values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum StrategyArg {
-    /// Uniform random points (ChaCha8, seeded by --seed).
-    Random,
-    /// The Halton low-dispersion sequence from index 0 (paper §3.2); --seed is not used.
-    Halton,
-    /// Owen-scrambled Sobol points (at most 65536); --seed selects the scramble.
-    Sobol,
-    /// A (k, ε)-covering suite: an IPOG covering array of strength --strength over the discrete
-    /// parameters, and a block of Halton points per array row.
-    Ipog,
-    /// As ipog, with a random k-wise array sized by Proposition 3.2.
-    Kwise,
-    /// Falsification: Nelder–Mead with restarts minimising robustness (argmin); discrete
-    /// parameters fixed per search by a pairwise covering array.
-    FalsifyNm,
-    /// Falsification: particle swarms minimising robustness (argmin).
-    FalsifyPso,
-    /// Falsification: simulated annealing minimising robustness (argmin).
-    FalsifySa,
-    /// Falsification: the cross-entropy method minimising robustness.
-    FalsifyCe,
-}
-
-impl From<StrategyArg> for Strategy {
-    fn from(s: StrategyArg) -> Self {
-        match s {
-            StrategyArg::Random => Strategy::Random,
-            StrategyArg::Halton => Strategy::Halton,
-            StrategyArg::Sobol => Strategy::Sobol,
-            StrategyArg::Ipog => Strategy::Ipog,
-            StrategyArg::Kwise => Strategy::KWise,
-            StrategyArg::FalsifyNm => Strategy::FalsifyNm,
-            StrategyArg::FalsifyPso => Strategy::FalsifyPso,
-            StrategyArg::FalsifySa => Strategy::FalsifySa,
-            StrategyArg::FalsifyCe => Strategy::FalsifyCe,
-        }
-    }
+/// The value parser of `--strategy`: the names of [`Strategy::LIST`], each with its
+/// [`Strategy::help`] in `--help`.
+pub fn strategy_parser() -> impl clap::builder::TypedValueParser<Value = Strategy> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(Strategy::LIST.map(|s| PossibleValue::new(s.name()).help(s.help())))
+        .map(|name| name.parse::<Strategy>().expect("a name of Strategy::LIST"))
 }
 
 /// The strategy named by `--strategy` and `--scramble`.
 ///
 /// # Errors
 /// A message when `--scramble` is given with a strategy other than `halton`.
-pub fn strategy(arg: StrategyArg, scramble: bool) -> Result<Strategy, String> {
-    match (Strategy::from(arg), scramble) {
-        (Strategy::Halton, true) => Ok(Strategy::ScrambledHalton),
+pub fn strategy(chosen: Strategy, scramble: bool) -> Result<Strategy, String> {
+    match (chosen, scramble) {
+        (Strategy::Halton | Strategy::ScrambledHalton, true) => Ok(Strategy::ScrambledHalton),
         (s, true) => Err(format!(
             "--scramble applies to --strategy halton only, not {s}"
         )),
@@ -75,12 +42,6 @@ pub fn parse_args<T: Parser>(tool: &str) -> Result<T, ExitCode> {
         }
     })
 }
-
-/// An error caused by the user's input (arguments, files): the tools exit with code 2 for it
-/// and 3 for anything else.
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct BadInput(pub String);
 
 /// The options that choose a system under test (`paracosm-fuzz` and its `replay`).
 #[derive(Debug, Clone, clap::Args)]
@@ -173,11 +134,11 @@ mod tests {
     #[test]
     fn scramble_only_goes_with_halton() {
         assert_eq!(
-            strategy(StrategyArg::Halton, true),
+            strategy(Strategy::Halton, true),
             Ok(Strategy::ScrambledHalton)
         );
-        assert_eq!(strategy(StrategyArg::Sobol, false), Ok(Strategy::Sobol));
-        assert!(strategy(StrategyArg::Random, true).is_err());
+        assert_eq!(strategy(Strategy::Sobol, false), Ok(Strategy::Sobol));
+        assert!(strategy(Strategy::Random, true).is_err());
     }
 
     #[test]

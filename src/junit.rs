@@ -7,7 +7,7 @@ use quick_xml::events::{BytesDecl, BytesText};
 use quick_xml::Writer;
 
 use crate::record::{RunRecord, Status};
-use crate::report::replay_command;
+use crate::replay::replay_command;
 
 fn params(r: &RunRecord) -> String {
     match &r.params {
@@ -121,7 +121,12 @@ pub fn render(scenario: &str, records: &[RunRecord], out: &Path) -> String {
 /// Writes [`render`]'s document to `path` (through a temporary file and a rename).
 ///
 /// # Errors
-/// A message naming `path` when it cannot be written.
-pub fn write(path: &Path, scenario: &str, records: &[RunRecord], out: &Path) -> Result<(), String> {
+/// [`crate::Error::Write`] naming `path` when it cannot be written.
+pub fn write(
+    path: &Path,
+    scenario: &str,
+    records: &[RunRecord],
+    out: &Path,
+) -> Result<(), crate::Error> {
     crate::atomic::write(path, render(scenario, records, out).as_bytes())
 }

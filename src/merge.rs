@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::campaign::RESULTS_FILE;
 use crate::campaign_file::CampaignFile;
 use crate::record::RunRecord;
+use crate::Error;
 
 /// A merged campaign, written to its folder (results and `campaign.json`; the caller writes
 /// the summary and plots with [`crate::report::write_outputs`]).
@@ -25,19 +26,20 @@ pub struct Merged {
 /// `campaign.json`.
 ///
 /// # Errors
-/// A message when a folder is not a shard, the shards belong to different campaigns
-/// (fingerprints), one is missing, given twice or incomplete, or a file cannot be read or
-/// written.
-pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, String> {
+/// [`Error::BadInput`] when a folder is not a shard, the shards belong to different campaigns
+/// (fingerprints), one is missing, given twice or incomplete; [`Error::Input`] when a file
+/// cannot be read; [`Error::Write`] when the merged folder cannot be written.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
+    let bad = |m: String| Error::BadInput(m);
     let mut shards: BTreeMap<u64, (PathBuf, CampaignFile)> = BTreeMap::new();
     let mut first: Option<(PathBuf, CampaignFile)> = None;
     for dir in dirs {
         let file = CampaignFile::read(dir)?;
         let Some(shard) = file.shard else {
-            return Err(format!(
+            return Err(bad(format!(
                 "`{}` holds a whole campaign, not a shard (run shards with --shard I/N)",
                 dir.display()
-            ));
+            )));
         };
         if let Some((first_dir, f)) = &first {
             let their_count = f.shard.map_or(1, |s| s.count);
@@ -47,27 +49,27 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, String> {
                 if their_count != shard.count {
                     diff.push(format!("shard counts: {their_count} vs {}", shard.count));
                 }
-                return Err(format!(
+                return Err(bad(format!(
                     "`{}` and `{}` are shards of different campaigns ({})",
                     first_dir.display(),
                     dir.display(),
                     diff.join("; ")
-                ));
+                )));
             }
         } else {
             first = Some((dir.clone(), file.clone()));
         }
         if let Some((other, _)) = shards.get(&shard.index) {
-            return Err(format!(
+            return Err(bad(format!(
                 "shard {shard} is given twice: `{}` and `{}`",
                 other.display(),
                 dir.display()
-            ));
+            )));
         }
         shards.insert(shard.index, (dir.clone(), file));
     }
     let Some((_, template)) = first else {
-        return Err("no shard folders given".into());
+        return Err(bad("no shard folders given".into()));
     };
     let count = template.shard.map_or(1, |s| s.count);
     let missing: Vec<String> = (0..count)
@@ -75,13 +77,13 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, String> {
         .map(|i| format!("{i}/{count}"))
         .collect();
     if !missing.is_empty() {
-        return Err(format!(
+        return Err(bad(format!(
             "shard {} of the campaign {} missing",
             missing.join(", "),
             if missing.len() == 1 { "is" } else { "are" }
-        ));
+        )));
     }
-    let mut scenario = paracosm_scenarios::load(&template.scenario).map_err(|e| e.to_string())?;
+    let mut scenario = paracosm_scenarios::load(&template.scenario)?;
     if let Some(sut) = template.sut.config()? {
         scenario.sut = sut;
     }
@@ -91,7 +93,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, String> {
         let existing = crate::results::load(dir, &scenario.space, ids.clone(), false)?;
         let done = existing.records.len() as u64;
         if done != ids.end - ids.start {
-            return Err(format!(
+            return Err(bad(format!(
                 "shard {} in `{}` is incomplete: {} of {} tests; finish it with \
                  `paracosm-fuzz --resume --out {}`",
                 file.shard.expect("checked"),
@@ -99,23 +101,27 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, String> {
                 done,
                 ids.end - ids.start,
                 dir.display()
-            ));
+            )));
         }
         records.extend(existing.records);
     }
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create `{}`: {e}", out.display()))?;
+    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
     let mut whole = CampaignFile {
         shard: None,
         ..template
     };
     whole.tool = format!("paracosm {}", env!("CARGO_PKG_VERSION"));
     let results = out.join(RESULTS_FILE);
-    crate::atomic::with_temp(&results, |tmp| -> Result<(), String> {
-        let mut f = std::io::BufWriter::new(std::fs::File::create(tmp).map_err(|e| e.to_string())?);
-        for (dir, _) in shards.values() {
-            crate::results::append_file(&mut f, dir)?;
+    let lines: Vec<Vec<u8>> = shards
+        .values()
+        .map(|(dir, _)| crate::results::whole_lines(dir))
+        .collect::<Result<_, _>>()?;
+    crate::atomic::with_temp(&results, |tmp| -> std::io::Result<()> {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(tmp)?);
+        for bytes in &lines {
+            f.write_all(bytes)?;
         }
-        f.flush().map_err(|e| e.to_string())
+        f.flush()
     })?;
     whole.write(out)?;
     Ok(Merged {
@@ -123,4 +129,47 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, String> {
         records,
         scenario,
     })
+}
+
+/// `paracosm-fuzz merge`: [`merge`]s `dirs` into `out` (which must be empty unless
+/// `replace`), writes the summary, plots and JUnit (when `junit`), and returns the human
+/// summary, the counts and the plots that could not be drawn. The wall time is the shards'
+/// own, added up.
+///
+/// # Errors
+/// As [`merge`]; [`Error::BadInput`] for a non-empty `out`; [`Error::Write`] when a file
+/// cannot be written.
+pub fn merge_folders(
+    dirs: &[PathBuf],
+    out: &Path,
+    replace: bool,
+    junit: Option<&Path>,
+) -> Result<(String, crate::summary::Counts, Vec<String>), Error> {
+    crate::session::prepare_out_dir(out, replace, false)?;
+    let m = merge(dirs, out)?;
+    let wall_s: f64 = dirs
+        .iter()
+        .filter_map(|d| crate::summary::Summary::read(d).ok())
+        .map(|s| s.wall_s)
+        .sum();
+    let written = crate::report::write_outputs(&crate::report::Finished {
+        out,
+        scenario: &m.scenario,
+        file: &m.file,
+        records: &m.records,
+        jobs: 1,
+        wall_s,
+        junit,
+        warnings: crate::session::warnings_of(&m.scenario),
+    })?;
+    if let Some(path) = junit {
+        crate::junit::write(path, &m.scenario.name, &m.records, out)?;
+    }
+    let text = format!(
+        "merged {} shards into {}\n{}",
+        dirs.len(),
+        out.display(),
+        crate::report::human(&written.summary, &m.scenario, out, m.file.budget)
+    );
+    Ok((text, written.summary.counts, written.plot_warnings))
 }

@@ -120,6 +120,15 @@ impl RunRecord {
         self.cost(&[])
     }
 
+    /// The names of the monitors that failed, in the scenario's order.
+    pub fn failed_monitors(&self) -> Vec<String> {
+        self.monitors
+            .iter()
+            .filter(|(_, m)| !m.passed)
+            .map(|(n, _)| n.clone())
+            .collect()
+    }
+
     /// The falsification cost of the test: the smallest robustness over its monitors, where
     /// the `passive` ones (see `Scenario::passive_monitors`) count only when `<= 0`; `+inf`
     /// when nothing counts, NaN for a test that ended in `error`. `<= 0` exactly when the test
@@ -169,7 +178,8 @@ impl RunRecord {
     }
 }
 
-fn f64_or_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+/// A number, or `null` read as NaN (JSON has no NaN or infinity).
+pub(crate) fn f64_or_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 

@@ -6,19 +6,11 @@ use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{CameraFrame, CameraSpec};
 use paracosm_generators::{Point, Strategy};
 use paracosm_scenarios::RunOptions;
-use thiserror::Error;
 
-use crate::campaign::Campaign;
+use crate::campaign::{Campaign, RESULTS_FILE};
 use crate::campaign_file::CampaignFile;
 use crate::record::{RunRecord, Status};
-
-/// Why a replay cannot run.
-#[derive(Debug, Error)]
-pub enum ReplayError {
-    /// A file cannot be read or written, or does not parse.
-    #[error("{0}")]
-    Input(String),
-}
+use crate::Error;
 
 /// The outcome of a replay.
 #[derive(Debug)]
@@ -35,12 +27,21 @@ pub struct Replay {
     pub contact_sheet: Option<PathBuf>,
 }
 
-fn input(e: impl std::fmt::Display) -> ReplayError {
-    ReplayError::Input(e.to_string())
+fn input(e: impl std::fmt::Display) -> Error {
+    Error::BadInput(e.to_string())
+}
+
+/// The command that replays test `id` of the campaign in `out`.
+pub fn replay_command(out: &Path, id: u64) -> String {
+    format!(
+        "paracosm-fuzz replay {} --id {id} --frames {}",
+        out.join(RESULTS_FILE).display(),
+        out.join(format!("frames-{id}")).display()
+    )
 }
 
 /// The line of `results` whose `id` is `id`.
-fn find_record(results: &Path, id: u64) -> Result<(usize, String), ReplayError> {
+fn find_record(results: &Path, id: u64) -> Result<(usize, String), Error> {
     let text = std::fs::read_to_string(results)
         .map_err(|e| input(format!("cannot read `{}`: {e}", results.display())))?;
     let mut ids = Vec::new();
@@ -86,14 +87,14 @@ fn find_record(results: &Path, id: u64) -> Result<(usize, String), ReplayError> 
 /// for systems without one), and `contact_sheet.png`. `sut` replaces the recorded system.
 ///
 /// # Errors
-/// [`ReplayError::Input`] when a file is missing or malformed, the id is not in the results,
+/// [`Error::BadInput`] when a file is missing or malformed, the id is not in the results,
 /// the scenario does not load, or a frame cannot be written.
 pub fn replay(
     results: &Path,
     id: u64,
     frames: Option<&Path>,
     sut: Option<SutConfig>,
-) -> Result<Replay, ReplayError> {
+) -> Result<Replay, Error> {
     let dir = results.parent().unwrap_or(Path::new("."));
     let (line_no, line) = find_record(results, id)?;
     let campaign_file = CampaignFile::read(dir).map_err(input)?;
@@ -186,6 +187,48 @@ fn verdicts_match(recorded: &serde_json::Value, replayed: &RunRecord) -> bool {
         return false;
     };
     recorded["status"] == replayed["status"] && recorded["monitors"] == replayed["monitors"]
+}
+
+impl Replay {
+    /// What `paracosm-fuzz replay` prints for test `id`: both verdicts, what the program
+    /// printed, the frames written (into `frames`), and whether the verdicts agree.
+    pub fn text(&self, id: u64, frames: Option<&Path>) -> String {
+        let recorded = self.recorded["status"].as_str().unwrap_or("?");
+        let verdicts: Vec<String> = self
+            .replayed
+            .monitors
+            .iter()
+            .map(|(n, m)| {
+                let word = if m.passed { "passed" } else { "failed" };
+                format!("{n} {word} (robustness {:.3})", m.robustness)
+            })
+            .collect();
+        let error = self.replayed.error.as_deref();
+        let mut lines = vec![format!(
+            "test {id}: recorded {recorded}, replayed {}: {}{}",
+            status_name(self.replayed.status),
+            verdicts.join(", "),
+            error.map(|e| format!(" ({e})")).unwrap_or_default()
+        )];
+        lines.extend(self.replayed.log.iter().map(|l| format!("print: {l}")));
+        if let Some(sheet) = &self.contact_sheet {
+            lines.push(format!(
+                "wrote {} frames to {} and {}",
+                self.frames.len(),
+                frames.unwrap_or(Path::new(".")).display(),
+                sheet.display()
+            ));
+        }
+        lines.push(if self.matches {
+            "the replayed verdict equals the recorded one".to_owned()
+        } else {
+            format!(
+                "the replayed verdict DIFFERS from the recorded one: recorded monitors {}",
+                self.recorded["monitors"]
+            )
+        });
+        lines.join("\n")
+    }
 }
 
 /// `pass`, `fail` or `error`.

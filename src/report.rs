@@ -9,52 +9,11 @@ use paracosm_scenarios::Scenario;
 use crate::campaign::RESULTS_FILE;
 use crate::campaign_file::CampaignFile;
 use crate::record::{RunRecord, Status};
+use crate::replay::replay_command;
 use crate::summary::{Counts, FailureEntry, FirstFailure, Summary};
 
 /// File name of the summary in the output folder.
 pub const SUMMARY_FILE: &str = "summary.json";
-
-/// Outcome counts of `records`.
-pub fn counts(records: &[RunRecord]) -> Counts {
-    let mut c = Counts::default();
-    for r in records {
-        match r.status {
-            Status::Pass => c.pass += 1,
-            Status::Fail => c.fail += 1,
-            Status::Error => c.error += 1,
-        }
-    }
-    c
-}
-
-fn failed_monitors(r: &RunRecord) -> Vec<String> {
-    r.monitors
-        .iter()
-        .filter(|(_, m)| !m.passed)
-        .map(|(n, _)| n.clone())
-        .collect()
-}
-
-/// The failing test with the smallest id.
-pub fn first_failure(records: &[RunRecord]) -> Option<FirstFailure> {
-    records.iter().find_map(|r| match (&r.status, &r.params) {
-        (Status::Fail, Some(params)) => Some(FirstFailure {
-            id: r.id,
-            params: params.clone(),
-            failed_monitors: failed_monitors(r),
-        }),
-        _ => None,
-    })
-}
-
-/// The command that replays test `id` of the campaign in `out`.
-pub fn replay_command(out: &Path, id: u64) -> String {
-    format!(
-        "paracosm-fuzz replay {} --id {id} --frames {}",
-        out.join(RESULTS_FILE).display(),
-        out.join(format!("frames-{id}")).display()
-    )
-}
 
 /// Every failed test, smallest robustness first (ties by id; NaN last).
 pub fn failures(records: &[RunRecord], out: &Path) -> Vec<FailureEntry> {
@@ -68,7 +27,7 @@ pub fn failures(records: &[RunRecord], out: &Path) -> Vec<FailureEntry> {
                 .iter()
                 .map(|(_, m)| m.robustness)
                 .fold(f64::INFINITY, f64::min),
-            failed_monitors: failed_monitors(r),
+            failed_monitors: r.failed_monitors(),
             params: r.params.clone(),
             replay: replay_command(out, r.id),
         })
@@ -96,7 +55,8 @@ pub struct Finished<'a> {
     pub jobs: usize,
     /// Wall time in seconds.
     pub wall_s: f64,
-    /// Where to write JUnit XML, if asked.
+    /// Where JUnit XML is written, if asked (listed in the summary's outputs; written by
+    /// the caller, [`crate::junit::write`]).
     pub junit: Option<&'a Path>,
     /// The warnings the scenario loaded with for this campaign's system under test
     /// ([`Scenario::warnings_for`]), recorded in the summary.
@@ -122,15 +82,15 @@ fn plan_plots(scenario: &Scenario) -> Vec<&'static str> {
     }
 }
 
-/// Writes `summary.json`, then JUnit XML when asked, then the plots (`failure_map`,
+/// Writes `summary.json`, then the plots (`failure_map`,
 /// `failure_rate`: none without open parameters, a strip plot with one, categorical columns for
 /// discrete ones), each file through a temporary file and a rename. The summary comes first so
 /// that no plotting problem can cost it: a plot that cannot be drawn is a warning, and the
 /// summary is written again without it and with the warning.
 ///
 /// # Errors
-/// A message naming the file when `summary.json` or the JUnit file cannot be written.
-pub fn write_outputs(f: &Finished<'_>) -> Result<Written, String> {
+/// [`crate::Error::Write`] when `summary.json` cannot be written.
+pub fn write_outputs(f: &Finished<'_>) -> Result<Written, crate::Error> {
     let scenario = f.scenario;
     let planned = plan_plots(scenario);
     let plot_files = |stems: &[&str]| -> Vec<String> {
@@ -151,9 +111,6 @@ pub fn write_outputs(f: &Finished<'_>) -> Result<Written, String> {
     outputs.extend(plot_files(&planned));
     let mut summary = summarise(f, outputs);
     write_summary(f.out, &summary)?;
-    if let Some(path) = f.junit {
-        crate::junit::write(path, &scenario.name, f.records, f.out)?;
-    }
 
     let counts = summary.counts;
     let mut drawn = Vec::new();
@@ -207,7 +164,7 @@ pub fn write_outputs(f: &Finished<'_>) -> Result<Written, String> {
     })
 }
 
-fn write_summary(out: &Path, summary: &Summary) -> Result<(), String> {
+fn write_summary(out: &Path, summary: &Summary) -> Result<(), crate::Error> {
     let text = serde_json::to_string_pretty(summary).expect("summaries serialise") + "\n";
     crate::atomic::write(&out.join(SUMMARY_FILE), text.as_bytes())
 }
@@ -289,8 +246,8 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
         jobs: f.jobs,
         space: scenario.space.params().to_vec(),
         unused_params: scenario.unused_params.clone(),
-        counts: counts(f.records),
-        first_failure: first_failure(f.records),
+        counts: Counts::of(f.records),
+        first_failure: FirstFailure::of(f.records),
         coverage,
         warnings: f.warnings.clone(),
         wall_s: f.wall_s,
@@ -379,4 +336,62 @@ pub fn human(summary: &Summary, scenario: &Scenario, out: &Path, expected: u64) 
             .join(", ")
     ));
     lines.join("\n")
+}
+
+/// `paracosm-fuzz report DIR`: the human summary of a finished or partial campaign folder,
+/// computed again from its records (and the wall time and thread count of its
+/// `summary.json`, when there is one), with a line on how to finish a partial one. Returns
+/// the text and the counts.
+///
+/// # Errors
+/// [`crate::Error::Input`] when `campaign.json` or `results.jsonl` is missing or malformed;
+/// [`crate::Error::Scenario`] when the campaign's scenario no longer loads.
+pub fn reread(dir: &Path) -> Result<(String, Counts), crate::Error> {
+    let file = CampaignFile::read(dir)?;
+    let mut scenario = paracosm_scenarios::load(&file.scenario)?;
+    if let Some(s) = file.sut.config()? {
+        scenario.sut = s;
+    }
+    let ids = file.ids();
+    let existing = crate::results::load(dir, &scenario.space, ids.clone(), false)?;
+    let stored = Summary::read(dir).ok();
+    let wall_s = stored.as_ref().map_or_else(
+        || existing.records.iter().map(|r| r.wall_ms).sum::<f64>() / 1e3,
+        |s| s.wall_s,
+    );
+    let outputs: Vec<String> = [
+        RESULTS_FILE,
+        SUMMARY_FILE,
+        "failure_map.png",
+        "failure_map.svg",
+        "failure_rate.png",
+        "failure_rate.svg",
+    ]
+    .iter()
+    .filter(|f| dir.join(f).exists())
+    .map(|f| f.to_string())
+    .collect();
+    let summary = summarise(
+        &Finished {
+            out: dir,
+            scenario: &scenario,
+            file: &file,
+            records: &existing.records,
+            jobs: stored.as_ref().map_or(1, |s| s.jobs),
+            wall_s,
+            junit: None,
+            warnings: crate::session::warnings_of(&scenario),
+        },
+        outputs,
+    );
+    let expected = ids.end - ids.start;
+    let mut text = human(&summary, &scenario, dir, expected);
+    if (existing.records.len() as u64) < expected {
+        text.push_str(&format!(
+            "\npartial: {} of {expected} tests; finish it with `paracosm-fuzz --resume --out {}`",
+            existing.records.len(),
+            dir.display()
+        ));
+    }
+    Ok((text, summary.counts))
 }

@@ -1,6 +1,5 @@
 //! Reading a folder's `results.jsonl` back: for `--resume`, `merge` and `report`.
 
-use std::io::Write;
 use std::ops::Range;
 use std::path::Path;
 
@@ -8,6 +7,7 @@ use paracosm_generators::ParamSpace;
 
 use crate::campaign::RESULTS_FILE;
 use crate::record::RunRecord;
+use crate::Error;
 
 /// The records found in a folder.
 #[derive(Debug)]
@@ -25,51 +25,52 @@ pub struct Existing {
 /// runner writes them so. A missing file reads as no records.
 ///
 /// # Errors
-/// A message with `file:line:column` for a line that is not a record, or naming the first id
-/// out of sequence; or the file system's message.
+/// [`Error::Input`] with `file:line:column` for a line that is not a record, or naming the
+/// first id out of sequence, or with the file system's reason.
 pub fn load(
     dir: &Path,
     space: &ParamSpace,
     ids: Range<u64>,
     repair: bool,
-) -> Result<Existing, String> {
+) -> Result<Existing, Error> {
     let path = dir.join(RESULTS_FILE);
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
-        Err(e) => return Err(format!("cannot read `{}`: {e}", path.display())),
+        Err(e) => return Err(Error::input(&path, e)),
     };
+    let bad = |message: String| Error::malformed(&path, message);
     let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
     let repaired_bytes = bytes.len() - whole;
     if repaired_bytes > 0 && repair {
         let f = std::fs::OpenOptions::new()
             .write(true)
             .open(&path)
-            .map_err(|e| format!("cannot repair `{}`: {e}", path.display()))?;
+            .map_err(|e| Error::write(&path, e))?;
         f.set_len(whole as u64)
             .and_then(|()| f.sync_all())
-            .map_err(|e| format!("cannot repair `{}`: {e}", path.display()))?;
+            .map_err(|e| Error::write(&path, e))?;
     }
     let text = std::str::from_utf8(&bytes[..whole]).map_err(|e| {
-        format!(
+        bad(format!(
             "{}: not UTF-8 text (byte {}); is it a results file?",
             path.display(),
             e.valid_up_to()
-        )
+        ))
     })?;
     let mut records = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let r = RunRecord::from_line(line, space).map_err(|e| {
-            format!(
+            bad(format!(
                 "{}:{}:{}: not a results record: {e}",
                 path.display(),
                 n + 1,
                 e.column()
-            )
+            ))
         })?;
         let expected = ids.start + records.len() as u64;
         if r.id != expected || !ids.contains(&r.id) {
-            return Err(format!(
+            return Err(bad(format!(
                 "{}:{}: test id {} where {} was expected (this folder runs ids {}..{}); the file \
                  was not written by this campaign",
                 path.display(),
@@ -78,7 +79,7 @@ pub fn load(
                 expected,
                 ids.start,
                 ids.end
-            ));
+            )));
         }
         records.push(r);
     }
@@ -88,17 +89,16 @@ pub fn load(
     })
 }
 
-/// Appends `src`'s `results.jsonl` bytes to `out` (whole lines only).
+/// The whole lines of `src`'s `results.jsonl`, as bytes.
 ///
 /// # Errors
-/// The file system's message.
-pub fn append_file(out: &mut impl Write, src: &Path) -> Result<(), String> {
+/// [`Error::Input`] when the file cannot be read.
+pub fn whole_lines(src: &Path) -> Result<Vec<u8>, Error> {
     let path = src.join(RESULTS_FILE);
-    let bytes =
-        std::fs::read(&path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+    let mut bytes = std::fs::read(&path).map_err(|e| Error::input(&path, e))?;
     let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
-    out.write_all(&bytes[..whole])
-        .map_err(|e| format!("cannot write the merged results: {e}"))
+    bytes.truncate(whole);
+    Ok(bytes)
 }
 
 #[cfg(test)]
@@ -129,10 +129,14 @@ mod tests {
         let repaired = std::fs::read_to_string(&path).unwrap();
         assert!(repaired.ends_with('\n') && full.starts_with(&repaired));
         // A shard that should start at id 2 does not accept ids 0..3.
-        let err = load(dir.path(), &s.space, 2..4, false).unwrap_err();
+        let err = load(dir.path(), &s.space, 2..4, false)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains(":1: test id 0 where 2 was expected"), "{err}");
         std::fs::write(&path, "{\"id\": 0, oops\n").unwrap();
-        let err = load(dir.path(), &s.space, 0..4, false).unwrap_err();
+        let err = load(dir.path(), &s.space, 0..4, false)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("results.jsonl:1:"), "{err}");
     }
 }

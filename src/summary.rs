@@ -1,11 +1,13 @@
 //! `summary.json`: a campaign's settings, counts and first failure.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use paracosm_generators::{Assignment, Param};
 
+use crate::record::{RunRecord, Status};
+
 /// Counts of test outcomes.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Counts {
     /// Tests whose monitors all passed.
     pub pass: u64,
@@ -15,8 +17,35 @@ pub struct Counts {
     pub error: u64,
 }
 
+impl Counts {
+    /// The tools' exit code for these outcomes: 1 when a test failed, else 3 when one ended
+    /// in an error, else 0.
+    pub fn exit_code(&self) -> u8 {
+        if self.fail > 0 {
+            1
+        } else if self.error > 0 {
+            3
+        } else {
+            0
+        }
+    }
+
+    /// The outcome counts of `records`: the one place they are counted.
+    pub fn of(records: &[RunRecord]) -> Counts {
+        let mut c = Counts::default();
+        for r in records {
+            match r.status {
+                Status::Pass => c.pass += 1,
+                Status::Fail => c.fail += 1,
+                Status::Error => c.error += 1,
+            }
+        }
+        c
+    }
+}
+
 /// The first failing test, by id.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FirstFailure {
     /// Test id.
     pub id: u64,
@@ -26,13 +55,28 @@ pub struct FirstFailure {
     pub failed_monitors: Vec<String>,
 }
 
+impl FirstFailure {
+    /// The failing test of `records` (in id order) with the smallest id, if any.
+    pub fn of(records: &[RunRecord]) -> Option<FirstFailure> {
+        records.iter().find_map(|r| match (&r.status, &r.params) {
+            (Status::Fail, Some(params)) => Some(FirstFailure {
+                id: r.id,
+                params: params.clone(),
+                failed_monitors: r.failed_monitors(),
+            }),
+            _ => None,
+        })
+    }
+}
+
 /// A failed test as `summary.json` lists it.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FailureEntry {
     /// Test id.
     pub id: u64,
     /// The smallest robustness over its monitors (the most violated); `null` when not a
-    /// number.
+    /// number (read back as NaN).
+    #[serde(deserialize_with = "crate::record::f64_or_null")]
     pub robustness: f64,
     /// The monitors that failed.
     pub failed_monitors: Vec<String>,
@@ -43,7 +87,7 @@ pub struct FailureEntry {
 }
 
 /// The contents of `summary.json`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
     /// Every failed test, most violated (smallest robustness) first, each with the command
     /// that replays it.
@@ -84,4 +128,25 @@ pub struct Summary {
     pub wall_s: f64,
     /// Files written, relative to the output folder.
     pub outputs: Vec<String>,
+}
+
+impl Summary {
+    /// Reads `summary.json` from the campaign folder `dir`.
+    ///
+    /// # Errors
+    /// [`crate::Error::Input`] naming the file when it cannot be read or is not a summary
+    /// (with its line and column).
+    pub fn read(dir: &std::path::Path) -> Result<Summary, crate::Error> {
+        let path = dir.join(crate::report::SUMMARY_FILE);
+        let text = std::fs::read_to_string(&path).map_err(|e| crate::Error::input(&path, e))?;
+        serde_json::from_str(&text).map_err(|e| {
+            let message = format!(
+                "{}:{}:{}: not a summary: {e}",
+                path.display(),
+                e.line(),
+                e.column()
+            );
+            crate::Error::malformed(&path, message)
+        })
+    }
 }

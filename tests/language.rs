@@ -545,3 +545,24 @@ fn a_combinator_of_the_wrong_kind_is_named_by_its_place() {
         "{error}"
     );
 }
+
+/// A level keeps its type: the text `"true"` stays a text (it was taken for a bool, so
+/// `mode == "true"` was never true), and a bool level is a bool in the program and in the
+/// results.
+#[test]
+fn levels_keep_their_type_a_text_true_is_not_a_bool() {
+    let src = "w = World()\nr = RoadSegment(len = 300.0, nlanes = 4)\nmode = VarEnum([\"true\", \"off\"])\nfast = VarEnum([True, False])\nv = AutonomousVehicle(loc = r.onLane(1, 10), speed = 8.0 if mode == \"true\" else 3.0)\nlead = Car(loc = r.onLane(1, 200), enabled = fast)\nw.place(r, v, lead)\nstart = Monitor(v.speed.take(1), over = \"end\")\n";
+    let (records, _, stderr) = run_src(src, "4", &["--strategy", "ipog"], 0);
+    assert!(!stderr.contains("no object reads"), "{stderr}");
+    let mut seen = std::collections::BTreeSet::new();
+    for r in &records {
+        let mode = r["params"]["mode"].as_str().expect("a text level");
+        let fast = r["params"]["fast"].as_bool().expect("a bool level");
+        let start = r["monitors"]["start"]["robustness"].as_f64().unwrap();
+        // The program saw the text: "true" gives the 8 m/s start, "off" the 3 m/s one.
+        let expected = if mode == "true" { 8.0 } else { 3.0 };
+        assert!((start - expected).abs() < 0.5, "{r}");
+        seen.insert((mode.to_owned(), fast));
+    }
+    assert_eq!(seen.len(), 4, "{seen:?}");
+}

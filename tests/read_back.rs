@@ -34,7 +34,12 @@ fn a_space_with_levels_of_every_kind_reads_back() {
         },
         Param {
             name: "colour".into(),
-            domain: Domain::Levels(vec![Value::Text("red".into()), Value::Text("1".into())]),
+            domain: Domain::Levels(vec![Value::Text("red".into()), Value::Text("true".into())]),
+            unit: None,
+        },
+        Param {
+            name: "oncoming".into(),
+            domain: Domain::Levels(vec![Value::Bool(true), Value::Bool(false)]),
             unit: None,
         },
         Param::interval("speed", 0.5, 2.5, "m/s"),
@@ -52,7 +57,16 @@ fn a_space_with_levels_of_every_kind_reads_back() {
             Value::Text("x".into())
         ]
     );
-    assert!(serde_json::from_str::<Value>("true").is_err());
+    // A bool level is a bool; a text "true" stays a text.
+    assert_eq!(
+        serde_json::from_str::<Value>("true").unwrap(),
+        Value::Bool(true)
+    );
+    assert_eq!(
+        serde_json::from_str::<Value>("\"true\"").unwrap(),
+        Value::Text("true".into())
+    );
+    assert!(serde_json::from_str::<Value>("[1]").is_err());
 }
 
 #[test]

@@ -37,6 +37,6 @@ pub enum GeneratorError {
     #[error("covering array: {0}")]
     Covering(String),
     /// A strategy name that no generator answers to.
-    #[error("unknown strategy `{0}` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise, falsify-nm, falsify-pso, falsify-sa, falsify-ce)")]
+    #[error("unknown strategy `{0}` (expected one of: {names})", names = crate::Strategy::names())]
     UnknownStrategy(String),
 }

@@ -5,9 +5,9 @@ use crate::{GeneratorError, Point};
 
 /// A value of a parameter, in the parameter's unit.
 ///
-/// In JSON an integer (`3`), a real (`0.4`, `3.0`) or a text (`"red"`); a number written
-/// with a fraction or an exponent reads back as [`Value::Real`], one without as
-/// [`Value::Int`].
+/// In JSON an integer (`3`), a real (`0.4`, `3.0`), a bool (`true`) or a text (`"red"`); a
+/// number written with a fraction or an exponent reads back as [`Value::Real`], one without
+/// as [`Value::Int`]. A text level `"true"` stays a text.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Value {
@@ -15,6 +15,8 @@ pub enum Value {
     Int(i64),
     /// A real number, e.g. a speed in m/s.
     Real(f64),
+    /// A truth value, e.g. whether an oncoming car is there.
+    Bool(bool),
     /// A named level, e.g. a colour.
     Text(String),
 }
@@ -32,20 +34,21 @@ impl<'de> Deserialize<'de> for Value {
                 (None, None) => Err(D::Error::custom(format!("{n} is not a finite number"))),
             },
             serde_json::Value::String(s) => Ok(Value::Text(s)),
+            serde_json::Value::Bool(b) => Ok(Value::Bool(b)),
             other => Err(D::Error::custom(format!(
-                "a parameter's value is a number or a text, not `{other}`"
+                "a parameter's value is a number, a bool or a text, not `{other}`"
             ))),
         }
     }
 }
 
 impl Value {
-    /// The value as `f64`: reals as they are, integers converted, text `None`.
+    /// The value as `f64`: reals as they are, integers converted, bools and text `None`.
     pub fn as_f64(&self) -> Option<f64> {
         match self {
             Value::Real(x) => Some(*x),
             Value::Int(i) => Some(*i as f64),
-            Value::Text(_) => None,
+            Value::Bool(_) | Value::Text(_) => None,
         }
     }
 }
@@ -54,6 +57,7 @@ impl std::fmt::Display for Value {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Value::Int(i) => write!(f, "{i}"),
+            Value::Bool(b) => write!(f, "{b}"),
             Value::Real(x) => write!(f, "{x}"),
             Value::Text(s) => write!(f, "{s}"),
         }
@@ -294,6 +298,30 @@ impl Serialize for Assignment {
             map.serialize_entry(n, v)?;
         }
         map.end()
+    }
+}
+
+/// Reads the object [`Assignment`]'s `Serialize` writes, keeping the keys' order.
+impl<'de> Deserialize<'de> for Assignment {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Ordered;
+        impl<'de> serde::de::Visitor<'de> for Ordered {
+            type Value = Assignment;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an object of parameter values")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut map: A,
+            ) -> Result<Assignment, A::Error> {
+                let mut values = Vec::new();
+                while let Some(entry) = map.next_entry::<String, Value>()? {
+                    values.push(entry);
+                }
+                Ok(Assignment { values })
+            }
+        }
+        d.deserialize_map(Ordered)
     }
 }
 

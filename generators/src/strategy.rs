@@ -43,6 +43,21 @@ impl Strategy {
         Strategy::FalsifyCe,
     ];
 
+    /// Every strategy, in the order the command line lists them: the one list from which
+    /// names, help, parsing and error messages are derived.
+    pub const LIST: [Strategy; 10] = [
+        Strategy::Random,
+        Strategy::Halton,
+        Strategy::ScrambledHalton,
+        Strategy::Sobol,
+        Strategy::Ipog,
+        Strategy::KWise,
+        Strategy::FalsifyNm,
+        Strategy::FalsifyPso,
+        Strategy::FalsifySa,
+        Strategy::FalsifyCe,
+    ];
+
     /// Every point generator that needs no budget, in the order the CLI lists them.
     pub const ALL: [Strategy; 4] = [
         Strategy::Random,
@@ -65,6 +80,42 @@ impl Strategy {
             Strategy::FalsifySa => "falsify-sa",
             Strategy::FalsifyCe => "falsify-ce",
         }
+    }
+
+    /// One line on what the strategy does, for `--help`.
+    pub fn help(self) -> &'static str {
+        match self {
+            Strategy::Random => "Uniform random points (ChaCha8, seeded by --seed)",
+            Strategy::Halton => {
+                "The Halton low-dispersion sequence from index 0 (paper §3.2); --seed is not used"
+            }
+            Strategy::ScrambledHalton => {
+                "The Halton sequence with random digit permutations (Owen 2017), drawn by \
+                 --seed; the same as halton with --scramble"
+            }
+            Strategy::Sobol => {
+                "Owen-scrambled Sobol points (at most 65536); --seed selects the scramble"
+            }
+            Strategy::Ipog => {
+                "A (k, ε)-covering suite: an IPOG covering array of strength --strength over the \
+                 discrete parameters, and a block of Halton points per array row"
+            }
+            Strategy::KWise => "As ipog, with a random k-wise array sized by Proposition 3.2",
+            Strategy::FalsifyNm => {
+                "Falsification: Nelder–Mead with restarts minimising robustness (argmin); \
+                 discrete parameters fixed per search by a pairwise covering array"
+            }
+            Strategy::FalsifyPso => "Falsification: particle swarms minimising robustness (argmin)",
+            Strategy::FalsifySa => {
+                "Falsification: simulated annealing minimising robustness (argmin)"
+            }
+            Strategy::FalsifyCe => "Falsification: the cross-entropy method minimising robustness",
+        }
+    }
+
+    /// The names of [`Strategy::LIST`], comma-separated, for messages.
+    pub fn names() -> String {
+        Strategy::LIST.map(Strategy::name).join(", ")
     }
 
     /// The search method of an adaptive strategy, `None` for the others.
@@ -161,10 +212,8 @@ impl FromStr for Strategy {
     type Err = GeneratorError;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Strategy::ALL
+        Strategy::LIST
             .into_iter()
-            .chain(Strategy::SUITES)
-            .chain(Strategy::FALSIFIERS)
             .find(|st| st.name() == s)
             .ok_or_else(|| GeneratorError::UnknownStrategy(s.to_owned()))
     }
@@ -182,13 +231,22 @@ mod tests {
 
     #[test]
     fn names_round_trip_and_unknown_names_are_errors() {
+        for s in Strategy::LIST {
+            assert_eq!(s.name().parse::<Strategy>().unwrap(), s);
+            assert!(!s.help().is_empty());
+        }
+        // The groups are parts of the list.
         for s in Strategy::ALL
             .into_iter()
             .chain(Strategy::SUITES)
             .chain(Strategy::FALSIFIERS)
         {
-            assert_eq!(s.name().parse::<Strategy>().unwrap(), s);
+            assert!(Strategy::LIST.contains(&s));
         }
+        assert_eq!(
+            Strategy::ALL.len() + Strategy::SUITES.len() + Strategy::FALSIFIERS.len(),
+            Strategy::LIST.len()
+        );
         assert_eq!(
             "annealing".parse::<Strategy>().unwrap_err().to_string(),
             "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise, falsify-nm, falsify-pso, falsify-sa, falsify-ce)"

@@ -77,7 +77,11 @@ pub fn scenario() -> Scenario {
     }
 }
 
-fn world(a: &Assignment) -> Result<WorldSpec, ScenarioError> {
+/// The study's world for one assignment (walking speed, m/s; trigger distance, m).
+///
+/// # Errors
+/// [`ScenarioError::MissingParam`] when the assignment lacks either parameter.
+pub fn world(a: &Assignment) -> Result<WorldSpec, ScenarioError> {
     Ok(WorldSpec::straight_road(
         200.0,
         EGO_START_M,

@@ -247,6 +247,15 @@ pub struct Scenario {
     pub(crate) worlds: Arc<dyn Worlds>,
 }
 
+impl Scenario {
+    /// The scenario with its worlds built by `worlds` instead: for a library user's own
+    /// world builder (or a test's), keeping the space, monitors and system under test.
+    pub fn with_worlds(mut self, worlds: Arc<dyn Worlds>) -> Self {
+        self.worlds = worlds;
+        self
+    }
+}
+
 /// Builds the world of each test (paper §3.1: a test case closes every open stream).
 pub trait Worlds: Send + Sync {
     /// Builds the world for `assignment` and calls `run` with it and a host for its lambdas

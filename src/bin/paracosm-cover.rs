@@ -11,8 +11,8 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
-use paracosm::cli::{BadInput, StrategyArg};
 use paracosm::cover::{estimate, load_space, plan, read_tests, Metric};
+use paracosm::Error;
 use paracosm_generators::coverage::{discrepancy, Discrepancy};
 use paracosm_generators::{Halton, ParamSpace, Strategy};
 
@@ -79,8 +79,8 @@ enum Command {
         #[arg(long, value_enum, default_value = "ipog")]
         algorithm: Algorithm,
         /// How points are chosen.
-        #[arg(long, value_enum, default_value = "halton")]
-        strategy: StrategyArg,
+        #[arg(long, value_parser = paracosm::cli::strategy_parser(), default_value = "halton")]
+        strategy: Strategy,
         /// With --strategy halton: randomise it by digit permutations (Owen 2017).
         #[arg(long)]
         scramble: bool,
@@ -171,11 +171,7 @@ fn main() -> ExitCode {
             }) {
                 return ExitCode::SUCCESS;
             }
-            let code = if e.downcast_ref::<BadInput>().is_some() {
-                2
-            } else {
-                3
-            };
+            let code = e.downcast_ref::<Error>().map_or(3, Error::exit_code);
             eprintln!("paracosm-cover: {e:#}");
             ExitCode::from(code)
         }
@@ -213,8 +209,9 @@ fn read_trace(path: &std::path::Path, dt_s: f64) -> Result<paracosm_oracles::stl
     })
 }
 
+/// The user's input cannot be honoured: exit code 2.
 fn bad(e: impl ToString) -> anyhow::Error {
-    BadInput(e.to_string()).into()
+    Error::BadInput(e.to_string()).into()
 }
 
 fn run(cli: Cli) -> Result<()> {

@@ -144,6 +144,7 @@ pub fn parse_tests(
 fn level_matches(level: &Value, text: &str) -> bool {
     match level {
         Value::Text(s) => s == text,
+        Value::Bool(b) => text == b.to_string(),
         Value::Int(i) => text.parse::<f64>().is_ok_and(|v| v == *i as f64),
         Value::Real(x) => text.parse::<f64>().is_ok_and(|v| v == *x),
     }

@@ -3,7 +3,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use paracosm_generators::coverage::{
     discrepancy, dispersion, k_epsilon_covering, kwise_coverage, star_discrepancy, CoverageError,
@@ -45,7 +45,7 @@ impl FromStr for Metric {
 }
 
 /// The coverage of a test set.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Estimate {
     /// Number of tests.
     pub tests: usize,

@@ -101,8 +101,9 @@ pub fn parse_space(file: &str, text: &str) -> Result<ParamSpace, SpecError> {
                         toml::Value::Integer(i) => Ok(Value::Int(i)),
                         toml::Value::Float(x) => Ok(Value::Real(x)),
                         toml::Value::String(s) => Ok(Value::Text(s)),
+                        toml::Value::Boolean(b) => Ok(Value::Bool(b)),
                         other => Err(invalid(format!(
-                            "parameter `{}`: level {other} is not a number or a string",
+                            "parameter `{}`: level {other} is not a number, a bool or a string",
                             p.name
                         ))),
                     })

@@ -63,7 +63,10 @@ fn png_and_svg(
     let (png_path, svg_path) = (stem.with_extension("png"), stem.with_extension("svg"));
     let failed = |path: &Path| {
         let path = path.to_path_buf();
-        move |reason| PlotError::Draw { path, reason }
+        move |e: crate::Error| PlotError::Draw {
+            path,
+            reason: e.to_string(),
+        }
     };
     crate::atomic::with_temp(&png_path, |tmp| {
         png(BitMapBackend::new(tmp, size).into_drawing_area())

@@ -1,6 +1,6 @@
 use std::collections::BTreeMap;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::{
     dispersion, kwise_coverage, CoverageError, Dispersion, DispersionOptions, KWiseCoverage,
@@ -8,7 +8,7 @@ use super::{
 use crate::{ParamSpace, Point};
 
 /// Whether a mixed test set is (k, ε)-covering (PARACOSM §3.1), with the evidence.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct KEpsilonCovering {
     /// The strength `k` of condition 1.
     pub k: usize,

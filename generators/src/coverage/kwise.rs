@@ -1,5 +1,5 @@
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::CoverageError;
 use crate::{Domain, ParamSpace, Point, Value};
@@ -8,7 +8,7 @@ use crate::{Domain, ParamSpace, Point, Value};
 pub const MAX_STRENGTH: usize = 6;
 
 /// One t-tuple that no test covers: `(parameter name, value)` pairs in declaration order.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MissingTuple {
     /// The tuple's values, by parameter.
     pub values: Vec<(String, Value)>,
@@ -16,7 +16,7 @@ pub struct MissingTuple {
 
 /// k-wise (t-wise) combinatorial coverage of the discrete parameters at one strength
 /// (PARACOSM §3.1; Kuhn, Kacker, Lei, "Introduction to Combinatorial Testing", 2013).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct KWiseCoverage {
     /// The strength `t`.
     pub strength: usize,

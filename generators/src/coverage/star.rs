@@ -1,12 +1,12 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::{check_unit_points, CoverageError};
 
 /// The L∞ star discrepancy of a point set: exact, or a certified bracket.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StarDiscrepancy {
     /// A lower bound: the local discrepancy at `witness`, which anyone can recompute in `O(nd)`.
     pub lower: f64,

@@ -6,7 +6,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
-use super::lane::reflect;
+use super::reflect;
 
 /// Cross-entropy search over `[0, 1]^d` with an axis-aligned Gaussian sampling density.
 ///

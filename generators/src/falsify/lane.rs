@@ -19,7 +19,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::cross_entropy::CrossEntropy;
-use super::{Method, Tuning, ABANDONED_COST};
+use super::{reflect, Method, Tuning, ABANDONED_COST};
 
 /// The cost function a search thread sees: every evaluation is a round trip to the generator.
 pub(super) struct Bridge {
@@ -82,16 +82,6 @@ impl Anneal for Bridge {
             .iter()
             .map(|&x| reflect(x + rng.random_range(-scale..=scale)))
             .collect())
-    }
-}
-
-/// `x` reflected at the faces of `[0, 1]` (a move past a face comes back by its excess).
-pub(super) fn reflect(x: f64) -> f64 {
-    let m = x.rem_euclid(2.0);
-    if m > 1.0 {
-        2.0 - m
-    } else {
-        m
     }
 }
 
@@ -187,18 +177,5 @@ pub(super) fn search(
                 }
             }
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn reflection_keeps_points_in_the_cube() {
-        assert_eq!(reflect(0.25), 0.25);
-        assert!((reflect(1.25) - 0.75).abs() < 1e-12);
-        assert!((reflect(-0.25) - 0.25).abs() < 1e-12);
-        assert!((reflect(2.5) - 0.5).abs() < 1e-12);
     }
 }

@@ -392,9 +392,27 @@ impl Generator for Falsifier {
     }
 }
 
+/// `x` reflected at the faces of `[0, 1]` (a move past a face comes back by its excess).
+pub(super) fn reflect(x: f64) -> f64 {
+    let m = x.rem_euclid(2.0);
+    if m > 1.0 {
+        2.0 - m
+    } else {
+        m
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn reflection_keeps_points_in_the_cube() {
+        assert_eq!(reflect(0.25), 0.25);
+        assert!((reflect(1.25) - 0.75).abs() < 1e-12);
+        assert!((reflect(-0.25) - 0.25).abs() < 1e-12);
+        assert!((reflect(2.5) - 0.5).abs() < 1e-12);
+    }
     use crate::{Param, Value};
 
     const ALL: [Method; 4] = [

@@ -835,8 +835,11 @@ impl SceneBuilder {
     }
 }
 
-/// An engine error's message without the `invalid world: ` prefix.
+/// An engine error's message, without the `invalid world: ` that an
+/// [`paracosm_engine::EngineError::InvalidWorld`] adds (the program's message says where).
 pub fn strip(e: paracosm_engine::EngineError) -> String {
-    let s = e.to_string();
-    s.strip_prefix("invalid world: ").unwrap_or(&s).to_owned()
+    match e {
+        paracosm_engine::EngineError::InvalidWorld(reason) => reason,
+        other => other.to_string(),
+    }
 }

@@ -224,8 +224,7 @@ pub fn level_value(l: &Level) -> Rx {
     match l {
         Level::Int(i) => Rx::Num(*i as f64),
         Level::Real(x) => Rx::Num(*x),
-        Level::Text(t) if t == "true" => Rx::Bool(true),
-        Level::Text(t) if t == "false" => Rx::Bool(false),
+        Level::Bool(b) => Rx::Bool(*b),
         Level::Text(t) => Rx::Text(t.clone()),
     }
 }

@@ -4,13 +4,13 @@ mod bracket;
 mod plane;
 mod sweep;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::{check_unit_points, CoverageError};
 
 /// An axis-parallel box `(lo_1, hi_1) × ... × (lo_d, hi_d)` inside `[0, 1]^d`, open: a point
 /// on its boundary is not inside it.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EmptyBox {
     /// Lower corner, `d` values in `[0, 1]`.
     pub lo: Vec<f64>,
@@ -47,7 +47,7 @@ impl EmptyBox {
 }
 
 /// The dispersion of a point set: exact, or a certified bracket.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Dispersion {
     /// A lower bound: the volume of `witness`, an empty box anyone can check.
     pub lower: f64,

@@ -1,0 +1,376 @@
+#![allow(non_snake_case)] // The paper's keyword names: numLane, minD, minT.
+
+//! Actors: `AutonomousVehicle`, `Car`, `ChangeLane`, `Obstacle`, `Pedestrian`.
+
+use anyhow::{anyhow, bail};
+use paracosm_engine::behaviour::{Actor, Output};
+use paracosm_engine::rx::{StreamId, Value as Rx};
+use paracosm_engine::sut::{AebConfig, SutConfig};
+use starlark::environment::GlobalsBuilder;
+use starlark::eval::Evaluator;
+use starlark::starlark_module;
+use starlark::values::list::UnpackList;
+use starlark::values::{UnpackValue, Value, ValueLike};
+
+use crate::lang::scene::{turns, ObjectDecl, PedTrigger, Pending, SceneBuilder};
+use crate::lang::types;
+use crate::lang::values::{
+    ActorKind, ActorVal, ChangeStart, LaneChangeVal, Loc, ObstacleVal, Stream,
+};
+
+use super::*;
+
+pub(super) fn location(v: Value, what: &str) -> anyhow::Result<usize> {
+    v.downcast_ref::<Loc>().map(|l| l.index).ok_or_else(|| {
+        anyhow!(
+            "{what} must be a location from r.onLane(lane, at), got a {}",
+            v.get_type()
+        )
+    })
+}
+
+pub(super) fn declare(
+    eval: &Evaluator,
+    b: &mut SceneBuilder,
+    what: &str,
+    kind: ActorKind,
+    pending: Pending,
+) -> ActorVal {
+    let actor = match kind {
+        ActorKind::Ego => Actor::Ego,
+        ActorKind::Pedestrian(i) => Actor::Pedestrian(i),
+        ActorKind::Car(i) => Actor::Car(i),
+    };
+    let outputs = [
+        Output::Pos,
+        Output::Vel,
+        Output::Heading,
+        Output::Speed,
+        Output::Collision,
+    ]
+    .map(|o| b.probe(actor, o).0);
+    b.objects.push(ObjectDecl {
+        name: object_name(eval, what),
+        at: here(eval),
+        variable: variable_here(eval),
+        actor: Some(actor),
+        pending,
+        placed: false,
+    });
+    ActorVal {
+        kind,
+        outputs,
+        object: b.objects.len() - 1,
+    }
+}
+
+/// A route: `None`, one turn (a string, `Const("left")`, or an open `VarEnum` of turns) or a
+/// list of turns.
+pub(super) fn route_arg(
+    v: Option<Value>,
+    b: &SceneBuilder,
+) -> anyhow::Result<Option<Vec<paracosm_engine::network::Turn>>> {
+    let one = |v: Value| text_value(v, b);
+    match v {
+        None => Ok(None),
+        Some(v) if v.is_none() => Ok(None),
+        // One turn, e.g. an open parameter `VarEnum(["left", "straight", "right"])`.
+        Some(v) if one(v).is_some() => turns(&[one(v).unwrap_or_default()])
+            .map(Some)
+            .map_err(|e| anyhow!(e)),
+        Some(v) if v.downcast_ref::<Stream>().is_some() => bail!(
+            "route is fixed for a test, since the path is planned when the world is built: give \
+             a turn, a list of turns or an open VarEnum of turns, not a stream"
+        ),
+        Some(v) => {
+            let wrong = || {
+                anyhow!(
+                    "route must be a turn or a list of turns such as [\"left\", \"straight\"], \
+                     got a {}",
+                    v.get_type()
+                )
+            };
+            let items = UnpackList::<Value>::unpack_value(v)
+                .ok()
+                .flatten()
+                .ok_or_else(wrong)?;
+            let list = items
+                .items
+                .into_iter()
+                .map(|t| one(t).ok_or_else(wrong))
+                .collect::<anyhow::Result<Vec<String>>>()?;
+            turns(&list).map(Some).map_err(|e| anyhow!(e))
+        }
+    }
+}
+
+/// The builtins of this topic.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register(builder: &mut GlobalsBuilder) {
+    /// `AutonomousVehicle(loc=, sut="aeb", route=None, speed=None)`: the ego vehicle and its
+    /// default system under test (`aeb` or `vision`; `--sut`/`--sut-cmd` override it).
+    fn AutonomousVehicle<'v>(
+        #[starlark(require = named)] loc: Value<'v>,
+        #[starlark(require = named)] sut: Option<&str>,
+        #[starlark(require = named)] route: Option<Value<'v>>,
+        #[starlark(require = named)] speed: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<ActorVal> {
+        let loc = location(loc, "loc")?;
+        let sut = SutConfig::builtin(sut.unwrap_or("aeb")).map_err(anyhow::Error::msg)?;
+        let initial_speed_mps = match speed {
+            Some(v) => number(v, "AutonomousVehicle(speed=), the initial speed,")?,
+            None => AebConfig::default().cruise.target_speed_mps,
+        };
+        if !(initial_speed_mps.is_finite() && initial_speed_mps >= 0.0) {
+            bail!("speed {initial_speed_mps} m/s must be >= 0");
+        }
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        let route = route_arg(route, &b)?;
+        Ok(declare(
+            eval,
+            &mut b,
+            "AutonomousVehicle",
+            ActorKind::Ego,
+            Pending::Ego {
+                loc,
+                route,
+                initial_speed_mps,
+                sut,
+            },
+        ))
+    }
+
+    /// `Car(loc=, speed=10.0, route=[], color="red", enabled=True, lane_change=None)`: an
+    /// NPC car that follows the lane graph, and may change lanes once (`ChangeLane`).
+    fn Car<'v>(
+        #[starlark(require = named)] loc: Value<'v>,
+        #[starlark(require = named)] speed: Option<Value<'v>>,
+        #[starlark(require = named)] route: Option<Value<'v>>,
+        #[starlark(require = named)] color: Option<Value<'v>>,
+        #[starlark(require = named)] enabled: Option<Value<'v>>,
+        #[starlark(require = named)] lane_change: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<ActorVal> {
+        let loc = location(loc, "loc")?;
+        let lane_change = match lane_change {
+            None => None,
+            Some(v) if v.is_none() => None,
+            Some(v) => Some(*v.downcast_ref::<LaneChangeVal>().ok_or_else(|| {
+                anyhow!(
+                    "Car(lane_change=) takes ChangeLane(to = lane, at = seconds or when = stream, duration = seconds), got a {}",
+                    v.get_type()
+                )
+            })?),
+        };
+        let heap = eval.heap();
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        let route = route_arg(route, &b)?.unwrap_or_default();
+        let at = object_at(eval);
+        let speed = typed_arg(
+            speed.unwrap_or_else(|| heap.alloc(10.0)),
+            &mut b,
+            &types::CAR_SPEED,
+            "Car",
+            &at,
+        )?;
+        let color = match fixed_typed(
+            color.unwrap_or_else(|| heap.alloc("red")),
+            &b,
+            &types::COLOR,
+            "Car",
+        )? {
+            Rx::Text(t) => t.to_ascii_lowercase(),
+            c => bail!("Car(color=) takes a colour name, got a {}", c.kind()),
+        };
+        let enabled = fixed_typed(
+            enabled.unwrap_or_else(|| Value::new_bool(true)),
+            &b,
+            &types::ENABLED,
+            "Car",
+        )?
+        .as_bool()
+        .unwrap_or(true);
+        let i = b.n_cars;
+        b.n_cars += 1;
+        Ok(declare(
+            eval,
+            &mut b,
+            "Car",
+            ActorKind::Car(i),
+            Pending::Car {
+                loc,
+                route,
+                speed,
+                color,
+                enabled,
+                lane_change,
+            },
+        ))
+    }
+
+    /// `ChangeLane(to=, at=None, when=None, duration=3.0)`: a lane change for
+    /// `Car(lane_change=)`: to lane `to` of the car's segment, starting `at` seconds into the
+    /// test or at the first event of the stream `when`, over `duration` seconds.
+    fn ChangeLane<'v>(
+        #[starlark(require = named)] to: Value<'v>,
+        #[starlark(require = named)] at: Option<Value<'v>>,
+        #[starlark(require = named)] when: Option<Value<'v>>,
+        #[starlark(require = named)] duration: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<LaneChangeVal> {
+        let to = number(to, "ChangeLane(to=)")?;
+        if to.fract() != 0.0 || to == 0.0 {
+            bail!("ChangeLane(to=) is a lane number (1, 2, ... or -1, -2, ...), got {to}");
+        }
+        let duration_s = match duration {
+            Some(v) => number(v, "ChangeLane(duration=)")?,
+            None => 3.0,
+        };
+        if !(duration_s.is_finite() && duration_s > 0.0) {
+            bail!("ChangeLane(duration=) takes a number in s, > 0, got {duration_s}");
+        }
+        let start = match (at, when) {
+            (Some(t), None) => {
+                let t = number(t, "ChangeLane(at=)")?;
+                if !(t.is_finite() && t >= 0.0) {
+                    bail!("ChangeLane(at=) takes a number in s, >= 0, got {t}");
+                }
+                ChangeStart::At(t)
+            }
+            (None, Some(w)) => {
+                let st = state(eval)?;
+                let mut b = st.scene.borrow_mut();
+                ChangeStart::When(stream_arg(w, &mut b, "ChangeLane(when=)")?.0)
+            }
+            _ => bail!("ChangeLane needs either at = seconds or when = a stream"),
+        };
+        Ok(LaneChangeVal {
+            to: to as i32,
+            start,
+            duration_s,
+        })
+    }
+
+    /// `Obstacle(loc=, size=(4.5, 1.8, 1.5), color="grey")`: a static box (a parked car, a
+    /// cone, a barrier) standing at `loc`, turned along its lane; `size` is its length, width
+    /// and height in metres. It collides with the ego vehicle, stops lidar beams and is drawn
+    /// by the camera.
+    fn Obstacle<'v>(
+        #[starlark(require = named)] loc: Value<'v>,
+        #[starlark(require = named)] size: Option<Value<'v>>,
+        #[starlark(require = named)] color: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<ObstacleVal> {
+        let loc = location(loc, "loc")?;
+        let size = match size {
+            None => paracosm_engine::Size::CAR,
+            Some(v) => {
+                let items: Vec<Value> = v
+                    .iterate(eval.heap())
+                    .map_err(|_| {
+                        anyhow!(
+                            "Obstacle(size=) takes (length, width, height) in m, got a {}",
+                            v.get_type()
+                        )
+                    })?
+                    .collect();
+                let [l, w, h] = items.as_slice() else {
+                    bail!(
+                        "Obstacle(size=) takes three numbers (length, width, height) in m, got {}",
+                        items.len()
+                    );
+                };
+                let size = paracosm_engine::Size {
+                    length_m: number(*l, "Obstacle(size=) length")?,
+                    width_m: number(*w, "Obstacle(size=) width")?,
+                    height_m: number(*h, "Obstacle(size=) height")?,
+                };
+                if !size.is_valid() {
+                    bail!("Obstacle(size=) needs three positive lengths in m, got {size:?}");
+                }
+                size
+            }
+        };
+        let heap = eval.heap();
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        let color = match fixed_typed(
+            color.unwrap_or_else(|| heap.alloc("grey")),
+            &b,
+            &types::COLOR,
+            "Obstacle",
+        )? {
+            Rx::Text(t) => t.to_ascii_lowercase(),
+            c => bail!("Obstacle(color=) takes a colour name, got a {}", c.kind()),
+        };
+        b.objects.push(ObjectDecl {
+            name: object_name(eval, "Obstacle"),
+            at: here(eval),
+            variable: variable_here(eval),
+            actor: None,
+            pending: Pending::Obstacle { loc, size, color },
+            placed: false,
+        });
+        Ok(ObstacleVal {
+            object: b.objects.len() - 1,
+        })
+    }
+
+    /// `Pedestrian(start=, target=, speed=, dist=None, car=None, trigger=None)`: walks from
+    /// `start` to `target` once `car` comes within `dist` metres of `start` (or once
+    /// `trigger` fires).
+    fn Pedestrian<'v>(
+        #[starlark(require = named)] start: Value<'v>,
+        #[starlark(require = named)] target: Value<'v>,
+        #[starlark(require = named)] speed: Value<'v>,
+        #[starlark(require = named)] dist: Option<Value<'v>>,
+        #[starlark(require = named)] car: Option<Value<'v>>,
+        #[starlark(require = named)] trigger: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<ActorVal> {
+        let (start, target) = (location(start, "start")?, location(target, "target")?);
+        let at = object_at(eval);
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        let owner = "Pedestrian";
+        let speed = typed_arg(speed, &mut b, &types::PEDESTRIAN_SPEED, owner, &at)?;
+        let trigger = match (dist, car, trigger) {
+            (Some(d), Some(c), None) => {
+                let car = match c.downcast_ref::<ActorVal>() {
+                    Some(a) => StreamId(a.outputs[0]),
+                    None => typed_arg(c, &mut b, &types::WATCHED_POSITION, owner, &at)?,
+                };
+                PedTrigger::Near {
+                    car,
+                    dist: typed_arg(d, &mut b, &types::TRIGGER_DISTANCE, owner, &at)?,
+                }
+            }
+            (None, None, Some(t)) => {
+                PedTrigger::Stream(typed_arg(t, &mut b, &types::TRIGGER, owner, &at)?)
+            }
+            (None, None, None) => PedTrigger::Never,
+            _ => bail!(
+                "Pedestrian takes dist= and car= together, or trigger=, or neither (then it \
+                 walks only when an action moves it: stream.foreach(p.walk))"
+            ),
+        };
+        let i = b.n_pedestrians;
+        b.n_pedestrians += 1;
+        Ok(declare(
+            eval,
+            &mut b,
+            "Pedestrian",
+            ActorKind::Pedestrian(i),
+            Pending::Pedestrian {
+                start,
+                target,
+                speed,
+                trigger,
+            },
+        ))
+    }
+}

@@ -1,0 +1,287 @@
+#![allow(non_snake_case)] // The paper's keyword names: numLane, minD, minT.
+
+//! Monitors: the built-in ones, `Stl`, and the program's own (`Monitor`, `Assert`, `Signal`, paper §2, "Invariants and Monitors").
+
+use anyhow::{anyhow, bail};
+use starlark::environment::GlobalsBuilder;
+use starlark::eval::Evaluator;
+use starlark::starlark_module;
+use starlark::values::none::NoneType;
+use starlark::values::{Value, ValueLike};
+
+use crate::lang::scene::SceneBuilder;
+use crate::lang::types;
+use crate::lang::values::{ActorKind, ActorVal, MonitorVal, Stream};
+use crate::MonitorSpec;
+
+use super::*;
+
+pub(super) fn unique_monitor_name(b: &SceneBuilder, name: &str) -> anyhow::Result<()> {
+    if b.monitors.iter().any(|m| m.name() == name) {
+        bail!(
+            "two monitors are named `{name}`: results are keyed by monitor name, so give one \
+             another name="
+        );
+    }
+    Ok(())
+}
+
+/// Publishes the stream a `Monitor` or `Assert` named `name` judges, checking that it carries
+/// `want` (numbers or bools) when that is known; returns the signal's name.
+pub(super) fn publish_monitored(
+    eval: &Evaluator,
+    stream: Value,
+    name: &str,
+    what: &str,
+    want: types::SType,
+) -> anyhow::Result<String> {
+    let st = state(eval)?;
+    let mut b = st.scene.borrow_mut();
+    if stream.downcast_ref::<Stream>().is_none() {
+        bail!(
+            "{what} judges a stream (such as `v.speed.map(lambda s: 20 - s)`), got a {}",
+            stream.get_type()
+        );
+    }
+    let id = stream_arg(stream, &mut b, what)?;
+    let kind = types::stream_types(&b)[id.0];
+    if kind != want && kind != types::SType::Any {
+        bail!(
+            "{what} needs a stream of {}, and this one carries {}{}",
+            want.name(),
+            kind.name(),
+            if want == types::SType::Num {
+                " (for a stream of bools, use Assert)"
+            } else {
+                ""
+            }
+        );
+    }
+    let signal = format!("monitor:{name}");
+    b.published.push((signal.clone(), id));
+    Ok(signal)
+}
+
+pub(super) fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<MonitorVal> {
+    let st = state(eval)?;
+    let mut b = st.scene.borrow_mut();
+    unique_monitor_name(&b, spec.name())?;
+    b.monitors.push(spec);
+    b.monitors_at.push(here(eval));
+    Ok(MonitorVal {
+        index: b.monitors.len() - 1,
+    })
+}
+
+pub(super) fn ego_arg(v: Value, what: &str) -> anyhow::Result<()> {
+    match v.downcast_ref::<ActorVal>() {
+        Some(a) if a.kind == ActorKind::Ego => Ok(()),
+        _ => bail!(
+            "{what} watches the AutonomousVehicle; got a {}",
+            v.get_type()
+        ),
+    }
+}
+
+/// The builtins of this topic.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register(builder: &mut GlobalsBuilder) {
+    /// `CollisionMonitor(v, name="collision")`: fails when the ego vehicle touches a
+    /// pedestrian or a car; robustness is the smallest separation in metres.
+    fn CollisionMonitor<'v>(
+        v: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        ego_arg(v, "CollisionMonitor")?;
+        monitor(
+            eval,
+            MonitorSpec::Collision {
+                name: name.unwrap_or("collision").to_owned(),
+            },
+        )
+    }
+
+    /// `OffRoadMonitor(v, name="offroad")`: fails when the centre of the ego vehicle's
+    /// footprint leaves the driving surface (a sidewalk, an island, the ground beside the road
+    /// or past a dead end); robustness is the smallest signed distance to the surface's edge
+    /// in metres.
+    fn OffRoadMonitor<'v>(
+        v: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        ego_arg(v, "OffRoadMonitor")?;
+        monitor(
+            eval,
+            MonitorSpec::OffRoad {
+                name: name.unwrap_or("offroad").to_owned(),
+                implicit: false,
+            },
+        )
+    }
+
+    /// `DistanceMonitor(v, minD=, name="distance")`: fails unless the ego vehicle travels at
+    /// least `minD` metres; robustness `D - minD` in metres.
+    fn DistanceMonitor<'v>(
+        v: Value<'v>,
+        #[starlark(require = named)] minD: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        ego_arg(v, "DistanceMonitor")?;
+        let min_distance_m = number(minD, "minD")?;
+        monitor(
+            eval,
+            MonitorSpec::Distance {
+                name: name.unwrap_or("distance").to_owned(),
+                min_distance_m,
+            },
+        )
+    }
+
+    /// `Stl(formula, name="stl")`: a signal temporal logic property over the runner's
+    /// signals ([`crate::signal::ALL`]), judged at the start of the test; robustness in the
+    /// formula's units. The formula is parsed when the program loads: a syntax error shows a
+    /// caret, an unknown signal is named.
+    fn Stl<'v>(
+        #[starlark(require = pos)] formula: &str,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        // Signal names are checked once the program has run (a Signal(...) or an actor may
+        // come later in the program).
+        paracosm_oracles::stl::parse(formula).map_err(anyhow::Error::msg)?;
+        monitor(
+            eval,
+            MonitorSpec::Stl {
+                name: name.unwrap_or("stl").to_owned(),
+                formula: formula.to_owned(),
+            },
+        )
+    }
+
+    /// `Monitor(stream, name=<variable> or "monitor", unit=None, over="always")`: a monitor
+    /// written by the program; its robustness is the stream's value taken `over` the test
+    /// (`"always"`: the minimum, failing at the first value `<= 0`; `"end"`: the last value;
+    /// `"eventually"`: the maximum), in `unit`.
+    fn Monitor<'v>(
+        #[starlark(require = pos)] stream: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        #[starlark(require = named)] unit: Option<&str>,
+        #[starlark(require = named)] over: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        let word = over.unwrap_or("always");
+        let over = paracosm_oracles::Over::parse(word).ok_or_else(|| {
+            anyhow!("Monitor(over=) is \"always\", \"end\" or \"eventually\", got {word:?}")
+        })?;
+        let name = name
+            .map(str::to_owned)
+            .or_else(|| variable_here(eval))
+            .unwrap_or_else(|| "monitor".to_owned());
+        let signal = publish_monitored(eval, stream, &name, "Monitor", types::SType::Num)?;
+        monitor(
+            eval,
+            MonitorSpec::Stream {
+                name,
+                signal,
+                unit: unit.map(str::to_owned),
+                over,
+            },
+        )
+    }
+
+    /// `Assert(stream, name=<variable> or "assert")`: fails at the first event of the stream
+    /// (of bools) that is false; robustness `+1` or `-1`.
+    fn Assert<'v>(
+        #[starlark(require = pos)] stream: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        let name = name
+            .map(str::to_owned)
+            .or_else(|| variable_here(eval))
+            .unwrap_or_else(|| "assert".to_owned());
+        let signal = publish_monitored(eval, stream, &name, "Assert", types::SType::Bool)?;
+        monitor(eval, MonitorSpec::Assert { name, signal })
+    }
+
+    /// `Signal(name, stream)`: publishes a stream of numbers, bools or vectors under `name`
+    /// for `Stl` formulas (a vector as `name.x`, `name.y`, `name.z`).
+    fn Signal<'v>(
+        #[starlark(require = pos)] name: &str,
+        #[starlark(require = pos)] stream: Value<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<NoneType> {
+        let valid = name.split('.').all(|part| {
+            part.chars()
+                .next()
+                .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+                && part.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        });
+        if !valid {
+            bail!(
+                "Signal: `{name}` is not a signal name (letters, digits and _, parts joined by .)"
+            );
+        }
+        if crate::runner::signal::ALL.contains(&name) {
+            bail!("Signal: `{name}` is one of the runner's own signals; choose another name");
+        }
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        if b.published.iter().any(|(n, _)| n == name) {
+            bail!("Signal: `{name}` is published twice");
+        }
+        let id = stream_arg(stream, &mut b, "Signal")?;
+        let kind = types::stream_types(&b)[id.0];
+        if matches!(
+            kind,
+            types::SType::Text | types::SType::Tuple | types::SType::Unit
+        ) {
+            bail!(
+                "Signal `{name}` carries {}; a signal is a number, a bool or a vector",
+                kind.name()
+            );
+        }
+        b.published.push((name.to_owned(), id));
+        Ok(NoneType)
+    }
+
+    /// `TimeToFailure(m, minT=0.0)`: wraps monitor `m`; reports the time of its first
+    /// violation and fails when it comes before `minT` seconds.
+    fn TimeToFailure<'v>(
+        m: Value<'v>,
+        #[starlark(require = named)] minT: Option<Value<'v>>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<MonitorVal> {
+        let inner = m
+            .downcast_ref::<MonitorVal>()
+            .ok_or_else(|| anyhow!("TimeToFailure wraps a monitor, got a {}", m.get_type()))?
+            .index;
+        let min_s = match minT {
+            Some(v) => number(v, "minT")?,
+            None => 0.0,
+        };
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        let wrapped = b
+            .monitors
+            .get(inner)
+            .cloned()
+            .ok_or_else(|| anyhow!("that monitor is already wrapped"))?;
+        let name = name.unwrap_or("time_to_failure");
+        if wrapped.name() != name {
+            unique_monitor_name(&b, name)?;
+        }
+        b.monitors_at[inner] = here(eval);
+        b.monitors[inner] = MonitorSpec::TimeToFailure {
+            name: name.to_owned(),
+            inner: Box::new(wrapped),
+            min_s,
+        };
+        Ok(MonitorVal { index: inner })
+    }
+}

@@ -1,0 +1,206 @@
+#![allow(non_snake_case)] // The paper's keyword names: numLane, minD, minT.
+
+//! The world and its roads: `World`, `RoadSegment`, `TIntersection`, `CrossIntersection`, `Roundabout`, `SideWalk` (paper §2, "Road pieces").
+
+use anyhow::{anyhow, bail};
+use paracosm_engine::network::PieceKind;
+use paracosm_engine::rx::{Node, StreamId, Value as Rx};
+use paracosm_engine::NOMINAL_LIGHT;
+use starlark::environment::GlobalsBuilder;
+use starlark::eval::Evaluator;
+use starlark::starlark_module;
+use starlark::values::Value;
+
+use crate::lang::scene::SceneBuilder;
+use crate::lang::types;
+use crate::lang::values::{LaneSide, Road, WorldVal};
+
+use super::*;
+
+pub(super) fn lanes(v: Option<Value>, b: &SceneBuilder, default: u32) -> anyhow::Result<u32> {
+    let Some(v) = v else { return Ok(default) };
+    let x = load_time_number(v, b, "nlanes=")?;
+    if x.fract() != 0.0 || !(2.0..=16.0).contains(&x) || (x as u32) % 2 == 1 {
+        bail!("nlanes must be an even whole number from 2 to 16, got {x}");
+    }
+    Ok(x as u32)
+}
+
+pub(super) fn add_piece(
+    eval: &Evaluator,
+    what: &str,
+    kind: PieceKind,
+    friction: StreamId,
+) -> anyhow::Result<Road> {
+    let st = state(eval)?;
+    let mut b = st.scene.borrow_mut();
+    let segment = matches!(kind, PieceKind::Segment { .. });
+    let ports = kind.ports().len();
+    let name = object_name(eval, what);
+    let id = b
+        .roads
+        .add(&name, kind)
+        .map_err(|e| anyhow!(crate::lang::scene::strip(e)))?;
+    b.frictions.push((id, friction));
+    Ok(Road {
+        piece: id.0,
+        ports,
+        segment,
+        network: false,
+    })
+}
+
+/// A road piece from its keyword arguments: `make` gets the program's declarations, the lane
+/// count (default 2) and the friction at the start (default 0.8; for a friction that varies
+/// over the test, its value is set from its stream every step) and reads any further
+/// arguments.
+pub(super) fn road_piece(
+    eval: &Evaluator,
+    what: &str,
+    nlanes: Option<Value>,
+    friction: Option<Value>,
+    make: impl FnOnce(&SceneBuilder, u32, f64) -> anyhow::Result<PieceKind>,
+) -> anyhow::Result<Road> {
+    let at = object_at(eval);
+    let (kind, stream) = {
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        let stream = match friction {
+            Some(v) => typed_arg(v, &mut b, &types::FRICTION, what, &at)?,
+            None => b.graph.push(Node::Const(Rx::Num(0.8))),
+        };
+        let mu = match b.graph.nodes().get(stream.0) {
+            Some(Node::Const(Rx::Num(mu))) => *mu,
+            _ => 0.8,
+        };
+        let lanes = lanes(nlanes, &b, 2)?;
+        (make(&b, lanes, mu)?, stream)
+    };
+    add_piece(eval, what, kind, stream)
+}
+
+/// The builtins of this topic.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register(builder: &mut GlobalsBuilder) {
+    const SideWalk: LaneSide = LaneSide { opposite: false };
+
+    /// `World(light=0.5, fog=0.0)`: global conditions as streams (light 0.5 is the nominal
+    /// daylight a camera's exposure is calibrated for).
+    fn World<'v>(
+        #[starlark(require = named)] light: Option<Value<'v>>,
+        #[starlark(require = named)] fog: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<WorldVal> {
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        if b.world.is_some() {
+            bail!("a program has one World");
+        }
+        let heap = eval.heap();
+        let at = object_at(eval);
+        let light = typed_arg(
+            light.unwrap_or_else(|| heap.alloc(NOMINAL_LIGHT)),
+            &mut b,
+            &types::LIGHT,
+            "World",
+            &at,
+        )?;
+        let fog = typed_arg(
+            fog.unwrap_or_else(|| heap.alloc(0.0)),
+            &mut b,
+            &types::FOG,
+            "World",
+            &at,
+        )?;
+        b.world = Some((light, fog));
+        Ok(WorldVal {
+            light: light.0,
+            fog: fog.0,
+        })
+    }
+
+    /// `RoadSegment(len=200.0, nlanes=2, friction=0.8)`.
+    fn RoadSegment<'v>(
+        #[starlark(require = named)] len: Option<Value<'v>>,
+        #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        road_piece(
+            eval,
+            "RoadSegment",
+            nlanes,
+            friction,
+            |b, lanes, friction| {
+                let length_m = match len {
+                    Some(v) => load_time_number(v, b, "RoadSegment(len=)")?,
+                    None => 200.0,
+                };
+                Ok(PieceKind::Segment {
+                    length_m,
+                    lanes,
+                    friction,
+                })
+            },
+        )
+    }
+
+    /// `TIntersection(nlanes=2, friction=0.8)`; `numLane=` is the paper's spelling.
+    fn TIntersection<'v>(
+        #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] numLane: Option<Value<'v>>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        road_piece(
+            eval,
+            "TIntersection",
+            nlanes.or(numLane),
+            friction,
+            |_, lanes, friction| Ok(PieceKind::TIntersection { lanes, friction }),
+        )
+    }
+
+    /// `CrossIntersection(nlanes=2, friction=0.8)`; `numLane=` too.
+    fn CrossIntersection<'v>(
+        #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] numLane: Option<Value<'v>>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        road_piece(
+            eval,
+            "CrossIntersection",
+            nlanes.or(numLane),
+            friction,
+            |_, lanes, friction| Ok(PieceKind::CrossIntersection { lanes, friction }),
+        )
+    }
+
+    /// `Roundabout(nlanes=2, radius=20.0, friction=0.8)`.
+    fn Roundabout<'v>(
+        #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] radius: Option<Value<'v>>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        road_piece(
+            eval,
+            "Roundabout",
+            nlanes,
+            friction,
+            |b, lanes, friction| {
+                let radius_m = match radius {
+                    Some(v) => load_time_number(v, b, "Roundabout(radius=)")?,
+                    None => 20.0,
+                };
+                Ok(PieceKind::Roundabout {
+                    lanes,
+                    radius_m,
+                    friction,
+                })
+            },
+        )
+    }
+}

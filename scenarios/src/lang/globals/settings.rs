@@ -1,0 +1,69 @@
+#![allow(non_snake_case)] // The paper's keyword names: numLane, minD, minT.
+
+//! The test's settings: `test(horizon=, map=, offroad=)`.
+
+use anyhow::bail;
+use starlark::environment::GlobalsBuilder;
+use starlark::eval::Evaluator;
+use starlark::starlark_module;
+use starlark::values::list::UnpackList;
+use starlark::values::none::NoneType;
+use starlark::values::{UnpackValue, Value};
+
+use super::*;
+
+/// The builtins of this topic.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register(builder: &mut GlobalsBuilder) {
+    /// `test(horizon=15.0, map=None, offroad=True)`: the test length in seconds, the failure
+    /// map's axes (one or two parameter names), and whether the default `OffRoadMonitor` is
+    /// added to a program that declares none.
+    fn test<'v>(
+        #[starlark(require = named)] horizon: Option<Value<'v>>,
+        #[starlark(require = named)] map: Option<Value<'v>>,
+        #[starlark(require = named)] offroad: Option<bool>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<NoneType> {
+        let st = state(eval)?;
+        let mut b = st.scene.borrow_mut();
+        b.test_at = Some(here(eval));
+        if let Some(h) = horizon {
+            let h = number(h, "horizon")?;
+            if !(h.is_finite() && h > 0.0 && h <= 3600.0) {
+                bail!("horizon {h} s must be in (0, 3600]");
+            }
+            b.horizon_s = Some(h);
+        }
+        if let Some(m) = map {
+            let axes: Vec<String> = if let Some(one) = m.unpack_str() {
+                vec![one.to_owned()]
+            } else {
+                let items = UnpackList::<String>::unpack_value(m)
+                    .ok()
+                    .flatten()
+                    .map(|l| l.items)
+                    .or_else(|| {
+                        starlark::values::tuple::TupleRef::from_value(m).and_then(|t| {
+                            t.content()
+                                .iter()
+                                .map(|v| v.unpack_str().map(str::to_owned))
+                                .collect::<Option<Vec<String>>>()
+                        })
+                    });
+                match items {
+                    Some(items) if (1..=2).contains(&items.len()) => items,
+                    _ => bail!(
+                        "test(map=) takes one or two parameter names, such as \"speed\" or \
+                         (\"speed\", \"dist\"), got {m}"
+                    ),
+                }
+            };
+            b.map_axes = Some(axes);
+        }
+        if let Some(o) = offroad {
+            b.offroad = Some(o);
+        }
+        Ok(NoneType)
+    }
+}

@@ -1,0 +1,172 @@
+#![allow(non_snake_case)] // The paper's keyword names: numLane, minD, minT.
+
+//! Open parameters and streams: `tick`, `Const`, `VarInterval`, `VarEnum`, `Piecewise`, `Polynomial` (paper §2, "A Family of Worlds"; §3.3).
+
+use anyhow::{anyhow, bail};
+use paracosm_engine::rx::{Node, Value as Rx};
+use paracosm_generators::{Domain, Value as Level};
+use starlark::environment::GlobalsBuilder;
+use starlark::eval::Evaluator;
+use starlark::starlark_module;
+use starlark::values::{Value, ValueLike};
+
+use crate::lang::scene::{OverTime, ParamDecl};
+use crate::lang::values::{OverTimeVal, Stream};
+
+use super::*;
+
+/// Declares an open parameter; returns what the program sees: the test's value as a plain
+/// Starlark value (a float for an interval; an int, float, string or bool for a level), or,
+/// for one that varies over time, its stream.
+pub(super) fn declare_param<'v>(
+    eval: &mut Evaluator<'v, '_, '_>,
+    decl: ParamDecl,
+) -> anyhow::Result<Value<'v>> {
+    let heap = eval.heap();
+    let st = state(eval)?;
+    let got = st
+        .scene
+        .borrow_mut()
+        .param(decl)
+        .map_err(anyhow::Error::msg)?;
+    Ok(match got {
+        Ok(Level::Int(i)) => heap.alloc(i),
+        Ok(Level::Real(x)) => heap.alloc(x),
+        Ok(Level::Bool(b)) => Value::new_bool(b),
+        Ok(Level::Text(t)) => heap.alloc(t.as_str()),
+        Err(id) => heap.alloc(Stream::of(id.0)),
+    })
+}
+
+/// The builtins of this topic.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register(builder: &mut GlobalsBuilder) {
+    const tick: Stream = Stream {
+        id: crate::lang::scene::TICK.0,
+        number: None,
+    };
+    /// `Const(v)`: the constant stream of `v`.
+    fn Const<'v>(v: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
+        let c = constant(v).ok_or_else(|| {
+            anyhow!(
+                "Const takes a number, a bool or a string, got a {}",
+                v.get_type()
+            )
+        })?;
+        let number = match c {
+            Rx::Num(x) => Some(x),
+            _ => None,
+        };
+        let st = state(eval)?;
+        let id = st.scene.borrow_mut().graph.push(Node::Const(c));
+        Ok(Stream { id: id.0, number })
+    }
+
+    /// `VarInterval(lo, hi, unit=None, name=None, over_time=None)`: an open real parameter:
+    /// the test's value in `[lo, hi)`, or with `over_time=` a stream of values in `[lo, hi]`.
+    fn VarInterval<'v>(
+        lo: Value<'v>,
+        hi: Value<'v>,
+        #[starlark(require = named)] unit: Option<&str>,
+        #[starlark(require = named)] name: Option<&str>,
+        #[starlark(require = named)] over_time: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Value<'v>> {
+        let (lo, hi) = (number(lo, "VarInterval lo")?, number(hi, "VarInterval hi")?);
+        if !(lo.is_finite() && hi.is_finite()) || lo >= hi {
+            bail!("VarInterval({lo}, {hi}) is empty: lo must be below hi");
+        }
+        let over_time = match over_time {
+            None => OverTime::Constant,
+            Some(v) if v.is_none() => OverTime::Constant,
+            Some(v) => v
+                .downcast_ref::<OverTimeVal>()
+                .map(|o| o.over_time)
+                .ok_or_else(|| {
+                    anyhow!(
+                        "over_time must be Piecewise(k) or Polynomial(deg), got a {}",
+                        v.get_type()
+                    )
+                })?,
+        };
+        let at = here(eval);
+        declare_param(
+            eval,
+            ParamDecl {
+                name: name.map(str::to_owned),
+                domain: Domain::Interval { lo, hi },
+                unit: unit.map(str::to_owned),
+                over_time,
+                at,
+            },
+        )
+    }
+
+    /// `VarEnum([levels...], name=None)`: an open discrete parameter: the test's level.
+    fn VarEnum<'v>(
+        levels: Value<'v>,
+        #[starlark(require = named)] name: Option<&str>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Value<'v>> {
+        let items: Vec<Value> = levels
+            .iterate(eval.heap())
+            .map_err(|_| {
+                anyhow!(
+                    "VarEnum takes a list of levels, got a {}",
+                    levels.get_type()
+                )
+            })?
+            .collect();
+        if items.is_empty() {
+            bail!("VarEnum([]) has no levels");
+        }
+        let mut out = Vec::new();
+        for v in items {
+            let level = if let Some(b) = v.unpack_bool() {
+                Level::Bool(b)
+            } else if let Some(i) = v.unpack_i32() {
+                Level::Int(i64::from(i))
+            } else if let Some(s) = v.unpack_str() {
+                Level::Text(s.to_owned())
+            } else {
+                Level::Real(number(v, "a VarEnum level")?)
+            };
+            if out.contains(&level) {
+                bail!("VarEnum lists the level {level} twice");
+            }
+            out.push(level);
+        }
+        let at = here(eval);
+        declare_param(
+            eval,
+            ParamDecl {
+                name: name.map(str::to_owned),
+                domain: Domain::Levels(out),
+                unit: None,
+                over_time: OverTime::Constant,
+                at,
+            },
+        )
+    }
+
+    /// `Piecewise(k)`: an open stream held constant on `k` equal parts of the test.
+    fn Piecewise(k: i32) -> anyhow::Result<OverTimeVal> {
+        if !(1..=64).contains(&k) {
+            bail!("Piecewise(k) needs 1 <= k <= 64, got {k}");
+        }
+        Ok(OverTimeVal {
+            over_time: OverTime::Piecewise(k as usize),
+        })
+    }
+
+    /// `Polynomial(deg)`: an open stream that is a Bernstein polynomial of degree `deg` in time.
+    fn Polynomial(deg: i32) -> anyhow::Result<OverTimeVal> {
+        if !(0..=16).contains(&deg) {
+            bail!("Polynomial(deg) needs 0 <= deg <= 16, got {deg}");
+        }
+        Ok(OverTimeVal {
+            over_time: OverTime::Polynomial(deg as usize),
+        })
+    }
+}

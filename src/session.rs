@@ -1,0 +1,538 @@
+//! A campaign from its settings to its files, as `paracosm-fuzz` runs it: the settings checked
+//! against the output folder, a resume, the loop with its observers, and `summary.json`, the
+//! plots and JUnit at the end. The binary parses arguments into a [`Request`] and maps the
+//! [`Error`] to an exit code; other front ends (the Python package) do the same.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use paracosm_engine::sut::SutConfig;
+use paracosm_generators::Strategy;
+use paracosm_scenarios::Scenario;
+
+use crate::campaign::{Campaign, CampaignReport, Observer, ResultsFile, RESULTS_FILE};
+use crate::campaign_file::{CampaignFile, Shard, SutChoice, CAMPAIGN_FILE};
+use crate::record::RunRecord;
+use crate::report::{write_outputs, Finished};
+use crate::summary::Summary;
+use crate::Error;
+
+/// What to run: `paracosm-fuzz`'s arguments as data. `None` fields take the defaults (or,
+/// with `resume`, the stored campaign's values).
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// A built-in scenario's name or a `.star` path; `None` only with `resume` (taken from
+    /// the folder's `campaign.json`).
+    pub scenario: Option<String>,
+    /// The strategy [default: halton].
+    pub strategy: Option<Strategy>,
+    /// Campaign seed [default: 0].
+    pub seed: Option<u64>,
+    /// Tests of the whole campaign, `>= 1` [default: 100].
+    pub budget: Option<u64>,
+    /// Strength of the covering suites [default: 2].
+    pub strength: Option<usize>,
+    /// Only this shard of the campaign.
+    pub shard: Option<Shard>,
+    /// A system under test instead of the scenario's.
+    pub sut: Option<SutConfig>,
+    /// The campaign folder.
+    pub out: PathBuf,
+    /// Replace what `out` holds (`--force`).
+    pub replace: bool,
+    /// Finish the campaign in `out` (`--resume`).
+    pub resume: bool,
+    /// Worker threads [default: all cores]; results do not depend on it.
+    pub jobs: Option<usize>,
+    /// End at the first failed test.
+    pub stop_at_first_failure: bool,
+    /// Refuse a scenario that loads with warnings.
+    pub deny_warnings: bool,
+    /// Also write JUnit XML here.
+    pub junit: Option<PathBuf>,
+}
+
+impl Request {
+    /// A request for `scenario` into `out`, everything else by default.
+    pub fn new(scenario: &str, out: &Path) -> Self {
+        Request {
+            scenario: Some(scenario.to_owned()),
+            strategy: None,
+            seed: None,
+            budget: None,
+            strength: None,
+            shard: None,
+            sut: None,
+            out: out.to_path_buf(),
+            replace: false,
+            resume: false,
+            jobs: None,
+            stop_at_first_failure: false,
+            deny_warnings: false,
+            junit: None,
+        }
+    }
+}
+
+/// What a session tells its observers before the first test: enough for a progress bar and
+/// the messages of a resume.
+#[derive(Debug)]
+pub struct Plan<'a> {
+    /// The scenario under test.
+    pub scenario: &'a Scenario,
+    /// The campaign's settings, as stored in `campaign.json`.
+    pub file: &'a CampaignFile,
+    /// The scenario's warnings for this system under test.
+    pub warnings: &'a [String],
+    /// Records already in the folder (a resume).
+    pub done: u64,
+    /// Tests this run will do at most.
+    pub to_run: u64,
+    /// Bytes of a half-written last line cut off `results.jsonl` (a resume after a kill).
+    pub repaired_bytes: u64,
+    /// Whether this run finishes an earlier one.
+    pub resumed: bool,
+}
+
+impl Plan<'_> {
+    /// What a front end tells the user before the first test: the warnings, a half-written
+    /// line cut off, how far a resumed campaign had got.
+    pub fn notes(&self) -> Vec<String> {
+        let mut notes = self.warnings.to_vec();
+        if self.repaired_bytes > 0 {
+            notes.push(format!(
+                "cut a half-written last line ({} bytes) off results.jsonl; that test runs again",
+                self.repaired_bytes
+            ));
+        }
+        if self.resumed {
+            notes.push(format!(
+                "resuming: {} of {} tests already done",
+                self.done,
+                self.done + self.to_run
+            ));
+        }
+        notes
+    }
+}
+
+/// A finished (or interrupted) session.
+#[derive(Debug)]
+pub struct Outcome {
+    /// The campaign's settings.
+    pub file: CampaignFile,
+    /// The scenario.
+    pub scenario: Scenario,
+    /// The folder.
+    pub out: PathBuf,
+    /// What the loop reported (this run's records only).
+    pub report: CampaignReport,
+    /// Records in the folder now (earlier and this run's).
+    pub done: u64,
+    /// Tests the folder should hold (the shard's or the campaign's).
+    pub expected: u64,
+    /// `summary.json` as written; `None` when interrupted (the folder is to be resumed).
+    pub summary: Option<Summary>,
+    /// Plots that could not be drawn (also in the summary's warnings).
+    pub plot_warnings: Vec<String>,
+}
+
+impl Outcome {
+    /// What a front end tells the user besides the summary: an interruption and how to
+    /// resume, a stop at the first failure, plots that could not be drawn.
+    pub fn notes(&self) -> Vec<String> {
+        let mut notes = Vec::new();
+        if self.summary.is_none() {
+            notes.push(format!(
+                "interrupted: {} of {} tests are in {}; finish the campaign with:\n    \
+                 paracosm-fuzz --resume --out {}",
+                self.done,
+                self.expected,
+                results_path(&self.out).display(),
+                self.out.display()
+            ));
+        }
+        if self.report.stopped_at_failure {
+            notes.push(format!(
+                "--stop-at-first-failure: stopped after {} of {} tests",
+                self.done, self.expected
+            ));
+        }
+        notes.extend(self.plot_warnings.iter().map(|w| format!("warning: {w}")));
+        notes
+    }
+
+    /// The human summary ([`crate::report::human`]), `None` when interrupted.
+    pub fn human(&self) -> Option<String> {
+        let summary = self.summary.as_ref()?;
+        Some(crate::report::human(
+            summary,
+            &self.scenario,
+            &self.out,
+            self.expected,
+        ))
+    }
+
+    /// The tools' exit code: 130 interrupted, 1 a test failed, 3 a test ended in an error, 0
+    /// otherwise.
+    pub fn exit_code(&self) -> u8 {
+        match &self.summary {
+            None => 130,
+            Some(s) if s.counts.fail > 0 => 1,
+            Some(s) if s.counts.error > 0 => 3,
+            Some(_) => 0,
+        }
+    }
+}
+
+/// The scenario's warnings for its system under test, as text.
+pub fn warnings_of(scenario: &Scenario) -> Vec<String> {
+    scenario
+        .warnings_for(&scenario.sut)
+        .iter()
+        .map(ToString::to_string)
+        .collect()
+}
+
+/// Runs `request`: checks it (against the folder's campaign when resuming), prepares the
+/// folder, runs the tests it lacks with a [`ResultsFile`] and `observers`, and writes
+/// `summary.json`, the plots and JUnit. `started` is called with the [`Plan`] before any test
+/// runs; `stop` is the Ctrl-C flag.
+///
+/// # Errors
+/// [`Error::BadInput`] for settings that cannot be honoured (a non-empty folder without
+/// `replace` or `resume`, other settings than the stored campaign's, a budget past the
+/// strategy's capacity, a shard of an adaptive campaign, warnings with `deny_warnings`);
+/// [`Error::Scenario`] when it does not load; [`Error::Input`] for an unreadable campaign
+/// folder; [`Error::Write`] when a file cannot be written. Records already written stay.
+pub fn run(
+    request: &Request,
+    stop: Option<&AtomicBool>,
+    started: &mut dyn FnMut(&Plan<'_>),
+    observers: &mut [&mut dyn Observer],
+) -> Result<Outcome, Error> {
+    let out = &request.out;
+    let stored = if request.resume && out.join(CAMPAIGN_FILE).exists() {
+        Some(CampaignFile::read(out)?)
+    } else {
+        None
+    };
+    let (file, scenario) = settings(request, stored.as_ref())?;
+    let warnings = warnings_of(&scenario);
+    if request.deny_warnings && !warnings.is_empty() {
+        return Err(Error::BadInput(format!(
+            "--deny-warnings: the scenario loads with {} warning{}: {}",
+            warnings.len(),
+            if warnings.len() == 1 { "" } else { "s" },
+            warnings.join("; ")
+        )));
+    }
+    let strategy: Strategy = file.strategy.parse()?;
+    if let Some(cap) = strategy.capacity().filter(|&cap| file.budget > cap) {
+        return Err(Error::BadInput(format!(
+            "--budget {} is more than the {cap} points {strategy} can produce",
+            file.budget
+        )));
+    }
+    if file.shard.is_some() && strategy.method().is_some() {
+        return Err(Error::BadInput(format!(
+            "--shard cannot split a {strategy} campaign: each of its tests depends on all \
+             earlier ones. Run it whole (it is parallel inside: --jobs)"
+        )));
+    }
+    let jobs = request.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    });
+    prepare_out_dir(out, request.replace, request.resume)?;
+    if stored.is_none() {
+        file.write(out)?;
+    }
+    let ids = file.ids();
+    let existing = match stored {
+        Some(_) => crate::results::load(out, &scenario.space, ids.clone(), true)?,
+        None => crate::results::Existing {
+            records: Vec::new(),
+            repaired_bytes: 0,
+        },
+    };
+    let start = ids.start + existing.records.len() as u64;
+    started(&Plan {
+        scenario: &scenario,
+        file: &file,
+        warnings: &warnings,
+        done: existing.records.len() as u64,
+        to_run: ids.end - start,
+        repaired_bytes: existing.repaired_bytes as u64,
+        resumed: stored.is_some(),
+    });
+    let campaign = Campaign {
+        scenario: &scenario,
+        strategy,
+        seed: file.seed,
+        budget: file.budget,
+        strength: file.strength,
+        jobs,
+        stop_at_first_failure: request.stop_at_first_failure,
+    };
+    let mut chain = Chain {
+        results: ResultsFile::new(out, stored.is_some()),
+        others: observers,
+        junit: request.junit.as_deref().map(|path| JUnit {
+            path: path.to_path_buf(),
+            out: out.clone(),
+            scenario: scenario.name.clone(),
+            records: Vec::new(),
+        }),
+    };
+    let prior = stored.is_some().then_some(existing.records.as_slice());
+    let report = campaign.run_ids(start..ids.end, prior, stop, &mut [&mut chain])?;
+    let junit = chain.junit;
+    let mut records = existing.records;
+    records.extend(report.records.iter().cloned());
+    let mut outcome = Outcome {
+        done: records.len() as u64,
+        expected: ids.end - ids.start,
+        summary: None,
+        plot_warnings: Vec::new(),
+        report,
+        file,
+        scenario,
+        out: out.clone(),
+    };
+    if outcome.report.interrupted {
+        return Ok(outcome);
+    }
+    let written = write_outputs(&Finished {
+        out,
+        scenario: &outcome.scenario,
+        file: &outcome.file,
+        records: &records,
+        jobs,
+        wall_s: outcome.report.wall_s,
+        junit: request.junit.as_deref(),
+        warnings,
+    })?;
+    if let Some(j) = junit {
+        j.write()?;
+    }
+    outcome.summary = Some(written.summary);
+    outcome.plot_warnings = written.plot_warnings;
+    Ok(outcome)
+}
+
+/// The session's observers in their order: the results file first (a record reaches the
+/// others once it is on disk), the caller's, then JUnit.
+struct Chain<'a, 'b> {
+    results: ResultsFile,
+    others: &'a mut [&'b mut dyn Observer],
+    junit: Option<JUnit>,
+}
+
+impl Chain<'_, '_> {
+    fn each(
+        &mut self,
+        mut f: impl FnMut(&mut dyn Observer) -> Result<(), Error>,
+    ) -> Result<(), Error> {
+        f(&mut self.results)?;
+        for o in self.others.iter_mut() {
+            f(&mut **o)?;
+        }
+        match self.junit.as_mut() {
+            Some(j) => f(j),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Observer for Chain<'_, '_> {
+    fn started(&mut self, prior: &[RunRecord]) -> Result<(), Error> {
+        self.each(|o| o.started(prior))
+    }
+
+    fn record(&mut self, record: &RunRecord) -> Result<(), Error> {
+        self.each(|o| o.record(record))
+    }
+
+    fn finished(&mut self, report: &CampaignReport) -> Result<(), Error> {
+        self.each(|o| o.finished(report))
+    }
+}
+
+/// The [`Observer`] that gathers the records for JUnit XML ([`crate::junit`]), written with
+/// the summary.
+struct JUnit {
+    path: PathBuf,
+    out: PathBuf,
+    scenario: String,
+    records: Vec<RunRecord>,
+}
+
+impl Observer for JUnit {
+    fn started(&mut self, prior: &[RunRecord]) -> Result<(), Error> {
+        self.records = prior.to_vec();
+        Ok(())
+    }
+
+    fn record(&mut self, record: &RunRecord) -> Result<(), Error> {
+        self.records.push(record.clone());
+        Ok(())
+    }
+}
+
+impl JUnit {
+    fn write(&self) -> Result<(), Error> {
+        crate::junit::write(&self.path, &self.scenario, &self.records, &self.out)
+    }
+}
+
+/// The campaign's settings and scenario: from the request (checked against the folder's
+/// campaign when resuming), or from the folder's campaign alone (a resume without a scenario).
+fn settings(
+    request: &Request,
+    stored: Option<&CampaignFile>,
+) -> Result<(CampaignFile, Scenario), Error> {
+    let refuse = |diffs: Vec<String>| {
+        Error::BadInput(format!(
+            "refusing to resume: `{}` holds a campaign with other settings ({}); resume without \
+             those arguments, or start a new campaign with --force or another --out",
+            request.out.display(),
+            diffs.join("; ")
+        ))
+    };
+    let sut = request.sut.as_ref();
+    let load = |name: &str, choice: &SutChoice| -> Result<Scenario, Error> {
+        let mut scenario = paracosm_scenarios::load(name)?;
+        if let Some(s) = choice.config()? {
+            scenario.sut = s;
+        }
+        Ok(scenario)
+    };
+    match (&request.scenario, stored) {
+        (Some(name), _) => {
+            let choice = SutChoice::of(sut);
+            let scenario = load(name, &choice)?;
+            let file = CampaignFile::new(
+                name,
+                &scenario,
+                choice,
+                request.strategy.unwrap_or(Strategy::Halton).name(),
+                request.seed.unwrap_or(0),
+                request.budget.unwrap_or(100),
+                request.strength.unwrap_or(2),
+                request.shard,
+            );
+            match stored.map(|st| st.differences(&file)) {
+                Some(diffs) if !diffs.is_empty() => Err(refuse(diffs)),
+                _ => Ok((file, scenario)),
+            }
+        }
+        (None, Some(st)) => {
+            // Settings given with a bare resume must agree with the stored campaign.
+            let mut diffs = Vec::new();
+            let mut check = |name: &str, given: Option<String>, stored: String| {
+                if let Some(g) = given.filter(|g| *g != stored) {
+                    diffs.push(format!("{name}: {stored} vs {g}"));
+                }
+            };
+            check(
+                "seed",
+                request.seed.map(|v| v.to_string()),
+                st.seed.to_string(),
+            );
+            check(
+                "budget",
+                request.budget.map(|v| v.to_string()),
+                st.budget.to_string(),
+            );
+            check(
+                "strength",
+                request.strength.map(|v| v.to_string()),
+                st.strength.to_string(),
+            );
+            check(
+                "strategy",
+                request.strategy.map(|s| s.name().to_owned()),
+                st.strategy.clone(),
+            );
+            let shard = |s: Option<Shard>| s.map_or("none".to_owned(), |s| s.to_string());
+            check(
+                "shard",
+                request.shard.map(|s| shard(Some(s))),
+                shard(st.shard),
+            );
+            if sut.is_some() && SutChoice::of(sut) != st.sut {
+                diffs.push("system under test differs".into());
+            }
+            if !diffs.is_empty() {
+                return Err(refuse(diffs));
+            }
+            let scenario = load(&st.scenario, &st.sut)?;
+            let again = CampaignFile::new(
+                &st.scenario,
+                &scenario,
+                st.sut.clone(),
+                &st.strategy,
+                st.seed,
+                st.budget,
+                st.strength,
+                st.shard,
+            );
+            if again.fingerprint != st.fingerprint {
+                return Err(refuse(vec![format!(
+                    "the scenario `{}` changed since the campaign started",
+                    st.scenario
+                )]));
+            }
+            Ok((st.clone(), scenario))
+        }
+        (None, None) => Err(Error::BadInput(format!(
+            "--resume without SCENARIO needs a campaign in `{}`, which has no {CAMPAIGN_FILE}",
+            request.out.display()
+        ))),
+    }
+}
+
+/// Creates `out`; refuses a non-empty folder unless `replace` or `resume`, and a folder that
+/// cannot be written.
+///
+/// # Errors
+/// [`Error::BadInput`] naming the folder.
+pub fn prepare_out_dir(out: &Path, replace: bool, resume: bool) -> Result<(), Error> {
+    let non_empty = std::fs::read_dir(out)
+        .map(|mut d| d.next().is_some())
+        .unwrap_or(false);
+    if out.exists() && !out.is_dir() {
+        return Err(Error::BadInput(format!(
+            "--out `{}` is not a folder",
+            out.display()
+        )));
+    }
+    if non_empty && !replace && !resume {
+        return Err(Error::BadInput(format!(
+            "`{}` is not empty; pass --resume to finish the campaign in it, --force to replace \
+             it, or choose another --out",
+            out.display()
+        )));
+    }
+    std::fs::create_dir_all(out).map_err(|e| {
+        Error::BadInput(format!(
+            "cannot create output folder `{}`: {e}",
+            out.display()
+        ))
+    })?;
+    // Probe writability now, before any test runs.
+    let probe = out.join(".paracosm-write-probe");
+    std::fs::write(&probe, b"").map_err(|e| {
+        Error::BadInput(format!(
+            "cannot write to output folder `{}`: {e}",
+            out.display()
+        ))
+    })?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// The path of the results file in `out`, for messages.
+pub fn results_path(out: &Path) -> PathBuf {
+    out.join(RESULTS_FILE)
+}
