@@ -6,6 +6,8 @@ use clap::Parser;
 use paracosm_engine::sut::{ExternalConfig, SutConfig};
 use paracosm_generators::Strategy;
 
+use crate::Error;
+
 /// The value parser of `--strategy`: the names of [`Strategy::LIST`], each with its
 /// [`Strategy::help`] in `--help`.
 pub fn strategy_parser() -> impl clap::builder::TypedValueParser<Value = Strategy> {
@@ -17,13 +19,13 @@ pub fn strategy_parser() -> impl clap::builder::TypedValueParser<Value = Strateg
 /// The strategy named by `--strategy` and `--scramble`.
 ///
 /// # Errors
-/// A message when `--scramble` is given with a strategy other than `halton`.
-pub fn strategy(chosen: Strategy, scramble: bool) -> Result<Strategy, String> {
+/// [`Error::BadInput`] when `--scramble` is given with a strategy other than `halton`.
+pub fn strategy(chosen: Strategy, scramble: bool) -> Result<Strategy, Error> {
     match (chosen, scramble) {
         (Strategy::Halton | Strategy::ScrambledHalton, true) => Ok(Strategy::ScrambledHalton),
-        (s, true) => Err(format!(
+        (s, true) => Err(Error::BadInput(format!(
             "--scramble applies to --strategy halton only, not {s}"
-        )),
+        ))),
         (s, false) => Ok(s),
     }
 }
@@ -68,23 +70,23 @@ impl SutArgs {
     /// the scenario's.
     ///
     /// # Errors
-    /// A message for an unknown name, a command that does not split (an unclosed quote) or is
-    /// empty, or a timeout that is not a positive number of seconds.
-    pub fn config(&self) -> Result<Option<SutConfig>, String> {
+    /// [`Error::BadInput`] for an unknown name, a command that does not split (an unclosed
+    /// quote) or is empty, or a timeout that is not a positive number of seconds.
+    pub fn config(&self) -> Result<Option<SutConfig>, Error> {
         let timeout_s = self.sut_timeout;
         if !(timeout_s.is_finite() && timeout_s > 0.0) {
-            return Err(format!(
+            return Err(Error::BadInput(format!(
                 "--sut-timeout {timeout_s} must be a positive number of seconds"
-            ));
+            )));
         }
         match (&self.sut, &self.sut_cmd) {
             (Some(n), _) => SutConfig::builtin(n)
                 .map(Some)
-                .map_err(|e| format!("--sut: {e}")),
+                .map_err(|e| Error::BadInput(format!("--sut: {e}"))),
             (None, Some(c)) => {
-                let words = shlex::split(c)
-                    .filter(|w| !w.is_empty())
-                    .ok_or_else(|| format!("--sut-cmd {c:?} is empty or has an unclosed quote"))?;
+                let words = shlex::split(c).filter(|w| !w.is_empty()).ok_or_else(|| {
+                    Error::BadInput(format!("--sut-cmd {c:?} is empty or has an unclosed quote"))
+                })?;
                 Ok(Some(SutConfig::External(ExternalConfig::new(
                     words,
                     timeout_s,
@@ -96,7 +98,8 @@ impl SutArgs {
     }
 }
 
-/// Parses a count that must be at least 1 (`--budget`, `-n`).
+/// Parses a count that must be at least 1 (`--budget`, `-n`). A clap value parser: its
+/// message becomes clap's usage error (exit code 2).
 ///
 /// # Errors
 /// A message naming the rule, for clap to report.
@@ -134,10 +137,10 @@ mod tests {
     #[test]
     fn scramble_only_goes_with_halton() {
         assert_eq!(
-            strategy(Strategy::Halton, true),
-            Ok(Strategy::ScrambledHalton)
+            strategy(Strategy::Halton, true).unwrap(),
+            Strategy::ScrambledHalton
         );
-        assert_eq!(strategy(Strategy::Sobol, false), Ok(Strategy::Sobol));
+        assert_eq!(strategy(Strategy::Sobol, false).unwrap(), Strategy::Sobol);
         assert!(strategy(Strategy::Random, true).is_err());
     }
 
@@ -149,7 +152,7 @@ mod tests {
             sut_timeout: timeout,
             sut_fresh: false,
         };
-        assert_eq!(args(None, None, 10.0).config(), Ok(None));
+        assert_eq!(args(None, None, 10.0).config().unwrap(), None);
         assert_eq!(
             args(Some("vision"), None, 10.0)
                 .config()
@@ -166,6 +169,7 @@ mod tests {
         assert!(args(Some("lidar"), None, 10.0)
             .config()
             .unwrap_err()
+            .to_string()
             .contains("aeb, vision"));
         assert!(args(None, Some("python3 'oops"), 10.0).config().is_err());
         assert!(args(None, Some("   "), 10.0).config().is_err());

@@ -160,7 +160,7 @@ pub fn merge_folders(
         jobs: 1,
         wall_s,
         junit,
-        warnings: crate::session::warnings_of(&m.scenario),
+        warnings: crate::report::warnings_of(&m.scenario),
     })?;
     if let Some(path) = junit {
         crate::junit::write(path, &m.scenario.name, &m.records, out)?;

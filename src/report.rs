@@ -12,8 +12,7 @@ use crate::record::{RunRecord, Status};
 use crate::replay::replay_command;
 use crate::summary::{Counts, FailureEntry, FirstFailure, Summary};
 
-/// File name of the summary in the output folder.
-pub const SUMMARY_FILE: &str = "summary.json";
+pub use crate::summary::SUMMARY_FILE;
 
 /// Every failed test, smallest robustness first (ties by id; NaN last).
 pub fn failures(records: &[RunRecord], out: &Path) -> Vec<FailureEntry> {
@@ -216,6 +215,15 @@ fn used_only(space: &ParamSpace, points: &[Point], unused: &[String]) -> (ParamS
     (sub, points)
 }
 
+/// The scenario's warnings for its system under test, as text.
+pub fn warnings_of(scenario: &Scenario) -> Vec<String> {
+    scenario
+        .warnings_for(&scenario.sut)
+        .iter()
+        .map(ToString::to_string)
+        .collect()
+}
+
 /// The summary of a folder's records, listing `outputs` as the files written. Coverage is
 /// computed over the parameters that objects read; the others are listed as `unused_params`.
 pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
@@ -380,7 +388,7 @@ pub fn reread(dir: &Path) -> Result<(String, Counts), crate::Error> {
             jobs: stored.as_ref().map_or(1, |s| s.jobs),
             wall_s,
             junit: None,
-            warnings: crate::session::warnings_of(&scenario),
+            warnings: warnings_of(&scenario),
         },
         outputs,
     );

@@ -13,7 +13,7 @@ use paracosm_scenarios::Scenario;
 use crate::campaign::{Campaign, CampaignReport, Observer, ResultsFile, RESULTS_FILE};
 use crate::campaign_file::{CampaignFile, Shard, SutChoice, CAMPAIGN_FILE};
 use crate::record::RunRecord;
-use crate::report::{write_outputs, Finished};
+use crate::report::{warnings_of, write_outputs, Finished};
 use crate::summary::Summary;
 use crate::Error;
 
@@ -183,15 +183,6 @@ impl Outcome {
             Some(_) => 0,
         }
     }
-}
-
-/// The scenario's warnings for its system under test, as text.
-pub fn warnings_of(scenario: &Scenario) -> Vec<String> {
-    scenario
-        .warnings_for(&scenario.sut)
-        .iter()
-        .map(ToString::to_string)
-        .collect()
 }
 
 /// Runs `request`: checks it (against the folder's campaign when resuming), prepares the

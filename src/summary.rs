@@ -6,6 +6,9 @@ use paracosm_generators::{Assignment, Param};
 
 use crate::record::{RunRecord, Status};
 
+/// File name of the summary in the output folder.
+pub const SUMMARY_FILE: &str = "summary.json";
+
 /// Counts of test outcomes.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Counts {
@@ -137,7 +140,7 @@ impl Summary {
     /// [`crate::Error::Input`] naming the file when it cannot be read or is not a summary
     /// (with its line and column).
     pub fn read(dir: &std::path::Path) -> Result<Summary, crate::Error> {
-        let path = dir.join(crate::report::SUMMARY_FILE);
+        let path = dir.join(SUMMARY_FILE);
         let text = std::fs::read_to_string(&path).map_err(|e| crate::Error::input(&path, e))?;
         serde_json::from_str(&text).map_err(|e| {
             let message = format!(

@@ -163,7 +163,7 @@ fn main() -> ExitCode {
         .init();
     let result = match &cli.command {
         Some(Sub::Replay(a)) => {
-            let sut = a.sut.config().map_err(Error::BadInput);
+            let sut = a.sut.config();
             sut.and_then(|s| paracosm::replay::replay(&a.results, a.id, a.frames.as_deref(), s))
                 .map_err(anyhow::Error::new)
                 .and_then(|r| say(&r.text(a.id, a.frames.as_deref())).map(|()| r))
@@ -268,12 +268,12 @@ impl Cli {
             .map(|s| paracosm::cli::strategy(s, self.scramble));
         Ok(Request {
             scenario: self.scenario.clone(),
-            strategy: strategy.transpose().map_err(Error::BadInput)?,
+            strategy: strategy.transpose()?,
             seed: self.seed,
             budget: self.budget,
             strength: self.strength,
             shard: self.shard,
-            sut: self.sut.config().map_err(Error::BadInput)?,
+            sut: self.sut.config()?,
             out: self.out.clone(),
             replace: self.force,
             resume: self.resume,

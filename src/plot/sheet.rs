@@ -4,7 +4,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{register_font, FAMILY};
+use super::{register_font, PlotError, FAMILY};
 
 /// Width of one tile of a contact sheet, in pixels.
 const TILE_W: u32 = 240;
@@ -14,12 +14,12 @@ const TILE_W: u32 = 240;
 /// under it, and `title` on top. Writes PNG to `path`.
 ///
 /// # Errors
-/// The backend's message when the file cannot be written.
+/// [`PlotError::Draw`] when the file cannot be written.
 pub fn contact_sheet(
     path: &Path,
     frames: &[(f64, image::RgbImage)],
     title: &str,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     register_font();
     const COLS: usize = 6;
     const MAX: usize = 36;
@@ -41,7 +41,10 @@ pub fn contact_sheet(
     let (label, top) = (20u32, 36u32);
     let size = (COLS as u32 * TILE_W, top + rows * (tile_h + label));
     let root = BitMapBackend::new(path, size).into_drawing_area();
-    let fail = |e: &dyn std::fmt::Display| format!("cannot draw `{}`: {e}", path.display());
+    let fail = |e: &dyn std::fmt::Display| PlotError::Draw {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    };
     root.fill(&WHITE).map_err(|e| fail(&e))?;
     root.draw(&Text::new(title, (8, 8), (FAMILY, 18).into_font()))
         .map_err(|e| fail(&e))?;

@@ -10,8 +10,11 @@ use starlark::values::tuple::{TupleRef, UnpackTuple};
 use starlark::values::{none::NoneType, Value, ValueLike};
 
 use super::globals::{here, number, state, stream_arg};
+use super::position::Loc;
 use super::scene::LaneRef;
-use super::values::{Action, ActorVal, LaneSide, Loc, Port, Road, Stream};
+use super::values::{Action, ActorVal, LaneSide, Port, Road, Stream, WorldVal, PORTS};
+use starlark::environment::Methods;
+use starlark::values::{starlark_value, Heap, StarlarkValue};
 
 /// Stores `f` as host function `n` and returns `Func::Host(n)`.
 fn lambda<'v>(f: Value<'v>, what: &str, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Func> {
@@ -483,5 +486,68 @@ pub(crate) fn world_methods(builder: &mut MethodsBuilder) {
         }
         b.place(&actors).map_err(|e| anyhow!(e))?;
         Ok(NoneType)
+    }
+}
+
+// The Starlark types with methods, here beside their methods so that `values.rs` needs
+// nothing of this module.
+
+starlark::methods_static!(STREAM_METHODS = stream_methods);
+
+#[starlark_value(type = "Stream")]
+impl<'v> StarlarkValue<'v> for Stream {
+    fn get_methods() -> Option<&'static Methods> {
+        Some(STREAM_METHODS.methods())
+    }
+}
+
+starlark::methods_static!(ROAD_METHODS = road_methods);
+
+#[starlark_value(type = "Road")]
+impl<'v> StarlarkValue<'v> for Road {
+    fn get_methods() -> Option<&'static Methods> {
+        Some(ROAD_METHODS.methods())
+    }
+
+    fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
+        if attribute == "SideWalk" && self.segment {
+            return Some(heap.alloc(LaneSide { opposite: false }));
+        }
+        let i = PORTS.iter().position(|p| *p == attribute)?;
+        (i < self.ports && !self.network).then(|| {
+            heap.alloc(Port {
+                piece: self.piece,
+                index: i,
+            })
+        })
+    }
+
+    fn dir_attr(&self) -> Vec<String> {
+        let mut v: Vec<String> = PORTS[..self.ports].iter().map(|s| s.to_string()).collect();
+        if self.segment {
+            v.push("SideWalk".into());
+        }
+        v
+    }
+}
+
+starlark::methods_static!(WORLD_METHODS = world_methods);
+
+#[starlark_value(type = "World")]
+impl<'v> StarlarkValue<'v> for WorldVal {
+    fn get_methods() -> Option<&'static Methods> {
+        Some(WORLD_METHODS.methods())
+    }
+
+    fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
+        match attribute {
+            "light" => Some(heap.alloc(Stream::of(self.light))),
+            "fog" => Some(heap.alloc(Stream::of(self.fog))),
+            _ => None,
+        }
+    }
+
+    fn dir_attr(&self) -> Vec<String> {
+        vec!["light".into(), "fog".into()]
     }
 }

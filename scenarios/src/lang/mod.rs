@@ -27,7 +27,7 @@ use starlark::syntax::{AstModule, Dialect};
 use crate::{Scenario, ScenarioError};
 
 pub use program::{MAX_CHECKED_WORLDS, MAX_CHECK_STEPS};
-pub use scene::OverTime;
+pub use values::OverTime;
 
 /// The length of a test when the program does not set one with `test(horizon=)`, seconds.
 pub const DEFAULT_HORIZON_S: f64 = 15.0;

@@ -273,7 +273,7 @@ pub fn abs_of<'v>(x: Value<'v>, heap: Heap<'v>) -> anyhow::Result<Value<'v>> {
     anyhow::bail!(
         "abs takes a number or a Vector, got a {}{}",
         x.get_type(),
-        super::globals::stream_hint(x)
+        super::values::stream_hint(x)
     )
 }
 
@@ -288,7 +288,7 @@ pub fn dist_of(a: Value, b: Value) -> anyhow::Result<f64> {
             anyhow::anyhow!(
                 "dist takes two positions (locations or vectors), got a {}{}",
                 v.get_type(),
-                super::globals::stream_hint(v)
+                super::values::stream_hint(v)
             )
         })
     };

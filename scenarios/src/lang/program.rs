@@ -18,8 +18,9 @@ use starlark::values::Value;
 use super::globals::LoadState;
 use super::host::StarHost;
 use super::names::{final_names, Syntax};
-use super::scene::{self, coordinate_names, OverTime, ParamDecl, ParamValue, SceneBuilder};
+use super::scene::{self, coordinate_names, ParamDecl, ParamValue, SceneBuilder};
 use super::usage;
+use super::values::OverTime;
 use crate::scenario::Warning;
 use crate::{MonitorSpec, Scenario, ScenarioError};
 

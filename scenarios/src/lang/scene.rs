@@ -13,18 +13,18 @@ use paracosm_engine::{
 };
 use paracosm_generators::{Domain, Value as Level};
 
+use super::values::OverTime;
 use crate::scenario::Warning;
 use crate::MonitorSpec;
 
-/// How an open stream varies over a test (paper §3.3).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum OverTime {
-    /// One value for the whole test.
-    Constant,
-    /// `Piecewise(k)`: `k` values, each held for `T / k`.
-    Piecewise(usize),
-    /// `Polynomial(deg)`: a Bernstein polynomial with `deg + 1` coefficients.
-    Polynomial(usize),
+/// A level as the stream carries it: numbers as numbers, bools as bools, texts as strings.
+pub fn level_value(l: &Level) -> Value {
+    match l {
+        Level::Int(i) => Value::Num(*i as f64),
+        Level::Real(x) => Value::Num(*x),
+        Level::Bool(b) => Value::Bool(*b),
+        Level::Text(t) => Value::Text(t.clone()),
+    }
 }
 
 /// The `tick` stream: the first node of every program's graph.
@@ -408,7 +408,7 @@ fn over_time_streams(b: &SceneBuilder, horizon_s: f64) -> Vec<OpenStream> {
             };
             match v {
                 ParamValue::Over(s) => s,
-                ParamValue::Level(l) => OpenStream::Constant(super::types::level_value(&l)),
+                ParamValue::Level(l) => OpenStream::Constant(level_value(&l)),
             }
         })
         .collect()

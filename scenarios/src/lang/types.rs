@@ -8,9 +8,9 @@ use std::sync::Arc;
 use anyhow::bail;
 use paracosm_engine::behaviour::{decode_probe, Output};
 use paracosm_engine::rx::{describe, Expect, Node, StreamId, Value as Rx};
-use paracosm_generators::{Domain, Value as Level};
+use paracosm_generators::Domain;
 
-use super::scene::{ParamDecl, SceneBuilder};
+use super::scene::{level_value, ParamDecl, SceneBuilder};
 
 /// What an input accepts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -215,17 +215,6 @@ fn of_value(v: &Rx) -> SType {
         Rx::Vec3(_) => SType::Vec3,
         Rx::Tuple(_) => SType::Tuple,
         Rx::Unit => SType::Unit,
-    }
-}
-
-/// A level as the stream carries it: numbers as numbers, the texts `true`/`false` as bools
-/// (how `VarEnum([True, False])` stores them), other texts as strings.
-pub fn level_value(l: &Level) -> Rx {
-    match l {
-        Level::Int(i) => Rx::Num(*i as f64),
-        Level::Real(x) => Rx::Num(*x),
-        Level::Bool(b) => Rx::Bool(*b),
-        Level::Text(t) => Rx::Text(t.clone()),
     }
 }
 

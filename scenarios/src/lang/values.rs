@@ -1,17 +1,25 @@
 //! The Starlark values of the scenario language. Each holds indices into the program's
-//! [`super::scene::SceneBuilder`], never other Starlark values, so all are simple values.
+//! scene builder (`SceneBuilder`), never other Starlark values, so all are simple values.
 
 use std::fmt;
 
 use allocative::Allocative;
-use starlark::environment::Methods;
 use starlark::starlark_simple_value;
 use starlark::values::{
-    starlark_value, Heap, NoSerialize, ProvidesStaticType, StarlarkValue, Value,
+    starlark_value, Heap, NoSerialize, ProvidesStaticType, StarlarkValue, Value, ValueLike,
 };
 use starlark::StarlarkPagablePanic;
 
-use super::scene::OverTime;
+/// How an open stream varies over a test (paper §3.3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OverTime {
+    /// One value for the whole test.
+    Constant,
+    /// `Piecewise(k)`: `k` values, each held for `T / k`.
+    Piecewise(usize),
+    /// `Polynomial(deg)`: a Bernstein polynomial with `deg + 1` coefficients.
+    Polynomial(usize),
+}
 
 /// A stream (paper §2): `tick`, `Const(...)`, an open parameter, an output of an object, or a
 /// combinator over streams.
@@ -36,16 +44,7 @@ impl fmt::Display for Stream {
     }
 }
 
-starlark::methods_static!(STREAM_METHODS = super::methods::stream_methods);
-
 starlark_simple_value!(Stream);
-
-#[starlark_value(type = "Stream")]
-impl<'v> StarlarkValue<'v> for Stream {
-    fn get_methods() -> Option<&'static Methods> {
-        Some(STREAM_METHODS.methods())
-    }
-}
 
 /// A road piece, or a network of connected pieces represented by its first piece.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -70,39 +69,10 @@ impl fmt::Display for Road {
     }
 }
 
-starlark::methods_static!(ROAD_METHODS = super::methods::road_methods);
-
-const PORTS: [&str; 4] = ["ONE", "TWO", "THREE", "FOUR"];
+/// The names of a piece's ports, in order.
+pub(crate) const PORTS: [&str; 4] = ["ONE", "TWO", "THREE", "FOUR"];
 
 starlark_simple_value!(Road);
-
-#[starlark_value(type = "Road")]
-impl<'v> StarlarkValue<'v> for Road {
-    fn get_methods() -> Option<&'static Methods> {
-        Some(ROAD_METHODS.methods())
-    }
-
-    fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
-        if attribute == "SideWalk" && self.segment {
-            return Some(heap.alloc(LaneSide { opposite: false }));
-        }
-        let i = PORTS.iter().position(|p| *p == attribute)?;
-        (i < self.ports && !self.network).then(|| {
-            heap.alloc(Port {
-                piece: self.piece,
-                index: i,
-            })
-        })
-    }
-
-    fn dir_attr(&self) -> Vec<String> {
-        let mut v: Vec<String> = PORTS[..self.ports].iter().map(|s| s.to_string()).collect();
-        if self.segment {
-            v.push("SideWalk".into());
-        }
-        v
-    }
-}
 
 /// A connection point of a road piece (`t.ONE`).
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -151,8 +121,6 @@ impl<'v> StarlarkValue<'v> for LaneSide {
         }))
     }
 }
-
-pub use super::position::Loc;
 
 /// What kind of actor an [`ActorVal`] is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Allocative)]
@@ -408,28 +376,7 @@ impl fmt::Display for WorldVal {
     }
 }
 
-starlark::methods_static!(WORLD_METHODS = super::methods::world_methods);
-
 starlark_simple_value!(WorldVal);
-
-#[starlark_value(type = "World")]
-impl<'v> StarlarkValue<'v> for WorldVal {
-    fn get_methods() -> Option<&'static Methods> {
-        Some(WORLD_METHODS.methods())
-    }
-
-    fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
-        match attribute {
-            "light" => Some(heap.alloc(Stream::of(self.light))),
-            "fog" => Some(heap.alloc(Stream::of(self.fog))),
-            _ => None,
-        }
-    }
-
-    fn dir_attr(&self) -> Vec<String> {
-        vec!["light".into(), "fog".into()]
-    }
-}
 
 /// A monitor, registered when created.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
@@ -524,3 +471,13 @@ starlark_simple_value!(ObstacleVal);
 
 #[starlark_value(type = "Obstacle")]
 impl<'v> StarlarkValue<'v> for ObstacleVal {}
+
+/// A hint for a stream passed where a value is needed, empty for anything else.
+pub(crate) fn stream_hint(v: Value) -> &'static str {
+    if v.downcast_ref::<Stream>().is_some() {
+        " (a stream has a value only while a test runs: apply the function inside a lambda, \
+         e.g. s.map(lambda x: sqrt(x)))"
+    } else {
+        ""
+    }
+}

@@ -12,11 +12,10 @@ use starlark::starlark_module;
 use starlark::values::list::UnpackList;
 use starlark::values::{UnpackValue, Value, ValueLike};
 
+use crate::lang::position::Loc;
 use crate::lang::scene::{turns, ObjectDecl, PedTrigger, Pending, SceneBuilder};
 use crate::lang::types;
-use crate::lang::values::{
-    ActorKind, ActorVal, ChangeStart, LaneChangeVal, Loc, ObstacleVal, Stream,
-};
+use crate::lang::values::{ActorKind, ActorVal, ChangeStart, LaneChangeVal, ObstacleVal, Stream};
 
 use super::*;
 

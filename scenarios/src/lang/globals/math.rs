@@ -8,7 +8,7 @@ use starlark::eval::Evaluator;
 use starlark::starlark_module;
 use starlark::values::Value;
 
-use super::*;
+use crate::lang::values::stream_hint;
 
 /// A number argument of a math builtin.
 pub(super) fn math_number(v: Value, what: &str) -> anyhow::Result<f64> {

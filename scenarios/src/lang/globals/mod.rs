@@ -232,16 +232,6 @@ pub(super) fn load_time_number(v: Value, b: &SceneBuilder, what: &str) -> anyhow
     number(v, what)
 }
 
-/// A hint for a stream passed where a value is needed, empty for anything else.
-pub(crate) fn stream_hint(v: Value) -> &'static str {
-    if v.downcast_ref::<Stream>().is_some() {
-        " (a stream has a value only while a test runs: apply the function inside a lambda, \
-         e.g. s.map(lambda x: sqrt(x)))"
-    } else {
-        ""
-    }
-}
-
 /// A string fixed for a test: a plain string, `Const("...")` or an open `VarEnum` level.
 pub(crate) fn text_value(v: Value, b: &SceneBuilder) -> Option<String> {
     if let Some(t) = v.unpack_str() {

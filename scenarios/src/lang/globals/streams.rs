@@ -10,7 +10,8 @@ use starlark::eval::Evaluator;
 use starlark::starlark_module;
 use starlark::values::{Value, ValueLike};
 
-use crate::lang::scene::{OverTime, ParamDecl};
+use crate::lang::scene::ParamDecl;
+use crate::lang::values::OverTime;
 use crate::lang::values::{OverTimeVal, Stream};
 
 use super::*;
