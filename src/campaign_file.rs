@@ -132,6 +132,25 @@ impl std::fmt::Display for Shard {
     }
 }
 
+/// What decides a campaign's tests besides its scenario: the settings [`CampaignFile::new`]
+/// records (field by field, not flattened: serde's flattening reads numbers wrongly under
+/// serde_json's `arbitrary_precision`, see `tests/read_back.rs`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// The system under test.
+    pub sut: SutChoice,
+    /// Strategy name (`halton`, `random`, ...; see `Strategy::LIST`).
+    pub strategy: String,
+    /// Campaign seed.
+    pub seed: u64,
+    /// Number of tests of the whole campaign, `>= 1`.
+    pub budget: u64,
+    /// Strength of the covering-suite strategies.
+    pub strength: usize,
+    /// The shard this folder runs, `None` for the whole campaign.
+    pub shard: Option<Shard>,
+}
+
 /// The contents of `campaign.json`: everything needed to rebuild any test of the campaign.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CampaignFile {
@@ -143,20 +162,34 @@ pub struct CampaignFile {
     pub fingerprint: String,
     /// The scenario as given: a built-in name, or the absolute path of a `.star` file.
     pub scenario: String,
-    /// The system under test.
+    /// [`Settings::sut`].
     pub sut: SutChoice,
-    /// Strategy name (`halton`, `random`, ...).
+    /// [`Settings::strategy`].
     pub strategy: String,
-    /// Campaign seed.
+    /// [`Settings::seed`].
     pub seed: u64,
-    /// Number of tests of the whole campaign.
+    /// [`Settings::budget`].
     pub budget: u64,
-    /// Strength of covering-array strategies.
+    /// [`Settings::strength`].
     pub strength: usize,
-    /// This folder's shard, or `null` for a whole campaign.
+    /// [`Settings::shard`] (`null` in the file for a whole campaign).
     pub shard: Option<Shard>,
     /// The scenario's open parameters.
     pub space: Vec<Param>,
+}
+
+impl CampaignFile {
+    /// The settings it records.
+    pub fn settings(&self) -> Settings {
+        Settings {
+            sut: self.sut.clone(),
+            strategy: self.strategy.clone(),
+            seed: self.seed,
+            budget: self.budget,
+            strength: self.strength,
+            shard: self.shard,
+        }
+    }
 }
 
 /// What decides a campaign's results, hashed into its fingerprint.
@@ -180,19 +213,22 @@ fn sha256_hex(bytes: &[u8]) -> String {
 }
 
 impl CampaignFile {
-    /// The settings of a campaign of `scenario` (loaded from `scenario_arg`), with its
+    /// The campaign of `scenario` (loaded from `scenario_arg`) with `settings`, and its
     /// fingerprint.
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         scenario_arg: &str,
         scenario: &paracosm_scenarios::Scenario,
-        sut: SutChoice,
-        strategy: &str,
-        seed: u64,
-        budget: u64,
-        strength: usize,
-        shard: Option<Shard>,
+        settings: Settings,
     ) -> CampaignFile {
+        let Settings {
+            sut,
+            strategy,
+            seed,
+            budget,
+            strength,
+            shard,
+        } = settings;
+        let strategy = strategy.as_str();
         let space = scenario.space.params().to_vec();
         let fingerprint = {
             let f = Fingerprinted {
@@ -318,18 +354,16 @@ mod tests {
     #[test]
     fn the_fingerprint_covers_the_settings_and_the_program_text() {
         let s = paracosm_scenarios::builtin("pedestrian-crossing").unwrap();
-        let make = |seed, shard| {
-            CampaignFile::new(
-                "pedestrian-crossing",
-                &s,
-                SutChoice::Scenario,
-                "halton",
-                seed,
-                100,
-                2,
-                shard,
-            )
+        let settings = |seed, shard| Settings {
+            sut: SutChoice::Scenario,
+            strategy: "halton".into(),
+            seed,
+            budget: 100,
+            strength: 2,
+            shard,
         };
+        let make =
+            |seed, shard| CampaignFile::new("pedestrian-crossing", &s, settings(seed, shard));
         let a = make(0, None);
         assert_eq!(a.fingerprint, make(0, None).fingerprint);
         assert_ne!(a.fingerprint, make(1, None).fingerprint);
@@ -338,16 +372,7 @@ mod tests {
         assert_eq!(a.differences(&make(1, None)), ["seed: 0 vs 1"]);
         let mut edited = s.clone();
         edited.source = "# edited\n".into();
-        let b = CampaignFile::new(
-            "pedestrian-crossing",
-            &edited,
-            SutChoice::Scenario,
-            "halton",
-            0,
-            100,
-            2,
-            None,
-        );
+        let b = CampaignFile::new("pedestrian-crossing", &edited, settings(0, None));
         assert_eq!(a.differences(&b), ["the scenario program's text differs"]);
     }
 }

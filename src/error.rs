@@ -40,6 +40,9 @@ pub enum Error {
         /// The operating system's reason.
         reason: String,
     },
+    /// A plot cannot be drawn (its file cannot be written): `PlotError`'s message.
+    #[error("{0}")]
+    Plot(String),
     /// A defect of paracosm or of its machine: a worker pool that does not start, a panic
     /// outside a test.
     #[error("internal error: {0}")]
@@ -54,7 +57,7 @@ impl Error {
             Error::BadInput(_) | Error::Input { .. } | Error::Scenario(_) | Error::Generator(_) => {
                 2
             }
-            Error::Write { .. } | Error::Internal(_) => 3,
+            Error::Write { .. } | Error::Plot(_) | Error::Internal(_) => 3,
         }
     }
 

@@ -11,7 +11,7 @@ use paracosm_generators::Strategy;
 use paracosm_scenarios::Scenario;
 
 use crate::campaign::{Campaign, CampaignReport, Observer, ResultsFile, RESULTS_FILE};
-use crate::campaign_file::{CampaignFile, Shard, SutChoice, CAMPAIGN_FILE};
+use crate::campaign_file::{CampaignFile, Settings, Shard, SutChoice, CAMPAIGN_FILE};
 use crate::record::RunRecord;
 use crate::report::{warnings_of, write_outputs, Finished};
 use crate::summary::Summary;
@@ -405,12 +405,14 @@ fn settings(
             let file = CampaignFile::new(
                 name,
                 &scenario,
-                choice,
-                request.strategy.unwrap_or(Strategy::Halton).name(),
-                request.seed.unwrap_or(0),
-                request.budget.unwrap_or(100),
-                request.strength.unwrap_or(2),
-                request.shard,
+                Settings {
+                    sut: choice,
+                    strategy: request.strategy.unwrap_or(Strategy::Halton).name().into(),
+                    seed: request.seed.unwrap_or(0),
+                    budget: request.budget.unwrap_or(100),
+                    strength: request.strength.unwrap_or(2),
+                    shard: request.shard,
+                },
             );
             match stored.map(|st| st.differences(&file)) {
                 Some(diffs) if !diffs.is_empty() => Err(refuse(diffs)),
@@ -458,16 +460,7 @@ fn settings(
                 return Err(refuse(diffs));
             }
             let scenario = load(&st.scenario, &st.sut)?;
-            let again = CampaignFile::new(
-                &st.scenario,
-                &scenario,
-                st.sut.clone(),
-                &st.strategy,
-                st.seed,
-                st.budget,
-                st.strength,
-                st.shard,
-            );
+            let again = CampaignFile::new(&st.scenario, &scenario, st.settings());
             if again.fingerprint != st.fingerprint {
                 return Err(refuse(vec![format!(
                     "the scenario `{}` changed since the campaign started",

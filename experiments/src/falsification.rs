@@ -3,7 +3,9 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use paracosm::Error;
+
+use crate::Result;
 use paracosm::Campaign;
 use paracosm_generators::Strategy;
 use serde::Serialize;
@@ -146,9 +148,7 @@ pub fn falsification_study(settings: &StudySettings<'_>, out: &Path) -> Result<S
                     .join(name)
                     .join(strategy.name())
                     .join(format!("seed-{seed}"));
-                let report = campaign
-                    .run(&run_dir, |_| {})
-                    .with_context(|| format!("{name}, {strategy}, seed {seed}"))?;
+                let report = campaign.run(&run_dir, |_| {})?;
                 trials.push(Trial {
                     scenario: name.to_owned(),
                     strategy: strategy.name().to_owned(),
@@ -175,14 +175,14 @@ pub fn falsification_study(settings: &StudySettings<'_>, out: &Path) -> Result<S
         .copied()
         .chain([SYNTHETIC])
         .collect();
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(|e| Error::write(&dir, e))?;
     let csv_path = dir.join("trials.csv");
-    let mut w = csv::Writer::from_path(&csv_path)
-        .with_context(|| format!("writing {}", csv_path.display()))?;
+    let written = |e: &dyn std::fmt::Display| Error::write(&csv_path, e);
+    let mut w = csv::Writer::from_path(&csv_path).map_err(|e| written(&e))?;
     for t in &trials {
-        w.serialize(t)?;
+        w.serialize(t).map_err(|e| written(&e))?;
     }
-    w.flush()?;
+    w.flush().map_err(|e| written(&e))?;
 
     let values = |scenario: &str, strategy: &str| -> Vec<f64> {
         trials
@@ -227,8 +227,7 @@ pub fn falsification_study(settings: &StudySettings<'_>, out: &Path) -> Result<S
         table.push('\n');
     }
     let table_path = dir.join("study.md");
-    std::fs::write(&table_path, &table)
-        .with_context(|| format!("writing {}", table_path.display()))?;
+    std::fs::write(&table_path, &table).map_err(|e| Error::write(&table_path, e))?;
 
     let panels: Vec<paracosm::plot::BoxPanel> = columns
         .iter()

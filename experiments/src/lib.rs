@@ -11,7 +11,10 @@ pub mod falsification;
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use paracosm::Error;
+
+/// What the experiments return: the root library's typed error.
+pub type Result<T> = std::result::Result<T, Error>;
 use paracosm::{Campaign, RunRecord};
 use paracosm_generators::Strategy;
 
@@ -52,9 +55,7 @@ pub fn figure9(budget: u64, seed: u64, jobs: usize, out: &Path) -> Result<Figure
             jobs,
             stop_at_first_failure: false,
         };
-        let report = campaign
-            .run(&dir.join(strategy.name()), |_| {})
-            .with_context(|| format!("running the {strategy} campaign"))?;
+        let report = campaign.run(&dir.join(strategy.name()), |_| {})?;
         let title = format!(
             "{strategy}: {budget} tests, {} collisions",
             report.counts.fail

@@ -43,6 +43,12 @@ pub enum PlotError {
     },
 }
 
+impl From<PlotError> for crate::Error {
+    fn from(e: PlotError) -> Self {
+        crate::Error::Plot(e.to_string())
+    }
+}
+
 fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {

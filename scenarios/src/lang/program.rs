@@ -265,7 +265,7 @@ impl Program {
                 b.test_at.as_deref().unwrap_or(&self.file)
             ));
         }
-        if b.ego.as_ref().map(|e| &e.sut) != Some(&self.sut) {
+        if b.sut.as_ref() != Some(&self.sut) {
             let at = b
                 .objects
                 .iter()
@@ -548,9 +548,8 @@ pub fn load(
     program.monitors = first.monitors.clone();
     program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
     program.sut = first
-        .ego
-        .as_ref()
-        .map(|e| e.sut.clone())
+        .sut
+        .clone()
         .ok_or_else(|| lang("the program places no AutonomousVehicle".into()))?;
 
     let mut space = Vec::new();

@@ -187,47 +187,6 @@ pub struct ObjectDecl {
     pub placed: bool,
 }
 
-/// A pedestrian as resolved.
-#[derive(Debug, Clone)]
-pub struct PedestrianDecl {
-    /// Feet start and target, metres.
-    pub start: [f64; 3],
-    /// Target, metres.
-    pub target: [f64; 3],
-    /// Speed stream.
-    pub speed: StreamId,
-}
-
-/// A car as resolved.
-#[derive(Debug, Clone)]
-pub struct CarDecl {
-    /// Its route, world `[x, z]` metres.
-    pub path: Vec<[f64; 2]>,
-    /// Speed stream, m/s.
-    pub speed: StreamId,
-    /// Colour name.
-    pub color: String,
-    /// Presence.
-    pub enabled: bool,
-    /// Its lane change, if any.
-    pub lane_change: Option<paracosm_engine::LaneChangeSpec>,
-    /// Lanes for `changeLane` ([`paracosm_engine::CarSpec::lane_offsets_m`]).
-    pub lane_offsets_m: Vec<(i32, f64)>,
-}
-
-/// The ego vehicle as resolved.
-#[derive(Debug, Clone)]
-pub struct EgoDecl {
-    /// Start.
-    pub start: Location,
-    /// Route, empty to keep its lane.
-    pub route: Vec<[f64; 2]>,
-    /// Initial speed, m/s.
-    pub initial_speed_mps: f64,
-    /// System under test.
-    pub sut: SutConfig,
-}
-
 /// Everything one evaluation of a program declares.
 #[derive(Debug)]
 pub struct SceneBuilder {
@@ -242,12 +201,15 @@ pub struct SceneBuilder {
     pub roads: Network,
     /// Each piece's friction stream.
     pub frictions: Vec<(PieceId, StreamId)>,
-    /// The ego vehicle, once placed.
-    pub ego: Option<EgoDecl>,
+    /// The ego vehicle, once placed: the engine's spec (an actor goes from its declaration,
+    /// [`Pending`], straight to the engine's spec when `place` resolves its locations).
+    pub ego: Option<EgoSpec>,
+    /// The ego vehicle's system under test (`AutonomousVehicle(sut=)`), once placed.
+    pub sut: Option<SutConfig>,
     /// Pedestrians.
-    pub pedestrians: Vec<PedestrianDecl>,
+    pub pedestrians: Vec<PedestrianSpec>,
     /// Cars.
-    pub cars: Vec<CarDecl>,
+    pub cars: Vec<CarSpec>,
     /// Static obstacles.
     pub obstacles: Vec<ObstacleSpec>,
     /// `World(light=, fog=)`.
@@ -332,6 +294,7 @@ impl SceneBuilder {
             roads: Network::new(),
             frictions: Vec::new(),
             ego: None,
+            sut: None,
             pedestrians: Vec::new(),
             cars: Vec::new(),
             obstacles: Vec::new(),
@@ -440,39 +403,13 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
             _ => friction_streams.push((piece, stream)),
         }
     }
-    let cars = b
-        .cars
-        .iter()
-        .map(|c| CarSpec {
-            path: c.path.clone(),
-            speed: c.speed,
-            color: c.color.clone(),
-            size: Size::CAR,
-            enabled: c.enabled,
-            lane_change: c.lane_change,
-            lane_offsets_m: c.lane_offsets_m.clone(),
-        })
-        .collect();
     Ok(WorldSpec {
         dt_s: DEFAULT_DT_S,
         network,
         frictions: friction_streams,
-        ego: EgoSpec {
-            start: ego.start,
-            initial_speed_mps: ego.initial_speed_mps,
-            vehicle: VehicleParams::default(),
-            route: ego.route.clone(),
-        },
-        pedestrians: b
-            .pedestrians
-            .iter()
-            .map(|p| PedestrianSpec {
-                start: p.start,
-                target: p.target,
-                speed: p.speed,
-            })
-            .collect(),
-        cars,
+        ego: ego.clone(),
+        pedestrians: b.pedestrians.clone(),
+        cars: b.cars.clone(),
         obstacles: b.obstacles.clone(),
         environment: EnvironmentSpec { light, fog },
         streams,
@@ -685,12 +622,13 @@ impl SceneBuilder {
                     if self.ego.is_some() {
                         return Err(format!("{}: a scenario has one AutonomousVehicle", o.name));
                     }
-                    self.ego = Some(EgoDecl {
+                    self.ego = Some(EgoSpec {
                         start,
-                        route,
                         initial_speed_mps,
-                        sut,
+                        vehicle: VehicleParams::default(),
+                        route,
                     });
+                    self.sut = Some(sut);
                 }
                 Pending::Pedestrian {
                     start,
@@ -710,7 +648,7 @@ impl SceneBuilder {
                         PedTrigger::Never => {}
                     }
                     ped_index += 1;
-                    self.pedestrians.push(PedestrianDecl {
+                    self.pedestrians.push(PedestrianSpec {
                         start: s,
                         target: t,
                         speed,
@@ -734,10 +672,11 @@ impl SceneBuilder {
                         None => None,
                     };
                     let lane_offsets_m = self.lane_offsets(&start);
-                    self.cars.push(CarDecl {
+                    self.cars.push(CarSpec {
                         path,
                         speed,
                         color,
+                        size: Size::CAR,
                         enabled,
                         lane_change,
                         lane_offsets_m,
