@@ -221,6 +221,7 @@ impl Campaign<'_> {
                 wall_s: started.elapsed().as_secs_f64(),
             };
             for o in observers.iter_mut() {
+                o.started(prior.unwrap_or(&[]))?;
                 o.finished(&report)?;
             }
             return Ok(report);

@@ -265,61 +265,64 @@ pub fn run(
         jobs,
         stop_at_first_failure: request.stop_at_first_failure,
     };
+    let mut written = None;
+    let junit_path = request.junit.as_deref();
     let mut chain = Chain {
         results: ResultsFile::new(out, stored.is_some()),
         others: observers,
-        junit: request.junit.as_deref().map(|path| JUnit {
-            path: path.to_path_buf(),
-            out: out.clone(),
-            scenario: scenario.name.clone(),
-            records: Vec::new(),
+        // summary.json (counts, first failure, coverage of the points run) and the plots.
+        outputs: AtEnd::new(Box::new(
+            |records: &[RunRecord], report: &CampaignReport| {
+                written = Some(write_outputs(&Finished {
+                    out,
+                    scenario: &scenario,
+                    file: &file,
+                    records,
+                    jobs,
+                    wall_s: report.wall_s,
+                    junit: junit_path,
+                    warnings: warnings.clone(),
+                })?);
+                Ok(())
+            },
+        )),
+        junit: junit_path.map(|path| {
+            let name = scenario.name.clone();
+            AtEnd::new(Box::new(move |records: &[RunRecord], _: &CampaignReport| {
+                crate::junit::write(path, &name, records, out)
+            }) as AtEndFn<'_>)
         }),
     };
     let prior = stored.is_some().then_some(existing.records.as_slice());
     let report = campaign.run_ids(start..ids.end, prior, stop, &mut [&mut chain])?;
-    let junit = chain.junit;
-    let mut records = existing.records;
-    records.extend(report.records.iter().cloned());
-    let mut outcome = Outcome {
-        done: records.len() as u64,
+    let done = chain.outputs.records.len() as u64;
+    drop(chain);
+    Ok(Outcome {
+        done,
         expected: ids.end - ids.start,
-        summary: None,
-        plot_warnings: Vec::new(),
+        plot_warnings: written
+            .as_ref()
+            .map(|w: &crate::report::Written| w.plot_warnings.clone())
+            .unwrap_or_default(),
+        summary: written.map(|w| w.summary),
         report,
         file,
         scenario,
         out: out.clone(),
-    };
-    if outcome.report.interrupted {
-        return Ok(outcome);
-    }
-    let written = write_outputs(&Finished {
-        out,
-        scenario: &outcome.scenario,
-        file: &outcome.file,
-        records: &records,
-        jobs,
-        wall_s: outcome.report.wall_s,
-        junit: request.junit.as_deref(),
-        warnings,
-    })?;
-    if let Some(j) = junit {
-        j.write()?;
-    }
-    outcome.summary = Some(written.summary);
-    outcome.plot_warnings = written.plot_warnings;
-    Ok(outcome)
+    })
 }
 
 /// The session's observers in their order: the results file first (a record reaches the
-/// others once it is on disk), the caller's, then JUnit.
-struct Chain<'a, 'b> {
+/// others once it is on disk), the caller's, the summary with its coverage and plots, then
+/// JUnit.
+struct Chain<'a, 'b, 'c> {
     results: ResultsFile,
     others: &'a mut [&'b mut dyn Observer],
-    junit: Option<JUnit>,
+    outputs: AtEnd<AtEndFn<'c>>,
+    junit: Option<AtEnd<AtEndFn<'c>>>,
 }
 
-impl Chain<'_, '_> {
+impl Chain<'_, '_, '_> {
     fn each(
         &mut self,
         mut f: impl FnMut(&mut dyn Observer) -> Result<(), Error>,
@@ -328,6 +331,7 @@ impl Chain<'_, '_> {
         for o in self.others.iter_mut() {
             f(&mut **o)?;
         }
+        f(&mut self.outputs)?;
         match self.junit.as_mut() {
             Some(j) => f(j),
             None => Ok(()),
@@ -335,7 +339,7 @@ impl Chain<'_, '_> {
     }
 }
 
-impl Observer for Chain<'_, '_> {
+impl Observer for Chain<'_, '_, '_> {
     fn started(&mut self, prior: &[RunRecord]) -> Result<(), Error> {
         self.each(|o| o.started(prior))
     }
@@ -349,16 +353,27 @@ impl Observer for Chain<'_, '_> {
     }
 }
 
-/// The [`Observer`] that gathers the records for JUnit XML ([`crate::junit`]), written with
-/// the summary.
-struct JUnit {
-    path: PathBuf,
-    out: PathBuf,
-    scenario: String,
+/// What an [`AtEnd`] does with the records when the campaign finishes.
+type AtEndFn<'a> = Box<dyn FnMut(&[RunRecord], &CampaignReport) -> Result<(), Error> + 'a>;
+
+/// An [`Observer`] that gathers every record of the folder (earlier ones included) and hands
+/// them to `then` when the campaign finishes: the summary and plots, JUnit XML. Nothing is
+/// written after an interruption: the folder is to be resumed.
+struct AtEnd<F> {
     records: Vec<RunRecord>,
+    then: F,
 }
 
-impl Observer for JUnit {
+impl<F> AtEnd<F> {
+    fn new(then: F) -> Self {
+        AtEnd {
+            records: Vec::new(),
+            then,
+        }
+    }
+}
+
+impl<F: FnMut(&[RunRecord], &CampaignReport) -> Result<(), Error>> Observer for AtEnd<F> {
     fn started(&mut self, prior: &[RunRecord]) -> Result<(), Error> {
         self.records = prior.to_vec();
         Ok(())
@@ -368,11 +383,12 @@ impl Observer for JUnit {
         self.records.push(record.clone());
         Ok(())
     }
-}
 
-impl JUnit {
-    fn write(&self) -> Result<(), Error> {
-        crate::junit::write(&self.path, &self.scenario, &self.records, &self.out)
+    fn finished(&mut self, report: &CampaignReport) -> Result<(), Error> {
+        if report.interrupted {
+            return Ok(());
+        }
+        (self.then)(&self.records, report)
     }
 }
 
