@@ -210,27 +210,7 @@ pub fn run(
     };
     let (file, scenario) = settings(request, stored.as_ref())?;
     let warnings = warnings_of(&scenario);
-    if request.deny_warnings && !warnings.is_empty() {
-        return Err(Error::BadInput(format!(
-            "--deny-warnings: the scenario loads with {} warning{}: {}",
-            warnings.len(),
-            if warnings.len() == 1 { "" } else { "s" },
-            warnings.join("; ")
-        )));
-    }
-    let strategy: Strategy = file.strategy.parse()?;
-    if let Some(cap) = strategy.capacity().filter(|&cap| file.budget > cap) {
-        return Err(Error::BadInput(format!(
-            "--budget {} is more than the {cap} points {strategy} can produce",
-            file.budget
-        )));
-    }
-    if file.shard.is_some() && strategy.method().is_some() {
-        return Err(Error::BadInput(format!(
-            "--shard cannot split a {strategy} campaign: each of its tests depends on all \
-             earlier ones. Run it whole (it is parallel inside: --jobs)"
-        )));
-    }
+    let strategy = refusals(request, &file, &warnings)?;
     let jobs = request.jobs.unwrap_or_else(|| {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
@@ -310,6 +290,38 @@ pub fn run(
         scenario,
         out: out.clone(),
     })
+}
+
+/// The campaign's strategy, unless the campaign must be refused before anything is written:
+/// warnings under `deny_warnings`, a budget past the strategy's capacity, a shard of an
+/// adaptive strategy.
+fn refusals(
+    request: &Request,
+    file: &CampaignFile,
+    warnings: &[String],
+) -> Result<Strategy, Error> {
+    if request.deny_warnings && !warnings.is_empty() {
+        return Err(Error::BadInput(format!(
+            "--deny-warnings: the scenario loads with {} warning{}: {}",
+            warnings.len(),
+            if warnings.len() == 1 { "" } else { "s" },
+            warnings.join("; ")
+        )));
+    }
+    let strategy: Strategy = file.strategy.parse()?;
+    if let Some(cap) = strategy.capacity().filter(|&cap| file.budget > cap) {
+        return Err(Error::BadInput(format!(
+            "--budget {} is more than the {cap} points {strategy} can produce",
+            file.budget
+        )));
+    }
+    if file.shard.is_some() && strategy.method().is_some() {
+        return Err(Error::BadInput(format!(
+            "--shard cannot split a {strategy} campaign: each of its tests depends on all \
+             earlier ones. Run it whole (it is parallel inside: --jobs)"
+        )));
+    }
+    Ok(strategy)
 }
 
 /// The session's observers in their order: the results file first (a record reaches the
