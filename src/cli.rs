@@ -98,6 +98,27 @@ impl SutArgs {
     }
 }
 
+/// `paracosm-fuzz report`'s options that redraw plots from the records.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct Redraw {
+    /// Redraw the failure map and the failure-rate plot over these one or two parameters
+    /// (`--map walking_speed,trigger_distance`), into `failure_map-A-B.{png,svg}` and
+    /// `failure_rate-A-B.{png,svg}` beside the records.
+    #[arg(long, value_delimiter = ',', value_name = "A,B")]
+    pub map: Option<Vec<String>>,
+    /// What the failure map's points are coloured by: `outcome` (red failed, blue passed) or
+    /// `robustness` (a diverging scale centred at 0, so near misses show; the file name ends
+    /// in `-robustness`). Given alone, redraws the map over the scenario's map axes.
+    #[arg(long, value_name = "outcome|robustness")]
+    pub color: Option<crate::plot::Coloring>,
+    /// Redraw the scatterplot matrix of the parameters (`pairs.{png,svg}`).
+    #[arg(long)]
+    pub pairs: bool,
+    /// Write the campaign's web page again (`report.html`).
+    #[arg(long)]
+    pub html: bool,
+}
+
 /// Parses a count that must be at least 1 (`--budget`, `-n`). A clap value parser: its
 /// message becomes clap's usage error (exit code 2).
 ///

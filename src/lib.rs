@@ -14,6 +14,7 @@ pub mod cli;
 pub mod cover;
 mod error;
 pub mod fuzz;
+pub mod html;
 pub mod junit;
 pub mod merge;
 pub mod plot;
@@ -25,6 +26,7 @@ pub mod results;
 pub mod seed;
 pub mod session;
 pub mod summary;
+pub mod triage;
 
 pub use campaign::{Campaign, CampaignReport, Observer, OnRecord, ResultsFile};
 pub use error::Error;

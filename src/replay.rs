@@ -33,6 +33,12 @@ fn input(e: impl std::fmt::Display) -> Error {
 
 /// The command that replays test `id` of the campaign in `out`.
 pub fn replay_command(out: &Path, id: u64) -> String {
+    replay_command_for(out, &id.to_string())
+}
+
+/// [`replay_command`] with `id` as given: `{id}` gives the command's template (the web
+/// report fills it in).
+pub fn replay_command_for(out: &Path, id: &str) -> String {
     format!(
         "paracosm-fuzz replay {} --id {id} --frames {}",
         out.join(RESULTS_FILE).display(),

@@ -71,21 +71,150 @@ pub struct Written {
     pub plot_warnings: Vec<String>,
 }
 
-/// The plots of a campaign: `(file stem, what)` for the failure map and the failure-rate heat
-/// map, none for a scenario without open parameters.
-fn plan_plots(scenario: &Scenario) -> Vec<&'static str> {
-    if scenario.map_axes.is_empty() {
-        Vec::new()
-    } else {
-        vec!["failure_map", "failure_rate"]
+/// A plot of a campaign folder.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Plot {
+    /// The failure map (paper Figure 9) over one or two parameters, its points coloured by
+    /// outcome or robustness.
+    Map {
+        /// One or two parameter names.
+        axes: Vec<String>,
+        /// What the points are coloured by.
+        color: crate::plot::Coloring,
+    },
+    /// The failure-rate heat map (Figure 10a) over one or two parameters, with cells adapted
+    /// to the number of tests ([`crate::plot::adaptive_bins`]).
+    Rate {
+        /// One or two parameter names.
+        axes: Vec<String>,
+    },
+    /// The scatterplot matrix of the parameters ([`pairs_params`]).
+    Pairs,
+}
+
+/// The parameters the pairs plot shows, in declaration order, and those it leaves out: all of
+/// them up to [`crate::plot::MAX_PAIRS`], else the most relevant by `triage`'s ranking (the
+/// first ones declared without a ranking).
+pub fn pairs_params(
+    space: &ParamSpace,
+    triage: Option<&crate::triage::Triage>,
+) -> (Vec<String>, Vec<String>) {
+    let all: Vec<String> = space.params().iter().map(|p| p.name.clone()).collect();
+    if all.len() <= crate::plot::MAX_PAIRS {
+        return (all, Vec::new());
+    }
+    let ranked: Vec<String> = match triage {
+        Some(t) => t.ranking.iter().map(|r| r.param.clone()).collect(),
+        None => all.clone(),
+    };
+    let chosen = &ranked[..crate::plot::MAX_PAIRS];
+    let (shown, left): (Vec<String>, Vec<String>) =
+        all.into_iter().partition(|n| chosen.contains(n));
+    (shown, left)
+}
+
+/// What a campaign's plots are drawn from.
+pub struct PlotData<'a> {
+    /// The scenario's name (in titles).
+    pub scenario: &'a str,
+    /// The strategy's name (in titles).
+    pub strategy: &'a str,
+    /// The scenario's parameters.
+    pub space: &'a ParamSpace,
+    /// The records.
+    pub records: &'a [RunRecord],
+    /// The failure rules and ranking, which pick the pairs plot's parameters.
+    pub triage: Option<&'a crate::triage::Triage>,
+}
+
+impl PlotData<'_> {
+    /// Draws `plot` into `stem.png` and `stem.svg` and returns their paths.
+    ///
+    /// # Errors
+    /// [`crate::plot::PlotError`] when an axis is not a parameter, or a file cannot be written.
+    pub fn draw(
+        &self,
+        stem: &Path,
+        plot: &Plot,
+    ) -> Result<[std::path::PathBuf; 2], crate::plot::PlotError> {
+        let n = self.records.len();
+        let fail = self
+            .records
+            .iter()
+            .filter(|r| r.status == Status::Fail)
+            .count();
+        match plot {
+            Plot::Map { axes, color } => {
+                let title = format!(
+                    "{}: {}, {n} tests, {fail} failed",
+                    self.scenario, self.strategy
+                );
+                crate::plot::failure_map(stem, self.space, axes, &[(&title, self.records)], *color)
+            }
+            Plot::Rate { axes } => crate::plot::failure_rate_map(
+                stem,
+                self.space,
+                axes,
+                &format!("{}: failure rate ({n} tests)", self.scenario),
+                self.records,
+                crate::plot::adaptive_bins(n, self.space, axes),
+            ),
+            Plot::Pairs => {
+                let (shown, left) = pairs_params(self.space, self.triage);
+                let note = if left.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "{} more parameters, less relevant, not shown: {}",
+                        left.len(),
+                        left.join(", ")
+                    )
+                };
+                crate::plot::pairs_plot(
+                    stem,
+                    self.space,
+                    &shown,
+                    &format!(
+                        "{}: {}, {n} tests, {fail} failed",
+                        self.scenario, self.strategy
+                    ),
+                    &note,
+                    self.records,
+                )
+            }
+        }
     }
 }
 
-/// Writes `summary.json`, then the plots (`failure_map`,
-/// `failure_rate`: none without open parameters, a strip plot with one, categorical columns for
-/// discrete ones), each file through a temporary file and a rename. The summary comes first so
-/// that no plotting problem can cost it: a plot that cannot be drawn is a warning, and the
-/// summary is written again without it and with the warning.
+/// The plots of a campaign, by file stem: the failure map and the failure-rate heat map over
+/// the scenario's map axes, and the pairs plot; none without open parameters.
+fn plan_plots(scenario: &Scenario) -> Vec<(&'static str, Plot)> {
+    if scenario.map_axes.is_empty() {
+        return Vec::new();
+    }
+    vec![
+        (
+            "failure_map",
+            Plot::Map {
+                axes: scenario.map_axes.clone(),
+                color: crate::plot::Coloring::Outcome,
+            },
+        ),
+        (
+            "failure_rate",
+            Plot::Rate {
+                axes: scenario.map_axes.clone(),
+            },
+        ),
+        ("pairs", Plot::Pairs),
+    ]
+}
+
+/// Writes `summary.json`, then the plots (`failure_map`, `failure_rate`, `pairs`: none without
+/// open parameters, a strip plot with one, categorical columns for discrete ones), each file
+/// through a temporary file and a rename. The summary comes first so that no plotting problem
+/// can cost it: a plot that cannot be drawn is a warning, and the summary is written again
+/// without it and with the warning.
 ///
 /// # Errors
 /// [`crate::Error::Write`] when `summary.json` cannot be written.
@@ -107,52 +236,46 @@ pub fn write_outputs(f: &Finished<'_>) -> Result<Written, crate::Error> {
         outputs.push(j.display().to_string());
     }
     let base = outputs.clone();
-    outputs.extend(plot_files(&planned));
+    let stems: Vec<&str> = planned.iter().map(|(s, _)| *s).collect();
+    outputs.extend(plot_files(&stems));
+    outputs.push(crate::html::REPORT_FILE.to_owned());
     let mut summary = summarise(f, outputs);
     write_summary(f.out, &summary)?;
 
-    let counts = summary.counts;
+    let data = PlotData {
+        scenario: &scenario.name,
+        strategy: &f.file.strategy,
+        space: &scenario.space,
+        records: f.records,
+        triage: summary.triage.as_ref(),
+    };
     let mut drawn = Vec::new();
     let mut plot_warnings = Vec::new();
-    for stem in planned {
-        let path = f.out.join(stem);
-        let result = match stem {
-            "failure_map" => {
-                let title = format!(
-                    "{}: {}, {} tests, {} failed",
-                    scenario.name,
-                    f.file.strategy,
-                    f.records.len(),
-                    counts.fail
-                );
-                crate::plot::failure_map(
-                    &path,
-                    &scenario.space,
-                    &scenario.map_axes,
-                    &[(&title, f.records)],
-                )
-            }
-            _ => crate::plot::failure_rate_map(
-                &path,
-                &scenario.space,
-                &scenario.map_axes,
-                &format!(
-                    "{}: failure rate ({} tests)",
-                    scenario.name,
-                    f.records.len()
-                ),
-                f.records,
-                8,
-            ),
-        };
-        match result {
-            Ok(_) => drawn.push(stem),
+    for (stem, plot) in &planned {
+        match data.draw(&f.out.join(stem), plot) {
+            Ok(_) => drawn.push(*stem),
             Err(e) => plot_warnings.push(format!("the plot {stem} was not drawn: {e}")),
         }
+    }
+    let page = crate::html::write(&crate::html::Page {
+        out: f.out,
+        summary: &summary,
+        space: &scenario.space,
+        records: f.records,
+        map_axes: &scenario.map_axes,
+    });
+    if let Err(e) = &page {
+        plot_warnings.push(format!(
+            "the page {} was not written: {e}",
+            crate::html::REPORT_FILE
+        ));
     }
     if !plot_warnings.is_empty() {
         let mut outputs = base;
         outputs.extend(plot_files(&drawn));
+        if page.is_ok() {
+            outputs.push(crate::html::REPORT_FILE.to_owned());
+        }
         summary.outputs = outputs;
         summary.warnings.extend(plot_warnings.iter().cloned());
         write_summary(f.out, &summary)?;
@@ -257,6 +380,7 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
         counts: Counts::of(f.records),
         first_failure: FirstFailure::of(f.records),
         coverage,
+        triage: crate::triage::triage(&scenario.space, f.records),
         warnings: f.warnings.clone(),
         wall_s: f.wall_s,
         outputs,
@@ -334,6 +458,9 @@ pub fn human(summary: &Summary, scenario: &Scenario, out: &Path, expected: u64) 
             lines.push(format!("coverage: {}", parts.join(", ")));
         }
     }
+    if let Some(t) = &summary.triage {
+        lines.extend(triage_lines(t));
+    }
     lines.push(format!(
         "files: {}",
         summary
@@ -346,15 +473,55 @@ pub fn human(summary: &Summary, scenario: &Scenario, out: &Path, expected: u64) 
     lines.join("\n")
 }
 
+/// Rules shown on the console; the others are in `summary.json`.
+const RULES_SHOWN: usize = 5;
+
+/// The console lines of a triage: the failure regions, then the parameters by relevance.
+fn triage_lines(t: &crate::triage::Triage) -> Vec<String> {
+    let mut lines = Vec::new();
+    if !t.rules.is_empty() {
+        lines.push(format!(
+            "where failures are (decision tree of depth {} on {} tests):",
+            t.max_depth, t.tests
+        ));
+        for r in t.rules.iter().take(RULES_SHOWN) {
+            lines.push(format!("  {}", r.text));
+        }
+        if t.rules.len() > RULES_SHOWN {
+            lines.push(format!(
+                "  and {} more regions in summary.json",
+                t.rules.len() - RULES_SHOWN
+            ));
+        }
+    }
+    let ranked: Vec<String> = t
+        .ranking
+        .iter()
+        .map(|r| {
+            let assoc = match (r.association, r.association_kind.as_str()) {
+                (Some(a), "eta") => format!(", η {a:.2}"),
+                (Some(a), _) => format!(", ρ {a:+.2}"),
+                (None, _) => String::new(),
+            };
+            format!("{} (importance {:.2}{assoc})", r.param, r.importance)
+        })
+        .collect();
+    lines.push(format!("parameters by relevance: {}", ranked.join(", ")));
+    lines
+}
+
 /// `paracosm-fuzz report DIR`: the human summary of a finished or partial campaign folder,
 /// computed again from its records (and the wall time and thread count of its
-/// `summary.json`, when there is one), with a line on how to finish a partial one. Returns
-/// the text and the counts.
+/// `summary.json`, when there is one), with a line on how to finish a partial one; then the
+/// plots `redraw` asks for, drawn from the records (their paths are added to the text).
+/// Returns the text and the counts.
 ///
 /// # Errors
 /// [`crate::Error::Input`] when `campaign.json` or `results.jsonl` is missing or malformed;
-/// [`crate::Error::Scenario`] when the campaign's scenario no longer loads.
-pub fn reread(dir: &Path) -> Result<(String, Counts), crate::Error> {
+/// [`crate::Error::Scenario`] when the campaign's scenario no longer loads;
+/// [`crate::Error::BadInput`] when `--map` names a parameter the scenario lacks, or not one
+/// or two; [`crate::Error::Plot`] when a plot cannot be written.
+pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts), crate::Error> {
     let file = CampaignFile::read(dir)?;
     let mut scenario = paracosm_scenarios::load(&file.scenario)?;
     if let Some(s) = file.sut.config()? {
@@ -374,6 +541,9 @@ pub fn reread(dir: &Path) -> Result<(String, Counts), crate::Error> {
         "failure_map.svg",
         "failure_rate.png",
         "failure_rate.svg",
+        "pairs.png",
+        "pairs.svg",
+        crate::html::REPORT_FILE,
     ]
     .iter()
     .filter(|f| dir.join(f).exists())
@@ -401,5 +571,78 @@ pub fn reread(dir: &Path) -> Result<(String, Counts), crate::Error> {
             dir.display()
         ));
     }
+    let data = PlotData {
+        scenario: &scenario.name,
+        strategy: &file.strategy,
+        space: &scenario.space,
+        records: &existing.records,
+        triage: summary.triage.as_ref(),
+    };
+    let mut drawn = redraw_plots(dir, &data, &scenario.map_axes, redraw)?;
+    if redraw.html {
+        let page = crate::html::write(&crate::html::Page {
+            out: dir,
+            summary: &summary,
+            space: &scenario.space,
+            records: &existing.records,
+            map_axes: &scenario.map_axes,
+        })?;
+        drawn.push(page.display().to_string());
+    }
+    if !drawn.is_empty() {
+        text.push_str(&format!("\nwrote: {}", drawn.join(", ")));
+    }
     Ok((text, summary.counts))
+}
+
+/// Draws what `redraw` asks for into `dir` and returns the files' paths.
+fn redraw_plots(
+    dir: &Path,
+    data: &PlotData<'_>,
+    map_axes: &[String],
+    redraw: &crate::cli::Redraw,
+) -> Result<Vec<String>, crate::Error> {
+    let mut plots: Vec<(String, Plot)> = Vec::new();
+    if redraw.map.is_some() || redraw.color.is_some() {
+        let axes = redraw.map.clone().unwrap_or_else(|| map_axes.to_vec());
+        let names: Vec<String> = data.space.params().iter().map(|p| p.name.clone()).collect();
+        if axes.is_empty() || axes.len() > 2 {
+            return Err(crate::Error::BadInput(format!(
+                "--map takes one or two parameters, got {}; the scenario's: {}",
+                axes.len(),
+                names.join(", ")
+            )));
+        }
+        if let Some(bad) = axes.iter().find(|a| !names.contains(a)) {
+            return Err(crate::Error::BadInput(format!(
+                "--map: `{bad}` is not a parameter of the scenario; its parameters: {}",
+                names.join(", ")
+            )));
+        }
+        let color = redraw.color.unwrap_or_default();
+        let suffix = if color == crate::plot::Coloring::Robustness {
+            "-robustness"
+        } else {
+            ""
+        };
+        let key = axes.join("-");
+        plots.push((
+            format!("failure_map-{key}{suffix}"),
+            Plot::Map {
+                axes: axes.clone(),
+                color,
+            },
+        ));
+        plots.push((format!("failure_rate-{key}"), Plot::Rate { axes }));
+    }
+    if redraw.pairs {
+        plots.push(("pairs".to_owned(), Plot::Pairs));
+    }
+    let mut drawn = Vec::new();
+    for (stem, plot) in &plots {
+        let [png, svg] = data.draw(&dir.join(stem), plot)?;
+        drawn.push(png.display().to_string());
+        drawn.push(svg.display().to_string());
+    }
+    Ok(drawn)
 }

@@ -124,6 +124,11 @@ pub struct Summary {
     /// coverage of the discrete parameters, dispersion, discrepancies and star discrepancy of
     /// the continuous ones (unit cube); `null` without such parameters.
     pub coverage: Option<crate::cover::Estimate>,
+    /// Where failures are: rules from a shallow decision tree fitted on the records, and the
+    /// parameters ranked by how much they explain the outcome ([`crate::triage`]); `null` with
+    /// fewer than 10 tests that passed or failed, or no open parameter.
+    #[serde(default)]
+    pub triage: Option<crate::triage::Triage>,
     /// The scenario's warnings for this campaign (LANGUAGE.md, "Warnings") and any plot that
     /// could not be drawn.
     pub warnings: Vec<String>,

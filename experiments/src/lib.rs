@@ -71,6 +71,7 @@ pub fn figure9(budget: u64, seed: u64, jobs: usize, out: &Path) -> Result<Figure
         &scenario.space,
         &scenario.map_axes,
         &panels,
+        paracosm::plot::Coloring::Outcome,
     )?;
     Ok(Figure9 {
         random_failures: runs[0].2,

@@ -107,7 +107,7 @@ enum Sub {
     /// fingerprint and that none is missing, given twice or incomplete.
     Merge(MergeArgs),
     /// Reprint the summary of a finished or partial campaign folder: counts, first failure,
-    /// coverage and plot paths.
+    /// coverage, where failures are, and plot paths; redraw plots on other parameters.
     Report(ReportArgs),
 }
 
@@ -131,6 +131,9 @@ struct MergeArgs {
 struct ReportArgs {
     /// A campaign (or shard) folder.
     dir: PathBuf,
+    /// Plots to redraw from the records.
+    #[command(flatten)]
+    redraw: paracosm::cli::Redraw,
 }
 
 #[derive(Debug, clap::Args)]
@@ -179,7 +182,7 @@ fn main() -> ExitCode {
                     say(&text).map(|()| counts.exit_code())
                 })
         }
-        Some(Sub::Report(a)) => paracosm::report::reread(&a.dir)
+        Some(Sub::Report(a)) => paracosm::report::reread(&a.dir, &a.redraw)
             .map_err(anyhow::Error::new)
             .and_then(|(text, counts)| say(&text).map(|()| counts.exit_code())),
         None => run(&cli),

@@ -88,45 +88,128 @@ fn chart_on<'a, DB: DrawingBackend>(
     Ok(chart)
 }
 
+/// What the points of a failure map are coloured by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Coloring {
+    /// Red crosses for failed tests, blue circles for passed ones, grey triangles for errors.
+    #[default]
+    Outcome,
+    /// The same shapes, coloured by the test's robustness (the smallest over its monitors) on a
+    /// diverging scale centred at 0: red below, blue above, grey at 0, so near misses show.
+    /// The scale spans ± the 95th percentile of |robustness| over the tests (clipped beyond).
+    Robustness,
+}
+
+impl std::str::FromStr for Coloring {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "outcome" => Ok(Coloring::Outcome),
+            "robustness" => Ok(Coloring::Robustness),
+            other => Err(format!(
+                "`{other}` is not a colouring: use `outcome` or `robustness`"
+            )),
+        }
+    }
+}
+
+const BLUE: RGBColor = RGBColor(31, 119, 180);
+const RED: RGBColor = RGBColor(214, 39, 40);
+const MID: RGBColor = RGBColor(200, 200, 200);
+
+/// The colour of robustness `r` on the diverging scale spanning `±m`: red at `-m` and below,
+/// grey at 0, blue at `+m` and above.
+pub(crate) fn diverging(r: f64, m: f64) -> RGBColor {
+    let t = (r / m).clamp(-1.0, 1.0);
+    let to = if t < 0.0 { RED } else { BLUE };
+    let a = t.abs();
+    let mix =
+        |from: u8, to: u8| (f64::from(from) + a * (f64::from(to) - f64::from(from))).round() as u8;
+    RGBColor(mix(MID.0, to.0), mix(MID.1, to.1), mix(MID.2, to.2))
+}
+
+/// Half the span of the robustness scale: the 95th percentile of |robustness| over the tests
+/// with a finite one (1 when there is none or it is 0).
+pub(crate) fn robustness_span(records: &[RunRecord]) -> f64 {
+    let mut a: Vec<f64> = records
+        .iter()
+        .map(|r| r.robustness().abs())
+        .filter(|x| x.is_finite())
+        .collect();
+    if a.is_empty() {
+        return 1.0;
+    }
+    a.sort_by(f64::total_cmp);
+    let m = a[((a.len() - 1) as f64 * 0.95).round() as usize];
+    if m > 0.0 {
+        m
+    } else {
+        1.0
+    }
+}
+
 /// One panel: `title` on top, a red cross per failed test, a blue circle per passed test and
-/// a grey triangle per error, at the tests' places on `x` and `y`.
+/// a grey triangle per error, at the tests' places on `x` and `y`; with
+/// [`Coloring::Robustness`], the crosses and circles take the colour of their robustness on
+/// the scale `±span`.
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     records: &[RunRecord],
     (x, y): (&Axis, &Axis),
     title: &str,
+    color: Coloring,
+    span: f64,
 ) -> Result<(), String> {
     let mut chart = chart_on(area, x, y, title, true)?;
     let at = |r: &RunRecord| -> Option<(f64, f64)> { Some((x.coord(r, 1)?, y.coord(r, 2)?)) };
-    let of = |status: Status| -> Vec<(f64, f64)> {
+    let of = |status: Status| -> Vec<((f64, f64), RGBColor)> {
         records
             .iter()
             .filter(|r| r.status == status)
-            .filter_map(at)
+            .filter_map(|r| {
+                let c = match (color, status) {
+                    (Coloring::Robustness, Status::Pass | Status::Fail) => {
+                        let rob = r.robustness();
+                        if rob.is_nan() {
+                            MID
+                        } else {
+                            diverging(rob, span)
+                        }
+                    }
+                    (_, Status::Fail) => RED,
+                    _ => BLUE,
+                };
+                Some((at(r)?, c))
+            })
             .collect()
     };
     let (pass, fail, error) = (of(Status::Pass), of(Status::Fail), of(Status::Error));
-    let blue = RGBColor(31, 119, 180);
-    let red = RGBColor(214, 39, 40);
+    let (pass_key, fail_key) = match color {
+        Coloring::Outcome => (BLUE, RED),
+        Coloring::Robustness => (RGBColor(90, 90, 90), RGBColor(90, 90, 90)),
+    };
     chart
         .draw_series(
             pass.iter()
-                .map(|&p| Circle::new(p, 3, blue.stroke_width(1))),
+                .map(|&(p, c)| Circle::new(p, 3, c.stroke_width(1))),
         )
         .map_err(|e| e.to_string())?
         .label(format!("pass ({})", pass.len()))
-        .legend(move |p| Circle::new(p, 3, blue.stroke_width(1)));
+        .legend(move |p| Circle::new(p, 3, pass_key.stroke_width(1)));
     chart
-        .draw_series(fail.iter().map(|&p| Cross::new(p, 4, red.stroke_width(2))))
+        .draw_series(
+            fail.iter()
+                .map(|&(p, c)| Cross::new(p, 4, c.stroke_width(2))),
+        )
         .map_err(|e| e.to_string())?
         .label(format!("fail ({})", fail.len()))
-        .legend(move |p| Cross::new(p, 4, red.stroke_width(2)));
+        .legend(move |p| Cross::new(p, 4, fail_key.stroke_width(2)));
     if !error.is_empty() {
         chart
             .draw_series(
                 error
                     .iter()
-                    .map(|&p| TriangleMarker::new(p, 4, BLACK.mix(0.5))),
+                    .map(|&(p, _)| TriangleMarker::new(p, 4, BLACK.mix(0.5))),
             )
             .map_err(|e| e.to_string())?
             .label(format!("error ({})", error.len()))
@@ -143,10 +226,48 @@ fn draw_panel<DB: DrawingBackend>(
     Ok(())
 }
 
+/// The colour bar of [`Coloring::Robustness`]: the scale from `-span` to `+span`.
+fn draw_color_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    span: f64,
+) -> Result<(), String> {
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(50)
+        .margin_bottom(57)
+        .margin_right(8)
+        .y_label_area_size(0)
+        .right_y_label_area_size(52)
+        .build_cartesian_2d(0.0..1.0, -span..span)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc("robustness (smallest over monitors)")
+        .label_style((FAMILY, 12))
+        .axis_desc_style((FAMILY, 13))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    let steps = 60;
+    chart
+        .draw_series((0..steps).map(|k| {
+            let lo = -span + 2.0 * span * k as f64 / steps as f64;
+            let hi = -span + 2.0 * span * (k + 1) as f64 / steps as f64;
+            Rectangle::new(
+                [(0.0, lo), (1.0, hi)],
+                diverging((lo + hi) / 2.0, span).filled(),
+            )
+        }))
+        .map_err(|e| e.to_string())?;
+    Ok(())
+}
+
 /// Draws `panels` side by side (each: title and records) into `stem.png` and `stem.svg`, and
 /// returns the two paths. `axes` names one parameter (a strip plot of it against the outcome,
 /// pass / fail / error, jittered within each band) or two (x and y); a discrete parameter has
-/// a column per level with the points jittered within it. Size: 760 × 600 pixels per panel.
+/// a column per level with the points jittered within it. `color` picks what the points are
+/// coloured by; with [`Coloring::Robustness`] a colour bar is drawn on the right (one scale for
+/// all panels). Size: 760 × 600 pixels per panel, plus 110 for the colour bar.
 ///
 /// # Errors
 /// [`PlotError::NotAnAxis`] when an axis is not a parameter of `space`, [`PlotError::Axes`]
@@ -156,30 +277,66 @@ pub fn failure_map(
     space: &ParamSpace,
     axes: &[String],
     panels: &[(&str, &[RunRecord])],
+    color: Coloring,
 ) -> Result<[PathBuf; 2], PlotError> {
     register_font();
     let (x, y) = scatter_axes(space, axes)?;
-    let size = (760 * panels.len().max(1) as u32, 600);
+    let bar = if color == Coloring::Robustness {
+        110
+    } else {
+        0
+    };
+    let size = (760 * panels.len().max(1) as u32 + bar, 600);
+    let all: Vec<RunRecord> = panels.iter().flat_map(|(_, r)| r.iter().cloned()).collect();
+    let span = robustness_span(&all);
     png_and_svg(
         stem,
         size,
-        |root| render(root, (&x, &y), panels),
-        |root| render(root, (&x, &y), panels),
+        |root| render(root, (&x, &y), panels, color, span, bar),
+        |root| render(root, (&x, &y), panels, color, span, bar),
     )
 }
 
-/// Fills `root` with the panels side by side and writes it out.
+/// Fills `root` with the panels side by side (and the colour bar, `bar` pixels wide) and writes
+/// it out.
 fn render<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     axes: (&Axis, &Axis),
     panels: &[(&str, &[RunRecord])],
+    color: Coloring,
+    span: f64,
+    bar: u32,
 ) -> Result<(), String> {
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let areas = root.split_evenly((1, panels.len().max(1)));
+    let (w, _) = root.dim_in_pixel();
+    let (maps, scale) = root.split_horizontally(w - bar);
+    let areas = maps.split_evenly((1, panels.len().max(1)));
     for (area, (title, records)) in areas.iter().zip(panels) {
-        draw_panel(area, records, axes, title)?;
+        draw_panel(area, records, axes, title, color, span)?;
+    }
+    if bar > 0 {
+        draw_color_bar(&scale, span)?;
     }
     root.present().map_err(|e| e.to_string())
+}
+
+/// Cells along each continuous axis of a failure-rate grid over `axes` for `tests` tests, so
+/// that the cells hold about 5 tests on average: `(tests / (5 L))^(1/c)` rounded, within
+/// `[2, 16]`, where `c` is the number of continuous axes and `L` the product of the discrete
+/// axes' level counts. An unknown axis counts as continuous.
+pub fn adaptive_bins(tests: usize, space: &ParamSpace, axes: &[String]) -> usize {
+    let (mut c, mut levels) = (0i32, 1.0f64);
+    for a in axes {
+        match space.param(a).map(|p| &p.domain) {
+            Some(paracosm_generators::Domain::Levels(l)) => levels *= l.len().max(1) as f64,
+            _ => c += 1,
+        }
+    }
+    if c == 0 {
+        return 2;
+    }
+    let per_axis = (tests as f64 / (5.0 * levels)).powf(1.0 / f64::from(c));
+    (per_axis.round() as usize).clamp(2, 16)
 }
 
 /// Failure counts on a grid over one or two parameters: `cells[row * columns + column]` is
@@ -365,6 +522,7 @@ mod tests {
             &s,
             &names(&["speed", "dist"]),
             &[("t", &records)],
+            Coloring::Outcome,
         )
         .unwrap();
         assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
@@ -393,6 +551,7 @@ mod tests {
             &s,
             &names(&["colour", "speed"]),
             &[("t", &records)],
+            Coloring::Outcome,
         )
         .unwrap();
         let shown = texts(&std::fs::read_to_string(svg).unwrap());
@@ -432,6 +591,7 @@ mod tests {
             &s,
             &names(&["speed"]),
             &[("t", &records)],
+            Coloring::Outcome,
         )
         .unwrap();
         let shown = texts(&std::fs::read_to_string(svg).unwrap());
@@ -486,11 +646,44 @@ mod tests {
     fn an_unknown_axis_or_no_axis_is_an_error_and_writes_nothing() {
         let s = space();
         let dir = tempfile::tempdir().unwrap();
-        let err =
-            failure_map(&dir.path().join("m"), &s, &names(&["speed", "nope"]), &[]).unwrap_err();
+        let err = failure_map(
+            &dir.path().join("m"),
+            &s,
+            &names(&["speed", "nope"]),
+            &[],
+            Coloring::Outcome,
+        )
+        .unwrap_err();
         assert!(matches!(err, PlotError::NotAnAxis(ref n) if n == "nope"));
-        let err = failure_map(&dir.path().join("m"), &s, &[], &[]).unwrap_err();
+        let err = failure_map(&dir.path().join("m"), &s, &[], &[], Coloring::Outcome).unwrap_err();
         assert!(matches!(err, PlotError::Axes(0)));
         assert!(!dir.path().join("m.png").exists());
+    }
+
+    #[test]
+    fn bins_adapt_to_about_five_tests_per_cell_up_to_sixteen() {
+        let s = space();
+        assert_eq!(adaptive_bins(50, &s, &names(&["speed", "dist"])), 3);
+        assert_eq!(adaptive_bins(500, &s, &names(&["speed", "dist"])), 10);
+        assert_eq!(adaptive_bins(100_000, &s, &names(&["speed", "dist"])), 16);
+        assert_eq!(adaptive_bins(4, &s, &names(&["speed"])), 2);
+        // A two-level axis halves the tests per column: 200 / (5 * 2) = 20, capped at 16.
+        assert_eq!(adaptive_bins(200, &s, &names(&["speed", "colour"])), 16);
+        assert_eq!(adaptive_bins(100, &s, &names(&["speed", "colour"])), 10);
+    }
+
+    #[test]
+    fn the_robustness_scale_is_centred_at_zero_and_clipped() {
+        let m = 2.0;
+        assert_eq!(diverging(0.0, m), MID);
+        assert_eq!(diverging(-m, m), RED);
+        assert_eq!(diverging(5.0 * m, m), BLUE);
+        let near = diverging(-0.1, m);
+        assert!(
+            near.0 > near.2 && near.0 < RED.0 + 1,
+            "slightly red: {near:?}"
+        );
+        assert_eq!("robustness".parse::<Coloring>(), Ok(Coloring::Robustness));
+        assert!("blue".parse::<Coloring>().is_err());
     }
 }

@@ -1,22 +1,27 @@
 //! Plots, as PNG and SVG, drawn with `plotters` and a bundled font so that they render on
 //! machines without system fonts: the failure map and the failure-rate heat map over any one
-//! or two parameters, continuous or discrete ([`map`]), contact sheets of camera frames
+//! or two parameters, continuous or discrete ([`map`]), the scatterplot matrix of every
+//! parameter ([`pairs_plot`]), contact sheets of camera frames
 //! ([`sheet`]) and box plots ([`boxes`]).
 
 mod axis;
 mod boxes;
 mod map;
+mod pairs;
 mod sheet;
 
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
+use image::ImageEncoder;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use thiserror::Error;
 
 pub use boxes::{box_plot, BoxPanel};
-pub use map::{failure_map, failure_rate_map, failure_rates, RateGrid};
+pub(crate) use map::robustness_span;
+pub use map::{adaptive_bins, failure_map, failure_rate_map, failure_rates, Coloring, RateGrid};
+pub use pairs::{pairs_plot, MAX_PAIRS};
 pub use sheet::contact_sheet;
 
 /// DejaVu Sans (Bitstream Vera license, see `assets/fonts/LICENSE`), bundled so plots draw on
@@ -74,10 +79,27 @@ fn png_and_svg(
             reason: e.to_string(),
         }
     };
-    crate::atomic::with_temp(&png_path, |tmp| {
-        png(BitMapBackend::new(tmp, size).into_drawing_area())
-    })
-    .map_err(failed(&png_path))?;
+    // Drawn into memory, then encoded with the best compression (plots are mostly flat
+    // colour; this halves a busy pairs plot, which the web report embeds).
+    let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
+    png(BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area()).map_err(|reason| {
+        PlotError::Draw {
+            path: png_path.clone(),
+            reason,
+        }
+    })?;
+    let mut encoded = Vec::new();
+    image::codecs::png::PngEncoder::new_with_quality(
+        &mut encoded,
+        image::codecs::png::CompressionType::Best,
+        image::codecs::png::FilterType::Adaptive,
+    )
+    .write_image(&pixels, size.0, size.1, image::ColorType::Rgb8)
+    .map_err(|e| PlotError::Draw {
+        path: png_path.clone(),
+        reason: e.to_string(),
+    })?;
+    crate::atomic::write(&png_path, &encoded).map_err(failed(&png_path))?;
     crate::atomic::with_temp(&svg_path, |tmp| {
         svg(SVGBackend::new(tmp, size).into_drawing_area())
     })
