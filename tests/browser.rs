@@ -11,12 +11,13 @@ use common::{expect_code, fuzz};
 
 /// Runs `tests/browser/report.test.mjs` on `report` expecting `tests` points; returns what it
 /// printed.
-fn open_in_chromium(report: &Path, tests: usize, screenshot: &Path) -> String {
+fn open_in_chromium(report: &Path, tests: usize, screenshot: &Path, extra: &[&str]) -> String {
     let o = Command::new("node")
         .arg("tests/browser/report.test.mjs")
         .arg(report)
         .arg(tests.to_string())
         .arg(screenshot)
+        .args(extra)
         .output()
         .expect("node runs (scripts/test installs the browser test's packages)");
     let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
@@ -42,7 +43,7 @@ fn the_report_page_loads_offline_draws_every_test_redraws_and_shows_a_replay_com
     expect_code(&o, 1);
     let page = out.join("report.html");
     let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-screenshot.png");
-    let seen = open_in_chromium(&page, 150, &shot);
+    let seen = open_in_chromium(&page, 150, &shot, &[]);
     let seen: serde_json::Value = serde_json::from_str(seen.trim()).unwrap();
     assert_eq!(seen["domPoints"], 150);
     assert_eq!(seen["consoleErrors"].as_array().unwrap().len(), 0);
@@ -67,6 +68,36 @@ fn the_report_page_loads_offline_draws_every_test_redraws_and_shows_a_replay_com
         png.starts_with(b"\x89PNG") && png.len() > 50_000,
         "a screenshot of the page"
     );
+}
+
+#[test]
+fn pages_of_scenarios_without_parameters_with_one_or_with_levels_only_load_and_draw_every_test() {
+    let dir = tempfile::tempdir().unwrap();
+    for (program, budget) in [
+        ("tests/scenarios/no_params.star", 3),
+        ("tests/scenarios/one_param.star", 12),
+        ("tests/scenarios/all_discrete.star", 12),
+    ] {
+        let out = dir
+            .path()
+            .join(budget.to_string() + program.rsplit('/').next().unwrap());
+        let o = fuzz(&[
+            program,
+            "--budget",
+            &budget.to_string(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{program}: {o:?}");
+        let seen = open_in_chromium(
+            &out.join("report.html"),
+            budget,
+            &dir.path().join("shot.png"),
+            &["--load-only"],
+        );
+        let seen: serde_json::Value = serde_json::from_str(seen.trim()).unwrap();
+        assert_eq!(seen["scenePoints"], budget, "{program}");
+    }
 }
 
 #[test]

@@ -1,5 +1,6 @@
 // Opens a campaign's report.html in headless Chromium and checks it as a user would:
-//   node tests/browser/report.test.mjs REPORT_HTML EXPECTED_TESTS SCREENSHOT_PNG
+//   node tests/browser/report.test.mjs REPORT_HTML EXPECTED_TESTS SCREENSHOT_PNG [--load-only]
+// (--load-only: the load, request and point checks, then the screenshot)
 // - the page loads with no console error and no request besides the file itself;
 // - the map draws one point per test;
 // - changing the x-axis menu redraws the map on the new parameter;
@@ -11,7 +12,8 @@ import { chromium } from "playwright-core";
 import { pathToFileURL } from "node:url";
 import path from "node:path";
 
-const [reportPath, expectedArg, screenshot] = process.argv.slice(2);
+const [reportPath, expectedArg, screenshot, mode] = process.argv.slice(2);
+const loadOnly = mode === "--load-only";
 if (!reportPath || !expectedArg || !screenshot) {
   console.error("usage: report.test.mjs REPORT_HTML EXPECTED_TESTS SCREENSHOT_PNG");
   process.exit(2);
@@ -51,6 +53,11 @@ try {
   seen.scenePoints = await page.evaluate(() => window.paracosmReport.pointsDrawn());
   check(seen.domPoints === expected, `points drawn ${seen.domPoints} != tests ${expected}`);
   check(seen.scenePoints === expected, `scene points ${seen.scenePoints} != tests ${expected}`);
+  if (loadOnly) {
+    await page.screenshot({ path: screenshot, fullPage: true });
+    console.log(JSON.stringify(seen));
+    process.exit(0);
+  }
 
   // Changing the x axis redraws on the chosen parameter.
   const axisTitles = () => page.locator("#map g.role-axis-title text").allTextContents();
