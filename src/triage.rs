@@ -341,21 +341,28 @@ pub fn triage(space: &ParamSpace, records: &[RunRecord]) -> Option<Triage> {
     })
 }
 
-/// Fits the tree: Gini, depth [`MAX_DEPTH`], leaves of at least 1 % of the tests (at least 3).
+/// Fits the tree: Gini, depth [`MAX_DEPTH`], leaves of at least 1 % of the tests (at least 3);
+/// `None` when `linfa-trees` fails.
 fn fit(samples: &[Sample], d: usize) -> Option<Tree> {
     let n = samples.len();
     let x = Array2::from_shape_fn((n, d), |(i, j)| samples[i].x[j]);
     let y: Array1<usize> = samples.iter().map(|s| usize::from(s.fail)).collect();
     let data = Dataset::new(x, y);
     let leaf = (n as f32 / 100.0).max(3.0);
-    let model = DecisionTree::params()
-        .split_quality(SplitQuality::Gini)
-        .max_depth(Some(MAX_DEPTH))
-        .min_weight_leaf(leaf)
-        .min_weight_split(2.0 * leaf)
-        .fit(&data)
-        .ok()?;
-    Some(Tree::of(model.root_node()))
+    // The summary must not be lost to the learning library: a panic inside it (it asserts on
+    // its inputs) is no triage, like an error.
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        DecisionTree::params()
+            .split_quality(SplitQuality::Gini)
+            .max_depth(Some(MAX_DEPTH))
+            .min_weight_leaf(leaf)
+            .min_weight_split(2.0 * leaf)
+            .fit(&data)
+            .ok()
+            .map(|model| Tree::of(model.root_node()))
+    }))
+    .ok()
+    .flatten()
 }
 
 /// The rule of a leaf reached by `path`, its bounds merged per parameter.
@@ -536,5 +543,99 @@ mod tests {
         assert_eq!(decimals(3.0), 2);
         assert_eq!(decimals(40.0), 1);
         assert_eq!(decimals(1000.0), 0);
+    }
+
+    /// Whether the test with assignment `a` lies in the rule's region.
+    fn inside(rule: &Rule, a: &paracosm_generators::Assignment) -> bool {
+        rule.conditions.iter().all(|c| match c {
+            Condition::Range { param, lo, hi } => {
+                let v = a.real(param).unwrap();
+                lo.is_none_or(|l| v > l) && hi.is_none_or(|h| v <= h)
+            }
+            Condition::Levels { param, levels } => levels.contains(a.get(param).unwrap()),
+        })
+    }
+
+    #[test]
+    fn each_rule_counts_exactly_the_tests_in_its_region_and_regions_do_not_overlap() {
+        use rand::{Rng, SeedableRng};
+        let space = ParamSpace::new(vec![
+            Param::interval("x", 0.0, 10.0, "m"),
+            Param::interval("y", -5.0, 5.0, "m/s"),
+            Param::levels(
+                "w",
+                vec![
+                    Value::Text("dry".into()),
+                    Value::Text("wet".into()),
+                    Value::Bool(true),
+                ],
+            ),
+        ])
+        .unwrap();
+        for seed in 0..5u64 {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let records: Vec<RunRecord> = (0..400)
+                .map(|id| {
+                    let point = paracosm_generators::Point {
+                        discrete: vec![rng.random_range(0..3)],
+                        continuous: vec![rng.random::<f64>(), rng.random::<f64>()],
+                    };
+                    let a = space.decode(&point).unwrap();
+                    let (x, y) = (a.real("x").unwrap(), a.real("y").unwrap());
+                    // A noisy region: mostly x > 6 with y < 1, or the third level.
+                    let fail = (x > 6.0 && y < 1.0) || (point.discrete[0] == 2 && x < 3.0);
+                    let flip = rng.random::<f64>() < 0.05;
+                    let status = match (fail != flip, id % 50 == 7) {
+                        (_, true) => Status::Error,
+                        (true, _) => Status::Fail,
+                        (false, _) => Status::Pass,
+                    };
+                    RunRecord {
+                        id,
+                        seed: 0,
+                        strategy: "random".into(),
+                        params: Some(a),
+                        point,
+                        status,
+                        monitors: vec![],
+                        metrics: vec![],
+                        error: None,
+                        log: Vec::new(),
+                        wall_ms: 0.0,
+                    }
+                })
+                .collect();
+            let t = triage(&space, &records).unwrap();
+            let judged: Vec<&RunRecord> = records
+                .iter()
+                .filter(|r| r.status != Status::Error)
+                .collect();
+            assert_eq!(t.tests as usize, judged.len());
+            assert!(!t.rules.is_empty());
+            for r in &t.rules {
+                let inside: Vec<&&RunRecord> = judged
+                    .iter()
+                    .filter(|rec| inside(r, rec.params.as_ref().unwrap()))
+                    .collect();
+                assert_eq!(inside.len() as u64, r.tests, "{}", r.text);
+                let failed = inside
+                    .iter()
+                    .filter(|rec| rec.status == Status::Fail)
+                    .count();
+                assert_eq!(failed as u64, r.failed, "{}", r.text);
+                assert!(2 * r.failed > r.tests, "a majority failed: {}", r.text);
+            }
+            for (i, a) in t.rules.iter().enumerate() {
+                for b in &t.rules[i + 1..] {
+                    let both = judged.iter().any(|rec| {
+                        let p = rec.params.as_ref().unwrap();
+                        inside(a, p) && inside(b, p)
+                    });
+                    assert!(!both, "{} overlaps {}", a.text, b.text);
+                }
+            }
+            let sum: f64 = t.ranking.iter().map(|r| r.importance).sum();
+            assert!((sum - 1.0).abs() < 1e-9);
+        }
     }
 }
