@@ -39,6 +39,9 @@ pub struct Campaign<'a> {
     /// End the campaign at the first failed test (robustness `<= 0`): no new test starts, the
     /// tests in flight finish and are written.
     pub stop_at_first_failure: bool,
+    /// The points of [`Strategy::Points`], in test order (`budget` of them at least); `None`
+    /// for every other strategy, which makes its own.
+    pub points: Option<&'a [Point]>,
 }
 
 /// What a finished campaign reports.
@@ -78,6 +81,15 @@ impl Campaign<'_> {
 
     /// The campaign's generator, fresh.
     fn generator(&self) -> Result<Box<dyn paracosm_generators::Generator>, Error> {
+        if self.strategy == Strategy::Points {
+            let points = self
+                .points
+                .ok_or(paracosm_generators::GeneratorError::NeedsPoints)?;
+            return Ok(Strategy::build_given(
+                &self.scenario.space,
+                points.to_vec(),
+            )?);
+        }
         Ok(self.strategy.build_sized(
             &self.scenario.space,
             self.seed,
@@ -521,6 +533,7 @@ mod tests {
             strength: 2,
             jobs,
             stop_at_first_failure: false,
+            points: None,
         }
     }
 

@@ -149,6 +149,31 @@ pub struct Settings {
     pub strength: usize,
     /// The shard this folder runs, `None` for the whole campaign.
     pub shard: Option<Shard>,
+    /// The points file of strategy `points` (`--points`), `None` for the others.
+    pub points: Option<PointsFile>,
+}
+
+/// The file a `points` campaign takes its tests from: where it was and what it held. Its
+/// hash enters the fingerprint, so `--resume` and `merge` refuse a changed file.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PointsFile {
+    /// The file's absolute path when the campaign started.
+    pub path: String,
+    /// SHA-256 (hex) of its bytes.
+    pub sha256: String,
+}
+
+impl PointsFile {
+    /// `path`'s absolute path and the hash of `bytes`, its contents.
+    pub fn of(path: &Path, bytes: &[u8]) -> PointsFile {
+        PointsFile {
+            path: std::fs::canonicalize(path)
+                .unwrap_or_else(|_| path.to_path_buf())
+                .display()
+                .to_string(),
+            sha256: sha256_hex(bytes),
+        }
+    }
 }
 
 /// The contents of `campaign.json`: everything needed to rebuild any test of the campaign.
@@ -176,6 +201,9 @@ pub struct CampaignFile {
     pub shard: Option<Shard>,
     /// The scenario's open parameters.
     pub space: Vec<Param>,
+    /// [`Settings::points`] (left out of the file for the other strategies).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<PointsFile>,
 }
 
 impl CampaignFile {
@@ -188,6 +216,7 @@ impl CampaignFile {
             budget: self.budget,
             strength: self.strength,
             shard: self.shard,
+            points: self.points.clone(),
         }
     }
 }
@@ -203,6 +232,9 @@ struct Fingerprinted<'a> {
     seed: u64,
     budget: u64,
     strength: usize,
+    /// Only for `points` campaigns, so the fingerprints of the others stay as they were.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    points_sha256: Option<&'a str>,
 }
 
 fn sha256_hex(bytes: &[u8]) -> String {
@@ -227,6 +259,7 @@ impl CampaignFile {
             budget,
             strength,
             shard,
+            points,
         } = settings;
         let strategy = strategy.as_str();
         let space = scenario.space.params().to_vec();
@@ -240,6 +273,7 @@ impl CampaignFile {
                 seed,
                 budget,
                 strength,
+                points_sha256: points.as_ref().map(|p| p.sha256.as_str()),
             };
             sha256_hex(&serde_json::to_vec(&f).expect("settings serialise"))
         };
@@ -258,6 +292,7 @@ impl CampaignFile {
             strength,
             shard,
             space,
+            points,
         }
     }
 
@@ -291,6 +326,12 @@ impl CampaignFile {
         );
         let shard = |s: &Option<Shard>| s.map_or("none".to_owned(), |s| s.to_string());
         cmp("shard", shard(&self.shard), shard(&other.shard));
+        // The hash, not the path: shards may read copies of one file on other machines.
+        let points = |p: &Option<PointsFile>| {
+            p.as_ref()
+                .map_or("none".to_owned(), |p| format!("sha256 {}", p.sha256))
+        };
+        cmp("points file", points(&self.points), points(&other.points));
         if self.space != other.space {
             out.push("parameter space differs".into());
         }
@@ -355,6 +396,7 @@ mod tests {
     fn the_fingerprint_covers_the_settings_and_the_program_text() {
         let s = paracosm_scenarios::builtin("pedestrian-crossing").unwrap();
         let settings = |seed, shard| Settings {
+            points: None,
             sut: SutChoice::Scenario,
             strategy: "halton".into(),
             seed,

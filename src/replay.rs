@@ -127,6 +127,7 @@ pub fn replay(
         strength: campaign_file.strength,
         jobs: 1,
         stop_at_first_failure: false,
+        points: None,
     };
     if let Some(dir) = frames {
         std::fs::create_dir_all(dir)

@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use paracosm_engine::sut::SutConfig;
-use paracosm_generators::Strategy;
+use paracosm_generators::{GeneratorError, Point, Strategy};
 use paracosm_scenarios::Scenario;
 
 use crate::campaign::{Campaign, CampaignReport, Observer, ResultsFile, RESULTS_FILE};
-use crate::campaign_file::{CampaignFile, Settings, Shard, SutChoice, CAMPAIGN_FILE};
+use crate::campaign_file::{CampaignFile, PointsFile, Settings, Shard, SutChoice, CAMPAIGN_FILE};
 use crate::record::RunRecord;
 use crate::report::{warnings_of, write_outputs, Finished};
 use crate::summary::Summary;
@@ -50,6 +50,10 @@ pub struct Request {
     pub deny_warnings: bool,
     /// Also write JUnit XML here.
     pub junit: Option<PathBuf>,
+    /// Run the tests of this file (`--points`): a CSV with a header naming the parameters,
+    /// values in their units (levels as written), one test per row in file order, or the
+    /// `results.jsonl` of another campaign. Strategy `points`; the budget is the row count.
+    pub points: Option<PathBuf>,
 }
 
 impl Request {
@@ -70,6 +74,7 @@ impl Request {
             stop_at_first_failure: false,
             deny_warnings: false,
             junit: None,
+            points: None,
         }
     }
 }
@@ -208,7 +213,7 @@ pub fn run(
     } else {
         None
     };
-    let (file, scenario) = settings(request, stored.as_ref())?;
+    let (file, scenario, points) = settings(request, stored.as_ref())?;
     let warnings = warnings_of(&scenario);
     let strategy = refusals(request, &file, &warnings)?;
     let jobs = request.jobs.unwrap_or_else(|| {
@@ -244,6 +249,7 @@ pub fn run(
         strength: file.strength,
         jobs,
         stop_at_first_failure: request.stop_at_first_failure,
+        points: points.as_deref(),
     };
     let mut written = None;
     let junit_path = request.junit.as_deref();
@@ -409,7 +415,7 @@ impl<F: FnMut(&[RunRecord], &CampaignReport) -> Result<(), Error>> Observer for 
 fn settings(
     request: &Request,
     stored: Option<&CampaignFile>,
-) -> Result<(CampaignFile, Scenario), Error> {
+) -> Result<(CampaignFile, Scenario, Option<Vec<Point>>), Error> {
     let refuse = |diffs: Vec<String>| {
         Error::BadInput(format!(
             "refusing to resume: `{}` holds a campaign with other settings ({}); resume without \
@@ -430,21 +436,37 @@ fn settings(
         (Some(name), _) => {
             let choice = SutChoice::of(sut);
             let scenario = load(name, &choice)?;
+            let given = match &request.points {
+                Some(path) => Some(read_points(path, request, &scenario)?),
+                None if request.strategy == Some(Strategy::Points) => {
+                    return Err(Error::Generator(GeneratorError::NeedsPoints))
+                }
+                None => None,
+            };
             let file = CampaignFile::new(
                 name,
                 &scenario,
                 Settings {
                     sut: choice,
-                    strategy: request.strategy.unwrap_or(Strategy::Halton).name().into(),
+                    strategy: match given {
+                        Some(_) => Strategy::Points,
+                        None => request.strategy.unwrap_or(Strategy::Halton),
+                    }
+                    .name()
+                    .into(),
                     seed: request.seed.unwrap_or(0),
-                    budget: request.budget.unwrap_or(100),
+                    budget: match &given {
+                        Some((_, points)) => points.len() as u64,
+                        None => request.budget.unwrap_or(100),
+                    },
                     strength: request.strength.unwrap_or(2),
                     shard: request.shard,
+                    points: given.as_ref().map(|(f, _)| f.clone()),
                 },
             );
             match stored.map(|st| st.differences(&file)) {
                 Some(diffs) if !diffs.is_empty() => Err(refuse(diffs)),
-                _ => Ok((file, scenario)),
+                _ => Ok((file, scenario, given.map(|(_, p)| p))),
             }
         }
         (None, Some(st)) => {
@@ -495,13 +517,60 @@ fn settings(
                     st.scenario
                 )]));
             }
-            Ok((st.clone(), scenario))
+            let points = match &st.points {
+                Some(stored_file) => {
+                    let path = Path::new(&stored_file.path);
+                    let (now, points) = read_points(path, request, &scenario)?;
+                    if now.sha256 != stored_file.sha256 {
+                        return Err(refuse(vec![format!(
+                            "the points file `{}` changed since the campaign started",
+                            stored_file.path
+                        )]));
+                    }
+                    Some(points)
+                }
+                None => None,
+            };
+            Ok((st.clone(), scenario, points))
         }
         (None, None) => Err(Error::BadInput(format!(
             "--resume without SCENARIO needs a campaign in `{}`, which has no {CAMPAIGN_FILE}",
             request.out.display()
         ))),
     }
+}
+
+/// The tests of a `--points` file, read against the scenario's space, with the file's hash.
+/// Refuses `--strategy` other than `points` and a `--budget` other than the row count.
+fn read_points(
+    path: &Path,
+    request: &Request,
+    scenario: &Scenario,
+) -> Result<(PointsFile, Vec<Point>), Error> {
+    if let Some(s) = request.strategy.filter(|&s| s != Strategy::Points) {
+        return Err(Error::BadInput(format!(
+            "--points chooses the tests, so --strategy {s} cannot be used with it"
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(|e| Error::input(path, e))?;
+    let text = String::from_utf8(bytes.clone())
+        .map_err(|e| Error::malformed(path, format!("{}: not UTF-8 text: {e}", path.display())))?;
+    let is_jsonl = path.extension().is_some_and(|e| e == "jsonl");
+    let set = crate::cover::parse_tests(
+        &path.display().to_string(),
+        &text,
+        is_jsonl,
+        Some(&scenario.space),
+    )
+    .map_err(|e| Error::malformed(path, e.to_string()))?;
+    if let Some(b) = request.budget.filter(|&b| b != set.points.len() as u64) {
+        return Err(Error::BadInput(format!(
+            "--budget {b} differs from the {} tests of --points `{}`; leave --budget out",
+            set.points.len(),
+            path.display()
+        )));
+    }
+    Ok((PointsFile::of(path, &bytes), set.points))
 }
 
 /// Creates `out`; refuses a non-empty folder unless `replace` or `resume`, and a folder that

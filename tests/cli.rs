@@ -587,6 +587,7 @@ fn pedestrian_crossing_star_reproduces_the_rust_study_byte_for_byte() {
         strength: 2,
         jobs: 2,
         stop_at_first_failure: false,
+        points: None,
     };
     let out = dir.path().join("rust");
     campaign.run(&out, |_| {}).unwrap();

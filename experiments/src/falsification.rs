@@ -142,6 +142,7 @@ pub fn falsification_study(settings: &StudySettings<'_>, out: &Path) -> Result<S
                     strength: 2,
                     jobs: settings.jobs,
                     stop_at_first_failure: true,
+                    points: None,
                 };
                 let run_dir = dir
                     .join("runs")

@@ -54,6 +54,7 @@ pub fn figure9(budget: u64, seed: u64, jobs: usize, out: &Path) -> Result<Figure
             strength: 2,
             jobs,
             stop_at_first_failure: false,
+            points: None,
         };
         let report = campaign.run(&dir.join(strategy.name()), |_| {})?;
         let title = format!(

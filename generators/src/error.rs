@@ -33,6 +33,9 @@ pub enum GeneratorError {
     /// A covering-suite strategy was built without a budget ([`crate::Strategy::build_sized`]).
     #[error("strategy `{0}` needs a budget and a strength")]
     NeedsBudget(&'static str),
+    /// [`crate::Strategy::Points`] was built without its points ([`crate::Strategy::build_given`]).
+    #[error("strategy `points` takes its points from a file: give --points FILE")]
+    NeedsPoints,
     /// The covering array of a suite cannot be built.
     #[error("covering array: {0}")]
     Covering(String),

@@ -19,6 +19,7 @@ pub mod covering;
 mod error;
 pub mod falsify;
 mod generator;
+mod given;
 mod halton;
 mod point;
 mod random;
@@ -28,6 +29,7 @@ mod strategy;
 
 pub use error::GeneratorError;
 pub use generator::Generator;
+pub use given::GivenPoints;
 pub use halton::{first_primes, radical_inverse, Halton};
 pub use point::Point;
 pub use random::UniformRandom;

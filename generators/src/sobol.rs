@@ -60,6 +60,39 @@ impl Sobol {
     }
 }
 
+impl Sobol {
+    /// Points `start..start + n` of the unit cube as an `n × d` row-major matrix in `[0, 1)`
+    /// (`d` = every parameter of the space, level indices not applied): the layout of
+    /// `scipy.stats.qmc.Sobol.random`. Computed in parallel, the same on any thread count.
+    ///
+    /// # Errors
+    /// [`GeneratorError::CapacityExceeded`] when `start + n` passes [`SOBOL_MAX_POINTS`].
+    pub fn unit_points(&self, start: u64, n: usize) -> Result<Vec<f64>, GeneratorError> {
+        use rayon::prelude::*;
+        let end = start.saturating_add(n as u64);
+        if end > SOBOL_MAX_POINTS {
+            return Err(GeneratorError::CapacityExceeded {
+                generator: "sobol",
+                what: "points",
+                limit: SOBOL_MAX_POINTS,
+                requested: end,
+            });
+        }
+        let d = self.levels.len();
+        let mut out = vec![0.0; n * d];
+        if d == 0 {
+            return Ok(out);
+        }
+        out.par_chunks_mut(d).enumerate().for_each(|(r, row)| {
+            let j = (start + r as u64) as u32;
+            for (dim, slot) in row.iter_mut().enumerate() {
+                *slot = f64::from(sobol_burley::sample(j, dim as u32, self.seed));
+            }
+        });
+        Ok(out)
+    }
+}
+
 impl Generator for Sobol {
     fn name(&self) -> &'static str {
         "sobol"
@@ -103,6 +136,20 @@ mod tests {
         [0.6825801134109497, 0.7782303094863892],
         [0.022617220878601074, 0.10112440586090088],
     ];
+
+    #[test]
+    fn unit_points_are_the_points_of_the_sequence() {
+        let s = Sobol::new(&space(3), 9).unwrap();
+        let m = s.unit_points(5, 20).unwrap();
+        for r in 0..20 {
+            assert_eq!(
+                m[r * 3..r * 3 + 3],
+                s.point(5 + r as u64).unwrap().continuous[..]
+            );
+        }
+        assert!(s.unit_points(SOBOL_MAX_POINTS - 2, 3).is_err());
+        assert_eq!(s.unit_points(SOBOL_MAX_POINTS - 2, 2).unwrap().len(), 6);
+    }
 
     #[test]
     fn more_than_two_to_the_sixteen_points_is_an_error_not_a_wrap() {

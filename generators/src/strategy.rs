@@ -1,7 +1,7 @@
 use std::str::FromStr;
 
 use crate::falsify::{Falsifier, Method};
-use crate::{Generator, GeneratorError, Halton, ParamSpace, Sobol, UniformRandom};
+use crate::{Generator, GeneratorError, GivenPoints, Halton, ParamSpace, Sobol, UniformRandom};
 
 /// The test-generation strategies by name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -27,6 +27,9 @@ pub enum Strategy {
     FalsifySa,
     /// [`Falsifier`] with the cross-entropy method.
     FalsifyCe,
+    /// [`GivenPoints`]: points chosen outside paracosm (`paracosm-fuzz --points FILE`, an
+    /// array from Python), in their order; built by [`Strategy::build_given`].
+    Points,
 }
 
 impl Strategy {
@@ -45,7 +48,7 @@ impl Strategy {
 
     /// Every strategy, in the order the command line lists them: the one list from which
     /// names, help, parsing and error messages are derived.
-    pub const LIST: [Strategy; 10] = [
+    pub const LIST: [Strategy; 11] = [
         Strategy::Random,
         Strategy::Halton,
         Strategy::ScrambledHalton,
@@ -56,6 +59,7 @@ impl Strategy {
         Strategy::FalsifyPso,
         Strategy::FalsifySa,
         Strategy::FalsifyCe,
+        Strategy::Points,
     ];
 
     /// Every point generator that needs no budget, in the order the CLI lists them.
@@ -79,6 +83,7 @@ impl Strategy {
             Strategy::FalsifyPso => "falsify-pso",
             Strategy::FalsifySa => "falsify-sa",
             Strategy::FalsifyCe => "falsify-ce",
+            Strategy::Points => "points",
         }
     }
 
@@ -110,6 +115,10 @@ impl Strategy {
                 "Falsification: simulated annealing minimising robustness (argmin)"
             }
             Strategy::FalsifyCe => "Falsification: the cross-entropy method minimising robustness",
+            Strategy::Points => {
+                "The points of a CSV file, in file order (chosen by --points FILE, which sets \
+                 the budget to the file's row count)"
+            }
         }
     }
 
@@ -141,7 +150,8 @@ impl Strategy {
             | Strategy::FalsifyNm
             | Strategy::FalsifyPso
             | Strategy::FalsifySa
-            | Strategy::FalsifyCe => None,
+            | Strategy::FalsifyCe
+            | Strategy::Points => None,
         }
     }
 
@@ -151,7 +161,8 @@ impl Strategy {
     /// [`GeneratorError::CapacityExceeded`] when the space has more dimensions than the
     /// strategy supports; [`GeneratorError::Covering`] for a falsifier over a space without
     /// continuous parameters; [`GeneratorError::NeedsBudget`] for the covering suites, which are
-    /// built by [`Strategy::build_sized`].
+    /// built by [`Strategy::build_sized`]; [`GeneratorError::NeedsPoints`] for
+    /// [`Strategy::Points`], built by [`Strategy::build_given`].
     pub fn build(
         self,
         space: &ParamSpace,
@@ -165,6 +176,7 @@ impl Strategy {
             Strategy::Ipog | Strategy::KWise => {
                 return Err(GeneratorError::NeedsBudget(self.name()))
             }
+            Strategy::Points => return Err(GeneratorError::NeedsPoints),
             Strategy::FalsifyNm
             | Strategy::FalsifyPso
             | Strategy::FalsifySa
@@ -208,6 +220,19 @@ impl Strategy {
     }
 }
 
+impl Strategy {
+    /// The generator of [`Strategy::Points`]: `points`, in their order.
+    ///
+    /// # Errors
+    /// As [`GivenPoints::new`].
+    pub fn build_given(
+        space: &ParamSpace,
+        points: Vec<crate::Point>,
+    ) -> Result<Box<dyn Generator>, GeneratorError> {
+        Ok(Box::new(GivenPoints::new(space, points)?))
+    }
+}
+
 impl FromStr for Strategy {
     type Err = GeneratorError;
 
@@ -243,13 +268,14 @@ mod tests {
         {
             assert!(Strategy::LIST.contains(&s));
         }
+        // ... and with the given points, the whole list.
         assert_eq!(
-            Strategy::ALL.len() + Strategy::SUITES.len() + Strategy::FALSIFIERS.len(),
+            Strategy::ALL.len() + Strategy::SUITES.len() + Strategy::FALSIFIERS.len() + 1,
             Strategy::LIST.len()
         );
         assert_eq!(
             "annealing".parse::<Strategy>().unwrap_err().to_string(),
-            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise, falsify-nm, falsify-pso, falsify-sa, falsify-ce)"
+            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise, falsify-nm, falsify-pso, falsify-sa, falsify-ce, points)"
         );
     }
 }

@@ -83,6 +83,11 @@ struct Cli {
     /// verdicts, parameters and replay command.
     #[arg(long, value_name = "FILE")]
     junit: Option<PathBuf>,
+    /// Run the tests of FILE instead of generating them (strategy `points`): a CSV with a
+    /// header naming the parameters, values in their units (levels as written), one test per
+    /// row in order; or another campaign's results.jsonl. The budget is the row count.
+    #[arg(long, value_name = "FILE")]
+    points: Option<PathBuf>,
     /// Refuse to run (exit 2) when the scenario loads with warnings: no monitor, an open
     /// parameter no object reads or that cannot affect the ego (LANGUAGE.md, "Warnings").
     /// For CI.
@@ -284,6 +289,7 @@ impl Cli {
             stop_at_first_failure: self.stop_at_first_failure,
             deny_warnings: self.deny_warnings,
             junit: self.junit.clone(),
+            points: self.points.clone(),
         })
     }
 }

@@ -74,7 +74,7 @@ pub fn parse_tests(
     if text.trim().is_empty() {
         return Err(err(None, None, "the file is empty".into()));
     }
-    let (names, rows) = if is_jsonl {
+    let (names, positions, rows) = if is_jsonl {
         jsonl_rows(text, space, &err)?
     } else {
         csv_rows(text, space, &err)?
@@ -93,7 +93,7 @@ pub fn parse_tests(
     for (line, cells) in rows {
         let mut p = Point::default();
         for (j, (param, cell)) in space.params().iter().zip(&cells).enumerate() {
-            let col = Some((j + 1, param.name.clone()));
+            let col = Some((positions[j], param.name.clone()));
             match &param.domain {
                 Domain::Interval { lo, hi } => {
                     let v = match cell {
@@ -156,7 +156,9 @@ enum Cell {
     Text(String),
 }
 
-type Rows = (Vec<String>, Vec<(u64, Vec<Cell>)>);
+/// The parameters' names, the file column (from 1) each is read from, and the rows of cells
+/// in that order with their line numbers.
+type Rows = (Vec<String>, Vec<usize>, Vec<(u64, Vec<Cell>)>);
 
 fn csv_rows(
     text: &str,
@@ -215,7 +217,8 @@ fn csv_rows(
         }
         rows.push((line, cells));
     }
-    Ok((names, rows))
+    let positions = columns.iter().map(|c| c + 1).collect();
+    Ok((names, positions, rows))
 }
 
 /// The keys of a `results.jsonl` line.
@@ -302,7 +305,8 @@ fn jsonl_rows(
     if let Some(s) = space {
         names = s.params().iter().map(|p| p.name.clone()).collect();
     }
-    Ok((names, rows))
+    let positions = (1..=names.len()).collect();
+    Ok((names, positions, rows))
 }
 
 #[cfg(test)]

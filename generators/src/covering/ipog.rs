@@ -537,6 +537,24 @@ mod tests {
     }
 
     #[test]
+    fn constraints_that_forbid_every_row_are_refused_by_every_algorithm() {
+        use crate::covering::{random_kwise_with, random_until_covered_with, Constraints};
+        let none_left = Constraints::new(vec![vec![(0, 0)], vec![(0, 1)]]);
+        let levels = [2, 3];
+        let errs = [
+            ipog_with(&levels, 2, &none_left, &[]).unwrap_err(),
+            random_kwise_with(&levels, 2, 0.01, 1, &none_left, &[]).unwrap_err(),
+            random_until_covered_with(&levels, 2, 1, 1000, &none_left, &[]).unwrap_err(),
+        ];
+        for e in errs {
+            assert_eq!(e, CoveringError::Unsatisfiable);
+        }
+        // One level left is enough.
+        let one_left = Constraints::new(vec![vec![(0, 0)]]);
+        assert!(ipog_with(&levels, 2, &one_left, &[]).unwrap().len() == 3);
+    }
+
+    #[test]
     fn small_binary_arrays_are_near_optimal() {
         // CA(t = 2, k = 4, v = 2) has optimum 5; CA(2, 10, 2) has optimum 6.
         let a = ipog(&[2; 4], 2).unwrap();

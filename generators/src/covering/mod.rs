@@ -53,6 +53,9 @@ pub enum CoveringError {
         /// What is wrong.
         reason: String,
     },
+    /// The constraints forbid every row.
+    #[error("the constraints forbid every row: no test can be built")]
+    Unsatisfiable,
     /// A random array hit its row limit before covering every tuple.
     #[error("{rows} random rows did not cover every {t}-tuple")]
     NotCovered {
@@ -126,6 +129,14 @@ pub(crate) fn check_seeds(
                 });
             }
         }
+    }
+    if !constraints.is_empty()
+        && constraints
+            .complete(levels, &vec![constraints::OPEN; k])
+            .is_none()
+    {
+        // An empty array would cover every (zero) allowed tuple: a silent non-answer.
+        return Err(CoveringError::Unsatisfiable);
     }
     seeds
         .iter()

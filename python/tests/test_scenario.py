@@ -1,0 +1,257 @@
+"""paracosm.Scenario: the space, runs equal to paracosm-fuzz's, robustness for optimisers,
+threads, and its argument checks."""
+
+import json
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import paracosm
+from paracosm.scenario import points_csv
+
+
+def without_wall(line: str) -> dict:
+    record = json.loads(line)
+    record.pop("wall_ms")
+    return record
+
+
+def test_the_space_of_a_builtin_scenario():
+    s = paracosm.Scenario("follow-lead-car")
+    assert s.space.names == ["lead_color", "oncoming", "lead_speed", "brake_at", "decel", "friction"]
+    assert s.space.kinds == ["levels", "levels", "interval", "interval", "interval", "interval"]
+    assert s.space.levels[:2] == [["red", "white"], [True, False]]
+    assert s.space.bounds[2] == (5.0, 15.0) and s.space.units[2] == "m/s"
+    assert s.space["decel"].unit == "m/s^2"
+    assert len(s.space) == s.space.d == 6
+    assert s.monitors == ["collision", "distance", "offroad"]
+    assert s.horizon_s == 20.0
+    assert "pedestrian-crossing" in paracosm.BUILTIN_SCENARIOS
+
+
+def test_run_writes_what_paracosm_fuzz_writes_for_the_same_points(tmp_path, paracosm_fuzz):
+    s = paracosm.Scenario("follow-lead-car")
+    x = paracosm.qmc.Halton(len(s.space), scramble=True, rng=4).random(12)
+    points = s.space.to_units(x)
+    csv_path = tmp_path / "points.csv"
+    csv_path.write_text(points_csv(points, s.space))
+    out = tmp_path / "cli"
+    done = subprocess.run(
+        [paracosm_fuzz, "follow-lead-car", "--points", csv_path, "--seed", "3", "--out", out, "--jobs", "2"],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode in (0, 1), done.stderr
+    cli = (out / "results.jsonl").read_text().splitlines()
+    ours = s.run(points, seed=3, output="jsonl")
+    assert len(cli) == len(ours) == 12
+    assert [without_wall(line) for line in ours] == [without_wall(line) for line in cli]
+    # Byte for byte, apart from the wall-clock time at the end of each line.
+    strip = lambda line: line[: line.rindex(',"wall_ms"')]
+    assert [strip(a) for a in ours] == [strip(b) for b in cli]
+    assert all(json.loads(line)["strategy"] == "points" for line in ours)
+    # The same points as a DataFrame in units give the same records.
+    frame_lines = s.run(pd.DataFrame(points), seed=3, output="jsonl")
+    assert [strip(a) for a in frame_lines] == [strip(b) for b in cli]
+
+
+def test_unit_points_are_the_records_points(box_program):
+    s = paracosm.Scenario(box_program)
+    x = np.array([[0.25, 0.5, 0.1, 0.0], [0.75, 0.2, 0.9, 0.999], [1.0, 1.0, 1.0, 1.0]])
+    records = s.run(x, output="records")
+    assert [r["point"]["continuous"] for r in records[:2]] == [[0.25, 0.5, 0.1], [0.75, 0.2, 0.9]]
+    assert [r["point"]["discrete"] for r in records] == [[0], [2], [2]]
+    assert records[0]["params"] == {"a": 2.5, "b": 5.0, "c": 1.0, "d": "dry"}
+    # 1 is the upper end of each interval (the largest value below it).
+    assert records[2]["params"]["a"] == pytest.approx(10.0) and records[2]["params"]["a"] < 10.0
+
+
+def test_the_frame_has_params_verdicts_and_metrics(box_program):
+    s = paracosm.Scenario(box_program)
+    x = paracosm.qmc.Halton(4).random(40)
+    df = s.run(x, seed=1)
+    assert isinstance(df, pd.DataFrame) and len(df) == 40
+    for col in ["id", "seed", "status", "a", "b", "c", "d", "robustness", "outside.robustness", "outside.passed", "error", "wall_ms"]:
+        assert col in df.columns, col
+    assert list(df["id"]) == list(range(40))
+    inside = (df["a"] >= 2) & (df["a"] < 6) & (df["b"] >= 3) & (df["b"] < 8)
+    assert inside.any() and (~inside).any()
+    assert ((df["status"] == "fail") == inside).all()
+    assert ((df["robustness"] <= 0) == inside).all()
+    rows = s.run(x, seed=1, output="records")
+    assert [r["status"] for r in rows] == list(df["status"])
+
+
+def test_results_do_not_depend_on_jobs(box_program):
+    s = paracosm.Scenario(box_program)
+    x = paracosm.qmc.Halton(4).random(30)
+    one = [without_wall(line) for line in s.run(x, jobs=1, seed=9, output="jsonl")]
+    two = [without_wall(line) for line in s.run(x, jobs=2, seed=9, output="jsonl")]
+    assert one == two
+
+
+def test_robustness_of_one_point_for_optimisers(box_program):
+    s = paracosm.Scenario(box_program)
+    # Inside the box, a = 4 m and b = 5 m/s are 2 from its nearest faces: robustness -2.
+    inside = s.robustness([0.4, 0.5, 0.3, 0.5])
+    assert inside == pytest.approx(-2.0)
+    outside = s.robustness({"a": 9.0, "b": 5.0, "c": 1.0, "d": "icy"})
+    (record,) = s.run([{"a": 9.0, "b": 5.0, "c": 1.0, "d": "icy"}], output="records")
+    # 3 m outside the box. The implicit `offroad` monitor (ego to the road's edge, 1.75 m)
+    # is lower, but passive: it counts only when it fails, as in paracosm's falsifiers.
+    assert s.passive_monitors == ["offroad"]
+    assert record["monitors"]["outside"]["robustness"] == pytest.approx(3.0)
+    assert record["monitors"]["offroad"]["robustness"] == pytest.approx(1.75)
+    assert outside == pytest.approx(3.0)
+    df = s.run(np.array([[0.4, 0.5, 0.3, 0.5]]))
+    assert df["robustness"][0] == pytest.approx(inside)
+    with pytest.raises(ValueError, match="one point"):
+        s.robustness(np.zeros((2, 4)))
+
+
+def test_a_test_that_ends_in_error_is_never_a_number_by_accident(tmp_path):
+    program = tmp_path / "breaks.star"
+    program.write_text(
+        'a = VarInterval(0, 10, unit = "m")\n'
+        "w = World(light = 0.5, fog = 0.0)\n"
+        "r = RoadSegment(len = 100.0, nlanes = 2)\n"
+        "v = AutonomousVehicle(loc = r.onLane(1, 10))\n"
+        "w.place(r, v)\n"
+        "def f(t):\n"
+        "    return 1 // (a - a) if a > 5 else 1.0\n"
+        'm = Monitor(tick.map(lambda t: f(t)), unit = "m", over = "end")\n'
+        "test(horizon = 0.1)\n"
+    )
+    s = paracosm.Scenario(program)
+    assert s.robustness([0.1]) == pytest.approx(1.0)
+    with pytest.raises(paracosm.TestError, match="error") as e:
+        s.robustness([0.9])
+    assert e.value.record["status"] == "error"
+    assert np.isnan(s.robustness([0.9], on_error="nan"))
+    df = s.run(np.array([[0.9]]))
+    assert df["status"][0] == "error" and np.isnan(df["robustness"][0]) and df["error"][0]
+
+
+def test_two_threads_run_scenarios_at_once(box_program):
+    a = paracosm.Scenario(box_program)
+    b = paracosm.Scenario("pedestrian-crossing")
+    xa = paracosm.qmc.Halton(4).random(200)
+    xb = paracosm.qmc.Halton(len(b.space)).random(16)
+    alone_a = [without_wall(line) for line in a.run(xa, jobs=1, output="jsonl")]
+    alone_b = [without_wall(line) for line in b.run(xb, jobs=1, output="jsonl")]
+    got = {}
+
+    def run(key, s, x):
+        got[key] = [without_wall(line) for line in s.run(x, jobs=1, output="jsonl")]
+
+    threads = [
+        threading.Thread(target=run, args=("a", a, xa)),
+        threading.Thread(target=run, args=("b", b, xb)),
+        threading.Thread(target=run, args=("b2", b, xb)),
+    ]
+    ticks = 0
+    t0 = time.perf_counter()
+    for t in threads:
+        t.start()
+    while any(t.is_alive() for t in threads):
+        ticks += 1
+        time.sleep(0.001)
+    elapsed = time.perf_counter() - t0
+    assert got["a"] == alone_a and got["b"] == alone_b and got["b2"] == alone_b
+    # The runs release the GIL: this thread kept running beside them.
+    assert elapsed > 0.05 and ticks >= 10, (elapsed, ticks)
+
+
+def test_program_errors_name_the_file_line_and_column(tmp_path):
+    program = tmp_path / "typo.star"
+    program.write_text("a = VarInterval(0, 10)\nw = World(light = 0.5, fog = )\n")
+    with pytest.raises(ValueError, match=rf"{program}:2:\d+"):
+        paracosm.Scenario(program)
+    with pytest.raises(ValueError, match="no-such-scenario"):
+        paracosm.Scenario("no-such-scenario")
+
+
+def test_load_warnings_are_issued(tmp_path):
+    program = tmp_path / "unused.star"
+    program.write_text(
+        'a = VarInterval(0, 10, unit = "m")\n'
+        'unread = VarInterval(0, 1)\n'
+        "w = World(light = 0.5, fog = 0.0)\n"
+        "r = RoadSegment(len = 100.0, nlanes = 2)\n"
+        "v = AutonomousVehicle(loc = r.onLane(1, a))\n"
+        "w.place(r, v)\n"
+        "CollisionMonitor(v)\n"
+        "test(horizon = 0.1)\n"
+    )
+    with pytest.warns(paracosm.scenario.ScenarioWarning, match="unread"):
+        s = paracosm.Scenario(program)
+    assert any("unread" in w for w in s.warnings)
+
+
+@pytest.mark.parametrize(
+    "points, message",
+    [
+        (np.zeros((2, 3)), "3 columns, the scenario has 4 parameters"),
+        (np.full((1, 4), 1.5), r"points\[0, 0\] = 1.5 \(`a`\) is outside the unit interval"),
+        (np.array([[0.1, np.nan, 0.1, 0.1]]), r"points\[0, 1\] is NaN"),
+        (np.zeros((0, 4)), "empty"),
+        ([{"a": 1.0, "b": 1.0, "c": 1.0}], r"points\[0\] has no value for 'd'"),
+        ([{"a": 1.0, "b": 1.0, "c": 1.0, "d": "dry", "e": 2}], r"points\[0\] names 'e'"),
+        ([{"a": 1.0, "b": 1.0, "c": 1.0, "d": "snowy"}], "`snowy` is not one of the levels dry, wet, icy"),
+        ([{"a": 11.0, "b": 1.0, "c": 1.0, "d": "dry"}], r"value 11 is outside the domain \[0, 10\]"),
+        ([{"a": "fast", "b": 1.0, "c": 1.0, "d": "dry"}], "`fast` is not a number"),
+        ({"a": 1.0}, "one dict"),
+    ],
+)
+def test_points_that_do_not_fit_are_value_errors(box_program, points, message):
+    s = paracosm.Scenario(box_program)
+    with pytest.raises(ValueError, match=message):
+        s.run(points)
+
+
+def test_bad_run_arguments_are_value_errors(box_program):
+    s = paracosm.Scenario(box_program)
+    x = np.zeros((1, 4))
+    with pytest.raises(ValueError, match="unknown system under test `lidar2`"):
+        s.run(x, sut="lidar2")
+    with pytest.raises(ValueError, match="jobs must be at least 1"):
+        s.run(x, jobs=0)
+    with pytest.raises(ValueError, match="seed must be"):
+        s.run(x, seed=-1)
+    with pytest.raises(ValueError, match="output 'csv'"):
+        s.run(x, output="csv")
+    with pytest.raises(ValueError, match="sut must be"):
+        s.run(x, sut=3)
+
+
+def test_a_scenario_without_parameters_runs_n_tests():
+    repo = Path(__file__).resolve().parents[2]
+    s = paracosm.Scenario(repo / "tests" / "scenarios" / "no_params.star")
+    assert len(s.space) == 0
+    records = s.run(np.zeros((3, 0)), output="records")
+    assert [r["id"] for r in records] == [0, 1, 2]
+    assert len({r["seed"] for r in records}) == 3
+    assert s.robustness([]) == s.robustness(np.zeros(0))
+    with pytest.raises(ValueError, match="no open parameters"):
+        s.run(np.zeros((3, 1)))
+
+
+def test_ctrl_c_stops_a_run_and_raises_keyboard_interrupt():
+    import _thread
+
+    s = paracosm.Scenario("pedestrian-crossing")
+    x = paracosm.qmc.Halton(len(s.space)).random(4000)
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    t0 = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        s.run(x, jobs=1)
+    elapsed = time.perf_counter() - t0
+    timer.cancel()
+    # 4,000 tests take far longer than this: the run stopped at the interrupt.
+    assert elapsed < 5.0, elapsed
