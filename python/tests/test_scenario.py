@@ -255,3 +255,20 @@ def test_ctrl_c_stops_a_run_and_raises_keyboard_interrupt():
     timer.cancel()
     # 4,000 tests take far longer than this: the run stopped at the interrupt.
     assert elapsed < 5.0, elapsed
+
+
+def test_an_external_system_under_test_runs_from_python():
+    import sys
+
+    repo = Path(__file__).resolve().parents[2]
+    s = paracosm.Scenario("pedestrian-crossing")
+    x = paracosm.qmc.Halton(len(s.space)).random(12)
+    # The protocol example brakes by the same rule as the built-in aeb.
+    example = [sys.executable, str(repo / "examples" / "python" / "paracosm_sut.py")]
+    ext = s.run(x, sut=example, jobs=2)
+    aeb = s.run(x, sut="aeb", jobs=2)
+    assert list(ext["status"]) == list(aeb["status"])
+    assert "fail" in set(ext["status"])
+    crash = s.run(x[:2], sut=[sys.executable, str(repo / "tests" / "sut_faults" / "crash.py")])
+    assert list(crash["status"]) == ["error", "error"]
+    assert "controller exploded" in crash["error"][0]
