@@ -35,6 +35,13 @@ pub enum SutChoice {
         /// Whether processes were kept alive between tests.
         reuse: bool,
     },
+    /// An ONNX model chosen with `--sut-onnx`.
+    Onnx {
+        /// The model's path as given.
+        model: String,
+        /// SHA-256 of its bytes, hex: `--resume` and `replay` refuse a changed model.
+        sha256: String,
+    },
 }
 
 /// A number inside an internally tagged enum. serde buffers such an enum before it picks the
@@ -62,6 +69,13 @@ impl SutChoice {
                 timeout_s: e.timeout_s,
                 reuse: e.reuse,
             },
+            #[cfg(feature = "onnx")]
+            Some(SutConfig::Onnx(c)) if c.source != paracosm_engine::sut::PILOTNET => {
+                SutChoice::Onnx {
+                    model: c.source.clone(),
+                    sha256: c.sha256.clone(),
+                }
+            }
             Some(other) => SutChoice::Builtin { name: other.name() },
         }
     }
@@ -85,6 +99,16 @@ impl SutChoice {
                 *timeout_s,
                 *reuse,
             )))),
+            SutChoice::Onnx { model, sha256 } => {
+                let config = SutConfig::onnx(Path::new(model)).map_err(crate::Error::BadInput)?;
+                match config.model_sha256() {
+                    Some(now) if now != sha256 => Err(crate::Error::BadInput(format!(
+                        "the model `{model}` changed since the campaign ran (SHA-256 {now}, \
+                         recorded {sha256})"
+                    ))),
+                    _ => Ok(Some(config)),
+                }
+            }
         }
     }
 }
@@ -235,6 +259,9 @@ struct Fingerprinted<'a> {
     /// Only for `points` campaigns, so the fingerprints of the others stay as they were.
     #[serde(skip_serializing_if = "Option::is_none")]
     points_sha256: Option<&'a str>,
+    /// Only when the scenario's own system under test is an ONNX model.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    scenario_model_sha256: Option<&'a str>,
 }
 
 fn sha256_hex(bytes: &[u8]) -> String {
@@ -274,6 +301,7 @@ impl CampaignFile {
                 budget,
                 strength,
                 points_sha256: points.as_ref().map(|p| p.sha256.as_str()),
+                scenario_model_sha256: scenario.sut.model_sha256(),
             };
             sha256_hex(&serde_json::to_vec(&f).expect("settings serialise"))
         };

@@ -48,10 +48,14 @@ pub fn parse_args<T: Parser>(tool: &str) -> Result<T, ExitCode> {
 /// The options that choose a system under test (`paracosm-fuzz` and its `replay`).
 #[derive(Debug, Clone, clap::Args)]
 pub struct SutArgs {
-    /// Built-in system under test, instead of the scenario's default: aeb (lidar) or vision
-    /// (camera).
-    #[arg(long, value_name = "NAME", conflicts_with = "sut_cmd")]
+    /// Built-in system under test, instead of the scenario's default: aeb (lidar), vision
+    /// (camera) or pilotnet (the shipped ONNX network, camera).
+    #[arg(long, value_name = "NAME", conflicts_with_all = ["sut_cmd", "sut_onnx"])]
     pub sut: Option<String>,
+    /// Run an ONNX model as the system under test, in process (tract), with the TOML
+    /// manifest beside it (same stem, `.toml`) that declares its camera, input and outputs.
+    #[arg(long, value_name = "MODEL.onnx", conflicts_with = "sut_cmd")]
+    pub sut_onnx: Option<std::path::PathBuf>,
     /// Run the system under test as a program speaking SUT_PROTOCOL.md over stdin/stdout,
     /// e.g. "python3 my_controller.py" (split like a shell would, without expansion).
     #[arg(long, value_name = "COMMAND")]
@@ -78,6 +82,11 @@ impl SutArgs {
             return Err(Error::BadInput(format!(
                 "--sut-timeout {timeout_s} must be a positive number of seconds"
             )));
+        }
+        if let Some(model) = &self.sut_onnx {
+            return SutConfig::onnx(model)
+                .map(Some)
+                .map_err(|e| Error::BadInput(format!("--sut-onnx: {e}")));
         }
         match (&self.sut, &self.sut_cmd) {
             (Some(n), _) => SutConfig::builtin(n)
@@ -170,6 +179,7 @@ mod tests {
         let args = |sut: Option<&str>, cmd: Option<&str>, timeout: f64| SutArgs {
             sut: sut.map(str::to_owned),
             sut_cmd: cmd.map(str::to_owned),
+            sut_onnx: None,
             sut_timeout: timeout,
             sut_fresh: false,
         };

@@ -12,6 +12,7 @@ pub mod campaign;
 pub mod campaign_file;
 pub mod cli;
 pub mod cover;
+pub mod dataset;
 mod error;
 pub mod fuzz;
 pub mod html;

@@ -155,6 +155,7 @@ pub fn replay(
         &mut RunOptions {
             camera: frames.map(|_| CameraSpec::default()),
             on_frame: Some(&mut on_frame),
+            on_sample: None,
         },
     );
     if let Some(e) = write_error {

@@ -4,16 +4,7 @@
 use std::path::Path;
 
 mod common;
-use common::{expect_code, fuzz};
-
-/// `results.jsonl` lines without `wall_ms`.
-fn comparable(dir: &Path) -> Vec<String> {
-    std::fs::read_to_string(dir.join("results.jsonl"))
-        .unwrap()
-        .lines()
-        .map(|l| l[..l.rfind(",\"wall_ms\":").unwrap()].to_owned())
-        .collect()
-}
+use common::{comparable, expect_code, fuzz};
 
 const POINTS: &str = "\
 lead_speed,brake_at,decel,friction,lead_color,oncoming,comment

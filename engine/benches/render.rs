@@ -23,6 +23,8 @@ fn objects() -> Vec<RenderObject> {
             },
             heading_rad: 0.0,
             albedo: [0.92, 0.92, 0.92],
+            class: paracosm_engine::SemanticClass::Car,
+            actor: 0,
         },
         RenderObject {
             base_m: [30.0, 0.15, 5.0],
@@ -33,6 +35,8 @@ fn objects() -> Vec<RenderObject> {
             },
             heading_rad: 0.0,
             albedo: [0.75, 0.22, 0.18],
+            class: paracosm_engine::SemanticClass::Pedestrian,
+            actor: 0,
         },
     ]
 }

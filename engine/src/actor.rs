@@ -7,6 +7,8 @@ use std::marker::PhantomData;
 
 use serde::{Deserialize, Serialize};
 
+use crate::segmentation::SemanticClass;
+
 /// The size of a box-shaped body, metres: one struct and one axis order everywhere (the
 /// collider, the camera's drawing, the placement check, time to collision).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -52,6 +54,11 @@ pub struct VisibleBox {
     pub heading_rad: f64,
     /// Albedo, linear RGB in `[0, 1]`.
     pub albedo: [f32; 3],
+    /// What it is, for the camera's segmentation mask: [`SemanticClass::Car`],
+    /// [`SemanticClass::Pedestrian`] or [`SemanticClass::Obstacle`].
+    pub class: SemanticClass,
+    /// Its index in its kind's set (the mask's actor id, [`crate::segmentation`]).
+    pub actor: usize,
 }
 
 /// A handle to an actor of type `T` in its [`Set`]: its index, typed so that a car's handle

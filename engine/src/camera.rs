@@ -141,7 +141,7 @@ impl CameraSpec {
     }
 }
 
-/// One camera frame: an RGB image and the matching depth map.
+/// One camera frame: an RGB image, the matching depth map and the ground-truth labels.
 ///
 /// Conventions: images are row-major, origin at the top-left pixel, rows top to bottom;
 /// pixel `(u, v)` (column, row) is at index `v · width + u`.
@@ -158,6 +158,11 @@ pub struct CameraFrame {
     /// Depth in metres along the optical axis (z-depth, not range), `height × width`,
     /// row-major; `+inf` where the ray meets only sky (nothing within `far_m`).
     pub depth_m: Vec<f32>,
+    /// Ground-truth labels, `height × width`, row-major: each pixel's
+    /// [`crate::SemanticClass`] id in the low 8 bits and its actor (`1 +` index in its
+    /// kind's set, 0 for the world and the sky) above ([`crate::segmentation`]). Drawn by the
+    /// renderer with the image; unaffected by fog, light, blur and noise.
+    pub labels: Vec<u32>,
 }
 
 impl CameraFrame {
@@ -176,6 +181,32 @@ impl CameraFrame {
     /// If `(u, v)` is outside the image.
     pub fn depth_at(&self, u: u32, v: u32) -> f32 {
         self.depth_m[(v * self.width + u) as usize]
+    }
+
+    /// The semantic class of pixel `(u, v)`.
+    ///
+    /// # Panics
+    /// If `(u, v)` is outside the image.
+    pub fn class_at(&self, u: u32, v: u32) -> crate::SemanticClass {
+        crate::segmentation::class_of(self.labels[(v * self.width + u) as usize])
+    }
+
+    /// The segmentation mask as an 8-bit grey image whose values are the
+    /// [`crate::SemanticClass`] ids `0..=7`.
+    pub fn class_mask(&self) -> image::GrayImage {
+        let px = self
+            .labels
+            .iter()
+            .map(|&l| crate::segmentation::class_of(l).id())
+            .collect();
+        image::GrayImage::from_raw(self.width, self.height, px)
+            .expect("labels hold width × height values")
+    }
+
+    /// The 2-D bounding boxes of every visible actor, from the labels (pixels, occlusion
+    /// included), ordered by class then actor.
+    pub fn boxes(&self) -> Vec<crate::ObjectBox> {
+        crate::segmentation::boxes(&self.labels, self.width)
     }
 
     /// The image as an `image` crate buffer (for PNG output and image processing).

@@ -297,7 +297,7 @@ impl Car {
 
     /// The box the camera draws: from the road to its roof, so it covers the wheels under
     /// the collider's clearance.
-    pub(crate) fn visible(&self) -> Option<VisibleBox> {
+    pub(crate) fn visible(&self, index: usize) -> Option<VisibleBox> {
         self.body?;
         let ([x, z], heading_rad) = self.here;
         Some(VisibleBox {
@@ -308,6 +308,8 @@ impl Car {
             },
             heading_rad,
             albedo: self.albedo,
+            class: crate::segmentation::SemanticClass::Car,
+            actor: index,
         })
     }
 

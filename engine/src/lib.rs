@@ -27,6 +27,7 @@ pub mod placement;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod rx;
+pub mod segmentation;
 pub mod sensor;
 mod sim;
 mod spec;
@@ -43,6 +44,7 @@ pub use error::EngineError;
 pub use network::{Lane, Location, Network, PieceId, PieceKind};
 pub use obstacle::ObstacleState;
 pub use pedestrian::{PedestrianPhase, PedestrianState};
+pub use segmentation::{ObjectBox, SemanticClass};
 pub use sensor::lidar::{LidarReturn, LidarSpec};
 pub use sim::{EgoState, Observation, Simulation, Snapshot};
 pub use spec::{

@@ -65,12 +65,14 @@ impl Obstacle {
         self.state
     }
 
-    pub(crate) fn visible(&self) -> VisibleBox {
+    pub(crate) fn visible(&self, index: usize) -> VisibleBox {
         VisibleBox {
             base_m: self.state.base_m,
             size: self.state.size,
             heading_rad: self.state.heading_rad,
             albedo: self.albedo,
+            class: crate::segmentation::SemanticClass::Obstacle,
+            actor: index,
         }
     }
 

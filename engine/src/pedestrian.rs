@@ -125,12 +125,14 @@ impl Pedestrian {
     }
 
     /// The box the camera draws: the capsule's bounding box, [`crate::Size::PEDESTRIAN`].
-    pub(crate) fn visible(&self) -> crate::actor::VisibleBox {
+    pub(crate) fn visible(&self, index: usize) -> crate::actor::VisibleBox {
         crate::actor::VisibleBox {
             base_m: self.pos,
             size: crate::Size::PEDESTRIAN,
             heading_rad: 0.0,
             albedo: [0.75, 0.22, 0.18],
+            class: crate::segmentation::SemanticClass::Pedestrian,
+            actor: index,
         }
     }
 

@@ -387,10 +387,10 @@ impl Simulation {
     /// roof), every pedestrian and every obstacle.
     pub fn visible_boxes(&self) -> Vec<VisibleBox> {
         self.cars
-            .values()
-            .filter_map(Car::visible)
-            .chain(self.pedestrians.values().map(Pedestrian::visible))
-            .chain(self.obstacles.values().map(Obstacle::visible))
+            .iter()
+            .filter_map(|(h, c)| c.visible(h.index()))
+            .chain(self.pedestrians.iter().map(|(h, p)| p.visible(h.index())))
+            .chain(self.obstacles.iter().map(|(h, o)| o.visible(h.index())))
             .collect()
     }
 

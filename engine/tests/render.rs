@@ -28,6 +28,8 @@ fn car_at(x: f64, z: f64, albedo: [f32; 3]) -> RenderObject {
         },
         heading_rad: 0.0,
         albedo,
+        class: paracosm_engine::SemanticClass::Car,
+        actor: 0,
     }
 }
 
@@ -235,6 +237,8 @@ fn golden_cross_intersection_at_dusk() {
                 },
                 heading_rad: 0.0,
                 albedo: [0.75, 0.22, 0.18],
+                class: paracosm_engine::SemanticClass::Pedestrian,
+                actor: 0,
             },
         ],
         0.3,
@@ -537,5 +541,157 @@ fn standing_world(
         published: vec![],
         lidar: paracosm_engine::LidarSpec::default(),
         network,
+    }
+}
+
+/// Projects a world point through `camera` on a vehicle at `pose`: `(u, v, z-depth)`.
+fn project(camera: &CameraSpec, pose: CameraPose, p: [f64; 3]) -> (f64, f64, f64) {
+    let (s, c) = pose.heading_rad.sin_cos();
+    let fwd = [c, 0.0, -s];
+    let right = [s, 0.0, c];
+    let up = [0.0, 1.0, 0.0];
+    let [mf, mu, mr] = camera.mount_m;
+    let eye: Vec<f64> = (0..3)
+        .map(|i| pose.chassis_m[i] + fwd[i] * mf + up[i] * mu + right[i] * mr)
+        .collect();
+    let (ps, pc) = camera.pitch_rad.sin_cos();
+    let axis: Vec<f64> = (0..3).map(|i| fwd[i] * pc - up[i] * ps).collect();
+    let cam_up: Vec<f64> = (0..3).map(|i| fwd[i] * ps + up[i] * pc).collect();
+    let rel: Vec<f64> = (0..3).map(|i| p[i] - eye[i]).collect();
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let (x, y, z) = (dot(&rel, &right), dot(&rel, &cam_up), dot(&rel, &axis));
+    let f = camera.focal_px();
+    (
+        f64::from(camera.width) / 2.0 + f * x / z,
+        f64::from(camera.height) / 2.0 - f * y / z,
+        z,
+    )
+}
+
+/// The eight corners of a drawn box, world metres.
+fn corners(o: &RenderObject) -> Vec<[f64; 3]> {
+    let (s, c) = o.heading_rad.sin_cos();
+    let mut out = Vec::new();
+    for a in [-0.5, 0.5] {
+        for b in [-0.5, 0.5] {
+            for h in [0.0, 1.0] {
+                let (l, w) = (a * o.size.length_m, b * o.size.width_m);
+                out.push([
+                    o.base_m[0] + l * c + w * s,
+                    o.base_m[1] + h * o.size.height_m,
+                    o.base_m[2] - l * s + w * c,
+                ]);
+            }
+        }
+    }
+    out
+}
+
+/// Requirement (issue 20, 1): the boxes come from the renderer's labels and agree with the
+/// actor projected through the camera model, to a pixel on every edge.
+#[test]
+fn label_boxes_match_the_projected_actors() {
+    use paracosm_engine::SemanticClass;
+    let camera = CameraSpec::default();
+    let car = RenderObject {
+        actor: 2,
+        heading_rad: 0.3,
+        ..car_at(32.0, 3.0, WHITE)
+    };
+    let pedestrian = RenderObject {
+        base_m: [24.0, 0.0, -2.5],
+        size: Size::PEDESTRIAN,
+        heading_rad: 0.0,
+        albedo: [0.75, 0.22, 0.18],
+        class: SemanticClass::Pedestrian,
+        actor: 0,
+    };
+    let frame = render(&road(), &camera, pose(), &[car, pedestrian], 0.6, 0.4);
+    let boxes = frame.boxes();
+    assert_eq!(boxes.len(), 2, "{boxes:?}");
+    for (o, b) in [(car, boxes[0]), (pedestrian, boxes[1])] {
+        assert_eq!((b.class, b.actor), (o.class, o.actor));
+        let (mut u0, mut v0, mut u1, mut v1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+        for p in corners(&o) {
+            let (u, v, z) = project(&camera, pose(), p);
+            assert!(z > 0.0);
+            (u0, v0, u1, v1) = (u0.min(u), v0.min(v), u1.max(u), v1.max(v));
+        }
+        // Pixel i is covered when its centre i + 0.5 lies inside the projection.
+        let expected = [
+            (u0 - 0.5).ceil(),
+            (v0 - 0.5).ceil(),
+            (u1 - 0.5).floor() + 1.0,
+            (v1 - 0.5).floor() + 1.0,
+        ];
+        let got = [b.x0, b.y0, b.x1, b.y1].map(f64::from);
+        for (e, g) in expected.iter().zip(got) {
+            assert!(
+                (e - g).abs() <= 1.0,
+                "{:?}: box {got:?}, projected {expected:?}",
+                o.class
+            );
+        }
+        assert!(b.pixels > 50, "{b:?}");
+    }
+}
+
+/// Requirement (issue 20, 1): the mask agrees with the depth map on every pixel: sky exactly
+/// where the depth is infinite, each surface class at its height (road 0, markings 1 cm,
+/// sidewalk tops and curbs 0–15 cm, grass −2 cm), actors inside their box's depth range.
+#[test]
+fn the_mask_agrees_with_the_depth_map_on_every_pixel() {
+    use paracosm_engine::SemanticClass;
+    let camera = CameraSpec::default();
+    let car = car_at(30.0, -1.75, RED);
+    let frame = render(&road(), &camera, pose(), &[car], 0.6, 0.0);
+    let depth_range: Vec<f64> = corners(&car)
+        .iter()
+        .map(|&p| project(&camera, pose(), p).2)
+        .collect();
+    let (near, far) = (
+        depth_range.iter().copied().fold(f64::MAX, f64::min),
+        depth_range.iter().copied().fold(f64::MIN, f64::max),
+    );
+    let mut seen = std::collections::BTreeMap::new();
+    for v in 0..frame.height {
+        for u in 0..frame.width {
+            let class = frame.class_at(u, v);
+            *seen.entry(class).or_insert(0u32) += 1;
+            let d = f64::from(frame.depth_at(u, v));
+            assert_eq!(class == SemanticClass::Sky, d.is_infinite(), "({u}, {v})");
+            if d.is_infinite() {
+                continue;
+            }
+            let p = camera.camera_to_vehicle(camera.back_project(
+                f64::from(u) + 0.5,
+                f64::from(v) + 0.5,
+                d,
+            ));
+            let y = pose().chassis_m[1] + p[1];
+            let at = |h: f64, tol: f64| (y - h).abs() < tol;
+            let ok = match class {
+                SemanticClass::Road => at(0.0, 0.02),
+                SemanticClass::LaneMarking => at(0.01, 0.02),
+                SemanticClass::Sidewalk => (-0.02..0.17).contains(&y),
+                SemanticClass::Ground => at(-0.02, 0.03),
+                SemanticClass::Car => (near - 0.05..far + 0.05).contains(&d),
+                other => panic!("({u}, {v}): unexpected {other:?}"),
+            };
+            assert!(
+                ok,
+                "({u}, {v}) {class:?} at height {y:.3} m, depth {d:.2} m"
+            );
+        }
+    }
+    for c in [
+        SemanticClass::Sky,
+        SemanticClass::Road,
+        SemanticClass::LaneMarking,
+        SemanticClass::Sidewalk,
+        SemanticClass::Ground,
+        SemanticClass::Car,
+    ] {
+        assert!(seen.get(&c).copied().unwrap_or(0) > 20, "{c:?}: {seen:?}");
     }
 }

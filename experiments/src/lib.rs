@@ -8,6 +8,8 @@
 #![warn(missing_docs)]
 
 pub mod falsification;
+pub mod onnx_export;
+pub mod pilotnet;
 
 use std::path::{Path, PathBuf};
 
@@ -27,10 +29,13 @@ pub fn jobs_or_all_cores(jobs: Option<usize>) -> usize {
 /// What [`figure9`] measured and wrote.
 #[derive(Debug, Clone)]
 pub struct Figure9 {
-    /// Failed tests under random sampling.
+    /// Failed tests under random sampling (any monitor).
     pub random_failures: u64,
-    /// Failed tests under Halton sampling.
+    /// Failed tests under Halton sampling (any monitor).
     pub halton_failures: u64,
+    /// Exact dispersion (largest empty axis-aligned box, §3) of the random and the Halton
+    /// points in the unit square.
+    pub dispersion: [f64; 2],
     /// The PNG and SVG of the two-panel map.
     pub plots: [PathBuf; 2],
 }
@@ -42,9 +47,27 @@ pub struct Figure9 {
 /// # Errors
 /// When a campaign or a plot cannot be written.
 pub fn figure9(budget: u64, seed: u64, jobs: usize, out: &Path) -> Result<Figure9> {
-    let scenario = paracosm_scenarios::builtin("pedestrian-crossing")?;
-    let dir = out.join("fig9");
+    figure9_with(budget, seed, jobs, &out.join("fig9"), None)
+}
+
+/// As [`figure9`], into `dir`, with `sut` instead of the scenario's `aeb` (e.g. the shipped
+/// `pilotnet`: README, "Testing a learned driver").
+///
+/// # Errors
+/// When a campaign or a plot cannot be written.
+pub fn figure9_with(
+    budget: u64,
+    seed: u64,
+    jobs: usize,
+    dir: &Path,
+    sut: Option<paracosm_engine::sut::SutConfig>,
+) -> Result<Figure9> {
+    let mut scenario = paracosm_scenarios::builtin("pedestrian-crossing")?;
+    if let Some(sut) = sut {
+        scenario.sut = sut;
+    }
     let mut runs: Vec<(String, Vec<RunRecord>, u64)> = Vec::new();
+    let mut dispersion = [0.0; 2];
     for strategy in [Strategy::Random, Strategy::Halton] {
         let campaign = Campaign {
             scenario: &scenario,
@@ -57,9 +80,30 @@ pub fn figure9(budget: u64, seed: u64, jobs: usize, out: &Path) -> Result<Figure
             points: None,
         };
         let report = campaign.run(&dir.join(strategy.name()), |_| {})?;
+        let flat: Vec<f64> = report
+            .records
+            .iter()
+            .flat_map(|r| r.point.continuous.iter().copied())
+            .collect();
+        let d = paracosm_generators::coverage::dispersion(
+            &flat,
+            2,
+            &paracosm_generators::coverage::DispersionOptions::default(),
+        )
+        .map_err(|e| Error::Internal(e.to_string()))?;
+        dispersion[runs.len()] = d.lower;
+        let collisions = report
+            .records
+            .iter()
+            .filter(|r| {
+                r.monitors
+                    .iter()
+                    .any(|(name, m)| name == "collision" && !m.passed)
+            })
+            .count();
         let title = format!(
-            "{strategy}: {budget} tests, {} collisions",
-            report.counts.fail
+            "{strategy}: {budget} tests, {} failed ({collisions} collisions), dispersion {:.4}",
+            report.counts.fail, d.lower
         );
         runs.push((title, report.records, report.counts.fail));
     }
@@ -77,6 +121,7 @@ pub fn figure9(budget: u64, seed: u64, jobs: usize, out: &Path) -> Result<Figure
     Ok(Figure9 {
         random_failures: runs[0].2,
         halton_failures: runs[1].2,
+        dispersion,
         plots,
     })
 }

@@ -41,7 +41,10 @@ fn sut_config(
     fresh: bool,
 ) -> PyResult<Option<SutConfig>> {
     match (builtin, command) {
-        (Some(name), _) => SutConfig::builtin(name).map(Some).map_err(value_error),
+        // A built-in name, or `onnx:PATH` relative to the working directory.
+        (Some(name), _) => SutConfig::named(name, std::path::Path::new(""))
+            .map(Some)
+            .map_err(value_error),
         (None, Some(words)) => {
             if words.is_empty() {
                 return Err(value_error("sut: the command is empty"));

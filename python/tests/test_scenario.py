@@ -272,3 +272,23 @@ def test_an_external_system_under_test_runs_from_python():
     crash = s.run(x[:2], sut=[sys.executable, str(repo / "tests" / "sut_faults" / "crash.py")])
     assert list(crash["status"]) == ["error", "error"]
     assert "controller exploded" in crash["error"][0]
+
+
+def test_learned_systems_under_test_run_from_python(tmp_path):
+    """The shipped network by name, and an ONNX file by `onnx:PATH` (issue 20)."""
+    import shutil
+
+    repo = Path(__file__).resolve().parents[2]
+    s = paracosm.Scenario("pedestrian-crossing")
+    x = paracosm.qmc.Halton(len(s.space)).random(4)
+    shipped = s.run(x, sut="pilotnet", jobs=2)
+    assert set(shipped["status"]) <= {"pass", "fail"}
+    assert (shipped["distance_travelled_m"] > 15.0).all()
+    for ext in ("onnx", "toml"):
+        shutil.copy(repo / "assets" / "models" / f"pilotnet.{ext}", tmp_path / f"mine.{ext}")
+    mine = s.run(x, sut=f"onnx:{tmp_path / 'mine.onnx'}", jobs=1)
+    assert list(mine["status"]) == list(shipped["status"])
+    assert list(mine["distance_travelled_m"]) == list(shipped["distance_travelled_m"])
+    (tmp_path / "mine.toml").unlink()
+    with pytest.raises(ValueError, match="mine.toml"):
+        s.run(x, sut=f"onnx:{tmp_path / 'mine.onnx'}")

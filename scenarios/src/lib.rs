@@ -18,7 +18,7 @@ mod scenario;
 use std::path::Path;
 
 pub use error::ScenarioError;
-pub use runner::{signal, RunOptions, TestOutcome};
+pub use runner::{signal, RunOptions, Sample, TestOutcome};
 pub use scenario::{CameraOnly, MonitorSpec, RustWorlds, Scenario, Warning, Worlds};
 
 use paracosm_generators::Assignment;

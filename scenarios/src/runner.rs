@@ -1,7 +1,9 @@
 use std::ops::ControlFlow;
 
 use paracosm_engine::rx::Host;
-use paracosm_engine::{CameraFrame, CameraSpec, Control, Simulation, Snapshot, WorldSpec};
+use paracosm_engine::{
+    CameraFrame, CameraSpec, Control, EgoState, Simulation, Snapshot, WorldSpec,
+};
 use paracosm_generators::Assignment;
 use paracosm_oracles::{Frame, Monitor, Signals, Verdict};
 
@@ -180,8 +182,21 @@ impl Watch {
     }
 }
 
-/// Extras for one run: a camera to watch it with, and a callback for every camera frame
-/// (what `paracosm-fuzz replay --frames` uses).
+/// One camera frame with what the system under test did on seeing the world: what
+/// [`RunOptions::on_sample`] receives (a training sample of `paracosm-fuzz dataset`).
+#[derive(Debug, Clone, Copy)]
+pub struct Sample<'a> {
+    /// The frame (RGB, depth, labels), taken at this step.
+    pub frame: &'a CameraFrame,
+    /// The ego vehicle's state at the frame.
+    pub ego: EgoState,
+    /// The control the system under test applies from this step on (its answer at this
+    /// step, or the one it holds between decisions).
+    pub control: Control,
+}
+
+/// Extras for one run: a camera to watch it with, and callbacks for every camera frame
+/// (what `paracosm-fuzz replay --frames` and `paracosm-fuzz dataset` use).
 #[derive(Default)]
 pub struct RunOptions<'a> {
     /// A camera to mount when the system under test has none (frames for looking at; the
@@ -189,6 +204,9 @@ pub struct RunOptions<'a> {
     pub camera: Option<CameraSpec>,
     /// Called with every frame the camera takes.
     pub on_frame: Option<&'a mut dyn FnMut(&CameraFrame)>,
+    /// Called with every frame the camera takes, with the ego's state and the control the
+    /// system under test applies at that step.
+    pub on_sample: Option<&'a mut dyn FnMut(&Sample<'_>)>,
 }
 
 /// Every how many physics steps something at `hz` happens (at least every step).
@@ -285,6 +303,15 @@ impl Scenario {
                     obs.readings.retain(|(name, _)| *name != "camera");
                 }
                 control = sut.act(&obs)?;
+            }
+            if frame_every > 0 && tick % frame_every == 0 {
+                if let (Some(f), Some(frame)) = (options.on_sample.as_mut(), sim.camera_frame()) {
+                    f(&Sample {
+                        frame,
+                        ego: sim.ego_state(),
+                        control,
+                    });
+                }
             }
             sim.step(control, host)?;
             tick += 1;

@@ -114,6 +114,52 @@ enum Sub {
     /// Reprint the summary of a finished or partial campaign folder: counts, first failure,
     /// coverage, where failures are, and plot paths; redraw plots on other parameters.
     Report(ReportArgs),
+    /// Export training data: run a campaign with a teacher (the scenario's system under test
+    /// or --sut) and write, per recorded frame, the camera image, depth (.npy), segmentation
+    /// mask, COCO boxes, ego state and the teacher's control, indexed by frames.csv.
+    Dataset(DatasetArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct DatasetArgs {
+    /// Scenario: a `.star` path or a built-in name.
+    scenario: String,
+    /// How test points are chosen (not an adaptive strategy).
+    #[arg(long, value_parser = paracosm::cli::strategy_parser(), default_value = "halton")]
+    strategy: Strategy,
+    /// Strength t of --strategy ipog or kwise.
+    #[arg(long, default_value_t = 2)]
+    strength: usize,
+    /// Number of tests.
+    #[arg(long, value_parser = paracosm::cli::positive, default_value = "10")]
+    budget: u64,
+    /// Campaign seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Frames recorded per second of simulated time.
+    #[arg(long, value_name = "HZ", default_value_t = 10.0)]
+    rate: f64,
+    /// Camera image width in pixels (when the teacher has no camera of its own).
+    #[arg(long, default_value_t = 320)]
+    width: u32,
+    /// Camera image height in pixels.
+    #[arg(long, default_value_t = 240)]
+    height: u32,
+    /// Camera focal length in mm (36 mm sensor width).
+    #[arg(long, default_value_t = 24.0)]
+    focal_mm: f64,
+    /// Worker threads (default: all cores). The data set does not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    jobs: Option<u64>,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Replace what --out holds.
+    #[arg(long)]
+    force: bool,
+    /// The teacher, instead of the scenario's system under test.
+    #[command(flatten)]
+    sut: SutArgs,
 }
 
 #[derive(Debug, clap::Args)]
@@ -157,6 +203,33 @@ struct ReplayArgs {
     sut: SutArgs,
 }
 
+impl DatasetArgs {
+    fn request(&self) -> Result<paracosm::dataset::DatasetRequest, Error> {
+        Ok(paracosm::dataset::DatasetRequest {
+            scenario: self.scenario.clone(),
+            strategy: self.strategy,
+            seed: self.seed,
+            budget: self.budget,
+            strength: self.strength,
+            rate_hz: self.rate,
+            camera: paracosm_engine::CameraSpec {
+                width: self.width,
+                height: self.height,
+                focal_mm: self.focal_mm,
+                ..Default::default()
+            },
+            sut: self.sut.config()?,
+            out: self.out.clone(),
+            replace: self.force,
+            jobs: self.jobs.map_or_else(num_cpus, |j| j as usize),
+        })
+    }
+}
+
+fn num_cpus() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
 fn main() -> ExitCode {
     let cli = match paracosm::cli::parse_args::<Cli>("paracosm-fuzz") {
         Ok(cli) => cli,
@@ -190,6 +263,11 @@ fn main() -> ExitCode {
         Some(Sub::Report(a)) => paracosm::report::reread(&a.dir, &a.redraw)
             .map_err(anyhow::Error::new)
             .and_then(|(text, counts)| say(&text).map(|()| counts.exit_code())),
+        Some(Sub::Dataset(a)) => a
+            .request()
+            .and_then(|r| paracosm::dataset::export(&r, Some(&STOP)))
+            .map_err(anyhow::Error::new)
+            .and_then(|s| say(&s.text()).map(|()| s.exit_code())),
         None => run(&cli),
     };
     match result {

@@ -14,6 +14,16 @@ pub fn fuzz(args: &[&str]) -> Output {
         .expect("paracosm-fuzz runs")
 }
 
+/// The lines of `dir/results.jsonl` without their `wall_ms` (the one field that depends on
+/// the machine), for comparing runs.
+pub fn comparable(dir: &std::path::Path) -> Vec<String> {
+    std::fs::read_to_string(dir.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| l[..l.rfind(",\"wall_ms\":").unwrap()].to_owned())
+        .collect()
+}
+
 /// Asserts the exit code, showing stdout and stderr when it differs.
 pub fn expect_code(o: &Output, code: i32) {
     assert_eq!(

@@ -18,7 +18,10 @@ const SUN: [f32; 3] = [-0.45, 1.0, -0.3];
 
 const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 const DEPTH_OUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+const LABEL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 const ZBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Planes of a view's readback buffer: colour, depth, labels.
+const PLANES: u64 = 3;
 /// Near clipping plane, in metres.
 const NEAR_M: f32 = 0.05;
 
@@ -41,6 +44,8 @@ pub type RenderObject = crate::actor::VisibleBox;
 struct Instance {
     model: [[f32; 4]; 4],
     tint: [f32; 4],
+    /// OR-ed into the vertices' labels: the actor's label, 0 for the static world.
+    label: u32,
 }
 
 impl Instance {
@@ -48,6 +53,7 @@ impl Instance {
         Instance {
             model: glam::Mat4::IDENTITY.to_cols_array_2d(),
             tint: [1.0; 4],
+            label: 0,
         }
     }
 
@@ -70,6 +76,7 @@ impl Instance {
         Instance {
             model: model.to_cols_array_2d(),
             tint: [o.albedo[0], o.albedo[1], o.albedo[2], 1.0],
+            label: crate::segmentation::actor_label(o.class, o.actor),
         }
     }
 }
@@ -98,6 +105,8 @@ pub struct View {
     color_texture: wgpu::Texture,
     depth_out: wgpu::TextureView,
     depth_texture: wgpu::Texture,
+    labels: wgpu::TextureView,
+    label_texture: wgpu::Texture,
     zbuffer: wgpu::TextureView,
     readback: wgpu::Buffer,
     padded_row: u32,
@@ -213,9 +222,10 @@ impl Renderer {
             immediate_size: 0,
         });
         let vertex_attributes =
-            wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
+            wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 8 => Uint32];
         let instance_attributes = wgpu::vertex_attr_array![
-            3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4
+            3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4,
+            9 => Uint32
         ];
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("paracosm camera"),
@@ -262,6 +272,11 @@ impl Renderer {
                     }),
                     Some(wgpu::ColorTargetState {
                         format: DEPTH_OUT_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    }),
+                    Some(wgpu::ColorTargetState {
+                        format: LABEL_FORMAT,
                         blend: None,
                         write_mask: wgpu::ColorWrites::ALL,
                     }),
@@ -332,17 +347,18 @@ impl Renderer {
         let target = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
         let color_texture = texture("color", COLOR_FORMAT, target);
         let depth_texture = texture("depth", DEPTH_OUT_FORMAT, target);
+        let label_texture = texture("labels", LABEL_FORMAT, target);
         let zbuffer = texture(
             "z-buffer",
             ZBUFFER_FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         );
-        // Both targets have 4 bytes per pixel; rows are padded to 256 bytes for the copy.
+        // The three targets have 4 bytes per pixel; rows are padded to 256 bytes for the copy.
         let padded_row = (4 * camera.width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
-            size: 2 * u64::from(padded_row) * u64::from(camera.height),
+            size: PLANES * u64::from(padded_row) * u64::from(camera.height),
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             mapped_at_creation: false,
         });
@@ -367,6 +383,8 @@ impl Renderer {
             color_texture,
             depth_out: depth_texture.create_view(&Default::default()),
             depth_texture,
+            labels: label_texture.create_view(&Default::default()),
+            label_texture,
             zbuffer: zbuffer.create_view(&Default::default()),
             readback,
             padded_row,
@@ -489,6 +507,16 @@ impl Renderer {
                             store: wgpu::StoreOp::Store,
                         },
                     }),
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &view.labels,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            // Sky, no actor.
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
                 ],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &view.zbuffer,
@@ -521,7 +549,11 @@ impl Renderer {
             depth_or_array_layers: 1,
         };
         let plane = u64::from(view.padded_row) * u64::from(camera.height);
-        for (texture, offset) in [(&view.color_texture, 0), (&view.depth_texture, plane)] {
+        for (texture, offset) in [
+            (&view.color_texture, 0),
+            (&view.depth_texture, plane),
+            (&view.label_texture, 2 * plane),
+        ] {
             encoder.copy_texture_to_buffer(
                 wgpu::TexelCopyTextureInfo {
                     texture,
@@ -616,16 +648,17 @@ fn read_frame(job: &RenderJob<'_>) -> Result<CameraFrame, RenderError> {
         .map_err(|e| RenderError::Readback(e.to_string()))?;
     let mut rgb = Vec::with_capacity(w * h * 3);
     let mut depth_m = Vec::with_capacity(w * h);
+    let mut labels = Vec::with_capacity(w * h);
+    let word = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
     for y in 0..h {
         let line = &data[y * row..y * row + 4 * w];
         for px in line.chunks_exact(4) {
             rgb.extend_from_slice(&px[..3]);
         }
         let line = &data[(h + y) * row..(h + y) * row + 4 * w];
-        depth_m.extend(
-            line.chunks_exact(4)
-                .map(|b| f32::from_bits(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))),
-        );
+        depth_m.extend(line.chunks_exact(4).map(|b| f32::from_bits(word(b))));
+        let line = &data[(2 * h + y) * row..(2 * h + y) * row + 4 * w];
+        labels.extend(line.chunks_exact(4).map(word));
     }
     Ok(CameraFrame {
         t_s: job.t_s,
@@ -633,5 +666,6 @@ fn read_frame(job: &RenderJob<'_>) -> Result<CameraFrame, RenderError> {
         height: view.camera.height,
         rgb,
         depth_m,
+        labels,
     })
 }

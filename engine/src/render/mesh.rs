@@ -3,18 +3,64 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::segmentation::SemanticClass;
+
 use crate::network::{
     Network, Piece, PieceKind, CURB_HEIGHT_M, GROUND_MARGIN_M, GROUND_TOP_M, JUNCTION_APRON_M,
     LANE_WIDTH_M,
 };
 
-/// One vertex: position in world metres, unit normal, albedo (linear, `[0, 1]`).
+/// One vertex: position in world metres, unit normal, albedo (linear, `[0, 1]`), and its
+/// label ([`crate::segmentation`]; the class id alone, the world has no actor).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub(crate) struct Vertex {
     pub pos: [f32; 3],
     pub normal: [f32; 3],
     pub color: [f32; 3],
+    pub label: u32,
+}
+
+/// What a surface is: its albedo and its class in the segmentation mask.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Material {
+    pub albedo: [f32; 3],
+    pub class: SemanticClass,
+}
+
+/// The world's materials.
+pub(crate) mod material {
+    use super::{albedo, Material, SemanticClass};
+
+    pub const GRASS: Material = Material {
+        albedo: albedo::GRASS,
+        class: SemanticClass::Ground,
+    };
+    pub const ASPHALT: Material = Material {
+        albedo: albedo::ASPHALT,
+        class: SemanticClass::Road,
+    };
+    pub const CONCRETE: Material = Material {
+        albedo: albedo::CONCRETE,
+        class: SemanticClass::Sidewalk,
+    };
+    pub const PAINT_WHITE: Material = Material {
+        albedo: albedo::PAINT_WHITE,
+        class: SemanticClass::LaneMarking,
+    };
+    pub const PAINT_YELLOW: Material = Material {
+        albedo: albedo::PAINT_YELLOW,
+        class: SemanticClass::LaneMarking,
+    };
+    pub const ISLAND: Material = Material {
+        albedo: albedo::ISLAND,
+        class: SemanticClass::Ground,
+    };
+    /// The actors' unit cube: white, its label given per instance.
+    pub const ACTOR: Material = Material {
+        albedo: [1.0, 1.0, 1.0],
+        class: SemanticClass::Sky,
+    };
 }
 
 /// Albedos of the world's materials.
@@ -45,13 +91,14 @@ pub(crate) struct Mesh {
 }
 
 impl Mesh {
-    fn quad(&mut self, corners: [[f64; 3]; 4], normal: [f32; 3], color: [f32; 3]) {
+    fn quad(&mut self, corners: [[f64; 3]; 4], normal: [f32; 3], m: Material) {
         let base = self.vertices.len() as u32;
         for c in corners {
             self.vertices.push(Vertex {
                 pos: [c[0] as f32, c[1] as f32, c[2] as f32],
                 normal,
-                color,
+                color: m.albedo,
+                label: u32::from(m.class.id()),
             });
         }
         self.indices
@@ -59,7 +106,7 @@ impl Mesh {
     }
 
     /// A horizontal rectangle `[x0, x1] × [z0, z1]` of the piece's local frame at height `y`.
-    fn flat(&mut self, piece: &Piece, x: (f64, f64), z: (f64, f64), y: f64, color: [f32; 3]) {
+    fn flat(&mut self, piece: &Piece, x: (f64, f64), z: (f64, f64), y: f64, color: Material) {
         let w = |lx: f64, lz: f64| {
             let [wx, wz] = piece.pose.apply([lx, lz]);
             [wx, y, wz]
@@ -87,19 +134,20 @@ impl Mesh {
                 w(x.0, CURB_HEIGHT_M),
             ],
             normal,
-            albedo::CONCRETE,
+            material::CONCRETE,
         );
     }
 
     /// A horizontal disc of radius `r` at height `y`, centred on the piece's origin.
-    fn disc(&mut self, piece: &Piece, r: f64, y: f64, color: [f32; 3]) {
+    fn disc(&mut self, piece: &Piece, r: f64, y: f64, m: Material) {
         const SIDES: u32 = 48;
         let base = self.vertices.len() as u32;
         let [cx, cz] = piece.pose.apply([0.0, 0.0]);
         self.vertices.push(Vertex {
             pos: [cx as f32, y as f32, cz as f32],
             normal: [0.0, 1.0, 0.0],
-            color,
+            color: m.albedo,
+            label: u32::from(m.class.id()),
         });
         for i in 0..SIDES {
             let a = f64::from(i) / f64::from(SIDES) * std::f64::consts::TAU;
@@ -107,7 +155,8 @@ impl Mesh {
             self.vertices.push(Vertex {
                 pos: [x as f32, y as f32, z as f32],
                 normal: [0.0, 1.0, 0.0],
-                color,
+                color: m.albedo,
+                label: u32::from(m.class.id()),
             });
         }
         for i in 0..SIDES {
@@ -117,7 +166,7 @@ impl Mesh {
     }
 
     /// A painted line along local `x` from `x0` to `x1`, centred on `z`.
-    fn line(&mut self, piece: &Piece, x: (f64, f64), z: f64, color: [f32; 3]) {
+    fn line(&mut self, piece: &Piece, x: (f64, f64), z: f64, color: Material) {
         let h = LINE_WIDTH_M / 2.0;
         self.flat(piece, x, (z - h, z + h), PAINT_LIFT_M, color);
     }
@@ -129,7 +178,7 @@ impl Mesh {
                 piece,
                 (x, (x + DASH_M.0).min(length_m)),
                 z,
-                albedo::PAINT_WHITE,
+                material::PAINT_WHITE,
             );
             x += DASH_M.1;
         }
@@ -140,7 +189,7 @@ impl Mesh {
         let road = kind.half_road_m();
         let outer = kind.half_width_m();
         let along = (0.0, length_m);
-        self.flat(piece, along, (-road, road), 0.0, albedo::ASPHALT);
+        self.flat(piece, along, (-road, road), 0.0, material::ASPHALT);
         for side in [-1.0, 1.0] {
             let (a, b) = (side * road, side * outer);
             self.flat(
@@ -148,25 +197,25 @@ impl Mesh {
                 along,
                 (a.min(b), a.max(b)),
                 CURB_HEIGHT_M,
-                albedo::CONCRETE,
+                material::CONCRETE,
             );
             self.curb(piece, along, side * road, -side);
             // Edge line.
-            self.line(piece, along, side * (road - 0.3), albedo::PAINT_WHITE);
+            self.line(piece, along, side * (road - 0.3), material::PAINT_WHITE);
             // Lane dividers between lanes of one direction.
             for k in 1..kind.lanes() / 2 {
                 self.dashed(piece, length_m, side * f64::from(k) * LANE_WIDTH_M);
             }
             // Double yellow centre line.
-            self.line(piece, along, side * 0.12, albedo::PAINT_YELLOW);
+            self.line(piece, along, side * 0.12, material::PAINT_YELLOW);
         }
     }
 
     fn junction(&mut self, piece: &Piece) {
         let ([hx, hz], _) = piece.kind.footprint();
-        self.flat(piece, (-hx, hx), (-hz, hz), 0.0, albedo::ASPHALT);
+        self.flat(piece, (-hx, hx), (-hz, hz), 0.0, material::ASPHALT);
         if let Some(island) = piece.kind.island_radius_m() {
-            self.disc(piece, island, CURB_HEIGHT_M, albedo::ISLAND);
+            self.disc(piece, island, CURB_HEIGHT_M, material::ISLAND);
         } else {
             // Stop lines where the roads enter, across the incoming lanes.
             let road = piece.kind.half_road_m();
@@ -188,7 +237,7 @@ impl Mesh {
                     (edge - 0.25, edge + 0.25),
                     (-road, 0.0),
                     PAINT_LIFT_M,
-                    albedo::PAINT_WHITE,
+                    material::PAINT_WHITE,
                 );
             }
         }
@@ -213,7 +262,7 @@ impl Mesh {
                 [lo[0] - m, y, hi[1] + m],
             ],
             [0.0, 1.0, 0.0],
-            albedo::GRASS,
+            material::GRASS,
         );
         mesh
     }
@@ -223,7 +272,7 @@ impl Mesh {
     pub(crate) fn unit_cube() -> Mesh {
         let mut mesh = Mesh::default();
         let h = 0.5;
-        let white = [1.0, 1.0, 1.0];
+        let white = material::ACTOR;
         for axis in 0..3 {
             for sign in [-1.0f64, 1.0] {
                 let mut normal = [0.0f32; 3];

@@ -8,7 +8,7 @@ use crate::camera::{CameraFrame, CameraSpec};
 
 /// Applies the camera's blur (`image`'s Gaussian blur, σ in pixels) and additive noise (σ in
 /// 8-bit levels, drawn from ChaCha8 seeded with `seed`, clipped to `[0, 255]`). The depth map
-/// is left exact.
+/// and the labels are left exact.
 pub(crate) fn apply(mut frame: CameraFrame, camera: &CameraSpec, seed: u64) -> CameraFrame {
     if camera.blur_sigma_px > 0.0 {
         let blurred = image::imageops::blur(&frame.to_image(), camera.blur_sigma_px as f32);
@@ -36,6 +36,7 @@ mod tests {
             height: 4,
             rgb: vec![v; 8 * 4 * 3],
             depth_m: vec![1.0; 32],
+            labels: vec![2; 32],
         }
     }
 

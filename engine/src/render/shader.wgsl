@@ -1,6 +1,7 @@
 // The camera's only shader: diffuse shading under a fixed sun, exposure from the world's
-// light, exponential fog toward the sky colour, and z-depth in metres written as the bits of
-// an f32 into an R32Uint target (renderable on every backend, GL included).
+// light, exponential fog toward the sky colour, z-depth in metres written as the bits of
+// an f32 into an R32Uint target (renderable on every backend, GL included), and each pixel's
+// label (class id | actor << 8) into a second R32Uint target.
 
 struct Globals {
     view_proj: mat4x4<f32>,
@@ -22,6 +23,8 @@ struct VertexIn {
     @location(5) m2: vec4<f32>,
     @location(6) m3: vec4<f32>,
     @location(7) tint: vec4<f32>,
+    @location(8) label: u32,
+    @location(9) instance_label: u32,
 };
 
 struct VertexOut {
@@ -29,6 +32,7 @@ struct VertexOut {
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) color: vec3<f32>,
+    @location(3) @interpolate(flat) label: u32,
 };
 
 @vertex
@@ -40,12 +44,14 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.world = world.xyz;
     out.normal = (model * vec4<f32>(v.normal, 0.0)).xyz;
     out.color = v.color * v.tint.rgb;
+    out.label = v.label | v.instance_label;
     return out;
 }
 
 struct FragmentOut {
     @location(0) color: vec4<f32>,
     @location(1) depth: u32,
+    @location(2) label: u32,
 };
 
 @fragment
@@ -64,5 +70,6 @@ fn fs_main(in: VertexOut) -> FragmentOut {
     var out: FragmentOut;
     out.color = vec4<f32>(color, 1.0);
     out.depth = bitcast<u32>(z);
+    out.label = in.label;
     return out;
 }

@@ -10,12 +10,19 @@ mod aeb;
 mod constant;
 mod cruise;
 mod external;
+#[cfg(feature = "onnx")]
+mod onnx;
 mod vision;
 
 pub use aeb::{Aeb, AebConfig};
 pub use constant::ConstantControl;
 pub use cruise::Cruise;
 pub use external::{ExternalConfig, ExternalSut, ProcessPool, PROTOCOL_VERSION};
+#[cfg(feature = "onnx")]
+pub use onnx::{
+    manifest_path, preprocess, Channels, InputSpec, Layout, Manifest, OnnxConfig, OnnxSut,
+    OutputSpec,
+};
 pub use vision::{Perception, Vision, VisionConfig};
 
 use thiserror::Error;
@@ -73,10 +80,48 @@ pub enum SutConfig {
     Constant(Control),
     /// A program in another process (`--sut-cmd`).
     External(ExternalConfig),
+    /// An ONNX model run in process (`--sut-onnx`, `sut = "onnx:PATH"`).
+    #[cfg(feature = "onnx")]
+    Onnx(Box<OnnxConfig>),
 }
 
+/// The name of the shipped network (`--sut pilotnet`), and its [`OnnxConfig`]'s `source`.
+pub const PILOTNET: &str = "pilotnet";
+
 /// Names of the built-in systems under test, for `--sut` and `AutonomousVehicle(sut=)`.
-pub const BUILTIN_SUTS: [&str; 2] = ["aeb", "vision"];
+pub const BUILTIN_SUTS: [&str; 3] = ["aeb", "vision", PILOTNET];
+
+/// The shipped network (`assets/models/pilotnet.onnx` and its manifest, compiled in), loaded
+/// once per process.
+fn pilotnet() -> Result<SutConfig, String> {
+    #[cfg(feature = "onnx")]
+    {
+        use std::sync::OnceLock;
+        static MODEL: OnceLock<Result<OnnxConfig, String>> = OnceLock::new();
+        MODEL
+            .get_or_init(|| {
+                let manifest = Manifest::parse(
+                    include_str!("../../../assets/models/pilotnet.toml"),
+                    std::path::Path::new("assets/models/pilotnet.toml"),
+                )?;
+                OnnxConfig::from_bytes(
+                    PILOTNET,
+                    include_bytes!("../../../assets/models/pilotnet.onnx"),
+                    manifest,
+                )
+            })
+            .clone()
+            .map(|c| SutConfig::Onnx(Box::new(c)))
+    }
+    #[cfg(not(feature = "onnx"))]
+    {
+        Err(
+            "`pilotnet` is an ONNX model: this build of paracosm has no ONNX runtime (cargo \
+             feature `onnx`)"
+                .into(),
+        )
+    }
+}
 
 impl SutConfig {
     /// The built-in system called `name` (see [`BUILTIN_SUTS`]) with default settings.
@@ -87,6 +132,7 @@ impl SutConfig {
         match name {
             "aeb" => Ok(SutConfig::Aeb(AebConfig::default())),
             "vision" => Ok(SutConfig::Vision(VisionConfig::default())),
+            PILOTNET => pilotnet(),
             _ => Err(format!(
                 "unknown system under test `{name}`; built in: {}",
                 BUILTIN_SUTS.join(", ")
@@ -94,13 +140,59 @@ impl SutConfig {
         }
     }
 
-    /// A short name for reports: `aeb`, `vision`, `constant`, or the external command line.
+    /// The system a scenario names: a built-in name, or `onnx:PATH` with `PATH` relative to
+    /// `base` (the program's folder).
+    ///
+    /// # Errors
+    /// As [`SutConfig::builtin`] and [`SutConfig::onnx`].
+    pub fn named(spec: &str, base: &std::path::Path) -> Result<SutConfig, String> {
+        match spec.strip_prefix("onnx:") {
+            Some(path) => SutConfig::onnx(&base.join(path)),
+            None => SutConfig::builtin(spec),
+        }
+    }
+
+    /// The ONNX model at `path` with its manifest beside it (`--sut-onnx`).
+    ///
+    /// # Errors
+    /// The model's or the manifest's problem, naming the file; or that this build has no
+    /// ONNX runtime (cargo feature `onnx`).
+    pub fn onnx(path: &std::path::Path) -> Result<SutConfig, String> {
+        #[cfg(feature = "onnx")]
+        {
+            onnx::cached(path).map(|c| SutConfig::Onnx(Box::new(c)))
+        }
+        #[cfg(not(feature = "onnx"))]
+        {
+            Err(format!(
+                "cannot run the ONNX model `{}`: this build of paracosm has no ONNX runtime \
+                 (cargo feature `onnx`)",
+                path.display()
+            ))
+        }
+    }
+
+    /// SHA-256 of an ONNX model's bytes (hex), `None` for every other system.
+    pub fn model_sha256(&self) -> Option<&str> {
+        match self {
+            #[cfg(feature = "onnx")]
+            SutConfig::Onnx(c) => Some(&c.sha256),
+            _ => None,
+        }
+    }
+
+    /// A short name for reports: `aeb`, `vision`, `constant`, the external command line, or
+    /// `onnx:PATH`.
     pub fn name(&self) -> String {
         match self {
             SutConfig::Aeb(_) => "aeb".into(),
             SutConfig::Vision(_) => "vision".into(),
             SutConfig::Constant(_) => "constant".into(),
             SutConfig::External(e) => e.command.join(" "),
+            #[cfg(feature = "onnx")]
+            SutConfig::Onnx(c) if c.source == PILOTNET => PILOTNET.into(),
+            #[cfg(feature = "onnx")]
+            SutConfig::Onnx(c) => format!("onnx:{}", c.source),
         }
     }
 
@@ -111,6 +203,8 @@ impl SutConfig {
         match self {
             SutConfig::Aeb(_) | SutConfig::Constant(_) => Some(false),
             SutConfig::Vision(_) => Some(true),
+            #[cfg(feature = "onnx")]
+            SutConfig::Onnx(_) => Some(true),
             SutConfig::External(_) => None,
         }
     }
@@ -122,6 +216,8 @@ impl SutConfig {
             SutConfig::Vision(c) => Box::new(Vision::new(c.clone())),
             SutConfig::Constant(c) => Box::new(ConstantControl(*c)),
             SutConfig::External(c) => Box::new(ExternalSut::new(c.clone())),
+            #[cfg(feature = "onnx")]
+            SutConfig::Onnx(c) => Box::new(OnnxSut::new((**c).clone())),
         }
     }
 }

@@ -1,6 +1,10 @@
 //! `fig9`: the paper's Figure 9, random vs. Halton sampling of the pedestrian-crossing study.
 //!
 //! `cargo run --release -p paracosm-experiments --bin fig9 -- --budget 500`
+//!
+//! With a learned driver (README, "Testing a learned driver"):
+//! `cargo run --release -p paracosm-experiments --bin fig9 -- --budget 500 --sut pilotnet
+//! --docs docs/fig9_pilotnet.png`
 
 use std::path::PathBuf;
 
@@ -23,16 +27,36 @@ struct Cli {
     /// Output folder.
     #[arg(long, default_value = "experiments/out")]
     out: PathBuf,
+    /// The system under test, instead of the scenario's `aeb` (e.g. `pilotnet`); the
+    /// campaigns and the figure go to `OUT/fig9-NAME/`.
+    #[arg(long)]
+    sut: Option<String>,
+    /// Also copy the figure's PNG here (e.g. `docs/fig9_pilotnet.png`).
+    #[arg(long)]
+    docs: Option<PathBuf>,
 }
 
 fn main() -> Result<()> {
     let cli = Cli::parse();
     let jobs = paracosm_experiments::jobs_or_all_cores(cli.jobs);
-    let f = paracosm_experiments::figure9(cli.budget, cli.seed, jobs, &cli.out)?;
+    let f = match &cli.sut {
+        None => paracosm_experiments::figure9(cli.budget, cli.seed, jobs, &cli.out)?,
+        Some(name) => {
+            let sut = paracosm_engine::sut::SutConfig::builtin(name).map_err(anyhow::Error::msg)?;
+            let dir = cli.out.join(format!("fig9-{name}"));
+            paracosm_experiments::figure9_with(cli.budget, cli.seed, jobs, &dir, Some(sut))?
+        }
+    };
+    if let Some(docs) = &cli.docs {
+        std::fs::copy(&f.plots[0], docs)?;
+    }
     println!(
-        "random: {} collisions, halton: {} collisions in {} tests each; wrote {} and {}",
+        "random: {} failed (dispersion {:.4}), halton: {} failed (dispersion {:.4}) in {} tests \
+         each; wrote {} and {}",
         f.random_failures,
+        f.dispersion[0],
         f.halton_failures,
+        f.dispersion[1],
         cli.budget,
         f.plots[0].display(),
         f.plots[1].display()

@@ -108,7 +108,8 @@ pub(super) fn route_arg(
 #[allow(non_snake_case)]
 pub(super) fn register(builder: &mut GlobalsBuilder) {
     /// `AutonomousVehicle(loc=, sut="aeb", route=None, speed=None)`: the ego vehicle and its
-    /// default system under test (`aeb` or `vision`; `--sut`/`--sut-cmd` override it).
+    /// default system under test (`aeb`, `vision`, `pilotnet`, or `onnx:PATH` with `PATH`
+    /// relative to the program's file; `--sut`/`--sut-cmd`/`--sut-onnx` override it).
     fn AutonomousVehicle<'v>(
         #[starlark(require = named)] loc: Value<'v>,
         #[starlark(require = named)] sut: Option<&str>,
@@ -117,7 +118,13 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<ActorVal> {
         let loc = location(loc, "loc")?;
-        let sut = SutConfig::builtin(sut.unwrap_or("aeb")).map_err(anyhow::Error::msg)?;
+        // `onnx:PATH` is relative to the program's folder.
+        let at = super::here(eval);
+        let file = at.rsplitn(3, ':').nth(2).unwrap_or_default();
+        let base = std::path::Path::new(file)
+            .parent()
+            .unwrap_or(std::path::Path::new(""));
+        let sut = SutConfig::named(sut.unwrap_or("aeb"), base).map_err(anyhow::Error::msg)?;
         let initial_speed_mps = match speed {
             Some(v) => number(v, "AutonomousVehicle(speed=), the initial speed,")?,
             None => AebConfig::default().cruise.target_speed_mps,

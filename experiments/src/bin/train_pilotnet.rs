@@ -1,0 +1,285 @@
+//! Trains the PilotNet-style network ([`paracosm_experiments::pilotnet`]) on a data set
+//! written by `paracosm-fuzz dataset`, on the CPU with candle-nn, and writes it as ONNX with
+//! its manifest and a model card.
+//!
+//! ```text
+//! paracosm-fuzz dataset experiments/scenarios/pilotnet_train.star --budget 96 --rate 10 \
+//!     --out experiments/out/pilotnet-data
+//! cargo run --release -p paracosm-experiments --bin train_pilotnet -- \
+//!     --data experiments/out/pilotnet-data --out assets/models/pilotnet
+//! ```
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use candle_core::{DType, Device, Tensor, Var};
+use candle_nn::{AdamW, Optimizer, ParamsAdamW, VarBuilder, VarMap};
+use clap::Parser;
+use paracosm_engine::sut::{preprocess, Manifest};
+use paracosm_experiments::pilotnet::{self, PilotNet, HEIGHT, WIDTH};
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use rayon::prelude::*;
+
+#[derive(Debug, Parser)]
+struct Args {
+    /// A folder written by `paracosm-fuzz dataset`.
+    #[arg(long)]
+    data: PathBuf,
+    /// Output prefix: writes PREFIX.onnx, PREFIX.toml and PREFIX.md.
+    #[arg(long, default_value = "experiments/out/pilotnet")]
+    out: PathBuf,
+    /// Passes over the training frames.
+    #[arg(long, default_value_t = 8)]
+    epochs: usize,
+    /// Frames per gradient step.
+    #[arg(long, default_value_t = 64)]
+    batch: usize,
+    /// AdamW learning rate.
+    #[arg(long, default_value_t = 1e-3)]
+    lr: f64,
+    /// Seeds the initial weights and the shuffling (ChaCha8).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Tests whose id modulo this is its last value are held out for validation.
+    #[arg(long, default_value_t = 8)]
+    holdout_every: u64,
+}
+
+struct Frames {
+    images: Vec<f32>,
+    speeds: Vec<f32>,
+    targets: Vec<f32>,
+    tests: Vec<u64>,
+}
+
+const PIXELS: usize = 3 * HEIGHT * WIDTH;
+
+fn load(data: &std::path::Path, manifest: &Manifest) -> Result<Frames> {
+    let index = data.join("frames.csv");
+    let mut reader =
+        csv::Reader::from_path(&index).with_context(|| format!("reading {}", index.display()))?;
+    let header = reader.headers()?.clone();
+    let col = |n: &str| {
+        header
+            .iter()
+            .position(|h| h == n)
+            .with_context(|| format!("{}: no column `{n}`", index.display()))
+    };
+    let (c_test, c_image, c_speed, c_throttle, c_steering) = (
+        col("test")?,
+        col("image")?,
+        col("ego_speed_mps")?,
+        col("throttle")?,
+        col("steering")?,
+    );
+    let rows: Vec<csv::StringRecord> = reader.records().collect::<Result<_, _>>()?;
+    let images: Vec<Vec<f32>> = rows
+        .par_iter()
+        .map(|r| {
+            let path = data.join(&r[c_image]);
+            let rgb = image::open(&path)
+                .with_context(|| format!("reading {}", path.display()))?
+                .to_rgb8();
+            Ok(preprocess(&rgb, &manifest.input))
+        })
+        .collect::<Result<_>>()?;
+    let mut f = Frames {
+        images: Vec::with_capacity(rows.len() * PIXELS),
+        speeds: Vec::new(),
+        targets: Vec::new(),
+        tests: Vec::new(),
+    };
+    for (r, x) in rows.iter().zip(images) {
+        if x.len() != PIXELS {
+            bail!("an input has {} values, not {PIXELS}", x.len());
+        }
+        f.images.extend(x);
+        f.speeds.push(r[c_speed].parse()?);
+        f.targets.push(r[c_throttle].parse()?);
+        f.targets.push(r[c_steering].parse()?);
+        f.tests.push(r[c_test].parse()?);
+    }
+    Ok(f)
+}
+
+fn batch(f: &Frames, idx: &[usize], dev: &Device) -> Result<(Tensor, Tensor, Tensor)> {
+    let mut x = Vec::with_capacity(idx.len() * PIXELS);
+    let (mut s, mut y) = (Vec::new(), Vec::new());
+    for &i in idx {
+        x.extend_from_slice(&f.images[i * PIXELS..(i + 1) * PIXELS]);
+        s.push(f.speeds[i]);
+        y.extend_from_slice(&f.targets[2 * i..2 * i + 2]);
+    }
+    let n = idx.len();
+    Ok((
+        Tensor::from_vec(x, (n, 3, HEIGHT, WIDTH), dev)?,
+        Tensor::from_vec(s, (n, 1), dev)?,
+        Tensor::from_vec(y, (n, 2), dev)?,
+    ))
+}
+
+/// Mean squared error of throttle and steering, and the share of frames on which the network
+/// and the teacher agree about braking (throttle < -0.5), over `idx`.
+fn evaluate(net: &PilotNet, f: &Frames, idx: &[usize], dev: &Device) -> Result<[f64; 3]> {
+    let (mut se, mut agree) = ([0.0f64; 2], 0usize);
+    for chunk in idx.chunks(256) {
+        let (x, s, y) = batch(f, chunk, dev)?;
+        let p = net.forward(&x, &s)?.to_vec2::<f32>()?;
+        let y = y.to_vec2::<f32>()?;
+        for (p, y) in p.iter().zip(&y) {
+            for k in 0..2 {
+                se[k] += f64::from(p[k] - y[k]).powi(2);
+            }
+            agree += usize::from((p[0] < -0.5) == (y[0] < -0.5));
+        }
+    }
+    let n = idx.len().max(1) as f64;
+    Ok([se[0] / n, se[1] / n, agree as f64 / n])
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse();
+    let started = Instant::now();
+    let manifest = Manifest::parse(pilotnet::MANIFEST, std::path::Path::new("pilotnet.toml"))
+        .map_err(anyhow::Error::msg)?;
+    let frames = load(&args.data, &manifest)?;
+    let n = frames.speeds.len();
+    let (train, valid): (Vec<usize>, Vec<usize>) =
+        (0..n).partition(|&i| frames.tests[i] % args.holdout_every != args.holdout_every - 1);
+    let braking = |idx: &[usize]| {
+        idx.iter()
+            .filter(|&&i| frames.targets[2 * i] < -0.5)
+            .count()
+    };
+    eprintln!(
+        "{n} frames ({} training, {} braking; {} validation, {} braking) loaded in {:.1} s",
+        train.len(),
+        braking(&train),
+        valid.len(),
+        braking(&valid),
+        started.elapsed().as_secs_f64()
+    );
+    let dev = Device::Cpu;
+    let varmap = VarMap::new();
+    {
+        let mut vars = varmap.data().lock().expect("a fresh lock");
+        for (name, t) in pilotnet::tensors(&pilotnet::initial_weights(args.seed), &dev)? {
+            vars.insert(name, Var::from_tensor(&t)?);
+        }
+    }
+    let vb = VarBuilder::from_varmap(&varmap, DType::F32, &dev);
+    let net = PilotNet::new(&vb)?;
+    let mut opt = AdamW::new(
+        varmap.all_vars(),
+        ParamsAdamW {
+            lr: args.lr,
+            weight_decay: 0.0,
+            ..Default::default()
+        },
+    )?;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
+    let mut order = train.clone();
+    let mut log = Vec::new();
+    for epoch in 0..args.epochs {
+        order.shuffle(&mut rng);
+        let mut total = 0.0;
+        for chunk in order.chunks(args.batch) {
+            let (x, s, y) = batch(&frames, chunk, &dev)?;
+            let loss = candle_nn::loss::mse(&net.forward(&x, &s)?, &y)?;
+            opt.backward_step(&loss)?;
+            total += f64::from(loss.to_scalar::<f32>()?) * chunk.len() as f64;
+        }
+        let [t, st, agree] = evaluate(&net, &frames, &valid, &dev)?;
+        let line = format!(
+            "epoch {}: training MSE {:.4}; validation MSE throttle {t:.4}, steering {st:.5}, \
+             braking agreement {:.1} % ({:.0} s)",
+            epoch + 1,
+            total / train.len() as f64,
+            100.0 * agree,
+            started.elapsed().as_secs_f64()
+        );
+        eprintln!("{line}");
+        log.push(line);
+    }
+    // The trained weights, in the order of `pilotnet::variables`.
+    let vars = varmap.data().lock().expect("training is over");
+    let weights: Vec<pilotnet::Weight> = pilotnet::variables()
+        .into_iter()
+        .map(|(name, shape)| {
+            let v = vars[&name].as_tensor().flatten_all()?.to_vec1::<f32>()?;
+            Ok((name, shape, v))
+        })
+        .collect::<Result<_>>()?;
+    drop(vars);
+    let [t, st, agree] = evaluate(&net, &frames, &valid, &dev)?;
+    let dataset: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(args.data.join("dataset.json")).context("reading dataset.json")?,
+    )?;
+    let doc = format!(
+        "PilotNet-style driver trained by paracosm-experiments train_pilotnet on {}",
+        dataset["scenario"]
+    );
+    let onnx = pilotnet::to_onnx(&weights, &doc);
+    if let Some(dir) = args.out.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let path = |ext: &str| args.out.with_extension(ext);
+    std::fs::write(path("onnx"), &onnx)?;
+    std::fs::write(path("toml"), pilotnet::MANIFEST)?;
+    let card = format!(
+        "# Model card: pilotnet\n\n\
+         A PilotNet-style network (Bojarski et al. 2016, the system PARACOSM §4.2.2 tests), \
+         scaled down for CPU: 4 convolutions, 3 dense layers, {params} parameters; input a \
+         48 × 96 crop of the 320 × 240 camera (rows 96–200, columns 60–260) and the ego speed; \
+         output throttle and steering in (-1, 1).\n\n\
+         | | |\n|---|---|\n\
+         | training scenario | `{scenario}` |\n\
+         | teacher | `{teacher}` (lidar time-to-collision braking, lane keeping) |\n\
+         | tests | {tests} ({strategy} points, seed {dseed}) at {rate} frames/s |\n\
+         | frames | {n} ({ntrain} training, {nvalid} validation: tests with id mod {h} = {hl}) |\n\
+         | training | candle-nn {cv}, AdamW lr {lr}, batch {batch}, {epochs} epochs, seed {seed}, \
+         MSE on (throttle, steering) |\n\
+         | validation MSE | throttle {t:.4}, steering {st:.5} |\n\
+         | braking agreement | {agree:.1} % of validation frames (throttle < -0.5 on both or \
+         neither) |\n\
+         | training time | {secs:.0} s on {threads} threads |\n\
+         | file | `pilotnet.onnx`, {bytes} bytes, ONNX opset 13; manifest `pilotnet.toml` |\n\n\
+         Parameter ranges of the training data are those of the scenario (see its header). \
+         Outside them the network has seen nothing: that is what the studies in README, \
+         \"Testing a learned driver\", probe.\n\n\
+         Training log:\n\n```\n{log}\n```\n",
+        params = pilotnet::parameter_count(),
+        scenario = dataset["scenario"].as_str().unwrap_or("?"),
+        teacher = dataset["teacher"].as_str().unwrap_or("?"),
+        tests = dataset["tests"],
+        strategy = dataset["strategy"].as_str().unwrap_or("?"),
+        dseed = dataset["seed"],
+        rate = dataset["rate_hz"],
+        ntrain = train.len(),
+        nvalid = valid.len(),
+        h = args.holdout_every,
+        hl = args.holdout_every - 1,
+        cv = "0.11",
+        lr = args.lr,
+        batch = args.batch,
+        epochs = args.epochs,
+        seed = args.seed,
+        agree = 100.0 * agree,
+        secs = started.elapsed().as_secs_f64(),
+        threads = rayon::current_num_threads(),
+        bytes = onnx.len(),
+        log = log.join("\n"),
+    );
+    std::fs::write(path("md"), card)?;
+    println!(
+        "wrote {} ({} bytes), {} and {} in {:.0} s",
+        path("onnx").display(),
+        onnx.len(),
+        path("toml").display(),
+        path("md").display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
