@@ -24,6 +24,7 @@ use std::time::Instant;
 
 use ndarray::Array2;
 use paracosm_engine::sut::SutConfig;
+use paracosm_engine::Control;
 use paracosm_engine::{CameraFrame, CameraSpec, ObjectBox, SemanticClass};
 use paracosm_generators::{Strategy, Value};
 use paracosm_scenarios::{RunOptions, Sample};
@@ -67,6 +68,72 @@ pub struct DatasetRequest {
     pub replace: bool,
     /// Worker threads, `>= 1`.
     pub jobs: usize,
+    /// Steering noise injected into what the vehicle applies, in steering units (`[-1, 1]`
+    /// is the full lock), `[0, 1]`; 0: none. See [`SteerNoise`].
+    pub steer_noise: f64,
+    /// How long each noise value is held, s, `> 0`.
+    pub noise_hold_s: f64,
+}
+
+/// Noise injected into the teacher's steering while it drives (DART: Laskey et al. 2017,
+/// "DART: Noise Injection for Robust Imitation Learning"). A network cloned from a teacher that
+/// never leaves the lane centre has seen no way back to it; with noise, the vehicle drifts and
+/// the teacher's answers, which `frames.csv` records as `steering` (the label), steer back.
+/// What the vehicle applied is the column `applied_steering`.
+///
+/// The noise is piecewise constant: a value drawn uniformly from `[-amplitude, amplitude]`
+/// every `hold_s` seconds, from a ChaCha8 stream seeded by the test's seed, so a data set is
+/// the same for any `--jobs`.
+#[derive(Debug, Clone)]
+pub struct SteerNoise {
+    amplitude: f64,
+    hold_s: f64,
+    rng: rand_chacha::ChaCha8Rng,
+    value: f64,
+    next_s: f64,
+}
+
+impl SteerNoise {
+    /// Noise of `amplitude` (steering units, `[0, 1]`) held `hold_s` seconds (`> 0`), drawn
+    /// from `seed`.
+    ///
+    /// # Errors
+    /// [`Error::BadInput`] for an amplitude outside `[0, 1]` or a hold that is not a positive
+    /// number.
+    pub fn new(amplitude: f64, hold_s: f64, seed: u64) -> Result<Self, Error> {
+        if !(0.0..=1.0).contains(&amplitude) {
+            return Err(Error::BadInput(format!(
+                "--steer-noise {amplitude} must be in [0, 1] (steering units; 1 is full lock)"
+            )));
+        }
+        if !(hold_s.is_finite() && hold_s > 0.0) {
+            return Err(Error::BadInput(format!(
+                "--noise-hold {hold_s} must be a positive number of seconds"
+            )));
+        }
+        use rand::SeedableRng;
+        Ok(Self {
+            amplitude,
+            hold_s,
+            rng: rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ 0x6e6f_6973_655f_7374),
+            value: 0.0,
+            next_s: 0.0,
+        })
+    }
+
+    /// The control to apply at `t_s` for the teacher's `answer`: its steering plus the noise
+    /// value current at `t_s`, clamped to `[-1, 1]`; throttle unchanged.
+    pub fn apply(&mut self, t_s: f64, answer: Control) -> Control {
+        use rand::Rng;
+        while t_s + 1e-9 >= self.next_s {
+            self.value = self.amplitude * (2.0 * self.rng.random::<f64>() - 1.0);
+            self.next_s += self.hold_s;
+        }
+        Control {
+            steering: (answer.steering + self.value).clamp(-1.0, 1.0),
+            ..answer
+        }
+    }
 }
 
 /// What an export wrote.
@@ -133,6 +200,7 @@ struct FrameRow {
     ego: paracosm_engine::EgoState,
     throttle: f64,
     steering: f64,
+    applied_steering: f64,
     boxes: Vec<ObjectBox>,
 }
 
@@ -208,6 +276,7 @@ pub fn export(req: &DatasetRequest, stop: Option<&AtomicBool>) -> Result<Dataset
             req.rate_hz
         )));
     }
+    SteerNoise::new(req.steer_noise, req.noise_hold_s, 0)?;
     let camera = CameraSpec {
         rate_hz: req.rate_hz,
         ..req.camera.clone()
@@ -244,7 +313,7 @@ pub fn export(req: &DatasetRequest, stop: Option<&AtomicBool>) -> Result<Dataset
                 if stop.is_some_and(|s| s.load(Ordering::SeqCst)) {
                     return Ok(None);
                 }
-                record_test(&campaign, id as u64, point, &camera, req.rate_hz, out).map(Some)
+                record_test(&campaign, id as u64, point, &camera, req, out).map(Some)
             })
             .collect()
     });
@@ -266,9 +335,16 @@ fn record_test(
     id: u64,
     point: &paracosm_generators::Point,
     camera: &CameraSpec,
-    rate_hz: f64,
+    req: &DatasetRequest,
     out: &Path,
 ) -> Result<TestData, Error> {
+    let rate_hz = req.rate_hz;
+    let mut noise = SteerNoise::new(
+        req.steer_noise,
+        req.noise_hold_s,
+        crate::seed::test_seed(req.seed, id),
+    )?;
+    let mut perturb = |t_s: f64, c: Control| noise.apply(t_s, c);
     let mut rows = Vec::new();
     let mut failed = None;
     // Frames are kept on the grid k / rate_hz: a teacher's own camera may be faster.
@@ -294,6 +370,7 @@ fn record_test(
             ego: s.ego,
             throttle: s.control.throttle,
             steering: s.control.steering,
+            applied_steering: s.applied.steering,
             boxes: s.frame.boxes(),
         });
     };
@@ -304,6 +381,7 @@ fn record_test(
             camera: Some(camera.clone()),
             on_frame: None,
             on_sample: Some(&mut on_sample),
+            perturb: (req.steer_noise > 0.0).then_some(&mut perturb as &mut dyn FnMut(_, _) -> _),
         },
     );
     match failed {
@@ -398,6 +476,7 @@ fn write_index(
             "ego_speed_mps",
             "throttle",
             "steering",
+            "applied_steering",
         ]
         .map(String::from),
     );
@@ -431,6 +510,7 @@ fn write_index(
                     r.ego.speed_mps,
                     r.throttle,
                     r.steering,
+                    r.applied_steering,
                 ]
                 .map(|v| v.to_string()),
             );
@@ -501,6 +581,8 @@ fn write_index(
         "seed": req.seed,
         "budget": req.budget,
         "rate_hz": req.rate_hz,
+        "steer_noise": req.steer_noise,
+        "noise_hold_s": req.noise_hold_s,
         "teacher": scenario.sut.name(),
         "camera": camera,
         "tests": done.len(),
@@ -511,7 +593,7 @@ fn write_index(
         "depth": "z-depth along the optical axis in metres, float32 .npy, height x width; inf where only sky",
         "mask": "8-bit PNG, each pixel a class id",
         "classes": SemanticClass::ALL.iter().map(|c| (c.name(), c.id())).collect::<std::collections::BTreeMap<_, _>>(),
-        "control": "throttle in [-1, 1] (negative: brake), steering in [-1, 1] (positive: left), as the teacher answered for the frame's step",
+        "control": "throttle in [-1, 1] (negative: brake), steering in [-1, 1] (positive: left), as the teacher answered for the frame's step; applied_steering: what the vehicle applied (the answer plus the injected steer_noise)",
     });
     let manifest_path = out.join(MANIFEST_FILE);
     crate::atomic::write(

@@ -156,6 +156,7 @@ pub fn replay(
             camera: frames.map(|_| CameraSpec::default()),
             on_frame: Some(&mut on_frame),
             on_sample: None,
+            perturb: None,
         },
     );
     if let Some(e) = write_error {

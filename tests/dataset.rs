@@ -160,6 +160,18 @@ fn bad_dataset_settings_exit_2_with_the_reason() {
         (&["--strategy", "falsify-nm"][..], "its points exist only"),
         (&["--width", "0"][..], "outside 1..=4096"),
         (&["--sut", "lidar"][..], "unknown system under test"),
+        (
+            &["--steer-noise", "1.5"][..],
+            "--steer-noise 1.5 must be in [0, 1]",
+        ),
+        (
+            &["--steer-noise", "nan"][..],
+            "--steer-noise NaN must be in [0, 1]",
+        ),
+        (
+            &["--noise-hold", "0"][..],
+            "--noise-hold 0 must be a positive",
+        ),
     ] {
         let r = o(extra);
         expect_code(&r, 2);
@@ -174,5 +186,75 @@ fn bad_dataset_settings_exit_2_with_the_reason() {
     assert_eq!(
         std::fs::read_to_string(out.join("keep.txt")).unwrap(),
         "mine"
+    );
+}
+
+/// The columns `steering` and `applied_steering` of `dir/frames.csv`.
+fn steering(dir: &Path) -> Vec<(f64, f64)> {
+    let mut rows = csv::Reader::from_path(dir.join("frames.csv")).unwrap();
+    let header: Vec<String> = rows.headers().unwrap().iter().map(String::from).collect();
+    let col = |n: &str| header.iter().position(|h| h == n).unwrap();
+    let (s, a) = (col("steering"), col("applied_steering"));
+    rows.records()
+        .map(|r| {
+            let r = r.unwrap();
+            (r[s].parse().unwrap(), r[a].parse().unwrap())
+        })
+        .collect()
+}
+
+fn spread(v: impl Iterator<Item = f64> + Clone) -> f64 {
+    let n = v.clone().count() as f64;
+    let mean = v.clone().sum::<f64>() / n;
+    (v.map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt()
+}
+
+#[test]
+fn steering_noise_moves_the_car_and_the_teacher_steers_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let (clean, noisy, noisy2) = (
+        dir.path().join("clean"),
+        dir.path().join("noisy"),
+        dir.path().join("noisy2"),
+    );
+    export(&clean, "2", &[]);
+    let noise = ["--steer-noise", "0.2", "--noise-hold", "0.5"];
+    export(&noisy, "1", &noise);
+    export(&noisy2, "2", &noise);
+    let (a, b) = (tree(&noisy), tree(&noisy2));
+    for (name, bytes) in &a {
+        assert!(bytes == &b[name], "{name} differs between --jobs 1 and 2");
+    }
+    // Without noise the vehicle applies the teacher's answer.
+    let c = steering(&clean);
+    assert!(c.iter().all(|(s, a)| s == a));
+    // With it, what the vehicle applied differs from the answer by at most the amplitude,
+    // and does on most frames.
+    let n = steering(&noisy);
+    assert!(n.iter().all(|(s, a)| (s - a).abs() <= 0.2 + 1e-12));
+    let moved = n.iter().filter(|(s, a)| (s - a).abs() > 1e-3).count();
+    assert!(
+        moved * 10 > n.len() * 9,
+        "{moved} of {} frames perturbed",
+        n.len()
+    );
+    // The teacher answers the drift: its steering varies far more than on the clean run,
+    // and against the noise (a recovery), so the labels teach the way back.
+    let (sc, sn) = (spread(c.iter().map(|p| p.0)), spread(n.iter().map(|p| p.0)));
+    assert!(
+        sn > 5.0 * sc + 1e-3,
+        "teacher's steering spread {sn} with noise, {sc} without"
+    );
+    let against = n
+        .iter()
+        .filter(|(s, a)| (a - s).abs() > 0.05 && (a - s).signum() != s.signum())
+        .count();
+    let along = n
+        .iter()
+        .filter(|(s, a)| (a - s).abs() > 0.05 && (a - s).signum() == s.signum())
+        .count();
+    assert!(
+        against > along,
+        "teacher steered against the noise on {against} frames, with it on {along}"
     );
 }

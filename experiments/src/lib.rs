@@ -5,9 +5,12 @@
 //!   by side (paper §4.2.2, Figure 9).
 //! - [`falsification::falsification_study`]: simulations until the first failure, random and
 //!   quasi-random sampling against the adaptive falsifiers.
+//! - [`figure10`]: the paper's Figure 10 studies with learned drivers: light × fog, a 200 s
+//!   loop against fog, and other 3-D components (§4.2.2).
 #![warn(missing_docs)]
 
 pub mod falsification;
+pub mod figure10;
 pub mod onnx_export;
 pub mod pilotnet;
 

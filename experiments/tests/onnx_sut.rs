@@ -256,6 +256,8 @@ fn the_shipped_pilotnet_gives_tract_the_outputs_candle_computes() {
             out: dir.path().join("d"),
             replace: false,
             jobs: 2,
+            steer_noise: 0.0,
+            noise_hold_s: 1.0,
         },
         None,
     )

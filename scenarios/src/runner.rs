@@ -190,9 +190,12 @@ pub struct Sample<'a> {
     pub frame: &'a CameraFrame,
     /// The ego vehicle's state at the frame.
     pub ego: EgoState,
-    /// The control the system under test applies from this step on (its answer at this
-    /// step, or the one it holds between decisions).
+    /// The control the system under test answered for this step (or the answer it holds
+    /// between decisions): the label of a training sample.
     pub control: Control,
+    /// The control the vehicle applies from this step on: [`Sample::control`], or what
+    /// [`RunOptions::perturb`] made of it.
+    pub applied: Control,
 }
 
 /// Extras for one run: a camera to watch it with, and callbacks for every camera frame
@@ -207,6 +210,13 @@ pub struct RunOptions<'a> {
     /// Called with every frame the camera takes, with the ego's state and the control the
     /// system under test applies at that step.
     pub on_sample: Option<&'a mut dyn FnMut(&Sample<'_>)>,
+    /// Called each time the system under test decides, with the simulated time (s) and its
+    /// answer; the vehicle applies what it returns until the next decision. For noise
+    /// injection into training data (DART: Laskey et al. 2017, "DART: Noise Injection for
+    /// Robust Imitation Learning"): the vehicle drifts off the teacher's path and the
+    /// teacher's answers, recorded as [`Sample::control`], show how to recover. `None`: the
+    /// answer is applied as it is.
+    pub perturb: Option<&'a mut dyn FnMut(f64, Control) -> Control>,
 }
 
 /// Every how many physics steps something at `hz` happens (at least every step).
@@ -289,6 +299,7 @@ impl Scenario {
         let mut stopped = watch.observe(&sim)?;
         let mut tick = 0;
         let mut control = Control::default();
+        let mut applied = Control::default();
         while !stopped && tick < ticks {
             if frame_every > 0 && tick % frame_every == 0 {
                 if let (Some(f), Some(frame)) = (options.on_frame.as_mut(), sim.camera_frame()) {
@@ -303,6 +314,10 @@ impl Scenario {
                     obs.readings.retain(|(name, _)| *name != "camera");
                 }
                 control = sut.act(&obs)?;
+                applied = match options.perturb.as_mut() {
+                    Some(p) => p(tick as f64 * spec.dt_s, control),
+                    None => control,
+                };
             }
             if frame_every > 0 && tick % frame_every == 0 {
                 if let (Some(f), Some(frame)) = (options.on_sample.as_mut(), sim.camera_frame()) {
@@ -310,10 +325,11 @@ impl Scenario {
                         frame,
                         ego: sim.ego_state(),
                         control,
+                        applied,
                     });
                 }
             }
-            sim.step(control, host)?;
+            sim.step(applied, host)?;
             tick += 1;
             sim.evaluate(host)?;
             stopped = watch.observe(&sim)?;

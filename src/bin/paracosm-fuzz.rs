@@ -157,6 +157,13 @@ struct DatasetArgs {
     /// Replace what --out holds.
     #[arg(long)]
     force: bool,
+    /// Steering noise added to what the vehicle applies, in steering units (1 = full lock),
+    /// so that the teacher's recorded answers show how to recover (DART; README).
+    #[arg(long, value_name = "AMPLITUDE", default_value_t = 0.0)]
+    steer_noise: f64,
+    /// Seconds each noise value is held.
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    noise_hold: f64,
     /// The teacher, instead of the scenario's system under test.
     #[command(flatten)]
     sut: SutArgs,
@@ -222,6 +229,8 @@ impl DatasetArgs {
             out: self.out.clone(),
             replace: self.force,
             jobs: self.jobs.map_or_else(num_cpus, |j| j as usize),
+            steer_noise: self.steer_noise,
+            noise_hold_s: self.noise_hold,
         })
     }
 }

@@ -2,12 +2,14 @@
 //! machines without system fonts: the failure map and the failure-rate heat map over any one
 //! or two parameters, continuous or discrete ([`map`]), the scatterplot matrix of every
 //! parameter ([`pairs_plot`]), contact sheets of camera frames
-//! ([`sheet`]) and box plots ([`boxes`]).
+//! ([`sheet`]), box plots ([`boxes`]), and measured values over two axes or as series
+//! ([`value_map`], [`xy_plot`]).
 
 mod axis;
 mod boxes;
 mod map;
 mod pairs;
+mod series;
 mod sheet;
 
 use std::path::{Path, PathBuf};
@@ -22,6 +24,7 @@ pub use boxes::{box_plot, BoxPanel};
 pub(crate) use map::robustness_span;
 pub use map::{adaptive_bins, failure_map, failure_rate_map, failure_rates, Coloring, RateGrid};
 pub use pairs::{pairs_plot, MAX_PAIRS};
+pub use series::{value_map, xy_plot, Series, ValueMapLabels, ValuePoint, XyStyle};
 pub use sheet::contact_sheet;
 
 /// DejaVu Sans (Bitstream Vera license, see `assets/fonts/LICENSE`), bundled so plots draw on

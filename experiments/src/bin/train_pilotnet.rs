@@ -45,6 +45,17 @@ struct Args {
     /// Tests whose id modulo this is its last value are held out for validation.
     #[arg(long, default_value_t = 8)]
     holdout_every: u64,
+    /// Weight of the steering term of the loss against the throttle's (1: plain MSE). Raise
+    /// it for a network that must steer (the `loop` network), whose steering labels are small.
+    #[arg(long, default_value_t = 1.0)]
+    steering_weight: f32,
+    /// Train on the teacher's throttle averaged over a window of this many seconds centred
+    /// on each frame, within its test (0: as recorded). A braking rule that switches between
+    /// full brake and full throttle from one step to the next (`aeb` following a car) gives
+    /// labels that flip on near-identical images; their average over a window is the share
+    /// of braking, a smooth function of what the camera sees, which a network can learn.
+    #[arg(long, default_value_t = 0.0)]
+    smooth_s: f64,
 }
 
 struct Frames {
@@ -52,6 +63,29 @@ struct Frames {
     speeds: Vec<f32>,
     targets: Vec<f32>,
     tests: Vec<u64>,
+    times: Vec<f64>,
+}
+
+/// Replaces each frame's throttle target by the mean of its test's throttle over the frames
+/// within `window_s / 2` seconds of it (centred moving average, in place).
+fn smooth_throttle(f: &mut Frames, window_s: f64) {
+    let raw: Vec<f32> = (0..f.tests.len()).map(|i| f.targets[2 * i]).collect();
+    let n = raw.len();
+    let mut start = 0;
+    while start < n {
+        let mut end = start;
+        while end < n && f.tests[end] == f.tests[start] {
+            end += 1;
+        }
+        for i in start..end {
+            let near: Vec<f32> = (start..end)
+                .filter(|&j| (f.times[j] - f.times[i]).abs() <= window_s / 2.0 + 1e-9)
+                .map(|j| raw[j])
+                .collect();
+            f.targets[2 * i] = near.iter().sum::<f32>() / near.len() as f32;
+        }
+        start = end;
+    }
 }
 
 const PIXELS: usize = 3 * HEIGHT * WIDTH;
@@ -67,6 +101,7 @@ fn load(data: &std::path::Path, manifest: &Manifest) -> Result<Frames> {
             .position(|h| h == n)
             .with_context(|| format!("{}: no column `{n}`", index.display()))
     };
+    let c_time = col("t_s")?;
     let (c_test, c_image, c_speed, c_throttle, c_steering) = (
         col("test")?,
         col("image")?,
@@ -90,6 +125,7 @@ fn load(data: &std::path::Path, manifest: &Manifest) -> Result<Frames> {
         speeds: Vec::new(),
         targets: Vec::new(),
         tests: Vec::new(),
+        times: Vec::new(),
     };
     for (r, x) in rows.iter().zip(images) {
         if x.len() != PIXELS {
@@ -100,6 +136,7 @@ fn load(data: &std::path::Path, manifest: &Manifest) -> Result<Frames> {
         f.targets.push(r[c_throttle].parse()?);
         f.targets.push(r[c_steering].parse()?);
         f.tests.push(r[c_test].parse()?);
+        f.times.push(r[c_time].parse()?);
     }
     Ok(f)
 }
@@ -144,7 +181,10 @@ fn main() -> Result<()> {
     let started = Instant::now();
     let manifest = Manifest::parse(pilotnet::MANIFEST, std::path::Path::new("pilotnet.toml"))
         .map_err(anyhow::Error::msg)?;
-    let frames = load(&args.data, &manifest)?;
+    let mut frames = load(&args.data, &manifest)?;
+    if args.smooth_s > 0.0 {
+        smooth_throttle(&mut frames, args.smooth_s);
+    }
     let n = frames.speeds.len();
     let (train, valid): (Vec<usize>, Vec<usize>) =
         (0..n).partition(|&i| frames.tests[i] % args.holdout_every != args.holdout_every - 1);
@@ -182,12 +222,20 @@ fn main() -> Result<()> {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
     let mut order = train.clone();
     let mut log = Vec::new();
+    let weight = Tensor::new(&[1.0f32, args.steering_weight], &dev)?.reshape((1, 2))?;
     for epoch in 0..args.epochs {
         order.shuffle(&mut rng);
         let mut total = 0.0;
         for chunk in order.chunks(args.batch) {
             let (x, s, y) = batch(&frames, chunk, &dev)?;
-            let loss = candle_nn::loss::mse(&net.forward(&x, &s)?, &y)?;
+            let loss = if args.steering_weight == 1.0 {
+                candle_nn::loss::mse(&net.forward(&x, &s)?, &y)?
+            } else {
+                (net.forward(&x, &s)? - &y)?
+                    .sqr()?
+                    .broadcast_mul(&weight)?
+                    .mean_all()?
+            };
             opt.backward_step(&loss)?;
             total += f64::from(loss.to_scalar::<f32>()?) * chunk.len() as f64;
         }
@@ -228,8 +276,13 @@ fn main() -> Result<()> {
     let path = |ext: &str| args.out.with_extension(ext);
     std::fs::write(path("onnx"), &onnx)?;
     std::fs::write(path("toml"), pilotnet::MANIFEST)?;
+    let stem = args
+        .out
+        .file_name()
+        .map_or("pilotnet".into(), |n| n.to_string_lossy().into_owned());
+    let noise = dataset["steer_noise"].as_f64().unwrap_or(0.0);
     let card = format!(
-        "# Model card: pilotnet\n\n\
+        "# Model card: {stem}\n\n\
          A PilotNet-style network (Bojarski et al. 2016, the system PARACOSM §4.2.2 tests), \
          scaled down for CPU: 4 convolutions, 3 dense layers, {params} parameters; input a \
          48 × 96 crop of the 320 × 240 camera (rows 96–200, columns 60–260) and the ego speed; \
@@ -237,15 +290,15 @@ fn main() -> Result<()> {
          | | |\n|---|---|\n\
          | training scenario | `{scenario}` |\n\
          | teacher | `{teacher}` (lidar time-to-collision braking, lane keeping) |\n\
-         | tests | {tests} ({strategy} points, seed {dseed}) at {rate} frames/s |\n\
+         | tests | {tests} ({strategy} points, seed {dseed}) at {rate} frames/s{noise} |\n\
          | frames | {n} ({ntrain} training, {nvalid} validation: tests with id mod {h} = {hl}) |\n\
          | training | candle-nn {cv}, AdamW lr {lr}, batch {batch}, {epochs} epochs, seed {seed}, \
-         MSE on (throttle, steering) |\n\
+         MSE on (throttle, steering){sw} |\n\
          | validation MSE | throttle {t:.4}, steering {st:.5} |\n\
          | braking agreement | {agree:.1} % of validation frames (throttle < -0.5 on both or \
          neither) |\n\
          | training time | {secs:.0} s on {threads} threads |\n\
-         | file | `pilotnet.onnx`, {bytes} bytes, ONNX opset 13; manifest `pilotnet.toml` |\n\n\
+         | file | `{stem}.onnx`, {bytes} bytes, ONNX opset 13; manifest `{stem}.toml` |\n\n\
          Parameter ranges of the training data are those of the scenario (see its header). \
          Outside them the network has seen nothing: that is what the studies in README, \
          \"Testing a learned driver\", probe.\n\n\
@@ -271,6 +324,26 @@ fn main() -> Result<()> {
         threads = rayon::current_num_threads(),
         bytes = onnx.len(),
         log = log.join("\n"),
+        noise = if noise > 0.0 {
+            format!(
+                ", steering noise ±{noise} held {} s injected while the teacher drove (DART)",
+                dataset["noise_hold_s"]
+            )
+        } else {
+            String::new()
+        },
+        sw = if args.steering_weight == 1.0 {
+            String::new()
+        } else {
+            format!(", steering weighted {}", args.steering_weight)
+        } + &if args.smooth_s > 0.0 {
+            format!(
+                ", throttle targets averaged over {} s centred on each frame (validation too)",
+                args.smooth_s
+            )
+        } else {
+            String::new()
+        },
     );
     std::fs::write(path("md"), card)?;
     println!(

@@ -1,0 +1,127 @@
+//! `fig10`: the paper's Figure 10 studies with learned drivers (README, "Testing a learned
+//! driver").
+//!
+//! `cargo run --release -p paracosm-experiments --bin fig10 -- --docs docs`
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Parser;
+use paracosm_experiments::figure10::{self, LOOP_TIMEOUT_S};
+
+/// Reproduce PARACOSM Figure 10a, 10b and 10c with the networks of `experiments/models/`.
+#[derive(Debug, Parser)]
+#[command(name = "fig10")]
+struct Cli {
+    /// Which studies: a (light × fog), b (200 s loop against fog), c (3-D components).
+    #[arg(long, default_value = "abc")]
+    parts: String,
+    /// Halton tests of Figure 10a.
+    #[arg(long, default_value_t = 200, value_parser = paracosm::cli::positive)]
+    budget_a: u64,
+    /// Halton tests of Figure 10b.
+    #[arg(long, default_value_t = 40, value_parser = paracosm::cli::positive)]
+    budget_b: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Output folder; each study writes to OUT/fig10{a,b,c}/.
+    #[arg(long, default_value = "experiments/out")]
+    out: PathBuf,
+    /// Also copy each figure's PNG into this folder (as fig10a_follow.png, fig10b_loop.png,
+    /// fig10c_follow.png).
+    #[arg(long)]
+    docs: Option<PathBuf>,
+}
+
+/// `[lo, hi)` bands of width `step` over `[0, 1]`, the last one closed.
+fn band(x: f64, step: f64) -> usize {
+    ((x / step) as usize).min((1.0 / step).round() as usize - 1)
+}
+
+fn main() -> Result<()> {
+    let cli = Cli::parse();
+    let jobs = paracosm_experiments::jobs_or_all_cores(cli.jobs);
+    let copy = |from: &PathBuf, name: &str| -> Result<()> {
+        if let Some(docs) = &cli.docs {
+            std::fs::copy(from, docs.join(name))?;
+        }
+        Ok(())
+    };
+    if cli.parts.contains('a') {
+        let f = figure10::figure10a(cli.budget_a, jobs, &cli.out.join("fig10a"))?;
+        copy(&f.plots[0], "fig10a_follow.png")?;
+        println!(
+            "Figure 10a: {} tests ({} in error), {} collisions; wrote {}",
+            f.tests.len(),
+            f.errors,
+            f.tests.iter().filter(|t| t.collision).count(),
+            f.plots[0].display()
+        );
+        println!("collisions / tests and mean distance covered (m), light (columns) × fog (rows):");
+        println!("| fog \\ light | 0–0.2 | 0.2–0.4 | 0.4–0.6 | 0.6–0.8 | 0.8–1 |");
+        println!("|---|---|---|---|---|---|");
+        for fb in 0..4 {
+            let mut row = format!("| {:.2}–{:.2} |", fb as f64 * 0.25, fb as f64 * 0.25 + 0.25);
+            for lb in 0..5 {
+                let cell: Vec<_> = f
+                    .tests
+                    .iter()
+                    .filter(|t| band(t.fog, 0.25) == fb && band(t.light, 0.2) == lb)
+                    .collect();
+                let hits = cell.iter().filter(|t| t.collision).count();
+                let mean =
+                    cell.iter().map(|t| t.distance_m).sum::<f64>() / cell.len().max(1) as f64;
+                row.push_str(&format!(" {hits}/{}, {mean:.1} m |", cell.len()));
+            }
+            println!("{row}");
+        }
+    }
+    if cli.parts.contains('b') {
+        let f = figure10::figure10b(cli.budget_b, jobs, &cli.out.join("fig10b"))?;
+        copy(&f.plots[0], "fig10b_loop.png")?;
+        let failed = f
+            .tests
+            .iter()
+            .filter(|t| t.time_to_failure_s.is_some())
+            .count();
+        println!(
+            "Figure 10b: {} tests ({} in error), {failed} left the road within {LOOP_TIMEOUT_S} s; \
+             wrote {}",
+            f.tests.len(),
+            f.errors,
+            f.plots[0].display()
+        );
+        let mut sorted = f.tests.clone();
+        sorted.sort_by(|a, b| a.fog.total_cmp(&b.fog));
+        for t in &sorted {
+            match t.time_to_failure_s {
+                Some(s) => println!("  fog {:.3}: left the road at {s:.1} s", t.fog),
+                None => println!("  fog {:.3}: on the road at {LOOP_TIMEOUT_S} s", t.fog),
+            }
+        }
+    }
+    if cli.parts.contains('c') {
+        let f = figure10::figure10c(&cli.out.join("fig10c"))?;
+        copy(&f.plots[0], "fig10c_follow.png")?;
+        println!("Figure 10c: wrote {}", f.plots[0].display());
+        for c in &f.cases {
+            let at = |t: f64| {
+                c.speed
+                    .iter()
+                    .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+                    .map_or(f64::NAN, |p| p.1)
+            };
+            let low = c.speed.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+            println!(
+                "  {}: speed at 5/10/15/20 s {:.1}/{:.1}/{:.1}/{:.1} m/s, lowest {low:.1} m/s",
+                c.name,
+                at(5.0),
+                at(10.0),
+                at(15.0),
+                at(20.0)
+            );
+        }
+    }
+    Ok(())
+}
