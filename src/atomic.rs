@@ -1,5 +1,10 @@
 //! Whole-file writes that never leave a half-written file: write a temporary file in the same
 //! folder, then rename it over the target (atomic on POSIX file systems).
+//!
+//! A rename replaces whatever the target path names, so it is done only when the target is
+//! absent or a regular file. A symlink, a directory, a device (`/dev/full`, `/dev/null`) or a
+//! FIFO is refused with [`Error::BadInput`] (exit 2), before anything is written: paracosm
+//! never replaces what is not its own file (README, "Hostile input").
 
 use std::io::Write;
 use std::path::Path;
@@ -9,6 +14,7 @@ use crate::Error;
 /// Writes `bytes` to `path` through a temporary file and a rename.
 ///
 /// # Errors
+/// [`Error::BadInput`] when `path` is neither absent nor a regular file ([`check_target`]);
 /// [`Error::Write`] naming `path` with the file system's reason (e.g. no space left on
 /// device); the previous contents of `path`, if any, are then untouched.
 pub fn write(path: &Path, bytes: &[u8]) -> Result<(), Error> {
@@ -23,12 +29,14 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<(), Error> {
 /// over `path`. For writers that want a path, such as plotters' backends.
 ///
 /// # Errors
+/// [`Error::BadInput`] when `path` is neither absent nor a regular file ([`check_target`]);
 /// [`Error::Write`] naming `path` when `fill` or the rename fails; the temporary file is
 /// removed.
 pub fn with_temp<E: std::fmt::Display>(
     path: &Path,
     fill: impl FnOnce(&Path) -> Result<(), E>,
 ) -> Result<(), Error> {
+    check_target(path)?;
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
     let dir = dir.unwrap_or(Path::new("."));
     let suffix = path
@@ -43,6 +51,81 @@ pub fn with_temp<E: std::fmt::Display>(
     let tmp_path = tmp.into_temp_path();
     fill(&tmp_path).map_err(|e| Error::write(path, e))?;
     tmp_path.persist(path).map_err(|e| Error::write(path, e))
+}
+
+/// What `path` names when it is not a regular file: "a symlink", "a directory", "a device or
+/// a FIFO"; `None` when it is a regular file or absent (or cannot be looked at: the write then
+/// reports why).
+fn not_regular(path: &Path) -> Option<&'static str> {
+    let meta = std::fs::symlink_metadata(path).ok()?;
+    let t = meta.file_type();
+    if t.is_file() {
+        None
+    } else if t.is_symlink() {
+        Some("a symbolic link")
+    } else if t.is_dir() {
+        Some("a directory")
+    } else {
+        Some("a device, FIFO or socket")
+    }
+}
+
+/// Checks that an output path may be replaced by a rename: it is absent or a regular file.
+///
+/// # Errors
+/// [`Error::BadInput`] naming `path` and what it is (a symbolic link, a directory, a device,
+/// FIFO or socket).
+pub fn check_target(path: &Path) -> Result<(), Error> {
+    match not_regular(path) {
+        None => Ok(()),
+        Some(what) => Err(Error::BadInput(format!(
+            "`{}` is {what}: paracosm writes an output through a temporary file and a rename, \
+             which would replace it, so it writes only to a new or a regular file; give \
+             another path",
+            path.display()
+        ))),
+    }
+}
+
+/// The files of a campaign folder that the campaign itself writes and reads back.
+pub const CAMPAIGN_OWNED: [&str; 3] = ["results.jsonl", "campaign.json", "summary.json"];
+
+/// Checks a path given for another output (`--junit`) of the campaign in `out`: it may be
+/// replaced ([`check_target`]) and is not one of the campaign's own files
+/// ([`CAMPAIGN_OWNED`]) in `out`.
+///
+/// # Errors
+/// [`Error::BadInput`] naming `path` and `option`.
+pub fn check_side_output(path: &Path, option: &str, out: &Path) -> Result<(), Error> {
+    check_target(path)?;
+    let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
+        return Ok(());
+    };
+    if !CAMPAIGN_OWNED.contains(&name) {
+        return Ok(());
+    }
+    let absolute = |p: &Path| -> std::path::PathBuf {
+        let p = if p.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            p
+        };
+        std::fs::canonicalize(p).unwrap_or_else(|_| {
+            std::env::current_dir()
+                .map(|d| d.join(p))
+                .unwrap_or_else(|_| p.to_path_buf())
+        })
+    };
+    let dir = path.parent().unwrap_or(Path::new("."));
+    if absolute(dir) == absolute(out) {
+        return Err(Error::BadInput(format!(
+            "{option} `{}` is the campaign's own `{name}` in `{}`: writing there would destroy \
+             it; give another path",
+            path.display(),
+            out.display()
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -69,5 +152,48 @@ mod tests {
         assert_eq!(names, ["summary.json"]);
         write(&target, b"new").unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"new");
+    }
+
+    #[test]
+    fn links_directories_and_devices_are_refused_and_left_alone() {
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("real.xml");
+        std::fs::write(&real, b"mine").unwrap();
+        let link = dir.path().join("link.xml");
+        std::os::unix::fs::symlink(&real, &link).unwrap();
+        for (path, what) in [
+            (link.as_path(), "symbolic link"),
+            (dir.path(), "directory"),
+            (Path::new("/dev/null"), "device"),
+        ] {
+            let e = write(path, b"x").unwrap_err();
+            assert!(matches!(e, Error::BadInput(_)), "{e}");
+            assert!(e.to_string().contains(what), "{e}");
+        }
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read(&real).unwrap(), b"mine");
+        // A regular file and an absent one are written.
+        write(&real, b"new").unwrap();
+        write(&dir.path().join("fresh.xml"), b"new").unwrap();
+    }
+
+    #[test]
+    fn the_campaign_s_own_files_are_refused_as_side_outputs() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("d");
+        for name in CAMPAIGN_OWNED {
+            let e = check_side_output(&out.join(name), "--junit", &out).unwrap_err();
+            assert!(e.to_string().contains("campaign's own"), "{e}");
+        }
+        // The same names elsewhere, and other names inside, are fine.
+        check_side_output(&dir.path().join("results.jsonl"), "--junit", &out).unwrap();
+        check_side_output(&out.join("junit.xml"), "--junit", &out).unwrap();
+        // Spelled another way, it is still the same folder.
+        std::fs::create_dir_all(&out).unwrap();
+        let other = dir.path().join("d/../d/summary.json");
+        assert!(check_side_output(&other, "--junit", &out).is_err());
     }
 }

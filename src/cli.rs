@@ -60,7 +60,8 @@ pub struct SutArgs {
     /// e.g. "python3 my_controller.py" (split like a shell would, without expansion).
     #[arg(long, value_name = "COMMAND")]
     pub sut_cmd: Option<String>,
-    /// With --sut-cmd: longest wait for any answer of the program, in seconds.
+    /// With --sut-cmd: longest wait for any answer of the program, in seconds (at most
+    /// 3600).
     #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
     pub sut_timeout: f64,
     /// With --sut-cmd: start a fresh process for every test, instead of keeping one alive
@@ -69,18 +70,24 @@ pub struct SutArgs {
     pub sut_fresh: bool,
 }
 
+/// The longest `--sut-timeout`, s: an hour. Longer waits are no use to a test and overflow
+/// the clock's arithmetic.
+pub const MAX_SUT_TIMEOUT_S: f64 = 3600.0;
+
 impl SutArgs {
     /// The system under test chosen (`--sut NAME` or `--sut-cmd COMMAND`), or `None` to keep
     /// the scenario's.
     ///
     /// # Errors
     /// [`Error::BadInput`] for an unknown name, a command that does not split (an unclosed
-    /// quote) or is empty, or a timeout that is not a positive number of seconds.
+    /// quote) or is empty, or a timeout that is not a positive number of seconds up to
+    /// [`MAX_SUT_TIMEOUT_S`].
     pub fn config(&self) -> Result<Option<SutConfig>, Error> {
         let timeout_s = self.sut_timeout;
-        if !(timeout_s.is_finite() && timeout_s > 0.0) {
+        if !(timeout_s.is_finite() && timeout_s > 0.0 && timeout_s <= MAX_SUT_TIMEOUT_S) {
             return Err(Error::BadInput(format!(
-                "--sut-timeout {timeout_s} must be a positive number of seconds"
+                "--sut-timeout {timeout_s} must be a positive number of seconds, at most \
+                 {MAX_SUT_TIMEOUT_S} (an hour)"
             )));
         }
         if let Some(model) = &self.sut_onnx {
@@ -126,6 +133,50 @@ pub struct Redraw {
     /// Write the campaign's web page again (`report.html`).
     #[arg(long)]
     pub html: bool,
+}
+
+/// The text a tool prints on stderr for an error whose message is `message`: the first line
+/// is always `TOOL: error: REASON`, then the location and the caret where there is one, then
+/// (for an error raised inside a function of the program) the Starlark call stack, after the
+/// reason rather than before it.
+pub fn error_text(tool: &str, message: &str) -> String {
+    const TRACEBACK: &str = "Traceback (most recent call last):";
+    let (stack, rest) = match message.strip_prefix(TRACEBACK) {
+        Some(after) => match after.find("\nerror: ") {
+            Some(k) => (Some(after[..k].trim_matches('\n')), &after[k + 1..]),
+            None => (None, message),
+        },
+        None => (None, message),
+    };
+    let rest = rest.strip_prefix("error: ").unwrap_or(rest);
+    let mut out = format!("{tool}: error: {}", rest.trim_end());
+    if let Some(stack) = stack {
+        out.push_str(&format!("\n{TRACEBACK}\n{stack}"));
+    }
+    out
+}
+
+#[cfg(test)]
+mod error_text_tests {
+    use super::error_text;
+
+    #[test]
+    fn the_reason_comes_first_and_the_call_stack_after_it() {
+        let m = "Traceback (most recent call last):\n  * a.star:3, in <module>\n      x = f(5.0)\n\
+                 error: VarInterval(5, 1) is empty\n --> a.star:2:12\n  |\n";
+        let t = error_text("paracosm-fuzz", m);
+        let lines: Vec<&str> = t.lines().collect();
+        assert_eq!(lines[0], "paracosm-fuzz: error: VarInterval(5, 1) is empty");
+        assert_eq!(lines[1], " --> a.star:2:12");
+        assert!(t.contains("Traceback (most recent call last):\n  * a.star:3, in <module>"));
+        assert!(t.find("Traceback").unwrap() > t.find("-->").unwrap());
+        // A message that already says `error:` is not doubled; any other gets it.
+        assert_eq!(error_text("t", "error: x"), "t: error: x");
+        assert_eq!(
+            error_text("t", "`d` is not a folder"),
+            "t: error: `d` is not a folder"
+        );
+    }
 }
 
 /// Parses a count that must be at least 1 (`--budget`, `-n`). A clap value parser: its

@@ -17,6 +17,7 @@ mod error;
 pub mod fuzz;
 pub mod html;
 pub mod junit;
+pub mod lock;
 pub mod merge;
 pub mod plot;
 pub mod progress;

@@ -145,7 +145,11 @@ pub fn merge_folders(
     replace: bool,
     junit: Option<&Path>,
 ) -> Result<(String, crate::summary::Counts, Vec<String>), Error> {
+    if let Some(junit) = junit {
+        crate::atomic::check_side_output(junit, "--junit", out)?;
+    }
     crate::session::prepare_out_dir(out, replace, false)?;
+    let _lock = crate::lock::CampaignLock::acquire(out)?;
     let m = merge(dirs, out)?;
     let wall_s: f64 = dirs
         .iter()

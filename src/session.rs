@@ -208,6 +208,9 @@ pub fn run(
     observers: &mut [&mut dyn Observer],
 ) -> Result<Outcome, Error> {
     let out = &request.out;
+    if let Some(junit) = &request.junit {
+        crate::atomic::check_side_output(junit, "--junit", out)?;
+    }
     let stored = if request.resume && out.join(CAMPAIGN_FILE).exists() {
         Some(CampaignFile::read(out)?)
     } else {
@@ -220,6 +223,8 @@ pub fn run(
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
     prepare_out_dir(out, request.replace, request.resume)?;
+    // One writer per folder, from here to the end of the run (crate::lock).
+    let _lock = crate::lock::CampaignLock::acquire(out)?;
     if stored.is_none() {
         file.write(out)?;
     }
@@ -579,8 +584,9 @@ fn read_points(
 /// # Errors
 /// [`Error::BadInput`] naming the folder.
 pub fn prepare_out_dir(out: &Path, replace: bool, resume: bool) -> Result<(), Error> {
+    // The lock file of this very run ([`crate::lock`]) does not make a folder non-empty.
     let non_empty = std::fs::read_dir(out)
-        .map(|mut d| d.next().is_some())
+        .map(|mut d| d.any(|e| e.is_ok_and(|e| e.file_name() != crate::lock::LOCK_FILE)))
         .unwrap_or(false);
     if out.exists() && !out.is_dir() {
         return Err(Error::BadInput(format!(

@@ -153,10 +153,10 @@ fn a_resume_with_other_arguments_is_refused() {
     assert_eq!(std::fs::read(out.join("results.jsonl")).unwrap(), before);
 }
 
-#[test]
-fn ctrl_c_finishes_the_tests_in_flight_prints_how_to_resume_and_exits_130() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("int");
+/// Starts a 3,000-test campaign in `out`, sends it `signal` after 0.7 s, and checks that it
+/// exits with `code` having finished and written the tests in flight and printed how to
+/// resume; returns how many tests it wrote.
+fn interrupted_by(signal: &str, code: i32, out: &Path) -> usize {
     let child = bin()
         .args([
             "pedestrian-crossing",
@@ -173,25 +173,47 @@ fn ctrl_c_finishes_the_tests_in_flight_prints_how_to_resume_and_exits_130() {
         .unwrap();
     std::thread::sleep(Duration::from_millis(700));
     let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([signal, &child.id().to_string()])
         .status()
         .unwrap();
     assert!(status.success());
     let o = child.wait_with_output().unwrap();
-    expect_code(&o, 130);
+    expect_code(&o, code);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(
         stderr.contains("interrupted") && stderr.contains("paracosm-fuzz --resume --out"),
         "{stderr}"
     );
-    let done = comparable(&out).len();
+    let done = comparable(out).len();
     assert!(done > 0 && done < 3000, "{done}");
+    done
+}
+
+#[test]
+fn ctrl_c_finishes_the_tests_in_flight_prints_how_to_resume_and_exits_130() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("int");
+    interrupted_by("-INT", 130, &out);
     // Finishing it gives the whole campaign.
     expect_code(
         &fuzz(&["--resume", "--out", out.to_str().unwrap(), "--jobs", "2"]),
         1,
     );
     assert_eq!(comparable(&out).len(), 3000);
+}
+
+/// SIGTERM, which Slurm and Kubernetes send to stop a job, behaves as Ctrl-C: the tests in
+/// flight finish and are written, the resume command is printed; the exit code is 143.
+#[test]
+fn sigterm_finishes_the_tests_in_flight_prints_how_to_resume_and_exits_143() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("term");
+    interrupted_by("-TERM", 143, &out);
+    // Every line written is whole.
+    let lines = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+    for l in lines.lines() {
+        serde_json::from_str::<serde_json::Value>(l).unwrap();
+    }
 }
 
 #[test]

@@ -519,7 +519,7 @@ impl Simulation {
         let due: Vec<bool> = self
             .sensors
             .values()
-            .map(|s| tick % s.period_ticks() == 0)
+            .map(|s| tick.is_multiple_of(s.period_ticks()))
             .collect();
         self.capture_all(|h| due[h.index()])
     }

@@ -33,7 +33,7 @@ pub fn first_primes(d: usize) -> Vec<u64> {
         if primes
             .iter()
             .take_while(|&&p| p * p <= candidate)
-            .all(|&p| candidate % p != 0)
+            .all(|&p| !candidate.is_multiple_of(p))
         {
             primes.push(candidate);
         }

@@ -99,7 +99,8 @@ enum Command {
         /// Seed of the random, scrambled Halton and Sobol strategies.
         #[arg(long, default_value_t = 0)]
         seed: u64,
-        /// Write to this file instead of standard output.
+        /// Write to this file instead of standard output (a new or a regular file; a symbolic
+        /// link, a directory or a device is refused).
         #[arg(long)]
         output: Option<PathBuf>,
     },
@@ -172,7 +173,10 @@ fn main() -> ExitCode {
                 return ExitCode::SUCCESS;
             }
             let code = e.downcast_ref::<Error>().map_or(3, Error::exit_code);
-            eprintln!("paracosm-cover: {e:#}");
+            eprintln!(
+                "{}",
+                paracosm::cli::error_text("paracosm-cover", &format!("{e:#}"))
+            );
             ExitCode::from(code)
         }
     }
@@ -255,6 +259,9 @@ fn run(cli: Cli) -> Result<()> {
             seed,
             output,
         } => {
+            if let Some(path) = &output {
+                paracosm::atomic::check_target(path)?;
+            }
             if let Some(model) = model {
                 return generate_array(
                     &model,
@@ -287,24 +294,27 @@ fn run(cli: Cli) -> Result<()> {
                 .build_sized(&space, seed, budget, strength)
                 .and_then(|mut g| g.ask(budget as usize))
                 .map_err(bad)?;
-            let sink: Box<dyn Write> = match &output {
-                Some(path) => Box::new(
-                    std::fs::File::create(path)
-                        .map_err(|e| bad(format!("cannot write `{}`: {e}", path.display())))?,
-                ),
-                None => Box::new(std::io::stdout().lock()),
-            };
-            let mut w = csv::Writer::from_writer(sink);
-            let mut header = vec!["id".to_owned()];
-            header.extend(space.params().iter().map(|p| p.name.clone()));
-            w.write_record(&header)?;
-            for (i, p) in points.iter().enumerate() {
-                let a = space.decode(p)?;
-                let mut row = vec![i.to_string()];
-                row.extend(a.iter().map(|(_, v)| v.to_string()));
-                w.write_record(&row)?;
+            let mut buffer = Vec::new();
+            {
+                let sink: Box<dyn Write + '_> = match &output {
+                    Some(_) => Box::new(&mut buffer),
+                    None => Box::new(std::io::stdout().lock()),
+                };
+                let mut w = csv::Writer::from_writer(sink);
+                let mut header = vec!["id".to_owned()];
+                header.extend(space.params().iter().map(|p| p.name.clone()));
+                w.write_record(&header)?;
+                for (i, p) in points.iter().enumerate() {
+                    let a = space.decode(p)?;
+                    let mut row = vec![i.to_string()];
+                    row.extend(a.iter().map(|(_, v)| v.to_string()));
+                    w.write_record(&row)?;
+                }
+                w.flush().context("writing the design")?;
             }
-            w.flush().context("writing the design")?;
+            if let Some(path) = &output {
+                paracosm::atomic::write(path, &buffer)?;
+            }
             Ok(())
         }
         Command::Plan {
@@ -437,25 +447,28 @@ fn generate_array(
         }
     }
     .map_err(bad)?;
-    let sink: Box<dyn Write> = match output {
-        Some(path) => Box::new(
-            std::fs::File::create(path)
-                .map_err(|e| bad(format!("cannot write `{}`: {e}", path.display())))?,
-        ),
-        None => Box::new(std::io::stdout().lock()),
-    };
-    let mut w = csv::Writer::from_writer(sink);
-    w.write_record(m.params.iter().map(|(n, _)| n.as_str()))?;
-    for r in 0..array.len() {
-        w.write_record(
-            array
-                .row(r)
-                .iter()
-                .zip(&m.params)
-                .map(|(&v, (_, values))| values[v as usize].as_str()),
-        )?;
+    let mut buffer = Vec::new();
+    {
+        let sink: Box<dyn Write + '_> = match output {
+            Some(_) => Box::new(&mut buffer),
+            None => Box::new(std::io::stdout().lock()),
+        };
+        let mut w = csv::Writer::from_writer(sink);
+        w.write_record(m.params.iter().map(|(n, _)| n.as_str()))?;
+        for r in 0..array.len() {
+            w.write_record(
+                array
+                    .row(r)
+                    .iter()
+                    .zip(&m.params)
+                    .map(|(&v, (_, values))| values[v as usize].as_str()),
+            )?;
+        }
+        w.flush().context("writing the array")?;
     }
-    w.flush().context("writing the array")?;
+    if let Some(path) = output {
+        paracosm::atomic::write(path, &buffer)?;
+    }
     Ok(())
 }
 

@@ -239,7 +239,41 @@ fn num_cpus() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
+/// Set by SIGTERM (what Slurm and Kubernetes send to stop a job), besides [`STOP`]: the exit
+/// code of an interrupted run is then 143 instead of 130.
+static TERMINATED: AtomicBool = AtomicBool::new(false);
+
+/// Ctrl-C (SIGINT) and SIGTERM: no new test starts; the tests in flight finish and are
+/// written, and the tool says how to resume and exits 130 (SIGINT) or 143 (SIGTERM). A second
+/// signal exits at once with that code.
+fn stop_on_signals() {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
+        return;
+    };
+    std::thread::spawn(move || {
+        for signal in signals.forever() {
+            if signal == SIGTERM {
+                TERMINATED.store(true, Ordering::SeqCst);
+            }
+            if STOP.swap(true, Ordering::SeqCst) {
+                std::process::exit(if signal == SIGTERM { 143 } else { 130 });
+            }
+        }
+    });
+}
+
+/// The exit code of a run that ended with `code`: an interruption (130) by SIGTERM is 143.
+fn interrupted_code(code: u8) -> u8 {
+    if code == 130 && TERMINATED.load(Ordering::SeqCst) {
+        143
+    } else {
+        code
+    }
+}
+
 fn main() -> ExitCode {
+    stop_on_signals();
     let cli = match paracosm::cli::parse_args::<Cli>("paracosm-fuzz") {
         Ok(cli) => cli,
         Err(code) => return code,
@@ -280,9 +314,12 @@ fn main() -> ExitCode {
         None => run(&cli),
     };
     match result {
-        Ok(code) => ExitCode::from(code),
+        Ok(code) => ExitCode::from(interrupted_code(code)),
         Err(e) => {
-            eprintln!("paracosm-fuzz: {e:#}");
+            eprintln!(
+                "{}",
+                paracosm::cli::error_text("paracosm-fuzz", &format!("{e:#}"))
+            );
             let code = e.downcast_ref::<Error>().map_or(3, Error::exit_code);
             ExitCode::from(code)
         }
@@ -306,7 +343,7 @@ fn say(text: &str) -> Result<()> {
     }
 }
 
-/// Set by Ctrl-C: no new test starts.
+/// Set by Ctrl-C or SIGTERM ([`stop_on_signals`]): no new test starts.
 static STOP: AtomicBool = AtomicBool::new(false);
 
 fn run(cli: &Cli) -> Result<u8> {
@@ -323,13 +360,6 @@ fn run(cli: &Cli) -> Result<u8> {
         }
         return Ok(0);
     }
-    // Ctrl-C: finish the tests in flight, write them, and say how to resume. A second
-    // Ctrl-C exits at once.
-    let _ = ctrlc::set_handler(|| {
-        if STOP.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
-        }
-    });
     let mut progress = Progress::new(cli.verbose);
     let bar = progress.clone();
     let mut plan = |p: &Plan<'_>| {

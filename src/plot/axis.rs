@@ -46,11 +46,22 @@ fn unit_hash(id: u64, salt: u64) -> f64 {
 
 impl Axis {
     /// The axis of parameter `name` of `space`.
+    ///
+    /// # Errors
+    /// [`PlotError::NotAnAxis`] when `space` has no such parameter; [`PlotError::Span`] when
+    /// its interval is wider than a 64-bit float can measure.
     pub(crate) fn of(space: &ParamSpace, name: &str) -> Result<Axis, PlotError> {
         let p = space
             .param(name)
             .ok_or_else(|| PlotError::NotAnAxis(name.to_owned()))?;
         Ok(match &p.domain {
+            Domain::Interval { lo, hi } if !(hi - lo).is_finite() => {
+                return Err(PlotError::Span {
+                    name: name.to_owned(),
+                    lo: *lo,
+                    hi: *hi,
+                })
+            }
             Domain::Interval { lo, hi } => Axis::Interval {
                 name: name.to_owned(),
                 lo: *lo,

@@ -215,14 +215,7 @@ fn draw_panel<DB: DrawingBackend>(
             .label(format!("error ({})", error.len()))
             .legend(|p| TriangleMarker::new(p, 4, BLACK.mix(0.5)));
     }
-    chart
-        .configure_series_labels()
-        .label_font((FAMILY, 14))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| e.to_string())?;
+    super::draw_legend(&mut chart)?;
     Ok(())
 }
 

@@ -38,6 +38,20 @@ pub enum PlotError {
     /// An axis names no parameter of the space.
     #[error("cannot plot `{0}`: it is not a parameter of the scenario")]
     NotAnAxis(String),
+    /// An interval so wide that `hi - lo` overflows (e.g. `[-1e308, 1e308]`): no axis can
+    /// be drawn over it.
+    #[error(
+        "cannot plot `{name}`: its range [{lo:e}, {hi:e}] is wider than a 64-bit float can \
+         measure (hi - lo overflows)"
+    )]
+    Span {
+        /// The parameter.
+        name: String,
+        /// Its lower bound.
+        lo: f64,
+        /// Its upper bound.
+        hi: f64,
+    },
     /// A map over no parameter, or over more than two.
     #[error("a failure map has one or two axes, got {0}")]
     Axes(usize),
@@ -55,6 +69,21 @@ impl From<PlotError> for crate::Error {
     fn from(e: PlotError) -> Self {
         crate::Error::Plot(e.to_string())
     }
+}
+
+/// Draws a chart's series legend the one way every plot here draws it: upper right, on a
+/// translucent white box with a black border.
+fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .label_font((FAMILY, 14))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(|e| e.to_string())
 }
 
 fn register_font() {

@@ -142,14 +142,7 @@ fn draw_value_map<DB: DrawingBackend>(
         .map_err(|e| e.to_string())?
         .label(format!("{} ({})", labels.marked, marked.len()))
         .legend(move |p| Cross::new(p, 5, red.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .label_font((FAMILY, 14))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| e.to_string())?;
+    super::draw_legend(&mut chart)?;
     let mut scale = ChartBuilder::on(&bar)
         .margin_top(45)
         .margin_bottom(57)
@@ -265,14 +258,7 @@ fn draw_xy<DB: DrawingBackend>(
             .label(name.as_str())
             .legend(move |(x, y)| Rectangle::new([(x, y - 4), (x + 14, y + 4)], c.filled()));
     }
-    chart
-        .configure_series_labels()
-        .label_font((FAMILY, 14))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| e.to_string())?;
+    super::draw_legend(&mut chart)?;
     root.present().map_err(|e| e.to_string())
 }
 

@@ -35,6 +35,16 @@ pub fn expect_code(o: &Output, code: i32) {
     );
 }
 
+/// Asserts that a run finished: exit 0 (all passed) or 1 (a test failed), not an error.
+pub fn ran(o: &Output) {
+    assert!(
+        matches!(o.status.code(), Some(0 | 1)),
+        "exit {:?}: {}",
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
 /// The assignment with the given values by name (levels by value, intervals by value), the
 /// others at their lowest.
 pub fn assign(space: &ParamSpace, values: &[(&str, Value)]) -> Assignment {

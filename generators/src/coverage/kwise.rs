@@ -154,7 +154,7 @@ pub fn kwise_coverage_rows(
             discrete: k,
         });
     }
-    if rows.len() % k != 0 {
+    if !rows.len().is_multiple_of(k) {
         return Err(CoverageError::Shape(format!(
             "{} level indices do not form rows of {k}",
             rows.len()

@@ -30,7 +30,7 @@ pub(crate) fn check_unit_points(points: &[f64], d: usize) -> Result<usize, Cover
             "dimension d must be at least 1".into(),
         ));
     }
-    if points.len() % d != 0 {
+    if !points.len().is_multiple_of(d) {
         return Err(CoverageError::Shape(format!(
             "{} values do not form rows of {d}",
             points.len()

@@ -348,7 +348,7 @@ fn extend(
             }
             let bits = size * vi;
             let mut uncovered = vec![u64::MAX; bits.div_ceil(64) as usize];
-            if bits % 64 != 0 {
+            if !bits.is_multiple_of(64) {
                 *uncovered.last_mut().expect("at least one word") = (1u64 << (bits % 64)) - 1;
             }
             Block {

@@ -84,7 +84,7 @@ impl Monitor for StlMonitor {
                 self.trace.dt_s = t1 - t0;
             }
         }
-        if self.times.len() % CHECK_EVERY != 0 || self.times.len() < 2 {
+        if !self.times.len().is_multiple_of(CHECK_EVERY) || self.times.len() < 2 {
             return ControlFlow::Continue(());
         }
         let hi = match eval_bounds(&self.formula, &self.trace) {

@@ -66,6 +66,26 @@ fn an_empty_interval_is_refused() {
 }
 
 #[test]
+fn an_infinite_bound_is_named_as_such() {
+    for (src, shown) in [
+        (
+            "speed = VarInterval(0, float(\"inf\"))\n",
+            "VarInterval(0, inf)",
+        ),
+        (
+            "speed = VarInterval(-float(\"inf\"), 3.0)\n",
+            "VarInterval(-inf, 3)",
+        ),
+    ] {
+        assert_diag(
+            src,
+            &format!("{shown}: both bounds must be finite numbers"),
+            "1:9",
+        );
+    }
+}
+
+#[test]
 fn an_invalid_connection_is_refused() {
     let src = "a = RoadSegment(len = 50.0, nlanes = 2)\nb = RoadSegment(len = 50.0, nlanes = 6)\na.connect((a.TWO, b, b.ONE))\n";
     assert_diag(

@@ -75,7 +75,13 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Value<'v>> {
         let (lo, hi) = (number(lo, "VarInterval lo")?, number(hi, "VarInterval hi")?);
-        if !(lo.is_finite() && hi.is_finite()) || lo >= hi {
+        if !(lo.is_finite() && hi.is_finite()) {
+            bail!(
+                "VarInterval({lo}, {hi}): both bounds must be finite numbers (a test's value is \
+                 drawn from [lo, hi), which needs a finite width)"
+            );
+        }
+        if lo >= hi {
             bail!("VarInterval({lo}, {hi}) is empty: lo must be below hi");
         }
         let over_time = match over_time {
