@@ -79,6 +79,78 @@ impl Campaign<'_> {
         Ok(generator.ask(self.budget as usize)?)
     }
 
+    /// Checks that `records` (the tests `first_id..` in order, as read from `file`, whose line
+    /// `k + 1` holds `records[k]`) were written by this campaign: each record's seed is this
+    /// campaign's seed for its id ([`test_seed`]), its strategy is this campaign's, and, for a
+    /// non-adaptive strategy, its point is the one the strategy proposes for its id. A line
+    /// copied from a campaign with another seed, strategy or space fails here. (An adaptive
+    /// strategy's points are checked as its searches are replayed, in [`Campaign::run_ids`].)
+    ///
+    /// # Errors
+    /// [`Error::BadInput`] naming the file, the line and what differs; [`Error::Generator`]
+    /// when the strategy cannot produce the points.
+    pub fn check_origin(
+        &self,
+        records: &[RunRecord],
+        first_id: u64,
+        file: &Path,
+    ) -> Result<(), Error> {
+        let foreign = |k: usize, what: String| {
+            Error::BadInput(format!(
+                "{}:{}: {what}; the record was not written by this campaign (copied from \
+                 another one?). Remove the line and what follows it, then --resume again",
+                file.display(),
+                k + 1
+            ))
+        };
+        let strategy = self.strategy.to_string();
+        for (k, r) in records.iter().enumerate() {
+            if r.strategy != strategy {
+                return Err(foreign(
+                    k,
+                    format!(
+                        "test {} has strategy `{}`, this campaign's is `{strategy}`",
+                        r.id, r.strategy
+                    ),
+                ));
+            }
+            let seed = test_seed(self.seed, r.id);
+            if r.seed != seed {
+                return Err(foreign(
+                    k,
+                    format!(
+                        "test {} has seed {}, but this campaign (seed {}) gives it seed {seed}",
+                        r.id, r.seed, self.seed
+                    ),
+                ));
+            }
+        }
+        if records.is_empty() || (self.strategy == Strategy::Points && self.points.is_none()) {
+            // (`merge` does not read a points campaign's points file: seeds only.)
+            return Ok(());
+        }
+        let mut generator = self.generator()?;
+        if generator.batch().is_some() {
+            return Ok(());
+        }
+        generator.skip(first_id)?;
+        for (chunk, block) in records.chunks(POINT_CHUNK as usize).enumerate() {
+            let points = generator.ask(block.len())?;
+            for (j, (r, p)) in block.iter().zip(&points).enumerate() {
+                if &r.point != p {
+                    return Err(foreign(
+                        chunk * POINT_CHUNK as usize + j,
+                        format!(
+                            "test {}'s point is not the one {strategy} proposes for it",
+                            r.id
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The campaign's generator, fresh.
     fn generator(&self) -> Result<Box<dyn paracosm_generators::Generator>, Error> {
         if self.strategy == Strategy::Points {
@@ -238,9 +310,30 @@ impl Campaign<'_> {
             }
             return Ok(report);
         }
-        // Everything that can be refused is refused before the output folder is touched.
+        // Everything that can be refused is refused before the output folder is touched. A
+        // non-adaptive strategy's points are asked for in chunks as the tests run, so memory
+        // does not grow with the budget: the first chunk here.
         let upfront = match generator.batch() {
-            None => Some(generator.ask(ids.end as usize)?),
+            None => {
+                // Points are asked for in chunks as the tests run: a budget past what the
+                // strategy can produce is refused now, before anything runs.
+                let capacity = match self.strategy {
+                    Strategy::Points => self.points.map(|p| p.len() as u64),
+                    s => s.capacity(),
+                };
+                if let Some(limit) = capacity.filter(|&c| ids.end > c) {
+                    return Err(paracosm_generators::GeneratorError::CapacityExceeded {
+                        generator: generator.name(),
+                        what: "points",
+                        limit,
+                        requested: ids.end,
+                    }
+                    .into());
+                }
+                generator.skip(ids.start)?;
+                let n = POINT_CHUNK.min(ids.end - ids.start) as usize;
+                Some(generator.ask(n)?)
+            }
             Some(_) if ids.start != prior_len || ids.end != self.budget => {
                 return Err(Error::BadInput(format!(
                     "{} adapts each test to all earlier ones, so it runs whole campaigns \
@@ -254,8 +347,17 @@ impl Campaign<'_> {
             o.started(prior.unwrap_or(&[]))?;
         }
         let mut run = Run::open(self, stop)?;
-        if let Some(all) = upfront {
-            run.execute(ids.start, &all[ids.start as usize..], observers)?;
+        if let Some(first) = upfront {
+            let mut next = ids.start;
+            let mut points = first;
+            loop {
+                run.execute(next, &points, observers)?;
+                next += points.len() as u64;
+                if next >= ids.end || run.halted() {
+                    break;
+                }
+                points = generator.ask(POINT_CHUNK.min(ids.end - next) as usize)?;
+            }
         } else {
             let prior = prior.unwrap_or(&[]);
             let passive = self.scenario.passive_monitors();
@@ -312,6 +414,10 @@ impl Campaign<'_> {
         Ok(report)
     }
 }
+
+/// How many points of a non-adaptive strategy a campaign asks for at a time (each chunk runs
+/// in parallel; the next is asked for when it is done).
+const POINT_CHUNK: u64 = 4096;
 
 /// The state of a running campaign: the worker pool, the stop flags and the records reported
 /// so far.

@@ -103,6 +103,8 @@ impl SutArgs {
                 let words = shlex::split(c).filter(|w| !w.is_empty()).ok_or_else(|| {
                     Error::BadInput(format!("--sut-cmd {c:?} is empty or has an unclosed quote"))
                 })?;
+                paracosm_engine::sut::check_command(&words)
+                    .map_err(|e| Error::BadInput(format!("--sut-cmd: {e}")))?;
                 Ok(Some(SutConfig::External(ExternalConfig::new(
                     words,
                     timeout_s,

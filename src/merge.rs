@@ -91,6 +91,19 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
     for (dir, file) in shards.values() {
         let ids = file.ids();
         let existing = crate::results::load(dir, &scenario.space, ids.clone(), false)?;
+        let strategy: paracosm_generators::Strategy =
+            file.strategy.parse().map_err(|e| bad(format!("{e}")))?;
+        let campaign = crate::campaign::Campaign {
+            scenario: &scenario,
+            strategy,
+            seed: file.seed,
+            budget: file.budget,
+            strength: file.strength,
+            jobs: 1,
+            stop_at_first_failure: false,
+            points: None,
+        };
+        campaign.check_origin(&existing.records, ids.start, &dir.join(RESULTS_FILE))?;
         let done = existing.records.len() as u64;
         if done != ids.end - ids.start {
             return Err(bad(format!(

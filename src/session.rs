@@ -237,15 +237,6 @@ pub fn run(
         },
     };
     let start = ids.start + existing.records.len() as u64;
-    started(&Plan {
-        scenario: &scenario,
-        file: &file,
-        warnings: &warnings,
-        done: existing.records.len() as u64,
-        to_run: ids.end - start,
-        repaired_bytes: existing.repaired_bytes as u64,
-        resumed: stored.is_some(),
-    });
     let campaign = Campaign {
         scenario: &scenario,
         strategy,
@@ -256,6 +247,16 @@ pub fn run(
         stop_at_first_failure: request.stop_at_first_failure,
         points: points.as_deref(),
     };
+    campaign.check_origin(&existing.records, ids.start, &out.join(RESULTS_FILE))?;
+    started(&Plan {
+        scenario: &scenario,
+        file: &file,
+        warnings: &warnings,
+        done: existing.records.len() as u64,
+        to_run: ids.end - start,
+        repaired_bytes: existing.repaired_bytes as u64,
+        resumed: stored.is_some(),
+    });
     let mut written = None;
     let junit_path = request.junit.as_deref();
     let mut chain = Chain {

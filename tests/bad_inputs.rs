@@ -71,7 +71,16 @@ fn bad_scenario_programs() {
                 out.display().to_string(),
             ],
         );
-        assert_refused(&rel(&f), &o, &[&name(&f)]);
+        // A first line `# expect: PHRASE` names a phrase the message must contain too.
+        let text = std::fs::read(&f).unwrap();
+        let first =
+            String::from_utf8_lossy(text.split(|&b| b == b'\n').next().unwrap_or(&[])).into_owned();
+        let mut phrases = vec![name(&f)];
+        if let Some(p) = first.strip_prefix("# expect: ") {
+            phrases.push(p.trim().to_owned());
+        }
+        let phrases: Vec<&str> = phrases.iter().map(String::as_str).collect();
+        assert_refused(&rel(&f), &o, &phrases);
         assert!(
             !out.join("results.jsonl").exists(),
             "{}: nothing runs",

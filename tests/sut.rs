@@ -233,3 +233,67 @@ fn vision_fails_in_fog_dark_and_glare_but_not_in_clear_nominal_light() {
         "glare: the white car and the sky both clip at 255"
     );
 }
+
+/// Whether process `pid` is gone (or a zombie waiting for its reaper, which runs nothing).
+fn gone(pid: &str) -> bool {
+    match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
+        Err(_) => true,
+        Ok(stat) => stat
+            .rsplit(')')
+            .next()
+            .is_some_and(|rest| rest.trim_start().starts_with('Z')),
+    }
+}
+
+#[test]
+fn a_wrapper_script_and_the_helper_it_starts_are_killed_with_their_test() {
+    // The system under test is a shell script that starts a helper (which would sleep five
+    // minutes) and then runs the Python example: the helper is in the program's process group,
+    // which is killed after each test (--sut-fresh) or when the campaign ends (reused).
+    let dir = tempfile::tempdir().unwrap();
+    let pids = dir.path().join("helpers.txt");
+    let wrapper = dir.path().join("wrapper.sh");
+    std::fs::write(
+        &wrapper,
+        format!(
+            "#!/bin/sh\nsleep 300 </dev/null >/dev/null 2>&1 &\necho $! >> {}\nexec {}\n",
+            pids.display(),
+            script("examples/python/paracosm_sut.py")
+        ),
+    )
+    .unwrap();
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    for (name, fresh) in [("fresh", true), ("reused", false)] {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "pedestrian-crossing",
+            "--budget",
+            "3",
+            "--jobs",
+            "1",
+            "--sut-cmd",
+            wrapper.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if fresh {
+            args.push("--sut-fresh");
+        }
+        fuzz(&args);
+        assert!(!statuses(&out).contains(&"error".to_owned()), "{name}");
+    }
+    let started: Vec<String> = std::fs::read_to_string(&pids)
+        .unwrap()
+        .lines()
+        .map(str::to_owned)
+        .collect();
+    assert!(
+        started.len() >= 4,
+        "3 fresh and at least 1 reused: {started:?}"
+    );
+    let alive: Vec<&String> = started.iter().filter(|p| !gone(p)).collect();
+    assert!(alive.is_empty(), "helpers left running: {alive:?}");
+}

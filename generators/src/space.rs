@@ -130,11 +130,13 @@ impl ParamSpace {
     /// Builds a space, checking it.
     ///
     /// # Errors
-    /// [`GeneratorError::InvalidDomain`] for an interval with `lo >= hi` or a non-finite bound,
-    /// or an empty level list; [`GeneratorError::DuplicateParam`] for a repeated name.
+    /// [`GeneratorError::InvalidDomain`] for an interval with `lo >= hi`, a non-finite bound
+    /// or a width `hi - lo` that overflows, or an empty level list; [`GeneratorError::DuplicateParam`] for a repeated name.
     pub fn new(params: Vec<Param>) -> Result<Self, GeneratorError> {
-        for (i, p) in params.iter().enumerate() {
-            if params[..i].iter().any(|q| q.name == p.name) {
+        // Linear, not quadratic: a CSV may have a million columns.
+        let mut names = std::collections::HashSet::with_capacity(params.len());
+        for p in params.iter() {
+            if !names.insert(p.name.as_str()) {
                 return Err(GeneratorError::DuplicateParam(p.name.clone()));
             }
             let bad = |reason: String| GeneratorError::InvalidDomain {
@@ -145,6 +147,14 @@ impl ParamSpace {
                 Domain::Interval { lo, hi } => {
                     if !lo.is_finite() || !hi.is_finite() || lo >= hi {
                         return Err(bad(format!("interval [{lo}, {hi}] is empty or not finite")));
+                    }
+                    if !(hi - lo).is_finite() {
+                        // Unit coordinates map through `hi - lo`: every point would decode to
+                        // an infinity and every estimate would be meaningless.
+                        return Err(bad(format!(
+                            "interval [{lo}, {hi}] is wider than a float can hold (hi - lo \
+                             overflows); rescale it (for example to a unit of 1e300)"
+                        )));
                     }
                 }
                 Domain::Levels(levels) if levels.is_empty() => {

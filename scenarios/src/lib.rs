@@ -11,9 +11,11 @@
 
 mod error;
 pub mod lang;
+pub mod memory;
 pub mod reference;
 mod runner;
 mod scenario;
+pub mod text_file;
 
 use std::path::Path;
 

@@ -277,7 +277,11 @@ impl Scenario {
             None => 0,
         };
         let control_every = period_ticks(sensors.control_hz, spec.dt_s);
-        let monitors: Vec<Box<dyn Monitor>> = self.monitors.iter().map(|m| m.build()).collect();
+        let monitors: Vec<Box<dyn Monitor>> = self
+            .monitors
+            .iter()
+            .map(|m| m.build(self.horizon_s))
+            .collect();
         let mut watch = Watch {
             settled: vec![false; monitors.len()],
             monitors,

@@ -145,8 +145,11 @@ impl MonitorSpec {
         }
     }
 
-    /// A fresh monitor reading the runner's signals (see [`signal`]).
-    pub fn build(&self) -> Box<dyn Monitor> {
+    /// A fresh monitor reading the runner's signals (see [`signal`]), for a test of
+    /// `horizon_s` seconds: an `Stl` formula's bounds past it are lowered to it
+    /// ([`paracosm_oracles::stl::Formula::clamped`]; the verdict is the same, the memory
+    /// O(horizon samples)).
+    pub fn build(&self, horizon_s: f64) -> Box<dyn Monitor> {
         match self {
             MonitorSpec::Collision { name } => Box::new(CollisionMonitor::new(
                 name,
@@ -169,7 +172,10 @@ impl MonitorSpec {
             )),
             MonitorSpec::Stl { name, formula } => Box::new(paracosm_oracles::stl::StlMonitor::new(
                 name,
-                paracosm_oracles::stl::parse(formula).expect("checked when the program loaded"),
+                paracosm_oracles::stl::parse(formula)
+                    .expect("checked when the program loaded")
+                    .clamped(horizon_s)
+                    .0,
             )),
             MonitorSpec::Stream {
                 name, signal, over, ..
@@ -177,9 +183,9 @@ impl MonitorSpec {
             MonitorSpec::Assert { name, signal } => {
                 Box::new(StreamMonitor::assertion(name, signal))
             }
-            MonitorSpec::TimeToFailure { name, inner, min_s } => {
-                Box::new(TimeToFailureMonitor::new(name, inner.build(), *min_s))
-            }
+            MonitorSpec::TimeToFailure { name, inner, min_s } => Box::new(
+                TimeToFailureMonitor::new(name, inner.build(horizon_s), *min_s),
+            ),
         }
     }
 }

@@ -16,6 +16,11 @@ use paracosm::Error;
 use paracosm_generators::coverage::{discrepancy, Discrepancy};
 use paracosm_generators::{Halton, ParamSpace, Strategy};
 
+/// Counts what Starlark evaluation allocates, so one huge allocation of a program or lambda is a
+/// clear error with exit code 2 instead of an abort (`paracosm_scenarios::memory`).
+#[global_allocator]
+static ALLOC: paracosm_scenarios::memory::CountingAlloc = paracosm_scenarios::memory::CountingAlloc;
+
 /// Coverage of test sets, test designs and test budgets over a parameter space.
 #[derive(Debug, Parser)]
 #[command(name = "paracosm-cover", version)]
@@ -158,6 +163,7 @@ enum Algorithm {
 }
 
 fn main() -> ExitCode {
+    paracosm_scenarios::memory::set_tool_name("paracosm-cover");
     let cli = match paracosm::cli::parse_args::<Cli>("paracosm-cover") {
         Ok(cli) => cli,
         Err(code) => return code,
@@ -290,30 +296,45 @@ fn run(cli: Cli) -> Result<()> {
                     "--budget {budget} is more than the {cap} points {strategy} can produce"
                 )));
             }
-            let points = strategy
+            if budget > MAX_GENERATE {
+                return Err(bad(format!(
+                    "the design would have {budget} points, more than the {MAX_GENERATE} this \
+                     command writes (about 40 GB of CSV); give a smaller --budget or a larger \
+                     --epsilon"
+                )));
+            }
+            let mut generator = strategy
                 .build_sized(&space, seed, budget, strength)
-                .and_then(|mut g| g.ask(budget as usize))
                 .map_err(bad)?;
-            let mut buffer = Vec::new();
-            {
-                let sink: Box<dyn Write + '_> = match &output {
-                    Some(_) => Box::new(&mut buffer),
-                    None => Box::new(std::io::stdout().lock()),
-                };
+            // Points are asked for and written in chunks, so memory does not grow with the
+            // budget; into a temporary file renamed at the end with --output.
+            let mut write_design = |sink: &mut dyn Write| -> Result<()> {
                 let mut w = csv::Writer::from_writer(sink);
                 let mut header = vec!["id".to_owned()];
                 header.extend(space.params().iter().map(|p| p.name.clone()));
                 w.write_record(&header)?;
-                for (i, p) in points.iter().enumerate() {
-                    let a = space.decode(p)?;
-                    let mut row = vec![i.to_string()];
-                    row.extend(a.iter().map(|(_, v)| v.to_string()));
-                    w.write_record(&row)?;
+                let mut next = 0u64;
+                while next < budget {
+                    let n = (budget - next).min(1 << 16) as usize;
+                    for p in generator.ask(n).map_err(bad)? {
+                        let a = space.decode(&p)?;
+                        let mut row = vec![next.to_string()];
+                        row.extend(a.iter().map(|(_, v)| v.to_string()));
+                        w.write_record(&row)?;
+                        next += 1;
+                    }
                 }
                 w.flush().context("writing the design")?;
-            }
-            if let Some(path) = &output {
-                paracosm::atomic::write(path, &buffer)?;
+                Ok(())
+            };
+            match &output {
+                Some(path) => paracosm::atomic::with_temp(path, |tmp| -> Result<()> {
+                    let mut f = std::io::BufWriter::new(std::fs::File::create(tmp)?);
+                    write_design(&mut f)?;
+                    f.flush()?;
+                    Ok(())
+                })?,
+                None => write_design(&mut std::io::stdout().lock())?,
             }
             Ok(())
         }
@@ -387,6 +408,9 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// Most points `generate` writes: a billion rows of CSV, about 40 GB.
+const MAX_GENERATE: u64 = 1_000_000_000;
+
 /// The budget of a covering suite whose rows each get `ceil(C / ε)` Halton points.
 fn suite_budget(
     space: &ParamSpace,
@@ -414,7 +438,7 @@ fn suite_budget(
     let per_row = plan(space, strength, epsilon, 0.01)
         .halton_per_group
         .unwrap_or(1);
-    Ok(rows * per_row)
+    Ok(rows.saturating_mul(per_row))
 }
 
 /// `generate --model`: a covering array for a PICT model, written as CSV of value names.

@@ -18,6 +18,11 @@ use paracosm::session::{Plan, Request};
 use paracosm::Error;
 use paracosm_generators::Strategy;
 
+/// Counts what Starlark evaluation allocates, so one huge allocation of a program or lambda is a
+/// clear error with exit code 2 instead of an abort (`paracosm_scenarios::memory`).
+#[global_allocator]
+static ALLOC: paracosm_scenarios::memory::CountingAlloc = paracosm_scenarios::memory::CountingAlloc;
+
 /// Run a test campaign on a scenario: sample its open parameters, simulate each test, and
 /// write results.jsonl, summary.json and a failure map.
 #[derive(Debug, Parser)]
@@ -273,6 +278,7 @@ fn interrupted_code(code: u8) -> u8 {
 }
 
 fn main() -> ExitCode {
+    paracosm_scenarios::memory::set_tool_name("paracosm-fuzz");
     stop_on_signals();
     let cli = match paracosm::cli::parse_args::<Cli>("paracosm-fuzz") {
         Ok(cli) => cli,

@@ -48,8 +48,11 @@ pub fn read_tests(path: &Path, space: Option<&ParamSpace>) -> Result<TestSet, In
         column,
         message,
     };
-    let text =
-        std::fs::read_to_string(path).map_err(|e| err(None, None, format!("cannot read: {e}")))?;
+    let text = paracosm_scenarios::text_file::read_text(
+        path,
+        paracosm_scenarios::text_file::MAX_DATA_BYTES,
+    )
+    .map_err(|e| err(None, None, format!("cannot read: {e}")))?;
     let is_jsonl = path.extension().is_some_and(|e| e == "jsonl");
     parse_tests(&file, &text, is_jsonl, space)
 }

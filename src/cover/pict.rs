@@ -112,12 +112,9 @@ pub fn parse_pict(file: &str, text: &str) -> Result<PictModel, PictError> {
         if params.iter().any(|(n, _)| *n == name) {
             return Err(err(line, format!("parameter `{name}` is declared twice")));
         }
-        if let Some(d) = values
-            .iter()
-            .enumerate()
-            .find(|(j, v)| values[..*j].contains(v))
-        {
-            return Err(err(line, format!("value `{}` appears twice", d.1)));
+        let mut seen = std::collections::HashSet::with_capacity(values.len());
+        if let Some(d) = values.iter().find(|v| !seen.insert(v.as_str())) {
+            return Err(err(line, format!("value `{d}` appears twice")));
         }
         params.push((name, values));
     }

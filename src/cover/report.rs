@@ -63,7 +63,15 @@ pub struct Estimate {
     pub star: Option<StarDiscrepancy>,
     /// The (k, ε)-covering verdict, when ε was given.
     pub k_epsilon: Option<KEpsilonCovering>,
+    /// Metrics asked for but not computed, each with the reason (too costly for this `n` and
+    /// `d`, or a value that overflows). Empty when every metric was computed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub skipped: Vec<String>,
 }
+
+/// Largest `n² · d` for which the L2 discrepancies (CD, WD, MD, L2-star; `O(n² d)` each) are
+/// computed: 10^10, about 10 s each on one core.
+pub const MAX_L2_WORK: f64 = 1e10;
 
 /// Computes the requested metrics over the continuous coordinates of `set`, k-wise coverage
 /// for strengths `1..=strength` over its discrete ones (listing up to `max_missing` uncovered
@@ -111,6 +119,7 @@ pub fn estimate(
         discrepancy: Vec::new(),
         star: None,
         k_epsilon: None,
+        skipped: Vec::new(),
     };
     if nc > 0 {
         for m in metrics {
@@ -118,9 +127,27 @@ pub fn estimate(
                 Metric::Dispersion => {
                     out.dispersion = Some(dispersion(&coords, nc, &DispersionOptions::default())?)
                 }
-                Metric::L2(k) => out
-                    .discrepancy
-                    .push((k.name().to_owned(), discrepancy(&coords, nc, *k)?)),
+                Metric::L2(k) => {
+                    let n = set.points.len() as f64;
+                    if n * n * nc as f64 > MAX_L2_WORK {
+                        out.skipped.push(format!(
+                            "{}: skipped, n² · d = {:.1e} is past the limit of {MAX_L2_WORK:.0e}",
+                            k.name(),
+                            n * n * nc as f64
+                        ));
+                        continue;
+                    }
+                    let v = discrepancy(&coords, nc, *k)?;
+                    if v.is_finite() {
+                        out.discrepancy.push((k.name().to_owned(), v));
+                    } else {
+                        out.skipped.push(format!(
+                            "{}: not a finite number in d = {nc} (its product over the \
+                             dimensions overflows)",
+                            k.name()
+                        ));
+                    }
+                }
                 Metric::Star => {
                     out.star = Some(star_discrepancy(&coords, nc, &StarOptions::default())?)
                 }
@@ -183,6 +210,9 @@ impl fmt::Display for Estimate {
                 " (squared, as scipy)"
             };
             writeln!(f, "{name:<17} {v:.6e}{note}")?;
+        }
+        for note in &self.skipped {
+            writeln!(f, "{note}")?;
         }
         if let Some(s) = &self.star {
             if s.exact {

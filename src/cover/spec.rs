@@ -13,6 +13,10 @@ pub enum SpecError {
     /// Neither a built-in scenario nor a readable file.
     #[error("`{0}` is neither a built-in scenario ({1}) nor a readable file")]
     NotFound(String, String),
+    /// The file exists but cannot be read: a folder, unreadable, larger than
+    /// [`paracosm_scenarios::text_file::MAX_SOURCE_BYTES`], or not UTF-8 (line and column).
+    #[error("{0}: cannot read: {1}")]
+    Unreadable(String, String),
     /// The TOML file does not parse or describes an invalid space.
     #[error("{file}: {reason}")]
     Invalid {
@@ -60,12 +64,17 @@ pub fn load_space(spec: &str) -> Result<ParamSpace, SpecError> {
         return Ok(s.space);
     }
     let path = Path::new(spec);
-    let text = std::fs::read_to_string(path).map_err(|_| {
-        SpecError::NotFound(
+    if !path.exists() {
+        return Err(SpecError::NotFound(
             spec.to_owned(),
             paracosm_scenarios::builtin_names().join(", "),
-        )
-    })?;
+        ));
+    }
+    let text = paracosm_scenarios::text_file::read_text(
+        path,
+        paracosm_scenarios::text_file::MAX_SOURCE_BYTES,
+    )
+    .map_err(|e| SpecError::Unreadable(spec.to_owned(), e))?;
     parse_space(spec, &text)
 }
 

@@ -34,6 +34,51 @@ pub struct ExternalConfig {
     pub pool: Arc<ProcessPool>,
 }
 
+/// Checks that `command`'s program can be started: a path (with a `/`) names an executable
+/// file, a bare name is an executable file in a folder of `PATH`. Nothing is run.
+///
+/// # Errors
+/// "the command is empty", or "cannot start `P`: ..." naming what is missing.
+pub fn check_command(command: &[String]) -> Result<(), String> {
+    let program = command
+        .first()
+        .ok_or_else(|| "the command is empty".to_string())?;
+    let executable = |p: &std::path::Path| {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+    };
+    if program.contains('/') {
+        if executable(std::path::Path::new(program)) {
+            return Ok(());
+        }
+        return Err(format!(
+            "cannot start `{program}`: no executable file there (relative paths are from the \
+             current folder)"
+        ));
+    }
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    if std::env::split_paths(&path).any(|dir| executable(&dir.join(program))) {
+        return Ok(());
+    }
+    Err(format!(
+        "cannot start `{program}`: no executable of that name in a folder of PATH"
+    ))
+}
+
+/// Kills every process of the process group `pgid` (the system under test and what it
+/// started); a group already gone is not an error.
+fn kill_group(pgid: u32) {
+    if let Ok(pgid) = libc::pid_t::try_from(pgid) {
+        if pgid > 0 {
+            // SAFETY: kill(2) with a negative pid signals that process group; no memory is
+            // touched.
+            unsafe {
+                libc::kill(-pgid, libc::SIGKILL);
+            }
+        }
+    }
+}
+
 impl ExternalConfig {
     /// A configuration with a fresh, empty pool.
     pub fn new(command: Vec<String>, timeout_s: f64, reuse: bool) -> Self {
@@ -80,6 +125,8 @@ struct Process {
     wants_depth: bool,
     /// The sensors the program asked for by name with `true` in its hello (`lidar`...).
     wanted: Vec<String>,
+    /// Dropped after [`Process`]'s own drop: kills the program's process group.
+    _group: GroupGuard,
 }
 
 impl Drop for Process {
@@ -96,6 +143,19 @@ impl Drop for Process {
         let _ = self.child.wait();
     }
 }
+
+impl Drop for GroupGuard {
+    fn drop(&mut self) {
+        // Whatever the program started (a wrapper script's child, a helper) is in its group:
+        // none of it outlives the test.
+        kill_group(self.0);
+    }
+}
+
+/// Kills the system under test's process group when dropped (after [`Process`]'s own drop
+/// has let the program exit).
+#[derive(Debug)]
+struct GroupGuard(u32);
 
 fn read_message(r: &mut impl Read) -> Result<Option<Message>, String> {
     let mut len = [0u8; 4];
@@ -157,11 +217,14 @@ impl Process {
             .command
             .split_first()
             .ok_or_else(|| "the command is empty".to_string())?;
+        use std::os::unix::process::CommandExt;
+        // Its own process group, so that it and everything it starts can be killed at once.
         let mut child = Command::new(program)
             .args(args)
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
+            .process_group(0)
             .spawn()
             .map_err(|e| format!("cannot start `{program}`: {e}"))?;
         let stdin = child.stdin.take().expect("piped");
@@ -197,8 +260,10 @@ impl Process {
                 }
             }
         });
+        let group = GroupGuard(child.id());
         let mut p = Process {
             child,
+            _group: group,
             stdin: Some(stdin),
             replies,
             stderr,
@@ -280,7 +345,7 @@ impl Process {
             Ok(Ok(m)) => Ok(m),
             Ok(Err(e)) => Err(self.died(&e)),
             Err(RecvTimeoutError::Timeout) => {
-                let _ = self.child.kill();
+                kill_group(self.child.id());
                 Err(format!(
                     "did not answer within {timeout_s} s (--sut-timeout); killed it{}",
                     self.stderr_tail()

@@ -56,6 +56,26 @@ pub enum CoveringError {
     /// The constraints forbid every row.
     #[error("the constraints forbid every row: no test can be built")]
     Unsatisfiable,
+    /// The array, or the table of `t`-tuples it must cover, is too large to build.
+    #[error(
+        "a covering array of strength {t} over these levels needs at least {rows} rows (the \
+         product of the {t} largest level counts) and a table of about {cells} {t}-tuples, more \
+         than the limits of {max_rows} rows and {max_cells} tuples; use fewer levels or a lower \
+         strength"
+    )]
+    TooLarge {
+        /// The strength.
+        t: usize,
+        /// A lower bound on the rows.
+        rows: u128,
+        /// The `t`-tuples to cover: the sum over column sets of their level products (an
+        /// upper estimate: `C(k, t)` times the product of the `t` largest).
+        cells: u128,
+        /// [`MAX_ROWS`].
+        max_rows: u128,
+        /// [`MAX_TUPLES`].
+        max_cells: u128,
+    },
     /// A random array hit its row limit before covering every tuple.
     #[error("{rows} random rows did not cover every {t}-tuple")]
     NotCovered {
@@ -109,8 +129,29 @@ pub(crate) fn check(levels: &[u32], t: usize) -> Result<(), CoveringError> {
     if let Some(j) = levels.iter().position(|&v| v == 0) {
         return Err(CoveringError::NoLevels(j));
     }
+    let mut sorted: Vec<u128> = levels.iter().map(|&v| u128::from(v)).collect();
+    sorted.sort_unstable_by(|a, b| b.cmp(a));
+    let rows: u128 = sorted[..t].iter().fold(1u128, |a, &v| a.saturating_mul(v));
+    let subsets: u128 =
+        (0..t as u128).fold(1u128, |a, i| a.saturating_mul(k as u128 - i) / (i + 1));
+    let cells = rows.saturating_mul(subsets);
+    if rows > MAX_ROWS || cells > MAX_TUPLES {
+        return Err(CoveringError::TooLarge {
+            t,
+            rows,
+            cells,
+            max_rows: MAX_ROWS,
+            max_cells: MAX_TUPLES,
+        });
+    }
     Ok(())
 }
+
+/// Most rows a covering array may need (10 million); see [`CoveringError::TooLarge`].
+pub const MAX_ROWS: u128 = 10_000_000;
+/// Most `t`-tuples a covering array's table may hold (100 million; IPOG keeps a 4-byte count
+/// per tuple); see [`CoveringError::TooLarge`].
+pub const MAX_TUPLES: u128 = 100_000_000;
 
 /// Checks constraints and seeds against `levels`; returns the seeds with open cells as
 /// `OPEN`.

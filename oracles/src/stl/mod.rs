@@ -74,7 +74,46 @@ pub enum Formula {
     Until(f64, f64, Box<Formula>, Box<Formula>),
 }
 
+/// Most operators (`!`, `&`, `|`, `->`, `G`, `F`, `U`) plus bracket nesting a formula may have:
+/// parsing, evaluating and dropping a formula recurse once per level, and a chain of 10,000
+/// `G[0,1]` would overflow the stack (an abort, not an error).
+pub const MAX_OPERATORS: usize = 256;
+
 impl Formula {
+    /// The formula with every time bound above `horizon_s + 1` (seconds) lowered to it, and
+    /// whether any was. Over a trace of at most `horizon_s` seconds the robustness is
+    /// unchanged (a window is cut at the trace's end either way, and one that starts past it
+    /// stays past it), while online evaluation, which pads unknown samples up to the largest
+    /// bound, needs memory O(horizon samples) instead of O(bound).
+    pub fn clamped(&self, horizon_s: f64) -> (Formula, bool) {
+        let cap = horizon_s + 1.0;
+        let mut changed = false;
+        let mut c = |x: f64| {
+            if x > cap {
+                changed = true;
+                cap
+            } else {
+                x
+            }
+        };
+        let f = self.map_bounds(&mut c);
+        (f, changed)
+    }
+
+    fn map_bounds(&self, c: &mut dyn FnMut(f64) -> f64) -> Formula {
+        let b = |f: &Formula, c: &mut dyn FnMut(f64) -> f64| Box::new(f.map_bounds(c));
+        match self {
+            Formula::True | Formula::False | Formula::Pred { .. } => self.clone(),
+            Formula::Not(f) => Formula::Not(b(f, c)),
+            Formula::And(x, y) => Formula::And(b(x, c), b(y, c)),
+            Formula::Or(x, y) => Formula::Or(b(x, c), b(y, c)),
+            Formula::Implies(x, y) => Formula::Implies(b(x, c), b(y, c)),
+            Formula::Globally(lo, hi, f) => Formula::Globally(c(*lo), c(*hi), b(f, c)),
+            Formula::Eventually(lo, hi, f) => Formula::Eventually(c(*lo), c(*hi), b(f, c)),
+            Formula::Until(lo, hi, x, y) => Formula::Until(c(*lo), c(*hi), b(x, c), b(y, c)),
+        }
+    }
+
     /// The names of the signals it reads, sorted, without repeats.
     pub fn signals(&self) -> Vec<String> {
         let mut out = Vec::new();
@@ -117,4 +156,11 @@ pub enum StlError {
     /// The trace is malformed (signals of different lengths, a non-positive step).
     #[error("invalid trace: {0}")]
     Trace(String),
+    /// More operators and bracket nesting than [`MAX_OPERATORS`].
+    #[error(
+        "the STL formula has {0} operators and nested brackets, more than the limit of {limit}; \
+         split it into several Stl monitors",
+        limit = MAX_OPERATORS
+    )]
+    TooComplex(usize),
 }

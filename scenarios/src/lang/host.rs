@@ -3,7 +3,10 @@
 
 use paracosm_engine::rx::{Host, Runtime, StreamId, Value as Rx};
 
+use std::cell::Cell;
+
 use super::values::Stream;
+use crate::memory::{self, Budget};
 use starlark::eval::Evaluator;
 use starlark::values::float::StarlarkFloat;
 use starlark::values::tuple::{AllocTuple, TupleRef};
@@ -19,13 +22,22 @@ use starlark::values::{Heap, Value, ValueLike};
 pub struct StarHost<'a, 'v, 'b, 'e> {
     eval: &'a mut Evaluator<'v, 'b, 'e>,
     functions: &'a [Value<'v>],
+    limits: &'b CallLimits,
+    /// The program's file, for the hard heap limit's message.
+    file: &'static str,
     /// Module-level variables holding streams, with the stream each holds.
     captured: Vec<(String, StreamId)>,
 }
 
 impl<'a, 'v, 'b, 'e> StarHost<'a, 'v, 'b, 'e> {
-    /// A host calling `functions` (host function `n` is `functions[n]`) with `eval`.
-    pub fn new(eval: &'a mut Evaluator<'v, 'b, 'e>, functions: &'a [Value<'v>]) -> Self {
+    /// A host calling `functions` (host function `n` is `functions[n]`) with `eval`, whose
+    /// periodic check is `limits` ([`CallLimits::install`]); `file` is the program's.
+    pub fn new(
+        eval: &'a mut Evaluator<'v, 'b, 'e>,
+        functions: &'a [Value<'v>],
+        limits: &'b CallLimits,
+        file: &'static str,
+    ) -> Self {
         let module = eval.module();
         let mut captured: Vec<(String, StreamId)> = module
             .names()
@@ -39,6 +51,8 @@ impl<'a, 'v, 'b, 'e> StarHost<'a, 'v, 'b, 'e> {
         StarHost {
             eval,
             functions,
+            limits,
+            file,
             captured,
         }
     }
@@ -112,10 +126,28 @@ impl Host for StarHost<'_, '_, '_, '_> {
             .functions
             .get(f as usize)
             .ok_or_else(|| format!("no lambda {f}"))?;
-        let out = self
-            .eval
-            .eval_function(function, &args, &[])
-            .map_err(|e| format!("{e}"))?;
+        self.limits.checks.set(0);
+        self.limits.exceeded.set(None);
+        let budget = Budget::start(
+            memory::MAX_LAMBDA_HEAP_BYTES,
+            memory::HARD_LAMBDA_HEAP_BYTES,
+            self.file,
+            "a lambda, during a test,",
+        );
+        let out = self.eval.eval_function(function, &args, &[]);
+        let over_heap = memory::over_soft_limit();
+        drop(budget);
+        let out = match (out, self.limits.exceeded.get()) {
+            (Err(e), Some(limit)) => return Err(limit.message(&e)),
+            (_, _) if over_heap => {
+                return Err(format!(
+                    "heap limit: a lambda allocated more than {} MiB in one call (limit per \
+                     call, LANGUAGE.md \"Limits\")",
+                    memory::MAX_LAMBDA_HEAP_BYTES >> 20
+                ))
+            }
+            (out, _) => out.map_err(|e| format!("{e}"))?,
+        };
         // A function given to foreach may return the action to perform.
         if let Some(a) = out.downcast_ref::<super::values::Action>() {
             if let Some(test) = self.test() {
@@ -146,5 +178,75 @@ impl StarHost<'_, '_, '_, '_> {
         self.eval
             .extra
             .and_then(|e| e.downcast_ref::<super::values::TestState>())
+    }
+}
+
+/// Most evaluation steps (function calls and loop iterations) one lambda call may take during a
+/// test, counted in starlark's periods of 1,000 steps: about 1,000,000 (a behaviour's lambda
+/// takes tens). Past it the call fails with "step limit exceeded" and its test ends with
+/// status `error`.
+pub const MAX_LAMBDA_STEPS: u64 = 1_000_000;
+
+/// Which limit a lambda call passed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Limit {
+    Steps,
+    Heap,
+}
+
+impl Limit {
+    /// The test's error for a call stopped by this limit; `e` is starlark's error, whose
+    /// traceback names the lambda's file and line.
+    fn message(self, e: &starlark::Error) -> String {
+        let traceback = format!("{e}").replace("Evaluation cancelled", "stopped here");
+        match self {
+            Limit::Steps => format!(
+                "step limit exceeded: a lambda took more than {MAX_LAMBDA_STEPS} steps (loop \
+                 iterations and calls) in one call (LANGUAGE.md \"Limits\")\n{traceback}"
+            ),
+            Limit::Heap => format!(
+                "heap limit: a lambda allocated more than {} MiB in one call (LANGUAGE.md \
+                 \"Limits\")\n{traceback}",
+                memory::MAX_LAMBDA_HEAP_BYTES >> 20
+            ),
+        }
+    }
+}
+
+/// The per-call limits of the lambdas of one test: starlark calls [`CallLimits::check`] every
+/// 1,000 evaluation steps, and [`StarHost`] restarts the count before each call.
+#[derive(Default)]
+pub struct CallLimits {
+    /// Periodic checks (of 1,000 steps each) in the current call.
+    checks: Cell<u64>,
+    /// The limit the current call passed, if any.
+    exceeded: Cell<Option<Limit>>,
+}
+
+impl CallLimits {
+    /// Whether the current call must stop: past [`MAX_LAMBDA_STEPS`], or past the heap budget
+    /// of [`memory::MAX_LAMBDA_HEAP_BYTES`].
+    fn check(&self) -> bool {
+        let n = self.checks.get() + 1;
+        self.checks.set(n);
+        let limit = if n.saturating_mul(1000) > MAX_LAMBDA_STEPS {
+            Some(Limit::Steps)
+        } else if memory::over_soft_limit() {
+            Some(Limit::Heap)
+        } else {
+            None
+        };
+        self.exceeded.set(limit);
+        limit.is_some()
+    }
+
+    /// Makes `eval` check these limits, and limits its call depth to
+    /// [`super::MAX_CALL_DEPTH`].
+    ///
+    /// # Errors
+    /// starlark's, when the evaluator already has a call depth limit.
+    pub fn install<'a>(&'a self, eval: &mut Evaluator<'_, 'a, '_>) -> anyhow::Result<()> {
+        eval.set_check_cancelled(Box::new(move || self.check()));
+        eval.set_max_callstack_size(super::MAX_CALL_DEPTH)
     }
 }

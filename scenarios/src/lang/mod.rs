@@ -26,6 +26,7 @@ use starlark::syntax::{AstModule, Dialect};
 
 use crate::{Scenario, ScenarioError};
 
+pub use host::MAX_LAMBDA_STEPS;
 pub use program::{MAX_CHECKED_WORLDS, MAX_CHECK_STEPS};
 pub use values::OverTime;
 
@@ -50,14 +51,18 @@ fn lambda_name(n: u32) -> String {
 /// replaced by `-`; its description is the first paragraph of the file's header comment.
 ///
 /// # Errors
-/// [`ScenarioError::Io`] when the file cannot be read; [`ScenarioError::Language`] with a
+/// [`ScenarioError::Io`] when the file cannot be read, is larger than
+/// [`crate::text_file::MAX_SOURCE_BYTES`] or is not UTF-8 (naming the line and column of the
+/// first bad byte); [`ScenarioError::Language`] with a
 /// diagnostic naming the file, line and column (and a caret under the source) for any error
 /// in the program.
 pub fn load_file(path: &Path) -> Result<Scenario, ScenarioError> {
-    let source = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
+    let source = crate::text_file::read_text(path, crate::text_file::MAX_SOURCE_BYTES).map_err(
+        |message| ScenarioError::Io {
+            path: path.display().to_string(),
+            message,
+        },
+    )?;
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().replace('_', "-"))

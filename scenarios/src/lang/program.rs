@@ -16,7 +16,7 @@ use starlark::syntax::AstModule;
 use starlark::values::Value;
 
 use super::globals::LoadState;
-use super::host::StarHost;
+use super::host::{CallLimits, StarHost};
 use super::names::{final_names, Syntax};
 use super::scene::{self, coordinate_names, ParamDecl, ParamValue, SceneBuilder};
 use super::usage;
@@ -27,6 +27,10 @@ use crate::{MonitorSpec, Scenario, ScenarioError};
 /// Most combinations of parameter values checked when a program loads; beyond it, the rows
 /// of a pairwise covering array over them.
 pub const MAX_CHECKED_WORLDS: usize = 4096;
+
+/// Most values of one parameter evaluated at load to learn which inputs it changes (spread
+/// evenly over its levels, the first and last among them).
+const MAX_PROBED_VALUES: usize = 64;
 
 /// Most evaluation steps (function calls and loop iterations, as starlark counts them) that
 /// checking the combinations at load may take in all. A program whose every evaluation is
@@ -67,6 +71,9 @@ const BUILTINS: &[&str] = &[
 /// A program and what its first evaluation told about it.
 pub struct Program {
     file: String,
+    /// `file`, leaked once per load: the hard heap limit's message reads it from inside the
+    /// allocator, where nothing may be allocated ([`crate::memory`]).
+    file_static: &'static str,
     ast: AstModule,
     globals: Globals,
     /// Final name and declaration of each open parameter, in declaration order.
@@ -140,7 +147,26 @@ impl Program {
                 for l in limits {
                     l.map_err(|e| e.to_string())?;
                 }
+                // starlark checks its own heap every 1,000 steps; the budget also counts what
+                // one statement allocates ([`crate::memory`]).
+                let budget = crate::memory::Budget::start(
+                    super::MAX_LOAD_HEAP_BYTES,
+                    crate::memory::HARD_HEAP_BYTES,
+                    self.file_static,
+                    "the program",
+                );
+                eval.set_check_cancelled(Box::new(crate::memory::over_soft_limit));
                 let result = eval.eval_module(self.ast.clone(), &self.globals);
+                let result = match result {
+                    Err(_) if crate::memory::over_soft_limit() => {
+                        Err(starlark::Error::new_other(anyhow::anyhow!(
+                            "error: the program used more than the heap limit of {} MiB",
+                            super::MAX_LOAD_HEAP_BYTES >> 20
+                        )))
+                    }
+                    r => r,
+                };
+                drop(budget);
                 if result.is_err() && state.scene.borrow().values.is_some() {
                     // A parameter that only these values declare explains the failure first.
                     self.same_params_so_far(&state.scene.borrow())?;
@@ -346,7 +372,9 @@ impl Program {
     }
 
     /// Every combination of [`Program::checked_values`] when there are at most
-    /// [`MAX_CHECKED_WORLDS`], else the rows of a pairwise covering array over them.
+    /// [`MAX_CHECKED_WORLDS`], else the rows of a pairwise covering array over them, or of
+    /// one with each value once when a pairwise one would have more than 4 ×
+    /// [`MAX_CHECKED_WORLDS`] rows.
     fn combinations(&self) -> Vec<(Vec<ParamValue>, String)> {
         let options: Vec<Vec<(ParamValue, String)>> = (0..self.params.len())
             .map(|k| self.checked_values(k))
@@ -372,7 +400,17 @@ impl Program {
             rows
         } else {
             let levels: Vec<u32> = options.iter().map(|o| o.len() as u32).collect();
-            match paracosm_generators::covering::ipog(&levels, 2) {
+            // Pairwise when its array stays near the check's budget, else each value once
+            // (two 10,000-level parameters would need 10^8 pairwise rows).
+            let mut largest = levels.clone();
+            largest.sort_unstable_by(|a, b| b.cmp(a));
+            let pairs = u64::from(largest[0]) * u64::from(largest.get(1).copied().unwrap_or(1));
+            let t = if pairs <= 4 * MAX_CHECKED_WORLDS as u64 {
+                2
+            } else {
+                1
+            };
+            match paracosm_generators::covering::ipog(&levels, t) {
                 Ok(array) => (0..array.len())
                     .map(|r| array.row(r).iter().map(|&i| i as usize).collect())
                     .collect(),
@@ -437,10 +475,12 @@ impl Program {
             };
             let functions = lambda_values(&b, module)?;
             let test = super::values::TestState::default();
+            let limits = CallLimits::default();
             let mut eval = Evaluator::new(module);
             eval.extra = Some(&test);
             eval.set_print_handler(&test);
-            let mut host = StarHost::new(&mut eval, &functions);
+            limits.install(&mut eval).map_err(|e| e.to_string())?;
+            let mut host = StarHost::new(&mut eval, &functions, &limits, self.file_static);
             match sim.check_streams(&mut host) {
                 Ok(()) => Ok(()),
                 Err(e) => {
@@ -477,10 +517,12 @@ impl crate::Worlds for Program {
             let functions = lambda_values(&b, module)?;
             let test = super::values::TestState::default();
             test.log.borrow_mut().extend(b.log.iter().cloned());
+            let limits = CallLimits::default();
             let mut eval = Evaluator::new(module);
             eval.extra = Some(&test);
             eval.set_print_handler(&test);
-            let mut host = StarHost::new(&mut eval, &functions);
+            limits.install(&mut eval).map_err(|e| e.to_string())?;
+            let mut host = StarHost::new(&mut eval, &functions, &limits, self.file_static);
             run(&spec, &mut host);
             Ok(())
         })
@@ -511,6 +553,7 @@ pub fn load(
         objects: Arc::new(syntax.objects()),
         syntax,
         file: file.to_owned(),
+        file_static: Box::leak(file.to_owned().into_boxed_str()),
         ast,
         globals,
         params: Vec::new(),
@@ -580,7 +623,7 @@ pub fn load(
         let total = combinations.len();
         let mut steps = 0u64;
         for (done, (values, label)) in combinations.into_iter().enumerate() {
-            if steps > MAX_CHECK_STEPS {
+            if steps > MAX_CHECK_STEPS || done >= MAX_CHECKED_WORLDS {
                 checked = Some((done, total, steps));
                 break;
             }
@@ -599,7 +642,15 @@ pub fn load(
     let mut changes = Vec::with_capacity(program.params.len());
     for k in 0..program.params.len() {
         let mut seen = Vec::new();
-        for (v, label) in program.checked_values(k) {
+        // At most MAX_PROBED_VALUES of its values, spread over them (a VarEnum may have
+        // thousands of levels, each one evaluation of the program).
+        let all = program.checked_values(k);
+        let n = all.len();
+        let probed = all.into_iter().enumerate().filter(|(i, _)| {
+            n <= MAX_PROBED_VALUES
+                || (0..MAX_PROBED_VALUES).any(|j| j * (n - 1) / (MAX_PROBED_VALUES - 1) == *i)
+        });
+        for (_, (v, label)) in probed {
             if v == base_values[k] {
                 continue;
             }
@@ -659,8 +710,9 @@ pub fn load(
             at: format!("{file}:1:1"),
             message: format!(
                 "loading checked {done} of the {total} combinations of levels and interval ends \
-                 ({steps} evaluation steps, over the budget of {MAX_CHECK_STEPS}); a test whose \
-                 values break the world among the others ends with status `error`"
+                 ({steps} evaluation steps; the budget is {MAX_CHECK_STEPS} steps and \
+                 {MAX_CHECKED_WORLDS} worlds); a test whose values break the world among the \
+                 others ends with status `error`"
             ),
         });
     }
@@ -678,6 +730,26 @@ pub fn load(
                     .to_owned()
             },
         });
+    }
+    for (m, at) in first.monitors.iter().zip(&first.monitors_at) {
+        let MonitorSpec::Stl { name, formula } = m else {
+            continue;
+        };
+        let clamped = paracosm_oracles::stl::parse(formula)
+            .map(|f| f.clamped(program.horizon_s).1)
+            .unwrap_or(false);
+        if clamped {
+            warnings.push(Warning {
+                at: at.clone(),
+                message: format!(
+                    "Stl monitor `{name}`: time bounds past the test's horizon of {h} s are \
+                     lowered to {c} s, which changes no verdict (a window is cut at the end of \
+                     the test) and keeps its memory to the horizon's samples",
+                    h = program.horizon_s,
+                    c = program.horizon_s + 1.0
+                ),
+            });
+        }
     }
     let stl_reads_light = monitors
         .iter()

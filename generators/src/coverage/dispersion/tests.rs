@@ -161,3 +161,30 @@ fn bad_input_is_an_error() {
     assert!(dispersion(&[0.1, 0.2, 0.3], 2, &DispersionOptions::default()).is_err());
     assert!(dispersion(&[0.1], 0, &DispersionOptions::default()).is_err());
 }
+
+#[test]
+fn past_the_search_limits_the_bracket_is_the_widest_empty_slab_and_one() {
+    // 3 points in d = 40: the widest gap of any coordinate bounds the dispersion from below.
+    let d = 40;
+    let mut pts = vec![0.5; 3 * d];
+    pts[7] = 0.1; // point 0, axis 7: gaps 0.1, 0.4, 0.5 on axis 7 ...
+    pts[d + 7] = 0.2;
+    pts[2 * d + 7] = 0.9; // ... axis 7 has gaps 0.1, 0.1, 0.7, 0.1: the widest, 0.7
+    let r = dispersion(&pts, d, &DispersionOptions::default()).unwrap();
+    assert!((r.lower - 0.7).abs() < 1e-12, "{r:?}");
+    assert_eq!(r.upper, 1.0);
+    assert!(!r.exact);
+    assert!(r.method.contains("search limits"), "{}", r.method);
+    // The witness is empty and has the reported volume.
+    assert!((r.witness.volume() - 0.7).abs() < 1e-12);
+    // In d = 8 with many points, the cost rule picks the same fallback.
+    let many: Vec<f64> = (0..8 * 10_000)
+        .map(|i| ((i * 7919) % 10_007) as f64 / 10_007.0)
+        .collect();
+    let r = dispersion(&many, 8, &DispersionOptions::default()).unwrap();
+    assert!(
+        r.method.contains("search limits") && r.upper == 1.0,
+        "{}",
+        r.method
+    );
+}

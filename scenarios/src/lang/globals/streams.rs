@@ -81,6 +81,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                  drawn from [lo, hi), which needs a finite width)"
             );
         }
+        if !(hi - lo).is_finite() {
+            bail!(
+                "VarInterval({lo}, {hi}) is wider than a float can hold (hi - lo overflows), so \
+                 no value could be drawn from it; rescale it"
+            );
+        }
         if lo >= hi {
             bail!("VarInterval({lo}, {hi}) is empty: lo must be below hi");
         }
@@ -129,6 +135,9 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             bail!("VarEnum([]) has no levels");
         }
         let mut out = Vec::new();
+        // Levels seen, as hashable keys (linear in the levels, not quadratic: a VarEnum may
+        // have tens of thousands). `0.0` and `-0.0` are one level, as `==` says.
+        let mut seen = std::collections::HashSet::with_capacity(items.len());
         for v in items {
             let level = if let Some(b) = v.unpack_bool() {
                 Level::Bool(b)
@@ -139,7 +148,13 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             } else {
                 Level::Real(number(v, "a VarEnum level")?)
             };
-            if out.contains(&level) {
+            let key = match &level {
+                Level::Bool(b) => (0u8, u64::from(*b), String::new()),
+                Level::Int(i) => (1, *i as u64, String::new()),
+                Level::Real(x) => (2, if *x == 0.0 { 0 } else { x.to_bits() }, String::new()),
+                Level::Text(t) => (3, 0, t.clone()),
+            };
+            if !seen.insert(key) {
                 bail!("VarEnum lists the level {level} twice");
             }
             out.push(level);

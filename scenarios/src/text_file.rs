@@ -1,0 +1,68 @@
+//! Reading a text input (a program, a space, a CSV) with a size limit and a UTF-8 check that
+//! names the line and column of the first bad byte.
+
+use std::io::Read;
+use std::path::Path;
+
+/// Largest program, space or model file read, bytes (64 MiB).
+pub const MAX_SOURCE_BYTES: u64 = 64 << 20;
+/// Largest data file (a CSV of points) read, bytes (1 GiB).
+pub const MAX_DATA_BYTES: u64 = 1 << 30;
+
+/// Reads `path` as UTF-8 text of at most `limit` bytes. A device such as `/dev/zero` is
+/// read up to the limit, never to its end.
+///
+/// # Errors
+/// A message (without the path, which the caller adds with its own location format):
+/// the I/O error; "larger than the limit of N MiB"; or "not UTF-8: the first bad byte
+/// (0xNN) is at line L, column C".
+pub fn read_text(path: &Path, limit: u64) -> Result<String, String> {
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut bytes = Vec::new();
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > limit {
+        return Err(format!(
+            "larger than the limit of {} MiB for this kind of file",
+            limit >> 20
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let good = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        let (line, column) = line_column(&bytes[..good]);
+        format!(
+            "not UTF-8 text: the first bad byte (0x{:02x}) is at line {line}, column {column}",
+            bytes[good]
+        )
+    })
+}
+
+/// Line and column (from 1, the column in characters) just after the valid UTF-8 `prefix`.
+fn line_column(prefix: &[u8]) -> (usize, usize) {
+    let text = std::str::from_utf8(prefix).unwrap_or("");
+    let line = text.matches('\n').count() + 1;
+    let column = text.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_bad_byte_is_named_by_line_and_column() {
+        let dir = std::env::temp_dir().join(format!("paracosm-text-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("bad.star");
+        std::fs::write(&f, b"x = 1\ny = \"\xc3\xa9\xff\"\n").unwrap();
+        let e = read_text(&f, MAX_SOURCE_BYTES).unwrap_err();
+        assert!(e.contains("(0xff) is at line 2, column 7"), "{e}");
+        std::fs::write(&f, b"0123456789").unwrap();
+        let e = read_text(&f, 4).unwrap_err();
+        assert!(e.contains("larger than the limit"), "{e}");
+        assert_eq!(read_text(&f, 10).unwrap(), "0123456789");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

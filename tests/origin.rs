@@ -1,0 +1,136 @@
+//! Issue 22, requirement 4: records prove their origin. `--resume` and `merge` check each
+//! record's seed, strategy and point against the campaign and refuse a foreign one, naming its
+//! line.
+
+use std::path::Path;
+
+mod common;
+use common::{expect_code, fuzz, ran};
+
+fn lines(dir: &Path) -> Vec<String> {
+    std::fs::read_to_string(dir.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(str::to_owned)
+        .collect()
+}
+
+fn campaign(out: &Path, extra: &[&str]) {
+    let mut args = vec!["pedestrian-crossing", "--budget", "60", "--out"];
+    args.push(out.to_str().unwrap());
+    args.extend(extra);
+    ran(&fuzz(&args));
+}
+
+/// A copy of `base` whose results are its first `keep` lines, with line `at` (from 1)
+/// replaced by `line` (or `line` appended when `at == keep + 1`).
+fn forged(base: &Path, to: &Path, keep: usize, at: usize, line: &str) {
+    std::fs::create_dir_all(to).unwrap();
+    std::fs::copy(base.join("campaign.json"), to.join("campaign.json")).unwrap();
+    let mut l: Vec<String> = lines(base)[..keep].to_vec();
+    if at == keep + 1 {
+        l.push(line.to_owned());
+    } else {
+        l[at - 1] = line.to_owned();
+    }
+    std::fs::write(to.join("results.jsonl"), l.join("\n") + "\n").unwrap();
+}
+
+#[test]
+fn resume_refuses_a_record_of_another_seed_strategy_or_point() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b, c) = (
+        dir.path().join("a"),
+        dir.path().join("b"),
+        dir.path().join("c"),
+    );
+    campaign(&a, &[]);
+    campaign(&b, &["--seed", "8"]);
+    campaign(&c, &["--strategy", "random"]);
+    let seed8 = lines(&b);
+    let random = lines(&c);
+    // The same id's record with another point (the next test's point and params).
+    let mut moved: serde_json::Value = serde_json::from_str(&lines(&a)[49]).unwrap();
+    let next: serde_json::Value = serde_json::from_str(&lines(&a)[50]).unwrap();
+    moved["point"] = next["point"].clone();
+    moved["params"] = next["params"].clone();
+    let cases = [
+        ("seed8", 55, 50, seed8[49].clone(), "has seed"),
+        (
+            "random",
+            55,
+            50,
+            random[49].clone(),
+            "has strategy `random`",
+        ),
+        ("appended", 50, 51, seed8[50].clone(), "has seed"),
+        (
+            "moved",
+            55,
+            50,
+            moved.to_string(),
+            "point is not the one halton proposes",
+        ),
+    ];
+    for (name, keep, at, line, phrase) in cases {
+        let d = dir.path().join(name);
+        forged(&a, &d, keep, at, &line);
+        let before = std::fs::read(d.join("results.jsonl")).unwrap();
+        let o = fuzz(&["--resume", "--out", d.to_str().unwrap()]);
+        expect_code(&o, 2);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains(&format!("results.jsonl:{at}: ")),
+            "{name}: {err}"
+        );
+        assert!(err.contains(phrase), "{name}: {err}");
+        // Refused before any test: the file is as it was.
+        assert_eq!(
+            std::fs::read(d.join("results.jsonl")).unwrap(),
+            before,
+            "{name}"
+        );
+    }
+    // The untouched prefix resumes to the clean run's results.
+    let d = dir.path().join("clean");
+    forged(&a, &d, 50, 50, &lines(&a)[49]);
+    ran(&fuzz(&["--resume", "--out", d.to_str().unwrap()]));
+    assert_eq!(common::comparable(&d), common::comparable(&a));
+}
+
+#[test]
+fn merge_refuses_a_shard_with_a_foreign_record() {
+    let dir = tempfile::tempdir().unwrap();
+    let shard = |i: usize, seed: &str| {
+        let out = dir.path().join(format!("s{i}-{seed}"));
+        let s = format!("{i}/2");
+        ran(&fuzz(&[
+            "pedestrian-crossing",
+            "--budget",
+            "40",
+            "--seed",
+            seed,
+            "--shard",
+            &s,
+            "--out",
+            out.to_str().unwrap(),
+        ]));
+        out
+    };
+    let (s0, s1, other) = (shard(0, "0"), shard(1, "0"), shard(1, "8"));
+    let mut l = lines(&s1);
+    l[3] = lines(&other)[3].clone();
+    std::fs::write(s1.join("results.jsonl"), l.join("\n") + "\n").unwrap();
+    let out = dir.path().join("merged");
+    let o = fuzz(&[
+        "merge",
+        s0.to_str().unwrap(),
+        s1.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 2);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("results.jsonl:4: test 23 has seed"), "{err}");
+    assert!(!out.join("results.jsonl").exists());
+}
