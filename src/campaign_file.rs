@@ -228,6 +228,11 @@ pub struct CampaignFile {
     /// [`Settings::points`] (left out of the file for the other strategies).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub points: Option<PointsFile>,
+    /// SHA-256 (hex) of the scenario program's text, also folded into the fingerprint: kept
+    /// apart so that `--resume` can tell a changed program from a hand-edited campaign.json.
+    /// Absent in files written before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scenario_sha256: Option<String>,
 }
 
 impl CampaignFile {
@@ -290,10 +295,11 @@ impl CampaignFile {
         } = settings;
         let strategy = strategy.as_str();
         let space = scenario.space.params().to_vec();
+        let source_sha256 = sha256_hex(scenario.source.as_bytes());
         let fingerprint = {
             let f = Fingerprinted {
                 scenario_name: &scenario.name,
-                scenario_source_sha256: sha256_hex(scenario.source.as_bytes()),
+                scenario_source_sha256: source_sha256.clone(),
                 space: &space,
                 sut: &sut,
                 strategy,
@@ -321,6 +327,7 @@ impl CampaignFile {
             shard,
             space,
             points,
+            scenario_sha256: Some(source_sha256),
         }
     }
 

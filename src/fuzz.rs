@@ -15,9 +15,11 @@ fn study_space() -> &'static ParamSpace {
     SPACE.get_or_init(|| paracosm_scenarios::reference::scenario().space)
 }
 
-/// A space file (TOML) and a CSV test set, with and without a space.
+/// A space file (TOML), a CSV test set (with and without a space), and an STL formula (as
+/// `paracosm-cover stl` and `Stl(...)` read it).
 pub fn inputs(data: &[u8]) {
     let Some(s) = text(data) else { return };
+    let _ = paracosm_oracles::stl::parse(s);
     let _ = crate::cover::parse_space("fuzz.toml", s);
     let _ = crate::cover::parse_tests("fuzz.csv", s, false, None);
     let _ = crate::cover::parse_tests("fuzz.csv", s, false, Some(study_space()));

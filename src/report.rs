@@ -446,7 +446,14 @@ pub fn human(summary: &Summary, scenario: &Scenario, out: &Path, expected: u64) 
             });
         }
         if let Some(star) = &cov.star {
-            parts.push(format!("star discrepancy {:.4}", star.upper));
+            parts.push(if star.exact {
+                format!("star discrepancy {:.4}", star.lower)
+            } else {
+                format!("star discrepancy in [{:.4}, {:.4}]", star.lower, star.upper)
+            });
+        }
+        for note in &cov.skipped {
+            parts.push(note.clone());
         }
         for k in &cov.kwise {
             parts.push(format!(

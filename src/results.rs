@@ -53,9 +53,9 @@ pub fn load(
     }
     let text = std::str::from_utf8(&bytes[..whole]).map_err(|e| {
         bad(format!(
-            "{}: not UTF-8 text (byte {}); is it a results file?",
+            "{}: {}; is it a results file?",
             path.display(),
-            e.valid_up_to()
+            paracosm_scenarios::text_file::not_utf8(&bytes[..whole], e)
         ))
     })?;
     let mut records = Vec::new();

@@ -518,10 +518,36 @@ fn settings(
             let scenario = load(&st.scenario, &st.sut)?;
             let again = CampaignFile::new(&st.scenario, &scenario, st.settings());
             if again.fingerprint != st.fingerprint {
-                return Err(refuse(vec![format!(
-                    "the scenario `{}` changed since the campaign started",
-                    st.scenario
-                )]));
+                // Name what differs: the program, its parameters, or campaign.json itself.
+                let why = if st
+                    .scenario_sha256
+                    .as_ref()
+                    .is_some_and(|h| Some(h) != again.scenario_sha256.as_ref())
+                {
+                    format!(
+                        "the scenario program `{}` changed since the campaign started (its \
+                         SHA-256 differs)",
+                        st.scenario
+                    )
+                } else if st.space != again.space {
+                    format!(
+                        "the parameters of `{}` differ from the `space` in {CAMPAIGN_FILE}",
+                        st.scenario
+                    )
+                } else if st.scenario_sha256.is_some() {
+                    format!(
+                        "{CAMPAIGN_FILE} was edited: its strategy, seed, budget, strength or \
+                         system under test no longer give its `fingerprint` (the scenario \
+                         program is unchanged)"
+                    )
+                } else {
+                    format!(
+                        "the scenario `{}` changed since the campaign started, or {CAMPAIGN_FILE} \
+                         was edited",
+                        st.scenario
+                    )
+                };
+                return Err(refuse(vec![why]));
             }
             let points = match &st.points {
                 Some(stored_file) => {

@@ -193,3 +193,63 @@ fn an_stl_bound_past_the_horizon_is_lowered_with_a_warning_and_judges_as_before(
     assert!(outs[0].iter().any(|r| r["status"] == "fail"));
     assert!(outs[0].iter().any(|r| r["status"] == "pass"));
 }
+
+#[test]
+fn two_hundred_open_parameters_get_a_summary_with_cheap_coverage_brackets() {
+    // Exact dispersion in 200 dimensions never ended, so summary.json was never written.
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("p200.star");
+    let mut src: Vec<String> = (0..200)
+        .map(|i| format!("p{i} = VarInterval(0.0, 1.0)"))
+        .collect();
+    src.push(format!(
+        "total = {}",
+        (0..200)
+            .map(|i| format!("p{i}"))
+            .collect::<Vec<_>>()
+            .join(" + ")
+    ));
+    src.extend(
+        [
+            "w = World(light = 0.5, fog = 0.0)",
+            "r = RoadSegment(len = 200.0 + total, nlanes = 2)",
+            "v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 5.0)",
+            "w.place(r, v)",
+            "CollisionMonitor(v)",
+            "test(horizon = 1.0)",
+        ]
+        .map(str::to_owned),
+    );
+    std::fs::write(&p, src.join("\n") + "\n").unwrap();
+    let out = dir.path().join("o");
+    let o = fuzz(&[
+        p.to_str().unwrap(),
+        "--budget",
+        "50",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let cov = &summary["coverage"];
+    let d = &cov["dispersion"];
+    assert_eq!(d["upper"], 1.0);
+    assert!(d["lower"].as_f64().unwrap() > 0.5, "{d}");
+    assert!(
+        d["method"].as_str().unwrap().contains("search limits"),
+        "{d}"
+    );
+    let s = &cov["star"];
+    assert!(
+        s["method"].as_str().unwrap().contains("search limits"),
+        "{s}"
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("star discrepancy in ["), "{stdout}");
+}

@@ -134,3 +134,48 @@ fn merge_refuses_a_shard_with_a_foreign_record() {
     assert!(err.contains("results.jsonl:4: test 23 has seed"), "{err}");
     assert!(!out.join("results.jsonl").exists());
 }
+
+#[test]
+fn resume_names_what_changed_the_program_or_a_hand_edited_campaign_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("walk.star");
+    let source = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/pedestrian_crossing.star"),
+    )
+    .unwrap();
+    std::fs::write(&program, &source).unwrap();
+    let run = |out: &Path| {
+        ran(&fuzz(&[
+            program.to_str().unwrap(),
+            "--budget",
+            "10",
+            "--out",
+            out.to_str().unwrap(),
+        ]))
+    };
+    let resume = |out: &Path| {
+        let o = fuzz(&["--resume", "--out", out.to_str().unwrap()]);
+        expect_code(&o, 2);
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    // campaign.json's seed edited by hand.
+    let edited = dir.path().join("edited");
+    run(&edited);
+    let path = edited.join("campaign.json");
+    let mut c: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    c["seed"] = 5.into();
+    std::fs::write(&path, c.to_string()).unwrap();
+    let err = resume(&edited);
+    assert!(err.contains("campaign.json was edited"), "{err}");
+    assert!(err.contains("the scenario program is unchanged"), "{err}");
+    // The program's text changed (a comment added).
+    let changed = dir.path().join("changed");
+    run(&changed);
+    std::fs::write(&program, format!("# a new comment\n{source}")).unwrap();
+    let err = resume(&changed);
+    assert!(
+        err.contains("walk.star` changed since the campaign started (its SHA-256 differs)"),
+        "{err}"
+    );
+}

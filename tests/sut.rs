@@ -71,6 +71,11 @@ fn every_misbehaving_program_becomes_an_error_record_and_the_campaign_goes_on() 
         ("garbage.py", "is it printing to stdout?"),
         ("nan.py", "NaN and Infinity are not JSON numbers"),
         ("out_of_range.py", "answered throttle = 3, outside [-1, 1]"),
+        (
+            "answers_twice.py",
+            "answered step 0 to the observation of step 1: an extra or late answer",
+        ),
+        ("no_step.py", "without `step`"),
     ];
     for (file, message) in cases {
         let dir = tempfile::tempdir().unwrap();

@@ -27,7 +27,7 @@ try:
 except ImportError:  # numpy is optional
     np = None
 
-PROTOCOL_VERSION = 1
+PROTOCOL_VERSION = 2
 
 _DTYPES = {"uint8": 1, "float32": 4}
 
@@ -137,7 +137,8 @@ def serve(controller, stdin=None, stdout=None):
             write_frame(stdout, {"type": "ready"})
         elif kind == "observation":
             throttle, steering = controller.act(Observation(header, buffers))
-            write_frame(stdout, {"throttle": float(throttle), "steering": float(steering)})
+            write_frame(stdout, {"step": header["step"], "throttle": float(throttle),
+                                 "steering": float(steering)})
         else:
             raise ValueError("unknown message type %r" % kind)
 

@@ -46,8 +46,10 @@ thread_local! {
     static HARD: Cell<usize> = const { Cell::new(0) };
     /// The active budget's soft limit, bytes.
     static SOFT: Cell<usize> = const { Cell::new(usize::MAX) };
-    /// The program's file and what is being evaluated, for the hard limit's message.
-    static WHAT: Cell<(&'static str, &'static str)> = const { Cell::new(("", "")) };
+    /// The program's file (pointer and length of a `str` that the active [`Budget`] borrows)
+    /// and what is being evaluated, for the hard limit's message.
+    static WHAT: Cell<(*const u8, usize, &'static str)> =
+        const { Cell::new((std::ptr::null(), 0, "")) };
 }
 
 /// The global allocator of the paracosm binaries: [`System`], counting the bytes of threads
@@ -76,7 +78,14 @@ fn hard_limit_exceeded(hard: usize, request: usize) -> ! {
     use std::io::Write;
     // No allocation from here: the message is formatted into a buffer on the stack.
     HARD.with(|h| h.set(0));
-    let (file, what) = WHAT.with(Cell::get);
+    let (ptr, len, what) = WHAT.with(Cell::get);
+    let file = if ptr.is_null() {
+        ""
+    } else {
+        // SAFETY: set by `Budget::start` from a `&str` that the live `Budget` borrows (the
+        // budget is active, so it has not been dropped): valid UTF-8 of `len` bytes.
+        unsafe { std::str::from_utf8_unchecked(std::slice::from_raw_parts(ptr, len)) }
+    };
     let mut buf = [0u8; 1024];
     let mut cursor = std::io::Cursor::new(&mut buf[..]);
     let tool = TOOL.get().copied().unwrap_or("paracosm");
@@ -118,23 +127,28 @@ unsafe impl GlobalAlloc for CountingAlloc {
 }
 
 /// A heap budget active on the current thread until dropped (budgets do not nest: a new one
-/// replaces the outer one, whose count resumes from zero when it is restored).
-pub struct Budget {
-    saved: (isize, usize, usize, (&'static str, &'static str)),
+/// replaces the outer one, whose count resumes from zero when it is restored). It borrows the
+/// program's file name, which the hard limit's message shows.
+pub struct Budget<'a> {
+    saved: (isize, usize, usize, (*const u8, usize, &'static str)),
+    _file: std::marker::PhantomData<&'a str>,
 }
 
-impl Budget {
+impl<'a> Budget<'a> {
     /// Starts counting this thread's allocations from zero, with `soft` and `hard` limits in
     /// bytes. `file` (the program) and `what` (for example "the program, while loading") name
     /// the evaluation in the hard limit's message.
-    pub fn start(soft: usize, hard: usize, file: &'static str, what: &'static str) -> Budget {
+    pub fn start(soft: usize, hard: usize, file: &'a str, what: &'static str) -> Budget<'a> {
         let saved = (
             USED.with(|u| u.replace(0)),
             HARD.with(|h| h.replace(hard.max(1))),
             SOFT.with(|s| s.replace(soft)),
-            WHAT.with(|w| w.replace((file, what))),
+            WHAT.with(|w| w.replace((file.as_ptr(), file.len(), what))),
         );
-        Budget { saved }
+        Budget {
+            saved,
+            _file: std::marker::PhantomData,
+        }
     }
 
     /// Starts counting again from zero (for example before each lambda call), keeping the
@@ -144,7 +158,7 @@ impl Budget {
     }
 }
 
-impl Drop for Budget {
+impl Drop for Budget<'_> {
     fn drop(&mut self) {
         let (used, hard, soft, what) = self.saved;
         USED.with(|u| u.set(used));

@@ -28,15 +28,18 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String, String> {
             limit >> 20
         ));
     }
-    String::from_utf8(bytes).map_err(|e| {
-        let good = e.utf8_error().valid_up_to();
-        let bytes = e.as_bytes();
-        let (line, column) = line_column(&bytes[..good]);
-        format!(
-            "not UTF-8 text: the first bad byte (0x{:02x}) is at line {line}, column {column}",
-            bytes[good]
-        )
-    })
+    String::from_utf8(bytes).map_err(|e| not_utf8(e.as_bytes(), e.utf8_error()))
+}
+
+/// "not UTF-8 text: the first bad byte (0xNN) is at line L, column C" for `bytes`, whose
+/// decoding failed with `e`.
+pub fn not_utf8(bytes: &[u8], e: std::str::Utf8Error) -> String {
+    let good = e.valid_up_to();
+    let (line, column) = line_column(&bytes[..good]);
+    format!(
+        "not UTF-8 text: the first bad byte (0x{:02x}) is at line {line}, column {column}",
+        bytes.get(good).copied().unwrap_or(0)
+    )
 }
 
 /// Line and column (from 1, the column in characters) just after the valid UTF-8 `prefix`.

@@ -9,7 +9,9 @@
 # without systemd), starts munged, slurmctld and slurmd in the foreground (-D) under this shell,
 # submits the job array of deploy/slurm/paracosm-array.sbatch for the pedestrian study and the
 # merge step that depends on it, waits, and compares the merged results.jsonl with a local run
-# (sorted, without wall_ms). Stops the daemons and deletes the folder at the end. Needs root.
+# (sorted, without wall_ms). Then submits one task again while it still runs (an overlapping
+# requeue): the second must be refused by the campaign's lock and the first must finish intact.
+# Stops the daemons and deletes the folder at the end. Needs root.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 repo=$(pwd)
@@ -116,3 +118,42 @@ for k in $(seq 0 $((shards - 1))); do
   [ -f "$out/shard-$k/campaign.json" ] || { echo "shard $k missing" >&2; exit 1; }
 done
 echo "ok: $shards Slurm array tasks + merge = the local run ($lines tests)"
+
+echo "== a requeued task that overlaps its predecessor is refused (one writer per campaign)"
+# Task 0 of a one-task array runs a long campaign; while it runs, the same task is submitted
+# again (what a requeue that overlaps its predecessor does). The second must exit 2 at once
+# with the lock's message, and the first must finish a campaign equal to a local run.
+ov="$work/overlap"
+mkdir -p "$ov"
+long=(--strategy halton --budget 3000 --seed 5)
+# One core each (the script asks for two), so that both fit the node at once.
+sbatch --parsable --wait --array=0-0 --cpus-per-task=1 --chdir="$ov" --export=ALL \
+  "$repo/deploy/slurm/paracosm-array.sbatch" pedestrian-crossing "$ov" "${long[@]}" \
+  >"$work/first.id" &
+first=$!
+for _ in $(seq 1 300); do
+  [ -s "$ov/shard-0/results.jsonl" ] && break
+  sleep 0.1
+done
+[ -s "$ov/shard-0/results.jsonl" ] || { echo "the first task never started writing" >&2; exit 1; }
+code=0
+second=$(sbatch --parsable --wait --array=0-0 --cpus-per-task=1 --chdir="$ov" --export=ALL \
+  "$repo/deploy/slurm/paracosm-array.sbatch" pedestrian-crossing "$ov" "${long[@]}") || code=$?
+if [ "$code" -eq 0 ]; then
+  echo "the overlapping task was accepted (exit $code); jobs:" >&2
+  scontrol show job 2>&1 | grep -E "JobId=|StartTime|ExitCode" >&2 || true
+  ls "$ov" >&2; tail -n 3 "$ov"/paracosm-*.out >&2 || true
+  exit 1
+fi
+if ! grep -q "is being written by process" "$ov"/paracosm-"${second%%;*}"_0.out; then
+  echo "the overlapping task did not name the lock:" >&2
+  cat "$ov"/paracosm-"${second%%;*}"_0.out >&2 || true
+  exit 1
+fi
+wait "$first"
+"$fuzz" pedestrian-crossing "${long[@]}" --out "$work/local-long" >/dev/null || [ $? -eq 1 ]
+if ! diff <(strip "$work/local-long/results.jsonl") <(strip "$ov/shard-0/results.jsonl") >/dev/null; then
+  echo "the campaign written beside the refused task differs from a local run" >&2
+  exit 1
+fi
+echo "ok: the overlapping task exited with the lock's message; the first finished intact ($(wc -l < "$ov/shard-0/results.jsonl") tests)"

@@ -16,7 +16,7 @@ use super::{Sensors, Sut, SutError};
 use crate::{CameraSpec, Control, Observation};
 
 /// The protocol version sent in the `hello` message.
-pub const PROTOCOL_VERSION: u32 = 1;
+pub const PROTOCOL_VERSION: u32 = 2;
 /// The largest header accepted from a system under test, in bytes.
 const MAX_HEADER_BYTES: u32 = 1 << 20;
 
@@ -394,6 +394,9 @@ pub struct ExternalSut {
     config: ExternalConfig,
     process: Option<Process>,
     healthy: bool,
+    /// The number of the next observation in this test, from 0: sent as `step`, and the
+    /// answer must carry it back (SUT_PROTOCOL.md).
+    step: u64,
 }
 
 impl ExternalSut {
@@ -403,6 +406,7 @@ impl ExternalSut {
             config,
             process: None,
             healthy: false,
+            step: 0,
         }
     }
 
@@ -440,6 +444,7 @@ impl Sut for ExternalSut {
     fn reset(&mut self, seed: u64) -> Result<(), SutError> {
         // The physics step is not known here; the hello carries the default step.
         let dt_s = crate::DEFAULT_DT_S;
+        self.step = 0;
         if self.process.is_none() {
             let pooled = if self.config.reuse {
                 self.config
@@ -477,8 +482,11 @@ impl Sut for ExternalSut {
         let Some(p) = self.process.as_mut() else {
             return Err(self.fail("was not started (no reset)".into()));
         };
+        let step = self.step;
+        self.step += 1;
         let mut header = json!({
             "type": "observation",
+            "step": step,
             "t_s": obs.t_s,
             "ego": {
                 "pos_m": obs.ego.pos_m,
@@ -532,6 +540,35 @@ impl Sut for ExternalSut {
             }
             Ok(x)
         };
+        // An answer that runs behind (a second answer to an earlier observation) or ahead is
+        // an error of this test, never a control applied at the wrong step.
+        match reply.header.get("step").map(Json::as_u64) {
+            Some(Some(s)) if s == step => {}
+            Some(Some(s)) => {
+                return Err(self.fail(format!(
+                    "answered step {s} to the observation of step {step}: {} (each \
+                     observation gets exactly one answer, which carries its `step`)",
+                    if s < step {
+                        "an extra or late answer"
+                    } else {
+                        "an answer ahead of its observation"
+                    }
+                )))
+            }
+            Some(None) => {
+                return Err(self.fail(format!(
+                    "answered `step` = {}; it must be the observation's step, a whole number",
+                    reply.header["step"]
+                )))
+            }
+            None => {
+                return Err(self.fail(format!(
+                    "answered {} without `step` (protocol {PROTOCOL_VERSION}: the answer \
+                     carries the observation's step)",
+                    reply.header
+                )))
+            }
+        }
         match (value("throttle"), value("steering")) {
             (Ok(throttle), Ok(steering)) => Ok(Control { throttle, steering }),
             (Err(e), _) | (_, Err(e)) => Err(self.fail(e)),

@@ -24,7 +24,7 @@ pub struct StarHost<'a, 'v, 'b, 'e> {
     functions: &'a [Value<'v>],
     limits: &'b CallLimits,
     /// The program's file, for the hard heap limit's message.
-    file: &'static str,
+    file: &'b str,
     /// Module-level variables holding streams, with the stream each holds.
     captured: Vec<(String, StreamId)>,
 }
@@ -36,7 +36,7 @@ impl<'a, 'v, 'b, 'e> StarHost<'a, 'v, 'b, 'e> {
         eval: &'a mut Evaluator<'v, 'b, 'e>,
         functions: &'a [Value<'v>],
         limits: &'b CallLimits,
-        file: &'static str,
+        file: &'b str,
     ) -> Self {
         let module = eval.module();
         let mut captured: Vec<(String, StreamId)> = module

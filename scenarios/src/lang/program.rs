@@ -71,9 +71,6 @@ const BUILTINS: &[&str] = &[
 /// A program and what its first evaluation told about it.
 pub struct Program {
     file: String,
-    /// `file`, leaked once per load: the hard heap limit's message reads it from inside the
-    /// allocator, where nothing may be allocated ([`crate::memory`]).
-    file_static: &'static str,
     ast: AstModule,
     globals: Globals,
     /// Final name and declaration of each open parameter, in declaration order.
@@ -152,7 +149,7 @@ impl Program {
                 let budget = crate::memory::Budget::start(
                     super::MAX_LOAD_HEAP_BYTES,
                     crate::memory::HARD_HEAP_BYTES,
-                    self.file_static,
+                    &self.file,
                     "the program",
                 );
                 eval.set_check_cancelled(Box::new(crate::memory::over_soft_limit));
@@ -480,7 +477,7 @@ impl Program {
             eval.extra = Some(&test);
             eval.set_print_handler(&test);
             limits.install(&mut eval).map_err(|e| e.to_string())?;
-            let mut host = StarHost::new(&mut eval, &functions, &limits, self.file_static);
+            let mut host = StarHost::new(&mut eval, &functions, &limits, &self.file);
             match sim.check_streams(&mut host) {
                 Ok(()) => Ok(()),
                 Err(e) => {
@@ -522,7 +519,7 @@ impl crate::Worlds for Program {
             eval.extra = Some(&test);
             eval.set_print_handler(&test);
             limits.install(&mut eval).map_err(|e| e.to_string())?;
-            let mut host = StarHost::new(&mut eval, &functions, &limits, self.file_static);
+            let mut host = StarHost::new(&mut eval, &functions, &limits, &self.file);
             run(&spec, &mut host);
             Ok(())
         })
@@ -553,7 +550,6 @@ pub fn load(
         objects: Arc::new(syntax.objects()),
         syntax,
         file: file.to_owned(),
-        file_static: Box::leak(file.to_owned().into_boxed_str()),
         ast,
         globals,
         params: Vec::new(),
