@@ -80,7 +80,8 @@ impl Campaign<'_> {
     }
 
     /// Checks that `records` (the tests `first_id..` in order, as read from `file`, whose line
-    /// `k + 1` holds `records[k]`) were written by this campaign: each record's seed is this
+    /// `k + 1` holds `records[k]`) were written by this campaign: each record's `campaign` tag
+    /// is `tag` (when both are known: files written before tags existed have none), its seed is this
     /// campaign's seed for its id ([`test_seed`]), its strategy is this campaign's, and, for a
     /// non-adaptive strategy, its point is the one the strategy proposes for its id. A line
     /// copied from a campaign with another seed, strategy or space fails here. (An adaptive
@@ -94,6 +95,7 @@ impl Campaign<'_> {
         records: &[RunRecord],
         first_id: u64,
         file: &Path,
+        tag: Option<&str>,
     ) -> Result<(), Error> {
         let foreign = |k: usize, what: String| {
             Error::BadInput(format!(
@@ -105,6 +107,17 @@ impl Campaign<'_> {
         };
         let strategy = self.strategy.to_string();
         for (k, r) in records.iter().enumerate() {
+            if let (Some(ours), Some(theirs)) = (tag, r.campaign.as_deref()) {
+                if ours != theirs {
+                    return Err(foreign(
+                        k,
+                        format!(
+                            "test {} carries campaign tag `{theirs}`, this campaign's is `{ours}`",
+                            r.id
+                        ),
+                    ));
+                }
+            }
             if r.strategy != strategy {
                 return Err(foreign(
                     k,
@@ -220,6 +233,7 @@ impl Campaign<'_> {
             Err(e) => (Status::Error, Vec::new(), Vec::new(), Some(e), Vec::new()),
         };
         RunRecord {
+            campaign: None,
             id,
             seed,
             strategy: self.strategy.name().to_owned(),
@@ -579,6 +593,7 @@ impl<F: FnMut(&RunRecord)> Observer for OnRecord<F> {
 pub struct ResultsFile {
     path: PathBuf,
     append: bool,
+    tag: Option<String>,
     out: Option<BufWriter<File>>,
 }
 
@@ -589,8 +604,15 @@ impl ResultsFile {
         ResultsFile {
             path: dir.join(RESULTS_FILE),
             append,
+            tag: None,
             out: None,
         }
+    }
+
+    /// Writes `tag` (the campaign's, `CampaignFile::tag`) into every record's `campaign`.
+    pub fn tagged(mut self, tag: String) -> Self {
+        self.tag = Some(tag);
+        self
     }
 }
 
@@ -618,6 +640,17 @@ impl Observer for ResultsFile {
             .out
             .as_mut()
             .ok_or_else(|| Error::Internal("a record before the campaign started".into()))?;
+        let tagged;
+        let record = match &self.tag {
+            Some(tag) if record.campaign.as_ref() != Some(tag) => {
+                tagged = RunRecord {
+                    campaign: Some(tag.clone()),
+                    ..record.clone()
+                };
+                &tagged
+            }
+            _ => record,
+        };
         serde_json::to_writer(&mut *out, record)
             .map_err(std::io::Error::from)
             .and_then(|()| out.write_all(b"\n"))

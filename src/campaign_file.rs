@@ -4,6 +4,7 @@
 //! arguments with the stored one; `merge` checks that every shard has the same; `replay`
 //! rebuilds any test from it.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use paracosm_engine::sut::{ExternalConfig, SutConfig};
@@ -233,6 +234,11 @@ pub struct CampaignFile {
     /// Absent in files written before it existed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scenario_sha256: Option<String>,
+    /// A short hash (8 hex digits of SHA-256) of each setting as written, by field name
+    /// ([`CampaignFile::field_checks`]), so that `--resume` names the field of a hand-edited
+    /// campaign.json. Absent in files written before it existed.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub checks: BTreeMap<String, String>,
 }
 
 impl CampaignFile {
@@ -328,7 +334,57 @@ impl CampaignFile {
             space,
             points,
             scenario_sha256: Some(source_sha256),
+            checks: BTreeMap::new(),
         }
+        .checked()
+    }
+
+    /// `self` with [`CampaignFile::checks`] computed from its fields.
+    pub(crate) fn checked(mut self) -> CampaignFile {
+        self.checks = self.field_checks();
+        self
+    }
+
+    /// The short hash of each setting's JSON as it stands now: `sut`, `strategy`, `seed`,
+    /// `budget`, `strength`, `shard`, `space`, `points` and `fingerprint`.
+    pub fn field_checks(&self) -> BTreeMap<String, String> {
+        fn h<T: Serialize>(v: &T) -> String {
+            let json = serde_json::to_vec(v).expect("settings serialise");
+            sha256_hex(&json)[..8].to_owned()
+        }
+        [
+            ("sut", h(&self.sut)),
+            ("strategy", h(&self.strategy)),
+            ("seed", h(&self.seed)),
+            ("budget", h(&self.budget)),
+            ("strength", h(&self.strength)),
+            ("shard", h(&self.shard)),
+            ("space", h(&self.space)),
+            ("points", h(&self.points)),
+            ("fingerprint", h(&self.fingerprint)),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_owned(), v))
+        .collect()
+    }
+
+    /// The fields whose [`CampaignFile::checks`] no longer match their values (empty for a
+    /// file without checks): the fields edited by hand since the campaign was written.
+    pub fn edited_fields(&self) -> Vec<String> {
+        if self.checks.is_empty() {
+            return Vec::new();
+        }
+        let now = self.field_checks();
+        now.iter()
+            .filter(|(k, v)| self.checks.get(*k) != Some(v))
+            .map(|(k, _)| k.clone())
+            .collect()
+    }
+
+    /// The campaign's tag, written into each of its records (`campaign`): the first 16 hex
+    /// digits (64 bits) of [`CampaignFile::fingerprint`]. Shards of one campaign share it.
+    pub fn tag(&self) -> String {
+        self.fingerprint.chars().take(16).collect()
     }
 
     /// The ids this folder runs: its shard's, or all.

@@ -35,6 +35,15 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
     let mut first: Option<(PathBuf, CampaignFile)> = None;
     for dir in dirs {
         let file = CampaignFile::read(dir)?;
+        let edited = file.edited_fields();
+        if !edited.is_empty() {
+            return Err(bad(format!(
+                "{}: edited by hand ({} no longer as the shard wrote {})",
+                dir.join(crate::campaign_file::CAMPAIGN_FILE).display(),
+                edited.join(", "),
+                if edited.len() == 1 { "it" } else { "them" }
+            )));
+        }
         let Some(shard) = file.shard else {
             return Err(bad(format!(
                 "`{}` holds a whole campaign, not a shard (run shards with --shard I/N)",
@@ -103,7 +112,12 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
             stop_at_first_failure: false,
             points: None,
         };
-        campaign.check_origin(&existing.records, ids.start, &dir.join(RESULTS_FILE))?;
+        campaign.check_origin(
+            &existing.records,
+            ids.start,
+            &dir.join(RESULTS_FILE),
+            Some(&file.tag()),
+        )?;
         let done = existing.records.len() as u64;
         if done != ids.end - ids.start {
             return Err(bad(format!(
@@ -122,7 +136,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
     let mut whole = CampaignFile {
         shard: None,
         ..template
-    };
+    }
+    .checked();
     whole.tool = format!("paracosm {}", env!("CARGO_PKG_VERSION"));
     let results = out.join(RESULTS_FILE);
     let lines: Vec<Vec<u8>> = shards

@@ -61,6 +61,12 @@ impl From<&Verdict> for MonitorResult {
 /// machine and the moment; it comes last so that tools can drop it to compare runs.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunRecord {
+    /// The campaign that wrote it: the first 16 hex digits of its fingerprint
+    /// (`CampaignFile::tag`). `--resume` and `merge` refuse a record whose tag is not the
+    /// campaign's. Left out (`None`) by runs outside a campaign folder (the Python package's
+    /// `Scenario.run`, the library's `Campaign::run`), and in files written before it existed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub campaign: Option<String>,
     /// Test index in the campaign, `0..budget`.
     pub id: u64,
     /// The test's own seed, derived from the campaign seed and `id` ([`crate::seed::test_seed`]).
@@ -96,6 +102,8 @@ pub struct RunRecord {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Line {
+    #[serde(default)]
+    campaign: Option<String>,
     id: u64,
     seed: u64,
     strategy: String,
@@ -163,6 +171,7 @@ impl RunRecord {
             )));
         }
         Ok(RunRecord {
+            campaign: l.campaign,
             id: l.id,
             seed: l.seed,
             strategy: l.strategy,
@@ -240,6 +249,7 @@ mod tests {
             continuous: vec![0.25],
         };
         let r = RunRecord {
+            campaign: None,
             id: 3,
             seed: 9,
             strategy: "halton".into(),

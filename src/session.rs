@@ -247,7 +247,12 @@ pub fn run(
         stop_at_first_failure: request.stop_at_first_failure,
         points: points.as_deref(),
     };
-    campaign.check_origin(&existing.records, ids.start, &out.join(RESULTS_FILE))?;
+    campaign.check_origin(
+        &existing.records,
+        ids.start,
+        &out.join(RESULTS_FILE),
+        Some(&file.tag()),
+    )?;
     started(&Plan {
         scenario: &scenario,
         file: &file,
@@ -260,7 +265,7 @@ pub fn run(
     let mut written = None;
     let junit_path = request.junit.as_deref();
     let mut chain = Chain {
-        results: ResultsFile::new(out, stored.is_some()),
+        results: ResultsFile::new(out, stored.is_some()).tagged(file.tag()),
         others: observers,
         // summary.json (counts, first failure, coverage of the points run) and the plots.
         outputs: AtEnd::new(Box::new(
@@ -514,6 +519,22 @@ fn settings(
             }
             if !diffs.is_empty() {
                 return Err(refuse(diffs));
+            }
+            let edited = st.edited_fields();
+            if !edited.is_empty() {
+                return Err(Error::BadInput(format!(
+                    "refusing to resume: {} was edited by hand: {} no longer match{} what the \
+                     campaign wrote. Put the value{} back, or start a new campaign with --force \
+                     or another --out",
+                    request.out.join(CAMPAIGN_FILE).display(),
+                    edited
+                        .iter()
+                        .map(|f| format!("`{f}`"))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    if edited.len() == 1 { "es" } else { "" },
+                    if edited.len() == 1 { "" } else { "s" },
+                )));
             }
             let scenario = load(&st.scenario, &st.sut)?;
             let again = CampaignFile::new(&st.scenario, &scenario, st.settings());

@@ -591,6 +591,7 @@ mod tests {
                         (false, _) => Status::Pass,
                     };
                     RunRecord {
+                        campaign: None,
                         id,
                         seed: 0,
                         strategy: "random".into(),

@@ -26,16 +26,13 @@ fn loads(src: &str) -> paracosm_scenarios::Scenario {
         .unwrap_or_else(|e| panic!("{e}\n{src}"))
 }
 
-/// The records of a campaign, each without its `wall_ms`.
+/// The records of a campaign, each without its `wall_ms` and campaign tag (tests here compare
+/// different programs).
 fn records(out: &Path) -> Vec<Json> {
     std::fs::read_to_string(out.join("results.jsonl"))
         .unwrap()
         .lines()
-        .map(|l| {
-            let mut r: Json = serde_json::from_str(l).unwrap();
-            r.as_object_mut().unwrap().remove("wall_ms");
-            r
-        })
+        .map(common::untagged_record)
         .collect()
 }
 

@@ -1,6 +1,6 @@
 //! Issue 22, requirement 4: records prove their origin. `--resume` and `merge` check each
-//! record's seed, strategy and point against the campaign and refuse a foreign one, naming its
-//! line.
+//! record's campaign tag, seed, strategy and point against the campaign and refuse a foreign
+//! one, naming its line; a hand-edited campaign.json is refused naming the field.
 
 use std::path::Path;
 
@@ -20,6 +20,14 @@ fn campaign(out: &Path, extra: &[&str]) {
     args.push(out.to_str().unwrap());
     args.extend(extra);
     ran(&fuzz(&args));
+}
+
+/// `line` without its `campaign` tag, as a line written by hand (or by an older version)
+/// would be: the seed, strategy and point checks must catch it on their own.
+fn untagged(line: &str) -> String {
+    let mut v: serde_json::Value = serde_json::from_str(line).unwrap();
+    assert!(v.as_object_mut().unwrap().remove("campaign").is_some());
+    v.to_string()
 }
 
 /// A copy of `base` whose results are its first `keep` lines, with line `at` (from 1)
@@ -54,16 +62,29 @@ fn resume_refuses_a_record_of_another_seed_strategy_or_point() {
     let next: serde_json::Value = serde_json::from_str(&lines(&a)[50]).unwrap();
     moved["point"] = next["point"].clone();
     moved["params"] = next["params"].clone();
+    let tag = |l: &str| {
+        let v: serde_json::Value = serde_json::from_str(l).unwrap();
+        v["campaign"].as_str().unwrap().to_owned()
+    };
+    let ours = tag(&lines(&a)[0]);
+    assert_eq!(ours.len(), 16);
+    assert!(lines(&a).iter().all(|l| tag(l) == ours));
+    assert_ne!(tag(&seed8[0]), ours);
+    let tagged = format!(
+        "test 49 carries campaign tag `{}`, this campaign's is `{ours}`",
+        tag(&seed8[0])
+    );
     let cases = [
-        ("seed8", 55, 50, seed8[49].clone(), "has seed"),
+        ("tagged", 55, 50, seed8[49].clone(), tagged.as_str()),
+        ("seed8", 55, 50, untagged(&seed8[49]), "has seed"),
         (
             "random",
             55,
             50,
-            random[49].clone(),
+            untagged(&random[49]),
             "has strategy `random`",
         ),
-        ("appended", 50, 51, seed8[50].clone(), "has seed"),
+        ("appended", 50, 51, untagged(&seed8[50]), "has seed"),
         (
             "moved",
             55,
@@ -118,10 +139,40 @@ fn merge_refuses_a_shard_with_a_foreign_record() {
         out
     };
     let (s0, s1, other) = (shard(0, "0"), shard(1, "0"), shard(1, "8"));
-    let mut l = lines(&s1);
-    l[3] = lines(&other)[3].clone();
-    std::fs::write(s1.join("results.jsonl"), l.join("\n") + "\n").unwrap();
+    let clean = lines(&s1);
     let out = dir.path().join("merged");
+    for (line, phrase) in [
+        (
+            lines(&other)[3].clone(),
+            "results.jsonl:4: test 23 carries campaign tag",
+        ),
+        (
+            untagged(&lines(&other)[3]),
+            "results.jsonl:4: test 23 has seed",
+        ),
+    ] {
+        let mut l = clean.clone();
+        l[3] = line;
+        std::fs::write(s1.join("results.jsonl"), l.join("\n") + "\n").unwrap();
+        let o = fuzz(&[
+            "merge",
+            s0.to_str().unwrap(),
+            s1.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        expect_code(&o, 2);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(phrase), "{err}");
+        assert!(!out.join("results.jsonl").exists());
+    }
+    // A shard whose campaign.json was edited is refused naming the field.
+    std::fs::write(s1.join("results.jsonl"), clean.join("\n") + "\n").unwrap();
+    let path = s1.join("campaign.json");
+    let mut c: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    c["strength"] = 3.into();
+    std::fs::write(&path, c.to_string()).unwrap();
     let o = fuzz(&[
         "merge",
         s0.to_str().unwrap(),
@@ -131,8 +182,7 @@ fn merge_refuses_a_shard_with_a_foreign_record() {
     ]);
     expect_code(&o, 2);
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("results.jsonl:4: test 23 has seed"), "{err}");
-    assert!(!out.join("results.jsonl").exists());
+    assert!(err.contains("edited by hand (strength no longer"), "{err}");
 }
 
 #[test]
@@ -158,15 +208,42 @@ fn resume_names_what_changed_the_program_or_a_hand_edited_campaign_json() {
         expect_code(&o, 2);
         String::from_utf8_lossy(&o.stderr).into_owned()
     };
-    // campaign.json's seed edited by hand.
-    let edited = dir.path().join("edited");
-    run(&edited);
-    let path = edited.join("campaign.json");
+    // A field of campaign.json edited by hand: the message names it.
+    for (name, field, value) in [
+        ("seed", "seed", serde_json::json!(5)),
+        ("budget", "budget", serde_json::json!(11)),
+        (
+            "shard",
+            "shard",
+            serde_json::json!({"index": 0, "count": 2}),
+        ),
+        ("fp", "fingerprint", serde_json::json!("0".repeat(64))),
+    ] {
+        let edited = dir.path().join(name);
+        run(&edited);
+        let path = edited.join("campaign.json");
+        let mut c: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        c[field] = value;
+        std::fs::write(&path, c.to_string()).unwrap();
+        let err = resume(&edited);
+        assert!(
+            err.contains(&format!(
+                "campaign.json was edited by hand: `{field}` no longer matches"
+            )),
+            "{err}"
+        );
+    }
+    // A file without the checks (older versions) still says what it can.
+    let legacy = dir.path().join("legacy");
+    run(&legacy);
+    let path = legacy.join("campaign.json");
     let mut c: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    c.as_object_mut().unwrap().remove("checks");
     c["seed"] = 5.into();
     std::fs::write(&path, c.to_string()).unwrap();
-    let err = resume(&edited);
+    let err = resume(&legacy);
     assert!(err.contains("campaign.json was edited"), "{err}");
     assert!(err.contains("the scenario program is unchanged"), "{err}");
     // The program's text changed (a comment added).

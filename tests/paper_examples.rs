@@ -29,11 +29,7 @@ fn run(file: &Path, budget: u32, code: i32) -> (Vec<Json>, String) {
     let records = std::fs::read_to_string(out.join("results.jsonl"))
         .unwrap()
         .lines()
-        .map(|l| {
-            let mut r: Json = serde_json::from_str(l).unwrap();
-            r.as_object_mut().unwrap().remove("wall_ms");
-            r
-        })
+        .map(common::untagged_record)
         .collect();
     (records, String::from_utf8_lossy(&o.stderr).into_owned())
 }

@@ -225,9 +225,9 @@ fn csv_rows(
 }
 
 /// The keys of a `results.jsonl` line.
-const RESULT_KEYS: [&str; 10] = [
-    "id", "seed", "strategy", "point", "params", "status", "monitors", "metrics", "error",
-    "wall_ms",
+const RESULT_KEYS: [&str; 12] = [
+    "campaign", "id", "seed", "strategy", "point", "params", "status", "monitors", "metrics",
+    "error", "log", "wall_ms",
 ];
 
 fn jsonl_rows(
@@ -373,5 +373,38 @@ mod tests {
         let j = write(&dir, "r.jsonl", "{\"params\":{\"walking_speed\":1}}\n");
         let e = read_tests(&j, Some(&space)).unwrap_err().to_string();
         assert!(e.contains(":1: column 2 (`trigger_distance`)"), "{e}");
+    }
+
+    /// paracosm-cover reads every key paracosm-fuzz writes: a record with all its optional
+    /// keys (the campaign tag, a log) is read, its point kept.
+    #[test]
+    fn reads_a_results_line_with_every_key_the_writer_writes() {
+        use paracosm_generators::{Param, ParamSpace, Point};
+        let space = ParamSpace::new(vec![Param::interval("v", 0.0, 2.0, "m/s")]).unwrap();
+        let point = Point {
+            discrete: vec![],
+            continuous: vec![0.25],
+        };
+        let record = crate::record::RunRecord {
+            campaign: Some("0123456789abcdef".into()),
+            id: 0,
+            seed: 1,
+            strategy: "halton".into(),
+            params: space.decode(&point).ok(),
+            point,
+            status: crate::record::Status::Error,
+            monitors: vec![],
+            metrics: vec![("simulated_s".into(), 1.0)],
+            error: Some("why".into()),
+            log: vec!["printed".into()],
+            wall_ms: 1.0,
+        };
+        let line = serde_json::to_string(&record).unwrap();
+        let value: serde_json::Value = serde_json::from_str(&line).unwrap();
+        for key in value.as_object().unwrap().keys() {
+            assert!(RESULT_KEYS.contains(&key.as_str()), "{key}");
+        }
+        let t = parse_tests("r.jsonl", &line, true, Some(&space)).unwrap();
+        assert_eq!(t.points[0].continuous, [0.25]);
     }
 }

@@ -465,6 +465,7 @@ mod tests {
             continuous: u.to_vec(),
         };
         RunRecord {
+            campaign: None,
             id,
             seed: 0,
             strategy: "random".into(),

@@ -24,6 +24,24 @@ pub fn comparable(dir: &std::path::Path) -> Vec<String> {
         .collect()
 }
 
+/// A line of `results.jsonl` as JSON without `wall_ms` and without the campaign tag, for
+/// comparing the records of two different campaigns (two programs that must behave alike);
+/// the tag is checked to be there (16 hex digits) first.
+pub fn untagged_record(line: &str) -> serde_json::Value {
+    let mut r: serde_json::Value = serde_json::from_str(line).unwrap();
+    let o = r.as_object_mut().unwrap();
+    o.remove("wall_ms");
+    let tag = o
+        .remove("campaign")
+        .expect("each record carries its campaign's tag");
+    let tag = tag.as_str().unwrap();
+    assert!(
+        tag.len() == 16 && tag.bytes().all(|b| b.is_ascii_hexdigit()),
+        "{tag}"
+    );
+    r
+}
+
 /// Asserts the exit code, showing stdout and stderr when it differs.
 pub fn expect_code(o: &Output, code: i32) {
     assert_eq!(
