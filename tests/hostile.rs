@@ -2,7 +2,7 @@
 //! runs that must end with a clear error or a warning rather than hang, abort or mislead.
 
 mod common;
-use common::fuzz;
+use common::{fuzz, records};
 
 #[test]
 fn a_parameter_range_wider_than_a_float_spans_is_refused_at_load() {
@@ -53,14 +53,6 @@ fn program(dir: &std::path::Path, fog: &str, extra: &str) -> std::path::PathBuf 
     )
     .unwrap();
     p
-}
-
-fn records(out: &std::path::Path) -> Vec<serde_json::Value> {
-    std::fs::read_to_string(out.join("results.jsonl"))
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect()
 }
 
 #[test]

@@ -5,15 +5,7 @@ use std::path::Path;
 use std::process::Command;
 
 mod common;
-use common::{expect_code, fuzz};
-
-fn records(dir: &Path) -> Vec<serde_json::Value> {
-    std::fs::read_to_string(dir.join("results.jsonl"))
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect()
-}
+use common::{expect_code, fuzz, records};
 
 fn statuses(dir: &Path) -> Vec<String> {
     records(dir)

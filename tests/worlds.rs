@@ -231,15 +231,11 @@ fn the_set_of_open_parameters_may_not_depend_on_their_values() {
 fn a_world_invalid_only_inside_an_interval_is_an_error_for_those_tests_alone() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let o = fuzz(&[
-        path("tests/scenarios", "interior_collision.star")
-            .to_str()
-            .unwrap(),
-        "--budget",
+    let o = common::campaign(
+        &path("tests/scenarios", "interior_collision.star"),
         "40",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+        &out,
+    );
     expect_code(&o, 3);
     let records: Vec<Json> = std::fs::read_to_string(out.join("results.jsonl"))
         .unwrap()

@@ -294,3 +294,93 @@ fn a_sensor_written_outside_the_engine_mounts_and_its_readings_reach_the_observa
     // What SUT_PROTOCOL.md would send for it: its arrays as they are.
     assert_eq!(reading.payloads(false), arrays.to_vec());
 }
+
+/// Issue 21: on a bend of a clothoid, an arc and a clothoid the car rides on the curved
+/// pieces' own colliders (its chassis keeps the height it has on the straight: without them
+/// it would sink onto the grass 2 cm lower) and `aeb` follows its lane round the bend.
+#[test]
+fn aeb_drives_a_spiral_arc_spiral_bend_on_the_curved_pieces_colliders() {
+    use paracosm_engine::network::{Network, PieceKind, Turn};
+    let mut n = Network::new();
+    let seg = |n: &mut Network, name: &str| {
+        n.add(
+            name,
+            PieceKind::Segment {
+                length_m: 60.0,
+                lanes: 2,
+                friction: 0.8,
+            },
+        )
+        .unwrap()
+    };
+    let spiral = |n: &mut Network, name: &str, k0: f64, k1: f64| {
+        n.add(
+            name,
+            PieceKind::Clothoid {
+                length_m: 25.0,
+                curv_start: k0,
+                curv_end: k1,
+                lanes: 2,
+                friction: 0.8,
+            },
+        )
+        .unwrap()
+    };
+    let r = 35.0;
+    let a = seg(&mut n, "a");
+    let c1 = spiral(&mut n, "c1", 0.0, -1.0 / r);
+    let b = n
+        .add(
+            "b",
+            PieceKind::Arc {
+                radius_m: r,
+                angle_rad: -1.4,
+                lanes: 2,
+                friction: 0.8,
+            },
+        )
+        .unwrap();
+    let c2 = spiral(&mut n, "c2", -1.0 / r, 0.0);
+    let e = seg(&mut n, "e");
+    n.connect(a, 1, c1, 0).unwrap();
+    n.connect(c1, 1, b, 0).unwrap();
+    n.connect(b, 1, c2, 0).unwrap();
+    n.connect(c2, 1, e, 0).unwrap();
+    let mut spec = WorldSpec::straight_road(200.0, 10.0, 0.0, &[]).unwrap();
+    spec.ego.start = n.on_lane(a, Lane::Driving(1), 5.0).unwrap();
+    spec.ego.route = n.route(&spec.ego.start, &[] as &[Turn], 1000.0).unwrap();
+    spec.network = n.clone();
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut sut = Aeb::new(AebConfig::default());
+    let mut settled_y = None;
+    let mut on_curves = 0;
+    while sim.t_s() < 18.0 {
+        let c = sut.act(&sim.observation()).unwrap();
+        sim.step(c, &mut NoHost).unwrap();
+        let p = sim.ego_state().pos_m;
+        let under = n.driving_surface_at([p[0], p[2]]);
+        assert!(under.is_some(), "left the road at t = {} s", sim.t_s());
+        if sim.t_s() > 2.0 {
+            let y0 = *settled_y.get_or_insert(p[1]);
+            assert!(
+                (p[1] - y0).abs() < 0.01,
+                "chassis at {} m, {} m on the straight, at t = {} s",
+                p[1],
+                y0,
+                sim.t_s()
+            );
+        }
+        if under.is_some_and(|id| [c1, b, c2].contains(&id)) {
+            on_curves += 1;
+        }
+        assert!(
+            sim.snapshot().ego_lane_offset_m.abs() < 0.6,
+            "t = {}",
+            sim.t_s()
+        );
+    }
+    // 25 + 49 + 25 m of curves at up to 10 m/s: over 8 s of 60 Hz steps on them.
+    assert!(on_curves > 480, "{on_curves} steps on the curved pieces");
+    let end = sim.ego_state().pos_m;
+    assert_eq!(n.driving_surface_at([end[0], end[2]]), Some(e));
+}

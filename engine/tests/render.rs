@@ -695,3 +695,87 @@ fn the_mask_agrees_with_the_depth_map_on_every_pixel() {
         assert!(seen.get(&c).copied().unwrap_or(0) > 20, "{c:?}: {seen:?}");
     }
 }
+
+/// Issue 21: a bend to the left drawn with its curved surfaces and markings. Beside the
+/// golden image, a check that does not depend on it: the double yellow centre line, which
+/// starts to the left of the camera, runs further left as it recedes (on a straight road it
+/// converges toward the image centre).
+#[test]
+fn golden_left_bend_with_curved_markings() {
+    let mut n = Network::new();
+    let a = n
+        .add(
+            "a",
+            PieceKind::Segment {
+                length_m: 30.0,
+                lanes: 2,
+                friction: 0.8,
+            },
+        )
+        .unwrap();
+    let c = n
+        .add(
+            "c",
+            PieceKind::Clothoid {
+                length_m: 20.0,
+                curv_start: 0.0,
+                curv_end: 1.0 / 30.0,
+                lanes: 2,
+                friction: 0.8,
+            },
+        )
+        .unwrap();
+    let b = n
+        .add(
+            "b",
+            PieceKind::Arc {
+                radius_m: 30.0,
+                angle_rad: 1.5,
+                lanes: 2,
+                friction: 0.8,
+            },
+        )
+        .unwrap();
+    n.connect(a, 1, c, 0).unwrap();
+    n.connect(c, 1, b, 0).unwrap();
+    let pose = CameraPose {
+        chassis_m: [28.0, 0.5, 1.75],
+        heading_rad: 0.0,
+    };
+    let frame = render(&n, &CameraSpec::default(), pose, &[], NOMINAL_LIGHT, 0.0);
+    assert_golden("left_bend", &frame);
+    // The mean column of the centre line's pixels 10 to 25 m ahead, where the bend has
+    // moved it 0.5 to 6 m to the left.
+    let far_centre_line = |frame: &CameraFrame| {
+        let (w, h) = (frame.width, frame.height);
+        let mut cols = Vec::new();
+        for v in 0..h {
+            for u in 0..w {
+                let [r, g, b] = frame.rgb_at(u, v);
+                let d = frame.depth_at(u, v);
+                // Yellow, or yellow blended with asphalt where the line is under a pixel wide.
+                let paint = i32::from(r) > i32::from(b) + 30
+                    && i32::from(g) > i32::from(b) + 15
+                    && i32::from(r) + 10 >= i32::from(g);
+                if paint && (10.0..25.0).contains(&d) {
+                    cols.push(f64::from(u));
+                }
+            }
+        }
+        assert!(cols.len() > 10, "no centre line 10 to 25 m ahead");
+        cols.iter().sum::<f64>() / cols.len() as f64
+    };
+    let straight = render(
+        &Network::single_segment(200.0, 2, 0.8).unwrap(),
+        &CameraSpec::default(),
+        pose,
+        &[],
+        NOMINAL_LIGHT,
+        0.0,
+    );
+    let (bend, ahead) = (far_centre_line(&frame), far_centre_line(&straight));
+    assert!(
+        bend < ahead - 6.0,
+        "the far centre line at column {bend} on the bend, {ahead} on a straight road"
+    );
+}

@@ -26,7 +26,7 @@ pub use scenario::{CameraOnly, MonitorSpec, RustWorlds, Scenario, Warning, World
 use paracosm_generators::Assignment;
 
 /// The shipped scenario programs: `(file name, source)`.
-pub const BUILTIN_SOURCES: [(&str, &str); 9] = [
+pub const BUILTIN_SOURCES: [(&str, &str); 10] = [
     (
         "pedestrian_crossing.star",
         include_str!("../pedestrian_crossing.star"),
@@ -45,6 +45,10 @@ pub const BUILTIN_SOURCES: [(&str, &str); 9] = [
         include_str!("../family_of_worlds.star"),
     ),
     ("example_3_1.star", include_str!("../example_3_1.star")),
+    (
+        "curve_pedestrian.star",
+        include_str!("../curve_pedestrian.star"),
+    ),
 ];
 
 /// Names of the built-in scenarios: the file stems with hyphens (`pedestrian-crossing`, ...).

@@ -24,6 +24,26 @@ pub fn comparable(dir: &std::path::Path) -> Vec<String> {
         .collect()
 }
 
+/// Every record of `dir/results.jsonl`, as JSON, in file order.
+pub fn records(dir: &std::path::Path) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(dir.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+/// Runs `paracosm-fuzz FILE --budget BUDGET --out OUT`.
+pub fn campaign(file: &std::path::Path, budget: &str, out: &std::path::Path) -> Output {
+    fuzz(&[
+        file.to_str().unwrap(),
+        "--budget",
+        budget,
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
 /// A line of `results.jsonl` as JSON without `wall_ms` and without the campaign tag, for
 /// comparing the records of two different campaigns (two programs that must behave alike);
 /// the tag is checked to be there (16 hex digits) first.

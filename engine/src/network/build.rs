@@ -10,7 +10,8 @@ const SLAB_THICKNESS_M: f64 = 0.2;
 
 impl Network {
     /// Inserts every piece as fixed colliders with its friction: a slab whose top is the
-    /// surface `y = 0`, raised sidewalks along segments, and a roundabout's raised island;
+    /// surface `y = 0`, raised sidewalks along segments (on curved pieces, slab and sidewalks
+    /// are convex prisms over slices whose chords depart from the curve by at most 1 cm), and a roundabout's raised island;
     /// then the ground (grass, top [`GROUND_TOP_M`], friction [`GROUND_FRICTION`]) reaching
     /// [`GROUND_MARGIN_M`] beyond the network, so a vehicle that leaves the road drives on
     /// instead of falling. The ground goes in last, so the pieces' collider handles do not
@@ -49,6 +50,33 @@ impl Network {
             let slab = SLAB_THICKNESS_M as f32;
             let ([hx, hz], centre) = p.kind.footprint();
             match p.kind {
+                PieceKind::Arc { .. } | PieceKind::Clothoid { .. } => {
+                    let line = p.kind.ref_line().expect("curved");
+                    let hw = p.kind.half_road_m();
+                    let sw = SIDEWALK_WIDTH_M;
+                    let curb = CURB_HEIGHT_M as f32;
+                    // Each slice's chord departs from the curve by at most 1 cm.
+                    let step = (0.08 / line.max_curvature().max(1e-9)).sqrt().min(2.0);
+                    let frames = line.frames(step);
+                    for pair in frames.windows(2) {
+                        for (t0, t1, top) in
+                            [(-hw, hw, 0.0), (hw, hw + sw, curb), (-hw - sw, -hw, curb)]
+                        {
+                            let mut corners = Vec::with_capacity(8);
+                            for f in pair {
+                                for t in [t0, t1] {
+                                    let [x, z] = p.pose.apply(f.offset(t));
+                                    for y in [-slab, top] {
+                                        corners.push(Vector::new(x as f32, y, z as f32));
+                                    }
+                                }
+                            }
+                            if let Some(c) = ColliderBuilder::convex_hull(&corners) {
+                                physics.insert_collider(c.friction(mu), None);
+                            }
+                        }
+                    }
+                }
                 PieceKind::Segment { length_m, .. } => {
                     let hw = p.kind.half_road_m();
                     physics.insert_collider(

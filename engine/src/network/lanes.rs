@@ -45,8 +45,32 @@ pub struct LanePath {
     pub points: Vec<[f64; 2]>,
 }
 
+/// Largest step between the points of a curved piece's lane paths, metres (their chords
+/// depart from the curve by at most 3 mm at the tightest radius, 10 m).
+pub const LANE_STEP_M: f64 = 0.5;
+
 /// Points sampled along each turning path.
 const CURVE_POINTS: usize = 12;
+
+/// Lane `j` of a road piece (segment or curve) both ways: `fwd` from port `ONE` to `TWO`,
+/// `back` from `TWO` to `ONE`.
+fn both_ways(
+    out: &mut Vec<LanePath>,
+    piece: PieceId,
+    j: u32,
+    fwd: Vec<[f64; 2]>,
+    back: Vec<[f64; 2]>,
+) {
+    for (entry, exit, points) in [(0, 1, fwd), (1, 0, back)] {
+        out.push(LanePath {
+            piece,
+            entry: (entry, j),
+            exit: (exit, j),
+            turn: Turn::Straight,
+            points,
+        });
+    }
+}
 
 fn add(a: [f64; 2], b: [f64; 2], s: f64) -> [f64; 2] {
     [a[0] + s * b[0], a[1] + s * b[1]]
@@ -64,20 +88,21 @@ impl Network {
                 let z = offset(j);
                 let fwd = vec![p.pose.apply([0.0, z]), p.pose.apply([length_m, z])];
                 let back = vec![p.pose.apply([length_m, -z]), p.pose.apply([0.0, -z])];
-                out.push(LanePath {
-                    piece,
-                    entry: (0, j),
-                    exit: (1, j),
-                    turn: Turn::Straight,
-                    points: fwd,
-                });
-                out.push(LanePath {
-                    piece,
-                    entry: (1, j),
-                    exit: (0, j),
-                    turn: Turn::Straight,
-                    points: back,
-                });
+                both_ways(&mut out, piece, j, fwd, back);
+            }
+            return out;
+        }
+        if let Some(line) = p.kind.ref_line() {
+            let frames = line.frames(LANE_STEP_M);
+            for j in 1..=half {
+                let t = offset(j);
+                let fwd = frames.iter().map(|f| p.pose.apply(f.offset(t))).collect();
+                let back = frames
+                    .iter()
+                    .rev()
+                    .map(|f| p.pose.apply(f.offset(-t)))
+                    .collect();
+                both_ways(&mut out, piece, j, fwd, back);
             }
             return out;
         }
@@ -172,10 +197,36 @@ impl Network {
                     .into_iter()
                     .find(|l| l.entry == (entry, j))
                     .expect("a segment has both directions of each lane");
-                let points = vec![
-                    [start.pos_m[0], start.pos_m[2]],
-                    *path.points.last().expect("two points"),
-                ];
+                let mut points = vec![[start.pos_m[0], start.pos_m[2]]];
+                match self.pieces[start.piece.0].kind.ref_line() {
+                    // A curved piece: the lane's points beyond the start, in driving order.
+                    Some(line) => {
+                        let stations = line.stations(LANE_STEP_M);
+                        let ahead = |s: f64| {
+                            if k > 0 {
+                                s > start.at_m
+                            } else {
+                                s < start.at_m
+                            }
+                        };
+                        let order: Vec<f64> = if k > 0 {
+                            stations
+                        } else {
+                            stations.into_iter().rev().collect()
+                        };
+                        points.extend(
+                            order
+                                .iter()
+                                .zip(&path.points)
+                                .filter(|(s, _)| ahead(**s))
+                                .map(|(_, q)| *q),
+                        );
+                        if points.len() < 2 {
+                            points.push(*path.points.last().expect("two points"));
+                        }
+                    }
+                    None => points.push(*path.points.last().expect("two points")),
+                }
                 (path, points)
             }
         };

@@ -8,20 +8,23 @@
 //! already coincide.
 
 mod build;
+mod curve;
 mod geometry;
 mod lanes;
 mod piece;
 mod surface;
 
+pub use curve::{Frame, RefLine, SampledLine, POLYLINE_STEP_M};
 pub use geometry::{direction, wrap, Pose2};
 pub use lanes::{LanePath, Turn};
 pub use piece::{
-    Piece, PieceKind, PortGeometry, JUNCTION_APRON_M, LANE_WIDTH_M, PORT_NAMES, SIDEWALK_WIDTH_M,
+    Piece, PieceKind, PortGeometry, JUNCTION_APRON_M, LANE_WIDTH_M, MAX_TURN_RAD,
+    MIN_CURVE_RADIUS_M, PORT_NAMES, SIDEWALK_WIDTH_M,
 };
 pub use surface::{Surface, GROUND_FRICTION, GROUND_MARGIN_M, GROUND_TOP_M};
 
 use rapier3d::parry::query::intersection_test;
-use rapier3d::parry::shape::Cuboid;
+use rapier3d::parry::shape::{Cuboid, SharedShape};
 use rapier3d::prelude::{Pose, Rotation, Vector};
 use serde::{Deserialize, Serialize};
 
@@ -297,22 +300,61 @@ impl Network {
         Ok(())
     }
 
-    fn footprint(&self, id: PieceId) -> (Pose, Cuboid) {
+    /// The piece's footprint as convex parts in world coordinates, shrunk by
+    /// [`TOUCH_MARGIN_M`]: one box for a segment or junction; for a curved piece, one
+    /// quadrilateral prism per slice of at most 2 m, whose ends lie across the reference line
+    /// (so the first and last end exactly at the ports).
+    fn footprint_parts(&self, id: PieceId) -> Vec<(Pose, SharedShape)> {
         let p = &self.pieces[id.0];
+        let shrink = |h: f64| (h - TOUCH_MARGIN_M).max(0.001);
+        if let Some(line) = p.kind.ref_line() {
+            let w = shrink(p.kind.half_width_m());
+            let mut frames = line.frames(2.0);
+            let last = frames.len() - 1;
+            // The ends pulled in along the line, so that pieces meeting at a port only touch.
+            for (i, sign) in [(0, 1.0), (last, -1.0)] {
+                let f = &mut frames[i];
+                let along = [f.right[1], -f.right[0]];
+                f.point = [
+                    f.point[0] + sign * TOUCH_MARGIN_M * along[0],
+                    f.point[1] + sign * TOUCH_MARGIN_M * along[1],
+                ];
+            }
+            let mut parts = Vec::with_capacity(last);
+            for pair in frames.windows(2) {
+                let mut corners = Vec::with_capacity(8);
+                for f in pair {
+                    for t in [-w, w] {
+                        let [x, z] = p.pose.apply(f.offset(t));
+                        for y in [-0.5f32, 0.5] {
+                            corners.push(Vector::new(x as f32, y, z as f32));
+                        }
+                    }
+                }
+                if let Some(shape) = SharedShape::convex_hull(&corners) {
+                    parts.push((Pose::identity(), shape));
+                }
+            }
+            return parts;
+        }
         let ([hx, hz], centre) = p.kind.footprint();
         let [x, z] = p.pose.apply(centre);
         let pose = Pose::from_parts(
             Vector::new(x as f32, 0.0, z as f32),
             Rotation::from_rotation_y(p.pose.heading_rad as f32),
         );
-        let shrink = |h: f64| (h - TOUCH_MARGIN_M).max(0.001) as f32;
-        (pose, Cuboid::new(Vector::new(shrink(hx), 0.5, shrink(hz))))
+        let cuboid = Cuboid::new(Vector::new(shrink(hx) as f32, 0.5, shrink(hz) as f32));
+        vec![(pose, SharedShape::new(cuboid))]
     }
 
     fn overlap(&self, a: PieceId, b: PieceId) -> bool {
-        let (pa, sa) = self.footprint(a);
-        let (pb, sb) = self.footprint(b);
-        intersection_test(&pa, &sa, &pb, &sb).map_or(true, |i| i.intersecting)
+        let pa = self.footprint_parts(a);
+        let pb = self.footprint_parts(b);
+        pa.iter().any(|(xa, sa)| {
+            pb.iter().any(|(xb, sb)| {
+                intersection_test(xa, sa.as_ref(), xb, sb.as_ref()).map_or(true, |i| i.intersecting)
+            })
+        })
     }
 
     /// `piece.onLane(lane, at)`: the point on `lane` of segment `piece`, `at_m` metres from its
@@ -323,12 +365,9 @@ impl Network {
     /// beyond `±lanes/2`, or `at_m` outside `[0, len]`.
     pub fn on_lane(&self, piece: PieceId, lane: Lane, at_m: f64) -> Result<Location, EngineError> {
         let p = &self.pieces[piece.0];
-        let PieceKind::Segment {
-            length_m, lanes, ..
-        } = p.kind
-        else {
+        let (Some(length_m), lanes) = (p.kind.road_length_m(), p.kind.lanes()) else {
             return Err(EngineError::InvalidWorld(format!(
-                "onLane needs a RoadSegment; {} is a {}",
+                "onLane(lane, at) needs a RoadSegment, Arc or Clothoid; {} is a {}",
                 p.name,
                 p.kind.type_name()
             )));
@@ -355,11 +394,17 @@ impl Network {
             Lane::SideWalk => (sidewalk_z, CURB_HEIGHT_M, false),
             Lane::OppositeSideWalk => (-sidewalk_z, CURB_HEIGHT_M, false),
         };
-        let [x, wz] = p.pose.apply([at_m, z]);
+        let (local, local_heading) = match p.kind.ref_line() {
+            Some(line) => (line.offset(at_m, z), line.heading(at_m)),
+            None => ([at_m, z], 0.0),
+        };
+        let [x, wz] = p.pose.apply(local);
         let heading = if reverse {
-            wrap(p.pose.heading_rad + std::f64::consts::PI)
-        } else {
+            wrap(p.pose.heading_rad + local_heading + std::f64::consts::PI)
+        } else if local_heading == 0.0 {
             p.pose.heading_rad
+        } else {
+            wrap(p.pose.heading_rad + local_heading)
         };
         Ok(Location {
             pos_m: [x, y, wz],
@@ -389,10 +434,11 @@ impl Network {
     ) -> Result<Location, EngineError> {
         let p = &self.pieces[piece.0];
         let bad = |m: String| Err(EngineError::InvalidWorld(m));
-        if matches!(p.kind, PieceKind::Segment { .. }) {
+        if p.kind.road_length_m().is_some() {
             return bad(format!(
-                "{} is a RoadSegment: give onLane a lane number and a distance",
-                p.name
+                "{} is a {}: give onLane a lane number and a distance",
+                p.name,
+                p.kind.type_name()
             ));
         }
         let half = p.kind.lanes() / 2;
@@ -456,6 +502,10 @@ impl Network {
             heading_rad: -piece.pose.heading_rad,
         };
         let q = inv.apply([p[0] - piece.pose.x, p[1] - piece.pose.z]);
+        if let Some(line) = piece.kind.ref_line() {
+            let (_, t, past) = SampledLine::new(&line).project(q);
+            return past.hypot((t.abs() - piece.kind.half_width_m()).max(0.0));
+        }
         let ([hx, hz], [cx, cz]) = piece.kind.footprint();
         let dx = ((q[0] - cx).abs() - hx).max(0.0);
         let dz = ((q[1] - cz).abs() - hz).max(0.0);

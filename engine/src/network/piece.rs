@@ -1,10 +1,17 @@
 use serde::{Deserialize, Serialize};
 
+use super::curve::RefLine;
 use super::geometry::{direction, Pose2};
 use crate::EngineError;
 
 /// Width of one driving lane, in metres, on every piece.
 pub const LANE_WIDTH_M: f64 = 3.5;
+/// Smallest radius of a curved piece's reference line, metres (a tighter bend is no road a
+/// car of the ego's size can follow).
+pub const MIN_CURVE_RADIUS_M: f64 = 10.0;
+/// Largest angle a curved piece may turn through, rad (3π/2: a fuller turn would bring its
+/// ends onto each other).
+pub const MAX_TURN_RAD: f64 = 3.0 * std::f64::consts::FRAC_PI_2;
 /// Width of each sidewalk along a road segment, in metres.
 pub const SIDEWALK_WIDTH_M: f64 = 2.0;
 /// Extra paved margin on each side of an intersection beyond the roads' width, in metres, so
@@ -15,7 +22,8 @@ pub const JUNCTION_APRON_M: f64 = 3.0;
 /// What a road piece is, in its own frame (paper §2, "More Complex Worlds").
 ///
 /// Local frames: a segment runs along `+x` from port `ONE` at `x = 0` to port `TWO` at
-/// `x = len`. Junctions are centred on their origin with port `ONE` east (`+x`), `TWO` south
+/// `x = len`. A curved piece (`Arc`, `Clothoid`) starts at port `ONE` at the origin heading
+/// along `+x` and follows its [`RefLine`] to port `TWO`. Junctions are centred on their origin with port `ONE` east (`+x`), `TWO` south
 /// (`+z`), `THREE` west (`-x`) and, for four-way pieces, `FOUR` north (`-z`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -24,6 +32,33 @@ pub enum PieceKind {
     Segment {
         /// Length in metres, `> 0`.
         length_m: f64,
+        /// Driving lanes, even and `>= 2`: half each way.
+        lanes: u32,
+        /// Tyre–road friction, in `(0, 2]`.
+        friction: f64,
+    },
+    /// `Arc`: a road of constant curvature with sidewalks, ports `ONE` (start) and `TWO` (end).
+    Arc {
+        /// Radius of the reference line (the centre line), metres, `>= 10` and wide enough
+        /// that the inner sidewalk keeps a radius of at least 1 m.
+        radius_m: f64,
+        /// Angle turned, rad: positive turns left (counter-clockwise seen from above),
+        /// `0 < |angle| <= 3π/2`.
+        angle_rad: f64,
+        /// Driving lanes, even and `>= 2`: half each way.
+        lanes: u32,
+        /// Tyre–road friction, in `(0, 2]`.
+        friction: f64,
+    },
+    /// `Clothoid`: a road whose curvature changes linearly with arc length (an Euler spiral,
+    /// OpenDRIVE's `spiral`), ports `ONE` (start) and `TWO` (end).
+    Clothoid {
+        /// Length along the reference line, metres, in `(0, 10000]`.
+        length_m: f64,
+        /// Curvature at port `ONE`, 1/m (positive: turning left).
+        curv_start: f64,
+        /// Curvature at port `TWO`, 1/m.
+        curv_end: f64,
         /// Driving lanes, even and `>= 2`: half each way.
         lanes: u32,
         /// Tyre–road friction, in `(0, 2]`.
@@ -72,6 +107,8 @@ impl PieceKind {
     pub fn type_name(&self) -> &'static str {
         match self {
             PieceKind::Segment { .. } => "RoadSegment",
+            PieceKind::Arc { .. } => "Arc",
+            PieceKind::Clothoid { .. } => "Clothoid",
             PieceKind::TIntersection { .. } => "TIntersection",
             PieceKind::CrossIntersection { .. } => "CrossIntersection",
             PieceKind::Roundabout { .. } => "Roundabout",
@@ -82,6 +119,8 @@ impl PieceKind {
     pub fn lanes(&self) -> u32 {
         match *self {
             PieceKind::Segment { lanes, .. }
+            | PieceKind::Arc { lanes, .. }
+            | PieceKind::Clothoid { lanes, .. }
             | PieceKind::TIntersection { lanes, .. }
             | PieceKind::CrossIntersection { lanes, .. }
             | PieceKind::Roundabout { lanes, .. } => lanes,
@@ -92,6 +131,8 @@ impl PieceKind {
     pub fn friction(&self) -> f64 {
         match *self {
             PieceKind::Segment { friction, .. }
+            | PieceKind::Arc { friction, .. }
+            | PieceKind::Clothoid { friction, .. }
             | PieceKind::TIntersection { friction, .. }
             | PieceKind::CrossIntersection { friction, .. }
             | PieceKind::Roundabout { friction, .. } => friction,
@@ -103,6 +144,8 @@ impl PieceKind {
         let mut k = self.clone();
         match &mut k {
             PieceKind::Segment { friction, .. }
+            | PieceKind::Arc { friction, .. }
+            | PieceKind::Clothoid { friction, .. }
             | PieceKind::TIntersection { friction, .. }
             | PieceKind::CrossIntersection { friction, .. }
             | PieceKind::Roundabout { friction, .. } => *friction = mu,
@@ -147,6 +190,57 @@ impl PieceKind {
             PieceKind::Segment { length_m, .. } if !(length_m.is_finite() && length_m > 0.0) => {
                 bad(format!("RoadSegment length {length_m} m is not positive"))
             }
+            PieceKind::Arc {
+                radius_m,
+                angle_rad,
+                ..
+            } => {
+                let min = MIN_CURVE_RADIUS_M.max(self.half_width_m() + 1.0);
+                if !(radius_m.is_finite() && radius_m >= min) {
+                    bad(format!(
+                        "Arc radius {radius_m} m is too tight for {lanes} lanes (at least {min} m)"
+                    ))
+                } else if !(angle_rad.is_finite()
+                    && angle_rad != 0.0
+                    && angle_rad.abs() <= MAX_TURN_RAD + 1e-12)
+                {
+                    bad(format!(
+                        "Arc angle {angle_rad} rad must be non-zero and within ±3π/2 (±{MAX_TURN_RAD:.4})"
+                    ))
+                } else {
+                    Ok(())
+                }
+            }
+            PieceKind::Clothoid {
+                length_m,
+                curv_start,
+                curv_end,
+                ..
+            } => {
+                let max_k = 1.0 / MIN_CURVE_RADIUS_M.max(self.half_width_m() + 1.0);
+                if !(length_m.is_finite() && length_m > 0.0 && length_m <= 10_000.0) {
+                    bad(format!(
+                        "Clothoid length {length_m} m is outside (0, 10000]"
+                    ))
+                } else if !(curv_start.is_finite() && curv_end.is_finite())
+                    || curv_start.abs().max(curv_end.abs()) > max_k
+                {
+                    bad(format!(
+                        "Clothoid curvature from {curv_start} to {curv_end} 1/m is too tight for \
+                         {lanes} lanes (|curvature| at most {max_k:.4} 1/m, a radius of {:.1} m)",
+                        1.0 / max_k
+                    ))
+                } else {
+                    let turn = self.ref_line().expect("curved").heading(length_m);
+                    if turn.abs() > MAX_TURN_RAD + 1e-12 {
+                        bad(format!(
+                            "Clothoid turns {turn:.4} rad; at most ±3π/2 (±{MAX_TURN_RAD:.4})"
+                        ))
+                    } else {
+                        Ok(())
+                    }
+                }
+            }
             PieceKind::Roundabout { radius_m, .. } => {
                 let min = self.half_width_m() + 3.0;
                 if !(radius_m.is_finite() && radius_m >= min) {
@@ -161,9 +255,56 @@ impl PieceKind {
         }
     }
 
-    /// Half-extents `[along x, along z]` of the rectangular footprint, in metres, and its
-    /// centre in the local frame.
+    /// The reference line of a curved piece (`Arc`, `Clothoid`), `None` for the others.
+    pub fn ref_line(&self) -> Option<RefLine> {
+        match *self {
+            PieceKind::Arc {
+                radius_m,
+                angle_rad,
+                ..
+            } => Some(RefLine::arc(radius_m, angle_rad)),
+            PieceKind::Clothoid {
+                length_m,
+                curv_start,
+                curv_end,
+                ..
+            } => Some(RefLine {
+                length_m,
+                curv_start,
+                curv_end,
+            }),
+            _ => None,
+        }
+    }
+
+    /// Length along the reference line of a segment or curved piece, metres (`None` for
+    /// junctions): the range of `onLane`'s `at`.
+    pub fn road_length_m(&self) -> Option<f64> {
+        match *self {
+            PieceKind::Segment { length_m, .. } => Some(length_m),
+            _ => self.ref_line().map(|l| l.length_m),
+        }
+    }
+
+    /// Half-extents `[along x, along z]` of the rectangular footprint (for a curved piece,
+    /// the bounding box of its road and sidewalks), in metres, and its centre in the local
+    /// frame.
     pub fn footprint(&self) -> ([f64; 2], [f64; 2]) {
+        if let Some(line) = self.ref_line() {
+            let w = self.half_width_m();
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            for f in line.frames(1.0) {
+                for t in [-w, w] {
+                    let p = f.offset(t);
+                    lo = [lo[0].min(p[0]), lo[1].min(p[1])];
+                    hi = [hi[0].max(p[0]), hi[1].max(p[1])];
+                }
+            }
+            return (
+                [(hi[0] - lo[0]) / 2.0 + 0.1, (hi[1] - lo[1]) / 2.0 + 0.1],
+                [(hi[0] + lo[0]) / 2.0, (hi[1] + lo[1]) / 2.0],
+            );
+        }
         match *self {
             PieceKind::Segment { length_m, .. } => {
                 ([length_m / 2.0, self.half_width_m()], [length_m / 2.0, 0.0])
@@ -173,6 +314,7 @@ impl PieceKind {
                 ([h, h], [0.0, 0.0])
             }
             PieceKind::Roundabout { radius_m, .. } => ([radius_m, radius_m], [0.0, 0.0]),
+            PieceKind::Arc { .. } | PieceKind::Clothoid { .. } => unreachable!("curved above"),
         }
     }
 
@@ -212,6 +354,19 @@ impl PieceKind {
                     heading_rad: 0.0,
                 },
             ],
+            PieceKind::Arc { .. } | PieceKind::Clothoid { .. } => {
+                let line = self.ref_line().expect("curved");
+                vec![
+                    PortGeometry {
+                        pos: [0.0, 0.0],
+                        heading_rad: PI,
+                    },
+                    PortGeometry {
+                        pos: line.point(line.length_m),
+                        heading_rad: super::geometry::wrap(line.heading(line.length_m)),
+                    },
+                ]
+            }
             PieceKind::TIntersection { .. } => compass(self.junction_half_m(), 3),
             PieceKind::CrossIntersection { .. } => compass(self.junction_half_m(), 4),
             PieceKind::Roundabout { radius_m, .. } => compass(radius_m, 4),
@@ -220,6 +375,10 @@ impl PieceKind {
 
     /// Whether the local point `[x, z]` is on the driving surface (not a sidewalk).
     pub fn on_driving_surface(&self, p: [f64; 2]) -> bool {
+        if let Some(line) = self.ref_line() {
+            let (_, t, past) = super::curve::SampledLine::new(&line).project(p);
+            return past == 0.0 && t.abs() <= self.half_road_m();
+        }
         match *self {
             PieceKind::Segment { length_m, .. } => {
                 (0.0..=length_m).contains(&p[0]) && p[1].abs() <= self.half_road_m()

@@ -3,13 +3,15 @@
 //! it is from the centre line of the nearest lane.
 //!
 //! The driving surface is the union of the pieces' driving regions: a segment's carriageway
-//! (`[0, len] × [-nlanes·3.5/2, nlanes·3.5/2]` m in its frame, sidewalks excluded), and a
+//! (`[0, len] × [-nlanes·3.5/2, nlanes·3.5/2]` m in its frame, sidewalks excluded), a curved
+//! piece's carriageway (points within `nlanes·3.5/2` m of its reference line, found by
+//! projecting onto the line sampled every 25 cm), and a
 //! junction's or roundabout's square plaza less a roundabout's island. Where two pieces are
 //! connected the shared port edge is no edge of the union; an unconnected port is a dead end,
 //! and its edge is.
 
 use super::geometry::{direction, Pose2};
-use super::{Network, PieceId, PieceKind, PORT_NAMES};
+use super::{Network, PieceId, PieceKind, SampledLine, PORT_NAMES};
 
 /// Friction coefficient of the ground beside and beyond the road network (grass), used for a
 /// wheel or a car on no road piece. Dry grass and earth are commonly given 0.35–0.55; 0.5 is
@@ -27,6 +29,14 @@ pub const GROUND_MARGIN_M: f64 = 2000.0;
 enum Shape {
     /// A carriageway from `x = 0` to `x = length_m`, `half_road_m` each side of the centre line.
     Segment { length_m: f64, half_road_m: f64 },
+    /// A curved carriageway along a sampled reference line of length `length_m`,
+    /// `half_road_m` each side of it; the footprint reaches `half_width_m` (sidewalks).
+    Curve {
+        line: SampledLine,
+        length_m: f64,
+        half_road_m: f64,
+        half_width_m: f64,
+    },
     /// A square plaza `[-half_m, half_m]²`; road openings `half_road_m` each side of a port's
     /// centre; an island of radius `island_m` at the centre of a roundabout.
     Plaza {
@@ -68,14 +78,51 @@ impl PieceShape {
 
     fn in_footprint(&self, q: [f64; 2], margin_m: f64) -> bool {
         let ([hx, hz], [cx, cz]) = self.footprint;
-        (q[0] - cx).abs() <= hx + margin_m && (q[1] - cz).abs() <= hz + margin_m
+        let in_box = (q[0] - cx).abs() <= hx + margin_m && (q[1] - cz).abs() <= hz + margin_m;
+        match &self.shape {
+            Shape::Curve {
+                line, half_width_m, ..
+            } if in_box => {
+                let (_, t, past) = line.project(q);
+                past <= margin_m && t.abs() <= half_width_m + margin_m
+            }
+            _ => in_box,
+        }
     }
 
     /// Signed distance from local point `q` to the edge of this piece's driving region, in
     /// metres: `> 0` inside (ignoring connected port edges), `< 0` outside.
     fn signed_edge_m(&self, q: [f64; 2]) -> f64 {
         let [x, z] = q;
+        match &self.shape {
+            Shape::Curve {
+                line,
+                length_m,
+                half_road_m,
+                ..
+            } => {
+                let (at, t, past) = line.project(q);
+                if past == 0.0 && t.abs() <= *half_road_m {
+                    let mut d = half_road_m - t.abs();
+                    if !self.connected[0] {
+                        d = d.min(at);
+                    }
+                    if !self.connected[1] {
+                        d = d.min(length_m - at);
+                    }
+                    d
+                } else {
+                    -past.hypot((t.abs() - half_road_m).max(0.0))
+                }
+            }
+            _ => self.signed_edge_straight_m(x, z),
+        }
+    }
+
+    /// [`PieceShape::signed_edge_m`] of a segment or plaza.
+    fn signed_edge_straight_m(&self, x: f64, z: f64) -> f64 {
         match self.shape {
+            Shape::Curve { .. } => unreachable!("curves are measured by projection"),
             Shape::Segment {
                 length_m,
                 half_road_m,
@@ -176,6 +223,15 @@ impl Surface {
                         length_m,
                         half_road_m: p.kind.half_road_m(),
                     },
+                    PieceKind::Arc { .. } | PieceKind::Clothoid { .. } => {
+                        let line = p.kind.ref_line().expect("curved");
+                        Shape::Curve {
+                            line: SampledLine::new(&line),
+                            length_m: line.length_m,
+                            half_road_m: p.kind.half_road_m(),
+                            half_width_m: p.kind.half_width_m(),
+                        }
+                    }
                     _ => Shape::Plaza {
                         half_m: p.kind.footprint().0[0],
                         half_road_m: p.kind.half_road_m(),

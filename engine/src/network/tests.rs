@@ -243,3 +243,193 @@ fn driving_surfaces_exclude_sidewalks_and_the_roundabout_island() {
     let end = route.last().unwrap();
     assert!(end[1] < -19.0, "{end:?}");
 }
+
+fn arc(n: &mut Network, name: &str, radius_m: f64, angle_rad: f64) -> PieceId {
+    n.add(
+        name,
+        PieceKind::Arc {
+            radius_m,
+            angle_rad,
+            lanes: 2,
+            friction: 0.6,
+        },
+    )
+    .unwrap()
+}
+
+fn clothoid(n: &mut Network, name: &str, length_m: f64, k0: f64, k1: f64) -> PieceId {
+    n.add(
+        name,
+        PieceKind::Clothoid {
+            length_m,
+            curv_start: k0,
+            curv_end: k1,
+            lanes: 2,
+            friction: 0.8,
+        },
+    )
+    .unwrap()
+}
+
+/// Segment, clothoid easing into an arc, the arc, a clothoid out, segment: a quarter turn to
+/// the left, every port meeting the next.
+fn bend(n: &mut Network) -> [PieceId; 5] {
+    use std::f64::consts::FRAC_PI_2;
+    let r = 40.0;
+    let a = seg(n, "a", 50.0, 2);
+    let c1 = clothoid(n, "c1", 20.0, 0.0, 1.0 / r);
+    let b = arc(n, "b", r, FRAC_PI_2 - 20.0 / r);
+    let c2 = clothoid(n, "c2", 20.0, 1.0 / r, 0.0);
+    let e = seg(n, "e", 50.0, 2);
+    n.connect(a, TWO, c1, ONE).unwrap();
+    n.connect(c1, TWO, b, ONE).unwrap();
+    n.connect(b, TWO, c2, ONE).unwrap();
+    n.connect(c2, TWO, e, ONE).unwrap();
+    [a, c1, b, c2, e]
+}
+
+#[test]
+fn a_spiral_arc_spiral_bend_turns_a_quarter_with_every_port_meeting_the_next() {
+    let mut n = Network::new();
+    let [a, c1, b, c2, e] = bend(&mut n);
+    // Each clothoid turns (0 + 1/40)/2 · 20 = 0.25 rad, the arc the rest: π/2 in all.
+    let out = n.piece(e).port(TWO).unwrap();
+    assert!(
+        (out.heading_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12,
+        "{}",
+        out.heading_rad
+    );
+    assert!(
+        (n.piece(e).pose.heading_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12,
+        "the exit road heads north"
+    );
+    for (p, q) in [(a, c1), (c1, b), (b, c2), (c2, e)] {
+        let (x, y) = (n.piece(p).port(TWO).unwrap(), n.piece(q).port(ONE).unwrap());
+        assert!(close(x.pos, y.pos), "{x:?} {y:?}");
+    }
+    n.check_all_overlaps().unwrap();
+    // The arc's world end, from the circle: its start pose rotated about the centre.
+    let start = n.piece(b).pose;
+    let line = n.piece(b).kind.ref_line().unwrap();
+    let k = 1.0 / 40.0;
+    let local = [
+        (k * line.length_m).sin() / k,
+        -(1.0 - (k * line.length_m).cos()) / k,
+    ];
+    assert!(close(start.apply(local), n.piece(b).port(TWO).unwrap().pos));
+}
+
+#[test]
+fn curved_pieces_that_cross_are_refused_as_overlapping() {
+    use std::f64::consts::PI;
+    let mut n = Network::new();
+    let a = arc(&mut n, "a", 20.0, PI);
+    let s = seg(&mut n, "s", 50.0, 2);
+    let b = arc(&mut n, "b", 20.0, PI);
+    let back = seg(&mut n, "back", 100.0, 2);
+    n.connect(a, TWO, s, ONE).unwrap();
+    n.connect(s, TWO, b, ONE).unwrap();
+    // b ends at (-50, 0) heading +x: a road east from there runs through a's start.
+    let err = n.connect(b, TWO, back, ONE).unwrap_err().to_string();
+    assert!(err.contains("road pieces overlap"), "{err}");
+    assert!(err.contains("back") && err.contains('a'), "{err}");
+    // The same loop closed by a road that stops short of a touches it only at a's port ONE.
+    let mut m = Network::new();
+    let a = arc(&mut m, "a", 20.0, PI);
+    let s1 = seg(&mut m, "s1", 50.0, 2);
+    let b = arc(&mut m, "b", 20.0, PI);
+    let s2 = seg(&mut m, "s2", 50.0, 2);
+    m.connect(a, TWO, s1, ONE).unwrap();
+    m.connect(s1, TWO, b, ONE).unwrap();
+    m.connect(b, TWO, s2, ONE).unwrap();
+    m.connect(s2, TWO, a, ONE).unwrap();
+    m.check_all_overlaps().unwrap();
+}
+
+#[test]
+fn on_lane_follows_an_arc_with_the_lanes_direction_of_travel() {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let mut n = Network::new();
+    let b = arc(&mut n, "b", 30.0, FRAC_PI_2);
+    // A left turn about the centre (0, -30): lane 1 (right of travel) is outside it.
+    let centre = [0.0, -30.0];
+    let r = |p: [f64; 3]| (p[0] - centre[0]).hypot(p[2] - centre[1]);
+    for at in [0.0, 10.0, 30.0, 47.1] {
+        let theta = at / 30.0;
+        let l1 = n.on_lane(b, Lane::Driving(1), at).unwrap();
+        assert!((r(l1.pos_m) - 31.75).abs() < 1e-9);
+        assert!((l1.heading_rad - theta).abs() < 1e-12);
+        let back = n.on_lane(b, Lane::Driving(-1), at).unwrap();
+        assert!((r(back.pos_m) - 28.25).abs() < 1e-9);
+        assert!((wrap(back.heading_rad - theta - PI)).abs() < 1e-12);
+        let walk = n.on_lane(b, Lane::SideWalk, at).unwrap();
+        assert!((r(walk.pos_m) - (30.0 + 3.5 + 1.0)).abs() < 1e-9);
+        assert_eq!(walk.pos_m[1], CURB_HEIGHT_M);
+        let other = n.on_lane(b, Lane::OppositeSideWalk, at).unwrap();
+        assert!((r(other.pos_m) - (30.0 - 3.5 - 1.0)).abs() < 1e-9);
+    }
+    let err = n
+        .on_lane(b, Lane::Driving(1), 48.0)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("outside b [0, 47.12"), "{err}");
+    let err = n
+        .on_junction_lane(b, 0, Turn::Straight, 1, 1.0)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("b is a Arc: give onLane a lane number"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_surface_of_a_curve_is_its_carriageway_and_its_lanes_follow_the_curve() {
+    let mut n = Network::new();
+    let [a, _, b, _, _] = bend(&mut n);
+    let s = Surface::new(&n);
+    let arc_piece = n.piece(b);
+    let line = arc_piece.kind.ref_line().unwrap();
+    let at = |t: f64| arc_piece.pose.apply(line.offset(line.length_m / 2.0, t));
+    // Lane 1's centre: 1.75 m from either edge, on lane (offset 0), the arc's friction.
+    let centre = at(1.75);
+    assert!((s.edge_distance_m(centre) - 1.75).abs() < 2e-3);
+    let heading = arc_piece.pose.heading_rad + line.heading(line.length_m / 2.0);
+    assert!(s.lane_offset_m(centre, heading).abs() < 2e-3);
+    assert!((s.lane_offset_m(at(2.05), heading) - 0.3).abs() < 2e-3);
+    assert_eq!(s.friction_at(centre), 0.6);
+    // The sidewalk is the arc's but off the driving surface; beyond it and inside the bend
+    // (within the arc's bounding box) is grass.
+    assert_eq!(s.friction_at(at(4.5)), 0.6);
+    assert!((s.edge_distance_m(at(4.5)) + 1.0).abs() < 2e-3);
+    assert_eq!(s.friction_at(at(-8.0)), GROUND_FRICTION);
+    assert_eq!(s.friction_at(at(-20.0)), GROUND_FRICTION);
+    assert!(n.driving_surface_at(at(-20.0)).is_none());
+    assert_eq!(n.driving_surface_at(centre), Some(b));
+    assert!((n.distance_to_piece_m(b, at(-8.0)) - 2.5).abs() < 2e-3);
+    // A route from the straight approach follows lane 1 round the bend, every point on the
+    // lane's centre line.
+    let start = n.on_lane(a, Lane::Driving(1), 5.0).unwrap();
+    let route = n.route(&start, &[], 1000.0).unwrap();
+    let worst = route
+        .iter()
+        .map(|&p| {
+            s.lane_offset_m(p, 0.0)
+                .abs()
+                .min(3.5 - s.lane_offset_m(p, 0.0).abs())
+        })
+        .fold(0.0f64, f64::max);
+    assert!(
+        worst < 5e-3,
+        "a route point {worst} m off its lane's centre line"
+    );
+    let end = route.last().unwrap();
+    let exit = n.piece(PieceId(4)).port(TWO).unwrap().pos;
+    assert!((end[0] - exit[0] - 1.75).abs() < 1e-6 && (end[1] - exit[1]).abs() < 1e-6);
+    let length: f64 = route
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .sum();
+    // 45 m + 20 m + the arc + 20 m + 50 m, each curved piece's lane 1.75 m outside its line.
+    assert!(length > 45.0 + 40.0 + 40.0 * 1.07 + 50.0, "{length}");
+}

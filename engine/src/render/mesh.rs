@@ -6,8 +6,8 @@ use bytemuck::{Pod, Zeroable};
 use crate::segmentation::SemanticClass;
 
 use crate::network::{
-    Network, Piece, PieceKind, CURB_HEIGHT_M, GROUND_MARGIN_M, GROUND_TOP_M, JUNCTION_APRON_M,
-    LANE_WIDTH_M,
+    Frame, Network, Piece, PieceKind, RefLine, CURB_HEIGHT_M, GROUND_MARGIN_M, GROUND_TOP_M,
+    JUNCTION_APRON_M, LANE_WIDTH_M,
 };
 
 /// One vertex: position in world metres, unit normal, albedo (linear, `[0, 1]`), and its
@@ -211,6 +211,134 @@ impl Mesh {
         }
     }
 
+    /// A curved piece: the segment's surfaces and markings laid along its reference line,
+    /// in slices whose chords depart from the curve by at most 1 cm.
+    fn curved(&mut self, piece: &Piece, line: &RefLine) {
+        let kind = &piece.kind;
+        let road = kind.half_road_m();
+        let outer = kind.half_width_m();
+        let step = (0.08 / line.max_curvature().max(1e-9)).sqrt().min(2.0);
+        let stations = line.frames(step);
+        let all = (0.0, line.length_m);
+        self.band(
+            piece,
+            line,
+            &stations,
+            all,
+            (-road, road),
+            0.0,
+            material::ASPHALT,
+        );
+        for side in [-1.0, 1.0] {
+            let (a, b) = (side * road, side * outer);
+            self.band(
+                piece,
+                line,
+                &stations,
+                all,
+                (a.min(b), a.max(b)),
+                CURB_HEIGHT_M,
+                material::CONCRETE,
+            );
+            self.curved_curb(piece, line, &stations, side * road, -side);
+            let paint = |m: &mut Mesh, range: (f64, f64), t: f64, color: Material| {
+                let h = LINE_WIDTH_M / 2.0;
+                m.band(
+                    piece,
+                    line,
+                    &stations,
+                    range,
+                    (t - h, t + h),
+                    PAINT_LIFT_M,
+                    color,
+                );
+            };
+            paint(self, all, side * (road - 0.3), material::PAINT_WHITE);
+            for k in 1..kind.lanes() / 2 {
+                let mut x = DASH_M.1 / 2.0;
+                while x < line.length_m {
+                    let range = (x, (x + DASH_M.0).min(line.length_m));
+                    paint(
+                        self,
+                        range,
+                        side * f64::from(k) * LANE_WIDTH_M,
+                        material::PAINT_WHITE,
+                    );
+                    x += DASH_M.1;
+                }
+            }
+            paint(self, all, side * 0.12, material::PAINT_YELLOW);
+        }
+    }
+
+    /// A horizontal band of a curved piece from station `s.0` to `s.1` (m) and from `t.0` to
+    /// `t.1` metres right of the reference line, at height `y`, one quad per slice between
+    /// `stations` (and the band's own ends).
+    #[allow(clippy::too_many_arguments)]
+    fn band(
+        &mut self,
+        piece: &Piece,
+        line: &RefLine,
+        stations: &[Frame],
+        s: (f64, f64),
+        t: (f64, f64),
+        y: f64,
+        color: Material,
+    ) {
+        let end = |at: f64| {
+            stations
+                .iter()
+                .find(|f| f.s == at)
+                .copied()
+                .unwrap_or_else(|| line.frame(at))
+        };
+        let mut cuts = vec![end(s.0)];
+        cuts.extend(stations.iter().copied().filter(|f| f.s > s.0 && f.s < s.1));
+        cuts.push(end(s.1));
+        let w = |f: &Frame, b: f64| {
+            let [x, z] = piece.pose.apply(f.offset(b));
+            [x, y, z]
+        };
+        for c in cuts.windows(2) {
+            self.quad(
+                [w(&c[0], t.0), w(&c[1], t.0), w(&c[1], t.1), w(&c[0], t.1)],
+                [0.0, 1.0, 0.0],
+                color,
+            );
+        }
+    }
+
+    /// The vertical curb face of a curved piece at `t0` metres right of its reference line,
+    /// facing `side` (`±1`: to the right or left of the direction of travel).
+    fn curved_curb(
+        &mut self,
+        piece: &Piece,
+        line: &RefLine,
+        stations: &[Frame],
+        t0: f64,
+        side: f64,
+    ) {
+        let w = |f: &Frame, y: f64| {
+            let [x, z] = piece.pose.apply(f.offset(t0));
+            [x, y, z]
+        };
+        for c in stations.windows(2) {
+            let r = line.right((c[0].s + c[1].s) / 2.0);
+            let [nx, nz] = piece.pose.apply([side * r[0], side * r[1]]);
+            let normal = [(nx - piece.pose.x) as f32, 0.0, (nz - piece.pose.z) as f32];
+            self.quad(
+                [
+                    w(&c[0], 0.0),
+                    w(&c[1], 0.0),
+                    w(&c[1], CURB_HEIGHT_M),
+                    w(&c[0], CURB_HEIGHT_M),
+                ],
+                normal,
+                material::CONCRETE,
+            );
+        }
+    }
+
     fn junction(&mut self, piece: &Piece) {
         let ([hx, hz], _) = piece.kind.footprint();
         self.flat(piece, (-hx, hx), (-hz, hz), 0.0, material::ASPHALT);
@@ -249,6 +377,10 @@ impl Mesh {
         for piece in network.pieces() {
             match piece.kind {
                 PieceKind::Segment { length_m, .. } => mesh.segment(piece, length_m),
+                PieceKind::Arc { .. } | PieceKind::Clothoid { .. } => {
+                    let line = piece.kind.ref_line().expect("curved");
+                    mesh.curved(piece, &line);
+                }
                 _ => mesh.junction(piece),
             }
         }

@@ -98,6 +98,20 @@ impl Vision {
 
     /// Reads one frame. `chassis_height_m` is the chassis centre's height above the road.
     pub fn perceive(&self, frame: &CameraFrame, chassis_height_m: f64) -> Perception {
+        self.perceive_on_curve(frame, chassis_height_m, 0.0)
+    }
+
+    /// [`Vision::perceive`] on a road of curvature `curvature` (1/m, positive to the left)
+    /// ahead: each marking's lateral position `y` at distance `x` is read as `y + κx²/2`, its
+    /// offset from the arc through the vehicle, so the markings of a bend line up as on a
+    /// straight road; [`Perception::lane_centre_m`] is then the lane centre's offset from that
+    /// arc.
+    pub fn perceive_on_curve(
+        &self,
+        frame: &CameraFrame,
+        chassis_height_m: f64,
+        curvature: f64,
+    ) -> Perception {
         let c = &self.config;
         let cam = &c.camera;
         let (w, h) = (frame.width, frame.height);
@@ -151,10 +165,11 @@ impl Vision {
             } else if height.abs() < 0.1 && (4.0..16.0).contains(&p[0]) {
                 let luma = rgb.iter().map(|&v| f64::from(v)).sum::<f64>() / 3.0;
                 if luma >= road_luma + c.contrast_threshold.max(0.5 * road_luma) {
-                    if (-3.0..-0.3).contains(&p[2]) {
-                        left.push(p[2]);
-                    } else if (0.3..3.0).contains(&p[2]) {
-                        right.push(p[2]);
+                    let y = p[2] + curvature * p[0] * p[0] / 2.0;
+                    if (-3.0..-0.3).contains(&y) {
+                        left.push(y);
+                    } else if (0.3..3.0).contains(&y) {
+                        right.push(y);
                     }
                 }
             }
@@ -195,7 +210,9 @@ impl Vision {
 
     fn decide(&self, frame: &CameraFrame, obs: &Observation<'_>) -> Control {
         let c = &self.config;
-        let seen = self.perceive(frame, obs.ego.pos_m[1]);
+        // The route's curvature ahead (0 without a route): where the lane bends.
+        let kappa = route_curvature(obs, c.lookahead_m);
+        let seen = self.perceive_on_curve(frame, obs.ego.pos_m[1], kappa);
         let throttle = c.cruise.throttle(
             obs.ego.speed_mps,
             c.cruise.target_speed_mps,
@@ -204,11 +221,42 @@ impl Vision {
         let steering = seen.lane_centre_m.map_or(0.0, |y| {
             // Pure pursuit: curvature 2y / L² toward the point (L, y); z (y) points right,
             // and positive steering turns left.
-            let curvature = 2.0 * y / c.lookahead_m.powi(2);
+            // The lane centre `lookahead_m` ahead lies `y − κL²/2` to the right.
+            let curvature = 2.0 * y / c.lookahead_m.powi(2) - kappa;
             -(c.wheelbase_m * curvature).atan() / c.max_steer_rad
         });
         Control { throttle, steering }.clamped()
     }
+}
+
+/// The mean curvature (1/m, positive to the left) of the observation's route over the
+/// `ahead_m` metres after the route point nearest the vehicle: the heading change over that
+/// stretch divided by its length. 0 without a route.
+fn route_curvature(obs: &Observation<'_>, ahead_m: f64) -> f64 {
+    let route = obs.route;
+    if route.len() < 3 {
+        return 0.0;
+    }
+    let (x, z) = (obs.ego.pos_m[0], obs.ego.pos_m[2]);
+    let d2 = |p: [f64; 2]| (p[0] - x).powi(2) + (p[1] - z).powi(2);
+    let i = (0..route.len() - 1)
+        .min_by(|&a, &b| d2(route[a]).total_cmp(&d2(route[b])))
+        .unwrap_or(0);
+    let heading = |a: [f64; 2], b: [f64; 2]| (-(b[1] - a[1])).atan2(b[0] - a[0]);
+    let h0 = heading(route[i], route[i + 1]);
+    let mut walked = 0.0;
+    let mut j = i + 1;
+    while j + 1 < route.len() && walked < ahead_m {
+        walked += (route[j][0] - route[j - 1][0]).hypot(route[j][1] - route[j - 1][1]);
+        j += 1;
+    }
+    if walked <= 0.0 {
+        return 0.0;
+    }
+    let h1 = heading(route[j - 1], route[j]);
+    let turn =
+        (h1 - h0 + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    turn / walked
 }
 
 /// Adds a pixel to a running `(sum, count)` of colours.

@@ -75,6 +75,11 @@ pub fn load_file(path: &Path) -> Result<Scenario, ScenarioError> {
 const KEYWORDS: &[(&str, &[&str])] = &[
     ("World", &["light", "fog"]),
     ("RoadSegment", &["len", "nlanes", "friction"]),
+    ("Arc", &["radius", "angle", "nlanes", "friction"]),
+    (
+        "Clothoid",
+        &["length", "curv_start", "curv_end", "nlanes", "friction"],
+    ),
     ("TIntersection", &["nlanes", "numLane", "friction"]),
     ("CrossIntersection", &["nlanes", "numLane", "friction"]),
     ("Roundabout", &["nlanes", "radius", "friction"]),

@@ -44,6 +44,8 @@ pub const MAX_CHECK_STEPS: u64 = 50_000_000;
 const BUILTINS: &[&str] = &[
     "World",
     "RoadSegment",
+    "Arc",
+    "Clothoid",
     "TIntersection",
     "CrossIntersection",
     "Roundabout",

@@ -617,6 +617,17 @@ impl SceneBuilder {
                             .roads
                             .route(&start, &turns, MAX_ROUTE_M)
                             .map_err(strip)?,
+                        // Without a route the ego keeps its lane: the start line on straight
+                        // roads, and the lane's path (straight on through junctions) where
+                        // its network has a curved piece.
+                        None if self
+                            .roads
+                            .group_of(start.piece)
+                            .iter()
+                            .any(|&id| self.roads.piece(id).kind.ref_line().is_some()) =>
+                        {
+                            self.roads.route(&start, &[], MAX_ROUTE_M).map_err(strip)?
+                        }
                         None => vec![],
                     };
                     if self.ego.is_some() {

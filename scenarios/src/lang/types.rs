@@ -97,17 +97,27 @@ pub const ENABLED: Input = Input {
     kind: Kind::Bool,
 };
 
+/// The largest turn of a curved piece, rad (3π/2).
+const MAX_TURN: f64 = paracosm_engine::network::MAX_TURN_RAD;
+
 /// `Builtin(keyword=)`'s input, for the builtins whose inputs take numbers with a unit or a
 /// range (used to check the unit a parameter declares).
 pub fn input_of(builtin: &str, keyword: &str) -> Option<Input> {
     Some(match (builtin, keyword) {
         ("World", "light") => LIGHT,
         ("World", "fog") => FOG,
-        ("RoadSegment" | "TIntersection" | "CrossIntersection" | "Roundabout", "friction") => {
-            FRICTION
-        }
+        (
+            "RoadSegment" | "Arc" | "Clothoid" | "TIntersection" | "CrossIntersection"
+            | "Roundabout",
+            "friction",
+        ) => FRICTION,
         ("RoadSegment", "len") => number("len", "m", 0.0, f64::INFINITY, true),
         ("Roundabout", "radius") => number("radius", "m", 0.0, f64::INFINITY, true),
+        ("Arc", "radius") => number("radius", "m", 0.0, f64::INFINITY, true),
+        ("Arc", "angle") => number("angle", "rad", -MAX_TURN, MAX_TURN, false),
+        ("Clothoid", "length") => number("length", "m", 0.0, 10_000.0, true),
+        ("Clothoid", "curv_start") => number("curv_start", "1/m", -0.1, 0.1, false),
+        ("Clothoid", "curv_end") => number("curv_end", "1/m", -0.1, 0.1, false),
         ("AutonomousVehicle", "speed") => number("speed", "m/s", 0.0, f64::INFINITY, false),
         ("Car", "speed") => CAR_SPEED,
         ("Pedestrian", "speed") => PEDESTRIAN_SPEED,

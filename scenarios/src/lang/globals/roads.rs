@@ -1,6 +1,7 @@
 #![allow(non_snake_case)] // The paper's keyword names: numLane, minD, minT.
 
-//! The world and its roads: `World`, `RoadSegment`, `TIntersection`, `CrossIntersection`, `Roundabout`, `SideWalk` (paper §2, "Road pieces").
+//! The world and its roads: `World`, `RoadSegment`, `Arc`, `Clothoid`, `TIntersection`,
+//! `CrossIntersection`, `Roundabout`, `SideWalk` (paper §2, "Road pieces").
 
 use anyhow::{anyhow, bail};
 use paracosm_engine::network::PieceKind;
@@ -26,6 +27,11 @@ pub(super) fn lanes(v: Option<Value>, b: &SceneBuilder, default: u32) -> anyhow:
     Ok(x as u32)
 }
 
+/// A piece's size argument: its one value for the test (see `load_time_number`), or `default`.
+fn number_or(v: Option<Value>, b: &SceneBuilder, what: &str, default: f64) -> anyhow::Result<f64> {
+    v.map_or(Ok(default), |v| load_time_number(v, b, what))
+}
+
 pub(super) fn add_piece(
     eval: &Evaluator,
     what: &str,
@@ -34,7 +40,8 @@ pub(super) fn add_piece(
 ) -> anyhow::Result<Road> {
     let st = state(eval)?;
     let mut b = st.scene.borrow_mut();
-    let segment = matches!(kind, PieceKind::Segment { .. });
+    // Segments and curved pieces have onLane(lane, at) and sidewalks.
+    let segment = kind.road_length_m().is_some();
     let ports = kind.ports().len();
     let name = object_name(eval, what);
     let id = b
@@ -144,6 +151,47 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 })
             },
         )
+    }
+
+    /// `Arc(radius=50.0, angle=π/2, nlanes=2, friction=0.8)`: a bend of constant curvature;
+    /// `radius` in m (of the centre line), `angle` in rad, positive to the left.
+    fn Arc<'v>(
+        #[starlark(require = named)] radius: Option<Value<'v>>,
+        #[starlark(require = named)] angle: Option<Value<'v>>,
+        #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        road_piece(eval, "Arc", nlanes, friction, |b, lanes, friction| {
+            Ok(PieceKind::Arc {
+                radius_m: number_or(radius, b, "Arc(radius=)", 50.0)?,
+                angle_rad: number_or(angle, b, "Arc(angle=)", std::f64::consts::FRAC_PI_2)?,
+                lanes,
+                friction,
+            })
+        })
+    }
+
+    /// `Clothoid(length=50.0, curv_start=0.0, curv_end=0.02, nlanes=2, friction=0.8)`: a
+    /// road whose curvature (1/m, positive to the left) changes linearly along its `length`
+    /// (m), the transition between a straight and a bend.
+    fn Clothoid<'v>(
+        #[starlark(require = named)] length: Option<Value<'v>>,
+        #[starlark(require = named)] curv_start: Option<Value<'v>>,
+        #[starlark(require = named)] curv_end: Option<Value<'v>>,
+        #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        road_piece(eval, "Clothoid", nlanes, friction, |b, lanes, friction| {
+            Ok(PieceKind::Clothoid {
+                length_m: number_or(length, b, "Clothoid(length=)", 50.0)?,
+                curv_start: number_or(curv_start, b, "Clothoid(curv_start=)", 0.0)?,
+                curv_end: number_or(curv_end, b, "Clothoid(curv_end=)", 0.02)?,
+                lanes,
+                friction,
+            })
+        })
     }
 
     /// `TIntersection(nlanes=2, friction=0.8)`; `numLane=` is the paper's spelling.
