@@ -499,15 +499,21 @@ impl<'c, 'a> Run<'c, 'a> {
                 pool.scope(|s| {
                     for _ in 0..jobs {
                         let tx = tx.clone();
-                        s.spawn(move |_| loop {
-                            if halted() {
-                                break;
+                        s.spawn(move |_| {
+                            // Past a hard heap limit, park: the loop below writes what
+                            // finished before, then ends the process.
+                            paracosm_scenarios::memory::park_on_hard_limit(true);
+                            loop {
+                                if halted() {
+                                    break;
+                                }
+                                let i = next.fetch_add(1, Ordering::Relaxed);
+                                let Some(p) = points.get(i) else { break };
+                                if tx.send(campaign.run_one(first + i as u64, p)).is_err() {
+                                    break; // the writer gave up; stop taking work
+                                }
                             }
-                            let i = next.fetch_add(1, Ordering::Relaxed);
-                            let Some(p) = points.get(i) else { break };
-                            if tx.send(campaign.run_one(first + i as u64, p)).is_err() {
-                                break; // the writer gave up; stop taking work
-                            }
+                            paracosm_scenarios::memory::park_on_hard_limit(false);
                         });
                     }
                 });
@@ -515,7 +521,29 @@ impl<'c, 'a> Run<'c, 'a> {
             // With stop_at_first_failure, records after the first failure (in id order) are
             // tests that were in flight: dropped, so the file does not depend on timing.
             let mut closed = false;
-            for record in rx {
+            loop {
+                let record = match rx.recv_timeout(std::time::Duration::from_millis(50)) {
+                    Ok(record) => record,
+                    Err(mpsc::RecvTimeoutError::Disconnected) => break,
+                    Err(mpsc::RecvTimeoutError::Timeout) => {
+                        if !paracosm_scenarios::memory::hard_limit_hit() {
+                            continue;
+                        }
+                        // A worker passed a hard heap limit (its message is printed) and is
+                        // parked: write the records that follow on without a gap, then end
+                        // the process as the limit promises (exit 2).
+                        while let Ok(r) = rx.try_recv() {
+                            pending.insert(r.id, r);
+                        }
+                        while let Some(r) = pending.remove(&(first + done.len() as u64)) {
+                            if observed.is_ok() {
+                                observed = observers.iter_mut().try_for_each(|o| o.record(&r));
+                            }
+                            done.push(r);
+                        }
+                        std::process::exit(2);
+                    }
+                };
                 if campaign.stop_at_first_failure && record.status == Status::Fail {
                     failed.store(true, Ordering::Relaxed);
                 }

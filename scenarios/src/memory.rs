@@ -11,7 +11,9 @@
 //!   status `error`);
 //! - past the hard limit, within one statement, the allocator itself prints the reason
 //!   (`error: ... heap limit ...` and the program's file) and exits the process with code 2:
-//!   no allocation of that size is attempted, and what the campaign already wrote stays.
+//!   no allocation of that size is attempted, and what the campaign already wrote stays. On a
+//!   campaign's worker thread it parks instead, and the campaign writes the records of the
+//!   tests finished before it, then exits with code 2 ([`park_on_hard_limit`]).
 //!
 //! The binaries install it (`#[global_allocator]`); a program that does not counts nothing,
 //! and only starlark's own (later) checks apply.
@@ -50,6 +52,8 @@ thread_local! {
     /// and what is being evaluated, for the hard limit's message.
     static WHAT: Cell<(*const u8, usize, &'static str)> =
         const { Cell::new((std::ptr::null(), 0, "")) };
+    /// Whether a hard limit parks this thread ([`park_on_hard_limit`]) instead of exiting.
+    static PARK: Cell<bool> = const { Cell::new(false) };
 }
 
 /// The global allocator of the paracosm binaries: [`System`], counting the bytes of threads
@@ -99,7 +103,34 @@ fn hard_limit_exceeded(hard: usize, request: usize) -> ! {
     );
     let n = cursor.position() as usize;
     let _ = std::io::stderr().write_all(&buf[..n]);
+    if PARK.with(Cell::get) {
+        // A campaign's worker: its collector writes the records of the tests finished before
+        // this one, then exits the process with code 2 ([`hard_limit_hit`]). Sleeping does
+        // not allocate.
+        HIT.store(true, std::sync::atomic::Ordering::SeqCst);
+        loop {
+            std::thread::sleep(std::time::Duration::from_secs(3600));
+        }
+    }
     std::process::exit(2)
+}
+
+/// Whether a thread of a campaign has passed a hard heap limit and waits, parked, for the
+/// process to end (see [`park_on_hard_limit`]).
+static HIT: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Makes the current thread, past a hard heap limit, print the message and park instead of
+/// ending the process, so that the campaign's collector can write the records already
+/// finished and then exit (`false` restores the default, an immediate exit). For the worker
+/// threads of a campaign, whose collector polls [`hard_limit_hit`].
+pub fn park_on_hard_limit(park: bool) {
+    PARK.with(|p| p.set(park));
+}
+
+/// Whether a thread set to [`park_on_hard_limit`] has passed a hard heap limit: the process
+/// must now end with exit code 2, the message being printed.
+pub fn hard_limit_hit() -> bool {
+    HIT.load(std::sync::atomic::Ordering::SeqCst)
 }
 
 // SAFETY: every method forwards to `System` with the same arguments; the counting touches only
