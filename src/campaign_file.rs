@@ -239,6 +239,11 @@ pub struct CampaignFile {
     /// campaign.json. Absent in files written before it existed.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub checks: BTreeMap<String, String>,
+    /// The files the program read (its OpenDRIVE maps) with their SHA-256, also folded into
+    /// the fingerprint: kept apart so that `--resume` can name a changed map. Left out of the
+    /// file when the program reads none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub input_files: Vec<paracosm_scenarios::InputFile>,
 }
 
 impl CampaignFile {
@@ -273,6 +278,10 @@ struct Fingerprinted<'a> {
     /// Only when the scenario's own system under test is an ONNX model.
     #[serde(skip_serializing_if = "Option::is_none")]
     scenario_model_sha256: Option<&'a str>,
+    /// The files the program read (OpenDRIVE maps) and their SHA-256; only when it read any,
+    /// so the fingerprints of the others stay as they were.
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    input_files: &'a [paracosm_scenarios::InputFile],
 }
 
 fn sha256_hex(bytes: &[u8]) -> String {
@@ -314,6 +323,7 @@ impl CampaignFile {
                 strength,
                 points_sha256: points.as_ref().map(|p| p.sha256.as_str()),
                 scenario_model_sha256: scenario.sut.model_sha256(),
+                input_files: &scenario.input_files,
             };
             sha256_hex(&serde_json::to_vec(&f).expect("settings serialise"))
         };
@@ -335,6 +345,7 @@ impl CampaignFile {
             points,
             scenario_sha256: Some(source_sha256),
             checks: BTreeMap::new(),
+            input_files: scenario.input_files.clone(),
         }
         .checked()
     }

@@ -35,8 +35,19 @@ pub fn results(data: &[u8]) {
     let _ = crate::cover::parse_tests("fuzz.jsonl", s, true, Some(study_space()));
 }
 
-/// A scenario program.
+/// A scenario program, or (an input that starts with `<`) an OpenDRIVE map as
+/// `OpenDrive(...)` reads it: checked, baked, and its surface indexed.
 pub fn scenario(data: &[u8]) {
     let Some(s) = text(data) else { return };
+    if s.trim_start().starts_with('<') {
+        if let Ok(imported) = paracosm_engine::network::opendrive::import("fuzz.xodr", s) {
+            let mut network = paracosm_engine::Network::new();
+            if network.add_map("OpenDrive fuzz", imported.map, 0.8).is_ok() {
+                let surface = paracosm_engine::network::Surface::new(&network);
+                let _ = surface.edge_distance_m([0.0, 0.0]);
+            }
+        }
+        return;
+    }
     let _ = paracosm_scenarios::lang::load_source("fuzz.star", s, "fuzz");
 }

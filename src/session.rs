@@ -550,6 +550,25 @@ fn settings(
                          SHA-256 differs)",
                         st.scenario
                     )
+                } else if let Some((was, now)) = st
+                    .input_files
+                    .iter()
+                    .zip(&again.input_files)
+                    .find(|(a, b)| a != b)
+                {
+                    format!(
+                        "the file `{}` that the scenario program reads changed since the \
+                         campaign started (SHA-256 {} then, {} now)",
+                        now.path,
+                        &was.sha256[..12],
+                        &now.sha256[..12]
+                    )
+                } else if st.input_files.len() != again.input_files.len() {
+                    format!(
+                        "the scenario program `{}` reads other files than when the campaign \
+                         started",
+                        st.scenario
+                    )
                 } else if st.space != again.space {
                     format!(
                         "the parameters of `{}` differ from the `space` in {CAMPAIGN_FILE}",

@@ -92,6 +92,88 @@ fn bad_scenario_programs() {
     assert_refused("a folder", &o, &["Is a directory"]);
 }
 
+/// A program in `dir` that loads the map at `map` and places the ego on its road "1".
+fn map_program(dir: &Path, map: &Path) -> PathBuf {
+    let program = dir.join(format!("{}.star", name(map)));
+    std::fs::write(
+        &program,
+        format!(
+            "w = World()\nm = OpenDrive(\"{}\")\nv = AutonomousVehicle(loc = m.onLane(road = \"1\", lane = -1, s = 10.0))\nw.place(m, v)\n",
+            map.display()
+        ),
+    )
+    .unwrap();
+    program
+}
+
+#[test]
+fn bad_opendrive_maps() {
+    let tmp = tempfile::tempdir().unwrap();
+    for f in files("maps") {
+        let program = map_program(tmp.path(), &f);
+        let out = tmp.path().join(format!("out-{}", name(&f)));
+        let o = run(
+            "fuzz",
+            &[
+                program.display().to_string(),
+                "--budget".into(),
+                "1".into(),
+                "--out".into(),
+                out.display().to_string(),
+            ],
+        );
+        // A first line `<!-- expect: PHRASE -->` names a phrase the message must contain.
+        let text = std::fs::read_to_string(&f).unwrap();
+        let mut phrases = vec![name(&f), "the OpenDRIVE map".to_owned()];
+        if let Some(p) = text
+            .lines()
+            .next()
+            .and_then(|l| l.strip_prefix("<!-- expect: "))
+            .and_then(|l| l.strip_suffix(" -->"))
+        {
+            phrases.push(p.to_owned());
+        }
+        let phrases: Vec<&str> = phrases.iter().map(String::as_str).collect();
+        assert_refused(&rel(&f), &o, &phrases);
+        assert!(
+            !out.join("results.jsonl").exists(),
+            "{}: nothing runs",
+            rel(&f)
+        );
+    }
+}
+
+#[test]
+fn a_50_mb_map_is_refused_by_its_size_before_it_is_parsed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let big = tmp.path().join("huge.xodr");
+    let valid = std::fs::read_to_string(root().join("scenarios/maps/bend.xodr")).unwrap();
+    let padding = format!("<!-- {} -->\n", "x".repeat(50 << 20));
+    std::fs::write(
+        &big,
+        valid.replacen("<OpenDRIVE>", &format!("<OpenDRIVE>\n{padding}"), 1),
+    )
+    .unwrap();
+    assert!(std::fs::metadata(&big).unwrap().len() > 50 << 20);
+    let program = map_program(tmp.path(), &big);
+    let out = tmp.path().join("out");
+    let o = run(
+        "fuzz",
+        &[
+            program.display().to_string(),
+            "--budget".into(),
+            "1".into(),
+            "--out".into(),
+            out.display().to_string(),
+        ],
+    );
+    assert_refused(
+        "a 50 MB map",
+        &o,
+        &["huge.xodr", "larger than the limit of 16 MiB"],
+    );
+}
+
 #[test]
 fn bad_space_files() {
     let tmp = tempfile::tempdir().unwrap();

@@ -613,7 +613,7 @@ fn list_and_help_show_every_built_in_with_its_parameters() {
     let help = fuzz(&["--help"]);
     let help = String::from_utf8_lossy(&help.stdout);
     let names = paracosm_scenarios::builtin_names();
-    assert_eq!(names.len(), 10, "{names:?}");
+    assert_eq!(names.len(), 11, "{names:?}");
     for name in &names {
         assert!(s.contains(name.as_str()), "{name} missing from:\n{s}");
         assert!(

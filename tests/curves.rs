@@ -138,7 +138,7 @@ fn curved_pieces_with_bad_sizes_are_refused_at_load_naming_the_line() {
 fn the_curve_study_finds_collisions_and_keeps_the_ego_on_the_road() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let study = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/curve_pedestrian.star");
+    let study = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/curve_pieces.star");
     let o = campaign(&study, "40", &out);
     expect_code(&o, 1);
     let rs = records(&out);

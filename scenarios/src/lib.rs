@@ -21,12 +21,12 @@ use std::path::Path;
 
 pub use error::ScenarioError;
 pub use runner::{signal, RunOptions, Sample, TestOutcome};
-pub use scenario::{CameraOnly, MonitorSpec, RustWorlds, Scenario, Warning, Worlds};
+pub use scenario::{CameraOnly, InputFile, MonitorSpec, RustWorlds, Scenario, Warning, Worlds};
 
 use paracosm_generators::Assignment;
 
 /// The shipped scenario programs: `(file name, source)`.
-pub const BUILTIN_SOURCES: [(&str, &str); 10] = [
+pub const BUILTIN_SOURCES: [(&str, &str); 11] = [
     (
         "pedestrian_crossing.star",
         include_str!("../pedestrian_crossing.star"),
@@ -49,6 +49,10 @@ pub const BUILTIN_SOURCES: [(&str, &str); 10] = [
         "curve_pedestrian.star",
         include_str!("../curve_pedestrian.star"),
     ),
+    (
+        "opendrive_junction.star",
+        include_str!("../opendrive_junction.star"),
+    ),
 ];
 
 /// Names of the built-in scenarios: the file stems with hyphens (`pedestrian-crossing`, ...).
@@ -68,7 +72,7 @@ pub fn builtin(name: &str) -> Result<Scenario, ScenarioError> {
     for (file, source) in BUILTIN_SOURCES {
         let stem = file.trim_end_matches(".star").replace('_', "-");
         if stem == wanted {
-            return lang::load_source(&format!("scenarios/{file}"), source, &stem);
+            return lang::load_builtin(&format!("scenarios/{file}"), source, &stem);
         }
     }
     Err(ScenarioError::UnknownScenario {

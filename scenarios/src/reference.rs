@@ -74,6 +74,7 @@ pub fn scenario() -> Scenario {
         camera_only: vec![],
         worlds: Arc::new(crate::scenario::RustWorlds(world)),
         source: Arc::from(""),
+        input_files: Vec::new(),
     }
 }
 

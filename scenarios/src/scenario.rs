@@ -207,6 +207,15 @@ impl std::fmt::Display for Warning {
     }
 }
 
+/// A file a program read, as it names it, and the SHA-256 of its bytes (64 hex digits).
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct InputFile {
+    /// The path as the program writes it (relative to the program's folder).
+    pub path: String,
+    /// SHA-256 of the file's bytes, lowercase hex.
+    pub sha256: String,
+}
+
 /// An open parameter that only a camera can see (the light, a colour): it affects the ego
 /// only when the system under test has a camera.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -249,6 +258,9 @@ pub struct Scenario {
     /// The program text it was loaded from (empty for scenarios written in Rust): part of a
     /// campaign's fingerprint, so a resumed campaign runs the same program.
     pub source: Arc<str>,
+    /// The files the program read (its OpenDRIVE maps), with their SHA-256: part of a
+    /// campaign's fingerprint, so `--resume` refuses a campaign whose map has changed.
+    pub input_files: Vec<InputFile>,
     /// Builds each test's world.
     pub(crate) worlds: Arc<dyn Worlds>,
 }

@@ -37,7 +37,7 @@ struct Cli {
     command: Option<Sub>,
     /// Scenario to test: a path to a `.star` program, or a built-in name (see --list):
     /// pedestrian-crossing, follow-lead-car, fog-light, t-loop, grid-world, cut-in,
-    /// roundabout, family-of-worlds, example-3-1, curve-pedestrian. Optional with --resume (taken from the folder's campaign.json).
+    /// roundabout, family-of-worlds, example-3-1, curve-pedestrian, opendrive-junction. Optional with --resume (taken from the folder's campaign.json).
     #[arg(required_unless_present_any = ["list", "resume"])]
     scenario: Option<String>,
     /// List the built-in scenarios and exit.

@@ -49,7 +49,22 @@ impl Network {
             };
             let slab = SLAB_THICKNESS_M as f32;
             let ([hx, hz], centre) = p.kind.footprint();
-            match p.kind {
+            match &p.kind {
+                PieceKind::Map { map, .. } => {
+                    // One triangle mesh of every lane's strip at the surface y = 0 (maps are
+                    // flat and have no curbs).
+                    let (vertices, indices) = map.0.strip_triangles();
+                    let vertices = vertices
+                        .iter()
+                        .map(|q| {
+                            let [x, z] = p.pose.apply(*q);
+                            Vector::new(x as f32, 0.0, z as f32)
+                        })
+                        .collect();
+                    if let Ok(c) = ColliderBuilder::trimesh(vertices, indices) {
+                        physics.insert_collider(c.friction(mu), None);
+                    }
+                }
                 PieceKind::Arc { .. } | PieceKind::Clothoid { .. } => {
                     let line = p.kind.ref_line().expect("curved");
                     let hw = p.kind.half_road_m();
@@ -77,7 +92,7 @@ impl Network {
                         }
                     }
                 }
-                PieceKind::Segment { length_m, .. } => {
+                &PieceKind::Segment { length_m, .. } => {
                     let hw = p.kind.half_road_m();
                     physics.insert_collider(
                         ColliderBuilder::cuboid(hx as f32, slab / 2.0, hw as f32)

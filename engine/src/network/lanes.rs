@@ -166,6 +166,12 @@ impl Network {
                 "a route must start on a driving lane".into(),
             ));
         };
+        if let (Some(lane), super::PieceKind::Map { map, .. }) =
+            (start.map_lane, &self.pieces[start.piece.0].kind)
+        {
+            let points = map.0.route(lane, start.at_m, turns, max_len_m);
+            return Ok(resample(&points, ROUTE_SPACING_M));
+        }
         let j = k.unsigned_abs();
         let (mut path, mut points) = match start.through {
             // Inside a junction: the rest of the lane path it is on.

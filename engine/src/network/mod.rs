@@ -11,12 +11,15 @@ mod build;
 mod curve;
 mod geometry;
 mod lanes;
+mod map;
+pub mod opendrive;
 mod piece;
 mod surface;
 
 pub use curve::{Frame, RefLine, SampledLine, POLYLINE_STEP_M};
 pub use geometry::{direction, wrap, Pose2};
 pub use lanes::{LanePath, Turn};
+pub use map::{MapIndex, MapLane, MapRef, MapRoad, RoadMap};
 pub use piece::{
     Piece, PieceKind, PortGeometry, JUNCTION_APRON_M, LANE_WIDTH_M, MAX_TURN_RAD,
     MIN_CURVE_RADIUS_M, PORT_NAMES, SIDEWALK_WIDTH_M,
@@ -73,6 +76,9 @@ pub struct Location {
     /// In a junction or roundabout: the lane path it is on, `(entry port, exit port)`;
     /// `None` on a segment.
     pub through: Option<(usize, usize)>,
+    /// On an OpenDRIVE map: the lane, an index into [`RoadMap::lanes`]; `None` elsewhere.
+    #[serde(default)]
+    pub map_lane: Option<usize>,
 }
 
 /// Two connected ports: `(piece, port index)` each.
@@ -129,6 +135,71 @@ impl Network {
         });
         self.group.push(id);
         Ok(PieceId(id))
+    }
+
+    /// Adds every road of an OpenDRIVE map as one piece, where the map puts it, with tyre–road
+    /// friction `friction` on all its lanes.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] for a friction outside `(0, 2]`.
+    pub fn add_map(
+        &mut self,
+        name: &str,
+        map: std::sync::Arc<RoadMap>,
+        friction: f64,
+    ) -> Result<PieceId, EngineError> {
+        self.add(
+            name,
+            PieceKind::Map {
+                map: MapRef(map),
+                friction,
+            },
+        )
+    }
+
+    /// `m.onLane(road=, lane=, s=)` on an OpenDRIVE map: the centre of lane `lane` (its
+    /// `<lane id>`) of road `road` (its `<road id>`) at `s_m` metres along the road's
+    /// reference line, heading in the lane's direction of travel.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] when `piece` is no map, or as [`RoadMap::lane_at`].
+    pub fn on_map_lane(
+        &self,
+        piece: PieceId,
+        road: &str,
+        lane: i32,
+        s_m: f64,
+    ) -> Result<Location, EngineError> {
+        let p = &self.pieces[piece.0];
+        let PieceKind::Map { map, .. } = &p.kind else {
+            return Err(EngineError::InvalidWorld(format!(
+                "onLane(road=, lane=, s=) is for an OpenDrive map; {} is a {}",
+                p.name,
+                p.kind.type_name()
+            )));
+        };
+        let k = map
+            .0
+            .lane_at(road, lane, s_m)
+            .map_err(EngineError::InvalidWorld)?;
+        let l = &map.0.lanes[k];
+        let (q, heading_rad) = l.pose(s_m);
+        let [x, z] = p.pose.apply(q);
+        Ok(Location {
+            pos_m: [x, 0.0, z],
+            heading_rad: wrap(heading_rad + p.pose.heading_rad),
+            piece,
+            lane: if l.drivable {
+                Lane::Driving(lane)
+            } else if lane < 0 {
+                Lane::SideWalk
+            } else {
+                Lane::OppositeSideWalk
+            },
+            at_m: s_m,
+            through: None,
+            map_lane: Some(k),
+        })
     }
 
     /// Sets the friction of piece `id` (a test case's value for an open friction stream).
@@ -196,6 +267,14 @@ impl Network {
         child_port: usize,
     ) -> Result<(), EngineError> {
         let bad = |m: String| Err(EngineError::InvalidWorld(m));
+        for id in [parent, child] {
+            if let PieceKind::Map { .. } = self.pieces[id.0].kind {
+                return bad(format!(
+                    "{} is an OpenDRIVE map: its roads are linked by the map, and connect cannot join other pieces to it",
+                    self.pieces[id.0].name
+                ));
+            }
+        }
         let pp = self.port(parent, port)?;
         let cp = self.port(child, child_port)?;
         let (a, b) = ((parent, port), (child, child_port));
@@ -413,6 +492,7 @@ impl Network {
             lane,
             at_m,
             through: None,
+            map_lane: None,
         })
     }
 
@@ -474,6 +554,7 @@ impl Network {
             lane: Lane::Driving(lane as i32),
             at_m,
             through: Some((path.entry.0, path.exit.0)),
+            map_lane: None,
         })
     }
 
@@ -502,6 +583,9 @@ impl Network {
             heading_rad: -piece.pose.heading_rad,
         };
         let q = inv.apply([p[0] - piece.pose.x, p[1] - piece.pose.z]);
+        if let PieceKind::Map { map, .. } = &piece.kind {
+            return map.0.distance_m(q);
+        }
         if let Some(line) = piece.kind.ref_line() {
             let (_, t, past) = SampledLine::new(&line).project(q);
             return past.hypot((t.abs() - piece.kind.half_width_m()).max(0.0));

@@ -2,6 +2,7 @@ use serde::{Deserialize, Serialize};
 
 use super::curve::RefLine;
 use super::geometry::{direction, Pose2};
+use super::map::MapRef;
 use crate::EngineError;
 
 /// Width of one driving lane, in metres, on every piece.
@@ -88,6 +89,14 @@ pub enum PieceKind {
         /// Friction.
         friction: f64,
     },
+    /// `OpenDrive("map.xodr")`: every road, lane and junction of an OpenDRIVE map, placed
+    /// where the map puts it (no ports: the map links its own roads).
+    Map {
+        /// The baked map.
+        map: MapRef,
+        /// Tyre–road friction of every lane, in `(0, 2]`.
+        friction: f64,
+    },
 }
 
 /// A connection point of a piece, in the piece's frame.
@@ -112,6 +121,7 @@ impl PieceKind {
             PieceKind::TIntersection { .. } => "TIntersection",
             PieceKind::CrossIntersection { .. } => "CrossIntersection",
             PieceKind::Roundabout { .. } => "Roundabout",
+            PieceKind::Map { .. } => "OpenDrive",
         }
     }
 
@@ -124,6 +134,7 @@ impl PieceKind {
             | PieceKind::TIntersection { lanes, .. }
             | PieceKind::CrossIntersection { lanes, .. }
             | PieceKind::Roundabout { lanes, .. } => lanes,
+            PieceKind::Map { .. } => 0,
         }
     }
 
@@ -135,7 +146,8 @@ impl PieceKind {
             | PieceKind::Clothoid { friction, .. }
             | PieceKind::TIntersection { friction, .. }
             | PieceKind::CrossIntersection { friction, .. }
-            | PieceKind::Roundabout { friction, .. } => friction,
+            | PieceKind::Roundabout { friction, .. }
+            | PieceKind::Map { friction, .. } => friction,
         }
     }
 
@@ -148,7 +160,8 @@ impl PieceKind {
             | PieceKind::Clothoid { friction, .. }
             | PieceKind::TIntersection { friction, .. }
             | PieceKind::CrossIntersection { friction, .. }
-            | PieceKind::Roundabout { friction, .. } => *friction = mu,
+            | PieceKind::Roundabout { friction, .. }
+            | PieceKind::Map { friction, .. } => *friction = mu,
         }
         k
     }
@@ -177,6 +190,13 @@ impl PieceKind {
         let bad = |m: String| Err(EngineError::InvalidWorld(m));
         let name = self.type_name();
         let lanes = self.lanes();
+        if let PieceKind::Map { friction, .. } = self {
+            return if *friction > 0.0 && *friction <= 2.0 {
+                Ok(())
+            } else {
+                bad(format!("OpenDrive friction {friction} is outside (0, 2]"))
+            };
+        }
         if lanes == 0 || lanes % 2 == 1 {
             return bad(format!(
                 "{name} has {lanes} lanes; need an even number >= 2"
@@ -305,15 +325,22 @@ impl PieceKind {
                 [(hi[0] + lo[0]) / 2.0, (hi[1] + lo[1]) / 2.0],
             );
         }
-        match *self {
+        match self {
             PieceKind::Segment { length_m, .. } => {
                 ([length_m / 2.0, self.half_width_m()], [length_m / 2.0, 0.0])
+            }
+            PieceKind::Map { map, .. } => {
+                let (lo, hi) = map.0.bounds_m();
+                (
+                    [(hi[0] - lo[0]) / 2.0 + 0.1, (hi[1] - lo[1]) / 2.0 + 0.1],
+                    [(hi[0] + lo[0]) / 2.0, (hi[1] + lo[1]) / 2.0],
+                )
             }
             PieceKind::TIntersection { .. } | PieceKind::CrossIntersection { .. } => {
                 let h = self.junction_half_m();
                 ([h, h], [0.0, 0.0])
             }
-            PieceKind::Roundabout { radius_m, .. } => ([radius_m, radius_m], [0.0, 0.0]),
+            PieceKind::Roundabout { radius_m, .. } => ([*radius_m, *radius_m], [0.0, 0.0]),
             PieceKind::Arc { .. } | PieceKind::Clothoid { .. } => unreachable!("curved above"),
         }
     }
@@ -370,6 +397,7 @@ impl PieceKind {
             PieceKind::TIntersection { .. } => compass(self.junction_half_m(), 3),
             PieceKind::CrossIntersection { .. } => compass(self.junction_half_m(), 4),
             PieceKind::Roundabout { radius_m, .. } => compass(radius_m, 4),
+            PieceKind::Map { .. } => Vec::new(),
         }
     }
 
@@ -379,10 +407,11 @@ impl PieceKind {
             let (_, t, past) = super::curve::SampledLine::new(&line).project(p);
             return past == 0.0 && t.abs() <= self.half_road_m();
         }
-        match *self {
+        match self {
             PieceKind::Segment { length_m, .. } => {
-                (0.0..=length_m).contains(&p[0]) && p[1].abs() <= self.half_road_m()
+                (0.0..=*length_m).contains(&p[0]) && p[1].abs() <= self.half_road_m()
             }
+            PieceKind::Map { map, .. } => map.0.on_driving_surface(p),
             _ => {
                 let ([hx, hz], _) = self.footprint();
                 let r = p[0].hypot(p[1]);

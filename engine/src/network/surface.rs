@@ -11,7 +11,7 @@
 //! and its edge is.
 
 use super::geometry::{direction, Pose2};
-use super::{Network, PieceId, PieceKind, SampledLine, PORT_NAMES};
+use super::{MapIndex, Network, PieceId, PieceKind, SampledLine, PORT_NAMES};
 
 /// Friction coefficient of the ground beside and beyond the road network (grass), used for a
 /// wheel or a car on no road piece. Dry grass and earth are commonly given 0.35–0.55; 0.5 is
@@ -37,6 +37,8 @@ enum Shape {
         half_road_m: f64,
         half_width_m: f64,
     },
+    /// An OpenDRIVE map's lanes (world coordinates: a map's pose is the identity).
+    Map(Box<MapIndex>),
     /// A square plaza `[-half_m, half_m]²`; road openings `half_road_m` each side of a port's
     /// centre; an island of radius `island_m` at the centre of a roundabout.
     Plaza {
@@ -80,6 +82,7 @@ impl PieceShape {
         let ([hx, hz], [cx, cz]) = self.footprint;
         let in_box = (q[0] - cx).abs() <= hx + margin_m && (q[1] - cz).abs() <= hz + margin_m;
         match &self.shape {
+            Shape::Map(index) if in_box => index.on_any_lane(q),
             Shape::Curve {
                 line, half_width_m, ..
             } if in_box => {
@@ -95,6 +98,7 @@ impl PieceShape {
     fn signed_edge_m(&self, q: [f64; 2]) -> f64 {
         let [x, z] = q;
         match &self.shape {
+            Shape::Map(index) => index.edge_distance_m(q),
             Shape::Curve {
                 line,
                 length_m,
@@ -122,7 +126,9 @@ impl PieceShape {
     /// [`PieceShape::signed_edge_m`] of a segment or plaza.
     fn signed_edge_straight_m(&self, x: f64, z: f64) -> f64 {
         match self.shape {
-            Shape::Curve { .. } => unreachable!("curves are measured by projection"),
+            Shape::Curve { .. } | Shape::Map(_) => {
+                unreachable!("curves and maps are measured by projection")
+            }
             Shape::Segment {
                 length_m,
                 half_road_m,
@@ -218,8 +224,11 @@ impl Surface {
             .map(|(p, &connected)| PieceShape {
                 pose: p.pose,
                 sin_cos: p.pose.heading_rad.sin_cos(),
-                shape: match p.kind {
-                    PieceKind::Segment { length_m, .. } => Shape::Segment {
+                shape: match &p.kind {
+                    PieceKind::Map { map, .. } => {
+                        Shape::Map(Box::new(MapIndex::new(map.0.clone())))
+                    }
+                    &PieceKind::Segment { length_m, .. } => Shape::Segment {
                         length_m,
                         half_road_m: p.kind.half_road_m(),
                     },
@@ -242,14 +251,15 @@ impl Surface {
                 friction: p.kind.friction(),
                 connected,
             })
-            .collect();
+            .collect::<Vec<PieceShape>>();
         let lanes = (0..network.pieces().len())
-            .map(|i| {
-                network
+            .map(|i| match &pieces[i].shape {
+                Shape::Map(index) => index.lane_lines(),
+                _ => network
                     .lane_paths(PieceId(i))
                     .into_iter()
                     .map(|l| l.points)
-                    .collect()
+                    .collect(),
             })
             .collect();
         debug_assert!(PORT_NAMES.len() == 4);

@@ -6,8 +6,8 @@ use bytemuck::{Pod, Zeroable};
 use crate::segmentation::SemanticClass;
 
 use crate::network::{
-    Frame, Network, Piece, PieceKind, RefLine, CURB_HEIGHT_M, GROUND_MARGIN_M, GROUND_TOP_M,
-    JUNCTION_APRON_M, LANE_WIDTH_M,
+    Frame, MapLane, Network, Piece, PieceKind, RefLine, RoadMap, CURB_HEIGHT_M, GROUND_MARGIN_M,
+    GROUND_TOP_M, JUNCTION_APRON_M, LANE_WIDTH_M,
 };
 
 /// One vertex: position in world metres, unit normal, albedo (linear, `[0, 1]`), and its
@@ -371,12 +371,127 @@ impl Mesh {
         }
     }
 
+    /// A band along a map lane from `t.0` to `t.1` metres right of its centre line (right of
+    /// increasing `s`) at height `y`, over the stations for which `keep` holds.
+    fn lane_band(
+        &mut self,
+        piece: &Piece,
+        lane: &MapLane,
+        t: (f64, f64),
+        y: f64,
+        color: Material,
+        keep: impl Fn(f64) -> bool,
+    ) {
+        let at = |i: usize, off: f64| {
+            let r = lane.right(i);
+            let c = lane.centre[i];
+            let [x, z] = piece.pose.apply([c[0] + off * r[0], c[1] + off * r[1]]);
+            [x, y, z]
+        };
+        for i in 0..lane.s.len() - 1 {
+            if !keep(lane.s[i]) {
+                continue;
+            }
+            // Wound as a curved piece's bands are (stations increasing, `t` to the right).
+            self.quad(
+                [at(i, t.0), at(i + 1, t.0), at(i + 1, t.1), at(i, t.1)],
+                [0.0, 1.0, 0.0],
+                color,
+            );
+        }
+    }
+
+    /// An OpenDRIVE map: asphalt on driving lanes, concrete on the others, and markings on
+    /// roads outside junctions: a double yellow line between the two directions, dashed
+    /// white between lanes of one direction, a solid white edge line where the driving
+    /// surface ends.
+    fn map(&mut self, piece: &Piece, map: &RoadMap) {
+        use std::collections::HashMap;
+        let by_id: HashMap<(usize, usize, i32), &MapLane> = map
+            .lanes
+            .iter()
+            .map(|l| ((l.road, l.section, l.od_id), l))
+            .collect();
+        for l in &map.lanes {
+            let h = |i: usize| l.width[i] / 2.0;
+            let w = l.width.iter().copied().fold(0.0, f64::max) / 2.0;
+            let m = if l.drivable {
+                material::ASPHALT
+            } else {
+                material::CONCRETE
+            };
+            // Each quad spans the widest half-width; narrower stretches come out right only
+            // for constant widths, so varying lanes are drawn quad by quad.
+            if l.width.windows(2).all(|p| (p[0] - p[1]).abs() < 1e-9) {
+                self.lane_band(piece, l, (-w, w), 0.0, m, |_| true);
+            } else {
+                for i in 0..l.s.len() - 1 {
+                    let hw = h(i).max(h(i + 1));
+                    let s0 = l.s[i];
+                    self.lane_band(piece, l, (-hw, hw), 0.0, m, |s| s == s0);
+                }
+            }
+            if !l.drivable || map.roads[l.road].junction.is_some() {
+                continue;
+            }
+            // Outward: +t (right of s) for right lanes (negative ids), -t for left ones.
+            let out = if l.od_id < 0 { 1.0 } else { -1.0 };
+            let outer = by_id.get(&(
+                l.road,
+                l.section,
+                l.od_id + if l.od_id < 0 { -1 } else { 1 },
+            ));
+            let half_line = LINE_WIDTH_M / 2.0;
+            match outer {
+                Some(o) if o.drivable => {
+                    let edge = out * w;
+                    self.lane_band(
+                        piece,
+                        l,
+                        (edge - half_line, edge + half_line),
+                        PAINT_LIFT_M,
+                        material::PAINT_WHITE,
+                        |s| (s + DASH_M.1 / 2.0).rem_euclid(DASH_M.1) < DASH_M.0,
+                    );
+                }
+                _ => {
+                    let edge = out * (w - 0.3);
+                    self.lane_band(
+                        piece,
+                        l,
+                        (edge - half_line, edge + half_line),
+                        PAINT_LIFT_M,
+                        material::PAINT_WHITE,
+                        |_| true,
+                    );
+                }
+            }
+            if l.od_id.abs() == 1
+                && by_id
+                    .get(&(l.road, l.section, -l.od_id))
+                    .is_some_and(|o| o.drivable && o.forward != l.forward)
+            {
+                let inner = -out * w;
+                let c = inner + out * 0.12;
+                self.lane_band(
+                    piece,
+                    l,
+                    (c - half_line, c + half_line),
+                    PAINT_LIFT_M,
+                    material::PAINT_YELLOW,
+                    |_| true,
+                );
+            }
+        }
+    }
+
     /// The static world of `network`: a ground plane and every road piece.
     pub(crate) fn world(network: &Network) -> Mesh {
         let mut mesh = Mesh::default();
         for piece in network.pieces() {
-            match piece.kind {
-                PieceKind::Segment { length_m, .. } => mesh.segment(piece, length_m),
+            match &piece.kind {
+                PieceKind::Map { map, .. } => mesh.map(piece, &map.0),
+                &PieceKind::Segment { length_m, .. } => mesh.segment(piece, length_m),
                 PieceKind::Arc { .. } | PieceKind::Clothoid { .. } => {
                     let line = piece.kind.ref_line().expect("curved");
                     mesh.curved(piece, &line);

@@ -1,7 +1,10 @@
 //! Methods of streams, roads and the world.
+// `onLane` has three forms (segment, junction, map) and so eight arguments; starlark_module
+// generates a function per method, which an attribute on the module function does not reach.
+#![allow(clippy::too_many_arguments)]
 
 use anyhow::{anyhow, bail};
-use paracosm_engine::network::{Lane, PieceId, Turn};
+use paracosm_engine::network::{Lane, PieceId, PieceKind, Turn};
 use paracosm_engine::rx::{Func, Node, StreamId, Value as Rx};
 use starlark::environment::MethodsBuilder;
 use starlark::eval::Evaluator;
@@ -295,7 +298,8 @@ fn check_lane(a: &Action, eval: &Evaluator<'_, '_, '_>) -> anyhow::Result<()> {
             "{}.changeLane({lane}): the segment it starts on has {}",
             object.name,
             if known.is_empty() {
-                "no lanes to change to (it starts inside a junction)".to_owned()
+                "no lanes to change to (it starts inside a junction or on an OpenDRIVE map)"
+                    .to_owned()
             } else {
                 format!("the lanes {}", known.join(", "))
             }
@@ -332,12 +336,17 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
     /// `j.onLane(port, turn, at, lane=1)` in a junction or roundabout: the point `at` metres
     /// along the lane path that enters through `port` in lane `lane` and makes `turn`
     /// (`"straight"`, `"left"`, `"right"`).
+    /// `m.onLane(road=, lane=, s=)` on an OpenDRIVE map: the centre of lane `lane` (its
+    /// `<lane id>`, negative right of the reference line) of road `road` (its `<road id>`) at
+    /// `s` metres along the road's reference line.
     fn onLane<'v>(
         this: &Road,
-        #[starlark(require = pos)] first: Value<'v>,
-        #[starlark(require = pos)] second: Value<'v>,
+        #[starlark(require = pos)] first: Option<Value<'v>>,
+        #[starlark(require = pos)] second: Option<Value<'v>>,
         #[starlark(require = pos)] at: Option<Value<'v>>,
         #[starlark(require = named)] lane: Option<Value<'v>>,
+        #[starlark(require = named)] road: Option<Value<'v>>,
+        #[starlark(require = named)] s: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Loc> {
         if this.network {
@@ -346,6 +355,62 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
         let piece = PieceId(this.piece);
+        if this.map != (road.is_some() || s.is_some())
+            || (this.map && (first.is_some() || second.is_some() || at.is_some()))
+        {
+            if this.map {
+                bail!("an OpenDrive map's onLane takes road=, lane= and s= by name: m.onLane(road = \"1\", lane = -1, s = 20.0)");
+            }
+            bail!("onLane(road=, lane=, s=) is for an OpenDrive map; this is a road piece");
+        }
+        if this.map {
+            let (Some(road), Some(lane), Some(s)) = (road, lane, s) else {
+                bail!("an OpenDrive map's onLane needs road=, lane= and s=: m.onLane(road = \"1\", lane = -1, s = 20.0)");
+            };
+            let road = match super::globals::text_value(road, &b) {
+                Some(t) => t,
+                None => {
+                    let x = number(road, "onLane(road=)").map_err(|_| {
+                        anyhow!("onLane(road=) is a <road id>, a string such as \"1\", got {road}")
+                    })?;
+                    if x.fract() != 0.0 {
+                        bail!("onLane(road=) is a <road id>, a string such as \"1\", got {x}");
+                    }
+                    format!("{x:.0}")
+                }
+            };
+            let lane = number(lane, "onLane(lane=)")?;
+            if lane.fract() != 0.0 || lane == 0.0 || lane.abs() > 100.0 {
+                bail!("onLane(lane=) on a map is an OpenDRIVE <lane id>: a whole number, not 0 (negative right of the reference line), got {lane}");
+            }
+            let s_m = number(s, "onLane(s=)")?;
+            let PieceKind::Map { map, .. } = &b.roads.piece(piece).kind else {
+                bail!("{this} is no map");
+            };
+            let index = map.0.roads.iter().position(|r| r.od_id == road);
+            let r = match index {
+                Some(index) => LaneRef::Map {
+                    piece,
+                    road: index,
+                    lane: lane as i32,
+                    s_m,
+                },
+                // The map's message lists its roads.
+                None => return Err(anyhow!(map.0.lane_at(&road, lane as i32, s_m).unwrap_err())),
+            };
+            let at = r.resolve(&b.roads).map_err(|e| anyhow!(e))?;
+            b.locs.push(r);
+            if let Ok(mut t) = b.loc_table.write() {
+                t.push(Some(at));
+            }
+            return Ok(Loc {
+                index: b.locs.len() - 1,
+                table: b.loc_table.clone(),
+            });
+        }
+        let (Some(first), Some(second)) = (first, second) else {
+            bail!("onLane takes (lane, at) on a road piece, (port, turn, at, lane=) in a junction");
+        };
         let r = if this.segment {
             if at.is_some() || lane.is_some() {
                 bail!("a RoadSegment's onLane takes (lane, at); onLane(port, turn, at, lane=) is for junctions");

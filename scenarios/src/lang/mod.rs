@@ -10,6 +10,7 @@
 
 mod globals;
 mod host;
+pub mod map_files;
 mod methods;
 mod names;
 mod position;
@@ -83,6 +84,8 @@ const KEYWORDS: &[(&str, &[&str])] = &[
     ("TIntersection", &["nlanes", "numLane", "friction"]),
     ("CrossIntersection", &["nlanes", "numLane", "friction"]),
     ("Roundabout", &["nlanes", "radius", "friction"]),
+    ("OpenDrive", &["friction"]),
+    ("onLane", &["lane", "road", "s"]),
     ("AutonomousVehicle", &["loc", "sut", "route", "speed"]),
     (
         "Car",
@@ -232,6 +235,24 @@ fn check_nesting(source: &str) -> Result<(), (usize, usize)> {
 /// [`ScenarioError::Language`] as for [`load_file`]; an error that only some values cause
 /// names them.
 pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, ScenarioError> {
+    load_with_base(file, source, name, map_files::Base::of(file, false))
+}
+
+/// [`load_source`] for a built-in scenario, whose maps are built in too.
+pub(crate) fn load_builtin(
+    file: &str,
+    source: &str,
+    name: &str,
+) -> Result<Scenario, ScenarioError> {
+    load_with_base(file, source, name, map_files::Base::Builtin)
+}
+
+fn load_with_base(
+    file: &str,
+    source: &str,
+    name: &str,
+    base: map_files::Base,
+) -> Result<Scenario, ScenarioError> {
     let lang = |m: String| ScenarioError::Language(m);
     let dialect = Dialect {
         enable_load: false,
@@ -245,7 +266,7 @@ pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, Sce
     })?;
     let ast =
         AstModule::parse(file, source.to_owned(), &dialect).map_err(|e| lang(format!("{e}")))?;
-    program::load(file, source, name, ast, globals())
+    program::load(file, source, name, ast, globals(), base)
 }
 
 #[cfg(test)]

@@ -49,6 +49,7 @@ const BUILTINS: &[&str] = &[
     "TIntersection",
     "CrossIntersection",
     "Roundabout",
+    "OpenDrive",
     "AutonomousVehicle",
     "Car",
     "Pedestrian",
@@ -84,6 +85,8 @@ pub struct Program {
     syntax: Syntax,
     /// [`Syntax::objects`], shared with every evaluation.
     objects: Arc<std::collections::HashMap<String, String>>,
+    /// The maps it reads, read once and shared with every evaluation.
+    maps: Arc<super::map_files::MapFiles>,
 }
 
 fn lambda_values<'v>(b: &SceneBuilder, module: &Module<'v>) -> Result<Vec<Value<'v>>, String> {
@@ -132,7 +135,7 @@ impl Program {
         then: impl FnOnce(SceneBuilder, &Module) -> Result<R, String>,
     ) -> Result<(R, u64), String> {
         Module::with_temp_heap(|module| {
-            let state = LoadState::new(values, self.objects.clone());
+            let state = LoadState::new(values, self.objects.clone(), self.maps.clone());
             let steps;
             {
                 let mut eval = Evaluator::new(&module);
@@ -545,6 +548,7 @@ pub fn load(
     name: &str,
     ast: AstModule,
     globals: Globals,
+    base: super::map_files::Base,
 ) -> Result<Scenario, ScenarioError> {
     let lang = ScenarioError::Language;
     let syntax = Syntax::of(&ast, BUILTINS);
@@ -558,6 +562,7 @@ pub fn load(
         monitors: Vec::new(),
         horizon_s: super::DEFAULT_HORIZON_S,
         sut: SutConfig::builtin("aeb").map_err(lang)?,
+        maps: Arc::new(super::map_files::MapFiles::new(base)),
     };
     let first = program.evaluate(None, |b, _| Ok(b)).map_err(lang)?;
     program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
@@ -772,6 +777,14 @@ pub fn load(
     });
     warnings.extend(found.warnings);
     warnings.extend(usage::unit_warnings(&program.params, syntax));
+    for message in program.maps.warnings() {
+        // "file:line: what": the map's own place.
+        let (at, what) = match message.split_once(": ") {
+            Some((at, what)) if at.contains(':') => (at.to_owned(), what.to_owned()),
+            _ => (file.to_owned(), message.clone()),
+        };
+        warnings.push(Warning { at, message: what });
+    }
     let unused_params: Vec<String> = found
         .unused
         .iter()
@@ -792,6 +805,7 @@ pub fn load(
         unused_params,
         camera_only: found.camera_only,
         source: Arc::from(source),
+        input_files: program.maps.inputs(),
         worlds: Arc::new(program),
     })
 }

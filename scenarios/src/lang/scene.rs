@@ -4,7 +4,7 @@
 //! worlds"), and a few times when it loads, to learn its parameters and check its worlds.
 
 use paracosm_engine::behaviour::{probe, Actor, GraphBuilder, Output};
-use paracosm_engine::network::{Location, Network, PieceId, Turn};
+use paracosm_engine::network::{Location, Network, PieceId, PieceKind, Turn};
 use paracosm_engine::rx::{Node, OpenStream, StreamId, Value};
 use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{
@@ -96,6 +96,17 @@ pub enum LaneRef {
         /// Distance along the path, m.
         at_m: f64,
     },
+    /// `m.onLane(road=, lane=, s=)` on an OpenDRIVE map.
+    Map {
+        /// The map.
+        piece: PieceId,
+        /// The road, an index into the map's [`paracosm_engine::network::RoadMap::roads`].
+        road: usize,
+        /// The lane's OpenDRIVE id.
+        lane: i32,
+        /// Distance along the road's reference line, m.
+        s_m: f64,
+    },
 }
 
 impl LaneRef {
@@ -113,6 +124,18 @@ impl LaneRef {
                 lane,
                 at_m,
             } => roads.on_junction_lane(piece, entry, turn, lane, at_m),
+            LaneRef::Map {
+                piece,
+                road,
+                lane,
+                s_m,
+            } => {
+                let PieceKind::Map { map, .. } = &roads.piece(piece).kind else {
+                    return Err("onLane(road=, lane=, s=) on a piece that is no map".into());
+                };
+                let od_id = map.0.roads[road].od_id.clone();
+                roads.on_map_lane(piece, &od_id, lane, s_m)
+            }
         }
         .map_err(strip)
     }
@@ -620,11 +643,10 @@ impl SceneBuilder {
                         // Without a route the ego keeps its lane: the start line on straight
                         // roads, and the lane's path (straight on through junctions) where
                         // its network has a curved piece.
-                        None if self
-                            .roads
-                            .group_of(start.piece)
-                            .iter()
-                            .any(|&id| self.roads.piece(id).kind.ref_line().is_some()) =>
+                        None if self.roads.group_of(start.piece).iter().any(|&id| {
+                            let kind = &self.roads.piece(id).kind;
+                            kind.ref_line().is_some() || matches!(kind, PieceKind::Map { .. })
+                        }) =>
                         {
                             self.roads.route(&start, &[], MAX_ROUTE_M).map_err(strip)?
                         }
@@ -715,7 +737,7 @@ impl SceneBuilder {
     /// `start`'s lane (m, positive to the right of the direction of travel); empty inside a
     /// junction.
     pub fn lane_offsets(&self, start: &Location) -> Vec<(i32, f64)> {
-        if start.through.is_some() {
+        if start.through.is_some() || start.map_lane.is_some() {
             return Vec::new();
         }
         let h = start.heading_rad;

@@ -108,7 +108,7 @@ pub fn input_of(builtin: &str, keyword: &str) -> Option<Input> {
         ("World", "fog") => FOG,
         (
             "RoadSegment" | "Arc" | "Clothoid" | "TIntersection" | "CrossIntersection"
-            | "Roundabout",
+            | "Roundabout" | "OpenDrive",
             "friction",
         ) => FRICTION,
         ("RoadSegment", "len") => number("len", "m", 0.0, f64::INFINITY, true),

@@ -57,6 +57,8 @@ pub struct Road {
     pub segment: bool,
     /// Whether this value stands for a whole network (the result of `connect`).
     pub network: bool,
+    /// Whether it is an OpenDRIVE map (`OpenDrive(...)`: `onLane(road=, lane=, s=)`).
+    pub map: bool,
 }
 
 impl fmt::Display for Road {

@@ -31,6 +31,8 @@ pub struct LoadState {
     pub objects: std::sync::Arc<std::collections::HashMap<String, String>>,
     /// What the program printed while evaluating.
     pub log: RefCell<Vec<String>>,
+    /// The maps the program reads, shared by its evaluations.
+    pub(crate) maps: std::sync::Arc<crate::lang::map_files::MapFiles>,
 }
 
 impl starlark::PrintHandler for LoadState {
@@ -46,11 +48,13 @@ impl LoadState {
     pub fn new(
         values: Option<Vec<super::scene::ParamValue>>,
         objects: std::sync::Arc<std::collections::HashMap<String, String>>,
+        maps: std::sync::Arc<crate::lang::map_files::MapFiles>,
     ) -> Self {
         LoadState {
             scene: RefCell::new(SceneBuilder::new(values)),
             objects,
             log: RefCell::new(Vec::new()),
+            maps,
         }
     }
 }

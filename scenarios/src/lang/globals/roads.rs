@@ -1,7 +1,8 @@
 #![allow(non_snake_case)] // The paper's keyword names: numLane, minD, minT.
 
 //! The world and its roads: `World`, `RoadSegment`, `Arc`, `Clothoid`, `TIntersection`,
-//! `CrossIntersection`, `Roundabout`, `SideWalk` (paper §2, "Road pieces").
+//! `CrossIntersection`, `Roundabout`, `SideWalk` (paper §2, "Road pieces"), and `OpenDrive`
+//! maps.
 
 use anyhow::{anyhow, bail};
 use paracosm_engine::network::PieceKind;
@@ -54,6 +55,7 @@ pub(super) fn add_piece(
         ports,
         segment,
         network: false,
+        map: false,
     })
 }
 
@@ -192,6 +194,42 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 friction,
             })
         })
+    }
+
+    /// `OpenDrive(path, friction=0.8)`: every road, lane and junction of the OpenDRIVE map at
+    /// `path` (relative to the program's file; a string, or a `VarEnum` of them), with
+    /// tyre–road friction `friction` on all its lanes.
+    fn OpenDrive<'v>(
+        #[starlark(require = pos)] path: Value<'v>,
+        #[starlark(require = named)] friction: Option<Value<'v>>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> anyhow::Result<Road> {
+        let at = object_at(eval);
+        let (kind, stream) = {
+            let st = state(eval)?;
+            let mut b = st.scene.borrow_mut();
+            let file = crate::lang::globals::text_value(path, &b).ok_or_else(|| {
+                anyhow!("OpenDrive takes the path of a .xodr file (a string, or a VarEnum of them), got {path}")
+            })?;
+            let map = st.maps.load(&file).map_err(|e| anyhow!(e))?;
+            let stream = match friction {
+                Some(v) => typed_arg(v, &mut b, &types::FRICTION, "OpenDrive", &at)?,
+                None => b.graph.push(Node::Const(Rx::Num(0.8))),
+            };
+            let mu = match b.graph.nodes().get(stream.0) {
+                Some(Node::Const(Rx::Num(mu))) => *mu,
+                _ => 0.8,
+            };
+            (
+                PieceKind::Map {
+                    map: paracosm_engine::network::MapRef(map),
+                    friction: mu,
+                },
+                stream,
+            )
+        };
+        let road = add_piece(eval, "OpenDrive", kind, stream)?;
+        Ok(Road { map: true, ..road })
     }
 
     /// `TIntersection(nlanes=2, friction=0.8)`; `numLane=` is the paper's spelling.

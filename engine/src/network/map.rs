@@ -1,0 +1,524 @@
+//! A road network read from an OpenDRIVE map ([`super::opendrive`]), baked into lane strips:
+//! each lane's centre line sampled along its road's reference line, with its width, its
+//! direction of travel and the lanes it leads into.
+//!
+//! Coordinates: OpenDRIVE's `(x, y)` plane is paracosm's ground plane with `x = x` and
+//! `z = -y`, so that a heading measured counter-clockwise from `+x` (OpenDRIVE's `hdg`) is
+//! paracosm's heading as well ([`super::direction`]). Maps are flat: every lane lies at
+//! `y = 0` (the importer warns about elevation it drops).
+
+use std::sync::Arc;
+
+use rstar::primitives::{GeomWithData, Line};
+use rstar::RTree;
+use serde::{Deserialize, Serialize};
+
+use super::geometry::wrap;
+use super::lanes::Turn;
+
+/// One OpenDRIVE road of a map.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MapRoad {
+    /// Its `<road id>`.
+    pub od_id: String,
+    /// Its length along the reference line, m.
+    pub length_m: f64,
+    /// The `<junction id>` it belongs to (a connecting road), `None` outside junctions.
+    pub junction: Option<String>,
+}
+
+/// One lane of one lane section of a map.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MapLane {
+    /// Index of its road in [`RoadMap::roads`].
+    pub road: usize,
+    /// Zero-based lane section of the road, in order of `s`.
+    pub section: usize,
+    /// Its OpenDRIVE `<lane id>`: negative right of the reference line, positive left.
+    pub od_id: i32,
+    /// Its OpenDRIVE `type` (`driving`, `sidewalk`, `shoulder`...).
+    pub kind: String,
+    /// Whether cars drive on it (paracosm's driving surface).
+    pub drivable: bool,
+    /// Whether traffic runs along increasing `s` (right-hand traffic: lanes with negative
+    /// ids).
+    pub forward: bool,
+    /// Stations along the road's reference line, m, increasing, at most 0.5 m apart.
+    pub s: Vec<f64>,
+    /// The centre line at each station, world `[x, z]`, m.
+    pub centre: Vec<[f64; 2]>,
+    /// The lane's width at each station, m, `>= 0`.
+    pub width: Vec<f64>,
+    /// The lanes (indices into [`RoadMap::lanes`]) that a car leaving this lane's travel end
+    /// drives into.
+    pub successors: Vec<usize>,
+}
+
+impl MapLane {
+    /// The centre line in the direction of travel, world `[x, z]` m.
+    pub fn travel_points(&self) -> Vec<[f64; 2]> {
+        let mut p = self.centre.clone();
+        if !self.forward {
+            p.reverse();
+        }
+        p
+    }
+
+    /// The segment index `i` (between stations `i` and `i + 1`) and fraction holding road
+    /// station `s` (clamped to the lane's stations).
+    fn locate(&self, s: f64) -> (usize, f64) {
+        let n = self.s.len();
+        let i = self.s.partition_point(|&x| x <= s).clamp(1, n - 1) - 1;
+        let span = self.s[i + 1] - self.s[i];
+        let u = if span > 0.0 {
+            ((s - self.s[i]) / span).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (i, u)
+    }
+
+    /// The centre point at road station `s`, world `[x, z]` m, and the direction of travel
+    /// there, rad.
+    pub fn pose(&self, s: f64) -> ([f64; 2], f64) {
+        let (i, u) = self.locate(s);
+        let (a, b) = (self.centre[i], self.centre[i + 1]);
+        let p = [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])];
+        // The tangents at the two stations (central differences, exact on a circle),
+        // interpolated.
+        let (h0, h1) = (self.tangent(i), self.tangent(i + 1));
+        let along = wrap(h0 + u * wrap(h1 - h0));
+        let heading = if self.forward {
+            along
+        } else {
+            wrap(along + std::f64::consts::PI)
+        };
+        (p, heading)
+    }
+
+    /// The unit vector to the right of increasing `s` at station `i`, world `[x, z]`: the
+    /// mean of the neighbouring segments' normals.
+    pub fn right(&self, i: usize) -> [f64; 2] {
+        let n = self.centre.len();
+        let (a, b) = (
+            self.centre[i.saturating_sub(1)],
+            self.centre[(i + 1).min(n - 1)],
+        );
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let len = d[0].hypot(d[1]).max(1e-12);
+        [-d[1] / len, d[0] / len]
+    }
+
+    /// The direction of increasing `s` at station `i`, rad: of the chord between the stations
+    /// either side (the one chord at an end).
+    fn tangent(&self, i: usize) -> f64 {
+        let n = self.centre.len();
+        let (a, b) = (
+            self.centre[i.saturating_sub(1)],
+            self.centre[(i + 1).min(n - 1)],
+        );
+        (-(b[1] - a[1])).atan2(b[0] - a[0])
+    }
+
+    /// The station range `[first, last]`, m.
+    pub fn s_range(&self) -> (f64, f64) {
+        (self.s[0], self.s[self.s.len() - 1])
+    }
+}
+
+/// A map's roads and lanes (see the module documentation).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RoadMap {
+    /// The file it was read from, as the program names it (for messages).
+    pub source: String,
+    /// Its roads.
+    pub roads: Vec<MapRoad>,
+    /// Its lanes: every lane of every section with a positive width somewhere.
+    pub lanes: Vec<MapLane>,
+}
+
+/// A shared, immutable [`RoadMap`]: cloning a network clones the handle, not the map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapRef(pub Arc<RoadMap>);
+
+impl Serialize for MapRef {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.0.serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for MapRef {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        RoadMap::deserialize(d).map(|m| MapRef(Arc::new(m)))
+    }
+}
+
+impl RoadMap {
+    /// The bounding box of every lane's strip, world `([x_min, z_min], [x_max, z_max])` m.
+    pub fn bounds_m(&self) -> ([f64; 2], [f64; 2]) {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for lane in &self.lanes {
+            for (p, w) in lane.centre.iter().zip(&lane.width) {
+                lo = [lo[0].min(p[0] - w / 2.0), lo[1].min(p[1] - w / 2.0)];
+                hi = [hi[0].max(p[0] + w / 2.0), hi[1].max(p[1] + w / 2.0)];
+            }
+        }
+        if lo[0] > hi[0] {
+            return ([0.0; 2], [0.0; 2]);
+        }
+        (lo, hi)
+    }
+
+    /// The lane `od_id` of road `road` (its `<road id>`) at station `s` (m).
+    ///
+    /// # Errors
+    /// A message naming the roads (for an unknown road), the lanes of the road at `s` (for a
+    /// lane it lacks there), or the road's length (for `s` outside it).
+    pub fn lane_at(&self, road: &str, od_id: i32, s: f64) -> Result<usize, String> {
+        let Some(r) = self.roads.iter().position(|r| r.od_id == road) else {
+            let mut ids: Vec<&str> = self.roads.iter().map(|r| r.od_id.as_str()).collect();
+            ids.truncate(20);
+            return Err(format!(
+                "{} has no road \"{road}\" (its roads: {})",
+                self.source,
+                ids.join(", ")
+            ));
+        };
+        let length = self.roads[r].length_m;
+        if !(0.0..=length).contains(&s) {
+            return Err(format!(
+                "s = {s} m is outside road \"{road}\" of {}, [0, {length:.2}] m",
+                self.source
+            ));
+        }
+        let here: Vec<usize> = (0..self.lanes.len())
+            .filter(|&i| {
+                let l = &self.lanes[i];
+                let (a, b) = l.s_range();
+                l.road == r && a - 1e-9 <= s && s <= b + 1e-9
+            })
+            .collect();
+        here.iter()
+            .copied()
+            .find(|&i| self.lanes[i].od_id == od_id)
+            .ok_or_else(|| {
+                let ids: Vec<String> = here
+                    .iter()
+                    .map(|&i| format!("{} ({})", self.lanes[i].od_id, self.lanes[i].kind))
+                    .collect();
+                format!(
+                    "road \"{road}\" of {} has no lane {od_id} at s = {s} m; its lanes there: {}",
+                    self.source,
+                    ids.join(", ")
+                )
+            })
+    }
+
+    /// The heading change from the end of lane `from`'s travel to the end of lane `to`'s,
+    /// rad, positive to the left.
+    fn turn_between(&self, from: usize, to: usize) -> f64 {
+        let travel_end = |l: &MapLane| {
+            let (a, b) = l.s_range();
+            l.pose(if l.forward { b } else { a }).1
+        };
+        wrap(travel_end(&self.lanes[to]) - travel_end(&self.lanes[from]))
+    }
+
+    /// The route from road station `s` of lane `lane` in its direction of travel, then on
+    /// through its successors until the lanes end or the route is `max_len_m` long. At a
+    /// fork it takes the next turn of `turns` (straight on when the list is used up or the
+    /// turn is not there): straight on is the successor whose heading at its end differs
+    /// least from the lane's at its end, left and right the ones that turn most to either
+    /// side of it. World `[x, z]` m.
+    pub fn route(&self, lane: usize, s: f64, turns: &[Turn], max_len_m: f64) -> Vec<[f64; 2]> {
+        let l = &self.lanes[lane];
+        let mut points = vec![l.pose(s).0];
+        let ahead =
+            l.s.iter()
+                .zip(&l.centre)
+                .filter(|(x, _)| if l.forward { **x > s } else { **x < s })
+                .map(|(_, p)| *p);
+        if l.forward {
+            points.extend(ahead);
+        } else {
+            let mut back: Vec<[f64; 2]> = ahead.collect();
+            back.reverse();
+            points.extend(back);
+        }
+        let mut length: f64 = points
+            .windows(2)
+            .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+            .sum();
+        let mut turns = turns.iter();
+        let mut at = lane;
+        let mut visits = 0usize;
+        while length < max_len_m && visits < 10_000 {
+            visits += 1;
+            let next = &self.lanes[at].successors;
+            let pick = match next.len() {
+                0 => break,
+                1 => next[0],
+                _ => {
+                    // Straight on is the successor that turns least; left and right, the ones
+                    // that turn most either way of it.
+                    let turn: Vec<f64> = next.iter().map(|&n| self.turn_between(at, n)).collect();
+                    let by = |key: &dyn Fn(f64) -> f64| {
+                        (0..next.len())
+                            .min_by(|&a, &b| key(turn[a]).total_cmp(&key(turn[b])))
+                            .expect("two or more")
+                    };
+                    let straight = by(&|t: f64| t.abs());
+                    let left = Some(by(&|t: f64| -t)).filter(|&i| turn[i] > turn[straight]);
+                    let right = Some(by(&|t: f64| t)).filter(|&i| turn[i] < turn[straight]);
+                    let of = |t: Turn| match t {
+                        Turn::Straight => Some(straight),
+                        Turn::Left => left,
+                        Turn::Right => right,
+                    };
+                    let wanted = turns.next().copied();
+                    let i = wanted
+                        .into_iter()
+                        .chain([Turn::Straight])
+                        .find_map(of)
+                        .unwrap_or(straight);
+                    next[i]
+                }
+            };
+            for q in self.lanes[pick].travel_points() {
+                let last = *points.last().expect("non-empty");
+                let d = (q[0] - last[0]).hypot(q[1] - last[1]);
+                if d > 1e-6 {
+                    length += d;
+                    points.push(q);
+                }
+            }
+            at = pick;
+        }
+        if points.len() < 2 {
+            let (p, h) = l.pose(s);
+            points.push([p[0] + h.cos() * 0.5, p[1] - h.sin() * 0.5]);
+        }
+        points
+    }
+
+    /// Every lane's strip as triangles: vertices (world `[x, z]` m, the left and right
+    /// border at each station) and index triples, two triangles per step of each lane.
+    pub fn strip_triangles(&self) -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
+        let (mut vertices, mut indices) = (Vec::new(), Vec::new());
+        for l in &self.lanes {
+            let base = vertices.len() as u32;
+            for i in 0..l.s.len() {
+                let r = l.right(i);
+                let h = l.width[i] / 2.0;
+                let c = l.centre[i];
+                vertices.push([c[0] - h * r[0], c[1] - h * r[1]]);
+                vertices.push([c[0] + h * r[0], c[1] + h * r[1]]);
+            }
+            for i in 0..l.s.len() as u32 - 1 {
+                let (a, b, c, d) = (
+                    base + 2 * i,
+                    base + 2 * i + 1,
+                    base + 2 * i + 2,
+                    base + 2 * i + 3,
+                );
+                indices.push([a, c, b]);
+                indices.push([b, c, d]);
+            }
+        }
+        (vertices, indices)
+    }
+
+    /// Whether the world point `[x, z]` lies on a drivable lane (a linear scan: for checks
+    /// at load; [`MapIndex`] answers the per-step queries).
+    pub fn on_driving_surface(&self, p: [f64; 2]) -> bool {
+        self.lanes
+            .iter()
+            .filter(|l| l.drivable)
+            .any(|l| (0..l.s.len() - 1).any(|i| strip_offset(l, i, p).is_some()))
+    }
+
+    /// Distance from the world point `[x, z]` to the nearest lane strip, m (0 on one).
+    pub fn distance_m(&self, p: [f64; 2]) -> f64 {
+        let mut best = f64::INFINITY;
+        for l in &self.lanes {
+            for i in 0..l.s.len() - 1 {
+                let (d, _, _) = segment_projection(p, l.centre[i], l.centre[i + 1]);
+                let w = l.width[i].max(l.width[i + 1]) / 2.0;
+                best = best.min((d - w).max(0.0));
+            }
+        }
+        best
+    }
+}
+
+/// The distance from `p` to segment `a b`, the signed lateral offset (positive to the right
+/// of `a → b`) and the unclamped fraction along it.
+fn segment_projection(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64, f64) {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let rel = [p[0] - a[0], p[1] - a[1]];
+    let len2 = d[0] * d[0] + d[1] * d[1];
+    if len2 == 0.0 {
+        return (rel[0].hypot(rel[1]), 0.0, 0.0);
+    }
+    let raw = (rel[0] * d[0] + rel[1] * d[1]) / len2;
+    let u = raw.clamp(0.0, 1.0);
+    let e = [rel[0] - u * d[0], rel[1] - u * d[1]];
+    let lateral = (rel[1] * d[0] - rel[0] * d[1]) / len2.sqrt();
+    (e[0].hypot(e[1]), lateral, raw)
+}
+
+/// Whether `p` lies on segment `i` of lane `l`'s strip: its lateral offset from the centre
+/// line if so. Between two segments of one lane the joint is covered by a disc of the
+/// lane's half width; past the lane's first and last station nothing is.
+fn strip_offset(l: &MapLane, i: usize, p: [f64; 2]) -> Option<f64> {
+    let (d, lateral, raw) = segment_projection(p, l.centre[i], l.centre[i + 1]);
+    let u = raw.clamp(0.0, 1.0);
+    let w = l.width[i] + u * (l.width[i + 1] - l.width[i]);
+    let first = i == 0 && raw < 0.0;
+    let last = i + 2 == l.s.len() && raw > 1.0;
+    (!first && !last && d <= w / 2.0 && w > 0.0).then_some(lateral)
+}
+
+type Segment = GeomWithData<Line<[f64; 2]>, (usize, usize)>;
+
+/// Point queries on a map, precomputed once per world: R-trees of the lanes' centre-line
+/// segments and of the driving surface's edges.
+#[derive(Debug, Clone)]
+pub struct MapIndex {
+    map: Arc<RoadMap>,
+    centres: RTree<Segment>,
+    edges: RTree<GeomWithData<Line<[f64; 2]>, ()>>,
+    widest_m: f64,
+}
+
+impl MapIndex {
+    /// Indexes `map`. The edges of the driving surface are the borders of drivable lanes
+    /// with no drivable lane beyond them (probed 0.2 m outside), and the ends of drivable
+    /// lanes that nothing continues.
+    pub fn new(map: Arc<RoadMap>) -> MapIndex {
+        let mut segments = Vec::new();
+        let mut widest = 0.0f64;
+        for (k, l) in map.lanes.iter().enumerate() {
+            for i in 0..l.s.len() - 1 {
+                segments.push(Segment::new(
+                    Line::new(l.centre[i], l.centre[i + 1]),
+                    (k, i),
+                ));
+                widest = widest.max(l.width[i]).max(l.width[i + 1]);
+            }
+        }
+        let mut index = MapIndex {
+            map: map.clone(),
+            centres: RTree::bulk_load(segments),
+            edges: RTree::new(),
+            widest_m: widest,
+        };
+        let mut has_predecessor = vec![false; map.lanes.len()];
+        for l in &map.lanes {
+            for &n in &l.successors {
+                has_predecessor[n] = true;
+            }
+        }
+        let mut edges = Vec::new();
+        for (k, l) in map.lanes.iter().enumerate().filter(|(_, l)| l.drivable) {
+            let n = l.s.len();
+            let normal = |i: usize| {
+                let (a, b) = (l.centre[i.min(n - 2)], l.centre[(i + 1).min(n - 1).max(1)]);
+                let d = [b[0] - a[0], b[1] - a[1]];
+                let len = d[0].hypot(d[1]).max(1e-12);
+                // Right of a → b: (-d_z, d_x).
+                [-d[1] / len, d[0] / len]
+            };
+            for side in [1.0, -1.0] {
+                let border = |i: usize, extra: f64| {
+                    let r = normal(i);
+                    let t = side * (l.width[i] / 2.0 + extra);
+                    [l.centre[i][0] + t * r[0], l.centre[i][1] + t * r[1]]
+                };
+                let closed: Vec<bool> = (0..n)
+                    .map(|i| !index.drivable_at(border(i, 0.2), Some(k)))
+                    .collect();
+                for i in 0..n - 1 {
+                    if closed[i] || closed[i + 1] {
+                        edges.push(GeomWithData::new(
+                            Line::new(border(i, 0.0), border(i + 1, 0.0)),
+                            (),
+                        ));
+                    }
+                }
+            }
+            let (start_open, end_open) = if l.forward {
+                (has_predecessor[k], !l.successors.is_empty())
+            } else {
+                (!l.successors.is_empty(), has_predecessor[k])
+            };
+            for (i, open) in [(0, start_open), (n - 1, end_open)] {
+                if !open {
+                    let r = normal(i);
+                    let h = l.width[i] / 2.0;
+                    let c = l.centre[i];
+                    edges.push(GeomWithData::new(
+                        Line::new(
+                            [c[0] - h * r[0], c[1] - h * r[1]],
+                            [c[0] + h * r[0], c[1] + h * r[1]],
+                        ),
+                        (),
+                    ));
+                }
+            }
+        }
+        index.edges = RTree::bulk_load(edges);
+        index
+    }
+
+    /// The map.
+    pub fn map(&self) -> &RoadMap {
+        &self.map
+    }
+
+    /// The lanes whose strips hold `p`, with `p`'s lateral offset from their centre line
+    /// (m, positive to the right of increasing `s`).
+    fn strips_at(&self, p: [f64; 2]) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let r = self.widest_m / 2.0 + 1e-9;
+        self.centres
+            .locate_within_distance(p, r * r)
+            .filter_map(move |seg| {
+                let (k, i) = seg.data;
+                strip_offset(&self.map.lanes[k], i, p).map(|t| (k, t))
+            })
+    }
+
+    fn drivable_at(&self, p: [f64; 2], except: Option<usize>) -> bool {
+        self.strips_at(p)
+            .any(|(k, _)| Some(k) != except && self.map.lanes[k].drivable)
+    }
+
+    /// Whether the world point `[x, z]` lies on any lane of the map (driving or not).
+    pub fn on_any_lane(&self, p: [f64; 2]) -> bool {
+        self.strips_at(p).next().is_some()
+    }
+
+    /// Signed distance from the world point `[x, z]` to the edge of the map's driving
+    /// surface, m: `> 0` on it, `<= 0` off it (see [`super::Surface::edge_distance_m`]).
+    pub fn edge_distance_m(&self, p: [f64; 2]) -> f64 {
+        let d = self.edges.nearest_neighbor(p).map_or(f64::INFINITY, |e| {
+            let l = e.geom();
+            segment_projection(p, l.from, l.to).0
+        });
+        if self.drivable_at(p, None) {
+            d
+        } else {
+            -d
+        }
+    }
+
+    /// Each drivable lane's centre line in its direction of travel, world `[x, z]` m.
+    pub fn lane_lines(&self) -> Vec<Vec<[f64; 2]>> {
+        self.map
+            .lanes
+            .iter()
+            .filter(|l| l.drivable)
+            .map(MapLane::travel_points)
+            .collect()
+    }
+}

@@ -1,0 +1,588 @@
+//! OpenDRIVE import: a `.xodr` document baked into a [`RoadMap`].
+//!
+//! The `xodr` crate parses the document and evaluates its geometry (line, arc, spiral, poly3,
+//! paramPoly3 records, lane sections with width polynomials, lane offsets, junction
+//! connections) into lane centre lines and a lane graph. This module adds what a testing
+//! tool needs on top:
+//!
+//! - every element is checked against the OpenDRIVE schema's element names: an unknown one is
+//!   an error naming its line;
+//! - what paracosm does not use (elevation beyond flat, superelevation, signals, objects,
+//!   lane borders, road marks, speed records...) is named in a warning, with a count and the
+//!   first line;
+//! - faults the crate would repair silently or with a warning (a dropped road or geometry, a
+//!   lane link that does not meet, a road that does not exist) are errors, as are a lane
+//!   width below zero and a gap between consecutive geometry records;
+//! - lanes are sampled every 0.5 m of their road's reference line.
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use roxmltree::{Document, Node};
+
+use super::map::{MapLane, MapRoad, RoadMap};
+
+/// Largest distance between consecutive geometry records' end and start, m, and between a
+/// baked centre line and its record's start, before the map is refused as having a gap.
+pub const GEOMETRY_GAP_M: f64 = 0.01;
+
+/// Largest step between a lane's stations, m.
+pub const MAP_STEP_M: f64 = 0.5;
+
+/// Most lane stations a map may bake into (all lanes together): about 250 km of lane.
+pub const MAX_MAP_STATIONS: usize = 500_000;
+
+/// An OpenDRIVE document that cannot be used, with where.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}{}: {message}", .line.map(|l| format!(":{l}")).unwrap_or_default())]
+pub struct MapError {
+    /// The file, as the program names it.
+    pub file: String,
+    /// The 1-based line of the element at fault, where known.
+    pub line: Option<u32>,
+    /// What is wrong, naming the element.
+    pub message: String,
+}
+
+/// A map read from a document, with what it did not use.
+#[derive(Debug, Clone)]
+pub struct Imported {
+    /// The map.
+    pub map: Arc<RoadMap>,
+    /// One line per kind of element or record paracosm does not use (for example
+    /// "12 <signal> elements (first at line 40): signals are not simulated").
+    pub warnings: Vec<String>,
+}
+
+/// Elements paracosm bakes into the map.
+const USED: &[&str] = &[
+    "OpenDRIVE",
+    "header",
+    "geoReference",
+    "offset",
+    "road",
+    "link",
+    "predecessor",
+    "successor",
+    "planView",
+    "geometry",
+    "line",
+    "arc",
+    "spiral",
+    "poly3",
+    "paramPoly3",
+    "lanes",
+    "laneOffset",
+    "laneSection",
+    "left",
+    "center",
+    "right",
+    "lane",
+    "width",
+    "junction",
+    "connection",
+    "laneLink",
+    "elevationProfile",
+    "lateralProfile",
+];
+
+/// Elements of the OpenDRIVE schema paracosm reads nothing from: `(name, why)`. Their
+/// children are not checked.
+const UNUSED: &[(&str, &str)] = &[
+    ("signals", "traffic signals and signs are not simulated"),
+    ("objects", "road objects are not simulated"),
+    (
+        "roadMark",
+        "lane markings are drawn by paracosm's own rule, not the map's",
+    ),
+    (
+        "border",
+        "lane <border>s are baked by the xodr crate; paracosm has no test of them",
+    ),
+    (
+        "speed",
+        "speed limits are not read (each car's speed is the program's)",
+    ),
+    ("type", "road types are not read"),
+    (
+        "material",
+        "lane materials are not read (a map has one friction)",
+    ),
+    ("access", "lane access rules are not read"),
+    ("height", "lane heights are dropped: maps are flat"),
+    ("rule", "lane rules are not read"),
+    ("visibility", "lane visibility is not read"),
+    ("surface", "OpenCRG surfaces are dropped: maps are flat"),
+    ("railroad", "railways are not simulated"),
+    ("controller", "signal controllers are not simulated"),
+    (
+        "priority",
+        "junction priorities are not read (NPC cars do not yield)",
+    ),
+    ("controller", "junction controllers are not read"),
+    ("crossPath", "junction cross paths are not read"),
+    ("boundary", "junction boundaries are not read"),
+    (
+        "elevationGrid",
+        "junction elevation grids are dropped: maps are flat",
+    ),
+    ("junctionGroup", "junction groups are not read"),
+    ("station", "stations are not simulated"),
+    ("neighbor", "road neighbours are not read"),
+    ("userData", "user data is not read"),
+    ("include", "includes are not read"),
+    ("dataQuality", "data-quality records are not read"),
+    ("shape", "lateral shapes are dropped: maps are flat"),
+];
+
+/// Profile records that are kept only when they say nothing: `(name, why when not)`.
+const FLAT: &[(&str, &str)] = &[
+    ("elevation", "elevation is dropped: maps are flat, at y = 0"),
+    ("superelevation", "superelevation is dropped: maps are flat"),
+    ("crossfall", "crossfall is dropped: maps are flat"),
+];
+
+/// `xodr` warnings that are faults of the map, refused rather than repaired.
+const FAULTS: &[&str] = &[
+    "RoadSkipped",
+    "GeometryDropped",
+    "LaneIdUnreadable",
+    "LaneOnWrongSide",
+    "LaneIdRepeated",
+    "LaneDropped",
+    "BorderCrossesInnerLane",
+    "ConnectionDropped",
+    "LaneLinkDropped",
+    "JunctionLinkMissing",
+    "RoadLengthMismatch",
+    "LinkGap",
+    "RecordDropped",
+    "RecordValueUnreadable",
+    "LaneSectionDropped",
+    "ContactPointMissing",
+];
+
+fn attr_f64(n: Node, name: &str) -> Option<f64> {
+    n.attribute(name).and_then(|v| v.trim().parse::<f64>().ok())
+}
+
+struct Reader<'a> {
+    file: &'a str,
+    doc: &'a Document<'a>,
+}
+
+impl Reader<'_> {
+    fn line(&self, n: Node) -> u32 {
+        self.doc.text_pos_at(n.range().start).row
+    }
+
+    fn error(&self, n: Option<Node>, message: String) -> MapError {
+        MapError {
+            file: self.file.to_owned(),
+            line: n.map(|n| self.line(n)),
+            message,
+        }
+    }
+
+    fn roads(&self) -> impl Iterator<Item = Node<'_, '_>> {
+        self.doc
+            .root_element()
+            .children()
+            .filter(|n| n.has_tag_name("road"))
+    }
+
+    fn road_node(&self, id: &str) -> Option<Node<'_, '_>> {
+        self.roads().find(|n| n.attribute("id") == Some(id))
+    }
+}
+
+/// Reads the OpenDRIVE document `text` (the contents of `file`).
+///
+/// # Errors
+/// [`MapError`] naming the file, the element and its line, for XML that is not well formed,
+/// a root that is not `<OpenDRIVE>`, an element the schema does not have, a road or junction
+/// that a link or connection names but the document lacks, a lane width below zero, a gap
+/// between geometry records, a fault the `xodr` crate reports, or a map too large to bake.
+pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
+    let doc = Document::parse(text).map_err(|e| {
+        let pos = e.pos();
+        MapError {
+            file: file.to_owned(),
+            line: Some(pos.row),
+            message: format!("malformed XML (column {}): {e}", pos.col),
+        }
+    })?;
+    let r = Reader { file, doc: &doc };
+    let root = doc.root_element();
+    if !root.has_tag_name("OpenDRIVE") {
+        return Err(r.error(
+            Some(root),
+            format!(
+                "the root element is <{}>; an OpenDRIVE map's is <OpenDRIVE>",
+                root.tag_name().name()
+            ),
+        ));
+    }
+    let mut warnings = check_elements(&r, root)?;
+    check_references(&r)?;
+    check_widths(&r)?;
+    let (net, provenance) = xodr::load_str_with_provenance(text).map_err(|e| MapError {
+        file: file.to_owned(),
+        line: None,
+        message: format!("{e}"),
+    })?;
+    for w in &provenance.warnings {
+        let debug = format!("{w:?}");
+        let variant = debug.split([' ', '{', '(']).next().unwrap_or("");
+        let road = debug
+            .split("road_id: \"")
+            .nth(1)
+            .and_then(|t| t.split('"').next());
+        let node = road.and_then(|id| r.road_node(id));
+        if FAULTS.contains(&variant) {
+            return Err(r.error(
+                node,
+                format!(
+                    "{}{w}",
+                    road.map(|id| format!("<road id=\"{id}\">: "))
+                        .unwrap_or_default()
+                ),
+            ));
+        }
+        if !w.is_ignored() {
+            warnings.push(format!("{w}"));
+        }
+    }
+    check_gaps(&r, &net)?;
+    let map = bake(&r, &net, &provenance)?;
+    Ok(Imported {
+        map: Arc::new(map),
+        warnings,
+    })
+}
+
+/// Walks the tree: unknown elements are errors; unused ones and non-flat profiles, warnings.
+fn check_elements(r: &Reader, root: Node) -> Result<Vec<String>, MapError> {
+    // name -> (count, first line, why)
+    let mut unused: BTreeMap<String, (usize, u32, &str)> = BTreeMap::new();
+    let mut stack = vec![root];
+    while let Some(n) = stack.pop() {
+        for c in n.children().filter(Node::is_element) {
+            let name = c.tag_name().name();
+            // A road's <type> holds <speed>; a lane's <link> its predecessors: both known.
+            if let Some((_, why)) = UNUSED.iter().find(|(u, _)| *u == name) {
+                let e = unused.entry(name.to_owned()).or_insert((0, r.line(c), why));
+                e.0 += 1;
+                continue;
+            }
+            if let Some((_, why)) = FLAT.iter().find(|(f, _)| *f == name) {
+                let sloped = ["b", "c", "d"]
+                    .iter()
+                    .any(|k| attr_f64(c, k).is_some_and(|v| v != 0.0))
+                    || (name != "elevation" && attr_f64(c, "a").is_some_and(|v| v != 0.0));
+                if sloped {
+                    let e = unused.entry(name.to_owned()).or_insert((0, r.line(c), why));
+                    e.0 += 1;
+                }
+                continue;
+            }
+            if !USED.contains(&name) {
+                return Err(r.error(
+                    Some(c),
+                    format!(
+                        "<{name}> (inside <{}>) is not an OpenDRIVE element",
+                        n.tag_name().name()
+                    ),
+                ));
+            }
+            stack.push(c);
+        }
+    }
+    let mut out: Vec<(u32, String)> = unused
+        .into_iter()
+        .map(|(name, (count, line, why))| {
+            (
+                line,
+                format!(
+                    "{}:{line}: {count} <{name}> element{} ignored: {why}",
+                    r.file,
+                    if count == 1 { "" } else { "s" }
+                ),
+            )
+        })
+        .collect();
+    out.sort();
+    Ok(out.into_iter().map(|(_, w)| w).collect())
+}
+
+/// Roads and junctions that links and connections name must exist.
+fn check_references(r: &Reader) -> Result<(), MapError> {
+    let root = r.doc.root_element();
+    let has = |tag: &str, id: &str| {
+        root.children()
+            .any(|n| n.has_tag_name(tag) && n.attribute("id") == Some(id))
+    };
+    for road in r.roads() {
+        let rid = road.attribute("id").unwrap_or("?");
+        for link in road.children().filter(|n| n.has_tag_name("link")) {
+            for end in link.children().filter(Node::is_element) {
+                let (Some(kind), Some(id)) =
+                    (end.attribute("elementType"), end.attribute("elementId"))
+                else {
+                    continue;
+                };
+                if (kind == "road" || kind == "junction") && !has(kind, id) {
+                    return Err(r.error(
+                        Some(end),
+                        format!(
+                            "<{}> of road \"{rid}\" names {kind} \"{id}\", which the map does not have",
+                            end.tag_name().name()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    for j in root.children().filter(|n| n.has_tag_name("junction")) {
+        let jid = j.attribute("id").unwrap_or("?");
+        for c in j.children().filter(|n| n.has_tag_name("connection")) {
+            for key in ["incomingRoad", "connectingRoad", "linkedRoad"] {
+                if let Some(id) = c.attribute(key) {
+                    if !has("road", id) {
+                        return Err(r.error(
+                            Some(c),
+                            format!(
+                                "<connection> of junction \"{jid}\" names {key} \"{id}\", which the map does not have"
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Every lane `<width>` polynomial stays at or above zero over its stretch.
+fn check_widths(r: &Reader) -> Result<(), MapError> {
+    for road in r.roads() {
+        let rid = road.attribute("id").unwrap_or("?");
+        let length = attr_f64(road, "length").unwrap_or(0.0);
+        let Some(lanes) = road.children().find(|n| n.has_tag_name("lanes")) else {
+            continue;
+        };
+        let sections: Vec<Node> = lanes
+            .children()
+            .filter(|n| n.has_tag_name("laneSection"))
+            .collect();
+        for (k, sec) in sections.iter().enumerate() {
+            let s0 = attr_f64(*sec, "s").unwrap_or(0.0);
+            let s1 = sections
+                .get(k + 1)
+                .and_then(|n| attr_f64(*n, "s"))
+                .unwrap_or(length);
+            let span = (s1 - s0).max(0.0);
+            for lane in sec.descendants().filter(|n| n.has_tag_name("lane")) {
+                let widths: Vec<Node> = lane
+                    .children()
+                    .filter(|n| n.has_tag_name("width"))
+                    .collect();
+                for (i, w) in widths.iter().enumerate() {
+                    let from = attr_f64(*w, "sOffset").unwrap_or(0.0);
+                    let to = widths
+                        .get(i + 1)
+                        .and_then(|n| attr_f64(*n, "sOffset"))
+                        .unwrap_or(span);
+                    let c: Vec<f64> = ["a", "b", "c", "d"]
+                        .iter()
+                        .map(|k| attr_f64(*w, k).unwrap_or(0.0))
+                        .collect();
+                    for j in 0..=16 {
+                        let ds = (to - from).max(0.0) * f64::from(j) / 16.0;
+                        let v = c[0] + ds * (c[1] + ds * (c[2] + ds * c[3]));
+                        if v < -1e-9 {
+                            return Err(r.error(
+                                Some(*w),
+                                format!(
+                                    "<width> of lane {} on road \"{rid}\" is negative: {v:.3} m at {:.2} m into its stretch",
+                                    lane.attribute("id").unwrap_or("?"),
+                                    ds
+                                ),
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Each geometry record starts where the one before it ends (to [`GEOMETRY_GAP_M`]).
+fn check_gaps(r: &Reader, net: &xodr::RoadNetwork) -> Result<(), MapError> {
+    for road in r.roads() {
+        let rid = road.attribute("id").unwrap_or("?");
+        let Some(baked) = net.road_by_od_id(rid) else {
+            continue;
+        };
+        let Some(plan) = road.children().find(|n| n.has_tag_name("planView")) else {
+            continue;
+        };
+        let geoms: Vec<Node> = plan
+            .children()
+            .filter(|n| n.has_tag_name("geometry"))
+            .collect();
+        for g in geoms.iter().skip(1) {
+            let (Some(s), Some(x), Some(y)) =
+                (attr_f64(*g, "s"), attr_f64(*g, "x"), attr_f64(*g, "y"))
+            else {
+                continue;
+            };
+            let before = net.road_point(xodr::RoadPosition {
+                road: baked.id(),
+                s: (s - 1e-6).max(0.0),
+                t: 0.0,
+            });
+            if let Some(p) = before {
+                let gap = (f64::from(p.x) - x).hypot(f64::from(p.y) - y);
+                // f32 points: allow their rounding at the coordinates' size.
+                let tolerance =
+                    GEOMETRY_GAP_M + 4.0 * f64::from(f32::EPSILON) * x.abs().max(y.abs());
+                if gap > tolerance {
+                    return Err(r.error(
+                        Some(*g),
+                        format!(
+                            "<geometry s=\"{s}\"> of road \"{rid}\" starts {gap:.3} m from where the record before it ends ({:.3}, {:.3}): a gap in the reference line",
+                            p.x, p.y
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Samples every permanent lane every [`MAP_STEP_M`] of its road.
+fn bake(
+    r: &Reader,
+    net: &xodr::RoadNetwork,
+    provenance: &xodr::Provenance,
+) -> Result<RoadMap, MapError> {
+    let mut roads: Vec<MapRoad> = Vec::new();
+    let mut road_index: BTreeMap<String, usize> = BTreeMap::new();
+    // Section ranges from the document: road id -> starts, and the road's length.
+    let mut sections: BTreeMap<String, (Vec<f64>, f64)> = BTreeMap::new();
+    for road in r.roads() {
+        let id = road.attribute("id").unwrap_or("").to_owned();
+        let length = attr_f64(road, "length").unwrap_or(0.0);
+        let starts = road
+            .descendants()
+            .filter(|n| n.has_tag_name("laneSection"))
+            .filter_map(|n| attr_f64(n, "s"))
+            .collect();
+        sections.insert(id, (starts, length));
+    }
+    let mut lanes: Vec<MapLane> = Vec::new();
+    let mut by_id: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut stations = 0usize;
+    for p in &provenance.lanes {
+        if p.layer != xodr::Layer::Permanent {
+            continue;
+        }
+        let Some(lane) = net.lane(p.lane) else {
+            continue;
+        };
+        let Some((starts, length)) = sections.get(&p.road_id) else {
+            continue;
+        };
+        let s0 = starts.get(p.section).copied().unwrap_or(0.0);
+        let s1 = starts.get(p.section + 1).copied().unwrap_or(*length);
+        if s1.partial_cmp(&s0) != Some(std::cmp::Ordering::Greater) {
+            continue;
+        }
+        let road = *road_index.entry(p.road_id.clone()).or_insert_with(|| {
+            let baked = net.road_by_od_id(&p.road_id);
+            roads.push(MapRoad {
+                od_id: p.road_id.clone(),
+                length_m: baked.map_or(*length, xodr::Road::length),
+                junction: baked.and_then(|b| b.junction().map(str::to_owned)),
+            });
+            roads.len() - 1
+        });
+        let n = ((s1 - s0) / MAP_STEP_M).ceil().max(1.0) as usize;
+        stations += n + 1;
+        if stations > MAX_MAP_STATIONS {
+            return Err(r.error(
+                None,
+                format!(
+                    "the map is too large: more than {MAX_MAP_STATIONS} lane stations at one every {MAP_STEP_M} m"
+                ),
+            ));
+        }
+        let (mut ss, mut centre, mut width) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..=n {
+            let s = if i == n {
+                s1
+            } else {
+                s0 + (s1 - s0) * i as f64 / n as f64
+            };
+            let at = xodr::LanePosition {
+                lane: p.lane,
+                s,
+                offset: 0.0,
+            };
+            let (Some(c), Some(cs)) = (net.lane_point(at), net.centerline_s(at)) else {
+                continue;
+            };
+            let w = f64::from(lane.width_at(cs));
+            if !(c.x.is_finite() && c.y.is_finite() && w.is_finite()) {
+                return Err(r.error(
+                    r.road_node(&p.road_id),
+                    format!(
+                        "lane {} of road \"{}\" is not finite at s = {s:.2} m",
+                        p.od_id, p.road_id
+                    ),
+                ));
+            }
+            ss.push(s);
+            centre.push([f64::from(c.x), -f64::from(c.y)]);
+            width.push(w.max(0.0));
+        }
+        if ss.len() < 2 || width.iter().all(|w| *w <= 0.0) {
+            continue;
+        }
+        by_id.insert(p.lane.0, lanes.len());
+        lanes.push(MapLane {
+            road,
+            section: p.section,
+            od_id: p.od_id,
+            kind: lane.kind.as_str().to_owned(),
+            drivable: lane.kind.is_drivable(),
+            forward: lane.direction != xodr::Direction::Backward,
+            s: ss,
+            centre,
+            width,
+            successors: Vec::new(),
+        });
+    }
+    for p in &provenance.lanes {
+        let (Some(&k), Some(lane)) = (by_id.get(&p.lane.0), net.lane(p.lane)) else {
+            continue;
+        };
+        lanes[k].successors = lane
+            .successors
+            .iter()
+            .filter_map(|id| by_id.get(&id.0).copied())
+            .filter(|&n| lanes[n].drivable)
+            .collect();
+    }
+    if !lanes.iter().any(|l| l.drivable) {
+        return Err(r.error(None, "the map has no driving lane".into()));
+    }
+    Ok(RoadMap {
+        source: r.file.to_owned(),
+        roads,
+        lanes,
+    })
+}

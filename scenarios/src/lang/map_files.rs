@@ -1,0 +1,159 @@
+//! The files a program reads: OpenDRIVE maps (`OpenDrive("map.xodr")`), the one file access
+//! a program has.
+//!
+//! A path is resolved against the folder of the program's file (for a built-in scenario,
+//! against the maps built into the binary; for a program given as text, against the current
+//! folder). Each file is read and checked once per program: every later evaluation (one per
+//! test) gets the same map, so a file changed during a campaign changes nothing in it. Its
+//! SHA-256 enters the campaign's fingerprint ([`crate::Scenario::input_files`]), so
+//! `--resume` refuses a campaign whose map has changed since.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use paracosm_engine::network::opendrive;
+use paracosm_engine::network::RoadMap;
+use sha2::{Digest, Sha256};
+
+use crate::scenario::InputFile;
+
+/// Largest OpenDRIVE file read, bytes (16 MiB: a city district; larger maps are refused).
+pub const MAX_MAP_BYTES: u64 = 16 << 20;
+
+/// The maps shipped with the built-in scenarios: `(path as the programs write it, text)`.
+pub const BUILTIN_MAPS: [(&str, &str); 3] = [
+    ("maps/bend.xodr", include_str!("../../maps/bend.xodr")),
+    (
+        "maps/junction.xodr",
+        include_str!("../../maps/junction.xodr"),
+    ),
+    (
+        "maps/roundabout.xodr",
+        include_str!("../../maps/roundabout.xodr"),
+    ),
+];
+
+/// Where a program's relative paths lead.
+#[derive(Debug, Clone)]
+pub(crate) enum Base {
+    /// The folder of the program's file.
+    Folder(PathBuf),
+    /// A built-in scenario: [`BUILTIN_MAPS`].
+    Builtin,
+}
+
+impl Base {
+    /// The base for a program loaded as `file` (its path, or `scenarios/NAME.star` for a
+    /// built-in one).
+    pub(crate) fn of(file: &str, builtin: bool) -> Base {
+        if builtin {
+            return Base::Builtin;
+        }
+        let path = Path::new(file);
+        match path.parent() {
+            Some(dir) if path.is_file() => Base::Folder(dir.to_path_buf()),
+            _ => Base::Folder(PathBuf::from(".")),
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Loaded {
+    map: Arc<RoadMap>,
+    warnings: Vec<String>,
+    sha256: String,
+}
+
+/// The maps a program has read, by the path it wrote.
+#[derive(Debug)]
+pub(crate) struct MapFiles {
+    base: Base,
+    loaded: Mutex<BTreeMap<String, Loaded>>,
+}
+
+fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+impl MapFiles {
+    pub(crate) fn new(base: Base) -> MapFiles {
+        MapFiles {
+            base,
+            loaded: Mutex::new(BTreeMap::new()),
+        }
+    }
+
+    /// The map at `path` (as the program writes it): read and checked the first time, the
+    /// same map after.
+    ///
+    /// # Errors
+    /// A message naming the file: it cannot be read, is larger than [`MAX_MAP_BYTES`], is not
+    /// UTF-8, or is no usable OpenDRIVE map ([`opendrive::import`]'s message, with the line).
+    pub(crate) fn load(&self, path: &str) -> Result<Arc<RoadMap>, String> {
+        let mut loaded = self.loaded.lock().map_err(|_| "a map load panicked")?;
+        if let Some(l) = loaded.get(path) {
+            return Ok(l.map.clone());
+        }
+        let (shown, text) = match &self.base {
+            Base::Builtin => {
+                let text = BUILTIN_MAPS
+                    .iter()
+                    .find(|(p, _)| *p == path)
+                    .map(|(_, t)| (*t).to_owned())
+                    .ok_or_else(|| {
+                        let known: Vec<&str> = BUILTIN_MAPS.iter().map(|(p, _)| *p).collect();
+                        format!(
+                            "no built-in map \"{path}\" (the built-in maps: {})",
+                            known.join(", ")
+                        )
+                    })?;
+                (format!("scenarios/{path}"), text)
+            }
+            Base::Folder(dir) => {
+                let full = dir.join(path);
+                let shown = full.display().to_string();
+                let text = crate::text_file::read_text(&full, MAX_MAP_BYTES)
+                    .map_err(|e| format!("cannot read the OpenDRIVE map {shown}: {e}"))?;
+                (shown, text)
+            }
+        };
+        let imported =
+            opendrive::import(&shown, &text).map_err(|e| format!("the OpenDRIVE map {e}"))?;
+        loaded.insert(
+            path.to_owned(),
+            Loaded {
+                map: imported.map.clone(),
+                warnings: imported.warnings,
+                sha256: sha256_hex(text.as_bytes()),
+            },
+        );
+        Ok(imported.map)
+    }
+
+    /// Every file read so far, in order of path, with its SHA-256.
+    pub(crate) fn inputs(&self) -> Vec<InputFile> {
+        self.loaded
+            .lock()
+            .map(|l| {
+                l.iter()
+                    .map(|(path, f)| InputFile {
+                        path: path.clone(),
+                        sha256: f.sha256.clone(),
+                    })
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
+    /// What the maps read so far do not use: `(file, message)`.
+    pub(crate) fn warnings(&self) -> Vec<String> {
+        self.loaded
+            .lock()
+            .map(|l| l.values().flat_map(|f| f.warnings.clone()).collect())
+            .unwrap_or_default()
+    }
+}

@@ -1,0 +1,299 @@
+//! Issue 21, requirements 2 and 3: `OpenDrive("map.xodr")` in programs. The shipped map
+//! scenarios run; programs written in forms not shipped (NPC traffic round the roundabout
+//! map, an open choice of map, a map beside the program) work; a changed map stops
+//! `--resume`; what a map holds that paracosm does not use is named at load; wrong roads and
+//! lanes are refused with the program's file, line and column.
+
+use std::path::{Path, PathBuf};
+
+mod common;
+use common::{campaign, expect_code, fuzz, records};
+
+fn maps() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/maps")
+}
+
+/// `dir` with `src` as `name` and a copy of the shipped maps under `dir/maps`.
+fn program(dir: &Path, name: &str, src: &str) -> PathBuf {
+    std::fs::create_dir_all(dir.join("maps")).unwrap();
+    for f in ["bend.xodr", "junction.xodr", "roundabout.xodr"] {
+        std::fs::copy(maps().join(f), dir.join("maps").join(f)).unwrap();
+    }
+    let p = dir.join(name);
+    std::fs::write(&p, src).unwrap();
+    p
+}
+
+#[test]
+fn the_shipped_map_scenarios_run_and_find_what_they_are_built_to_find() {
+    let dir = tempfile::tempdir().unwrap();
+    // The pedestrian study on the bend: the ego keeps its lane all the way round (never
+    // nearer the edge than 1.7 m: the lane is 3.5 m wide).
+    let out = dir.path().join("curve");
+    let o = fuzz(&[
+        "curve-pedestrian",
+        "--budget",
+        "60",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    // Exit 1: some tests failed (collisions with the pedestrian).
+    expect_code(&o, 1);
+    let rs = records(&out);
+    assert_eq!(rs.len(), 60);
+    for r in &rs {
+        assert_eq!(r["monitors"]["offroad"]["passed"], true, "{r}");
+        assert!(
+            r["metrics"]["min_road_edge_m"].as_f64().unwrap() > 1.7,
+            "{r}"
+        );
+        assert_eq!(r["monitors"]["distance"]["passed"], true, "{r}");
+    }
+    // The left turn across oncoming traffic: collisions happen, and only where the oncoming
+    // car reaches the junction while the ego turns (its arrival time at/speed in a band).
+    let out = dir.path().join("junction");
+    let o = fuzz(&[
+        "opendrive-junction",
+        "--budget",
+        "120",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 1);
+    let rs = records(&out);
+    let arrival = |r: &serde_json::Value| {
+        r["params"]["oncoming_at"].as_f64().unwrap()
+            / r["params"]["oncoming_speed"].as_f64().unwrap()
+    };
+    let failed: Vec<&serde_json::Value> = rs.iter().filter(|r| r["status"] == "fail").collect();
+    assert!(
+        failed.len() >= 5 && failed.len() <= 60,
+        "{} of 120 failed",
+        failed.len()
+    );
+    for r in &failed {
+        assert_eq!(r["monitors"]["collision"]["passed"], false, "{r}");
+        let t = arrival(r);
+        assert!(
+            (2.5..=7.5).contains(&t),
+            "a collision with the car arriving after {t} s: {r}"
+        );
+    }
+    // Cars arriving early or late never collide.
+    for r in rs.iter().filter(|r| !(2.5..=7.5).contains(&arrival(r))) {
+        assert_eq!(r["status"], "pass", "{r}");
+    }
+}
+
+/// A program not shipped: the roundabout map, the ego coming in from the west arm and
+/// leaving north, an NPC car circulating from the south arm; a monitor checks the NPC car
+/// keeps the ring's lane (radius 21.75 m) while on the ring. The ego's collisions are no
+/// concern here (NPC cars do not yield), so the exit code is not checked.
+const ROUNDABOUT: &str = r#"
+mu = VarInterval(0.4, 1.0)
+start = VarInterval(30.0, 50.0, unit = "m")
+w = World()
+rb = OpenDrive("maps/roundabout.xodr", friction = mu)
+ego = AutonomousVehicle(loc = rb.onLane(road = "3", lane = 1, s = start), route = ["right"], speed = 6.0)
+npc = Car(loc = rb.onLane(road = "4", lane = 1, s = 20.0), speed = 5.0, route = [], color = "red")
+w.place(rb, ego, npc)
+
+def off_ring(p):
+    # Inside 22.1 m from the centre only the ring's lane (and the last metres of an entry,
+    # which meets it tangentially) lie.
+    r = hypot(p.x, p.z)
+    return 0.4 - abs(r - 21.75) if r < 22.1 and r > 19.0 else 0.4
+ring = Monitor(npc.pos.map(off_ring), unit = "m")
+went = Monitor(npc.pos.map(lambda p: 1.0 if hypot(p.x, p.z) < 22.1 else -1.0), over = "eventually")
+CollisionMonitor(ego)
+test(horizon = 12.0, map = ("mu",))
+"#;
+
+#[test]
+fn npc_traffic_circulates_on_the_roundabout_map_in_its_lane() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = program(dir.path(), "ring.star", ROUNDABOUT);
+    let out = dir.path().join("out");
+    let o = campaign(&file, "4", &out);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{o:?}");
+    let rs = records(&out);
+    assert_eq!(rs.len(), 4);
+    for r in &rs {
+        let ring = &r["monitors"]["ring"];
+        assert_eq!(ring["passed"], true, "{r}");
+        // It reached the ring (`went` passes "eventually": its robustness is the maximum).
+        assert_eq!(
+            r["monitors"]["went"]["robustness"].as_f64(),
+            Some(1.0),
+            "{r}"
+        );
+        // Nearer than 40 cm to its lane's circle all the way round.
+        assert!(ring["robustness"].as_f64().unwrap() > 0.0, "{r}");
+        assert_eq!(r["error"], serde_json::Value::Null);
+    }
+    let mus: Vec<f64> = rs
+        .iter()
+        .map(|r| r["params"]["mu"].as_f64().unwrap())
+        .collect();
+    assert!(
+        mus.iter().any(|&m| m < 0.6) && mus.iter().any(|&m| m > 0.7),
+        "{mus:?}"
+    );
+}
+
+#[test]
+fn the_map_may_be_open_and_a_changed_map_stops_resume() {
+    let dir = tempfile::tempdir().unwrap();
+    // A narrower copy of the bend, chosen by an open VarEnum.
+    let narrow = std::fs::read_to_string(maps().join("bend.xodr"))
+        .unwrap()
+        .replace("a=\"3.500000000000\"", "a=\"3.000000000000\"");
+    let src = r#"
+which = VarEnum(["maps/bend.xodr", "maps/narrow.xodr"])
+w = World()
+m = OpenDrive(which)
+v = AutonomousVehicle(loc = m.onLane(road = "1", lane = -1, s = 10.0))
+w.place(m, v)
+CollisionMonitor(v)
+test(horizon = 4.0)
+"#;
+    let file = program(dir.path(), "open_map.star", src);
+    std::fs::write(dir.path().join("maps/narrow.xodr"), narrow).unwrap();
+    let out = dir.path().join("out");
+    let o = campaign(&file, "4", &out);
+    expect_code(&o, 0);
+    let rs = records(&out);
+    let edges: Vec<(String, f64)> = rs
+        .iter()
+        .map(|r| {
+            (
+                r["params"]["which"].as_str().unwrap().to_owned(),
+                r["metrics"]["min_road_edge_m"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    // The ego keeps its lane's centre: 1.75 m from the edge on the bend, 1.5 m on the copy.
+    for (map, edge) in &edges {
+        let half = if map.contains("narrow") { 1.5 } else { 1.75 };
+        assert!((edge - half).abs() < 0.05, "{map}: {edge}");
+    }
+    assert!(
+        edges.iter().any(|(m, _)| m.contains("narrow"))
+            && edges.iter().any(|(m, _)| !m.contains("narrow"))
+    );
+    // The files read enter campaign.json and its fingerprint.
+    let campaign_json = std::fs::read_to_string(out.join("campaign.json")).unwrap();
+    assert!(
+        campaign_json.contains("maps/narrow.xodr") && campaign_json.contains("sha256"),
+        "{campaign_json}"
+    );
+    // Change a map: --resume refuses, naming it; put it back: it resumes.
+    let bend = dir.path().join("maps/bend.xodr");
+    let before = std::fs::read_to_string(&bend).unwrap();
+    std::fs::write(
+        &bend,
+        before.replacen("a=\"2.000000000000\"", "a=\"2.100000000000\"", 1),
+    )
+    .unwrap();
+    let o = fuzz(&["--resume", "--out", out.to_str().unwrap()]);
+    expect_code(&o, 2);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("the file `maps/bend.xodr` that the scenario program reads changed"),
+        "{stderr}"
+    );
+    std::fs::write(&bend, before).unwrap();
+    let o = fuzz(&["--resume", "--out", out.to_str().unwrap()]);
+    expect_code(&o, 0);
+}
+
+#[test]
+fn what_a_map_holds_that_paracosm_does_not_use_is_named_at_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = program(
+        dir.path(),
+        "signals.star",
+        "w = World()\nm = OpenDrive(\"maps/signs.xodr\")\nv = AutonomousVehicle(loc = m.onLane(road = \"1\", lane = -1, s = 10.0))\nw.place(m, v)\n",
+    );
+    let with_signals = std::fs::read_to_string(maps().join("bend.xodr")).unwrap().replace(
+        "    <lanes>",
+        "    <signals><signal s=\"20\" t=\"-3\" id=\"9\" dynamic=\"no\" orientation=\"+\" type=\"206\" subtype=\"-1\"/></signals>\n    <lanes>",
+    );
+    std::fs::write(dir.path().join("maps/signs.xodr"), with_signals).unwrap();
+    let out = dir.path().join("out");
+    let o = campaign(&file, "1", &out);
+    expect_code(&o, 0);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains(
+            "warning: 1 <signals> element ignored: traffic signals and signs are not simulated"
+        ) && stderr.contains("signs.xodr:"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn wrong_roads_lanes_and_calls_on_a_map_are_refused_with_the_program_s_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            "m.onLane(road = \"9\", lane = -1, s = 10.0)",
+            "has no road \"9\" (its roads: 1)",
+        ),
+        (
+            "m.onLane(road = \"1\", lane = -3, s = 10.0)",
+            "has no lane -3 at s = 10 m; its lanes there:",
+        ),
+        (
+            "m.onLane(road = \"1\", lane = -1, s = 400.0)",
+            "s = 400 m is outside road \"1\"",
+        ),
+        (
+            "m.onLane(-1, 10.0)",
+            "an OpenDrive map's onLane takes road=, lane= and s= by name",
+        ),
+        ("m.onLane(road = \"1\", lane = 0, s = 10.0)", "not 0"),
+    ];
+    for (i, (call, phrase)) in cases.iter().enumerate() {
+        let src = format!("w = World()\nm = OpenDrive(\"maps/bend.xodr\")\nv = AutonomousVehicle(loc = {call})\nw.place(m, v)\n");
+        let file = program(dir.path(), &format!("bad{i}.star"), &src);
+        let o = fuzz(&[
+            file.to_str().unwrap(),
+            "--budget",
+            "1",
+            "--out",
+            dir.path().join(format!("o{i}")).to_str().unwrap(),
+        ]);
+        expect_code(&o, 2);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            stderr.contains(phrase),
+            "{call}: `{phrase}` not in\n{stderr}"
+        );
+        assert!(
+            stderr.contains(&format!("bad{i}.star:3:")),
+            "{call}: no place in\n{stderr}"
+        );
+    }
+    // A map that is not there.
+    let file = program(
+        dir.path(),
+        "missing.star",
+        "w = World()\nm = OpenDrive(\"maps/nowhere.xodr\")\n",
+    );
+    let o = fuzz(&[
+        file.to_str().unwrap(),
+        "--budget",
+        "1",
+        "--out",
+        dir.path().join("om").to_str().unwrap(),
+    ]);
+    expect_code(&o, 2);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("cannot read the OpenDRIVE map")
+            && stderr.contains("nowhere.xodr")
+            && stderr.contains("missing.star:2:"),
+        "{stderr}"
+    );
+}
