@@ -382,6 +382,8 @@ fn record_test(
             on_frame: None,
             on_sample: Some(&mut on_sample),
             perturb: (req.steer_noise > 0.0).then_some(&mut perturb as &mut dyn FnMut(_, _) -> _),
+            on_world: None,
+            on_step: None,
         },
     );
     match failed {

@@ -14,6 +14,7 @@ pub mod cli;
 pub mod cover;
 pub mod dataset;
 mod error;
+pub mod export;
 pub mod fuzz;
 pub mod html;
 pub mod junit;

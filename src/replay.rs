@@ -101,6 +101,22 @@ pub fn replay(
     frames: Option<&Path>,
     sut: Option<SutConfig>,
 ) -> Result<Replay, Error> {
+    replay_with(results, id, frames, sut, None, None)
+}
+
+/// [`replay`], also calling `on_world` with the test's world as built and `on_step` with its
+/// state at the start and after every step (what `paracosm-fuzz export` records).
+///
+/// # Errors
+/// As [`replay`].
+pub fn replay_with(
+    results: &Path,
+    id: u64,
+    frames: Option<&Path>,
+    sut: Option<SutConfig>,
+    on_world: Option<&mut dyn FnMut(&paracosm_engine::WorldSpec)>,
+    on_step: Option<&mut dyn FnMut(&paracosm_engine::Snapshot)>,
+) -> Result<Replay, Error> {
     let dir = results.parent().unwrap_or(Path::new("."));
     let (line_no, line) = find_record(results, id)?;
     let campaign_file = CampaignFile::read(dir).map_err(input)?;
@@ -157,6 +173,8 @@ pub fn replay(
             on_frame: Some(&mut on_frame),
             on_sample: None,
             perturb: None,
+            on_world: on_world.map(|f| f as &mut dyn FnMut(&paracosm_engine::WorldSpec)),
+            on_step: on_step.map(|f| f as &mut dyn FnMut(&paracosm_engine::Snapshot)),
         },
     );
     if let Some(e) = write_error {

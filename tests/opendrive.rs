@@ -297,3 +297,104 @@ fn wrong_roads_lanes_and_calls_on_a_map_are_refused_with_the_program_s_place() {
         "{stderr}"
     );
 }
+
+#[test]
+fn pieces_of_the_program_may_stand_beside_a_map_but_not_on_its_lanes() {
+    let dir = tempfile::tempdir().unwrap();
+    // A short segment at the origin: inside the roundabout's island (the ring's lanes start
+    // 20 m out), so it touches no lane; at the junction's centre it lies on its lanes.
+    let program_with = |map: &str, name: &str| {
+        program(
+            dir.path(),
+            name,
+            &format!(
+                "w = World()\nm = OpenDrive(\"maps/{map}\")\nr = RoadSegment(len = 8.0)\nv = AutonomousVehicle(loc = m.onLane(road = \"1\", lane = 1, s = 40.0))\nw.place(m, r, v)\ntest(horizon = 1.0)\n"
+            ),
+        )
+    };
+    let ok = program_with("roundabout.xodr", "island.star");
+    let o = fuzz(&[
+        ok.to_str().unwrap(),
+        "--budget",
+        "1",
+        "--out",
+        dir.path().join("a").to_str().unwrap(),
+    ]);
+    expect_code(&o, 0);
+    let bad = program_with("junction.xodr", "centre.star");
+    let o = fuzz(&[
+        bad.to_str().unwrap(),
+        "--budget",
+        "1",
+        "--out",
+        dir.path().join("b").to_str().unwrap(),
+    ]);
+    expect_code(&o, 2);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("road pieces overlap: OpenDrive m") && stderr.contains("RoadSegment r"),
+        "{stderr}"
+    );
+    // connect cannot join a piece to the map.
+    let joined = program(
+        dir.path(),
+        "joined.star",
+        "w = World()\nm = OpenDrive(\"maps/bend.xodr\")\nr = RoadSegment(len = 8.0)\nr.connect((r.TWO, m, m.ONE))\n",
+    );
+    let o = fuzz(&[
+        joined.to_str().unwrap(),
+        "--budget",
+        "1",
+        "--out",
+        dir.path().join("c").to_str().unwrap(),
+    ]);
+    expect_code(&o, 2);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("joined.star:4:"), "{stderr}");
+    // Lane changes are not available on a map, and say so.
+    let change = program(
+        dir.path(),
+        "change.star",
+        "w = World()\nm = OpenDrive(\"maps/bend.xodr\")\nv = AutonomousVehicle(loc = m.onLane(road = \"1\", lane = -1, s = 10.0))\nc = Car(loc = m.onLane(road = \"1\", lane = -1, s = 40.0), speed = 5.0, lane_change = ChangeLane(to = 1, at = 2.0))\nw.place(m, v, c)\n",
+    );
+    let o = fuzz(&[
+        change.to_str().unwrap(),
+        "--budget",
+        "1",
+        "--out",
+        dir.path().join("d").to_str().unwrap(),
+    ]);
+    expect_code(&o, 2);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("on an OpenDRIVE map"), "{stderr}");
+}
+
+#[test]
+fn vision_keeps_its_lane_round_the_map_bend() {
+    // The camera-only system steers by the markings the map's lanes are drawn with.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("v");
+    let o = fuzz(&[
+        "curve-pedestrian",
+        "--sut",
+        "vision",
+        "--budget",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{o:?}");
+    for r in records(&out) {
+        assert_eq!(r["monitors"]["offroad"]["passed"], true, "{r}");
+        // Round the bend (the arc starts 120 m ahead of the start) and within 10 cm of the
+        // lane's centre all the way (its edge is 1.75 m away).
+        assert!(
+            r["metrics"]["distance_travelled_m"].as_f64().unwrap() > 150.0,
+            "{r}"
+        );
+        assert!(
+            r["metrics"]["min_road_edge_m"].as_f64().unwrap() > 1.65,
+            "{r}"
+        );
+    }
+}

@@ -205,6 +205,7 @@ fn a_param_poly3_record_follows_its_parabola() {
         worst < 2e-3,
         "the reference line leaves the parabola by {worst} m"
     );
+    println!("paramPoly3: the reference line within {worst:.2e} m of y = c x^2");
 }
 
 /// The route's last point and the heading of its last step, rad.

@@ -217,6 +217,11 @@ pub struct RunOptions<'a> {
     /// teacher's answers, recorded as [`Sample::control`], show how to recover. `None`: the
     /// answer is applied as it is.
     pub perturb: Option<&'a mut dyn FnMut(f64, Control) -> Control>,
+    /// Called once with the test's world as it was built (its roads, actors and routes),
+    /// before the first step: what `paracosm-fuzz export` writes out.
+    pub on_world: Option<&'a mut dyn FnMut(&WorldSpec)>,
+    /// Called with the state of the world at the start and after every physics step.
+    pub on_step: Option<&'a mut dyn FnMut(&Snapshot)>,
 }
 
 /// Every how many physics steps something at `hz` happens (at least every step).
@@ -260,6 +265,9 @@ impl Scenario {
         host: &mut dyn Host,
         options: &mut RunOptions<'_>,
     ) -> Result<TestOutcome, ScenarioError> {
+        if let Some(f) = options.on_world.as_mut() {
+            f(spec);
+        }
         let mut sim = Simulation::new(spec)?;
         let mut sut = self.sut.build();
         sut.reset(seed)?;
@@ -300,6 +308,9 @@ impl Scenario {
         // Streams are evaluated for the state a snapshot shows, so a published stream's value
         // and the runner's own signals describe the same moment.
         sim.evaluate(host)?;
+        if let Some(f) = options.on_step.as_mut() {
+            f(&sim.snapshot());
+        }
         let mut stopped = watch.observe(&sim)?;
         let mut tick = 0;
         let mut control = Control::default();
@@ -336,6 +347,9 @@ impl Scenario {
             sim.step(applied, host)?;
             tick += 1;
             sim.evaluate(host)?;
+            if let Some(f) = options.on_step.as_mut() {
+                f(&sim.snapshot());
+            }
             stopped = watch.observe(&sim)?;
         }
 

@@ -123,6 +123,25 @@ enum Sub {
     /// or --sut) and write, per recorded frame, the camera image, depth (.npy), segmentation
     /// mask, COCO boxes, ego state and the teacher's control, indexed by frames.csv.
     Dataset(DatasetArgs),
+    /// Write one recorded test as an ASAM OpenSCENARIO 1.2 scenario (DIR/test_ID.xosc) with
+    /// its road network as OpenDRIVE (DIR/test_ID.xodr: the program's map, or its pieces
+    /// written out), replayed from its parameters and seed: the ego's start, speed and route,
+    /// each car's trajectory as driven, each pedestrian's walk starting on the distance to the
+    /// ego that triggered it. Exit 0, or 3 when the replayed verdict differs from the recorded
+    /// one.
+    Export(ExportArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct ExportArgs {
+    /// A campaign's results.jsonl.
+    results: PathBuf,
+    /// Id of the test to export.
+    #[arg(long)]
+    id: u64,
+    /// Folder for test_ID.xosc and test_ID.xodr (created if missing).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
 }
 
 #[derive(Debug, clap::Args)]
@@ -317,19 +336,54 @@ fn main() -> ExitCode {
             .and_then(|r| paracosm::dataset::export(&r, Some(&STOP)))
             .map_err(anyhow::Error::new)
             .and_then(|s| say(&s.text()).map(|()| s.exit_code())),
+        Some(Sub::Export(a)) => paracosm::export::export(&a.results, a.id, &a.out)
+            .map_err(anyhow::Error::new)
+            .and_then(|e| {
+                let text = format!(
+                    "wrote {} (OpenSCENARIO 1.2) and {} (OpenDRIVE){}",
+                    e.xosc.display(),
+                    e.xodr.display(),
+                    if e.matches {
+                        ""
+                    } else {
+                        "\nwarning: the replayed verdict differs from the recorded one; the files describe the replay"
+                    }
+                );
+                say(&text).map(|()| if e.matches { 0 } else { 3 })
+            }),
         None => run(&cli),
     };
-    match result {
-        Ok(code) => ExitCode::from(interrupted_code(code)),
+    let code = match result {
+        Ok(code) => interrupted_code(code),
         Err(e) => {
             eprintln!(
                 "{}",
                 paracosm::cli::error_text("paracosm-fuzz", &format!("{e:#}"))
             );
-            let code = e.downcast_ref::<Error>().map_or(3, Error::exit_code);
-            ExitCode::from(code)
+            e.downcast_ref::<Error>().map_or(3, Error::exit_code)
         }
+    };
+    drop(cli);
+    exit_without_teardown(code)
+}
+
+/// Ends the process with `code`, stdout and stderr flushed, without the C library's exit
+/// handlers. The camera's GPU device lives in a static that is never dropped, and Mesa's
+/// lavapipe tears its driver down in those handlers while its worker threads may still run:
+/// once, in CI, a campaign that had written every file aborted there ("corrupted size vs.
+/// prev_size in fastbins", exit by signal 6 instead of 0). Every file is written, flushed and
+/// closed before this (the campaign's writers are dropped when `run` returns).
+fn exit_without_teardown(code: u8) -> ExitCode {
+    use std::io::Write;
+    let _ = std::io::stdout().flush();
+    let _ = std::io::stderr().flush();
+    #[cfg(unix)]
+    // SAFETY: `_exit` ends the process at once; nothing runs after it.
+    unsafe {
+        libc::_exit(i32::from(code))
     }
+    #[cfg(not(unix))]
+    ExitCode::from(code)
 }
 
 /// Writes `text` and a newline to stdout. A reader that has gone (`| head`) is not an

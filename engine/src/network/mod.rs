@@ -26,6 +26,7 @@ pub use piece::{
 };
 pub use surface::{Surface, GROUND_FRICTION, GROUND_MARGIN_M, GROUND_TOP_M};
 
+use rapier3d::parry::bounding_volume::BoundingVolume;
 use rapier3d::parry::query::intersection_test;
 use rapier3d::parry::shape::{Cuboid, SharedShape};
 use rapier3d::prelude::{Pose, Rotation, Vector};
@@ -380,12 +381,31 @@ impl Network {
     }
 
     /// The piece's footprint as convex parts in world coordinates, shrunk by
-    /// [`TOUCH_MARGIN_M`]: one box for a segment or junction; for a curved piece, one
+    /// [`TOUCH_MARGIN_M`] (a map's lanes are not): one box for a segment or junction; for an
+    /// OpenDRIVE map, one prism per 0.5 m step of each lane; for a curved piece, one
     /// quadrilateral prism per slice of at most 2 m, whose ends lie across the reference line
     /// (so the first and last end exactly at the ports).
     fn footprint_parts(&self, id: PieceId) -> Vec<(Pose, SharedShape)> {
         let p = &self.pieces[id.0];
         let shrink = |h: f64| (h - TOUCH_MARGIN_M).max(0.001);
+        if let PieceKind::Map { map, .. } = &p.kind {
+            // One quadrilateral prism per step of each lane (the map's pose is the identity).
+            let (vertices, triangles) = map.0.strip_triangles();
+            return triangles
+                .chunks(2)
+                .filter_map(|pair| {
+                    let corners: Vec<Vector> = pair
+                        .iter()
+                        .flatten()
+                        .flat_map(|&v| {
+                            let [x, z] = p.pose.apply(vertices[v as usize]);
+                            [-0.5f32, 0.5].map(|y| Vector::new(x as f32, y, z as f32))
+                        })
+                        .collect();
+                    SharedShape::convex_hull(&corners).map(|s| (Pose::identity(), s))
+                })
+                .collect();
+        }
         if let Some(line) = p.kind.ref_line() {
             let w = shrink(p.kind.half_width_m());
             let mut frames = line.frames(2.0);
@@ -429,9 +449,19 @@ impl Network {
     fn overlap(&self, a: PieceId, b: PieceId) -> bool {
         let pa = self.footprint_parts(a);
         let pb = self.footprint_parts(b);
-        pa.iter().any(|(xa, sa)| {
-            pb.iter().any(|(xb, sb)| {
-                intersection_test(xa, sa.as_ref(), xb, sb.as_ref()).map_or(true, |i| i.intersecting)
+        // Bounding boxes first: a map has thousands of parts.
+        let boxes = |parts: &[(Pose, SharedShape)]| {
+            parts
+                .iter()
+                .map(|(x, s)| s.compute_aabb(x))
+                .collect::<Vec<_>>()
+        };
+        let (ba, bb) = (boxes(&pa), boxes(&pb));
+        pa.iter().zip(&ba).any(|((xa, sa), aa)| {
+            pb.iter().zip(&bb).any(|((xb, sb), ab)| {
+                aa.intersects(ab)
+                    && intersection_test(xa, sa.as_ref(), xb, sb.as_ref())
+                        .map_or(true, |i| i.intersecting)
             })
         })
     }

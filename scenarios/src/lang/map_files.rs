@@ -58,6 +58,31 @@ impl Base {
     }
 }
 
+/// The text of the file `path` (as a program writes it) that the scenario `scenario` (a
+/// program's path, or a built-in scenario's name, as `paracosm-fuzz` takes it) reads: what
+/// `paracosm-fuzz export` copies beside the test it writes.
+///
+/// # Errors
+/// A message naming the file when it cannot be read, is larger than [`MAX_MAP_BYTES`] or is
+/// not UTF-8, or when a built-in scenario has no such map.
+pub fn read_input_file(scenario: &str, path: &str) -> Result<String, String> {
+    let program = Path::new(scenario);
+    let builtin = !(scenario.ends_with(".star") || program.exists());
+    let base = Base::of(scenario, builtin);
+    match base {
+        Base::Builtin => BUILTIN_MAPS
+            .iter()
+            .find(|(p, _)| *p == path)
+            .map(|(_, t)| (*t).to_owned())
+            .ok_or_else(|| format!("no built-in map \"{path}\"")),
+        Base::Folder(dir) => {
+            let full = dir.join(path);
+            crate::text_file::read_text(&full, MAX_MAP_BYTES)
+                .map_err(|e| format!("cannot read {}: {e}", full.display()))
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 struct Loaded {
     map: Arc<RoadMap>,

@@ -773,6 +773,11 @@ impl SceneBuilder {
                 "{name}: a lane change starts on a RoadSegment's lane, not inside a junction"
             ));
         }
+        if start.map_lane.is_some() {
+            return Err(format!(
+                "{name}: ChangeLane is not available on an OpenDRIVE map (start the car in the lane it should drive, or give it a route)"
+            ));
+        }
         let target = self
             .roads
             .on_lane(

@@ -1,0 +1,123 @@
+//! `paracosm-fuzz export`: one recorded test as an ASAM OpenSCENARIO 1.2 scenario (`.xosc`)
+//! with its road network as OpenDRIVE (`.xodr`), for a team that runs esmini or CARLA.
+//!
+//! The test is replayed from its campaign (as `replay` does: its recorded point and seed), and
+//! its world and the states it went through are written out ([`xosc`]). The network is the
+//! program's OpenDRIVE map, copied as it is, or else written from its pieces ([`xodr`]).
+
+pub mod xml;
+pub mod xodr;
+pub mod xosc;
+
+use std::path::{Path, PathBuf};
+
+use paracosm_engine::network::PieceKind;
+use paracosm_engine::{Snapshot, WorldSpec};
+
+use crate::campaign_file::CampaignFile;
+use crate::Error;
+
+/// What an export wrote.
+#[derive(Debug)]
+pub struct Exported {
+    /// The OpenSCENARIO file.
+    pub xosc: PathBuf,
+    /// The OpenDRIVE file beside it.
+    pub xodr: PathBuf,
+    /// Whether the replayed verdict equals the recorded one (the export is of the replay).
+    pub matches: bool,
+}
+
+fn input(e: impl std::fmt::Display) -> Error {
+    Error::BadInput(e.to_string())
+}
+
+/// Writes test `id` of the campaign whose results are `results` into `out` as `test_ID.xosc`
+/// and `test_ID.xodr`.
+///
+/// # Errors
+/// [`Error::BadInput`] as for [`crate::replay::replay`], for a network that mixes an
+/// OpenDRIVE map with pieces of the program, or a map that can no longer be read;
+/// [`Error::Write`] when `out` or a file cannot be written.
+pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
+    let dir = results.parent().unwrap_or(Path::new("."));
+    let campaign = CampaignFile::read(dir).map_err(input)?;
+    let scenario = paracosm_scenarios::load(&campaign.scenario).map_err(input)?;
+    let mut world: Option<WorldSpec> = None;
+    let mut states: Vec<Snapshot> = Vec::new();
+    let mut on_world = |w: &WorldSpec| world = Some(w.clone());
+    let mut on_step = |s: &Snapshot| states.push(s.clone());
+    let replayed = crate::replay::replay_with(
+        results,
+        id,
+        None,
+        None,
+        Some(&mut on_world),
+        Some(&mut on_step),
+    )?;
+    let world = world.ok_or_else(|| {
+        input(format!(
+            "test {id} built no world: {}",
+            replayed.replayed.error.clone().unwrap_or_default()
+        ))
+    })?;
+    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
+    let stem = format!("test_{id}");
+    let xodr_name = format!("{stem}.xodr");
+    // The network: the program's map as it is, or the pieces written out.
+    let maps: Vec<&PieceKind> = world
+        .network
+        .pieces()
+        .iter()
+        .map(|p| &p.kind)
+        .filter(|k| matches!(k, PieceKind::Map { .. }))
+        .collect();
+    let network = if maps.is_empty() {
+        xodr::write(&world.network, &scenario.name).map_err(input)?
+    } else if maps.len() == 1 && world.network.pieces().len() == 1 {
+        let read = scenario
+            .input_files
+            .iter()
+            .find(|f| {
+                matches!(maps[0], PieceKind::Map { map, .. }
+                    if map.0.source.ends_with(f.path.trim_start_matches("./")))
+            })
+            .or(scenario.input_files.first())
+            .ok_or_else(|| input("the program's map is not among the files it read"))?;
+        paracosm_scenarios::lang::map_files::read_input_file(&campaign.scenario, &read.path)
+            .map_err(input)?
+    } else {
+        return Err(input(
+            "the test's network mixes an OpenDRIVE map with other pieces, which cannot be exported as one OpenDRIVE file",
+        ));
+    };
+    let params: Vec<(String, serde_json::Value)> = replayed.recorded["params"]
+        .as_object()
+        .map(|m| m.iter().map(|(k, v)| (k.clone(), v.clone())).collect())
+        .unwrap_or_default();
+    let description = format!(
+        "paracosm test {id} of {} (campaign {}, seed {}): {}",
+        scenario.name,
+        &campaign.fingerprint[..16.min(campaign.fingerprint.len())],
+        campaign.seed,
+        replayed.recorded["status"].as_str().unwrap_or("?")
+    );
+    let document = xosc::write(&xosc::Test {
+        description,
+        params,
+        network_file: xodr_name.clone(),
+        world: &world,
+        states: &states,
+        horizon_s: scenario.horizon_s,
+    });
+    let xosc_path = out.join(format!("{stem}.xosc"));
+    let xodr_path = out.join(&xodr_name);
+    for (path, text) in [(&xodr_path, &network), (&xosc_path, &document)] {
+        crate::atomic::write(path, text.as_bytes())?;
+    }
+    Ok(Exported {
+        xosc: xosc_path,
+        xodr: xodr_path,
+        matches: replayed.matches,
+    })
+}

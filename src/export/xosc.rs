@@ -1,0 +1,462 @@
+//! An ASAM OpenSCENARIO 1.2 document of one concrete test, written from the world the test
+//! built and the states it went through (for `paracosm-fuzz export`).
+//!
+//! - **Entities.** The ego vehicle (`ego`), the NPC cars (`car1`, ...), the pedestrians
+//!   (`pedestrian1`, ...) and the obstacles (`obstacle1`, ...), with their bounding boxes.
+//!   Positions are the centre of each actor's footprint on the road surface; OpenSCENARIO's
+//!   `(x, y, z)` is paracosm's `(x, -z, y)`, headings agree.
+//! - **Init.** Every entity is placed where the test starts it (`TeleportAction`); the ego and
+//!   the cars get their initial speed (`AbsoluteTargetSpeed`); the ego gets its route as an
+//!   `AssignRouteAction` (waypoints every 10 m): the system under test drives it.
+//! - **Story.** Each car follows the trajectory it drove in the test, timed (`Polyline`
+//!   vertices every 0.1 s, absolute time), from the start. Each pedestrian that walked starts
+//!   on a `DistanceCondition`: when the ego comes within the distance at which it started
+//!   walking in the test (its trigger, measured from the recording); it then follows its walk
+//!   as a trajectory timed from that moment.
+//! - **Stop.** At the test's horizon (`SimulationTimeCondition`).
+//!
+//! The header's date is the Unix epoch, so that one test always exports to the same bytes.
+
+use paracosm_engine::Snapshot;
+use paracosm_engine::{Size, WorldSpec};
+
+use super::xml::El;
+
+/// Every how many seconds a trajectory has a vertex.
+pub const VERTEX_EVERY_S: f64 = 0.1;
+/// Longest distance between two waypoints of the ego's route, m.
+pub const WAYPOINT_EVERY_M: f64 = 10.0;
+
+/// What the export writes about one test: what it is, and what it went through.
+pub struct Test<'a> {
+    /// One line describing the test (campaign, id, verdict).
+    pub description: String,
+    /// The test's parameters, `(name, value as written)`, numbers first.
+    pub params: Vec<(String, serde_json::Value)>,
+    /// The road network's file, relative to the `.xosc`.
+    pub network_file: String,
+    /// The world as built.
+    pub world: &'a WorldSpec,
+    /// The states at the start and after every step.
+    pub states: &'a [Snapshot],
+    /// The test's horizon, s.
+    pub horizon_s: f64,
+}
+
+fn world_position(p: [f64; 3], h: f64) -> El {
+    El::new("Position").child(
+        El::new("WorldPosition")
+            .num("x", p[0])
+            .num("y", -p[2])
+            .num("z", 0.0)
+            .num("h", h),
+    )
+}
+
+fn bounding_box(size: Size) -> El {
+    El::new("BoundingBox")
+        .child(
+            El::new("Center")
+                .num("x", 0.0)
+                .num("y", 0.0)
+                .num("z", size.height_m / 2.0),
+        )
+        .child(
+            El::new("Dimensions")
+                .num("width", size.width_m)
+                .num("length", size.length_m)
+                .num("height", size.height_m),
+        )
+}
+
+fn vehicle(name: &str, size: Size) -> El {
+    let axle = |tag: &str, x: f64, steer: f64| {
+        El::new(tag)
+            .num("maxSteering", steer)
+            .num("wheelDiameter", 0.7)
+            .num("trackWidth", size.width_m - 0.2)
+            .num("positionX", x)
+            .num("positionZ", 0.35)
+    };
+    El::new("Vehicle")
+        .attr("name", name)
+        .attr("vehicleCategory", "car")
+        .child(bounding_box(size))
+        .child(
+            El::new("Performance")
+                .num("maxSpeed", 60.0)
+                .num("maxAcceleration", 5.0)
+                .num("maxDeceleration", 10.0),
+        )
+        .child(
+            El::new("Axles")
+                .child(axle("FrontAxle", size.length_m * 0.3, 0.6))
+                .child(axle("RearAxle", -size.length_m * 0.3, 0.0)),
+        )
+        .child(El::new("Properties"))
+}
+
+fn private(entity: &str, actions: Vec<El>) -> El {
+    El::new("Private").attr("entityRef", entity).children(
+        actions
+            .into_iter()
+            .map(|a| El::new("PrivateAction").child(a)),
+    )
+}
+
+fn teleport(p: [f64; 3], h: f64) -> El {
+    El::new("TeleportAction").child(world_position(p, h))
+}
+
+fn speed(v: f64) -> El {
+    El::new("LongitudinalAction").child(
+        El::new("SpeedAction")
+            .child(
+                El::new("SpeedActionDynamics")
+                    .attr("dynamicsShape", "step")
+                    .num("value", 0.0)
+                    .attr("dynamicsDimension", "time"),
+            )
+            .child(
+                El::new("SpeedActionTarget").child(El::new("AbsoluteTargetSpeed").num("value", v)),
+            ),
+    )
+}
+
+fn condition(name: &str, edge: &str, inner: El) -> El {
+    El::new("ConditionGroup").child(
+        El::new("Condition")
+            .attr("name", name)
+            .num("delay", 0.0)
+            .attr("conditionEdge", edge)
+            .child(inner),
+    )
+}
+
+fn time_condition(name: &str, edge: &str, rule: &str, t: f64) -> El {
+    condition(
+        name,
+        edge,
+        El::new("ByValueCondition").child(
+            El::new("SimulationTimeCondition")
+                .num("value", t)
+                .attr("rule", rule),
+        ),
+    )
+}
+
+/// A timed trajectory of `(t, position, heading)`, `absolute` or relative to the action's
+/// start.
+fn follow(name: &str, points: &[(f64, [f64; 3], f64)], absolute: bool) -> El {
+    let vertices = points.iter().map(|(t, p, h)| {
+        El::new("Vertex")
+            .num("time", *t)
+            .child(world_position(*p, *h))
+    });
+    El::new("RoutingAction").child(
+        El::new("FollowTrajectoryAction")
+            .child(
+                El::new("TrajectoryRef").child(
+                    El::new("Trajectory")
+                        .attr("name", name)
+                        .attr("closed", "false")
+                        .child(El::new("Shape").child(El::new("Polyline").children(vertices))),
+                ),
+            )
+            .child(
+                El::new("TimeReference").child(
+                    El::new("Timing")
+                        .attr(
+                            "domainAbsoluteRelative",
+                            if absolute { "absolute" } else { "relative" },
+                        )
+                        .num("scale", 1.0)
+                        .num("offset", 0.0),
+                ),
+            )
+            .child(El::new("TrajectoryFollowingMode").attr("followingMode", "position")),
+    )
+}
+
+fn maneuver_group(entity: &str, event: El) -> El {
+    El::new("ManeuverGroup")
+        .attr("maximumExecutionCount", 1)
+        .attr("name", entity)
+        .child(
+            El::new("Actors")
+                .attr("selectTriggeringEntities", "false")
+                .child(El::new("EntityRef").attr("entityRef", entity)),
+        )
+        .child(El::new("Maneuver").attr("name", entity).child(event))
+}
+
+fn event(name: &str, action: El, trigger: El) -> El {
+    El::new("Event")
+        .attr("name", name)
+        .attr("priority", "override")
+        .attr("maximumExecutionCount", 1)
+        .child(
+            El::new("Action")
+                .attr("name", name)
+                .child(El::new("PrivateAction").child(action)),
+        )
+        .child(El::new("StartTrigger").child(trigger))
+}
+
+/// The states every [`VERTEX_EVERY_S`], and the last one.
+fn sampled(states: &[Snapshot]) -> Vec<&Snapshot> {
+    let mut out: Vec<&Snapshot> = Vec::new();
+    for s in states {
+        if out
+            .last()
+            .is_none_or(|l| s.t_s - l.t_s >= VERTEX_EVERY_S - 1e-9)
+        {
+            out.push(s);
+        }
+    }
+    if let (Some(last), Some(end)) = (out.last(), states.last()) {
+        if last.t_s < end.t_s {
+            out.push(end);
+        }
+    }
+    out
+}
+
+/// The document.
+pub fn write(test: &Test<'_>) -> String {
+    let w = test.world;
+    let frames = sampled(test.states);
+    let Some(first) = test.states.first() else {
+        return String::new();
+    };
+    let params = El::new("ParameterDeclarations").children(test.params.iter().map(|(n, v)| {
+        let (kind, value) = match v {
+            serde_json::Value::Number(x) => ("double", x.to_string()),
+            serde_json::Value::String(s) => ("string", s.clone()),
+            other => ("string", other.to_string()),
+        };
+        El::new("ParameterDeclaration")
+            .attr("name", n)
+            .attr("parameterType", kind)
+            .attr("value", value)
+    }));
+    let mut entities = vec![El::new("ScenarioObject")
+        .attr("name", "ego")
+        .child(vehicle("ego", w.ego.vehicle.size))];
+    for (i, c) in w.cars.iter().enumerate() {
+        entities.push(
+            El::new("ScenarioObject")
+                .attr("name", format!("car{}", i + 1))
+                .child(vehicle(&format!("car{} ({})", i + 1, c.color), c.size)),
+        );
+    }
+    for i in 0..w.pedestrians.len() {
+        let name = format!("pedestrian{}", i + 1);
+        entities.push(
+            El::new("ScenarioObject").attr("name", &name).child(
+                El::new("Pedestrian")
+                    .attr("name", &name)
+                    .num("mass", 75.0)
+                    .attr("pedestrianCategory", "pedestrian")
+                    .child(bounding_box(Size::PEDESTRIAN))
+                    .child(El::new("Properties")),
+            ),
+        );
+    }
+    for (i, o) in w.obstacles.iter().enumerate() {
+        let name = format!("obstacle{}", i + 1);
+        entities.push(
+            El::new("ScenarioObject").attr("name", &name).child(
+                El::new("MiscObject")
+                    .attr("name", &name)
+                    .num("mass", 500.0)
+                    .attr("miscObjectCategory", "obstacle")
+                    .child(bounding_box(o.size))
+                    .child(El::new("Properties")),
+            ),
+        );
+    }
+
+    // Init: where everything starts.
+    let mut init = Vec::new();
+    let ego = &first.ego;
+    let mut ego_actions = vec![
+        teleport(ego.pos_m, ego.heading_rad),
+        speed(w.ego.initial_speed_mps),
+    ];
+    if w.ego.route.len() >= 2 {
+        let mut waypoints = vec![w.ego.route[0]];
+        let mut walked = 0.0;
+        for pair in w.ego.route.windows(2) {
+            walked += (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1]);
+            if walked >= WAYPOINT_EVERY_M {
+                waypoints.push(pair[1]);
+                walked = 0.0;
+            }
+        }
+        let last = *w.ego.route.last().expect("two points");
+        if waypoints.last() != Some(&last) {
+            waypoints.push(last);
+        }
+        ego_actions.push(
+            El::new("RoutingAction").child(
+                El::new("AssignRouteAction").child(
+                    El::new("Route")
+                        .attr("name", "ego route")
+                        .attr("closed", "false")
+                        .children(waypoints.iter().map(|q| {
+                            El::new("Waypoint")
+                                .attr("routeStrategy", "shortest")
+                                .child(world_position([q[0], 0.0, q[1]], 0.0))
+                        })),
+                ),
+            ),
+        );
+    }
+    init.push(private("ego", ego_actions));
+    for (i, c) in first.cars.iter().enumerate() {
+        init.push(private(
+            &format!("car{}", i + 1),
+            vec![teleport(c.pos_m, c.heading_rad), speed(c.speed_mps)],
+        ));
+    }
+    for (i, p) in first.pedestrians.iter().enumerate() {
+        let s = &w.pedestrians[i];
+        let h = (-(s.target[2] - s.start[2])).atan2(s.target[0] - s.start[0]);
+        init.push(private(
+            &format!("pedestrian{}", i + 1),
+            vec![teleport(p.pos_m, h)],
+        ));
+    }
+    for (i, o) in first.obstacles.iter().enumerate() {
+        init.push(private(
+            &format!("obstacle{}", i + 1),
+            vec![teleport(o.base_m, o.heading_rad)],
+        ));
+    }
+
+    // The story: cars drive their trajectories; pedestrians walk when the ego comes near.
+    let mut groups = Vec::new();
+    for i in 0..w.cars.len() {
+        let name = format!("car{}", i + 1);
+        let points: Vec<(f64, [f64; 3], f64)> = frames
+            .iter()
+            .filter_map(|s| s.cars.get(i).map(|c| (s.t_s, c.pos_m, c.heading_rad)))
+            .collect();
+        groups.push(maneuver_group(
+            &name,
+            event(
+                &format!("{name} drives"),
+                follow(&format!("{name} as driven"), &points, true),
+                time_condition("start", "none", "greaterOrEqual", 0.0),
+            ),
+        ));
+    }
+    for i in 0..w.pedestrians.len() {
+        let name = format!("pedestrian{}", i + 1);
+        let Some(started) = test
+            .states
+            .iter()
+            .find_map(|s| s.pedestrians.get(i).and_then(|p| p.triggered_at_s))
+        else {
+            continue; // It never walked.
+        };
+        let at = test
+            .states
+            .iter()
+            .find(|s| s.t_s >= started - 1e-9)
+            .unwrap_or(first);
+        let start = w.pedestrians[i].start;
+        let d = (at.ego.pos_m[0] - start[0]).hypot(at.ego.pos_m[2] - start[2]);
+        let target = w.pedestrians[i].target;
+        let h = (-(target[2] - start[2])).atan2(target[0] - start[0]);
+        let walk: Vec<(f64, [f64; 3], f64)> = frames
+            .iter()
+            .filter(|s| s.t_s >= started - 1e-9)
+            .filter_map(|s| s.pedestrians.get(i).map(|p| (s.t_s - started, p.pos_m, h)))
+            .collect();
+        if walk.len() < 2 {
+            continue;
+        }
+        let trigger = condition(
+            &format!("ego within {d:.2} m"),
+            "rising",
+            El::new("ByEntityCondition")
+                .child(
+                    El::new("TriggeringEntities")
+                        .attr("triggeringEntitiesRule", "any")
+                        .child(El::new("EntityRef").attr("entityRef", "ego")),
+                )
+                .child(
+                    El::new("EntityCondition").child(
+                        El::new("DistanceCondition")
+                            .attr("freespace", "false")
+                            .attr("rule", "lessOrEqual")
+                            .num("value", d)
+                            .attr("relativeDistanceType", "euclidianDistance")
+                            .attr("coordinateSystem", "entity")
+                            .child(world_position(start, h)),
+                    ),
+                ),
+        );
+        groups.push(maneuver_group(
+            &name,
+            event(
+                &format!("{name} walks"),
+                follow(&format!("{name} as walked"), &walk, false),
+                trigger,
+            ),
+        ));
+    }
+    if groups.is_empty() {
+        // An act holds at least one group: the ego's, with nothing to do.
+        groups.push(
+            El::new("ManeuverGroup")
+                .attr("maximumExecutionCount", 1)
+                .attr("name", "ego")
+                .child(
+                    El::new("Actors")
+                        .attr("selectTriggeringEntities", "false")
+                        .child(El::new("EntityRef").attr("entityRef", "ego")),
+                ),
+        );
+    }
+    let story = El::new("Story").attr("name", "test").child(
+        El::new("Act")
+            .attr("name", "actors")
+            .children(groups)
+            .child(El::new("StartTrigger").child(time_condition(
+                "start",
+                "none",
+                "greaterOrEqual",
+                0.0,
+            ))),
+    );
+    El::new("OpenSCENARIO")
+        .child(
+            El::new("FileHeader")
+                .attr("revMajor", 1)
+                .attr("revMinor", 2)
+                .attr("date", "1970-01-01T00:00:00")
+                .attr("description", &test.description)
+                .attr("author", "paracosm"),
+        )
+        .child(params)
+        .child(El::new("CatalogLocations"))
+        .child(
+            El::new("RoadNetwork").child(El::new("LogicFile").attr("filepath", &test.network_file)),
+        )
+        .child(El::new("Entities").children(entities))
+        .child(
+            El::new("Storyboard")
+                .child(El::new("Init").child(El::new("Actions").children(init)))
+                .child(story)
+                .child(El::new("StopTrigger").child(time_condition(
+                    "horizon",
+                    "rising",
+                    "greaterThan",
+                    test.horizon_s,
+                ))),
+        )
+        .document()
+}
