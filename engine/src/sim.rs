@@ -155,6 +155,10 @@ impl Simulation {
         }
         let mut physics = PhysicsWorld::new();
         physics.integration_parameters.dt = spec.dt_s as f32;
+        // A test's world holds a few dozen colliders, most of them fixed: rapier's incremental
+        // tree optimizer rebuilt the broad phase's BVH on most steps for no gain (issue 23).
+        physics.broad_phase =
+            BroadPhaseBvh::with_optimization_strategy(BvhOptimizationStrategy::None);
         spec.network.build(&mut physics);
 
         let start = spec.ego.start;
@@ -445,14 +449,17 @@ impl Simulation {
                 self.environment.light,
                 NOMINAL_LIGHT,
                 t,
-                "the light",
+                || "the light".into(),
             )?,
-            number(&self.streams, self.environment.fog, 0.0, t, "the fog")?,
+            number(&self.streams, self.environment.fog, 0.0, t, || {
+                "the fog".into()
+            })?,
         );
         for &(piece, stream) in &self.frictions {
             let mu = self.network.piece(piece).kind.friction();
-            let what = format!("the friction of {}", self.network.piece(piece).name);
-            let mu = number(&self.streams, stream, mu, t, &what)?;
+            let network = &self.network;
+            let what = || format!("the friction of {}", network.piece(piece).name);
+            let mu = number(&self.streams, stream, mu, t, what)?;
             self.surface.set_friction(piece, mu);
         }
         self.ego.apply(control, dt);
@@ -466,8 +473,8 @@ impl Simulation {
             let v = match car.speed_override {
                 Some(v) => v,
                 None => {
-                    let what = format!("the speed of car {i}");
-                    number(&self.streams, car.speed_stream, 0.0, t, &what)?
+                    let what = || format!("the speed of car {i}");
+                    number(&self.streams, car.speed_stream, 0.0, t, what)?
                 }
             };
             match car.lane_change.map(|c| c.start) {
@@ -516,6 +523,13 @@ impl Simulation {
         }
         self.tick += 1;
         let tick = self.tick;
+        if self
+            .sensors
+            .values()
+            .all(|s| !tick.is_multiple_of(s.period_ticks()))
+        {
+            return Ok(());
+        }
         let due: Vec<bool> = self
             .sensors
             .values()
@@ -590,8 +604,8 @@ impl Simulation {
             match decode_sink(*sink) {
                 Action::Walk(i) => {
                     if let Some(p) = self.pedestrians.get_mut(Handle::from_index(i as usize)) {
-                        let what = format!("the speed of pedestrian {i}");
-                        let v = number(&self.streams, p.speed_stream, 0.0, t, &what)?;
+                        let what = || format!("the speed of pedestrian {i}");
+                        let v = number(&self.streams, p.speed_stream, 0.0, t, what)?;
                         p.walk(&mut self.physics, t, dt, v);
                     }
                 }
@@ -789,13 +803,13 @@ fn number(
     id: StreamId,
     default: f64,
     t_s: f64,
-    what: &str,
+    what: impl FnOnce() -> String,
 ) -> Result<f64, EngineError> {
     match rt.current(id) {
         None => Ok(default),
         Some(Value::Num(x)) if x.is_finite() => Ok(*x),
         Some(v) => Err(crate::rx::RxError::Input {
-            name: what.to_owned(),
+            name: what(),
             t_s,
             value: crate::rx::describe(v),
             expected: "a finite number".into(),

@@ -2,10 +2,17 @@
 //! monitors), written three ways: the Rust reference, `pedestrian_crossing.star` (native
 //! trigger), and the same program with its trigger as a Starlark lambda called every step.
 //! Issue 5 asks that per-step lambdas cost at most 2× the Rust version.
+//!
+//! `rapier_alone/lidar` is the same test's physics and lidar written with rapier only
+//! (`engine/benches/rapier_alone.rs`): issue 23 asks that a whole test (`safe_15s/star`) cost
+//! at most 1.2× that, measured in this one run.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use paracosm_generators::Point;
 use paracosm_scenarios::{builtin, lang, reference, Scenario};
+
+#[path = "../../engine/benches/rapier_alone.rs"]
+mod rapier_alone;
 
 fn bench(c: &mut Criterion) {
     let lambdas = lang::load_source(
@@ -40,6 +47,9 @@ fn bench(c: &mut Criterion) {
             });
         }
     }
+    group.bench_function("rapier_alone/lidar", |b| {
+        b.iter(|| rapier_alone::run_test(0.975, 54.5, true))
+    });
     group.finish();
 }
 

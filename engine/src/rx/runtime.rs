@@ -103,6 +103,11 @@ impl Runtime {
     ) -> Result<(), RxError> {
         for k in 0..self.graph.order().len() {
             let i = self.graph.order()[k];
+            // A constant emits the same value every step: keep the one it holds.
+            if let (Node::Const(_), Some(_)) = (&self.graph.nodes()[i], &self.states[i].value) {
+                self.states[i].fired = !self.states[i].done;
+                continue;
+            }
             let out = self.eval(i, t_s, inputs, host, sinks)?;
             let s = &mut self.states[i];
             s.fired = out.is_some();

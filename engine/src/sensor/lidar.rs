@@ -86,36 +86,149 @@ impl LidarSpec {
         Ok(())
     }
 
+    /// Beam directions in the vehicle frame (`x` forward, `y` up, `z` right), unit vectors in
+    /// the order of [`LidarSpec::directions`]; a positive (left) azimuth is `-z`.
+    pub(crate) fn local_directions(directions: &[(f64, f64)]) -> Vec<Vector> {
+        directions
+            .iter()
+            .map(|&(az, el)| {
+                Vector::new(
+                    (el.cos() * az.cos()) as f32,
+                    el.sin() as f32,
+                    -(el.cos() * az.sin()) as f32,
+                )
+            })
+            .collect()
+    }
+
     /// Casts every beam from the mount of the chassis at `chassis` (pose), ignoring the
-    /// vehicle's own body, out to `range_m` metres (the spec's range, or less in fog). Sees fixed geometry and actors, including sensor colliders
-    /// (pedestrians).
+    /// vehicle's own body, out to `range_m` metres (the spec's range, or less in fog). Sees
+    /// fixed geometry and actors, including sensor colliders (pedestrians).
+    ///
+    /// Each return is the one rapier's query pipeline gives
+    /// (`QueryPipeline::cast_ray(ray, range, solid = true)`): the nearest hit, strictly within
+    /// the range, of any collider but the ego's. The colliders are culled first, with no effect
+    /// on the result (issue 23): one that lies out of range, or off the plane of a horizontal
+    /// channel, is skipped for the scan; a beam then casts only at the colliders within its
+    /// azimuth's reach whose bounding box (widened by 1 cm) it crosses, and a beam that no
+    /// collider can reach is not cast. `beams` must come from one world's scans: it caches
+    /// the boxes of that world's fixed colliders.
     pub(crate) fn scan(
         &self,
         physics: &PhysicsWorld,
         chassis: &Pose,
         own_body: RigidBodyHandle,
-        directions: &[(f64, f64)],
+        beams: &mut Beams,
         range_m: f64,
         out: &mut Vec<LidarReturn>,
     ) {
+        let fixed_boxes = &mut beams.fixed_boxes;
         out.clear();
-        let filter = QueryFilter::default().exclude_rigid_body(own_body);
-        let queries = physics.query_pipeline_with_filter(filter);
         let mount_local = Vector::new(
             self.mount_m[0] as f32,
             self.mount_m[1] as f32,
             self.mount_m[2] as f32,
         );
         let origin = chassis.transform_point(mount_local);
-        for &(az, el) in directions {
-            // Vehicle frame: x forward, y up, z right, so a positive (left) azimuth is -z.
-            let local = Vector::new(
-                (el.cos() * az.cos()) as f32,
-                el.sin() as f32,
-                -(el.cos() * az.sin()) as f32,
-            );
-            let ray = Ray::new(origin, chassis.rotation * local);
-            if let Some((_, toi)) = queries.cast_ray(&ray, range_m as f32, true) {
+        let max_toi = range_m as f32;
+        // Every collider the query pipeline's filter would keep, with its world bounding box,
+        // unless it lies beyond the range.
+        let mut scratch: Vec<Candidate<'_>> = Vec::with_capacity(physics.colliders.len());
+        let to_chassis = chassis.rotation.inverse();
+        // A beam of azimuth `az` and elevation `el` (|el| < π/2) meets only points whose
+        // azimuth about the mount, in the chassis frame, is `az`: a box is seen by the beams
+        // whose azimuth lies within its angular half-width of its centre's.
+        let by_azimuth = beams
+            .directions
+            .iter()
+            .all(|&(_, el)| el.abs() < std::f64::consts::FRAC_PI_2 - 1e-3);
+        for (handle, co) in physics.colliders.iter() {
+            if co.parent() == Some(own_body) {
+                continue;
+            }
+            // A collider with no body is fixed: its box is computed once per test.
+            let (mins, maxs) = match co.parent() {
+                None => {
+                    let index = handle.into_raw_parts().0 as usize;
+                    if fixed_boxes.len() <= index {
+                        fixed_boxes.resize(index + 1, None);
+                    }
+                    *fixed_boxes[index].get_or_insert_with(|| widened_box(co))
+                }
+                Some(_) => widened_box(co),
+            };
+            let nearest = origin.clamp(mins, maxs);
+            if (nearest - origin).length() > max_toi {
+                continue;
+            }
+            // Every hit within range lies in the cube of half side `max_toi` round the
+            // origin: clipping the box to it lets the plane test skip a ground that only
+            // meets the channel's plane out of range.
+            let reach = Vector::splat(max_toi);
+            let (mins, maxs) = (mins.max(origin - reach), maxs.min(origin + reach));
+            let mut arcs = [(-f64::INFINITY, f64::INFINITY), EMPTY_ARC, EMPTY_ARC];
+            if by_azimuth {
+                let centre = to_chassis * ((mins + maxs) * 0.5 - origin);
+                let radius = f64::from((maxs - mins).length() * 0.5);
+                let across = f64::from(centre.x).hypot(f64::from(centre.z));
+                if across > radius {
+                    let az = f64::from(-centre.z).atan2(f64::from(centre.x));
+                    let half = (radius / across).asin() + AZIMUTH_MARGIN_RAD;
+                    let tau = std::f64::consts::TAU;
+                    arcs = [
+                        (az - half, az + half),
+                        (az - half - tau, az + half - tau),
+                        (az - half + tau, az + half + tau),
+                    ];
+                }
+            }
+            scratch.push(Candidate {
+                mins,
+                maxs,
+                collider: co,
+                in_plane: true,
+                arcs,
+            });
+        }
+        let mut channel_el = f64::NAN;
+        for (&(az, el), &local) in beams.directions.iter().zip(&beams.local) {
+            if el != channel_el {
+                // A horizontal channel's beams span the chassis's x–z plane through the
+                // mount; a box that this plane misses is missed by every beam of the channel.
+                channel_el = el;
+                let normal = chassis.rotation * Vector::Y;
+                for c in scratch.iter_mut() {
+                    c.in_plane = el != 0.0 || {
+                        let centre = (c.mins + c.maxs) * 0.5;
+                        let half = (c.maxs - c.mins) * 0.5;
+                        normal.dot(centre - origin).abs() <= normal.abs().dot(half)
+                    };
+                }
+            }
+            let seen = |c: &&Candidate<'_>| {
+                c.in_plane && c.arcs.iter().any(|&(lo, hi)| lo <= az && az <= hi)
+            };
+            if !scratch.iter().any(|c| seen(&c)) {
+                continue;
+            }
+            let dir = chassis.rotation * local;
+            let ray = Ray::new(origin, dir);
+            let inv = dir.recip();
+            let mut best: Option<f32> = None;
+            for c in scratch.iter().filter(seen) {
+                let limit = best.unwrap_or(max_toi);
+                if !ray_meets_box(origin, dir, inv, c.mins, c.maxs, limit) {
+                    continue;
+                }
+                if let Some(toi) =
+                    c.collider
+                        .shape()
+                        .cast_ray(c.collider.position(), &ray, limit, true)
+                {
+                    best = Some(toi);
+                }
+            }
+            if let Some(toi) = best.filter(|&toi| toi < max_toi) {
                 let p = mount_local + local * toi;
                 out.push(LidarReturn {
                     azimuth_rad: az,
@@ -128,11 +241,99 @@ impl LidarSpec {
     }
 }
 
+/// A lidar's beams, computed once: `(azimuth, elevation)` in rad ([`LidarSpec::directions`])
+/// and the matching unit vectors in the vehicle frame ([`LidarSpec::local_directions`]); and
+/// the widened bounding boxes of the fixed colliders (the road) of the world it scans, by
+/// collider index, computed on first use.
+pub(crate) struct Beams {
+    pub(crate) directions: Vec<(f64, f64)>,
+    pub(crate) local: Vec<Vector>,
+    fixed_boxes: Vec<Option<(Vector, Vector)>>,
+}
+
+impl Beams {
+    /// The beams of `spec`.
+    pub(crate) fn of(spec: &LidarSpec) -> Self {
+        let directions = spec.directions();
+        Beams {
+            local: LidarSpec::local_directions(&directions),
+            directions,
+            fixed_boxes: Vec::new(),
+        }
+    }
+}
+
+/// How far a collider's bounding box is widened before culling beams against it, in metres:
+/// far more than the rounding of a ray–box test, so culling never drops a hit.
+const CULL_MARGIN_M: f32 = 0.01;
+
+/// A collider a scan may see, with its widened world bounding box (metres).
+pub(crate) struct Candidate<'a> {
+    mins: Vector,
+    maxs: Vector,
+    collider: &'a Collider,
+    /// Whether the current channel's beams can reach the box.
+    in_plane: bool,
+    /// The beam azimuths (rad, chassis frame) that can reach the box: up to three intervals,
+    /// the second and third being the first shifted by ∓2π.
+    arcs: [(f64, f64); 3],
+}
+
+/// A collider's world bounding box widened by [`CULL_MARGIN_M`]: `(mins, maxs)` in metres.
+fn widened_box(co: &Collider) -> (Vector, Vector) {
+    let aabb = co.compute_aabb();
+    let margin = Vector::splat(CULL_MARGIN_M);
+    (aabb.mins - margin, aabb.maxs + margin)
+}
+
+/// An empty azimuth interval.
+const EMPTY_ARC: (f64, f64) = (1.0, 0.0);
+
+/// Slack added to a box's angular half-width, in rad: far more than the rounding of the
+/// chassis rotation in `f32`, so culling by azimuth never drops a hit.
+const AZIMUTH_MARGIN_RAD: f64 = 1e-3;
+
+/// Whether the ray from `origin` along `dir` (with `inv` its componentwise inverse) meets the
+/// box `[mins, maxs]` at a distance in `[0, limit]` (the slab test of Kay and Kajiya, 1986).
+/// An axis the ray runs parallel to is checked by position alone, so no infinity or NaN
+/// enters the test.
+fn ray_meets_box(
+    origin: Vector,
+    dir: Vector,
+    inv: Vector,
+    mins: Vector,
+    maxs: Vector,
+    limit: f32,
+) -> bool {
+    let (mut near, mut far) = (0.0f32, limit);
+    for axis in 0..3 {
+        let o = origin[axis];
+        if dir[axis] == 0.0 {
+            if o < mins[axis] || o > maxs[axis] {
+                return false;
+            }
+            continue;
+        }
+        let (t1, t2) = ((mins[axis] - o) * inv[axis], (maxs[axis] - o) * inv[axis]);
+        let (enter, exit) = if t1 <= t2 { (t1, t2) } else { (t2, t1) };
+        if enter > near {
+            near = enter;
+        }
+        if exit < far {
+            far = exit;
+        }
+        if near > far {
+            return false;
+        }
+    }
+    true
+}
+
 /// The lidar as a [`crate::sensor::Sensor`]: scans at its rate, its range capped by the fog's
 /// visibility ([`crate::visibility_m`]); light does not affect it.
 pub(crate) struct Lidar {
     spec: LidarSpec,
-    directions: Vec<(f64, f64)>,
+    beams: Beams,
     period: u64,
     scan: Vec<LidarReturn>,
 }
@@ -141,7 +342,7 @@ impl Lidar {
     /// A lidar of `spec` on a simulation stepping `dt_s` seconds.
     pub(crate) fn new(spec: &LidarSpec, dt_s: f64) -> Self {
         Lidar {
-            directions: spec.directions(),
+            beams: Beams::of(spec),
             period: ((1.0 / (spec.rate_hz * dt_s)).round() as u64).max(1),
             spec: spec.clone(),
             scan: Vec::new(),
@@ -165,7 +366,7 @@ impl crate::sensor::Sensor for Lidar {
             scene.physics,
             &pose,
             scene.ego_body,
-            &self.directions,
+            &mut self.beams,
             range_m,
             &mut self.scan,
         );
@@ -180,6 +381,136 @@ impl crate::sensor::Sensor for Lidar {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The plain scan issue 23 replaced: every beam through rapier's query pipeline.
+    fn reference_scan(
+        spec: &LidarSpec,
+        physics: &PhysicsWorld,
+        chassis: &Pose,
+        own: RigidBodyHandle,
+        range_m: f64,
+    ) -> Vec<LidarReturn> {
+        let queries =
+            physics.query_pipeline_with_filter(QueryFilter::default().exclude_rigid_body(own));
+        let mount = Vector::new(
+            spec.mount_m[0] as f32,
+            spec.mount_m[1] as f32,
+            spec.mount_m[2] as f32,
+        );
+        let origin = chassis.transform_point(mount);
+        let directions = spec.directions();
+        let beams = LidarSpec::local_directions(&directions);
+        let mut out = Vec::new();
+        for (&(az, el), &local) in directions.iter().zip(&beams) {
+            let ray = Ray::new(origin, chassis.rotation * local);
+            if let Some((_, toi)) = queries.cast_ray(&ray, range_m as f32, true) {
+                let p = mount + local * toi;
+                out.push(LidarReturn {
+                    azimuth_rad: az,
+                    elevation_rad: el,
+                    range_m: f64::from(toi),
+                    point_m: [f64::from(p.x), f64::from(p.y), f64::from(p.z)],
+                });
+            }
+        }
+        out
+    }
+
+    /// The culled scan returns exactly what the query pipeline returns, beam for beam, bit for
+    /// bit: random worlds of boxes, capsules, cylinders, balls and convex hulls round a
+    /// chassis pitched, rolled and turned at random, for a planar lidar, a 3-channel one and
+    /// a 360° one (azimuths wrapping round ±π).
+    #[test]
+    fn culling_changes_no_return() {
+        use rand::{Rng, SeedableRng};
+        let specs = [
+            LidarSpec::default(),
+            LidarSpec {
+                channels: 3,
+                beams: 31,
+                vertical_fov_rad: 0.4,
+                ..LidarSpec::default()
+            },
+            LidarSpec {
+                beams: 90,
+                horizontal_fov_rad: std::f64::consts::TAU,
+                range_m: 25.0,
+                ..LidarSpec::default()
+            },
+        ];
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
+        let (mut returns, mut cases) = (0, 0);
+        for world in 0..60 {
+            let mut physics = PhysicsWorld::new();
+            // Ground and road slabs, as the network builds them.
+            physics.insert_collider(
+                ColliderBuilder::cuboid(150.0, 0.5, 60.0).translation(Vector::new(0.0, -0.52, 0.0)),
+                None,
+            );
+            physics.insert_collider(
+                ColliderBuilder::cuboid(100.0, 0.1, 3.5).translation(Vector::new(0.0, -0.1, 0.0)),
+                None,
+            );
+            let mut coord = |r: f32| rng.random_range(-r..r);
+            for _ in 0..12 {
+                let at = Vector::new(coord(40.0), coord(1.5) + 0.5, coord(15.0));
+                let rot =
+                    Rotation::from_rotation_y(coord(3.0)) * Rotation::from_rotation_x(coord(0.3));
+                let builder = match world % 5 {
+                    0 => ColliderBuilder::cuboid(1.0 + coord(0.8), 0.8, 2.0 + coord(1.5)),
+                    1 => ColliderBuilder::capsule_y(0.6, 0.3),
+                    2 => ColliderBuilder::cylinder(0.4, 3.0),
+                    3 => ColliderBuilder::ball(0.7),
+                    _ => ColliderBuilder::convex_hull(&[
+                        Vector::new(0.0, 0.0, 0.0),
+                        Vector::new(2.0, 0.0, 0.3),
+                        Vector::new(0.4, 1.5, 0.0),
+                        Vector::new(0.3, 0.2, 1.8),
+                    ])
+                    .unwrap(),
+                };
+                // Half the actors move (kinematic bodies), half are fixed.
+                if coord(1.0) > 0.0 {
+                    let body = physics.bodies.insert(
+                        RigidBodyBuilder::kinematic_position_based()
+                            .pose(Pose::from_parts(at, rot)),
+                    );
+                    physics.insert_collider(builder, Some(body));
+                } else {
+                    physics.insert_collider(builder.position(Pose::from_parts(at, rot)), None);
+                }
+            }
+            let chassis_pose = Pose::from_parts(
+                Vector::new(coord(5.0), 0.9 + coord(0.3), coord(2.0)),
+                Rotation::from_rotation_y(coord(3.2))
+                    * Rotation::from_rotation_z(coord(0.05))
+                    * Rotation::from_rotation_x(coord(0.05)),
+            );
+            let own = physics
+                .bodies
+                .insert(RigidBodyBuilder::kinematic_position_based().pose(chassis_pose));
+            physics.insert_collider(ColliderBuilder::cuboid(2.25, 0.5, 0.9), Some(own));
+            physics.step();
+            let chassis = *physics.bodies[own].position();
+            for spec in &specs {
+                let mut fast = Vec::new();
+                spec.scan(
+                    &physics,
+                    &chassis,
+                    own,
+                    &mut Beams::of(spec),
+                    spec.range_m,
+                    &mut fast,
+                );
+                let plain = reference_scan(spec, &physics, &chassis, own, spec.range_m);
+                assert_eq!(fast, plain, "world {world}");
+                returns += plain.len();
+                cases += 1;
+            }
+        }
+        // The worlds are not empty: many beams hit something.
+        assert!(returns > 20 * cases, "{returns} returns in {cases} scans");
+    }
 
     #[test]
     fn directions_span_the_field_of_view() {

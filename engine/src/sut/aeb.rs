@@ -64,6 +64,10 @@ pub struct Aeb {
     line: Option<(f64, f64, f64)>,
     /// Index of the route vertex reached so far.
     progress: usize,
+    /// [`curvature`] of the route being followed, and that route's address (cleared by
+    /// `reset`).
+    curves: Vec<(f64, f64)>,
+    curves_of: usize,
 }
 
 impl Aeb {
@@ -73,6 +77,8 @@ impl Aeb {
             config,
             line: None,
             progress: 0,
+            curves: Vec::new(),
+            curves_of: 0,
         }
     }
 
@@ -102,6 +108,7 @@ impl Sut for Aeb {
     fn reset(&mut self, _seed: u64) -> Result<(), SutError> {
         self.line = None;
         self.progress = 0;
+        self.curves.clear();
         Ok(())
     }
 
@@ -173,18 +180,16 @@ impl Aeb {
         let mut speed = c.cruise.target_speed_mps;
         let mut ahead = 0.0;
         let horizon = v * v / (2.0 * c.curve_decel_mps2) + 20.0;
-        let pts = &route[self.progress..];
-        for i in 1..pts.len().saturating_sub(1) {
-            let (a, b, d) = (pts[i - 1], pts[i], pts[i + 1]);
-            let l1 = (b[0] - a[0]).hypot(b[1] - a[1]);
-            let l2 = (d[0] - b[0]).hypot(d[1] - b[1]);
+        if self.curves.len() != route.len() || self.curves_of != route.as_ptr() as usize {
+            self.curves = curvature(route);
+            self.curves_of = route.as_ptr() as usize;
+        }
+        let pts = &self.curves[self.progress..];
+        for &(l1, kappa) in pts.iter().skip(1).take(pts.len().saturating_sub(2)) {
             ahead += l1;
             if ahead > horizon {
                 break;
             }
-            let turn =
-                wrap((-(d[1] - b[1])).atan2(d[0] - b[0]) - (-(b[1] - a[1])).atan2(b[0] - a[0]));
-            let kappa = turn.abs() / ((l1 + l2) / 2.0).max(1e-6);
             if kappa > 1e-4 {
                 let v_curve = (c.lateral_accel_mps2 / kappa).sqrt();
                 speed = speed.min((v_curve * v_curve + 2.0 * c.curve_decel_mps2 * ahead).sqrt());
@@ -192,6 +197,21 @@ impl Aeb {
         }
         (steer, speed)
     }
+}
+
+/// For each point `i` of `route` with neighbours on both sides: the length of the leg into it
+/// (m) and the curvature there (1/m), the turn between its legs over their mean length;
+/// `(0, 0)` at the ends. Computed once per route, since `act` reads it every step.
+fn curvature(route: &[[f64; 2]]) -> Vec<(f64, f64)> {
+    let mut out = vec![(0.0, 0.0); route.len()];
+    for i in 1..route.len().saturating_sub(1) {
+        let (a, b, d) = (route[i - 1], route[i], route[i + 1]);
+        let l1 = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let l2 = (d[0] - b[0]).hypot(d[1] - b[1]);
+        let turn = wrap((-(d[1] - b[1])).atan2(d[0] - b[0]) - (-(b[1] - a[1])).atan2(b[0] - a[0]));
+        out[i] = (l1, turn.abs() / ((l1 + l2) / 2.0).max(1e-6));
+    }
+    out
 }
 
 fn wrap(a: f64) -> f64 {
