@@ -714,19 +714,36 @@ impl Simulation {
             .map(|p| p.collider)
             .chain(self.cars.values().filter_map(|c| c.body.map(|(_, c)| c)))
             .chain(self.obstacles.values().map(|o| o.collider));
-        let min_sep = colliders
-            .filter_map(|handle| {
-                let c = &self.physics.colliders[handle];
-                rapier3d::parry::query::distance(
-                    chassis.position(),
-                    chassis.shape(),
-                    c.position(),
-                    c.shape(),
-                )
-                .ok()
-                .map(|d| f64::from(d.distance))
+        // The exact distance (GJK) to the nearest actor. The distance between bounding boxes
+        // is a lower bound, so an actor whose bound is no smaller than the best distance found
+        // cannot change the minimum, and is skipped; nearest bounds are tried first.
+        let chassis_box = chassis.compute_aabb();
+        let mut by_bound: Vec<(f32, ColliderHandle)> = colliders
+            .map(|handle| {
+                let b = self.physics.colliders[handle].compute_aabb();
+                let gap = (b.mins - chassis_box.maxs)
+                    .max(chassis_box.mins - b.maxs)
+                    .max(Vector::ZERO);
+                (gap.length(), handle)
             })
-            .fold(f64::INFINITY, f64::min);
+            .collect();
+        by_bound.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut min_sep = f64::INFINITY;
+        for (bound, handle) in by_bound {
+            // 1 mm of slack covers the rounding of both computations.
+            if f64::from(bound) - 1e-3 >= min_sep {
+                break;
+            }
+            let c = &self.physics.colliders[handle];
+            if let Ok(d) = rapier3d::parry::query::distance(
+                chassis.position(),
+                chassis.shape(),
+                c.position(),
+                c.shape(),
+            ) {
+                min_sep = min_sep.min(f64::from(d.distance));
+            }
+        }
         let ego = self.ego_state();
         let centre = [ego.pos_m[0], ego.pos_m[2]];
         let edge = self.surface.edge_distance_m(centre);

@@ -108,11 +108,12 @@ impl LidarSpec {
     /// Each return is the one rapier's query pipeline gives
     /// (`QueryPipeline::cast_ray(ray, range, solid = true)`): the nearest hit, strictly within
     /// the range, of any collider but the ego's. The colliders are culled first, with no effect
-    /// on the result (issue 23): one that lies out of range, or off the plane of a horizontal
-    /// channel, is skipped for the scan; a beam then casts only at the colliders within its
+    /// on the result (issue 23): one that lies out of range, off the plane of a horizontal
+    /// channel, or outside the field of view, is skipped for the scan; a beam then casts only at the colliders within its
     /// azimuth's reach whose bounding box (widened by 1 cm) it crosses, and a beam that no
-    /// collider can reach is not cast. `beams` must come from one world's scans: it caches
-    /// the boxes of that world's fixed colliders.
+    /// collider can reach is not cast. `beams` must come from one world's scans: it keeps
+    /// that world's colliders sorted into fixed and moving, with the fixed ones' boxes, and
+    /// sorts them again when the number of colliders changes.
     pub(crate) fn scan(
         &self,
         physics: &PhysicsWorld,
@@ -122,7 +123,6 @@ impl LidarSpec {
         range_m: f64,
         out: &mut Vec<LidarReturn>,
     ) {
-        let fixed_boxes = &mut beams.fixed_boxes;
         out.clear();
         let mount_local = Vector::new(
             self.mount_m[0] as f32,
@@ -133,7 +133,7 @@ impl LidarSpec {
         let max_toi = range_m as f32;
         // Every collider the query pipeline's filter would keep, with its world bounding box,
         // unless it lies beyond the range.
-        let mut scratch: Vec<Candidate<'_>> = Vec::with_capacity(physics.colliders.len());
+        let mut scratch: Vec<Candidate<'_>> = Vec::new();
         let to_chassis = chassis.rotation.inverse();
         // A beam of azimuth `az` and elevation `el` (|el| < π/2) meets only points whose
         // azimuth about the mount, in the chassis frame, is `az`: a box is seen by the beams
@@ -142,21 +142,26 @@ impl LidarSpec {
             .directions
             .iter()
             .all(|&(_, el)| el.abs() < std::f64::consts::FRAC_PI_2 - 1e-3);
-        for (handle, co) in physics.colliders.iter() {
-            if co.parent() == Some(own_body) {
-                continue;
-            }
-            // A collider with no body is fixed: its box is computed once per test.
-            let (mins, maxs) = match co.parent() {
-                None => {
-                    let index = handle.into_raw_parts().0 as usize;
-                    if fixed_boxes.len() <= index {
-                        fixed_boxes.resize(index + 1, None);
-                    }
-                    *fixed_boxes[index].get_or_insert_with(|| widened_box(co))
-                }
-                Some(_) => widened_box(co),
-            };
+        // The beams' azimuths span [first, last] (rad).
+        let fov = beams
+            .directions
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &(az, _)| {
+                (lo.min(az), hi.max(az))
+            });
+        // With one horizontal channel, the channel's plane test can drop a box at once.
+        let planar = beams.directions.iter().all(|&(_, el)| el == 0.0);
+        let normal = chassis.rotation * Vector::Y;
+        if beams.known_colliders != Some(physics.colliders.len()) {
+            beams.gather(physics, own_body);
+        }
+        let fixed = beams.fixed.iter().map(|&(h, mins, maxs)| (h, mins, maxs));
+        let moving = beams.moving.iter().filter_map(|&h| {
+            let co = physics.colliders.get(h)?;
+            let (mins, maxs) = widened_box(co);
+            Some((h, mins, maxs))
+        });
+        for (handle, mins, maxs) in fixed.chain(moving) {
             let nearest = origin.clamp(mins, maxs);
             if (nearest - origin).length() > max_toi {
                 continue;
@@ -166,6 +171,9 @@ impl LidarSpec {
             // meets the channel's plane out of range.
             let reach = Vector::splat(max_toi);
             let (mins, maxs) = (mins.max(origin - reach), maxs.min(origin + reach));
+            if planar && !meets_plane(normal, origin, mins, maxs) {
+                continue;
+            }
             let mut arcs = [(-f64::INFINITY, f64::INFINITY), EMPTY_ARC, EMPTY_ARC];
             if by_azimuth {
                 let centre = to_chassis * ((mins + maxs) * 0.5 - origin);
@@ -182,10 +190,14 @@ impl LidarSpec {
                     ];
                 }
             }
+            // A box outside the field of view is seen by no beam.
+            if !arcs.iter().any(|&(lo, hi)| lo <= fov.1 && fov.0 <= hi) {
+                continue;
+            }
             scratch.push(Candidate {
                 mins,
                 maxs,
-                collider: co,
+                collider: &physics.colliders[handle],
                 in_plane: true,
                 arcs,
             });
@@ -196,13 +208,8 @@ impl LidarSpec {
                 // A horizontal channel's beams span the chassis's x–z plane through the
                 // mount; a box that this plane misses is missed by every beam of the channel.
                 channel_el = el;
-                let normal = chassis.rotation * Vector::Y;
                 for c in scratch.iter_mut() {
-                    c.in_plane = el != 0.0 || {
-                        let centre = (c.mins + c.maxs) * 0.5;
-                        let half = (c.maxs - c.mins) * 0.5;
-                        normal.dot(centre - origin).abs() <= normal.abs().dot(half)
-                    };
+                    c.in_plane = el != 0.0 || meets_plane(normal, origin, c.mins, c.maxs);
                 }
             }
             let seen = |c: &&Candidate<'_>| {
@@ -248,7 +255,12 @@ impl LidarSpec {
 pub(crate) struct Beams {
     pub(crate) directions: Vec<(f64, f64)>,
     pub(crate) local: Vec<Vector>,
-    fixed_boxes: Vec<Option<(Vector, Vector)>>,
+    /// The fixed colliders (no body: the road) with their widened boxes.
+    fixed: Vec<(ColliderHandle, Vector, Vector)>,
+    /// The colliders on bodies other than the ego's (actors), boxes computed per scan.
+    moving: Vec<ColliderHandle>,
+    /// How many colliders the world had when `fixed` and `moving` were gathered.
+    known_colliders: Option<usize>,
 }
 
 impl Beams {
@@ -258,8 +270,27 @@ impl Beams {
         Beams {
             local: LidarSpec::local_directions(&directions),
             directions,
-            fixed_boxes: Vec::new(),
+            fixed: Vec::new(),
+            moving: Vec::new(),
+            known_colliders: None,
         }
+    }
+
+    /// Sorts the colliders a scan may see, all but those of `own_body`, into fixed and moving.
+    fn gather(&mut self, physics: &PhysicsWorld, own_body: RigidBodyHandle) {
+        self.fixed.clear();
+        self.moving.clear();
+        for (handle, co) in physics.colliders.iter() {
+            match co.parent() {
+                None => {
+                    let (mins, maxs) = widened_box(co);
+                    self.fixed.push((handle, mins, maxs));
+                }
+                Some(body) if body != own_body => self.moving.push(handle),
+                Some(_) => {}
+            }
+        }
+        self.known_colliders = Some(physics.colliders.len());
     }
 }
 
@@ -277,6 +308,14 @@ pub(crate) struct Candidate<'a> {
     /// The beam azimuths (rad, chassis frame) that can reach the box: up to three intervals,
     /// the second and third being the first shifted by ∓2π.
     arcs: [(f64, f64); 3],
+}
+
+/// Whether the plane through `origin` with normal `normal` meets the box `[mins, maxs]`: the
+/// centre's distance to the plane is within the box's half extent along the normal.
+fn meets_plane(normal: Vector, origin: Vector, mins: Vector, maxs: Vector) -> bool {
+    let centre = (mins + maxs) * 0.5;
+    let half = (maxs - mins) * 0.5;
+    normal.dot(centre - origin).abs() <= normal.abs().dot(half)
 }
 
 /// A collider's world bounding box widened by [`CULL_MARGIN_M`]: `(mins, maxs)` in metres.
@@ -491,21 +530,29 @@ mod tests {
                 .insert(RigidBodyBuilder::kinematic_position_based().pose(chassis_pose));
             physics.insert_collider(ColliderBuilder::cuboid(2.25, 0.5, 0.9), Some(own));
             physics.step();
-            let chassis = *physics.bodies[own].position();
-            for spec in &specs {
-                let mut fast = Vec::new();
-                spec.scan(
-                    &physics,
-                    &chassis,
-                    own,
-                    &mut Beams::of(spec),
-                    spec.range_m,
-                    &mut fast,
-                );
-                let plain = reference_scan(spec, &physics, &chassis, own, spec.range_m);
-                assert_eq!(fast, plain, "world {world}");
-                returns += plain.len();
-                cases += 1;
+            let mut beams: Vec<Beams> = specs.iter().map(Beams::of).collect();
+            // Two scans per lidar, the actors moved between them: the second reuses the
+            // fixed colliders' boxes gathered by the first.
+            for scan in 0..2 {
+                if scan == 1 {
+                    let shift = Vector::new(coord(3.0), 0.0, coord(3.0));
+                    for (h, body) in physics.bodies.iter_mut() {
+                        if h != own && body.is_kinematic() {
+                            let to = body.translation() + shift;
+                            body.set_next_kinematic_translation(to);
+                        }
+                    }
+                    physics.step();
+                }
+                let chassis = *physics.bodies[own].position();
+                for (spec, beams) in specs.iter().zip(&mut beams) {
+                    let mut fast = Vec::new();
+                    spec.scan(&physics, &chassis, own, beams, spec.range_m, &mut fast);
+                    let plain = reference_scan(spec, &physics, &chassis, own, spec.range_m);
+                    assert_eq!(fast, plain, "world {world}, scan {scan}");
+                    returns += plain.len();
+                    cases += 1;
+                }
             }
         }
         // The worlds are not empty: many beams hit something.
