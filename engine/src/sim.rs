@@ -728,10 +728,13 @@ impl Simulation {
             })
             .collect();
         by_bound.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let far = chassis.position().translation.abs().max_element();
+        let slack = 1e-3 + 8.0 * f64::from(f32::EPSILON) * f64::from(far.max(1.0));
         let mut min_sep = f64::INFINITY;
         for (bound, handle) in by_bound {
-            // 1 mm of slack covers the rounding of both computations.
-            if f64::from(bound) - 1e-3 >= min_sep {
+            // 1 mm of slack, plus the f32 rounding of coordinates this far from the origin,
+            // covers the rounding of both computations.
+            if f64::from(bound) - slack >= min_sep {
                 break;
             }
             let c = &self.physics.colliders[handle];

@@ -16,7 +16,7 @@ pub struct LidarSpec {
     pub beams: u32,
     /// Horizontal field of view in rad, in `(0, 2π]`. Default 60° (1.047 rad).
     pub horizontal_fov_rad: f64,
-    /// Vertical field of view in rad, `>= 0`. Default 0 (one horizontal plane).
+    /// Vertical field of view in rad, in `[0, π]`. Default 0 (one horizontal plane).
     pub vertical_fov_rad: f64,
     /// Maximum range in metres, `> 0`. Default 60 m.
     pub range_m: f64,
@@ -83,6 +83,20 @@ impl LidarSpec {
         if !ok(self.range_m) || !ok(self.rate_hz) || !ok(self.horizontal_fov_rad) {
             return Err("lidar range, rate and horizontal field of view must be positive".into());
         }
+        if self.horizontal_fov_rad > std::f64::consts::TAU {
+            return Err(format!(
+                "lidar horizontal field of view {} rad is more than a full turn (2π)",
+                self.horizontal_fov_rad
+            ));
+        }
+        if !(self.vertical_fov_rad.is_finite()
+            && (0.0..=std::f64::consts::PI).contains(&self.vertical_fov_rad))
+        {
+            return Err(format!(
+                "lidar vertical field of view {} rad is not in [0, π]",
+                self.vertical_fov_rad
+            ));
+        }
         Ok(())
     }
 
@@ -105,15 +119,18 @@ impl LidarSpec {
     /// vehicle's own body, out to `range_m` metres (the spec's range, or less in fog). Sees
     /// fixed geometry and actors, including sensor colliders (pedestrians).
     ///
-    /// Each return is the one rapier's query pipeline gives
+    /// Each return is the one rapier's query pipeline gives (bit for bit for boxes, balls,
+    /// capsules, cylinders and convex hulls; on a map's triangle mesh, a hit where the mesh
+    /// meets another surface exactly may differ in the last bit of its range)
     /// (`QueryPipeline::cast_ray(ray, range, solid = true)`): the nearest hit, strictly within
     /// the range, of any collider but the ego's. The colliders are culled first, with no effect
     /// on the result (issue 23): one that lies out of range, off the plane of a horizontal
     /// channel, or outside the field of view, is skipped for the scan; a beam then casts only at the colliders within its
     /// azimuth's reach whose bounding box (widened by 1 cm) it crosses, and a beam that no
     /// collider can reach is not cast. `beams` must come from one world's scans: it keeps
-    /// that world's colliders sorted into fixed and moving, with the fixed ones' boxes, and
-    /// sorts them again when the number of colliders changes.
+    /// that world's colliders sorted into fixed and moving, with the fixed ones' boxes (a fixed
+    /// collider must not move), and sorts them again when the number of colliders changes or
+    /// a fixed one is gone.
     pub(crate) fn scan(
         &self,
         physics: &PhysicsWorld,
@@ -152,7 +169,14 @@ impl LidarSpec {
         // With one horizontal channel, the channel's plane test can drop a box at once.
         let planar = beams.directions.iter().all(|&(_, el)| el == 0.0);
         let normal = chassis.rotation * Vector::Y;
-        if beams.known_colliders != Some(physics.colliders.len()) {
+        let stale = beams.known_colliders != Some(physics.colliders.len())
+            || beams.fixed.iter().any(|&(h, ..)| {
+                physics
+                    .colliders
+                    .get(h)
+                    .is_none_or(|c| c.parent().is_some())
+            });
+        if stale {
             beams.gather(physics, own_body);
         }
         let fixed = beams.fixed.iter().map(|&(h, mins, maxs)| (h, mins, maxs));
@@ -162,6 +186,10 @@ impl LidarSpec {
             Some((h, mins, maxs))
         });
         for (handle, mins, maxs) in fixed.chain(moving) {
+            // The query pipeline holds only enabled colliders.
+            if !physics.colliders[handle].is_enabled() {
+                continue;
+            }
             let nearest = origin.clamp(mins, maxs);
             if (nearest - origin).length() > max_toi {
                 continue;
