@@ -7,7 +7,9 @@ discrepancies of a fixed random 4000x8 array. Each SciPy time is the best of
 default workers=1). Paracosm's numbers come from
 `target/release/paracosm-cover bench --json` (build it first with
 `cargo build --release --bin paracosm-cover`), or from a file given with
---paracosm-json. Prints a markdown table.
+--paracosm-json. Prints a markdown table, then checks that paracosm's four discrepancies of
+the same array equal scipy's to 1e-12 relative (`paracosm-cover estimate` on the array
+written as CSV; skipped with --paracosm-json) and exits 1 when one does not.
 
 Run from anywhere:
 
@@ -32,6 +34,8 @@ REPO_ROOT = Path(__file__).resolve().parents[2]
 PARACOSM_BIN = REPO_ROOT / "target" / "release" / "paracosm-cover"
 
 REPEATS = 7
+# Largest relative difference allowed between paracosm's and scipy's values (issue 23).
+VALUE_TOLERANCE = 1e-12
 DISC_N, DISC_D = 4000, 8
 
 # (label, key in paracosm's JSON)
@@ -102,6 +106,40 @@ def paracosm_times(json_file):
     return data
 
 
+def value_check(skip):
+    """Compare paracosm's CD, WD, MD and L2-star with scipy's on the timed 4000x8 array.
+
+    Writes the array to a CSV (Python's repr round-trips every float), runs
+    `paracosm-cover estimate FILE --metrics cd,wd,md,l2star --json` and returns rows
+    (method, scipy, paracosm, relative difference). Empty when `skip`.
+    """
+    if skip:
+        return []
+    import tempfile
+    import numpy as np
+    from scipy.stats import qmc
+
+    x = np.random.default_rng(0).random((DISC_N, DISC_D))
+    with tempfile.NamedTemporaryFile("w", suffix=".csv", delete=False) as f:
+        f.write(",".join(f"x{k}" for k in range(DISC_D)) + "\n")
+        for row in x:
+            f.write(",".join(repr(float(v)) for v in row) + "\n")
+        path = f.name
+    cmd = [str(PARACOSM_BIN), "estimate", path, "--metrics", "cd,wd,md,l2star", "--json"]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    os.unlink(path)
+    if proc.returncode != 0:
+        sys.stderr.write(proc.stderr)
+        print(f"error: `{' '.join(cmd)}` exited with {proc.returncode}", file=sys.stderr)
+        sys.exit(1)
+    ours = dict(json.loads(proc.stdout)["discrepancy"])
+    rows = []
+    for name, method in (("cd", "CD"), ("wd", "WD"), ("md", "MD"), ("l2star", "L2-star")):
+        theirs = float(qmc.discrepancy(x, method=method))
+        rows.append((method, theirs, ours[name], abs(ours[name] - theirs) / abs(theirs)))
+    return rows
+
+
 def nproc():
     try:
         return len(os.sched_getaffinity(0))
@@ -135,6 +173,19 @@ def main():
     print(f"scipy {scipy.__version__}, numpy {np.__version__} (scipy workers=1); "
           f"paracosm threads: {ours['threads']}; nproc: {nproc()}; "
           f"best of {REPEATS} after 1 warm-up; speed-up = scipy / paracosm.")
+
+    rows = value_check(args.paracosm_json is not None)
+    if rows:
+        print()
+        print("| value | scipy | paracosm | relative difference |")
+        print("|---|---:|---:|---:|")
+        for method, theirs, mine, rel in rows:
+            print(f"| {method} | {theirs!r} | {mine!r} | {rel:.1e} |")
+        worst = max(r[3] for r in rows)
+        if worst > VALUE_TOLERANCE:
+            print(f"error: a value differs from scipy's by {worst:.1e} relative "
+                  f"(more than {VALUE_TOLERANCE:g})", file=sys.stderr)
+            sys.exit(1)
 
 
 if __name__ == "__main__":
