@@ -55,6 +55,20 @@ pub struct LidarReturn {
     pub point_m: [f64; 3],
 }
 
+impl LidarReturn {
+    /// The return of the beam `(azimuth_rad, elevation_rad)` with unit vector `local` (vehicle
+    /// frame) from the mount `mount_m` (vehicle frame, m) that hit at `toi` m.
+    fn hit(azimuth_rad: f64, elevation_rad: f64, mount_m: Vector, local: Vector, toi: f32) -> Self {
+        let p = mount_m + local * toi;
+        LidarReturn {
+            azimuth_rad,
+            elevation_rad,
+            range_m: f64::from(toi),
+            point_m: [f64::from(p.x), f64::from(p.y), f64::from(p.z)],
+        }
+    }
+}
+
 impl LidarSpec {
     /// Beam directions `(azimuth, elevation)` in rad, channel-major.
     pub(crate) fn directions(&self) -> Vec<(f64, f64)> {
@@ -152,22 +166,7 @@ impl LidarSpec {
         // unless it lies beyond the range.
         let mut scratch: Vec<Candidate<'_>> = Vec::new();
         let to_chassis = chassis.rotation.inverse();
-        // A beam of azimuth `az` and elevation `el` (|el| < π/2) meets only points whose
-        // azimuth about the mount, in the chassis frame, is `az`: a box is seen by the beams
-        // whose azimuth lies within its angular half-width of its centre's.
-        let by_azimuth = beams
-            .directions
-            .iter()
-            .all(|&(_, el)| el.abs() < std::f64::consts::FRAC_PI_2 - 1e-3);
-        // The beams' azimuths span [first, last] (rad).
-        let fov = beams
-            .directions
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &(az, _)| {
-                (lo.min(az), hi.max(az))
-            });
-        // With one horizontal channel, the channel's plane test can drop a box at once.
-        let planar = beams.directions.iter().all(|&(_, el)| el == 0.0);
+        let (by_azimuth, fov, planar) = (beams.by_azimuth, beams.fov, beams.planar);
         let normal = chassis.rotation * Vector::Y;
         let stale = beams.known_colliders != Some(physics.colliders.len())
             || beams.fixed.iter().any(|&(h, ..)| {
@@ -264,13 +263,7 @@ impl LidarSpec {
                 }
             }
             if let Some(toi) = best.filter(|&toi| toi < max_toi) {
-                let p = mount_local + local * toi;
-                out.push(LidarReturn {
-                    azimuth_rad: az,
-                    elevation_rad: el,
-                    range_m: f64::from(toi),
-                    point_m: [f64::from(p.x), f64::from(p.y), f64::from(p.z)],
-                });
+                out.push(LidarReturn::hit(az, el, mount_local, local, toi));
             }
         }
     }
@@ -289,18 +282,39 @@ pub(crate) struct Beams {
     moving: Vec<ColliderHandle>,
     /// How many colliders the world had when `fixed` and `moving` were gathered.
     known_colliders: Option<usize>,
+    /// Whether every beam's elevation is within π/2 of the horizon (less 1 mrad): a beam of
+    /// azimuth `az` then meets only points whose azimuth about the mount, in the chassis
+    /// frame, is `az`, so a box is seen only by the beams within its angular half-width of
+    /// its centre's azimuth.
+    by_azimuth: bool,
+    /// The smallest and largest beam azimuth, rad.
+    fov: (f64, f64),
+    /// Whether the lidar has one horizontal channel, so the plane test can drop a box at once.
+    planar: bool,
 }
 
 impl Beams {
     /// The beams of `spec`.
     pub(crate) fn of(spec: &LidarSpec) -> Self {
         let directions = spec.directions();
+        let by_azimuth = directions
+            .iter()
+            .all(|&(_, el)| el.abs() < std::f64::consts::FRAC_PI_2 - 1e-3);
+        let fov = directions
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &(az, _)| {
+                (lo.min(az), hi.max(az))
+            });
+        let planar = directions.iter().all(|&(_, el)| el == 0.0);
         Beams {
             local: LidarSpec::local_directions(&directions),
             directions,
             fixed: Vec::new(),
             moving: Vec::new(),
             known_colliders: None,
+            by_azimuth,
+            fov,
+            planar,
         }
     }
 
@@ -471,13 +485,7 @@ mod tests {
         for (&(az, el), &local) in directions.iter().zip(&beams) {
             let ray = Ray::new(origin, chassis.rotation * local);
             if let Some((_, toi)) = queries.cast_ray(&ray, range_m as f32, true) {
-                let p = mount + local * toi;
-                out.push(LidarReturn {
-                    azimuth_rad: az,
-                    elevation_rad: el,
-                    range_m: f64::from(toi),
-                    point_m: [f64::from(p.x), f64::from(p.y), f64::from(p.z)],
-                });
+                out.push(LidarReturn::hit(az, el, mount, local, toi));
             }
         }
         out
