@@ -323,6 +323,52 @@ fn signals_and_monitors_of_the_wrong_kind_are_refused_at_load() {
     assert!(e.contains("\"always\", \"end\" or \"eventually\""), "{e}");
 }
 
+/// A lambda's stream has no kind until it is called: a `Monitor` of a lambda that returns
+/// bools, or an `Assert` of one that returns numbers, is refused at load from the sample
+/// values (a bool was once read as 0 or 1 and failed the test as a verdict), and a value of
+/// the wrong kind that only appears later ends the test as an error, not a verdict.
+#[test]
+fn monitors_of_lambdas_of_the_wrong_kind_are_refused_not_read_as_numbers() {
+    let base = format!("{ROAD}lead = Car(loc = r.onLane(1, 100))\nw.place(r, v, lead)\n");
+    let e = load_err(&format!(
+        "{base}slow = Monitor(v.speed.map(lambda s: s < 3))\n"
+    ));
+    assert!(
+        e.contains("monitor `slow`")
+            && e.contains("a bool is not a number")
+            && e.contains("t.star:"),
+        "{e}"
+    );
+    let e = load_err(&format!(
+        "{base}def margin(s):\n    return 20 - s\nok = Assert(v.speed.map(margin))\n"
+    ));
+    assert!(
+        e.contains("monitor `ok`") && e.contains("a number is not a bool"),
+        "{e}"
+    );
+    // Inside TimeToFailure too, and a vector is no number either.
+    let e = load_err(&format!(
+        "{base}TimeToFailure(Monitor(v.pos.map(lambda p: p - p), name = \"m\"), minT = 1.0)\n"
+    ));
+    assert!(
+        e.contains("monitor `m`") && e.contains("Monitor reads numbers"),
+        "{e}"
+    );
+    // Numbers at t = 0, a bool from 0.5 s on: each test ends as an error at that moment.
+    let late = format!(
+        "{base}late = Monitor(tick.map(lambda t: 1.0 if t < 0.5 else True))\nCollisionMonitor(v)\ntest(horizon = 2.0)\n"
+    );
+    let (records, _, _) = run_src(&late, "2", &[], 3);
+    for r in &records {
+        assert_eq!(r["status"], "error", "{r}");
+        let m = r["error"].as_str().unwrap();
+        assert!(
+            m.contains("at t = 0.5") && m.contains("monitor `late`"),
+            "{m}"
+        );
+    }
+}
+
 /// `print` writes to the test's log: in results.jsonl, on stderr with --verbose, never on
 /// stdout during a campaign.
 #[test]

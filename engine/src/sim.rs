@@ -573,13 +573,17 @@ impl Simulation {
 
     /// Calls every function of the stream graph once on sample values of this world at its
     /// current time ([`crate::rx::Runtime::check`]), on a copy: the simulation is unchanged.
+    /// Returns the sample value of each stream, indexed by [`StreamId`] (`None` for a stream
+    /// that had none: a `take(0)`, or a stream fed by one).
     ///
     /// # Errors
     /// [`EngineError::Stream`] with the first failure.
-    pub fn check_streams(&self, host: &mut dyn Host) -> Result<(), EngineError> {
+    pub fn check_streams(&self, host: &mut dyn Host) -> Result<Vec<Option<Value>>, EngineError> {
         let mut copy = Runtime::new(self.streams.graph().clone());
         copy.check(self.t_s(), &self.inputs(), host)?;
-        Ok(())
+        Ok((0..copy.graph().nodes().len())
+            .map(|i| copy.current(StreamId(i)).cloned())
+            .collect())
     }
 
     /// Performs this step's `foreach` events, in order: walking steps, car speeds, brakes and

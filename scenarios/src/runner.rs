@@ -7,7 +7,7 @@ use paracosm_engine::{
 use paracosm_generators::Assignment;
 use paracosm_oracles::{Frame, Monitor, Signals, Verdict};
 
-use crate::{Scenario, ScenarioError};
+use crate::{MonitorSpec, Scenario, ScenarioError};
 
 /// Names of the signals the runner publishes to monitors each step.
 pub mod signal {
@@ -107,6 +107,9 @@ struct Published {
     name: String,
     components: [String; 3],
     id: paracosm_engine::rx::StreamId,
+    /// For the stream of a `Monitor` or an `Assert`: whether it must carry bools (`Assert`)
+    /// rather than numbers (`Monitor`).
+    judged: Option<bool>,
 }
 
 /// Sets each published stream's latest value as a signal: a number as is, a bool as 0 or 1,
@@ -121,6 +124,15 @@ fn publish_streams(
 ) -> Result<(), ScenarioError> {
     use paracosm_engine::rx::Value as Rx;
     for p in published {
+        if let (Some(bools), Some(value)) = (p.judged, sim.current(p.id)) {
+            if let Some(why) = crate::scenario::judged_kind_error(value, bools) {
+                let m = p.name.strip_prefix("monitor:").unwrap_or(&p.name);
+                return Err(ScenarioError::Language(format!(
+                    "at t = {:.3} s, monitor `{m}`: {why}",
+                    sim.t_s()
+                )));
+            }
+        }
         match sim.current(p.id) {
             None => out.unset(&p.name),
             Some(Rx::Num(x)) => out.set_named(&p.name, *x),
@@ -301,6 +313,12 @@ impl Scenario {
                     components: [".x", ".y", ".z"].map(|c| format!("{name}{c}")),
                     name: name.clone(),
                     id: *id,
+                    judged: self
+                        .monitors
+                        .iter()
+                        .filter_map(MonitorSpec::judged_stream)
+                        .find(|(_, signal, _)| *signal == name)
+                        .map(|(_, _, bools)| bools),
                 })
                 .collect(),
         };

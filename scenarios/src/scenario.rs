@@ -81,6 +81,18 @@ pub enum MonitorSpec {
 }
 
 impl MonitorSpec {
+    /// The name of a `Monitor` or an `Assert` (also when wrapped in `TimeToFailure`) and the
+    /// signal of the stream it judges, with whether that must carry bools (`Assert`) rather
+    /// than numbers (`Monitor`); `None` for the other monitors.
+    pub fn judged_stream(&self) -> Option<(&str, &str, bool)> {
+        match self {
+            MonitorSpec::Stream { name, signal, .. } => Some((name, signal, false)),
+            MonitorSpec::Assert { name, signal } => Some((name, signal, true)),
+            MonitorSpec::TimeToFailure { inner, .. } => inner.judged_stream(),
+            _ => None,
+        }
+    }
+
     /// `CollisionMonitor` named `collision`.
     pub fn collision() -> Self {
         MonitorSpec::Collision {
@@ -364,5 +376,33 @@ impl std::fmt::Debug for Scenario {
             .field("sut", &self.sut)
             .field("monitors", &self.monitors)
             .finish_non_exhaustive()
+    }
+}
+
+/// Why a `Monitor` (`bools = false`, it reads numbers) or an `Assert` (`bools = true`) cannot
+/// judge `value`; `None` when it can. A bool is not a number, nor a number a bool: nothing is
+/// read as 0 or 1 in place of the kind the monitor judges.
+pub(crate) fn judged_kind_error(value: &paracosm_engine::rx::Value, bools: bool) -> Option<String> {
+    use paracosm_engine::rx::{describe, Value};
+    match (value, bools) {
+        (Value::Num(_), false) | (Value::Bool(_), true) => None,
+        (Value::Bool(_), false) => Some(format!(
+            "Monitor reads numbers, and its stream carried {}: a bool is not a number here (for \
+             a stream of bools, use Assert)",
+            describe(value)
+        )),
+        (Value::Num(_), true) => Some(format!(
+            "Assert reads bools, and its stream carried {}: a number is not a bool here (write \
+             the condition meant, e.g. `.map(lambda x: x > 0)`)",
+            describe(value)
+        )),
+        (_, false) => Some(format!(
+            "Monitor reads numbers, and its stream carried {}",
+            describe(value)
+        )),
+        (_, true) => Some(format!(
+            "Assert reads bools, and its stream carried {}",
+            describe(value)
+        )),
     }
 }

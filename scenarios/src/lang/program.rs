@@ -484,7 +484,7 @@ impl Program {
             limits.install(&mut eval).map_err(|e| e.to_string())?;
             let mut host = StarHost::new(&mut eval, &functions, &limits, &self.file);
             match sim.check_streams(&mut host) {
-                Ok(()) => Ok(()),
+                Ok(samples) => judged_kinds(&b, &samples),
                 Err(e) => {
                     // A lambda's message has its own traceback and location.
                     let message = match e {
@@ -504,6 +504,35 @@ impl Program {
             }
         })
     }
+}
+
+/// Checks that each `Monitor` judges numbers and each `Assert` bools, by their streams' sample
+/// values from the check at load: a stream made by a lambda has no kind until it is called.
+///
+/// # Errors
+/// The first monitor whose sample is of the other kind, with the monitor's `file:line:col`.
+fn judged_kinds(
+    b: &SceneBuilder,
+    samples: &[Option<paracosm_engine::rx::Value>],
+) -> Result<(), String> {
+    for (m, at) in b.monitors.iter().zip(&b.monitors_at) {
+        let Some((name, signal, bools)) = m.judged_stream() else {
+            continue;
+        };
+        let sample = b
+            .published
+            .iter()
+            .find(|(name, _)| name == signal)
+            .and_then(|(_, id)| samples.get(id.0))
+            .and_then(Option::as_ref);
+        if let Some(why) = sample.and_then(|v| crate::scenario::judged_kind_error(v, bools)) {
+            return Err(format!(
+                "error: monitor `{name}`: {why} (found when loading, from the sample value its \
+                 stream gives in the first test's world at t = 0)\n --> {at}"
+            ));
+        }
+    }
+    Ok(())
 }
 
 impl crate::Worlds for Program {
