@@ -369,6 +369,51 @@ fn monitors_of_lambdas_of_the_wrong_kind_are_refused_not_read_as_numbers() {
     }
 }
 
+/// A route's turn that a junction lacks is an error naming the actor, the turn and what the
+/// junction offers, not another turn taken in its place; so is a turn the path never reaches.
+#[test]
+fn a_route_turn_the_junction_lacks_or_never_reaches_is_refused() {
+    // A T whose three ports lead on: entered by its east port (ONE), it has straight and left.
+    let net = r#"
+w = World()
+t = TIntersection()
+e = RoadSegment(len = 60.0)
+s = RoadSegment(len = 60.0)
+x = RoadSegment(len = 60.0)
+t.connect((t.ONE, e, e.TWO), (t.TWO, s, s.ONE), (t.THREE, x, x.ONE))
+"#;
+    let ego = |route: &str| {
+        format!(
+            "{net}v = AutonomousVehicle(loc = e.onLane(1, 5), route = {route})\n\
+             w.place(t, e, s, x, v)\nCollisionMonitor(v)\n"
+        )
+    };
+    let car = format!(
+        "{net}v = AutonomousVehicle(loc = x.onLane(1, 50))\n\
+         c = Car(loc = e.onLane(1, 5), route = [\"right\"])\n\
+         w.place(t, e, s, x, v, c)\nCollisionMonitor(v)\n"
+    );
+    let e = load_err(&car);
+    assert!(
+        e.contains("Car c: the route's turn 1 (\"right\") is not possible at TIntersection t")
+            && e.contains("it offers \"straight\" and \"left\"")
+            && e.contains("t.star:"),
+        "{e}"
+    );
+    // The stem (left) ends at s.TWO, so a second turn is never taken.
+    let e = load_err(&ego("[\"left\", \"right\"]"));
+    assert!(
+        e.contains("AutonomousVehicle v: the route's turn 2 (\"right\") is never taken")
+            && e.contains("after 1 junction with a choice"),
+        "{e}"
+    );
+    // Each turn the junction has loads; an open turn is checked for each of its levels.
+    loads(&ego("[\"left\"]"));
+    loads(&ego("[\"straight\"]"));
+    let e = load_err(&ego("[VarEnum([\"left\", \"right\"])]"));
+    assert!(e.contains("(\"right\") is not possible"), "{e}");
+}
+
 /// `print` writes to the test's log: in results.jsonl, on stderr with --verbose, never on
 /// stdout during a campaign.
 #[test]

@@ -17,6 +17,15 @@ pub enum Turn {
 }
 
 impl Turn {
+    /// The turn's name in programs: `"straight"`, `"left"` or `"right"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Turn::Straight => "straight",
+            Turn::Left => "left",
+            Turn::Right => "right",
+        }
+    }
+
     /// Parses `"straight"`, `"left"` or `"right"`.
     pub fn parse(s: &str) -> Option<Turn> {
         match s {
@@ -147,14 +156,18 @@ impl Network {
     }
 
     /// The path a vehicle drives from `start` (a driving lane of a segment): along its lane,
-    /// then across the connected pieces, taking at each junction with a choice the next turn
-    /// of `turns` (then `straight`, `right`, `left`, in that order of preference, when the
-    /// list is used up or the turn is not there; exits into the network before dead ends),
-    /// until the network ends or the path is
-    /// `max_len_m` metres long. World `[x, z]` points in metres.
+    /// then across the connected pieces, until the network ends or the path is `max_len_m`
+    /// metres long. A junction offers a choice where more than one of its exits leads on into
+    /// the network; there the path takes the next turn of `turns` (even into a dead end), and
+    /// once the list is used up, `straight`, `right`, `left` in that order of preference. A
+    /// junction without a choice takes its one exit that leads on. World `[x, z]` points in
+    /// metres.
     ///
     /// # Errors
-    /// [`EngineError::InvalidWorld`] when `start` is not on a driving lane.
+    /// [`EngineError::InvalidWorld`] when `start` is not on a driving lane; when a turn of
+    /// `turns` is not one the junction it falls on has (naming the turn, the junction, the
+    /// port it is entered by and the turns it has); when the network ends, short of
+    /// `max_len_m`, before every turn is taken.
     pub fn route(
         &self,
         start: &Location,
@@ -237,7 +250,10 @@ impl Network {
             }
         };
         let mut length = points.windows(2).map(|w| dist(w[0], w[1])).sum::<f64>();
+        let all_turns = turns;
         let mut turns = turns.iter();
+        // How many of the turns the path has taken.
+        let mut used = 0;
         while length < max_len_m {
             let out = (path.piece, path.exit.0);
             let Some(next) = self.links.iter().find_map(|l| {
@@ -256,20 +272,44 @@ impl Network {
                 .into_iter()
                 .filter(|l| l.entry == (next.1, path.exit.1))
                 .collect();
-            // Prefer exits that lead on into the network over dead ends.
+            // Prefer exits that lead on into the network over dead ends: a junction offers a
+            // choice when more than one exit leads on, and only there is a turn used.
             let linked = |l: &LanePath| {
                 let end = (l.piece, l.exit.0);
                 self.links.iter().any(|k| k.a == end || k.b == end)
             };
+            let all = candidates.clone();
             if candidates.iter().any(linked) {
                 candidates.retain(linked);
             }
             let pick = if candidates.len() > 1 {
-                let wanted = turns.next().copied();
-                wanted
-                    .into_iter()
-                    .chain([Turn::Straight, Turn::Right, Turn::Left])
-                    .find_map(|t| candidates.iter().find(|c| c.turn == t))
+                match turns.next().copied() {
+                    // The route's next turn, which the junction must have (into a dead end,
+                    // if the program asks for one).
+                    Some(t) => {
+                        let Some(c) = all.iter().find(|c| c.turn == t) else {
+                            let offered: Vec<String> = [Turn::Straight, Turn::Left, Turn::Right]
+                                .into_iter()
+                                .filter(|o| all.iter().any(|c| c.turn == *o))
+                                .map(|o| format!("\"{}\"", o.name()))
+                                .collect();
+                            return Err(EngineError::InvalidWorld(format!(
+                                "the route's turn {} (\"{}\") is not possible at {}, entered by \
+                                 {}: it offers {} there",
+                                used + 1,
+                                t.name(),
+                                self.pieces[next.0 .0].name,
+                                self.port_name(next),
+                                offered.join(" and ")
+                            )));
+                        };
+                        used += 1;
+                        Some(c)
+                    }
+                    None => [Turn::Straight, Turn::Right, Turn::Left]
+                        .into_iter()
+                        .find_map(|t| candidates.iter().find(|c| c.turn == t)),
+                }
             } else {
                 candidates.first()
             };
@@ -279,6 +319,19 @@ impl Network {
                 points.push(q);
             }
             path = pick;
+        }
+        if length < max_len_m && used < all_turns.len() {
+            // The network ended before the route did: a turn the program wrote was never taken.
+            return Err(EngineError::InvalidWorld(format!(
+                "the route's turn {} (\"{}\") is never taken: after {} junction{} with a choice \
+                 of ways on, the path meets no other and ends at {} (a junction counts where \
+                 more than one of its exits leads on into the network)",
+                used + 1,
+                all_turns[used].name(),
+                used,
+                if used == 1 { "" } else { "s" },
+                self.port_name((path.piece, path.exit.0))
+            )));
         }
         Ok(resample(&points, ROUTE_SPACING_M))
     }

@@ -639,7 +639,7 @@ impl SceneBuilder {
                         Some(turns) => self
                             .roads
                             .route(&start, &turns, MAX_ROUTE_M)
-                            .map_err(strip)?,
+                            .map_err(|e| format!("{}: {}", o.name, strip(e)))?,
                         // Without a route the ego keeps its lane: the start line on straight
                         // roads, and the lane's path (straight on through junctions) where
                         // its network has a curved piece.
@@ -699,7 +699,7 @@ impl SceneBuilder {
                     let path = self
                         .roads
                         .route(&start, &route, MAX_ROUTE_M)
-                        .map_err(strip)?;
+                        .map_err(|e| format!("{}: {}", o.name, strip(e)))?;
                     let lane_change = match lane_change {
                         Some(c) => Some(self.lane_change(&o.name, &start, c)?),
                         None => None,
