@@ -404,7 +404,7 @@ t.connect((t.ONE, e, e.TWO), (t.TWO, s, s.ONE), (t.THREE, x, x.ONE))
     let e = load_err(&ego("[\"left\", \"right\"]"));
     assert!(
         e.contains("AutonomousVehicle v: the route's turn 2 (\"right\") is never taken")
-            && e.contains("after 1 junction with a choice"),
+            && e.contains("the path passes 1 junction and ends at RoadSegment s.TWO"),
         "{e}"
     );
     // Each turn the junction has loads; an open turn is checked for each of its levels.
@@ -412,6 +412,23 @@ t.connect((t.ONE, e, e.TWO), (t.TWO, s, s.ONE), (t.THREE, x, x.ONE))
     loads(&ego("[\"straight\"]"));
     let e = load_err(&ego("[VarEnum([\"left\", \"right\"])]"));
     assert!(e.contains("(\"right\") is not possible"), "{e}");
+    // A junction counts whether or not its other exits lead anywhere: on a cross with two
+    // ports connected, "left" is the one way on, and "straight" drives into the dead end.
+    let cross = |route: &str| {
+        format!(
+            "w = World()\nj = CrossIntersection()\ne = RoadSegment(len = 60.0)\n\
+             s = RoadSegment(len = 60.0)\nj.connect((j.ONE, e, e.TWO), (j.TWO, s, s.ONE))\n\
+             v = AutonomousVehicle(loc = e.onLane(1, 5), route = {route})\n\
+             w.place(j, e, s, v)\nCollisionMonitor(v)\ntest(horizon = 8.0)\n"
+        )
+    };
+    loads(&cross("[\"left\"]"));
+    let (records, _, _) = run_src(&cross("[\"straight\"]"), "1", &[], 1);
+    assert_eq!(
+        records[0]["monitors"]["offroad"]["passed"], false,
+        "{}",
+        records[0]
+    );
 }
 
 /// `print` writes to the test's log: in results.jsonl, on stderr with --verbose, never on

@@ -157,11 +157,10 @@ impl Network {
 
     /// The path a vehicle drives from `start` (a driving lane of a segment): along its lane,
     /// then across the connected pieces, until the network ends or the path is `max_len_m`
-    /// metres long. A junction offers a choice where more than one of its exits leads on into
-    /// the network; there the path takes the next turn of `turns` (even into a dead end), and
-    /// once the list is used up, `straight`, `right`, `left` in that order of preference. A
-    /// junction without a choice takes its one exit that leads on. World `[x, z]` points in
-    /// metres.
+    /// metres long. Each junction on the way (a piece with more than one exit from the lane it
+    /// is entered by) takes the next turn of `turns`, even into a dead end; once the list is
+    /// used up, exits that lead on into the network before dead ends, then `straight`,
+    /// `right`, `left` in that order of preference. World `[x, z]` points in metres.
     ///
     /// # Errors
     /// [`EngineError::InvalidWorld`] when `start` is not on a driving lane; when a turn of
@@ -272,46 +271,48 @@ impl Network {
                 .into_iter()
                 .filter(|l| l.entry == (next.1, path.exit.1))
                 .collect();
-            // Prefer exits that lead on into the network over dead ends: a junction offers a
-            // choice when more than one exit leads on, and only there is a turn used.
-            let linked = |l: &LanePath| {
-                let end = (l.piece, l.exit.0);
-                self.links.iter().any(|k| k.a == end || k.b == end)
-            };
-            let all = candidates.clone();
-            if candidates.iter().any(linked) {
-                candidates.retain(linked);
-            }
-            let pick = if candidates.len() > 1 {
-                match turns.next().copied() {
-                    // The route's next turn, which the junction must have (into a dead end,
-                    // if the program asks for one).
-                    Some(t) => {
-                        let Some(c) = all.iter().find(|c| c.turn == t) else {
-                            let offered: Vec<String> = [Turn::Straight, Turn::Left, Turn::Right]
-                                .into_iter()
-                                .filter(|o| all.iter().any(|c| c.turn == *o))
-                                .map(|o| format!("\"{}\"", o.name()))
-                                .collect();
-                            return Err(EngineError::InvalidWorld(format!(
-                                "the route's turn {} (\"{}\") is not possible at {}, entered by \
-                                 {}: it offers {} there",
-                                used + 1,
-                                t.name(),
-                                self.pieces[next.0 .0].name,
-                                self.port_name(next),
-                                offered.join(" and ")
-                            )));
-                        };
-                        used += 1;
-                        Some(c)
-                    }
-                    None => [Turn::Straight, Turn::Right, Turn::Left]
-                        .into_iter()
-                        .find_map(|t| candidates.iter().find(|c| c.turn == t)),
-                }
+            // Each junction on the way (a piece with more than one exit from this lane) takes
+            // the route's next turn, which it must have; into a dead end if the program asks.
+            let wanted = if candidates.len() > 1 {
+                turns.next().copied()
             } else {
-                candidates.first()
+                None
+            };
+            let pick = match wanted {
+                Some(t) => {
+                    let Some(c) = candidates.iter().find(|c| c.turn == t) else {
+                        let offered: Vec<String> = [Turn::Straight, Turn::Left, Turn::Right]
+                            .into_iter()
+                            .filter(|o| candidates.iter().any(|c| c.turn == *o))
+                            .map(|o| format!("\"{}\"", o.name()))
+                            .collect();
+                        return Err(EngineError::InvalidWorld(format!(
+                            "the route's turn {} (\"{}\") is not possible at {}, entered by {}: \
+                             it offers {} there",
+                            used + 1,
+                            t.name(),
+                            self.pieces[next.0 .0].name,
+                            self.port_name(next),
+                            offered.join(" and ")
+                        )));
+                    };
+                    used += 1;
+                    Some(c)
+                }
+                // No turn left to take: exits that lead on into the network before dead ends,
+                // then straight, right, left.
+                None => {
+                    let linked = |l: &LanePath| {
+                        let end = (l.piece, l.exit.0);
+                        self.links.iter().any(|k| k.a == end || k.b == end)
+                    };
+                    if candidates.iter().any(linked) {
+                        candidates.retain(linked);
+                    }
+                    [Turn::Straight, Turn::Right, Turn::Left]
+                        .into_iter()
+                        .find_map(|t| candidates.iter().find(|c| c.turn == t))
+                }
             };
             let Some(pick) = pick.cloned() else { break };
             for &q in &pick.points[1..] {
@@ -323,9 +324,8 @@ impl Network {
         if length < max_len_m && used < all_turns.len() {
             // The network ended before the route did: a turn the program wrote was never taken.
             return Err(EngineError::InvalidWorld(format!(
-                "the route's turn {} (\"{}\") is never taken: after {} junction{} with a choice \
-                 of ways on, the path meets no other and ends at {} (a junction counts where \
-                 more than one of its exits leads on into the network)",
+                "the route's turn {} (\"{}\") is never taken: the path passes {} junction{} \
+                 and ends at {} with turns left over",
                 used + 1,
                 all_turns[used].name(),
                 used,
