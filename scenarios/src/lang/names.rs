@@ -21,6 +21,9 @@ pub struct Site {
     pub name: Option<String>,
     /// The variable it is assigned to, if it is.
     pub variable: Option<String>,
+    /// The builtin and keyword it is written inline as an argument of, if it is
+    /// (`Car(speed = VarInterval(...))`: `("Car", "speed")`).
+    pub argument_of: Option<(String, String)>,
 }
 
 /// What the syntax of a program says, by call site (`"line:col"`, from 1).
@@ -80,9 +83,19 @@ impl Walker<'_> {
         format!("{}", self.ast.file_span(e.span).resolve_span().begin)
     }
 
-    fn site(&mut self, e: &AstExpr, name: Option<String>, variable: Option<String>) {
+    fn site(
+        &mut self,
+        e: &AstExpr,
+        name: Option<String>,
+        variable: Option<String>,
+        argument_of: Option<(String, String)>,
+    ) {
         let key = self.pos(e);
-        self.out.sites.entry(key).or_insert(Site { name, variable });
+        self.out.sites.entry(key).or_insert(Site {
+            name,
+            variable,
+            argument_of,
+        });
     }
 
     fn stmt(&mut self, s: &AstStmt, in_code: bool) {
@@ -131,7 +144,7 @@ impl Walker<'_> {
                 let name = callee(f);
                 if is_declarer(e) {
                     let given = target.map(str::to_owned);
-                    self.site(e, given.clone(), given);
+                    self.site(e, given.clone(), given, None);
                 }
                 let builtin = name
                     .as_deref()
@@ -141,7 +154,11 @@ impl Walker<'_> {
                     if let (ArgumentP::Named(kw, _), true) = (&a.node, is_declarer(value)) {
                         let owner = target.map(str::to_owned).or_else(|| name.clone());
                         let n = owner.map(|o| format!("{o}.{}", kw.node));
-                        self.site(value, n, None);
+                        let argument_of = name
+                            .clone()
+                            .filter(|_| builtin)
+                            .map(|b| (b, kw.node.clone()));
+                        self.site(value, n, None, argument_of);
                     }
                     // A positional argument of a method: `lead.brake(VarEnum(...))` is
                     // `lead.brake`.
@@ -150,7 +167,7 @@ impl Walker<'_> {
                     {
                         if let ExprP::Identifier(o) = &obj.node {
                             let n = format!("{}.{}", o.node.ident, method.node);
-                            self.site(value, Some(n), None);
+                            self.site(value, Some(n), None, None);
                         }
                     }
                     match (&value.node, builtin) {

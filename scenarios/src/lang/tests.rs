@@ -355,6 +355,40 @@ fn a_parameter_in_another_unit_than_its_input_is_a_warning() {
         ),
         "{w:?}"
     );
+    // Written inline in the call, as a new user writes it; and a unit on an input that has
+    // none (fog is a plain number in [0, 1]).
+    let inline = with_car(", speed = VarInterval(10, 50, unit = \"km/h\")", "").replace(
+        "w = World(light = 1.0, fog = 0.0)",
+        "w = World(light = 1.0, fog = VarInterval(0, 0.5, unit = \"%\"))",
+    );
+    assert!(inline.contains("fog = VarInterval"), "{inline}");
+    let s = load_source("inline.star", &inline, "inline").unwrap();
+    let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(
+        w.iter()
+            .any(|w| w
+                .contains("`c.speed` is declared in km/h but feeds Car(speed=), which is in m/s")),
+        "{w:?}"
+    );
+    assert!(
+        w.iter().any(|w| w.contains(
+            "`w.fog` is declared in % but feeds World(fog=), which is a plain number (no unit)"
+        )),
+        "{w:?}"
+    );
+    // The input's own unit, or "1" on a plain number, is no warning.
+    let fine = with_car(", speed = VarInterval(1, 5, unit = \"m/s\")", "").replace(
+        "w = World(light = 1.0, fog = 0.0)",
+        "w = World(fog = VarInterval(0, 0.5, unit = \"1\"))",
+    );
+    let s = load_source("fine.star", &fine, "fine").unwrap();
+    assert!(
+        !s.warnings
+            .iter()
+            .any(|w| w.to_string().contains("is declared in")),
+        "{:?}",
+        s.warnings
+    );
 }
 
 #[test]

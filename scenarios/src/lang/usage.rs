@@ -249,21 +249,40 @@ pub fn unit_warnings(params: &[(String, ParamDecl)], syntax: &Syntax) -> Vec<War
     let norm = |u: &str| u.split_whitespace().collect::<String>();
     let mut out = Vec::new();
     for (name, decl) in params {
-        let (Some(unit), Some(variable)) = (
-            &decl.unit,
-            syntax.site(&decl.at).and_then(|s| s.variable.clone()),
-        ) else {
+        let (Some(unit), Some(site)) = (&decl.unit, syntax.site(&decl.at)) else {
             continue;
         };
-        for (builtin, keyword) in syntax.passed_to(&variable) {
+        // Where it is passed whole: through its variable, or written inline in the call.
+        let mut inputs: Vec<(&str, &str)> = site
+            .variable
+            .as_deref()
+            .map(|v| syntax.passed_to(v))
+            .unwrap_or_default();
+        if let Some((builtin, keyword)) = &site.argument_of {
+            inputs.push((builtin, keyword));
+        }
+        for (builtin, keyword) in inputs {
             if let Some(input) = types::input_of(builtin, keyword) {
                 if let types::Kind::Number { unit: theirs, .. } = input.kind {
-                    if !theirs.is_empty() && norm(theirs) != norm(unit) {
+                    // A dimensionless input: any unit but "1" or "-" says the program expects
+                    // another scale (`unit = "%"` for a fog in [0, 1]).
+                    let plain = theirs.is_empty();
+                    let mismatch = if plain {
+                        !matches!(norm(unit).as_str(), "" | "1" | "-")
+                    } else {
+                        norm(theirs) != norm(unit)
+                    };
+                    if mismatch {
+                        let theirs = if plain {
+                            "a plain number (no unit)".to_owned()
+                        } else {
+                            format!("in {theirs}")
+                        };
                         out.push(Warning {
                             at: decl.at.clone(),
                             message: format!(
                                 "`{name}` is declared in {unit} but feeds {builtin}({keyword}=), \
-                                 which is in {theirs}"
+                                 which is {theirs}"
                             ),
                         });
                     }
