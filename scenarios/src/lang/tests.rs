@@ -470,3 +470,28 @@ fn a_test_without_monitors_runs_to_its_horizon() {
         .1;
     assert!((simulated - 3.0).abs() < 1e-9, "{simulated}");
 }
+
+/// Levels equal under `==` are one level: `VarEnum([1, 1.0])` would count one value twice in
+/// k-wise coverage. A bool is not a number, so `[1, True]` is two levels, as Starlark says.
+#[test]
+fn a_varenum_refuses_levels_that_are_equal() {
+    for levels in [
+        "[1, 1.0]",
+        "[0.0, -0.0]",
+        "[0, -0.0]",
+        "[\"a\", \"b\", \"a\"]",
+        "[2, 3, 2]",
+    ] {
+        let m = err(&format!("{HEADER}w.place(r, v)\nx = VarEnum({levels})\n"));
+        assert!(m.contains("twice"), "{levels}: {m}");
+        assert!(m.contains("bad.star:5:5"), "{levels}: {m}");
+    }
+    for levels in ["[1, True]", "[1, 2.5]", "[\"1\", 1]"] {
+        load_source(
+            "ok.star",
+            &format!("{HEADER}w.place(r, v)\nx = VarEnum({levels})\n"),
+            "ok",
+        )
+        .unwrap_or_else(|e| panic!("{levels}: {e}"));
+    }
+}

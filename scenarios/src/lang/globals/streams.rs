@@ -136,7 +136,8 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         }
         let mut out = Vec::new();
         // Levels seen, as hashable keys (linear in the levels, not quadratic: a VarEnum may
-        // have tens of thousands). `0.0` and `-0.0` are one level, as `==` says.
+        // have tens of thousands). `0.0` and `-0.0` are one level, as `==` says, and so are
+        // `1` and `1.0` (an int here fits in 32 bits, so its f64 is exact).
         let mut seen = std::collections::HashSet::with_capacity(items.len());
         for v in items {
             let level = if let Some(b) = v.unpack_bool() {
@@ -150,7 +151,11 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             };
             let key = match &level {
                 Level::Bool(b) => (0u8, u64::from(*b), String::new()),
-                Level::Int(i) => (1, *i as u64, String::new()),
+                Level::Int(i) => (
+                    2,
+                    if *i == 0 { 0 } else { (*i as f64).to_bits() },
+                    String::new(),
+                ),
                 Level::Real(x) => (2, if *x == 0.0 { 0 } else { x.to_bits() }, String::new()),
                 Level::Text(t) => (3, 0, t.clone()),
             };
