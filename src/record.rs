@@ -26,7 +26,8 @@ pub struct MonitorResult {
     /// Whether the monitor's property held.
     pub passed: bool,
     /// Robustness in the monitor's unit; `> 0` satisfied. Non-finite values are written as
-    /// `null` (JSON has no infinity) and read back as NaN.
+    /// `null` (JSON has no infinity); [`RunRecord::from_line`] reads a `null` back as `+inf`
+    /// when the monitor passed and `-inf` when it failed.
     #[serde(deserialize_with = "f64_or_null")]
     pub robustness: f64,
     /// Time of the first violation in seconds since the start, or `null`.
@@ -153,8 +154,8 @@ impl RunRecord {
     }
 
     /// Reads one line of `results.jsonl` written for a scenario with parameter space `space`
-    /// (`params` is decoded again from `point`; robustness and metrics written as `null` come
-    /// back as NaN).
+    /// (`params` is decoded again from `point`; a monitor's robustness written as `null` comes
+    /// back as `+inf` if it passed and `-inf` if it failed, metrics written as `null` as NaN).
     ///
     /// # Errors
     /// serde_json's error (with its column) when the line is not a results record.
@@ -178,7 +179,23 @@ impl RunRecord {
             params,
             point: l.point,
             status: l.status,
-            monitors: l.monitors,
+            monitors: l
+                .monitors
+                .into_iter()
+                .map(|(name, mut m)| {
+                    // `null` is an infinite robustness: +inf for a monitor that passed, -inf
+                    // for one that failed. Read as NaN, `f64::min` would skip it, and a failed
+                    // monitor's cost would disappear from a resumed campaign.
+                    if m.robustness.is_nan() {
+                        m.robustness = if m.passed {
+                            f64::INFINITY
+                        } else {
+                            f64::NEG_INFINITY
+                        };
+                    }
+                    (name, m)
+                })
+                .collect(),
             metrics: l.metrics,
             error: l.error,
             log: l.log,
@@ -298,5 +315,48 @@ mod tests {
             line,
             r#"{"id":3,"seed":9,"strategy":"halton","point":{"discrete":[],"continuous":[0.25]},"params":{"v":0.5},"status":"fail","monitors":{"collision":{"passed":false,"robustness":0.0,"first_violation_s":1.5}},"metrics":{"min_distance_m":0.0,"time_to_failure_s":1.5},"error":null,"wall_ms":2.5}"#
         );
+    }
+
+    #[test]
+    fn an_infinite_robustness_written_null_reads_back_with_its_sign() {
+        let space = ParamSpace::new(vec![Param::interval("v", 0.0, 2.0, "m/s")]).unwrap();
+        let monitor = |passed: bool, robustness: f64| MonitorResult {
+            passed,
+            robustness,
+            first_violation_s: None,
+            cut_short: false,
+        };
+        let point = Point {
+            discrete: vec![],
+            continuous: vec![0.25],
+        };
+        let r = RunRecord {
+            campaign: None,
+            id: 0,
+            seed: 1,
+            strategy: "halton".into(),
+            params: space.decode(&point).ok(),
+            point,
+            status: Status::Fail,
+            monitors: vec![
+                ("collision".into(), monitor(true, f64::INFINITY)),
+                ("never".into(), monitor(false, f64::NEG_INFINITY)),
+                ("offroad".into(), monitor(true, 1.75)),
+            ],
+            metrics: vec![],
+            error: None,
+            log: Vec::new(),
+            wall_ms: 1.0,
+        };
+        let line = serde_json::to_string(&r).unwrap();
+        assert!(
+            line.contains(r#""never":{"passed":false,"robustness":null"#),
+            "{line}"
+        );
+        let back = RunRecord::from_line(&line, &space).unwrap();
+        assert_eq!(back, r);
+        // The failed monitor's -inf is the test's cost, not skipped as a NaN would be.
+        assert_eq!(back.cost(&[]), f64::NEG_INFINITY);
+        assert_eq!(serde_json::to_string(&back).unwrap(), line);
     }
 }

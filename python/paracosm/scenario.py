@@ -212,13 +212,21 @@ def _sut_args(sut) -> dict:
     raise ValueError(f"sut must be None, a built-in name or a command as a list of words, not {sut!r}")
 
 
+def _monitor_robustness(m: dict) -> float:
+    """A monitor's robustness as a float. JSON has no infinity, so paracosm writes an infinite
+    robustness as null: +inf when the monitor passed (nothing to measure, e.g. a
+    CollisionMonitor with no other actor), -inf when it failed (a stream with no event)."""
+    if m["robustness"] is None:
+        return math.inf if m["passed"] else -math.inf
+    return m["robustness"]
+
+
 def _robustness(monitors: dict, passive=()) -> float:
     """The smallest robustness over the monitors (<= 0: failed; +inf without monitors), the
     `passive` ones counting only where they are <= 0 (paracosm's falsification cost)."""
+    values = [_monitor_robustness(m) for m in monitors.values()]
     values = [
-        math.nan if m["robustness"] is None else m["robustness"]
-        for name, m in monitors.items()
-        if name not in passive or (m["robustness"] is not None and m["robustness"] <= 0.0)
+        v for v, name in zip(values, monitors) if name not in passive or v <= 0.0
     ]
     return min(values, default=math.inf)
 
@@ -234,7 +242,7 @@ def _flat(record: dict, space: Space) -> dict:
     monitors = record["monitors"]
     row["robustness"] = math.nan if record["status"] == "error" else _robustness(monitors)
     for name, m in monitors.items():
-        row[f"{name}.robustness"] = math.nan if m["robustness"] is None else m["robustness"]
+        row[f"{name}.robustness"] = _monitor_robustness(m)
         row[f"{name}.passed"] = m["passed"]
         row[f"{name}.first_violation_s"] = (
             math.nan if m["first_violation_s"] is None else m["first_violation_s"]

@@ -123,6 +123,31 @@ def test_robustness_of_one_point_for_optimisers(box_program):
         s.robustness(np.zeros((2, 4)))
 
 
+def test_an_infinite_robustness_keeps_its_sign(tmp_path):
+    """results.jsonl writes an infinite robustness as null; read back, a failed monitor's is
+    -inf (never NaN, which min() would skip or keep by order) and a passed one's +inf."""
+    program = tmp_path / "never.star"
+    program.write_text(
+        "a = VarInterval(0, 10)\n"
+        "r = RoadSegment(len = 150.0)\n"
+        "w = World()\n"
+        "v = AutonomousVehicle(loc = r.onLane(1, 10.0), speed = a)\n"
+        "w.place(r, v)\n"
+        "CollisionMonitor(v)\n"
+        "never = Monitor(tick.filter(lambda t: t > 100).map(lambda t: 1.0))\n"
+        "test(horizon = 1.0)\n"
+    )
+    s = paracosm.Scenario(str(program))
+    (record,) = s.run([{"a": 5.0}], output="records")
+    assert record["monitors"]["never"] == {"passed": False, "robustness": None, "first_violation_s": None}
+    assert record["monitors"]["collision"]["robustness"] is None
+    assert s.robustness({"a": 5.0}) == -np.inf
+    df = s.run([{"a": 5.0}])
+    assert df["robustness"][0] == -np.inf
+    assert df["never.robustness"][0] == -np.inf
+    assert df["collision.robustness"][0] == np.inf
+
+
 def test_a_test_that_ends_in_error_is_never_a_number_by_accident(tmp_path):
     program = tmp_path / "breaks.star"
     program.write_text(
