@@ -427,6 +427,34 @@ t.connect((t.ONE, e, e.TWO), (t.TWO, s, s.ONE), (t.THREE, x, x.ONE))
     );
 }
 
+/// A car enters the test at its speed stream's first value, so its `speed` and `vel` read
+/// that value at t = 0 too (they read 0 there, and a monitor over them failed at t = 0):
+/// a constant speed, an open one varying over time, and STL over the published signal.
+#[test]
+fn a_cars_speed_at_t0_is_the_speed_it_enters_at() {
+    let src = format!(
+        "{ROAD}lead = Car(loc = r.onLane(1, 60.0), speed = 8.0)\n\
+         other = Car(loc = r.onLane(2, 100.0), speed = VarInterval(6.0, 7.0, over_time = Piecewise(2), name = \"s\"))\n\
+         w.place(r, v, lead, other)\n\
+         Monitor(lead.speed.map(lambda s: s - 7.9), name = \"lead_speed\")\n\
+         Monitor(lead.vel.map(lambda u: abs(u) - 7.9), name = \"lead_vel\")\n\
+         Monitor(other.speed.map(lambda s: s - 5.9), name = \"other_speed\")\n\
+         Stl(\"G[0,1] (lead.speed >= 7.9)\", name = \"stl\")\n\
+         test(horizon = 1.0)\n"
+    );
+    let (records, _, _) = run_src(&src, "2", &[], 0);
+    for r in &records {
+        let m = &r["monitors"];
+        for name in ["lead_speed", "lead_vel", "other_speed", "stl"] {
+            assert_eq!(m[name]["passed"], true, "{name}: {r}");
+        }
+        assert!(
+            (m["lead_speed"]["robustness"].as_f64().unwrap() - 0.1).abs() < 1e-9,
+            "{r}"
+        );
+    }
+}
+
 /// `print` writes to the test's log: in results.jsonl, on stderr with --verbose, never on
 /// stdout during a campaign.
 #[test]

@@ -242,7 +242,14 @@ impl Car {
         self.change_started_s = Some(t_s);
     }
 
-    /// Its speed along the path in the last step, m/s.
+    /// Sets the speed it reports before its first step (m/s, negative counts as 0): the speed
+    /// it enters the test at. The first step sets its speed from the speed stream anyway.
+    pub(crate) fn enter_at(&mut self, speed_mps: f64) {
+        self.speed = speed_mps.max(0.0);
+    }
+
+    /// Its speed along the path in the last step (before the first step, the speed it enters
+    /// the test at, when known), m/s.
     pub(crate) fn speed_mps(&self) -> f64 {
         self.speed
     }

@@ -10,7 +10,7 @@ use crate::car::{Car, CarState, LaneChangeStart};
 use crate::network::{Lane, Network, PieceId, Surface};
 use crate::obstacle::{Obstacle, ObstacleState};
 use crate::pedestrian::Pedestrian;
-use crate::rx::{Host, Inputs, Runtime, StreamId, Value};
+use crate::rx::{Host, Inputs, Node, Runtime, StreamId, Value};
 use crate::sensor::{Reading, Scene, Sensor, Sensors};
 use crate::spec::EnvironmentSpec;
 use crate::vehicle::EgoVehicle;
@@ -227,6 +227,20 @@ impl Simulation {
                 c.speed,
             );
             car.lane_change = c.lane_change;
+            // A car enters the test at its speed stream's first value, so at t = 0 (before a
+            // step has measured it) its speed is that value where it is known without running
+            // the program's code: a constant or an open parameter, also one varying over time.
+            let first = match spec.streams.nodes().get(c.speed.0) {
+                Some(Node::Const(Value::Num(v))) => Some(*v),
+                Some(Node::Open(o)) => match o.at(0.0) {
+                    Value::Num(v) => Some(v),
+                    _ => None,
+                },
+                _ => None,
+            };
+            if let Some(v) = first.filter(|v| v.is_finite()) {
+                car.enter_at(v);
+            }
             let collider = car.body.map(|(_, c)| c);
             let h = cars.insert(car);
             if let Some(collider) = collider {
