@@ -37,8 +37,9 @@ enum Command {
     Estimate {
         /// A CSV file with a header, or the results.jsonl of paracosm-fuzz.
         file: PathBuf,
-        /// The parameters' domains: a built-in scenario name or a TOML file. Without it every
-        /// column must lie in [0, 1] and is continuous (a first column `id` is skipped).
+        /// The parameters' domains: a built-in scenario name, a scenario program (`.star`) or a
+        /// TOML file. Without it every column must lie in [0, 1] and is continuous (a first
+        /// column `id` is skipped).
         #[arg(long)]
         space: Option<String>,
         /// Largest k-wise strength to report (default: 2, or the number of discrete
@@ -66,7 +67,8 @@ enum Command {
     /// the parameter names), or, with --model, a covering array for a PICT model (header: the
     /// parameter names, then rows of values as written in the model).
     Generate {
-        /// The parameters' domains: a built-in scenario name or a TOML file.
+        /// The parameters' domains: a built-in scenario name, a scenario program (`.star`) or a
+        /// TOML file.
         #[arg(long, required_unless_present = "model", conflicts_with = "model")]
         space: Option<String>,
         /// A PICT model: `Name: v1, v2` lines and `IF [A] = "x" THEN [B] <> "y";` constraints.
@@ -112,7 +114,8 @@ enum Command {
     /// Print how many tests a (k, ε)-covering set needs: random k-wise rows by Proposition 3.2
     /// and its union bound, Halton points per row from the measured n·dispersion constant.
     Plan {
-        /// The parameters' domains: a built-in scenario name or a TOML file.
+        /// The parameters' domains: a built-in scenario name, a scenario program (`.star`) or a
+        /// TOML file.
         #[arg(long)]
         space: String,
         /// Strength k of the discrete part.

@@ -1,4 +1,5 @@
-//! `--space SPEC`: a built-in scenario's space, or a small TOML file.
+//! `--space SPEC`: a built-in scenario's space, a scenario program's (`.star`), or a small TOML
+//! file.
 
 use std::path::Path;
 
@@ -17,6 +18,10 @@ pub enum SpecError {
     /// [`paracosm_scenarios::text_file::MAX_SOURCE_BYTES`], or not UTF-8 (line and column).
     #[error("{0}: cannot read: {1}")]
     Unreadable(String, String),
+    /// The scenario program (`.star`) does not load; the message names its file, line and
+    /// column.
+    #[error("{0}")]
+    Program(String),
     /// The TOML file does not parse or describes an invalid space.
     #[error("{file}: {reason}")]
     Invalid {
@@ -42,8 +47,9 @@ struct SpecParam {
     unit: Option<String>,
 }
 
-/// The space named by `spec`: a built-in scenario name (e.g. `pedestrian-crossing`), or a TOML
-/// file of `[[param]]` tables, each with a `name`, either `interval = [lo, hi]` or
+/// The space named by `spec`: a built-in scenario name (e.g. `pedestrian-crossing`), a scenario
+/// program (a file ending in `.star`: the space of its open parameters, as `paracosm-fuzz` samples
+/// it), or a TOML file of `[[param]]` tables, each with a `name`, either `interval = [lo, hi]` or
 /// `levels = [...]` (integers, numbers or strings), and an optional `unit`:
 ///
 /// ```toml
@@ -58,12 +64,18 @@ struct SpecParam {
 /// ```
 ///
 /// # Errors
-/// [`SpecError`] naming the file, and the line and column of a TOML error.
+/// [`SpecError`] naming the file, and the line and column of a TOML error or of the program's
+/// error ([`SpecError::Program`]).
 pub fn load_space(spec: &str) -> Result<ParamSpace, SpecError> {
     if let Ok(s) = paracosm_scenarios::builtin(spec) {
         return Ok(s.space);
     }
     let path = Path::new(spec);
+    if spec.ends_with(".star") {
+        return paracosm_scenarios::load(spec)
+            .map(|s| s.space)
+            .map_err(|e| SpecError::Program(e.to_string()));
+    }
     if !path.exists() {
         return Err(SpecError::NotFound(
             spec.to_owned(),
@@ -162,5 +174,38 @@ mod tests {
             .to_string()
             .contains("exactly one of"));
         assert!(matches!(load_space("nope"), Err(SpecError::NotFound(..))));
+    }
+
+    #[test]
+    fn a_scenario_program_gives_the_space_of_its_open_parameters() {
+        let dir = tempfile::tempdir().unwrap();
+        let good = dir.path().join("w.star");
+        std::fs::write(
+            &good,
+            "w = World(fog = VarEnum([0.0, 0.3, 0.6]))\n\
+             r = RoadSegment(len = 120.0, nlanes = 2)\n\
+             ego = AutonomousVehicle(loc = r.onLane(1, 10.0))\n\
+             gap = VarInterval(20.0, 60.0, unit = \"m\")\n\
+             lead = Car(loc = r.onLane(1, gap), speed = Const(5.0))\n\
+             w.place(r, ego, lead)\n\
+             CollisionMonitor(ego)\n",
+        )
+        .unwrap();
+        let s = load_space(good.to_str().unwrap()).unwrap();
+        let names: Vec<&str> = s.params().iter().map(|p| p.name.as_str()).collect();
+        assert!(
+            names.contains(&"w.fog") && names.contains(&"gap"),
+            "{names:?}"
+        );
+        assert_eq!(s.level_counts(), [3]);
+        assert_eq!(s.continuous_dims(), 1);
+        // A program that does not load is an error naming its file, line and column, not a
+        // TOML error.
+        let bad = dir.path().join("b.star");
+        std::fs::write(&bad, "w = World(fog = VarInterval(0.5))\n").unwrap();
+        let e = load_space(bad.to_str().unwrap()).unwrap_err();
+        assert!(matches!(e, SpecError::Program(_)), "{e:?}");
+        let e = e.to_string();
+        assert!(e.contains("b.star:1:"), "{e}");
     }
 }
