@@ -369,6 +369,108 @@ fn monitors_of_lambdas_of_the_wrong_kind_are_refused_not_read_as_numbers() {
     }
 }
 
+/// A computed input whose values are of the wrong kind (a string for a speed, a number for
+/// the pedestrian's watched car) is refused when the program loads, naming the input and its
+/// `file:line:col`, not read as something else in every test; a kind that only a later value
+/// shows stays the test's error, and a number out of range is left to the tests.
+#[test]
+fn computed_inputs_of_the_wrong_kind_are_refused_at_load() {
+    let walker = |dist: &str, car: &str| {
+        format!(
+            "{ROAD}p = Pedestrian(start = r.onLane(r.SideWalk, 60.0), \
+             target = r.onLane(-r.SideWalk, 60.0), speed = 1.0, dist = {dist}, car = {car})\n\
+             w.place(r, v, p)\nCollisionMonitor(v)\n"
+        )
+    };
+    let e = load_err(&walker("tick.map(lambda t: \"far\")", "v"));
+    assert!(
+        e.contains("the dist of Pedestrian p (t.star:")
+            && e.contains("\"far\" (a string)")
+            && e.contains("a number in m, >= 0"),
+        "{e}"
+    );
+    let e = load_err(&walker("20.0", "tick.map(lambda t: 3.0)"));
+    assert!(
+        e.contains("the car of Pedestrian p (t.star:") && e.contains("a position"),
+        "{e}"
+    );
+    let e = load_err(&format!(
+        "{ROAD}c = Car(loc = r.onLane(1, 60.0), speed = tick.map(lambda t: \"fast\"))\n\
+         w.place(r, v, c)\nCollisionMonitor(v)\n"
+    ));
+    assert!(
+        e.contains("the speed of Car c (t.star:") && e.contains("\"fast\" (a string)"),
+        "{e}"
+    );
+    let e = load_err(&format!(
+        "{}\nw.place(r, v)\nCollisionMonitor(v)\n",
+        ROAD.replace("World()", "World(light = tick.map(lambda t: t > 1))")
+    ));
+    assert!(
+        e.contains("the light of World w") && e.contains("False (a bool)"),
+        "{e}"
+    );
+    // A distance that goes negative after 0.5 s loads, and each test ends as an error then.
+    let late = format!(
+        "{}test(horizon = 2.0)\n",
+        walker("tick.map(lambda t: 10.0 - 20.0 * t)", "v")
+    );
+    let (records, _, _) = run_src(&late, "2", &[], 3);
+    for r in &records {
+        assert_eq!(r["status"], "error", "{r}");
+        let m = r["error"].as_str().unwrap();
+        assert!(
+            m.contains("the dist of Pedestrian p") && m.contains(">= 0"),
+            "{m}"
+        );
+    }
+}
+
+/// A disabled car is not in the test: its outputs have no events, so a pedestrian it would
+/// trigger stays put, and a monitor over its outputs (which would judge a car that is not
+/// there) is refused at load, naming the monitor and the car.
+#[test]
+fn a_disabled_cars_outputs_have_no_events_and_monitors_of_them_are_refused() {
+    let base = format!(
+        "{ROAD}c = Car(loc = r.onLane(2, 60.0), speed = 8.0, enabled = VarEnum([True, False]))\n\
+         p = Pedestrian(start = r.onLane(r.SideWalk, 150.0), \
+         target = r.onLane(-r.SideWalk, 150.0), speed = 1.5, dist = 500.0, car = c)\n\
+         w.place(r, v, c, p)\nCollisionMonitor(v)\n"
+    );
+    let e = load_err(&format!(
+        "{base}moves = Monitor(c.speed.map(lambda s: s - 1.0))\n"
+    ));
+    assert!(
+        e.contains("monitor `moves` reads Car c")
+            && e.contains("enabled = False")
+            && e.contains("t.star:"),
+        "{e}"
+    );
+    let e = load_err(&format!(
+        "{base}Stl(\"G[0,3] (c.speed > 1)\", name = \"fast\")\n"
+    ));
+    assert!(e.contains("monitor `fast` reads Car c"), "{e}");
+    // Through a top-level variable the program judges the car only when it is there; the
+    // pedestrian walks only when the car that triggers it is in the test.
+    let ok = format!(
+        "{base}c_speed = c.speed\n\
+         moves = Monitor(tick.map(lambda t: 1.0 if c_speed == None else c_speed - 1.0))\n\
+         walked = Monitor(p.speed.max().map(lambda s: s - 0.5), over = \"end\")\n\
+         test(horizon = 3.0)\n"
+    );
+    let (records, _, _) = run_src(&ok, "2", &[], 1);
+    assert_eq!(records.len(), 2);
+    for r in &records {
+        let enabled = r["params"]["c.enabled"].as_bool().unwrap();
+        let m = &r["monitors"];
+        assert_eq!(m["walked"]["passed"].as_bool().unwrap(), enabled, "{r}");
+        assert_eq!(m["moves"]["passed"], true, "{r}");
+        let moves = m["moves"]["robustness"].as_f64().unwrap();
+        let want = if enabled { 7.0 } else { 1.0 };
+        assert!((moves - want).abs() < 1e-6, "{r}");
+    }
+}
+
 /// A route's turn that a junction lacks is an error naming the actor, the turn and what the
 /// junction offers, not another turn taken in its place.
 #[test]

@@ -917,7 +917,10 @@ impl Inputs for WorldInputs<'_> {
                 }
             },
             Actor::Car(i) => match self.cars.get(Handle::from_index(i as usize)) {
+                // A disabled car is not in the test: its outputs have no events (it still
+                // moves along its path unseen, which nothing reads).
                 None => Value::Unit,
+                Some(c) if c.body.is_none() => Value::Unit,
                 Some(c) => {
                     let s = c.state();
                     let d = crate::network::direction(s.heading_rad);

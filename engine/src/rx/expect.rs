@@ -44,6 +44,19 @@ impl Expect {
     }
 }
 
+impl Expect {
+    /// Whether `v` is of the accepted kind (a number, a bool, a position), whatever its value:
+    /// `NaN` and `-1` are numbers here, and a string is not.
+    pub fn accepts_kind(&self, v: &Value) -> bool {
+        matches!(
+            (self, v),
+            (Expect::Number { .. }, Value::Num(_))
+                | (Expect::Bool, Value::Bool(_))
+                | (Expect::Position, Value::Vec3(_))
+        )
+    }
+}
+
 impl fmt::Display for Expect {
     /// E.g. `a number in m/s, >= 0`, `a number in [0, 1]`, `a bool`, `a position`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

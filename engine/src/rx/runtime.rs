@@ -4,7 +4,8 @@ use super::{Func, Graph, Node, RxError, StreamId, Value};
 
 /// The physics outputs a graph's [`Node::Probe`]s read, supplied by the simulation each step.
 pub trait Inputs {
-    /// The current value of probe `id`.
+    /// The current value of probe `id`; [`Value::Unit`] for an actor that is not in the test
+    /// (a disabled car), whose probes then have no event.
     fn probe(&self, id: u32) -> Value;
 }
 
@@ -128,7 +129,9 @@ impl Runtime {
     ///
     /// # Errors
     /// The first [`RxError::Host`] or [`RxError::Type`] a function raised: a filter predicate
-    /// that returns no bool, a `sum` of values that do not add.
+    /// that returns no bool, a `sum` of values that do not add; [`RxError::Input`] for an
+    /// input checked by a [`Node::Check`] whose sample is of the wrong kind (a string or a
+    /// bool where a number belongs; not a number out of range, which the tests find).
     pub fn check(
         &mut self,
         t_s: f64,
@@ -141,7 +144,7 @@ impl Runtime {
             let node = self.graph.nodes()[i].clone();
             let out = match &node {
                 Node::Const(_) | Node::Tick | Node::Open(_) | Node::Probe(_) | Node::Param(_) => {
-                    Some(source(i, &node, t_s, inputs)?)
+                    source(i, &node, t_s, inputs)?
                 }
                 Node::Map { src, f } => match sample(self, src) {
                     Some(v) => Some(call(i, f, &[v], host, self)?),
@@ -169,8 +172,21 @@ impl Runtime {
                 },
                 Node::Take { src, .. }
                 | Node::SkipUntil { src, .. }
-                | Node::TakeUntil { src, .. }
-                | Node::Check { src, .. } => sample(self, src),
+                | Node::TakeUntil { src, .. } => sample(self, src),
+                // The kind of an input's value is known from its sample (a string or a
+                // position where a number belongs); its range is left to the tests, where
+                // the values are real.
+                Node::Check { src, expect, name } => match sample(self, src) {
+                    Some(v) if !expect.accepts_kind(&v) => {
+                        return Err(RxError::Input {
+                            name: name.to_string(),
+                            t_s,
+                            value: super::describe(&v),
+                            expected: expect.to_string(),
+                        })
+                    }
+                    v => v,
+                },
                 Node::Concat(a, b) => sample(self, a).or_else(|| sample(self, b)),
                 Node::Sum { src, init, f } => match sample(self, src) {
                     Some(v) => Some(match f {
@@ -219,7 +235,7 @@ impl Runtime {
         let node = &self.graph.nodes()[i];
         let out = match node {
             Node::Const(_) | Node::Tick | Node::Open(_) | Node::Probe(_) | Node::Param(_) => {
-                Some(source(i, node, t_s, inputs)?)
+                source(i, node, t_s, inputs)?
             }
             Node::Map { src, f } => {
                 let f = f.clone();
@@ -397,12 +413,17 @@ impl Runtime {
 /// # Errors
 /// [`RxError::Unbound`] for an open parameter slot; [`RxError::Type`] for a node that is not
 /// a source.
-fn source(i: usize, node: &Node, t_s: f64, inputs: &dyn Inputs) -> Result<Value, RxError> {
+/// The event of source node `i` now: `None` for a probe of an actor that is not in the test
+/// (its probe reads [`Value::Unit`]).
+fn source(i: usize, node: &Node, t_s: f64, inputs: &dyn Inputs) -> Result<Option<Value>, RxError> {
     match node {
-        Node::Const(v) => Ok(v.clone()),
-        Node::Tick => Ok(Value::Num(t_s)),
-        Node::Open(o) => Ok(o.at(t_s)),
-        Node::Probe(p) => Ok(inputs.probe(*p)),
+        Node::Const(v) => Ok(Some(v.clone())),
+        Node::Tick => Ok(Some(Value::Num(t_s))),
+        Node::Open(o) => Ok(Some(o.at(t_s))),
+        Node::Probe(p) => Ok(match inputs.probe(*p) {
+            Value::Unit => None,
+            v => Some(v),
+        }),
         Node::Param(slot) => Err(RxError::Unbound {
             node: i,
             slot: *slot,

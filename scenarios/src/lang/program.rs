@@ -99,19 +99,38 @@ fn lambda_values<'v>(b: &SceneBuilder, module: &Module<'v>) -> Result<Vec<Value<
         .collect()
 }
 
-/// Checks what every evaluation must have declared once the program has run.
-fn finished(b: &SceneBuilder) -> Result<(), String> {
+/// Checks what every evaluation must have declared once the program has run; the error is
+/// the whole message, pointing at the declaration at fault, else at `file`.
+fn finished(b: &SceneBuilder, file: &str) -> Result<(), String> {
+    finished_message(b).map_err(|(m, at)| format!("error: {m}\n --> {}", at.unwrap_or(file)))
+}
+
+/// What [`finished`] finds wrong, and where, when one declaration is at fault.
+fn finished_message(b: &SceneBuilder) -> Result<(), (String, Option<&str>)> {
     if !b.placed {
-        return Err("the program never calls place(...): nothing to test".into());
+        return Err((
+            "the program never calls place(...): nothing to test".into(),
+            None,
+        ));
     }
     if let Some(o) = b.objects.iter().find(|o| !o.placed) {
-        return Err(format!("{} is never placed: pass it to place(...)", o.name));
+        return Err((
+            format!(
+                "{} is declared after place(...), so it is never placed: declare every actor \
+                 and obstacle before place(...), and list it there",
+                o.name
+            ),
+            Some(&o.at),
+        ));
     }
     if b.ego.is_none() {
-        return Err("the program places no AutonomousVehicle: nothing to test".into());
+        return Err((
+            "the program places no AutonomousVehicle: nothing to test".into(),
+            None,
+        ));
     }
     if b.world.is_none() {
-        return Err("the program has no World(...)".into());
+        return Err(("the program has no World(...)".into(), None));
     }
     Ok(())
 }
@@ -221,7 +240,7 @@ impl Program {
                 }
             }
             b.log = printed;
-            finished(&b).map_err(|m| format!("error: {m}\n --> {}", self.file))?;
+            finished(&b, &self.file)?;
             Ok((then(b, &module)?, steps))
         })
     }

@@ -412,6 +412,7 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
     let (light, fog) = b.world.ok_or("the program has no World(...)")?;
     let mut nodes = b.graph.clone();
     let published = published(b, &mut nodes)?;
+    refuse_monitors_of_absent_cars(b, nodes.nodes(), &published)?;
     let graph = nodes.finish().map_err(|e| e.to_string())?;
     let streams = graph
         .bind(&over_time_streams(b, horizon_s))
@@ -439,6 +440,68 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
         published,
         lidar: LidarSpec::default(),
     })
+}
+
+/// Refuses a world in which a monitor reads the outputs of a car this world leaves out
+/// (`Car(enabled = False)`): such a car is not in the test, its outputs carry no events, and
+/// the monitor would have nothing to judge. A stream depends on a car when the car's probe
+/// feeds it through any input but a `takeUntil`'s stop (a stop that never fires cuts
+/// nothing).
+///
+/// # Errors
+/// A message naming the monitor, the car, how to read an optional car, and the monitor's
+/// `file:line:col`.
+fn refuse_monitors_of_absent_cars(
+    b: &SceneBuilder,
+    nodes: &[Node],
+    published: &[(String, StreamId)],
+) -> Result<(), String> {
+    let absent: Vec<usize> = (0..b.cars.len()).filter(|&i| !b.cars[i].enabled).collect();
+    if absent.is_empty() {
+        return Ok(());
+    }
+    // The absent car each stream depends on, in topological order (a node's inputs come
+    // before it).
+    let mut reads: Vec<Option<usize>> = vec![None; nodes.len()];
+    for (i, node) in nodes.iter().enumerate() {
+        reads[i] = match node {
+            Node::Probe(p) => match paracosm_engine::behaviour::decode_probe(*p).0 {
+                Actor::Car(c) if absent.contains(&(c as usize)) => Some(c as usize),
+                _ => None,
+            },
+            Node::TakeUntil { src, .. } => reads.get(src.0).copied().flatten(),
+            other => other
+                .inputs()
+                .iter()
+                .find_map(|s| reads.get(s.0).copied().flatten()),
+        };
+    }
+    for (name, id) in published {
+        let Some(car) = reads.get(id.0).copied().flatten() else {
+            continue;
+        };
+        let reader = b.monitors.iter().enumerate().find(|(_, m)| {
+            m.signals().iter().any(|s| {
+                s == name
+                    || s.strip_prefix(name.as_str())
+                        .is_some_and(|c| [".x", ".y", ".z"].contains(&c))
+            })
+        });
+        if let Some((k, m)) = reader {
+            let at = b.monitors_at.get(k).map(String::as_str).unwrap_or("");
+            let car_name = b.car_names.get(car).map(String::as_str).unwrap_or("a Car");
+            return Err(format!(
+                "monitor `{}` reads {car_name}, which this world leaves out (enabled = False): \
+                 the car is not in the test, its outputs have no events, and the monitor \
+                 would have nothing to judge. For a car that is in some tests only, read it \
+                 in a lambda through a top-level variable (`lead_speed = lead.speed`), which \
+                 is None while the car is absent, and judge a stream that always fires \
+                 (`tick.map(...)`)\n --> {at}",
+                m.name()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Checks that every signal a monitor reads is published by the runner, the program or an
@@ -598,7 +661,11 @@ impl SceneBuilder {
             self.objects[o].placed = true;
         }
         if let Some(o) = self.objects.iter().find(|o| !o.placed) {
-            return Err(format!("{} is never placed: pass it to place(...)", o.name));
+            return Err(format!(
+                "{} is not in this place(...): place(...) is called once, and lists every \
+                 actor and obstacle",
+                o.name
+            ));
         }
         let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(&b.roads);
         // Check the starting positions before anything depends on them (routes, behaviours).

@@ -265,6 +265,26 @@ fn inputs_of_the_wrong_kind_or_out_of_range_are_refused_at_load() {
         (walker("speed = 1.0, dist = VarInterval(-5, 5), car = v"), "Pedestrian(dist=) takes a number in m, >= 0, got -5 (a number)", "4:5"),
         (walker("speed = 1.0, dist = 10.0, car = 3.0"), "Pedestrian(car=) takes a position (x, y, z) in m, got 3 (a number)", "4:5"),
         (walker("speed = 1.0, dist = 10.0, car = v.speed"), "but this stream carries numbers", "4:5"),
+        (
+            world("") + "test(horizon = 5.0)\ntest(horizon = 8.0)\n",
+            "test(...) is called once per program; it was already called at bad.star:5:1",
+            "6:1",
+        ),
+        (
+            with_car("", "") + "OffRoadMonitor(c)\n",
+            "OffRoadMonitor watches the AutonomousVehicle; got a Car (to judge another actor",
+            "7:1",
+        ),
+        (
+            format!("{HEADER}c = Car(loc = r.onLane(1, 60))\nw.place(r, v)\n"),
+            "Car c is not in this place(...): place(...) is called once, and lists every actor",
+            "5:1",
+        ),
+        (
+            format!("{HEADER}w.place(r, v)\nc = Car(loc = r.onLane(1, 60))\n"),
+            "Car c is declared after place(...), so it is never placed",
+            "5:5",
+        ),
     ];
     for (src, message, at) in cases {
         let m = err(&src);
@@ -316,17 +336,26 @@ fn computed_values_are_checked_as_the_test_runs() {
         e.starts_with("at t = 2.017 s, the fog of World w (run.star:1:5) was 1.0083333333333333 (a number); it must be a number in [0, 1]"),
         "{e}"
     );
+    let e = run_once(&with_car(
+        ", speed = tick.map(lambda t: -1.0 if t > 1 else 3.0)",
+        "",
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("the speed of Car c (run.star:4:5)") && e.contains("was -1 (a number)"),
+        "{e}"
+    );
+    // A value of the wrong kind is found at load, where every stream is sampled once.
     for (speed, value) in [
-        (
-            "tick.map(lambda t: -1.0 if t > 1 else 3.0)",
-            "was -1 (a number)",
-        ),
         ("tick.map(lambda t: t > 1)", "was False (a bool)"),
         ("tick.map(lambda t: (t, t))", "(a tuple)"),
     ] {
-        let e = run_once(&with_car(&format!(", speed = {speed}"), ""))
-            .unwrap_err()
-            .to_string();
+        let src = with_car(&format!(", speed = {speed}"), "");
+        let Err(e) = load_source("run.star", &src, "run") else {
+            panic!("{speed}: a speed of the wrong kind loads");
+        };
+        let e = e.to_string();
         assert!(
             e.contains("the speed of Car c (run.star:4:5)") && e.contains(value),
             "{speed}: {e}"

@@ -74,13 +74,18 @@ pub(super) fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<Mon
 }
 
 pub(super) fn ego_arg(v: Value, what: &str) -> anyhow::Result<()> {
-    match v.downcast_ref::<ActorVal>() {
-        Some(a) if a.kind == ActorKind::Ego => Ok(()),
-        _ => bail!(
-            "{what} watches the AutonomousVehicle; got a {}",
-            v.get_type()
-        ),
-    }
+    let got = match v.downcast_ref::<ActorVal>() {
+        Some(a) => match a.kind {
+            ActorKind::Ego => return Ok(()),
+            ActorKind::Car(_) => "a Car".to_owned(),
+            ActorKind::Pedestrian(_) => "a Pedestrian".to_owned(),
+        },
+        None => format!("a {}", v.get_type()),
+    };
+    bail!(
+        "{what} watches the AutonomousVehicle; got {got} (to judge another actor, write a \
+         Monitor or an Stl formula over its outputs, e.g. `c.speed`)"
+    )
 }
 
 /// The builtins of this topic.

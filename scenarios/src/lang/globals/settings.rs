@@ -18,7 +18,8 @@ use super::*;
 pub(super) fn register(builder: &mut GlobalsBuilder) {
     /// `test(horizon=15.0, map=None, offroad=True)`: the test length in seconds, the failure
     /// map's axes (one or two parameter names), and whether the default `OffRoadMonitor` is
-    /// added to a program that declares none.
+    /// added to a program that declares none. Called at most once: a second call is an error
+    /// naming the first.
     fn test<'v>(
         #[starlark(require = named)] horizon: Option<Value<'v>>,
         #[starlark(require = named)] map: Option<Value<'v>>,
@@ -27,6 +28,10 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
     ) -> anyhow::Result<NoneType> {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
+        if let Some(first) = &b.test_at {
+            // A second call would silently replace the first one's horizon and map.
+            bail!("test(...) is called once per program; it was already called at {first}");
+        }
         b.test_at = Some(here(eval));
         if let Some(h) = horizon {
             let h = number(h, "horizon")?;
