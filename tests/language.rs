@@ -587,6 +587,8 @@ test(horizon = 1.5)
         "{log:?}"
     );
     assert!(stderr.contains("test 1: one second in"), "{stderr}");
+    // What the program prints at load is shown once, though loading runs it more than once.
+    assert_eq!(stderr.matches("print: loaded").count(), 1, "{stderr}");
 }
 
 /// Actions: `car.setSpeed` and `car.brake(decel)` change a car's speed, `car.changeLane(lane)`

@@ -67,14 +67,22 @@ fn eval(f: &Formula, t: &Trace) -> Result<Vec<f64>, StlError> {
     Ok(match f {
         Formula::True => vec![f64::INFINITY; n],
         Formula::False => vec![f64::NEG_INFINITY; n],
-        Formula::Pred { signal, op, value } => {
-            let x = t
-                .signals
-                .get(signal)
-                .ok_or_else(|| StlError::MissingSignal(signal.clone()))?;
+        Formula::Pred { terms, op, value } => {
+            // Σ c·x, summed in the order written; a single term with coefficient 1 is the
+            // signal itself, bit for bit.
+            let mut sum = vec![0.0; n];
+            for (k, (c, signal)) in terms.iter().enumerate() {
+                let x = t
+                    .signals
+                    .get(signal)
+                    .ok_or_else(|| StlError::MissingSignal(signal.clone()))?;
+                for (s, v) in sum.iter_mut().zip(x) {
+                    *s = if k == 0 { c * v } else { *s + c * v };
+                }
+            }
             match op {
-                Cmp::Gt | Cmp::Ge => x.iter().map(|v| v - value).collect(),
-                Cmp::Lt | Cmp::Le => x.iter().map(|v| value - v).collect(),
+                Cmp::Gt | Cmp::Ge => sum.iter().map(|v| v - value).collect(),
+                Cmp::Lt | Cmp::Le => sum.iter().map(|v| value - v).collect(),
             }
         }
         Formula::Not(g) => eval(g, t)?.into_iter().map(|r| -r).collect(),
@@ -270,7 +278,7 @@ mod tests {
     fn errors_show_the_column_and_name_the_problem() {
         let e = parse("G[0,1] (a > )").unwrap_err().to_string();
         assert!(
-            e.contains("1:13") && e.contains('^') && e.contains("expected number"),
+            e.contains("1:13") && e.contains('^') && e.contains("expected a signal or a number"),
             "{e}"
         );
         assert_eq!(parse("F[2,1] a > 0"), Err(StlError::Interval(2.0, 1.0)));

@@ -1,13 +1,15 @@
 //! Signal temporal logic (STL) with quantitative robustness (space robustness of Fainekos &
 //! Pappas 2009; Donzé & Maler 2010), in discrete time over uniformly sampled traces.
 //!
-//! Syntax ([`parse`], a `pest` grammar): predicates `signal < c`, `<=`, `>`, `>=`; `true`,
-//! `false`; `!φ` (or `not`), `φ & ψ` (`and`), `φ | ψ` (`or`), `φ -> ψ`; `G[a,b] φ`,
+//! Syntax ([`parse`], a `pest` grammar): predicates `signal < c`, `<=`, `>`, `>=`, and
+//! comparisons of linear combinations of signals (`a - b > 8`, `x < y + 1`, `2 * x <= y`);
+//! `true`, `false`; `!φ` (or `not`), `φ & ψ` (`and`), `φ | ψ` (`or`), `φ -> ψ`; `G[a,b] φ`,
 //! `F[a,b] φ` and `φ U[a,b] ψ` with bounds in seconds. Example:
 //! `G[0,10](a > 0 -> F[0,2](b < 1))`.
 //!
 //! Robustness ρ at sample `i` (positive: satisfied with that margin):
-//! - `x > c`, `x >= c`: `x(i) - c`; `x < c`, `x <= c`: `c - x(i)`;
+//! - `x > c`, `x >= c`: `x(i) - c`; `x < c`, `x <= c`: `c - x(i)`; for linear combinations
+//!   `L > R`: `L(i) - R(i)`, and `L < R`: `R(i) - L(i)` (as RTAMT and Breach do);
 //! - `!φ`: `-ρφ`; `φ & ψ`: `min`; `φ | ψ`: `max`; `φ -> ψ`: `max(-ρφ, ρψ)`;
 //! - `G[a,b] φ`: `min` of `ρφ(j)` over `j ∈ [i + a/dt, i + b/dt]` within the trace (`+inf`
 //!   when the window is past the end); `F[a,b] φ`: `max` (`-inf` when empty);
@@ -49,13 +51,15 @@ pub enum Formula {
     True,
     /// `false`: robustness `-inf`.
     False,
-    /// `signal op value`.
+    /// `Σ coefficient × signal  op  value`: a comparison of two linear combinations of
+    /// signals, with every signal moved to the left and every constant to the right
+    /// (`a - b > 8`, `speed < lead.speed + 1`: terms `[(1, speed), (-1, lead.speed)]`, value 1).
     Pred {
-        /// The signal's name.
-        signal: String,
+        /// `(coefficient, signal name)`, each signal once; empty for a comparison of constants.
+        terms: Vec<(f64, String)>,
         /// The comparison.
         op: Cmp,
-        /// The threshold, in the signal's unit.
+        /// The threshold, in the signals' unit.
         value: f64,
     },
     /// `!φ`.
@@ -126,7 +130,7 @@ impl Formula {
     fn collect(&self, out: &mut Vec<String>) {
         match self {
             Formula::True | Formula::False => {}
-            Formula::Pred { signal, .. } => out.push(signal.clone()),
+            Formula::Pred { terms, .. } => out.extend(terms.iter().map(|(_, s)| s.clone())),
             Formula::Not(f) | Formula::Globally(_, _, f) | Formula::Eventually(_, _, f) => {
                 f.collect(out)
             }

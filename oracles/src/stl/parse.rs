@@ -21,7 +21,7 @@ pub fn parse(text: &str) -> Result<Formula, StlError> {
         return Err(StlError::TooComplex(n));
     }
     let mut pairs =
-        StlParser::parse(Rule::formula, text).map_err(|e| StlError::Parse(e.to_string()))?;
+        StlParser::parse(Rule::formula, text).map_err(|e| StlError::Parse(describe(e)))?;
     let formula = pairs.next().expect("the formula rule");
     let inner = formula.into_inner().next().expect("an implication");
     build(inner)
@@ -67,6 +67,28 @@ fn complexity(text: &str) -> usize {
     operators + deepest
 }
 
+/// pest's report, with the grammar's rules named as a reader of the formula knows them.
+fn describe(e: pest::error::Error<Rule>) -> String {
+    e.renamed_rules(|rule| {
+        match rule {
+            Rule::sum | Rule::term => "a signal or a number (a sum like `a - b + 2`)",
+            Rule::cmp => "a comparison (<, <=, >, >=)",
+            Rule::addop => "+ or -",
+            Rule::number => "a number",
+            Rule::ident => "a signal",
+            Rule::interval => "a time interval [a,b]",
+            Rule::implies => "->",
+            Rule::or => "| (or)",
+            Rule::and => "& (and)",
+            Rule::until => "U[a,b]",
+            Rule::EOI => "the end of the formula",
+            other => return format!("{other:?}"),
+        }
+        .to_owned()
+    })
+    .to_string()
+}
+
 fn number(p: Pair<'_, Rule>) -> f64 {
     p.as_str().parse().unwrap_or(f64::NAN)
 }
@@ -81,6 +103,34 @@ fn interval(p: Pair<'_, Rule>) -> Result<(f64, f64), StlError> {
         return Err(StlError::Interval(a, b));
     }
     Ok((a, b))
+}
+
+/// Adds `sign ×` the sum `p` to `terms` (a signal written twice gets one coefficient) and
+/// `constant`.
+fn linear(p: Pair<'_, Rule>, sign: f64, terms: &mut Vec<(f64, String)>, constant: &mut f64) {
+    let mut term_sign = sign;
+    for part in p.into_inner() {
+        match part.as_rule() {
+            Rule::addop => term_sign = if part.as_str() == "-" { -sign } else { sign },
+            _ => {
+                let mut coefficient = term_sign;
+                let mut signal = None;
+                for x in part.into_inner() {
+                    match x.as_rule() {
+                        Rule::number => coefficient *= number(x),
+                        _ => signal = Some(x.as_str().to_owned()),
+                    }
+                }
+                match signal {
+                    Some(name) => match terms.iter_mut().find(|(_, s)| *s == name) {
+                        Some((c, _)) => *c += coefficient,
+                        None => terms.push((coefficient, name)),
+                    },
+                    None => *constant += coefficient,
+                }
+            }
+        }
+    }
 }
 
 fn build(p: Pair<'_, Rule>) -> Result<Formula, StlError> {
@@ -136,17 +186,24 @@ fn build(p: Pair<'_, Rule>) -> Result<Formula, StlError> {
         Rule::constant if text.starts_with("true") => Formula::True,
         Rule::constant => Formula::False,
         Rule::predicate => {
-            let signal = it.next().expect("ident").as_str().to_owned();
+            let left = it.next().expect("left sum");
             let op = match it.next().expect("cmp").as_str() {
                 "<" => Cmp::Lt,
                 "<=" => Cmp::Le,
                 ">" => Cmp::Gt,
                 _ => Cmp::Ge,
             };
+            let right = it.next().expect("right sum");
+            // L op R as (L - R) op 0: signals to the left, constants to the right.
+            let mut terms: Vec<(f64, String)> = Vec::new();
+            let mut constant = 0.0;
+            for (sum, sign) in [(left, 1.0), (right, -1.0)] {
+                linear(sum, sign, &mut terms, &mut constant);
+            }
             Formula::Pred {
-                signal,
+                terms,
                 op,
-                value: number(it.next().expect("number")),
+                value: -constant,
             }
         }
         other => unreachable!("rule {other:?} is never built directly"),
@@ -168,6 +225,47 @@ mod tests {
         let ok = format!("{}(x > 0)", "not ".repeat(MAX_OPERATORS - 1));
         assert!(parse(&ok).is_ok());
         assert!(parse("G[0,1] (and_x > 0 and notx > 1)").is_ok());
+    }
+
+    #[test]
+    fn predicates_compare_linear_combinations_of_signals() {
+        let trace = Trace {
+            dt_s: 0.1,
+            signals: [
+                ("a".to_owned(), vec![10.0, 12.0, 7.5]),
+                ("b.x".to_owned(), vec![1.0, 5.0, -2.0]),
+            ]
+            .into_iter()
+            .collect(),
+        };
+        let rho = |text: &str| robustness(&parse(text).unwrap(), &trace).unwrap();
+        // L > R is L - R, L < R is R - L.
+        assert_eq!(rho("a - b.x > 8"), [1.0, -1.0, 1.5]);
+        assert_eq!(rho("a < b.x + 9"), [0.0, 2.0, -0.5]);
+        assert_eq!(rho("2 * b.x <= a - 1"), [7.0, 1.0, 10.5]);
+        assert_eq!(rho("-a + 3 >= -2 * b.x"), [-5.0, 1.0, -8.5]);
+        // A signal written twice gets one coefficient; a plain predicate is unchanged.
+        assert_eq!(rho("a + a > a + 1"), rho("a > 1"));
+        assert_eq!(
+            parse("a + a > a + 1").unwrap(),
+            Formula::Pred {
+                terms: vec![(1.0, "a".into())],
+                op: Cmp::Gt,
+                value: 1.0
+            }
+        );
+        assert_eq!(parse("x - y > 1").unwrap().signals(), ["x", "y"]);
+        // `->` after a predicate is still an implication, not a minus.
+        assert!(matches!(
+            parse("a > 0 -> b.x < 1").unwrap(),
+            Formula::Implies(..)
+        ));
+        assert!(matches!(
+            parse("a > 0->b.x < 1").unwrap(),
+            Formula::Implies(..)
+        ));
+        // Products of signals are not linear: a syntax error.
+        assert!(matches!(parse("a * b.x > 1"), Err(StlError::Parse(_))));
     }
 
     #[test]

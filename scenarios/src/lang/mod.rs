@@ -75,15 +75,22 @@ pub fn load_file(path: &Path) -> Result<Scenario, ScenarioError> {
 /// (starlark reports the unknown keyword but suggests nothing).
 const KEYWORDS: &[(&str, &[&str])] = &[
     ("World", &["light", "fog"]),
-    ("RoadSegment", &["len", "nlanes", "friction"]),
-    ("Arc", &["radius", "angle", "nlanes", "friction"]),
+    ("RoadSegment", &["len", "nlanes", "numLane", "friction"]),
+    ("Arc", &["radius", "angle", "nlanes", "numLane", "friction"]),
     (
         "Clothoid",
-        &["length", "curv_start", "curv_end", "nlanes", "friction"],
+        &[
+            "length",
+            "curv_start",
+            "curv_end",
+            "nlanes",
+            "numLane",
+            "friction",
+        ],
     ),
     ("TIntersection", &["nlanes", "numLane", "friction"]),
     ("CrossIntersection", &["nlanes", "numLane", "friction"]),
-    ("Roundabout", &["nlanes", "radius", "friction"]),
+    ("Roundabout", &["nlanes", "numLane", "radius", "friction"]),
     ("OpenDrive", &["friction"]),
     ("onLane", &["lane", "road", "s"]),
     ("AutonomousVehicle", &["loc", "sut", "route", "speed"]),

@@ -17,7 +17,8 @@ const DECLARERS: [&str; 2] = ["VarInterval", "VarEnum"];
 pub struct Site {
     /// The name it gets from where it stands: the variable it is assigned to (`speed`), else
     /// `<variable>.<keyword>` of the call whose argument it is (`w.fog`), else
-    /// `<Callee>.<keyword>` (`World.fog`); `None` elsewhere.
+    /// `<Callee>.<keyword>` (`World.fog`), with `[i]` for item `i` of a tuple or list
+    /// argument (`o.size[0]`); `None` elsewhere.
     pub name: Option<String>,
     /// The variable it is assigned to, if it is.
     pub variable: Option<String>,
@@ -159,6 +160,20 @@ impl Walker<'_> {
                             .filter(|_| builtin)
                             .map(|b| (b, kw.node.clone()));
                         self.site(value, n, None, argument_of);
+                    }
+                    // An item of a tuple or list argument: `o = Obstacle(size = (VarInterval(
+                    // ...), 1, 1))` is `o.size[0]`, `route = [VarEnum(...)]` of `v` is
+                    // `v.route[0]`.
+                    if let (ArgumentP::Named(kw, _), ExprP::Tuple(items) | ExprP::List(items)) =
+                        (&a.node, &value.node)
+                    {
+                        let owner = target.map(str::to_owned).or_else(|| name.clone());
+                        for (i, x) in items.iter().enumerate() {
+                            if is_declarer(x) {
+                                let n = owner.as_ref().map(|o| format!("{o}.{}[{i}]", kw.node));
+                                self.site(x, n, None, None);
+                            }
+                        }
                     }
                     // A positional argument of a method: `lead.brake(VarEnum(...))` is
                     // `lead.brake`.

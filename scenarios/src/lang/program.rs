@@ -87,6 +87,9 @@ pub struct Program {
     objects: Arc<std::collections::HashMap<String, String>>,
     /// The maps it reads, read once and shared with every evaluation.
     maps: Arc<super::map_files::MapFiles>,
+    /// Whether what the program prints at load has been shown (the load evaluates it more
+    /// than once with the representative values; its output is shown once).
+    load_output_shown: std::sync::atomic::AtomicBool,
 }
 
 fn lambda_values<'v>(b: &SceneBuilder, module: &Module<'v>) -> Result<Vec<Value<'v>>, String> {
@@ -233,7 +236,11 @@ impl Program {
             }
             let printed = std::mem::take(&mut *state.log.borrow_mut());
             let mut b = state.scene.into_inner();
-            if b.values.is_none() {
+            if b.values.is_none()
+                && !self
+                    .load_output_shown
+                    .swap(true, std::sync::atomic::Ordering::Relaxed)
+            {
                 // The evaluation at load: what the program prints is shown once, on stderr.
                 for line in &printed {
                     eprintln!("{}: print: {line}", self.file);
@@ -611,6 +618,7 @@ pub fn load(
         horizon_s: super::DEFAULT_HORIZON_S,
         sut: SutConfig::builtin("aeb").map_err(lang)?,
         maps: Arc::new(super::map_files::MapFiles::new(base)),
+        load_output_shown: false.into(),
     };
     let first = program.evaluate(None, |b, _| Ok(b)).map_err(lang)?;
     program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);

@@ -144,6 +144,13 @@ fn parameters_take_their_global_names_and_over_time_adds_coordinates() {
     let s = load_source("ok.star", &src, "ok").unwrap();
     let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["fog.c0", "fog.c1", "fog.c2", "levels"]);
+    // Items of a tuple or list argument are named by their index.
+    let src = format!(
+        "{HEADER}o = Obstacle(loc = r.onLane(-1, 80), size = (VarInterval(0.5, 2), 1.0, VarInterval(1, 2)))\nc = Car(loc = r.onLane(1, 40), route = [VarEnum([\"left\", \"right\"])])\nw.place(r, v, o, c)\nCollisionMonitor(v)\n"
+    );
+    let s = load_source("ok.star", &src, "ok").unwrap();
+    let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["o.size[0]", "o.size[2]", "c.route[0]"]);
 }
 
 #[test]
@@ -198,13 +205,42 @@ fn stl_monitors_judge_tests_and_settle_early() {
     let safe = run(1.0, 55.0);
     assert!(safe.monitors[1].1.passed && safe.monitors[1].1.robustness > 0.5);
 
+    // A predicate may compare signals: the pedestrian's distance ahead of the ego along x,
+    // against the ego's own speed. Its robustness is the difference of the two sides.
+    let both = program.replace(
+        "G[0,15] (ego_separation_m > 0.5)",
+        "G[0,15] (p.pos.x - ego_x_m + 1 > 0.5 * ego_speed_mps)",
+    )
+        + "Stl(\"G[0,15] (p.pos.x - ego_x_m > 0.5 * ego_speed_mps - 1)\", name = \"ahead\")\n";
+    let s2 = load_source("stl.star", &both, "stl").unwrap();
+    let a = s2
+        .space
+        .decode(&paracosm_generators::Point {
+            discrete: vec![],
+            continuous: vec![(1.0 - 0.5) / 9.5, (55.0 - 5.0) / 55.0],
+        })
+        .unwrap();
+    let o = s2.run(&a, 1).unwrap();
+    let rho = |name: &str| {
+        o.monitors
+            .iter()
+            .find(|(n, _)| n == name)
+            .unwrap()
+            .1
+            .robustness
+    };
+    // The same inequality written two ways; a finite margin that a pass and a failure would
+    // both show.
+    assert!(rho("keep_clear").is_finite() && rho("keep_clear") != 0.0);
+    assert!((rho("keep_clear") - rho("ahead")).abs() < 1e-9, "{o:?}");
+
     let bad = |f: &str| {
         let p = program.replace("G[0,15] (ego_separation_m > 0.5)", f);
         load_source("stl.star", &p, "stl").unwrap_err().to_string()
     };
     let e = bad("G[0,15] (ego_separation_m > )");
     assert!(
-        e.contains("expected number") && e.contains('^') && e.contains("stl.star:"),
+        e.contains("expected a signal or a number") && e.contains('^') && e.contains("stl.star:"),
         "{e}"
     );
     let e = bad("G[0,15] (dist_ped > 0.5)");
@@ -281,6 +317,11 @@ fn inputs_of_the_wrong_kind_or_out_of_range_are_refused_at_load() {
             "5:1",
         ),
         (
+            format!("{HEADER}a = Arc(nlanes = 2, numLane = 4)\n"),
+            "Arc takes nlanes= or numLane= (the paper's spelling of it), not both",
+            "4:5",
+        ),
+        (
             format!("{HEADER}w.place(r, v)\nc = Car(loc = r.onLane(1, 60))\n"),
             "Car c is declared after place(...), so it is never placed",
             "5:5",
@@ -308,6 +349,10 @@ fn inputs_of_the_right_kind_load_whatever_their_form() {
             panic!("{car}: {e}");
         }
     }
+    // `numLane=`, the paper's spelling, on every piece, open or not.
+    let src = "w = World()\nn = VarEnum([2, 4])\nr = RoadSegment(len = 100.0, numLane = n)\na = Arc(radius = 40.0, numLane = n)\nk = Clothoid(numLane = n)\nx = CrossIntersection(numLane = n)\nro = Roundabout(numLane = n)\nr.connect((r.TWO, a, a.ONE), (a.TWO, k, k.ONE), (k.TWO, x, x.ONE), (x.THREE, ro, ro.ONE))\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, a, k, x, ro, v)\nCollisionMonitor(v)\n";
+    let s = load_source("ok.star", src, "ok").unwrap();
+    assert_eq!(s.space.params()[0].name, "n");
     let src = format!("{HEADER}r2 = RoadSegment(len = 50.0, friction = VarEnum([0.3, 0.9]))\nnet = r.connect((r.TWO, r2, r2.ONE))\np = Pedestrian(start = r.onLane(r.SideWalk, 100), target = r.onLane(-r.SideWalk, 100), speed = 1.0, dist = 10.0, car = v.pos.map(lambda p: p))\nw.place(r, r2, v, p)\nCollisionMonitor(v)\n");
     load_source("ok.star", &src, "ok").unwrap();
 }

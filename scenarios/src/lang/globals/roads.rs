@@ -88,6 +88,23 @@ pub(super) fn road_piece(
     add_piece(eval, what, kind, stream)
 }
 
+/// The lane count given as `nlanes=` or as the paper's `numLane=`.
+///
+/// # Errors
+/// Both given: one would be ignored.
+fn lane_count<'v>(
+    what: &str,
+    nlanes: Option<Value<'v>>,
+    num_lane: Option<Value<'v>>,
+) -> anyhow::Result<Option<Value<'v>>> {
+    match (nlanes, num_lane) {
+        (Some(_), Some(_)) => Err(anyhow!(
+            "{what} takes nlanes= or numLane= (the paper's spelling of it), not both"
+        )),
+        (a, b) => Ok(a.or(b)),
+    }
+}
+
 /// The builtins of this topic.
 #[starlark_module]
 #[allow(non_snake_case)]
@@ -129,17 +146,19 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         })
     }
 
-    /// `RoadSegment(len=200.0, nlanes=2, friction=0.8)`.
+    /// `RoadSegment(len=200.0, nlanes=2, friction=0.8)`; `numLane=` is the paper's spelling of
+    /// `nlanes=` (every piece takes either, not both).
     fn RoadSegment<'v>(
         #[starlark(require = named)] len: Option<Value<'v>>,
         #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] numLane: Option<Value<'v>>,
         #[starlark(require = named)] friction: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Road> {
         road_piece(
             eval,
             "RoadSegment",
-            nlanes,
+            lane_count("RoadSegment", nlanes, numLane)?,
             friction,
             |b, lanes, friction| {
                 let length_m = match len {
@@ -161,9 +180,11 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] radius: Option<Value<'v>>,
         #[starlark(require = named)] angle: Option<Value<'v>>,
         #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] numLane: Option<Value<'v>>,
         #[starlark(require = named)] friction: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Road> {
+        let nlanes = lane_count("Arc", nlanes, numLane)?;
         road_piece(eval, "Arc", nlanes, friction, |b, lanes, friction| {
             Ok(PieceKind::Arc {
                 radius_m: number_or(radius, b, "Arc(radius=)", 50.0)?,
@@ -182,9 +203,11 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] curv_start: Option<Value<'v>>,
         #[starlark(require = named)] curv_end: Option<Value<'v>>,
         #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] numLane: Option<Value<'v>>,
         #[starlark(require = named)] friction: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Road> {
+        let nlanes = lane_count("Clothoid", nlanes, numLane)?;
         road_piece(eval, "Clothoid", nlanes, friction, |b, lanes, friction| {
             Ok(PieceKind::Clothoid {
                 length_m: number_or(length, b, "Clothoid(length=)", 50.0)?,
@@ -242,7 +265,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         road_piece(
             eval,
             "TIntersection",
-            nlanes.or(numLane),
+            lane_count("TIntersection", nlanes, numLane)?,
             friction,
             |_, lanes, friction| Ok(PieceKind::TIntersection { lanes, friction }),
         )
@@ -258,15 +281,16 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         road_piece(
             eval,
             "CrossIntersection",
-            nlanes.or(numLane),
+            lane_count("CrossIntersection", nlanes, numLane)?,
             friction,
             |_, lanes, friction| Ok(PieceKind::CrossIntersection { lanes, friction }),
         )
     }
 
-    /// `Roundabout(nlanes=2, radius=20.0, friction=0.8)`.
+    /// `Roundabout(nlanes=2, radius=20.0, friction=0.8)`; `numLane=` too.
     fn Roundabout<'v>(
         #[starlark(require = named)] nlanes: Option<Value<'v>>,
+        #[starlark(require = named)] numLane: Option<Value<'v>>,
         #[starlark(require = named)] radius: Option<Value<'v>>,
         #[starlark(require = named)] friction: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
@@ -274,7 +298,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         road_piece(
             eval,
             "Roundabout",
-            nlanes,
+            lane_count("Roundabout", nlanes, numLane)?,
             friction,
             |b, lanes, friction| {
                 let radius_m = match radius {
