@@ -145,7 +145,7 @@ _METHODS = ("CD", "WD", "MD", "L2-star")
 
 def discrepancy(sample, *, method: str = "CD") -> float:
     """The discrepancy of `sample` (`(n, d)`, values in [0, 1]), as
-    `scipy.stats.qmc.discrepancy(sample, method=method)` (equal to it within 1e-10 relative):
+    `scipy.stats.qmc.discrepancy(sample, method=method)` (the same bits, for scipy 1.17):
 
     - `CD`: centered L2, squared (Hickernell, Math. Comp. 67, 1998, eq. 3.7c);
     - `WD`: wrap-around L2, squared (Hickernell 1998, eq. 3.8b);

@@ -30,12 +30,13 @@ def test_discrepancy_equals_scipy(name, method):
     sample = fixed_sets()[name]
     ours = qmc.discrepancy(sample, method=method)
     theirs = sqmc.discrepancy(sample, method=method)
-    assert ours == pytest.approx(theirs, rel=1e-10, abs=0.0), (name, method, ours, theirs)
+    # The same bits: paracosm evaluates each term and adds them in scipy's order.
+    assert ours == theirs, (name, method, ours, theirs)
 
 
 def test_discrepancy_takes_integers_and_lists_as_scipy_does():
-    assert qmc.discrepancy([[0, 1], [1, 0]]) == pytest.approx(
-        sqmc.discrepancy(np.array([[0.0, 1.0], [1.0, 0.0]])), rel=1e-12
+    assert qmc.discrepancy([[0, 1], [1, 0]]) == sqmc.discrepancy(
+        np.array([[0.0, 1.0], [1.0, 0.0]])
     )
 
 

@@ -10,6 +10,7 @@ mod discrepancy;
 mod dispersion;
 mod error;
 mod kwise;
+mod ordered_sum;
 mod star;
 
 pub use covering::{k_epsilon_covering, KEpsilonCovering};
