@@ -1,7 +1,7 @@
 //! The coverage estimators at the sizes issue 3 names: exact dispersion for d = 2 (n = 100,000)
-//! and d = 3 (n = 1,000), the centered discrepancy (n = 4,000, d = 8), k-wise coverage of
-//! 10,000 rows × 50 binary parameters at t = 3, the star discrepancy (d = 2, n = 2,000), and
-//! the scrambled Halton sequence (2^16 points, d = 8).
+//! and d = 3 (n = 1,000), the centered and wrap-around discrepancies (n = 4,000, d = 8), k-wise
+//! coverage of 10,000 rows × 50 binary parameters at t = 3, the star discrepancy (d = 2,
+//! n = 2,000), and the scrambled Halton sequence (2^16 points, d = 8).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use paracosm_generators::coverage::{
@@ -41,6 +41,9 @@ fn bench(c: &mut Criterion) {
     let x = points(Strategy::Random, 4000, 8);
     g.bench_function("cd_n4000_d8", |b| {
         b.iter(|| discrepancy(&x, 8, Discrepancy::Centered).unwrap())
+    });
+    g.bench_function("wd_n4000_d8", |b| {
+        b.iter(|| discrepancy(&x, 8, Discrepancy::WrapAround).unwrap())
     });
     let rows: Vec<u32> = (0..10_000u64 * 50)
         .map(|i| ((i.wrapping_mul(2_654_435_761) >> 7) % 2) as u32)

@@ -2,6 +2,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::ordered_sum::ordered_sum;
+use super::wrap_around::wrap_around_pair_sum;
 use super::{check_unit_points, CoverageError};
 
 /// The L2-type discrepancies of `scipy.stats.qmc.discrepancy`, with scipy's conventions.
@@ -53,7 +54,8 @@ impl Discrepancy {
 /// **square-rooted**, as scipy does. Formulas on [`Discrepancy`].
 ///
 /// `O(d · n²)` time, `O(n)` memory. Products are computed in parallel (rayon), sums in
-/// scipy's order, so the result is bit-identical on any thread count.
+/// scipy's order, so the result is bit-identical on any thread count. WD's products are
+/// symmetric, so each is computed once for its two places in that order (`wrap_around.rs`).
 ///
 /// # Errors
 /// [`CoverageError::Shape`] for `d = 0`, a ragged length or `n = 0`;
@@ -83,18 +85,22 @@ pub fn discrepancy(points: &[f64], d: usize, kind: Discrepancy) -> Result<f64, C
             (13.0f64 / 12.0).powf(df) - 2.0 / nf * s1 + 1.0 / (nf * nf) * s2
         }
         Discrepancy::WrapAround => {
-            let s = pair_sum(
-                points,
-                d,
-                Order::Flat,
-                |_| 0.0,
-                |_| 0.0,
-                |_, a, _, b| {
-                    let t = (a - b).abs();
-                    // scipy: 3/2 - |a - b| + |a - b|², left to right.
-                    1.5 - t + t * t
-                },
-            );
+            // scipy's loop, each symmetric product computed once (wrap_around.rs), unless
+            // its terms are too often ties for that: then each product twice, here.
+            let s = wrap_around_pair_sum(points, d).unwrap_or_else(|| {
+                pair_sum(
+                    points,
+                    d,
+                    Order::Flat,
+                    |_| 0.0,
+                    |_| 0.0,
+                    |_, a, _, b| {
+                        let t = (a - b).abs();
+                        // scipy: 3/2 - |a - b| + |a - b|², left to right.
+                        1.5 - t + t * t
+                    },
+                )
+            });
             -(4.0f64 / 3.0).powf(df) + 1.0 / (nf * nf) * s
         }
         Discrepancy::Mixture => {
@@ -243,7 +249,8 @@ fn single_sum(points: &[f64], d: usize, f: impl Fn(f64) -> f64) -> f64 {
 /// How [`pair_sum`] adds the products, following scipy's code for each discrepancy.
 #[derive(Clone, Copy, PartialEq)]
 enum Order {
-    /// One accumulator over `i`, then `j` (scipy's CD, WD and MD loops).
+    /// One accumulator over `i`, then `j` (scipy's CD and MD loops; its WD loop too, which
+    /// `wrap_around.rs` computes with half the products).
     Flat,
     /// A sum per row `i`, then the rows added in order (scipy's L2-star loop).
     ByRow,

@@ -12,6 +12,7 @@ mod error;
 mod kwise;
 mod ordered_sum;
 mod star;
+mod wrap_around;
 
 pub use covering::{k_epsilon_covering, KEpsilonCovering};
 pub use discrepancy::{discrepancy, Discrepancy};

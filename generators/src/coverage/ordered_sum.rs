@@ -22,7 +22,7 @@
 const CHUNK: usize = 1024;
 /// `2^52`: adding then subtracting it rounds a value in `[0, 2^52)` to the nearest integer
 /// (ties to even), in the current rounding mode (round-to-nearest).
-const ROUND: f64 = 4_503_599_627_370_496.0;
+pub(super) const ROUND: f64 = 4_503_599_627_370_496.0;
 /// `2^51` units: a larger term is refused, so a chunk's integer sum stays below
 /// `CHUNK · 2^51 = 2^61` and cannot overflow.
 const TERM_LIMIT: f64 = 2_251_799_813_685_248.0;
