@@ -53,7 +53,7 @@ impl Discrepancy {
 /// made by scipy 1.17, `tests/scipy_discrepancy.rs`): CD, WD and MD are returned **squared**, L2-star
 /// **square-rooted**, as scipy does. Formulas on [`Discrepancy`].
 ///
-/// `O(d · n²)` time, `O(n)` memory. Products are computed in parallel (rayon), sums in
+/// `O(d · n²)` time, `O(n · threads)` memory (WD keeps two `n`-long accumulators per piece of rayon's split). Products are computed in parallel (rayon), sums in
 /// scipy's order, so the result is bit-identical on any thread count. WD's products are
 /// symmetric, so each is computed once for its two places in that order (`wrap_around.rs`).
 ///
