@@ -53,6 +53,16 @@ impl LaneChangeSpec {
     }
 }
 
+/// The disc round the ego within which an NPC car stays in the physics step
+/// ([`Car::advance`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AwakeZone {
+    /// The ego chassis centre `[x, z]`, m.
+    pub(crate) ego_m: [f64; 2],
+    /// The radius, m: beyond it no sensor reads the car and the ego cannot touch it.
+    pub(crate) radius_m: f64,
+}
+
 /// Gravitational acceleration in m/s², for the tyres' friction limit `μ·g`.
 pub(crate) const GRAVITY_MPS2: f64 = 9.81;
 
@@ -67,6 +77,10 @@ pub(crate) struct Car {
     pub(crate) body: Option<(RigidBodyHandle, ColliderHandle)>,
     path: Vec<[f64; 2]>,
     cumulative: Vec<f64>,
+    /// The leg the car was on at its last lookup, and that leg's heading (rad): arc lengths
+    /// only grow, so the next lookup walks on from there instead of searching the whole
+    /// path, and the heading is worked out once per leg.
+    leg: std::cell::Cell<(usize, f64)>,
     s: f64,
     /// Speed along the path in the last step, m/s.
     speed: f64,
@@ -114,6 +128,7 @@ impl Car {
             body: None,
             path,
             cumulative,
+            leg: std::cell::Cell::new((0, f64::NAN)),
             s: 0.0,
             speed: 0.0,
             rolling: None,
@@ -143,12 +158,37 @@ impl Car {
         car
     }
 
+    /// The leg `i` (`path[i - 1] → path[i]`, `1 <= i < path.len()`) that arc length `s` lies
+    /// on: the first whose end is beyond `s`, or the last. Walks on from the last lookup's
+    /// leg, which holds for an `s` no smaller than that leg's start; searches otherwise.
+    fn leg_at(&self, s: f64) -> usize {
+        let last = self.path.len() - 1;
+        let mut i = self.leg.get().0.clamp(1, last);
+        if self.cumulative[i - 1] > s {
+            i = self.cumulative.partition_point(|&c| c <= s).clamp(1, last);
+        }
+        while i < last && self.cumulative[i] <= s {
+            i += 1;
+        }
+        i
+    }
+
+    /// The heading (rad) of leg `i`.
+    fn leg_heading(&self, i: usize) -> f64 {
+        match self.leg.get() {
+            (leg, heading) if leg == i => heading,
+            _ => {
+                let (a, b) = (self.path[i - 1], self.path[i]);
+                let heading = (-(b[1] - a[1])).atan2(b[0] - a[0]);
+                self.leg.set((i, heading));
+                heading
+            }
+        }
+    }
+
     /// Position `[x, z]` and heading at arc length `s`.
     fn at(&self, s: f64) -> ([f64; 2], f64) {
-        let i = self
-            .cumulative
-            .partition_point(|&c| c <= s)
-            .clamp(1, self.path.len() - 1);
+        let i = self.leg_at(s);
         let (a, b) = (self.path[i - 1], self.path[i]);
         let len = self.cumulative[i] - self.cumulative[i - 1];
         let u = if len > 0.0 {
@@ -156,14 +196,15 @@ impl Car {
         } else {
             0.0
         };
-        let heading = (-(b[1] - a[1])).atan2(b[0] - a[0]);
         (
             [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])],
-            heading,
+            self.leg_heading(i),
         )
     }
 
-    fn pose(&self) -> Pose {
+    /// The pose of its collider now: the body's pose when it is in the physics step, and the
+    /// pose it would have when it is asleep (out of the step, its collider left behind).
+    pub(crate) fn pose(&self) -> Pose {
         let ([x, z], h) = self.here;
         Pose::from_parts(
             Vector::new(
@@ -254,18 +295,32 @@ impl Car {
         self.speed
     }
 
+    /// How far from its ground point the car's collider reaches, horizontally or up, m: half
+    /// its box's diagonal plus its clearance.
+    pub(crate) fn radius_m(&self) -> f64 {
+        let s = self.size;
+        0.5 * (s.length_m.powi(2) + s.width_m.powi(2) + s.height_m.powi(2)).sqrt() + CLEARANCE_M
+    }
+
     /// Drives one step of `dt_s` at time `t_s` toward the commanded `speed_mps` (negative
     /// counts as 0) on a surface of friction `friction`: the speed changes by at most
     /// `friction · g · dt_s` (except in the first step, which sets it), and the car does not
     /// pass its path's end.
+    ///
+    /// A car outside `zone` once it has moved is asleep: its body and collider are disabled,
+    /// so rapier's step, contacts and ray casts skip it (its pose is still kept here,
+    /// [`Car::pose`]). A car that wakes is put back where it was at the start of the step
+    /// before it is moved, so rapier sees the same motion, and the same velocity, as if it
+    /// had never slept.
     pub(crate) fn advance(
         &mut self,
         physics: &mut PhysicsWorld,
         speed_mps: f64,
         friction: f64,
-        t_s: f64,
-        dt_s: f64,
+        (t_s, dt_s): (f64, f64),
+        zone: AwakeZone,
     ) {
+        let start_pose = self.pose();
         let end = *self.cumulative.last().expect("non-empty");
         let before = self.s;
         let wanted = speed_mps.max(0.0);
@@ -281,10 +336,32 @@ impl Car {
         self.rolling = Some(if self.s >= end { 0.0 } else { rolling });
         self.speed = (self.s - before) / dt_s;
         self.here = self.place_at(self.s, t_s + dt_s);
-        if let Some((body, _)) = self.body {
-            let pose = self.pose();
-            physics.bodies[body].set_next_kinematic_position(pose);
+        if let Some((body, collider)) = self.body {
+            let [x, z] = self.here.0;
+            // Not `>`: a distance that is not a number keeps the car awake.
+            let asleep = (x - zone.ego_m[0]).hypot(z - zone.ego_m[1]) > zone.radius_m;
+            let rb = &mut physics.bodies[body];
+            if asleep {
+                if rb.is_enabled() {
+                    rb.set_enabled(false);
+                    physics.colliders[collider].set_enabled(false);
+                }
+                return;
+            }
+            if !rb.is_enabled() {
+                rb.set_enabled(true);
+                rb.set_position(start_pose, false);
+                physics.colliders[collider].set_enabled(true);
+            }
+            physics.bodies[body].set_next_kinematic_position(self.pose());
         }
+    }
+
+    /// Whether the car is in the test but asleep, out of the physics step.
+    #[cfg(test)]
+    pub(crate) fn asleep(&self, physics: &PhysicsWorld) -> bool {
+        self.body
+            .is_some_and(|(body, _)| !physics.bodies[body].is_enabled())
     }
 
     /// The car as the time-to-collision test sees it, `None` when it is not in this test.
@@ -327,6 +404,53 @@ impl Car {
             heading_rad,
             speed_mps: self.speed,
             enabled: self.body.is_some(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn car(path: Vec<[f64; 2]>) -> Car {
+        let size = Size {
+            length_m: 4.5,
+            width_m: 1.8,
+            height_m: 1.5,
+        };
+        Car::build(
+            &mut PhysicsWorld::new(),
+            path,
+            size,
+            false,
+            [0.5; 3],
+            StreamId(0),
+        )
+    }
+
+    #[test]
+    fn the_leg_walked_on_is_the_leg_a_search_finds() {
+        // Legs of unequal length, one of zero length, and arc lengths that go forward, stay,
+        // jump, go back and run past the end.
+        let c = car(vec![
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, 0.0],
+            [3.0, 1.0],
+            [3.5, 4.0],
+            [10.0, 4.0],
+        ]);
+        let search = |s: f64| c.cumulative.partition_point(|&x| x <= s).clamp(1, 5);
+        let end = *c.cumulative.last().unwrap();
+        let mut queries: Vec<f64> = (0..400).map(|k| k as f64 * 0.05).collect();
+        queries.extend([1.0, 1.0, 0.5, 3.2, 0.0, end, end + 3.0, 2.0, -1.0, 7.0]);
+        for s in queries {
+            assert_eq!(c.leg_at(s), search(s), "s = {s}");
+            let (p, h) = c.at(s);
+            let i = search(s);
+            let (a, b) = (c.path[i - 1], c.path[i]);
+            assert_eq!(h, (-(b[1] - a[1])).atan2(b[0] - a[0]));
+            assert!(p.iter().all(|v| v.is_finite()));
         }
     }
 }

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use crate::actor::{Handle, Set, Size, VisibleBox};
 use crate::behaviour::{decode_probe, decode_sink, Action, Actor, Output};
-use crate::car::{Car, CarState, LaneChangeStart};
+use crate::car::{AwakeZone, Car, CarState, LaneChangeStart};
 use crate::network::{Lane, Network, PieceId, Surface};
 use crate::obstacle::{Obstacle, ObstacleState};
 use crate::pedestrian::Pedestrian;
@@ -483,6 +483,19 @@ impl Simulation {
             p.rest();
         }
         self.act(t)?;
+        // NPC cars beyond the reach of every sensor that reads the physics world, and of the
+        // ego's body, sleep out of rapier's step (Car::advance).
+        let reach_m = self
+            .sensors
+            .values()
+            .map(|s| s.physics_reach_m())
+            .fold(0.0, f64::max);
+        let chassis = self.physics.bodies[self.ego.body].position().translation;
+        let ego_m = [f64::from(chassis.x), f64::from(chassis.z)];
+        let ego_radius_m = {
+            let s = self.ego.size();
+            0.5 * (s.length_m.powi(2) + s.width_m.powi(2) + s.height_m.powi(2)).sqrt()
+        };
         for (i, car) in self.cars.iter_mut().enumerate() {
             let v = match car.speed_override {
                 Some(v) => v,
@@ -497,7 +510,11 @@ impl Simulation {
                 _ => {}
             }
             let friction = self.surface.friction_at(car.ground_m());
-            car.advance(&mut self.physics, v, friction, t, dt);
+            let zone = AwakeZone {
+                ego_m,
+                radius_m: reach_m + ego_radius_m + car.radius_m() + SLEEP_MARGIN_M,
+            };
+            car.advance(&mut self.physics, v, friction, (t, dt), zone);
         }
         if self.tick == 0 {
             // The first lidar scan was taken before light and fog were known.
@@ -726,42 +743,48 @@ impl Simulation {
     /// The state monitors are computed from.
     pub fn snapshot(&self) -> Snapshot {
         let chassis = &self.physics.colliders[self.ego.collider];
-        let colliders = self
+        let collider = |h: ColliderHandle| {
+            let c = &self.physics.colliders[h];
+            (*c.position(), c.shape())
+        };
+        // Each actor's shape where it is now: a sleeping car's collider stays where it fell
+        // asleep, so cars give the pose they keep themselves (equal to the collider's when
+        // awake).
+        let actors = self
             .pedestrians
             .values()
-            .map(|p| p.collider)
-            .chain(self.cars.values().filter_map(|c| c.body.map(|(_, c)| c)))
-            .chain(self.obstacles.values().map(|o| o.collider));
+            .map(|p| collider(p.collider))
+            .chain(self.cars.values().filter_map(|c| {
+                c.body
+                    .map(|(_, h)| (c.pose(), self.physics.colliders[h].shape()))
+            }))
+            .chain(self.obstacles.values().map(|o| collider(o.collider)));
         // The exact distance (GJK) to the nearest actor. The distance between bounding boxes
         // is a lower bound, so an actor whose bound is no smaller than the best distance found
         // cannot change the minimum, and is skipped; nearest bounds are tried first.
         let chassis_box = chassis.compute_aabb();
-        let mut by_bound: Vec<(f32, ColliderHandle)> = colliders
-            .map(|handle| {
-                let b = self.physics.colliders[handle].compute_aabb();
+        let mut by_bound: Vec<(f32, Pose, &dyn Shape)> = actors
+            .map(|(pose, shape)| {
+                let b = shape.compute_aabb(&pose);
                 let gap = (b.mins - chassis_box.maxs)
                     .max(chassis_box.mins - b.maxs)
                     .max(Vector::ZERO);
-                (gap.length(), handle)
+                (gap.length(), pose, shape)
             })
             .collect();
         by_bound.sort_by(|a, b| a.0.total_cmp(&b.0));
         let far = chassis.position().translation.abs().max_element();
         let slack = 1e-3 + 8.0 * f64::from(f32::EPSILON) * f64::from(far.max(1.0));
         let mut min_sep = f64::INFINITY;
-        for (bound, handle) in by_bound {
+        for (bound, pose, shape) in by_bound {
             // 1 mm of slack, plus the f32 rounding of coordinates this far from the origin,
             // covers the rounding of both computations.
             if f64::from(bound) - slack >= min_sep {
                 break;
             }
-            let c = &self.physics.colliders[handle];
-            if let Ok(d) = rapier3d::parry::query::distance(
-                chassis.position(),
-                chassis.shape(),
-                c.position(),
-                c.shape(),
-            ) {
+            if let Ok(d) =
+                rapier3d::parry::query::distance(chassis.position(), chassis.shape(), &pose, shape)
+            {
                 min_sep = min_sep.min(f64::from(d.distance));
             }
         }
@@ -830,6 +853,10 @@ impl Simulation {
         Some([f64::from(h.x), f64::from(h.y), f64::from(h.z)])
     }
 }
+
+/// Slack added to the distance within which an NPC car stays in the physics step, m: more
+/// than the car and the ego can close in one step at any speed the engine models.
+const SLEEP_MARGIN_M: f64 = 10.0;
 
 /// The number stream `id` holds now (its latest event), `default` before its first event.
 ///
@@ -1036,6 +1063,95 @@ mod tests {
         assert!(!snap.ego_contact);
         // 30 m between centres, less half the car (2.25 m) and the capsule radius (0.3 m).
         assert!((snap.min_separation_m - 27.45).abs() < 0.05);
+    }
+
+    /// A sensor that reads nothing and gives no reach: with it mounted, no car ever sleeps.
+    struct Unbounded;
+
+    impl Sensor for Unbounded {
+        fn name(&self) -> &'static str {
+            "unbounded"
+        }
+        fn period_ticks(&self) -> u64 {
+            u64::MAX
+        }
+        fn capture(&mut self, _: &crate::sensor::Scene<'_>) -> Result<(), EngineError> {
+            Ok(())
+        }
+        fn reading(&self) -> Option<Reading<'_>> {
+            None
+        }
+    }
+
+    /// A 1 km road with the ego at 10 m and three NPC cars: one pulling away ahead in the
+    /// ego's lane, one oncoming from 500 m in the other lane, one stopped 350 m ahead.
+    fn with_cars() -> WorldSpec {
+        let mut s = WorldSpec::straight_road(1000.0, 10.0, 12.0, &[]).unwrap();
+        let mut nodes = s.streams.nodes().to_vec();
+        let mut car = |from: f64, to: f64, z: f64, speed: f64| {
+            nodes.push(crate::rx::Node::Const(Value::Num(speed)));
+            crate::CarSpec {
+                path: vec![[from, z], [to, z]],
+                speed: StreamId(nodes.len() - 1),
+                color: "red".into(),
+                size: crate::Size::CAR,
+                enabled: true,
+                lane_change: None,
+                lane_offsets_m: vec![],
+            }
+        };
+        s.cars = vec![
+            car(40.0, 1000.0, 1.75, 25.0),
+            car(500.0, 0.0, -1.75, 10.0),
+            car(360.0, 1000.0, 1.75, 0.0),
+        ];
+        s.streams = crate::rx::Graph::new(nodes).unwrap();
+        s
+    }
+
+    #[test]
+    fn far_cars_sleep_out_of_the_physics_step_and_nothing_observed_changes() {
+        let spec = with_cars();
+        let mut sleepy = Simulation::new(&spec).unwrap();
+        let mut awake = Simulation::new(&spec).unwrap();
+        awake.mount(Box::new(Unbounded)).unwrap();
+        let (mut asleep_steps, mut woke, mut was_asleep) = (0, 0, vec![false; 3]);
+        let mut seen_oncoming = false;
+        // 30 s at a steady throttle: the first car leaves the lidar's reach, the oncoming one
+        // enters it, passes and leaves, and the ego closes on the stopped one.
+        for _ in 0..1800 {
+            let control = Control {
+                throttle: 0.2,
+                steering: 0.0,
+            };
+            sleepy.step(control, &mut NoHost).unwrap();
+            awake.step(control, &mut NoHost).unwrap();
+            assert_eq!(
+                format!("{:?}", sleepy.snapshot()),
+                format!("{:?}", awake.snapshot())
+            );
+            assert_eq!(sleepy.observation().lidar, awake.observation().lidar);
+            seen_oncoming |= sleepy
+                .observation()
+                .lidar
+                .iter()
+                .any(|r| r.point_m[2] < -2.5);
+            for (i, car) in sleepy.cars.values().enumerate() {
+                let asleep = car.asleep(&sleepy.physics);
+                asleep_steps += usize::from(asleep);
+                woke += usize::from(was_asleep[i] && !asleep);
+                was_asleep[i] = asleep;
+                let (_, collider) = car.body.unwrap();
+                if !asleep {
+                    // An awake car's collider is where the car says it is, bit for bit.
+                    assert_eq!(*sleepy.physics.colliders[collider].position(), car.pose());
+                }
+            }
+            assert!(awake.cars.values().all(|c| !c.asleep(&awake.physics)));
+        }
+        assert!(asleep_steps > 1000, "{asleep_steps}");
+        assert!(woke >= 2, "{woke}");
+        assert!(seen_oncoming);
     }
 
     #[test]

@@ -37,7 +37,23 @@ impl Network {
         );
     }
 
+    /// Inserts the pieces' shapes. Shapes of equal friction go into one compound collider
+    /// (in piece order), so the broad phase holds one leaf for the whole road instead of
+    /// one per slab and sidewalk: with several moving actors, rapier refits and traverses
+    /// its whole tree every step, and a few dozen road leaves made that cost grow with the
+    /// network (issue 23, long horizons). A ray or a contact sees the same shapes at the same
+    /// poses: the compound sits at the origin, and each part keeps its own pose. A map's
+    /// triangle mesh, itself a composite shape, stays a collider of its own.
     fn build_pieces(&self, physics: &mut PhysicsWorld) {
+        // (friction, parts) in order of first appearance.
+        let mut groups: Vec<(f32, Vec<(Pose, SharedShape)>)> = Vec::new();
+        let mut add = |mu: f32, pose: Pose, shape: SharedShape| match groups
+            .iter_mut()
+            .find(|(f, _)| f.to_bits() == mu.to_bits())
+        {
+            Some((_, parts)) => parts.push((pose, shape)),
+            None => groups.push((mu, vec![(pose, shape)])),
+        };
         for p in &self.pieces {
             let mu = p.kind.friction() as f32;
             let rotation = Rotation::from_rotation_y(p.pose.heading_rad as f32);
@@ -86,51 +102,46 @@ impl Network {
                                     }
                                 }
                             }
-                            if let Some(c) = ColliderBuilder::convex_hull(&corners) {
-                                physics.insert_collider(c.friction(mu), None);
+                            if let Some(hull) = SharedShape::convex_hull(&corners) {
+                                add(mu, Pose::IDENTITY, hull);
                             }
                         }
                     }
                 }
                 &PieceKind::Segment { length_m, .. } => {
                     let hw = p.kind.half_road_m();
-                    physics.insert_collider(
-                        ColliderBuilder::cuboid(hx as f32, slab / 2.0, hw as f32)
-                            .position(at(centre, -slab / 2.0))
-                            .friction(mu),
-                        None,
+                    add(
+                        mu,
+                        at(centre, -slab / 2.0),
+                        SharedShape::cuboid(hx as f32, slab / 2.0, hw as f32),
                     );
                     let sw = SIDEWALK_WIDTH_M;
                     let curb = CURB_HEIGHT_M as f32;
                     let h = (slab + curb) / 2.0;
                     for side in [1.0, -1.0] {
-                        physics.insert_collider(
-                            ColliderBuilder::cuboid(hx as f32, h, (sw / 2.0) as f32)
-                                .position(at([length_m / 2.0, side * (hw + sw / 2.0)], curb - h))
-                                .friction(mu),
-                            None,
+                        add(
+                            mu,
+                            at([length_m / 2.0, side * (hw + sw / 2.0)], curb - h),
+                            SharedShape::cuboid(hx as f32, h, (sw / 2.0) as f32),
                         );
                     }
                 }
                 _ => {
-                    physics.insert_collider(
-                        ColliderBuilder::cuboid(hx as f32, slab / 2.0, hz as f32)
-                            .position(at(centre, -slab / 2.0))
-                            .friction(mu),
-                        None,
+                    add(
+                        mu,
+                        at(centre, -slab / 2.0),
+                        SharedShape::cuboid(hx as f32, slab / 2.0, hz as f32),
                     );
                     if let Some(r) = p.kind.island_radius_m() {
                         let curb = CURB_HEIGHT_M as f32;
                         let h = (slab + curb) / 2.0;
-                        physics.insert_collider(
-                            ColliderBuilder::cylinder(h, r as f32)
-                                .position(at(centre, curb - h))
-                                .friction(mu),
-                            None,
-                        );
+                        add(mu, at(centre, curb - h), SharedShape::cylinder(h, r as f32));
                     }
                 }
             }
+        }
+        for (mu, parts) in groups {
+            physics.insert_collider(ColliderBuilder::compound(parts).friction(mu), None);
         }
     }
 }

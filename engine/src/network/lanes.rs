@@ -249,6 +249,9 @@ impl Network {
             }
         };
         let mut length = points.windows(2).map(|w| dist(w[0], w[1])).sum::<f64>();
+        // A route of kilometres passes the same pieces again and again: each piece's lane
+        // paths are worked out once per route.
+        let mut paths_of: Vec<Option<Vec<LanePath>>> = vec![None; self.pieces.len()];
         let mut turns = turns.iter();
         // How many of the turns the path has taken.
         let mut used = 0;
@@ -265,9 +268,9 @@ impl Network {
             }) else {
                 break;
             };
-            let mut candidates: Vec<LanePath> = self
-                .lane_paths(next.0)
-                .into_iter()
+            let mut candidates: Vec<&LanePath> = paths_of[next.0 .0]
+                .get_or_insert_with(|| self.lane_paths(next.0))
+                .iter()
                 .filter(|l| l.entry == (next.1, path.exit.1))
                 .collect();
             // Each junction on the way (a piece with more than one exit from this lane) takes
@@ -301,7 +304,7 @@ impl Network {
                 // No turn left to take: exits that lead on into the network before dead ends,
                 // then straight, right, left.
                 None => {
-                    let linked = |l: &LanePath| {
+                    let linked = |l: &&LanePath| {
                         let end = (l.piece, l.exit.0);
                         self.links.iter().any(|k| k.a == end || k.b == end)
                     };
@@ -313,7 +316,9 @@ impl Network {
                         .find_map(|t| candidates.iter().find(|c| c.turn == t))
                 }
             };
-            let Some(pick) = pick.cloned() else { break };
+            let Some(pick) = pick.map(|&c| c.clone()) else {
+                break;
+            };
             for &q in &pick.points[1..] {
                 length += dist(*points.last().expect("non-empty"), q);
                 points.push(q);

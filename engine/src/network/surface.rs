@@ -61,13 +61,172 @@ struct PieceShape {
     connected: [bool; 4],
 }
 
+/// How far beyond a piece's footprint [`Surface::lane_offset_m`] counts it as near, in
+/// metres.
+const NEAR_M: f64 = 2.0;
+
+/// A uniform grid over the pieces' footprints: each cell lists, in network order, the pieces
+/// whose footprint widened by [`NEAR_M`] may reach into it. A point query then tests the few
+/// pieces of its cell instead of every piece of the network, with the same answer: a piece
+/// whose widened footprint holds a point is always listed in the point's cell.
+#[derive(Debug, Clone)]
+struct PieceGrid {
+    /// World `[x, z]` (m) of the grid's low corner.
+    origin: [f64; 2],
+    /// Side of a cell, m.
+    cell_m: f64,
+    /// Cells along `x` and along `z`.
+    dims: [usize; 2],
+    /// Cell `c`'s pieces are `pieces[starts[c]..starts[c + 1]]` (cells row-major, `z` rows).
+    starts: Vec<usize>,
+    pieces: Vec<usize>,
+}
+
+/// Most cells a [`PieceGrid`] has; the cells grow for larger networks.
+const MAX_CELLS: f64 = 4096.0;
+
+impl PieceGrid {
+    /// The grid over `boxes`, each piece's world box `[min x, max x, min z, max z]` (m).
+    fn new(boxes: &[[f64; 4]]) -> Self {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for b in boxes {
+            lo = [lo[0].min(b[0]), lo[1].min(b[2])];
+            hi = [hi[0].max(b[1]), hi[1].max(b[3])];
+        }
+        if !(lo[0].is_finite() && lo[1].is_finite() && hi[0].is_finite() && hi[1].is_finite()) {
+            return PieceGrid {
+                origin: [0.0; 2],
+                cell_m: 1.0,
+                dims: [0, 0],
+                starts: vec![0],
+                pieces: Vec::new(),
+            };
+        }
+        let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(1.0);
+        let cell_m = (area / MAX_CELLS).sqrt().max(5.0);
+        let count = |span: f64| ((span / cell_m).floor() as usize).saturating_add(1);
+        let mut grid = PieceGrid {
+            origin: lo,
+            cell_m,
+            dims: [count(hi[0] - lo[0]), count(hi[1] - lo[1])],
+            starts: Vec::new(),
+            pieces: Vec::new(),
+        };
+        let mut cells = vec![Vec::new(); grid.dims[0] * grid.dims[1]];
+        for (i, b) in boxes.iter().enumerate() {
+            // The same index function as a query's, so that monotone rounding keeps every
+            // point of the box within the cells it is listed in.
+            let (Some(x0), Some(x1), Some(z0), Some(z1)) = (
+                grid.index(b[0], 0),
+                grid.index(b[1], 0),
+                grid.index(b[2], 1),
+                grid.index(b[3], 1),
+            ) else {
+                continue;
+            };
+            for z in z0..=z1 {
+                for x in x0..=x1 {
+                    cells[z * grid.dims[0] + x].push(i);
+                }
+            }
+        }
+        grid.starts.push(0);
+        for c in cells {
+            grid.pieces.extend(c);
+            grid.starts.push(grid.pieces.len());
+        }
+        grid
+    }
+
+    /// The cell index along `axis` (0: `x`, 1: `z`) of coordinate `v`, `None` outside.
+    fn index(&self, v: f64, axis: usize) -> Option<usize> {
+        let k = ((v - self.origin[axis]) / self.cell_m).floor();
+        (k >= 0.0 && k < self.dims[axis] as f64).then_some(k as usize)
+    }
+
+    /// The pieces that may hold the world point `p` or lie within [`NEAR_M`] of it, in
+    /// network order; none for a point off the grid (or not finite).
+    fn near(&self, p: [f64; 2]) -> &[usize] {
+        match (self.index(p[0], 0), self.index(p[1], 1)) {
+            (Some(x), Some(z)) => {
+                let c = z * self.dims[0] + x;
+                &self.pieces[self.starts[c]..self.starts[c + 1]]
+            }
+            _ => &[],
+        }
+    }
+}
+
+/// The world box `[min x, max x, min z, max z]` (m) of a piece's footprint widened by
+/// [`NEAR_M`], and by far more than the rounding of [`PieceShape::local`].
+fn near_box(piece: &PieceShape) -> [f64; 4] {
+    let ([hx, hz], [cx, cz]) = piece.footprint;
+    let (hx, hz) = (hx + NEAR_M, hz + NEAR_M);
+    let mut b = [
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for (dx, dz) in [(-hx, -hz), (-hx, hz), (hx, -hz), (hx, hz)] {
+        let [x, z] = piece.pose.apply([cx + dx, cz + dz]);
+        b = [b[0].min(x), b[1].max(x), b[2].min(z), b[3].max(z)];
+    }
+    let slack = 1e-6 + 1e-9 * b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    [b[0] - slack, b[1] + slack, b[2] - slack, b[3] + slack]
+}
+
 /// Point queries on a [`Network`]'s surface, precomputed once per world.
 #[derive(Debug, Clone)]
 pub struct Surface {
     pieces: Vec<PieceShape>,
+    /// Which pieces each part of the plane may concern.
+    grid: PieceGrid,
     /// Each piece's lane centre lines: polylines in world `[x, z]` metres, in their direction
     /// of travel.
     lanes: Vec<Vec<Vec<[f64; 2]>>>,
+    /// For each lane line of `lanes`, the bounding box `[min x, max x, min z, max z]` (m) of
+    /// each run of [`LEGS_PER_BOX`] legs: [`Surface::lane_offset_m`] skips a run whose box is
+    /// farther than the nearest leg found so far.
+    lane_boxes: Vec<Vec<Vec<[f64; 4]>>>,
+}
+
+/// Legs of a lane line per bounding box of [`Surface`]'s `lane_boxes`.
+const LEGS_PER_BOX: usize = 16;
+
+/// The bounding boxes of `line`'s runs of [`LEGS_PER_BOX`] legs, widened by far more than the
+/// rounding of a point–segment distance, so that a box's distance is a lower bound of the
+/// distance [`segment_offset`] computes to any leg of its run.
+fn leg_boxes(line: &[[f64; 2]]) -> Vec<[f64; 4]> {
+    (0..line.len().saturating_sub(1))
+        .step_by(LEGS_PER_BOX)
+        .map(|start| {
+            let run = &line[start..(start + LEGS_PER_BOX + 1).min(line.len())];
+            let mut b = [
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+            ];
+            for q in run {
+                b = [
+                    b[0].min(q[0]),
+                    b[1].max(q[0]),
+                    b[2].min(q[1]),
+                    b[3].max(q[1]),
+                ];
+            }
+            let slack = 1e-6 + 1e-9 * b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            [b[0] - slack, b[1] + slack, b[2] - slack, b[3] + slack]
+        })
+        .collect()
+}
+
+/// The squared distance (m²) from `p` to the box `[min x, max x, min z, max z]`.
+fn box_distance2(p: [f64; 2], b: &[f64; 4]) -> f64 {
+    let dx = (b[0] - p[0]).max(p[0] - b[1]).max(0.0);
+    let dz = (b[2] - p[1]).max(p[1] - b[3]).max(0.0);
+    dx * dx + dz * dz
 }
 
 impl PieceShape {
@@ -252,7 +411,7 @@ impl Surface {
                 connected,
             })
             .collect::<Vec<PieceShape>>();
-        let lanes = (0..network.pieces().len())
+        let lanes: Vec<Vec<Vec<[f64; 2]>>> = (0..network.pieces().len())
             .map(|i| match &pieces[i].shape {
                 Shape::Map(index) => index.lane_lines(),
                 _ => network
@@ -263,7 +422,17 @@ impl Surface {
             })
             .collect();
         debug_assert!(PORT_NAMES.len() == 4);
-        Surface { pieces, lanes }
+        let lane_boxes = lanes
+            .iter()
+            .map(|lines| lines.iter().map(|l| leg_boxes(l)).collect())
+            .collect();
+        let grid = PieceGrid::new(&pieces.iter().map(near_box).collect::<Vec<_>>());
+        Surface {
+            pieces,
+            grid,
+            lanes,
+            lane_boxes,
+        }
     }
 
     /// Sets the friction of piece `id` (a friction that varies over the test); an id not of
@@ -277,10 +446,14 @@ impl Surface {
     /// The piece whose footprint (carriageway, sidewalks, plaza) contains the world point
     /// `[x, z]` (m), if any; the first in network order where two touch.
     pub fn piece_under(&self, p: [f64; 2]) -> Option<PieceId> {
-        self.pieces
+        self.grid
+            .near(p)
             .iter()
-            .position(|s| s.in_footprint(s.local(p), 0.0))
-            .map(PieceId)
+            .find(|&&i| {
+                let s = &self.pieces[i];
+                s.in_footprint(s.local(p), 0.0)
+            })
+            .map(|&i| PieceId(i))
     }
 
     /// The friction coefficient under the world point `[x, z]` (m): the friction of the piece
@@ -298,7 +471,7 @@ impl Surface {
         // On the road: the largest inside distance over the pieces whose footprint holds the
         // point (the others' would be negative). Off it: the distance to the nearest piece.
         let mut inside = f64::NEG_INFINITY;
-        for s in &self.pieces {
+        for s in self.grid.near(p).iter().map(|&i| &self.pieces[i]) {
             let q = s.local(p);
             if s.in_footprint(q, 0.0) {
                 inside = inside.max(s.signed_edge_m(q));
@@ -327,23 +500,42 @@ impl Surface {
         // The lanes of the pieces around the point, or of every piece when it is off them all.
         let near = |i: &usize| {
             let s = &self.pieces[*i];
-            s.in_footprint(s.local(p), 2.0)
+            s.in_footprint(s.local(p), NEAR_M)
         };
-        let any_near = (0..self.pieces.len()).any(|i| near(&i));
+        let candidates = self.grid.near(p);
+        let any_near = candidates.iter().any(near);
         let h = direction(heading_rad);
         let (mut agreeing, mut any) = ((f64::INFINITY, f64::NAN), (f64::INFINITY, f64::NAN));
-        for i in (0..self.pieces.len()).filter(|i| !any_near || near(i)) {
-            for line in &self.lanes[i] {
-                for w in line.windows(2) {
-                    let (dist2, lateral, u) = segment_offset(p, w[0], w[1]);
-                    if dist2 < any.0 {
-                        any = (dist2, lateral);
+        let mut visit = |i: usize| {
+            for (line, boxes) in self.lanes[i].iter().zip(&self.lane_boxes[i]) {
+                for (k, b) in boxes.iter().enumerate() {
+                    // No leg of the run is nearer than its box: when the box is farther than
+                    // the nearest agreeing leg (no farther than the nearest of any
+                    // direction), no leg of it can replace either; skipping it changes
+                    // nothing.
+                    if box_distance2(p, b) > agreeing.0 {
+                        continue;
                     }
-                    if u[0] * h[0] + u[1] * h[1] > 0.0 && dist2 < agreeing.0 {
-                        agreeing = (dist2, lateral);
+                    let start = k * LEGS_PER_BOX;
+                    for w in line[start..(start + LEGS_PER_BOX + 1).min(line.len())].windows(2) {
+                        let (dist2, lateral, u) = segment_offset(p, w[0], w[1]);
+                        if dist2 < any.0 {
+                            any = (dist2, lateral);
+                        }
+                        if u[0] * h[0] + u[1] * h[1] > 0.0 && dist2 < agreeing.0 {
+                            agreeing = (dist2, lateral);
+                        }
                     }
                 }
             }
+        };
+        if any_near {
+            candidates
+                .iter()
+                .filter(|i| near(i))
+                .for_each(|&i| visit(i));
+        } else {
+            (0..self.pieces.len()).for_each(&mut visit);
         }
         if agreeing.0.is_finite() {
             agreeing.1
@@ -434,6 +626,114 @@ mod tests {
                 < 1e-9
         );
         assert_eq!(s.friction_at([0.0, 10.0]), 0.7);
+    }
+
+    /// [`Surface::lane_offset_m`] without the boxes: every leg of every lane line near `p`.
+    fn lane_offset_every_leg(s: &Surface, p: [f64; 2], heading_rad: f64) -> f64 {
+        let near = |i: &usize| s.pieces[*i].in_footprint(s.pieces[*i].local(p), 2.0);
+        let any_near = (0..s.pieces.len()).any(|i| near(&i));
+        let h = direction(heading_rad);
+        let (mut agreeing, mut any) = ((f64::INFINITY, f64::NAN), (f64::INFINITY, f64::NAN));
+        for i in (0..s.pieces.len()).filter(|i| !any_near || near(i)) {
+            for w in s.lanes[i].iter().flat_map(|l| l.windows(2)) {
+                let (dist2, lateral, u) = segment_offset(p, w[0], w[1]);
+                if dist2 < any.0 {
+                    any = (dist2, lateral);
+                }
+                if u[0] * h[0] + u[1] * h[1] > 0.0 && dist2 < agreeing.0 {
+                    agreeing = (dist2, lateral);
+                }
+            }
+        }
+        if agreeing.0.is_finite() {
+            agreeing.1
+        } else {
+            any.1
+        }
+    }
+
+    #[test]
+    fn the_grid_and_the_boxes_change_no_answer() {
+        // A cross junction (turning paths of many legs), an arc and a roundabout, probed on a
+        // grid of points and headings, on the network and off it.
+        let mut n = Network::new();
+        let a = n.add("a", segment(40.0, 0.8)).unwrap();
+        let x = n
+            .add(
+                "x",
+                PieceKind::CrossIntersection {
+                    lanes: 2,
+                    friction: 0.8,
+                },
+            )
+            .unwrap();
+        let bend = n
+            .add(
+                "bend",
+                PieceKind::Arc {
+                    radius_m: 25.0,
+                    angle_rad: 1.2,
+                    lanes: 2,
+                    friction: 0.8,
+                },
+            )
+            .unwrap();
+        let o = n
+            .add(
+                "o",
+                PieceKind::Roundabout {
+                    lanes: 2,
+                    radius_m: 15.0,
+                    friction: 0.8,
+                },
+            )
+            .unwrap();
+        n.connect(a, 1, x, 2).unwrap();
+        n.connect(x, 0, bend, 0).unwrap();
+        n.connect(x, 1, o, 3).unwrap();
+        let s = Surface::new(&n);
+        assert!(s.lane_boxes.iter().flatten().any(|b| b.len() > 1));
+        // The grid has more than one cell, and cells that list fewer pieces than the network.
+        assert!(s.grid.dims[0] * s.grid.dims[1] > 1);
+        assert!((0..s.grid.starts.len() - 1)
+            .any(|c| s.grid.starts[c + 1] - s.grid.starts[c] < s.pieces.len()));
+        let mut probed = 0;
+        let mut points: Vec<[f64; 2]> = (-30..=60)
+            .flat_map(|i| (-40..=40).map(move |j| [i as f64 * 2.37, j as f64 * 2.11]))
+            .collect();
+        points.extend([[1e6, 0.0], [f64::NAN, 0.0], [-500.0, 3.0]]);
+        for p in points {
+            // Every piece, in network order, as before the grid.
+            let under = s
+                .pieces
+                .iter()
+                .position(|q| q.in_footprint(q.local(p), 0.0))
+                .map(PieceId);
+            assert_eq!(s.piece_under(p), under, "{p:?}");
+            let inside = s
+                .pieces
+                .iter()
+                .filter(|q| q.in_footprint(q.local(p), 0.0))
+                .map(|q| q.signed_edge_m(q.local(p)))
+                .fold(f64::NEG_INFINITY, f64::max);
+            let edge = if inside >= 0.0 {
+                inside
+            } else {
+                -s.pieces
+                    .iter()
+                    .map(|q| -q.signed_edge_m(q.local(p)))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            assert_eq!(s.edge_distance_m(p).to_bits(), edge.to_bits(), "{p:?}");
+            for k in 0..5 {
+                let heading = k as f64 * 1.3 - 2.6;
+                let fast = s.lane_offset_m(p, heading);
+                let every = lane_offset_every_leg(&s, p, heading);
+                assert_eq!(fast.to_bits(), every.to_bits(), "{p:?} {heading}");
+                probed += 1;
+            }
+        }
+        assert!(probed > 30_000);
     }
 
     #[test]

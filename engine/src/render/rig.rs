@@ -33,6 +33,11 @@ impl crate::sensor::Sensor for CameraRig {
         true
     }
 
+    fn physics_reach_m(&self) -> f64 {
+        // It draws the scene's boxes; it casts nothing into the physics world.
+        0.0
+    }
+
     fn capture(&mut self, scene: &crate::sensor::Scene<'_>) -> Result<(), EngineError> {
         let pose = CameraPose {
             chassis_m: scene.ego.pos_m,

@@ -185,8 +185,10 @@ impl LidarSpec {
             Some((h, mins, maxs))
         });
         for (handle, mins, maxs) in fixed.chain(moving) {
-            // The query pipeline holds only enabled colliders.
-            if !physics.colliders[handle].is_enabled() {
+            // The query pipeline holds only enabled colliders, and none of a disabled body
+            // (an NPC car taken out of the step, whose collider is left where it was).
+            let co = &physics.colliders[handle];
+            if !co.is_enabled() || co.parent().is_some_and(|b| !physics.bodies[b].is_enabled()) {
                 continue;
             }
             let nearest = origin.clamp(mins, maxs);
@@ -438,6 +440,12 @@ impl crate::sensor::Sensor for Lidar {
 
     fn period_ticks(&self) -> u64 {
         self.period
+    }
+
+    fn physics_reach_m(&self) -> f64 {
+        // Its beams start at the mount and end at the spec's range (fog only shortens it).
+        let [x, y, z] = self.spec.mount_m;
+        self.spec.range_m + (x * x + y * y + z * z).sqrt()
     }
 
     fn capture(&mut self, scene: &crate::sensor::Scene<'_>) -> Result<(), crate::EngineError> {

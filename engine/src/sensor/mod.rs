@@ -113,6 +113,15 @@ pub trait Sensor: Send {
     fn draws(&self) -> bool {
         false
     }
+    /// How far from the ego chassis centre, in metres, this sensor can sense a collider of
+    /// [`Scene::physics`]. An NPC car farther than every sensor's reach, and too far to touch
+    /// the ego, is taken out of the physics step until it comes nearer (its body and collider
+    /// disabled; [`crate::Simulation::step`]), so a sensor that reads the physics world must
+    /// not under-state this. Default: unbounded (no car is ever taken out). A sensor that
+    /// draws [`Scene::boxes`] instead, as a camera does, reaches no collider: 0.
+    fn physics_reach_m(&self) -> f64 {
+        f64::INFINITY
+    }
     /// Captures a reading of `scene`.
     ///
     /// # Errors

@@ -68,6 +68,70 @@ pub struct Aeb {
     /// `reset`).
     curves: Vec<(f64, f64)>,
     curves_of: usize,
+    /// The bounding box `[min x, max x, min z, max z]` (m) of each run of [`RUN`] route
+    /// points of that route, for [`nearest_vertex`].
+    boxes: Vec<[f64; 4]>,
+}
+
+/// Route points per bounding box of [`Aeb`]'s `boxes`.
+const RUN: usize = 8;
+
+/// How many route points ahead of the last one reached [`nearest_vertex`] looks at.
+const WINDOW: usize = 64;
+
+/// The index of the route point nearest `(x, z)` among the [`WINDOW`] points from `from` on:
+/// the first of the smallest squared distances, compared with `f64::total_cmp`. A run of
+/// points whose box is farther than the nearest point found so far is skipped: each point's
+/// squared distance is at least its box's (floating-point subtraction, squaring and addition
+/// are monotone), so it could not be smaller.
+fn nearest_vertex(route: &[[f64; 2]], boxes: &[[f64; 4]], from: usize, x: f64, z: f64) -> usize {
+    let d2 = |p: [f64; 2]| (p[0] - x).powi(2) + (p[1] - z).powi(2);
+    let end = route.len().min(from + WINDOW);
+    let (mut best, mut best_d2) = (from, f64::NAN);
+    let mut i = from;
+    while i < end {
+        let run_end = ((i / RUN + 1) * RUN).min(end);
+        let b = &boxes[i / RUN];
+        let dx = (b[0] - x).max(x - b[1]).max(0.0);
+        let dz = (b[2] - z).max(z - b[3]).max(0.0);
+        if i > from && dx.powi(2) + dz.powi(2) > best_d2 {
+            i = run_end;
+            continue;
+        }
+        for (k, &p) in route.iter().enumerate().take(run_end).skip(i) {
+            let d = d2(p);
+            if k == from || d.total_cmp(&best_d2) == std::cmp::Ordering::Less {
+                (best, best_d2) = (k, d);
+            }
+        }
+        i = run_end;
+    }
+    best
+}
+
+/// The bounding boxes of `route`'s runs of [`RUN`] points.
+fn run_boxes(route: &[[f64; 2]]) -> Vec<[f64; 4]> {
+    route
+        .chunks(RUN)
+        .map(|run| {
+            run.iter().fold(
+                [
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                ],
+                |b, p| {
+                    [
+                        b[0].min(p[0]),
+                        b[1].max(p[0]),
+                        b[2].min(p[1]),
+                        b[3].max(p[1]),
+                    ]
+                },
+            )
+        })
+        .collect()
 }
 
 impl Aeb {
@@ -79,6 +143,7 @@ impl Aeb {
             progress: 0,
             curves: Vec::new(),
             curves_of: 0,
+            boxes: Vec::new(),
         }
     }
 
@@ -151,10 +216,14 @@ impl Aeb {
         let route = obs.route;
         let (x, z) = (obs.ego.pos_m[0], obs.ego.pos_m[2]);
         let d2 = |p: [f64; 2]| (p[0] - x).powi(2) + (p[1] - z).powi(2);
-        let window = self.progress..route.len().min(self.progress + 64);
-        self.progress = window
-            .min_by(|&a, &b| d2(route[a]).total_cmp(&d2(route[b])))
-            .unwrap_or(self.progress);
+        if self.curves.len() != route.len() || self.curves_of != route.as_ptr() as usize {
+            self.curves = curvature(route);
+            self.boxes = run_boxes(route);
+            self.curves_of = route.as_ptr() as usize;
+        }
+        if self.progress < route.len() {
+            self.progress = nearest_vertex(route, &self.boxes, self.progress, x, z);
+        }
         let v = obs.ego.speed_mps.max(0.0);
         let lookahead = (v * c.lookahead_s).max(c.min_lookahead_m);
         let mut target = *route.last().expect("two points");
@@ -180,10 +249,6 @@ impl Aeb {
         let mut speed = c.cruise.target_speed_mps;
         let mut ahead = 0.0;
         let horizon = v * v / (2.0 * c.curve_decel_mps2) + 20.0;
-        if self.curves.len() != route.len() || self.curves_of != route.as_ptr() as usize {
-            self.curves = curvature(route);
-            self.curves_of = route.as_ptr() as usize;
-        }
         let pts = &self.curves[self.progress..];
         for &(l1, kappa) in pts.iter().skip(1).take(pts.len().saturating_sub(2)) {
             ahead += l1;
@@ -254,6 +319,41 @@ mod tests {
             readings: vec![("lidar", crate::sensor::Reading::Lidar(&lidar))],
         })
         .unwrap()
+    }
+
+    #[test]
+    fn skipping_far_runs_finds_the_nearest_vertex_of_the_whole_window() {
+        // A spiral that comes back near itself, with repeated points, probed from points
+        // on it, beside it and far away, from every start index.
+        let mut route: Vec<[f64; 2]> = (0..300)
+            .map(|i| {
+                let t = i as f64 * 0.21;
+                [(3.0 + 0.2 * t) * t.cos(), (3.0 + 0.2 * t) * t.sin()]
+            })
+            .collect();
+        route.insert(40, route[40]);
+        route.insert(41, route[40]);
+        let boxes = run_boxes(&route);
+        let probes = [
+            [0.0, 0.0],
+            [3.1, 0.2],
+            [-8.0, 5.0],
+            [40.0, -40.0],
+            [1e4, 3.0],
+        ];
+        for from in 0..route.len() {
+            for &[x, z] in &probes {
+                let d2 = |p: [f64; 2]| (p[0] - x).powi(2) + (p[1] - z).powi(2);
+                let plain = (from..route.len().min(from + WINDOW))
+                    .min_by(|&a, &b| d2(route[a]).total_cmp(&d2(route[b])))
+                    .unwrap();
+                assert_eq!(
+                    nearest_vertex(&route, &boxes, from, x, z),
+                    plain,
+                    "{from} {x} {z}"
+                );
+            }
+        }
     }
 
     #[test]
