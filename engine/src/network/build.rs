@@ -5,6 +5,10 @@ use super::{
     SIDEWALK_WIDTH_M,
 };
 
+/// Road shapes of one friction from which they go into one compound collider
+/// ([`Network::build`]).
+const COMPOUND_FROM: usize = 8;
+
 /// Thickness of the road slab under the surface `y = 0`, in metres.
 const SLAB_THICKNESS_M: f64 = 0.2;
 
@@ -38,8 +42,8 @@ impl Network {
     }
 
     /// Inserts the pieces' shapes. Shapes of equal friction go into one compound collider
-    /// (in piece order), so the broad phase holds one leaf for the whole road instead of
-    /// one per slab and sidewalk: with several moving actors, rapier refits and traverses
+    /// (in piece order) when there are [`COMPOUND_FROM`] or more of them, so the broad phase
+    /// holds one leaf for the whole road instead of one per slab and sidewalk: with several moving actors, rapier refits and traverses
     /// its whole tree every step, and a few dozen road leaves made that cost grow with the
     /// network (issue 23, long horizons). A ray or a contact sees the same shapes at the same
     /// poses: the compound sits at the origin, and each part keeps its own pose. A map's
@@ -141,7 +145,17 @@ impl Network {
             }
         }
         for (mu, parts) in groups {
-            physics.insert_collider(ColliderBuilder::compound(parts).friction(mu), None);
+            if parts.len() < COMPOUND_FROM {
+                // A few shapes: a compound would only add a tree level to every ray.
+                for (pose, shape) in parts {
+                    physics.insert_collider(
+                        ColliderBuilder::new(shape).position(pose).friction(mu),
+                        None,
+                    );
+                }
+            } else {
+                physics.insert_collider(ColliderBuilder::compound(parts).friction(mu), None);
+            }
         }
     }
 }

@@ -80,7 +80,13 @@ struct PieceGrid {
     /// Cell `c`'s pieces are `pieces[starts[c]..starts[c + 1]]` (cells row-major, `z` rows).
     starts: Vec<usize>,
     pieces: Vec<usize>,
+    /// Every piece, for a network of at most [`GRID_FROM`] pieces: testing them all is cheaper
+    /// than finding the cell.
+    all: Option<Vec<usize>>,
 }
+
+/// Networks of fewer pieces than this are not gridded.
+const GRID_FROM: usize = 4;
 
 /// Most cells a [`PieceGrid`] has; the cells grow for larger networks.
 const MAX_CELLS: f64 = 4096.0;
@@ -100,6 +106,7 @@ impl PieceGrid {
                 dims: [0, 0],
                 starts: vec![0],
                 pieces: Vec::new(),
+                all: None,
             };
         }
         let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(1.0);
@@ -111,6 +118,7 @@ impl PieceGrid {
             dims: [count(hi[0] - lo[0]), count(hi[1] - lo[1])],
             starts: Vec::new(),
             pieces: Vec::new(),
+            all: (boxes.len() < GRID_FROM).then(|| (0..boxes.len()).collect()),
         };
         let mut cells = vec![Vec::new(); grid.dims[0] * grid.dims[1]];
         for (i, b) in boxes.iter().enumerate() {
@@ -138,15 +146,19 @@ impl PieceGrid {
         grid
     }
 
-    /// The cell index along `axis` (0: `x`, 1: `z`) of coordinate `v`, `None` outside.
+    /// The cell index along `axis` (0: `x`, 1: `z`) of coordinate `v`, `None` outside (or
+    /// not a number). The conversion truncates, which is the floor for `k >= 0`.
     fn index(&self, v: f64, axis: usize) -> Option<usize> {
-        let k = ((v - self.origin[axis]) / self.cell_m).floor();
+        let k = (v - self.origin[axis]) / self.cell_m;
         (k >= 0.0 && k < self.dims[axis] as f64).then_some(k as usize)
     }
 
     /// The pieces that may hold the world point `p` or lie within [`NEAR_M`] of it, in
     /// network order; none for a point off the grid (or not finite).
     fn near(&self, p: [f64; 2]) -> &[usize] {
+        if let Some(all) = &self.all {
+            return all;
+        }
         match (self.index(p[0], 0), self.index(p[1], 1)) {
             (Some(x), Some(z)) => {
                 let c = z * self.dims[0] + x;
