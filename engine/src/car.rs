@@ -205,7 +205,12 @@ impl Car {
     /// The pose of its collider now: the body's pose when it is in the physics step, and the
     /// pose it would have when it is asleep (out of the step, its collider left behind).
     pub(crate) fn pose(&self) -> Pose {
-        let ([x, z], h) = self.here;
+        self.pose_at(self.here)
+    }
+
+    /// The collider's pose for the ground point `[x, z]` (m) and heading (rad) `here`.
+    fn pose_at(&self, here: ([f64; 2], f64)) -> Pose {
+        let ([x, z], h) = here;
         Pose::from_parts(
             Vector::new(
                 x as f32,
@@ -320,7 +325,7 @@ impl Car {
         (t_s, dt_s): (f64, f64),
         zone: AwakeZone,
     ) {
-        let start_pose = self.pose();
+        let start = self.here;
         let end = *self.cumulative.last().expect("non-empty");
         let before = self.s;
         let wanted = speed_mps.max(0.0);
@@ -338,8 +343,9 @@ impl Car {
         self.here = self.place_at(self.s, t_s + dt_s);
         if let Some((body, collider)) = self.body {
             let [x, z] = self.here.0;
-            // Not `>`: a distance that is not a number keeps the car awake.
-            let asleep = (x - zone.ego_m[0]).hypot(z - zone.ego_m[1]) > zone.radius_m;
+            let (dx, dz) = (x - zone.ego_m[0], z - zone.ego_m[1]);
+            // A distance that is not a number keeps the car awake.
+            let asleep = dx * dx + dz * dz > zone.radius_m * zone.radius_m;
             let rb = &mut physics.bodies[body];
             if asleep {
                 if rb.is_enabled() {
@@ -350,7 +356,7 @@ impl Car {
             }
             if !rb.is_enabled() {
                 rb.set_enabled(true);
-                rb.set_position(start_pose, false);
+                rb.set_position(self.pose_at(start), false);
                 physics.colliders[collider].set_enabled(true);
             }
             physics.bodies[body].set_next_kinematic_position(self.pose());

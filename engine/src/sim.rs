@@ -755,8 +755,10 @@ impl Simulation {
             .values()
             .map(|p| collider(p.collider))
             .chain(self.cars.values().filter_map(|c| {
-                c.body
-                    .map(|(_, h)| (c.pose(), self.physics.colliders[h].shape()))
+                let (body, h) = c.body?;
+                let co = &self.physics.colliders[h];
+                let awake = self.physics.bodies[body].is_enabled();
+                Some((if awake { *co.position() } else { c.pose() }, co.shape()))
             }))
             .chain(self.obstacles.values().map(|o| collider(o.collider)));
         // The exact distance (GJK) to the nearest actor. The distance between bounding boxes

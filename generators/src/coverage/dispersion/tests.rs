@@ -88,6 +88,11 @@ proptest! {
     }
 
     #[test]
+    fn exact_4d_matches_brute_force(points in grid_points(4, 4)) {
+        check(&points, 4)?;
+    }
+
+    #[test]
     fn the_bracket_contains_the_exact_value(
         raw in prop::collection::vec(0.0f64..1.0, 9..60),
     ) {
