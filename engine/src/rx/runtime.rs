@@ -104,8 +104,11 @@ impl Runtime {
     ) -> Result<(), RxError> {
         for k in 0..self.graph.order().len() {
             let i = self.graph.order()[k];
-            // A constant emits the same value every step: keep the one it holds.
-            if let (Node::Const(_), Some(_)) = (&self.graph.nodes()[i], &self.states[i].value) {
+            // A constant, or an open stream given one value for the test, emits the same value
+            // every step: keep the one it holds.
+            if let (Node::Const(_) | Node::Open(super::OpenStream::Constant(_)), Some(_)) =
+                (&self.graph.nodes()[i], &self.states[i].value)
+            {
                 self.states[i].fired = !self.states[i].done;
                 continue;
             }
