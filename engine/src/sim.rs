@@ -969,6 +969,7 @@ impl Inputs for WorldInputs<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::network::PieceKind;
     use crate::rx::NoHost;
     use crate::{EgoSpec, Lane, LidarSpec, TriggeredPedestrian};
 
@@ -1154,6 +1155,103 @@ mod tests {
         assert!(asleep_steps > 1000, "{asleep_steps}");
         assert!(woke >= 2, "{woke}");
         assert!(seen_oncoming);
+    }
+
+    #[test]
+    fn one_compound_road_gives_the_bits_of_separate_colliders() {
+        // A segment, a cross junction, a segment, a T junction, a segment: 11 road shapes in
+        // one compound. The ego drives through both junctions with a little steering, so its
+        // wheels cross from slab to slab, and passes a car stopped in the other lane.
+        let mut n = Network::new();
+        let seg = |n: &mut Network, name: &str| {
+            n.add(
+                name,
+                PieceKind::Segment {
+                    length_m: 60.0,
+                    lanes: 2,
+                    friction: 0.8,
+                },
+            )
+            .unwrap()
+        };
+        let a = seg(&mut n, "a");
+        let x = n
+            .add(
+                "x",
+                PieceKind::CrossIntersection {
+                    lanes: 2,
+                    friction: 0.8,
+                },
+            )
+            .unwrap();
+        let b = seg(&mut n, "b");
+        let t = n
+            .add(
+                "t",
+                PieceKind::TIntersection {
+                    lanes: 2,
+                    friction: 0.8,
+                },
+            )
+            .unwrap();
+        let c = seg(&mut n, "c");
+        n.connect(a, 1, x, 2).unwrap();
+        n.connect(x, 0, b, 0).unwrap();
+        n.connect(b, 1, t, 2).unwrap();
+        n.connect(t, 0, c, 0).unwrap();
+        // Then a bend: its slices stay colliders of their own either way.
+        let ease = n
+            .add(
+                "ease",
+                PieceKind::Clothoid {
+                    length_m: 30.0,
+                    curv_start: 0.0,
+                    curv_end: 1.0 / 60.0,
+                    lanes: 2,
+                    friction: 0.8,
+                },
+            )
+            .unwrap();
+        n.connect(c, 1, ease, 0).unwrap();
+        let mut spec = with_cars();
+        spec.ego.start = n.on_lane(a, Lane::Driving(1), 10.0).unwrap();
+        let far = n.on_lane(c, Lane::Driving(-1), 40.0).unwrap().pos_m;
+        spec.cars.truncate(1);
+        spec.cars[0].path = vec![[far[0], far[2]], [far[0] + 50.0, far[2]]];
+        let stopped = spec.cars[0].speed;
+        let mut nodes = spec.streams.nodes().to_vec();
+        nodes[stopped.0] = crate::rx::Node::Const(Value::Num(0.0));
+        spec.streams = crate::rx::Graph::new(nodes).unwrap();
+        spec.network = n;
+        let compound = Simulation::new(&spec).unwrap();
+        crate::network::SEPARATE_ROAD.with(|s| s.set(true));
+        let separate = Simulation::new(&spec).unwrap();
+        crate::network::SEPARATE_ROAD.with(|s| s.set(false));
+        assert_eq!(
+            compound.physics.colliders.len() + 10,
+            separate.physics.colliders.len()
+        );
+        let (mut compound, mut separate) = (compound, separate);
+        for k in 0..1500 {
+            let control = Control {
+                throttle: 0.4,
+                steering: 0.02 * ((k as f64) * 0.01).sin(),
+            };
+            compound.step(control, &mut NoHost).unwrap();
+            separate.step(control, &mut NoHost).unwrap();
+            assert_eq!(
+                format!("{:?}", compound.snapshot()),
+                format!("{:?}", separate.snapshot()),
+                "step {k}"
+            );
+            assert_eq!(compound.observation().lidar, separate.observation().lidar);
+        }
+        // The ego crossed both junctions and reached the bend.
+        assert!(
+            compound.ego_state().pos_m[0] > 260.0,
+            "{:?}",
+            compound.ego_state()
+        );
     }
 
     #[test]

@@ -8,6 +8,8 @@
 //! already coincide.
 
 mod build;
+#[cfg(test)]
+pub(crate) use build::SEPARATE_ROAD;
 mod curve;
 mod geometry;
 mod lanes;
