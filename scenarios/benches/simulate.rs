@@ -6,6 +6,10 @@
 //! `rapier_alone/lidar` is the same test's physics and lidar written with rapier only
 //! (`engine/benches/rapier_alone.rs`): issue 23 asks that a whole test (`safe_15s/star`) cost
 //! at most 1.2× that, measured in this one run.
+//!
+//! `long_horizons/*` runs one whole test of `grid-world` (40 s, four NPC cars) and of
+//! `t-loop` (200 s): with `safe_15s/star` they give the cost per simulated second that issue
+//! 23 compares (`experiments/bench/long_horizons.py` measures whole campaigns).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use paracosm_generators::Point;
@@ -50,6 +54,44 @@ fn bench(c: &mut Criterion) {
     group.bench_function("rapier_alone/lidar", |b| {
         b.iter(|| rapier_alone::run_test(0.975, 54.5, true))
     });
+    group.finish();
+
+    // Issue 23's long horizons: one whole test of each, to its horizon (points of Halton
+    // campaigns whose tests pass), named with the simulated time so a cost per simulated
+    // second can be read off.
+    let mut group = c.benchmark_group("long_horizons");
+    group.sample_size(10);
+    for (name, u) in [
+        (
+            "grid_world",
+            [0.125, 0.4444444444444444, 0.8, 0.5714285714285714],
+        ),
+        (
+            "t_loop",
+            [0.625, 0.7777777777777778, 0.04, 0.7142857142857143],
+        ),
+    ] {
+        let s = builtin(&name.replace('_', "-")).unwrap();
+        let a = s
+            .space
+            .decode(&Point {
+                discrete: vec![],
+                continuous: u.to_vec(),
+            })
+            .unwrap();
+        let outcome = s.run(&a, 0).unwrap();
+        assert!(outcome.passed(), "{name}");
+        let simulated = outcome
+            .metrics
+            .iter()
+            .find(|(k, _)| *k == "simulated_s")
+            .map(|(_, v)| *v)
+            .unwrap();
+        assert_eq!(simulated, s.horizon_s, "{name} runs to its horizon");
+        group.bench_function(format!("{name}_{simulated}s"), |b| {
+            b.iter(|| s.run(&a, 0).unwrap())
+        });
+    }
     group.finish();
 }
 
