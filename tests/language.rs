@@ -229,6 +229,35 @@ test(horizon = 10.0)
     let _ = assign(&s.space, &[("lim[0]", Value::Real(3.0))]);
 }
 
+/// An actor's output read inside a lambda without a top-level variable stays a stream: the
+/// error at load says how to read its current value, whatever the operation.
+#[test]
+fn a_stream_inside_a_lambda_is_refused_with_how_to_read_its_value() {
+    let base = format!("{ROAD}lead = Car(loc = r.onLane(1, 100))\nw.place(r, v, lead)\n");
+    for body in [
+        "Monitor(v.speed.map(lambda s: s - lead.speed + 5))",
+        "Assert(v.speed.map(lambda s: s < lead.speed + 5))",
+        "Monitor(v.speed.map(lambda s: abs(lead.pos.x - 3)))",
+        "Monitor(v.pos.map(lambda c: abs(c - lead.pos) - 4))",
+    ] {
+        let e = load_err(&format!("{base}{body}\n"));
+        assert!(
+            e.contains("t.star:7:")
+                && e.contains("hint: inside a lambda, a stream reads as its current value"),
+            "{body}: {e}"
+        );
+    }
+    // As the hint says, a top-level variable reads as the current value.
+    loads(&format!(
+        "{base}lead_speed = lead.speed\nMonitor(v.speed.map(lambda s: lead_speed - s + 20))\n"
+    ));
+    // An error without a stream in it gets no such hint.
+    let e = load_err(&format!(
+        "{base}Monitor(v.speed.map(lambda s: s - \"a\"))\n"
+    ));
+    assert!(!e.contains("hint: inside a lambda"), "{e}");
+}
+
 const ROAD: &str = r#"
 w = World()
 r = RoadSegment(len = 300.0, nlanes = 4)
@@ -321,6 +350,36 @@ fn signals_and_monitors_of_the_wrong_kind_are_refused_at_load() {
     assert!(e.contains("a signal is a number"), "{e}");
     let e = load_err(&format!("{base}Monitor(v.speed, over = \"sometimes\")\n"));
     assert!(e.contains("\"always\", \"end\" or \"eventually\""), "{e}");
+    // A lambda's stream has its kind from its sample value at load: a Signal of strings or
+    // of tuples is refused there (it was an error in every test), with the Signal's place.
+    let e = load_err(&format!(
+        "{base}CollisionMonitor(v)\nSignal(\"label\", lead.pos.map(lambda p: \"near\" if p.x < 5 else \"far\"))\n"
+    ));
+    assert!(
+        e.contains("Signal `label` carried \"far\" (a string)")
+            && e.contains("a signal is a number, a bool or a vector")
+            && e.contains("t.star:8:"),
+        "{e}"
+    );
+    let e = load_err(&format!(
+        "{base}CollisionMonitor(v)\nSignal(\"pair\", v.speed.map(lambda s: (s, s)))\n"
+    ));
+    assert!(
+        e.contains("Signal `pair` carried") && e.contains("t.star:8:"),
+        "{e}"
+    );
+    // A Signal of a lambda that gives numbers loads.
+    loads(&format!(
+        "{base}Signal(\"gap\", lead.pos.zip(v.pos).map(lambda p: p[0].x - p[1].x))\n\
+         Stl(\"G[0,5] (gap > 1)\")\n"
+    ));
+    // Thresholds of the built-in monitors that no test could fail are refused.
+    let e = load_err(&format!("{base}DistanceMonitor(v, minD = -5)\n"));
+    assert!(e.contains("minD is a distance in metres, >= 0"), "{e}");
+    let e = load_err(&format!(
+        "{base}TimeToFailure(CollisionMonitor(v), minT = -1.0)\n"
+    ));
+    assert!(e.contains("minT is a time in seconds, >= 0"), "{e}");
 }
 
 /// A lambda's stream has no kind until it is called: a `Monitor` of a lambda that returns

@@ -522,9 +522,14 @@ impl Program {
                         return Ok(());
                     }
                     Err(format!(
-                        "{message}\n(found when loading: every lambda and combinator is called \
+                        "{message}{}\n(found when loading: every lambda and combinator is called \
                          once on sample values of its stream's type, those of the first test's \
-                         world at t = 0)"
+                         world at t = 0)",
+                        if message.contains("Stream") {
+                            STREAM_IN_LAMBDA
+                        } else {
+                            ""
+                        }
                     ))
                 }
             }
@@ -532,11 +537,19 @@ impl Program {
     }
 }
 
-/// Checks that each `Monitor` judges numbers and each `Assert` bools, by their streams' sample
-/// values from the check at load: a stream made by a lambda has no kind until it is called.
+/// The hint added to an error at load that involves a stream inside a lambda (`lambda s: s -
+/// lead.speed`): LANGUAGE.md, "What a lambda sees".
+const STREAM_IN_LAMBDA: &str = "\nhint: inside a lambda, a stream reads as its current value only \
+     when a variable at the top level of the program holds it: write `lead_speed = lead.speed` \
+     at the top level and use `lead_speed` in the lambda; or zip the stream in \
+     (`v.speed.zip(lead.speed).map(lambda p: p[1] - p[0])`)";
+
+/// Checks that each `Monitor` judges numbers, each `Assert` bools and each `Signal` numbers,
+/// bools or vectors, by their streams' sample values from the check at load: a stream made by
+/// a lambda has no kind until it is called.
 ///
 /// # Errors
-/// The first monitor whose sample is of the other kind, with the monitor's `file:line:col`.
+/// The first monitor or signal whose sample is of another kind, with its `file:line:col`.
 fn judged_kinds(
     b: &SceneBuilder,
     samples: &[Option<paracosm_engine::rx::Value>],
@@ -555,6 +568,23 @@ fn judged_kinds(
             return Err(format!(
                 "error: monitor `{name}`: {why} (found when loading, from the sample value its \
                  stream gives in the first test's world at t = 0)\n --> {at}"
+            ));
+        }
+    }
+    for (name, at) in &b.signals_at {
+        let sample = b
+            .published
+            .iter()
+            .find(|(n, _)| n == name)
+            .and_then(|(_, id)| samples.get(id.0))
+            .and_then(Option::as_ref);
+        use paracosm_engine::rx::Value;
+        if let Some(v @ (Value::Unit | Value::Tuple(_) | Value::Text(_))) = sample {
+            return Err(format!(
+                "error: Signal `{name}` carried {}; a signal is a number, a bool or a vector \
+                 (found when loading, from the sample value its stream gives in the first \
+                 test's world at t = 0)\n --> {at}",
+                paracosm_engine::rx::describe(v)
             ));
         }
     }

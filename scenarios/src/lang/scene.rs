@@ -262,6 +262,8 @@ pub struct SceneBuilder {
     pub lambdas: u32,
     /// Streams published by name to monitors (`Monitor`, `Assert`, `Signal`).
     pub published: Vec<(String, StreamId)>,
+    /// Each `Signal(name, ...)`'s name and where it was called, `file:line:col`.
+    pub signals_at: Vec<(String, String)>,
     /// What the program printed while this evaluation ran (the start of a test's log).
     pub log: Vec<String>,
     /// `onLane` results, by index.
@@ -334,6 +336,7 @@ impl SceneBuilder {
             car_names: Vec::new(),
             lambdas: 0,
             published: Vec::new(),
+            signals_at: Vec::new(),
             log: Vec::new(),
             locs: Vec::new(),
             loc_table: Default::default(),

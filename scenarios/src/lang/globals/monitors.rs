@@ -137,6 +137,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
     ) -> anyhow::Result<MonitorVal> {
         ego_arg(v, "DistanceMonitor")?;
         let min_distance_m = number(minD, "minD")?;
+        if !(min_distance_m.is_finite() && min_distance_m >= 0.0) {
+            bail!(
+                "DistanceMonitor(minD = {min_distance_m}): minD is a distance in metres, >= 0 \
+                 (below it no test could fail)"
+            );
+        }
         monitor(
             eval,
             MonitorSpec::Distance {
@@ -251,11 +257,13 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             );
         }
         b.published.push((name.to_owned(), id));
+        b.signals_at.push((name.to_owned(), here(eval)));
         Ok(NoneType)
     }
 
     /// `TimeToFailure(m, minT=0.0)`: wraps monitor `m`; reports the time of its first
-    /// violation and fails when it comes before `minT` seconds.
+    /// violation and fails when it comes before `minT` seconds (`minT >= 0`, finite, or an
+    /// error).
     fn TimeToFailure<'v>(
         m: Value<'v>,
         #[starlark(require = named)] minT: Option<Value<'v>>,
@@ -270,6 +278,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             Some(v) => number(v, "minT")?,
             None => 0.0,
         };
+        if !(min_s.is_finite() && min_s >= 0.0) {
+            bail!(
+                "TimeToFailure(minT = {min_s}): minT is a time in seconds, >= 0 (a failure \
+                 before it fails the monitor)"
+            );
+        }
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
         let wrapped = b
