@@ -858,3 +858,45 @@ fn levels_keep_their_type_a_text_true_is_not_a_bool() {
     }
     assert_eq!(seen.len(), 4, "{seen:?}");
 }
+
+/// `onLane` takes its arguments by position or by keyword (LANGUAGE.md, Conventions), and
+/// open values among several positional arguments of a method are named by position.
+#[test]
+fn on_lane_takes_keywords_and_its_open_arguments_have_names_of_their_own() {
+    let names = |src: &str| -> Vec<String> {
+        loads(src)
+            .space
+            .params()
+            .iter()
+            .map(|p| p.name.clone())
+            .collect()
+    };
+    let segment = "w = World()\nr = RoadSegment(len = 300.0, nlanes = 4)\n";
+    let n = names(&format!(
+        "{segment}v = AutonomousVehicle(loc = r.onLane(lane = 1, at = 10.0))\n\
+         c = Car(loc = r.onLane(VarEnum([2, -2]), VarInterval(40.0, 60.0)))\n\
+         d = Car(loc = r.onLane(-1, VarInterval(100.0, 120.0)))\n\
+         w.place(r, v, c, d)\nCollisionMonitor(v)\n"
+    ));
+    assert_eq!(n, ["r.onLane[0]", "r.onLane[1]", "r.onLane"]);
+    // The same place by keyword and by position (a difference fails the load).
+    loads(&format!(
+        "{segment}a = r.onLane(lane = -1, at = 42.0)\nb = r.onLane(-1, 42.0)\n\
+         if not (a == b and a.heading == b.heading and a.lane == b.lane): fail(\"differ\")\n\
+         if a == r.onLane(-1, 43.0): fail(\"1 m apart are equal\")\n\
+         v = AutonomousVehicle(loc = r.onLane(1, at = 10.0))\nw.place(r, v)\nCollisionMonitor(v)\n"
+    ));
+    let e = load_err(&format!(
+        "{segment}v = AutonomousVehicle(loc = r.onLane(1, lane = 2, at = 10.0))\nw.place(r, v)\n"
+    ));
+    assert!(e.contains("lane is given twice"), "{e}");
+    let e = load_err(&format!(
+        "{segment}v = AutonomousVehicle(loc = r.onLane(lane = 1))\nw.place(r, v)\n"
+    ));
+    assert!(e.contains("needs a lane and how far along it"), "{e}");
+    let junction = "w = World()\nj = CrossIntersection(nlanes = 2)\n";
+    loads(&format!(
+        "{junction}v = AutonomousVehicle(loc = j.onLane(port = j.ONE, turn = \"left\", at = 3.0, lane = 1))\n\
+         w.place(j, v)\nCollisionMonitor(v)\ntest(offroad = False)\n"
+    ));
+}

@@ -361,3 +361,30 @@ fn connect_refuses_to_join_a_piece_to_a_map() {
         "{e}"
     );
 }
+
+/// Past the dead end of each outer road of `maps/junction.xodr`, the driving surface stops:
+/// a point 0.5 m beyond the last station of a lane's centre line is off the road, one 0.5 m
+/// before it on. (A vehicle 1 m past road 4's end once read as on the road.)
+#[test]
+fn the_junction_maps_dead_ends_end_the_road() {
+    let (net, id, _) = map_network("junction.xodr", &shipped("junction.xodr"));
+    let surface = Surface::new(&net);
+    for road in ["1", "2", "3", "4"] {
+        for lane in [-1, 1] {
+            let end = net.on_map_lane(id, road, lane, 70.0).unwrap();
+            let before = net.on_map_lane(id, road, lane, 69.0).unwrap();
+            let dir = [
+                end.pos_m[0] - before.pos_m[0],
+                end.pos_m[2] - before.pos_m[2],
+            ];
+            let at = |k: f64| [end.pos_m[0] + k * dir[0], end.pos_m[2] + k * dir[1]];
+            let inside = surface.edge_distance_m(at(-0.5));
+            let outside = surface.edge_distance_m(at(0.5));
+            assert!(inside > 0.0, "road {road} lane {lane}: {inside}");
+            assert!(
+                outside < 0.0 && surface.off_road(at(0.5)),
+                "road {road} lane {lane}: {outside}"
+            );
+        }
+    }
+}

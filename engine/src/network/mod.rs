@@ -567,8 +567,9 @@ impl Network {
             .find(|l| l.entry == (entry, lane) && l.turn == turn)
         else {
             return bad(format!(
-                "{} has no {turn:?} turn from port {}",
+                "{} has no \"{}\" turn from port {}",
                 p.name,
+                turn.name(),
                 PORT_NAMES.get(entry).copied().unwrap_or("?")
             ));
         };

@@ -343,8 +343,10 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
         this: &Road,
         #[starlark(require = pos)] first: Option<Value<'v>>,
         #[starlark(require = pos)] second: Option<Value<'v>>,
-        #[starlark(require = pos)] at: Option<Value<'v>>,
+        at: Option<Value<'v>>,
         #[starlark(require = named)] lane: Option<Value<'v>>,
+        #[starlark(require = named)] port: Option<Value<'v>>,
+        #[starlark(require = named)] turn: Option<Value<'v>>,
         #[starlark(require = named)] road: Option<Value<'v>>,
         #[starlark(require = named)] s: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
@@ -356,7 +358,12 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
         let mut b = st.scene.borrow_mut();
         let piece = PieceId(this.piece);
         if this.map != (road.is_some() || s.is_some())
-            || (this.map && (first.is_some() || second.is_some() || at.is_some()))
+            || (this.map
+                && (first.is_some()
+                    || second.is_some()
+                    || at.is_some()
+                    || port.is_some()
+                    || turn.is_some()))
         {
             if this.map {
                 bail!("an OpenDrive map's onLane takes road=, lane= and s= by name: m.onLane(road = \"1\", lane = -1, s = 20.0)");
@@ -408,26 +415,50 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
                 table: b.loc_table.clone(),
             });
         }
-        let (Some(first), Some(second)) = (first, second) else {
-            bail!("onLane takes (lane, at) on a road piece, (port, turn, at, lane=) in a junction");
+        // Each argument may be given by position or by name, once.
+        let once = |pos: Option<Value<'v>>, named: Option<Value<'v>>, what: &str| match (pos, named)
+        {
+            (Some(_), Some(_)) => Err(anyhow!(
+                "onLane: {what} is given twice, by position and as {what}="
+            )),
+            (p, n) => Ok(p.or(n)),
         };
         let r = if this.segment {
-            if at.is_some() || lane.is_some() {
-                bail!("a RoadSegment's onLane takes (lane, at); onLane(port, turn, at, lane=) is for junctions");
+            if port.is_some() || turn.is_some() {
+                bail!("a RoadSegment's onLane takes (lane, at); port= and turn= are for junctions: j.onLane(port, turn, at, lane=)");
             }
+            let (lane, at) = match (first, second, at) {
+                (_, Some(_), Some(_)) => bail!(
+                    "a RoadSegment's onLane takes (lane, at), each once; onLane(port, turn, at, lane=) is for junctions"
+                ),
+                (first, second, at) => (once(first, lane, "lane")?, second.or(at)),
+            };
+            let (Some(lane), Some(at)) = (lane, at) else {
+                bail!("a RoadSegment's onLane needs a lane and how far along it: r.onLane(lane, at), or r.onLane(lane = 1, at = 20.0)");
+            };
             LaneRef::Segment {
                 piece,
-                lane: lane_of(first)?,
-                at_m: number(second, "onLane(at=)")?,
+                lane: lane_of(lane)?,
+                at_m: number(at, "onLane(at=)")?,
             }
         } else {
-            let port = first
-                .downcast_ref::<Port>()
-                .filter(|p| p.piece == this.piece)
-                .ok_or_else(|| {
-                    anyhow!("a junction's onLane takes one of its ports first (such as j.ONE), got {first}")
-                })?
-                .index;
+            let (Some(first), Some(second)) =
+                (once(first, port, "port")?, once(second, turn, "turn")?)
+            else {
+                bail!("a junction's onLane takes (port, turn, at, lane=): j.onLane(j.ONE, \"left\", 5.0), or j.onLane(port = j.ONE, turn = \"left\", at = 5.0)");
+            };
+            let port = match first.downcast_ref::<Port>() {
+                Some(p) if p.piece == this.piece => p.index,
+                Some(p) => bail!(
+                    "a junction's onLane takes one of its own ports first (such as j.ONE), got {}.{}, a port of another piece",
+                    b.roads.piece(PieceId(p.piece)).name,
+                    crate::lang::values::PORTS[p.index]
+                ),
+                None => bail!(
+                    "a junction's onLane takes one of its ports first (such as j.ONE), got a {}",
+                    first.get_type()
+                ),
+            };
             let turn = super::globals::text_value(second, &b)
                 .as_deref()
                 .and_then(Turn::parse)

@@ -150,7 +150,16 @@ impl Walker<'_> {
                 let builtin = name
                     .as_deref()
                     .is_some_and(|n| self.builtins.contains(&n) && !DECLARERS.contains(&n));
-                for a in &args.args {
+                // Open parameters among a method's positional arguments: one is named by the
+                // method, several by their positions too.
+                let open_positional = args
+                    .args
+                    .iter()
+                    .filter(|a| {
+                        matches!(a.node, ArgumentP::Positional(_)) && is_declarer(a.node.expr())
+                    })
+                    .count();
+                for (position, a) in args.args.iter().enumerate() {
                     let value = a.node.expr();
                     if let (ArgumentP::Named(kw, _), true) = (&a.node, is_declarer(value)) {
                         let owner = target.map(str::to_owned).or_else(|| name.clone());
@@ -176,12 +185,17 @@ impl Walker<'_> {
                         }
                     }
                     // A positional argument of a method: `lead.brake(VarEnum(...))` is
-                    // `lead.brake`.
+                    // `lead.brake`; with several, `r.onLane(VarEnum(...), VarInterval(...))`
+                    // gives `r.onLane[0]` and `r.onLane[1]`.
                     if let (ArgumentP::Positional(_), true, ExprP::Dot(obj, method)) =
                         (&a.node, is_declarer(value), &f.node)
                     {
                         if let ExprP::Identifier(o) = &obj.node {
-                            let n = format!("{}.{}", o.node.ident, method.node);
+                            let n = if open_positional > 1 {
+                                format!("{}.{}[{position}]", o.node.ident, method.node)
+                            } else {
+                                format!("{}.{}", o.node.ident, method.node)
+                            };
                             self.site(value, Some(n), None, None);
                         }
                     }

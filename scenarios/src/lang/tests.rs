@@ -299,7 +299,9 @@ fn inputs_of_the_wrong_kind_or_out_of_range_are_refused_at_load() {
         (with_car(", speed = tick.zip(tick)", ""), "but this stream carries tuples", "4:5"),
         (walker("speed = \"slow\", trigger = tick"), "Pedestrian(speed=) takes a number in m/s, >= 0, got \"slow\"", "4:5"),
         (walker("speed = 1.0, dist = VarInterval(-5, 5), car = v"), "Pedestrian(dist=) takes a number in m, >= 0, got -5 (a number)", "4:5"),
-        (walker("speed = 1.0, dist = 10.0, car = 3.0"), "Pedestrian(car=) takes a position (x, y, z) in m, got 3 (a number)", "4:5"),
+        (walker("speed = 1.0, dist = 10.0, car = 3.0"), "Pedestrian(car=) takes a position (x, y, z) in m that moves", "4:5"),
+        (walker("speed = 1.0, dist = 10.0, car = (30.0, 0.0, 1.75)"), "got (30.0, 0.0, 1.75) (a tuple); a fixed point cannot come near", "4:5"),
+        (walker("speed = 1.0, dist = 10.0, car = r.onLane(1, 30.0)"), "(a Location); a fixed point cannot come near", "4:5"),
         (walker("speed = 1.0, dist = 10.0, car = v.speed"), "but this stream carries numbers", "4:5"),
         (
             world("") + "test(horizon = 5.0)\ntest(horizon = 8.0)\n",

@@ -296,7 +296,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                     height_m: number(*h, "Obstacle(size=) height")?,
                 };
                 if !size.is_valid() {
-                    bail!("Obstacle(size=) needs three positive lengths in m, got {size:?}");
+                    bail!(
+                        "Obstacle(size=) needs three positive, finite lengths in m, got ({}, {}, {})",
+                        size.length_m,
+                        size.width_m,
+                        size.height_m
+                    );
                 }
                 size
             }
@@ -348,6 +353,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             (Some(d), Some(c), None) => {
                 let car = match c.downcast_ref::<ActorVal>() {
                     Some(a) => StreamId(a.outputs[0]),
+                    None if c.downcast_ref::<Stream>().is_none() => bail!(
+                        "Pedestrian(car=) takes a position (x, y, z) in m that moves: the actor \
+                         whose approach triggers the walk (`car = v`) or a stream of its position \
+                         (`car = v.pos`), got {c} (a {}); a fixed point cannot come near",
+                        c.get_type()
+                    ),
                     None => typed_arg(c, &mut b, &types::WATCHED_POSITION, owner, &at)?,
                 };
                 PedTrigger::Near {
