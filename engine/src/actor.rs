@@ -35,12 +35,16 @@ impl Size {
         height_m: 1.8,
     };
 
-    /// Whether every extent is finite and positive.
+    /// Whether every extent is positive and at most [`Size::MAX_EXTENT_M`] (1 km): the
+    /// physics works in `f32`, and a box 10^30 m tall touched a vehicle in another lane.
     pub fn is_valid(&self) -> bool {
         [self.length_m, self.width_m, self.height_m]
             .iter()
-            .all(|v| v.is_finite() && *v > 0.0)
+            .all(|v| *v > 0.0 && *v <= Size::MAX_EXTENT_M)
     }
+
+    /// The largest extent of a box, m.
+    pub const MAX_EXTENT_M: f64 = 1000.0;
 }
 
 /// A box the camera draws: a car, a pedestrian, an obstacle.
@@ -179,6 +183,20 @@ mod tests {
         assert!(!Size {
             length_m: 1.0,
             width_m: 0.0,
+            height_m: 1.0
+        }
+        .is_valid());
+        for bad in [1e30, f64::INFINITY, f64::NAN, 1000.5] {
+            assert!(!Size {
+                length_m: 50.0,
+                width_m: 0.5,
+                height_m: bad
+            }
+            .is_valid());
+        }
+        assert!(Size {
+            length_m: 1000.0,
+            width_m: 0.5,
             height_m: 1.0
         }
         .is_valid());

@@ -273,7 +273,54 @@ fn load_with_base(
     })?;
     let ast =
         AstModule::parse(file, source.to_owned(), &dialect).map_err(|e| lang(format!("{e}")))?;
-    program::load(file, source, name, ast, globals(), base)
+    program::load(file, source, name, ast, globals(), base).map_err(|e| match e {
+        ScenarioError::Language(m) => ScenarioError::Language(with_source_lines(&m, file, source)),
+        other => other,
+    })
+}
+
+/// Adds the source line and a caret under each ` --> FILE:LINE:COL` of `message` that names
+/// `file` and is not followed by them already, as starlark's own diagnostics show them
+/// (LANGUAGE.md, "Errors and limits": every error names the file, line and column, with the
+/// source line and a caret).
+fn with_source_lines(message: &str, file: &str, source: &str) -> String {
+    let lines: Vec<&str> = message.lines().collect();
+    let mut out = String::with_capacity(message.len() + 256);
+    for (k, line) in lines.iter().enumerate() {
+        out.push_str(line);
+        out.push('\n');
+        let shown = lines
+            .get(k + 1)
+            .is_some_and(|next| next.trim_start().starts_with('|'));
+        let Some(place) = line.trim_start().strip_prefix("--> ") else {
+            continue;
+        };
+        let Some(rest) = place.strip_prefix(file).and_then(|r| r.strip_prefix(':')) else {
+            continue;
+        };
+        let mut parts = rest.splitn(2, ':');
+        let (Some(Ok(row)), Some(Ok(col))) = (
+            parts.next().map(str::parse::<usize>),
+            parts.next().map(|c| c.trim_end().parse::<usize>()),
+        ) else {
+            continue;
+        };
+        let Some(text) = source.lines().nth(row.wrapping_sub(1)) else {
+            continue;
+        };
+        if shown {
+            continue;
+        }
+        let gutter = " ".repeat(row.to_string().len());
+        let indent = " ".repeat(col.saturating_sub(1).min(text.chars().count()));
+        out.push_str(&format!(
+            "{gutter} |\n{row} | {text}\n{gutter} | {indent}^\n"
+        ));
+    }
+    if !message.ends_with('\n') {
+        out.pop();
+    }
+    out
 }
 
 #[cfg(test)]

@@ -299,6 +299,7 @@ fn inputs_of_the_wrong_kind_or_out_of_range_are_refused_at_load() {
         (with_car(", speed = tick.zip(tick)", ""), "but this stream carries tuples", "4:5"),
         (walker("speed = \"slow\", trigger = tick"), "Pedestrian(speed=) takes a number in m/s, >= 0, got \"slow\"", "4:5"),
         (walker("speed = 1.0, dist = VarInterval(-5, 5), car = v"), "Pedestrian(dist=) takes a number in m, >= 0, got -5 (a number)", "4:5"),
+        (format!("{HEADER}o = Obstacle(loc = r.onLane(-1, 80), size = (50.0, 0.5, 1e30))\n"), "Obstacle(size=) needs three lengths in m, each > 0 and <= 1000, got (50, 0.5, 1000000000000000000000000000000)", "4:5"),
         (walker("speed = 1.0, dist = 10.0, car = 3.0"), "Pedestrian(car=) takes a position (x, y, z) in m that moves", "4:5"),
         (walker("speed = 1.0, dist = 10.0, car = (30.0, 0.0, 1.75)"), "got (30.0, 0.0, 1.75) (a tuple); a fixed point cannot come near", "4:5"),
         (walker("speed = 1.0, dist = 10.0, car = r.onLane(1, 30.0)"), "(a Location); a fixed point cannot come near", "4:5"),
@@ -570,4 +571,21 @@ fn a_varenum_refuses_levels_that_are_equal() {
         )
         .unwrap_or_else(|e| panic!("{levels}: {e}"));
     }
+}
+
+/// Errors that paracosm words itself (not starlark) show the source line and a caret under
+/// their `file:line:col` too.
+#[test]
+fn every_located_error_shows_its_source_line_and_a_caret() {
+    let m = err(&format!(
+        "{HEADER}w.place(r, v)\nCollisionMonitor(v)\nk = VarEnum([1, 2])\nif k == 2:\n    extra = VarInterval(0.0, 1.0)\n"
+    ));
+    assert!(m.contains("depend on their values"), "{m}");
+    assert!(
+        m.contains("bad.star:8:13\n  |\n8 |     extra = VarInterval(0.0, 1.0)\n  |             ^"),
+        "{m}"
+    );
+    // starlark's own diagnostics keep their one snippet.
+    let m = err(&format!("{HEADER}x = VarInterval(5, 1)\n"));
+    assert_eq!(m.matches("x = VarInterval(5, 1)").count(), 2, "{m}");
 }

@@ -297,7 +297,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 };
                 if !size.is_valid() {
                     bail!(
-                        "Obstacle(size=) needs three positive, finite lengths in m, got ({}, {}, {})",
+                        "Obstacle(size=) needs three lengths in m, each > 0 and <= 1000, got ({}, {}, {})",
                         size.length_m,
                         size.width_m,
                         size.height_m
