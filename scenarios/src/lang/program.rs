@@ -129,7 +129,7 @@ fn finished_message(b: &SceneBuilder) -> Result<(), (String, Option<&str>)> {
     if b.ego.is_none() {
         return Err((
             "the program places no AutonomousVehicle: nothing to test".into(),
-            None,
+            b.placed_at.as_deref(),
         ));
     }
     if b.world.is_none() {
@@ -669,8 +669,8 @@ pub fn load(
             if let Some(j) = (0..i).find(|&j| explicit[j].as_deref() == Some(a)) {
                 return Err(lang(format!(
                     "error: two open parameters are named `{a}` (declared at {} and {}); give \
-                     one another name=\n --> {file}",
-                    first.params[j].at, first.params[i].at
+                     one another name=\n --> {}",
+                    first.params[j].at, first.params[i].at, first.params[i].at
                 )));
             }
         }

@@ -589,3 +589,20 @@ fn every_located_error_shows_its_source_line_and_a_caret() {
     let m = err(&format!("{HEADER}x = VarInterval(5, 1)\n"));
     assert_eq!(m.matches("x = VarInterval(5, 1)").count(), 2, "{m}");
 }
+
+/// A program without an ego vehicle, and two parameters of one explicit name, are located.
+#[test]
+fn whole_program_errors_point_at_a_line() {
+    let m = err("w = World()\nr = RoadSegment(len = 100.0)\nc = Car(loc = r.onLane(1, 10))\nw.place(r, c)\n");
+    assert!(
+        m.contains("places no AutonomousVehicle") && m.contains("bad.star:4:1\n"),
+        "{m}"
+    );
+    let m = err(&format!(
+        "{HEADER}a = VarInterval(0, 1, name = \"x\")\nb = VarInterval(0, 1, name = \"x\")\nw.place(r, v)\n"
+    ));
+    assert!(
+        m.contains("two open parameters are named `x`") && m.contains("--> bad.star:5:5\n"),
+        "{m}"
+    );
+}
