@@ -554,17 +554,21 @@ fn judged_kinds(
     b: &SceneBuilder,
     samples: &[Option<paracosm_engine::rx::Value>],
 ) -> Result<(), String> {
+    // The sample value of the stream published as `signal`, if it had one.
+    let sample_of = |signal: &str| {
+        b.published
+            .iter()
+            .find(|(name, _)| name == signal)
+            .and_then(|(_, id)| samples.get(id.0))
+            .and_then(Option::as_ref)
+    };
     for (m, at) in b.monitors.iter().zip(&b.monitors_at) {
         let Some((name, signal, bools)) = m.judged_stream() else {
             continue;
         };
-        let sample = b
-            .published
-            .iter()
-            .find(|(name, _)| name == signal)
-            .and_then(|(_, id)| samples.get(id.0))
-            .and_then(Option::as_ref);
-        if let Some(why) = sample.and_then(|v| crate::scenario::judged_kind_error(v, bools)) {
+        if let Some(why) =
+            sample_of(signal).and_then(|v| crate::scenario::judged_kind_error(v, bools))
+        {
             return Err(format!(
                 "error: monitor `{name}`: {why} (found when loading, from the sample value its \
                  stream gives in the first test's world at t = 0)\n --> {at}"
@@ -572,14 +576,8 @@ fn judged_kinds(
         }
     }
     for (name, at) in &b.signals_at {
-        let sample = b
-            .published
-            .iter()
-            .find(|(n, _)| n == name)
-            .and_then(|(_, id)| samples.get(id.0))
-            .and_then(Option::as_ref);
         use paracosm_engine::rx::Value;
-        if let Some(v @ (Value::Unit | Value::Tuple(_) | Value::Text(_))) = sample {
+        if let Some(v @ (Value::Unit | Value::Tuple(_) | Value::Text(_))) = sample_of(name) {
             return Err(format!(
                 "error: Signal `{name}` carried {}; a signal is a number, a bool or a vector \
                  (found when loading, from the sample value its stream gives in the first \
