@@ -139,6 +139,12 @@ impl GraphBuilder {
         &self.nodes
     }
 
+    /// Where node `node` was made (`file:line:col`), when it was pushed with
+    /// [`GraphBuilder::push_at`].
+    pub fn site(&self, node: usize) -> Option<&str> {
+        self.sites.get(node).and_then(Option::as_deref)
+    }
+
     /// The checked graph.
     ///
     /// # Errors

@@ -46,7 +46,7 @@ pub use obstacle::ObstacleState;
 pub use pedestrian::{PedestrianPhase, PedestrianState};
 pub use segmentation::{ObjectBox, SemanticClass};
 pub use sensor::lidar::{LidarReturn, LidarSpec};
-pub use sim::{EgoState, Observation, Simulation, Snapshot};
+pub use sim::{EgoState, Observation, Simulation, Snapshot, SnapshotParts};
 pub use spec::{
     CarSpec, EgoSpec, EnvironmentSpec, ObstacleSpec, PedestrianSpec, TriggeredPedestrian,
     WorldSpec, DEFAULT_DT_S,

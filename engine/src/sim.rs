@@ -71,7 +71,8 @@ pub struct Snapshot {
     /// car's or an obstacle's body, in metres; `0` when touching, `+inf` without actors.
     pub min_separation_m: f64,
     /// Path time to collision of the ego vehicle in seconds ([`crate::ttc::time_to_collision_s`]):
-    /// `+inf` when nothing in its path is closing in, `0` when touching.
+    /// `+inf` when nothing in its path is closing in, `0` when touching; NaN when
+    /// [`Simulation::snapshot_of`] left it out.
     pub ttc_s: f64,
     /// Light intensity now, `[0, 1]`.
     pub light: f64,
@@ -85,8 +86,48 @@ pub struct Snapshot {
     pub ego_road_edge_m: f64,
     /// Lateral offset of the ego vehicle's centre from the centre line of the nearest lane
     /// in its direction of travel, in metres, positive to the right
-    /// ([`Surface::lane_offset_m`]).
+    /// ([`Surface::lane_offset_m`]); NaN when [`Simulation::snapshot_of`] left it out.
     pub ego_lane_offset_m: f64,
+}
+
+/// Which of a [`Snapshot`]'s costlier signals [`Simulation::snapshot_of`] computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SnapshotParts {
+    /// [`Snapshot::ttc_s`], the path time to collision (one prediction per actor).
+    pub ttc: bool,
+    /// [`Snapshot::ego_lane_offset_m`] (a search of the lanes near the ego vehicle).
+    pub lane_offset: bool,
+}
+
+impl SnapshotParts {
+    /// Every signal.
+    pub const ALL: SnapshotParts = SnapshotParts {
+        ttc: true,
+        lane_offset: true,
+    };
+}
+
+/// How messages name the actors: [`crate::CarSpec::name`], [`crate::PedestrianSpec::name`].
+#[derive(Debug, Clone, Default)]
+struct ActorNames {
+    cars: Vec<String>,
+    pedestrians: Vec<String>,
+}
+
+impl ActorNames {
+    fn car(&self, i: usize) -> String {
+        match self.cars.get(i) {
+            Some(n) if !n.is_empty() => n.clone(),
+            _ => format!("car {i}"),
+        }
+    }
+
+    fn pedestrian(&self, i: usize) -> String {
+        match self.pedestrians.get(i) {
+            Some(n) if !n.is_empty() => n.clone(),
+            _ => format!("pedestrian {i}"),
+        }
+    }
 }
 
 /// Which actor a collider belongs to.
@@ -120,6 +161,8 @@ pub struct Simulation {
     sinks: Vec<(u32, Value)>,
     /// Each car's lanes for `changeLane` ([`crate::CarSpec::lane_offsets_m`]).
     car_lanes: Vec<Vec<(i32, f64)>>,
+    /// How messages name each car and each pedestrian ([`crate::CarSpec::name`]).
+    names: ActorNames,
     sensors: Sensors,
     events: Receiver<CollisionEvent>,
     collector: ChannelEventCollector,
@@ -183,7 +226,7 @@ impl Simulation {
             .chain(spec.frictions.iter().map(|f| f.1))
             .chain(spec.published.iter().map(|p| p.1))
             .chain([spec.environment.light, spec.environment.fog]);
-        for id in ids {
+        for id in ids.clone() {
             if id.0 >= n {
                 return Err(invalid(format!("stream {} does not exist", id.0)));
             }
@@ -288,10 +331,24 @@ impl Simulation {
                 constant(&spec.streams, spec.environment.light).unwrap_or(NOMINAL_LIGHT),
                 constant(&spec.streams, spec.environment.fog).unwrap_or(0.0),
             ),
-            streams: Runtime::new(spec.streams.clone()),
+            streams: {
+                // The streams the world reads; the rest of the graph is evaluated only where
+                // these, an action or a function need it (Runtime::evaluate_only).
+                let mut rt = Runtime::new(spec.streams.clone());
+                let when = spec.cars.iter().filter_map(|c| match c.lane_change?.start {
+                    LaneChangeStart::When(s) => Some(s),
+                    LaneChangeStart::At(_) => None,
+                });
+                rt.evaluate_only(ids.clone().chain(when));
+                rt
+            },
             evaluated: None,
             sinks: Vec::new(),
             car_lanes: spec.cars.iter().map(|c| c.lane_offsets_m.clone()).collect(),
+            names: ActorNames {
+                cars: spec.cars.iter().map(|c| c.name.clone()).collect(),
+                pedestrians: spec.pedestrians.iter().map(|p| p.name.clone()).collect(),
+            },
             sensors,
             events,
             collector: ChannelEventCollector::new(collision_tx, force_tx, tear_tx),
@@ -457,18 +514,6 @@ impl Simulation {
         let dt = self.dt_s;
         let t = self.t_s();
         self.evaluate(host)?;
-        self.light_fog = (
-            number(
-                &self.streams,
-                self.environment.light,
-                NOMINAL_LIGHT,
-                t,
-                || "the light".into(),
-            )?,
-            number(&self.streams, self.environment.fog, 0.0, t, || {
-                "the fog".into()
-            })?,
-        );
         for &(piece, stream) in &self.frictions {
             let mu = self.network.piece(piece).kind.friction();
             let network = &self.network;
@@ -500,7 +545,8 @@ impl Simulation {
             let v = match car.speed_override {
                 Some(v) => v,
                 None => {
-                    let what = || format!("the speed of car {i}");
+                    let names = &self.names;
+                    let what = || format!("the speed of {}", names.car(i));
                     number(&self.streams, car.speed_stream, 0.0, t, what)?
                 }
             };
@@ -593,6 +639,19 @@ impl Simulation {
         };
         self.streams.step(t, &inputs, host, &mut self.sinks)?;
         self.evaluated = Some(self.tick);
+        // Light and fog now: the step from here uses them, and a snapshot shows them.
+        self.light_fog = (
+            number(
+                &self.streams,
+                self.environment.light,
+                NOMINAL_LIGHT,
+                t,
+                || "the light".into(),
+            )?,
+            number(&self.streams, self.environment.fog, 0.0, t, || {
+                "the fog".into()
+            })?,
+        );
         Ok(())
     }
 
@@ -639,7 +698,7 @@ impl Simulation {
             match decode_sink(*sink) {
                 Action::Walk(i) => {
                     if let Some(p) = self.pedestrians.get_mut(Handle::from_index(i as usize)) {
-                        let what = || format!("the speed of pedestrian {i}");
+                        let what = || format!("the speed of {}", self.names.pedestrian(i as usize));
                         let v = number(&self.streams, p.speed_stream, 0.0, t, what)?;
                         p.walk(&mut self.physics, t, dt, v);
                     }
@@ -656,7 +715,10 @@ impl Simulation {
                         }
                         _ => {
                             return Err(bad(
-                                format!("the speed given to car {i}'s setSpeed"),
+                                format!(
+                                    "the speed given to {}'s setSpeed",
+                                    self.names.car(i as usize)
+                                ),
                                 value,
                                 "a finite number >= 0 (m/s)",
                             ))
@@ -673,7 +735,10 @@ impl Simulation {
                         }
                         _ => {
                             return Err(bad(
-                                format!("the deceleration given to car {i}'s brake"),
+                                format!(
+                                    "the deceleration given to {}'s brake",
+                                    self.names.car(i as usize)
+                                ),
                                 value,
                                 "a finite number > 0 (m/s²)",
                             ))
@@ -698,7 +763,10 @@ impl Simulation {
                     else {
                         let known: Vec<String> = lanes.iter().map(|(l, _)| l.to_string()).collect();
                         return Err(bad(
-                            format!("the lane given to car {i}'s changeLane"),
+                            format!(
+                                "the lane given to {}'s changeLane",
+                                self.names.car(i as usize)
+                            ),
                             value,
                             &if known.is_empty() {
                                 "a lane of the segment the car starts on; it starts inside a junction, where there is none".to_owned()
@@ -740,8 +808,16 @@ impl Simulation {
             || self.obstacles.values().any(|o| o.touching)
     }
 
-    /// The state monitors are computed from.
+    /// The state monitors are computed from, every field of it.
     pub fn snapshot(&self) -> Snapshot {
+        self.snapshot_of(SnapshotParts::ALL)
+    }
+
+    /// The state monitors are computed from, with only the costlier signals in `parts`
+    /// computed: a field left out ([`Snapshot::ttc_s`], [`Snapshot::ego_lane_offset_m`]) is
+    /// NaN, for a runner whose monitors do not read it. Every other field is as
+    /// [`Simulation::snapshot`] gives it, bit for bit.
+    pub fn snapshot_of(&self, parts: SnapshotParts) -> Snapshot {
         let chassis = &self.physics.colliders[self.ego.collider];
         let collider = |h: ColliderHandle| {
             let c = &self.physics.colliders[h];
@@ -803,17 +879,22 @@ impl Simulation {
             heading_rad: ego.heading_rad,
             half_size_m: [size.length_m / 2.0, size.width_m / 2.0],
         };
-        let movers: Vec<crate::ttc::Mover> = self
-            .pedestrians
-            .values()
-            .map(Pedestrian::mover)
-            .chain(self.cars.values().filter_map(Car::mover))
-            .chain(self.obstacles.values().map(Obstacle::mover))
-            .collect();
+        let ttc_s = if parts.ttc {
+            let movers: Vec<crate::ttc::Mover> = self
+                .pedestrians
+                .values()
+                .map(Pedestrian::mover)
+                .chain(self.cars.values().filter_map(Car::mover))
+                .chain(self.obstacles.values().map(Obstacle::mover))
+                .collect();
+            crate::ttc::time_to_collision_s(&ego_mover, &movers)
+        } else {
+            f64::NAN
+        };
         Snapshot {
             t_s: self.t_s(),
             ego,
-            ttc_s: crate::ttc::time_to_collision_s(&ego_mover, &movers),
+            ttc_s,
             pedestrians: self.pedestrians.values().map(Pedestrian::state).collect(),
             cars: self.cars.values().map(Car::state).collect(),
             obstacles: self.obstacles.values().map(Obstacle::state).collect(),
@@ -823,7 +904,11 @@ impl Simulation {
             fog: self.light_fog.1,
             ego_off_road: edge < 0.0,
             ego_road_edge_m: edge,
-            ego_lane_offset_m: self.surface.lane_offset_m(centre, ego.heading_rad),
+            ego_lane_offset_m: if parts.lane_offset {
+                self.surface.lane_offset_m(centre, ego.heading_rad)
+            } else {
+                f64::NAN
+            },
         }
     }
 
@@ -1101,6 +1186,7 @@ mod tests {
                 enabled: true,
                 lane_change: None,
                 lane_offsets_m: vec![],
+                name: String::new(),
             }
         };
         s.cars = vec![
@@ -1110,6 +1196,43 @@ mod tests {
         ];
         s.streams = crate::rx::Graph::new(nodes).unwrap();
         s
+    }
+
+    #[test]
+    fn a_partial_snapshot_leaves_out_only_what_it_was_told_to() {
+        let spec = with_cars();
+        let mut sim = Simulation::new(&spec).unwrap();
+        let control = Control {
+            throttle: 0.3,
+            steering: 0.0,
+        };
+        let mut closing = 0;
+        for _ in 0..600 {
+            sim.step(control, &mut NoHost).unwrap();
+            sim.evaluate(&mut NoHost).unwrap();
+            let full = sim.snapshot();
+            let none = sim.snapshot_of(SnapshotParts {
+                ttc: false,
+                lane_offset: false,
+            });
+            assert!(none.ttc_s.is_nan() && none.ego_lane_offset_m.is_nan());
+            let filled = Snapshot {
+                ttc_s: full.ttc_s,
+                ego_lane_offset_m: full.ego_lane_offset_m,
+                ..none
+            };
+            assert_eq!(format!("{full:?}"), format!("{filled:?}"));
+            let ttc_only = sim.snapshot_of(SnapshotParts {
+                ttc: true,
+                lane_offset: false,
+            });
+            assert_eq!(ttc_only.ttc_s.to_bits(), full.ttc_s.to_bits());
+            closing += usize::from(full.ttc_s.is_finite());
+        }
+        assert!(
+            closing > 0,
+            "the stopped car ahead gives a finite time to collision"
+        );
     }
 
     #[test]

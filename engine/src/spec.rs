@@ -32,6 +32,9 @@ pub struct PedestrianSpec {
     pub target: [f64; 3],
     /// Walking speed stream, m/s; read at each walking step, values `<= 0` stand still.
     pub speed: StreamId,
+    /// How run-time messages name it, e.g. `Pedestrian p (f.star:9:5)`; empty: `pedestrian
+    /// N`, by its index.
+    pub name: String,
 }
 
 /// An NPC car (paper §2, `Car`): a kinematic box that drives along `path` at the speed its
@@ -54,6 +57,9 @@ pub struct CarSpec {
     /// starts on and that lane's sideways offset from its start lane, m, positive to the
     /// right of its direction. Empty when it starts inside a junction.
     pub lane_offsets_m: Vec<(i32, f64)>,
+    /// How run-time messages name it, e.g. `Car lead (f.star:4:5)`; empty: `car N`, by its
+    /// index.
+    pub name: String,
 }
 
 /// A static obstacle (`Obstacle(loc=, size=, color=)`): a box that never moves.
@@ -163,6 +169,7 @@ impl WorldSpec {
                 start: s,
                 target: t,
                 speed,
+                name: String::new(),
             });
         }
         Ok(WorldSpec {

@@ -63,6 +63,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
             enabled: true,
             lane_change: None,
             lane_offsets_m: vec![],
+            name: String::new(),
         });
     }
     WorldSpec {

@@ -18,6 +18,8 @@ pub struct DistanceMonitor {
     travelled_m: f64,
     last: Option<(f64, f64)>,
     broken_trace: bool,
+    /// Time of the last frame seen, seconds: when a failed verdict was reached.
+    last_t_s: Option<f64>,
 }
 
 impl DistanceMonitor {
@@ -37,6 +39,7 @@ impl DistanceMonitor {
             travelled_m: 0.0,
             last: None,
             broken_trace: false,
+            last_t_s: None,
         }
     }
 
@@ -52,6 +55,7 @@ impl Monitor for DistanceMonitor {
     }
 
     fn observe(&mut self, frame: &Frame<'_>) -> ControlFlow<()> {
+        self.last_t_s = Some(frame.t_s);
         let (Ok(x), Ok(z)) = (
             frame.signals.get(self.x_signal),
             frame.signals.get(self.z_signal),
@@ -77,7 +81,9 @@ impl Monitor for DistanceMonitor {
             // only with a positive margin, like every other monitor.
             passed: robustness > 0.0,
             robustness,
-            first_violation_s: None,
+            // The distance is judged on the run as a whole: a failure is known at its last
+            // frame (the horizon, or where the run stopped), or where the trace broke.
+            first_violation_s: (robustness <= 0.0).then(|| self.last_t_s.unwrap_or(0.0)),
             metrics: vec![("distance_travelled_m", self.travelled_m)],
         }
     }
@@ -108,6 +114,7 @@ mod tests {
         let v = m.verdict();
         assert!(v.passed);
         assert_eq!(v.robustness, 2.0);
+        assert_eq!(v.first_violation_s, None);
     }
 
     #[test]
@@ -117,5 +124,6 @@ mod tests {
         let v = m.verdict();
         assert!(!v.passed);
         assert_eq!(v.robustness, -1.0);
+        assert_eq!(v.first_violation_s, Some(9.0), "judged at the last frame");
     }
 }

@@ -14,6 +14,8 @@ pub struct TimeToFailureMonitor {
     name: String,
     inner: Box<dyn Monitor>,
     min_s: f64,
+    /// Time of the last frame seen, seconds.
+    last_t_s: Option<f64>,
 }
 
 impl TimeToFailureMonitor {
@@ -23,6 +25,7 @@ impl TimeToFailureMonitor {
             name: name.to_owned(),
             inner,
             min_s,
+            last_t_s: None,
         }
     }
 }
@@ -33,14 +36,21 @@ impl Monitor for TimeToFailureMonitor {
     }
 
     fn observe(&mut self, frame: &Frame<'_>) -> ControlFlow<()> {
+        self.last_t_s = Some(frame.t_s);
         self.inner.observe(frame)
     }
 
     fn verdict(&self) -> Verdict {
         let inner = self.inner.verdict();
-        let (passed, robustness) = match inner.first_violation_s {
-            Some(ttf) => (ttf >= self.min_s, ttf - self.min_s),
-            None => (inner.passed, inner.robustness),
+        // Only a failed verdict has a time to failure: a wrapped `TimeToFailure` that passed
+        // (its monitor failed late) reports that failure's time but did not fail itself. A
+        // failure with no time of its own counts from the last frame seen.
+        let (passed, robustness) = match (inner.passed, inner.first_violation_s) {
+            (false, ttf) => {
+                let ttf = ttf.or(self.last_t_s).unwrap_or(0.0);
+                (ttf >= self.min_s, ttf - self.min_s)
+            }
+            (true, _) => (true, inner.robustness),
         };
         Verdict {
             passed,
@@ -89,5 +99,78 @@ mod tests {
         let never = run(None, 5.0);
         assert!(never.passed);
         assert_eq!(never.robustness, 1.0, "the wrapped monitor's separation");
+    }
+
+    /// A monitor that fails at the end of the run and gives no time of its own.
+    struct FailsUntimed;
+
+    impl Monitor for FailsUntimed {
+        fn name(&self) -> &str {
+            "untimed"
+        }
+        fn observe(&mut self, _: &Frame<'_>) -> ControlFlow<()> {
+            ControlFlow::Continue(())
+        }
+        fn verdict(&self) -> Verdict {
+            Verdict {
+                passed: false,
+                robustness: -3.0,
+                first_violation_s: None,
+                metrics: vec![],
+            }
+        }
+    }
+
+    fn feed(m: &mut dyn Monitor, until_s: f64) {
+        let s = Signals::new();
+        let mut t = 0.0;
+        while t <= until_s {
+            let _ = m.observe(&Frame {
+                t_s: t,
+                signals: &s,
+            });
+            t += 1.0;
+        }
+    }
+
+    #[test]
+    fn a_failure_without_a_time_counts_from_the_last_frame() {
+        let mut late = TimeToFailureMonitor::new("ttf", Box::new(FailsUntimed), 1.0);
+        feed(&mut late, 3.0);
+        let v = late.verdict();
+        assert_eq!((v.passed, v.robustness), (true, 2.0));
+        let mut early = TimeToFailureMonitor::new("ttf", Box::new(FailsUntimed), 5.0);
+        feed(&mut early, 3.0);
+        let v = early.verdict();
+        assert_eq!((v.passed, v.robustness), (false, -2.0));
+    }
+
+    #[test]
+    fn a_wrapped_time_to_failure_that_passed_is_no_failure() {
+        // The inner one passes (collision at 7 s, minT 5 s); the outer one, minT 10 s, must
+        // not read the collision as the inner one's failure.
+        let inner = TimeToFailureMonitor::new(
+            "inner",
+            Box::new(CollisionMonitor::new("collision", "contact", "sep")),
+            5.0,
+        );
+        let mut outer = TimeToFailureMonitor::new("outer", Box::new(inner), 10.0);
+        let mut s = Signals::new();
+        for i in 0..=10 {
+            let t = i as f64;
+            s.set_bool("contact", t >= 7.0);
+            s.set("sep", if t >= 7.0 { 0.0 } else { 1.0 });
+            if outer
+                .observe(&Frame {
+                    t_s: t,
+                    signals: &s,
+                })
+                .is_break()
+            {
+                break;
+            }
+        }
+        let v = outer.verdict();
+        assert_eq!((v.passed, v.robustness), (true, 2.0), "{v:?}");
     }
 }

@@ -2,7 +2,7 @@ use std::ops::ControlFlow;
 
 use paracosm_engine::rx::Host;
 use paracosm_engine::{
-    CameraFrame, CameraSpec, Control, EgoState, Simulation, Snapshot, WorldSpec,
+    CameraFrame, CameraSpec, Control, EgoState, Simulation, Snapshot, SnapshotParts, WorldSpec,
 };
 use paracosm_generators::Assignment;
 use paracosm_oracles::{Frame, Monitor, Signals, Verdict};
@@ -87,16 +87,22 @@ impl TestOutcome {
     }
 }
 
-fn publish(snap: &Snapshot, out: &mut Signals) {
+/// Sets the runner's signals from `snap`; those `parts` leaves out (no monitor reads them)
+/// are not set, so a monitor that read one would find it missing, never a NaN.
+fn publish(snap: &Snapshot, parts: SnapshotParts, out: &mut Signals) {
     out.set(signal::EGO_X_M, snap.ego.pos_m[0]);
     out.set(signal::EGO_Z_M, snap.ego.pos_m[2]);
     out.set(signal::EGO_SPEED_MPS, snap.ego.speed_mps);
     out.set_bool(signal::EGO_CONTACT, snap.ego_contact);
     out.set(signal::EGO_SEPARATION_M, snap.min_separation_m);
-    out.set(signal::EGO_TTC_S, snap.ttc_s);
+    if parts.ttc {
+        out.set(signal::EGO_TTC_S, snap.ttc_s);
+    }
     out.set_bool(signal::EGO_OFFROAD, snap.ego_off_road);
     out.set(signal::EGO_ROAD_EDGE_M, snap.ego_road_edge_m);
-    out.set(signal::EGO_LANE_OFFSET_M, snap.ego_lane_offset_m);
+    if parts.lane_offset {
+        out.set(signal::EGO_LANE_OFFSET_M, snap.ego_lane_offset_m);
+    }
     out.set(signal::FOG, snap.fog);
     out.set(signal::LIGHT, snap.light);
 }
@@ -165,6 +171,8 @@ struct Watch {
     settled: Vec<bool>,
     signals: Signals,
     published: Vec<Published>,
+    /// The costlier runner signals some monitor reads.
+    parts: SnapshotParts,
 }
 
 impl Watch {
@@ -172,9 +180,20 @@ impl Watch {
     /// may stop: every monitor has settled, or one has settled as failed. Monitors are
     /// independent: one settling (passed) never stops the others observing. A test without
     /// monitors runs to its horizon.
-    fn observe(&mut self, sim: &Simulation) -> Result<bool, ScenarioError> {
-        let snap = sim.snapshot();
-        publish(&snap, &mut self.signals);
+    fn observe(
+        &mut self,
+        sim: &Simulation,
+        on_step: Option<&mut &mut dyn FnMut(&Snapshot)>,
+    ) -> Result<bool, ScenarioError> {
+        let snap = match on_step {
+            Some(f) => {
+                let snap = sim.snapshot();
+                f(&snap);
+                snap
+            }
+            None => sim.snapshot_of(self.parts),
+        };
+        publish(&snap, self.parts, &mut self.signals);
         publish_streams(sim, &self.published, &mut self.signals)?;
         let frame = Frame {
             t_s: snap.t_s,
@@ -321,15 +340,22 @@ impl Scenario {
                         .map(|(_, _, bools)| bools),
                 })
                 .collect(),
+            parts: SnapshotParts {
+                ttc: self
+                    .monitors
+                    .iter()
+                    .any(|m| m.reads_runner_signal(signal::EGO_TTC_S)),
+                lane_offset: self
+                    .monitors
+                    .iter()
+                    .any(|m| m.reads_runner_signal(signal::EGO_LANE_OFFSET_M)),
+            },
         };
         let ticks = (self.horizon_s / spec.dt_s).round() as u64;
         // Streams are evaluated for the state a snapshot shows, so a published stream's value
         // and the runner's own signals describe the same moment.
         sim.evaluate(host)?;
-        if let Some(f) = options.on_step.as_mut() {
-            f(&sim.snapshot());
-        }
-        let mut stopped = watch.observe(&sim)?;
+        let mut stopped = watch.observe(&sim, options.on_step.as_mut())?;
         let mut tick = 0;
         let mut control = Control::default();
         let mut applied = Control::default();
@@ -365,10 +391,7 @@ impl Scenario {
             sim.step(applied, host)?;
             tick += 1;
             sim.evaluate(host)?;
-            if let Some(f) = options.on_step.as_mut() {
-                f(&sim.snapshot());
-            }
-            stopped = watch.observe(&sim)?;
+            stopped = watch.observe(&sim, options.on_step.as_mut())?;
         }
 
         let cut_short: Vec<String> = if tick < ticks {

@@ -144,6 +144,25 @@ impl MonitorSpec {
         }
     }
 
+    /// Whether the monitor it builds ([`MonitorSpec::build`]) reads the runner's signal
+    /// `name` (see [`crate::runner::signal`]): the built-in monitors their own, an `Stl`
+    /// formula or a user monitor those it names.
+    pub fn reads_runner_signal(&self, name: &str) -> bool {
+        match self {
+            MonitorSpec::Collision { .. } => {
+                [signal::EGO_CONTACT, signal::EGO_SEPARATION_M].contains(&name)
+            }
+            MonitorSpec::Distance { .. } => [signal::EGO_X_M, signal::EGO_Z_M].contains(&name),
+            MonitorSpec::OffRoad { .. } => {
+                [signal::EGO_OFFROAD, signal::EGO_ROAD_EDGE_M].contains(&name)
+            }
+            MonitorSpec::TimeToFailure { inner, .. } => inner.reads_runner_signal(name),
+            MonitorSpec::Stl { .. } | MonitorSpec::Stream { .. } | MonitorSpec::Assert { .. } => {
+                self.reads_signal(name)
+            }
+        }
+    }
+
     /// Its key in results files.
     pub fn name(&self) -> &str {
         match self {

@@ -30,6 +30,14 @@ pub trait Host {
     fn log(&mut self) -> Vec<String> {
         Vec::new()
     }
+
+    /// The streams whose latest values this host's functions read through
+    /// [`Runtime::current`] besides their arguments (a Starlark lambda sees the program's
+    /// module-level stream variables). A runtime that evaluates only the streams something
+    /// reads ([`Runtime::evaluate_only`]) keeps these. The default host reads none.
+    fn reads(&self) -> &[StreamId] {
+        &[]
+    }
 }
 
 /// A [`Host`] without functions: every call is an error. For graphs built in Rust.
@@ -58,6 +66,11 @@ struct State {
 pub struct Runtime {
     graph: Graph,
     states: Vec<State>,
+    /// The nodes a step evaluates ([`Runtime::evaluate_only`]); `None`: every node.
+    live: Option<Vec<bool>>,
+    /// Whether the host's reads ([`Host::reads`]) have been added to `live`: at the first
+    /// step, so that a stream they keep has every event from the start.
+    host_reads_kept: bool,
 }
 
 impl Runtime {
@@ -65,7 +78,70 @@ impl Runtime {
     /// [`Node::Param`] left).
     pub fn new(graph: Graph) -> Self {
         let states = vec![State::default(); graph.nodes().len()];
-        Runtime { graph, states }
+        Runtime {
+            graph,
+            states,
+            live: None,
+            host_reads_kept: false,
+        }
+    }
+
+    /// Evaluates, from the first step on, only the streams something reads: `roots` (the
+    /// streams the caller reads with [`Runtime::current`] or [`Runtime::fired`]), the streams
+    /// the host's functions read ([`Host::reads`], added at the first step), every node that
+    /// acts or may fail (a `foreach`, a function of the program or a native one, a `sum`, a
+    /// [`Node::Check`]), and every stream these read, transitively. The others (a probe of an
+    /// actor's output no monitor reads, a `zip` of them, a constant) are pure and cannot
+    /// fail, so leaving them out changes no event of a stream that is evaluated, no action
+    /// and no error; their [`Runtime::current`] stays `None`.
+    ///
+    /// Call it before the first [`Runtime::step`]; a later call is ignored (a stream kept
+    /// from then on would have missed events).
+    pub fn evaluate_only(&mut self, roots: impl IntoIterator<Item = StreamId>) {
+        if self.host_reads_kept || self.states.iter().any(|s| s.value.is_some()) {
+            return;
+        }
+        let nodes = self.graph.nodes();
+        let mut live: Vec<bool> = nodes
+            .iter()
+            .map(|n| {
+                !matches!(
+                    n,
+                    Node::Const(_)
+                        | Node::Tick
+                        | Node::Open(_)
+                        | Node::Probe(_)
+                        | Node::Zip(..)
+                        | Node::Take { .. }
+                        | Node::SkipUntil { .. }
+                        | Node::TakeUntil { .. }
+                        | Node::Concat(..)
+                )
+            })
+            .collect();
+        for id in roots {
+            if let Some(l) = live.get_mut(id.0) {
+                *l = true;
+            }
+        }
+        self.live = Some(live);
+        self.propagate_live();
+    }
+
+    /// Marks every stream a live stream reads as live: one pass against the topological
+    /// order, since a node's inputs come before it.
+    fn propagate_live(&mut self) {
+        let Some(live) = self.live.as_mut() else {
+            return;
+        };
+        let nodes = self.graph.nodes();
+        for &i in self.graph.order().iter().rev() {
+            if live[i] {
+                for input in nodes[i].inputs() {
+                    live[input.0] = true;
+                }
+            }
+        }
     }
 
     /// The graph.
@@ -102,8 +178,22 @@ impl Runtime {
         host: &mut dyn Host,
         sinks: &mut Vec<(u32, Value)>,
     ) -> Result<(), RxError> {
+        if !self.host_reads_kept {
+            self.host_reads_kept = true;
+            if let Some(live) = self.live.as_mut() {
+                for id in host.reads() {
+                    if let Some(l) = live.get_mut(id.0) {
+                        *l = true;
+                    }
+                }
+                self.propagate_live();
+            }
+        }
         for k in 0..self.graph.order().len() {
             let i = self.graph.order()[k];
+            if self.live.as_ref().is_some_and(|live| !live[i]) {
+                continue;
+            }
             // A constant, or an open stream given one value for the test, emits the same value
             // every step: keep the one it holds.
             if let (Node::Const(_) | Node::Open(super::OpenStream::Constant(_)), Some(_)) =
@@ -194,7 +284,7 @@ impl Runtime {
                 Node::Sum { src, init, f } => match sample(self, src) {
                     Some(v) => Some(match f {
                         Some(f) => call(i, f, &[init.clone(), v], host, self)?,
-                        None => init.add(&v).ok_or_else(|| {
+                        None => total(init, &v).ok_or_else(|| {
                             type_error(&self.graph, i, "sum", "numbers or vectors of one kind", &v)
                         })?,
                     }),
@@ -356,7 +446,7 @@ impl Runtime {
                         let acc = self.states[i].value.clone().unwrap_or(init);
                         Some(match &f {
                             Some(f) => call(i, f, &[acc, v], host, self)?,
-                            None => acc.add(&v).ok_or_else(|| {
+                            None => total(&acc, &v).ok_or_else(|| {
                                 type_error(
                                     &self.graph,
                                     i,
@@ -436,6 +526,19 @@ fn source(i: usize, node: &Node, t_s: f64, inputs: &dyn Inputs) -> Result<Option
             at: format!("stream {i}"),
             message: "not a source stream".into(),
         }),
+    }
+}
+
+/// A running total `acc + v` of numbers or vectors; `acc` [`Value::Unit`] (a `sum()` with no
+/// initial value) starts the total from zero of `v`'s kind.
+fn total(acc: &Value, v: &Value) -> Option<Value> {
+    match acc {
+        Value::Unit => match v {
+            Value::Num(_) => Value::Num(0.0).add(v),
+            Value::Vec3(_) => Value::Vec3([0.0; 3]).add(v),
+            _ => None,
+        },
+        acc => acc.add(v),
     }
 }
 

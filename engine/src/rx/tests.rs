@@ -368,3 +368,104 @@ fn open_streams_bind_and_vary_over_time() {
         .step(0.0, &Script(vec![]), &mut NoHost, &mut sinks)
         .is_err());
 }
+
+/// Counts the probes it answers (every probe reads 1.0).
+struct Counting(std::cell::Cell<usize>);
+
+impl Inputs for Counting {
+    fn probe(&self, _: u32) -> Value {
+        self.0.set(self.0.get() + 1);
+        Value::Num(1.0)
+    }
+}
+
+/// A host whose function 0 fails once `t >= 2` and which reads stream `reads` (as a lambda
+/// reads a module-level stream).
+struct Reading {
+    reads: Vec<StreamId>,
+    seen: Vec<Option<Value>>,
+}
+
+impl Host for Reading {
+    fn call(&mut self, _: u32, args: &[Value], streams: &Runtime) -> Result<Value, String> {
+        for id in &self.reads {
+            self.seen.push(streams.current(*id).cloned());
+        }
+        match args[0].as_num() {
+            Some(t) if t >= 2.0 => Err(format!("failed at {t}")),
+            _ => Ok(Value::Num(0.0)),
+        }
+    }
+    fn reads(&self) -> &[StreamId] {
+        &self.reads
+    }
+}
+
+#[test]
+fn streams_nothing_reads_are_not_evaluated_and_change_nothing_else() {
+    // 0, 1: probes nobody reads; 2: a probe the caller reads; 3: a zip of the unread ones;
+    // 4: a probe feeding a sink; 5: the sink.
+    let nodes = vec![
+        Node::Probe(0),
+        Node::Probe(1),
+        Node::Probe(2),
+        Node::Zip(StreamId(0), StreamId(1)),
+        Node::Probe(3),
+        Node::Foreach {
+            src: StreamId(4),
+            sink: 9,
+        },
+    ];
+    let graph = Graph::new(nodes).unwrap();
+    let inputs = Counting(std::cell::Cell::new(0));
+    let (mut all, mut some) = (Runtime::new(graph.clone()), Runtime::new(graph));
+    some.evaluate_only([StreamId(2)]);
+    let (mut sinks_all, mut sinks_some) = (Vec::new(), Vec::new());
+    for k in 0..3 {
+        all.step(k as f64, &inputs, &mut NoHost, &mut sinks_all)
+            .unwrap();
+    }
+    assert_eq!(inputs.0.replace(0), 12, "four probes a step");
+    for k in 0..3 {
+        some.step(k as f64, &inputs, &mut NoHost, &mut sinks_some)
+            .unwrap();
+    }
+    assert_eq!(
+        inputs.0.get(),
+        6,
+        "the read probe and the sink's, each step"
+    );
+    assert_eq!(sinks_all, sinks_some);
+    assert_eq!(all.current(StreamId(2)), some.current(StreamId(2)));
+    assert!(all.current(StreamId(3)).is_some());
+    assert_eq!(some.current(StreamId(3)), None, "never evaluated");
+}
+
+#[test]
+fn a_function_whose_stream_nobody_reads_still_runs_and_fails() {
+    // 0: tick; 1: a host function of it, read by nobody: its error must end the run. 2: a
+    // probe that only the host's function reads; it must hold its value when called.
+    let nodes = vec![
+        Node::Tick,
+        Node::Map {
+            src: StreamId(0),
+            f: Func::Host(0),
+        },
+        Node::Probe(0),
+    ];
+    let mut rt = Runtime::new(Graph::new(nodes).unwrap());
+    rt.evaluate_only([]);
+    let inputs = Counting(std::cell::Cell::new(0));
+    let mut host = Reading {
+        reads: vec![StreamId(2)],
+        seen: Vec::new(),
+    };
+    let mut sinks = Vec::new();
+    rt.step(0.0, &inputs, &mut host, &mut sinks).unwrap();
+    rt.step(1.0, &inputs, &mut host, &mut sinks).unwrap();
+    // The probe comes after the function in the graph: the first call sees no value yet,
+    // the second sees the first step's.
+    assert_eq!(host.seen, vec![None, Some(Value::Num(1.0))]);
+    let e = rt.step(2.0, &inputs, &mut host, &mut sinks).unwrap_err();
+    assert!(e.to_string().contains("failed at 2"), "{e}");
+}

@@ -336,38 +336,37 @@ fn cover_bound(points: &[f64], d: usize, max_cells: usize) -> (f64, usize) {
         hist[idx] += 1;
     }
     // Inclusive cumulative sums: hist[k] = #points with cell index <= k on every axis.
+    // Axis by axis, from the last (stride 1): within each block of `m · stride` cells, the
+    // cells at coordinate c >= 1 on this axis add those at c - 1.
     let mut stride = 1;
     for _ in 0..d {
-        for idx in 0..cells {
-            if (idx / stride) % m != 0 {
+        for block in (0..cells).step_by(m * stride) {
+            for idx in block + stride..block + m * stride {
                 hist[idx] += hist[idx - stride];
             }
         }
         stride *= m;
     }
-    let at = |k: &[usize]| -> u64 {
-        // #points with cell index <= k_i on every axis, 0 if some k_i < 0 (encoded as m).
-        if k.contains(&usize::MAX) {
-            return 0;
-        }
-        let mut idx = 0;
-        for &c in k {
-            idx = idx * m + c;
-        }
-        hist[idx]
-    };
     let inv = 1.0 / m as f64;
     let mut best: f64 = 0.0;
     let mut k = vec![0usize; d];
     for _ in 0..cells {
-        // a = k/m, b = (k+1)/m. A([0,a)) counts cells < k: inclusive sums at k-1.
-        let below: Vec<usize> = k.iter().map(|&c| c.wrapping_sub(1)).collect();
-        // A([0,b]) may include points on the face x_i = b_i: count cells <= k+1 (capped).
-        let upto: Vec<usize> = k.iter().map(|&c| (c + 1).min(m - 1)).collect();
-        let vol_a: f64 = k.iter().map(|&c| c as f64 * inv).product();
-        let vol_b: f64 = k.iter().map(|&c| ((c + 1) as f64 * inv).min(1.0)).product();
-        let open_a = at(&below) as f64 / n as f64;
-        let closed_b = at(&upto) as f64 / n as f64;
+        // a = k/m, b = (k+1)/m. A([0,a)) counts cells < k: inclusive sums at k-1, none when
+        // some k_i = 0. A([0,b]) may include points on the face x_i = b_i: count cells
+        // <= k+1 (capped). Volumes are products over the axes in order.
+        let (mut below, mut empty_below, mut upto) = (0usize, false, 0usize);
+        let (mut vol_a, mut vol_b) = (1.0f64, 1.0f64);
+        for &c in &k {
+            match c.checked_sub(1) {
+                Some(b) => below = below * m + b,
+                None => empty_below = true,
+            }
+            upto = upto * m + (c + 1).min(m - 1);
+            vol_a *= c as f64 * inv;
+            vol_b *= ((c + 1) as f64 * inv).min(1.0);
+        }
+        let open_a = if empty_below { 0 } else { hist[below] } as f64 / n as f64;
+        let closed_b = hist[upto] as f64 / n as f64;
         best = best.max(vol_b - open_a).max(closed_b - vol_a);
         // next cell
         for c in k.iter_mut().rev() {
@@ -436,7 +435,55 @@ mod tests {
         assert!((s.upper - 0.05).abs() < 1e-12 && s.exact);
     }
 
+    /// The δ-cover bound counted directly: for every grid cell, the points in `[0, a)` and
+    /// in `[0, b]` by a scan of the set (no cumulative sums).
+    fn cover_bound_by_counting(points: &[f64], d: usize, max_cells: usize) -> f64 {
+        let n = points.len() / d;
+        let m = ((max_cells as f64).powf(1.0 / d as f64).floor() as usize).max(1);
+        let cell = |x: f64| ((x * m as f64) as usize).min(m - 1);
+        let mut best: f64 = 0.0;
+        for mut idx in 0..m.pow(d as u32) {
+            let mut k = vec![0; d];
+            for c in k.iter_mut().rev() {
+                *c = idx % m;
+                idx /= m;
+            }
+            let inside = |p: &[f64], upper: &dyn Fn(usize, usize) -> bool| {
+                p.iter().zip(&k).all(|(&x, &c)| upper(cell(x), c))
+            };
+            let open_a = points
+                .chunks_exact(d)
+                .filter(|p| inside(p, &|i, c| i < c))
+                .count();
+            let closed_b = points
+                .chunks_exact(d)
+                .filter(|p| inside(p, &|i, c| i <= (c + 1).min(m - 1)))
+                .count();
+            let inv = 1.0 / m as f64;
+            let vol_a: f64 = k.iter().map(|&c| c as f64 * inv).product();
+            let vol_b: f64 = k.iter().map(|&c| ((c + 1) as f64 * inv).min(1.0)).product();
+            best = best
+                .max(vol_b - open_a as f64 / n as f64)
+                .max(closed_b as f64 / n as f64 - vol_a);
+        }
+        best.min(1.0)
+    }
+
     proptest! {
+        #[test]
+        fn the_cover_bound_equals_counting_each_cell(
+            d in 1usize..5,
+            cells in 1usize..3000,
+            raw in prop::collection::vec(0u8..=255, 4..80),
+        ) {
+            let n = raw.len() / d;
+            prop_assume!(n >= 1);
+            // Values 0, 1 and cell boundaries included.
+            let pts: Vec<f64> = raw[..n * d].iter().map(|&v| f64::from(v.min(250)) / 250.0).collect();
+            let (bound, _) = cover_bound(&pts, d, cells);
+            prop_assert_eq!(bound.to_bits(), cover_bound_by_counting(&pts, d, cells).to_bits());
+        }
+
         #[test]
         fn exact_matches_brute_force(
             d in 1usize..4,

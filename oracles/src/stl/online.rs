@@ -24,6 +24,12 @@ const CHECK_EVERY: usize = 15;
 /// bound is the first sample's margin over 60, not the largest), which would tell a
 /// falsifier that every passing test was near failure. At the end of the run the verdict
 /// is the offline robustness of the trace seen (windows cut at its end).
+///
+/// `first_violation_s` of a violated formula is the time of the first sample whose prefix
+/// decides the violation, whatever the check's period: for `G[0,10] (x < 30)` the sample
+/// where `x` reaches 30, not the check that found it (so `TimeToFailure` compares the
+/// moment of the failure with its `minT`); the last sample's time when only the end of the
+/// trace decided it.
 #[derive(Debug, Clone)]
 pub struct StlMonitor {
     name: String,
@@ -34,6 +40,9 @@ pub struct StlMonitor {
     trace: Trace,
     settled: Option<Verdict>,
     missing: Option<(String, f64)>,
+    /// Samples whose prefix is known not to decide a violation (the upper bound over their
+    /// continuations was `> 0` at the last check).
+    undecided: usize,
 }
 
 impl StlMonitor {
@@ -51,7 +60,41 @@ impl StlMonitor {
             times: Vec::new(),
             settled: None,
             missing: None,
+            undecided: 0,
         }
+    }
+
+    /// The upper bound of the robustness over every continuation of the first `k` samples.
+    fn upper_bound_after(&self, k: usize) -> f64 {
+        let mut prefix = Trace {
+            dt_s: self.trace.dt_s,
+            signals: self.trace.signals.clone(),
+        };
+        for v in prefix.signals.values_mut() {
+            v.truncate(k);
+        }
+        eval_bounds(&self.formula, &prefix).map_or(f64::INFINITY, |(_, hi)| hi)
+    }
+
+    /// The time of the first sample whose prefix decides the violation (the upper bound over
+    /// its continuations is `<= 0`), searched among samples `undecided + 1 ..= n` (the bound
+    /// only falls as samples come, so a bisection finds it); the last sample's time when no
+    /// prefix decides it (a violation known only once the trace ended, windows cut there).
+    fn first_violation_s(&self, n: usize) -> f64 {
+        let (mut lo, mut hi) = (self.undecided, n);
+        if self.upper_bound_after(hi) > 0.0 {
+            return self.times[n - 1];
+        }
+        // Invariant: the prefix of `hi` samples decides it, that of `lo` does not.
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if self.upper_bound_after(mid) <= 0.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        self.times[hi - 1]
     }
 }
 
@@ -95,11 +138,12 @@ impl Monitor for StlMonitor {
             self.settled = Some(Verdict {
                 passed: false,
                 robustness: hi,
-                first_violation_s: Some(frame.t_s),
+                first_violation_s: Some(self.first_violation_s(self.times.len())),
                 metrics: vec![],
             });
             ControlFlow::Break(())
         } else {
+            self.undecided = self.times.len();
             ControlFlow::Continue(())
         }
     }
@@ -123,7 +167,10 @@ impl Monitor for StlMonitor {
         Verdict {
             passed: r > 0.0,
             robustness: r,
-            first_violation_s: (r <= 0.0).then(|| self.times.last().copied().unwrap_or(0.0)),
+            first_violation_s: (r <= 0.0).then(|| match self.times.len() {
+                0 => 0.0,
+                n => self.first_violation_s(n),
+            }),
             metrics: vec![],
         }
     }
@@ -162,6 +209,23 @@ mod tests {
         assert_eq!(fed, 600);
         assert!(v.passed);
         assert_eq!(v.robustness, 539.0);
+    }
+
+    #[test]
+    fn the_first_violation_is_the_sample_that_decides_it_not_the_check_that_saw_it() {
+        // x = i: x < 30 fails from sample 30 (robustness 0 is a violation), at 0.5 s; the
+        // check every 15 samples sees it at sample 44.
+        let (v, fed) = run("G[0,10] (x < 30)", |i| i as f64, 600);
+        assert_eq!((fed, v.first_violation_s), (45, Some(30.0 / 60.0)));
+        // Violated from the first sample.
+        let (v, _) = run("G[0,4] (x > 6.5)", |_| 6.0, 600);
+        assert_eq!(v.first_violation_s, Some(0.0));
+        // A trace that ends before a check: the verdict at the end finds it too.
+        let (v, fed) = run("G[0,10] (x < 30)", |i| i as f64, 40);
+        assert_eq!((fed, v.passed, v.first_violation_s), (40, false, Some(0.5)));
+        // Decided only by the end of the trace (the window reaches past it): its last sample.
+        let (v, _) = run("F[0,10] (x > 1000)", |i| i as f64, 100);
+        assert_eq!((v.passed, v.first_violation_s), (false, Some(99.0 / 60.0)));
     }
 
     #[test]

@@ -27,6 +27,8 @@ pub struct StarHost<'a, 'v, 'b, 'e> {
     file: &'b str,
     /// Module-level variables holding streams, with the stream each holds.
     captured: Vec<(String, StreamId)>,
+    /// The streams of `captured`, which lambdas read ([`Host::reads`]).
+    reads: Vec<StreamId>,
 }
 
 impl<'a, 'v, 'b, 'e> StarHost<'a, 'v, 'b, 'e> {
@@ -48,12 +50,14 @@ impl<'a, 'v, 'b, 'e> StarHost<'a, 'v, 'b, 'e> {
             })
             .collect();
         captured.sort();
+        let reads = captured.iter().map(|(_, id)| *id).collect();
         StarHost {
             eval,
             functions,
             limits,
             file,
             captured,
+            reads,
         }
     }
 }
@@ -169,6 +173,10 @@ impl Host for StarHost<'_, '_, '_, '_> {
         self.test()
             .map(|t| std::mem::take(&mut *t.log.borrow_mut()))
             .unwrap_or_default()
+    }
+
+    fn reads(&self) -> &[StreamId] {
+        &self.reads
     }
 }
 

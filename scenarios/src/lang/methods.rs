@@ -154,7 +154,9 @@ pub(crate) fn stream_methods(builder: &mut MethodsBuilder) {
         push(eval, Node::Concat(StreamId(this.id), b))
     }
 
-    /// `s.sum(init=0.0, f=None)`: running total, or running fold `acc = f(acc, v)`.
+    /// `s.sum(init=0.0, f=None)`: running total of numbers or vectors (from zero of the
+    /// stream's kind, or from `init`: a number or a `Vector`), or running fold
+    /// `acc = f(acc, v)` (from `init`, default 0.0).
     fn sum<'v>(
         this: &Stream,
         #[starlark(default = NoneType)] init: Value<'v>,
@@ -162,9 +164,19 @@ pub(crate) fn stream_methods(builder: &mut MethodsBuilder) {
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Stream> {
         let init = if init.is_none() {
-            Rx::Num(0.0)
+            // A total starts from zero of the kind of the first event; a fold from 0.0.
+            if f.is_none() {
+                Rx::Unit
+            } else {
+                Rx::Num(0.0)
+            }
+        } else if let Some(v) = init.downcast_ref::<super::position::Vector>() {
+            Rx::Vec3(v.0)
         } else {
-            Rx::Num(number(init, "sum(init=)")?)
+            Rx::Num(number(
+                init,
+                "sum(init=) (a number, or a Vector for a sum of vectors)",
+            )?)
         };
         let f = if f.is_none() {
             None

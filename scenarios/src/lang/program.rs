@@ -512,9 +512,16 @@ impl Program {
             match sim.check_streams(&mut host) {
                 Ok(samples) => judged_kinds(&b, &samples),
                 Err(e) => {
-                    // A lambda's message has its own traceback and location.
+                    // A lambda's message has its own traceback and location, but for a call
+                    // stopped by a limit: that one is located at the combinator.
                     let message = match e {
-                        EngineError::Stream(RxError::Host { message, .. }) => message,
+                        EngineError::Stream(RxError::Host { message, at, .. }) => {
+                            if message.contains(&format!("{}:", self.file)) {
+                                message
+                            } else {
+                                format!("{message}\n --> {at}")
+                            }
+                        }
                         e => e.to_string(),
                     };
                     let lower = message.to_ascii_lowercase();
@@ -572,6 +579,50 @@ fn judged_kinds(
             return Err(format!(
                 "error: monitor `{name}`: {why} (found when loading, from the sample value its \
                  stream gives in the first test's world at t = 0)\n --> {at}"
+            ));
+        }
+    }
+    // An action's argument from a lambda: its kind is known from the sample (a string given
+    // to setSpeed would otherwise end each test where it first fires, or never be noticed).
+    for (i, node) in b.graph.nodes().iter().enumerate() {
+        use paracosm_engine::behaviour::{decode_sink, Action};
+        use paracosm_engine::rx::Value;
+        let paracosm_engine::rx::Node::Foreach { src, sink } = node else {
+            continue;
+        };
+        let Some(v) = samples.get(src.0).and_then(Option::as_ref) else {
+            continue;
+        };
+        let car = |c: u32| b.car_names.get(c as usize).map_or("a Car", String::as_str);
+        let (what, ok, wanted) = match decode_sink(*sink) {
+            Action::Walk(_) => continue,
+            Action::SetSpeed(c) => (
+                format!("setSpeed of {}", car(c)),
+                matches!(v, Value::Num(_)),
+                "a number (m/s)",
+            ),
+            Action::Brake(c) => (
+                format!("brake of {}", car(c)),
+                matches!(v, Value::Num(_)),
+                "a number (m/s²)",
+            ),
+            Action::ChangeLane(c) => (
+                format!("changeLane of {}", car(c)),
+                match v {
+                    Value::Num(_) => true,
+                    Value::Tuple(t) => t.len() == 2 && t.iter().all(|x| matches!(x, Value::Num(_))),
+                    _ => false,
+                },
+                "a lane number or a (lane, duration in s) pair",
+            ),
+        };
+        if !ok {
+            let at = b.graph.site(i).unwrap_or("");
+            return Err(format!(
+                "error: {what} is given {} by its stream; it takes {wanted} (found when \
+                 loading, from the sample value the stream gives in the first test's world at \
+                 t = 0)\n --> {at}",
+                paracosm_engine::rx::describe(v)
             ));
         }
     }
@@ -754,11 +805,12 @@ pub fn load(
     let has_off_road = monitors.iter().any(MonitorSpec::judges_off_road);
     if first.offroad.unwrap_or(true) && !has_off_road {
         let implicit = MonitorSpec::implicit_off_road();
-        if monitors.iter().any(|m| m.name() == implicit.name()) {
+        if let Some(k) = monitors.iter().position(|m| m.name() == implicit.name()) {
+            let at = first.monitors_at.get(k).map_or(file, String::as_str);
             return Err(lang(format!(
                 "error: a monitor is named `{}`, the name of the default OffRoadMonitor: rename \
                  it, declare OffRoadMonitor(v) yourself, or opt out with test(offroad = False)\n \
-                 --> {file}",
+                 --> {at}",
                 implicit.name()
             )));
         }
@@ -771,12 +823,13 @@ pub fn load(
                     let known: Vec<&str> = space.params().iter().map(|p| p.name.as_str()).collect();
                     return Err(lang(format!(
                         "error: test(map=...) names `{a}`, which is not a parameter (the \
-                         parameters: {})\n --> {file}",
+                         parameters: {})\n --> {}",
                         if known.is_empty() {
                             "none".to_owned()
                         } else {
                             known.join(", ")
-                        }
+                        },
+                        first.test_at.as_deref().unwrap_or(file),
                     )));
                 }
             }
@@ -819,6 +872,24 @@ pub fn load(
         });
     }
     for (m, at) in first.monitors.iter().zip(&first.monitors_at) {
+        // A Monitor or Assert of a constant (`Monitor(5.0)`) judges nothing of the world.
+        if let Some((name, signal, _)) = m.judged_stream() {
+            let constant = first
+                .published
+                .iter()
+                .find(|(n, _)| n == signal)
+                .and_then(|(_, id)| first.graph.nodes().get(id.0))
+                .is_some_and(|n| matches!(n, paracosm_engine::rx::Node::Const(_)));
+            if constant {
+                warnings.push(Warning {
+                    at: at.clone(),
+                    message: format!(
+                        "monitor `{name}` judges a constant stream: its verdict is the same in \
+                         every test, whatever the world does"
+                    ),
+                });
+            }
+        }
         let MonitorSpec::Stl { name, formula } = m else {
             continue;
         };

@@ -210,6 +210,17 @@ pub struct ObjectDecl {
     pub placed: bool,
 }
 
+impl ObjectDecl {
+    /// How run-time messages name it: `Car lead (f.star:4:5)` for an object assigned to a
+    /// variable, else `Car at f.star:4:5`; `kind` is its builtin's name.
+    pub fn runtime_name(&self, kind: &str) -> String {
+        match &self.variable {
+            Some(v) => format!("{kind} {v} ({})", self.at),
+            None => format!("{kind} at {}", self.at),
+        }
+    }
+}
+
 /// Everything one evaluation of a program declares.
 #[derive(Debug)]
 pub struct SceneBuilder {
@@ -536,6 +547,25 @@ fn published(
     b: &SceneBuilder,
     graph: &mut GraphBuilder,
 ) -> Result<Vec<(String, StreamId)>, String> {
+    // A Signal may not take an actor output's name (`Signal("lead.speed", ...)`): a formula
+    // reading `lead.speed` would read the Signal in the car's place.
+    for (name, at) in &b.signals_at {
+        let mut parts = name.split('.');
+        let (Some(var), Some(field)) = (parts.next(), parts.next()) else {
+            continue;
+        };
+        let actor = b
+            .objects
+            .iter()
+            .find(|o| o.actor.is_some() && o.variable.as_deref() == Some(var));
+        if let (Some(o), true) = (actor, ACTOR_SIGNALS.iter().any(|(n, _)| *n == field)) {
+            return Err(format!(
+                "Signal `{name}` takes the name of an output of {} (`{var}.{field}`), which \
+                 monitors read as that actor's; give the Signal another name\n --> {at}",
+                o.name
+            ));
+        }
+    }
     let mut out = b.published.clone();
     let known = |out: &[(String, StreamId)], s: &str| {
         crate::runner::signal::ALL.contains(&s)
@@ -697,6 +727,8 @@ impl SceneBuilder {
         check(&placed, &self.roads).map_err(strip)?;
         let mut ped_index = 0u32;
         for o in self.objects.clone() {
+            let runtime_name = |kind: &str| o.runtime_name(kind);
+            let (car_name, pedestrian_name) = (runtime_name("Car"), runtime_name("Pedestrian"));
             match o.pending {
                 Pending::Ego {
                     loc,
@@ -755,6 +787,7 @@ impl SceneBuilder {
                         start: s,
                         target: t,
                         speed,
+                        name: pedestrian_name,
                     });
                 }
                 Pending::Car {
@@ -783,6 +816,7 @@ impl SceneBuilder {
                         enabled,
                         lane_change,
                         lane_offsets_m,
+                        name: car_name,
                     });
                     self.car_names.push(o.name.clone());
                 }

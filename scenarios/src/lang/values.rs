@@ -385,6 +385,9 @@ starlark_simple_value!(WorldVal);
 pub struct MonitorVal {
     /// Index in the program's monitor list.
     pub index: usize,
+    /// How many `TimeToFailure`s wrap the monitor it stands for (0 for a monitor as
+    /// declared): the slot at `index` holds it only while it has not been wrapped again.
+    pub wraps: usize,
 }
 
 impl fmt::Display for MonitorVal {

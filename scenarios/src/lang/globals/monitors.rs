@@ -11,7 +11,7 @@ use starlark::values::{Value, ValueLike};
 
 use crate::lang::scene::SceneBuilder;
 use crate::lang::types;
-use crate::lang::values::{ActorKind, ActorVal, MonitorVal, Stream};
+use crate::lang::values::{ActorKind, ActorVal, MonitorVal};
 use crate::MonitorSpec;
 
 use super::*;
@@ -37,13 +37,14 @@ pub(super) fn publish_monitored(
 ) -> anyhow::Result<String> {
     let st = state(eval)?;
     let mut b = st.scene.borrow_mut();
-    if stream.downcast_ref::<Stream>().is_none() {
-        bail!(
+    // A plain number or bool stands for a constant stream, as everywhere a stream is
+    // expected (loading warns that its verdict is the same in every test).
+    let id = stream_arg(stream, &mut b, what).map_err(|_| {
+        anyhow!(
             "{what} judges a stream (such as `v.speed.map(lambda s: 20 - s)`), got a {}",
             stream.get_type()
-        );
-    }
-    let id = stream_arg(stream, &mut b, what)?;
+        )
+    })?;
     let kind = types::stream_types(&b)[id.0];
     if kind != want && kind != types::SType::Any {
         bail!(
@@ -70,6 +71,7 @@ pub(super) fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<Mon
     b.monitors_at.push(here(eval));
     Ok(MonitorVal {
         index: b.monitors.len() - 1,
+        wraps: 0,
     })
 }
 
@@ -270,10 +272,10 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] name: Option<&str>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<MonitorVal> {
-        let inner = m
+        let m = *m
             .downcast_ref::<MonitorVal>()
-            .ok_or_else(|| anyhow!("TimeToFailure wraps a monitor, got a {}", m.get_type()))?
-            .index;
+            .ok_or_else(|| anyhow!("TimeToFailure wraps a monitor, got a {}", m.get_type()))?;
+        let inner = m.index;
         let min_s = match minT {
             Some(v) => number(v, "minT")?,
             None => 0.0,
@@ -290,7 +292,39 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             .monitors
             .get(inner)
             .cloned()
-            .ok_or_else(|| anyhow!("that monitor is already wrapped"))?;
+            .ok_or_else(|| anyhow!("no such monitor"))?;
+        // The slot holds the outermost wrapper: a monitor wrapped once already is not there
+        // any more, and wrapping it again would wrap that wrapper in its name.
+        let depth = {
+            let mut d = 0;
+            let mut spec = &wrapped;
+            while let MonitorSpec::TimeToFailure { inner, .. } = spec {
+                d += 1;
+                spec = inner;
+            }
+            d
+        };
+        if depth != m.wraps {
+            // The wrapper directly around `m`: `depth - m.wraps - 1` levels inside the slot.
+            let mut spec = &wrapped;
+            for _ in 0..depth - m.wraps - 1 {
+                if let MonitorSpec::TimeToFailure { inner, .. } = spec {
+                    spec = inner;
+                }
+            }
+            let at = if depth - m.wraps == 1 {
+                format!(" ({})", b.monitors_at[inner])
+            } else {
+                String::new()
+            };
+            bail!(
+                "this monitor is wrapped already, by TimeToFailure `{}`{at}: a monitor takes \
+                 part in one TimeToFailure, which takes its place in the results; to judge \
+                 its failure time against a second minT, declare a second monitor of the same \
+                 kind, or wrap that TimeToFailure",
+                spec.name(),
+            );
+        }
         let name = name.unwrap_or("time_to_failure");
         if wrapped.name() != name {
             unique_monitor_name(&b, name)?;
@@ -301,6 +335,9 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             inner: Box::new(wrapped),
             min_s,
         };
-        Ok(MonitorVal { index: inner })
+        Ok(MonitorVal {
+            index: inner,
+            wraps: depth + 1,
+        })
     }
 }

@@ -1,0 +1,314 @@
+//! Verdicts that must not depend on how a program is written: when a failure happened, which
+//! signal a formula reads, what a wrapped monitor reports, and the load errors and warnings
+//! that refuse or flag a program rather than judge it wrongly.
+
+mod common;
+
+use std::path::Path;
+
+use common::{expect_code, fuzz};
+use serde_json::Value as Json;
+
+/// A 400 m road with the ego at 5 m/s and a lead car at 6 m/s, 50 m ahead.
+const ROAD: &str = r#"
+w = World()
+r = RoadSegment(len = 400.0, nlanes = 2)
+v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 5.0)
+lead = Car(loc = r.onLane(1, 60), speed = 6.0)
+"#;
+
+fn records(out: &Path) -> Vec<Json> {
+    std::fs::read_to_string(out.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(common::untagged_record)
+        .collect()
+}
+
+/// Runs `src` for one test; returns its record and what the run printed on stderr.
+fn run_one(src: &str, code: i32) -> (Json, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("t.star");
+    std::fs::write(&file, src).unwrap();
+    let out = dir.path().join("out");
+    let o = fuzz(&[
+        file.to_str().unwrap(),
+        "--budget",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, code);
+    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+    (records(&out).remove(0), stderr)
+}
+
+fn load_err(src: &str) -> String {
+    match paracosm_scenarios::lang::load_source("t.star", src, "t") {
+        Ok(_) => panic!("the program loaded:\n{src}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn number(v: &Json) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+/// An `Stl` formula's failure time is when the trace decided it, not when its periodic check
+/// saw it: `TimeToFailure` over it fails a formula false from the start, and the moment of a
+/// later failure is the step it happened at, with or without other monitors beside it.
+#[test]
+fn a_formulas_failure_time_is_when_it_failed() {
+    let src = format!(
+        "{ROAD}w.place(r, v, lead)
+TimeToFailure(Stl(\"G[0,4] (lead.speed > 6.5)\", name = \"slow\"), minT = 0.2, name = \"early\")
+test(horizon = 4.0, offroad = False)
+"
+    );
+    let (r, _) = run_one(&src, 1);
+    let early = &r["monitors"]["early"];
+    assert_eq!(early["passed"], false, "{early}");
+    assert_eq!(number(&early["first_violation_s"]), 0.0);
+    assert!((number(&early["robustness"]) + 0.2).abs() < 1e-12);
+
+    // The lead passes x = 100 at t = 40/6 = 6.67 s: the formula fails at the first step with
+    // lead.pos.x >= 100 (robustness 0 is a violation), whether or not a user monitor of the
+    // same condition runs beside it.
+    let stl = "Stl(\"G[0,10] (lead.pos.x < 100)\", name = \"before\")";
+    let alone =
+        format!("{ROAD}w.place(r, v, lead)\n{stl}\ntest(horizon = 10.0, offroad = False)\n");
+    let both = format!(
+        "{ROAD}w.place(r, v, lead)\n{stl}\nMonitor(lead.pos.map(lambda p: 100 - p.x), name = \"m\")\ntest(horizon = 10.0, offroad = False)\n"
+    );
+    let (a, _) = run_one(&alone, 1);
+    let (b, _) = run_one(&both, 1);
+    let ta = number(&a["monitors"]["before"]["first_violation_s"]);
+    let tb = number(&b["monitors"]["before"]["first_violation_s"]);
+    let tm = number(&b["monitors"]["m"]["first_violation_s"]);
+    assert_eq!(ta, tb);
+    assert_eq!(
+        ta, tm,
+        "the formula and the user monitor fail at the same step"
+    );
+    assert!((ta - 40.0 / 6.0).abs() < 1.0 / 60.0 + 1e-9, "{ta}");
+}
+
+/// `TimeToFailure` over a monitor judged only at the end (a distance) compares the end with
+/// `minT`; wrapping a monitor twice is refused; nesting judges the inner verdict.
+#[test]
+fn time_to_failure_judges_every_kind_of_monitor_once() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 400.0, nlanes = 2)
+v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 5.0)
+w.place(r, v)
+TimeToFailure(DistanceMonitor(v, minD = 500), minT = 1.0, name = "late")
+TimeToFailure(DistanceMonitor(v, minD = 500, name = "d2"), minT = 5.0, name = "early")
+m = Monitor(tick.map(lambda t: 1.0 - t), name = "m")
+TimeToFailure(TimeToFailure(m, minT = 0.5, name = "inner"), minT = 2.0, name = "outer")
+test(horizon = 3.0, offroad = False)
+"#;
+    let (r, _) = run_one(src, 1);
+    let m = &r["monitors"];
+    // Judged at the end of the 3 s run: after minT = 1, before minT = 5.
+    assert_eq!(m["late"]["passed"], true, "{m}");
+    assert_eq!(number(&m["late"]["first_violation_s"]), 3.0);
+    assert_eq!(m["early"]["passed"], false, "{m}");
+    assert!((number(&m["early"]["robustness"]) + 2.0).abs() < 1e-9);
+    // m fails at t = 1 >= 0.5: the inner one passes, so the outer one has no failure to time.
+    assert_eq!(m["outer"]["passed"], true, "{m}");
+    assert!(
+        (number(&m["outer"]["robustness"]) - 0.5).abs() < 1e-9,
+        "{m}"
+    );
+
+    let twice = load_err(
+        r#"
+w = World()
+r = RoadSegment(len = 400.0, nlanes = 2)
+v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 5.0)
+w.place(r, v)
+m = Monitor(tick.map(lambda t: 1.0 - t), name = "m")
+a = TimeToFailure(m, minT = 0.5, name = "ttf_a")
+b = TimeToFailure(m, minT = 1.5, name = "ttf_b")
+"#,
+    );
+    assert!(
+        twice.contains("wrapped already, by TimeToFailure `ttf_a` (t.star:7:5)")
+            && twice.contains("t.star:8:5"),
+        "{twice}"
+    );
+}
+
+/// `fog` and `light` are the world's values now, equal to the World's own streams at every
+/// frame, from t = 0 on.
+#[test]
+fn fog_and_light_signals_are_the_worlds_values_now() {
+    let src = r#"
+w = World(light = tick.map(lambda t: 0.2 + t / 100), fog = tick.map(lambda t: 0.4 + t / 50))
+r = RoadSegment(len = 400.0, nlanes = 2)
+v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 5.0)
+w.place(r, v)
+Signal("myfog", tick.map(lambda t: 0.4 + t / 50))
+Signal("mylight", tick.map(lambda t: 0.2 + t / 100))
+Stl("G[0,2] (myfog - fog < 1e-12 & fog - myfog < 1e-12)", name = "fog_now")
+Stl("G[0,2] (mylight - light < 1e-12 & light - mylight < 1e-12)", name = "light_now")
+Stl("G[0,2] (fog < 0.45)", name = "fog_peak")
+test(horizon = 2.0, offroad = False)
+"#;
+    let (r, _) = run_one(src, 0);
+    let m = &r["monitors"];
+    assert_eq!(m["fog_now"]["passed"], true, "{m}");
+    assert_eq!(m["light_now"]["passed"], true, "{m}");
+    // The fog reaches 0.44 at t = 2: the margin is 0.45 - fog(2), not fog one step earlier
+    // (which would leave 1/3000 more).
+    let peak = number(&m["fog_peak"]["robustness"]);
+    assert!((peak - 0.01).abs() < 1e-12, "{peak}");
+}
+
+/// A `Signal` may not take the name of an actor's output, which it would silently replace.
+#[test]
+fn a_signal_named_like_an_actors_output_is_refused() {
+    for name in ["lead.speed", "lead.pos", "lead.pos.x"] {
+        let e = load_err(&format!(
+            "{ROAD}w.place(r, v, lead)\nSignal(\"{name}\", tick)\nStl(\"G[0,2] (lead.speed > 5)\")\n"
+        ));
+        assert!(
+            e.contains(&format!("Signal `{name}` takes the name of an output of"))
+                && e.contains("t.star:7:1"),
+            "{e}"
+        );
+    }
+    // Another name under the actor's variable is no output of it.
+    let ok = format!(
+        "{ROAD}w.place(r, v, lead)\nSignal(\"lead.gap\", tick)\nStl(\"G[0,2] (lead.gap > -1)\")\n"
+    );
+    paracosm_scenarios::lang::load_source("t.star", &ok, "t").unwrap();
+}
+
+/// `sum()` adds vectors as LANGUAGE.md promises, from zero or from a `Vector`; a fold keeps
+/// starting from 0.0.
+#[test]
+fn sums_of_vectors_run() {
+    let src = format!(
+        "{ROAD}w.place(r, v, lead)
+total = lead.vel.sum()
+Monitor(total.map(lambda p: p.x), name = \"x\", over = \"end\")
+base = r.onLane(1, 20) - r.onLane(1, 10)
+shifted = lead.vel.sum(init = base)
+Monitor(shifted.map(lambda p: p.x), name = \"from_base\", over = \"end\")
+count = tick.sum(init = 0.0, f = lambda acc, t: acc + 1)
+Monitor(count, name = \"count\", over = \"end\")
+test(horizon = 1.0, offroad = False)
+"
+    );
+    let (r, _) = run_one(&src, 0);
+    let m = &r["monitors"];
+    // 61 events (t = 0 .. 1 s) of 6 m/s along x.
+    assert!((number(&m["x"]["robustness"]) - 366.0).abs() < 1e-9, "{m}");
+    assert!(
+        (number(&m["from_base"]["robustness"]) - 376.0).abs() < 1e-9,
+        "{m}"
+    );
+    assert_eq!(number(&m["count"]["robustness"]), 61.0);
+}
+
+/// A constant stands for a constant stream in `Monitor` and `Assert` too, with a warning that
+/// its verdict never depends on the world.
+#[test]
+fn a_monitor_of_a_constant_loads_with_a_warning() {
+    let src = format!("{ROAD}w.place(r, v, lead)\nMonitor(5.0, name = \"c\")\nAssert(True, name = \"a\")\nCollisionMonitor(v)\n");
+    let s = paracosm_scenarios::lang::load_source("t.star", &src, "t").unwrap();
+    let w: Vec<String> = s
+        .warnings
+        .iter()
+        .map(|w| format!("{}: {}", w.at, w.message))
+        .collect();
+    assert!(
+        w.iter()
+            .any(|w| w.starts_with("t.star:7:1: monitor `c` judges a constant stream")),
+        "{w:?}"
+    );
+    assert!(
+        w.iter()
+            .any(|w| w.contains("monitor `a` judges a constant")),
+        "{w:?}"
+    );
+    let e = load_err(&format!("{ROAD}w.place(r, v, lead)\nMonitor(\"fast\")\n"));
+    assert!(e.contains("Monitor needs a stream of numbers"), "{e}");
+}
+
+/// An action's argument of the wrong kind is refused at load, even from a stream that never
+/// fires during a test; at run time, errors name the car by its variable.
+#[test]
+fn action_arguments_are_checked_at_load_and_name_their_car() {
+    let e = load_err(&format!(
+        "{ROAD}w.place(r, v, lead)\ntick.filter(lambda t: t > 100).map(lambda t: \"fast\").foreach(lead.setSpeed)\n"
+    ));
+    assert!(
+        e.contains("setSpeed of Car lead is given \"fast\" (a string)") && e.contains("t.star:7:"),
+        "{e}"
+    );
+    let src = format!(
+        "{ROAD}w.place(r, v, lead)\ntick.filter(lambda t: t > 0.5).map(lambda t: -2.0).foreach(lead.setSpeed)\nCollisionMonitor(v)\ntest(horizon = 2.0)\n"
+    );
+    let (r, _) = run_one(&src, 3);
+    let error = r["error"].as_str().unwrap();
+    assert!(
+        error.contains("the speed given to Car lead (")
+            && error.contains("t.star:5:8)'s setSpeed was -2"),
+        "{error}"
+    );
+}
+
+/// Load errors that had only the file now point at the line: a lambda over the step limit
+/// while loading, `test(map=)` naming no parameter, a monitor named `offroad`.
+#[test]
+fn load_errors_point_at_their_line() {
+    let e = load_err(&format!(
+        "{ROAD}w.place(r, v, lead)\nMonitor(tick.map(lambda t: len([x for x in range(2000000)]) - t), name = \"m\")\n"
+    ));
+    assert!(
+        e.contains("step limit exceeded") && e.contains("t.star:7:9"),
+        "{e}"
+    );
+    let e = load_err(&format!(
+        "{ROAD}s = VarInterval(1.0, 5.0)\nw.place(r, v, lead)\nCollisionMonitor(v)\ntest(map = \"speed\")\n"
+    ));
+    assert!(
+        e.contains("names `speed`") && e.contains("t.star:9:1"),
+        "{e}"
+    );
+    let e = load_err(&format!(
+        "{ROAD}w.place(r, v, lead)\nMonitor(v.speed, name = \"offroad\")\n"
+    ));
+    assert!(
+        e.contains("default OffRoadMonitor") && e.contains("t.star:7:1"),
+        "{e}"
+    );
+}
+
+/// The costlier runner signals (time to collision, lane offset) are computed for a test only
+/// when a monitor reads them, and then have their values: a stopped car 50 m ahead of the
+/// ego is seconds away, and the ego keeps the centre of its lane.
+#[test]
+fn signals_computed_on_demand_have_their_values_when_read() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 400.0, nlanes = 2)
+v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 5.0)
+stopped = Car(loc = r.onLane(1, 60), speed = 0.0)
+w.place(r, v, stopped)
+Stl("G[0,0.5] (ego_ttc_s > 0)", name = "ttc")
+Stl("G[0,0.5] (ego_lane_offset_m < 0.3 & ego_lane_offset_m > -0.3)", name = "lane")
+test(horizon = 0.5, offroad = False)
+"#;
+    let (r, _) = run_one(src, 0);
+    let m = &r["monitors"];
+    // The gap between the bodies is 50 m less a car's length, closed at 5 m/s or more (the
+    // system under test speeds up): finite, a few seconds; unset it would read -inf.
+    let ttc = number(&m["ttc"]["robustness"]);
+    assert!(ttc > 3.0 && ttc < 10.0, "{m}");
+    let lane = number(&m["lane"]["robustness"]);
+    assert!(lane > 0.25 && lane <= 0.3, "{m}");
+}
