@@ -187,13 +187,22 @@ impl Frame {
 pub struct SampledLine {
     /// Station (m) and point `[x, z]` (piece frame) of each sample, in order.
     pub samples: Vec<(f64, [f64; 2])>,
+    /// The line's unit tangents at its start and its end, `[x, z]`: the ends' cross-sections
+    /// are perpendicular to them (not to the first and last chords, which turn by half a
+    /// step's angle less).
+    pub end_tangents: [[f64; 2]; 2],
 }
 
 impl SampledLine {
     /// Samples `line`.
     pub fn new(line: &RefLine) -> Self {
+        let tangent = |s: f64| {
+            let (sin, cos) = line.heading(s).sin_cos();
+            [cos, -sin]
+        };
         SampledLine {
             samples: line.polyline(POLYLINE_STEP_M),
+            end_tangents: [tangent(0.0), tangent(line.length_m)],
         }
     }
 
@@ -229,10 +238,15 @@ impl SampledLine {
                 let len = len2.sqrt();
                 // Right of travel along d: (-d_z, d_x) in the (x, z) plane.
                 let lateral = (rel[1] * d[0] - rel[0] * d[1]) / len;
-                let past = if i == 0 && raw < 0.0 {
-                    -raw * len
-                } else if i == n - 2 && raw > 1.0 {
-                    (raw - 1.0) * len
+                // Past an end: beyond the end's cross-section, perpendicular to the line's
+                // tangent there (the chord's perpendicular would leave a wedge of up to
+                // |t|·κ·step/2 between this piece and the next one at the outer lanes).
+                let along =
+                    |end: [f64; 2], t: [f64; 2]| (p[0] - end[0]) * t[0] + (p[1] - end[1]) * t[1];
+                let past = if i == 0 && raw <= 0.5 {
+                    (-along(a, self.end_tangents[0])).max(0.0)
+                } else if i == n - 2 && raw >= 0.5 {
+                    along(b, self.end_tangents[1]).max(0.0)
                 } else {
                     0.0
                 };
