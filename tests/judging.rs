@@ -312,3 +312,21 @@ test(horizon = 0.5, offroad = False)
     let lane = number(&m["lane"]["robustness"]);
     assert!(lane > 0.25 && lane <= 0.3, "{m}");
 }
+
+/// A `VarInterval` given to an input of whole numbers is refused at load, though both ends of
+/// its interval are whole: loading builds the world at a value inside it too.
+#[test]
+fn an_interval_for_a_whole_number_input_is_refused_at_load() {
+    for (decl, what) in [
+        ("r = RoadSegment(len = 200, nlanes = VarInterval(2, 6))\nv = AutonomousVehicle(loc = r.onLane(1, 10))", "nlanes must be an even whole number"),
+        ("r = RoadSegment(len = 200, nlanes = 4)\nv = AutonomousVehicle(loc = r.onLane(VarInterval(1, 2), 10))", "a lane is a whole number"),
+    ] {
+        let e = load_err(&format!(
+            "w = World()\n{decl}\nw.place(r, v)\nCollisionMonitor(v)\n"
+        ));
+        assert!(
+            e.contains(what) && e.contains("inside its interval") && e.contains("t.star:"),
+            "{e}"
+        );
+    }
+}

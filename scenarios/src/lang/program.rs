@@ -28,6 +28,10 @@ use crate::{MonitorSpec, Scenario, ScenarioError};
 /// of a pairwise covering array over them.
 pub const MAX_CHECKED_WORLDS: usize = 4096;
 
+/// Where inside an interval loading probes one more value of each `VarInterval`, as a
+/// fraction of its width: the golden ratio's, so that the value is no round number.
+const INTERIOR_FRACTION: f64 = 0.618_033_988_749_894_8;
+
 /// Most values of one parameter evaluated at load to learn which inputs it changes (spread
 /// evenly over its levels, the first and last among them).
 const MAX_PROBED_VALUES: usize = 64;
@@ -373,6 +377,24 @@ impl Program {
 
     /// The test values a parameter is checked at when the program loads: every level; an
     /// interval's two ends (over time: all coefficients at one end, then at the other).
+    /// The value `x` of interval parameter `k` (constant, or the same at every coordinate of
+    /// one varying over time).
+    fn checked_values_at(&self, k: usize, x: f64) -> ParamValue {
+        let (name, p) = &self.params[k];
+        let n = coordinate_names(name, p.over_time).len();
+        match p.over_time {
+            OverTime::Constant => ParamValue::Level(Level::Real(x)),
+            OverTime::Piecewise(_) => ParamValue::Over(OpenStream::Piecewise {
+                values: vec![x; n],
+                horizon_s: self.horizon_s,
+            }),
+            OverTime::Polynomial(_) => ParamValue::Over(OpenStream::Polynomial {
+                coefficients: vec![x; n],
+                horizon_s: self.horizon_s,
+            }),
+        }
+    }
+
     fn checked_values(&self, k: usize) -> Vec<(ParamValue, String)> {
         let (name, p) = &self.params[k];
         let n = coordinate_names(name, p.over_time).len();
@@ -782,7 +804,23 @@ pub fn load(
         let mut seen = Vec::new();
         // At most MAX_PROBED_VALUES of its values, spread over them (a VarEnum may have
         // thousands of levels, each one evaluation of the program).
-        let all = program.checked_values(k);
+        let mut all = program.checked_values(k);
+        // And a value inside an interval, not a round one: a world that takes only whole
+        // numbers (`nlanes`, a lane) fails there, though both ends may be whole.
+        if let (name, Domain::Interval { lo, hi }) =
+            (&program.params[k].0, &program.params[k].1.domain)
+        {
+            let x = lo + (hi - lo) * INTERIOR_FRACTION;
+            let values = program.checked_values_at(k, x);
+            all.push((
+                values,
+                format!(
+                    "{name} = {x}, inside its interval [{lo}, {hi}): every value of a \
+                     VarInterval must build a valid world; an input of whole numbers takes a \
+                     VarEnum of them"
+                ),
+            ));
+        }
         let n = all.len();
         let probed = all.into_iter().enumerate().filter(|(i, _)| {
             n <= MAX_PROBED_VALUES
