@@ -470,7 +470,18 @@ fn settings(
                         Some((_, points)) => points.len() as u64,
                         None => request.budget.unwrap_or(100),
                     },
-                    strength: request.strength.unwrap_or(2),
+                    // The default strength, 2, is lowered to the number of discrete
+                    // parameters when there are fewer (a strength asked for is kept, and
+                    // refused if too high).
+                    strength: request.strength.unwrap_or_else(|| {
+                        let suite = request
+                            .strategy
+                            .is_some_and(|s| Strategy::SUITES.contains(&s));
+                        match scenario.space.level_counts().len() {
+                            1 if suite => 1,
+                            _ => 2,
+                        }
+                    }),
                     shard: request.shard,
                     points: given.as_ref().map(|(f, _)| f.clone()),
                 },

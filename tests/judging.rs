@@ -330,3 +330,160 @@ fn an_interval_for_a_whole_number_input_is_refused_at_load() {
         );
     }
 }
+
+/// Actions take their arguments by keyword as LANGUAGE.md names them, each once; their open
+/// arguments and `onLane`'s are named alike by keyword and by position; a tuple assignment
+/// names each parameter by its variable.
+#[test]
+fn keywords_and_positions_are_one_and_name_parameters_alike() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 300, nlanes = 4)
+s = RoadSegment(len = 300, nlanes = 4)
+r.connect((r.TWO, s, s.ONE))
+v = AutonomousVehicle(loc = r.onLane(1, 10))
+lead = Car(loc = r.onLane(1, 60), speed = 5.0)
+a, b = VarInterval(10, 20), VarInterval(0, 5)
+c = Car(loc = s.onLane(lane = 1, at = VarInterval(10, 20)), speed = b)
+e = Car(loc = r.onLane(VarEnum([-1, -2]), at = VarInterval(100, 120)))
+tick.filter(lambda t: t > 3).take(1).foreach(lead.changeLane(lane = 2, duration = 2.0))
+tick.filter(lambda t: t > 4).take(1).foreach(lead.setSpeed(v = a))
+tick.filter(lambda t: t > 5).take(1).foreach(c.brake(decel = VarInterval(1, 3)))
+w.place(r, s, v, lead, c, e)
+CollisionMonitor(v)
+"#;
+    let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
+    let mut names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "a",
+            "b",
+            "c.brake",
+            "r.onLane[0]",
+            "r.onLane[1]",
+            "s.onLane"
+        ]
+    );
+    for (call, message) in [
+        (
+            "lead.changeLane(lanes = 2)",
+            "changeLane has no argument `lanes`: it is changeLane(lane, duration)",
+        ),
+        ("lead.brake(3, decel = 2)", "`decel` is given twice"),
+        ("lead.setSpeed()", "setSpeed needs `v`"),
+        ("lead.brake(1, 2)", "brake takes 1 argument"),
+    ] {
+        let e = load_err(&src.replace("lead.changeLane(lane = 2, duration = 2.0)", call));
+        assert!(
+            e.contains(message) && e.contains("t.star:11:"),
+            "{call}: {e}"
+        );
+    }
+}
+
+/// Units are checked on every input that has one, whatever the form of the argument.
+#[test]
+fn units_are_checked_on_lane_changes_obstacles_positions_and_actions() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 300, nlanes = 4)
+v = AutonomousVehicle(loc = r.onLane(1, VarInterval(10, 20, unit = "s")))
+c = Car(loc = r.onLane(lane = -1, at = VarInterval(50, 60, unit = "km")), lane_change = ChangeLane(to = -2, at = VarInterval(1, 2, unit = "m"), duration = VarInterval(1, 2, unit = "km")))
+o = Obstacle(loc = r.onLane(-2, 200), size = (VarInterval(1, 2, unit = "s"), 1, 1))
+d = VarInterval(2, 3, unit = "m/s")
+tick.filter(lambda t: t > 100).take(1).foreach(c.brake(d))
+w.place(r, v, c, o)
+CollisionMonitor(v)
+"#;
+    let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
+    let w: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
+    for expected in [
+        "`r.onLane_1` is declared in s but feeds onLane(at=), which is in m",
+        "`r.onLane_2` is declared in km but feeds onLane(at=), which is in m",
+        "`ChangeLane.at` is declared in m but feeds ChangeLane(at=), which is in s",
+        "`ChangeLane.duration` is declared in km but feeds ChangeLane(duration=), which is in s",
+        "`o.size[0]` is declared in s but feeds Obstacle(size[0]=), which is in m",
+        "`d` is declared in m/s but feeds brake(decel=), which is in m/s²",
+    ] {
+        assert!(w.contains(&expected), "{expected}\n{w:#?}");
+    }
+}
+
+/// A lane change into the other direction's lane is allowed, with a warning; levels that
+/// depend on another parameter are refused with both sets of levels named.
+#[test]
+fn wrong_way_lane_changes_warn_and_levels_that_vary_are_named() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 300, nlanes = 4)
+v = AutonomousVehicle(loc = r.onLane(1, 10))
+c = Car(loc = r.onLane(2, 60), speed = 5.0, lane_change = ChangeLane(to = -1, at = 1.0))
+w.place(r, v, c)
+CollisionMonitor(v)
+"#;
+    let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.at == "t.star:5:5"
+            && w.message.contains(
+                "ChangeLane(to = -1) moves it from lane 2 into a lane of the other direction"
+            )),
+        "{:?}",
+        s.warnings
+    );
+    let e = load_err(
+        r#"
+n = VarEnum([2, 4])
+w = World()
+m = VarEnum([1, n // 2 + 5])
+r = RoadSegment(len = 300, nlanes = n)
+v = AutonomousVehicle(loc = r.onLane(1, 10 + m))
+w.place(r, v)
+CollisionMonitor(v)
+"#,
+    );
+    assert!(
+        e.contains("`m` has the levels [1, 6] for some values and the levels [1, 7] for others")
+            && e.contains("t.star:4:5"),
+        "{e}"
+    );
+}
+
+/// `--strategy ipog` without `--strength` covers a program with one discrete parameter (the
+/// default strength 2 is lowered to 1 there); asked for explicitly, strength 2 is refused.
+#[test]
+fn a_covering_suite_over_one_discrete_parameter_runs_by_default() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("one.star");
+    std::fs::write(
+        &file,
+        "w = World()\nn = VarEnum([2, 4])\nr = RoadSegment(len = 200, nlanes = n)\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, v)\nCollisionMonitor(v)\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            file.to_str().unwrap(),
+            "--strategy",
+            "ipog",
+            "--budget",
+            "4",
+            "--force",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        fuzz(&args)
+    };
+    let o = run(&[]);
+    expect_code(&o, 0);
+    let rs = records(&out);
+    assert_eq!(rs.len(), 4);
+    let levels: std::collections::BTreeSet<String> =
+        rs.iter().map(|r| r["params"]["n"].to_string()).collect();
+    assert_eq!(levels.len(), 2, "both levels covered: {levels:?}");
+    let o = run(&["--strength", "2"]);
+    expect_code(&o, 2);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("strength t = 2"));
+}

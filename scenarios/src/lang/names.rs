@@ -69,6 +69,33 @@ fn callee(e: &AstExpr) -> Option<String> {
     }
 }
 
+/// The keyword of a method's positional argument `position`, for its unit:
+/// `r.onLane(lane, at)`'s `at`, `car.brake(decel)`, `car.setSpeed(speed)`.
+fn positional_keyword(method: &str, position: usize) -> Option<&'static str> {
+    match (method, position) {
+        ("onLane", 1) => Some("at"),
+        ("brake", 0) => Some("decel"),
+        ("setSpeed", 0) => Some("v"),
+        _ => None,
+    }
+}
+
+/// The position in `method`'s signature of its argument named `keyword`, given the keywords
+/// of the call (a junction's `onLane` has a port and a turn first): `r.onLane(at = x)` is
+/// argument 1, as in `r.onLane(1, x)`.
+fn method_position(method: &str, keyword: &str, keywords: &[&str]) -> Option<usize> {
+    let junction = keywords.iter().any(|k| matches!(*k, "port" | "turn"));
+    let order: &[&str] = match (method, junction) {
+        ("onLane", false) => &["lane", "at"],
+        ("onLane", true) => &["port", "turn", "at", "lane"],
+        ("changeLane", _) => &["lane", "duration"],
+        ("brake", _) => &["decel"],
+        ("setSpeed", _) => &["v"],
+        _ => return None,
+    };
+    order.iter().position(|k| *k == keyword)
+}
+
 fn is_declarer(e: &AstExpr) -> bool {
     matches!(&e.node, ExprP::Call(f, _) if callee(f).is_some_and(|c| DECLARERS.contains(&c.as_str())))
 }
@@ -109,6 +136,24 @@ impl Walker<'_> {
                 // `dist = trigger_distance`: an alias may be read anywhere, so the value is
                 // read by code.
                 let alias = matches!(a.rhs.node, ExprP::Identifier(_));
+                // `a, b = VarInterval(...), VarInterval(...)`: each item is assigned to its
+                // own variable, and named by it.
+                if let (AssignTargetP::Tuple(targets), ExprP::Tuple(items)) =
+                    (&a.lhs.node, &a.rhs.node)
+                {
+                    if targets.len() == items.len() {
+                        for (t, x) in targets.iter().zip(items) {
+                            let name = match &t.node {
+                                AssignTargetP::Identifier(id) => Some(id.node.ident.clone()),
+                                _ => None,
+                            };
+                            let alias = matches!(x.node, ExprP::Identifier(_));
+                            self.expr(x, name.as_deref(), in_code || alias);
+                        }
+                        a.lhs.visit_expr(|e| self.expr(e, None, true));
+                        return;
+                    }
+                }
                 self.expr(&a.rhs, target.as_deref(), in_code || alias);
                 a.lhs.visit_expr(|e| self.expr(e, None, true));
             }
@@ -159,9 +204,53 @@ impl Walker<'_> {
                         matches!(a.node, ArgumentP::Positional(_)) && is_declarer(a.node.expr())
                     })
                     .count();
+                // A method of an object named by a variable (`r.onLane(...)`): its open
+                // arguments are named after the object and the method, by keyword as by
+                // position (`r.onLane(lane = 1, at = x)` is `r.onLane(1, x)`).
+                let method_of = match &f.node {
+                    ExprP::Dot(obj, method) => match &obj.node {
+                        ExprP::Identifier(o) => Some((o.node.ident.clone(), method.node.clone())),
+                        _ => None,
+                    },
+                    _ => None,
+                };
+                let keywords: Vec<&str> = args
+                    .args
+                    .iter()
+                    .filter_map(|a| match &a.node {
+                        ArgumentP::Named(kw, _) => Some(kw.node.as_str()),
+                        _ => None,
+                    })
+                    .collect();
+                let open_named = args
+                    .args
+                    .iter()
+                    .filter(|a| {
+                        matches!(a.node, ArgumentP::Named(..)) && is_declarer(a.node.expr())
+                    })
+                    .count();
                 for (position, a) in args.args.iter().enumerate() {
                     let value = a.node.expr();
-                    if let (ArgumentP::Named(kw, _), true) = (&a.node, is_declarer(value)) {
+                    let signature_position = match (&a.node, &method_of) {
+                        (ArgumentP::Named(kw, _), Some((_, m))) => {
+                            method_position(m, &kw.node, &keywords)
+                        }
+                        _ => None,
+                    };
+                    if let (ArgumentP::Named(kw, _), true, Some(i), Some((o, m))) =
+                        (&a.node, is_declarer(value), signature_position, &method_of)
+                    {
+                        let n = if open_named + open_positional > 1 {
+                            format!("{o}.{m}[{i}]")
+                        } else {
+                            format!("{o}.{m}")
+                        };
+                        let argument_of = name
+                            .clone()
+                            .filter(|_| builtin)
+                            .map(|b| (b, kw.node.clone()));
+                        self.site(value, Some(n), None, argument_of);
+                    } else if let (ArgumentP::Named(kw, _), true) = (&a.node, is_declarer(value)) {
                         let owner = target.map(str::to_owned).or_else(|| name.clone());
                         let n = owner.map(|o| format!("{o}.{}", kw.node));
                         let argument_of = name
@@ -180,7 +269,11 @@ impl Walker<'_> {
                         for (i, x) in items.iter().enumerate() {
                             if is_declarer(x) {
                                 let n = owner.as_ref().map(|o| format!("{o}.{}[{i}]", kw.node));
-                                self.site(x, n, None, None);
+                                let argument_of = name
+                                    .clone()
+                                    .filter(|_| builtin)
+                                    .map(|b| (b, format!("{}[{i}]", kw.node)));
+                                self.site(x, n, None, argument_of);
                             }
                         }
                     }
@@ -191,25 +284,29 @@ impl Walker<'_> {
                         (&a.node, is_declarer(value), &f.node)
                     {
                         if let ExprP::Identifier(o) = &obj.node {
-                            let n = if open_positional > 1 {
+                            let n = if open_positional + open_named > 1 {
                                 format!("{}.{}[{position}]", o.node.ident, method.node)
                             } else {
                                 format!("{}.{}", o.node.ident, method.node)
                             };
-                            self.site(value, Some(n), None, None);
+                            // The input it feeds, for its unit: `onLane(lane, at)`'s `at`.
+                            let argument_of = positional_keyword(&method.node, position)
+                                .map(|k| (method.node.to_string(), k.to_owned()));
+                            self.site(value, Some(n), None, argument_of);
                         }
                     }
                     match (&value.node, builtin) {
                         // A variable passed whole to a builtin: the world shows its effect.
                         (ExprP::Identifier(id), true) => {
-                            if let ArgumentP::Named(kw, _) = &a.node {
-                                if let Some(n) = &name {
-                                    self.out.passed.push((
-                                        n.clone(),
-                                        kw.node.clone(),
-                                        id.node.ident.clone(),
-                                    ));
+                            let keyword = match (&a.node, &method_of) {
+                                (ArgumentP::Named(kw, _), _) => Some(kw.node.clone()),
+                                (ArgumentP::Positional(_), Some((_, m))) => {
+                                    positional_keyword(m, position).map(str::to_owned)
                                 }
+                                _ => None,
+                            };
+                            if let (Some(kw), Some(n)) = (keyword, &name) {
+                                self.out.passed.push((n.clone(), kw, id.node.ident.clone()));
                             }
                             if in_code {
                                 *self

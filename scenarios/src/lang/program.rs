@@ -67,6 +67,9 @@ const BUILTINS: &[&str] = &[
     "Stl",
     "test",
     "onLane",
+    "brake",
+    "setSpeed",
+    "changeLane",
     "connect",
     "place",
     "zip",
@@ -262,6 +265,37 @@ impl Program {
         for (k, d) in b.params.iter().enumerate() {
             match self.params.get(k) {
                 Some((_, decl)) if d == decl => {}
+                Some((name, decl)) if decl.at == d.at => {
+                    // The same declaration, evaluated to another range, levels, unit or
+                    // over_time.
+                    let what = |p: &ParamDecl| match &p.domain {
+                        Domain::Interval { lo, hi } => format!("[{lo}, {hi})"),
+                        Domain::Levels(levels) => format!(
+                            "the levels [{}]",
+                            levels
+                                .iter()
+                                .map(ToString::to_string)
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
+                    };
+                    let differs = if decl.domain != d.domain {
+                        format!("{} for some values and {} for others", what(decl), what(d))
+                    } else if decl.unit != d.unit {
+                        format!(
+                            "the unit {:?} for some values and {:?} for others",
+                            decl.unit, d.unit
+                        )
+                    } else {
+                        "another over_time or name for some values".to_owned()
+                    };
+                    return Err(format!(
+                        "error: the open parameters depend on their values: `{name}` has \
+                         {differs}; its range, levels, unit and over_time must be the same in \
+                         every test (compute with the value instead: `base + m`)\n --> {}",
+                        d.at
+                    ));
+                }
                 Some((name, decl)) => {
                     return Err(format!(
                     "error: the open parameters depend on their values: parameter {k} is `{name}` \

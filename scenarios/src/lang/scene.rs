@@ -804,7 +804,24 @@ impl SceneBuilder {
                         .route(&start, &route, MAX_ROUTE_M)
                         .map_err(|e| format!("{}: {}", o.name, strip(e)))?;
                     let lane_change = match lane_change {
-                        Some(c) => Some(self.lane_change(&o.name, &start, c)?),
+                        Some(c) => {
+                            // Into a lane of the other direction: allowed (an overtaking
+                            // manoeuvre), but the car keeps its own direction there.
+                            if let paracosm_engine::Lane::Driving(k) = start.lane {
+                                if k.signum() != c.to.signum() {
+                                    self.warnings.push(Warning {
+                                        at: o.at.clone(),
+                                        message: format!(
+                                            "{}: ChangeLane(to = {}) moves it from lane {k} into \
+                                             a lane of the other direction, where it goes on \
+                                             driving its own way (against the traffic there)",
+                                            o.name, c.to
+                                        ),
+                                    });
+                                }
+                            }
+                            Some(self.lane_change(&o.name, &start, c)?)
+                        }
                         None => None,
                     };
                     let lane_offsets_m = self.lane_offsets(&start);

@@ -122,6 +122,14 @@ pub fn input_of(builtin: &str, keyword: &str) -> Option<Input> {
         ("Car", "speed") => CAR_SPEED,
         ("Pedestrian", "speed") => PEDESTRIAN_SPEED,
         ("Pedestrian", "dist") => TRIGGER_DISTANCE,
+        ("ChangeLane", "at") => number("at", "s", 0.0, f64::INFINITY, false),
+        ("ChangeLane", "duration") => number("duration", "s", 0.0, f64::INFINITY, true),
+        ("Obstacle", "size[0]" | "size[1]" | "size[2]") => {
+            number("size", "m", 0.0, f64::INFINITY, true)
+        }
+        ("onLane", "at") => number("at", "m", f64::NEG_INFINITY, f64::INFINITY, false),
+        ("brake", "decel") => number("decel", "m/s²", 0.0, f64::INFINITY, true),
+        ("setSpeed", "v") => number("v", "m/s", 0.0, f64::INFINITY, false),
         _ => return None,
     })
 }

@@ -289,25 +289,50 @@ impl<'v> StarlarkValue<'v> for Action {
                     ))
                 })
         };
-        let bound = match self.method {
-            "walk" => {
-                args.no_named_args()?;
-                let [] = args.positional(heap)?;
-                None
+        // Each argument by position or by keyword (the names LANGUAGE.md's table gives), once.
+        let signature: &[&str] = match self.method {
+            "walk" => &[],
+            "changeLane" => &["lane", "duration"],
+            "brake" => &["decel"],
+            _ => &["v"],
+        };
+        let usage = format!("{}({})", self.method, signature.join(", "));
+        let mut given: Vec<Option<Value<'v>>> = vec![None; signature.len()];
+        for (i, v) in args.positions(heap)?.enumerate() {
+            let slot = given.get_mut(i).ok_or_else(|| {
+                fail(format!(
+                    "{self} takes {} argument{} ({usage}), got more",
+                    signature.len(),
+                    if signature.len() == 1 { "" } else { "s" }
+                ))
+            })?;
+            *slot = Some(v);
+        }
+        for (k, v) in args.names_map()?.iter() {
+            let Some(i) = signature.iter().position(|n| *n == k.as_str()) else {
+                return Err(fail(format!(
+                    "{self} has no argument `{}`: it is {usage}",
+                    k.as_str()
+                )));
+            };
+            if given[i].replace(*v).is_some() {
+                return Err(fail(format!(
+                    "{self}: `{}` is given twice, by position and by name ({usage})",
+                    k.as_str()
+                )));
             }
+        }
+        let required = |i: usize| {
+            given[i].ok_or_else(|| fail(format!("{self} needs `{}`: it is {usage}", signature[i])))
+        };
+        let bound = match self.method {
+            "walk" => None,
             "changeLane" => {
-                let [lane] = args.positional(heap)?;
-                let mut duration = None;
-                for (k, v) in args.names_map()?.iter() {
-                    if k.as_str() != "duration" {
-                        return Err(fail(format!(
-                            "changeLane takes (lane, duration = s), not `{}`",
-                            k.as_str()
-                        )));
-                    }
-                    duration = Some(number(*v, "duration (s)")?);
-                }
-                let lane = number(lane, "the lane")?;
+                let lane = number(required(0)?, "the lane")?;
+                let duration = match given[1] {
+                    Some(v) => Some(number(v, "duration (s)")?),
+                    None => None,
+                };
                 if lane.fract() != 0.0 || lane == 0.0 {
                     return Err(fail(format!(
                         "changeLane: a lane is a whole number other than 0, got {lane}"
@@ -319,10 +344,8 @@ impl<'v> StarlarkValue<'v> for Action {
                 Some((lane, duration))
             }
             method => {
-                args.no_named_args()?;
-                let [v] = args.positional(heap)?;
                 let v = number(
-                    v,
+                    required(0)?,
                     if method == "brake" {
                         "the deceleration (m/s²)"
                     } else {
