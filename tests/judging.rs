@@ -487,3 +487,14 @@ fn a_covering_suite_over_one_discrete_parameter_runs_by_default() {
     expect_code(&o, 2);
     assert!(String::from_utf8_lossy(&o.stderr).contains("strength t = 2"));
 }
+
+/// An NPC car's `pos` is its body's centre, as LANGUAGE.md says and as the ego's is its
+/// chassis centre: above the road, not on it.
+#[test]
+fn a_cars_position_is_its_centre() {
+    let src = format!(
+        "{ROAD}w.place(r, v, lead)\nSignal(\"lead_y\", lead.pos.map(lambda p: p.y))\nStl(\"G[0,1] (lead_y > 0.5 & lead_y < 1.5)\", name = \"centre\")\ntest(horizon = 1.0, offroad = False)\n"
+    );
+    let (r, _) = run_one(&src, 0);
+    assert_eq!(r["monitors"]["centre"]["passed"], true, "{}", r["monitors"]);
+}

@@ -403,6 +403,13 @@ impl Car {
         })
     }
 
+    /// The centre of its body `[x, y, z]`, metres: its `pos` output (an actor's reference
+    /// point, as the ego's chassis centre is the ego's).
+    pub(crate) fn centre_m(&self) -> [f64; 3] {
+        let ([x, z], _) = self.here;
+        [x, CLEARANCE_M + self.size.height_m / 2.0, z]
+    }
+
     pub(crate) fn state(&self) -> CarState {
         let ([x, z], heading_rad) = self.here;
         CarState {

@@ -1039,7 +1039,7 @@ impl Inputs for WorldInputs<'_> {
                     let s = c.state();
                     let d = crate::network::direction(s.heading_rad);
                     match output {
-                        Output::Pos => Value::Vec3(s.pos_m),
+                        Output::Pos => Value::Vec3(c.centre_m()),
                         Output::Vel => Value::Vec3([d[0] * s.speed_mps, 0.0, d[1] * s.speed_mps]),
                         Output::Heading => Value::Num(s.heading_rad),
                         Output::Speed => Value::Num(s.speed_mps),
