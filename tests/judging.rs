@@ -265,27 +265,23 @@ fn action_arguments_are_checked_at_load_and_name_their_car() {
 /// while loading, `test(map=)` naming no parameter, a monitor named `offroad`.
 #[test]
 fn load_errors_point_at_their_line() {
-    let e = load_err(&format!(
-        "{ROAD}w.place(r, v, lead)\nMonitor(tick.map(lambda t: len([x for x in range(2000000)]) - t), name = \"m\")\n"
-    ));
-    assert!(
-        e.contains("step limit exceeded") && e.contains("t.star:7:9"),
-        "{e}"
-    );
-    let e = load_err(&format!(
-        "{ROAD}s = VarInterval(1.0, 5.0)\nw.place(r, v, lead)\nCollisionMonitor(v)\ntest(map = \"speed\")\n"
-    ));
-    assert!(
-        e.contains("names `speed`") && e.contains("t.star:9:1"),
-        "{e}"
-    );
-    let e = load_err(&format!(
-        "{ROAD}w.place(r, v, lead)\nMonitor(v.speed, name = \"offroad\")\n"
-    ));
-    assert!(
-        e.contains("default OffRoadMonitor") && e.contains("t.star:7:1"),
-        "{e}"
-    );
+    for (tail, needles) in [
+        (
+            "Monitor(tick.map(lambda t: len([x for x in range(2000000)]) - t), name = \"m\")\n",
+            ["step limit exceeded", "t.star:7:9"],
+        ),
+        (
+            "CollisionMonitor(v)\ntest(map = \"speed\")\n",
+            ["names `speed`", "t.star:8:1"],
+        ),
+        (
+            "Monitor(v.speed, name = \"offroad\")\n",
+            ["default OffRoadMonitor", "t.star:7:1"],
+        ),
+    ] {
+        let e = load_err(&format!("{ROAD}w.place(r, v, lead)\n{tail}"));
+        assert!(needles.iter().all(|n| e.contains(n)), "{e}");
+    }
 }
 
 /// The costlier runner signals (time to collision, lane offset) are computed for a test only

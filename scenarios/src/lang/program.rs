@@ -409,8 +409,6 @@ impl Program {
             .collect()
     }
 
-    /// The test values a parameter is checked at when the program loads: every level; an
-    /// interval's two ends (over time: all coefficients at one end, then at the other).
     /// The value `x` of interval parameter `k` (constant, or the same at every coordinate of
     /// one varying over time).
     fn checked_values_at(&self, k: usize, x: f64) -> ParamValue {
@@ -429,24 +427,14 @@ impl Program {
         }
     }
 
+    /// The test values a parameter is checked at when the program loads: every level; an
+    /// interval's two ends (over time: all coefficients at one end, then at the other).
     fn checked_values(&self, k: usize) -> Vec<(ParamValue, String)> {
         let (name, p) = &self.params[k];
-        let n = coordinate_names(name, p.over_time).len();
-        let over = |x: f64| match p.over_time {
-            OverTime::Constant => ParamValue::Level(Level::Real(x)),
-            OverTime::Piecewise(_) => ParamValue::Over(OpenStream::Piecewise {
-                values: vec![x; n],
-                horizon_s: self.horizon_s,
-            }),
-            OverTime::Polynomial(_) => ParamValue::Over(OpenStream::Polynomial {
-                coefficients: vec![x; n],
-                horizon_s: self.horizon_s,
-            }),
-        };
         match &p.domain {
             Domain::Interval { lo, hi } => vec![
-                (over(*lo), format!("{name} = {lo}")),
-                (over(*hi), format!("{name} = {hi}")),
+                (self.checked_values_at(k, *lo), format!("{name} = {lo}")),
+                (self.checked_values_at(k, *hi), format!("{name} = {hi}")),
             ],
             Domain::Levels(levels) => levels
                 .iter()
