@@ -129,25 +129,29 @@ impl RunRecord {
         self.cost(&[])
     }
 
-    /// The names of the monitors that failed, in the scenario's order.
+    /// The names of the monitors that failed, in the scenario's order, but those cut short by
+    /// another monitor's failure (their verdict covers only the run up to it).
     pub fn failed_monitors(&self) -> Vec<String> {
         self.monitors
             .iter()
-            .filter(|(_, m)| !m.passed)
+            .filter(|(_, m)| !m.passed && !m.cut_short)
             .map(|(n, _)| n.clone())
             .collect()
     }
 
     /// The falsification cost of the test: the smallest robustness over its monitors, where
-    /// the `passive` ones (see `Scenario::passive_monitors`) count only when `<= 0`; `+inf`
-    /// when nothing counts, NaN for a test that ended in `error`. `<= 0` exactly when the test
-    /// failed.
+    /// the `passive` ones (see `Scenario::passive_monitors`) count only when `<= 0` and those
+    /// cut short by another monitor's failure not at all (an `eventually` cut at 0.2 s reads
+    /// `-inf` though the rest of the run might have met it; the failure that cut it counts);
+    /// `+inf` when nothing counts, NaN for a test that ended in `error`. `<= 0` exactly when
+    /// the test failed.
     pub fn cost(&self, passive: &[String]) -> f64 {
         if self.status == Status::Error {
             return f64::NAN;
         }
         self.monitors
             .iter()
+            .filter(|(_, m)| !m.cut_short)
             .filter(|(n, m)| m.robustness <= 0.0 || !passive.contains(n))
             .map(|(_, m)| m.robustness)
             .fold(f64::INFINITY, f64::min)

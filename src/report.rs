@@ -21,11 +21,7 @@ pub fn failures(records: &[RunRecord], out: &Path) -> Vec<FailureEntry> {
         .filter(|r| r.status == Status::Fail)
         .map(|r| FailureEntry {
             id: r.id,
-            robustness: r
-                .monitors
-                .iter()
-                .map(|(_, m)| m.robustness)
-                .fold(f64::INFINITY, f64::min),
+            robustness: r.robustness(),
             failed_monitors: r.failed_monitors(),
             params: r.params.clone(),
             replay: replay_command(out, r.id),

@@ -494,3 +494,69 @@ fn a_cars_position_is_its_centre() {
     let (r, _) = run_one(&src, 0);
     assert_eq!(r["monitors"]["centre"]["passed"], true, "{}", r["monitors"]);
 }
+
+/// A formula compares numbers: a vector named whole (an actor's `pos`, a vector `Signal`),
+/// a component of a number, or no output at all is an error at load with the formula's
+/// line, never a test failed at `-inf`.
+#[test]
+fn a_formula_over_a_vector_or_a_missing_component_is_refused_at_load() {
+    for (formula, message) in [
+        ("lead.pos > 3", "`lead.pos` is a vector"),
+        ("lead.vel > 3", "`lead.vel` is a vector"),
+        (
+            "lead.speed.x > 3",
+            "`lead.speed` is a number, with no component `x`",
+        ),
+        ("lead.pos.w > 3", "`lead.pos.w` is no output of `lead.pos`"),
+        ("lp > 0", "`lp` is a vector"),
+        ("lq.x > 0", "`lq` carries numbers, with no component `x`"),
+    ] {
+        let e = load_err(&format!(
+            "{ROAD}w.place(r, v, lead)\nSignal(\"lp\", lead.pos)\nSignal(\"lq\", lead.speed.map(lambda s: s))\nStl(\"G[0,10] ({formula})\")\n"
+        ));
+        assert!(
+            e.contains(message) && e.contains("t.star:9:1"),
+            "{formula}: {e}"
+        );
+    }
+}
+
+/// A monitor cut short by another's failure covers only the run up to it: it does not count
+/// in the test's robustness nor among its failed monitors (an `eventually` cut at 0.2 s would
+/// read `-inf`).
+#[test]
+fn monitors_cut_short_do_not_count_in_the_tests_verdict() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 1000.0)
+v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 12.0)
+w.place(r, v)
+test(horizon = 10.0, offroad = False)
+late = Stl("F[9,10] (ego_x_m > 0)", name = "late")
+now = Stl("ego_x_m > 11", name = "now")
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("t.star");
+    std::fs::write(&file, src).unwrap();
+    let out = dir.path().join("out");
+    let o = fuzz(&[
+        file.to_str().unwrap(),
+        "--budget",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 1);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("monitors failed: now\n"), "{stdout}");
+    let summary: Json =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let failure = &summary["failures"][0];
+    assert_eq!(failure["failed_monitors"], serde_json::json!(["now"]));
+    assert!(
+        (number(&failure["robustness"]) + 1.0).abs() < 1e-9,
+        "{failure}"
+    );
+    let r = &records(&out)[0];
+    assert_eq!(r["monitors"]["late"]["cut_short"], true);
+}

@@ -223,10 +223,13 @@ def _monitor_robustness(m: dict) -> float:
 
 def _robustness(monitors: dict, passive=()) -> float:
     """The smallest robustness over the monitors (<= 0: failed; +inf without monitors), the
-    `passive` ones counting only where they are <= 0 (paracosm's falsification cost)."""
-    values = [_monitor_robustness(m) for m in monitors.values()]
+    `passive` ones counting only where they are <= 0, and monitors cut short by another's
+    failure not at all (paracosm's falsification cost)."""
     values = [
-        v for v, name in zip(values, monitors) if name not in passive or v <= 0.0
+        _monitor_robustness(m)
+        for name, m in monitors.items()
+        if not m.get("cut_short", False)
+        and (name not in passive or _monitor_robustness(m) <= 0.0)
     ]
     return min(values, default=math.inf)
 

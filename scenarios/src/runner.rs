@@ -78,10 +78,12 @@ impl TestOutcome {
         self.monitors.iter().all(|(_, v)| v.passed)
     }
 
-    /// The smallest robustness over the monitors (`+inf` with none).
+    /// The smallest robustness over the monitors (`+inf` with none), but those cut short
+    /// ([`TestOutcome::cut_short`]).
     pub fn robustness(&self) -> f64 {
         self.monitors
             .iter()
+            .filter(|(n, _)| !self.cut_short.contains(n))
             .map(|(_, v)| v.robustness)
             .fold(f64::INFINITY, f64::min)
     }

@@ -670,6 +670,38 @@ fn judged_kinds(
             ));
         }
     }
+    // A formula reads numbers: a vector Signal named whole, or a component of a number, is
+    // known from the sample where a lambda computes the stream.
+    for (m, at) in b.monitors.iter().zip(&b.monitors_at) {
+        use paracosm_engine::rx::Value;
+        for s in m.signals() {
+            for (n, _) in b
+                .published
+                .iter()
+                .filter(|(n, _)| !n.starts_with("monitor:"))
+            {
+                let component = s
+                    .strip_prefix(n.as_str())
+                    .is_some_and(|c| [".x", ".y", ".z"].contains(&c));
+                let why = match (n == &s, component, sample_of(n)) {
+                    (true, _, Some(Value::Vec3(_))) => format!(
+                        "`{s}` carries vectors: a formula compares numbers, so write `{s}.x`, \
+                         `{s}.y` or `{s}.z`"
+                    ),
+                    (false, true, Some(Value::Num(_) | Value::Bool(_))) => format!(
+                        "`{n}` carries numbers, with no component `{}`: write `{n}`",
+                        &s[n.len() + 1..]
+                    ),
+                    _ => continue,
+                };
+                return Err(format!(
+                    "error: {} reads the signal: {why} (found when loading, from the sample \
+                     value its stream gives in the first test's world at t = 0)\n --> {at}",
+                    m.name()
+                ));
+            }
+        }
+    }
     for (name, at) in &b.signals_at {
         use paracosm_engine::rx::Value;
         if let Some(v @ (Value::Unit | Value::Tuple(_) | Value::Text(_))) = sample_of(name) {

@@ -567,18 +567,53 @@ fn published(
         }
     }
     let mut out = b.published.clone();
-    let known = |out: &[(String, StreamId)], s: &str| {
-        crate::runner::signal::ALL.contains(&s)
-            || out.iter().any(|(n, _)| {
-                n == s
-                    || s.strip_prefix(n.as_str())
-                        .is_some_and(|c| [".x", ".y", ".z"].contains(&c))
-            })
+    // Whether each published stream carries vectors: `Some(true)` it does, `Some(false)` it
+    // carries numbers or bools, `None` unknown until the test runs (a lambda's values; the
+    // check at load looks at its sample, `program::judged_kinds`).
+    let types = super::types::stream_types(b);
+    let mut vector: Vec<Option<bool>> = out
+        .iter()
+        .map(|(_, id)| match types.get(id.0) {
+            Some(super::types::SType::Vec3) => Some(true),
+            Some(super::types::SType::Any) | None => None,
+            Some(_) => Some(false),
+        })
+        .collect();
+    // Whether `s` names a published signal: a stream of numbers or bools by its name, a
+    // vector's component by `name.x`, `.y`, `.z`; a vector named whole, or a component of a
+    // number, is an error.
+    let known = |out: &[(String, StreamId)], vector: &[Option<bool>], s: &str| {
+        if crate::runner::signal::ALL.contains(&s) {
+            return Ok(true);
+        }
+        for ((n, _), v) in out.iter().zip(vector) {
+            let component = s
+                .strip_prefix(n.as_str())
+                .is_some_and(|c| [".x", ".y", ".z"].contains(&c));
+            match (n == s, component, v) {
+                (true, _, Some(true)) => {
+                    return Err(format!(
+                        "`{s}` is a vector: a formula compares numbers, so write `{s}.x`, \
+                         `{s}.y` or `{s}.z`"
+                    ))
+                }
+                (false, true, Some(false)) => {
+                    return Err(format!(
+                        "`{n}` is a number, with no component `{}`: write `{n}`",
+                        &s[n.len() + 1..]
+                    ))
+                }
+                (true, _, _) | (_, true, _) => return Ok(true),
+                _ => {}
+            }
+        }
+        Ok(false)
     };
     for (k, m) in b.monitors.iter().enumerate() {
         let at = b.monitors_at.get(k).map(String::as_str).unwrap_or("");
+        let located = |e: String| format!("{} reads the signal: {e}\n --> {at}", m.name());
         for s in m.signals() {
-            if known(&out, &s) {
+            if known(&out, &vector, &s).map_err(located)? {
                 continue;
             }
             let found = s.split_once('.').and_then(|(var, rest)| {
@@ -594,21 +629,14 @@ fn published(
             match found {
                 Some((name, actor, output)) => {
                     let id = graph.push(Node::Probe(probe(actor, output)));
-                    out.push((name, id));
-                    if !known(&out, &s) {
-                        return Err(format!(
-                            "{} reads the signal `{s}`: `{}` is a {}, so write `{}` or, for a \
-                             position or velocity, `{}.x`, `.y` or `.z`",
-                            m.name(),
-                            out.last().map_or("", |(n, _)| n.as_str()),
-                            if matches!(output, Output::Pos | Output::Vel) {
-                                "vector"
-                            } else {
-                                "number"
-                            },
-                            out.last().map_or("", |(n, _)| n.as_str()),
-                            out.last().map_or("", |(n, _)| n.as_str()),
-                        ));
+                    out.push((name.clone(), id));
+                    vector.push(Some(matches!(output, Output::Pos | Output::Vel)));
+                    if !known(&out, &vector, &s).map_err(located)? {
+                        return Err(located(format!(
+                            "`{s}` is no output of `{name}`; an actor's outputs are .pos.x, \
+                             .pos.y, .pos.z, .vel.x, .vel.y, .vel.z, .speed, .heading and \
+                             .collision"
+                        )));
                     }
                 }
                 None => {
