@@ -560,3 +560,26 @@ now = Stl("ego_x_m > 11", name = "now")
     let r = &records(&out)[0];
     assert_eq!(r["monitors"]["late"]["cut_short"], true);
 }
+
+/// Headings are in `(-π, π]` everywhere: a car driving west publishes `π`, as the location it
+/// starts at reports, and a monitor's name defaults to its variable for `Stl` as for `Monitor`.
+#[test]
+fn westbound_headings_agree_and_formulas_take_their_variables_name() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 1000.0)
+v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 12.0)
+start = r.onLane(-1, 900)
+opp = Car(loc = start, speed = 10.0)
+w.place(r, v, opp)
+test(horizon = 2.0, offroad = False)
+CollisionMonitor(v)
+westbound = Stl("G[0,2] (opp.heading > 3.14159)")
+Signal("start_heading", tick.map(lambda t: start.heading))
+same = Stl("G[0,2] (opp.heading - start_heading > -1e-12 & start_heading - opp.heading > -1e-12)")
+"#;
+    let (r, _) = run_one(src, 0);
+    let m = &r["monitors"];
+    assert_eq!(m["westbound"]["passed"], true, "{m}");
+    assert_eq!(m["same"]["passed"], true, "{m}");
+}

@@ -985,7 +985,7 @@ fn ego_state(physics: &PhysicsWorld, ego: &EgoVehicle) -> EgoState {
     let forward = *body.rotation() * Vector::X;
     EgoState {
         pos_m: [p.x, p.y, p.z].map(f64::from),
-        heading_rad: f64::from(-forward.z).atan2(f64::from(forward.x)),
+        heading_rad: half_open(f64::from(-forward.z).atan2(f64::from(forward.x))),
         speed_mps: f64::from(body.linvel().dot(forward)),
     }
 }
@@ -998,6 +998,16 @@ struct WorldInputs<'a> {
     ego_touching: bool,
     pedestrians: &'a Set<Pedestrian>,
     cars: &'a Set<Car>,
+}
+
+/// A heading from `atan2`, in `[-π, π]`, as one in `(-π, π]` (a location's and the ego's
+/// range): `-π` becomes `π`, every other value keeps its bits.
+fn half_open(heading_rad: f64) -> f64 {
+    if heading_rad <= -std::f64::consts::PI {
+        heading_rad + std::f64::consts::TAU
+    } else {
+        heading_rad
+    }
 }
 
 impl Inputs for WorldInputs<'_> {
@@ -1024,7 +1034,7 @@ impl Inputs for WorldInputs<'_> {
                     match output {
                         Output::Pos => Value::Vec3(p.pos()),
                         Output::Vel => Value::Vec3(v),
-                        Output::Heading => Value::Num((-v[2]).atan2(v[0])),
+                        Output::Heading => Value::Num(half_open((-v[2]).atan2(v[0]))),
                         Output::Speed => Value::Num(v[0].hypot(v[2])),
                         Output::Collision => Value::Bool(p.touching),
                     }
@@ -1041,7 +1051,7 @@ impl Inputs for WorldInputs<'_> {
                     match output {
                         Output::Pos => Value::Vec3(c.centre_m()),
                         Output::Vel => Value::Vec3([d[0] * s.speed_mps, 0.0, d[1] * s.speed_mps]),
-                        Output::Heading => Value::Num(s.heading_rad),
+                        Output::Heading => Value::Num(half_open(s.heading_rad)),
                         Output::Speed => Value::Num(s.speed_mps),
                         Output::Collision => Value::Bool(c.touching),
                     }

@@ -169,7 +169,11 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         monitor(
             eval,
             MonitorSpec::Stl {
-                name: name.unwrap_or("stl").to_owned(),
+                // As a Monitor: the variable it is assigned to, else `stl`.
+                name: name
+                    .map(str::to_owned)
+                    .or_else(|| variable_here(eval))
+                    .unwrap_or_else(|| "stl".to_owned()),
                 formula: formula.to_owned(),
             },
         )
