@@ -199,22 +199,51 @@ fn read_trace(path: &std::path::Path, dt_s: f64) -> Result<paracosm_oracles::stl
         .headers()
         .map_err(|e| bad(format!("{file}: {e}")))?
         .iter()
-        .map(str::to_owned)
+        .map(|n| n.trim().to_owned())
         .collect();
+    if names.iter().all(String::is_empty) {
+        return Err(bad(format!(
+            "{file}:1: the trace is empty: it needs a header of signal names and a row per sample"
+        )));
+    }
+    for (j, n) in names.iter().enumerate() {
+        if n.is_empty() {
+            return Err(bad(format!("{file}:1: column {}: no signal name", j + 1)));
+        }
+        if let Some(k) = names[..j].iter().position(|m| m == n) {
+            return Err(bad(format!(
+                "{file}:1: column {} (`{n}`): the signal is named twice (column {} too)",
+                j + 1,
+                k + 1
+            )));
+        }
+    }
     let mut columns = vec![Vec::new(); names.len()];
     for (row, record) in reader.records().enumerate() {
         let record = record.map_err(|e| bad(format!("{file}:{}: {e}", row + 2)))?;
         for (j, cell) in record.iter().enumerate() {
-            let v: f64 = cell.trim().parse().map_err(|_| {
-                bad(format!(
-                    "{file}:{}: column {} (`{}`): `{cell}` is not a number",
-                    row + 2,
-                    j + 1,
-                    names[j]
-                ))
-            })?;
+            // A sample is a finite number: NaN compares false with everything and would be
+            // skipped by min and max, infinity is no measurement.
+            let v: f64 = cell
+                .trim()
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite())
+                .ok_or_else(|| {
+                    bad(format!(
+                        "{file}:{}: column {} (`{}`): `{cell}` is not a finite number",
+                        row + 2,
+                        j + 1,
+                        names[j]
+                    ))
+                })?;
             columns[j].push(v);
         }
+    }
+    if columns.first().is_none_or(Vec::is_empty) {
+        return Err(bad(format!(
+            "{file}: the trace has no samples (a header and no rows)"
+        )));
     }
     Ok(paracosm_oracles::stl::Trace {
         dt_s,
@@ -289,6 +318,12 @@ fn run(cli: Cli) -> Result<()> {
                      needs a simulator: run it with paracosm-fuzz --strategy {strategy}"
                 )));
             }
+            if strategy == Strategy::Points {
+                return Err(bad(
+                    "points replays the rows of a CSV file: it is a paracosm-fuzz strategy \
+                     (--strategy points --points FILE); generate writes new designs",
+                ));
+            }
             let budget = match (budget, epsilon) {
                 (Some(b), _) => b,
                 (None, Some(eps)) => suite_budget(&space, strategy, strength, eps, seed)?,
@@ -362,7 +397,7 @@ fn run(cli: Cli) -> Result<()> {
                     nd.min(6)
                 )));
             }
-            let p = plan(&space, strength, epsilon, delta);
+            let p = plan(&space, strength, epsilon, delta).map_err(bad)?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&p)?);
             } else {
@@ -438,9 +473,9 @@ fn suite_budget(
     let rows = CoveringSuite::new(space, strength, kind, 1, seed)
         .map_err(bad)?
         .rows() as u64;
-    let per_row = plan(space, strength, epsilon, 0.01)
-        .halton_per_group
-        .unwrap_or(1);
+    let (per_row, _) =
+        paracosm::cover::suite_per_row(space, strength, kind, epsilon, seed, MAX_GENERATE)
+            .map_err(bad)?;
     Ok(rows.saturating_mul(per_row))
 }
 

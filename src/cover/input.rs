@@ -272,6 +272,7 @@ fn jsonl_rows(
                         Ok(Cell::Number(x.as_f64().unwrap_or(f64::NAN)))
                     }
                     serde_json::Value::String(t) => Ok(Cell::Text(t.clone())),
+                    serde_json::Value::Bool(b) => Ok(Cell::Text(b.to_string())),
                     _ => Err(err(
                         Some(ln),
                         Some((j + 1, p.name.clone())),
@@ -280,6 +281,21 @@ fn jsonl_rows(
                 })
                 .collect::<Result<_, _>>()?,
             None => {
+                // Discrete coordinates are level indices: without the space they cannot be
+                // named or counted, and dropping them would report the coverage of a smaller
+                // space than the one tested.
+                if v["point"]["discrete"]
+                    .as_array()
+                    .is_some_and(|d| !d.is_empty())
+                {
+                    return Err(err(
+                        Some(ln),
+                        None,
+                        "the tests have discrete parameters (`point.discrete`); give --space \
+                         with the scenario they were run on to read them by name"
+                            .into(),
+                    ));
+                }
                 let coords = v["point"]["continuous"]
                     .as_array()
                     .ok_or_else(|| err(Some(ln), None, "no `point.continuous` array".into()))?;
@@ -299,8 +315,17 @@ fn jsonl_rows(
                 }
                 coords
                     .iter()
-                    .map(|c| Cell::Number(c.as_f64().unwrap_or(f64::NAN)))
-                    .collect()
+                    .enumerate()
+                    .map(|(j, c)| {
+                        c.as_f64().map(Cell::Number).ok_or_else(|| {
+                            err(
+                                Some(ln),
+                                Some((j + 1, names[j].clone())),
+                                format!("`{c}` in `point.continuous` is not a number"),
+                            )
+                        })
+                    })
+                    .collect::<Result<_, _>>()?
             }
         };
         rows.push((ln, cells));
@@ -406,5 +431,38 @@ mod tests {
         }
         let t = parse_tests("r.jsonl", &line, true, Some(&space)).unwrap();
         assert_eq!(t.points[0].continuous, [0.25]);
+    }
+
+    /// A VarEnum of bools is written to `params` as JSON `true`/`false` by paracosm-fuzz and
+    /// read back as its level; text levels and numbers alike.
+    #[test]
+    fn reads_bool_text_and_number_levels_from_results() {
+        use paracosm_generators::{Param, ParamSpace, Value};
+        let space = ParamSpace::new(vec![
+            Param::levels("wet", vec![Value::Bool(false), Value::Bool(true)]),
+            Param::levels(
+                "kind",
+                vec![Value::Text("car".into()), Value::Text("van".into())],
+            ),
+            Param::levels("lanes", vec![Value::Int(2), Value::Int(4)]),
+        ])
+        .unwrap();
+        let lines = "{\"params\":{\"wet\":true,\"kind\":\"van\",\"lanes\":2}}\n\
+                     {\"params\":{\"wet\":false,\"kind\":\"car\",\"lanes\":4}}\n";
+        let t = parse_tests("r.jsonl", lines, true, Some(&space)).unwrap();
+        assert_eq!(t.points[0].discrete, [1, 1, 0]);
+        assert_eq!(t.points[1].discrete, [0, 0, 1]);
+        let e = parse_tests(
+            "r.jsonl",
+            "{\"params\":{\"wet\":1,\"kind\":\"car\",\"lanes\":4}}\n",
+            true,
+            Some(&space),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("`1` is not one of the levels false, true"),
+            "{e}"
+        );
     }
 }

@@ -38,7 +38,10 @@ pub struct Plan {
 /// the discrete part (Proposition 3.2 and its union-bound form for mixed levels), and for each
 /// of its rows a Halton set whose dispersion is at most `ε`, sized from the measured constant
 /// `C = max_n n · dispersion(E_n)` (Proposition 3.3: dispersion is `O(1/n)`).
-pub fn plan(space: &ParamSpace, strength: usize, epsilon: f64, delta: f64) -> Plan {
+///
+/// # Errors
+/// A message when the plan would count [`MAX_PLANNED`] tests or more (a tiny `ε`).
+pub fn plan(space: &ParamSpace, strength: usize, epsilon: f64, delta: f64) -> Result<Plan, String> {
     let levels = space.level_counts();
     let nd = levels.len();
     let k = strength.min(nd);
@@ -84,10 +87,27 @@ pub fn plan(space: &ParamSpace, strength: usize, epsilon: f64, delta: f64) -> Pl
             })
             .fold(0.0, f64::max);
         constant = Some(c);
-        per_group = Some((c / epsilon).ceil().max(1.0) as u64);
+        let n = (c / epsilon).ceil().max(1.0);
+        if n >= MAX_PLANNED as f64 {
+            return Err(format!(
+                "ε = {epsilon:e} needs about {n:.3e} Halton points per discrete group, more than \
+                 the {MAX_PLANNED} a plan counts; give a larger --epsilon"
+            ));
+        }
+        per_group = Some(n as u64);
     }
     let rows = exact.unwrap_or(1);
-    Plan {
+    let total = rows
+        .checked_mul(per_group.unwrap_or(1))
+        .filter(|&t| t < MAX_PLANNED)
+        .ok_or_else(|| {
+            format!(
+                "the plan needs {rows} rows × {} points, more than the {MAX_PLANNED} tests a \
+                 plan counts; give a larger --epsilon or --delta",
+                per_group.unwrap_or(1)
+            )
+        })?;
+    Ok(Plan {
         strength: k,
         epsilon,
         delta,
@@ -96,7 +116,66 @@ pub fn plan(space: &ParamSpace, strength: usize, epsilon: f64, delta: f64) -> Pl
         random_kwise_exact_union: exact,
         halton_constant: constant,
         halton_per_group: per_group,
-        total: rows * per_group.unwrap_or(1),
+        total,
+    })
+}
+
+/// The most tests a plan counts, 2^53 (every count below it is exact as a float, and no
+/// campaign comes near it).
+pub const MAX_PLANNED: u64 = 1 << 53;
+
+/// Halton points per row of a covering suite of strength `strength` over `space` such that
+/// every row's block of points has dispersion at most `epsilon` (its upper bound where the
+/// dispersion is bracketed): from [`plan`]'s `ceil(C / ε)`, measured on each row's own block
+/// and raised in proportion until every block meets `ε` (the rows take consecutive blocks of
+/// the Halton sequence, and a later block's `n · dispersion` can exceed the constant measured
+/// at the sequence's start). Returns the points per row and the largest block dispersion.
+///
+/// # Errors
+/// A message when the plan overflows, the covering array cannot be built (a strength out of
+/// range), or the suite would need more than `max_points` points.
+pub fn suite_per_row(
+    space: &ParamSpace,
+    strength: usize,
+    kind: paracosm_generators::covering::ArrayKind,
+    epsilon: f64,
+    seed: u64,
+    max_points: u64,
+) -> Result<(u64, f64), String> {
+    use paracosm_generators::covering::CoveringSuite;
+    let nc = space.continuous_dims();
+    let mut per_row = plan(space, strength, epsilon, 0.01)?
+        .halton_per_group
+        .unwrap_or(1);
+    if nc == 0 {
+        return Ok((1, 0.0));
+    }
+    loop {
+        let suite =
+            CoveringSuite::new(space, strength, kind, per_row, seed).map_err(|e| e.to_string())?;
+        let rows = suite.rows() as u64;
+        if rows.saturating_mul(per_row) > max_points {
+            return Err(format!(
+                "a suite with every row's dispersion at most ε = {epsilon:e} needs {rows} rows \
+                 × {per_row} points or more, past the {max_points} this command writes; give a \
+                 larger --epsilon"
+            ));
+        }
+        let mut worst: f64 = 0.0;
+        for r in 0..rows {
+            let block: Vec<f64> = (0..per_row)
+                .flat_map(|i| suite.point(r + rows * i).continuous)
+                .collect();
+            let d =
+                dispersion(&block, nc, &DispersionOptions::default()).map_err(|e| e.to_string())?;
+            worst = worst.max(d.upper);
+        }
+        if worst <= epsilon {
+            return Ok((per_row, worst));
+        }
+        // n · dispersion is about constant: scale by the shortfall, 5 % more.
+        let next = (per_row as f64 * worst / epsilon * 1.05).ceil() as u64;
+        per_row = next.max(per_row + 1);
     }
 }
 

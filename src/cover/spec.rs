@@ -137,6 +137,18 @@ pub fn parse_space(file: &str, text: &str) -> Result<ParamSpace, SpecError> {
                 )))
             }
         };
+        // The same level twice would be one value counted as two: k-wise coverage would ask
+        // for tuples nobody can tell apart. Levels are compared as written (1 and 1.0 alike).
+        if let Domain::Levels(levels) = &domain {
+            for (j, l) in levels.iter().enumerate() {
+                if levels[..j].iter().any(|m| m.to_string() == l.to_string()) {
+                    return Err(invalid(format!(
+                        "parameter `{}`: the level {l} is listed twice",
+                        p.name
+                    )));
+                }
+            }
+        }
         params.push(Param {
             name: p.name,
             domain,
