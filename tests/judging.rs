@@ -389,8 +389,10 @@ v = AutonomousVehicle(loc = r.onLane(1, VarInterval(10, 20, unit = "s")))
 c = Car(loc = r.onLane(lane = -1, at = VarInterval(50, 60, unit = "km")), lane_change = ChangeLane(to = -2, at = VarInterval(1, 2, unit = "m"), duration = VarInterval(1, 2, unit = "km")))
 o = Obstacle(loc = r.onLane(-2, 200), size = (VarInterval(1, 2, unit = "s"), 1, 1))
 d = VarInterval(2, 3, unit = "m/s")
+sz = VarInterval(1, 2, unit = "km/h")
+o2 = Obstacle(loc = r.onLane(-2, 250), size = (1, 1, sz))
 tick.filter(lambda t: t > 100).take(1).foreach(c.brake(d))
-w.place(r, v, c, o)
+w.place(r, v, c, o, o2)
 CollisionMonitor(v)
 "#;
     let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
@@ -402,6 +404,7 @@ CollisionMonitor(v)
         "`ChangeLane.duration` is declared in km but feeds ChangeLane(duration=), which is in s",
         "`o.size[0]` is declared in s but feeds Obstacle(size[0]=), which is in m",
         "`d` is declared in m/s but feeds brake(decel=), which is in m/s²",
+        "`sz` is declared in km/h but feeds Obstacle(size[2]=), which is in m",
     ] {
         assert!(w.contains(&expected), "{expected}\n{w:#?}");
     }
@@ -582,4 +585,88 @@ same = Stl("G[0,2] (opp.heading - start_heading > -1e-12 & start_heading - opp.h
     let m = &r["monitors"];
     assert_eq!(m["westbound"]["passed"], true, "{m}");
     assert_eq!(m["same"]["passed"], true, "{m}");
+}
+
+/// A monitor decided between two of an `Stl` formula's checks is not cut short by a monitor
+/// that fails after it: the rear-ending car breaks the gap at 0.5 s, and the collision comes
+/// at about 0.57 s, before the formula's next check (0.75 s).
+#[test]
+fn a_formula_violated_before_a_collision_fails_and_is_not_cut_short() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 400.0, nlanes = 2)
+v = AutonomousVehicle(loc = r.onLane(1, 20), speed = 5.0)
+c = Car(loc = r.onLane(1, 5), speed = 25.0)
+w.place(r, v, c)
+CollisionMonitor(v)
+keep_gap = Stl("G[0,5] (ego_separation_m > 1)")
+test(horizon = 5.0)
+"#;
+    let (r, _) = run_one(src, 1);
+    let m = &r["monitors"];
+    let gap = &m["keep_gap"];
+    assert_eq!(gap["passed"], false, "{m}");
+    assert!(gap.get("cut_short").is_none(), "{m}");
+    let (t_gap, t_hit) = (
+        number(&gap["first_violation_s"]),
+        number(&m["collision"]["first_violation_s"]),
+    );
+    assert!(t_gap < t_hit, "{m}");
+    assert_eq!(number(&r["metrics"]["time_to_failure_s"]), t_gap);
+    // Alone, the formula gives the same verdict and failure time.
+    let (alone, _) = run_one(&src.replace("CollisionMonitor(v)\n", ""), 1);
+    let a = &alone["monitors"]["keep_gap"];
+    assert_eq!(
+        (a["passed"].clone(), number(&a["first_violation_s"])),
+        (Json::Bool(false), t_gap)
+    );
+}
+
+/// A monitor over a stream that never fires fails when the test ends, for every `over`: its
+/// failure time is the last step, so `TimeToFailure` reads the same time for each.
+#[test]
+fn a_stream_that_never_fires_fails_at_the_end_whatever_its_over() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 400.0, nlanes = 2)
+v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 5.0)
+w.place(r, v)
+late = tick.filter(lambda t: t > 100.0).map(lambda t: 1.0)
+m_end = Monitor(late, over = "end")
+m_alw = Monitor(late, over = "always")
+m_evt = Monitor(late, over = "eventually")
+TimeToFailure(m_end, minT = 1.0, name = "ttf_end")
+TimeToFailure(m_alw, minT = 1.0, name = "ttf_alw")
+TimeToFailure(m_evt, minT = 3.0, name = "ttf_evt")
+test(horizon = 2.0)
+"#;
+    let (r, _) = run_one(src, 1);
+    let m = &r["monitors"];
+    for (name, passed) in [("ttf_end", true), ("ttf_alw", true), ("ttf_evt", false)] {
+        assert_eq!(m[name]["passed"], passed, "{name}: {m}");
+        let t = number(&m[name]["first_violation_s"]);
+        assert!((t - 2.0).abs() < 1e-9, "{name}: {m}");
+    }
+    assert!((number(&r["metrics"]["time_to_failure_s"]) - 2.0).abs() < 1e-9);
+}
+
+/// An obstacle's colour is seen by a camera only: under `aeb` (lidar) an open one is named
+/// in a warning, as a car's colour is.
+#[test]
+fn an_open_obstacle_colour_under_a_lidar_system_warns() {
+    let src = r#"
+w = World()
+r = RoadSegment(len = 400.0, nlanes = 2)
+v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 5.0)
+box_color = VarEnum(["orange", "grey"])
+o = Obstacle(loc = r.onLane(1, 200), size = (1.0, 1.0, 1.0), color = box_color)
+w.place(r, v, o)
+CollisionMonitor(v)
+test(horizon = 1.0)
+"#;
+    let (_, stderr) = run_one(src, 0);
+    assert!(
+        stderr.contains("`box_color` sets the colour of Obstacle"),
+        "{stderr}"
+    );
 }

@@ -42,4 +42,14 @@ pub trait Monitor: Send {
 
     /// The verdict over the frames seen so far.
     fn verdict(&self) -> Verdict;
+
+    /// Called when the run stops early (another monitor settled as failed) while this one has
+    /// not settled: settles it if the frames already seen decide its verdict, and says whether
+    /// they do. A monitor that checks its verdict only every few frames (an `Stl` formula,
+    /// every 0.25 s) may have been decided by a frame since its last check; such a monitor
+    /// failed and was not cut short. The default, for monitors that settle on the frame that
+    /// decides them: `false`.
+    fn settle_now(&mut self) -> bool {
+        false
+    }
 }

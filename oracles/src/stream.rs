@@ -43,6 +43,11 @@ impl Over {
 /// test in which it never has one fails with robustness `-inf`, as does a value that is not
 /// a number (NaN): nothing a monitor was asked to judge is skipped silently. `End` and
 /// `Eventually` settle only at the end of the test; `Always` settles at its first violation.
+///
+/// `first_violation_s`, the time a failed verdict was decided (what `TimeToFailure` and the
+/// `time_to_failure_s` metric read), s: for `Always`, the frame of the first value `<= 0`;
+/// otherwise, and for an `Always` whose signal never had a value, the last frame observed,
+/// with or without a value: the end of the test (or the moment it stopped).
 /// With `boolean`, the value is a truth value (`> 0.5` true) and the robustness is `+1` or
 /// `-1` (`Assert`).
 #[derive(Debug, Clone)]
@@ -52,7 +57,8 @@ pub struct StreamMonitor {
     over: Over,
     boolean: bool,
     value: Option<f64>,
-    last_t_s: f64,
+    /// Time of the last frame observed, with or without a value, s.
+    last_frame_s: f64,
     first_violation_s: Option<f64>,
 }
 
@@ -65,7 +71,7 @@ impl StreamMonitor {
             over,
             boolean: false,
             value: None,
-            last_t_s: 0.0,
+            last_frame_s: 0.0,
             first_violation_s: None,
         }
     }
@@ -85,10 +91,10 @@ impl Monitor for StreamMonitor {
     }
 
     fn observe(&mut self, frame: &Frame<'_>) -> ControlFlow<()> {
+        self.last_frame_s = frame.t_s;
         let Ok(raw) = frame.signals.get(&self.signal) else {
             return ControlFlow::Continue(());
         };
-        self.last_t_s = frame.t_s;
         let v = if raw.is_nan() {
             f64::NEG_INFINITY
         } else if self.boolean {
@@ -118,9 +124,10 @@ impl Monitor for StreamMonitor {
         Verdict {
             passed,
             robustness,
-            first_violation_s: match self.over {
-                Over::Always => self.first_violation_s,
-                _ => (!passed).then_some(self.last_t_s),
+            first_violation_s: match (self.over, self.first_violation_s) {
+                (Over::Always, Some(t)) => Some(t),
+                // Decided at the end: the last frame, whether or not it carried a value.
+                _ => (!passed).then_some(self.last_frame_s),
             },
             metrics: vec![],
         }
@@ -188,6 +195,20 @@ mod tests {
         let v = run(&mut m, &[None, None]);
         assert!(!v.passed);
         assert_eq!(v.robustness, f64::NEG_INFINITY);
+        // Decided when the test ended (the last frame, t = 1), not at t = 0, for every `over`.
+        for over in [Over::End, Over::Eventually, Over::Always] {
+            let mut m = StreamMonitor::new("m", "x", over);
+            let v = run(&mut m, &[None, None]);
+            assert_eq!(
+                (v.passed, v.first_violation_s),
+                (false, Some(1.0)),
+                "{over:?}"
+            );
+        }
+        // `end` is decided at the end even when its last value came earlier.
+        let mut m = StreamMonitor::new("m", "x", Over::End);
+        let v = run(&mut m, &[Some(-1.0), None, None]);
+        assert_eq!(v.first_violation_s, Some(2.0));
         let mut m = StreamMonitor::new("m", "x", Over::Eventually);
         let v = run(&mut m, &[Some(f64::NAN)]);
         assert!(!v.passed);

@@ -40,6 +40,10 @@ impl Monitor for TimeToFailureMonitor {
         self.inner.observe(frame)
     }
 
+    fn settle_now(&mut self) -> bool {
+        self.inner.settle_now()
+    }
+
     fn verdict(&self) -> Verdict {
         let inner = self.inner.verdict();
         // Only a failed verdict has a time to failure: a wrapped `TimeToFailure` that passed

@@ -396,6 +396,15 @@ impl Scenario {
             stopped = watch.observe(&sim, options.on_step.as_mut())?;
         }
 
+        if tick < ticks {
+            // Stopped early: a monitor that checks only every few frames may already be
+            // decided by the frames it saw (an `Stl` violation since its last check).
+            for (m, settled) in watch.monitors.iter_mut().zip(&mut watch.settled) {
+                if !*settled && m.settle_now() {
+                    *settled = true;
+                }
+            }
+        }
         let cut_short: Vec<String> = if tick < ticks {
             watch
                 .monitors

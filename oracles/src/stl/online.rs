@@ -98,6 +98,29 @@ impl StlMonitor {
     }
 }
 
+impl StlMonitor {
+    /// Bounds the robustness over every continuation of the samples so far and settles the
+    /// verdict as failed when that bound is `<= 0`; whether it settled.
+    fn check(&mut self) -> bool {
+        let hi = match eval_bounds(&self.formula, &self.trace) {
+            Ok((_, hi)) => hi,
+            Err(_) => return false,
+        };
+        if hi <= 0.0 {
+            self.settled = Some(Verdict {
+                passed: false,
+                robustness: hi,
+                first_violation_s: Some(self.first_violation_s(self.times.len())),
+                metrics: vec![],
+            });
+            true
+        } else {
+            self.undecided = self.times.len();
+            false
+        }
+    }
+}
+
 impl Monitor for StlMonitor {
     fn name(&self) -> &str {
         &self.name
@@ -130,22 +153,15 @@ impl Monitor for StlMonitor {
         if !self.times.len().is_multiple_of(CHECK_EVERY) || self.times.len() < 2 {
             return ControlFlow::Continue(());
         }
-        let hi = match eval_bounds(&self.formula, &self.trace) {
-            Ok((_, hi)) => hi,
-            Err(_) => return ControlFlow::Continue(()),
-        };
-        if hi <= 0.0 {
-            self.settled = Some(Verdict {
-                passed: false,
-                robustness: hi,
-                first_violation_s: Some(self.first_violation_s(self.times.len())),
-                metrics: vec![],
-            });
+        if self.check() {
             ControlFlow::Break(())
         } else {
-            self.undecided = self.times.len();
             ControlFlow::Continue(())
         }
+    }
+
+    fn settle_now(&mut self) -> bool {
+        self.settled.is_some() || self.missing.is_some() || (self.times.len() >= 2 && self.check())
     }
 
     fn verdict(&self) -> Verdict {
@@ -226,6 +242,29 @@ mod tests {
         // Decided only by the end of the trace (the window reaches past it): its last sample.
         let (v, _) = run("F[0,10] (x > 1000)", |i| i as f64, 100);
         assert_eq!((v.passed, v.first_violation_s), (false, Some(99.0 / 60.0)));
+    }
+
+    #[test]
+    fn a_stop_between_checks_settles_a_formula_the_frames_already_violate() {
+        // 40 samples end before the check at sample 45: x reached 30 at sample 30.
+        let mut m = StlMonitor::new("stl", super::super::parse("G[0,10] (x < 30)").unwrap());
+        let mut n = StlMonitor::new("ok", super::super::parse("G[0,10] (x < 300)").unwrap());
+        for i in 0..40 {
+            let mut s = Signals::new();
+            s.set("x", i as f64);
+            let f = Frame {
+                t_s: i as f64 / 60.0,
+                signals: &s,
+            };
+            assert!(m.observe(&f).is_continue() && n.observe(&f).is_continue());
+        }
+        assert!(m.settle_now());
+        let v = m.verdict();
+        assert_eq!((v.passed, v.first_violation_s), (false, Some(0.5)));
+        assert!(v.robustness <= 0.0);
+        // Not yet violated: not settled, still passing so far.
+        assert!(!n.settle_now());
+        assert!(n.verdict().passed);
     }
 
     #[test]

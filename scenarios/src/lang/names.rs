@@ -267,6 +267,17 @@ impl Walker<'_> {
                     {
                         let owner = target.map(str::to_owned).or_else(|| name.clone());
                         for (i, x) in items.iter().enumerate() {
+                            // A variable as an item (`size = (sz, 1, 1)`): passed whole to
+                            // that item's input, for its unit.
+                            if let (ExprP::Identifier(id), true, Some(b)) =
+                                (&x.node, builtin, &name)
+                            {
+                                self.out.passed.push((
+                                    b.clone(),
+                                    format!("{}[{i}]", kw.node),
+                                    id.node.ident.clone(),
+                                ));
+                            }
                             if is_declarer(x) {
                                 let n = owner.as_ref().map(|o| format!("{o}.{}[{i}]", kw.node));
                                 let argument_of = name

@@ -800,8 +800,44 @@ pub fn load(
             }
         }
     }
+    // An explicit name that another parameter takes from where it stands (`b = VarInterval(
+    // ..., name = "a")` beside `a = VarInterval(...)`) would file one under the other's name.
+    for (i, a) in explicit.iter().enumerate() {
+        let Some(a) = a else { continue };
+        if let Some(j) = (0..explicit.len())
+            .find(|&j| j != i && explicit[j].is_none() && derived[j].as_deref() == Some(a))
+        {
+            return Err(lang(format!(
+                "error: name = \"{a}\" (declared at {}) is the name the open parameter declared \
+                 at {} takes from where it stands; give one another name=\n --> {}",
+                first.params[i].at, first.params[j].at, first.params[i].at
+            )));
+        }
+    }
     let names = final_names(&explicit, &derived);
     program.params = names.iter().cloned().zip(first.params.clone()).collect();
+    // Every coordinate of the space has its own name: an explicit `name = "f[0]"` or
+    // `"a_1"` must not meet a coordinate of a parameter that varies over time or a suffix.
+    let mut coordinates: std::collections::HashMap<String, usize> = Default::default();
+    for (k, (name, p)) in program.params.iter().enumerate() {
+        for c in coordinate_names(name, p.over_time) {
+            if let Some(&j) = coordinates.get(&c) {
+                let (a, b) = (&program.params[j], &program.params[k]);
+                // Point at the parameter whose name was written out, if one was.
+                let at = if explicit[j].is_some() && explicit[k].is_none() {
+                    &a.1.at
+                } else {
+                    &b.1.at
+                };
+                return Err(lang(format!(
+                    "error: two open parameters give a coordinate the name `{c}`: `{}` (declared \
+                     at {}) and `{}` (declared at {}); give one another name=\n --> {at}",
+                    a.0, a.1.at, b.0, b.1.at
+                )));
+            }
+            coordinates.insert(c, k);
+        }
+    }
     program.monitors = first.monitors.clone();
     program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
     program.sut = first

@@ -269,6 +269,8 @@ pub struct SceneBuilder {
     pub warnings: Vec<Warning>,
     /// The cars' names for messages, in the order of [`SceneBuilder::cars`].
     pub car_names: Vec<String>,
+    /// The obstacles' names for messages, in the order of [`SceneBuilder::obstacles`].
+    pub obstacle_names: Vec<String>,
     /// Number of lambdas stored so far.
     pub lambdas: u32,
     /// Streams published by name to monitors (`Monitor`, `Assert`, `Signal`).
@@ -345,6 +347,7 @@ impl SceneBuilder {
             test_at: None,
             warnings: Vec::new(),
             car_names: Vec::new(),
+            obstacle_names: Vec::new(),
             lambdas: 0,
             published: Vec::new(),
             signals_at: Vec::new(),
@@ -873,6 +876,7 @@ impl SceneBuilder {
                         size,
                         color,
                     });
+                    self.obstacle_names.push(o.name.clone());
                 }
             }
         }

@@ -605,4 +605,46 @@ fn whole_program_errors_point_at_a_line() {
         m.contains("two open parameters are named `x`") && m.contains("--> bad.star:5:5\n"),
         "{m}"
     );
+    // An explicit name another parameter takes from its variable, in either order.
+    for (first, second, at) in [
+        (
+            "a = VarInterval(1, 2)",
+            "b = VarInterval(5, 6, name = \"a\")",
+            "bad.star:5:5",
+        ),
+        (
+            "b = VarInterval(5, 6, name = \"a\")",
+            "a = VarInterval(1, 2)",
+            "bad.star:4:5",
+        ),
+    ] {
+        let m = err(&format!("{HEADER}{first}\n{second}\nw.place(r, v)\n"));
+        assert!(
+            m.contains("name = \"a\"") && m.contains("takes from where it stands"),
+            "{m}"
+        );
+        assert!(m.contains(&format!("--> {at}\n")), "{m}");
+    }
+    // An explicit name equal to a coordinate of a parameter varying over time, or to a suffix.
+    for (decl, coordinate) in [
+        (
+            "f = VarInterval(0.1, 0.9, over_time = Piecewise(2))\ng = VarInterval(0.1, 0.9, name = \"f[0]\")",
+            "f[0]",
+        ),
+        (
+            "f = VarInterval(0.1, 0.9, over_time = Polynomial(1))\ng = VarInterval(0.1, 0.9, name = \"f.c1\")",
+            "f.c1",
+        ),
+        (
+            "for i in range(2):\n    x = VarInterval(0, 1)\ng = VarInterval(0.1, 0.9, name = \"x_1\")",
+            "x_1",
+        ),
+    ] {
+        let m = err(&format!("{HEADER}{decl}\nw.place(r, v)\n"));
+        assert!(
+            m.contains(&format!("give a coordinate the name `{coordinate}`")),
+            "{m}"
+        );
+        assert!(m.contains(" --> bad.star:"), "{m}");
+    }
 }

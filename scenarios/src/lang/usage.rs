@@ -20,6 +20,8 @@ pub enum Change {
     Light,
     /// The colour of car `i`.
     Colour(usize),
+    /// The colour of obstacle `i`.
+    ObstacleColour(usize),
     /// The friction of a road piece.
     Friction(PieceId),
     /// Anything else: geometry, an actor, a speed, the fog, a stream's value...
@@ -75,7 +77,18 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec) -> Vec<Change> {
     }
     other(differ(&a.ego, &b.ego), &mut out);
     other(differ(&a.pedestrians, &b.pedestrians), &mut out);
-    other(differ(&a.obstacles, &b.obstacles), &mut out);
+    if a.obstacles.len() != b.obstacles.len() {
+        out.push(Change::Other);
+    } else {
+        for (i, (x, y)) in a.obstacles.iter().zip(&b.obstacles).enumerate() {
+            if x.color != y.color {
+                out.push(Change::ObstacleColour(i));
+            }
+            let mut y2 = y.clone();
+            y2.color = x.color.clone();
+            other(differ(x, &y2), &mut out);
+        }
+    }
     other(
         differ(&a.environment, &b.environment) || a.dt_s != b.dt_s,
         &mut out,
@@ -204,7 +217,8 @@ pub fn analyse(i: Inputs<'_>) -> Usage {
         }
         let undriven = |c: &Change| matches!(c, Change::Friction(p) if !driven.contains(p));
         let visual = |c: &Change| {
-            matches!(c, Change::Colour(_)) || (*c == Change::Light && !i.stl_reads_light)
+            matches!(c, Change::Colour(_) | Change::ObstacleColour(_))
+                || (*c == Change::Light && !i.stl_reads_light)
         };
         if changes.iter().all(undriven) {
             let pieces: BTreeSet<String> = changes
@@ -233,6 +247,13 @@ pub fn analyse(i: Inputs<'_>) -> Usage {
                     Change::Colour(car) => format!(
                         "the colour of {}",
                         i.world.car_names.get(*car).map_or("a car", String::as_str)
+                    ),
+                    Change::ObstacleColour(k) => format!(
+                        "the colour of {}",
+                        i.world
+                            .obstacle_names
+                            .get(*k)
+                            .map_or("an obstacle", String::as_str)
                     ),
                     _ => continue,
                 };
