@@ -23,8 +23,8 @@ use starlark::values::{starlark_value, Heap, StarlarkValue};
 fn lambda<'v>(f: Value<'v>, what: &str, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Func> {
     if f.get_type() != "function" {
         bail!(
-            "{what} needs a function (a lambda or a def), got a {}",
-            f.get_type()
+            "{what} needs a function (a lambda or a def), got {}",
+            crate::lang::a_type(f.get_type())
         );
     }
     let st = state(eval)?;
@@ -246,8 +246,8 @@ pub(crate) fn stream_methods(builder: &mut MethodsBuilder) {
         if action.get_type() != "function" {
             bail!(
                 "foreach needs an action (`p.walk`, `car.brake(6)`, `car.setSpeed`, \
-                 `car.changeLane(2)`) or a function that performs actions, got a {}",
-                action.get_type()
+                 `car.changeLane(2)`) or a function that performs actions, got {}",
+                crate::lang::a_type(action.get_type())
             );
         }
         let f = lambda(action, "foreach", eval)?;
@@ -334,8 +334,8 @@ fn lane_of(v: Value) -> anyhow::Result<Lane> {
         Ok(x) => bail!("a lane is a whole number, got {x}"),
         Err(e) if v.downcast_ref::<Stream>().is_some() => Err(e),
         Err(_) => bail!(
-            "a lane is a lane number or r.SideWalk / -r.SideWalk, got a {}",
-            v.get_type()
+            "a lane is a lane number or r.SideWalk / -r.SideWalk, got {}",
+            crate::lang::a_type(v.get_type())
         ),
     }
 }
@@ -467,8 +467,8 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
                     crate::lang::values::PORTS[p.index]
                 ),
                 None => bail!(
-                    "a junction's onLane takes one of its ports first (such as j.ONE), got a {}",
-                    first.get_type()
+                    "a junction's onLane takes one of its ports first (such as j.ONE), got {}",
+                    crate::lang::a_type(first.get_type())
                 ),
             };
             let turn = super::globals::text_value(second, &b)
@@ -587,8 +587,8 @@ pub(crate) fn world_methods(builder: &mut MethodsBuilder) {
                 actors.push(x.object);
             } else if o.downcast_ref::<Road>().is_none() {
                 bail!(
-                    "place takes roads, actors and obstacles, got a {}",
-                    o.get_type()
+                    "place takes roads, actors and obstacles, got {}",
+                    crate::lang::a_type(o.get_type())
                 );
             }
         }

@@ -114,6 +114,16 @@ const KEYWORDS: &[(&str, &[&str])] = &[
     ("test", &["horizon", "map", "offroad"]),
 ];
 
+/// A Starlark type name with its article, for messages: `an int`, `a list`, `an Arc`, and
+/// `None` for `NoneType`.
+pub(crate) fn a_type(type_name: &str) -> String {
+    match type_name {
+        "NoneType" => "None".to_owned(),
+        t if t.starts_with(['a', 'e', 'i', 'o', 'u', 'A', 'E', 'I', 'O', 'U']) => format!("an {t}"),
+        t => format!("a {t}"),
+    }
+}
+
 /// Adds "did you mean `x`?" to starlark's "Found `y` extra named parameter(s) for call to F".
 pub(crate) fn suggest_keyword(message: &str) -> String {
     let Some(rest) = message.split("Found `").nth(1) else {
@@ -271,12 +281,42 @@ fn load_with_base(
             "error: brackets nest deeper than {MAX_NESTING} levels\n --> {file}:{line}:{column}"
         ))
     })?;
-    let ast =
-        AstModule::parse(file, source.to_owned(), &dialect).map_err(|e| lang(format!("{e}")))?;
+    let ast = AstModule::parse(file, source.to_owned(), &dialect)
+        .map_err(|e| lang(with_set_hint(format!("{e}"), file, source)))?;
     program::load(file, source, name, ast, globals(), base).map_err(|e| match e {
         ScenarioError::Language(m) => ScenarioError::Language(with_source_lines(&m, file, source)),
         other => other,
     })
+}
+
+/// Adds a note to a syntax error on a line that writes `VarEnum({...})`, the paper's set
+/// notation (§2: `VarEnum({2,4,6})`): in Starlark `{...}` is a dict, so the parser stops at
+/// its first `,` expecting `:`, and the note says to write a list.
+fn with_set_hint(message: String, file: &str, source: &str) -> String {
+    let at = format!("{file}:");
+    let line = message
+        .lines()
+        .filter_map(|l| l.trim_start().strip_prefix("--> "))
+        .filter_map(|l| l.strip_prefix(at.as_str()))
+        .filter_map(|l| l.split(':').next()?.parse::<usize>().ok())
+        .next();
+    let writes_set = line
+        .and_then(|n| source.lines().nth(n.checked_sub(1)?))
+        .is_some_and(|l| {
+            l.split("VarEnum").skip(1).any(|rest| {
+                rest.trim_start()
+                    .strip_prefix('(')
+                    .is_some_and(|r| r.trim_start().starts_with('{'))
+            })
+        });
+    if writes_set {
+        format!(
+            "{message}\nnote: `{{...}}` is a dict in Starlark, not a set: write the paper's \
+             `VarEnum({{2, 4, 6}})` as `VarEnum([2, 4, 6])`"
+        )
+    } else {
+        message
+    }
 }
 
 /// Adds the source line and a caret under each ` --> FILE:LINE:COL` of `message` that names

@@ -271,8 +271,8 @@ pub fn abs_of<'v>(x: Value<'v>, heap: Heap<'v>) -> anyhow::Result<Value<'v>> {
         );
     }
     anyhow::bail!(
-        "abs takes a number or a Vector, got a {}{}",
-        x.get_type(),
+        "abs takes a number or a Vector, got {}{}",
+        crate::lang::a_type(x.get_type()),
         super::values::stream_hint(x)
     )
 }
@@ -286,8 +286,8 @@ pub fn dist_of(a: Value, b: Value) -> anyhow::Result<f64> {
     let point = |v: Value| {
         as_point(v).ok_or_else(|| {
             anyhow::anyhow!(
-                "dist takes two positions (locations or vectors), got a {}{}",
-                v.get_type(),
+                "dist takes two positions (locations or vectors), got {}{}",
+                crate::lang::a_type(v.get_type()),
                 super::values::stream_hint(v)
             )
         })

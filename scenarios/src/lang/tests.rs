@@ -648,3 +648,32 @@ fn whole_program_errors_point_at_a_line() {
         assert!(m.contains(" --> bad.star:"), "{m}");
     }
 }
+
+/// Messages that name a value's type read as English (`an int`, `None`), a `ChangeLane` given
+/// both starts says so, and the paper's `VarEnum({2, 4, 6})` gets a note that `{...}` is a
+/// dict in Starlark.
+#[test]
+fn type_names_take_their_article_and_common_slips_get_a_hint() {
+    let m = err(&format!("{HEADER}w.place(r, v)\nTimeToFailure(5)\n"));
+    assert!(
+        m.contains("TimeToFailure wraps a monitor, got an int"),
+        "{m}"
+    );
+    let m = err(&format!("{HEADER}w.place(r, v)\nTimeToFailure(None)\n"));
+    assert!(m.contains("got None"), "{m}");
+    let m = err(&format!(
+        "{HEADER}c = Car(loc = r.onLane(1, 40), lane_change = ChangeLane(to = -1, at = 1.0, when = tick))\nw.place(r, v, c)\n"
+    ));
+    assert!(m.contains("not both") && m.contains("bad.star:4:"), "{m}");
+    let m = err(&format!(
+        "{HEADER}n = VarEnum({{2, 4, 6}})\nw.place(r, v)\n"
+    ));
+    assert!(
+        m.contains("bad.star:4:")
+            && m.contains("write the paper's `VarEnum({2, 4, 6})` as `VarEnum([2, 4, 6])`"),
+        "{m}"
+    );
+    // Another syntax error gets no such note.
+    let m = err(&format!("{HEADER}n = [2, 4\nw.place(r, v)\n"));
+    assert!(!m.contains("VarEnum([2, 4, 6])"), "{m}");
+}

@@ -283,9 +283,9 @@ impl<'v> StarlarkValue<'v> for Action {
                 })
                 .ok_or_else(|| {
                     fail(format!(
-                        "{}: {what} is a number, got a {}",
+                        "{}: {what} is a number, got {}",
                         self.method,
-                        v.get_type()
+                        crate::lang::a_type(v.get_type())
                     ))
                 })
         };

@@ -22,8 +22,8 @@ use super::*;
 pub(super) fn location(v: Value, what: &str) -> anyhow::Result<usize> {
     v.downcast_ref::<Loc>().map(|l| l.index).ok_or_else(|| {
         anyhow!(
-            "{what} must be a location from r.onLane(lane, at), got a {}",
-            v.get_type()
+            "{what} must be a location from r.onLane(lane, at), got {}",
+            crate::lang::a_type(v.get_type())
         )
     })
 }
@@ -85,8 +85,8 @@ pub(super) fn route_arg(
             let wrong = || {
                 anyhow!(
                     "route must be a turn or a list of turns such as [\"left\", \"straight\"], \
-                     got a {}",
-                    v.get_type()
+                     got {}",
+                    crate::lang::a_type(v.get_type())
                 )
             };
             let items = UnpackList::<Value>::unpack_value(v)
@@ -166,8 +166,8 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             Some(v) if v.is_none() => None,
             Some(v) => Some(*v.downcast_ref::<LaneChangeVal>().ok_or_else(|| {
                 anyhow!(
-                    "Car(lane_change=) takes ChangeLane(to = lane, at = seconds or when = stream, duration = seconds), got a {}",
-                    v.get_type()
+                    "Car(lane_change=) takes ChangeLane(to = lane, at = seconds or when = stream, duration = seconds), got {}",
+                    crate::lang::a_type(v.get_type())
                 )
             })?),
         };
@@ -252,7 +252,11 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 let mut b = st.scene.borrow_mut();
                 ChangeStart::When(stream_arg(w, &mut b, "ChangeLane(when=)")?.0)
             }
-            _ => bail!("ChangeLane needs either at = seconds or when = a stream"),
+            (Some(_), Some(_)) => bail!(
+                "ChangeLane takes one start, at = seconds or when = a stream, not both: a lane \
+                 change starts once"
+            ),
+            (None, None) => bail!("ChangeLane needs either at = seconds or when = a stream"),
         };
         Ok(LaneChangeVal {
             to: to as i32,
@@ -279,8 +283,8 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                     .iterate(eval.heap())
                     .map_err(|_| {
                         anyhow!(
-                            "Obstacle(size=) takes (length, width, height) in m, got a {}",
-                            v.get_type()
+                            "Obstacle(size=) takes (length, width, height) in m, got {}",
+                            crate::lang::a_type(v.get_type())
                         )
                     })?
                     .collect();

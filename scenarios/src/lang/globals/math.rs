@@ -14,8 +14,8 @@ use crate::lang::values::stream_hint;
 pub(super) fn math_number(v: Value, what: &str) -> anyhow::Result<f64> {
     crate::lang::position::num(v).ok_or_else(|| {
         anyhow!(
-            "{what} takes numbers, got a {}{}",
-            v.get_type(),
+            "{what} takes numbers, got {}{}",
+            crate::lang::a_type(v.get_type()),
             stream_hint(v)
         )
     })

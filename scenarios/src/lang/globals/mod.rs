@@ -148,7 +148,10 @@ pub fn number(v: Value, what: &str) -> anyhow::Result<f64> {
              value (an open parameter that varies over time is one)"
         );
     }
-    bail!("{what} must be a number, got a {}", v.get_type())
+    bail!(
+        "{what} must be a number, got {}",
+        crate::lang::a_type(v.get_type())
+    )
 }
 
 pub(super) fn constant(v: Value) -> Option<Rx> {
@@ -169,8 +172,8 @@ pub fn stream_arg(v: Value, b: &mut SceneBuilder, what: &str) -> anyhow::Result<
     match constant(v) {
         Some(c) => Ok(b.graph.push(Node::Const(c))),
         None => bail!(
-            "{what} must be a stream or a constant, got a {}",
-            v.get_type()
+            "{what} must be a stream or a constant, got {}",
+            crate::lang::a_type(v.get_type())
         ),
     }
 }
@@ -211,10 +214,10 @@ pub(super) fn fixed_typed(
         },
         None => constant(v).ok_or_else(|| {
             anyhow!(
-                "{owner}({}=) takes {}, got a {}",
+                "{owner}({}=) takes {}, got {}",
                 input.keyword,
                 input.kind,
-                v.get_type()
+                crate::lang::a_type(v.get_type())
             )
         })?,
     };

@@ -41,8 +41,8 @@ pub(super) fn publish_monitored(
     // expected (loading warns that its verdict is the same in every test).
     let id = stream_arg(stream, &mut b, what).map_err(|_| {
         anyhow!(
-            "{what} judges a stream (such as `v.speed.map(lambda s: 20 - s)`), got a {}",
-            stream.get_type()
+            "{what} judges a stream (such as `v.speed.map(lambda s: 20 - s)`), got {}",
+            crate::lang::a_type(stream.get_type())
         )
     })?;
     let kind = types::stream_types(&b)[id.0];
@@ -276,9 +276,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] name: Option<&str>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<MonitorVal> {
-        let m = *m
-            .downcast_ref::<MonitorVal>()
-            .ok_or_else(|| anyhow!("TimeToFailure wraps a monitor, got a {}", m.get_type()))?;
+        let m = *m.downcast_ref::<MonitorVal>().ok_or_else(|| {
+            anyhow!(
+                "TimeToFailure wraps a monitor, got {}",
+                crate::lang::a_type(m.get_type())
+            )
+        })?;
         let inner = m.index;
         let min_s = match minT {
             Some(v) => number(v, "minT")?,

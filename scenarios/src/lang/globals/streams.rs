@@ -51,8 +51,8 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
     fn Const<'v>(v: Value<'v>, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Stream> {
         let c = constant(v).ok_or_else(|| {
             anyhow!(
-                "Const takes a number, a bool or a string, got a {}",
-                v.get_type()
+                "Const takes a number, a bool or a string, got {}",
+                crate::lang::a_type(v.get_type())
             )
         })?;
         let number = match c {
@@ -98,8 +98,8 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 .map(|o| o.over_time)
                 .ok_or_else(|| {
                     anyhow!(
-                        "over_time must be Piecewise(k) or Polynomial(deg), got a {}",
-                        v.get_type()
+                        "over_time must be Piecewise(k) or Polynomial(deg), got {}",
+                        crate::lang::a_type(v.get_type())
                     )
                 })?,
         };
@@ -126,8 +126,8 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             .iterate(eval.heap())
             .map_err(|_| {
                 anyhow!(
-                    "VarEnum takes a list of levels, got a {}",
-                    levels.get_type()
+                    "VarEnum takes a list of levels, got {}",
+                    crate::lang::a_type(levels.get_type())
                 )
             })?
             .collect();
