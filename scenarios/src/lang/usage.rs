@@ -49,6 +49,31 @@ fn read_streams(w: &WorldSpec) -> HashSet<usize> {
         .collect()
 }
 
+/// What differs between two lists of painted things (cars, obstacles): item `i`'s colour alone
+/// is `colour(i)`; any other difference, or another count, is [`Change::Other`].
+fn recoloured<T: Clone + PartialEq + std::fmt::Debug>(
+    a: &[T],
+    b: &[T],
+    paint: impl Fn(&mut T) -> &mut String,
+    colour: fn(usize) -> Change,
+    out: &mut Vec<Change>,
+) {
+    if a.len() != b.len() {
+        out.push(Change::Other);
+        return;
+    }
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        let (mut x2, mut y2) = (x.clone(), y.clone());
+        if paint(&mut x2) != paint(&mut y2) {
+            out.push(colour(i));
+        }
+        *paint(&mut y2) = paint(&mut x2).clone();
+        if differ(x, &y2) {
+            out.push(Change::Other);
+        }
+    }
+}
+
 /// What differs between `a` and `b`, two worlds of one program.
 pub fn changes(a: &WorldSpec, b: &WorldSpec) -> Vec<Change> {
     let mut out = Vec::new();
@@ -77,36 +102,20 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec) -> Vec<Change> {
     }
     other(differ(&a.ego, &b.ego), &mut out);
     other(differ(&a.pedestrians, &b.pedestrians), &mut out);
-    if a.obstacles.len() != b.obstacles.len() {
-        out.push(Change::Other);
-    } else {
-        for (i, (x, y)) in a.obstacles.iter().zip(&b.obstacles).enumerate() {
-            if x.color != y.color {
-                out.push(Change::ObstacleColour(i));
-            }
-            let mut y2 = y.clone();
-            y2.color = x.color.clone();
-            other(differ(x, &y2), &mut out);
-        }
-    }
+    recoloured(
+        &a.obstacles,
+        &b.obstacles,
+        |o| &mut o.color,
+        Change::ObstacleColour,
+        &mut out,
+    );
     other(
         differ(&a.environment, &b.environment) || a.dt_s != b.dt_s,
         &mut out,
     );
     other(differ(&a.lidar, &b.lidar), &mut out);
     other(differ(&a.frictions, &b.frictions), &mut out);
-    if a.cars.len() != b.cars.len() {
-        out.push(Change::Other);
-    } else {
-        for (i, (x, y)) in a.cars.iter().zip(&b.cars).enumerate() {
-            if x.color != y.color {
-                out.push(Change::Colour(i));
-            }
-            let mut y2 = y.clone();
-            y2.color = x.color.clone();
-            other(differ(x, &y2), &mut out);
-        }
-    }
+    recoloured(&a.cars, &b.cars, |c| &mut c.color, Change::Colour, &mut out);
     // Streams: the light, a piece's friction, or anything else.
     let (na, nb) = (a.streams.nodes(), b.streams.nodes());
     if na.len() != nb.len() {
