@@ -670,3 +670,66 @@ test(horizon = 1.0)
         "{stderr}"
     );
 }
+
+/// A parameter that changes nothing from the first world, but does where another parameter
+/// takes another value, is neither left out of coverage nor named in a warning: a radius read
+/// only on the `bend` branch of an `if` (whichever level comes first), a friction reached only
+/// from the second start. A parameter that changes nothing anywhere still is, and a friction
+/// no start reaches still warns.
+#[test]
+fn a_parameter_that_matters_only_for_other_values_of_another_is_used() {
+    let bend = |levels: &str| {
+        format!(
+            r#"
+shape = VarEnum({levels})
+rad = VarInterval(20.0, 60.0)
+idle = VarInterval(0.0, 1.0)
+s = RoadSegment(len = 50.0)
+if shape == "bend":
+    b = Arc(radius = rad, angle = 1.0)
+else:
+    b = RoadSegment(len = 40.0)
+net = s.connect((s.TWO, b, b.ONE))
+w = World()
+v = AutonomousVehicle(loc = s.onLane(1, 5.0), speed = 5.0)
+w.place(net, v)
+CollisionMonitor(v)
+test(horizon = 3.0)
+"#
+        )
+    };
+    for levels in [r#"["straight", "bend"]"#, r#"["bend", "straight"]"#] {
+        let s = paracosm_scenarios::lang::load_source("t.star", &bend(levels), "t").unwrap();
+        assert_eq!(s.unused_params, vec!["idle".to_owned()], "{levels}");
+        assert_eq!(s.warnings.len(), 1, "{levels}: {:?}", s.warnings);
+        assert!(s.warnings[0].message.contains("`idle`"), "{:?}", s.warnings);
+    }
+    let start = |starts: &str| {
+        format!(
+            r#"
+k = VarEnum([0, 1])
+far_mu = VarInterval(0.1, 0.9)
+a = RoadSegment(len = 600.0)
+ice = RoadSegment(len = 100.0, friction = far_mu)
+net = a.connect((a.TWO, ice, ice.ONE))
+w = World()
+v = AutonomousVehicle(loc = a.onLane(1, {starts}[k]), speed = 10.0)
+o = Obstacle(loc = ice.onLane(1, 50.0))
+w.place(net, v, o)
+CollisionMonitor(v)
+test(horizon = 10.0)
+"#
+        )
+    };
+    let s = paracosm_scenarios::lang::load_source("t.star", &start("[5.0, 580.0]"), "t").unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let s = paracosm_scenarios::lang::load_source("t.star", &start("[5.0, 6.0]"), "t").unwrap();
+    assert!(
+        s.warnings.len() == 1
+            && s.warnings[0]
+                .message
+                .contains("`far_mu` sets the friction of"),
+        "{:?}",
+        s.warnings
+    );
+}

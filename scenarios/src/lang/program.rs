@@ -36,6 +36,16 @@ const INTERIOR_FRACTION: f64 = 0.618_033_988_749_894_8;
 /// evenly over its levels, the first and last among them).
 const MAX_PROBED_VALUES: usize = 64;
 
+/// Most combinations of the other parameters' values from which a parameter that seems not
+/// to matter is varied again ([`Program::changes_elsewhere`]).
+const MAX_REPROBE_BASES: usize = 16;
+
+/// Most values of such a parameter tried from each of those combinations.
+const MAX_REPROBED_VALUES: usize = 4;
+
+/// Most evaluation steps that varying one such parameter again may take.
+const MAX_REPROBE_STEPS: u64 = 5_000_000;
+
 /// Most evaluation steps (function calls and loop iterations, as starlark counts them) that
 /// checking the combinations at load may take in all. A program whose every evaluation is
 /// long would otherwise take up to [`MAX_CHECKED_WORLDS`] × [`super::MAX_LOAD_STEPS`] steps;
@@ -507,6 +517,72 @@ impl Program {
             .collect()
     }
 
+    /// What parameter `k` changes when the other parameters take other values than `base`'s:
+    /// its checked values (at most [`MAX_REPROBED_VALUES`], its first and last among them)
+    /// against each of at most [`MAX_REPROBE_BASES`] combinations of the others' values
+    /// (spread over [`Program::combinations`], those equal to `base` but for `k` left out),
+    /// stopping at the first change that can affect the ego. Worlds that fail are skipped
+    /// (their tests report the error), and the probing stops after [`MAX_REPROBE_STEPS`]
+    /// evaluation steps.
+    fn changes_elsewhere(&self, k: usize, base: &[ParamValue]) -> Vec<usage::Change> {
+        let mut out = Vec::new();
+        let mut steps = 0u64;
+        let spread = |n: usize, most: usize| -> Vec<usize> {
+            if n <= most {
+                (0..n).collect()
+            } else {
+                let mut v: Vec<usize> = (0..most).map(|j| j * (n - 1) / (most - 1)).collect();
+                v.dedup();
+                v
+            }
+        };
+        let values = self.checked_values(k);
+        let chosen: Vec<&ParamValue> = spread(values.len(), MAX_REPROBED_VALUES)
+            .into_iter()
+            .map(|i| &values[i].0)
+            .collect();
+        let others = |v: &[ParamValue]| -> bool {
+            v.iter()
+                .zip(base)
+                .enumerate()
+                .any(|(j, (a, b))| j != k && a != b)
+        };
+        let rows: Vec<Vec<ParamValue>> = self
+            .combinations()
+            .into_iter()
+            .map(|(v, _)| v)
+            .filter(|v| others(v))
+            .collect();
+        for r in spread(rows.len(), MAX_REPROBE_BASES) {
+            let row = &rows[r];
+            let Ok((from, s)) = self.world_counted(row.clone()) else {
+                continue;
+            };
+            steps += s;
+            for v in &chosen {
+                if **v == row[k] || steps > MAX_REPROBE_STEPS {
+                    continue;
+                }
+                let mut values = row.clone();
+                values[k] = (*v).clone();
+                let Ok((to, s)) = self.world_counted(values) else {
+                    continue;
+                };
+                steps += s;
+                let found = usage::changes(&from, &to, self.horizon_s);
+                let decisive = found.iter().any(|c| !usage::inert(c, false));
+                out.extend(found);
+                if decisive {
+                    return out;
+                }
+            }
+            if steps > MAX_REPROBE_STEPS {
+                break;
+            }
+        }
+        out
+    }
+
     /// The world of one evaluation with `values`, checked for consistency.
     fn world_for(&self, values: Vec<ParamValue>) -> Result<WorldSpec, String> {
         self.world_counted(values).map(|(w, _)| w)
@@ -923,7 +999,7 @@ pub fn load(
             let mut values = base_values.clone();
             values[k] = v;
             let other = program.world_for(values).map_err(|m| with(&label, m))?;
-            seen.extend(usage::changes(&base, &other));
+            seen.extend(usage::changes(&base, &other, program.horizon_s));
         }
         changes.push(seen);
     }
@@ -1050,13 +1126,21 @@ pub fn load(
                 .is_some_and(|v| syntax.read_in_code(v))
         })
         .collect();
+    // A parameter that, from the first world, changes nothing or nothing the ego can meet may
+    // still matter where the others take other values: a radius read only on one branch of an
+    // `if`, a friction reached only from another start. Before a warning calls it unused, it
+    // is varied again from other combinations of the others' values.
+    for (k, seen) in changes.iter_mut().enumerate() {
+        if !read_in_code[k] && seen.iter().all(|c| usage::inert(c, stl_reads_light)) {
+            seen.extend(program.changes_elsewhere(k, &base_values));
+        }
+    }
     let found = usage::analyse(usage::Inputs {
         params: &program.params,
         changes: &changes,
         read_in_code: &read_in_code,
         stl_reads_light,
         world: &first,
-        horizon_s: program.horizon_s,
     });
     warnings.extend(found.warnings);
     warnings.extend(usage::unit_warnings(&program.params, syntax));

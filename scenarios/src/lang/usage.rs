@@ -22,8 +22,14 @@ pub enum Change {
     Colour(usize),
     /// The colour of obstacle `i`.
     ObstacleColour(usize),
-    /// The friction of a road piece.
-    Friction(PieceId),
+    /// The friction of a road piece, named, and whether a vehicle can be on it during a test
+    /// in either of the two worlds compared (see [`driven`]).
+    Friction {
+        /// The piece's name in messages.
+        piece: String,
+        /// Whether the ego can reach it within the horizon, or a car's route crosses it.
+        driven: bool,
+    },
     /// Anything else: geometry, an actor, a speed, the fog, a stream's value...
     Other,
 }
@@ -74,9 +80,22 @@ fn recoloured<T: Clone + PartialEq + std::fmt::Debug>(
     }
 }
 
-/// What differs between `a` and `b`, two worlds of one program.
-pub fn changes(a: &WorldSpec, b: &WorldSpec) -> Vec<Change> {
+/// What differs between `a` and `b`, two worlds of one program whose tests last `horizon_s`.
+pub fn changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
     let mut out = Vec::new();
+    // The pieces a vehicle can be on, in either world, worked out once a friction differs.
+    let mut reached: Option<HashSet<PieceId>> = None;
+    let mut friction = |p: PieceId, out: &mut Vec<Change>| {
+        let reached = reached.get_or_insert_with(|| {
+            let mut r = driven(a, horizon_s);
+            r.extend(driven(b, horizon_s));
+            r
+        });
+        out.push(Change::Friction {
+            piece: a.network.piece(p).name.clone(),
+            driven: reached.contains(&p),
+        });
+    };
     let other = |c: bool, out: &mut Vec<Change>| {
         if c {
             out.push(Change::Other);
@@ -94,7 +113,7 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec) -> Vec<Change> {
             let mut y2 = y.clone();
             y2.kind = y.kind.with_friction(x.kind.friction());
             if *x == y2 {
-                out.push(Change::Friction(PieceId(i)));
+                friction(PieceId(i), &mut out);
             } else {
                 out.push(Change::Other);
             }
@@ -139,7 +158,7 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec) -> Vec<Change> {
             } else if i == a.environment.light.0 {
                 out.push(Change::Light);
             } else if let Some(p) = piece {
-                out.push(Change::Friction(p));
+                friction(p, &mut out);
             }
             // Any other stream is read by nothing: a constant friction, which the network
             // carries and the comparison of the pieces has seen.
@@ -159,10 +178,8 @@ pub struct Inputs<'a> {
     pub read_in_code: &'a [bool],
     /// Whether an `Stl` formula reads the `light` signal.
     pub stl_reads_light: bool,
-    /// The program's first evaluation.
+    /// The program's first evaluation (for the cars' and obstacles' names).
     pub world: &'a SceneBuilder,
-    /// The test length, seconds.
-    pub horizon_s: f64,
 }
 
 /// The findings: warnings, the parameters no object reads (by index), and those only a camera
@@ -176,33 +193,41 @@ pub struct Usage {
     pub camera_only: Vec<CameraOnly>,
 }
 
-/// Pieces a vehicle can be on during a test: every piece the ego can reach within the
-/// horizon (on or off the road, at full throttle all the way: the engine bounds any system's
-/// acceleration), and every piece an NPC car's route crosses.
-fn driven(b: &SceneBuilder, horizon_s: f64) -> HashSet<PieceId> {
+/// Pieces a vehicle can be on during a test of world `w`: every piece the ego can reach
+/// within the horizon (on or off the road, at full throttle all the way: the engine bounds any
+/// system's acceleration), and every piece an NPC car in the test drives over on its route.
+fn driven(w: &WorldSpec, horizon_s: f64) -> HashSet<PieceId> {
     let mut driven = HashSet::new();
-    if let Some(ego) = &b.ego {
-        let vehicle = paracosm_engine::VehicleParams::default();
-        // Two driven wheels (rear-wheel drive).
-        let a = 2.0 * vehicle.max_engine_force_n / vehicle.mass_kg;
-        let reach_m = ego.initial_speed_mps * horizon_s + 0.5 * a * horizon_s * horizon_s;
-        let start = [ego.start.pos_m[0], ego.start.pos_m[2]];
-        driven.extend(
-            (0..b.roads.pieces().len())
-                .map(PieceId)
-                .filter(|&id| b.roads.distance_to_piece_m(id, start) <= reach_m),
-        );
-    }
-    let surface = Surface::new(&b.roads);
-    for c in &b.cars {
+    let ego = &w.ego;
+    // Two driven wheels (rear-wheel drive).
+    let a = 2.0 * ego.vehicle.max_engine_force_n / ego.vehicle.mass_kg;
+    let reach_m = ego.initial_speed_mps * horizon_s + 0.5 * a * horizon_s * horizon_s;
+    let start = [ego.start.pos_m[0], ego.start.pos_m[2]];
+    driven.extend(
+        (0..w.network.pieces().len())
+            .map(PieceId)
+            .filter(|&id| w.network.distance_to_piece_m(id, start) <= reach_m),
+    );
+    let surface = Surface::new(&w.network);
+    for c in w.cars.iter().filter(|c| c.enabled) {
         driven.extend(c.path.iter().filter_map(|&p| surface.piece_under(p)));
     }
     driven
 }
 
+/// Whether a change cannot affect the ego: a friction where no vehicle can be, or what only a
+/// camera sees (a colour; the light, unless an `Stl` formula reads it).
+pub fn inert(c: &Change, stl_reads_light: bool) -> bool {
+    match c {
+        Change::Friction { driven, .. } => !driven,
+        Change::Colour(_) | Change::ObstacleColour(_) => true,
+        Change::Light => !stl_reads_light,
+        Change::Other => false,
+    }
+}
+
 /// Classifies every parameter by what it changes.
 pub fn analyse(i: Inputs<'_>) -> Usage {
-    let driven = driven(i.world, i.horizon_s);
     let mut usage = Usage {
         warnings: Vec::new(),
         unused: Vec::new(),
@@ -224,16 +249,12 @@ pub fn analyse(i: Inputs<'_>) -> Usage {
             });
             continue;
         }
-        let undriven = |c: &Change| matches!(c, Change::Friction(p) if !driven.contains(p));
-        let visual = |c: &Change| {
-            matches!(c, Change::Colour(_) | Change::ObstacleColour(_))
-                || (*c == Change::Light && !i.stl_reads_light)
-        };
+        let undriven = |c: &Change| matches!(c, Change::Friction { driven: false, .. });
         if changes.iter().all(undriven) {
             let pieces: BTreeSet<String> = changes
                 .iter()
                 .filter_map(|c| match c {
-                    Change::Friction(p) => Some(i.world.roads.piece(*p).name.clone()),
+                    Change::Friction { piece, .. } => Some(piece.clone()),
                     _ => None,
                 })
                 .collect();
@@ -248,7 +269,7 @@ pub fn analyse(i: Inputs<'_>) -> Usage {
             });
             continue;
         }
-        if changes.iter().all(|c| undriven(c) || visual(c)) {
+        if changes.iter().all(|c| inert(c, i.stl_reads_light)) {
             let mut sets: Vec<String> = Vec::new();
             for c in changes {
                 let s = match c {
