@@ -733,3 +733,27 @@ test(horizon = 10.0)
         s.warnings
     );
 }
+
+/// A disabled car is left out of `place`'s checks as it is out of the test: two cars on one
+/// spot, one enabled for each level, load; a disabled car overlapping the ego or on a sidewalk
+/// loads, and the ego drives through it without a collision.
+#[test]
+fn a_disabled_car_is_left_out_of_the_placement_checks() {
+    let head = "w = World()\nr = RoadSegment(len = 300.0, nlanes = 2)\nv = AutonomousVehicle(loc = r.onLane(1, 10), speed = 8.0)\n";
+    let s = format!(
+        "{head}on = VarEnum([True, False])\nc = Car(loc = r.onLane(1, 60.0), speed = 0.0, enabled = on)\nc2 = Car(loc = r.onLane(1, 60.0), speed = 0.0, enabled = not on)\nw.place(r, v, c, c2)\nCollisionMonitor(v)\n"
+    );
+    paracosm_scenarios::lang::load_source("t.star", &s, "t").unwrap();
+    for loc in ["r.onLane(1, 10.0)", "r.onLane(r.SideWalk, 40.0)"] {
+        let s = format!(
+            "{head}ghost = Car(loc = {loc}, speed = 0.0, enabled = False)\nw.place(r, v, ghost)\nCollisionMonitor(v)\ntest(horizon = 3.0)\n"
+        );
+        let (r, _) = run_one(&s, 0);
+        assert_eq!(r["monitors"]["collision"]["passed"], true, "{loc}: {r}");
+    }
+    // Enabled, the same car is refused.
+    let s = format!(
+        "{head}ghost = Car(loc = r.onLane(1, 10.0), speed = 0.0, enabled = True)\nw.place(r, v, ghost)\nCollisionMonitor(v)\n"
+    );
+    assert!(load_err(&s).contains("start in collision"));
+}

@@ -735,6 +735,11 @@ impl SceneBuilder {
         // Check the starting positions before anything depends on them (routes, behaviours).
         let mut placed = Vec::new();
         for o in &self.objects {
+            // A disabled car is not in the test: nothing can start in collision with it, and
+            // where it would stand does not matter.
+            if matches!(o.pending, Pending::Car { enabled: false, .. }) {
+                continue;
+            }
             let (loc, footprint, on_road) = match &o.pending {
                 Pending::Ego { loc, .. } => (*loc, Some(VehicleParams::default().size), true),
                 Pending::Car { loc, .. } => (*loc, Some(Size::CAR), true),
@@ -830,10 +835,16 @@ impl SceneBuilder {
                     lane_change,
                 } => {
                     let start = resolve(self, loc)?;
-                    let path = self
-                        .roads
-                        .route(&start, &route, MAX_ROUTE_M)
-                        .map_err(|e| format!("{}: {}", o.name, strip(e)))?;
+                    let path = match self.roads.route(&start, &route, MAX_ROUTE_M) {
+                        Ok(path) => path,
+                        // A disabled car is not in the test: where it would drive does not
+                        // matter (it may stand on a sidewalk); one metre ahead stands in.
+                        Err(_) if !enabled => {
+                            let (p, h) = (start.pos_m, start.heading_rad);
+                            vec![[p[0], p[2]], [p[0] + h.cos(), p[2] - h.sin()]]
+                        }
+                        Err(e) => return Err(format!("{}: {}", o.name, strip(e))),
+                    };
                     let lane_change = match lane_change {
                         Some(c) => {
                             // Into a lane of the other direction: allowed (an overtaking
@@ -851,7 +862,11 @@ impl SceneBuilder {
                                     });
                                 }
                             }
-                            Some(self.lane_change(&o.name, &start, c)?)
+                            match self.lane_change(&o.name, &start, c) {
+                                Ok(change) => Some(change),
+                                Err(_) if !enabled => None,
+                                Err(e) => return Err(e),
+                            }
                         }
                         None => None,
                     };
