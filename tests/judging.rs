@@ -757,3 +757,69 @@ fn a_disabled_car_is_left_out_of_the_placement_checks() {
     );
     assert!(load_err(&s).contains("start in collision"));
 }
+
+/// Found by programs written from LANGUAGE.md: a number from a `filter` predicate is refused
+/// (it was read as true unless exactly 0); a Signal named like a component of another
+/// (`lp.x` beside a vector `lp`) is refused (it hid the vector's component); an explicit
+/// name equal to the `param<i>` another parameter takes is refused (it renamed that one);
+/// open parameters in a list or dict that a lambda reads are used (they were dropped from
+/// coverage); a `def` that returns an unbound action performs it with the event's value; a
+/// top-level variable holding `tick` reads as the time in a lambda.
+#[test]
+fn silent_misreadings_found_by_new_programs_are_refused_or_read_right() {
+    let head = "w = World()\nr = RoadSegment(len = 400.0)\nv = AutonomousVehicle(loc = r.onLane(1, 10), speed = 0.0)\nlead = Car(loc = r.onLane(1, 60), speed = 5.0)\nw.place(r, v, lead)\n";
+    let e = load_err(&format!(
+        "{head}m = Monitor(tick.filter(lambda t: t - 0.5).map(lambda t: 1.0).sum(), over = \"end\")\n"
+    ));
+    assert!(
+        e.contains("filter predicate needs bool, got a number"),
+        "{e}"
+    );
+    assert!(e.contains("t.star:6:"), "{e}");
+    for (a, b) in [("lp", "lp.x"), ("lp.z", "lp")] {
+        let first = if a == "lp" {
+            "lead.pos"
+        } else {
+            "tick.map(lambda t: 5.0)"
+        };
+        let second = if a == "lp" {
+            "tick.map(lambda t: 5.0)"
+        } else {
+            "lead.pos"
+        };
+        let e = load_err(&format!(
+            "{head}Signal(\"{a}\", {first})\nSignal(\"{b}\", {second})\ns = Stl(\"G[0,1] (lp.x > 0)\")\n"
+        ));
+        assert!(e.contains("clash") && e.contains("t.star:7:1"), "{e}");
+    }
+    let e = load_err(&format!(
+        "{head}z = [VarInterval(0, 1)]\nq = VarInterval(0, 1, name = \"param0\")\nMonitor(tick.map(lambda t: z[0] + q))\n"
+    ));
+    assert!(e.contains("takes from where it stands"), "{e}");
+    let s = paracosm_scenarios::lang::load_source(
+        "t.star",
+        &format!(
+            "{head}xs = [VarInterval(0, 1), VarInterval(0, 1)]\ncfg = {{\"lim\": VarInterval(0, 1)}}\ndef lim():\n    return cfg[\"lim\"]\nm = Monitor(tick.map(lambda t: xs[0] - 0.5), over = \"end\")\nm2 = Monitor(tick.map(lambda t: lim() - 0.5), over = \"end\")\n"
+        ),
+        "t",
+    )
+    .unwrap();
+    assert!(s.unused_params.is_empty(), "{:?}", s.unused_params);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    // The returned unbound action sets the lead's speed to the event's value, 7 m/s.
+    let (r, _) = run_one(
+        &format!(
+            "{head}def h(s):\n    return lead.setSpeed\ntick.filter(lambda t: t > 1).take(1).map(lambda t: 7.0).foreach(h)\ntop = Monitor(lead.speed.map(lambda s: s), over = \"end\")\nticks = tick\nclock = Monitor(v.speed.map(lambda s: 100 - ticks), over = \"end\")\ntest(horizon = 3.0, offroad = False)\n"
+        ),
+        0,
+    );
+    assert_eq!(r["status"], "pass", "{r}");
+    assert!(
+        (number(&r["monitors"]["top"]["robustness"]) - 7.0).abs() < 1e-9,
+        "{r}"
+    );
+    assert!(
+        (number(&r["monitors"]["clock"]["robustness"]) - 97.0).abs() < 1e-9,
+        "{r}"
+    );
+}

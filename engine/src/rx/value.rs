@@ -35,11 +35,12 @@ impl Value {
         }
     }
 
-    /// The truth value: a [`Value::Bool`], or a number that is not `0`.
+    /// The truth value of a [`Value::Bool`]; `None` for every other kind, numbers included:
+    /// a number is not a truth value (`filter(lambda p: p.x - 100)` is a mistake, not "fires
+    /// unless the difference is exactly 0").
     pub fn as_bool(&self) -> Option<bool> {
         match self {
             Value::Bool(b) => Some(*b),
-            Value::Num(x) => Some(*x != 0.0),
             _ => None,
         }
     }

@@ -110,8 +110,8 @@ fn from_star(v: Value) -> Result<Rx, String> {
         return Ok(Rx::Tuple(items));
     }
     Err(format!(
-        "a lambda returned a {}; streams carry numbers, bools, strings and tuples",
-        v.get_type()
+        "a lambda returned {}; streams carry numbers, bools, strings and tuples",
+        crate::lang::a_type(v.get_type())
     ))
 }
 
@@ -125,6 +125,10 @@ impl Host for StarHost<'_, '_, '_, '_> {
             };
             self.eval.module().set(name, now);
         }
+        let event = match args {
+            [v] => Some(v.clone()),
+            _ => None,
+        };
         let args: Vec<Value> = args.iter().map(|a| to_star(a, heap)).collect();
         let function = *self
             .functions
@@ -152,10 +156,12 @@ impl Host for StarHost<'_, '_, '_, '_> {
             }
             (out, _) => out.map_err(|e| format!("{e}"))?,
         };
-        // A function given to foreach may return the action to perform.
+        // A function given to foreach may return the action to perform: bound
+        // (`c.setSpeed(2.0)`), or unbound (`c.setSpeed`), which takes the event's value as
+        // when it is given to foreach itself.
         if let Some(a) = out.downcast_ref::<super::values::Action>() {
             if let Some(test) = self.test() {
-                let value = a.bound_value().unwrap_or(Rx::Unit);
+                let value = a.bound_value().or(event).unwrap_or(Rx::Unit);
                 test.performed.borrow_mut().push((a.sink, value));
             }
             return Ok(Rx::Unit);

@@ -25,6 +25,9 @@ pub struct Site {
     /// The builtin and keyword it is written inline as an argument of, if it is
     /// (`Car(speed = VarInterval(...))`: `("Car", "speed")`).
     pub argument_of: Option<(String, String)>,
+    /// The variable holding the list, tuple or dict literal it is an item of, if it is
+    /// (`xs = [VarInterval(...), ...]`: `xs`): code that reads `xs` reads it.
+    pub container: Option<String>,
 }
 
 /// What the syntax of a program says, by call site (`"line:col"`, from 1).
@@ -104,6 +107,8 @@ struct Walker<'a> {
     ast: &'a AstModule,
     builtins: &'a [&'a str],
     out: Syntax,
+    /// The variable assigned the list, tuple or dict literal being walked, if any.
+    container: Option<String>,
 }
 
 impl Walker<'_> {
@@ -119,10 +124,12 @@ impl Walker<'_> {
         argument_of: Option<(String, String)>,
     ) {
         let key = self.pos(e);
+        let container = self.container.clone();
         self.out.sites.entry(key).or_insert(Site {
             name,
             variable,
             argument_of,
+            container,
         });
     }
 
@@ -154,7 +161,24 @@ impl Walker<'_> {
                         return;
                     }
                 }
+                // `xs = [VarInterval(...), ...]`, `cfg = {"k": VarEnum(...)}`: the items are
+                // read through the variable.
+                let literal = matches!(
+                    a.rhs.node,
+                    ExprP::List(_)
+                        | ExprP::Tuple(_)
+                        | ExprP::Dict(_)
+                        | ExprP::ListComprehension(..)
+                        | ExprP::DictComprehension(..)
+                );
+                let outer = self.container.take();
+                self.container = if literal {
+                    target.clone()
+                } else {
+                    outer.clone()
+                };
                 self.expr(&a.rhs, target.as_deref(), in_code || alias);
+                self.container = outer;
                 a.lhs.visit_expr(|e| self.expr(e, None, true));
             }
             // Everything a function does is code.
@@ -365,6 +389,7 @@ impl Syntax {
             ast,
             builtins,
             out: Syntax::default(),
+            container: None,
         };
         w.stmt(ast.statement(), false);
         assigned_once(ast, ast.statement(), &mut w.out.assigned_once);

@@ -101,8 +101,8 @@ fn positions_equal(me: [f64; 3], me_loc: bool, other: Value) -> starlark::Result
             Ok(norm(d) <= POSITION_TOLERANCE_M)
         }
         None => Err(starlark::Error::new_other(anyhow::anyhow!(
-            "`==` compares a position with a position (a location or a vector), not with a {}",
-            other.get_type()
+            "`==` compares a position with a position (a location or a vector), not with {}",
+            crate::lang::a_type(other.get_type())
         ))),
     }
 }

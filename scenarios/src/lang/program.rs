@@ -197,6 +197,17 @@ impl Program {
                     "the program",
                 );
                 eval.set_check_cancelled(Box::new(crate::memory::over_soft_limit));
+                // `tick` as a variable of the module, on its heap, rather than the frozen
+                // global alone: starlark inlines a module variable that holds a frozen value
+                // into the lambdas it compiles, so `ticks = tick` read in a lambda stayed a
+                // stream instead of reading as its current value, as every other top-level
+                // stream variable does.
+                module.set(
+                    "tick",
+                    module
+                        .heap()
+                        .alloc(super::values::Stream::of(super::scene::TICK.0)),
+                );
                 let result = eval.eval_module(self.ast.clone(), &self.globals);
                 let result = match result {
                     Err(_) if crate::memory::over_soft_limit() => {
@@ -880,8 +891,11 @@ pub fn load(
     // ..., name = "a")` beside `a = VarInterval(...)`) would file one under the other's name.
     for (i, a) in explicit.iter().enumerate() {
         let Some(a) = a else { continue };
-        if let Some(j) = (0..explicit.len())
-            .find(|&j| j != i && explicit[j].is_none() && derived[j].as_deref() == Some(a))
+        // What parameter `j` is named from where it stands: its derived name, else its
+        // position (`param3`, as `names::final_names` gives it).
+        let standing = |j: usize| derived[j].clone().unwrap_or_else(|| format!("param{j}"));
+        if let Some(j) =
+            (0..explicit.len()).find(|&j| j != i && explicit[j].is_none() && standing(j) == *a)
         {
             return Err(lang(format!(
                 "error: name = \"{a}\" (declared at {}) is the name the open parameter declared \
@@ -1120,10 +1134,12 @@ pub fn load(
         .params
         .iter()
         .map(|(_, d)| {
-            syntax
-                .site(&d.at)
-                .and_then(|s| s.variable.as_deref())
-                .is_some_and(|v| syntax.read_in_code(v))
+            syntax.site(&d.at).is_some_and(|s| {
+                [&s.variable, &s.container]
+                    .into_iter()
+                    .flatten()
+                    .any(|v| syntax.read_in_code(v))
+            })
         })
         .collect();
     // A parameter that, from the first world, changes nothing or nothing the ego can meet may

@@ -569,6 +569,27 @@ fn published(
             ));
         }
     }
+    // Nor the name of a component another Signal gives itself (`Signal("lp", lead.pos)`
+    // publishes `lp.x`, `lp.y` and `lp.z`): one would hide the other.
+    for (k, (name, at)) in b.signals_at.iter().enumerate() {
+        let whole = b.signals_at[..k].iter().find(|(other, _)| {
+            [".x", ".y", ".z"]
+                .iter()
+                .any(|c| *name == format!("{other}{c}") || *other == format!("{name}{c}"))
+        });
+        if let Some((other, first)) = whole {
+            let (vector, component) = if name.len() > other.len() {
+                (other, name)
+            } else {
+                (name, other)
+            };
+            return Err(format!(
+                "Signal `{name}` and Signal `{other}` (declared at {first}) clash: a vector \
+                 Signal `{vector}` is published as `{vector}.x`, `{vector}.y` and `{vector}.z`, \
+                 so `{component}` would read one of them; give one another name\n --> {at}"
+            ));
+        }
+    }
     let mut out = b.published.clone();
     // Whether each published stream carries vectors: `Some(true)` it does, `Some(false)` it
     // carries numbers or bools, `None` unknown until the test runs (a lambda's values; the

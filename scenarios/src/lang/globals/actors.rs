@@ -360,8 +360,8 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                     None if c.downcast_ref::<Stream>().is_none() => bail!(
                         "Pedestrian(car=) takes a position (x, y, z) in m that moves: the actor \
                          whose approach triggers the walk (`car = v`) or a stream of its position \
-                         (`car = v.pos`), got {c} (a {}); a fixed point cannot come near",
-                        c.get_type()
+                         (`car = v.pos`), got {c} ({}); a fixed point cannot come near",
+                        crate::lang::a_type(c.get_type())
                     ),
                     None => typed_arg(c, &mut b, &types::WATCHED_POSITION, owner, &at)?,
                 };

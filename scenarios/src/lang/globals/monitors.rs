@@ -82,7 +82,7 @@ pub(super) fn ego_arg(v: Value, what: &str) -> anyhow::Result<()> {
             ActorKind::Car(_) => "a Car".to_owned(),
             ActorKind::Pedestrian(_) => "a Pedestrian".to_owned(),
         },
-        None => format!("a {}", v.get_type()),
+        None => crate::lang::a_type(v.get_type()),
     };
     bail!(
         "{what} watches the AutonomousVehicle; got {got} (to judge another actor, write a \
