@@ -823,3 +823,19 @@ fn silent_misreadings_found_by_new_programs_are_refused_or_read_right() {
         "{r}"
     );
 }
+
+/// A Monitor or Assert of an open parameter's value is no constant of the campaign: it is
+/// neither warned about as one nor its parameter as unused; `Monitor(5.0)` still is.
+#[test]
+fn a_monitor_of_an_open_value_is_not_a_constant_one() {
+    let s = paracosm_scenarios::lang::load_source(
+        "t.star",
+        "w = World()\nr = RoadSegment(len = 200.0)\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, v)\nk = VarInterval(-1, 1)\nm = Monitor(k)\na = Assert(VarEnum([True, False]))\nc = Monitor(5.0)\n",
+        "t",
+    )
+    .unwrap();
+    let w: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
+    assert_eq!(w.len(), 1, "{w:#?}");
+    assert!(w[0].contains("monitor `c` judges a constant stream"), "{w:#?}");
+    assert!(s.unused_params.is_empty(), "{:?}", s.unused_params);
+}

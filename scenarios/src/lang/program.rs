@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use paracosm_engine::rx::{Host, OpenStream, RxError};
+use paracosm_engine::rx::{Host, Node, OpenStream, RxError, StreamId};
 use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{EngineError, WorldSpec};
 use paracosm_generators::{Assignment, Domain, Param, ParamSpace, Value as Level};
@@ -1089,15 +1089,51 @@ pub fn load(
             },
         });
     }
+    // The constant a published signal holds in a world, if it is one.
+    let constant_of = |published: &[(String, StreamId)], nodes: &[Node], signal: &str| {
+        published
+            .iter()
+            .find(|(n, _)| n == signal)
+            .and_then(|(_, id)| nodes.get(id.0))
+            .and_then(|n| match n {
+                Node::Const(v) => Some(format!("{v:?}")),
+                _ => None,
+            })
+    };
+    // Monitors of a constant in the first world, and whether that constant is an open
+    // parameter's (`Monitor(k)`): then it differs between the worlds of some combinations.
+    let mut constants: Vec<(String, Option<String>, bool)> = first
+        .monitors
+        .iter()
+        .filter_map(|m| m.judged_stream())
+        .map(|(_, signal, _)| {
+            let c = constant_of(&first.published, first.graph.nodes(), signal);
+            (signal.to_owned(), c, false)
+        })
+        .collect();
+    if constants.iter().any(|(_, c, _)| c.is_some()) {
+        let rows = program.combinations();
+        let n = rows.len();
+        for (i, (values, _)) in rows.into_iter().enumerate() {
+            if n > 16 && !(0..16).any(|j| j * (n - 1) / 15 == i) {
+                continue;
+            }
+            let Ok(w) = program.world_for(values) else {
+                continue;
+            };
+            for (signal, c, varies) in constants.iter_mut() {
+                if c.is_some() && constant_of(&w.published, w.streams.nodes(), signal) != *c {
+                    *varies = true;
+                }
+            }
+        }
+    }
     for (m, at) in first.monitors.iter().zip(&first.monitors_at) {
         // A Monitor or Assert of a constant (`Monitor(5.0)`) judges nothing of the world.
         if let Some((name, signal, _)) = m.judged_stream() {
-            let constant = first
-                .published
+            let constant = constants
                 .iter()
-                .find(|(n, _)| n == signal)
-                .and_then(|(_, id)| first.graph.nodes().get(id.0))
-                .is_some_and(|n| matches!(n, paracosm_engine::rx::Node::Const(_)));
+                .any(|(s, c, varies)| s == signal && c.is_some() && !varies);
             if constant {
                 warnings.push(Warning {
                     at: at.clone(),

@@ -147,6 +147,8 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
             .map(|c| c.speed.0)
             .chain(a.pedestrians.iter().map(|p| p.speed.0))
             .chain([a.environment.fog.0])
+            // What the monitors judge: `Monitor(k)`, `Assert(VarEnum([True, False]))`.
+            .chain(a.published.iter().map(|(_, id)| id.0))
             .collect();
         for (i, (x, y)) in na.iter().zip(nb).enumerate() {
             if debug(x) == debug(y) {
