@@ -392,6 +392,9 @@ d = VarInterval(2, 3, unit = "m/s")
 sz = VarInterval(1, 2, unit = "km/h")
 o2 = Obstacle(loc = r.onLane(-2, 250), size = (1, 1, sz))
 tick.filter(lambda t: t > 100).take(1).foreach(c.brake(d))
+tick.filter(lambda t: t > 100).take(1).foreach(c.changeLane(-1, duration = VarInterval(1, 2, unit = "m")))
+dur = VarInterval(1, 2, unit = "km")
+tick.filter(lambda t: t > 200).take(1).foreach(c.changeLane(-1, dur))
 w.place(r, v, c, o, o2)
 CollisionMonitor(v)
 "#;
@@ -405,6 +408,8 @@ CollisionMonitor(v)
         "`o.size[0]` is declared in s but feeds Obstacle(size[0]=), which is in m",
         "`d` is declared in m/s but feeds brake(decel=), which is in m/s²",
         "`sz` is declared in km/h but feeds Obstacle(size[2]=), which is in m",
+        "`c.changeLane` is declared in m but feeds changeLane(duration=), which is in s",
+        "`dur` is declared in km but feeds changeLane(duration=), which is in s",
     ] {
         assert!(w.contains(&expected), "{expected}\n{w:#?}");
     }

@@ -79,6 +79,7 @@ fn positional_keyword(method: &str, position: usize) -> Option<&'static str> {
         ("onLane", 1) => Some("at"),
         ("brake", 0) => Some("decel"),
         ("setSpeed", 0) => Some("v"),
+        ("changeLane", 1) => Some("duration"),
         _ => None,
     }
 }

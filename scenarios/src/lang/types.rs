@@ -130,6 +130,7 @@ pub fn input_of(builtin: &str, keyword: &str) -> Option<Input> {
         ("onLane", "at") => number("at", "m", f64::NEG_INFINITY, f64::INFINITY, false),
         ("brake", "decel") => number("decel", "m/s²", 0.0, f64::INFINITY, true),
         ("setSpeed", "v") => number("v", "m/s", 0.0, f64::INFINITY, false),
+        ("changeLane", "duration") => number("duration", "s", 0.0, f64::INFINITY, true),
         _ => return None,
     })
 }
