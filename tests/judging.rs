@@ -841,6 +841,9 @@ fn a_monitor_of_an_open_value_is_not_a_constant_one() {
     .unwrap();
     let w: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
     assert_eq!(w.len(), 1, "{w:#?}");
-    assert!(w[0].contains("monitor `c` judges a constant stream"), "{w:#?}");
+    assert!(
+        w[0].contains("monitor `c` judges a constant stream"),
+        "{w:#?}"
+    );
     assert!(s.unused_params.is_empty(), "{:?}", s.unused_params);
 }

@@ -7,6 +7,11 @@ use super::eval::{eval_bounds, robustness, Trace};
 use super::Formula;
 use crate::{Frame, Monitor, Verdict};
 
+/// The trace's name for the frames' times, kept only for a formula that reads no signal
+/// (`G[0,1] (3 > 2)`): a trace's length is its signals', and without one every window would
+/// be empty (robustness `+inf`). No formula can name it: a signal name has no space.
+const CLOCK: &str = " clock";
+
 /// Check whether the verdict is settled every this many samples (0.25 s at 60 Hz): each check
 /// re-evaluates the trace, so checking every sample would make a test quadratic.
 const CHECK_EVERY: usize = 15;
@@ -49,11 +54,16 @@ impl StlMonitor {
     /// A monitor named `name` (its key in results files) for `formula`.
     pub fn new(name: &str, formula: Formula) -> Self {
         let signals = formula.signals();
+        let mut columns: std::collections::BTreeMap<String, Vec<f64>> =
+            signals.iter().map(|s| (s.clone(), Vec::new())).collect();
+        if columns.is_empty() {
+            columns.insert(CLOCK.to_owned(), Vec::new());
+        }
         StlMonitor {
             name: name.to_owned(),
             trace: Trace {
                 dt_s: 1.0,
-                signals: signals.iter().map(|s| (s.clone(), Vec::new())).collect(),
+                signals: columns,
             },
             signals,
             formula,
@@ -143,6 +153,9 @@ impl Monitor for StlMonitor {
                     return ControlFlow::Break(());
                 }
             }
+        }
+        if let Some(clock) = self.trace.signals.get_mut(CLOCK) {
+            clock.push(frame.t_s);
         }
         self.times.push(frame.t_s);
         if let [t0, t1] = self.times[..] {
@@ -242,6 +255,15 @@ mod tests {
         // Decided only by the end of the trace (the window reaches past it): its last sample.
         let (v, _) = run("F[0,10] (x > 1000)", |i| i as f64, 100);
         assert_eq!((v.passed, v.first_violation_s), (false, Some(99.0 / 60.0)));
+    }
+
+    #[test]
+    fn a_formula_of_constants_has_the_robustness_of_its_comparison() {
+        for (formula, expected) in [("G[0,1] (3 > 2)", 1.0), ("F[0,1] (2 >= 3)", -1.0)] {
+            let (v, _) = run(formula, |_| 0.0, 120);
+            assert_eq!(v.robustness, expected, "{formula}");
+            assert_eq!(v.passed, expected > 0.0, "{formula}");
+        }
     }
 
     #[test]

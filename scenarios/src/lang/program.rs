@@ -1147,6 +1147,15 @@ pub fn load(
         let MonitorSpec::Stl { name, formula } = m else {
             continue;
         };
+        if paracosm_oracles::stl::parse(formula).is_ok_and(|f| f.signals().is_empty()) {
+            warnings.push(Warning {
+                at: at.clone(),
+                message: format!(
+                    "Stl monitor `{name}` reads no signal: its verdict is the same in every test, \
+                     whatever the world does"
+                ),
+            });
+        }
         let clamped = paracosm_oracles::stl::parse(formula)
             .map(|f| f.clamped(program.horizon_s).1)
             .unwrap_or(false);
