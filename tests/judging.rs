@@ -847,3 +847,19 @@ fn a_monitor_of_an_open_value_is_not_a_constant_one() {
     );
     assert!(s.unused_params.is_empty(), "{:?}", s.unused_params);
 }
+
+/// A horizon between two steps is rounded up to whole steps of 1/60 s: 0.005 s runs one step
+/// (it ran none, and every monitor judged an empty test), 1.01 s runs 61.
+#[test]
+fn a_horizon_between_steps_is_rounded_up() {
+    for (horizon, steps) in [("0.005", 1.0), ("1.01", 61.0), ("2.0", 120.0)] {
+        let (r, _) = run_one(
+            &format!(
+                "w = World()\nr = RoadSegment(len = 200.0)\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, v)\nCollisionMonitor(v)\ntest(horizon = {horizon})\n"
+            ),
+            0,
+        );
+        let simulated = number(&r["metrics"]["simulated_s"]);
+        assert!((simulated - steps / 60.0).abs() < 1e-9, "{horizon}: {r}");
+    }
+}

@@ -353,7 +353,9 @@ impl Scenario {
                     .any(|m| m.reads_runner_signal(signal::EGO_LANE_OFFSET_M)),
             },
         };
-        let ticks = (self.horizon_s / spec.dt_s).round() as u64;
+        // Whole steps covering the horizon: a horizon between two steps is rounded up (a
+        // horizon of 0.005 s is one step, not none), within 1e-9 of a step it is that step.
+        let ticks = ((self.horizon_s / spec.dt_s - 1e-9).ceil() as u64).max(1);
         // Streams are evaluated for the state a snapshot shows, so a published stream's value
         // and the runner's own signals describe the same moment.
         sim.evaluate(host)?;
