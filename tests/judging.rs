@@ -863,3 +863,36 @@ fn a_horizon_between_steps_is_rounded_up() {
         assert!((simulated - steps / 60.0).abs() < 1e-9, "{horizon}: {r}");
     }
 }
+
+/// An error a lambda raises during a test names the moment, the stream that called it and
+/// the program's line, without starlark's header for a call from the engine.
+#[test]
+fn a_lambdas_error_during_a_test_names_the_time_and_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("t.star");
+    std::fs::write(
+        &file,
+        "w = World()\nr = RoadSegment(len = 200.0)\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, v)\ndef f(t):\n    return 1 // 0 if t > 1 else 1.0\nm = Monitor(tick.map(f))\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = fuzz(&[
+        file.to_str().unwrap(),
+        "--budget",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 3);
+    let r = records(&out).remove(0);
+    let e = r["error"].as_str().unwrap();
+    assert!(e.starts_with("at t = 1.017 s, "), "{e}");
+    assert!(
+        e.contains("t.star:7:13: ") && e.contains("t.star:6:12"),
+        "{e}"
+    );
+    assert!(
+        e.contains("Floor division by zero") && !e.contains("Traceback"),
+        "{e}"
+    );
+}

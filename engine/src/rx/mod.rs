@@ -89,7 +89,7 @@ pub enum RxError {
         expected: String,
     },
     /// A host function (a Starlark lambda) failed.
-    #[error("{at}: {message}")]
+    #[error("{}{at}: {message}", at_time(.t_s))]
     Host {
         /// The node that called it.
         node: usize,
@@ -97,5 +97,14 @@ pub enum RxError {
         at: String,
         /// The host's message.
         message: String,
+        /// Simulated time of the step it failed in, s; `None` outside a step (the check at
+        /// load).
+        t_s: Option<f64>,
     },
+}
+
+/// `at t = 1.017 s, ` for an error at a known time, else nothing.
+fn at_time(t_s: &Option<f64>) -> String {
+    t_s.map(|t| format!("at t = {t:.3} s, "))
+        .unwrap_or_default()
 }

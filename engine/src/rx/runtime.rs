@@ -202,7 +202,22 @@ impl Runtime {
                 self.states[i].fired = !self.states[i].done;
                 continue;
             }
-            let out = self.eval(i, t_s, inputs, host, sinks)?;
+            let out = self
+                .eval(i, t_s, inputs, host, sinks)
+                .map_err(|e| match e {
+                    RxError::Host {
+                        node,
+                        at,
+                        message,
+                        t_s: None,
+                    } => RxError::Host {
+                        node,
+                        at,
+                        message,
+                        t_s: Some(t_s),
+                    },
+                    e => e,
+                })?;
             let s = &mut self.states[i];
             s.fired = out.is_some();
             if let Some(v) = out {
@@ -561,6 +576,7 @@ fn call(
                 node,
                 at: streams.graph.site(node),
                 message,
+                t_s: None,
             }),
     }
 }

@@ -154,7 +154,19 @@ impl Host for StarHost<'_, '_, '_, '_> {
                     memory::MAX_LAMBDA_HEAP_BYTES >> 20
                 ))
             }
-            (out, _) => out.map_err(|e| format!("{e}"))?,
+            // starlark's header says nothing here (the call comes from the engine, "File
+            // <builtin>"); the frames of the program's own functions and the located error
+            // stay.
+            (out, _) => out.map_err(|e| {
+                format!("{e}")
+                    .lines()
+                    .filter(|l| {
+                        !(l.starts_with("Traceback (most recent call last)")
+                            || l.trim_start().starts_with("File <builtin>"))
+                    })
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            })?,
         };
         // A function given to foreach may return the action to perform: bound
         // (`c.setSpeed(2.0)`), or unbound (`c.setSpeed`), which takes the event's value as
