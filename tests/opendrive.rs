@@ -398,3 +398,48 @@ fn vision_keeps_its_lane_round_the_map_bend() {
         );
     }
 }
+
+/// A route's turn that a fork of the map lacks is an error at load naming the turn, the
+/// road and lane that end there and the turns the fork offers, as on paracosm's own pieces
+/// (the ring's forks offer straight on and an exit to the right: `left` was taken as
+/// straight on without a word). The turns it offers load.
+#[test]
+fn a_turn_a_map_fork_lacks_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = |route: &str| {
+        format!(
+            "m = OpenDrive(\"maps/roundabout.xodr\")\nw = World()\nc = Car(loc = m.onLane(road = \"1\", lane = 1, s = 40.0), speed = 6.0, route = {route})\nv = AutonomousVehicle(loc = m.onLane(road = \"3\", lane = -1, s = 55.0), speed = 0.0)\nw.place(m, v, c)\nCollisionMonitor(v)\n"
+        )
+    };
+    let file = program(dir.path(), "left.star", &src("[\"left\", \"right\"]"));
+    let o = fuzz(&[
+        file.to_str().unwrap(),
+        "--budget",
+        "1",
+        "--out",
+        dir.path().join("o1").to_str().unwrap(),
+    ]);
+    expect_code(&o, 2);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("Car c: the route's turn 1 (\"left\") is not possible at the fork")
+            && stderr.contains("roundabout.xodr ends: it offers \"straight\" and \"right\" there")
+            && stderr.contains("left.star:5:1"),
+        "{stderr}"
+    );
+    for route in ["[\"straight\", \"right\"]", "[\"right\"]", "[]"] {
+        let file = program(dir.path(), "ok.star", &src(route));
+        let o = fuzz(&[
+            file.to_str().unwrap(),
+            "--budget",
+            "1",
+            "--out",
+            dir.path().join("o2").to_str().unwrap(),
+            "--force",
+        ]);
+        assert!(
+            o.status.code() == Some(0) || o.status.code() == Some(1),
+            "{route}: {o:?}"
+        );
+    }
+}

@@ -181,7 +181,10 @@ impl Network {
         if let (Some(lane), super::PieceKind::Map { map, .. }) =
             (start.map_lane, &self.pieces[start.piece.0].kind)
         {
-            let points = map.0.route(lane, start.at_m, turns, max_len_m);
+            let points = map
+                .0
+                .route(lane, start.at_m, turns, max_len_m)
+                .map_err(EngineError::InvalidWorld)?;
             return Ok(resample(&points, ROUTE_SPACING_M));
         }
         let j = k.unsigned_abs();

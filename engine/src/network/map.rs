@@ -226,11 +226,22 @@ impl RoadMap {
 
     /// The route from road station `s` of lane `lane` in its direction of travel, then on
     /// through its successors until the lanes end or the route is `max_len_m` long. At a
-    /// fork it takes the next turn of `turns` (straight on when the list is used up or the
-    /// turn is not there): straight on is the successor whose heading at its end differs
-    /// least from the lane's at its end, left and right the ones that turn most to either
-    /// side of it. World `[x, z]` m.
-    pub fn route(&self, lane: usize, s: f64, turns: &[Turn], max_len_m: f64) -> Vec<[f64; 2]> {
+    /// fork it takes the next turn of `turns` (straight on when the list is used up):
+    /// straight on is the successor whose heading at its end differs least from the lane's
+    /// at its end, left and right the ones that turn most to either side of it. World
+    /// `[x, z]` m.
+    ///
+    /// # Errors
+    /// A message when a fork lacks the turn the list gives it (naming the turn, its place in
+    /// the list, the road and lane that end there and the turns the fork offers): a turn is
+    /// never replaced by another. Turns left over where the lanes end are not an error.
+    pub fn route(
+        &self,
+        lane: usize,
+        s: f64,
+        turns: &[Turn],
+        max_len_m: f64,
+    ) -> Result<Vec<[f64; 2]>, String> {
         let l = &self.lanes[lane];
         let mut points = vec![l.pose(s).0];
         let ahead =
@@ -249,7 +260,7 @@ impl RoadMap {
             .windows(2)
             .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
             .sum();
-        let mut turns = turns.iter();
+        let mut turns = turns.iter().enumerate();
         let mut at = lane;
         let mut visits = 0usize;
         while length < max_len_m && visits < 10_000 {
@@ -275,13 +286,31 @@ impl RoadMap {
                         Turn::Left => left,
                         Turn::Right => right,
                     };
-                    let wanted = turns.next().copied();
-                    let i = wanted
-                        .into_iter()
-                        .chain([Turn::Straight])
-                        .find_map(of)
-                        .unwrap_or(straight);
-                    next[i]
+                    match turns.next() {
+                        None => next[straight],
+                        Some((k, &t)) => match of(t) {
+                            Some(i) => next[i],
+                            None => {
+                                let offered: Vec<String> =
+                                    [Turn::Straight, Turn::Left, Turn::Right]
+                                        .into_iter()
+                                        .filter(|&o| of(o).is_some())
+                                        .map(|o| format!("\"{}\"", o.name()))
+                                        .collect();
+                                let here = &self.lanes[at];
+                                return Err(format!(
+                                    "the route's turn {} (\"{}\") is not possible at the fork \
+                                     where lane {} of road {} of {} ends: it offers {} there",
+                                    k + 1,
+                                    t.name(),
+                                    here.od_id,
+                                    self.roads[here.road].od_id,
+                                    self.source,
+                                    offered.join(" and ")
+                                ));
+                            }
+                        },
+                    }
                 }
             };
             for q in self.lanes[pick].travel_points() {
@@ -298,7 +327,7 @@ impl RoadMap {
             let (p, h) = l.pose(s);
             points.push([p[0] + h.cos() * 0.5, p[1] - h.sin() * 0.5]);
         }
-        points
+        Ok(points)
     }
 
     /// Every lane's strip as triangles: vertices (world `[x, z]` m, the left and right
