@@ -896,3 +896,34 @@ fn a_lambdas_error_during_a_test_names_the_time_and_its_line() {
         "{e}"
     );
 }
+
+/// An NPC car brakes ahead of a dead end no harder than its tyres let it (`μ·g`) and stops
+/// with its front at the end (it stopped from 15 m/s within one step, its centre at the end).
+#[test]
+fn a_car_brakes_for_a_dead_end_within_its_grip() {
+    for mu in [0.8, 0.1] {
+        let (r, _) = run_one(
+            &format!(
+                r#"
+r = RoadSegment(len = 300.0, friction = {mu})
+w = World()
+v = AutonomousVehicle(loc = r.onLane(-1, 295.0), speed = 0.0)
+c = Car(loc = r.onLane(1, 5.0), speed = 15.0)
+prev = c.speed.take(1).concat(c.speed)
+decel = c.speed.zip(prev).map(lambda p: (p[1] - p[0]) * 60.0)
+grip = Monitor(decel.map(lambda d: {mu} * 9.81 * (1 + 1e-6) - d))
+front = Monitor(c.pos.map(lambda p: p.x + 2.25 - 300.0 + 1e-6), over = "end")
+still = Monitor(c.speed.map(lambda s: 1e-9 - s), over = "end")
+test(horizon = 30.0, offroad = False)
+w.place(r, v, c)
+"#
+            ),
+            0,
+        );
+        let m = &r["monitors"];
+        for name in ["grip", "front", "still"] {
+            assert_eq!(m[name]["passed"], true, "μ = {mu}, {name}: {m}");
+        }
+        assert!(number(&m["front"]["robustness"]) < 1e-3, "μ = {mu}: {m}");
+    }
+}

@@ -63,6 +63,33 @@ pub(crate) struct AwakeZone {
     pub(crate) radius_m: f64,
 }
 
+/// The highest speed (m/s) a car may move at over the next step of `dt_s` s and still stop
+/// within `d_m` m braking at no more than `a_mps2`, in the runner's discrete motion (each step
+/// moves `v·dt` and changes `v` by at most `a·dt`; it stops after a step slower than `a·dt`).
+/// From speed `v` in `(n·u, (n+1)·u]`, `u = a·dt`, the shortest stop is the `n + 1` steps
+/// `v, v − u, …, v − n·u`, `dt·(n+1)·(v − n·u/2)` m; this inverts it. `0` for `d_m <= 0`.
+fn stopping_speed(d_m: f64, a_mps2: f64, dt_s: f64) -> f64 {
+    if d_m <= 0.0 {
+        return 0.0;
+    }
+    if !(a_mps2 > 0.0 && dt_s > 0.0) {
+        return f64::INFINITY;
+    }
+    let u = a_mps2 * dt_s;
+    // The distance of the shortest stop from speed (n + 1)·u: dt·u·(n+1)(n+2)/2.
+    let full = |n: f64| dt_s * u * (n + 1.0) * (n + 2.0) / 2.0;
+    let mut n = ((-3.0 + (1.0 + 8.0 * d_m / (dt_s * u)).sqrt()) / 2.0)
+        .ceil()
+        .max(0.0);
+    while n > 0.0 && full(n - 1.0) >= d_m {
+        n -= 1.0;
+    }
+    while full(n) < d_m {
+        n += 1.0;
+    }
+    d_m / (dt_s * (n + 1.0)) + u * n / 2.0
+}
+
 /// Gravitational acceleration in m/s², for the tyres' friction limit `μ·g`.
 pub(crate) const GRAVITY_MPS2: f64 = 9.81;
 
@@ -72,11 +99,18 @@ pub(crate) const GRAVITY_MPS2: f64 = 9.81;
 /// It enters the test at its commanded speed; from then on its speed follows the command no
 /// faster than its tyres allow: by at most `μ·g` m/s² (the friction circle's longitudinal
 /// limit), where `μ` is the friction of the road piece under the car that step (or the
-/// ground's off the network).
+/// ground's off the network). Where its path ends (a dead end) it brakes at most as hard, to
+/// stop with its front at the end: its speed is held to the fastest from which it can still
+/// stop there ([`stopping_speed`], about `√(2·μ·g·d)`, `d` the distance left). A car that
+/// enters the test too fast to stop before the end brakes at `μ·g` from its first step and
+/// stops at the end with what speed is left.
 pub(crate) struct Car {
     pub(crate) body: Option<(RigidBodyHandle, ColliderHandle)>,
     path: Vec<[f64; 2]>,
     cumulative: Vec<f64>,
+    /// Arc length where it stops, m: its front at the path's end (half its length before
+    /// it), or where it starts when that is beyond.
+    stop_s: f64,
     /// The leg the car was on at its last lookup, and that leg's heading (rad): arc lengths
     /// only grow, so the next lookup walks on from there instead of searching the whole
     /// path, and the heading is worked out once per leg.
@@ -124,10 +158,12 @@ impl Car {
             let last = *cumulative.last().expect("non-empty");
             cumulative.push(last + (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]));
         }
+        let stop_s = (cumulative.last().expect("non-empty") - size.length_m / 2.0).max(0.0);
         let mut car = Car {
             body: None,
             path,
             cumulative,
+            stop_s,
             leg: std::cell::Cell::new((0, f64::NAN)),
             s: 0.0,
             speed: 0.0,
@@ -326,11 +362,15 @@ impl Car {
         zone: AwakeZone,
     ) {
         let start = self.here;
-        let end = *self.cumulative.last().expect("non-empty");
+        let end = self.stop_s.max(self.s);
         let before = self.s;
-        let wanted = speed_mps.max(0.0);
+        // No faster than it can still stop at the end, braking at `μ·g`.
+        let room = stopping_speed(end - self.s, friction * GRAVITY_MPS2, dt_s);
+        let wanted = speed_mps.max(0.0).min(room);
         let rolling = match self.rolling {
-            None => wanted,
+            // It enters the test at its command; one too fast to stop before the end brakes
+            // at `μ·g` from the first step and stops at the end.
+            None => speed_mps.max(0.0),
             Some(v) => {
                 let dv = friction * GRAVITY_MPS2 * dt_s;
                 wanted.clamp(v - dv, v + dv)
@@ -424,6 +464,43 @@ impl Car {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Braking by [`stopping_speed`] each step, the discrete motion stops exactly at the
+    /// end, never braking harder than `a` (to rounding), from any speed and distance.
+    #[test]
+    fn stopping_speed_stops_at_the_end_within_the_limit() {
+        let dt = 1.0 / 60.0;
+        for a in [0.49, 0.98, 7.85, 16.7] {
+            for v0 in [0.5, 3.0, 15.0, 50.0] {
+                for d0 in [0.01, 0.7, 7.5, 92.75] {
+                    let (mut s, mut v_prev) = (0.0f64, None::<f64>);
+                    let mut worst: f64 = 0.0;
+                    // The first step enters at the capped speed (as `advance` does).
+                    let mut last = None::<f64>;
+                    for _ in 0..100_000 {
+                        let want = v0.min(stopping_speed(d0 - s, a, dt));
+                        let v = match v_prev {
+                            None => want,
+                            Some(p) => want.clamp(p - a * dt, p + a * dt),
+                        };
+                        let before = s;
+                        s = (s + v * dt).min(d0);
+                        let moved = (s - before) / dt;
+                        if let Some(l) = last {
+                            worst = worst.max((l - moved) / dt);
+                        }
+                        last = Some(moved);
+                        v_prev = Some(if s >= d0 { 0.0 } else { v });
+                        if s >= d0 && moved == 0.0 {
+                            break;
+                        }
+                    }
+                    assert_eq!(s, d0, "a {a}, v0 {v0}, d {d0}");
+                    assert!(worst <= a * (1.0 + 1e-6), "a {a}, v0 {v0}, d {d0}: {worst}");
+                }
+            }
+        }
+    }
 
     fn car(path: Vec<[f64; 2]>) -> Car {
         let size = Size {
