@@ -781,7 +781,7 @@ fn objects_are_named_by_their_variable_or_where_they_were_made() {
         "{ROAD}lead = Car(loc = r.onLane(1, 10))\nw.place(r, v, lead)\n"
     ));
     assert!(
-        e.contains("AutonomousVehicle v and Car lead start in collision"),
+        e.contains("AutonomousVehicle v (t.star:4:5) and Car lead (t.star:5:8) start in collision"),
         "{e}"
     );
 }

@@ -240,7 +240,8 @@ impl Network {
             .collect()
     }
 
-    fn port_name(&self, (piece, port): (PieceId, usize)) -> String {
+    /// A port as messages name it: its piece's name and the port's (`RoadSegment r.TWO`).
+    pub fn port_name(&self, (piece, port): (PieceId, usize)) -> String {
         format!("{}.{}", self.pieces[piece.0].name, PORT_NAMES[port])
     }
 
@@ -375,11 +376,23 @@ impl Network {
     /// # Errors
     /// [`EngineError::InvalidWorld`] naming the first overlapping pair.
     pub fn check_all_overlaps(&self) -> Result<(), EngineError> {
-        for i in 0..self.pieces.len() {
-            let ys: Vec<PieceId> = (i + 1..self.pieces.len()).map(PieceId).collect();
-            self.check_overlaps(&[PieceId(i)], &ys)?;
+        match self.first_overlap() {
+            Some((a, b)) => Err(EngineError::InvalidWorld(format!(
+                "road pieces overlap: {} and {}",
+                self.pieces[a.0].name, self.pieces[b.0].name
+            ))),
+            None => Ok(()),
         }
-        Ok(())
+    }
+
+    /// The first pair of pieces that overlap (in piece order; see
+    /// [`Network::check_overlaps`]), if any.
+    pub fn first_overlap(&self) -> Option<(PieceId, PieceId)> {
+        (0..self.pieces.len()).find_map(|i| {
+            (i + 1..self.pieces.len())
+                .find(|&j| self.overlap(PieceId(i), PieceId(j)))
+                .map(|j| (PieceId(i), PieceId(j)))
+        })
     }
 
     /// The piece's footprint as convex parts in world coordinates, shrunk by

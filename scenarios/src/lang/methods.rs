@@ -356,7 +356,7 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
         #[starlark(require = pos)] first: Option<Value<'v>>,
         #[starlark(require = pos)] second: Option<Value<'v>>,
         at: Option<Value<'v>>,
-        #[starlark(require = named)] lane: Option<Value<'v>>,
+        lane: Option<Value<'v>>,
         #[starlark(require = named)] port: Option<Value<'v>>,
         #[starlark(require = named)] turn: Option<Value<'v>>,
         #[starlark(require = named)] road: Option<Value<'v>>,
@@ -532,25 +532,36 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
                 })?;
             let items = t.content();
             let port = |v: Value<'v>| {
-                v.downcast_ref::<Port>()
-                    .copied()
-                    .ok_or_else(|| anyhow!("expected a port such as t.ONE, got {v}"))
+                v.downcast_ref::<Port>().copied().ok_or_else(|| {
+                    anyhow!(
+                        "connect's tuples name ports first and last (such as t.ONE), got {}",
+                        crate::lang::a_type(v.get_type())
+                    )
+                })
             };
             let (p, c) = (port(items[0])?, port(items[2])?);
-            let child = items[1]
-                .downcast_ref::<Road>()
-                .ok_or_else(|| anyhow!("expected a road piece, got {}", items[1]))?;
+            let child = items[1].downcast_ref::<Road>().ok_or_else(|| {
+                anyhow!(
+                    "connect's tuples name a road piece second, got {}",
+                    crate::lang::a_type(items[1].get_type())
+                )
+            })?;
+            let port_name = |q: Port| b.roads.port_name((PieceId(q.piece), q.index));
+            let piece_name = |i: usize| b.roads.piece(PieceId(i)).name.clone();
             if c.piece != child.piece {
                 bail!(
-                    "the child port {} does not belong to the child road {}",
-                    items[2],
-                    items[1]
+                    "the child port {} is not a port of the child {}: the third item of each \
+                     tuple is a port of the second",
+                    port_name(c),
+                    piece_name(child.piece),
                 );
             }
             if b.roads.group_of(PieceId(p.piece)) != b.roads.group_of(PieceId(this.piece)) {
                 bail!(
-                    "port {} belongs to neither this road nor its network",
-                    items[0]
+                    "the port {} belongs to neither {} nor a piece already connected to it: \
+                     connect it from its own piece or network",
+                    port_name(p),
+                    piece_name(this.piece)
                 );
             }
             b.roads

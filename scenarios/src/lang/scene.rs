@@ -235,6 +235,8 @@ pub struct SceneBuilder {
     pub roads: Network,
     /// Each piece's friction stream.
     pub frictions: Vec<(PieceId, StreamId)>,
+    /// Where each road piece was declared (`file:line:col`), by piece.
+    pub pieces_at: Vec<String>,
     /// The ego vehicle, once placed: the engine's spec (an actor goes from its declaration,
     /// [`Pending`], straight to the engine's spec when `place` resolves its locations).
     pub ego: Option<EgoSpec>,
@@ -331,6 +333,7 @@ impl SceneBuilder {
             values,
             roads: Network::new(),
             frictions: Vec::new(),
+            pieces_at: Vec::new(),
             ego: None,
             sut: None,
             pedestrians: Vec::new(),
@@ -420,6 +423,16 @@ fn over_time_streams(b: &SceneBuilder, horizon_s: f64) -> Vec<OpenStream> {
 /// The test's world from a finished, placed evaluation.
 ///
 /// # Errors
+/// An object's name with where it was declared, `Car c (f.star:4:5)`, unless the name already
+/// says it (`Car at f.star:2:12 (called from ...)`).
+fn declared(name: &str, at: &str) -> String {
+    if at.is_empty() || name.contains(at) {
+        name.to_owned()
+    } else {
+        format!("{name} ({at})")
+    }
+}
+
 /// A message when the program placed nothing or no ego vehicle, or its graph is invalid.
 pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
     let ego = b
@@ -741,7 +754,17 @@ impl SceneBuilder {
         if self.placed {
             return Err("place(...) may be called only once".into());
         }
-        self.roads.check_all_overlaps().map_err(strip)?;
+        if let Some((a, b)) = self.roads.first_overlap() {
+            let named = |p: PieceId| {
+                let name = &self.roads.piece(p).name;
+                declared(name, self.pieces_at.get(p.0).map_or("", String::as_str))
+            };
+            return Err(format!(
+                "road pieces overlap: {} and {}",
+                named(a),
+                named(b)
+            ));
+        }
         for &o in objects {
             self.objects[o].placed = true;
         }
@@ -769,7 +792,7 @@ impl SceneBuilder {
             };
             let at = resolve(self, loc)?;
             placed.push(Placed {
-                name: o.name.clone(),
+                name: declared(&o.name, &o.at),
                 footprint: match footprint {
                     Some(size) => Footprint::Vehicle {
                         pos_m: at.pos_m,

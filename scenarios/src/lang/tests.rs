@@ -100,7 +100,7 @@ fn objects_starting_in_collision_are_both_named() {
     let src = format!("{HEADER}c = Car(loc = r.onLane(1, 12))\nw.place(r, v, c)\n");
     assert_diag(
         &src,
-        "AutonomousVehicle v and Car c start in collision",
+        "AutonomousVehicle v (bad.star:3:5) and Car c (bad.star:4:5) start in collision",
         "5:1",
     );
 }
@@ -108,7 +108,22 @@ fn objects_starting_in_collision_are_both_named() {
 #[test]
 fn a_vehicle_off_the_road_is_refused() {
     let src = format!("{HEADER}c = Car(loc = r.onLane(r.SideWalk, 50))\nw.place(r, v, c)\n");
-    assert_diag(&src, "Car c is off the road", "5:1");
+    assert_diag(&src, "Car c (bad.star:4:5) is off the road", "5:1");
+}
+
+/// Overlapping road pieces are named with where each was declared (LANGUAGE.md, `place`).
+#[test]
+fn overlapping_pieces_are_named_with_their_lines() {
+    let src = format!(
+        "{HEADER}r2 = RoadSegment(len = 50.0)
+w.place(r, v)
+"
+    );
+    assert_diag(
+        &src,
+        "road pieces overlap: RoadSegment r (bad.star:2:5) and RoadSegment r2 (bad.star:4:6)",
+        "5:1",
+    );
 }
 
 #[test]
@@ -676,4 +691,30 @@ fn type_names_take_their_article_and_common_slips_get_a_hint() {
     // Another syntax error gets no such note.
     let m = err(&format!("{HEADER}n = [2, 4\nw.place(r, v)\n"));
     assert!(!m.contains("VarEnum([2, 4, 6])"), "{m}");
+}
+
+/// A junction's `onLane` takes its lane fourth by position as by keyword.
+#[test]
+fn a_junctions_lane_may_come_fourth() {
+    let src = "t = TIntersection(nlanes = 4)\ne = RoadSegment(len = 60.0, nlanes = 4)\ns = RoadSegment(len = 60.0, nlanes = 4)\nt.connect((t.ONE, e, e.ONE), (t.TWO, s, s.ONE))\nw = World()\nv = AutonomousVehicle(loc = s.onLane(-1, 40))\na = t.onLane(t.ONE, \"left\", 1.0, 2)\nb = t.onLane(t.ONE, \"left\", 1.0, lane = 2)\nc = t.onLane(t.ONE, \"left\", 1.0)\nif a.lane != 2 or a != b or a == c:\n    fail(\"lane by position\")\nw.place(t, e, s, v)\nCollisionMonitor(v)\n";
+    load_source("ok.star", src, "ok").unwrap_or_else(|e| panic!("{e}"));
+}
+
+/// `connect`'s mistakes name the pieces and ports by their variables.
+#[test]
+fn connect_errors_name_pieces_by_their_variables() {
+    let head =
+        "a = RoadSegment(len = 50.0)\nb = RoadSegment(len = 50.0)\nc = RoadSegment(len = 50.0)\n";
+    let m = err(&format!("{head}a.connect((a.TWO, b, c.ONE))\n"));
+    assert!(
+        m.contains("the child port RoadSegment c.ONE is not a port of the child RoadSegment b"),
+        "{m}"
+    );
+    let m = err(&format!("{head}a.connect((b.TWO, c, c.ONE))\n"));
+    assert!(
+        m.contains("the port RoadSegment b.TWO belongs to neither RoadSegment a nor"),
+        "{m}"
+    );
+    let m = err(&format!("{head}a.connect((a.TWO, 5, c.ONE))\n"));
+    assert!(m.contains("a road piece second, got an int"), "{m}");
 }

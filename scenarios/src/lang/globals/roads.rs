@@ -50,6 +50,7 @@ pub(super) fn add_piece(
         .add(&name, kind)
         .map_err(|e| anyhow!(crate::lang::scene::strip(e)))?;
     b.frictions.push((id, friction));
+    b.pieces_at.push(super::here(eval));
     Ok(Road {
         piece: id.0,
         ports,
