@@ -718,3 +718,24 @@ fn connect_errors_name_pieces_by_their_variables() {
     let m = err(&format!("{head}a.connect((a.TWO, 5, c.ONE))\n"));
     assert!(m.contains("a road piece second, got an int"), "{m}");
 }
+
+/// A parameter's explicit name is a key of results.jsonl and a CSV column: empty or with
+/// spaces it is refused.
+#[test]
+fn a_parameter_name_with_spaces_or_none_is_refused() {
+    for name in ["", "a b", " a", "a\tb"] {
+        let m = err(&format!(
+            "{HEADER}x = VarInterval(0, 1, name = {name:?})\nw.place(r, v)\n"
+        ));
+        assert!(
+            m.contains("is no parameter name") && m.contains("bad.star:4:5"),
+            "{m}"
+        );
+    }
+    load_source(
+        "ok.star",
+        &format!("{HEADER}x = VarInterval(0, 1, name = \"lead.gap[0]\")\nw.place(r, v)\nCollisionMonitor(v)\n"),
+        "ok",
+    )
+    .unwrap();
+}

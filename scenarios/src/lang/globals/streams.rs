@@ -23,6 +23,14 @@ pub(super) fn declare_param<'v>(
     eval: &mut Evaluator<'v, '_, '_>,
     decl: ParamDecl,
 ) -> anyhow::Result<Value<'v>> {
+    if let Some(n) = &decl.name {
+        if n.is_empty() || n.chars().any(|c| c.is_whitespace() || c.is_control()) {
+            anyhow::bail!(
+                "name = {n:?} is no parameter name: a name keys results.jsonl's params, the CSV \
+                 columns and test(map=), so it is written without spaces (letters, digits, _ . [ ])"
+            );
+        }
+    }
     let heap = eval.heap();
     let st = state(eval)?;
     let got = st
