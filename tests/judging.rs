@@ -927,3 +927,35 @@ w.place(r, v, c)
         assert!(number(&m["front"]["robustness"]) < 1e-3, "μ = {mu}: {m}");
     }
 }
+
+/// A car on a loop drives on for the whole horizon: routes are planned as far as 60 m/s goes
+/// in the horizon (a route stopped at 5 km, so a car at 15 m/s stopped after 333 s of a
+/// 600 s test).
+#[test]
+fn a_car_on_a_loop_drives_the_whole_of_a_long_horizon() {
+    let (r, _) = run_one(
+        r#"
+R = 40.0
+PI = 3.141592653589793
+a1 = Arc(radius = R, angle = PI / 2)
+a2 = Arc(radius = R, angle = PI / 2)
+a3 = Arc(radius = R, angle = PI / 2)
+a4 = Arc(radius = R, angle = PI / 2)
+s1 = RoadSegment(len = 50.0)
+s2 = RoadSegment(len = 50.0)
+s1.connect((s1.TWO, a1, a1.ONE), (a1.TWO, a2, a2.ONE), (a2.TWO, s2, s2.ONE), (s2.TWO, a3, a3.ONE), (a3.TWO, a4, a4.ONE))
+a4.connect((a4.TWO, s1, s1.ONE))
+w = World()
+v = AutonomousVehicle(loc = s1.onLane(1, 10), speed = 0.0)
+c = Car(loc = s2.onLane(-1, 20), speed = 15.0)
+moving = Monitor(c.speed.map(lambda s: s - 1.0), over = "end")
+test(horizon = 600.0, offroad = False)
+w.place(s1, s2, a1, a2, a3, a4, v, c)
+"#,
+        0,
+    );
+    assert!(
+        (number(&r["monitors"]["moving"]["robustness"]) - 14.0).abs() < 1e-9,
+        "{r}"
+    );
+}

@@ -175,6 +175,7 @@ impl Program {
     ) -> Result<(R, u64), String> {
         Module::with_temp_heap(|module| {
             let state = LoadState::new(values, self.objects.clone(), self.maps.clone());
+            state.scene.borrow_mut().route_m = scene::route_length_m(self.horizon_s);
             let steps;
             {
                 let mut eval = Evaluator::new(&module);

@@ -237,6 +237,8 @@ pub struct SceneBuilder {
     pub frictions: Vec<(PieceId, StreamId)>,
     /// Where each road piece was declared (`file:line:col`), by piece.
     pub pieces_at: Vec<String>,
+    /// How far routes are planned, m ([`route_length_m`] of the horizon).
+    pub route_m: f64,
     /// The ego vehicle, once placed: the engine's spec (an actor goes from its declaration,
     /// [`Pending`], straight to the engine's spec when `place` resolves its locations).
     pub ego: Option<EgoSpec>,
@@ -334,6 +336,7 @@ impl SceneBuilder {
             roads: Network::new(),
             frictions: Vec::new(),
             pieces_at: Vec::new(),
+            route_m: MAX_ROUTE_M,
             ego: None,
             sut: None,
             pedestrians: Vec::new(),
@@ -729,6 +732,16 @@ pub fn turns(names: &[String]) -> Result<Vec<Turn>, String> {
 /// Longest route computed for an actor, in metres.
 const MAX_ROUTE_M: f64 = 5000.0;
 
+/// Fastest an NPC car or the ego is taken to drive when its route is planned, m/s (216 km/h):
+/// a route is planned as far as that speed goes in the test's horizon (at least
+/// [`MAX_ROUTE_M`]), so that on a loop a car does not run out of route and stop.
+pub const ROUTE_SPEED_MPS: f64 = 60.0;
+
+/// How far routes are planned for a test of `horizon_s` seconds, m.
+pub fn route_length_m(horizon_s: f64) -> f64 {
+    MAX_ROUTE_M.max(ROUTE_SPEED_MPS * horizon_s)
+}
+
 impl SceneBuilder {
     /// Resolves every location again on the network as it stands (after `connect` moved
     /// pieces); a location that no longer resolves is `None` until it does.
@@ -820,7 +833,7 @@ impl SceneBuilder {
                     let route = match route {
                         Some(turns) => self
                             .roads
-                            .route(&start, &turns, MAX_ROUTE_M)
+                            .route(&start, &turns, self.route_m)
                             .map_err(|e| format!("{}: {}", o.name, strip(e)))?,
                         // Without a route the ego keeps its lane: the start line on straight
                         // roads, and the lane's path (straight on through junctions) where
@@ -830,7 +843,7 @@ impl SceneBuilder {
                             kind.ref_line().is_some() || matches!(kind, PieceKind::Map { .. })
                         }) =>
                         {
-                            self.roads.route(&start, &[], MAX_ROUTE_M).map_err(strip)?
+                            self.roads.route(&start, &[], self.route_m).map_err(strip)?
                         }
                         None => vec![],
                     };
@@ -879,7 +892,7 @@ impl SceneBuilder {
                     lane_change,
                 } => {
                     let start = resolve(self, loc)?;
-                    let path = match self.roads.route(&start, &route, MAX_ROUTE_M) {
+                    let path = match self.roads.route(&start, &route, self.route_m) {
                         Ok(path) => path,
                         // A disabled car is not in the test: where it would drive does not
                         // matter (it may stand on a sidewalk); one metre ahead stands in.
