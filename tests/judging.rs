@@ -959,3 +959,48 @@ w.place(s1, s2, a1, a2, a3, a4, v, c)
         "{r}"
     );
 }
+
+/// An action performed by a function given to `map` is an error at the moment it happens (it
+/// took effect only when some unrelated `foreach` next ran), and a computed input whose stream
+/// has not fired is an error, not its default (a friction stream that fires only after 100 s
+/// braked the car at 0.8·g; a fog stream, 0).
+#[test]
+fn actions_outside_foreach_and_inputs_without_a_value_end_the_test_in_error() {
+    let road = "w = World()\nr = RoadSegment(len = 600.0)\nv = AutonomousVehicle(loc = r.onLane(-1, 590), speed = 0.0)\n";
+    let cases = [
+        (
+            format!("{road}c = Car(loc = r.onLane(1, 10), speed = 20.0)\nw.place(r, v, c)\ndef slow(t):\n    if t > 1.0:\n        c.setSpeed(2.0)\n    return 1.0\nok = Monitor(tick.map(slow))\n"),
+            "at t = 1.017 s, ",
+            "only foreach performs actions",
+        ),
+        (
+            // A piece of its own, beyond r, whose friction stream fires only after 100 s.
+            format!("{road}r2 = RoadSegment(len = 50.0, friction = tick.filter(lambda t: t > 100).map(lambda t: 0.1))\nr.connect((r.TWO, r2, r2.ONE))\nw.place(r, v)\nCollisionMonitor(v)\n"),
+            "at t = 0.000 s, the friction of",
+            "without a value",
+        ),
+        (
+            road.replace("World()", "World(fog = tick.filter(lambda t: t > 100).map(lambda t: 1.0))")
+                + "w.place(r, v)\nCollisionMonitor(v)\n",
+            "at t = 0.000 s, the fog",
+            "without a value",
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (i, (src, when, what)) in cases.iter().enumerate() {
+        let file = dir.path().join(format!("t{i}.star"));
+        std::fs::write(&file, src).unwrap();
+        let out = dir.path().join(format!("o{i}"));
+        let o = fuzz(&[
+            file.to_str().unwrap(),
+            "--budget",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        expect_code(&o, 3);
+        let r = records(&out).remove(0);
+        let e = r["error"].as_str().unwrap_or_default();
+        assert!(e.starts_with(when) && e.contains(what), "{i}: {e}");
+    }
+}

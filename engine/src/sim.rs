@@ -515,10 +515,9 @@ impl Simulation {
         let t = self.t_s();
         self.evaluate(host)?;
         for &(piece, stream) in &self.frictions {
-            let mu = self.network.piece(piece).kind.friction();
             let network = &self.network;
             let what = || format!("the friction of {}", network.piece(piece).name);
-            let mu = number(&self.streams, stream, mu, t, what)?;
+            let mu = number(&self.streams, stream, t, what)?;
             self.surface.set_friction(piece, mu);
         }
         self.ego.apply(control, dt);
@@ -547,7 +546,7 @@ impl Simulation {
                 None => {
                     let names = &self.names;
                     let what = || format!("the speed of {}", names.car(i));
-                    number(&self.streams, car.speed_stream, 0.0, t, what)?
+                    number(&self.streams, car.speed_stream, t, what)?
                 }
             };
             match car.lane_change.map(|c| c.start) {
@@ -641,16 +640,10 @@ impl Simulation {
         self.evaluated = Some(self.tick);
         // Light and fog now: the step from here uses them, and a snapshot shows them.
         self.light_fog = (
-            number(
-                &self.streams,
-                self.environment.light,
-                NOMINAL_LIGHT,
-                t,
-                || "the light".into(),
-            )?,
-            number(&self.streams, self.environment.fog, 0.0, t, || {
-                "the fog".into()
+            number(&self.streams, self.environment.light, t, || {
+                "the light".into()
             })?,
+            number(&self.streams, self.environment.fog, t, || "the fog".into())?,
         );
         Ok(())
     }
@@ -699,7 +692,7 @@ impl Simulation {
                 Action::Walk(i) => {
                     if let Some(p) = self.pedestrians.get_mut(Handle::from_index(i as usize)) {
                         let what = || format!("the speed of {}", self.names.pedestrian(i as usize));
-                        let v = number(&self.streams, p.speed_stream, 0.0, t, what)?;
+                        let v = number(&self.streams, p.speed_stream, t, what)?;
                         p.walk(&mut self.physics, t, dt, v);
                     }
                 }
@@ -945,20 +938,30 @@ impl Simulation {
 /// than the car and the ego can close in one step at any speed the engine models.
 const SLEEP_MARGIN_M: f64 = 10.0;
 
-/// The number stream `id` holds now (its latest event), `default` before its first event.
+/// The number stream `id` holds now (its latest event).
 ///
 /// # Errors
-/// [`crate::rx::RxError::Input`] naming `what` when the latest value is not a finite number:
-/// an input is never read as 0 in its place.
+/// [`crate::rx::RxError::Input`] naming `what` when the stream has no value yet (it has not
+/// fired) or its latest value is not a finite number: an input is never read as a default or
+/// as 0 in its place.
 fn number(
     rt: &Runtime,
     id: StreamId,
-    default: f64,
     t_s: f64,
     what: impl FnOnce() -> String,
 ) -> Result<f64, EngineError> {
     match rt.current(id) {
-        None => Ok(default),
+        // Never a default in place of a value the program's stream did not give.
+        None => Err(crate::rx::RxError::Input {
+            name: what(),
+            t_s,
+            value: "without a value (its stream had not fired yet)".into(),
+            expected: "a number from the test's first step on: a computed input needs a \
+                       stream that fires at t = 0, such as tick.map(lambda t: 0.1 if t > 100 \
+                       else 0.8)"
+                .into(),
+        }
+        .into()),
         Some(Value::Num(x)) if x.is_finite() => Ok(*x),
         Some(v) => Err(crate::rx::RxError::Input {
             name: what(),

@@ -307,7 +307,7 @@ impl Runtime {
                 },
                 Node::Perform { src, f } => {
                     if let Some(v) = sample(self, src) {
-                        call(i, f, &[v], host, self)?;
+                        call_acting(i, f, &[v], host, self)?;
                         host.performed();
                     }
                     None
@@ -496,7 +496,7 @@ impl Runtime {
             Node::Perform { src, f } => {
                 let (src, f) = (*src, f.clone());
                 if let Some(v) = self.event(src).cloned() {
-                    call(i, &f, &[v], host, self)?;
+                    call_acting(i, &f, &[v], host, self)?;
                     sinks.extend(host.performed());
                 }
                 self.states[i].done = done(self, src);
@@ -557,7 +557,34 @@ fn total(acc: &Value, v: &Value) -> Option<Value> {
     }
 }
 
+/// Calls `f` for node `node` where it computes a value (`map`, `filter`, `sum`): a host
+/// function that performs an action here is an error, since only `foreach` performs them
+/// (its actions would otherwise take effect whenever some `foreach` next ran).
 fn call(
+    node: usize,
+    f: &Func,
+    args: &[Value],
+    host: &mut dyn Host,
+    streams: &Runtime,
+) -> Result<Value, RxError> {
+    let out = call_acting(node, f, args, host, streams)?;
+    if host.performed().is_empty() {
+        Ok(out)
+    } else {
+        Err(RxError::Host {
+            node,
+            at: streams.graph.site(node),
+            message: "a function given to map, filter or sum performed an action (car.setSpeed, \
+                      car.brake, car.changeLane, p.walk): only foreach performs actions \
+                      (`stream.foreach(f)`); map, filter and sum compute values"
+                .into(),
+            t_s: None,
+        })
+    }
+}
+
+/// Calls `f` for node `node`, leaving the actions it performs to the caller (`foreach`).
+fn call_acting(
     node: usize,
     f: &Func,
     args: &[Value],
