@@ -244,6 +244,11 @@ pub struct CampaignFile {
     /// file when the program reads none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub input_files: Vec<paracosm_scenarios::InputFile>,
+    /// Whether the campaign stops at its first failure (`--stop-at-first-failure`), kept so
+    /// that `--resume` stops where the uninterrupted run would have. Left out of the file
+    /// when false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub stop_at_first_failure: bool,
 }
 
 impl CampaignFile {
@@ -346,6 +351,7 @@ impl CampaignFile {
             scenario_sha256: Some(source_sha256),
             checks: BTreeMap::new(),
             input_files: scenario.input_files.clone(),
+            stop_at_first_failure: false,
         }
         .checked()
     }

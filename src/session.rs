@@ -216,7 +216,23 @@ pub fn run(
     } else {
         None
     };
-    let (file, scenario, points) = settings(request, stored.as_ref())?;
+    // Records without their campaign: nothing tells which campaign they belong to, and
+    // starting one here would replace them.
+    if request.resume && stored.is_none() && out.join(RESULTS_FILE).exists() {
+        return Err(Error::BadInput(format!(
+            "`{}` holds {RESULTS_FILE} but no {CAMPAIGN_FILE}: its records belong to no campaign \
+             that can be resumed, and a new one would replace them; move them away, or pass \
+             --force to replace them",
+            out.display()
+        )));
+    }
+    let (mut file, scenario, points) = settings(request, stored.as_ref())?;
+    // A campaign that stops at its first failure does so when resumed too.
+    let stop_at_first_failure = match &stored {
+        Some(s) => s.stop_at_first_failure || request.stop_at_first_failure,
+        None => request.stop_at_first_failure,
+    };
+    file.stop_at_first_failure = stop_at_first_failure;
     let warnings = warnings_of(&scenario);
     let strategy = refusals(request, &file, &warnings)?;
     let jobs = request.jobs.unwrap_or_else(|| {
@@ -244,7 +260,7 @@ pub fn run(
         budget: file.budget,
         strength: file.strength,
         jobs,
-        stop_at_first_failure: request.stop_at_first_failure,
+        stop_at_first_failure,
         points: points.as_deref(),
     };
     campaign.check_origin(

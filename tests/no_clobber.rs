@@ -146,3 +146,49 @@ fn cover_output_that_is_a_link_is_refused() {
         "a header and 4 rows"
     );
 }
+
+/// `--resume` in a folder that holds records but no campaign.json is refused and leaves them
+/// (it started a new campaign that replaced them), and a campaign that stops at its first
+/// failure stops there when resumed without the flag (the flag was not kept, so a resumed
+/// run went on to the whole budget).
+#[test]
+fn resume_keeps_orphan_records_and_the_stop_at_the_first_failure() {
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole");
+    let o = common::fuzz(&[
+        "pedestrian-crossing",
+        "--budget",
+        "60",
+        "--stop-at-first-failure",
+        "--out",
+        whole.to_str().unwrap(),
+    ]);
+    common::expect_code(&o, 1);
+    let n = common::records(&whole).len();
+    assert!((2..60).contains(&n), "{n} records");
+    // Interrupted after the first record: resume without the flag.
+    let cut = dir.path().join("cut");
+    std::fs::create_dir_all(&cut).unwrap();
+    std::fs::copy(whole.join("campaign.json"), cut.join("campaign.json")).unwrap();
+    let first = std::fs::read_to_string(whole.join("results.jsonl")).unwrap();
+    let first = format!("{}\n", first.lines().next().unwrap());
+    std::fs::write(cut.join("results.jsonl"), &first).unwrap();
+    let o = common::fuzz(&["--resume", "--out", cut.to_str().unwrap()]);
+    common::expect_code(&o, 1);
+    assert_eq!(common::comparable(&cut), common::comparable(&whole));
+    // Records without their campaign.json.
+    let orphan = dir.path().join("orphan");
+    std::fs::create_dir_all(&orphan).unwrap();
+    std::fs::write(orphan.join("results.jsonl"), &first).unwrap();
+    let o = common::fuzz(&[
+        "pedestrian-crossing",
+        "--budget",
+        "5",
+        "--resume",
+        "--out",
+        orphan.to_str().unwrap(),
+    ]);
+    common::expect_code(&o, 2);
+    assert!(stderr(&o).contains("but no campaign.json"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(orphan.join("results.jsonl")).unwrap(), first);
+}
