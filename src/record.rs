@@ -175,6 +175,36 @@ impl RunRecord {
                 serde_json::to_value(&params)?
             )));
         }
+        // The status must be what the verdicts say: a line edited to read `pass` beside a
+        // failed monitor would count as passed everywhere it is read back.
+        let failed: Vec<&str> = l
+            .monitors
+            .iter()
+            .filter(|(_, m)| !m.passed)
+            .map(|(n, _)| n.as_str())
+            .collect();
+        let contradiction = match l.status {
+            Status::Pass => (!failed.is_empty() || l.error.is_some()).then(|| {
+                format!(
+                    "`status` is \"pass\" but {}",
+                    match failed.first() {
+                        Some(n) => format!("monitor `{n}` failed"),
+                        None => "`error` is set".to_owned(),
+                    }
+                )
+            }),
+            Status::Fail => (failed.is_empty() || l.error.is_some()).then(|| {
+                "`status` is \"fail\" but no monitor failed (or `error` is set)".to_owned()
+            }),
+            Status::Error => (l.error.is_none() || !l.monitors.is_empty()).then(|| {
+                "`status` is \"error\" but `error` is null or monitors have verdicts".to_owned()
+            }),
+        };
+        if let Some(c) = contradiction {
+            return Err(serde::de::Error::custom(format!(
+                "{c}: the record contradicts itself (was it edited?)"
+            )));
+        }
         Ok(RunRecord {
             campaign: l.campaign,
             id: l.id,

@@ -189,6 +189,13 @@ fn resume_keeps_orphan_records_and_the_stop_at_the_first_failure() {
         orphan.to_str().unwrap(),
     ]);
     common::expect_code(&o, 2);
-    assert!(stderr(&o).contains("but no campaign.json"), "{}", stderr(&o));
-    assert_eq!(std::fs::read_to_string(orphan.join("results.jsonl")).unwrap(), first);
+    assert!(
+        stderr(&o).contains("but no campaign.json"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read_to_string(orphan.join("results.jsonl")).unwrap(),
+        first
+    );
 }

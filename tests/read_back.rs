@@ -144,3 +144,55 @@ fn a_campaign_with_levels_of_every_kind_is_reported_replayed_and_resumed() {
     assert_eq!(no_wall(&again), no_wall(&full));
     assert!(full.contains("\"r.friction\":0.8"), "{full}");
 }
+
+/// A record whose status contradicts its verdicts (a line edited to read `pass` beside a
+/// failed monitor) is refused where results are read back, naming its line: `report` counted
+/// it as passed, and `--resume` and `merge` accepted it.
+#[test]
+fn a_record_whose_status_contradicts_its_monitors_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let o = fuzz(&[
+        "pedestrian-crossing",
+        "--budget",
+        "40",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 1);
+    let text = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+    let n = text
+        .lines()
+        .position(|l| l.contains("\"status\":\"fail\""))
+        .unwrap();
+    let flipped: String = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            let l = if i == n {
+                l.replace("\"status\":\"fail\"", "\"status\":\"pass\"")
+            } else {
+                l.to_owned()
+            };
+            l + "\n"
+        })
+        .collect();
+    std::fs::write(out.join("results.jsonl"), &flipped).unwrap();
+    for args in [
+        vec!["report", out.to_str().unwrap()],
+        vec!["--resume", "--out", out.to_str().unwrap()],
+    ] {
+        let o = fuzz(&args);
+        expect_code(&o, 2);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            stderr.contains(&format!("results.jsonl:{}:", n + 1))
+                && stderr.contains("`status` is \"pass\" but monitor `collision` failed"),
+            "{args:?}: {stderr}"
+        );
+    }
+    assert_eq!(
+        std::fs::read_to_string(out.join("results.jsonl")).unwrap(),
+        flipped
+    );
+}
