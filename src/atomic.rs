@@ -43,9 +43,13 @@ pub fn with_temp<E: std::fmt::Display>(
         .extension()
         .map(|e| format!(".{}", e.to_string_lossy()))
         .unwrap_or_default();
-    let tmp = tempfile::Builder::new()
-        .prefix(".paracosm-")
-        .suffix(&suffix)
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".paracosm-").suffix(&suffix);
+    // As any file a program creates: readable by others as the umask allows (tempfile's own
+    // default, 0600, kept summaries, plots and exports from the rest of a team).
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let tmp = builder
         .tempfile_in(dir)
         .map_err(|e| Error::write(path, e))?;
     let tmp_path = tmp.into_temp_path();
@@ -131,6 +135,25 @@ pub fn check_side_output(path: &Path, option: &str, out: &Path) -> Result<(), Er
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A file written through a temporary file has the mode any new file gets (0666 less the
+    /// umask), not tempfile's private 0600.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn written_files_are_as_readable_as_the_umask_allows() {
+        use std::os::unix::fs::PermissionsExt;
+        let status = std::fs::read_to_string("/proc/self/status").unwrap();
+        let umask = status
+            .lines()
+            .find_map(|l| l.strip_prefix("Umask:"))
+            .map(|m| u32::from_str_radix(m.trim(), 8).unwrap())
+            .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("summary.json");
+        write(&path, b"{}").unwrap();
+        let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o666 & !umask);
+    }
 
     #[test]
     fn a_failed_write_leaves_the_old_file_and_no_temporary() {
