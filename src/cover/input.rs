@@ -168,6 +168,26 @@ fn csv_rows(
     space: Option<&ParamSpace>,
     err: &dyn Fn(Option<u64>, Option<(usize, String)>, String) -> InputError,
 ) -> Result<Rows, InputError> {
+    // A quote left open swallows the rest of the file into one field, which the csv crate
+    // reads without a word: refuse it where it opens.
+    let mut open_at = None;
+    for (n, line) in text.lines().enumerate() {
+        for (c, ch) in line.chars().enumerate() {
+            if ch == '"' {
+                open_at = match open_at {
+                    Some(_) => None,
+                    None => Some((n as u64 + 1, c + 1)),
+                };
+            }
+        }
+    }
+    if let Some((line, column)) = open_at {
+        return Err(err(
+            Some(line),
+            Some((column, "\"".to_owned())),
+            "a quote opens here and is never closed".into(),
+        ));
+    }
     let mut reader = csv::ReaderBuilder::new().from_reader(text.as_bytes());
     let header: Vec<String> = reader
         .headers()
@@ -175,6 +195,20 @@ fn csv_rows(
         .iter()
         .map(str::to_owned)
         .collect();
+    // A name twice would be read from one of its columns and the other ignored.
+    for (j, h) in header.iter().enumerate() {
+        if let Some(i) = header[..j].iter().position(|g| g == h) {
+            return Err(err(
+                Some(1),
+                Some((j + 1, h.clone())),
+                format!(
+                    "the column `{h}` appears twice (columns {} and {})",
+                    i + 1,
+                    j + 1
+                ),
+            ));
+        }
+    }
     // Which CSV column feeds each parameter.
     let (names, columns): (Vec<String>, Vec<usize>) = match space {
         Some(s) => {
@@ -380,6 +414,16 @@ mod tests {
             ),
             ("nan.csv", "x,y\n0.1,NaN\n", ":2: column 2 (`y`): value NaN"),
             ("out.csv", "x,y\n0.1,1.5\n", "outside the domain [0, 1]"),
+            (
+                "twice.csv",
+                "x,y,x\n0.1,0.2,0.9\n",
+                ":1: column 3 (`x`): the column `x` appears twice (columns 1 and 3)",
+            ),
+            (
+                "quote.csv",
+                "x,y\n0.1,0.2\n0.3,\"0.4\n",
+                ":3: column 5 (`\"`): a quote opens here and is never closed",
+            ),
         ];
         for (name, text, needle) in cases {
             let f = write(&dir, name, text);

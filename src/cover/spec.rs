@@ -41,9 +41,9 @@ struct SpecFile {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SpecParam {
-    name: String,
-    interval: Option<[f64; 2]>,
-    levels: Option<Vec<toml::Value>>,
+    name: toml::Spanned<String>,
+    interval: Option<toml::Spanned<Vec<f64>>>,
+    levels: Option<toml::Spanned<Vec<toml::Value>>>,
     unit: Option<String>,
 }
 
@@ -99,24 +99,53 @@ pub fn parse_space(file: &str, text: &str) -> Result<ParamSpace, SpecError> {
         file: file.to_owned(),
         reason,
     };
+    // "line L, column C: " of a byte offset of `text`.
+    let at = |start: usize| {
+        let before = &text[..start.min(text.len())];
+        let line = before.matches('\n').count() + 1;
+        let col = before.chars().count()
+            - before
+                .rfind('\n')
+                .map_or(0, |i| before[..=i].chars().count())
+            + 1;
+        format!("line {line}, column {col}: ")
+    };
     let parsed: SpecFile = toml::from_str(text).map_err(|e| {
-        let at = e
-            .span()
-            .map(|s| {
-                let before = &text[..s.start.min(text.len())];
-                let line = before.matches('\n').count() + 1;
-                let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-                format!("line {line}, column {col}: ")
-            })
-            .unwrap_or_default();
-        invalid(format!("{at}{}", e.message()))
+        let place = e.span().map(|s| at(s.start)).unwrap_or_default();
+        invalid(format!("{place}{}", e.message()))
     })?;
-    let mut params = Vec::new();
+    let mut params: Vec<Param> = Vec::new();
     for p in parsed.param {
+        let name_at = at(p.name.span().start);
+        let name = p.name.into_inner();
+        if params.iter().any(|q| q.name == name) {
+            return Err(invalid(format!(
+                "{name_at}parameter `{name}` is declared twice"
+            )));
+        }
         let domain = match (p.interval, p.levels) {
-            (Some([lo, hi]), None) => Domain::Interval { lo, hi },
+            (Some(interval), None) => {
+                let here = at(interval.span().start);
+                match interval.into_inner()[..] {
+                    [lo, hi] if lo < hi => Domain::Interval { lo, hi },
+                    [lo, hi] => {
+                        return Err(invalid(format!(
+                            "{here}parameter `{name}`: interval [{lo}, {hi}] is empty: lo must \
+                             be below hi"
+                        )))
+                    }
+                    ref other => {
+                        return Err(invalid(format!(
+                            "{here}parameter `{name}`: interval = [lo, hi] takes two numbers, \
+                             got {}",
+                            other.len()
+                        )))
+                    }
+                }
+            }
             (None, Some(levels)) => Domain::Levels(
                 levels
+                    .into_inner()
                     .into_iter()
                     .map(|v| match v {
                         toml::Value::Integer(i) => Ok(Value::Int(i)),
@@ -124,16 +153,15 @@ pub fn parse_space(file: &str, text: &str) -> Result<ParamSpace, SpecError> {
                         toml::Value::String(s) => Ok(Value::Text(s)),
                         toml::Value::Boolean(b) => Ok(Value::Bool(b)),
                         other => Err(invalid(format!(
-                            "parameter `{}`: level {other} is not a number, a bool or a string",
-                            p.name
+                            "{name_at}parameter `{name}`: level {other} is not a number, a bool \
+                             or a string"
                         ))),
                     })
                     .collect::<Result<_, _>>()?,
             ),
             _ => {
                 return Err(invalid(format!(
-                    "parameter `{}` needs exactly one of `interval` and `levels`",
-                    p.name
+                    "{name_at}parameter `{name}` needs exactly one of `interval` and `levels`"
                 )))
             }
         };
@@ -143,14 +171,13 @@ pub fn parse_space(file: &str, text: &str) -> Result<ParamSpace, SpecError> {
             for (j, l) in levels.iter().enumerate() {
                 if levels[..j].iter().any(|m| m.to_string() == l.to_string()) {
                     return Err(invalid(format!(
-                        "parameter `{}`: the level {l} is listed twice",
-                        p.name
+                        "{name_at}parameter `{name}`: the level {l} is listed twice"
                     )));
                 }
             }
         }
         params.push(Param {
-            name: p.name,
+            name,
             domain,
             unit: p.unit,
         });
@@ -161,6 +188,29 @@ pub fn parse_space(file: &str, text: &str) -> Result<ParamSpace, SpecError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Settings that make no sense are refused with the line and column of the parameter:
+    /// an interval of three numbers (the third was dropped), an empty one, a name twice.
+    #[test]
+    fn senseless_settings_name_their_line() {
+        for (text, needle) in [
+            (
+                "[[param]]\nname = \"a\"\ninterval = [0, 1, 2]\n",
+                "line 3, column 12: parameter `a`: interval = [lo, hi] takes two numbers, got 3",
+            ),
+            (
+                "[[param]]\nname = \"a\"\ninterval = [1, 0]\n",
+                "line 3, column 12: parameter `a`: interval [1, 0] is empty",
+            ),
+            (
+                "[[param]]\nname = \"a\"\nlevels = [1]\n[[param]]\nname = \"a\"\nlevels = [2]\n",
+                "line 5, column 8: parameter `a` is declared twice",
+            ),
+        ] {
+            let e = parse_space("s.toml", text).unwrap_err().to_string();
+            assert!(e.contains(needle), "{e}");
+        }
+    }
 
     #[test]
     fn loads_builtin_and_toml_spaces_and_reports_errors_with_position() {
