@@ -355,10 +355,14 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
             .iter()
             .filter_map(|m| m.parse().ok())
             .collect();
+        // k-wise coverage up to the campaign's strength (at least 2): an `ipog` or `kwise`
+        // campaign of strength 3 reports its 3-wise coverage.
+        let nd = set.space.level_counts().len();
+        let strength = (nd > 0).then(|| f.file.strength.max(2).min(nd.min(6)));
         if set.space.params().is_empty() {
             None
         } else {
-            crate::cover::estimate(&set, &metrics, None, None, 10).ok()
+            crate::cover::estimate(&set, &metrics, strength, None, 10).ok()
         }
     };
     Summary {

@@ -13,8 +13,8 @@ mod suite;
 pub use constraints::Constraints;
 pub use ipog::{ipog, ipog_with};
 pub use random::{
-    random_kwise, random_kwise_rows, random_kwise_with, random_until_covered,
-    random_until_covered_with, RandomKWiseSize,
+    random_kwise, random_kwise_covering, random_kwise_rows, random_kwise_with,
+    random_until_covered, random_until_covered_with, RandomKWiseSize,
 };
 pub use suite::{ArrayKind, CoveringSuite};
 

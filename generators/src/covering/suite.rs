@@ -1,13 +1,14 @@
 use crate::{Generator, GeneratorError, Halton, ParamSpace, Point};
 
-use super::{ipog, random_kwise, CoveringError};
+use super::{ipog, random_kwise_covering, CoveringError};
 
 /// How the discrete half of a [`CoveringSuite`] is built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ArrayKind {
     /// [`super::ipog`].
     Ipog,
-    /// [`super::random_kwise`] with δ = 0.01.
+    /// [`super::random_kwise_covering`] with δ = 0.01: Proposition 3.2's draws, then on
+    /// until every t-tuple is covered.
     RandomKWise,
 }
 
@@ -50,14 +51,27 @@ impl CoveringSuite {
         } else {
             let a = match kind {
                 ArrayKind::Ipog => ipog(&levels, t)?,
-                ArrayKind::RandomKWise => random_kwise(&levels, t, 0.01, seed)?,
+                ArrayKind::RandomKWise => random_kwise_covering(&levels, t, 0.01, seed, 1 << 20)?,
             };
             (0..a.len()).map(|r| a.row(r).to_vec()).collect()
         };
         let continuous = ParamSpace::unit_cube(space.continuous_dims());
+        let mut rows = rows;
+        let mut per_row = per_row.max(1);
+        // Without continuous parameters a row's block would be the same test `per_row` times
+        // (same values, same results): the budget past the array goes to other combinations
+        // of levels instead, as long as there are any.
+        if space.continuous_dims() == 0 && k > 0 && per_row > 1 {
+            let target = rows.len() as u64 * per_row;
+            // A random array may draw a row twice: here that is one test run twice.
+            let mut kept = std::collections::HashSet::new();
+            rows.retain(|r| kept.insert(r.clone()));
+            extend_with_distinct_rows(&mut rows, &levels, target, seed);
+            per_row = target.div_ceil(rows.len() as u64);
+        }
         Ok(CoveringSuite {
             rows,
-            per_row: per_row.max(1),
+            per_row,
             halton: Halton::new(&continuous),
             next: 0,
             name: match kind {
@@ -95,6 +109,55 @@ impl CoveringSuite {
         Point {
             discrete: self.rows[r].clone(),
             continuous: h.continuous,
+        }
+    }
+}
+
+/// Appends to `rows` rows of `levels` that none of them repeats, drawn from
+/// `ChaCha8Rng::seed_from_u64(seed)`, until there are `target` rows or every combination of
+/// levels is there: all the others in a seeded random order when they are few (at most
+/// 2^20), else random rows not seen yet.
+fn extend_with_distinct_rows(rows: &mut Vec<Vec<u32>>, levels: &[u32], target: u64, seed: u64) {
+    use rand::seq::SliceRandom;
+    use rand::{Rng, SeedableRng};
+    let total = levels
+        .iter()
+        .try_fold(1u64, |n, &v| n.checked_mul(u64::from(v)))
+        .unwrap_or(u64::MAX);
+    let mut seen: std::collections::HashSet<Vec<u32>> = rows.iter().cloned().collect();
+    let want = target.min(total).saturating_sub(seen.len() as u64);
+    if want == 0 {
+        return;
+    }
+    // Its own stream: the array's draws (random k-wise) come from the seed itself.
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ 0x6469_7374_696e_6374);
+    if total <= 1 << 20 {
+        let mut others: Vec<Vec<u32>> = (0..total)
+            .map(|mut i| {
+                levels
+                    .iter()
+                    .rev()
+                    .map(|&v| {
+                        let cell = (i % u64::from(v)) as u32;
+                        i /= u64::from(v);
+                        cell
+                    })
+                    .collect::<Vec<u32>>()
+                    .into_iter()
+                    .rev()
+                    .collect()
+            })
+            .filter(|r: &Vec<u32>| !seen.contains(r))
+            .collect();
+        others.shuffle(&mut rng);
+        rows.extend(others.into_iter().take(want as usize));
+    } else {
+        let goal = target.min(total);
+        while (seen.len() as u64) < goal {
+            let r: Vec<u32> = levels.iter().map(|&v| rng.random_range(0..v)).collect();
+            if seen.insert(r.clone()) {
+                rows.push(r);
+            }
         }
     }
 }
@@ -157,6 +220,32 @@ mod tests {
         let h = Halton::new(&ParamSpace::unit_cube(2));
         assert_eq!(pts[1].continuous, h.point(16).continuous);
         assert!(suite.ask(1).is_err());
+    }
+
+    /// Without continuous parameters, the budget past the array runs other combinations of
+    /// levels, each once, before any repeats; the array's rows come first.
+    #[test]
+    fn a_discrete_space_gets_distinct_tests_past_the_array() {
+        let s = ParamSpace::new(
+            (0..7)
+                .map(|i| Param::levels(&format!("s{i}"), vec![Value::Int(0), Value::Int(1)]))
+                .collect(),
+        )
+        .unwrap();
+        for kind in [ArrayKind::Ipog, ArrayKind::RandomKWise] {
+            let array = CoveringSuite::new(&s, 2, kind, 1, 0).unwrap();
+            let rows = array.rows();
+            for budget in [60u64, 128, 300] {
+                let per_row = CoveringSuite::per_row_for_budget(rows, budget);
+                let mut suite = CoveringSuite::new(&s, 2, kind, per_row, 0).unwrap();
+                let pts = suite.ask(budget as usize).unwrap();
+                let distinct: std::collections::HashSet<&Vec<u32>> =
+                    pts.iter().map(|p| &p.discrete).collect();
+                assert_eq!(distinct.len() as u64, budget.min(128), "{kind:?} {budget}");
+                let c = kwise_coverage(&s, &pts[..rows], 2, 0).unwrap();
+                assert_eq!(c.covered, c.total, "{kind:?} {budget}");
+            }
+        }
     }
 
     #[test]
