@@ -288,12 +288,14 @@ fn check_lane(a: &Action, eval: &Evaluator<'_, '_, '_>) -> anyhow::Result<()> {
     let (Act::ChangeLane(car), Some((lane, _))) = (decode_sink(a.sink), a.bound) else {
         return Ok(());
     };
+    let at = super::globals::here(eval);
     let st = state(eval)?;
-    let b = st.scene.borrow();
+    let mut b = st.scene.borrow_mut();
     let Some(object) = b
         .objects
         .iter()
         .find(|o| o.actor == Some(paracosm_engine::behaviour::Actor::Car(car)))
+        .cloned()
     else {
         return Ok(());
     };
@@ -316,6 +318,20 @@ fn check_lane(a: &Action, eval: &Evaluator<'_, '_, '_>) -> anyhow::Result<()> {
                 format!("the lanes {}", known.join(", "))
             }
         );
+    }
+    // Into the other direction's lane: allowed (an overtaking manoeuvre), with the warning
+    // ChangeLane(to=) gives.
+    if let paracosm_engine::Lane::Driving(k) = start.lane {
+        if f64::from(k).signum() != lane.signum() {
+            b.warnings.push(crate::scenario::Warning {
+                at,
+                message: format!(
+                    "{}.changeLane({lane}) moves it from lane {k} into a lane of the other \
+                     direction, where it goes on driving its own way (against the traffic there)",
+                    object.name
+                ),
+            });
+        }
     }
     Ok(())
 }

@@ -43,6 +43,37 @@ pub struct Syntax {
     /// once per evaluation: `x = Builtin(...)` at the top level of the module or under an
     /// `if` there, not in a loop or a `def`.
     assigned_once: HashMap<String, String>,
+    /// `"line:col"` and text of each action called as a statement of the program's own code
+    /// (`c.setSpeed(2.0)` outside any `def`): it builds an action and drops it.
+    dropped_actions: Vec<(String, String)>,
+}
+
+/// The methods that make actions (LANGUAGE.md, "Actions").
+const ACTIONS: [&str; 3] = ["setSpeed", "brake", "changeLane"];
+
+/// Records every statement outside a `def` that is only a call of an action method.
+fn dropped_actions(ast: &AstModule, s: &AstStmt, out: &mut Vec<(String, String)>) {
+    match &s.node {
+        StmtP::Statements(list) => list.iter().for_each(|s| dropped_actions(ast, s, out)),
+        StmtP::If(_, body) => dropped_actions(ast, body, out),
+        StmtP::IfElse(_, bodies) => {
+            dropped_actions(ast, &bodies.0, out);
+            dropped_actions(ast, &bodies.1, out);
+        }
+        StmtP::For(f) => dropped_actions(ast, &f.body, out),
+        StmtP::Expression(e) => {
+            if let ExprP::Call(f, _) = &e.node {
+                if let ExprP::Dot(_, method) = &f.node {
+                    if ACTIONS.contains(&method.node.as_str()) {
+                        let span = ast.file_span(e.span);
+                        let at = format!("{}", span.resolve_span().begin);
+                        out.push((at, span.source_span().to_owned()));
+                    }
+                }
+            }
+        }
+        _ => {}
+    }
 }
 
 /// Records `x = f(...)` statements that run at most once per evaluation.
@@ -394,7 +425,14 @@ impl Syntax {
         };
         w.stmt(ast.statement(), false);
         assigned_once(ast, ast.statement(), &mut w.out.assigned_once);
+        dropped_actions(ast, ast.statement(), &mut w.out.dropped_actions);
         w.out
+    }
+
+    /// Actions called as statements outside any `def` (`c.setSpeed(2.0)` on a line of its
+    /// own): `("line:col", the call's text)`.
+    pub fn dropped_actions(&self) -> &[(String, String)] {
+        &self.dropped_actions
     }
 
     /// Every call assigned once to a variable: `"line:col"` of the call → the variable.

@@ -850,6 +850,14 @@ pub fn load(
 ) -> Result<Scenario, ScenarioError> {
     let lang = ScenarioError::Language;
     let syntax = Syntax::of(&ast, BUILTINS);
+    if let Some((at, call)) = syntax.dropped_actions().first() {
+        return Err(lang(format!(
+            "error: `{call}` on a line of its own does nothing: an action is performed by \
+             foreach, at the events of a stream (`tick.take(1).foreach({call})` performs it at \
+             t = 0; `tick.filter(lambda t: t > 5).take(1).foreach({call})` after 5 s)\n --> \
+             {file}:{at}"
+        )));
+    }
     let mut program = Program {
         objects: Arc::new(syntax.objects()),
         syntax,

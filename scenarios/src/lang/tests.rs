@@ -739,3 +739,30 @@ fn a_parameter_name_with_spaces_or_none_is_refused() {
     )
     .unwrap();
 }
+
+/// An action called on a line of its own does nothing, and says so at load; a changeLane
+/// action into the other direction's lane warns as ChangeLane(to=) does.
+#[test]
+fn a_dropped_action_is_refused_and_a_changelane_across_warns() {
+    let car =
+        "c = Car(loc = r.onLane(-1, 150), speed = 5.0)\nw.place(r, v, c)\nCollisionMonitor(v)\n";
+    for stmt in [
+        "c.setSpeed(2.0)",
+        "c.brake(3)",
+        "if True:\n    c.changeLane(1)",
+    ] {
+        let m = err(&format!("{HEADER}{car}{stmt}\n"));
+        assert!(
+            m.contains("on a line of its own does nothing") && m.contains(" --> bad.star:"),
+            "{m}"
+        );
+    }
+    let s = load_source("ok.star", &format!("{HEADER}{car}tick.take(1).foreach(c.changeLane(1))\ndef f(t):\n    c.brake(3)\ntick.filter(lambda t: t > 1).foreach(f)\n"), "ok").unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.message.contains(
+            "Car c.changeLane(1) moves it from lane -1 into a lane of the other direction"
+        ) && w.at == "ok.star:7:1"),
+        "{:?}",
+        s.warnings
+    );
+}
