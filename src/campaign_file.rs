@@ -289,7 +289,8 @@ struct Fingerprinted<'a> {
     input_files: &'a [paracosm_scenarios::InputFile],
 }
 
-fn sha256_hex(bytes: &[u8]) -> String {
+/// The SHA-256 of `bytes`, in lowercase hex.
+pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
     Sha256::digest(bytes)
         .iter()
         .map(|b| format!("{b:02x}"))

@@ -25,6 +25,10 @@ pub struct Replay {
     pub frames: Vec<PathBuf>,
     /// The contact sheet, when frames were written.
     pub contact_sheet: Option<PathBuf>,
+    /// What changed since the campaign ran, when something it recorded the hash of did: the
+    /// scenario program, or a file it reads (an OpenDRIVE map). A replay then runs the new
+    /// program, so a verdict that differs says nothing about reproducibility.
+    pub changed: Option<String>,
 }
 
 fn input(e: impl std::fmt::Display) -> Error {
@@ -121,6 +125,7 @@ pub fn replay_with(
     let (line_no, line) = find_record(results, id)?;
     let campaign_file = CampaignFile::read(dir).map_err(input)?;
     let mut scenario = paracosm_scenarios::load(&campaign_file.scenario).map_err(input)?;
+    let changed = changed_since(&campaign_file, &scenario);
     let record = RunRecord::from_line(&line, &scenario.space).map_err(|e| {
         input(format!(
             "{}:{line_no}:{}: not a results record of this campaign: {e}",
@@ -204,7 +209,37 @@ pub fn replay_with(
         matches,
         frames: written,
         contact_sheet,
+        changed,
     })
+}
+
+/// What of the campaign's inputs changed since `file` was written: the program (its SHA-256)
+/// or a file it reads; `None` when nothing did, or the file predates the hashes.
+pub fn changed_since(
+    file: &CampaignFile,
+    scenario: &paracosm_scenarios::Scenario,
+) -> Option<String> {
+    let now = crate::campaign_file::sha256_hex(scenario.source.as_bytes());
+    if file
+        .scenario_sha256
+        .as_ref()
+        .is_some_and(|then| *then != now)
+    {
+        return Some(format!(
+            "the scenario program `{}` changed since the campaign ran (its SHA-256 differs \
+             from campaign.json's)",
+            file.scenario
+        ));
+    }
+    file.input_files
+        .iter()
+        .find(|f| !scenario.input_files.contains(f))
+        .map(|f| {
+            format!(
+                "the file `{}` the program reads changed since the campaign ran",
+                f.path
+            )
+        })
 }
 
 /// Status, and each monitor's `passed`, `robustness` and `first_violation_s`, equal between a
@@ -254,6 +289,12 @@ impl Replay {
                 self.recorded["monitors"]
             )
         });
+        if let Some(c) = &self.changed {
+            lines.push(format!(
+                "note: {c}: this replay ran the program as it is now, not the one that made \
+                 the record"
+            ));
+        }
         lines.join("\n")
     }
 }

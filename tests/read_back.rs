@@ -196,3 +196,39 @@ fn a_record_whose_status_contradicts_its_monitors_is_refused() {
         flipped
     );
 }
+
+/// A replay after the program was edited says so: the verdict it prints comes from the
+/// program as it is now (a "DIFFERS" alone read as a reproducibility failure).
+#[test]
+fn a_replay_of_an_edited_program_names_the_change() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("p.star");
+    let src = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/pedestrian_crossing.star"),
+    )
+    .unwrap();
+    std::fs::write(&file, &src).unwrap();
+    let out = dir.path().join("o");
+    let o = fuzz(&[
+        file.to_str().unwrap(),
+        "--budget",
+        "30",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 1);
+    let results = out.join("results.jsonl");
+    let o = fuzz(&["replay", results.to_str().unwrap(), "--id", "0"]);
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        stdout.contains("equals the recorded one") && !stdout.contains("changed since"),
+        "{stdout}"
+    );
+    std::fs::write(&file, format!("{src}\n# edited\n")).unwrap();
+    let o = fuzz(&["replay", results.to_str().unwrap(), "--id", "0"]);
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        stdout.contains("changed since the campaign ran"),
+        "{stdout}"
+    );
+}
