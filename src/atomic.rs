@@ -102,6 +102,23 @@ pub const CAMPAIGN_OWNED: [&str; 3] = ["results.jsonl", "campaign.json", "summar
 /// [`Error::BadInput`] naming `path` and `option`.
 pub fn check_side_output(path: &Path, option: &str, out: &Path) -> Result<(), Error> {
     check_target(path)?;
+    // Its folder must exist: found only when the campaign has run, the file could not be
+    // written after all that work.
+    // (The campaign's folder itself is made before any test runs.)
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        let plain = |p: &Path| -> std::path::PathBuf {
+            p.components()
+                .filter(|c| !matches!(c, std::path::Component::CurDir))
+                .collect()
+        };
+        if !dir.is_dir() && plain(dir) != plain(out) {
+            return Err(Error::BadInput(format!(
+                "{option} `{}`: the folder `{}` does not exist; create it first",
+                path.display(),
+                dir.display()
+            )));
+        }
+    }
     let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
         return Ok(());
     };
@@ -214,6 +231,12 @@ mod tests {
         // The same names elsewhere, and other names inside, are fine.
         check_side_output(&dir.path().join("results.jsonl"), "--junit", &out).unwrap();
         check_side_output(&out.join("junit.xml"), "--junit", &out).unwrap();
+        // A folder that does not exist (but the campaign's own, made before any test).
+        let missing = dir.path().join("nowhere").join("junit.xml");
+        let e = check_side_output(&missing, "--junit", &out).unwrap_err();
+        assert!(e.to_string().contains("does not exist"), "{e}");
+        let fresh = dir.path().join("fresh");
+        check_side_output(&fresh.join("junit.xml"), "--junit", &fresh).unwrap();
         // Spelled another way, it is still the same folder.
         std::fs::create_dir_all(&out).unwrap();
         let other = dir.path().join("d/../d/summary.json");

@@ -235,6 +235,23 @@ pub fn run(
     file.stop_at_first_failure = stop_at_first_failure;
     let warnings = warnings_of(&scenario);
     let strategy = refusals(request, &file, &warnings)?;
+    // A strength asked for that the space cannot have: with fewer discrete parameters there
+    // are no t-tuples (and a space with none has no covering array at all).
+    if let (Some(t), true) = (request.strength, Strategy::SUITES.contains(&strategy)) {
+        let nd = scenario.space.level_counts().len();
+        if t > nd {
+            return Err(Error::BadInput(format!(
+                "--strength {t}: a covering array of strength {t} needs {t} discrete parameters, \
+                 and {} has {nd}{}",
+                scenario.name,
+                if nd == 0 {
+                    " (its suite is Halton points alone: leave --strength out)"
+                } else {
+                    ""
+                }
+            )));
+        }
+    }
     let jobs = request.jobs.unwrap_or_else(|| {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });

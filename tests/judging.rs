@@ -489,7 +489,8 @@ fn a_covering_suite_over_one_discrete_parameter_runs_by_default() {
     assert_eq!(levels.len(), 2, "both levels covered: {levels:?}");
     let o = run(&["--strength", "2"]);
     expect_code(&o, 2);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("strength t = 2"));
+    assert!(String::from_utf8_lossy(&o.stderr)
+        .contains("--strength 2: a covering array of strength 2 needs 2 discrete parameters"));
 }
 
 /// An NPC car's `pos` is its body's centre, as LANGUAGE.md says and as the ego's is its

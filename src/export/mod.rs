@@ -40,6 +40,13 @@ fn input(e: impl std::fmt::Display) -> Error {
 /// OpenDRIVE map with pieces of the program, or a map that can no longer be read;
 /// [`Error::Write`] when `out` or a file cannot be written.
 pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
+    // A file where the folder should be is the user's mistake, refused before the replay.
+    if out.exists() && !out.is_dir() {
+        return Err(Error::BadInput(format!(
+            "--out `{}` is a file, not a folder: give a folder for the exported files",
+            out.display()
+        )));
+    }
     let dir = results.parent().unwrap_or(Path::new("."));
     let campaign = CampaignFile::read(dir).map_err(input)?;
     let scenario = paracosm_scenarios::load(&campaign.scenario).map_err(input)?;
