@@ -179,11 +179,12 @@ pub fn merge_folders(
     crate::session::prepare_out_dir(out, replace, false)?;
     let _lock = crate::lock::CampaignLock::acquire(out)?;
     let m = merge(dirs, out)?;
+    // The shards' own times (0, not -0, when none has a summary).
     let wall_s: f64 = dirs
         .iter()
         .filter_map(|d| crate::summary::Summary::read(d).ok())
         .map(|s| s.wall_s)
-        .sum();
+        .fold(0.0, |a, b| a + b);
     let written = crate::report::write_outputs(&crate::report::Finished {
         out,
         scenario: &m.scenario,
@@ -201,7 +202,7 @@ pub fn merge_folders(
         "merged {} shards into {}\n{}",
         dirs.len(),
         out.display(),
-        crate::report::human(&written.summary, &m.scenario, out, m.file.budget)
+        crate::report::human(&written.summary, &m.scenario, out, m.file.budget, Some(0))
     );
     Ok((text, written.summary.counts, written.plot_warnings))
 }

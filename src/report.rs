@@ -388,10 +388,35 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
 }
 
 /// The human summary: counts and speed, the first failure, coverage, and the files.
-pub fn human(summary: &Summary, scenario: &Scenario, out: &Path, expected: u64) -> String {
+/// `ran_now`: how many of the tests this process ran in `summary.wall_s` (a resume ran only
+/// the missing ones; a merge ran none), `None` when the summary's time covers them all.
+pub fn human(
+    summary: &Summary,
+    scenario: &Scenario,
+    out: &Path,
+    expected: u64,
+    ran_now: Option<u64>,
+) -> String {
     let c = summary.counts;
+    let ran = ran_now.unwrap_or(summary.tests_run);
+    let speed = if ran == 0 {
+        "no test run now".to_owned()
+    } else if summary.wall_s > 0.0 {
+        format!(
+            "{}in {:.1} s ({:.0} tests/s)",
+            if ran == summary.tests_run {
+                String::new()
+            } else {
+                format!("{ran} run now ")
+            },
+            summary.wall_s,
+            ran as f64 / summary.wall_s
+        )
+    } else {
+        format!("{ran} run now")
+    };
     let mut lines = vec![format!(
-        "{} of {} tests of {} ({}, seed {}{}): {} passed, {} failed, {} errors in {:.1} s ({:.0} tests/s)",
+        "{} of {} tests of {} ({}, seed {}{}): {} passed, {} failed, {} errors{}{speed}",
         summary.tests_run,
         expected,
         scenario.name,
@@ -404,8 +429,7 @@ pub fn human(summary: &Summary, scenario: &Scenario, out: &Path, expected: u64) 
         c.pass,
         c.fail,
         c.error,
-        summary.wall_s,
-        summary.tests_run as f64 / summary.wall_s.max(1e-9)
+        if speed.starts_with("in ") { " " } else { "; " },
     )];
     if let Some(f) = &summary.first_failure {
         let values: Vec<String> = f
@@ -570,7 +594,18 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
         outputs,
     );
     let expected = ids.end - ids.start;
-    let mut text = human(&summary, &scenario, dir, expected);
+    // The stored time is the campaign's when its summary counted these very records; else
+    // no speed is claimed (the report runs no test).
+    let timed = stored
+        .as_ref()
+        .is_some_and(|s| s.tests_run == existing.records.len() as u64);
+    let mut text = human(
+        &summary,
+        &scenario,
+        dir,
+        expected,
+        if timed { None } else { Some(0) },
+    );
     if (existing.records.len() as u64) < expected {
         text.push_str(&format!(
             "\npartial: {} of {expected} tests; finish it with `paracosm-fuzz --resume --out {}`",

@@ -175,6 +175,7 @@ impl Outcome {
             &self.scenario,
             &self.out,
             self.expected,
+            Some(self.report.records.len() as u64),
         ))
     }
 
