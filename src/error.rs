@@ -86,3 +86,13 @@ impl Error {
         }
     }
 }
+
+/// `path:line:column`, or `path:line` when the column is unknown (0: serde_json's custom
+/// errors have none), for messages about a file.
+pub(crate) fn located(path: &std::path::Path, line: usize, column: usize) -> String {
+    if column == 0 {
+        format!("{}:{line}", path.display())
+    } else {
+        format!("{}:{line}:{column}", path.display())
+    }
+}

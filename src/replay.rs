@@ -62,10 +62,8 @@ fn find_record(results: &Path, id: u64) -> Result<(usize, String), Error> {
             Err(_) if n + 1 == text.lines().count() => continue,
             Err(e) => {
                 return Err(input(format!(
-                    "{}:{}:{}: not a results line: {e}",
-                    results.display(),
-                    n + 1,
-                    e.column()
+                    "{}: not a results line: {e}",
+                    crate::error::located(results, n + 1, e.column())
                 )))
             }
         };
@@ -128,9 +126,8 @@ pub fn replay_with(
     let changed = changed_since(&campaign_file, &scenario);
     let record = RunRecord::from_line(&line, &scenario.space).map_err(|e| {
         input(format!(
-            "{}:{line_no}:{}: not a results record of this campaign: {e}",
-            results.display(),
-            e.column()
+            "{}: not a results record of this campaign: {e}",
+            crate::error::located(results, line_no, e.column())
         ))
     })?;
     let recorded: serde_json::Value =

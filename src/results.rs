@@ -62,10 +62,8 @@ pub fn load(
     for (n, line) in text.lines().enumerate() {
         let r = RunRecord::from_line(line, space).map_err(|e| {
             bad(format!(
-                "{}:{}:{}: not a results record: {e}",
-                path.display(),
-                n + 1,
-                e.column()
+                "{}: not a results record: {e}",
+                crate::error::located(&path, n + 1, e.column())
             ))
         })?;
         let expected = ids.start + records.len() as u64;

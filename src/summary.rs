@@ -149,10 +149,8 @@ impl Summary {
         let text = std::fs::read_to_string(&path).map_err(|e| crate::Error::input(&path, e))?;
         serde_json::from_str(&text).map_err(|e| {
             let message = format!(
-                "{}:{}:{}: not a summary: {e}",
-                path.display(),
-                e.line(),
-                e.column()
+                "{}: not a summary: {e}",
+                crate::error::located(&path, e.line(), e.column())
             );
             crate::Error::malformed(&path, message)
         })

@@ -296,7 +296,29 @@ fn interrupted_code(code: u8) -> u8 {
     }
 }
 
+/// Gives Mesa's Vulkan loader the runtime folder it wants when the environment has none (a
+/// sandbox, a batch job): without one it prints "error: XDG_RUNTIME_DIR is invalid or not
+/// set" on every render, though rendering works. Set before any thread starts.
+fn runtime_dir() {
+    let valid =
+        std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+    if !valid {
+        // One folder per user, kept between runs (as the loader's own would be).
+        let user = std::env::var("USER").unwrap_or_else(|_| "user".into());
+        let dir = std::env::temp_dir().join(format!("paracosm-xdg-{user}"));
+        if std::fs::create_dir_all(&dir).is_ok() {
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::PermissionsExt;
+                let _ = std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700));
+            }
+            std::env::set_var("XDG_RUNTIME_DIR", &dir);
+        }
+    }
+}
+
 fn main() -> ExitCode {
+    runtime_dir();
     paracosm_scenarios::memory::set_tool_name("paracosm-fuzz");
     stop_on_signals();
     let cli = match paracosm::cli::parse_args::<Cli>("paracosm-fuzz") {
