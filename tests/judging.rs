@@ -869,23 +869,10 @@ fn a_horizon_between_steps_is_rounded_up() {
 /// the program's line, without starlark's header for a call from the engine.
 #[test]
 fn a_lambdas_error_during_a_test_names_the_time_and_its_line() {
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("t.star");
-    std::fs::write(
-        &file,
+    let (r, _) = run_one(
         "w = World()\nr = RoadSegment(len = 200.0)\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, v)\ndef f(t):\n    return 1 // 0 if t > 1 else 1.0\nm = Monitor(tick.map(f))\n",
-    )
-    .unwrap();
-    let out = dir.path().join("out");
-    let o = fuzz(&[
-        file.to_str().unwrap(),
-        "--budget",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    expect_code(&o, 3);
-    let r = records(&out).remove(0);
+        3,
+    );
     let e = r["error"].as_str().unwrap();
     assert!(e.starts_with("at t = 1.017 s, "), "{e}");
     assert!(
@@ -987,20 +974,8 @@ fn actions_outside_foreach_and_inputs_without_a_value_end_the_test_in_error() {
             "without a value",
         ),
     ];
-    let dir = tempfile::tempdir().unwrap();
     for (i, (src, when, what)) in cases.iter().enumerate() {
-        let file = dir.path().join(format!("t{i}.star"));
-        std::fs::write(&file, src).unwrap();
-        let out = dir.path().join(format!("o{i}"));
-        let o = fuzz(&[
-            file.to_str().unwrap(),
-            "--budget",
-            "1",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        expect_code(&o, 3);
-        let r = records(&out).remove(0);
+        let (r, _) = run_one(src, 3);
         let e = r["error"].as_str().unwrap_or_default();
         assert!(e.starts_with(when) && e.contains(what), "{i}: {e}");
     }
