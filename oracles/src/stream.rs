@@ -40,12 +40,16 @@ impl Over {
 /// when the robustness is `> 0`.
 ///
 /// Frames in which the signal has no value (its stream has not fired yet) are not judged. A
-/// test in which it never has one fails with robustness `-inf`, as does a value that is not
-/// a number (NaN): nothing a monitor was asked to judge is skipped silently. `End` and
-/// `Eventually` settle only at the end of the test; `Always` settles at its first violation.
+/// test in which it never has one fails with robustness `-inf`. A value that is not a number
+/// (NaN), in any frame and whatever `over` is, fails it at once with robustness `-inf`: a
+/// later or larger value does not make up for it (`Eventually` took the maximum, and `End`
+/// the last value, past it). Nothing a monitor was asked to judge is skipped silently. `End`
+/// and `Eventually` otherwise settle only at the end of the test; `Always` settles at its
+/// first violation.
 ///
 /// `first_violation_s`, the time a failed verdict was decided (what `TimeToFailure` and the
-/// `time_to_failure_s` metric read), s: for `Always`, the frame of the first value `<= 0`;
+/// `time_to_failure_s` metric read), s: the frame of the first NaN; for `Always`, the frame
+/// of the first value `<= 0`;
 /// otherwise, and for an `Always` whose signal never had a value, the last frame observed,
 /// with or without a value: the end of the test (or the moment it stopped).
 /// With `boolean`, the value is a truth value (`> 0.5` true) and the robustness is `+1` or
@@ -91,13 +95,19 @@ impl Monitor for StreamMonitor {
     }
 
     fn observe(&mut self, frame: &Frame<'_>) -> ControlFlow<()> {
+        if self.first_violation_s.is_some() {
+            return ControlFlow::Break(());
+        }
         self.last_frame_s = frame.t_s;
         let Ok(raw) = frame.signals.get(&self.signal) else {
             return ControlFlow::Continue(());
         };
-        let v = if raw.is_nan() {
-            f64::NEG_INFINITY
-        } else if self.boolean {
+        if raw.is_nan() {
+            self.value = Some(f64::NEG_INFINITY);
+            self.first_violation_s = Some(frame.t_s);
+            return ControlFlow::Break(());
+        }
+        let v = if self.boolean {
             if raw > 0.5 {
                 1.0
             } else {
@@ -125,7 +135,8 @@ impl Monitor for StreamMonitor {
             passed,
             robustness,
             first_violation_s: match (self.over, self.first_violation_s) {
-                (Over::Always, Some(t)) => Some(t),
+                // The first violation of `Always`, or a NaN under any `over`.
+                (_, Some(t)) => Some(t),
                 // Decided at the end: the last frame, whether or not it carried a value.
                 _ => (!passed).then_some(self.last_frame_s),
             },
@@ -212,6 +223,27 @@ mod tests {
         let mut m = StreamMonitor::new("m", "x", Over::Eventually);
         let v = run(&mut m, &[Some(f64::NAN)]);
         assert!(!v.passed);
+    }
+
+    #[test]
+    fn a_nan_fails_at_once_whatever_comes_after_it() {
+        // A NaN amid good values: `eventually` took the maximum past it and `end` the last
+        // value, so both passed with 1.0.
+        for over in [Over::Always, Over::End, Over::Eventually] {
+            let mut m = StreamMonitor::new("m", "x", over);
+            let v = run(&mut m, &[Some(1.0), Some(f64::NAN), Some(2.0), Some(3.0)]);
+            assert_eq!(
+                (v.passed, v.robustness, v.first_violation_s),
+                (false, f64::NEG_INFINITY, Some(1.0)),
+                "{over:?}"
+            );
+        }
+        let mut m = StreamMonitor::assertion("a", "x");
+        let v = run(&mut m, &[Some(1.0), Some(1.0), Some(f64::NAN), Some(1.0)]);
+        assert_eq!(
+            (v.passed, v.robustness, v.first_violation_s),
+            (false, f64::NEG_INFINITY, Some(2.0))
+        );
     }
 
     #[test]

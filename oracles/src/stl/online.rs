@@ -35,6 +35,10 @@ const CHECK_EVERY: usize = 15;
 /// where `x` reaches 30, not the check that found it (so `TimeToFailure` compares the
 /// moment of the failure with its `minT`); the last sample's time when only the end of the
 /// trace decided it.
+///
+/// A signal without a value in a frame (its stream has not fired), or whose value is not a
+/// number (NaN), fails the formula at that frame with robustness `-inf`: a NaN sample is not
+/// left out of a window's minimum or maximum.
 #[derive(Debug, Clone)]
 pub struct StlMonitor {
     name: String,
@@ -44,7 +48,9 @@ pub struct StlMonitor {
     /// The samples so far; `dt_s` is set from the first two frames.
     trace: Trace,
     settled: Option<Verdict>,
-    missing: Option<(String, f64)>,
+    /// The first signal without a value (its stream has not fired) or whose value is not a
+    /// number, and the time: the formula fails there with robustness `-inf`.
+    undefined: Option<(String, f64)>,
     /// Samples whose prefix is known not to decide a violation (the upper bound over their
     /// continuations was `> 0` at the last check).
     undecided: usize,
@@ -69,7 +75,7 @@ impl StlMonitor {
             formula,
             times: Vec::new(),
             settled: None,
-            missing: None,
+            undefined: None,
             undecided: 0,
         }
     }
@@ -137,19 +143,19 @@ impl Monitor for StlMonitor {
     }
 
     fn observe(&mut self, frame: &Frame<'_>) -> ControlFlow<()> {
-        if self.settled.is_some() || self.missing.is_some() {
+        if self.settled.is_some() || self.undefined.is_some() {
             return ControlFlow::Break(());
         }
         for s in &self.signals {
             match frame.signals.get(s) {
-                Ok(v) => self
+                Ok(v) if !v.is_nan() => self
                     .trace
                     .signals
                     .get_mut(s)
                     .expect("one per signal")
                     .push(v),
-                Err(_) => {
-                    self.missing = Some((s.clone(), frame.t_s));
+                _ => {
+                    self.undefined = Some((s.clone(), frame.t_s));
                     return ControlFlow::Break(());
                 }
             }
@@ -174,11 +180,13 @@ impl Monitor for StlMonitor {
     }
 
     fn settle_now(&mut self) -> bool {
-        self.settled.is_some() || self.missing.is_some() || (self.times.len() >= 2 && self.check())
+        self.settled.is_some()
+            || self.undefined.is_some()
+            || (self.times.len() >= 2 && self.check())
     }
 
     fn verdict(&self) -> Verdict {
-        if let Some((_, t)) = &self.missing {
+        if let Some((_, t)) = &self.undefined {
             return Verdict {
                 passed: false,
                 robustness: f64::NEG_INFINITY,
@@ -287,6 +295,26 @@ mod tests {
         // Not yet violated: not settled, still passing so far.
         assert!(!n.settle_now());
         assert!(n.verdict().passed);
+    }
+
+    #[test]
+    fn a_nan_sample_fails_the_formula_where_it_comes() {
+        // x is NaN from sample 30 on: G took the minimum over the others and passed with 1.
+        for formula in [
+            "G[0,1] (x > 0)",
+            "F[0,1] (x > 0)",
+            "G[0,10] (x > 0 | x < 5)",
+        ] {
+            let (v, fed) = run(formula, |i| if i >= 30 { f64::NAN } else { 1.0 }, 120);
+            assert_eq!(
+                (v.passed, v.robustness, v.first_violation_s, fed),
+                (false, f64::NEG_INFINITY, Some(0.5), 31),
+                "{formula}"
+            );
+        }
+        // All NaN: failed at the first sample, with its time.
+        let (v, _) = run("G[0,1] (x > 0)", |_| f64::NAN, 120);
+        assert_eq!((v.passed, v.first_violation_s), (false, Some(0.0)));
     }
 
     #[test]
