@@ -16,8 +16,11 @@ pub struct VehicleParams {
     /// Engine force at full throttle per driven (rear) wheel, in N. Default 2250 N, i.e.
     /// 3 m/s² on a 1500 kg car.
     pub max_engine_force_n: f64,
-    /// Brake force at full brake per wheel, in N. Default 3000 N, i.e. 8 m/s² on a 1500 kg
-    /// car; the tyres' friction limit (road friction) may cap it further.
+    /// Brake force at full brake per wheel on average, in N: the four wheels brake with four
+    /// times this together, shared among them in proportion to the load each carries (as
+    /// electronic brake-force distribution does). Default 3000 N, i.e. 8 m/s² on a 1500 kg
+    /// car. Each wheel's share is capped by its tyre's grip, `μ·N` (road friction times the
+    /// wheel's load), so on a road of friction `μ < 0.82` full braking gives `μ·g`.
     pub max_brake_force_n: f64,
     /// Front-wheel angle at full steering, in rad. Default 0.5 rad (about 29°).
     pub max_steer_rad: f64,
@@ -53,6 +56,10 @@ pub(crate) struct EgoVehicle {
     pub(crate) collider: ColliderHandle,
     controller: DynamicRayCastVehicleController,
     params: VehicleParams,
+    /// The engine force the last control asked of each wheel (N), and the brake impulse it
+    /// asked of the four together (N·s), before [`EgoVehicle::hold_to_grip`] shares and caps
+    /// them.
+    asked: ([f32; 4], f32),
 }
 
 impl EgoVehicle {
@@ -118,6 +125,7 @@ impl EgoVehicle {
             collider,
             controller,
             params: params.clone(),
+            asked: ([0.0; 4], 0.0),
         }
     }
 
@@ -133,6 +141,43 @@ impl EgoVehicle {
             wheel.steering = if front { steer } else { 0.0 };
             wheel.engine_force = if front { 0.0 } else { engine };
             wheel.brake = brake;
+            self.asked.0[i] = wheel.engine_force;
+        }
+        self.asked.1 = 4.0 * brake;
+    }
+
+    /// Shares the brake among the wheels and holds each wheel's engine force and brake to
+    /// what its tyre can pass to the road.
+    ///
+    /// The brake impulse asked of the four wheels goes to each in proportion to its load `N`
+    /// (its suspension force over the last step, N; the static share `m·g/4` before the first
+    /// step or after a wheel left the ground). Then each wheel's longitudinal force is at most
+    /// `sqrt((μ·N)² − S²)`, with `μ` the wheel's friction and `S` its side force over the last
+    /// step (N): a tyre's total force stays within Coulomb's friction circle `μ·N`, so full
+    /// braking on a road of friction `μ` decelerates at most `μ·g` (LANGUAGE.md, "friction").
+    ///
+    /// rapier's `DynamicRayCastVehicleController` alone does not: it limits
+    /// `(F/2)² + S² <= (friction_slip·N)²` (Bullet's `fwdFactor = 0.5`), which let a tyre
+    /// brake or pull with twice `friction_slip·N`: full braking on ice (`μ = 0.1`) stopped from
+    /// 12 m/s in 34 m, at 2.1 m/s² instead of 0.98.
+    fn hold_to_grip(&mut self, dt_s: f32) {
+        let static_n = (self.params.mass_kg * 9.81 / 4.0) as f32;
+        let load = |w: &rapier3d::control::Wheel| {
+            if w.wheel_suspension_force > 0.0 {
+                w.wheel_suspension_force
+            } else {
+                static_n
+            }
+        };
+        let total_n: f32 = self.controller.wheels().iter().map(load).sum();
+        let (engine, brake) = self.asked;
+        for (wheel, engine) in self.controller.wheels_mut().iter_mut().zip(engine) {
+            let n = load(wheel);
+            let grip_n = wheel.friction_slip * n;
+            let side_n = wheel.side_impulse / dt_s;
+            let room_n = (grip_n * grip_n - side_n * side_n).max(0.0).sqrt();
+            wheel.engine_force = engine.clamp(-room_n, room_n);
+            wheel.brake = (brake * n / total_n).min(room_n * dt_s);
         }
     }
 
@@ -168,6 +213,7 @@ impl EgoVehicle {
             &mut physics.colliders,
             QueryFilter::only_fixed().exclude_sensors(),
         );
+        self.hold_to_grip(dt_s as f32);
         self.controller.update_vehicle(dt_s as f32, queries);
     }
 

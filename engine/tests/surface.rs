@@ -150,6 +150,72 @@ fn braking_on_a_wet_piece_ahead_takes_longer_than_on_a_dry_one() {
     assert!(wet > 2.0 * dry, "wet {wet:.1} m vs dry {dry:.1} m");
 }
 
+/// The ego's mean deceleration under full braking from 12 m/s on one segment of friction
+/// `mu`, m/s², measured from 11 m/s down to 3 m/s.
+fn ego_deceleration(mu: f64) -> f64 {
+    let spec = world(road(&[(300.0, mu)]), 50.0, 12.0, &[]);
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut brake = ConstantControl(Control {
+        throttle: -1.0,
+        steering: 0.0,
+    });
+    let (mut t11, mut t3) = (None, None);
+    while sim.t_s() < 30.0 && t3.is_none() {
+        let c = brake.act(&sim.observation()).unwrap();
+        sim.step(c, &mut NoHost).unwrap();
+        let v = sim.ego_state().speed_mps;
+        if v <= 11.0 && t11.is_none() {
+            t11 = Some(sim.t_s());
+        }
+        if v <= 3.0 {
+            t3 = Some(sim.t_s());
+        }
+    }
+    8.0 / (t3.unwrap() - t11.unwrap())
+}
+
+#[test]
+fn the_ego_brakes_no_harder_than_mu_g_nor_than_its_brakes() {
+    // rapier's ray-cast vehicle alone let a tyre brake with twice its friction (2.1 m/s² on
+    // ice, 0.1): the friction circle held by `hold_to_grip` keeps it to μ·g.
+    // The chassis' linear damping, 0.02 /s, adds 0.02·v: at most 0.22 m/s² from 11 m/s.
+    let g = 9.81;
+    for mu in [0.1, 0.3, 0.5] {
+        let a = ego_deceleration(mu);
+        eprintln!("μ = {mu}: {a:.3} m/s²");
+        assert!(
+            a <= mu * g + 0.02 * 11.0 && a >= mu * g * 0.95,
+            "μ = {mu}: {a:.3} m/s², μ·g = {:.3}",
+            mu * g
+        );
+    }
+    // On dry asphalt the brakes, 8 m/s², are the limit, not the tyres (0.9 · g = 8.8).
+    let dry = ego_deceleration(0.9);
+    assert!((dry - 8.0).abs() < 0.4, "dry: {dry:.3} m/s²");
+}
+
+#[test]
+fn the_ego_pulls_away_on_ice_no_harder_than_its_driven_wheels_grip() {
+    // Full throttle from rest on ice: only the rear wheels pull, so at most μ·g times their
+    // share of the weight (about half), far below the engine's 3 m/s².
+    let mu = 0.1;
+    let spec = world(road(&[(300.0, mu)]), 50.0, 0.0, &[]);
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut gas = ConstantControl(Control {
+        throttle: 1.0,
+        steering: 0.0,
+    });
+    while sim.t_s() < 3.0 {
+        let c = gas.act(&sim.observation()).unwrap();
+        sim.step(c, &mut NoHost).unwrap();
+    }
+    let a = sim.ego_state().speed_mps / sim.t_s();
+    assert!(
+        a <= 0.55 * mu * 9.81 && a > 0.3 * mu * 9.81,
+        "{a:.3} m/s² on ice"
+    );
+}
+
 /// An NPC car told to stop dead at t = 1 s: its deceleration, m/s², measured over the step
 /// after the command.
 fn npc_deceleration(friction: f64) -> f64 {
