@@ -221,6 +221,11 @@ impl Graph {
         }
     }
 
+    /// Where node `node` was made (a program's `file:line:col`), when known.
+    pub fn made_at(&self, node: usize) -> Option<&str> {
+        self.sites.get(node).and_then(|s| s.as_deref())
+    }
+
     /// The nodes, by [`StreamId`].
     pub fn nodes(&self) -> &[Node] {
         &self.nodes

@@ -4,6 +4,7 @@
 //! parameters, to check its worlds over the levels and corners of its parameters, and to find
 //! which inputs each parameter changes.
 
+use std::io::Write;
 use std::sync::Arc;
 
 use paracosm_engine::rx::{Host, Node, OpenStream, RxError, StreamId};
@@ -271,8 +272,10 @@ impl Program {
                     .swap(true, std::sync::atomic::Ordering::Relaxed)
             {
                 // The evaluation at load: what the program prints is shown once, on stderr.
+                // A stderr that cannot be written (`2>&1 | head -1`) drops the lines.
+                let mut err = std::io::stderr().lock();
                 for line in &printed {
-                    eprintln!("{}: print: {line}", self.file);
+                    let _ = writeln!(err, "{}: print: {line}", self.file);
                 }
             }
             b.log = printed;
@@ -967,6 +970,8 @@ pub fn load(
         }
     };
     let mut checked = None;
+    // Streams nothing reads in any world checked: each world's, intersected.
+    let mut unread: Vec<std::collections::BTreeSet<String>> = Vec::new();
     if !program.params.is_empty() {
         let combinations = program.combinations();
         let total = combinations.len();
@@ -976,13 +981,18 @@ pub fn load(
                 checked = Some((done, total, steps));
                 break;
             }
-            let (_, s) = program.world_counted(values).map_err(|m| with(&label, m))?;
+            let (w, s) = program.world_counted(values).map_err(|m| with(&label, m))?;
+            unread.push(usage::unread_streams(&w));
             steps += s;
         }
     }
 
     // What each parameter changes: its other checked values against the first evaluation.
     let base = scene::world(&first, program.horizon_s).map_err(lang)?;
+    let mut unread_everywhere = usage::unread_streams(&base);
+    for other in &unread {
+        unread_everywhere.retain(|site| other.contains(site));
+    }
     let base_values: Vec<ParamValue> = program
         .params
         .iter()
@@ -1072,6 +1082,15 @@ pub fn load(
 
     let mut warnings = first.warnings.clone();
     let place_at = first.placed_at.clone().unwrap_or_default();
+    for site in unread_everywhere {
+        warnings.push(Warning {
+            at: site,
+            message: "this stream is read by nothing (no object's input, monitor, Signal or \
+                      foreach uses it, directly or through other streams): it is never \
+                      computed, and the parameters only its functions read change no result"
+                .to_owned(),
+        });
+    }
     if let Some((done, total, steps)) = checked {
         warnings.push(Warning {
             at: format!("{file}:1:1"),

@@ -481,6 +481,68 @@ fn a_parameter_in_another_unit_than_its_input_is_a_warning() {
         "{:?}",
         s.warnings
     );
+    // Spellings of m/s² a user types (the shipped follow-lead-car writes `m/s^2`), and a
+    // wrong one that still warns.
+    for (unit, warns) in [
+        ("m/s^2", false),
+        ("m / s**2", false),
+        ("m/s²", false),
+        ("m/s", true),
+    ] {
+        let src = with_car(
+            "",
+            &format!(
+                "decel = VarInterval(2.0, 8.0, unit = \"{unit}\")\n\
+                 tick.filter(lambda t: t > 3.0).foreach(c.brake(decel))\n"
+            ),
+        );
+        let s = load_source("decel.star", &src, "decel").unwrap();
+        let warned = s
+            .warnings
+            .iter()
+            .any(|w| w.to_string().contains("is declared in"));
+        assert_eq!(warned, warns, "{unit}: {:?}", s.warnings);
+    }
+}
+
+#[test]
+fn a_stream_nothing_reads_is_named_in_a_warning() {
+    let unread = |s: &crate::Scenario| -> Vec<String> {
+        s.warnings
+            .iter()
+            .map(|w| w.to_string())
+            .filter(|w| w.contains("this stream is read by nothing"))
+            .collect()
+    };
+    // `k` feeds a stream that no object, monitor or action reads: it was counted in coverage
+    // with no word, though it changes nothing.
+    let src = with_car(
+        "",
+        "k = VarInterval(0.0, 1.0)\ns = tick.map(lambda t: t * k).filter(lambda x: x > 0.5)\n",
+    );
+    let s = load_source("unread.star", &src, "unread").unwrap();
+    let w = unread(&s);
+    assert_eq!(w.len(), 1, "{:?}", s.warnings);
+    // The last stream of the chain (the filter), not each one.
+    assert!(w[0].contains("unread.star:6:"), "{w:?}");
+    // Read by a car, a Signal, a foreach or a monitor: no warning.
+    for (car, used) in [
+        (", speed = tick.map(lambda t: 5.0 + t)", ""),
+        ("", "Signal(\"late\", tick.map(lambda t: t - 1.0))\n"),
+        ("", "tick.filter(lambda t: t > 3.0).foreach(c.brake(2.0))\n"),
+        ("", "Monitor(c.speed.map(lambda v: 30.0 - v))\n"),
+    ] {
+        let src = with_car(car, used);
+        let s = load_source("used.star", &src, "used").unwrap();
+        assert!(unread(&s).is_empty(), "{used}: {:?}", s.warnings);
+    }
+    // Read in some worlds of the family only: not unread.
+    let src = with_car(", speed = fast if mode == \"a\" else 5.0", "").replace(
+        "c = Car",
+        "mode = VarEnum([\"a\", \"b\"])\nfast = tick.map(lambda t: 5.0 + t)\nc = Car",
+    );
+    let s = load_source("some.star", &src, "some").unwrap();
+    assert!(unread(&s).is_empty(), "{:?}", s.warnings);
 }
 
 #[test]
@@ -494,6 +556,20 @@ fn monitors_have_unique_names_and_the_default_offroad_monitor_yields_to_a_declar
         "{HEADER}w.place(r, v)\nStl(\"ego_speed_mps > 1\", name = \"offroad\")\n"
     ));
     assert!(m.contains("the name of the default OffRoadMonitor"), "{m}");
+    for bad in ["", "a b", "tab\\t"] {
+        for monitor in [
+            format!("Stl(\"G[0,10] (ego_speed_mps > 3)\", name = \"{bad}\")"),
+            format!("CollisionMonitor(v, name = \"{bad}\")"),
+            format!("Monitor(v.speed, name = \"{bad}\")"),
+        ] {
+            let m = err(&format!("{HEADER}w.place(r, v)\n{monitor}\n"));
+            assert!(
+                m.contains("must not be empty or hold spaces"),
+                "{monitor}: {m}"
+            );
+            assert!(m.contains("bad.star:5:1"), "{monitor}: {m}");
+        }
+    }
 
     let names = |src: &str| -> Vec<String> {
         let s = load_source("m.star", src, "m").unwrap();

@@ -55,6 +55,67 @@ fn read_streams(w: &WorldSpec) -> HashSet<usize> {
         .collect()
 }
 
+/// Where the program made streams that nothing reads (`file:line:col`): no object's input,
+/// friction, light, fog, lane change, published signal (`Monitor`, `Assert`, `Signal`) or
+/// `foreach` reads them, directly or through other streams, so they are never computed and
+/// any parameter read only by their functions changes no result. Only the last stream of an
+/// unread chain is named (`s = tick.map(f).filter(p)` names the `filter`), and only streams
+/// made by a combinator (`map`, `filter`, `zip`, `take`, `skipUntil`, `takeUntil`, `concat`,
+/// `sum`); a probe such as `v.speed` taken and left unused costs nothing.
+pub fn unread_streams(w: &WorldSpec) -> BTreeSet<String> {
+    use paracosm_engine::rx::Node;
+    let nodes = w.streams.nodes();
+    let mut stack: Vec<usize> = w
+        .cars
+        .iter()
+        .flat_map(|c| {
+            let when = match c.lane_change.map(|l| l.start) {
+                Some(paracosm_engine::LaneChangeStart::When(id)) => Some(id.0),
+                _ => None,
+            };
+            [Some(c.speed.0), when]
+        })
+        .flatten()
+        .chain(w.pedestrians.iter().map(|p| p.speed.0))
+        .chain(w.frictions.iter().map(|(_, s)| s.0))
+        .chain([w.environment.light.0, w.environment.fog.0])
+        .chain(w.published.iter().map(|(_, s)| s.0))
+        .chain(
+            nodes
+                .iter()
+                .enumerate()
+                .filter(|(_, n)| matches!(n, Node::Foreach { .. } | Node::Perform { .. }))
+                .map(|(i, _)| i),
+        )
+        .collect();
+    let mut live = vec![false; nodes.len()];
+    while let Some(i) = stack.pop() {
+        if i < nodes.len() && !live[i] {
+            live[i] = true;
+            stack.extend(nodes[i].inputs().iter().map(|s| s.0));
+        }
+    }
+    let read = read_streams(w);
+    nodes
+        .iter()
+        .enumerate()
+        .filter(|&(i, n)| {
+            !live[i]
+                && !read.contains(&i)
+                && !matches!(
+                    n,
+                    Node::Const(_)
+                        | Node::Tick
+                        | Node::Param(_)
+                        | Node::Open(_)
+                        | Node::Probe(_)
+                        | Node::Check { .. }
+                )
+        })
+        .filter_map(|(i, _)| w.streams.made_at(i).map(str::to_owned))
+        .collect()
+}
+
 /// What differs between two lists of painted things (cars, obstacles): item `i`'s colour alone
 /// is `colour(i)`; any other difference, or another count, is [`Change::Other`].
 fn recoloured<T: Clone + PartialEq + std::fmt::Debug>(
@@ -306,7 +367,14 @@ pub fn analyse(i: Inputs<'_>) -> Usage {
 /// A warning for each parameter declared with a `unit=` that is passed whole to an input in
 /// another unit (`unit = "km/h"` feeding `Car(speed=)`, in m/s).
 pub fn unit_warnings(params: &[(String, ParamDecl)], syntax: &Syntax) -> Vec<Warning> {
-    let norm = |u: &str| u.split_whitespace().collect::<String>();
+    // Spellings of one unit compare equal: spaces dropped, `m/s^2` and `m/s**2` are `m/s²`.
+    let norm = |u: &str| {
+        u.split_whitespace()
+            .collect::<String>()
+            .replace("**", "^")
+            .replace("^2", "²")
+            .replace("^3", "³")
+    };
     let mut out = Vec::new();
     for (name, decl) in params {
         let (Some(unit), Some(site)) = (&decl.unit, syntax.site(&decl.at)) else {

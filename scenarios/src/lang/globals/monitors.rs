@@ -17,6 +17,14 @@ use crate::MonitorSpec;
 use super::*;
 
 pub(super) fn unique_monitor_name(b: &SceneBuilder, name: &str) -> anyhow::Result<()> {
+    // A monitor's name keys its verdict in results.jsonl, the CSV columns and JUnit, as a
+    // parameter's name does: the same rule.
+    if name.is_empty() || name.chars().any(|c| c.is_whitespace() || c.is_control()) {
+        bail!(
+            "a monitor's name= must not be empty or hold spaces, got {name:?}: it keys the \
+             verdicts in results files, so it is written without spaces (letters, digits, _ . [ ])"
+        );
+    }
     if b.monitors.iter().any(|m| m.name() == name) {
         bail!(
             "two monitors are named `{name}`: results are keyed by monitor name, so give one \
