@@ -11,9 +11,27 @@ use crate::Error;
 /// The value parser of `--strategy`: the names of [`Strategy::LIST`], each with its
 /// [`Strategy::help`] in `--help`.
 pub fn strategy_parser() -> impl clap::builder::TypedValueParser<Value = Strategy> {
+    strategy_parser_of(|_| true)
+}
+
+/// The value parser of `paracosm-fuzz dataset --strategy`: the strategies that choose points
+/// up front (no falsifier, whose points follow robustness, and no `points`, which dataset
+/// has no `--points` for), so that `--help` offers only what it accepts.
+pub fn dataset_strategy_parser() -> impl clap::builder::TypedValueParser<Value = Strategy> {
+    strategy_parser_of(|s| s != Strategy::Points && !Strategy::FALSIFIERS.contains(&s))
+}
+
+fn strategy_parser_of(
+    keep: fn(Strategy) -> bool,
+) -> impl clap::builder::TypedValueParser<Value = Strategy> {
     use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-    PossibleValuesParser::new(Strategy::LIST.map(|s| PossibleValue::new(s.name()).help(s.help())))
-        .map(|name| name.parse::<Strategy>().expect("a name of Strategy::LIST"))
+    PossibleValuesParser::new(
+        Strategy::LIST
+            .into_iter()
+            .filter(|&s| keep(s))
+            .map(|s| PossibleValue::new(s.name()).help(s.help())),
+    )
+    .map(|name| name.parse::<Strategy>().expect("a name of Strategy::LIST"))
 }
 
 /// The strategy named by `--strategy` and `--scramble`.
@@ -30,13 +48,22 @@ pub fn strategy(chosen: Strategy, scramble: bool) -> Result<Strategy, Error> {
     }
 }
 
+/// Writes `line` and a newline to stderr. A stderr that cannot be written (a pipe whose
+/// reader has gone, as in `2>&1 | head -1`) is not an error: the line is dropped and the
+/// campaign goes on, writes its files and exits with its own code (`eprintln!` panicked
+/// there, exit 101, before the first test ran).
+pub fn to_stderr(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
+}
+
 /// Parses the command line of `tool`. On `--help`/`--version` prints and returns
 /// `Err(ExitCode::SUCCESS)`; on bad usage prints `tool: <one-line reason> (see --help)` to
 /// stderr and returns `Err(2)`.
 pub fn parse_args<T: Parser>(tool: &str) -> Result<T, ExitCode> {
     T::try_parse().map_err(|e| {
         if e.use_stderr() {
-            eprintln!("{tool}: {} (see --help)", one_line(&e));
+            to_stderr(&format!("{tool}: {} (see --help)", one_line(&e)));
             ExitCode::from(2)
         } else {
             let _ = e.print();
@@ -60,15 +87,18 @@ pub struct SutArgs {
     /// e.g. "python3 my_controller.py" (split like a shell would, without expansion).
     #[arg(long, value_name = "COMMAND")]
     pub sut_cmd: Option<String>,
-    /// With --sut-cmd: longest wait for any answer of the program, in seconds (at most
-    /// 3600).
-    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
-    pub sut_timeout: f64,
+    /// With --sut-cmd: longest wait for any answer of the program, in seconds (default 10, at
+    /// most 3600).
+    #[arg(long, value_name = "SECONDS", requires = "sut_cmd")]
+    pub sut_timeout: Option<f64>,
     /// With --sut-cmd: start a fresh process for every test, instead of keeping one alive
     /// per worker and sending it a reset message.
-    #[arg(long)]
+    #[arg(long, requires = "sut_cmd")]
     pub sut_fresh: bool,
 }
+
+/// `--sut-timeout` when it is not given, s.
+pub const DEFAULT_SUT_TIMEOUT_S: f64 = 10.0;
 
 /// The longest `--sut-timeout`, s: an hour. Longer waits are no use to a test and overflow
 /// the clock's arithmetic.
@@ -83,7 +113,7 @@ impl SutArgs {
     /// quote) or is empty, or a timeout that is not a positive number of seconds up to
     /// [`MAX_SUT_TIMEOUT_S`].
     pub fn config(&self) -> Result<Option<SutConfig>, Error> {
-        let timeout_s = self.sut_timeout;
+        let timeout_s = self.sut_timeout.unwrap_or(DEFAULT_SUT_TIMEOUT_S);
         if !(timeout_s.is_finite() && timeout_s > 0.0 && timeout_s <= MAX_SUT_TIMEOUT_S) {
             return Err(Error::BadInput(format!(
                 "--sut-timeout {timeout_s} must be a positive number of seconds, at most \
@@ -233,7 +263,7 @@ mod tests {
             sut: sut.map(str::to_owned),
             sut_cmd: cmd.map(str::to_owned),
             sut_onnx: None,
-            sut_timeout: timeout,
+            sut_timeout: Some(timeout),
             sut_fresh: false,
         };
         assert_eq!(args(None, None, 10.0).config().unwrap(), None);

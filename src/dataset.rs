@@ -197,6 +197,9 @@ struct FrameRow {
     frame: usize,
     t_s: f64,
     stem: String,
+    /// The image's size, pixels: the camera that took it (the teacher's own, if it has one).
+    width: u32,
+    height: u32,
     ego: paracosm_engine::EgoState,
     throttle: f64,
     steering: f64,
@@ -208,6 +211,8 @@ struct FrameRow {
 struct TestData {
     record: RunRecord,
     rows: Vec<FrameRow>,
+    /// The camera that took the test's frames, if it took any.
+    camera: Option<CameraSpec>,
 }
 
 fn write_error(path: &Path, e: impl std::fmt::Display) -> Error {
@@ -347,6 +352,7 @@ fn record_test(
     let mut perturb = |t_s: f64, c: Control| noise.apply(t_s, c);
     let mut rows = Vec::new();
     let mut failed = None;
+    let mut used: Option<CameraSpec> = None;
     // Frames are kept on the grid k / rate_hz: a teacher's own camera may be faster.
     let period_s = 1.0 / rate_hz;
     let mut next_s = 0.0;
@@ -362,11 +368,14 @@ fn record_test(
             failed = Some(e);
             return;
         }
+        used.get_or_insert_with(|| s.camera.clone());
         rows.push(FrameRow {
             test: id,
             frame: rows.len(),
             t_s: s.frame.t_s,
             stem,
+            width: s.frame.width,
+            height: s.frame.height,
             ego: s.ego,
             throttle: s.control.throttle,
             steering: s.control.steering,
@@ -388,7 +397,11 @@ fn record_test(
     );
     match failed {
         Some(e) => Err(e),
-        None => Ok(TestData { record, rows }),
+        None => Ok(TestData {
+            record,
+            rows,
+            camera: used,
+        }),
     }
 }
 
@@ -534,8 +547,8 @@ fn write_index(
             images.push(CocoImage {
                 id: image_id,
                 file_name: image,
-                width: camera.width,
-                height: camera.height,
+                width: r.width,
+                height: r.height,
                 test: r.test,
                 t_s: r.t_s,
                 depth_file: depth,
@@ -586,7 +599,14 @@ fn write_index(
         "steer_noise": req.steer_noise,
         "noise_hold_s": req.noise_hold_s,
         "teacher": scenario.sut.name(),
-        "camera": camera,
+        // The camera that took the frames: the teacher's own when it has one (a 64 × 48
+        // teacher camera was written up as the 320 × 240 default), else --camera's.
+        "camera": done.iter().find_map(|t| t.camera.as_ref()).unwrap_or(camera),
+        "camera_of": if done.iter().any(|t| t.camera.as_ref().is_some_and(|c| c != camera)) {
+            "teacher"
+        } else {
+            "dataset"
+        },
         "tests": done.len(),
         "tests_in_error": errors,
         "frames": frames,

@@ -48,7 +48,7 @@ impl Progress {
 
     /// Prints `line` on stderr without tearing the bar.
     pub fn note(&self, line: &str) {
-        self.bar.suspend(|| eprintln!("{line}"));
+        self.bar.suspend(|| crate::cli::to_stderr(line));
     }
 }
 
@@ -59,7 +59,7 @@ impl Observer for Progress {
             self.bar.suspend(|| {
                 r.log
                     .iter()
-                    .for_each(|line| eprintln!("test {}: {line}", r.id))
+                    .for_each(|line| crate::cli::to_stderr(&format!("test {}: {line}", r.id)))
             });
         }
         self.bar.set_message(format!("{} failed", self.failures));

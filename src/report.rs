@@ -229,7 +229,16 @@ pub fn write_outputs(f: &Finished<'_>) -> Result<Written, crate::Error> {
         crate::campaign_file::CAMPAIGN_FILE.to_owned(),
     ];
     if let Some(j) = f.junit {
-        outputs.push(j.display().to_string());
+        // Relative to the output folder, as the other files are (`--junit o7/j.xml --out o7`
+        // was listed as o7/o7/j.xml); a file outside it by its absolute path.
+        let (j_abs, out_abs) = (
+            std::path::absolute(j).unwrap_or_else(|_| j.to_owned()),
+            std::path::absolute(f.out).unwrap_or_else(|_| f.out.to_owned()),
+        );
+        outputs.push(match j_abs.strip_prefix(&out_abs) {
+            Ok(inside) => inside.display().to_string(),
+            Err(_) => j_abs.display().to_string(),
+        });
     }
     let base = outputs.clone();
     let stems: Vec<&str> = planned.iter().map(|(s, _)| *s).collect();

@@ -255,6 +255,26 @@ fn three_shards_merge_into_the_single_machine_run() {
     assert_eq!(summary["tests_run"], 400);
     assert_eq!(summary["shard"], serde_json::Value::Null);
     assert!(merged.join("failure_map.png").exists());
+    // Every file listed is where the list says, relative to the output folder: the JUnit
+    // file too, whether inside it or not.
+    let outputs: Vec<&str> = summary["outputs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| o.as_str().unwrap())
+        .collect();
+    assert!(outputs.len() > 5, "{outputs:?}");
+    for o in &outputs {
+        assert!(
+            merged.join(o).is_file(),
+            "{o} is not a file under {}",
+            merged.display()
+        );
+    }
+    assert!(
+        outputs.iter().any(|o| merged.join(o) == junit),
+        "{outputs:?}"
+    );
 
     // JUnit: well-formed, one test case per test, a failure per failed test.
     let xml = std::fs::read_to_string(&junit).unwrap();

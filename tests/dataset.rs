@@ -139,6 +139,48 @@ fn a_data_set_is_consistent_and_the_same_for_any_jobs() {
 }
 
 #[test]
+fn a_teachers_own_camera_is_the_one_the_metadata_describes() {
+    // `vision` sees through its own 160 × 120 camera: annotations.json and dataset.json said
+    // 320 × 240 (the dataset's default) while the images were 160 × 120.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("v");
+    let o = fuzz(&[
+        "dataset",
+        "pedestrian-crossing",
+        "--budget",
+        "1",
+        "--rate",
+        "1",
+        "--sut",
+        "vision",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 0);
+    let coco: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("annotations.json")).unwrap()).unwrap();
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("dataset.json")).unwrap()).unwrap();
+    let images = coco["images"].as_array().unwrap();
+    assert!(!images.is_empty());
+    for image in images {
+        let png = image::open(out.join(image["file_name"].as_str().unwrap())).unwrap();
+        assert_eq!(image["width"].as_u64().unwrap(), u64::from(png.width()));
+        assert_eq!(image["height"].as_u64().unwrap(), u64::from(png.height()));
+        assert_eq!(
+            manifest["camera"]["width"].as_u64().unwrap(),
+            u64::from(png.width())
+        );
+        assert_eq!(
+            manifest["camera"]["height"].as_u64().unwrap(),
+            u64::from(png.height())
+        );
+    }
+    assert_ne!(manifest["camera"]["width"], 320, "{}", manifest["camera"]);
+    assert_eq!(manifest["camera_of"], "teacher");
+}
+
+#[test]
 fn bad_dataset_settings_exit_2_with_the_reason() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("d");
@@ -157,7 +199,14 @@ fn bad_dataset_settings_exit_2_with_the_reason() {
     for (extra, reason) in [
         (&["--rate", "0"][..], "--rate 0 must be a positive"),
         (&["--rate", "nan"][..], "--rate NaN must be a positive"),
-        (&["--strategy", "falsify-nm"][..], "its points exist only"),
+        (
+            &["--strategy", "falsify-nm"][..],
+            "invalid value 'falsify-nm' for '--strategy",
+        ),
+        (
+            &["--strategy", "points"][..],
+            "invalid value 'points' for '--strategy",
+        ),
         (&["--width", "0"][..], "outside 1..=4096"),
         (&["--sut", "lidar"][..], "unknown system under test"),
         (

@@ -491,6 +491,35 @@ fn a_covering_suite_over_one_discrete_parameter_runs_by_default() {
     expect_code(&o, 2);
     assert!(String::from_utf8_lossy(&o.stderr)
         .contains("--strength 2: a covering array of strength 2 needs 2 discrete parameters"));
+    // A strength given to a strategy that builds no covering array had no effect.
+    let o = fuzz(&[
+        file.to_str().unwrap(),
+        "--strategy",
+        "random",
+        "--strength",
+        "1",
+        "--force",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 2);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains(
+            "--strength 1 applies to the covering-array strategies (ipog, kwise), not random"
+        ),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    // --sut-timeout and --sut-fresh without --sut-cmd were accepted and did nothing.
+    for flag in [&["--sut-timeout", "3"][..], &["--sut-fresh"][..]] {
+        let o = run(flag);
+        expect_code(&o, 2);
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains("--sut-cmd"),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
 }
 
 /// An NPC car's `pos` is its body's centre, as LANGUAGE.md says and as the ego's is its

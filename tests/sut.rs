@@ -98,6 +98,57 @@ fn every_misbehaving_program_becomes_an_error_record_and_the_campaign_goes_on() 
 }
 
 #[test]
+fn a_hello_that_cannot_be_honoured_ends_each_test_in_error_naming_it() {
+    // Each of these was run another way without a word: "yes" sent no lidar, a misspelt
+    // camera key gave the default camera, an unknown sensor sent nothing, 25 Hz ran at 30 Hz.
+    let cases = [
+        (r#"{"lidar": "yes"}"#, "null", "declared sensor `lidar` as \"yes\""),
+        (r#"{"camera": {"widht": 64}}"#, "null", "unknown field `widht`"),
+        (r#"{"camera": {"rate_hz": 25}}"#, "null", "camera rate_hz 25 is not a whole number"),
+        (r#"{"lidr": true}"#, "null", "declared sensor `lidr`, which the simulation does not mount (it mounts: camera, depth, lidar)"),
+        ("{}", "25", "declared control_hz 25 is not a whole number of physics steps (60 per second) per period: use 60 / k for a whole k, such as 30 or 20"),
+        ("{}", "1000", "such as 60"),
+    ];
+    for (sensors, hz, message) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let cmd = format!("{} '{sensors}' {hz}", script("tests/sut_faults/asks.py"));
+        let o = fuzz(&[
+            "pedestrian-crossing",
+            "--budget",
+            "2",
+            "--jobs",
+            "1",
+            "--out",
+            dir.path().to_str().unwrap(),
+            "--sut-cmd",
+            &cmd,
+        ]);
+        expect_code(&o, 3);
+        for r in records(dir.path()) {
+            assert_eq!(r["status"], "error", "{sensors} {hz}");
+            let error = r["error"].as_str().unwrap();
+            assert!(error.contains(message), "{sensors} {hz}: {error}");
+        }
+    }
+    // What can be honoured runs: 20 Hz, a lidar, a camera at 10 frames a second.
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = format!(
+        "{} '{{\"lidar\": true, \"camera\": {{\"width\": 32, \"height\": 24, \"rate_hz\": 10}}}}' 20",
+        script("tests/sut_faults/asks.py")
+    );
+    fuzz(&[
+        "pedestrian-crossing",
+        "--budget",
+        "1",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--sut-cmd",
+        &cmd,
+    ]);
+    assert_ne!(statuses(dir.path()), vec!["error".to_owned()]);
+}
+
+#[test]
 fn after_a_crash_the_next_test_gets_a_fresh_process() {
     let dir = tempfile::tempdir().unwrap();
     let marker = dir.path().join("crashed-once");

@@ -19,7 +19,7 @@ pub const SENSOR_HEIGHT_MM: f64 = 24.0;
 /// Mount: `mount_m` is `[forward, up, right]` from the ego chassis centre in metres; the camera
 /// looks along the vehicle's heading, tilted down by `pitch_rad`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct CameraSpec {
     /// Image width in pixels, `1..=4096`. Default 320.
     pub width: u32,
@@ -32,7 +32,8 @@ pub struct CameraSpec {
     pub mount_m: [f64; 3],
     /// Downward tilt in rad, `[-π/2, π/2]`. Default 0.05 rad (2.9°).
     pub pitch_rad: f64,
-    /// Frames per second of simulated time, `> 0`. Default 20 Hz.
+    /// Frames per second of simulated time: a whole number of physics steps per frame
+    /// (`60 / k` at the 60 Hz step: 60, 30, 20, 15, 12, 10, 7.5, ...). Default 20 Hz.
     pub rate_hz: f64,
     /// Standard deviation of additive Gaussian pixel noise, in 8-bit levels (`0` off). Default 0.
     pub noise_sigma: f64,
@@ -62,7 +63,8 @@ impl CameraSpec {
     /// Checks the documented ranges.
     ///
     /// # Errors
-    /// A message naming the first value out of range.
+    /// A message naming the first value out of range, or a `rate_hz` that is not a whole
+    /// number of physics steps per frame.
     pub fn validate(&self) -> Result<(), String> {
         let range = |name: &str, v: f64, ok: bool| {
             if ok && v.is_finite() {
@@ -88,6 +90,7 @@ impl CameraSpec {
             self.pitch_rad.abs() <= std::f64::consts::FRAC_PI_2,
         )?;
         range("rate_hz", self.rate_hz, self.rate_hz > 0.0)?;
+        crate::steps_per_period("camera rate_hz", self.rate_hz, crate::DEFAULT_DT_S)?;
         range("noise_sigma", self.noise_sigma, self.noise_sigma >= 0.0)?;
         range(
             "blur_sigma_px",

@@ -52,3 +52,34 @@ pub use spec::{
     WorldSpec, DEFAULT_DT_S,
 };
 pub use vehicle::VehicleParams;
+
+/// The physics steps of `dt_s` seconds between two events of a rate of `hz` per simulated
+/// second (`name` in messages), which must be a whole number `k >= 1`: `hz = 1 / (k · dt_s)`
+/// (at 60 Hz: 60, 30, 20, 15, 12, 10, 7.5, 6, 5, ...), to a relative 1e-9.
+///
+/// # Errors
+/// A message naming the rate and the nearest rates that are whole steps, for a rate that is
+/// not positive and finite, faster than the step, or between two whole periods (25 Hz ran as
+/// 30 Hz, 7 Hz as 6.67 Hz, 1,000 Hz as 60 Hz, each without a word).
+pub fn steps_per_period(name: &str, hz: f64, dt_s: f64) -> Result<u64, String> {
+    let steps = 1.0 / (hz * dt_s);
+    let k = steps.round();
+    if hz.is_finite() && hz > 0.0 && k >= 1.0 && (steps - k).abs() <= 1e-9 * k {
+        return Ok(k as u64);
+    }
+    let step_hz = 1.0 / dt_s;
+    let near: Vec<String> = [steps.floor(), steps.ceil()]
+        .into_iter()
+        .filter(|k| k.is_finite() && *k >= 1.0)
+        .map(|k| format!("{}", step_hz / k))
+        .collect();
+    Err(format!(
+        "{name} {hz} is not a whole number of physics steps ({step_hz} per second) per period: \
+         use {step_hz} / k for a whole k{}",
+        if near.is_empty() {
+            String::new()
+        } else {
+            format!(", such as {}", near.join(" or "))
+        }
+    ))
+}

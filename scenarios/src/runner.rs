@@ -221,6 +221,9 @@ impl Watch {
 pub struct Sample<'a> {
     /// The frame (RGB, depth, labels), taken at this step.
     pub frame: &'a CameraFrame,
+    /// The camera that took it: the system under test's own when it has one, else
+    /// [`RunOptions::camera`].
+    pub camera: &'a CameraSpec,
     /// The ego vehicle's state at the frame.
     pub ego: EgoState,
     /// The control the system under test answered for this step (or the answer it holds
@@ -383,9 +386,14 @@ impl Scenario {
                 };
             }
             if frame_every > 0 && tick % frame_every == 0 {
-                if let (Some(f), Some(frame)) = (options.on_sample.as_mut(), sim.camera_frame()) {
+                if let (Some(f), Some(frame), Some(camera)) = (
+                    options.on_sample.as_mut(),
+                    sim.camera_frame(),
+                    camera.as_ref(),
+                ) {
                     f(&Sample {
                         frame,
+                        camera,
                         ego: sim.ego_state(),
                         control,
                         applied,

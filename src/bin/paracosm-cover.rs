@@ -182,10 +182,10 @@ fn main() -> ExitCode {
                 return ExitCode::SUCCESS;
             }
             let code = e.downcast_ref::<Error>().map_or(3, Error::exit_code);
-            eprintln!(
-                "{}",
-                paracosm::cli::error_text("paracosm-cover", &format!("{e:#}"))
-            );
+            paracosm::cli::to_stderr(&paracosm::cli::error_text(
+                "paracosm-cover",
+                &format!("{e:#}"),
+            ));
             ExitCode::from(code)
         }
     }
@@ -399,9 +399,9 @@ fn run(cli: Cli) -> Result<()> {
             }
             let p = plan(&space, strength, epsilon, delta).map_err(bad)?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&p)?);
+                writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&p)?)?;
             } else {
-                print!("{p}");
+                write!(std::io::stdout(), "{p}")?;
             }
             Ok(())
         }
@@ -418,27 +418,29 @@ fn run(cli: Cli) -> Result<()> {
             let eval_s = started.elapsed().as_secs_f64();
             let r0 = r.first().copied().unwrap_or(f64::INFINITY);
             if json {
-                println!(
+                writeln!(
+                    std::io::stdout(),
                     "{}",
                     serde_json::json!({"robustness": r0, "samples": r.len(), "eval_s": eval_s})
-                );
+                )?;
             } else {
-                println!(
+                writeln!(
+                    std::io::stdout(),
                     "robustness {r0} ({}) over {} samples, evaluated in {:.3} ms",
                     if r0 > 0.0 { "satisfied" } else { "violated" },
                     r.len(),
                     eval_s * 1e3
-                );
+                )?;
             }
             Ok(())
         }
         Command::Bench { json } => {
             let r = bench();
             if json {
-                println!("{}", serde_json::to_string(&r)?);
+                writeln!(std::io::stdout(), "{}", serde_json::to_string(&r)?)?;
             } else {
                 for (k, v) in r.as_object().into_iter().flatten() {
-                    println!("{k:<30} {v}");
+                    writeln!(std::io::stdout(), "{k:<30} {v}")?;
                 }
             }
             Ok(())

@@ -149,7 +149,7 @@ struct DatasetArgs {
     /// Scenario: a `.star` path or a built-in name.
     scenario: String,
     /// How test points are chosen (not an adaptive strategy).
-    #[arg(long, value_parser = paracosm::cli::strategy_parser(), default_value = "halton")]
+    #[arg(long, value_parser = paracosm::cli::dataset_strategy_parser(), default_value = "halton")]
     strategy: Strategy,
     /// Strength t of --strategy ipog or kwise.
     #[arg(long, default_value_t = 2)]
@@ -346,7 +346,7 @@ fn main() -> ExitCode {
                 .and_then(|(text, counts, warnings)| {
                     warnings
                         .iter()
-                        .for_each(|w| eprintln!("paracosm-fuzz: warning: {w}"));
+                        .for_each(|w| paracosm::cli::to_stderr(&format!("paracosm-fuzz: warning: {w}")));
                     say(&text).map(|()| counts.exit_code())
                 })
         }
@@ -378,10 +378,10 @@ fn main() -> ExitCode {
     let code = match result {
         Ok(code) => interrupted_code(code),
         Err(e) => {
-            eprintln!(
-                "{}",
-                paracosm::cli::error_text("paracosm-fuzz", &format!("{e:#}"))
-            );
+            paracosm::cli::to_stderr(&paracosm::cli::error_text(
+                "paracosm-fuzz",
+                &format!("{e:#}"),
+            ));
             e.downcast_ref::<Error>().map_or(3, Error::exit_code)
         }
     };
@@ -447,7 +447,7 @@ fn run(cli: &Cli) -> Result<u8> {
     let mut plan = |p: &Plan<'_>| {
         p.notes()
             .iter()
-            .for_each(|n| eprintln!("paracosm-fuzz: {n}"));
+            .for_each(|n| paracosm::cli::to_stderr(&format!("paracosm-fuzz: {n}")));
         bar.start(p.to_run);
     };
     let outcome = paracosm::session::run(
@@ -460,7 +460,7 @@ fn run(cli: &Cli) -> Result<u8> {
     outcome
         .notes()
         .iter()
-        .for_each(|n| eprintln!("paracosm-fuzz: {n}"));
+        .for_each(|n| paracosm::cli::to_stderr(&format!("paracosm-fuzz: {n}")));
     if let Some(text) = outcome.human() {
         say(&text)?;
     }

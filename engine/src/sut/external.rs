@@ -285,6 +285,26 @@ impl Process {
             return Err(format!("answered the hello with {h} instead of a hello"));
         }
         let sensors = h.get("sensors").cloned().unwrap_or(Json::Null);
+        match &sensors {
+            Json::Null => {}
+            Json::Object(m) => {
+                // `"lidar": "yes"` sent nothing and said nothing: every sensor but the camera
+                // (which may be an object) is asked for with true or false.
+                for (name, v) in m {
+                    if name != "camera" && !v.is_boolean() {
+                        return Err(format!(
+                            "declared sensor `{name}` as {v}; a sensor is asked for with true \
+                             or false (the camera also with an object)"
+                        ));
+                    }
+                }
+            }
+            other => {
+                return Err(format!(
+                    "declared sensors {other}; need an object such as {{\"lidar\": true}}"
+                ))
+            }
+        }
         self.wants_depth = sensors
             .get("depth")
             .and_then(Json::as_bool)
@@ -316,7 +336,10 @@ impl Process {
         let control_hz = match h.get("control_hz") {
             None | Some(Json::Null) => None,
             Some(v) => match v.as_f64() {
-                Some(hz) if hz.is_finite() && hz > 0.0 => Some(hz),
+                Some(hz) if hz.is_finite() && hz > 0.0 => {
+                    crate::steps_per_period("declared control_hz", hz, crate::DEFAULT_DT_S)?;
+                    Some(hz)
+                }
                 _ => return Err(format!("declared control_hz {v}; need a positive number")),
             },
         };
@@ -496,6 +519,21 @@ impl Sut for ExternalSut {
         });
         // Every reading the program declared, as named arrays (SUT_PROTOCOL.md), in the
         // order of their names.
+        // A sensor asked for by a name the simulation does not mount (`"lidr": true`) ends
+        // the test, naming the ones it mounts, rather than sending nothing.
+        if let Some(unknown) = p.wanted.iter().find(|w| {
+            !matches!(w.as_str(), "camera" | "depth") && !obs.readings.iter().any(|(n, _)| n == w)
+        }) {
+            let mut mounted: Vec<&str> = obs.readings.iter().map(|(n, _)| *n).collect();
+            mounted.extend(["camera", "depth"]);
+            mounted.sort_unstable();
+            mounted.dedup();
+            let message = format!(
+                "declared sensor `{unknown}`, which the simulation does not mount (it mounts: {})",
+                mounted.join(", ")
+            );
+            return Err(self.fail(message));
+        }
         let mut readings: Vec<_> = obs.readings.iter().collect();
         readings.sort_by_key(|(name, _)| *name);
         let mut sent = Vec::new();
