@@ -15,14 +15,17 @@ use crate::{Generator, GeneratorError, ParamSpace, Point};
 /// If `q < 2` (no base-`q` representation exists); callers pass primes.
 pub fn radical_inverse(mut j: u64, q: u64) -> f64 {
     assert!(q >= 2, "radical inverse needs a base >= 2, got {q}");
-    let mut reversed: u64 = 0;
-    let mut denom: u64 = 1;
+    // u128: `q^k` passes 2^64 for the largest indices (it wrapped to 0, a value of inf).
+    let mut reversed: u128 = 0;
+    let mut denom: u128 = 1;
     while j > 0 {
-        reversed = reversed * q + j % q;
-        denom *= q;
+        reversed = reversed * u128::from(q) + u128::from(j % q);
+        denom *= u128::from(q);
         j /= q;
     }
-    reversed as f64 / denom as f64
+    // Below 1 whatever the rounding: with `q^k` past 2^53 (indices past 2^53 in base 2)
+    // numerator and denominator may round to the same float.
+    (reversed as f64 / denom as f64).min(1.0 - f64::EPSILON / 2.0)
 }
 
 /// The first `d` primes, `2, 3, 5, 7, ...`: the co-prime bases of the Halton sequence.

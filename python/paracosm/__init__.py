@@ -7,9 +7,24 @@ The numbers are those of the Rust crates behind the command-line tools `paracosm
 --points` for the same points and seed.
 """
 
-from . import covering, qmc
-from ._native import BUILTIN_SCENARIOS, RENDER, __version__
-from .scenario import Param, Scenario, Space, TestError
+import os as _os
+import tempfile as _tempfile
+
+# Mesa's Vulkan loader (the camera renders through it) prints "error: XDG_RUNTIME_DIR is
+# invalid or not set" on every render when the environment has no runtime folder (a sandbox,
+# a batch job), though rendering works. As paracosm-fuzz does, give it a private folder then,
+# kept between runs; an existing valid XDG_RUNTIME_DIR is left alone.
+if not _os.path.isdir(_os.environ.get("XDG_RUNTIME_DIR", "")):
+    _dir = _os.path.join(_tempfile.gettempdir(), f"paracosm-xdg-{_os.environ.get('USER', 'user')}")
+    try:
+        _os.makedirs(_dir, mode=0o700, exist_ok=True)
+        _os.environ["XDG_RUNTIME_DIR"] = _dir
+    except OSError:
+        pass
+
+from . import covering, qmc  # noqa: E402
+from ._native import BUILTIN_SCENARIOS, RENDER, __version__  # noqa: E402
+from .scenario import Param, Scenario, Space, TestError  # noqa: E402
 
 __all__ = [
     "BUILTIN_SCENARIOS",

@@ -9,12 +9,15 @@ import secrets
 import numpy as np
 
 
-def positive_int(value, name: str, minimum: int = 1) -> int:
-    """`value` as an int `>= minimum`; bools and non-integers are refused."""
+def positive_int(value, name: str, minimum: int = 1, maximum: int = 2**63 - 1) -> int:
+    """`value` as an int in `[minimum, maximum]` (by default at most 2**63 - 1, what the
+    native code takes); bools and non-integers are refused."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
         raise ValueError(f"{name} must be an integer, not {value!r}")
     if value < minimum:
         raise ValueError(f"{name} must be at least {minimum}, got {value}")
+    if value > maximum:
+        raise ValueError(f"{name} must be at most {maximum}, got {value}")
     return int(value)
 
 

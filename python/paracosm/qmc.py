@@ -13,7 +13,11 @@ Where the defaults differ from scipy's:
 
 - `Halton` is unscrambled by default (scipy: `scramble=True`): the sequence of the
   PARACOSM paper and of `paracosm-fuzz --strategy halton`, equal to
-  `scipy.stats.qmc.Halton(d, scramble=False)` point for point. `scramble=True` permutes
+  `scipy.stats.qmc.Halton(d, scramble=False)` point for point, to 4.4e-16: paracosm's
+  values are the correctly rounded radical inverses, scipy adds digit terms in floats (up to
+  3 ulp off, 3.3e-16, on 20,000 points in d = 8). At most
+  `HALTON_MAX_DIMENSIONS` (65,536) dimensions and `HALTON_MAX_INDEX` (2**53) points: past
+  that index a radical inverse has more bits than a float64. `scramble=True` permutes
   every base digit (Owen, "A randomized Halton algorithm in R", 2017), not scipy's
   permutations, so scrambled values differ from scipy's.
 - `Sobol` is always Owen-scrambled (hash-based, Burley, "Practical Hash-based Owen
@@ -41,6 +45,10 @@ SOBOL_MAX_POINTS: int = _native.SOBOL_MAX_POINTS
 """Points a `Sobol` sequence holds: 2**16."""
 SOBOL_MAX_DIMENSIONS: int = _native.SOBOL_MAX_DIMENSIONS
 """Dimensions a `Sobol` sequence supports."""
+HALTON_MAX_DIMENSIONS: int = _native.HALTON_MAX_DIMENSIONS
+"""Dimensions a `Halton` sequence supports: 2**16."""
+HALTON_MAX_INDEX: int = _native.HALTON_MAX_INDEX
+"""Points a `Halton` sequence holds: 2**53."""
 
 
 class _Engine:
@@ -76,17 +84,21 @@ class Halton(_Engine):
     """The Halton sequence in `d` dimensions (radical inverses in the first `d` primes).
 
     `scramble=False` (the default, unlike scipy's): the plain sequence from index 0, equal to
-    `scipy.stats.qmc.Halton(d, scramble=False)`. `scramble=True`: random digit permutations
+    `scipy.stats.qmc.Halton(d, scramble=False)` to 4.4e-16 (these are correctly rounded). `scramble=True`: random digit permutations
     (Owen 2017) drawn from `rng` (None: fresh entropy; an int seed; or a
     `numpy.random.Generator`).
 
-    Raises ValueError for `d` < 1 or not an integer, or a bad `rng`.
+    Raises ValueError for `d` < 1, past `HALTON_MAX_DIMENSIONS` or not an integer, or a bad
+    `rng`; `random` and `fast_forward` raise ValueError past index `HALTON_MAX_INDEX`, and
+    `random` MemoryError for an array that cannot be allocated.
     """
 
     def __init__(self, d: int, *, scramble: bool = False, rng=None):
         d = positive_int(d, "d")
         self.scramble = bool(scramble)
-        seed = seed_of(rng) if self.scramble else None
+        # A bad rng is refused even where it would not be used.
+        seed = seed_of(rng) if self.scramble or rng is not None else None
+        seed = seed if self.scramble else None
         super().__init__(d, _native.HaltonEngine(d, seed))
 
 
@@ -128,7 +140,7 @@ class Sobol(_Engine):
     def random_base2(self, m: int) -> np.ndarray:
         """The next `2**m` points; ValueError when the points drawn so far and these would not
         be a power of 2 in all."""
-        m = positive_int(m, "m", minimum=0)
+        m = positive_int(m, "m", minimum=0, maximum=16)
         n = 2**m
         total = self.num_generated + n
         if total & (total - 1) != 0:
@@ -185,12 +197,17 @@ def star_discrepancy(sample, *, seed: int = 0) -> Bracket:
     Exact for d <= 3 (n <= 20,000 for d = 2, n <= 400 for d = 3) by enumerating the critical
     grid (Bundschuh and Zhu, 1993); otherwise a bracket: the lower bound from a coordinate
     ascent over the grid (from random starts drawn by `seed`), the upper one from Thiemard's
-    delta-cover (J. Complexity 17, 2001). Raises ValueError as `discrepancy` does.
+    delta-cover (J. Complexity 17, 2001). Past d = 64 or n² · d = 5e7 (d = 8, n = 2,500)
+    the search and the cover are skipped: the bracket is the largest one-axis star
+    discrepancy below and 1 above, and a `RuntimeWarning` says so. Raises ValueError as
+    `discrepancy` does.
     """
     a = unit_matrix(sample, "sample")
     lower, upper, exact, corner, method = _native.star_discrepancy(
-        a, positive_int(seed, "seed", minimum=0)
+        a, positive_int(seed, "seed", minimum=0, maximum=2**64 - 1)
     )
+    if not exact and upper >= 1.0:
+        warnings.warn(f"star_discrepancy gives a loose bracket: {method}", RuntimeWarning, stacklevel=2)
     corner = np.asarray(corner, dtype=np.float64)
     return Bracket(lower, upper, exact, np.stack([np.zeros_like(corner), corner]), method)
 
@@ -200,12 +217,12 @@ def dispersion(sample, *, seed: int = 0) -> Bracket:
     axis-parallel box inside [0, 1]^d holding no point (PARACOSM, section 3.1).
 
     Exact for d <= 2, and for d >= 3 up to n = 2,500 (d = 3), 300 (d = 4), 120 (d = 5) and
-    60 (d >= 6); past those a certified bracket (greedy boxes from starts drawn by `seed`
+    60 (d = 6); for d >= 7, and past those sizes, a certified bracket (greedy boxes from starts drawn by `seed`
     below, a branch and bound above). No other library computes it exactly. Raises
     ValueError as `discrepancy` does.
     """
     a = unit_matrix(sample, "sample")
     lower, upper, exact, lo, hi, method = _native.dispersion(
-        a, positive_int(seed, "seed", minimum=0)
+        a, positive_int(seed, "seed", minimum=0, maximum=2**64 - 1)
     )
     return Bracket(lower, upper, exact, np.array([lo, hi], dtype=np.float64), method)

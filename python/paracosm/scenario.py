@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import re
 import math
 import numbers
 import os
@@ -200,6 +201,15 @@ def points_csv(points, space: Space) -> str:
     return out.getvalue()
 
 
+def _python_place(message: str) -> str:
+    """A message about line L, column C (`name`) of the CSV `points_csv` wrote, reworded to
+    name the Python input: `points[L - 2]['name']` (line 1 is the header)."""
+    m = re.match(r"points:(\d+): column \d+ \(`([^`]+)`\): (.*)", message, re.S)
+    if not m:
+        return message
+    return f"points[{int(m.group(1)) - 2}][{m.group(2)!r}]: {m.group(3)}"
+
+
 def _sut_args(sut) -> dict:
     """`sut` as the native arguments: None (the scenario's), a built-in name (`"aeb"`,
     `"vision"`), or a command (a list of words) speaking SUT_PROTOCOL.md."""
@@ -269,6 +279,8 @@ class Scenario:
     def __init__(self, name_or_path, *, sut=None):
         self._native = _native.ScenarioHandle(os.fspath(name_or_path))
         self._sut = _sut_args(sut)
+        # Checked now, as a run would check it: a bad name fails here, not at the first run.
+        self._sut_name = self._native.sut_name(**self._sut)
         self.space = Space([_param(p) for p in json.loads(self._native.space_json())])
         for w in self._native.warnings:
             warnings.warn(w, ScenarioWarning, stacklevel=2)
@@ -298,8 +310,9 @@ class Scenario:
 
     @property
     def sut(self) -> str:
-        """The system under test it runs by default."""
-        return self._native.sut
+        """The system under test it runs by default: the one given to the constructor, else
+        the scenario's."""
+        return self._sut_name
 
     @property
     def warnings(self) -> list[str]:
@@ -307,11 +320,9 @@ class Scenario:
         return self._native.warnings
 
     def _lines(self, points, *, sut, jobs, seed) -> list[str]:
-        seed = positive_int(seed, "seed", minimum=0)
-        if seed >= 2**64:
-            raise ValueError(f"seed {seed} is not in [0, 2**64)")
+        seed = positive_int(seed, "seed", minimum=0, maximum=2**64 - 1)
         if jobs is not None:
-            jobs = positive_int(jobs, "jobs")
+            jobs = positive_int(jobs, "jobs", maximum=4096)
         kw = dict(self._sut if sut is None else _sut_args(sut))
         if isinstance(points, dict):
             raise ValueError("points is one dict: give a list of dicts (one per test)")
@@ -319,7 +330,15 @@ class Scenario:
             isinstance(points, (list, tuple)) and len(points) > 0 and isinstance(points[0], dict)
         )
         if is_dicts:
-            return self._native.run_csv(points_csv(points, self.space), "points", seed, jobs, **kw)
+            rows = points.to_dict("records") if hasattr(points, "to_dict") else list(points)
+            if len(self.space) == 0:
+                # No parameter: each dict (empty) is one test, as a row of an (n, 0) array.
+                points_csv(rows, self.space)  # names any key the scenario lacks
+                return self._native.run_unit(np.zeros((len(rows), 0)), seed, jobs, **kw)
+            try:
+                return self._native.run_csv(points_csv(rows, self.space), "points", seed, jobs, **kw)
+            except ValueError as e:
+                raise ValueError(_python_place(str(e))) from None
         return self._native.run_unit(_unit_points(points, self.space), seed, jobs, **kw)
 
     def run(self, points, *, sut=None, jobs: int | None = None, seed: int = 0, output: str = "frame"):

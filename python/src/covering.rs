@@ -64,6 +64,10 @@ fn covering_array<'py>(
     cells.into_pyarray(py).reshape([n, k])
 }
 
+/// The most t-tuples counted under constraints: each is checked against the constraints
+/// one by one (2^27, about a minute).
+const MAX_CONSTRAINED_TUPLES: u64 = 1 << 27;
+
 /// k-wise coverage of `array` (`(n, k)` level indices, checked by the caller to lie in
 /// range): `(covered, total, missing)`; with forbidden combinations, `total` counts only the
 /// tuples some allowed row can hold, and `missing` is empty.
@@ -91,6 +95,14 @@ fn kwise_coverage(
         let raw = kwise_coverage_rows(&levels, &rows, strength, max_missing)?;
         if c.is_empty() {
             Ok((raw.covered, raw.total, raw.missing))
+        } else if raw.total > MAX_CONSTRAINED_TUPLES {
+            Err(paracosm_generators::coverage::CoverageError::Shape(
+                format!(
+                    "with constraints every {strength}-tuple is checked for an allowed row, and \
+                 these levels have {} of them (at most {MAX_CONSTRAINED_TUPLES})",
+                    raw.total
+                ),
+            ))
         } else {
             let (covered, total) = coverage_with_constraints(&levels, &rows, strength, &c);
             Ok((covered, total, Vec::new()))

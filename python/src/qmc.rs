@@ -21,6 +21,8 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dispersion, m)?)?;
     m.add("SOBOL_MAX_POINTS", paracosm_generators::SOBOL_MAX_POINTS)?;
     m.add("SOBOL_MAX_DIMENSIONS", SOBOL_MAX_DIMENSIONS)?;
+    m.add("HALTON_MAX_DIMENSIONS", HALTON_MAX_DIMENSIONS)?;
+    m.add("HALTON_MAX_INDEX", HALTON_MAX_INDEX)?;
     Ok(())
 }
 
@@ -42,12 +44,17 @@ pub struct HaltonEngine {
 
 #[pymethods]
 impl HaltonEngine {
-    /// A sequence of dimension `d >= 1`.
+    /// A sequence of dimension `1 <= d <= HALTON_MAX_DIMENSIONS`.
     #[new]
     #[pyo3(signature = (d, seed=None))]
     fn new(d: usize, seed: Option<u64>) -> PyResult<Self> {
         if d == 0 {
             return Err(value_error("d must be at least 1"));
+        }
+        if d > HALTON_MAX_DIMENSIONS {
+            return Err(value_error(format!(
+                "d = {d} is more than the {HALTON_MAX_DIMENSIONS} dimensions Halton supports"
+            )));
         }
         let space = ParamSpace::unit_cube(d);
         Ok(HaltonEngine {
@@ -61,8 +68,13 @@ impl HaltonEngine {
     }
 
     /// The next `n` points as an `(n, d)` float64 array in `[0, 1)`.
+    ///
+    /// Errors: ValueError past index `HALTON_MAX_INDEX`; MemoryError when `n × d` values
+    /// cannot be allocated.
     fn random<'py>(&mut self, py: Python<'py>, n: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let start = self.next;
+        within_halton(start, n as u64)?;
+        reserve(n, self.d)?;
         let halton = &self.halton;
         let v = py.detach(|| halton.unit_points(start, n));
         self.next += n as u64;
@@ -75,10 +87,42 @@ impl HaltonEngine {
         self.next
     }
 
-    /// Moves to index `i`.
-    fn seek(&mut self, i: u64) {
+    /// Moves to index `i <= HALTON_MAX_INDEX`; ValueError past it.
+    fn seek(&mut self, i: u64) -> PyResult<()> {
+        within_halton(i, 0)?;
         self.next = i;
+        Ok(())
     }
+}
+
+/// Dimensions a Halton sequence supports: one prime base each, the largest 821,641.
+pub(crate) const HALTON_MAX_DIMENSIONS: usize = 1 << 16;
+
+/// Points a Halton sequence holds: past index `2^53` a base-2 radical inverse has more bits
+/// than an `f64` and rounds to 1.
+pub(crate) const HALTON_MAX_INDEX: u64 = 1 << 53;
+
+/// ValueError unless points `start..start + n` are within [`HALTON_MAX_INDEX`].
+fn within_halton(start: u64, n: u64) -> PyResult<()> {
+    match start.checked_add(n) {
+        Some(end) if end <= HALTON_MAX_INDEX => Ok(()),
+        _ => Err(value_error(format!(
+            "Halton points past index 2**53 are not representable in float64 (they round to \
+             1): index {start} + {n} points"
+        ))),
+    }
+}
+
+/// MemoryError unless an `n × d` float64 array can be allocated (numpy's own error).
+fn reserve(n: usize, d: usize) -> PyResult<()> {
+    let too_big = || {
+        pyo3::exceptions::PyMemoryError::new_err(format!(
+            "Unable to allocate an array of {n} × {d} float64 values"
+        ))
+    };
+    let cells = n.checked_mul(d).ok_or_else(too_big)?;
+    let mut probe: Vec<f64> = Vec::new();
+    probe.try_reserve_exact(cells).map_err(|_| too_big())
 }
 
 /// Owen-scrambled Sobol points (`sobol_burley`: Joe–Kuo direction numbers, hash-based Owen

@@ -139,6 +139,9 @@ impl ScenarioHandle {
         if jobs == 0 {
             return Err(value_error("jobs must be at least 1"));
         }
+        // No more workers than tests: `jobs=2000` for 3 tests started 2,000 threads (9 s).
+        // The records do not depend on the number of workers.
+        let jobs = jobs.min(points.len());
         // The campaign runs on a thread of its own while this one, the GIL released, waits
         // for it and checks for Ctrl-C between waits: a KeyboardInterrupt stops the campaign
         // (no new test starts; the tests in flight finish) and is raised here.
@@ -256,6 +259,21 @@ impl ScenarioHandle {
     #[getter]
     fn sut(&self) -> String {
         self.scenario.sut.name()
+    }
+
+    /// The name of the system under test that these arguments choose (the scenario's own
+    /// when both are None); ValueError for an unknown built-in, a missing ONNX model, an
+    /// empty command or a bad timeout, as a run would raise it.
+    #[pyo3(signature = (sut=None, sut_cmd=None, sut_timeout=10.0, sut_fresh=false))]
+    fn sut_name(
+        &self,
+        sut: Option<&str>,
+        sut_cmd: Option<Vec<String>>,
+        sut_timeout: f64,
+        sut_fresh: bool,
+    ) -> PyResult<String> {
+        Ok(sut_config(sut, sut_cmd, sut_timeout, sut_fresh)?
+            .map_or_else(|| self.scenario.sut.name(), |s| s.name()))
     }
 
     /// What the program loads with but checks or varies less than it seems to.

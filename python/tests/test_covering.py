@@ -73,6 +73,19 @@ def test_partial_coverage_names_the_missing_tuples():
     assert (empty.covered, empty.total) == (0, 4)
 
 
+def test_coverage_of_columns_with_many_levels_fits_in_memory():
+    # 2**20 levels a column: 2**40 pairs, a 137 GB bitset that aborted the interpreter. The
+    # rows' distinct combinations give the same counts and the same first missing tuples.
+    c = covering.kwise_coverage(np.array([[0, 0], [0, 1], [5, 0], [0, 1]]), [2**20, 2**20], 2)
+    assert (c.covered, c.total) == (3, 2**40)
+    assert c.missing[:3] == [((0, 0), (1, 2)), ((0, 0), (1, 3)), ((0, 0), (1, 4))]
+    t3 = covering.kwise_coverage(np.zeros((1, 3), dtype=int), [2**16] * 3, 3)
+    assert (t3.covered, t3.total) == (1, 2**48)
+    # Under constraints every tuple is checked one by one: refused past 2**27.
+    with pytest.raises(ValueError, match="with constraints every 2-tuple"):
+        covering.kwise_coverage(np.zeros((1, 2), dtype=int), [2**20, 2**20], 2, constraints=[{0: 1}])
+
+
 @pytest.mark.parametrize(
     "call, message",
     [

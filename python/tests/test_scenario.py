@@ -262,6 +262,18 @@ def test_bad_run_arguments_are_value_errors(box_program):
         s.run(x, output="csv")
     with pytest.raises(ValueError, match="sut must be"):
         s.run(x, sut=3)
+    for big in (dict(jobs=2**70), dict(seed=2**64)):
+        with pytest.raises(ValueError, match="must be at most"):
+            s.run(x, **big)
+
+
+def test_the_system_under_test_given_to_the_constructor_is_checked_and_reported(box_program):
+    # `.sut` said the scenario's own `aeb` while runs used pilotnet; a bad name passed
+    # construction and failed at the first run.
+    assert paracosm.Scenario(box_program).sut == "aeb"
+    assert paracosm.Scenario(box_program, sut="pilotnet").sut == "pilotnet"
+    with pytest.raises(ValueError, match="unknown system under test `nope`"):
+        paracosm.Scenario(box_program, sut="nope")
 
 
 def test_a_scenario_without_parameters_runs_n_tests():
@@ -274,6 +286,20 @@ def test_a_scenario_without_parameters_runs_n_tests():
     assert s.robustness([]) == s.robustness(np.zeros(0))
     with pytest.raises(ValueError, match="no open parameters"):
         s.run(np.zeros((3, 1)))
+    # Dicts, as the docs allow for any scenario: empty ones here (was "the file is empty").
+    by_dicts = s.run([{}, {}, {}], output="records")
+    assert [r["seed"] for r in by_dicts] == [r["seed"] for r in records]
+    assert s.robustness({}) == s.robustness([])
+    with pytest.raises(ValueError, match="'x', not a parameter"):
+        s.run([{"x": 1.0}])
+
+
+def test_a_dict_out_of_range_is_named_as_the_python_input():
+    # It was named by the CSV written behind the scenes: "points:2: column 1 (`walking_speed`)".
+    s = paracosm.Scenario("pedestrian-crossing")
+    ok = {"walking_speed": 1.0, "trigger_distance": 10.0}
+    with pytest.raises(ValueError, match=r"^points\[1\]\['walking_speed'\]: value 100 is outside"):
+        s.run([ok, {"walking_speed": 100.0, "trigger_distance": 10.0}])
 
 
 def test_ctrl_c_stops_a_run_and_raises_keyboard_interrupt():

@@ -250,9 +250,6 @@ fn cover_subset(
         strides[i] = size;
         size = size.checked_mul(u64::from(levels[c]))?;
     }
-    let words = usize::try_from(size.div_ceil(64)).ok()?;
-    bits.clear();
-    bits.resize(words, 0);
     // Each row's combination index, one subset member at a time (a vectorisable loop).
     let n = columns.first().map_or(0, Vec::len);
     let mut index = vec![0u64; n];
@@ -261,25 +258,49 @@ fn cover_subset(
             *slot += u64::from(l) * strides[i];
         }
     }
-    for idx in index {
-        bits[(idx / 64) as usize] |= 1 << (idx % 64);
-    }
-    let covered: u64 = bits.iter().map(|w| u64::from(w.count_ones())).sum();
-    acc.covered += covered;
     acc.total = acc.total.checked_add(size)?;
-    if acc.missing.len() < max_missing && covered < size {
-        for idx in 0..size {
-            if bits[(idx / 64) as usize] & (1 << (idx % 64)) == 0 {
-                let tuple = subset
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &c)| (c, ((idx / strides[i]) % u64::from(levels[c])) as u32))
-                    .collect();
-                acc.missing.push(tuple);
-                if acc.missing.len() == max_missing {
-                    break;
+    let tuple = |idx: u64| -> Vec<(usize, u32)> {
+        subset
+            .iter()
+            .enumerate()
+            .map(|(i, &c)| (c, ((idx / strides[i]) % u64::from(levels[c])) as u32))
+            .collect()
+    };
+    // A bitset of the subset's tuples while it is small beside the rows; past that (levels of
+    // 2^20 make 2^40 pairs, a 137 GB bitset), the rows' sorted distinct indices: the same
+    // counts and the same first missing tuples, in memory proportional to the rows.
+    if size <= 64 * (n as u64).max(1 << 16) {
+        let words = usize::try_from(size.div_ceil(64)).ok()?;
+        bits.clear();
+        bits.resize(words, 0);
+        for idx in index {
+            bits[(idx / 64) as usize] |= 1 << (idx % 64);
+        }
+        let covered: u64 = bits.iter().map(|w| u64::from(w.count_ones())).sum();
+        acc.covered += covered;
+        if acc.missing.len() < max_missing && covered < size {
+            for idx in 0..size {
+                if bits[(idx / 64) as usize] & (1 << (idx % 64)) == 0 {
+                    acc.missing.push(tuple(idx));
+                    if acc.missing.len() == max_missing {
+                        break;
+                    }
                 }
             }
+        }
+    } else {
+        index.sort_unstable();
+        index.dedup();
+        let covered = index.len() as u64;
+        acc.covered += covered;
+        // The smallest indices no row holds: walk up from 0, skipping the rows' own.
+        let mut held = index.iter().peekable();
+        let mut idx = 0u64;
+        while acc.missing.len() < max_missing && idx < size {
+            if held.next_if_eq(&&idx).is_none() {
+                acc.missing.push(tuple(idx));
+            }
+            idx += 1;
         }
     }
     Some(())
@@ -379,6 +400,48 @@ mod tests {
         );
         let one = kwise_coverage(&space, &pts, 1, 5).unwrap();
         assert_eq!((one.covered, one.total), (4, 4));
+    }
+
+    #[test]
+    fn columns_with_many_levels_count_the_rows_distinct_tuples() {
+        // 3,000 × 3,000 pairs: past the bitset's limit for 500 rows, so the sorted path runs.
+        // Its counts and first missing tuples are those of a set of the rows' pairs.
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let levels = [3000u32, 3000, 2];
+        let mut rows = Vec::new();
+        for i in 0..500u32 {
+            // Repeats, and the first few combinations held, so that missing ones are skipped.
+            let r = if i < 40 {
+                [0, i / 2, i % 2]
+            } else {
+                [
+                    rng.random_range(0..3000),
+                    rng.random_range(0..3000),
+                    rng.random_range(0..2),
+                ]
+            };
+            rows.extend(r);
+        }
+        let got = kwise_coverage_rows(&levels, &rows, 2, 30).unwrap();
+        let mut covered = 0u64;
+        let mut missing = Vec::new();
+        for (a, b) in [(0usize, 1usize), (0, 2), (1, 2)] {
+            let held: std::collections::HashSet<(u32, u32)> =
+                rows.chunks_exact(3).map(|r| (r[a], r[b])).collect();
+            covered += held.len() as u64;
+            for x in 0..levels[a] {
+                for y in 0..levels[b] {
+                    if missing.len() < 30 && !held.contains(&(x, y)) {
+                        missing.push(vec![(a, x), (b, y)]);
+                    }
+                }
+            }
+        }
+        assert_eq!(got.covered, covered);
+        assert_eq!(got.total, 3000 * 3000 + 2 * 3000 * 2);
+        assert_eq!(got.missing, missing);
+        assert_eq!(got.missing[0], vec![(0, 0), (1, 20)]);
     }
 
     #[test]
