@@ -238,15 +238,6 @@ pub fn run(
     let strategy = refusals(request, &file, &warnings)?;
     // A strength asked for that the space cannot have: with fewer discrete parameters there
     // are no t-tuples (and a space with none has no covering array at all).
-    // And a strength for a strategy that builds no covering array (random, halton, sobol,
-    // the falsifiers) is refused: it was accepted and had no effect.
-    if let (Some(t), false) = (request.strength, Strategy::SUITES.contains(&strategy)) {
-        let suites: Vec<String> = Strategy::SUITES.iter().map(|s| s.to_string()).collect();
-        return Err(Error::BadInput(format!(
-            "--strength {t} applies to the covering-array strategies ({}), not {strategy}",
-            suites.join(", ")
-        )));
-    }
     if let (Some(t), true) = (request.strength, Strategy::SUITES.contains(&strategy)) {
         let nd = scenario.space.level_counts().len();
         if t > nd {

@@ -149,24 +149,29 @@ impl EgoVehicle {
     /// Shares the brake among the wheels and holds each wheel's engine force and brake to
     /// what its tyre can pass to the road.
     ///
-    /// The brake impulse asked of the four wheels goes to each in proportion to its load `N`
-    /// (its suspension force over the last step, N; the static share `m·g/4` before the first
-    /// step or after a wheel left the ground). Then each wheel's longitudinal force is at most
-    /// `sqrt((μ·N)² − S²)`, with `μ` the wheel's friction and `S` its side force over the last
-    /// step (N): a tyre's total force stays within Coulomb's friction circle `μ·N`, so full
-    /// braking on a road of friction `μ` decelerates at most `μ·g` (LANGUAGE.md, "friction").
+    /// The brake impulse asked of the four wheels goes to each in proportion to its load `N`:
+    /// its suspension force over the last step, N (0 for a wheel off the ground, which grips
+    /// nothing; the static share `m·g/4` before the first step). Then each wheel's
+    /// longitudinal force is at most `μ·N`, with `μ` the wheel's friction: full braking or
+    /// pulling on a road of friction `μ` accelerates at most `μ·g` (LANGUAGE.md, "friction").
+    /// Combined with a side force `S`, rapier's own limit `(F/2)² + S² <= (μ·N)²` then scales
+    /// both down together, so a tyre sliding sideways still brakes; the total may reach
+    /// `1.32·μ·N` (at `F = μ·N`), where Coulomb's circle would stop at `μ·N`.
     ///
-    /// rapier's `DynamicRayCastVehicleController` alone does not: it limits
+    /// rapier's `DynamicRayCastVehicleController` alone limits only
     /// `(F/2)² + S² <= (friction_slip·N)²` (Bullet's `fwdFactor = 0.5`), which let a tyre
     /// brake or pull with twice `friction_slip·N`: full braking on ice (`μ = 0.1`) stopped from
     /// 12 m/s in 34 m, at 2.1 m/s² instead of 0.98.
     fn hold_to_grip(&mut self, dt_s: f32) {
+        let first_step = self.controller.wheels().iter().all(|w| {
+            w.wheel_suspension_force == 0.0 && w.forward_impulse == 0.0 && w.side_impulse == 0.0
+        });
         let static_n = (self.params.mass_kg * 9.81 / 4.0) as f32;
         let load = |w: &rapier3d::control::Wheel| {
-            if w.wheel_suspension_force > 0.0 {
-                w.wheel_suspension_force
-            } else {
+            if first_step {
                 static_n
+            } else {
+                w.wheel_suspension_force.max(0.0)
             }
         };
         let total_n: f32 = self.controller.wheels().iter().map(load).sum();
@@ -174,10 +179,9 @@ impl EgoVehicle {
         for (wheel, engine) in self.controller.wheels_mut().iter_mut().zip(engine) {
             let n = load(wheel);
             let grip_n = wheel.friction_slip * n;
-            let side_n = wheel.side_impulse / dt_s;
-            let room_n = (grip_n * grip_n - side_n * side_n).max(0.0).sqrt();
-            wheel.engine_force = engine.clamp(-room_n, room_n);
-            wheel.brake = (brake * n / total_n).min(room_n * dt_s);
+            let share = if total_n > 0.0 { n / total_n } else { 0.0 };
+            wheel.engine_force = engine.clamp(-grip_n, grip_n);
+            wheel.brake = (brake * share).min(grip_n * dt_s);
         }
     }
 

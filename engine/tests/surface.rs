@@ -194,6 +194,33 @@ fn the_ego_brakes_no_harder_than_mu_g_nor_than_its_brakes() {
     assert!((dry - 8.0).abs() < 0.4, "dry: {dry:.3} m/s²");
 }
 
+/// Speed lost over 2 s from 12 m/s on ice with full steering and `throttle`, m/s.
+fn speed_lost_turning_on_ice(throttle: f64) -> f64 {
+    let spec = world(road(&[(300.0, 0.1)]), 50.0, 12.0, &[]);
+    let mut sim = Simulation::new(&spec).unwrap();
+    let mut sut = ConstantControl(Control {
+        throttle,
+        steering: 1.0,
+    });
+    while sim.t_s() < 2.0 {
+        let c = sut.act(&sim.observation()).unwrap();
+        sim.step(c, &mut NoHost).unwrap();
+    }
+    12.0 - sim.ego_state().speed_mps.abs()
+}
+
+#[test]
+fn a_car_sliding_sideways_on_ice_still_brakes() {
+    // Full steering on ice: the tyres slide sideways. Braking as well must still take its
+    // share of the grip (holding the side force first left the brake none while sliding).
+    let coasting = speed_lost_turning_on_ice(0.0);
+    let braking = speed_lost_turning_on_ice(-1.0);
+    eprintln!("lost {coasting:.3} m/s coasting, {braking:.3} m/s braking");
+    assert!(braking > coasting + 0.4, "coasting {coasting:.3}, braking {braking:.3}");
+    // At most what rapier's limit lets the grip give, 1.32·μ·g over 2 s, plus drag.
+    assert!(braking < 1.32 * 0.1 * 9.81 * 2.0 + 0.5, "braking {braking:.3}");
+}
+
 #[test]
 fn the_ego_pulls_away_on_ice_no_harder_than_its_driven_wheels_grip() {
     // Full throttle from rest on ice: only the rear wheels pull, so at most μ·g times their

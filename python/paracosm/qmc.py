@@ -14,8 +14,9 @@ Where the defaults differ from scipy's:
 - `Halton` is unscrambled by default (scipy: `scramble=True`): the sequence of the
   PARACOSM paper and of `paracosm-fuzz --strategy halton`, equal to
   `scipy.stats.qmc.Halton(d, scramble=False)` point for point, to 4.4e-16: paracosm's
-  values are the correctly rounded radical inverses, scipy adds digit terms in floats (up to
-  3 ulp off, 3.3e-16, on 20,000 points in d = 8). At most
+  values are the correctly rounded radical inverses while `q^k < 2**53` (for the first 8
+  bases, every index below 2e15), scipy adds digit terms in floats (up to 3 ulp off, 3.3e-16,
+  on 20,000 points in d = 8). At most
   `HALTON_MAX_DIMENSIONS` (65,536) dimensions and `HALTON_MAX_INDEX` (2**53) points: past
   that index a radical inverse has more bits than a float64. `scramble=True` permutes
   every base digit (Owen, "A randomized Halton algorithm in R", 2017), not scipy's
@@ -96,9 +97,13 @@ class Halton(_Engine):
     def __init__(self, d: int, *, scramble: bool = False, rng=None):
         d = positive_int(d, "d")
         self.scramble = bool(scramble)
-        # A bad rng is refused even where it would not be used.
-        seed = seed_of(rng) if self.scramble or rng is not None else None
-        seed = seed if self.scramble else None
+        if self.scramble:
+            seed = seed_of(rng)
+        else:
+            # A bad rng is refused even where it is not used; a good one is not drawn from.
+            if rng is not None and not isinstance(rng, np.random.Generator):
+                seed_of(rng)
+            seed = None
         super().__init__(d, _native.HaltonEngine(d, seed))
 
 

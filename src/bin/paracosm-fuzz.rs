@@ -50,7 +50,8 @@ struct Cli {
     /// the permutations.
     #[arg(long)]
     scramble: bool,
-    /// Strength t of the covering array of --strategy ipog or kwise [default: 2].
+    /// Strength t of the covering array of --strategy ipog or kwise, and, for any strategy,
+    /// the highest t of the k-wise coverage the summary reports [default: 2].
     #[arg(long)]
     strength: Option<usize>,
     /// Number of tests of the campaign, at least 1 [default: 100]. With --shard, of the

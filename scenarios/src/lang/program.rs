@@ -874,7 +874,21 @@ pub fn load(
         maps: Arc::new(super::map_files::MapFiles::new(base)),
         load_output_shown: false.into(),
     };
-    let first = program.evaluate(None, |b, _| Ok(b)).map_err(lang)?;
+    // The first world, and the streams its top-level variables hold: a lambda reads those by
+    // name (`lambda s: s > limit`), with no edge in the graph (host::StarHost's `captured`).
+    let (first, stream_variables) = program
+        .evaluate(None, |b, module| {
+            let held: Vec<(String, usize)> = module
+                .names()
+                .filter_map(|name| {
+                    let v = module.get(name.as_str())?;
+                    let s = starlark::values::ValueLike::downcast_ref::<super::values::Stream>(v)?;
+                    Some((name.as_str().to_owned(), s.id))
+                })
+                .collect();
+            Ok((b, held))
+        })
+        .map_err(lang)?;
     program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
     // Signals the monitors read exist (checked when the world is built).
     scene::check_signals(&first).map_err(lang)?;
@@ -982,14 +996,19 @@ pub fn load(
                 break;
             }
             let (w, s) = program.world_counted(values).map_err(|m| with(&label, m))?;
-            unread.push(usage::unread_streams(&w));
+            unread.push(usage::unread_streams(&w, &[]));
             steps += s;
         }
     }
 
     // What each parameter changes: its other checked values against the first evaluation.
     let base = scene::world(&first, program.horizon_s).map_err(lang)?;
-    let mut unread_everywhere = usage::unread_streams(&base);
+    let read_by_name: Vec<usize> = stream_variables
+        .iter()
+        .filter(|(name, _)| syntax.read_in_code(name))
+        .map(|&(_, id)| id)
+        .collect();
+    let mut unread_everywhere = usage::unread_streams(&base, &read_by_name);
     for other in &unread {
         unread_everywhere.retain(|site| other.contains(site));
     }
@@ -1085,9 +1104,9 @@ pub fn load(
     for site in unread_everywhere {
         warnings.push(Warning {
             at: site,
-            message: "this stream is read by nothing (no object's input, monitor, Signal or \
-                      foreach uses it, directly or through other streams): it is never \
-                      computed, and the parameters only its functions read change no result"
+            message: "nothing uses this stream's values (no object's input, monitor, Signal \
+                      or foreach, directly, through other streams or by its name in a lambda): \
+                      the parameters only its functions read change no result"
                 .to_owned(),
         });
     }

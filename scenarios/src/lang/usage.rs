@@ -55,14 +55,16 @@ fn read_streams(w: &WorldSpec) -> HashSet<usize> {
         .collect()
 }
 
-/// Where the program made streams that nothing reads (`file:line:col`): no object's input,
-/// friction, light, fog, lane change, published signal (`Monitor`, `Assert`, `Signal`) or
-/// `foreach` reads them, directly or through other streams, so they are never computed and
-/// any parameter read only by their functions changes no result. Only the last stream of an
-/// unread chain is named (`s = tick.map(f).filter(p)` names the `filter`), and only streams
-/// made by a combinator (`map`, `filter`, `zip`, `take`, `skipUntil`, `takeUntil`, `concat`,
-/// `sum`); a probe such as `v.speed` taken and left unused costs nothing.
-pub fn unread_streams(w: &WorldSpec) -> BTreeSet<String> {
+/// Where the program made streams whose values nothing uses (`file:line:col`): no object's
+/// input, friction, light, fog, lane change, published signal (`Monitor`, `Assert`,
+/// `Signal`), `foreach`, nor a lambda reading it by name (`read_by_name`: the streams of
+/// top-level variables that code reads, as `lambda s: s > limit` reads `limit`) uses them,
+/// directly or through other streams, so any parameter read only by their functions changes
+/// no result. Only the last stream of an unread chain is named (`s = tick.map(f).filter(p)`
+/// names the `filter`), and only streams made by a combinator (`map`, `filter`, `zip`,
+/// `take`, `skipUntil`, `takeUntil`, `concat`, `sum`); a probe such as `v.speed` taken and
+/// left unused costs nothing.
+pub fn unread_streams(w: &WorldSpec, read_by_name: &[usize]) -> BTreeSet<String> {
     use paracosm_engine::rx::Node;
     let nodes = w.streams.nodes();
     let mut stack: Vec<usize> = w
@@ -80,6 +82,7 @@ pub fn unread_streams(w: &WorldSpec) -> BTreeSet<String> {
         .chain(w.frictions.iter().map(|(_, s)| s.0))
         .chain([w.environment.light.0, w.environment.fog.0])
         .chain(w.published.iter().map(|(_, s)| s.0))
+        .chain(read_by_name.iter().copied())
         .chain(
             nodes
                 .iter()
