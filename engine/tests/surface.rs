@@ -216,9 +216,15 @@ fn a_car_sliding_sideways_on_ice_still_brakes() {
     let coasting = speed_lost_turning_on_ice(0.0);
     let braking = speed_lost_turning_on_ice(-1.0);
     eprintln!("lost {coasting:.3} m/s coasting, {braking:.3} m/s braking");
-    assert!(braking > coasting + 0.4, "coasting {coasting:.3}, braking {braking:.3}");
+    assert!(
+        braking > coasting + 0.4,
+        "coasting {coasting:.3}, braking {braking:.3}"
+    );
     // At most what rapier's limit lets the grip give, 1.32·μ·g over 2 s, plus drag.
-    assert!(braking < 1.32 * 0.1 * 9.81 * 2.0 + 0.5, "braking {braking:.3}");
+    assert!(
+        braking < 1.32 * 0.1 * 9.81 * 2.0 + 0.5,
+        "braking {braking:.3}"
+    );
 }
 
 #[test]
