@@ -267,6 +267,23 @@ def _flat(record: dict, space: Space) -> dict:
     return row
 
 
+def _uniform(rows: list[dict], records: list[dict], space: Space) -> list[dict]:
+    """The rows with the same columns in the documented order, whatever each test wrote: a
+    metric only a failed test has (`time_to_failure_s`), or monitors a test in error lacks,
+    are NaN in the other rows (the DataFrame's columns followed the first row that had them,
+    after `wall_ms`, or were missing when no test failed and had them)."""
+    def first_seen(keys):
+        return list(dict.fromkeys(k for ks in keys for k in ks))
+
+    monitors = first_seen(r["monitors"].keys() for r in records)
+    metrics = first_seen(r["metrics"].keys() for r in records)
+    columns = ["id", "seed", "status", *space.names, "robustness"]
+    for m in monitors:
+        columns += [f"{m}.robustness", f"{m}.passed", f"{m}.first_violation_s"]
+    columns += [*metrics, "error", "wall_ms"]
+    return [{c: row.get(c, math.nan) for c in columns} for row in rows]
+
+
 class Scenario:
     """A scenario program: a built-in name (`paracosm.BUILTIN_SCENARIOS`) or the path of a
     `.star` file.
@@ -372,7 +389,7 @@ class Scenario:
         records = [json.loads(line) for line in lines]
         if output == "records":
             return records
-        rows = [_flat(r, self.space) for r in records]
+        rows = _uniform([_flat(r, self.space) for r in records], records, self.space)
         try:
             import pandas as pd
         except ImportError:

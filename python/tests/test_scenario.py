@@ -294,6 +294,20 @@ def test_a_scenario_without_parameters_runs_n_tests():
         s.run([{"x": 1.0}])
 
 
+def test_frame_columns_do_not_depend_on_which_tests_failed():
+    # time_to_failure_s is a metric of failed tests only: it landed after wall_ms when the
+    # first test passed, and was missing when none failed.
+    s = paracosm.Scenario("pedestrian-crossing")
+    passing = {"walking_speed": 1.0, "trigger_distance": 50.0}
+    failing = {"walking_speed": 5.844, "trigger_distance": 7.037}
+    mixed = s.run([passing, failing])
+    assert list(mixed["status"]) == ["pass", "fail"]
+    assert list(mixed.columns[-2:]) == ["error", "wall_ms"]
+    assert "time_to_failure_s" in mixed.columns
+    only_passing = s.run([passing])
+    assert list(only_passing.columns) == [c for c in mixed.columns if c != "time_to_failure_s"]
+
+
 def test_a_dict_out_of_range_is_named_as_the_python_input():
     # It was named by the CSV written behind the scenes: "points:2: column 1 (`walking_speed`)".
     s = paracosm.Scenario("pedestrian-crossing")
