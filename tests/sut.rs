@@ -124,7 +124,9 @@ fn a_hello_that_cannot_be_honoured_ends_each_test_in_error_naming_it() {
             &cmd,
         ]);
         expect_code(&o, 3);
-        for r in records(dir.path()) {
+        let records = records(dir.path());
+        assert_eq!(records.len(), 2, "{sensors} {hz}");
+        for r in records {
             assert_eq!(r["status"], "error", "{sensors} {hz}");
             let error = r["error"].as_str().unwrap();
             assert!(error.contains(message), "{sensors} {hz}: {error}");

@@ -123,6 +123,10 @@ pub(crate) struct Car {
     rolling: Option<f64>,
     /// Ground point `[x, z]` (m) and heading (rad) at `s`, kept from the last move.
     here: ([f64; 2], f64),
+    /// Ground point and heading of its collider: `here` once the physics step has taken the
+    /// last move ([`Car::settle`]), the one before until then. Asleep, the collider is left
+    /// behind, and a lidar sees the car here instead ([`Car::collider_pose`]).
+    placed: ([f64; 2], f64),
     /// Its body; the collider spans `[CLEARANCE_M, CLEARANCE_M + height]` above the road.
     pub(crate) size: Size,
     /// How the camera draws it.
@@ -169,6 +173,7 @@ impl Car {
             speed: 0.0,
             rolling: None,
             here: ([0.0; 2], 0.0),
+            placed: ([0.0; 2], 0.0),
             size,
             albedo,
             speed_stream,
@@ -179,6 +184,7 @@ impl Car {
             speed_override: None,
         };
         car.here = car.at(0.0);
+        car.placed = car.here;
         if enabled {
             let pose = car.pose();
             let body = RigidBodyBuilder::kinematic_position_based().pose(pose);
@@ -242,6 +248,25 @@ impl Car {
     /// pose it would have when it is asleep (out of the step, its collider left behind).
     pub(crate) fn pose(&self) -> Pose {
         self.pose_at(self.here)
+    }
+
+    /// Where its collider is, asleep or awake, bit for bit: its pose ([`Car::pose`]) once
+    /// the physics step has taken its last move, and the pose before that move until then.
+    /// An awake car's collider is there; an asleep car's would be.
+    pub(crate) fn collider_pose(&self) -> Pose {
+        self.pose_at(self.placed)
+    }
+
+    /// Records that the physics step has taken the car's last move: its collider, or the one
+    /// it would have asleep, is now at [`Car::pose`].
+    pub(crate) fn settle(&mut self) {
+        self.placed = self.here;
+    }
+
+    /// Whether it is in the test but asleep, out of the physics step ([`Car::advance`]).
+    pub(crate) fn is_asleep(&self, physics: &PhysicsWorld) -> bool {
+        self.body
+            .is_some_and(|(body, _)| !physics.bodies[body].is_enabled())
     }
 
     /// The collider's pose for the ground point `[x, z]` (m) and heading (rad) `here`.
@@ -401,13 +426,6 @@ impl Car {
             }
             physics.bodies[body].set_next_kinematic_position(self.pose());
         }
-    }
-
-    /// Whether the car is in the test but asleep, out of the physics step.
-    #[cfg(test)]
-    pub(crate) fn asleep(&self, physics: &PhysicsWorld) -> bool {
-        self.body
-            .is_some_and(|(body, _)| !physics.bodies[body].is_enabled())
     }
 
     /// The car as the time-to-collision test sees it, `None` when it is not in this test.

@@ -483,7 +483,14 @@ impl Simulation {
         } else {
             Vec::new()
         };
+        let asleep: Vec<(ColliderHandle, Pose)> = self
+            .cars
+            .values()
+            .filter(|c| c.is_asleep(&self.physics))
+            .filter_map(|c| Some((c.body?.1, c.collider_pose())))
+            .collect();
         let scene = Scene {
+            asleep: &asleep,
             physics: &self.physics,
             ego_body: self.ego.body,
             ego: ego_state(&self.physics, &self.ego),
@@ -566,6 +573,9 @@ impl Simulation {
             self.capture_all_named("lidar")?;
         }
         self.physics.step_with_events(&(), &self.collector);
+        for car in self.cars.iter_mut() {
+            car.settle();
+        }
         while let Ok(event) = self.events.try_recv() {
             let (a, b, started) = match event {
                 CollisionEvent::Started(a, b, _) => (a, b, true),
@@ -1255,7 +1265,7 @@ mod tests {
         let mut awake = Simulation::new(&spec).unwrap();
         awake.mount(Box::new(Unbounded)).unwrap();
         let (mut asleep_steps, mut woke, mut was_asleep) = (0, 0, vec![false; 3]);
-        let mut seen_oncoming = false;
+        let (mut seen_oncoming, mut seen_asleep) = (false, 0);
         // 30 s at a steady throttle: the first car leaves the lidar's reach, the oncoming one
         // enters it, passes and leaves, and the ego closes on the stopped one.
         for _ in 0..1800 {
@@ -1270,13 +1280,17 @@ mod tests {
                 format!("{:?}", awake.snapshot())
             );
             assert_eq!(sleepy.observation().lidar, awake.observation().lidar);
-            seen_oncoming |= sleepy
+            let oncoming_seen = sleepy
                 .observation()
                 .lidar
                 .iter()
                 .any(|r| r.point_m[2] < -2.5);
+            seen_oncoming |= oncoming_seen;
+            // The lidar sees an asleep car where it would be awake.
+            let oncoming = sleepy.cars.values().nth(1).unwrap();
+            seen_asleep += usize::from(oncoming_seen && oncoming.is_asleep(&sleepy.physics));
             for (i, car) in sleepy.cars.values().enumerate() {
-                let asleep = car.asleep(&sleepy.physics);
+                let asleep = car.is_asleep(&sleepy.physics);
                 asleep_steps += usize::from(asleep);
                 woke += usize::from(was_asleep[i] && !asleep);
                 was_asleep[i] = asleep;
@@ -1286,11 +1300,12 @@ mod tests {
                     assert_eq!(*sleepy.physics.colliders[collider].position(), car.pose());
                 }
             }
-            assert!(awake.cars.values().all(|c| !c.asleep(&awake.physics)));
+            assert!(awake.cars.values().all(|c| !c.is_asleep(&awake.physics)));
         }
         assert!(asleep_steps > 1000, "{asleep_steps}");
         assert!(woke >= 2, "{woke}");
         assert!(seen_oncoming);
+        assert!(seen_asleep > 60, "{seen_asleep}");
     }
 
     #[test]

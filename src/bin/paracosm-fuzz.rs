@@ -161,7 +161,8 @@ struct DatasetArgs {
     /// Campaign seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Frames recorded per second of simulated time.
+    /// Frames recorded per second of simulated time: 60 divided by a whole number of physics
+    /// steps (60, 30, 20, 15, 12, 10, ...); another rate is refused.
     #[arg(long, value_name = "HZ", default_value_t = 10.0)]
     rate: f64,
     /// Camera image width in pixels (when the teacher has no camera of its own).

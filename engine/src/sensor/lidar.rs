@@ -145,15 +145,23 @@ impl LidarSpec {
     /// that world's colliders sorted into fixed and moving, with the fixed ones' boxes (a fixed
     /// collider must not move), and sorts them again when the number of colliders changes or
     /// a fixed one is gone.
+    ///
+    /// `seen.asleep` lists the colliders taken out of the physics step (NPC cars asleep, their
+    /// colliders disabled and left behind) with the pose each would have awake: the scan sees
+    /// them there, as the query pipeline would with every car awake.
     pub(crate) fn scan(
         &self,
-        physics: &PhysicsWorld,
+        seen: &Seen<'_>,
         chassis: &Pose,
-        own_body: RigidBodyHandle,
         beams: &mut Beams,
         range_m: f64,
         out: &mut Vec<LidarReturn>,
     ) {
+        let Seen {
+            physics,
+            own_body,
+            asleep,
+        } = *seen;
         out.clear();
         let mount_local = Vector::new(
             self.mount_m[0] as f32,
@@ -178,19 +186,25 @@ impl LidarSpec {
         if stale {
             beams.gather(physics, own_body);
         }
-        let fixed = beams.fixed.iter().map(|&(h, mins, maxs)| (h, mins, maxs));
+        let fixed = beams.fixed.iter().filter_map(|&(h, mins, maxs)| {
+            let co = &physics.colliders[h];
+            co.is_enabled().then(|| (co, *co.position(), mins, maxs))
+        });
         let moving = beams.moving.iter().filter_map(|&h| {
             let co = physics.colliders.get(h)?;
-            let (mins, maxs) = widened_box(co);
-            Some((h, mins, maxs))
+            // The query pipeline holds only enabled colliders, and none of a disabled body.
+            // An NPC car taken out of the step is seen where it would be awake.
+            let enabled =
+                co.is_enabled() && co.parent().is_none_or(|b| physics.bodies[b].is_enabled());
+            let pose = if enabled {
+                *co.position()
+            } else {
+                asleep.iter().find(|&&(a, _)| a == h)?.1
+            };
+            let (mins, maxs) = widened_box(co.shape(), &pose);
+            Some((co, pose, mins, maxs))
         });
-        for (handle, mins, maxs) in fixed.chain(moving) {
-            // The query pipeline holds only enabled colliders, and none of a disabled body
-            // (an NPC car taken out of the step, whose collider is left where it was).
-            let co = &physics.colliders[handle];
-            if !co.is_enabled() || co.parent().is_some_and(|b| !physics.bodies[b].is_enabled()) {
-                continue;
-            }
+        for (co, pose, mins, maxs) in fixed.chain(moving) {
             let nearest = origin.clamp(mins, maxs);
             if (nearest - origin).length() > max_toi {
                 continue;
@@ -226,7 +240,8 @@ impl LidarSpec {
             scratch.push(Candidate {
                 mins,
                 maxs,
-                collider: &physics.colliders[handle],
+                shape: co.shape(),
+                pose,
                 in_plane: true,
                 arcs,
             });
@@ -256,11 +271,7 @@ impl LidarSpec {
                 if !ray_meets_box(origin, dir, inv, c.mins, c.maxs, limit) {
                     continue;
                 }
-                if let Some(toi) =
-                    c.collider
-                        .shape()
-                        .cast_ray(c.collider.position(), &ray, limit, true)
-                {
+                if let Some(toi) = c.shape.cast_ray(&c.pose, &ray, limit, true) {
                     best = Some(toi);
                 }
             }
@@ -269,6 +280,15 @@ impl LidarSpec {
             }
         }
     }
+}
+
+/// What a scan sees: the physics world but the scanning vehicle's own body, and the colliders
+/// taken out of the physics step, each with the pose it would have awake.
+#[derive(Clone, Copy)]
+pub(crate) struct Seen<'a> {
+    pub(crate) physics: &'a PhysicsWorld,
+    pub(crate) own_body: RigidBodyHandle,
+    pub(crate) asleep: &'a [(ColliderHandle, Pose)],
 }
 
 /// A lidar's beams, computed once: `(azimuth, elevation)` in rad ([`LidarSpec::directions`])
@@ -327,7 +347,7 @@ impl Beams {
         for (handle, co) in physics.colliders.iter() {
             match co.parent() {
                 None => {
-                    let (mins, maxs) = widened_box(co);
+                    let (mins, maxs) = widened_box(co.shape(), co.position());
                     self.fixed.push((handle, mins, maxs));
                 }
                 Some(body) if body != own_body => self.moving.push(handle),
@@ -346,7 +366,9 @@ const CULL_MARGIN_M: f32 = 0.01;
 pub(crate) struct Candidate<'a> {
     mins: Vector,
     maxs: Vector,
-    collider: &'a Collider,
+    shape: &'a dyn Shape,
+    /// Where the shape is: its collider's pose, or the pose an asleep car would have awake.
+    pose: Pose,
     /// Whether the current channel's beams can reach the box.
     in_plane: bool,
     /// The beam azimuths (rad, chassis frame) that can reach the box: up to three intervals,
@@ -362,9 +384,10 @@ fn meets_plane(normal: Vector, origin: Vector, mins: Vector, maxs: Vector) -> bo
     normal.dot(centre - origin).abs() <= normal.abs().dot(half)
 }
 
-/// A collider's world bounding box widened by [`CULL_MARGIN_M`]: `(mins, maxs)` in metres.
-fn widened_box(co: &Collider) -> (Vector, Vector) {
-    let aabb = co.compute_aabb();
+/// The world bounding box of `shape` at `pose`, widened by [`CULL_MARGIN_M`]: `(mins, maxs)` in
+/// metres.
+fn widened_box(shape: &dyn Shape, pose: &Pose) -> (Vector, Vector) {
+    let aabb = shape.compute_aabb(pose);
     let margin = Vector::splat(CULL_MARGIN_M);
     (aabb.mins - margin, aabb.maxs + margin)
 }
@@ -443,22 +466,21 @@ impl crate::sensor::Sensor for Lidar {
     }
 
     fn physics_reach_m(&self) -> f64 {
-        // Its beams start at the mount and end at the spec's range (fog only shortens it).
-        let [x, y, z] = self.spec.mount_m;
-        self.spec.range_m + (x * x + y * y + z * z).sqrt()
+        // It sees an asleep car where it would be awake (`Scene::asleep`), so no car needs
+        // to stay in the physics step for it.
+        0.0
     }
 
     fn capture(&mut self, scene: &crate::sensor::Scene<'_>) -> Result<(), crate::EngineError> {
         let pose = *scene.physics.bodies[scene.ego_body].position();
         let range_m = self.spec.range_m.min(crate::visibility_m(scene.fog));
-        self.spec.scan(
-            scene.physics,
-            &pose,
-            scene.ego_body,
-            &mut self.beams,
-            range_m,
-            &mut self.scan,
-        );
+        let seen = Seen {
+            physics: scene.physics,
+            own_body: scene.ego_body,
+            asleep: scene.asleep,
+        };
+        self.spec
+            .scan(&seen, &pose, &mut self.beams, range_m, &mut self.scan);
         Ok(())
     }
 
@@ -591,7 +613,12 @@ mod tests {
                 let chassis = *physics.bodies[own].position();
                 for (spec, beams) in specs.iter().zip(&mut beams) {
                     let mut fast = Vec::new();
-                    spec.scan(&physics, &chassis, own, beams, spec.range_m, &mut fast);
+                    let seen = Seen {
+                        physics: &physics,
+                        own_body: own,
+                        asleep: &[],
+                    };
+                    spec.scan(&seen, &chassis, beams, spec.range_m, &mut fast);
                     let plain = reference_scan(spec, &physics, &chassis, own, spec.range_m);
                     assert_eq!(fast, plain, "world {world}, scan {scan}");
                     returns += plain.len();

@@ -31,6 +31,10 @@ pub struct Scene<'a> {
     pub t_s: f64,
     /// The boxes a camera draws (cars, pedestrians, obstacles).
     pub boxes: &'a [VisibleBox],
+    /// The colliders of [`Scene::physics`] taken out of the physics step (NPC cars asleep:
+    /// disabled, and left where they fell asleep), each with the pose it would have awake.
+    /// A sensor that casts into the physics world sees them there ([`Sensor::physics_reach_m`]).
+    pub asleep: &'a [(ColliderHandle, Pose)],
 }
 
 /// A sensor's last reading.
@@ -113,12 +117,13 @@ pub trait Sensor: Send {
     fn draws(&self) -> bool {
         false
     }
-    /// How far from the ego chassis centre, in metres, this sensor can sense a collider of
-    /// [`Scene::physics`]. An NPC car farther than every sensor's reach, and too far to touch
-    /// the ego, is taken out of the physics step until it comes nearer (its body and collider
-    /// disabled; [`crate::Simulation::step`]), so a sensor that reads the physics world must
-    /// not under-state this. Default: unbounded (no car is ever taken out). A sensor that
-    /// draws [`Scene::boxes`] instead, as a camera does, reaches no collider: 0.
+    /// How far from the ego chassis centre, in metres, this sensor can sense an NPC car's
+    /// collider through [`Scene::physics`] alone. An NPC car farther than every sensor's
+    /// reach, and too far to touch the ego, is taken out of the physics step until it comes
+    /// nearer (its body and collider disabled; [`crate::Simulation::step`]), so a sensor that
+    /// reads the physics world must not under-state this. Default: unbounded (no car is ever
+    /// taken out). A sensor that sees the cars taken out where [`Scene::asleep`] puts them, as
+    /// the lidar does, or that draws [`Scene::boxes`] instead, as a camera does: 0.
     fn physics_reach_m(&self) -> f64 {
         f64::INFINITY
     }

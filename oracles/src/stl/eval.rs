@@ -104,6 +104,54 @@ fn eval(f: &Formula, t: &Trace) -> Result<Vec<f64>, StlError> {
     })
 }
 
+/// The samples of each signal that the robustness at sample 0 reads, as inclusive ranges of
+/// sample indices (not cut at the trace's end): a predicate reads its own sample, `G`/`F` over
+/// `[a, b]` shift their operand's samples by `[a/dt, b/dt]`, and `U[a, b]` reads its right
+/// operand there and its left from the sample itself to one before the window's end.
+/// A value at any other sample changes nothing at sample 0.
+pub(crate) fn reads(f: &Formula, trace: &Trace) -> BTreeMap<String, Vec<(usize, usize)>> {
+    fn walk(
+        f: &Formula,
+        t: &Trace,
+        (lo, hi): (usize, usize),
+        out: &mut BTreeMap<String, Vec<(usize, usize)>>,
+    ) {
+        match f {
+            Formula::True | Formula::False => {}
+            Formula::Pred { terms, .. } => {
+                for (_, signal) in terms {
+                    out.entry(signal.clone()).or_default().push((lo, hi));
+                }
+            }
+            Formula::Not(g) => walk(g, t, (lo, hi), out),
+            Formula::And(a, b) | Formula::Or(a, b) | Formula::Implies(a, b) => {
+                walk(a, t, (lo, hi), out);
+                walk(b, t, (lo, hi), out);
+            }
+            Formula::Globally(a, b, g) | Formula::Eventually(a, b, g) => {
+                let (wl, wh) = t.steps(*a, *b);
+                walk(g, t, (lo.saturating_add(wl), hi.saturating_add(wh)), out);
+            }
+            Formula::Until(a, b, left, right) => {
+                let (wl, wh) = t.steps(*a, *b);
+                walk(
+                    right,
+                    t,
+                    (lo.saturating_add(wl), hi.saturating_add(wh)),
+                    out,
+                );
+                // min over k in [i, j), j <= i + wh.
+                if wh > 0 {
+                    walk(left, t, (lo, hi.saturating_add(wh - 1)), out);
+                }
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    walk(f, trace, (0, 0), &mut out);
+    out
+}
+
 /// Bounds `(lower, upper)` of the robustness at sample 0 over every continuation of `trace`:
 /// the trace is extended by the formula's horizon with unknown samples, which count as `-inf`
 /// in the lower bound and `+inf` in the upper (robustness is monotone in every predicate
@@ -308,6 +356,45 @@ mod tests {
                &format!("G[{lo},{hi}] a > 1 & G[{lo},{hi}] b < 2"))?;
             eq(&format!("F[{lo},{hi}] a > 1"), &format!("true U[{lo},{hi}] a > 1"))?;
             eq("a > 1 -> b < 2", "!(a > 1) | b < 2")?;
+        }
+
+        /// `reads` holds every sample whose value can change the robustness at sample 0: a
+        /// formula that reads a missing sample fails, and one it leaves out cannot matter.
+        #[test]
+        fn a_sample_outside_reads_never_changes_the_robustness_at_zero(
+            a in values(), lo in 0u32..4, w in 0u32..4, which in 0usize..6,
+        ) {
+            let b: Vec<f64> = a.iter().map(|x| 3.0 - x).collect();
+            let hi = lo + w;
+            let formula = [
+                format!("G[{lo},{hi}] a > 1"),
+                format!("F[{lo},{hi}] (a > 1 & b < 2)"),
+                format!("a > 0 U[{lo},{hi}] b > 1"),
+                format!("G[0,{lo}] F[{lo},{hi}] a > 0 | b < 0"),
+                format!("(G[{lo},{hi}] a > 0) & F[{hi},{}] b > 0", hi + 2),
+                format!("!(a > 0 U[{lo},{hi}] (G[0,{w}] b > 1)) -> a < 3"),
+            ][which].clone();
+            let f = parse(&formula).unwrap();
+            let t = trace(&a, &b);
+            let read = reads(&f, &t);
+            let base = robustness(&f, &t).unwrap()[0];
+            for signal in ["a", "b"] {
+                for k in 0..a.len() {
+                    let in_reads = read
+                        .get(signal)
+                        .is_some_and(|r| r.iter().any(|&(l, h)| l <= k && k <= h));
+                    for v in [-1e6, 1e6] {
+                        let mut changed = t.clone();
+                        changed.signals.get_mut(signal).unwrap()[k] = v;
+                        let r = robustness(&f, &changed).unwrap()[0];
+                        prop_assert!(
+                            in_reads || r == base,
+                            "{}: {}[{}] = {} changed {} to {} outside {:?}",
+                            formula, signal, k, v, base, r, read
+                        );
+                    }
+                }
+            }
         }
     }
 }

@@ -3,7 +3,7 @@
 
 use std::ops::ControlFlow;
 
-use super::eval::{eval_bounds, robustness, Trace};
+use super::eval::{eval_bounds, reads, robustness, Trace};
 use super::Formula;
 use crate::{Frame, Monitor, Verdict};
 
@@ -37,8 +37,10 @@ const CHECK_EVERY: usize = 15;
 /// trace decided it.
 ///
 /// A signal without a value in a frame (its stream has not fired), or whose value is not a
-/// number (NaN), fails the formula at that frame with robustness `-inf`: a NaN sample is not
-/// left out of a window's minimum or maximum.
+/// number (NaN), fails the formula at that frame with robustness `-inf` when the formula reads
+/// that sample ([`reads`]: `G[0.5,10] (x > 0)` reads `x` from 0.5 s to 10 s, so a signal that
+/// first fires at 0.1 s is no failure): such a sample is not left out of a window's minimum or
+/// maximum. One the formula does not read changes nothing.
 #[derive(Debug, Clone)]
 pub struct StlMonitor {
     name: String,
@@ -48,9 +50,13 @@ pub struct StlMonitor {
     /// The samples so far; `dt_s` is set from the first two frames.
     trace: Trace,
     settled: Option<Verdict>,
-    /// The first signal without a value (its stream has not fired) or whose value is not a
-    /// number, and the time: the formula fails there with robustness `-inf`.
-    undefined: Option<(String, f64)>,
+    /// The samples where a signal had no value (its stream had not fired) or one that is not
+    /// a number: `(signal, sample index)`, in order. The trace holds 0 there.
+    missing: Vec<(String, usize)>,
+    /// The samples of each signal the formula reads ([`reads`]), once the step is known.
+    read: Option<std::collections::BTreeMap<String, Vec<(usize, usize)>>>,
+    /// The first missing sample the formula reads: it fails there with robustness `-inf`.
+    undefined: Option<usize>,
     /// Samples whose prefix is known not to decide a violation (the upper bound over their
     /// continuations was `> 0` at the last check).
     undecided: usize,
@@ -75,6 +81,8 @@ impl StlMonitor {
             formula,
             times: Vec::new(),
             settled: None,
+            missing: Vec::new(),
+            read: None,
             undefined: None,
             undecided: 0,
         }
@@ -115,6 +123,38 @@ impl StlMonitor {
 }
 
 impl StlMonitor {
+    /// The first of `missing` that the formula reads, by `read`.
+    fn first_read(
+        missing: &[(String, usize)],
+        read: &std::collections::BTreeMap<String, Vec<(usize, usize)>>,
+    ) -> Option<usize> {
+        missing
+            .iter()
+            .filter(|(s, k)| {
+                read.get(s)
+                    .is_some_and(|r| r.iter().any(|&(lo, hi)| lo <= *k && *k <= hi))
+            })
+            .map(|&(_, k)| k)
+            .min()
+    }
+
+    /// The verdict of a formula that read a missing sample `k`: failed at `-inf`, at the
+    /// first sample whose prefix decides a violation, which is `k` unless the samples before
+    /// it already did.
+    fn undefined_verdict(&self, k: usize) -> Verdict {
+        let at = if k > self.undecided && self.upper_bound_after(k) <= 0.0 {
+            self.first_violation_s(k)
+        } else {
+            self.times[k]
+        };
+        Verdict {
+            passed: false,
+            robustness: f64::NEG_INFINITY,
+            first_violation_s: Some(at),
+            metrics: vec![],
+        }
+    }
+
     /// Bounds the robustness over every continuation of the samples so far and settles the
     /// verdict as failed when that bound is `<= 0`; whether it settled.
     fn check(&mut self) -> bool {
@@ -146,19 +186,21 @@ impl Monitor for StlMonitor {
         if self.settled.is_some() || self.undefined.is_some() {
             return ControlFlow::Break(());
         }
+        let k = self.times.len();
+        let missing_before = self.missing.len();
         for s in &self.signals {
-            match frame.signals.get(s) {
-                Ok(v) if !v.is_nan() => self
-                    .trace
-                    .signals
-                    .get_mut(s)
-                    .expect("one per signal")
-                    .push(v),
+            let v = match frame.signals.get(s) {
+                Ok(v) if !v.is_nan() => v,
                 _ => {
-                    self.undefined = Some((s.clone(), frame.t_s));
-                    return ControlFlow::Break(());
+                    self.missing.push((s.clone(), k));
+                    0.0
                 }
-            }
+            };
+            self.trace
+                .signals
+                .get_mut(s)
+                .expect("one per signal")
+                .push(v);
         }
         if let Some(clock) = self.trace.signals.get_mut(CLOCK) {
             clock.push(frame.t_s);
@@ -167,6 +209,17 @@ impl Monitor for StlMonitor {
         if let [t0, t1] = self.times[..] {
             if t1 > t0 {
                 self.trace.dt_s = t1 - t0;
+            }
+            // The step is known: which samples the formula reads, and whether it read a
+            // missing one so far.
+            self.read = Some(reads(&self.formula, &self.trace));
+        }
+        // Once the step is known, only this frame's missing samples are new.
+        let new = if k == 1 { 0 } else { missing_before };
+        if let Some(read) = &self.read {
+            if let Some(k) = Self::first_read(&self.missing[new..], read) {
+                self.undefined = Some(k);
+                return ControlFlow::Break(());
             }
         }
         if !self.times.len().is_multiple_of(CHECK_EVERY) || self.times.len() < 2 {
@@ -186,13 +239,14 @@ impl Monitor for StlMonitor {
     }
 
     fn verdict(&self) -> Verdict {
-        if let Some((_, t)) = &self.undefined {
-            return Verdict {
-                passed: false,
-                robustness: f64::NEG_INFINITY,
-                first_violation_s: Some(*t),
-                metrics: vec![],
-            };
+        if let Some(k) = self.undefined {
+            return self.undefined_verdict(k);
+        }
+        // A run of one frame: the step is not known, and the trace's default holds.
+        if self.read.is_none() {
+            if let Some(k) = Self::first_read(&self.missing, &reads(&self.formula, &self.trace)) {
+                return self.undefined_verdict(k);
+            }
         }
         if let Some(v) = &self.settled {
             return v.clone();
@@ -315,6 +369,52 @@ mod tests {
         // All NaN: failed at the first sample, with its time.
         let (v, _) = run("G[0,1] (x > 0)", |_| f64::NAN, 120);
         assert_eq!((v.passed, v.first_violation_s), (false, Some(0.0)));
+    }
+
+    #[test]
+    fn a_missing_sample_the_formula_does_not_read_changes_nothing() {
+        // x has no value for the first 0.1 s (a Signal that fires late): G[0.5,10] reads
+        // x from 0.5 s on, so it passes with the margin of x = 8 over 7 (it failed at t = 0).
+        let late = |i: usize| if i < 6 { f64::NAN } else { 8.0 };
+        let (v, fed) = run("G[0.5,10] (x > 7)", late, 900);
+        assert_eq!((v.passed, v.robustness, fed), (true, 1.0, 900));
+        // Two windows with a gap: NaN in the gap (2 to 4 s) is read by neither.
+        let gap = |i: usize| {
+            if (120..240).contains(&i) {
+                f64::NAN
+            } else {
+                1.0
+            }
+        };
+        let (v, _) = run("G[0,1] (x > 0) & G[5,6] (x > 0)", gap, 900);
+        assert_eq!((v.passed, v.robustness), (true, 1.0));
+        // U[0,2] reads its left operand from 0 up to the sample before 2 s, its right one
+        // over [0, 2]: NaN at 3 s is read by neither.
+        let (v, _) = run(
+            "(x > 0) U[0,2] (x > 5)",
+            |i| match i {
+                180 => f64::NAN,
+                i if i >= 60 => 6.0,
+                _ => 1.0,
+            },
+            900,
+        );
+        assert_eq!((v.passed, v.robustness), (true, 1.0));
+        // Read by the window: failed at -inf where it comes, as before.
+        let (v, fed) = run("G[0.05,10] (x > 7)", late, 900);
+        assert_eq!(
+            (v.passed, v.robustness, v.first_violation_s, fed),
+            (false, f64::NEG_INFINITY, Some(3.0 / 60.0), 4)
+        );
+        let (v, _) = run("F[2,3] (x > 0)", gap, 900);
+        assert_eq!((v.passed, v.first_violation_s), (false, Some(2.0)));
+        // A violation decided before the missing sample keeps its own time.
+        let (v, _) = run(
+            "G[0,10] (x < 30)",
+            |i| if i >= 40 { f64::NAN } else { i as f64 },
+            900,
+        );
+        assert_eq!((v.passed, v.first_violation_s), (false, Some(0.5)));
     }
 
     #[test]

@@ -6,7 +6,9 @@
 use std::collections::HashMap;
 
 use starlark::syntax::AstModule;
-use starlark_syntax::syntax::ast::{ArgumentP, AssignTargetP, AstExpr, AstStmt, ExprP, StmtP};
+use starlark_syntax::syntax::ast::{
+    ArgumentP, AssignTargetP, AstExpr, AstStmt, BinOp, ExprP, StmtP,
+};
 use starlark_syntax::syntax::uniplate::Visit;
 
 /// The builtins that declare open parameters.
@@ -39,6 +41,9 @@ pub struct Syntax {
     used_in_code: HashMap<String, usize>,
     /// `(builtin, keyword, variable)` for every `Builtin(keyword = variable)`.
     passed: Vec<(String, String, String)>,
+    /// `(builtin, keyword, variable)` for every variable added or subtracted in a sum given
+    /// to a builtin (`r.onLane(1, 10.0 + gap)`): its unit is the sum's.
+    summed: Vec<(String, String, String)>,
     /// The variable each call is assigned to, by call site (`"line:col"`), for calls that run
     /// once per evaluation: `x = Builtin(...)` at the top level of the module or under an
     /// `if` there, not in a loop or a `def`.
@@ -383,6 +388,25 @@ impl Walker<'_> {
                                     .or_default() += 1;
                             }
                         }
+                        // A sum or difference (`10.0 + gap`): each variable added whole
+                        // carries its unit into the sum, so it is checked against the input's.
+                        (ExprP::Op(_, BinOp::Add | BinOp::Subtract, _) | ExprP::Minus(_), true) => {
+                            let keyword = match (&a.node, &method_of) {
+                                (ArgumentP::Named(kw, _), _) => Some(kw.node.clone()),
+                                (ArgumentP::Positional(_), Some((_, m))) => {
+                                    positional_keyword(m, position).map(str::to_owned)
+                                }
+                                _ => None,
+                            };
+                            if let (Some(kw), Some(n)) = (keyword, &name) {
+                                let mut terms = Vec::new();
+                                summed_variables(value, &mut terms);
+                                for v in terms {
+                                    self.out.summed.push((n.clone(), kw.clone(), v));
+                                }
+                            }
+                            self.expr(value, None, true);
+                        }
                         _ => self.expr(value, None, in_code || !builtin),
                     }
                 }
@@ -461,6 +485,32 @@ impl Syntax {
             .filter(|(_, _, v)| v == variable)
             .map(|(b, k, _)| (b.as_str(), k.as_str()))
             .collect()
+    }
+
+    /// The `(builtin, keyword)` pairs that `variable` is added to or subtracted from others
+    /// in (`r.onLane(1, 10.0 + gap)` gives `("onLane", "at")` for `gap`): the sum is in the
+    /// variable's unit.
+    pub fn summed_in(&self, variable: &str) -> Vec<(&str, &str)> {
+        self.summed
+            .iter()
+            .filter(|(_, _, v)| v == variable)
+            .map(|(b, k, _)| (b.as_str(), k.as_str()))
+            .collect()
+    }
+}
+
+/// The variables that the sum or difference `e` adds or subtracts whole (`10.0 + gap - a`
+/// gives `gap` and `a`; `-gap` gives `gap`); a product's or a call's are not taken (`kmh /
+/// 3.6` converts a unit).
+fn summed_variables(e: &AstExpr, out: &mut Vec<String>) {
+    match &e.node {
+        ExprP::Identifier(id) => out.push(id.node.ident.clone()),
+        ExprP::Op(l, BinOp::Add | BinOp::Subtract, r) => {
+            summed_variables(l, out);
+            summed_variables(r, out);
+        }
+        ExprP::Minus(x) | ExprP::Plus(x) => summed_variables(x, out),
+        _ => {}
     }
 }
 

@@ -1106,7 +1106,8 @@ pub fn load(
             at: site,
             message: "nothing uses this stream's values (no object's input, monitor, Signal \
                       or foreach, directly, through other streams or by its name in a lambda): \
-                      the parameters only its functions read change no result"
+                      the parameters only its functions read change no verdict (its functions \
+                      still run every step; for an effect such as print, use foreach)"
                 .to_owned(),
         });
     }

@@ -503,6 +503,49 @@ fn a_parameter_in_another_unit_than_its_input_is_a_warning() {
             .any(|w| w.to_string().contains("is declared in"));
         assert_eq!(warned, warns, "{unit}: {:?}", s.warnings);
     }
+    // Added to other numbers, a parameter keeps its unit: `r.onLane(1, 10.0 + gap)` with a
+    // gap in s, and a speed in km/h less a constant, warn; a product may convert a unit
+    // (`kmh / 3.6`) and does not.
+    for (extra, car, warns) in [
+        (
+            "gap = VarInterval(20.0, 40.0, unit = \"s\")\n",
+            "",
+            "`gap` is declared in s but feeds onLane(at=), which is in m",
+        ),
+        ("gap = VarInterval(20.0, 40.0, unit = \"m\")\n", "", ""),
+        (
+            "kmh = VarInterval(30.0, 50.0, unit = \"km/h\")\n",
+            ", speed = -(2.0 - kmh)",
+            "`kmh` is declared in km/h but feeds Car(speed=), which is in m/s",
+        ),
+        (
+            "kmh = VarInterval(30.0, 50.0, unit = \"km/h\")\n",
+            ", speed = kmh / 3.6",
+            "",
+        ),
+    ] {
+        let src = format!(
+            "{extra}{}",
+            with_car(car, "").replace("r.onLane(1, 60)", "r.onLane(1, 10.0 + gap)")
+        );
+        let src = if extra.starts_with("kmh") {
+            src.replace("10.0 + gap", "60")
+        } else {
+            src
+        };
+        let s = load_source("sum.star", &src, "sum").unwrap();
+        let w: Vec<String> = s
+            .warnings
+            .iter()
+            .map(|w| w.to_string())
+            .filter(|w| w.contains("is declared in"))
+            .collect();
+        if warns.is_empty() {
+            assert!(w.is_empty(), "{src}: {w:?}");
+        } else {
+            assert!(w.len() == 1 && w[0].contains(warns), "{src}: {w:?}");
+        }
+    }
 }
 
 #[test]
@@ -544,10 +587,11 @@ fn a_stream_nothing_reads_is_named_in_a_warning() {
     );
     let s = load_source("named.star", &src, "named").unwrap();
     assert!(unread(&s).is_empty(), "{:?}", s.warnings);
-    // Read in some worlds of the family only: not unread.
-    let src = with_car(", speed = fast if mode == \"a\" else 5.0", "").replace(
+    // Read in some worlds of the family only: not unread. The first world (`mode = "b"`)
+    // leaves the stream unread; it is held in a list, so no variable names it.
+    let src = with_car(", speed = fast[0] if mode == \"a\" else 5.0", "").replace(
         "c = Car",
-        "mode = VarEnum([\"a\", \"b\"])\nfast = tick.map(lambda t: 5.0 + t)\nc = Car",
+        "mode = VarEnum([\"b\", \"a\"])\nfast = [tick.map(lambda t: 5.0 + t)]\nc = Car",
     );
     let s = load_source("some.star", &src, "some").unwrap();
     assert!(unread(&s).is_empty(), "{:?}", s.warnings);
@@ -849,4 +893,20 @@ fn a_dropped_action_is_refused_and_a_changelane_across_warns() {
         "{:?}",
         s.warnings
     );
+}
+
+#[test]
+fn a_parameter_of_a_car_disabled_in_every_test_changes_nothing() {
+    // `enabled = False`: the car is in no test, so its open speed and colour build the same
+    // test; they were counted in coverage without a word.
+    let src = with_car(", speed = s, color = paint, enabled = False", "").replace(
+        "c = Car",
+        "s = VarInterval(1.0, 9.0)\npaint = VarEnum([\"red\", \"blue\"])\nc = Car",
+    );
+    let s = load_source("off.star", &src, "off").unwrap();
+    assert_eq!(s.unused_params, ["s", "paint"], "{:?}", s.warnings);
+    // Enabled in some tests: both matter.
+    let src = src.replace("enabled = False", "enabled = VarEnum([False, True])");
+    let s = load_source("some.star", &src, "some").unwrap();
+    assert!(s.unused_params.is_empty(), "{:?}", s.unused_params);
 }

@@ -198,17 +198,33 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
     );
     other(differ(&a.lidar, &b.lidar), &mut out);
     other(differ(&a.frictions, &b.frictions), &mut out);
-    recoloured(&a.cars, &b.cars, |c| &mut c.color, Change::Colour, &mut out);
+    // A car disabled in both worlds is not in either test (nothing collides with it or sees
+    // it): what else differs about it changes nothing.
+    if a.cars.len() == b.cars.len() && a.cars.iter().any(|c| !c.enabled) {
+        let mut cars_b = b.cars.clone();
+        for (x, y) in a.cars.iter().zip(cars_b.iter_mut()) {
+            if !x.enabled && !y.enabled {
+                *y = x.clone();
+            }
+        }
+        recoloured(&a.cars, &cars_b, |c| &mut c.color, Change::Colour, &mut out);
+    } else {
+        recoloured(&a.cars, &b.cars, |c| &mut c.color, Change::Colour, &mut out);
+    }
     // Streams: the light, a piece's friction, or anything else.
     let (na, nb) = (a.streams.nodes(), b.streams.nodes());
     if na.len() != nb.len() {
         out.push(Change::Other);
     } else {
         let read = read_streams(a);
+        // A disabled car's speed drives nothing (a change of `enabled` itself is a change of
+        // the cars, above).
         let inputs: HashSet<usize> = a
             .cars
             .iter()
-            .map(|c| c.speed.0)
+            .zip(&b.cars)
+            .filter(|(x, y)| x.enabled || y.enabled)
+            .map(|(c, _)| c.speed.0)
             .chain(a.pedestrians.iter().map(|p| p.speed.0))
             .chain([a.environment.fog.0])
             // What the monitors judge: `Monitor(k)`, `Assert(VarEnum([True, False]))`.
@@ -383,11 +399,16 @@ pub fn unit_warnings(params: &[(String, ParamDecl)], syntax: &Syntax) -> Vec<War
         let (Some(unit), Some(site)) = (&decl.unit, syntax.site(&decl.at)) else {
             continue;
         };
-        // Where it is passed whole: through its variable, or written inline in the call.
+        // Where it is passed whole: through its variable, or written inline in the call; or
+        // added to other numbers through its variable (`onLane(1, 10.0 + gap)`).
         let mut inputs: Vec<(&str, &str)> = site
             .variable
             .as_deref()
-            .map(|v| syntax.passed_to(v))
+            .map(|v| {
+                let mut all = syntax.passed_to(v);
+                all.extend(syntax.summed_in(v));
+                all
+            })
             .unwrap_or_default();
         if let Some((builtin, keyword)) = &site.argument_of {
             inputs.push((builtin, keyword));
