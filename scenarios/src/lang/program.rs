@@ -174,6 +174,7 @@ impl Program {
         values: Option<Vec<ParamValue>>,
         then: impl FnOnce(SceneBuilder, &Module) -> Result<R, String>,
     ) -> Result<(R, u64), String> {
+        let again = values.clone();
         Module::with_temp_heap(|module| {
             let state = LoadState::new(values, self.objects.clone(), self.maps.clone());
             state.scene.borrow_mut().route_m = scene::route_length_m(self.horizon_s);
@@ -227,11 +228,15 @@ impl Program {
                 }
                 result.map_err(|e| {
                     let message = super::suggest_keyword(&format!("{e}"));
-                    // Limit errors (steps, heap) carry no span: say which program hit them.
+                    // Limit errors (steps, heap) carry no span: say which program hit them,
+                    // and the statement it was running then.
                     let message = if message.contains(&self.file) {
                         message
                     } else {
-                        format!("{message}\n --> {}", self.file)
+                        match self.where_stopped(again) {
+                            Some(at) => format!("{message}\n{at}"),
+                            None => format!("{message}\n --> {}", self.file),
+                        }
                     };
                     // The first evaluation: say which values it ran with.
                     let b = state.scene.borrow();
@@ -282,6 +287,61 @@ impl Program {
             finished(&b, &self.file)?;
             Ok((then(b, &module)?, steps))
         })
+    }
+
+    /// Where an evaluation with `values` that stopped at a limit (steps or heap) stopped:
+    /// ` --> file:line:col`, the line and a caret under the statement it was running. Found
+    /// by evaluating again, with the same values and limits, with a hook before every
+    /// statement that notes it: only on this error path, since the hook slows every
+    /// statement. `None` when the second evaluation ran no statement.
+    fn where_stopped(&self, values: Option<Vec<ParamValue>>) -> Option<String> {
+        let last: std::cell::Cell<Option<starlark::codemap::Span>> = std::cell::Cell::new(None);
+        let note = |at: starlark::codemap::FileSpanRef, _: bool, _: &mut Evaluator<'_, '_, '_>| {
+            last.set(Some(at.span));
+        };
+        Module::with_temp_heap(|module| {
+            let state = LoadState::new(values, self.objects.clone(), self.maps.clone());
+            state.scene.borrow_mut().route_m = scene::route_length_m(self.horizon_s);
+            let mut eval = Evaluator::new(&module);
+            eval.extra = Some(&state);
+            eval.set_print_handler(&state);
+            for limit in [
+                eval.set_max_tick_count(super::MAX_LOAD_STEPS),
+                eval.set_max_heap_size(super::MAX_LOAD_HEAP_BYTES),
+                eval.set_max_callstack_size(super::MAX_CALL_DEPTH),
+            ] {
+                limit.ok()?;
+            }
+            let budget = crate::memory::Budget::start(
+                super::MAX_LOAD_HEAP_BYTES,
+                crate::memory::HARD_HEAP_BYTES,
+                &self.file,
+                "the program",
+            );
+            eval.set_check_cancelled(Box::new(crate::memory::over_soft_limit));
+            eval.before_stmt_for_dap(starlark::eval::BeforeStmtFunc::Fn(&note));
+            module.set(
+                "tick",
+                module
+                    .heap()
+                    .alloc(super::values::Stream::of(super::scene::TICK.0)),
+            );
+            let _ = eval.eval_module(self.ast.clone(), &self.globals);
+            drop(budget);
+            Some(())
+        })?;
+        let span = self.ast.file_span(last.get()?);
+        let begin = span.resolve_span().begin;
+        let line = span.file.source_line(begin.line);
+        let number = (begin.line + 1).to_string();
+        let gutter = " ".repeat(number.len());
+        Some(format!(
+            "{gutter}--> {}:{number}:{}\n{gutter} |\n{number} | {line}\n{gutter} | {}^ running \
+             here when it stopped",
+            self.file,
+            begin.column + 1,
+            " ".repeat(begin.column),
+        ))
     }
 
     /// Checks that the parameters an evaluation declared so far are the first ones the first

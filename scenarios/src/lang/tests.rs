@@ -130,6 +130,13 @@ w.place(r, v)
 fn an_infinite_loop_is_stopped() {
     let m = err("def f():\n    for i in range(1000000000):\n        pass\nf()\n");
     assert!(m.contains("tick") || m.contains("limit"), "{m}");
+    // The statement it was running is named, at the top level as in a `def` (it named the
+    // file only).
+    assert!(m.contains("bad.star:2:5"), "{m}");
+    assert!(m.contains("2 |     for i in range(1000000000):"), "{m}");
+    let m = err("x = 0\nfor i in range(20000000):\n    x += 1\n");
+    assert!(m.contains("limit") && m.contains("bad.star:3:5"), "{m}");
+    assert!(m.contains("3 |     x += 1\n  |     ^"), "{m}");
 }
 
 #[test]
