@@ -233,6 +233,7 @@ impl Campaign<'_> {
             Err(e) => (Status::Error, Vec::new(), Vec::new(), Some(e), Vec::new()),
         };
         RunRecord {
+            passive: self.scenario.passive_monitors(),
             campaign: None,
             id,
             seed,

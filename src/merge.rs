@@ -99,7 +99,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
     let mut records = Vec::with_capacity(template.budget as usize);
     for (dir, file) in shards.values() {
         let ids = file.ids();
-        let existing = crate::results::load(dir, &scenario.space, ids.clone(), false)?;
+        let existing = crate::results::load(dir, &scenario, ids.clone(), false)?;
         let strategy: paracosm_generators::Strategy =
             file.strategy.parse().map_err(|e| bad(format!("{e}")))?;
         let campaign = crate::campaign::Campaign {

@@ -96,6 +96,11 @@ pub struct RunRecord {
     pub log: Vec<String>,
     /// Wall-clock time of the test in milliseconds. Machine-dependent.
     pub wall_ms: f64,
+    /// The monitors that count only where they fail, by name (the scenario's
+    /// `passive_monitors`: the default `OffRoadMonitor`), for [`RunRecord::robustness`]. Not
+    /// written: whoever makes or reads a record for a scenario sets it.
+    #[serde(skip)]
+    pub passive: Vec<String>,
 }
 
 /// The fields of a results line, as read back (`params` is rebuilt from `point`). Unknown
@@ -123,10 +128,13 @@ struct Line {
 }
 
 impl RunRecord {
-    /// The smallest robustness over the test's monitors (`<= 0`: it failed; `+inf` without
-    /// monitors), NaN for a test that ended in `error`.
+    /// The test's robustness, as the falsifiers see it: [`RunRecord::cost`] with the record's
+    /// `passive` monitors (`<= 0`: it failed; `+inf` when nothing counts), NaN for a test that
+    /// ended in `error`. The report's colours, the failure map's scale and the triage's
+    /// correlations use it, so a passing test's margin is not capped by the default off-road
+    /// monitor's distance to the road's edge.
     pub fn robustness(&self) -> f64 {
-        self.cost(&[])
+        self.cost(&self.passive)
     }
 
     /// The names of the monitors that failed, in the scenario's order, but those cut short by
@@ -206,6 +214,7 @@ impl RunRecord {
             )));
         }
         Ok(RunRecord {
+            passive: Vec::new(),
             campaign: l.campaign,
             id: l.id,
             seed: l.seed,
@@ -300,6 +309,7 @@ mod tests {
             continuous: vec![0.25],
         };
         let r = RunRecord {
+            passive: Vec::new(),
             campaign: None,
             id: 3,
             seed: 9,
@@ -365,6 +375,7 @@ mod tests {
             continuous: vec![0.25],
         };
         let r = RunRecord {
+            passive: Vec::new(),
             campaign: None,
             id: 0,
             seed: 1,

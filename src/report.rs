@@ -568,7 +568,7 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
         scenario.sut = s;
     }
     let ids = file.ids();
-    let existing = crate::results::load(dir, &scenario.space, ids.clone(), false)?;
+    let existing = crate::results::load(dir, &scenario, ids.clone(), false)?;
     let stored = Summary::read(dir).ok();
     let wall_s = stored.as_ref().map_or_else(
         || existing.records.iter().map(|r| r.wall_ms).sum::<f64>() / 1e3,

@@ -3,8 +3,6 @@
 use std::ops::Range;
 use std::path::Path;
 
-use paracosm_generators::ParamSpace;
-
 use crate::campaign::RESULTS_FILE;
 use crate::record::RunRecord;
 use crate::Error;
@@ -18,8 +16,9 @@ pub struct Existing {
     pub repaired_bytes: usize,
 }
 
-/// Reads `results.jsonl` in `dir`, written for a campaign whose folder runs `ids` with
-/// parameter space `space`. A last line without its newline (the process was killed while
+/// Reads `results.jsonl` in `dir`, written for a campaign of `scenario` whose folder runs
+/// `ids` (its parameter space reads the points; its passive monitors are set on each record,
+/// [`RunRecord::robustness`]). A last line without its newline (the process was killed while
 /// writing it) is cut off the file when `repair`, and ignored otherwise. Every other line must
 /// be a record, and the records must be `ids.start, ids.start + 1, ...` in order, since the
 /// runner writes them so. A missing file reads as no records.
@@ -29,10 +28,12 @@ pub struct Existing {
 /// first id out of sequence, or with the file system's reason.
 pub fn load(
     dir: &Path,
-    space: &ParamSpace,
+    scenario: &paracosm_scenarios::Scenario,
     ids: Range<u64>,
     repair: bool,
 ) -> Result<Existing, Error> {
+    let space = &scenario.space;
+    let passive = scenario.passive_monitors();
     let path = dir.join(RESULTS_FILE);
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
@@ -60,7 +61,7 @@ pub fn load(
     })?;
     let mut records = Vec::new();
     for (n, line) in text.lines().enumerate() {
-        let r = RunRecord::from_line(line, space).map_err(|e| {
+        let mut r = RunRecord::from_line(line, space).map_err(|e| {
             bad(format!(
                 "{}: not a results record: {e}",
                 crate::error::located(&path, n + 1, e.column())
@@ -79,6 +80,7 @@ pub fn load(
                 ids.end
             )));
         }
+        r.passive.clone_from(&passive);
         records.push(r);
     }
     Ok(Existing {
@@ -122,20 +124,16 @@ mod tests {
         let full = std::fs::read_to_string(&path).unwrap();
         let cut = full.len() - 20;
         std::fs::write(&path, &full[..cut]).unwrap();
-        let e = load(dir.path(), &s.space, 0..4, true).unwrap();
+        let e = load(dir.path(), &s, 0..4, true).unwrap();
         assert_eq!(e.records.len(), 3);
         assert!(e.repaired_bytes > 0);
         let repaired = std::fs::read_to_string(&path).unwrap();
         assert!(repaired.ends_with('\n') && full.starts_with(&repaired));
         // A shard that should start at id 2 does not accept ids 0..3.
-        let err = load(dir.path(), &s.space, 2..4, false)
-            .unwrap_err()
-            .to_string();
+        let err = load(dir.path(), &s, 2..4, false).unwrap_err().to_string();
         assert!(err.contains(":1: test id 0 where 2 was expected"), "{err}");
         std::fs::write(&path, "{\"id\": 0, oops\n").unwrap();
-        let err = load(dir.path(), &s.space, 0..4, false)
-            .unwrap_err()
-            .to_string();
+        let err = load(dir.path(), &s, 0..4, false).unwrap_err().to_string();
         assert!(err.contains("results.jsonl:1:"), "{err}");
     }
 }

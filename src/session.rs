@@ -264,7 +264,7 @@ pub fn run(
     }
     let ids = file.ids();
     let existing = match stored {
-        Some(_) => crate::results::load(out, &scenario.space, ids.clone(), true)?,
+        Some(_) => crate::results::load(out, &scenario, ids.clone(), true)?,
         None => crate::results::Existing {
             records: Vec::new(),
             repaired_bytes: 0,

@@ -591,6 +591,7 @@ mod tests {
                         (false, _) => Status::Pass,
                     };
                     RunRecord {
+                        passive: Vec::new(),
                         campaign: None,
                         id,
                         seed: 0,

@@ -180,6 +180,44 @@ test(horizon = 0.1)
         stdout.contains("parameters by relevance: a (importance 0.00, ρ +1.00)"),
         "{stdout}"
     );
+    // Above the default off-road monitor's margin (1.75 m in the middle of a lane): the
+    // test's robustness is the falsifiers' cost, which counts that monitor only where it
+    // fails, so `a` still ranks first with ρ = 1 (every test read 1.75 m, and ρ was 0).
+    std::fs::write(
+        &program,
+        std::fs::read_to_string(&program)
+            .unwrap()
+            .replace("0.1 + 0.5 * a", "5.0 + a"),
+    )
+    .unwrap();
+    let out = dir.path().join("above");
+    let o = fuzz(&[
+        program.to_str().unwrap(),
+        "--budget",
+        "20",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 0);
+    let t = &summary(&out)["triage"];
+    assert_eq!(t["ranking"][0]["param"], "a", "{t}");
+    assert!(
+        (t["ranking"][0]["association"].as_f64().unwrap() - 1.0).abs() < 1e-12,
+        "{t}"
+    );
+    // The report's per-test robustness too (its colours).
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let at = report
+        .find("\"robustness\":[")
+        .expect("the tests' robustness")
+        + 14;
+    let first: f64 = report[at..]
+        .split([',', ']'])
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((5.0..6.0).contains(&first), "{first}");
 }
 
 /// The texts an SVG shows.

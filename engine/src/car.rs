@@ -115,6 +115,11 @@ pub(crate) struct Car {
     /// only grow, so the next lookup walks on from there instead of searching the whole
     /// path, and the heading is worked out once per leg.
     leg: std::cell::Cell<(usize, f64)>,
+    /// Per path vertex, the sideways shift of one metre of offset to the right (m per m):
+    /// the mitre of the two legs' right normals, so a car offset from its path (a lane
+    /// change) moves on a parallel polyline whose legs meet at each vertex; worked out on
+    /// the first lane change.
+    mitres: std::cell::OnceCell<Vec<[f64; 2]>>,
     s: f64,
     /// Speed along the path in the last step, m/s.
     speed: f64,
@@ -169,6 +174,7 @@ impl Car {
             cumulative,
             stop_s,
             leg: std::cell::Cell::new((0, f64::NAN)),
+            mitres: std::cell::OnceCell::new(),
             s: 0.0,
             speed: 0.0,
             rolling: None,
@@ -287,8 +293,61 @@ impl Car {
         self.here.0
     }
 
+    /// The mitre at each vertex of the path ([`Car::mitres`]): the sum of the right normals
+    /// `n` of the legs before and after it (a leg of no length takes its neighbour's),
+    /// divided by `1 + n_before · n_after`, so the offset polyline's legs stay parallel to
+    /// the path's at the offset's distance; the divisor is held to at least 0.25 at a turn
+    /// sharper than about 140°.
+    fn mitres(&self) -> &[[f64; 2]] {
+        self.mitres.get_or_init(|| {
+            let n = self.path.len();
+            // The right normal of each leg, `None` for a leg of no length.
+            let normals: Vec<Option<[f64; 2]>> = self
+                .path
+                .windows(2)
+                .map(|w| {
+                    let (dx, dz) = (w[1][0] - w[0][0], w[1][1] - w[0][1]);
+                    let len = dx.hypot(dz);
+                    (len > 0.0).then(|| [-dz / len, dx / len])
+                })
+                .collect();
+            let first = normals
+                .iter()
+                .flatten()
+                .next()
+                .copied()
+                .unwrap_or([0.0, 1.0]);
+            // Each leg's normal, a leg of no length taking the one before it.
+            let mut legs = Vec::with_capacity(normals.len());
+            let mut last = first;
+            for nrm in &normals {
+                last = nrm.unwrap_or(last);
+                legs.push(last);
+            }
+            (0..n)
+                .map(|i| {
+                    let before = if i == 0 {
+                        legs.first()
+                    } else {
+                        legs.get(i - 1)
+                    };
+                    let after = legs.get(i).or(legs.last());
+                    match (before, after) {
+                        (Some(a), Some(b)) => {
+                            let k = (1.0 + a[0] * b[0] + a[1] * b[1]).max(0.25);
+                            [(a[0] + b[0]) / k, (a[1] + b[1]) / k]
+                        }
+                        _ => first,
+                    }
+                })
+                .collect()
+        })
+    }
+
     /// The ground point and heading at arc length `s` and time `t_s`, with the lane change's
-    /// sideways offset and the turn of its sideways speed.
+    /// sideways offset and the turn of its sideways speed. The offset is taken along the
+    /// path's mitres ([`Car::mitres`]), so the car moves on a polyline parallel to its path,
+    /// without a jump where the path turns.
     fn place_at(&self, s: f64, t_s: f64) -> ([f64; 2], f64) {
         let (p, heading) = self.at(s);
         let (Some(change), Some(t0)) = (self.lane_change, self.change_started_s) else {
@@ -298,15 +357,34 @@ impl Car {
         let (share, rate) = LaneChangeSpec::profile(tau);
         let from = self.change_from_m;
         let d = from + (change.offset_m - from) * share;
-        // Right of a driver heading along `heading`, in the (x, z) plane.
-        let right = [heading.sin(), heading.cos()];
+        let i = self.leg_at(s);
+        let (a, b) = (self.path[i - 1], self.path[i]);
+        let len = self.cumulative[i] - self.cumulative[i - 1];
+        let u = if len > 0.0 {
+            ((s - self.cumulative[i - 1]) / len).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let m = self.mitres();
+        let (ma, mb) = (m[i - 1], m[i]);
+        let shift = [ma[0] + u * (mb[0] - ma[0]), ma[1] + u * (mb[1] - ma[1])];
+        // The offset leg's heading at this offset (the path leg's when it has no length).
+        let (a2, b2) = (
+            [a[0] + d * ma[0], a[1] + d * ma[1]],
+            [b[0] + d * mb[0], b[1] + d * mb[1]],
+        );
+        let heading = if (b2[0] - a2[0]).hypot(b2[1] - a2[1]) > 1e-9 {
+            (-(b2[1] - a2[1])).atan2(b2[0] - a2[0])
+        } else {
+            heading
+        };
         let sideways_mps = if (0.0..1.0).contains(&tau) {
             (change.offset_m - from) * rate / change.duration_s
         } else {
             0.0
         };
         let turn = sideways_mps.atan2(self.speed.max(0.1));
-        ([p[0] + d * right[0], p[1] + d * right[1]], heading - turn)
+        ([p[0] + d * shift[0], p[1] + d * shift[1]], heading - turn)
     }
 
     /// Starts its lane change at `t_s` if it has one that has not started.
@@ -559,6 +637,62 @@ mod tests {
             let (a, b) = (c.path[i - 1], c.path[i]);
             assert_eq!(h, (-(b[1] - a[1])).atan2(b[0] - a[0]));
             assert!(p.iter().all(|v| v.is_finite()));
+        }
+    }
+
+    #[test]
+    fn a_car_offset_by_a_lane_change_moves_without_a_jump_where_its_path_turns() {
+        // A quarter circle of radius 30 m in 2 m legs, then a straight: the offset was taken
+        // along each leg's own normal, so at each vertex the car jumped sideways by
+        // 3.5 m × the turn (0.23 m in one step of 0.1 m).
+        let mut path: Vec<[f64; 2]> = (0..=24)
+            .map(|k| {
+                let a = f64::from(k) * std::f64::consts::FRAC_PI_2 / 24.0;
+                [30.0 * a.sin(), 30.0 - 30.0 * a.cos()]
+            })
+            .collect();
+        path.push([30.0, 80.0]);
+        let (dt, v) = (1.0 / 60.0, 6.0);
+        for offset in [3.5, -3.5] {
+            let mut c = car(path.clone());
+            c.lane_change = Some(LaneChangeSpec {
+                offset_m: offset,
+                start: LaneChangeStart::At(0.5),
+                duration_s: 2.0,
+            });
+            let mut physics = PhysicsWorld::new();
+            let zone = AwakeZone {
+                ego_m: [0.0, 0.0],
+                radius_m: 1e9,
+            };
+            let mut last = c.ground_m();
+            for k in 0..1200 {
+                let t = f64::from(k) * dt;
+                if t >= 0.5 {
+                    c.start_lane_change(0.5);
+                }
+                c.advance(&mut physics, v, 0.8, (t, dt), zone);
+                let here = c.ground_m();
+                let moved = (here[0] - last[0]).hypot(here[1] - last[1]);
+                // Along a parallel of radius 30 ± 3.5 m, plus the sideways speed of the change
+                // (at most 1.875 × 3.5 / 2 m/s).
+                let most = (v * 33.5 / 30.0 + 1.875 * 3.5 / 2.0) * dt;
+                assert!(
+                    moved <= most * 1.01,
+                    "offset {offset}, t = {t}: {moved} m in a step"
+                );
+                // (Before it brakes for the end of its path.)
+                if t < 14.0 {
+                    assert!(
+                        moved >= v * 26.5 / 30.0 * dt * 0.99,
+                        "{offset}, t = {t}: {moved}"
+                    );
+                }
+                last = here;
+            }
+            // It ends on the straight, 3.5 m to the side of it.
+            let [x, _] = c.ground_m();
+            assert!((x - (30.0 - offset)).abs() < 1e-6, "{x}");
         }
     }
 }

@@ -455,6 +455,7 @@ mod tests {
             continuous: vec![0.25],
         };
         let record = crate::record::RunRecord {
+            passive: Vec::new(),
             campaign: Some("0123456789abcdef".into()),
             id: 0,
             seed: 1,

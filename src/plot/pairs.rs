@@ -470,6 +470,7 @@ mod tests {
                     continuous: u.to_vec(),
                 };
                 RunRecord {
+                    passive: Vec::new(),
                     campaign: None,
                     id,
                     seed: 0,
