@@ -680,6 +680,49 @@ test(horizon = 2.0)
     assert!((number(&r["metrics"]["time_to_failure_s"]) - 2.0).abs() < 1e-9);
 }
 
+/// The test's `time_to_failure_s` is the earliest failure of a monitor that failed it: a
+/// `TimeToFailure` that passed (its monitor failed after `minT`) carries its monitor's time
+/// but failed nothing, and the metric read that time.
+#[test]
+fn the_tests_time_to_failure_is_that_of_a_monitor_that_failed_it() {
+    let program = |with_late_failure: bool| {
+        format!(
+            r#"
+w = World()
+r = RoadSegment(len = 400.0)
+v = AutonomousVehicle(loc = r.onLane(1, 10.0), speed = 12.0)
+w.place(r, v)
+s = Stl("G[0,20] (ego_x_m < 60)", name = "below60")
+TimeToFailure(s, minT = 3.0, name = "ttf_stl")
+{}
+test(horizon = 12.0)
+"#,
+            if with_late_failure {
+                "m = Monitor(v.pos.map(lambda p: 100.0 - p.x), name = \"below100\")\nTimeToFailure(m, minT = 20.0, name = \"ttf_mon\")"
+            } else {
+                ""
+            }
+        )
+    };
+    // Only the passing TimeToFailure: no failure, no time.
+    let (r, _) = run_one(&program(false), 0);
+    let m = &r["monitors"];
+    assert_eq!(m["ttf_stl"]["passed"], true, "{m}");
+    assert!(number(&m["ttf_stl"]["first_violation_s"]) < 5.0, "{m}");
+    assert!(
+        r["metrics"].get("time_to_failure_s").is_none(),
+        "{}",
+        r["metrics"]
+    );
+    // With a later failure that fails the test: its time, not the passing one's.
+    let (r, _) = run_one(&program(true), 1);
+    let m = &r["monitors"];
+    let t = number(&m["ttf_mon"]["first_violation_s"]);
+    assert_eq!(m["ttf_mon"]["passed"], false, "{m}");
+    assert!(t > number(&m["ttf_stl"]["first_violation_s"]), "{m}");
+    assert_eq!(number(&r["metrics"]["time_to_failure_s"]), t);
+}
+
 /// An obstacle's colour is seen by a camera only: under `aeb` (lidar) an open one is named
 /// in a warning, as a car's colour is.
 #[test]

@@ -435,8 +435,12 @@ impl Scenario {
             .iter()
             .flat_map(|(_, v)| v.metrics.iter().copied())
             .collect();
+        // The test's failure time: the earliest of the monitors that failed it. A monitor that
+        // passed may still carry a time (a `TimeToFailure` whose monitor failed after `minT`),
+        // and one cut short did not fail the test.
         if let Some(ttf) = monitors
             .iter()
+            .filter(|(n, v)| !v.passed && !cut_short.contains(n))
             .filter_map(|(_, v)| v.first_violation_s)
             .reduce(f64::min)
         {
