@@ -23,7 +23,7 @@ pub use geometry::{direction, wrap, Pose2};
 pub use lanes::{LanePath, Turn};
 pub use map::{MapIndex, MapLane, MapRef, MapRoad, RoadMap};
 pub use piece::{
-    Piece, PieceKind, PortGeometry, JUNCTION_APRON_M, LANE_WIDTH_M, MAX_TURN_RAD,
+    Piece, PieceKind, PortGeometry, JUNCTION_APRON_M, LANE_WIDTH_M, MAX_EXTENT_M, MAX_TURN_RAD,
     MIN_CURVE_RADIUS_M, PORT_NAMES, SIDEWALK_WIDTH_M,
 };
 pub use surface::{Surface, GROUND_FRICTION, GROUND_MARGIN_M, GROUND_TOP_M};

@@ -10,6 +10,20 @@ pub const LANE_WIDTH_M: f64 = 3.5;
 /// Smallest radius of a curved piece's reference line, metres (a tighter bend is no road a
 /// car of the ego's size can follow).
 pub const MIN_CURVE_RADIUS_M: f64 = 10.0;
+
+/// The longest road segment and the largest arc radius, metres (100 km): the physics runs in
+/// f32, whose steps are 8 mm at 100 km from the origin.
+pub const MAX_EXTENT_M: f64 = 100_000.0;
+
+/// `x` as a message shows it: in scientific notation from a billion on (`1e300`, not its 301
+/// digits).
+fn readable(x: f64) -> String {
+    if x.abs() >= 1e9 {
+        format!("{x:e}")
+    } else {
+        x.to_string()
+    }
+}
 /// Largest angle a curved piece may turn through, rad (3π/2: a fuller turn would bring its
 /// ends onto each other).
 pub const MAX_TURN_RAD: f64 = 3.0 * std::f64::consts::FRAC_PI_2;
@@ -207,8 +221,14 @@ impl PieceKind {
             return bad(format!("{name} friction {mu} is outside (0, 2]"));
         }
         match *self {
-            PieceKind::Segment { length_m, .. } if !(length_m.is_finite() && length_m > 0.0) => {
-                bad(format!("RoadSegment length {length_m} m is not positive"))
+            PieceKind::Segment { length_m, .. }
+                if !(length_m.is_finite() && length_m > 0.0 && length_m <= MAX_EXTENT_M) =>
+            {
+                bad(format!(
+                    "RoadSegment length {} m is outside (0, {MAX_EXTENT_M}] (the physics runs \
+                     in f32: 8 mm apart at 100 km)",
+                    readable(length_m)
+                ))
             }
             PieceKind::Arc {
                 radius_m,
@@ -219,6 +239,11 @@ impl PieceKind {
                 if !(radius_m.is_finite() && radius_m >= min) {
                     bad(format!(
                         "Arc radius {radius_m} m is too tight for {lanes} lanes (at least {min} m)"
+                    ))
+                } else if radius_m > MAX_EXTENT_M {
+                    bad(format!(
+                        "Arc radius {} m is over {MAX_EXTENT_M} m (use a RoadSegment)",
+                        readable(radius_m)
                     ))
                 } else if !(angle_rad.is_finite()
                     && angle_rad != 0.0
@@ -266,6 +291,11 @@ impl PieceKind {
                 if !(radius_m.is_finite() && radius_m >= min) {
                     bad(format!(
                         "Roundabout radius {radius_m} m is too small for {lanes} lanes (at least {min} m)"
+                    ))
+                } else if radius_m > 1_000.0 {
+                    bad(format!(
+                        "Roundabout radius {} m is over 1000 m",
+                        readable(radius_m)
                     ))
                 } else {
                     Ok(())

@@ -295,6 +295,9 @@ fn inputs_of_the_wrong_kind_or_out_of_range_are_refused_at_load() {
     };
     let cases: Vec<(String, &str, &str)> = vec![
         (world("light = 1.5"), "World(light=) takes a number in [0, 1], got 1.5 (a number)", "1:5"),
+        (world("").replace("len = 200.0", "len = 1e39"), "RoadSegment length 1e39 m is outside (0, 100000]", "2:5"),
+        (format!("{HEADER}a = Arc(radius = 2e5, angle = 0.5)\nw.place(r, a, v)\n"), "Arc radius 200000 m is over 100000 m", "4:5"),
+        (format!("{HEADER}o = Roundabout(radius = 1500.0)\nw.place(r, o, v)\n"), "Roundabout radius 1500 m is over 1000 m", "4:5"),
         (world("fog = Const(-0.1)"), "World(fog=) takes a number in [0, 1], got -0.1", "1:5"),
         (world("fog = True"), "World(fog=) takes a number in [0, 1], got True (a bool)", "1:5"),
         (world("fog = VarEnum([0.2, 1.5])"), "World(fog=) takes a number in [0, 1], got 1.5 (a number)", "1:5"),

@@ -111,9 +111,23 @@ pub fn input_of(builtin: &str, keyword: &str) -> Option<Input> {
             | "Roundabout" | "OpenDrive",
             "friction",
         ) => FRICTION,
-        ("RoadSegment", "len") => number("len", "m", 0.0, f64::INFINITY, true),
-        ("Roundabout", "radius") => number("radius", "m", 0.0, f64::INFINITY, true),
-        ("Arc", "radius") => number("radius", "m", 0.0, f64::INFINITY, true),
+        // At most 100 km (a roundabout's plaza 2 km): the physics runs in f32, 8 mm apart at
+        // 100 km from the origin, and `len = 1e38` moved the road's colliders by metres.
+        ("RoadSegment", "len") => number(
+            "len",
+            "m",
+            0.0,
+            paracosm_engine::network::MAX_EXTENT_M,
+            true,
+        ),
+        ("Roundabout", "radius") => number("radius", "m", 0.0, 1_000.0, true),
+        ("Arc", "radius") => number(
+            "radius",
+            "m",
+            0.0,
+            paracosm_engine::network::MAX_EXTENT_M,
+            true,
+        ),
         ("Arc", "angle") => number("angle", "rad", -MAX_TURN, MAX_TURN, false),
         ("Clothoid", "length") => number("length", "m", 0.0, 10_000.0, true),
         ("Clothoid", "curv_start") => number("curv_start", "1/m", -0.1, 0.1, false),
