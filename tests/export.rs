@@ -127,6 +127,49 @@ fn cars_follow_the_trajectories_they_drove() {
     );
 }
 
+/// The ego's route exports as waypoints that head along the route (every one had `h = 0`,
+/// and a simulator matches a waypoint to the lane of its heading).
+#[test]
+fn the_egos_route_waypoints_head_along_the_route() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("g");
+    let o = fuzz(&[
+        "grid-world",
+        "--budget",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{o:?}");
+    let (xosc, _) = export(&out.join("results.jsonl"), 0, &dir.path().join("x"));
+    let route = &xosc[xosc.find("<Route ").unwrap()..xosc.find("</Route>").unwrap()];
+    let points: Vec<(f64, f64, f64)> = route
+        .split("<Waypoint ")
+        .skip(1)
+        .map(|w| {
+            (
+                attr(w, "WorldPosition", "x"),
+                attr(w, "WorldPosition", "y"),
+                attr(w, "WorldPosition", "h"),
+            )
+        })
+        .collect();
+    assert!(points.len() > 20, "{}", points.len());
+    let wrap = |a: f64| {
+        (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+    };
+    for pair in points.windows(2) {
+        let ((x0, y0, h0), (x1, y1, _)) = (pair[0], pair[1]);
+        // OpenSCENARIO's y is paracosm's -z, and its headings are paracosm's: the chord to
+        // the next waypoint, 10 m on, is within most of a right-angle turn of the heading.
+        let chord = (y1 - y0).atan2(x1 - x0);
+        assert!(wrap(chord - h0).abs() < 1.2, "{pair:?}");
+    }
+    // The route turns (right, right, left): its waypoints head more than one way.
+    let turned = points.iter().any(|p| wrap(p.2 - points[0].2).abs() > 1.0);
+    assert!(turned, "{points:?}");
+}
+
 /// Segments, a clothoid, an arc and a cross-intersection, with a car so that the world has
 /// traffic.
 const PIECES: &str = r#"

@@ -285,29 +285,46 @@ pub fn write(test: &Test<'_>) -> String {
         speed(w.ego.initial_speed_mps),
     ];
     if w.ego.route.len() >= 2 {
-        let mut waypoints = vec![w.ego.route[0]];
+        let route = &w.ego.route;
+        // Indices of the route's points that become waypoints: the first, one every
+        // WAYPOINT_EVERY_M, the last.
+        let mut picked = vec![0];
         let mut walked = 0.0;
-        for pair in w.ego.route.windows(2) {
+        for (i, pair) in route.windows(2).enumerate() {
             walked += (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1]);
             if walked >= WAYPOINT_EVERY_M {
-                waypoints.push(pair[1]);
+                picked.push(i + 1);
                 walked = 0.0;
             }
         }
-        let last = *w.ego.route.last().expect("two points");
-        if waypoints.last() != Some(&last) {
-            waypoints.push(last);
+        if picked.last() != Some(&(route.len() - 1)) {
+            picked.push(route.len() - 1);
         }
+        // Each waypoint heads along the route there (a simulator matches a waypoint to the
+        // lane of that direction): toward the next distinct point, the last from the one
+        // before it.
+        let heading = |i: usize| {
+            let ahead = route[i + 1..].iter().find(|q| **q != route[i]);
+            let behind = route[..i].iter().rev().find(|q| **q != route[i]);
+            let (a, b) = match (ahead, behind) {
+                (Some(n), _) => (route[i], *n),
+                (None, Some(p)) => (*p, route[i]),
+                (None, None) => return 0.0,
+            };
+            (-(b[1] - a[1])).atan2(b[0] - a[0])
+        };
+        let waypoints: Vec<([f64; 2], f64)> =
+            picked.iter().map(|&i| (route[i], heading(i))).collect();
         ego_actions.push(
             El::new("RoutingAction").child(
                 El::new("AssignRouteAction").child(
                     El::new("Route")
                         .attr("name", "ego route")
                         .attr("closed", "false")
-                        .children(waypoints.iter().map(|q| {
+                        .children(waypoints.iter().map(|&(q, h)| {
                             El::new("Waypoint")
                                 .attr("routeStrategy", "shortest")
-                                .child(world_position([q[0], 0.0, q[1]], 0.0))
+                                .child(world_position([q[0], 0.0, q[1]], h))
                         })),
                 ),
             ),
