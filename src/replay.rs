@@ -258,7 +258,12 @@ impl Replay {
             .monitors
             .iter()
             .map(|(n, m)| {
-                let word = if m.passed { "passed" } else { "failed" };
+                // A monitor cut short by another's failure did not fail the test.
+                let word = match (m.passed, m.cut_short) {
+                    (true, _) => "passed",
+                    (false, true) => "cut short",
+                    (false, false) => "failed",
+                };
                 format!("{n} {word} (robustness {:.3})", m.robustness)
             })
             .collect();

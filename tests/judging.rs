@@ -1047,3 +1047,35 @@ fn actions_outside_foreach_and_inputs_without_a_value_end_the_test_in_error() {
         assert!(e.starts_with(when) && e.contains(what), "{i}: {e}");
     }
 }
+
+/// `replay` says a monitor cut short by another's failure was cut short: it printed "failed",
+/// though the campaign did not count it among the failed monitors.
+#[test]
+fn replay_names_a_monitor_cut_short_as_cut_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("t.star");
+    let src = format!(
+        "{ROAD}w.place(r, v, lead)\nCollisionMonitor(v)\nDistanceMonitor(v, minD = 300.0)\n\
+         Monitor(lead.pos.map(lambda p: 80.0 - p.x), name = \"lead_near\")\ntest(horizon = 30.0)\n"
+    );
+    std::fs::write(&file, src).unwrap();
+    let out = dir.path().join("out");
+    let o = fuzz(&[
+        file.to_str().unwrap(),
+        "--budget",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    expect_code(&o, 1);
+    let r = &records(&out)[0];
+    assert_eq!(r["monitors"]["distance"]["cut_short"], true, "{r}");
+    let results = out.join("results.jsonl");
+    let o = fuzz(&["replay", results.to_str().unwrap(), "--id", "0"]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("distance cut short (robustness"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("lead_near failed (robustness"), "{stdout}");
+}

@@ -1134,6 +1134,15 @@ pub fn load(
     }
     let map_axes = match &first.map_axes {
         Some(axes) => {
+            if let [a, b] = &axes[..] {
+                if a == b {
+                    return Err(lang(format!(
+                        "error: test(map=...) names `{a}` twice: a failure map needs two \
+                         different parameters\n --> {}",
+                        first.test_at.as_deref().unwrap_or(file),
+                    )));
+                }
+            }
             for a in axes {
                 if space.param(a).is_none() {
                     let known: Vec<&str> = space.params().iter().map(|p| p.name.as_str()).collect();

@@ -677,6 +677,8 @@ fn the_map_names_one_or_two_parameters_of_any_kind() {
     );
     let e = axes("(\"c\", \"f\", \"c\")").unwrap_err();
     assert!(e.contains("one or two parameter names"), "{e}");
+    let e = axes("(\"c\", \"c\")").unwrap_err();
+    assert!(e.contains("names `c` twice"), "{e}");
     // Without test(map=), the first two parameters, whatever their kind.
     let s = load_source("map.star", &base, "map").unwrap();
     assert_eq!(s.map_axes, ["c", "f"]);
