@@ -234,16 +234,23 @@ impl Car {
         }
     }
 
-    /// Position `[x, z]` and heading at arc length `s`.
-    fn at(&self, s: f64) -> ([f64; 2], f64) {
+    /// The leg `i` that arc length `s` lies on ([`Car::leg_at`]) and how far along it, `u`
+    /// in `[0, 1]` (0 on a leg of no length).
+    fn on_leg(&self, s: f64) -> (usize, f64) {
         let i = self.leg_at(s);
-        let (a, b) = (self.path[i - 1], self.path[i]);
         let len = self.cumulative[i] - self.cumulative[i - 1];
         let u = if len > 0.0 {
             ((s - self.cumulative[i - 1]) / len).clamp(0.0, 1.0)
         } else {
             0.0
         };
+        (i, u)
+    }
+
+    /// Position `[x, z]` and heading at arc length `s`.
+    fn at(&self, s: f64) -> ([f64; 2], f64) {
+        let (i, u) = self.on_leg(s);
+        let (a, b) = (self.path[i - 1], self.path[i]);
         (
             [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])],
             self.leg_heading(i),
@@ -357,14 +364,8 @@ impl Car {
         let (share, rate) = LaneChangeSpec::profile(tau);
         let from = self.change_from_m;
         let d = from + (change.offset_m - from) * share;
-        let i = self.leg_at(s);
+        let (i, u) = self.on_leg(s);
         let (a, b) = (self.path[i - 1], self.path[i]);
-        let len = self.cumulative[i] - self.cumulative[i - 1];
-        let u = if len > 0.0 {
-            ((s - self.cumulative[i - 1]) / len).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
         let m = self.mitres();
         let (ma, mb) = (m[i - 1], m[i]);
         let shift = [ma[0] + u * (mb[0] - ma[0]), ma[1] + u * (mb[1] - ma[1])];

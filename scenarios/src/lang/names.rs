@@ -367,16 +367,18 @@ impl Walker<'_> {
                             self.site(value, Some(n), None, argument_of);
                         }
                     }
+                    // The keyword of the input the argument feeds: its own, or a method's
+                    // by position (`r.onLane(1, x)`'s `at`).
+                    let keyword = match (&a.node, &method_of) {
+                        (ArgumentP::Named(kw, _), _) => Some(kw.node.clone()),
+                        (ArgumentP::Positional(_), Some((_, m))) => {
+                            positional_keyword(m, position).map(str::to_owned)
+                        }
+                        _ => None,
+                    };
                     match (&value.node, builtin) {
                         // A variable passed whole to a builtin: the world shows its effect.
                         (ExprP::Identifier(id), true) => {
-                            let keyword = match (&a.node, &method_of) {
-                                (ArgumentP::Named(kw, _), _) => Some(kw.node.clone()),
-                                (ArgumentP::Positional(_), Some((_, m))) => {
-                                    positional_keyword(m, position).map(str::to_owned)
-                                }
-                                _ => None,
-                            };
                             if let (Some(kw), Some(n)) = (keyword, &name) {
                                 self.out.passed.push((n.clone(), kw, id.node.ident.clone()));
                             }
@@ -391,13 +393,6 @@ impl Walker<'_> {
                         // A sum or difference (`10.0 + gap`): each variable added whole
                         // carries its unit into the sum, so it is checked against the input's.
                         (ExprP::Op(_, BinOp::Add | BinOp::Subtract, _) | ExprP::Minus(_), true) => {
-                            let keyword = match (&a.node, &method_of) {
-                                (ArgumentP::Named(kw, _), _) => Some(kw.node.clone()),
-                                (ArgumentP::Positional(_), Some((_, m))) => {
-                                    positional_keyword(m, position).map(str::to_owned)
-                                }
-                                _ => None,
-                            };
                             if let (Some(kw), Some(n)) = (keyword, &name) {
                                 let mut terms = Vec::new();
                                 summed_variables(value, &mut terms);

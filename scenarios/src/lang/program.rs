@@ -183,34 +183,7 @@ impl Program {
                 let mut eval = Evaluator::new(&module);
                 eval.extra = Some(&state);
                 eval.set_print_handler(&state);
-                let limits = [
-                    eval.set_max_tick_count(super::MAX_LOAD_STEPS),
-                    eval.set_max_heap_size(super::MAX_LOAD_HEAP_BYTES),
-                    eval.set_max_callstack_size(super::MAX_CALL_DEPTH),
-                ];
-                for l in limits {
-                    l.map_err(|e| e.to_string())?;
-                }
-                // starlark checks its own heap every 1,000 steps; the budget also counts what
-                // one statement allocates ([`crate::memory`]).
-                let budget = crate::memory::Budget::start(
-                    super::MAX_LOAD_HEAP_BYTES,
-                    crate::memory::HARD_HEAP_BYTES,
-                    &self.file,
-                    "the program",
-                );
-                eval.set_check_cancelled(Box::new(crate::memory::over_soft_limit));
-                // `tick` as a variable of the module, on its heap, rather than the frozen
-                // global alone: starlark inlines a module variable that holds a frozen value
-                // into the lambdas it compiles, so `ticks = tick` read in a lambda stayed a
-                // stream instead of reading as its current value, as every other top-level
-                // stream variable does.
-                module.set(
-                    "tick",
-                    module
-                        .heap()
-                        .alloc(super::values::Stream::of(super::scene::TICK.0)),
-                );
+                let budget = self.limit_load(&module, &mut eval)?;
                 let result = eval.eval_module(self.ast.clone(), &self.globals);
                 let result = match result {
                     Err(_) if crate::memory::over_soft_limit() => {
@@ -289,6 +262,45 @@ impl Program {
         })
     }
 
+    /// Sets the limits of an evaluation at load on `eval` (steps, heap, call depth, and the
+    /// allocation budget, returned: it holds until dropped) and puts `tick` in `module`.
+    ///
+    /// # Errors
+    /// starlark's message when a limit cannot be set.
+    fn limit_load<'v>(
+        &self,
+        module: &Module<'v>,
+        eval: &mut Evaluator<'v, '_, '_>,
+    ) -> Result<crate::memory::Budget<'_>, String> {
+        for limit in [
+            eval.set_max_tick_count(super::MAX_LOAD_STEPS),
+            eval.set_max_heap_size(super::MAX_LOAD_HEAP_BYTES),
+            eval.set_max_callstack_size(super::MAX_CALL_DEPTH),
+        ] {
+            limit.map_err(|e| e.to_string())?;
+        }
+        // starlark checks its own heap every 1,000 steps; the budget also counts what one
+        // statement allocates ([`crate::memory`]).
+        let budget = crate::memory::Budget::start(
+            super::MAX_LOAD_HEAP_BYTES,
+            crate::memory::HARD_HEAP_BYTES,
+            &self.file,
+            "the program",
+        );
+        eval.set_check_cancelled(Box::new(crate::memory::over_soft_limit));
+        // `tick` as a variable of the module, on its heap, rather than the frozen global
+        // alone: starlark inlines a module variable that holds a frozen value into the lambdas
+        // it compiles, so `ticks = tick` read in a lambda stayed a stream instead of reading as
+        // its current value, as every other top-level stream variable does.
+        module.set(
+            "tick",
+            module
+                .heap()
+                .alloc(super::values::Stream::of(super::scene::TICK.0)),
+        );
+        Ok(budget)
+    }
+
     /// Where an evaluation with `values` that stopped at a limit (steps or heap) stopped:
     /// ` --> file:line:col`, the line and a caret under the statement it was running. Found
     /// by evaluating again, with the same values and limits, with a hook before every
@@ -305,27 +317,8 @@ impl Program {
             let mut eval = Evaluator::new(&module);
             eval.extra = Some(&state);
             eval.set_print_handler(&state);
-            for limit in [
-                eval.set_max_tick_count(super::MAX_LOAD_STEPS),
-                eval.set_max_heap_size(super::MAX_LOAD_HEAP_BYTES),
-                eval.set_max_callstack_size(super::MAX_CALL_DEPTH),
-            ] {
-                limit.ok()?;
-            }
-            let budget = crate::memory::Budget::start(
-                super::MAX_LOAD_HEAP_BYTES,
-                crate::memory::HARD_HEAP_BYTES,
-                &self.file,
-                "the program",
-            );
-            eval.set_check_cancelled(Box::new(crate::memory::over_soft_limit));
+            let budget = self.limit_load(&module, &mut eval).ok()?;
             eval.before_stmt_for_dap(starlark::eval::BeforeStmtFunc::Fn(&note));
-            module.set(
-                "tick",
-                module
-                    .heap()
-                    .alloc(super::values::Stream::of(super::scene::TICK.0)),
-            );
             let _ = eval.eval_module(self.ast.clone(), &self.globals);
             drop(budget);
             Some(())
