@@ -506,10 +506,11 @@ const SLOTS: &[Slot] = &[
         Some(false),
         false,
     ),
+    // 28 m at least for 6 lanes (the ways onto and off the ring of its outer lane).
     slot(
         "radius",
-        "20.0",
-        "VarInterval(20.0, 30.0, name = \"x\")",
+        "30.0",
+        "VarInterval(30.0, 40.0, name = \"x\")",
         Some(false),
         false,
     ),

@@ -29,14 +29,23 @@ pub enum Output {
     /// Contact: `true` while the actor touches the ego vehicle (for the ego: touches any
     /// actor).
     Collision,
+    /// `true` from the step the actor first touched anything solid (the ego, a car, a
+    /// pedestrian, an obstacle) to the end of the test.
+    Collided,
+    /// The smallest distance from the actor's body to any other solid body (the ego, a car
+    /// in the test, a pedestrian, an obstacle), m; `0` while touching, `inf` with nothing
+    /// else in the world.
+    Separation,
 }
 
-const OUTPUTS: [Output; 5] = [
+const OUTPUTS: [Output; 7] = [
     Output::Pos,
     Output::Vel,
     Output::Heading,
     Output::Speed,
     Output::Collision,
+    Output::Collided,
+    Output::Separation,
 ];
 
 /// The probe number of `output` of `actor`, for [`Node::Probe`].
@@ -132,6 +141,14 @@ impl GraphBuilder {
         let id = self.push(node);
         self.sites[id.0] = Some(site);
         id
+    }
+
+    /// Names `site` (a program's `file:line:col`) as where node `id` was made, as
+    /// [`GraphBuilder::push_at`] does; an id past the graph is ignored.
+    pub fn set_site(&mut self, id: StreamId, site: String) {
+        if let Some(s) = self.sites.get_mut(id.0) {
+            *s = Some(site);
+        }
     }
 
     /// The nodes so far.

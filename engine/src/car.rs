@@ -2,7 +2,12 @@ use rapier3d::prelude::*;
 use serde::Serialize;
 
 use crate::actor::{Size, VisibleBox};
+use crate::contact::{Other, Solids};
 use crate::rx::StreamId;
+
+fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
 
 /// Height of an NPC car's body above the road, in metres.
 pub(crate) const CLEARANCE_M: f64 = 0.2;
@@ -111,18 +116,25 @@ pub(crate) struct Car {
     /// Arc length where it stops, m: its front at the path's end (half its length before
     /// it), or where it starts when that is beyond.
     stop_s: f64,
-    /// The leg the car was on at its last lookup, and that leg's heading (rad): arc lengths
-    /// only grow, so the next lookup walks on from there instead of searching the whole
-    /// path, and the heading is worked out once per leg.
-    leg: std::cell::Cell<(usize, f64)>,
+    /// The leg the car was on at its last lookup: arc lengths only grow, so the next lookup
+    /// walks on from there instead of searching the whole path.
+    leg: std::cell::Cell<usize>,
+    /// The path's tangent heading at each vertex, rad ([`crate::network::vertex_tangents`]):
+    /// the car's heading is interpolated between them, so it turns smoothly along a sampled
+    /// curve instead of jumping at each vertex.
+    tangents: Vec<f64>,
     /// Per path vertex, the sideways shift of one metre of offset to the right (m per m):
     /// the mitre of the two legs' right normals, so a car offset from its path (a lane
     /// change) moves on a parallel polyline whose legs meet at each vertex; worked out on
     /// the first lane change.
     mitres: std::cell::OnceCell<Vec<[f64; 2]>>,
     s: f64,
-    /// Speed along the path in the last step, m/s.
+    /// Its speed over the ground in the last step (the distance its ground point moved over
+    /// the step's length), m/s; before the first step, the speed it enters the test at.
     speed: f64,
+    /// Its velocity over the ground in the last step, `[x, z]` m/s: the ground point's move
+    /// over the step's length; before the first step, its entry speed along its heading.
+    velocity: [f64; 2],
     /// Speed the tyres hold (the command, limited to `μ·g` of change per second), m/s;
     /// `None` before the first step.
     rolling: Option<f64>,
@@ -140,6 +152,13 @@ pub(crate) struct Car {
     pub(crate) speed_stream: StreamId,
     /// Whether it touches the ego vehicle now.
     pub(crate) touching: bool,
+    /// Whether it has touched anything since the test began (the ego, a car, a pedestrian,
+    /// an obstacle).
+    pub(crate) collided: bool,
+    /// The gap it keeps to whatever is ahead on its path, m (`Car(keep_distance=)`): it
+    /// brakes, no harder than its tyres allow, to stop that far from it. `None`: it does not
+    /// brake for anything (it still stops against what it meets).
+    pub(crate) keep_distance_m: Option<f64>,
     /// Its lane change, if it has one.
     pub(crate) lane_change: Option<LaneChangeSpec>,
     /// When its lane change started, s.
@@ -168,15 +187,18 @@ impl Car {
             cumulative.push(last + (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]));
         }
         let stop_s = (cumulative.last().expect("non-empty") - size.length_m / 2.0).max(0.0);
+        let tangents = crate::network::vertex_tangents(&path);
         let mut car = Car {
             body: None,
             path,
             cumulative,
             stop_s,
-            leg: std::cell::Cell::new((0, f64::NAN)),
+            leg: std::cell::Cell::new(1),
+            tangents,
             mitres: std::cell::OnceCell::new(),
             s: 0.0,
             speed: 0.0,
+            velocity: [0.0; 2],
             rolling: None,
             here: ([0.0; 2], 0.0),
             placed: ([0.0; 2], 0.0),
@@ -184,6 +206,8 @@ impl Car {
             albedo,
             speed_stream,
             touching: false,
+            collided: false,
+            keep_distance_m: None,
             lane_change: None,
             change_started_s: None,
             change_from_m: 0.0,
@@ -211,27 +235,15 @@ impl Car {
     /// leg, which holds for an `s` no smaller than that leg's start; searches otherwise.
     fn leg_at(&self, s: f64) -> usize {
         let last = self.path.len() - 1;
-        let mut i = self.leg.get().0.clamp(1, last);
+        let mut i = self.leg.get().clamp(1, last);
         if self.cumulative[i - 1] > s {
             i = self.cumulative.partition_point(|&c| c <= s).clamp(1, last);
         }
         while i < last && self.cumulative[i] <= s {
             i += 1;
         }
+        self.leg.set(i);
         i
-    }
-
-    /// The heading (rad) of leg `i`.
-    fn leg_heading(&self, i: usize) -> f64 {
-        match self.leg.get() {
-            (leg, heading) if leg == i => heading,
-            _ => {
-                let (a, b) = (self.path[i - 1], self.path[i]);
-                let heading = (-(b[1] - a[1])).atan2(b[0] - a[0]);
-                self.leg.set((i, heading));
-                heading
-            }
-        }
     }
 
     /// The leg `i` that arc length `s` lies on ([`Car::leg_at`]) and how far along it, `u`
@@ -247,13 +259,15 @@ impl Car {
         (i, u)
     }
 
-    /// Position `[x, z]` and heading at arc length `s`.
+    /// Position `[x, z]` on the path and the path's heading at arc length `s`: the heading
+    /// is interpolated between the tangents at the leg's ends
+    /// ([`crate::network::heading_on_leg`]), continuous along the path.
     fn at(&self, s: f64) -> ([f64; 2], f64) {
         let (i, u) = self.on_leg(s);
         let (a, b) = (self.path[i - 1], self.path[i]);
         (
             [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])],
-            self.leg_heading(i),
+            crate::network::heading_on_leg(&self.tangents, i, u),
         )
     }
 
@@ -365,26 +379,21 @@ impl Car {
         let from = self.change_from_m;
         let d = from + (change.offset_m - from) * share;
         let (i, u) = self.on_leg(s);
-        let (a, b) = (self.path[i - 1], self.path[i]);
         let m = self.mitres();
         let (ma, mb) = (m[i - 1], m[i]);
         let shift = [ma[0] + u * (mb[0] - ma[0]), ma[1] + u * (mb[1] - ma[1])];
-        // The offset leg's heading at this offset (the path leg's when it has no length).
-        let (a2, b2) = (
-            [a[0] + d * ma[0], a[1] + d * ma[1]],
-            [b[0] + d * mb[0], b[1] + d * mb[1]],
-        );
-        let heading = if (b2[0] - a2[0]).hypot(b2[1] - a2[1]) > 1e-9 {
-            (-(b2[1] - a2[1])).atan2(b2[0] - a2[0])
-        } else {
-            heading
-        };
         let sideways_mps = if (0.0..1.0).contains(&tau) {
             (change.offset_m - from) * rate / change.duration_s
         } else {
             0.0
         };
-        let turn = sideways_mps.atan2(self.speed.max(0.1));
+        // Its speed is over the ground (`Car::advance`), sideways motion included: the rest
+        // is along the path.
+        let along = (self.speed * self.speed - sideways_mps * sideways_mps)
+            .max(0.0)
+            .sqrt()
+            .max(0.1);
+        let turn = sideways_mps.atan2(along);
         ([p[0] + d * shift[0], p[1] + d * shift[1]], heading - turn)
     }
 
@@ -432,6 +441,8 @@ impl Car {
     /// it enters the test at. The first step sets its speed from the speed stream anyway.
     pub(crate) fn enter_at(&mut self, speed_mps: f64) {
         self.speed = speed_mps.max(0.0);
+        let d = crate::network::direction(self.here.1);
+        self.velocity = [d[0] * self.speed, d[1] * self.speed];
     }
 
     /// Its speed along the path in the last step (before the first step, the speed it enters
@@ -450,13 +461,23 @@ impl Car {
     /// Drives one step of `dt_s` at time `t_s` toward the commanded `speed_mps` (negative
     /// counts as 0) on a surface of friction `friction`: the speed changes by at most
     /// `friction · g · dt_s` (except in the first step, which sets it), and the car does not
-    /// pass its path's end.
+    /// pass its path's end. The speed is over the ground: a car offset from its path (a lane
+    /// change) moves its path's station by as much as makes its ground point move
+    /// `speed · dt_s` (to 1e-6 of it), on a bend's outside as on its inside, sideways motion
+    /// included.
+    ///
+    /// `solids` are the other solid objects where they stand now (`me` is this car): the car
+    /// does not move into one. A move that would touch one ends where it touches (to 0.1 mm),
+    /// the car stops there, and the object is returned; the car records the collision. With
+    /// a [`Car::keep_distance_m`], it also brakes (at most `μ·g`) to stop that far short of
+    /// whatever is ahead on its path, the ego included.
     ///
     /// A car outside `zone` once it has moved is asleep: its body and collider are disabled,
     /// so rapier's step, contacts and ray casts skip it (its pose is still kept here,
     /// [`Car::pose`]). A car that wakes is put back where it was at the start of the step
     /// before it is moved, so rapier sees the same motion, and the same velocity, as if it
     /// had never slept.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn advance(
         &mut self,
         physics: &mut PhysicsWorld,
@@ -464,27 +485,68 @@ impl Car {
         friction: f64,
         (t_s, dt_s): (f64, f64),
         zone: AwakeZone,
-    ) {
+        solids: &Solids,
+        me: Other,
+    ) -> Option<Other> {
         let start = self.here;
         let end = self.stop_s.max(self.s);
-        let before = self.s;
+        let braking = friction * GRAVITY_MPS2;
+        let next_t = t_s + dt_s;
         // No faster than it can still stop at the end, braking at `μ·g`.
-        let room = stopping_speed(end - self.s, friction * GRAVITY_MPS2, dt_s);
+        let mut room = stopping_speed(end - self.s, braking, dt_s);
+        if let Some(keep) = self.keep_distance_m {
+            let reach = self.speed * self.speed / (2.0 * braking.max(1e-6))
+                + keep
+                + 2.0 * speed_mps.max(self.speed) * dt_s
+                + 1.0;
+            if let Some(gap) = self.free_ahead_m(solids, me, next_t, reach.min(end - self.s)) {
+                room = room.min(stopping_speed(gap - keep, braking, dt_s));
+            }
+        }
         let wanted = speed_mps.max(0.0).min(room);
         let rolling = match self.rolling {
             // It enters the test at its command; one too fast to stop before the end brakes
             // at `μ·g` from the first step and stops at the end.
             None => speed_mps.max(0.0),
             Some(v) => {
-                let dv = friction * GRAVITY_MPS2 * dt_s;
+                let dv = braking * dt_s;
                 wanted.clamp(v - dv, v + dv)
             }
         };
-        self.s = (self.s + rolling * dt_s).min(end);
-        // At the end of its path the car has stopped.
-        self.rolling = Some(if self.s >= end { 0.0 } else { rolling });
-        self.speed = (self.s - before) / dt_s;
-        self.here = self.place_at(self.s, t_s + dt_s);
+        let step = rolling * dt_s;
+        let mut s_new = (self.s + step).min(end);
+        if step > 0.0 && self.change_started_s.is_some() {
+            // Offset from its path, the ground moves other than the station (faster on a
+            // bend's outside, and sideways during a change): scale the station's step until
+            // the ground point moves `step`, to 1e-6 of it.
+            let mut k = 1.0;
+            for _ in 0..8 {
+                let ground = dist(self.place_at(self.s + k * step, next_t).0, start.0);
+                if ground <= 1e-12 || (ground - step).abs() <= 1e-6 * step {
+                    break;
+                }
+                k *= step / ground;
+            }
+            s_new = (self.s + k * step).min(end);
+        }
+        let hit = self.first_contact(solids, me, (self.s, s_new), next_t);
+        if let Some((free_s, _)) = hit {
+            s_new = free_s;
+            self.collided = true;
+        }
+        self.s = s_new;
+        // At the end of its path, or against what it ran into, the car has stopped.
+        self.rolling = Some(if self.s >= end || hit.is_some() {
+            0.0
+        } else {
+            rolling
+        });
+        self.here = self.place_at(self.s, next_t);
+        self.velocity = [
+            (self.here.0[0] - start.0[0]) / dt_s,
+            (self.here.0[1] - start.0[1]) / dt_s,
+        ];
+        self.speed = self.velocity[0].hypot(self.velocity[1]);
         if let Some((body, collider)) = self.body {
             let [x, z] = self.here.0;
             let (dx, dz) = (x - zone.ego_m[0], z - zone.ego_m[1]);
@@ -496,7 +558,7 @@ impl Car {
                     rb.set_enabled(false);
                     physics.colliders[collider].set_enabled(false);
                 }
-                return;
+                return hit.map(|(_, o)| o);
             }
             if !rb.is_enabled() {
                 rb.set_enabled(true);
@@ -505,6 +567,100 @@ impl Car {
             }
             physics.bodies[body].set_next_kinematic_position(self.pose());
         }
+        hit.map(|(_, o)| o)
+    }
+
+    /// Its collider's shape: a box of its size.
+    pub(crate) fn shape(&self) -> SharedShape {
+        SharedShape::cuboid(
+            (self.size.length_m / 2.0) as f32,
+            (self.size.height_m / 2.0) as f32,
+            (self.size.width_m / 2.0) as f32,
+        )
+    }
+
+    /// The first object of `solids` that the car touches moving from station `from` to `to`
+    /// at time `t_s`, and the last station before it touches (within 0.1 mm of the touch):
+    /// `from` itself when it touches there already. `None` when the move is free. Only the
+    /// end of the move is tested: a step (under 1 m at any speed a car has) is shorter than
+    /// a car, so its box at the start and at the end of the step cover the way between.
+    fn first_contact(
+        &self,
+        solids: &Solids,
+        me: Other,
+        (from, to): (f64, f64),
+        t_s: f64,
+    ) -> Option<(f64, Other)> {
+        self.body?;
+        let shape = self.shape();
+        let touches = |s: f64| {
+            solids.first_hit(
+                me,
+                shape.as_ref(),
+                &self.pose_at(self.place_at(s, t_s)),
+                false,
+            )
+        };
+        let other = touches(to)?;
+        if touches(from).is_some() {
+            return Some((from, other));
+        }
+        let (mut lo, mut hi) = (from, to);
+        while hi - lo > 1e-4 {
+            let mid = 0.5 * (lo + hi);
+            if touches(mid).is_some() {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Some((lo, other))
+    }
+
+    /// How far (m, along its path) the car can drive from where it is before its box
+    /// touches an object of `solids` (the ego included), looking `reach_m` ahead; `None`
+    /// when nothing is within reach. Found in steps of 0.5 m, then to 1 cm.
+    fn free_ahead_m(&self, solids: &Solids, me: Other, t_s: f64, reach_m: f64) -> Option<f64> {
+        self.body?;
+        let shape = self.shape();
+        let touches = |s: f64| {
+            solids
+                .first_hit(
+                    me,
+                    shape.as_ref(),
+                    &self.pose_at(self.place_at(s, t_s)),
+                    true,
+                )
+                .is_some()
+        };
+        if reach_m <= 0.0 {
+            return None;
+        }
+        let n = (reach_m / 0.5).ceil() as usize;
+        let mut lo = 0.0;
+        for k in 1..=n {
+            let d = (k as f64 * 0.5).min(reach_m);
+            if touches(self.s + d) {
+                let mut hi = d;
+                while hi - lo > 0.01 {
+                    let mid = 0.5 * (lo + hi);
+                    if touches(self.s + mid) {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                return Some(lo);
+            }
+            lo = d;
+        }
+        None
+    }
+
+    /// Its velocity over the ground in the last step, `[x, z]` m/s (before the first step,
+    /// its entry speed along its heading).
+    pub(crate) fn velocity_mps(&self) -> [f64; 2] {
+        self.velocity
     }
 
     /// The car as the time-to-collision test sees it, `None` when it is not in this test.
@@ -513,10 +669,7 @@ impl Car {
         let ([x, z], heading_rad) = self.here;
         Some(crate::ttc::Mover {
             pos_m: [x, z],
-            velocity_mps: [
-                self.speed * heading_rad.cos(),
-                -self.speed * heading_rad.sin(),
-            ],
+            velocity_mps: self.velocity,
             heading_rad,
             half_size_m: [self.size.length_m / 2.0, self.size.width_m / 2.0],
         })
@@ -634,10 +787,12 @@ mod tests {
         for s in queries {
             assert_eq!(c.leg_at(s), search(s), "s = {s}");
             let (p, h) = c.at(s);
-            let i = search(s);
-            let (a, b) = (c.path[i - 1], c.path[i]);
-            assert_eq!(h, (-(b[1] - a[1])).atan2(b[0] - a[0]));
-            assert!(p.iter().all(|v| v.is_finite()));
+            let (i, u) = c.on_leg(s);
+            assert_eq!(i, search(s));
+            // The heading is the leg's ends' tangents interpolated: between the headings of
+            // the legs that meet at its ends.
+            assert_eq!(h, crate::network::heading_on_leg(&c.tangents, i, u));
+            assert!(p.iter().all(|v| v.is_finite()) && h.is_finite());
         }
     }
 
@@ -672,7 +827,15 @@ mod tests {
                 if t >= 0.5 {
                     c.start_lane_change(0.5);
                 }
-                c.advance(&mut physics, v, 0.8, (t, dt), zone);
+                c.advance(
+                    &mut physics,
+                    v,
+                    0.8,
+                    (t, dt),
+                    zone,
+                    &Solids::new(),
+                    Other::Car(0),
+                );
                 let here = c.ground_m();
                 let moved = (here[0] - last[0]).hypot(here[1] - last[1]);
                 // Along a parallel of radius 30 ± 3.5 m, plus the sideways speed of the change

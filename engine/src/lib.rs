@@ -17,6 +17,7 @@ pub mod behaviour;
 mod camera;
 mod car;
 pub mod colour;
+mod contact;
 mod control;
 mod environment;
 mod error;

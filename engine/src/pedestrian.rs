@@ -31,7 +31,10 @@ pub struct PedestrianState {
 
 /// A kinematic pedestrian: a sensor capsule moved by position, not by forces. It never pushes
 /// the car; contact is reported through collision events on the sensor. Its behaviour comes
-/// from the stream graph: each event on its `walk` sink moves it one step toward the target.
+/// from the stream graph: a step with an event on its `walk` sink moves it one step toward
+/// the target, however many `walk` events the step has (two behaviours that walk it in the
+/// same step do not double its speed). It faces its target from the start and keeps that
+/// heading: it walks a straight line, so its heading never turns.
 pub(crate) struct Pedestrian {
     pub(crate) body: RigidBodyHandle,
     pub(crate) collider: ColliderHandle,
@@ -39,8 +42,15 @@ pub(crate) struct Pedestrian {
     pub(crate) speed_stream: crate::rx::StreamId,
     /// Whether it touches the ego vehicle now.
     pub(crate) touching: bool,
+    /// Whether it has touched anything since the test began (the ego, a car, an obstacle).
+    pub(crate) collided: bool,
     target: [f64; 3],
     pos: [f64; 3],
+    /// Where it was at the start of this step ([`Pedestrian::rest`]).
+    step_start: [f64; 3],
+    /// Whether it has taken this step's walking step.
+    walked: bool,
+    heading_rad: f64,
     velocity: [f64; 3],
     phase: PedestrianPhase,
     triggered_at_s: Option<f64>,
@@ -58,13 +68,22 @@ impl Pedestrian {
             .sensor(true)
             .active_events(ActiveEvents::COLLISION_EVENTS);
         let (body, collider) = physics.insert(body, collider);
+        let heading_rad = if (target[0], target[2]) == (start[0], start[2]) {
+            0.0
+        } else {
+            (-(target[2] - start[2])).atan2(target[0] - start[0])
+        };
         Pedestrian {
             body,
             collider,
             speed_stream,
             touching: false,
+            collided: false,
             target,
             pos: start,
+            step_start: start,
+            walked: false,
+            heading_rad,
             velocity: [0.0; 3],
             phase: PedestrianPhase::Waiting,
             triggered_at_s: None,
@@ -73,8 +92,13 @@ impl Pedestrian {
 
     /// One walking step at time `t_s`: `speed_mps · dt_s` metres toward the target, stopping
     /// there. Sets the kinematic target of the next physics step. The first step marks the
-    /// trigger time.
+    /// trigger time. A second call in the same step (after the same [`Pedestrian::rest`])
+    /// does nothing: a pedestrian takes at most one walking step per step.
     pub(crate) fn walk(&mut self, physics: &mut PhysicsWorld, t_s: f64, dt_s: f64, speed_mps: f64) {
+        if self.walked {
+            return;
+        }
+        self.walked = true;
         if self.phase == PedestrianPhase::Waiting {
             self.phase = PedestrianPhase::Walking;
             self.triggered_at_s = Some(t_s);
@@ -85,7 +109,7 @@ impl Pedestrian {
         let delta = [0, 1, 2].map(|i| self.target[i] - self.pos[i]);
         let remaining = delta.iter().map(|d| d * d).sum::<f64>().sqrt();
         let step = speed_mps.max(0.0) * dt_s;
-        let before = self.pos;
+        let before = self.step_start;
         if remaining <= step {
             self.pos = self.target;
             self.phase = PedestrianPhase::Arrived;
@@ -98,9 +122,21 @@ impl Pedestrian {
         physics.bodies[self.body].set_next_kinematic_translation(centre(self.pos));
     }
 
-    /// Clears the velocity of a step without a walk event.
+    /// Starts a step: until a walk event moves it, it stands still (velocity 0).
     pub(crate) fn rest(&mut self) {
         self.velocity = [0.0; 3];
+        self.step_start = self.pos;
+        self.walked = false;
+    }
+
+    /// The way it faces, rad: toward its target, all the test long.
+    pub(crate) fn heading_rad(&self) -> f64 {
+        self.heading_rad
+    }
+
+    /// Its capsule's pose now (its feet at [`Pedestrian::pos`]).
+    pub(crate) fn collider_pose(&self) -> Pose {
+        Pose::from_translation(centre(self.pos))
     }
 
     /// Feet position `[x, y, z]` in metres.
@@ -169,14 +205,22 @@ mod tests {
         );
         let dt = 0.1;
         assert_eq!(p.state().phase, PedestrianPhase::Waiting);
+        p.rest();
         p.walk(&mut physics, 0.1, dt, 2.0);
         let s = p.state();
         assert_eq!(s.phase, PedestrianPhase::Walking);
         assert_eq!(s.triggered_at_s, Some(0.1));
         assert!((s.pos_m[2] - 3.8).abs() < 1e-12);
         assert!((p.velocity()[2] + 2.0).abs() < 1e-9);
+        // A second walk event in the same step takes no second step.
+        p.walk(&mut physics, 0.1, dt, 2.0);
+        assert!((p.state().pos_m[2] - 3.8).abs() < 1e-12);
+        assert!((p.velocity()[2] + 2.0).abs() < 1e-9);
+        // It faces its target (-z: heading pi/2) from the start.
+        assert!((p.heading_rad() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
         // 8 m at 0.2 m per step: arrives after 40 steps in all, and stays.
         for i in 0..45 {
+            p.rest();
             p.walk(&mut physics, 0.2 + 0.1 * i as f64, dt, 2.0);
         }
         assert_eq!(p.state().phase, PedestrianPhase::Arrived);

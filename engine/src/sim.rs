@@ -7,9 +7,10 @@ use serde::Serialize;
 use crate::actor::{Handle, Set, Size, VisibleBox};
 use crate::behaviour::{decode_probe, decode_sink, Action, Actor, Output};
 use crate::car::{AwakeZone, Car, CarState, LaneChangeStart};
+use crate::contact::{Other, Solids};
 use crate::network::{Lane, Network, PieceId, Surface};
 use crate::obstacle::{Obstacle, ObstacleState};
-use crate::pedestrian::Pedestrian;
+use crate::pedestrian::{Pedestrian, PED_HALF_HEIGHT_M, PED_RADIUS_M};
 use crate::rx::{Host, Inputs, Node, Runtime, StreamId, Value};
 use crate::sensor::{Reading, Scene, Sensor, Sensors};
 use crate::spec::EnvironmentSpec;
@@ -168,6 +169,13 @@ pub struct Simulation {
     collector: ChannelEventCollector,
     dt_s: f64,
     tick: u64,
+    /// Whether the ego vehicle has touched anything since the test began.
+    ego_collided: bool,
+    /// The ego vehicle's velocity over the last step, m/s: its chassis centre's move over
+    /// the step's length (rapier integrates the position over substeps, so the body's final
+    /// `linvel` differs from the move by up to 0.06 m/s while the suspension settles); before
+    /// the first step, its body's velocity.
+    ego_velocity: [f64; 3],
 }
 
 impl Simulation {
@@ -270,6 +278,14 @@ impl Simulation {
                 c.speed,
             );
             car.lane_change = c.lane_change;
+            if let Some(keep) = c.keep_distance_m {
+                if !(keep.is_finite() && keep >= 0.0) {
+                    return Err(invalid(format!(
+                        "car {i} keeps the distance {keep} m (finite and >= 0)"
+                    )));
+                }
+            }
+            car.keep_distance_m = c.keep_distance_m;
             // A car enters the test at its speed stream's first value, so at t = 0 (before a
             // step has measured it) its speed is that value where it is known without running
             // the program's code: a constant or an open parameter, also one varying over time.
@@ -354,7 +370,11 @@ impl Simulation {
             collector: ChannelEventCollector::new(collision_tx, force_tx, tear_tx),
             dt_s: spec.dt_s,
             tick: 0,
+            ego_collided: false,
+            ego_velocity: [0.0; 3],
         };
+        let v = sim.physics.bodies[sim.ego.body].linvel();
+        sim.ego_velocity = [v.x, v.y, v.z].map(f64::from);
         // Contacts and ray casts need the broad phase filled before the first step.
         sim.physics.detect_collisions(&(), &());
         sim.capture_all(|_| true)?;
@@ -521,6 +541,7 @@ impl Simulation {
         let dt = self.dt_s;
         let t = self.t_s();
         self.evaluate(host)?;
+        let before = ego_state(&self.physics, &self.ego).pos_m;
         for &(piece, stream) in &self.frictions {
             let network = &self.network;
             let what = || format!("the friction of {}", network.piece(piece).name);
@@ -547,7 +568,15 @@ impl Simulation {
             let s = self.ego.size();
             0.5 * (s.length_m.powi(2) + s.width_m.powi(2) + s.height_m.powi(2)).sqrt()
         };
-        for (i, car) in self.cars.iter_mut().enumerate() {
+        // What a car may run into: obstacles, pedestrians (where this step's walk took
+        // them), the other cars (each where it is when this one moves), and the ego for a
+        // car that keeps its distance.
+        let mut solids = self.solids();
+        let handles: Vec<Handle<Car>> = self.cars.iter().map(|(h, _)| h).collect();
+        for (i, h) in handles.into_iter().enumerate() {
+            let Some(car) = self.cars.get_mut(h) else {
+                continue;
+            };
             let v = match car.speed_override {
                 Some(v) => v,
                 None => {
@@ -566,7 +595,49 @@ impl Simulation {
                 ego_m,
                 radius_m: reach_m + ego_radius_m + car.radius_m() + SLEEP_MARGIN_M,
             };
-            car.advance(&mut self.physics, v, friction, (t, dt), zone);
+            let hit = car.advance(
+                &mut self.physics,
+                v,
+                friction,
+                (t, dt),
+                zone,
+                &solids,
+                Other::Car(i),
+            );
+            if car.body.is_some() {
+                solids.move_to(Other::Car(i), car.pose());
+            }
+            match hit {
+                Some(Other::Car(j)) => {
+                    if let Some(c) = self.cars.get_mut(Handle::from_index(j)) {
+                        c.collided = true;
+                    }
+                }
+                Some(Other::Pedestrian(j)) => {
+                    if let Some(p) = self.pedestrians.get_mut(Handle::from_index(j)) {
+                        p.collided = true;
+                    }
+                }
+                _ => {}
+            }
+        }
+        // A pedestrian that walks into a car or an obstacle (rapier reports no contact
+        // between two kinematic bodies): both record the collision.
+        for (i, p) in self.pedestrians.iter_mut().enumerate() {
+            let shape = SharedShape::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M);
+            if let Some(o) = solids.first_hit(
+                Other::Pedestrian(i),
+                shape.as_ref(),
+                &p.collider_pose(),
+                false,
+            ) {
+                p.collided = true;
+                if let Other::Car(j) = o {
+                    if let Some(c) = self.cars.get_mut(Handle::from_index(j)) {
+                        c.collided = true;
+                    }
+                }
+            }
         }
         if self.tick == 0 {
             // The first lidar scan was taken before light and fog were known.
@@ -592,11 +663,13 @@ impl Simulation {
                 Some(Owner::Pedestrian(h)) => {
                     if let Some(p) = self.pedestrians.get_mut(*h) {
                         p.touching = started;
+                        p.collided |= started;
                     }
                 }
                 Some(Owner::Car(h)) => {
                     if let Some(c) = self.cars.get_mut(*h) {
                         c.touching = started;
+                        c.collided |= started;
                     }
                 }
                 Some(Owner::Obstacle(h)) => {
@@ -607,6 +680,9 @@ impl Simulation {
                 None => {}
             }
         }
+        self.ego_collided |= self.ego_contact();
+        let after = ego_state(&self.physics, &self.ego).pos_m;
+        self.ego_velocity = [0, 1, 2].map(|i| (after[i] - before[i]) / dt);
         self.tick += 1;
         let tick = self.tick;
         if self
@@ -643,8 +719,11 @@ impl Simulation {
             physics: &self.physics,
             ego: &self.ego,
             ego_touching: self.ego_contact(),
+            ego_collided: self.ego_collided,
+            ego_velocity: self.ego_velocity,
             pedestrians: &self.pedestrians,
             cars: &self.cars,
+            obstacles: &self.obstacles,
         };
         self.streams.step(t, &inputs, host, &mut self.sinks)?;
         self.evaluated = Some(self.tick);
@@ -656,6 +735,12 @@ impl Simulation {
             number(&self.streams, self.environment.fog, t, || "the fog".into())?,
         );
         Ok(())
+    }
+
+    /// What a program reads as `output` of `actor` now (the value its probe stream carries
+    /// at this step): the one source of every actor's reported motion.
+    pub fn read(&self, actor: Actor, output: Output) -> Value {
+        self.inputs().probe(crate::behaviour::probe(actor, output))
     }
 
     /// The latest value of stream `id` (after [`Simulation::evaluate`] for this step), `None`
@@ -788,6 +873,12 @@ impl Simulation {
         Ok(())
     }
 
+    /// Every solid object's collider where it is now, for the kinematic actors' contacts
+    /// ([`crate::contact`]): the ego, the cars in the test, the pedestrians, the obstacles.
+    fn solids(&self) -> Solids {
+        self.inputs().solids()
+    }
+
     fn capture_all_named(&mut self, name: &str) -> Result<(), EngineError> {
         let named: Vec<bool> = self.sensors.values().map(|s| s.name() == name).collect();
         self.capture_all(|h| named[h.index()])
@@ -799,8 +890,11 @@ impl Simulation {
             physics: &self.physics,
             ego: &self.ego,
             ego_touching: self.ego_contact(),
+            ego_collided: self.ego_collided,
+            ego_velocity: self.ego_velocity,
             pedestrians: &self.pedestrians,
             cars: &self.cars,
+            obstacles: &self.obstacles,
         }
     }
 
@@ -1009,8 +1103,13 @@ struct WorldInputs<'a> {
     ego: &'a EgoVehicle,
     /// Whether the ego vehicle touches any actor.
     ego_touching: bool,
+    /// Whether the ego vehicle has touched anything since the test began.
+    ego_collided: bool,
+    /// Its velocity over the last step, m/s ([`Simulation::ego_velocity`]).
+    ego_velocity: [f64; 3],
     pedestrians: &'a Set<Pedestrian>,
     cars: &'a Set<Car>,
+    obstacles: &'a Set<Obstacle>,
 }
 
 /// A heading from `atan2`, in `[-π, π]`, as one in `(-π, π]` (a location's and the ego's
@@ -1023,21 +1122,63 @@ fn half_open(heading_rad: f64) -> f64 {
     }
 }
 
+impl WorldInputs<'_> {
+    /// Every solid object's collider where it is now ([`Simulation::solids`]).
+    fn solids(&self) -> Solids {
+        let mut solids = Solids::new();
+        let ego = &self.physics.colliders[self.ego.collider];
+        solids.put(Other::Ego, *ego.position(), ego.shared_shape().clone());
+        for (i, (_, car)) in self.cars.iter().enumerate() {
+            if car.body.is_some() {
+                solids.put(Other::Car(i), car.pose(), car.shape());
+            }
+        }
+        for (i, (_, p)) in self.pedestrians.iter().enumerate() {
+            solids.put(
+                Other::Pedestrian(i),
+                p.collider_pose(),
+                SharedShape::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M),
+            );
+        }
+        for (i, (_, o)) in self.obstacles.iter().enumerate() {
+            let c = &self.physics.colliders[o.collider];
+            solids.put(Other::Obstacle(i), *c.position(), c.shared_shape().clone());
+        }
+        solids
+    }
+
+    /// The smallest distance from `me`'s `shape` at `pose` to every other solid, m (`0`
+    /// while `touching`).
+    fn separation(&self, me: Other, shape: &dyn Shape, pose: &Pose, touching: bool) -> Value {
+        if touching {
+            return Value::Num(0.0);
+        }
+        Value::Num(self.solids().clearance_m(me, shape, pose))
+    }
+}
+
 impl Inputs for WorldInputs<'_> {
     fn probe(&self, id: u32) -> Value {
         let (actor, output) = decode_probe(id);
         match actor {
             Actor::Ego => {
                 let s = ego_state(self.physics, self.ego);
+                let vel = self.ego_velocity;
                 match output {
                     Output::Pos => Value::Vec3(s.pos_m),
-                    Output::Vel => {
-                        let v = self.physics.bodies[self.ego.body].linvel();
-                        Value::Vec3([v.x, v.y, v.z].map(f64::from))
-                    }
+                    Output::Vel => Value::Vec3(vel),
                     Output::Heading => Value::Num(s.heading_rad),
-                    Output::Speed => Value::Num(s.speed_mps),
+                    // The size of its velocity, negative when it moves backwards.
+                    Output::Speed => {
+                        let norm = vel[0].hypot(vel[1]).hypot(vel[2]);
+                        Value::Num(if s.speed_mps < 0.0 { -norm } else { norm })
+                    }
                     Output::Collision => Value::Bool(self.ego_touching),
+                    Output::Collided => Value::Bool(self.ego_collided),
+                    Output::Separation => {
+                        let c = &self.physics.colliders[self.ego.collider];
+                        self.separation(Other::Ego, c.shape(), c.position(), self.ego_touching)
+                    }
                 }
             }
             Actor::Pedestrian(i) => match self.pedestrians.get(Handle::from_index(i as usize)) {
@@ -1047,9 +1188,16 @@ impl Inputs for WorldInputs<'_> {
                     match output {
                         Output::Pos => Value::Vec3(p.pos()),
                         Output::Vel => Value::Vec3(v),
-                        Output::Heading => Value::Num(half_open((-v[2]).atan2(v[0]))),
-                        Output::Speed => Value::Num(v[0].hypot(v[2])),
+                        Output::Heading => Value::Num(half_open(p.heading_rad())),
+                        Output::Speed => Value::Num(v[0].hypot(v[1]).hypot(v[2])),
                         Output::Collision => Value::Bool(p.touching),
+                        Output::Collided => Value::Bool(p.collided),
+                        Output::Separation => self.separation(
+                            Other::Pedestrian(i as usize),
+                            &Capsule::new_y(PED_HALF_HEIGHT_M, PED_RADIUS_M),
+                            &p.collider_pose(),
+                            p.touching,
+                        ),
                     }
                 }
             },
@@ -1060,13 +1208,20 @@ impl Inputs for WorldInputs<'_> {
                 Some(c) if c.body.is_none() => Value::Unit,
                 Some(c) => {
                     let s = c.state();
-                    let d = crate::network::direction(s.heading_rad);
+                    let [vx, vz] = c.velocity_mps();
                     match output {
                         Output::Pos => Value::Vec3(c.centre_m()),
-                        Output::Vel => Value::Vec3([d[0] * s.speed_mps, 0.0, d[1] * s.speed_mps]),
+                        Output::Vel => Value::Vec3([vx, 0.0, vz]),
                         Output::Heading => Value::Num(half_open(s.heading_rad)),
-                        Output::Speed => Value::Num(s.speed_mps),
+                        Output::Speed => Value::Num(vx.hypot(vz)),
                         Output::Collision => Value::Bool(c.touching),
+                        Output::Collided => Value::Bool(c.collided),
+                        Output::Separation => self.separation(
+                            Other::Car(i as usize),
+                            c.shape().as_ref(),
+                            &c.pose(),
+                            c.touching,
+                        ),
                     }
                 }
             },
@@ -1194,8 +1349,8 @@ mod tests {
         }
     }
 
-    /// A 1 km road with the ego at 10 m and three NPC cars: one pulling away ahead in the
-    /// ego's lane, one oncoming from 500 m in the other lane, one stopped 350 m ahead.
+    /// A 1 km road with the ego at 10 m and three NPC cars: one pulling away 355 m ahead in
+    /// the ego's lane, one oncoming from 500 m in the other lane, one stopped 350 m ahead.
     fn with_cars() -> WorldSpec {
         let mut s = WorldSpec::straight_road(1000.0, 10.0, 12.0, &[]).unwrap();
         let mut nodes = s.streams.nodes().to_vec();
@@ -1210,10 +1365,12 @@ mod tests {
                 lane_change: None,
                 lane_offsets_m: vec![],
                 name: String::new(),
+                keep_distance_m: None,
             }
         };
         s.cars = vec![
-            car(40.0, 1000.0, 1.75, 25.0),
+            // Ahead of the stopped car (a car stops against what it meets).
+            car(365.0, 1000.0, 1.75, 25.0),
             car(500.0, 0.0, -1.75, 10.0),
             car(360.0, 1000.0, 1.75, 0.0),
         ];

@@ -60,6 +60,10 @@ pub struct CarSpec {
     /// How run-time messages name it, e.g. `Car lead (f.star:4:5)`; empty: `car N`, by its
     /// index.
     pub name: String,
+    /// The gap it keeps to whatever is ahead on its path (an obstacle, a car, a pedestrian,
+    /// the ego), m, finite and `>= 0`: it brakes, at most `μ·g`, to stop that far short of
+    /// it. `None`: it brakes for nothing, and stops only against what it meets.
+    pub keep_distance_m: Option<f64>,
 }
 
 /// A static obstacle (`Obstacle(loc=, size=, color=)`): a box that never moves.

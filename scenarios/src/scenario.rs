@@ -297,6 +297,20 @@ pub struct Scenario {
 }
 
 impl Scenario {
+    /// Builds the world of the test `assignment` and calls `run` with it and the host that
+    /// runs its lambdas, for a caller that steps the test's [`paracosm_engine::Simulation`]
+    /// itself (to read every actor's outputs each step, as `tests/motion.rs` does).
+    ///
+    /// # Errors
+    /// As [`Worlds::with_world`].
+    pub fn with_world(
+        &self,
+        assignment: &Assignment,
+        run: &mut dyn FnMut(&WorldSpec, &mut dyn Host),
+    ) -> Result<(), ScenarioError> {
+        self.worlds.with_world(assignment, run)
+    }
+
     /// The scenario with its worlds built by `worlds` instead: for a library user's own
     /// world builder (or a test's), keeping the space, monitors and system under test.
     pub fn with_worlds(mut self, worlds: Arc<dyn Worlds>) -> Self {

@@ -226,9 +226,30 @@ fn junction(network: &Network, i: usize) -> (Vec<El>, El) {
         .attr("name", &p.name);
     for (n, path) in network.lane_paths(PieceId(i)).iter().enumerate() {
         let id = 1000 * (i + 1) + n;
+        // The path's own lines and arcs (`LanePath::curve`), so a simulator reading the map
+        // drives the same G1 curve; the polyline where a path has none.
         let mut plan = El::new("planView");
         let mut s = 0.0;
-        for w in path.points.windows(2) {
+        for (pose, line) in &path.curve {
+            if line.length_m < 1e-6 {
+                continue;
+            }
+            let shape = if line.curv_start == 0.0 {
+                El::new("line")
+            } else {
+                El::new("arc").num("curvature", line.curv_start)
+            };
+            plan = plan.child(geometry(
+                s,
+                pose.x,
+                -pose.z,
+                pose.heading_rad,
+                line.length_m,
+                shape,
+            ));
+            s += line.length_m;
+        }
+        for w in path.points.windows(2).filter(|_| path.curve.is_empty()) {
             let (a, b) = (w[0], w[1]);
             let length = (b[0] - a[0]).hypot(b[1] - a[1]);
             if length < 1e-6 {

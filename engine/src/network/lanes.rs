@@ -1,6 +1,7 @@
 use serde::{Deserialize, Serialize};
 
-use super::geometry::{direction, wrap};
+use super::curve::RefLine;
+use super::geometry::{direction, wrap, Pose2};
 use super::{Location, Network, PieceId, PieceKind, LANE_WIDTH_M};
 use crate::EngineError;
 
@@ -39,7 +40,9 @@ impl Turn {
 
 /// One lane's path across a piece: a polyline in world `[x, z]` metres, entering through a
 /// port's incoming lane `j` and leaving through a port's outgoing lane `j` (lanes counted
-/// from the centre line, `1..=n/2`).
+/// from the centre line, `1..=n/2`). Through a junction or a roundabout the polyline samples
+/// a G1-continuous chain of lines and circular arcs ([`LanePath::curve`]): its heading is
+/// continuous, and equals the arms' headings at the ports.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LanePath {
     /// The piece.
@@ -52,14 +55,26 @@ pub struct LanePath {
     pub turn: Turn,
     /// The polyline, at least two points.
     pub points: Vec<[f64; 2]>,
+    /// For a junction's or a roundabout's path, the curve the polyline samples: lines and
+    /// arcs ([`RefLine`]s of constant curvature), each placed by the pose of its start
+    /// (position `[x, z]` m, heading rad), end to end with equal headings where they meet.
+    /// Empty for a road piece's lanes, whose curve is the piece's own reference line.
+    pub curve: Vec<(Pose2, RefLine)>,
 }
 
+/// Smallest radius of a lane path through a junction or a roundabout, metres: the tightest
+/// turn an NPC car follows ([`crate::car`]'s yaw-rate limit is its speed over this radius).
+/// A roundabout's ring is placed so that its entry and exit curves keep to it.
+pub const MIN_PATH_RADIUS_M: f64 = 4.0;
+
+/// Distance from each end of an arc at which its sampled polyline has an extra point, m: the
+/// polyline's first and last legs on an arc then run along its end tangents (to `κ·ε/2` rad),
+/// so headings interpolated along the polyline ([`vertex_tangents`]) are continuous where a
+/// line meets an arc.
+const TANGENT_GUARD_M: f64 = 1e-3;
 /// Largest step between the points of a curved piece's lane paths, metres (their chords
 /// depart from the curve by at most 3 mm at the tightest radius, 10 m).
 pub const LANE_STEP_M: f64 = 0.5;
-
-/// Points sampled along each turning path.
-const CURVE_POINTS: usize = 12;
 
 /// Lane `j` of a road piece (segment or curve) both ways: `fwd` from port `ONE` to `TWO`,
 /// `back` from `TWO` to `ONE`.
@@ -77,6 +92,7 @@ fn both_ways(
             exit: (exit, j),
             turn: Turn::Straight,
             points,
+            curve: Vec::new(),
         });
     }
 }
@@ -139,15 +155,25 @@ impl Network {
                     let e = add(pa.pos, left, offset(j));
                     let x = add(pb.pos, right, offset(j));
                     let local = match p.kind.island_radius_m() {
-                        Some(island) => ring(e, x, island + p.kind.half_road_m() / 2.0 + 0.5),
-                        None => bend(e, direction(inward), x, direction(pb.heading_rad)),
+                        Some(island) => ring(
+                            (e, inward),
+                            (x, pb.heading_rad),
+                            island,
+                            island + p.kind.half_road_m() / 2.0 + 0.5,
+                        ),
+                        None => bend((e, inward), (x, pb.heading_rad)),
                     };
+                    let curve: Vec<(Pose2, RefLine)> = local
+                        .into_iter()
+                        .map(|(start, line)| (p.pose.compose(&start), line))
+                        .collect();
                     out.push(LanePath {
                         piece,
                         entry: (a, j),
                         exit: (b, j),
                         turn,
-                        points: local.into_iter().map(|q| p.pose.apply(q)).collect(),
+                        points: sample(&curve),
+                        curve,
                     });
                 }
             }
@@ -332,14 +358,16 @@ impl Network {
     }
 }
 
-/// The point `at_m` metres along the polyline `points` (clamped to its ends), the heading of
-/// the piece it is on, and the polyline's length, metres.
+/// The point `at_m` metres along the polyline `points` (clamped to its ends), the heading
+/// there ([`heading_on_leg`] of its [`vertex_tangents`]: continuous along the polyline, and
+/// the curve's tangent where the polyline samples a line or an arc), and the polyline's
+/// length, metres.
 pub(crate) fn along(points: &[[f64; 2]], at_m: f64) -> ([f64; 2], f64, f64) {
     let length: f64 = points.windows(2).map(|w| dist(w[0], w[1])).sum();
+    let tangents = vertex_tangents(points);
     let mut left = at_m.clamp(0.0, length);
-    for w in points.windows(2) {
+    for (i, w) in points.windows(2).enumerate() {
         let d = dist(w[0], w[1]);
-        let heading = (-(w[1][1] - w[0][1])).atan2(w[1][0] - w[0][0]);
         if left <= d || d == 0.0 && left == 0.0 {
             let u = if d > 0.0 { left / d } else { 0.0 };
             return (
@@ -347,15 +375,284 @@ pub(crate) fn along(points: &[[f64; 2]], at_m: f64) -> ([f64; 2], f64, f64) {
                     w[0][0] + u * (w[1][0] - w[0][0]),
                     w[0][1] + u * (w[1][1] - w[0][1]),
                 ],
-                heading,
+                heading_on_leg(&tangents, i + 1, u),
                 length,
             );
         }
         left -= d;
     }
     let n = points.len();
-    let (a, b) = (points[n - 2], points[n - 1]);
-    (b, (-(b[1] - a[1])).atan2(b[0] - a[0]), length)
+    (points[n - 1], tangents[n - 1], length)
+}
+
+/// The heading (rad) of the leg from `a` to `b` (`0` for a leg of no length).
+fn leg_heading(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (-(b[1] - a[1])).atan2(b[0] - a[0])
+}
+
+/// The tangent heading at each vertex of the polyline `points`, rad: between two legs of
+/// lengths `l₁` and `l₂` and headings `h₁`, `h₂`, `h₁ + (h₂ − h₁)·l₁/(l₁ + l₂)`, which is the
+/// exact tangent when both legs are chords of one circle (or of one line), so a polyline
+/// sampled from lines and arcs gives their tangents at its vertices; at the ends, the end
+/// legs' headings. Legs of no length are skipped (a vertex on one takes its neighbours'
+/// tangent). A polyline of one point, or of coincident points, has heading 0.
+pub(crate) fn vertex_tangents(points: &[[f64; 2]]) -> Vec<f64> {
+    let n = points.len();
+    // Each leg's length and heading; a leg of no length gets `None`.
+    let legs: Vec<Option<(f64, f64)>> = points
+        .windows(2)
+        .map(|w| {
+            let l = dist(w[0], w[1]);
+            (l > 0.0).then(|| (l, leg_heading(w[0], w[1])))
+        })
+        .collect();
+    // The nearest leg with a length before each vertex (`before[i]`, legs `< i`) and after it.
+    let mut before = vec![None; n];
+    for i in 1..n {
+        before[i] = legs[i - 1].or(before[i - 1]);
+    }
+    let mut after = vec![None; n];
+    for i in (0..n.saturating_sub(1)).rev() {
+        after[i] = legs[i].or(after[i + 1]);
+    }
+    (0..n)
+        .map(|i| match (before[i], after[i]) {
+            (Some((l1, h1)), Some((l2, h2))) => h1 + wrap(h2 - h1) * l1 / (l1 + l2),
+            (Some((_, h)), None) | (None, Some((_, h))) => h,
+            (None, None) => 0.0,
+        })
+        .collect()
+}
+
+/// The heading `u` of the way (in `[0, 1]`) along leg `i` (`points[i - 1] → points[i]`) of a
+/// polyline with vertex tangents `tangents` ([`vertex_tangents`]): interpolated between the
+/// two vertices' tangents the short way round, so it is continuous along the polyline and
+/// turns at a constant rate along each leg (on a sampled arc of curvature `κ`, `κ` rad per
+/// metre).
+pub(crate) fn heading_on_leg(tangents: &[f64], i: usize, u: f64) -> f64 {
+    let (a, b) = (tangents[i - 1], tangents[i]);
+    wrap(a + u * wrap(b - a))
+}
+
+/// The points of a chain of lines and arcs (each placed by its start pose), at most
+/// [`LANE_STEP_M`] apart in equal steps along each, with an extra point
+/// [`TANGENT_GUARD_M`] from each end of an arc; each piece's end is the next one's start, so
+/// it is listed once.
+pub(crate) fn sample(curve: &[(Pose2, RefLine)]) -> Vec<[f64; 2]> {
+    let mut out: Vec<[f64; 2]> = Vec::new();
+    for (pose, line) in curve {
+        let mut stations = line.stations(LANE_STEP_M);
+        if line.curv_start != 0.0 && line.length_m > 4.0 * TANGENT_GUARD_M {
+            let last = stations.len() - 1;
+            stations.insert(last, line.length_m - TANGENT_GUARD_M);
+            stations.insert(1, TANGENT_GUARD_M);
+        }
+        let skip = usize::from(!out.is_empty());
+        out.extend(
+            stations
+                .into_iter()
+                .skip(skip)
+                .map(|s| pose.apply(arc_point(line, s))),
+        );
+    }
+    out
+}
+
+/// The point `s` metres along a line or an arc (`line` of constant curvature `κ`), in its
+/// frame, in closed form: `(sin κs / κ, (cos κs − 1) / κ)`, or `(s, 0)` for a line (the
+/// quadrature of [`RefLine::point`] costs `O(s)`, too much for a ring kilometres round).
+fn arc_point(line: &RefLine, s: f64) -> [f64; 2] {
+    let k = line.curv_start;
+    if k == 0.0 {
+        [s, 0.0]
+    } else {
+        let (sin, cos) = (k * s).sin_cos();
+        [sin / k, (cos - 1.0) / k]
+    }
+}
+
+/// The pose at the end of `line` (a line or an arc) placed at `pose`.
+fn end_pose(pose: &Pose2, line: &RefLine) -> Pose2 {
+    let [x, z] = pose.apply(arc_point(line, line.length_m));
+    Pose2 {
+        x,
+        z,
+        heading_rad: wrap(pose.heading_rad + line.heading(line.length_m)),
+    }
+}
+
+/// A straight line of `length_m` metres (`> 0`).
+fn line(length_m: f64) -> RefLine {
+    RefLine {
+        length_m,
+        curv_start: 0.0,
+        curv_end: 0.0,
+    }
+}
+
+/// A turning path from `e` (heading `he`) to `x` (heading `hx`), both `(point, heading)`:
+/// along the entry line, a circular arc tangent to both lines, and along the exit line
+/// (the arc's tangent points are equally far from the lines' crossing, as far as the nearer
+/// of the two ends is). A straight line when the headings agree; lines and arcs are the
+/// pieces of the chain, each with its start pose.
+fn bend((e, he): ([f64; 2], f64), (x, hx): ([f64; 2], f64)) -> Vec<(Pose2, RefLine)> {
+    let start = Pose2 {
+        x: e[0],
+        z: e[1],
+        heading_rad: he,
+    };
+    let turn = wrap(hx - he);
+    let (de, dx) = (direction(he), direction(hx));
+    let cross = de[0] * dx[1] - de[1] * dx[0];
+    if turn.abs() < 1e-9 || cross.abs() < 1e-12 {
+        return vec![(start, line(dist(e, x)))];
+    }
+    // e + s·de + u·dx = x: the crossing is s along the entry line and u before the exit.
+    let r = [x[0] - e[0], x[1] - e[1]];
+    let s = (r[0] * dx[1] - r[1] * dx[0]) / cross;
+    let u = (de[0] * r[1] - de[1] * r[0]) / cross;
+    let tangent = s.min(u);
+    if tangent <= 0.0 {
+        // No arc fits (not a junction's geometry): the chord.
+        return vec![(
+            Pose2 {
+                heading_rad: leg_heading(e, x),
+                ..start
+            },
+            line(dist(e, x)),
+        )];
+    }
+    let radius = tangent / (turn.abs() / 2.0).tan();
+    let mut chain = Vec::new();
+    let mut at = start;
+    if s - tangent > 1e-9 {
+        chain.push((at, line(s - tangent)));
+        at = end_pose(&at, &line(s - tangent));
+    }
+    let arc = RefLine::arc(radius, turn);
+    chain.push((at, arc));
+    at = end_pose(&at, &arc);
+    if u - tangent > 1e-9 {
+        chain.push((at, line(u - tangent)));
+    }
+    chain
+}
+
+/// The radius of the arc that leaves a roundabout's entry point `e` (on the entry line,
+/// `o` metres left of the port's centre line, `d` metres from the centre) turning right and
+/// meets the ring of radius `r` from outside: `(d² + o² − r²) / (2 (r − o))`.
+fn fillet_radius(d: f64, o: f64, r: f64) -> f64 {
+    (d * d + o * o - r * r) / (2.0 * (r - o))
+}
+
+/// The ring radius of a roundabout's lane path: the one nearest `preferred` at least 1.2 m
+/// outside the island (the half width of a car and a margin) whose entry and exit curves
+/// (radius [`fillet_radius`]) are no tighter than [`MIN_PATH_RADIUS_M`] and leave at least
+/// 0.1 rad of ring between the entry and the exit of a right turn; `None` when none is (the
+/// plaza is too small for the lanes: [`roundabout_fits`]).
+fn ring_radius(d: f64, o: f64, island: f64, preferred: f64) -> Option<f64> {
+    let fits = |r: f64| {
+        let rho = fillet_radius(d, o, r);
+        r > o
+            && rho >= MIN_PATH_RADIUS_M
+            && 2.0 * (o + rho).atan2(d) <= std::f64::consts::FRAC_PI_2 - 0.1
+    };
+    if fits(preferred) {
+        return Some(preferred);
+    }
+    let lo = island + 1.2;
+    let hi = d - o;
+    (0..=4000)
+        .map(|k| lo + (hi - lo) * f64::from(k) / 4000.0)
+        .filter(|&r| fits(r))
+        .min_by(|a, b| (a - preferred).abs().total_cmp(&(b - preferred).abs()))
+}
+
+/// The ring radius of lane `j` of a roundabout of `lanes` lanes and plaza half side
+/// `radius_m`, and how far the lane's entry lies from the port's centre line (m).
+fn roundabout_lane(lanes: u32, radius_m: f64, j: u32) -> (Option<f64>, f64) {
+    let kind = PieceKind::Roundabout {
+        lanes,
+        radius_m,
+        friction: 1.0,
+    };
+    let island = kind.island_radius_m().unwrap_or(0.0);
+    let o = (f64::from(j) - 0.5) * LANE_WIDTH_M;
+    let preferred = island + kind.half_road_m() / 2.0 + 0.5;
+    (ring_radius(radius_m, o, island, preferred), o)
+}
+
+/// Whether every lane of a `Roundabout` of `lanes` lanes and half side `radius_m` (m) has a
+/// way onto its ring and off it no tighter than [`MIN_PATH_RADIUS_M`], with ring between
+/// entry and exit for a right turn ([`ring_radius`]): a plaza too small for its lanes has not.
+pub fn roundabout_fits(lanes: u32, radius_m: f64) -> bool {
+    (1..=lanes / 2).all(|j| roundabout_lane(lanes, radius_m, j).0.is_some())
+}
+
+/// The smallest half side (m, in steps of 0.25 m) at which a `Roundabout` of `lanes` lanes
+/// fits its lanes ([`roundabout_fits`]): 8.5 m for 2 lanes, 18.5 m for 4, 28 m for 6.
+pub fn min_roundabout_radius_m(lanes: u32) -> f64 {
+    let mut r = f64::from(lanes) * LANE_WIDTH_M / 2.0 + super::SIDEWALK_WIDTH_M + 3.0;
+    while !roundabout_fits(lanes, r) && r < 1_000.0 {
+        r += 0.25;
+    }
+    r
+}
+
+/// A roundabout's path (counter-clockwise) from the entry point `e` (heading `he`, toward the
+/// centre) to the exit point `x` (heading `hx`, away from it), about the origin: an arc
+/// turning right from the entry line onto the ring (radius [`ring_radius`], near `preferred`),
+/// the ring counter-clockwise, and an arc turning right off the ring onto the exit line. The
+/// arcs meet the ring tangentially, so the heading is continuous throughout.
+fn ring(
+    (e, he): ([f64; 2], f64),
+    (x, hx): ([f64; 2], f64),
+    island: f64,
+    preferred: f64,
+) -> Vec<(Pose2, RefLine)> {
+    // Distance from the centre along the port's line, and offset to the side of it.
+    let d = e[0] * direction(he)[0] + e[1] * direction(he)[1];
+    let d = -d;
+    let o = (e[0].hypot(e[1]).powi(2) - d * d).max(0.0).sqrt();
+    // A plaza too small for its lanes is refused when the piece is made
+    // (`roundabout_fits`); any ring between the lane and the port stands in.
+    let r = ring_radius(d, o, island, preferred).unwrap_or(0.5 * (o + d));
+    let rho = fillet_radius(d, o, r);
+    let angle = |p: [f64; 2]| (-p[1]).atan2(p[0]);
+    // The entry arc: centre `rho` to the right of the entry line, touching the ring where
+    // the line from the origin to that centre crosses it.
+    let right = |h: f64| direction(h - std::f64::consts::FRAC_PI_2);
+    let c_in = [e[0] + rho * right(he)[0], e[1] + rho * right(he)[1]];
+    let a0 = angle(c_in);
+    let ring_in = a0 + std::f64::consts::FRAC_PI_2;
+    let turn_in = -wrap(he - ring_in).abs();
+    // The exit arc: centre `rho` to the right of the exit line.
+    let c_out = [x[0] + rho * right(hx)[0], x[1] + rho * right(hx)[1]];
+    let mut a1 = angle(c_out);
+    while a1 <= a0 {
+        a1 += std::f64::consts::TAU;
+    }
+    let ring_out = a1 + std::f64::consts::FRAC_PI_2;
+    let turn_out = -wrap(ring_out - hx).abs();
+    let start = Pose2 {
+        x: e[0],
+        z: e[1],
+        heading_rad: he,
+    };
+    let entry = RefLine::arc(rho, turn_in);
+    let on_ring = Pose2 {
+        x: r * a0.cos(),
+        z: -r * a0.sin(),
+        heading_rad: wrap(ring_in),
+    };
+    let around = RefLine::arc(r, a1 - a0);
+    let off_ring = Pose2 {
+        x: r * a1.cos(),
+        z: -r * a1.sin(),
+        heading_rad: wrap(ring_out),
+    };
+    let exit = RefLine::arc(rho, turn_out);
+    vec![(start, entry), (on_ring, around), (off_ring, exit)]
 }
 
 /// Largest distance between consecutive points of a route, in metres, so that followers find
@@ -380,47 +677,4 @@ fn resample(points: &[[f64; 2]], max_m: f64) -> Vec<[f64; 2]> {
 
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
-}
-
-/// A quadratic Bézier from `e` (heading `de`) to `x` (heading `dx`) through the crossing of
-/// the two lines; a straight line when they are parallel.
-fn bend(e: [f64; 2], de: [f64; 2], x: [f64; 2], dx: [f64; 2]) -> Vec<[f64; 2]> {
-    let cross = de[0] * dx[1] - de[1] * dx[0];
-    if cross.abs() < 1e-9 {
-        return vec![e, x];
-    }
-    // e + s·de = x - u·dx, solved for s.
-    let r = [x[0] - e[0], x[1] - e[1]];
-    let s = (r[0] * dx[1] - r[1] * dx[0]) / cross;
-    let c = add(e, de, s);
-    (0..=CURVE_POINTS)
-        .map(|i| {
-            let t = i as f64 / CURVE_POINTS as f64;
-            let (a, b, d) = ((1.0 - t) * (1.0 - t), 2.0 * t * (1.0 - t), t * t);
-            [
-                a * e[0] + b * c[0] + d * x[0],
-                a * e[1] + b * c[1] + d * x[1],
-            ]
-        })
-        .collect()
-}
-
-/// From `e` onto a counter-clockwise circle of radius `r` about the origin, around to the
-/// angle of `x`, and out to `x`.
-fn ring(e: [f64; 2], x: [f64; 2], r: f64) -> Vec<[f64; 2]> {
-    let angle = |p: [f64; 2]| (-p[1]).atan2(p[0]);
-    // Join the ring a little after the entry and leave it a little before the exit.
-    let a0 = angle(e) + 0.35;
-    let mut a1 = angle(x) - 0.35;
-    while a1 <= a0 {
-        a1 += std::f64::consts::TAU;
-    }
-    let n = ((a1 - a0) / 0.15).ceil().max(2.0) as usize;
-    let mut pts = vec![e];
-    pts.extend((0..=n).map(|i| {
-        let a = a0 + (a1 - a0) * i as f64 / n as f64;
-        [r * a.cos(), -r * a.sin()]
-    }));
-    pts.push(x);
-    pts
 }

@@ -20,7 +20,8 @@ mod surface;
 
 pub use curve::{Frame, RefLine, SampledLine, POLYLINE_STEP_M};
 pub use geometry::{direction, wrap, Pose2};
-pub use lanes::{LanePath, Turn};
+pub(crate) use lanes::{heading_on_leg, vertex_tangents};
+pub use lanes::{LanePath, Turn, MIN_PATH_RADIUS_M};
 pub use map::{MapIndex, MapLane, MapRef, MapRoad, RoadMap};
 pub use piece::{
     Piece, PieceKind, PortGeometry, JUNCTION_APRON_M, LANE_WIDTH_M, MAX_EXTENT_M, MAX_TURN_RAD,

@@ -290,12 +290,21 @@ impl PieceKind {
                 let min = self.half_width_m() + 3.0;
                 if !(radius_m.is_finite() && radius_m >= min) {
                     bad(format!(
-                        "Roundabout radius {radius_m} m is too small for {lanes} lanes (at least {min} m)"
+                        "Roundabout radius {radius_m} m is too small for {lanes} lanes (at least {} m)",
+                        super::lanes::min_roundabout_radius_m(lanes)
                     ))
                 } else if radius_m > 1_000.0 {
                     bad(format!(
                         "Roundabout radius {} m is over 1000 m",
                         readable(radius_m)
+                    ))
+                } else if !super::lanes::roundabout_fits(lanes, radius_m) {
+                    bad(format!(
+                        "Roundabout radius {radius_m} m is too small for {lanes} lanes: the way \
+                         from an outer lane onto the ring and off it would turn tighter than \
+                         {} m or leave no ring between entry and exit (at least {} m)",
+                        super::lanes::MIN_PATH_RADIUS_M,
+                        super::lanes::min_roundabout_radius_m(lanes)
                     ))
                 } else {
                     Ok(())

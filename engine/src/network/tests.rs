@@ -433,3 +433,149 @@ fn the_surface_of_a_curve_is_its_carriageway_and_its_lanes_follow_the_curve() {
     // 45 m + 20 m + the arc + 20 m + 50 m, each curved piece's lane 1.75 m outside its line.
     assert!(length > 45.0 + 40.0 + 40.0 * 1.07 + 50.0, "{length}");
 }
+
+/// Every lane path through a junction or a roundabout is a G1 chain of lines and arcs: each
+/// piece starts where the last ended with its heading (to 1e-6 m, 1e-9 rad), the chain starts
+/// at its entry port heading into the piece and ends at its exit port heading out, no arc is
+/// tighter than `MIN_PATH_RADIUS_M`, and the sampled polyline's headings
+/// (`vertex_tangents`) turn by at most a leg's curvature between vertices.
+#[test]
+fn junction_and_roundabout_paths_are_g1_chains_of_lines_and_arcs() {
+    let mut kinds = Vec::new();
+    for lanes in [2, 4, 6] {
+        kinds.push(PieceKind::CrossIntersection {
+            lanes,
+            friction: 0.8,
+        });
+        kinds.push(PieceKind::TIntersection {
+            lanes,
+            friction: 0.8,
+        });
+        let min = lanes::min_roundabout_radius_m(lanes);
+        // Smaller plazas are refused, with the smallest that fits named.
+        let small = PieceKind::Roundabout {
+            lanes,
+            radius_m: min - 0.25,
+            friction: 0.8,
+        };
+        let e = small.validate().unwrap_err().to_string();
+        assert!(e.contains(&format!("at least {min} m")), "{e}");
+        for radius_m in [min, min + 0.5, 12.0, 20.0, 35.0, 120.0, 1000.0] {
+            if radius_m >= min {
+                kinds.push(PieceKind::Roundabout {
+                    lanes,
+                    radius_m,
+                    friction: 0.8,
+                });
+            }
+        }
+    }
+    let mut paths = 0;
+    for kind in kinds {
+        let mut n = Network::new();
+        let id = n.add("j", kind.clone()).unwrap();
+        // Turned and moved, so that the frame's pose is part of what is checked.
+        n.pieces[id.0].pose = Pose2 {
+            x: 30.0,
+            z: -12.0,
+            heading_rad: 0.4,
+        };
+        let piece = n.piece(id).clone();
+        for path in n.lane_paths(id) {
+            paths += 1;
+            let what = format!("{kind:?} {:?} -> {:?}", path.entry, path.exit);
+            assert!(!path.curve.is_empty(), "{what}");
+            let entry = piece.port(path.entry.0).unwrap();
+            let exit = piece.port(path.exit.0).unwrap();
+            let (first, _) = path.curve[0];
+            assert!(
+                wrap(first.heading_rad - (entry.heading_rad + std::f64::consts::PI)).abs() < 1e-9,
+                "{what}: starts heading {} at the port of {}",
+                first.heading_rad,
+                entry.heading_rad
+            );
+            for w in path.curve.windows(2) {
+                let (pose, line) = w[0];
+                let [x, z] = pose.apply(line.point(line.length_m));
+                let h = pose.heading_rad + line.heading(line.length_m);
+                let next = w[1].0;
+                assert!(
+                    (x - next.x).hypot(z - next.z) < 1e-6,
+                    "{what}: a gap of {} m",
+                    (x - next.x).hypot(z - next.z)
+                );
+                assert!(wrap(h - next.heading_rad).abs() < 1e-9, "{what}: a kink");
+            }
+            let (pose, line) = *path.curve.last().unwrap();
+            let end = pose.apply(line.point(line.length_m));
+            assert!(
+                wrap(pose.heading_rad + line.heading(line.length_m) - exit.heading_rad).abs()
+                    < 1e-9,
+                "{what}: ends off the exit's heading"
+            );
+            assert!(close(end, *path.points.last().unwrap()), "{what}");
+            for (_, line) in &path.curve {
+                let k = line.curv_start.abs();
+                assert!(
+                    k <= 1.0 / MIN_PATH_RADIUS_M + 1e-9,
+                    "{what}: a radius of {} m",
+                    1.0 / k
+                );
+            }
+            // The polyline's vertex tangents turn by at most the curvature times the leg.
+            let t = lanes::vertex_tangents(&path.points);
+            for (i, w) in path.points.windows(2).enumerate() {
+                let leg = (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]);
+                assert!(leg <= lanes::LANE_STEP_M + 1e-9, "{what}: a leg of {leg} m");
+                let turn = wrap(t[i + 1] - t[i]).abs();
+                assert!(
+                    turn <= leg / MIN_PATH_RADIUS_M * 1.001 + 1e-9,
+                    "{what}: {turn} rad over {leg} m"
+                );
+            }
+            // Its first and last tangents are the ports' headings.
+            assert!(
+                wrap(t[0] - first.heading_rad).abs() < 1e-3,
+                "{what}: {}",
+                t[0]
+            );
+            assert!(
+                wrap(t[t.len() - 1] - exit.heading_rad).abs() < 1e-3,
+                "{what}"
+            );
+        }
+    }
+    assert!(paths > 300, "{paths}");
+}
+
+/// A car placed at a junction's or a roundabout's port faces the arm's heading (it was 0.73
+/// rad off at a roundabout's port: the first leg of the path ran straight at the ring).
+#[test]
+fn a_location_at_a_port_faces_the_arm() {
+    for kind in [
+        PieceKind::Roundabout {
+            lanes: 2,
+            radius_m: 20.0,
+            friction: 0.8,
+        },
+        PieceKind::CrossIntersection {
+            lanes: 2,
+            friction: 0.8,
+        },
+    ] {
+        let mut n = Network::new();
+        let id = n.add("j", kind.clone()).unwrap();
+        for port in 0..4 {
+            for turn in [Turn::Straight, Turn::Left, Turn::Right] {
+                let at = n.on_junction_lane(id, port, turn, 1, 0.0).unwrap();
+                let inward = n.piece(id).port(port).unwrap().heading_rad + std::f64::consts::PI;
+                assert!(
+                    wrap(at.heading_rad - inward).abs() < 1e-3,
+                    "{kind:?} port {port} {turn:?}: {} against {}",
+                    at.heading_rad,
+                    wrap(inward)
+                );
+            }
+        }
+    }
+}

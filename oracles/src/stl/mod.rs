@@ -118,6 +118,53 @@ impl Formula {
         }
     }
 
+    /// The temporal operators whose window lies entirely after `horizon_s` seconds, each as
+    /// `(operator, lo, hi, start)`: the operator's letter (`'G'`, `'F'`, `'U'`), its bounds,
+    /// and the earliest time it reads, s (its `lo` plus the earliest time its enclosing
+    /// operators evaluate it at; the formula itself is judged at `t = 0`). Over a test of
+    /// `horizon_s` seconds no sample lies in such a window: an `F` or `U` there can never be
+    /// satisfied and a `G` never violated, whatever the test does.
+    pub fn windows_after(&self, horizon_s: f64) -> Vec<(char, f64, f64, f64)> {
+        let mut out = Vec::new();
+        self.windows_from(0.0, horizon_s, &mut out);
+        out
+    }
+
+    fn windows_from(&self, at: f64, horizon_s: f64, out: &mut Vec<(char, f64, f64, f64)>) {
+        let mut check = |op: char, lo: f64, hi: f64| {
+            if at + lo > horizon_s {
+                out.push((op, lo, hi, at + lo));
+                true
+            } else {
+                false
+            }
+        };
+        match self {
+            Formula::True | Formula::False | Formula::Pred { .. } => {}
+            Formula::Not(f) => f.windows_from(at, horizon_s, out),
+            Formula::And(a, b) | Formula::Or(a, b) | Formula::Implies(a, b) => {
+                a.windows_from(at, horizon_s, out);
+                b.windows_from(at, horizon_s, out);
+            }
+            Formula::Globally(lo, hi, f) => {
+                if !check('G', *lo, *hi) {
+                    f.windows_from(at + lo, horizon_s, out);
+                }
+            }
+            Formula::Eventually(lo, hi, f) => {
+                if !check('F', *lo, *hi) {
+                    f.windows_from(at + lo, horizon_s, out);
+                }
+            }
+            Formula::Until(lo, hi, a, b) => {
+                if !check('U', *lo, *hi) {
+                    a.windows_from(at, horizon_s, out);
+                    b.windows_from(at + lo, horizon_s, out);
+                }
+            }
+        }
+    }
+
     /// The names of the signals it reads, sorted, without repeats.
     pub fn signals(&self) -> Vec<String> {
         let mut out = Vec::new();

@@ -96,7 +96,15 @@ const KEYWORDS: &[(&str, &[&str])] = &[
     ("AutonomousVehicle", &["loc", "sut", "route", "speed"]),
     (
         "Car",
-        &["loc", "speed", "route", "color", "enabled", "lane_change"],
+        &[
+            "loc",
+            "speed",
+            "route",
+            "color",
+            "enabled",
+            "lane_change",
+            "keep_distance",
+        ],
     ),
     ("ChangeLane", &["to", "at", "when", "duration"]),
     ("Obstacle", &["loc", "size", "color"]),

@@ -156,6 +156,75 @@ fn finished_message(b: &SceneBuilder) -> Result<(), (String, Option<&str>)> {
     Ok(())
 }
 
+/// Refuses an `Stl` monitor with a temporal operator whose window lies entirely after the
+/// test's horizon ([`paracosm_oracles::stl::Formula::windows_after`]): no frame of a test is
+/// in it, so its verdict is the same in every test (an `F` always fails, a `G` always
+/// passes on it).
+fn windows_within_horizon(b: &SceneBuilder, horizon_s: f64) -> Result<(), String> {
+    for (m, at) in b.monitors.iter().zip(&b.monitors_at) {
+        let mut spec = m;
+        while let MonitorSpec::TimeToFailure { inner, .. } = spec {
+            spec = inner;
+        }
+        let MonitorSpec::Stl { name, formula } = spec else {
+            continue;
+        };
+        let Ok(f) = paracosm_oracles::stl::parse(formula) else {
+            continue;
+        };
+        if let Some(&(op, lo, hi, start)) = f.windows_after(horizon_s).first() {
+            let verdict = match op {
+                'G' => "it can never fail (nothing to check)",
+                _ => "it can never be satisfied, and fails every test",
+            };
+            return Err(format!(
+                "error: Stl monitor `{name}`: the window {op}[{lo},{hi}] starts at {start} s, \
+                 after the test's horizon of {horizon_s} s: no frame of a test falls in it, so \
+                 {verdict}; make the horizon longer (test(horizon = ...)) or the window \
+                 earlier\n --> {at}"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a pedestrian walked by two behaviours (its `dist=`/`car=` or `trigger=` and a
+/// `foreach(p.walk)`, or two `foreach(p.walk)`): each walks it when it fires, and a
+/// pedestrian takes one walking step per step, so one of the two would only change when it
+/// walks, without a word.
+fn one_walker_each(b: &SceneBuilder) -> Result<(), String> {
+    use paracosm_engine::behaviour::{decode_sink, Action};
+    let mut walkers: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
+    for (i, node) in b.graph.nodes().iter().enumerate() {
+        if let Node::Foreach { sink, .. } = node {
+            if let Action::Walk(p) = decode_sink(*sink) {
+                walkers.entry(p).or_default().push(i);
+            }
+        }
+    }
+    for (p, nodes) in walkers {
+        let [first, second, ..] = nodes[..] else {
+            continue;
+        };
+        let name = b
+            .objects
+            .iter()
+            .find(|o| o.actor == Some(paracosm_engine::behaviour::Actor::Pedestrian(p)))
+            .map_or_else(|| format!("pedestrian {p}"), |o| o.name.clone());
+        let site = |n: usize| b.graph.site(n).unwrap_or("?").to_owned();
+        return Err(format!(
+            "error: {name} is walked by two behaviours, at {} and at {}: a pedestrian takes one \
+             walking step per step, so the second would change only when it walks; keep one \
+             (a Pedestrian given dist= and car=, or trigger=, walks by itself: drop the \
+             foreach(...walk), or give the Pedestrian neither)\n --> {}",
+            site(first),
+            site(second),
+            site(second)
+        ));
+    }
+    Ok(())
+}
+
 impl Program {
     /// Evaluates the program with `values` (by declaration index; `None`: representative
     /// values) within the loading limits, checks that it finished, and calls `then` with what
@@ -943,6 +1012,8 @@ pub fn load(
         })
         .map_err(lang)?;
     program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
+    windows_within_horizon(&first, program.horizon_s).map_err(lang)?;
+    one_walker_each(&first).map_err(lang)?;
     // Signals the monitors read exist (checked when the world is built).
     scene::check_signals(&first).map_err(lang)?;
     program.check_lambdas().map_err(lang)?;

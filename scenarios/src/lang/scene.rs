@@ -180,6 +180,8 @@ pub enum Pending {
         enabled: bool,
         /// Its lane change, if any.
         lane_change: Option<super::values::LaneChangeVal>,
+        /// The gap it keeps to what is ahead, m (`Car(keep_distance=)`).
+        keep_distance_m: Option<f64>,
     },
     /// `Obstacle`.
     Obstacle {
@@ -547,12 +549,14 @@ pub fn check_signals(b: &SceneBuilder) -> Result<(), String> {
 }
 
 /// The outputs of an actor that `Stl` formulas may read as `<variable>.<output>`.
-const ACTOR_SIGNALS: [(&str, Output); 5] = [
+const ACTOR_SIGNALS: [(&str, Output); 7] = [
     ("pos", Output::Pos),
     ("vel", Output::Vel),
     ("speed", Output::Speed),
     ("heading", Output::Heading),
     ("collision", Output::Collision),
+    ("collided", Output::Collided),
+    ("separation", Output::Separation),
 ];
 
 /// The streams published to the monitors: those the program published (`Monitor`, `Assert`,
@@ -674,8 +678,8 @@ fn published(
                     if !known(&out, &vector, &s).map_err(located)? {
                         return Err(located(format!(
                             "`{s}` is no output of `{name}`; an actor's outputs are .pos.x, \
-                             .pos.y, .pos.z, .vel.x, .vel.y, .vel.z, .speed, .heading and \
-                             .collision"
+                             .pos.y, .pos.z, .vel.x, .vel.y, .vel.z, .speed, .heading, \
+                             .collision, .collided and .separation"
                         )));
                     }
                 }
@@ -835,9 +839,10 @@ impl SceneBuilder {
                             .roads
                             .route(&start, &turns, self.route_m)
                             .map_err(|e| format!("{}: {}", o.name, strip(e)))?,
-                        // Without a route the ego keeps its lane: the start line on straight
-                        // roads, and the lane's path (straight on through junctions) where
-                        // its network has a curved piece.
+                        // Without a route the ego keeps its lane: the lane's path (straight on
+                        // through junctions where it can, round a roundabout's ring, into a
+                        // T's turn from its stem), or, where that path is the start line
+                        // itself (straight roads), the start line.
                         None if self.roads.group_of(start.piece).iter().any(|&id| {
                             let kind = &self.roads.piece(id).kind;
                             kind.ref_line().is_some() || matches!(kind, PieceKind::Map { .. })
@@ -845,7 +850,15 @@ impl SceneBuilder {
                         {
                             self.roads.route(&start, &[], self.route_m).map_err(strip)?
                         }
-                        None => vec![],
+                        None => {
+                            let lane =
+                                self.roads.route(&start, &[], self.route_m).map_err(strip)?;
+                            if on_start_line(&start, &lane) {
+                                vec![]
+                            } else {
+                                lane
+                            }
+                        }
                     };
                     if self.ego.is_some() {
                         return Err(format!("{}: a scenario has one AutonomousVehicle", o.name));
@@ -875,6 +888,12 @@ impl SceneBuilder {
                         }
                         PedTrigger::Never => {}
                     }
+                    if !matches!(trigger, PedTrigger::Never) {
+                        // The behaviour's `foreach(walk)` is named by the Pedestrian's
+                        // declaration, for the check of two behaviours walking it.
+                        let walk = paracosm_engine::rx::StreamId(self.graph.nodes().len() - 1);
+                        self.graph.set_site(walk, o.at.clone());
+                    }
                     ped_index += 1;
                     self.pedestrians.push(PedestrianSpec {
                         start: s,
@@ -890,6 +909,7 @@ impl SceneBuilder {
                     color,
                     enabled,
                     lane_change,
+                    keep_distance_m,
                 } => {
                     let start = resolve(self, loc)?;
                     let path = match self.roads.route(&start, &route, self.route_m) {
@@ -937,6 +957,7 @@ impl SceneBuilder {
                         lane_change,
                         lane_offsets_m,
                         name: car_name,
+                        keep_distance_m,
                     });
                     self.car_names.push(o.name.clone());
                 }
@@ -955,6 +976,16 @@ impl SceneBuilder {
         self.placed = true;
         Ok(())
     }
+}
+
+/// Whether every point of `path` (world `[x, z]`, m) lies on the line ahead of `start` along
+/// its heading, to 1 cm: the ego following the start line drives that path.
+fn on_start_line(start: &Location, path: &[[f64; 2]]) -> bool {
+    let d = paracosm_engine::network::direction(start.heading_rad);
+    path.iter().all(|q| {
+        let r = [q[0] - start.pos_m[0], q[1] - start.pos_m[2]];
+        (r[0] * d[1] - r[1] * d[0]).abs() <= 0.01 && r[0] * d[0] + r[1] * d[1] >= -0.01
+    })
 }
 
 impl SceneBuilder {

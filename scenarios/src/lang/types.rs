@@ -134,6 +134,7 @@ pub fn input_of(builtin: &str, keyword: &str) -> Option<Input> {
         ("Clothoid", "curv_end") => number("curv_end", "1/m", -0.1, 0.1, false),
         ("AutonomousVehicle", "speed") => number("speed", "m/s", 0.0, f64::INFINITY, false),
         ("Car", "speed") => CAR_SPEED,
+        ("Car", "keep_distance") => number("keep_distance", "m", 0.0, f64::INFINITY, false),
         ("Pedestrian", "speed") => PEDESTRIAN_SPEED,
         ("Pedestrian", "dist") => TRIGGER_DISTANCE,
         ("ChangeLane", "at") => number("at", "s", 0.0, f64::INFINITY, false),
@@ -277,8 +278,8 @@ pub fn stream_types(b: &SceneBuilder) -> Vec<SType> {
             Node::Open(_) => SType::Any,
             Node::Probe(p) => match decode_probe(*p).1 {
                 Output::Pos | Output::Vel => SType::Vec3,
-                Output::Heading | Output::Speed => SType::Num,
-                Output::Collision => SType::Bool,
+                Output::Heading | Output::Speed | Output::Separation => SType::Num,
+                Output::Collision | Output::Collided => SType::Bool,
             },
             Node::Map { .. } => SType::Any,
             Node::Filter { src, .. }

@@ -141,13 +141,21 @@ pub enum ActorKind {
 pub struct ActorVal {
     /// Which actor.
     pub kind: ActorKind,
-    /// Output streams: pos, vel, heading, speed, collision.
-    pub outputs: [usize; 5],
+    /// Output streams: pos, vel, heading, speed, collision, collided, separation.
+    pub outputs: [usize; 7],
     /// Index in the placement list.
     pub object: usize,
 }
 
-const OUTPUT_NAMES: [&str; 5] = ["pos", "vel", "heading", "speed", "collision"];
+const OUTPUT_NAMES: [&str; 7] = [
+    "pos",
+    "vel",
+    "heading",
+    "speed",
+    "collision",
+    "collided",
+    "separation",
+];
 
 impl fmt::Display for ActorVal {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -1,3 +1,5 @@
+// `Car` takes one argument per keyword, as Starlark calls it: more than clippy's seven.
+#![allow(clippy::too_many_arguments)]
 #![allow(non_snake_case)] // The paper's keyword names: numLane, minD, minT.
 
 //! Actors: `AutonomousVehicle`, `Car`, `ChangeLane`, `Obstacle`, `Pedestrian`.
@@ -46,6 +48,8 @@ pub(super) fn declare(
         Output::Heading,
         Output::Speed,
         Output::Collision,
+        Output::Collided,
+        Output::Separation,
     ]
     .map(|o| b.probe(actor, o).0);
     b.objects.push(ObjectDecl {
@@ -149,8 +153,10 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         ))
     }
 
-    /// `Car(loc=, speed=10.0, route=[], color="red", enabled=True, lane_change=None)`: an
-    /// NPC car that follows the lane graph, and may change lanes once (`ChangeLane`).
+    /// `Car(loc=, speed=10.0, route=[], color="red", enabled=True, lane_change=None,
+    /// keep_distance=None)`: an NPC car that follows the lane graph, may change lanes once
+    /// (`ChangeLane`), stops against whatever it meets, and with `keep_distance` (m, `>= 0`)
+    /// brakes to stop that far short of whatever is ahead on its path.
     fn Car<'v>(
         #[starlark(require = named)] loc: Value<'v>,
         #[starlark(require = named)] speed: Option<Value<'v>>,
@@ -158,9 +164,24 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] color: Option<Value<'v>>,
         #[starlark(require = named)] enabled: Option<Value<'v>>,
         #[starlark(require = named)] lane_change: Option<Value<'v>>,
+        #[starlark(require = named)] keep_distance: Option<Value<'v>>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<ActorVal> {
         let loc = location(loc, "loc")?;
+        let keep_distance_m = match keep_distance {
+            None => None,
+            Some(v) if v.is_none() => None,
+            Some(v) => {
+                let d = number(v, "Car(keep_distance=)")?;
+                if !(d.is_finite() && d >= 0.0) {
+                    bail!(
+                        "Car(keep_distance=) is the gap in m the car keeps to what is ahead of \
+                         it, finite and >= 0, got {d}"
+                    );
+                }
+                Some(d)
+            }
+        };
         let lane_change = match lane_change {
             None => None,
             Some(v) if v.is_none() => None,
@@ -214,6 +235,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 color,
                 enabled,
                 lane_change,
+                keep_distance_m,
             },
         ))
     }

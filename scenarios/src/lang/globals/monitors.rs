@@ -71,6 +71,15 @@ pub(super) fn publish_monitored(
     Ok(signal)
 }
 
+/// A monitor's name: `name=` when given, else the variable the call is assigned to
+/// (`hit = CollisionMonitor(v)` is `hit`), else `default`. Every monitor builtin names its
+/// monitor so.
+fn monitor_name(eval: &Evaluator, name: Option<&str>, default: &str) -> String {
+    name.map(str::to_owned)
+        .or_else(|| variable_here(eval))
+        .unwrap_or_else(|| default.to_owned())
+}
+
 pub(super) fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<MonitorVal> {
     let st = state(eval)?;
     let mut b = st.scene.borrow_mut();
@@ -102,18 +111,62 @@ pub(super) fn ego_arg(v: Value, what: &str) -> anyhow::Result<()> {
 #[starlark_module]
 #[allow(non_snake_case)]
 pub(super) fn register(builder: &mut GlobalsBuilder) {
-    /// `CollisionMonitor(v, name="collision")`: fails when the ego vehicle touches a
-    /// pedestrian or a car; robustness is the smallest separation in metres.
+    /// `CollisionMonitor(a, name=<variable> or "collision")`: fails when actor `a` touches
+    /// anything solid (for the ego vehicle: a pedestrian, a car or an obstacle; for a car or
+    /// a pedestrian also each other and the ego); robustness is its smallest separation in
+    /// metres (`0` once it has collided).
     fn CollisionMonitor<'v>(
         v: Value<'v>,
         #[starlark(require = named)] name: Option<&str>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<MonitorVal> {
-        ego_arg(v, "CollisionMonitor")?;
+        let name = monitor_name(eval, name, "collision");
+        let actor = *v.downcast_ref::<ActorVal>().ok_or_else(|| {
+            anyhow!(
+                "CollisionMonitor watches an actor (the AutonomousVehicle, a Car or a \
+                 Pedestrian); got {}",
+                crate::lang::a_type(v.get_type())
+            )
+        })?;
+        if actor.kind == ActorKind::Ego {
+            return monitor(eval, MonitorSpec::Collision { name });
+        }
+        // Another actor: its separation, 0 from the step it first touched anything.
+        let signal = {
+            use paracosm_engine::rx::{Func, Node, StreamId, Value as Rx};
+            let st = state(eval)?;
+            let mut b = st.scene.borrow_mut();
+            unique_monitor_name(&b, &name)?;
+            // outputs: pos, vel, heading, speed, collision, collided, separation.
+            let pair = b.graph.push(Node::Zip(
+                StreamId(actor.outputs[5]),
+                StreamId(actor.outputs[6]),
+            ));
+            let clearance = b.graph.push(Node::Map {
+                src: pair,
+                f: Func::native("collided ? 0 : separation", |a| match &a[0] {
+                    Rx::Tuple(p) => match (&p[0], p[1].as_num()) {
+                        (Rx::Bool(true), _) => Ok(Rx::Num(0.0)),
+                        (Rx::Bool(false), Some(d)) => Ok(Rx::Num(d)),
+                        _ => Err("expected (collided, separation)".into()),
+                    },
+                    v => Err(format!(
+                        "expected a (collided, separation) pair, got a {}",
+                        v.kind()
+                    )),
+                }),
+            });
+            let signal = format!("monitor:{name}");
+            b.published.push((signal.clone(), clearance));
+            signal
+        };
         monitor(
             eval,
-            MonitorSpec::Collision {
-                name: name.unwrap_or("collision").to_owned(),
+            MonitorSpec::Stream {
+                name,
+                signal,
+                unit: Some("m".into()),
+                over: paracosm_oracles::Over::Always,
             },
         )
     }
@@ -131,7 +184,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         monitor(
             eval,
             MonitorSpec::OffRoad {
-                name: name.unwrap_or("offroad").to_owned(),
+                name: monitor_name(eval, name, "offroad"),
                 implicit: false,
             },
         )
@@ -156,7 +209,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         monitor(
             eval,
             MonitorSpec::Distance {
-                name: name.unwrap_or("distance").to_owned(),
+                name: monitor_name(eval, name, "distance"),
                 min_distance_m,
             },
         )
@@ -178,10 +231,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             eval,
             MonitorSpec::Stl {
                 // As a Monitor: the variable it is assigned to, else `stl`.
-                name: name
-                    .map(str::to_owned)
-                    .or_else(|| variable_here(eval))
-                    .unwrap_or_else(|| "stl".to_owned()),
+                name: monitor_name(eval, name, "stl"),
                 formula: formula.to_owned(),
             },
         )
@@ -202,10 +252,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         let over = paracosm_oracles::Over::parse(word).ok_or_else(|| {
             anyhow!("Monitor(over=) is \"always\", \"end\" or \"eventually\", got {word:?}")
         })?;
-        let name = name
-            .map(str::to_owned)
-            .or_else(|| variable_here(eval))
-            .unwrap_or_else(|| "monitor".to_owned());
+        let name = monitor_name(eval, name, "monitor");
         let signal = publish_monitored(eval, stream, &name, "Monitor", types::SType::Num)?;
         monitor(
             eval,
@@ -225,10 +272,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         #[starlark(require = named)] name: Option<&str>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<MonitorVal> {
-        let name = name
-            .map(str::to_owned)
-            .or_else(|| variable_here(eval))
-            .unwrap_or_else(|| "assert".to_owned());
+        let name = monitor_name(eval, name, "assert");
         let signal = publish_monitored(eval, stream, &name, "Assert", types::SType::Bool)?;
         monitor(eval, MonitorSpec::Assert { name, signal })
     }
@@ -340,7 +384,11 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 spec.name(),
             );
         }
-        let name = name.unwrap_or("time_to_failure");
+        let name = name
+            .map(str::to_owned)
+            .or_else(|| variable_here(eval))
+            .unwrap_or_else(|| "time_to_failure".to_owned());
+        let name = name.as_str();
         if wrapped.name() != name {
             unique_monitor_name(&b, name)?;
         }
