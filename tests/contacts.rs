@@ -4,6 +4,8 @@
 //! short. A car's speed is over the ground, on a lane change too, and a pedestrian walked by
 //! two behaviours, or a window past the horizon, is refused at load.
 
+mod common;
+
 use paracosm_engine::behaviour::{Actor, Output};
 use paracosm_engine::rx::Value;
 use paracosm_engine::sut::SutConfig;
@@ -93,13 +95,7 @@ test(horizon = 10.0, offroad = False)
     // The monitor named by its variable fails, with robustness 0 (it touched).
     let scenario = load(&program).unwrap();
     assert!(scenario.monitors.iter().any(|m| m.name() == "hit"));
-    let a = scenario
-        .space
-        .decode(&paracosm_generators::Point {
-            discrete: vec![],
-            continuous: vec![],
-        })
-        .unwrap();
+    let a = common::no_params(&scenario);
     let outcome = scenario.run(&a, 0).unwrap();
     let (_, hit) = outcome.monitors.iter().find(|(n, _)| n == "hit").unwrap();
     assert!(!hit.passed && hit.robustness == 0.0, "{hit:?}");
@@ -313,13 +309,7 @@ OffRoadMonitor(v)
 test(horizon = 8.0)
 "#;
     let scenario = load(program).unwrap();
-    let a = scenario
-        .space
-        .decode(&paracosm_generators::Point {
-            discrete: vec![],
-            continuous: vec![],
-        })
-        .unwrap();
+    let a = common::no_params(&scenario);
     let outcome = scenario.run(&a, 0).unwrap();
     let (_, offroad) = &outcome.monitors[0];
     assert!(offroad.passed, "{offroad:?}");

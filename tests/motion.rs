@@ -12,6 +12,8 @@
 //!   the ego at most `v / 5.3 m` (its steering limit), a pedestrian never (it walks a
 //!   straight line, facing its target).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use paracosm_engine::behaviour::{Actor, Output};
@@ -251,13 +253,7 @@ test(horizon = 20.0, offroad = False)
     )
     .unwrap();
     let scenario = paracosm_scenarios::load(path.to_str().unwrap()).unwrap();
-    let a = scenario
-        .space
-        .decode(&paracosm_generators::Point {
-            discrete: vec![],
-            continuous: vec![],
-        })
-        .unwrap();
+    let a = common::no_params(&scenario);
     let mut on_ring = Vec::new();
     scenario
         .with_world(&a, &mut |spec, host| {

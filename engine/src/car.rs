@@ -119,10 +119,10 @@ pub(crate) struct Car {
     /// The leg the car was on at its last lookup: arc lengths only grow, so the next lookup
     /// walks on from there instead of searching the whole path.
     leg: std::cell::Cell<usize>,
-    /// The path's tangent heading at each vertex, rad ([`crate::network::vertex_tangents`]):
-    /// the car's heading is interpolated between them, so it turns smoothly along a sampled
-    /// curve instead of jumping at each vertex.
-    tangents: Vec<f64>,
+    /// The leg whose ends' tangent headings (rad, [`crate::network::tangent_at`]) were worked
+    /// out last, and those tangents: the car's heading is interpolated between them, so it
+    /// turns smoothly along a sampled curve instead of jumping at each vertex.
+    tangents: std::cell::Cell<(usize, f64, f64)>,
     /// Per path vertex, the sideways shift of one metre of offset to the right (m per m):
     /// the mitre of the two legs' right normals, so a car offset from its path (a lane
     /// change) moves on a parallel polyline whose legs meet at each vertex; worked out on
@@ -146,6 +146,8 @@ pub(crate) struct Car {
     placed: ([f64; 2], f64),
     /// Its body; the collider spans `[CLEARANCE_M, CLEARANCE_M + height]` above the road.
     pub(crate) size: Size,
+    /// Its collider's shape, a box of its size ([`Car::shape`]).
+    collider_shape: SharedShape,
     /// How the camera draws it.
     pub(crate) albedo: [f32; 3],
     /// Its speed stream, m/s.
@@ -187,14 +189,13 @@ impl Car {
             cumulative.push(last + (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]));
         }
         let stop_s = (cumulative.last().expect("non-empty") - size.length_m / 2.0).max(0.0);
-        let tangents = crate::network::vertex_tangents(&path);
         let mut car = Car {
             body: None,
             path,
             cumulative,
             stop_s,
             leg: std::cell::Cell::new(1),
-            tangents,
+            tangents: std::cell::Cell::new((0, 0.0, 0.0)),
             mitres: std::cell::OnceCell::new(),
             s: 0.0,
             speed: 0.0,
@@ -203,6 +204,11 @@ impl Car {
             here: ([0.0; 2], 0.0),
             placed: ([0.0; 2], 0.0),
             size,
+            collider_shape: SharedShape::cuboid(
+                (size.length_m / 2.0) as f32,
+                (size.height_m / 2.0) as f32,
+                (size.width_m / 2.0) as f32,
+            ),
             albedo,
             speed_stream,
             touching: false,
@@ -265,10 +271,25 @@ impl Car {
     fn at(&self, s: f64) -> ([f64; 2], f64) {
         let (i, u) = self.on_leg(s);
         let (a, b) = (self.path[i - 1], self.path[i]);
+        let (ta, tb) = self.tangents_of(i);
         (
             [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])],
-            crate::network::heading_on_leg(&self.tangents, i, u),
+            crate::network::heading_between(ta, tb, u),
         )
+    }
+
+    /// The tangent headings at the two ends of leg `i` (`1 <= i`), rad, kept for the leg
+    /// looked up last.
+    fn tangents_of(&self, i: usize) -> (f64, f64) {
+        match self.tangents.get() {
+            (leg, a, b) if leg == i => (a, b),
+            _ => {
+                let a = crate::network::tangent_at(&self.path, i - 1);
+                let b = crate::network::tangent_at(&self.path, i);
+                self.tangents.set((i, a, b));
+                (a, b)
+            }
+        }
     }
 
     /// The pose of its collider now: the body's pose when it is in the physics step, and the
@@ -572,11 +593,7 @@ impl Car {
 
     /// Its collider's shape: a box of its size.
     pub(crate) fn shape(&self) -> SharedShape {
-        SharedShape::cuboid(
-            (self.size.length_m / 2.0) as f32,
-            (self.size.height_m / 2.0) as f32,
-            (self.size.width_m / 2.0) as f32,
-        )
+        self.collider_shape.clone()
     }
 
     /// The first object of `solids` that the car touches moving from station `from` to `to`
@@ -593,13 +610,20 @@ impl Car {
     ) -> Option<(f64, Other)> {
         self.body?;
         let shape = self.shape();
+        let reach = self.radius_m();
         let touches = |s: f64| {
-            solids.first_hit(
+            let here = self.place_at(s, t_s);
+            let [x, z] = here.0;
+            // Most steps nothing is near: no pose, no shape test.
+            if !solids.any_near(
                 me,
-                shape.as_ref(),
-                &self.pose_at(self.place_at(s, t_s)),
+                [x, CLEARANCE_M + self.size.height_m / 2.0, z],
+                reach,
                 false,
-            )
+            ) {
+                return None;
+            }
+            solids.first_hit(me, shape.as_ref(), &self.pose_at(here), false)
         };
         let other = touches(to)?;
         if touches(from).is_some() {
@@ -791,7 +815,8 @@ mod tests {
             assert_eq!(i, search(s));
             // The heading is the leg's ends' tangents interpolated: between the headings of
             // the legs that meet at its ends.
-            assert_eq!(h, crate::network::heading_on_leg(&c.tangents, i, u));
+            let tangents = crate::network::vertex_tangents(&c.path);
+            assert_eq!(h, crate::network::heading_on_leg(&tangents, i, u));
             assert!(p.iter().all(|v| v.is_finite()) && h.is_finite());
         }
     }

@@ -22,9 +22,23 @@ pub(crate) enum Other {
     Obstacle(usize),
 }
 
-/// The colliders of a step's solid objects, each with its pose now.
+/// The colliders of a step's solid objects, each with its pose now and the radius of its
+/// bounding sphere about its pose's origin (m): two objects whose origins are farther apart
+/// than their radii together cannot touch, which most pairs are, so they skip parry's test.
 pub(crate) struct Solids {
-    items: Vec<(Other, Pose, SharedShape)>,
+    items: Vec<(Other, Pose, SharedShape, f32)>,
+}
+
+/// The radius of `shape`'s bounding sphere about its frame's origin, m.
+fn reach(shape: &dyn Shape) -> f32 {
+    let s = shape.compute_local_bounding_sphere();
+    s.center().length() + s.radius()
+}
+
+/// Whether two bounding spheres about the origins of `a` and `b` (radii `ra`, `rb`) are
+/// apart (then the shapes cannot touch).
+fn apart(a: &Pose, ra: f32, b: &Pose, rb: f32) -> bool {
+    (a.translation - b.translation).length() > ra + rb
 }
 
 impl Solids {
@@ -35,18 +49,16 @@ impl Solids {
 
     /// Adds `who` with `shape` at `pose`, or moves it there when it is in the set.
     pub(crate) fn put(&mut self, who: Other, pose: Pose, shape: SharedShape) {
-        match self.items.iter_mut().find(|(o, _, _)| *o == who) {
-            Some(item) => {
-                item.1 = pose;
-                item.2 = shape;
-            }
-            None => self.items.push((who, pose, shape)),
+        let r = reach(shape.as_ref());
+        match self.items.iter_mut().find(|(o, ..)| *o == who) {
+            Some(item) => *item = (who, pose, shape, r),
+            None => self.items.push((who, pose, shape, r)),
         }
     }
 
     /// Moves `who` to `pose` (nothing when it is not in the set).
     pub(crate) fn move_to(&mut self, who: Other, pose: Pose) {
-        if let Some(item) = self.items.iter_mut().find(|(o, _, _)| *o == who) {
+        if let Some(item) = self.items.iter_mut().find(|(o, ..)| *o == who) {
             item.1 = pose;
         }
     }
@@ -60,16 +72,43 @@ impl Solids {
         pose: &Pose,
         with_ego: bool,
     ) -> Option<Other> {
+        let r = reach(shape);
         self.items
             .iter()
-            .filter(|(o, _, _)| *o != me && (with_ego || *o != Other::Ego))
-            .find(|(_, p, s)| {
+            .filter(|(o, ..)| *o != me && (with_ego || *o != Other::Ego))
+            .find(|(_, p, s, rs)| {
                 // A pair parry cannot test (no such pair among boxes and capsules) counts as
                 // touching: a contact is never assumed away.
-                query::intersection_test(pose, shape, p, s.as_ref())
-                    .map_or(true, |i| i.intersecting)
+                !apart(pose, r, p, *rs)
+                    && query::intersection_test(pose, shape, p, s.as_ref())
+                        .map_or(true, |i| i.intersecting)
             })
-            .map(|(o, _, _)| *o)
+            .map(|(o, ..)| *o)
+    }
+
+    /// Whether any object other than `me` (and the ego unless `with_ego`) has its bounding
+    /// sphere within `radius_m` of the point `centre` (m): when none has, nothing there can
+    /// touch a shape that reaches no farther than `radius_m` from it.
+    pub(crate) fn any_near(
+        &self,
+        me: Other,
+        centre: [f64; 3],
+        radius_m: f64,
+        with_ego: bool,
+    ) -> bool {
+        self.items
+            .iter()
+            .filter(|(o, ..)| *o != me && (with_ego || *o != Other::Ego))
+            .any(|(_, p, _, r)| {
+                let t = p.translation;
+                let d = [
+                    f64::from(t.x) - centre[0],
+                    f64::from(t.y) - centre[1],
+                    f64::from(t.z) - centre[2],
+                ];
+                let near = radius_m + f64::from(*r) + 1e-3;
+                d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= near * near
+            })
     }
 
     /// The smallest distance (m) from `shape` at `pose` to any object other than `me`, the
@@ -77,8 +116,8 @@ impl Solids {
     pub(crate) fn clearance_m(&self, me: Other, shape: &dyn Shape, pose: &Pose) -> f64 {
         self.items
             .iter()
-            .filter(|(o, _, _)| *o != me)
-            .map(|(_, p, s)| {
+            .filter(|(o, ..)| *o != me)
+            .map(|(_, p, s, _)| {
                 query::distance(pose, shape, p, s.as_ref())
                     .map_or(0.0, |d| f64::from(d.distance).max(0.0))
             })

@@ -541,7 +541,7 @@ impl Simulation {
         let dt = self.dt_s;
         let t = self.t_s();
         self.evaluate(host)?;
-        let before = ego_state(&self.physics, &self.ego).pos_m;
+        let before = self.physics.bodies[self.ego.body].translation();
         for &(piece, stream) in &self.frictions {
             let network = &self.network;
             let what = || format!("the friction of {}", network.piece(piece).name);
@@ -571,7 +571,15 @@ impl Simulation {
         // What a car may run into: obstacles, pedestrians (where this step's walk took
         // them), the other cars (each where it is when this one moves), and the ego for a
         // car that keeps its distance.
-        let mut solids = self.solids();
+        // (A world without NPC cars has nothing kinematic to stop: the pedestrians only, then,
+        // against obstacles.)
+        let kinematic_contacts =
+            !self.cars.is_empty() || !(self.pedestrians.is_empty() || self.obstacles.is_empty());
+        let mut solids = if kinematic_contacts {
+            self.solids()
+        } else {
+            Solids::new()
+        };
         let handles: Vec<Handle<Car>> = self.cars.iter().map(|(h, _)| h).collect();
         for (i, h) in handles.into_iter().enumerate() {
             let Some(car) = self.cars.get_mut(h) else {
@@ -623,14 +631,16 @@ impl Simulation {
         }
         // A pedestrian that walks into a car or an obstacle (rapier reports no contact
         // between two kinematic bodies): both record the collision.
-        for (i, p) in self.pedestrians.iter_mut().enumerate() {
-            let shape = SharedShape::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M);
-            if let Some(o) = solids.first_hit(
-                Other::Pedestrian(i),
-                shape.as_ref(),
-                &p.collider_pose(),
-                false,
-            ) {
+        let capsule = Capsule::new_y(PED_HALF_HEIGHT_M, PED_RADIUS_M);
+        for (i, p) in self
+            .pedestrians
+            .iter_mut()
+            .enumerate()
+            .filter(|_| kinematic_contacts)
+        {
+            if let Some(o) =
+                solids.first_hit(Other::Pedestrian(i), &capsule, &p.collider_pose(), false)
+            {
                 p.collided = true;
                 if let Other::Car(j) = o {
                     if let Some(c) = self.cars.get_mut(Handle::from_index(j)) {
@@ -681,8 +691,12 @@ impl Simulation {
             }
         }
         self.ego_collided |= self.ego_contact();
-        let after = ego_state(&self.physics, &self.ego).pos_m;
-        self.ego_velocity = [0, 1, 2].map(|i| (after[i] - before[i]) / dt);
+        let after = self.physics.bodies[self.ego.body].translation();
+        self.ego_velocity = [
+            (f64::from(after.x) - f64::from(before.x)) / dt,
+            (f64::from(after.y) - f64::from(before.y)) / dt,
+            (f64::from(after.z) - f64::from(before.z)) / dt,
+        ];
         self.tick += 1;
         let tick = self.tick;
         if self

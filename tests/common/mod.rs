@@ -105,3 +105,13 @@ pub fn assign(space: &ParamSpace, values: &[(&str, Value)]) -> Assignment {
     }
     space.decode(&point).unwrap()
 }
+
+/// The one test of a scenario without open parameters.
+pub fn no_params(s: &paracosm_scenarios::Scenario) -> Assignment {
+    s.space
+        .decode(&Point {
+            discrete: vec![],
+            continuous: vec![],
+        })
+        .unwrap()
+}

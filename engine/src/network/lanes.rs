@@ -397,40 +397,41 @@ fn leg_heading(a: [f64; 2], b: [f64; 2]) -> f64 {
 /// legs' headings. Legs of no length are skipped (a vertex on one takes its neighbours'
 /// tangent). A polyline of one point, or of coincident points, has heading 0.
 pub(crate) fn vertex_tangents(points: &[[f64; 2]]) -> Vec<f64> {
-    let n = points.len();
-    // Each leg's length and heading; a leg of no length gets `None`.
-    let legs: Vec<Option<(f64, f64)>> = points
-        .windows(2)
-        .map(|w| {
-            let l = dist(w[0], w[1]);
-            (l > 0.0).then(|| (l, leg_heading(w[0], w[1])))
-        })
-        .collect();
-    // The nearest leg with a length before each vertex (`before[i]`, legs `< i`) and after it.
-    let mut before = vec![None; n];
-    for i in 1..n {
-        before[i] = legs[i - 1].or(before[i - 1]);
+    (0..points.len()).map(|i| tangent_at(points, i)).collect()
+}
+
+/// The tangent heading at vertex `i` of the polyline `points`, rad: element `i` of
+/// [`vertex_tangents`], worked out from the legs next to it alone (a follower of a route
+/// kilometres long needs only the vertices it reaches).
+pub(crate) fn tangent_at(points: &[[f64; 2]], i: usize) -> f64 {
+    let leg = |k: usize| {
+        let (a, b) = (points[k], points[k + 1]);
+        let l = dist(a, b);
+        (l > 0.0).then(|| (l, leg_heading(a, b)))
+    };
+    // The nearest leg with a length before vertex `i` (legs `< i`) and after it.
+    let before = (0..i.min(points.len().saturating_sub(1)))
+        .rev()
+        .find_map(leg);
+    let after = (i..points.len().saturating_sub(1)).find_map(leg);
+    match (before, after) {
+        (Some((l1, h1)), Some((l2, h2))) => h1 + wrap(h2 - h1) * l1 / (l1 + l2),
+        (Some((_, h)), None) | (None, Some((_, h))) => h,
+        (None, None) => 0.0,
     }
-    let mut after = vec![None; n];
-    for i in (0..n.saturating_sub(1)).rev() {
-        after[i] = legs[i].or(after[i + 1]);
-    }
-    (0..n)
-        .map(|i| match (before[i], after[i]) {
-            (Some((l1, h1)), Some((l2, h2))) => h1 + wrap(h2 - h1) * l1 / (l1 + l2),
-            (Some((_, h)), None) | (None, Some((_, h))) => h,
-            (None, None) => 0.0,
-        })
-        .collect()
 }
 
 /// The heading `u` of the way (in `[0, 1]`) along leg `i` (`points[i - 1] → points[i]`) of a
-/// polyline with vertex tangents `tangents` ([`vertex_tangents`]): interpolated between the
-/// two vertices' tangents the short way round, so it is continuous along the polyline and
-/// turns at a constant rate along each leg (on a sampled arc of curvature `κ`, `κ` rad per
-/// metre).
+/// polyline with vertex tangents `tangents` ([`vertex_tangents`]): [`heading_between`] the
+/// two vertices' tangents.
 pub(crate) fn heading_on_leg(tangents: &[f64], i: usize, u: f64) -> f64 {
-    let (a, b) = (tangents[i - 1], tangents[i]);
+    heading_between(tangents[i - 1], tangents[i], u)
+}
+
+/// The heading `u` of the way (in `[0, 1]`) from tangent `a` to tangent `b` (rad), the short
+/// way round: continuous along a polyline, turning at a constant rate along each leg (on a
+/// sampled arc of curvature `κ`, `κ` rad per metre).
+pub(crate) fn heading_between(a: f64, b: f64, u: f64) -> f64 {
     wrap(a + u * wrap(b - a))
 }
 
@@ -448,12 +449,12 @@ pub(crate) fn sample(curve: &[(Pose2, RefLine)]) -> Vec<[f64; 2]> {
             stations.insert(1, TANGENT_GUARD_M);
         }
         let skip = usize::from(!out.is_empty());
-        out.extend(
-            stations
-                .into_iter()
-                .skip(skip)
-                .map(|s| pose.apply(arc_point(line, s))),
-        );
+        // `Pose2::apply` with its rotation worked out once.
+        let (sin, cos) = pose.heading_rad.sin_cos();
+        out.extend(stations.into_iter().skip(skip).map(|s| {
+            let [x, z] = arc_point(line, s);
+            [pose.x + x * cos + z * sin, pose.z - x * sin + z * cos]
+        }));
     }
     out
 }

@@ -20,6 +20,8 @@ mod surface;
 
 pub use curve::{Frame, RefLine, SampledLine, POLYLINE_STEP_M};
 pub use geometry::{direction, wrap, Pose2};
+pub(crate) use lanes::{heading_between, tangent_at};
+#[cfg(test)]
 pub(crate) use lanes::{heading_on_leg, vertex_tangents};
 pub use lanes::{LanePath, Turn, MIN_PATH_RADIUS_M};
 pub use map::{MapIndex, MapLane, MapRef, MapRoad, RoadMap};
