@@ -57,6 +57,23 @@ pub fn with_temp<E: std::fmt::Display>(
     tmp_path.persist(path).map_err(|e| Error::write(path, e))
 }
 
+/// Removes the temporary files ([`with_temp`]'s `.paracosm-*`) that a writer of `dir` killed
+/// mid-write left there. Call it holding the folder's lock ([`crate::lock`]), so that no other
+/// writer's temporary file is taken. Only regular files are removed (a link planted under such
+/// a name is left, and never followed); a file that cannot be removed is left as it is.
+pub fn remove_stale_temps(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let ours = name.to_string_lossy().starts_with(".paracosm-");
+        if ours && e.file_type().is_ok_and(|t| t.is_file()) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
 /// What `path` names when it is not a regular file: "a symlink", "a directory", "a device or
 /// a FIFO"; `None` when it is a regular file or absent (or cannot be looked at: the write then
 /// reports why).

@@ -457,6 +457,7 @@ impl CampaignFile {
     /// and column).
     pub fn read(dir: &Path) -> Result<CampaignFile, crate::Error> {
         let path = dir.join(CAMPAIGN_FILE);
+        paracosm_engine::files::regular_file(&path).map_err(|e| crate::Error::input(&path, e))?;
         let text = std::fs::read_to_string(&path).map_err(|e| crate::Error::input(&path, e))?;
         serde_json::from_str(&text).map_err(|e| {
             let message = format!(

@@ -52,6 +52,8 @@ pub fn replay_command_for(out: &Path, id: &str) -> String {
 
 /// The line of `results` whose `id` is `id`.
 fn find_record(results: &Path, id: u64) -> Result<(usize, String), Error> {
+    paracosm_engine::files::regular_file(results)
+        .map_err(|e| input(format!("cannot read `{}`: {e}", results.display())))?;
     let text = std::fs::read_to_string(results)
         .map_err(|e| input(format!("cannot read `{}`: {e}", results.display())))?;
     let mut ids = Vec::new();

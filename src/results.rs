@@ -35,6 +35,7 @@ pub fn load(
     let space = &scenario.space;
     let passive = scenario.passive_monitors();
     let path = dir.join(RESULTS_FILE);
+    paracosm_engine::files::regular_file(&path).map_err(|e| Error::input(&path, e))?;
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
@@ -95,6 +96,7 @@ pub fn load(
 /// [`Error::Input`] when the file cannot be read.
 pub fn whole_lines(src: &Path) -> Result<Vec<u8>, Error> {
     let path = src.join(RESULTS_FILE);
+    paracosm_engine::files::regular_file(&path).map_err(|e| Error::input(&path, e))?;
     let mut bytes = std::fs::read(&path).map_err(|e| Error::input(&path, e))?;
     let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
     bytes.truncate(whole);

@@ -259,6 +259,10 @@ pub fn run(
     prepare_out_dir(out, request.replace, request.resume)?;
     // One writer per folder, from here to the end of the run (crate::lock).
     let _lock = crate::lock::CampaignLock::acquire(out)?;
+    if request.resume {
+        // Ours alone now: what an earlier writer killed mid-write left is stale.
+        crate::atomic::remove_stale_temps(out);
+    }
     if stored.is_none() {
         file.write(out)?;
     }
@@ -669,6 +673,7 @@ fn read_points(
             "--points chooses the tests, so --strategy {s} cannot be used with it"
         )));
     }
+    paracosm_engine::files::regular_file(path).map_err(|e| Error::input(path, e))?;
     let bytes = std::fs::read(path).map_err(|e| Error::input(path, e))?;
     let text = String::from_utf8(bytes.clone())
         .map_err(|e| Error::malformed(path, format!("{}: not UTF-8 text: {e}", path.display())))?;
@@ -719,15 +724,17 @@ pub fn prepare_out_dir(out: &Path, replace: bool, resume: bool) -> Result<(), Er
             out.display()
         ))
     })?;
-    // Probe writability now, before any test runs.
-    let probe = out.join(".paracosm-write-probe");
-    std::fs::write(&probe, b"").map_err(|e| {
-        Error::BadInput(format!(
-            "cannot write to output folder `{}`: {e}",
-            out.display()
-        ))
-    })?;
-    let _ = std::fs::remove_file(&probe);
+    // Probe writability now, before any test runs: a new file of a fresh name (created
+    // exclusively, so a link planted in the folder is never followed), removed at once.
+    tempfile::Builder::new()
+        .prefix(".paracosm-probe-")
+        .tempfile_in(out)
+        .map_err(|e| {
+            Error::BadInput(format!(
+                "cannot write to output folder `{}`: {e}",
+                out.display()
+            ))
+        })?;
     Ok(())
 }
 

@@ -146,6 +146,7 @@ impl Summary {
     /// (with its line and column).
     pub fn read(dir: &std::path::Path) -> Result<Summary, crate::Error> {
         let path = dir.join(SUMMARY_FILE);
+        paracosm_engine::files::regular_file(&path).map_err(|e| crate::Error::input(&path, e))?;
         let text = std::fs::read_to_string(&path).map_err(|e| crate::Error::input(&path, e))?;
         serde_json::from_str(&text).map_err(|e| {
             let message = format!(

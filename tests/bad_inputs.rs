@@ -89,7 +89,7 @@ fn bad_scenario_programs() {
     }
     // A folder given as the scenario.
     let o = run("fuzz", &["tests/bad_inputs/scenarios".into()]);
-    assert_refused("a folder", &o, &["Is a directory"]);
+    assert_refused("a folder", &o, &["is a directory, not a regular file"]);
 }
 
 /// A program in `dir` that loads the map at `map` and places the ego on its road "1".

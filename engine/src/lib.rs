@@ -21,6 +21,7 @@ mod contact;
 mod control;
 mod environment;
 mod error;
+pub mod files;
 pub mod network;
 mod obstacle;
 mod pedestrian;

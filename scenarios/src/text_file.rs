@@ -9,14 +9,16 @@ pub const MAX_SOURCE_BYTES: u64 = 64 << 20;
 /// Largest data file (a CSV of points) read, bytes (1 GiB).
 pub const MAX_DATA_BYTES: u64 = 1 << 30;
 
-/// Reads `path` as UTF-8 text of at most `limit` bytes. A device such as `/dev/zero` is
-/// read up to the limit, never to its end.
+/// Reads `path` as UTF-8 text of at most `limit` bytes. A path that is not a regular file
+/// (a FIFO, which would block; a device; a directory) is refused before it is opened.
 ///
 /// # Errors
 /// A message (without the path, which the caller adds with its own location format):
-/// the I/O error; "larger than the limit of N MiB"; or "not UTF-8: the first bad byte
-/// (0xNN) is at line L, column C".
+/// "is a FIFO, not a regular file" ([`paracosm_engine::files::regular_file`]); the I/O
+/// error; "larger than the limit of N MiB"; or "not UTF-8: the first bad byte (0xNN) is at
+/// line L, column C".
 pub fn read_text(path: &Path, limit: u64) -> Result<String, String> {
+    paracosm_engine::files::regular_file(path)?;
     let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
     let mut bytes = Vec::new();
     file.take(limit + 1)

@@ -491,12 +491,16 @@ fn generate_array(
     output: Option<&std::path::Path>,
 ) -> Result<()> {
     use paracosm_generators::covering::{ipog_with, random_kwise_with, random_until_covered_with};
+    paracosm_engine::files::regular_file(model)
+        .map_err(|e| bad(format!("cannot read `{}`: {e}", model.display())))?;
     let text = std::fs::read_to_string(model)
         .map_err(|e| bad(format!("cannot read `{}`: {e}", model.display())))?;
     let m = paracosm::cover::parse_pict(&model.display().to_string(), &text).map_err(bad)?;
     let levels = m.levels();
     let seed_rows = match seeds {
         Some(path) => {
+            paracosm_engine::files::regular_file(path)
+                .map_err(|e| bad(format!("cannot read `{}`: {e}", path.display())))?;
             let text = std::fs::read_to_string(path)
                 .map_err(|e| bad(format!("cannot read `{}`: {e}", path.display())))?;
             paracosm::cover::read_seeds(&m, &path.display().to_string(), &text).map_err(bad)?

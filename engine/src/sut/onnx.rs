@@ -340,6 +340,10 @@ impl OnnxConfig {
     /// outputs.
     pub fn load(model: &Path) -> Result<OnnxConfig, String> {
         let manifest_file = manifest_path(model);
+        for f in [model, manifest_file.as_path()] {
+            crate::files::regular_file(f)
+                .map_err(|e| format!("cannot read `{}`: {e}", f.display()))?;
+        }
         let bytes = std::fs::read(model)
             .map_err(|e| format!("cannot read the model `{}`: {e}", model.display()))?;
         let text = std::fs::read_to_string(&manifest_file).map_err(|e| {
