@@ -78,17 +78,8 @@ pub fn remove_stale_temps(dir: &Path) {
 /// a FIFO"; `None` when it is a regular file or absent (or cannot be looked at: the write then
 /// reports why).
 fn not_regular(path: &Path) -> Option<&'static str> {
-    let meta = std::fs::symlink_metadata(path).ok()?;
-    let t = meta.file_type();
-    if t.is_file() {
-        None
-    } else if t.is_symlink() {
-        Some("a symbolic link")
-    } else if t.is_dir() {
-        Some("a directory")
-    } else {
-        Some("a device, FIFO or socket")
-    }
+    // The link itself, not what it points to: a rename would replace the link.
+    paracosm_engine::files::kind_of(&std::fs::symlink_metadata(path).ok()?.file_type())
 }
 
 /// Checks that an output path may be replaced by a rename: it is absent or a regular file.

@@ -284,3 +284,35 @@ fn bad_command_lines() {
     }
     assert!(n >= 30, "{n} cases");
 }
+
+/// A sum of 290 terms (under the expression depth limit of 300) loads and runs its tests on
+/// the worker threads; 1,000 terms (`scenarios/long_sum.star`) is refused at load.
+#[test]
+fn a_long_expression_under_the_depth_limit_runs_on_the_workers() {
+    let tmp = tempfile::tempdir().unwrap();
+    let program = tmp.path().join("sum.star");
+    let sum = vec!["x"; 290].join(" + ");
+    std::fs::write(
+        &program,
+        format!(
+            "x = VarInterval(1.0, 2.0, unit = \"m\")\ny = {sum}\nw = World(light = 0.5, fog = 0.0)\nr = RoadSegment(len = 200.0 + y * 0.0, nlanes = 2)\nv = AutonomousVehicle(loc = r.onLane(1, 10), sut = \"aeb\")\nw.place(r, v)\nCollisionMonitor(v)\ntest(horizon = 1.0)\n"
+        ),
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let o = run(
+        "fuzz",
+        &[
+            program.display().to_string(),
+            "--budget".into(),
+            "4".into(),
+            "--jobs".into(),
+            "2".into(),
+            "--out".into(),
+            out.display().to_string(),
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let lines = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+    assert_eq!(lines.lines().count(), 4);
+}

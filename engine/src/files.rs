@@ -9,8 +9,14 @@ use std::path::Path;
 /// device"`, `"a block device"`, `"a socket"`; `None` for a regular file (links followed) and
 /// for a path that cannot be looked at (absent, no permission: opening it then says why).
 pub fn not_regular(path: &Path) -> Option<&'static str> {
+    kind_of(&std::fs::metadata(path).ok()?.file_type())
+}
+
+/// What a file of type `t` is when it is not a regular file (`"a directory"`, `"a FIFO"`,
+/// `"a character device"`, `"a block device"`, `"a socket"`, `"a symbolic link"` for a link
+/// itself); `None` for a regular file.
+pub fn kind_of(t: &std::fs::FileType) -> Option<&'static str> {
     use std::os::unix::fs::FileTypeExt;
-    let t = std::fs::metadata(path).ok()?.file_type();
     if t.is_file() {
         None
     } else if t.is_dir() {
@@ -23,6 +29,8 @@ pub fn not_regular(path: &Path) -> Option<&'static str> {
         Some("a block device")
     } else if t.is_socket() {
         Some("a socket")
+    } else if t.is_symlink() {
+        Some("a symbolic link")
     } else {
         Some("not a regular file")
     }

@@ -181,6 +181,20 @@ fn the_ego_brakes_no_harder_than_mu_g_nor_than_its_brakes() {
     // ice, 0.1): the friction circle held by `hold_to_grip` keeps it to μ·g.
     // The chassis' linear damping, 0.02 /s, adds 0.02·v: at most 0.22 m/s² from 11 m/s.
     let g = 9.81;
+    // LANGUAGE.md gives the figure on ice as measured: it must be this one.
+    let docs = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../LANGUAGE.md"),
+    )
+    .unwrap()
+    .split_whitespace()
+    .collect::<Vec<_>>()
+    .join(" ");
+    let ice = format!(
+        "measured {:.2} with the body's air drag",
+        ego_deceleration(0.1)
+    );
+    assert!(docs.contains(&ice), "LANGUAGE.md does not say \"{ice}\"");
+    assert!(docs.contains("the default friction 0.8 included (7.85 m/s²)"));
     for mu in [0.1, 0.3, 0.5] {
         let a = ego_deceleration(mu);
         eprintln!("μ = {mu}: {a:.3} m/s²");

@@ -211,6 +211,23 @@ def test_program_errors_name_the_file_line_and_column(tmp_path):
         paracosm.Scenario("no-such-scenario")
 
 
+def test_a_too_deep_expression_is_a_value_error_not_a_crash(tmp_path):
+    # 1,000 terms loaded, then Scenario.run killed the interpreter (SIGSEGV) on a worker's
+    # stack; refused at load now, naming the line.
+    program = tmp_path / "sum.star"
+    terms = " + ".join(["x"] * 1000)
+    program.write_text(
+        'x = VarInterval(1.0, 2.0, unit = "m")\n'
+        f"y = {terms}\n"
+        "w = World(light = 0.5, fog = 0.0)\n"
+        "r = RoadSegment(len = 200.0 + y * 0.0, nlanes = 2)\n"
+        'v = AutonomousVehicle(loc = r.onLane(1, 10), sut = "aeb")\n'
+        "w.place(r, v)\n"
+    )
+    with pytest.raises(ValueError, match=rf"limit of 300[\s\S]*{program}:2:5"):
+        paracosm.Scenario(program)
+
+
 def test_load_warnings_are_issued(tmp_path):
     program = tmp_path / "unused.star"
     program.write_text(

@@ -43,6 +43,11 @@ pub const MAX_CALL_DEPTH: usize = 200;
 /// once per level and would overflow the stack (an abort, not an error) near 10,000 levels.
 pub const MAX_NESTING: usize = 100;
 
+/// Deepest an expression may nest, operators and calls included (`y = x + x + … + x` with
+/// 1,000 terms nests 999 deep): a test evaluates the program on a worker thread, whose 2 MiB
+/// stack held 600 and overflowed at 1,000, aborting the process. Refused at load instead.
+pub const MAX_EXPR_DEPTH: usize = 300;
+
 fn lambda_name(n: u32) -> String {
     // Not an identifier, so no program can read or overwrite it.
     format!("lambda#{n}")
@@ -291,6 +296,18 @@ fn load_with_base(
     })?;
     let ast = AstModule::parse(file, source.to_owned(), &dialect)
         .map_err(|e| lang(with_set_hint(format!("{e}"), file, source)))?;
+    if let Some((depth, at)) = names::deepest_expression(&ast, MAX_EXPR_DEPTH) {
+        return Err(lang(with_source_lines(
+            &format!(
+                "error: an expression nests {depth} operations deep, more than the limit of \
+                 {MAX_EXPR_DEPTH} (each test evaluates it on a worker thread whose stack it \
+                 would overflow): split it over several variables (`a = x + x`, then \
+                 `b = a + a`)\n --> {file}:{at}"
+            ),
+            file,
+            source,
+        )));
+    }
     program::load(file, source, name, ast, globals(), base).map_err(|e| match e {
         ScenarioError::Language(m) => ScenarioError::Language(with_source_lines(&m, file, source)),
         other => other,

@@ -11,6 +11,40 @@ use starlark_syntax::syntax::ast::{
 };
 use starlark_syntax::syntax::uniplate::Visit;
 
+/// The first expression of the program that nests deeper than `limit` (operators, calls,
+/// subscripts...: each level an expression inside another), with its depth (as far as it was
+/// followed: the walk stops past the limit) and its `line:col`; `None` when none does.
+pub fn deepest_expression(ast: &AstModule, limit: usize) -> Option<(usize, String)> {
+    fn expr(e: &AstExpr, limit: usize) -> usize {
+        let mut deepest = 0;
+        e.visit_expr(|c| {
+            if deepest <= limit {
+                deepest = deepest.max(expr(c, limit));
+            }
+        });
+        deepest + 1
+    }
+    fn stmt(s: &AstStmt, limit: usize, found: &mut Option<(usize, AstExpr)>) {
+        s.visit_children(|v| {
+            if found.is_some() {
+                return;
+            }
+            match v {
+                Visit::Stmt(s) => stmt(s, limit, found),
+                Visit::Expr(e) => {
+                    let d = expr(e, limit);
+                    if d > limit {
+                        *found = Some((d, e.clone()));
+                    }
+                }
+            }
+        });
+    }
+    let mut found = None;
+    stmt(ast.statement(), limit, &mut found);
+    found.map(|(d, e)| (d, format!("{}", ast.file_span(e.span).resolve_span().begin)))
+}
+
 /// The builtins that declare open parameters.
 const DECLARERS: [&str; 2] = ["VarInterval", "VarEnum"];
 
