@@ -134,6 +134,20 @@ fn a_model_drives_the_ego_and_a_nan_answer_ends_only_its_test() {
         assert!(e.contains("NaN for throttle"), "{e}");
         assert!(e.contains("nan.onnx"), "{e}");
     }
+    // A throttle of 1.7, outside [-1, 1]: an error as for an external system (it was clamped
+    // to 1 without a word).
+    let wild = write_model(
+        dir.path(),
+        "wild",
+        &model([1.7, 0.0], 8, 16, false),
+        Some(MANIFEST),
+    );
+    let records = campaign_records(SutConfig::onnx(&wild).unwrap(), 2, 1);
+    for r in &records {
+        assert_eq!(r.status, Status::Error);
+        let e = r.error.as_deref().unwrap();
+        assert!(e.contains("1.7") && e.contains("outside [-1, 1]"), "{e}");
+    }
 }
 
 #[test]
@@ -155,11 +169,17 @@ fn bad_models_and_manifests_are_refused_with_the_file() {
         let e = err(&path);
         assert!(wanted.iter().all(|w| e.contains(w)), "{name}: {e}");
     };
-    // The model takes 8 × 16; the manifest promises 48 × 96.
+    // The model takes 8 × 16; the manifest promises 48 × 96: refused from the input the
+    // model declares, before tract is given the manifest's (it ran a model declaring
+    // [1, 1, 10, 10] on [1, 3, 48, 96]).
     refused(
         "shape",
         MANIFEST.replace("width = 16\nheight = 8", "width = 96\nheight = 48"),
-        &["shape.onnx", "[1, 3, 48, 96]"],
+        &[
+            "shape.onnx",
+            "declares its input of shape [1, 3, 8, 16]",
+            "[1, 3, 48, 96]",
+        ],
     );
     // An unknown key, with its line and column.
     refused(

@@ -380,6 +380,7 @@ impl OnnxConfig {
                 }
             ));
         }
+        declared_input_matches(&model, source, &shape)?;
         model = model
             .with_input_fact(0, f32::fact(shape).into())
             .map_err(|e| fail("input", e))?;
@@ -527,30 +528,93 @@ impl OnnxSut {
             .config
             .run(&self.config.tensor(&frames), speed_mps as f32)
             .map_err(|e| SutError::Failed(format!("model `{}`: {e}", self.config.source)))?;
-        let read = |i: Option<usize>, what: &str| -> Result<Option<f64>, SutError> {
+        // `bounded`: a control the model gives directly, in [-1, 1] (an external system
+        // answering outside it gets `error` too; clamping it would hide a broken model).
+        let read = |i: Option<usize>, what: &str, bounded: bool| -> Result<Option<f64>, SutError> {
             match i.map(|i| f64::from(y[i])) {
-                Some(v) if !v.is_finite() => Err(SutError::Failed(format!(
-                    "model `{}` answered {v} for {what} (output {}) at t = {:.3} s",
-                    self.config.source,
-                    i.unwrap_or(0),
-                    frame.t_s
-                ))),
+                Some(v) if !v.is_finite() || (bounded && v.abs() > 1.0 + 1e-6) => {
+                    Err(SutError::Failed(format!(
+                        "model `{}` answered {v} for {what} (output {}) at t = {:.3} s{}",
+                        self.config.source,
+                        i.unwrap_or(0),
+                        frame.t_s,
+                        if v.is_finite() {
+                            ", outside [-1, 1]"
+                        } else {
+                            ""
+                        }
+                    )))
+                }
                 v => Ok(v),
             }
         };
         let o = &m.output;
-        let steering = read(o.steering, "steering")?.unwrap_or(0.0);
-        let throttle = match (read(o.throttle, "throttle")?, o.cruise_mps) {
+        let steering = read(o.steering, "steering", true)?.unwrap_or(0.0);
+        let throttle = match (read(o.throttle, "throttle", true)?, o.cruise_mps) {
             (Some(t), _) => t,
             (None, Some(target)) => super::Cruise::default().throttle(speed_mps, target, None),
             (None, None) => 0.0,
         };
-        let braking = read(o.brake, "brake")?.is_some_and(|b| b > o.brake_threshold);
+        let braking = read(o.brake, "brake", false)?.is_some_and(|b| b > o.brake_threshold);
         Ok(Control {
             throttle: if braking { -1.0 } else { throttle },
             steering,
         }
         .clamped())
+    }
+}
+
+/// Checks the image input a model declares (element type and the dimensions it fixes)
+/// against the manifest's `shape`: tract runs a model on whatever input fact it is given, so a
+/// model declaring `[1, 1, 10, 10]` ran on `[1, 3, 48, 96]`. Dimensions the model leaves open
+/// (a symbolic batch) take the manifest's.
+///
+/// # Errors
+/// A message naming the model, what it declares and what its manifest says.
+fn declared_input_matches(
+    model: &tract_onnx::prelude::InferenceModel,
+    source: &str,
+    shape: &[usize],
+) -> Result<(), String> {
+    use tract_onnx::prelude::DatumType;
+    use tract_onnx::tract_core::internal::DimLike;
+    use tract_onnx::tract_hir::infer::Factoid;
+    let fact = model
+        .input_fact(0)
+        .map_err(|e| format!("model `{source}`: no input: {e:#}"))?;
+    if let Some(t) = fact.datum_type.concretize() {
+        if t != DatumType::F32 {
+            return Err(format!(
+                "model `{source}` declares its input of type {t:?}; paracosm feeds it f32 \
+                 images (its manifest's [input])"
+            ));
+        }
+    }
+    if fact.shape.is_open() {
+        return Ok(());
+    }
+    let declared: Vec<Option<usize>> = fact
+        .shape
+        .dims()
+        .map(|d| d.concretize().and_then(|d| d.as_usize()))
+        .collect();
+    let fits = declared.len() == shape.len()
+        && declared
+            .iter()
+            .zip(shape)
+            .all(|(d, &s)| d.is_none_or(|d| d == s));
+    if fits {
+        Ok(())
+    } else {
+        let show: Vec<String> = declared
+            .iter()
+            .map(|d| d.map_or("?".to_owned(), |d| d.to_string()))
+            .collect();
+        Err(format!(
+            "model `{source}` declares its input of shape [{}], and its manifest describes \
+             {shape:?} (camera, crop and channels): they must agree",
+            show.join(", ")
+        ))
     }
 }
 
