@@ -35,19 +35,46 @@ pub fn results(data: &[u8]) {
     let _ = crate::cover::parse_tests("fuzz.jsonl", s, true, Some(study_space()));
 }
 
-/// A scenario program, or (an input that starts with `<`) an OpenDRIVE map as
-/// `OpenDrive(...)` reads it: checked, baked, and its surface indexed.
+/// A scenario program, or (an input that starts with `<`) an OpenDRIVE map ([`opendrive`]).
 pub fn scenario(data: &[u8]) {
     let Some(s) = text(data) else { return };
     if s.trim_start().starts_with('<') {
-        if let Ok(imported) = paracosm_engine::network::opendrive::import("fuzz.xodr", s) {
-            let mut network = paracosm_engine::Network::new();
-            if network.add_map("OpenDrive fuzz", imported.map, 0.8).is_ok() {
-                let surface = paracosm_engine::network::Surface::new(&network);
-                let _ = surface.edge_distance_m([0.0, 0.0]);
-            }
-        }
+        opendrive(data);
         return;
     }
     let _ = paracosm_scenarios::lang::load_source("fuzz.star", s, "fuzz");
+}
+
+/// An OpenDRIVE map as `OpenDrive(...)` reads it: checked, baked, its surface indexed, and a
+/// route of up to 200 m planned from the middle of each of its first 16 driving lanes, each
+/// turn taken in turn (the `opendrive` fuzz target; the repository's maps are its seeds).
+pub fn opendrive(data: &[u8]) {
+    use paracosm_engine::network::Turn;
+    let Some(s) = text(data) else { return };
+    let Ok(imported) = paracosm_engine::network::opendrive::import("fuzz.xodr", s) else {
+        return;
+    };
+    let map = imported.map.clone();
+    let mut network = paracosm_engine::Network::new();
+    if network
+        .add_map("OpenDrive fuzz", imported.map, 0.8)
+        .is_err()
+    {
+        return;
+    }
+    let surface = paracosm_engine::network::Surface::new(&network);
+    let _ = surface.edge_distance_m([0.0, 0.0]);
+    let turns = [Turn::Straight, Turn::Left, Turn::Right];
+    for (i, lane) in map
+        .lanes
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.drivable)
+        .take(16)
+    {
+        let (Some(first), Some(last)) = (lane.s.first(), lane.s.last()) else {
+            continue;
+        };
+        let _ = map.route(i, 0.5 * (first + last), &turns[i % 3..i % 3 + 1], 200.0);
+    }
 }

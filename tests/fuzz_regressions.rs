@@ -8,10 +8,11 @@ use std::path::Path;
 fn kept_fuzz_inputs_no_longer_crash() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions");
     type Target = fn(&[u8]);
-    let targets: [(&str, Target); 3] = [
+    let targets: [(&str, Target); 4] = [
         ("inputs", paracosm::fuzz::inputs),
         ("results", paracosm::fuzz::results),
         ("scenario", paracosm::fuzz::scenario),
+        ("opendrive", paracosm::fuzz::opendrive),
     ];
     let mut n = 0;
     for (target, run) in targets {
