@@ -49,6 +49,10 @@ fn sut_config(
             if words.is_empty() {
                 return Err(value_error("sut: the command is empty"));
             }
+            // As the CLI's --sut-cmd: a program that cannot start is refused before any test
+            // (it gave every test an error record).
+            paracosm_engine::sut::check_command(&words)
+                .map_err(|e| value_error(format!("sut: {e}")))?;
             if !(timeout_s.is_finite() && timeout_s > 0.0) {
                 return Err(value_error(format!(
                     "sut_timeout {timeout_s} must be a positive number of seconds"

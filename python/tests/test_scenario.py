@@ -384,6 +384,10 @@ def test_an_external_system_under_test_runs_from_python():
     crash = s.run(x[:2], sut=[sys.executable, str(repo / "tests" / "sut_faults" / "crash.py")])
     assert list(crash["status"]) == ["error", "error"]
     assert "controller exploded" in crash["error"][0]
+    # A program that cannot start is refused before any test, as the CLI's --sut-cmd is (it
+    # gave every test an error record).
+    with pytest.raises(ValueError, match="cannot start `/nonexistent`"):
+        s.run(x[:2], sut=["/nonexistent"])
 
 
 def test_learned_systems_under_test_run_from_python(tmp_path):
