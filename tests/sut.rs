@@ -357,3 +357,66 @@ fn a_wrapper_script_and_the_helper_it_starts_are_killed_with_their_test() {
     }
     assert!(alive.is_empty(), "helpers left running: {alive:?}");
 }
+
+/// The children of process `pid` (every thread's, from `/proc`).
+fn children(pid: u32) -> Vec<String> {
+    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
+        return Vec::new();
+    };
+    tasks
+        .flatten()
+        .filter_map(|t| std::fs::read_to_string(t.path().join("children")).ok())
+        .flat_map(|c| c.split_whitespace().map(str::to_owned).collect::<Vec<_>>())
+        .collect()
+}
+
+#[test]
+fn the_system_under_test_dies_with_paracosm_killed_by_sigkill() {
+    // Its own process group kept it alive after `kill -9` of paracosm (2 orphans per run): it
+    // now asks the kernel to kill it when paracosm goes (PR_SET_PDEATHSIG).
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let mut run = std::process::Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .args([
+            "pedestrian-crossing",
+            "--budget",
+            "100000",
+            "--jobs",
+            "2",
+            "--sut-cmd",
+            &script("examples/python/paracosm_sut.py"),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut suts = Vec::new();
+    for _ in 0..300 {
+        suts = children(run.id());
+        if !suts.is_empty() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    assert!(!suts.is_empty(), "no system under test started within 30 s");
+    // Let it run a few tests, then kill paracosm as a scheduler or a user would.
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    suts = children(run.id());
+    run.kill().unwrap();
+    run.wait().unwrap();
+    let mut alive: Vec<String> = suts;
+    for _ in 0..100 {
+        alive.retain(|p| !gone(p));
+        if alive.is_empty() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    assert!(
+        alive.is_empty(),
+        "systems under test left running: {alive:?}"
+    );
+}

@@ -65,6 +65,68 @@ pub fn check_command(command: &[String]) -> Result<(), String> {
     ))
 }
 
+/// A command to start and where to send the started child.
+type SpawnRequest = (Command, mpsc::Sender<std::io::Result<Child>>);
+
+/// Starts `command` so that the process dies with paracosm, however paracosm dies (`kill -9`
+/// included): the child asks the kernel for `SIGKILL` when its parent goes
+/// (`PR_SET_PDEATHSIG`, Linux). The kernel sends it when the *thread* that started the child
+/// ends, and the external processes are shared between the worker threads (a pool), so every
+/// one is started by a single thread that lives as long as paracosm. Whatever the program
+/// starts in turn (a wrapper's child) is not covered: a wrapper should `exec` its program.
+///
+/// # Errors
+/// The I/O error of the start (no such program, no permission).
+fn spawn_dying_with_us(mut command: Command) -> std::io::Result<Child> {
+    use std::os::unix::process::CommandExt;
+    use std::sync::OnceLock;
+    static SPAWNER: OnceLock<Mutex<mpsc::Sender<SpawnRequest>>> = OnceLock::new();
+    let parent = std::process::id() as libc::pid_t;
+    // SAFETY: the closure runs in the child between fork and exec and calls only prctl(2)
+    // and getppid(2), which are async-signal-safe; it allocates nothing.
+    unsafe {
+        command.pre_exec(move || {
+            if libc::prctl(
+                libc::PR_SET_PDEATHSIG,
+                libc::SIGKILL as libc::c_ulong,
+                0,
+                0,
+                0,
+            ) == -1
+            {
+                return Err(std::io::Error::last_os_error());
+            }
+            // The parent may have died before the request: then no signal would come.
+            if libc::getppid() != parent {
+                return Err(std::io::Error::from_raw_os_error(libc::ESRCH));
+            }
+            Ok(())
+        });
+    }
+    let spawner = SPAWNER.get_or_init(|| {
+        let (tx, rx) = mpsc::channel::<SpawnRequest>();
+        std::thread::Builder::new()
+            .name("paracosm-sut-spawner".into())
+            .spawn(move || {
+                // Never returns while paracosm runs: the sender lives in the static.
+                for (mut command, reply) in rx {
+                    let _ = reply.send(command.spawn());
+                }
+            })
+            .expect("a thread to start the systems under test");
+        Mutex::new(tx)
+    });
+    let (reply, started) = mpsc::channel();
+    spawner
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .send((command, reply))
+        .map_err(|_| std::io::Error::other("the spawner thread is gone"))?;
+    started
+        .recv()
+        .map_err(|_| std::io::Error::other("the spawner thread is gone"))?
+}
+
 /// Kills every process of the process group `pgid` (the system under test and what it
 /// started); a group already gone is not an error.
 fn kill_group(pgid: u32) {
@@ -219,14 +281,15 @@ impl Process {
             .ok_or_else(|| "the command is empty".to_string())?;
         use std::os::unix::process::CommandExt;
         // Its own process group, so that it and everything it starts can be killed at once.
-        let mut child = Command::new(program)
+        let mut command = Command::new(program);
+        command
             .args(args)
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
-            .process_group(0)
-            .spawn()
-            .map_err(|e| format!("cannot start `{program}`: {e}"))?;
+            .process_group(0);
+        let mut child =
+            spawn_dying_with_us(command).map_err(|e| format!("cannot start `{program}`: {e}"))?;
         let stdin = child.stdin.take().expect("piped");
         let stdout = child.stdout.take().expect("piped");
         let mut err_pipe = child.stderr.take().expect("piped");
