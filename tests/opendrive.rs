@@ -443,3 +443,100 @@ fn a_turn_a_map_fork_lacks_is_refused() {
         );
     }
 }
+
+/// `text` with every `<geometry>`'s `x` and `y` attributes moved by `by`, OpenDRIVE m.
+fn moved_map(text: &str, by: [f64; 2]) -> String {
+    let mut out = String::new();
+    for (i, part) in text.split("<geometry ").enumerate() {
+        if i == 0 {
+            out.push_str(part);
+            continue;
+        }
+        out.push_str("<geometry ");
+        let end = part.find('>').unwrap();
+        let mut head = part[..end].to_owned();
+        for (k, key) in [" x=\"", " y=\""].into_iter().enumerate() {
+            let at = head.find(key).unwrap() + key.len();
+            let len = head[at..].find('"').unwrap();
+            let v: f64 = head[at..at + len].parse().unwrap();
+            head.replace_range(at..at + len, &format!("{}", v + by[k]));
+        }
+        out.push_str(&head);
+        out.push_str(&part[end..]);
+    }
+    out
+}
+
+/// Hostile input, second round, requirement 2: the same junction study with its map moved to
+/// x = 10^8 m (where an f32 resolves 8 m) gives the same verdicts as at the origin, names the
+/// move in a warning, and exports the ego's start in the file's own coordinates.
+#[test]
+fn a_map_far_from_the_origin_gives_the_verdicts_it_gives_at_the_origin() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/opendrive_junction.star"),
+    )
+    .unwrap();
+    let near = program(&dir.path().join("near"), "junction.star", &src);
+    let far = program(&dir.path().join("far"), "junction.star", &src);
+    let by = [1e8, -2.5e6];
+    let text = std::fs::read_to_string(maps().join("junction.xodr")).unwrap();
+    std::fs::write(
+        dir.path().join("far/maps/junction.xodr"),
+        moved_map(&text, by),
+    )
+    .unwrap();
+    let (out_near, out_far) = (dir.path().join("out-near"), dir.path().join("out-far"));
+    let o = campaign(&near, "24", &out_near);
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("moved by"));
+    let o = campaign(&far, "24", &out_far);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("the map lies 100031.2 km from the origin")
+            && stderr.contains("it is simulated moved by (-100000000, 2500000) m"),
+        "{stderr}"
+    );
+    let (a, b) = (records(&out_near), records(&out_far));
+    assert_eq!(a.len(), 24);
+    let failed = a.iter().filter(|r| r["status"] == "fail").count();
+    assert!(
+        failed > 0 && failed < 24,
+        "{failed} of 24 failed at the origin"
+    );
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x["status"], y["status"], "{x}\n{y}");
+        assert_eq!(x["monitors"], y["monitors"]);
+    }
+    // The export writes the ego's start where the file puts it: 10^8 m east.
+    let first_fail = b.iter().find(|r| r["status"] == "fail").unwrap()["id"]
+        .as_u64()
+        .unwrap();
+    for (out, shift) in [(&out_near, [0.0, 0.0]), (&out_far, by)] {
+        let ex = out.join("export");
+        let o = fuzz(&[
+            "export",
+            out.join("results.jsonl").to_str().unwrap(),
+            "--id",
+            &first_fail.to_string(),
+            "--out",
+            ex.to_str().unwrap(),
+        ]);
+        expect_code(&o, 0);
+        let xosc = std::fs::read_to_string(ex.join(format!("test_{first_fail}.xosc"))).unwrap();
+        let at = xosc.find("<WorldPosition ").unwrap();
+        let el = &xosc[at..at + xosc[at..].find('>').unwrap()];
+        let num = |k: &str| -> f64 {
+            let v = &el[el.find(&format!(" {k}=\"")).unwrap() + k.len() + 3..];
+            v[..v.find('"').unwrap()].parse().unwrap()
+        };
+        // The west arm's lane 1 at s = 45: x = -45 - 6 (the junction's half width), y = -1.75.
+        println!(
+            "export from {}: ego at ({}, {})",
+            out.display(),
+            num("x"),
+            num("y")
+        );
+        assert!((num("x") - shift[0] + 51.0).abs() < 8.0, "{el}");
+        assert!((num("y") - shift[1]).abs() < 8.0, "{el}");
+    }
+}

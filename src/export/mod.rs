@@ -98,6 +98,13 @@ pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
             "the test's network mixes an OpenDRIVE map with other pieces, which cannot be exported as one OpenDRIVE file",
         ));
     };
+    let origin_m = maps
+        .first()
+        .and_then(|k| match k {
+            PieceKind::Map { map, .. } => Some(map.0.origin_m),
+            _ => None,
+        })
+        .unwrap_or([0.0, 0.0]);
     let params: Vec<(String, serde_json::Value)> = replayed.recorded["params"]
         .as_object()
         .map(|m| m.iter().map(|(k, v)| (k.clone(), v.clone())).collect())
@@ -116,6 +123,7 @@ pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
         world: &world,
         states: &states,
         horizon_s: scenario.horizon_s,
+        origin_m,
     });
     let xosc_path = out.join(format!("{stem}.xosc"));
     let xodr_path = out.join(&xodr_name);

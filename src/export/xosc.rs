@@ -41,6 +41,10 @@ pub struct Test<'a> {
     pub states: &'a [Snapshot],
     /// The test's horizon, s.
     pub horizon_s: f64,
+    /// Where the network's origin lies in its file's coordinates, OpenDRIVE `[x, y]` m: a map
+    /// far from the origin is simulated moved (`RoadMap::origin_m`), and the scenario's
+    /// positions are written back in the file's own coordinates. `[0, 0]` for pieces.
+    pub origin_m: [f64; 2],
 }
 
 fn world_position(p: [f64; 3], h: f64) -> El {
@@ -225,6 +229,9 @@ fn sampled(states: &[Snapshot]) -> Vec<&Snapshot> {
 /// The document.
 pub fn write(test: &Test<'_>) -> String {
     let w = test.world;
+    // A simulated world position `[x, y, z]` in the file's frame (OpenDRIVE y is -z).
+    let origin = test.origin_m;
+    let g = |p: [f64; 3]| [p[0] + origin[0], p[1], p[2] - origin[1]];
     let frames = sampled(test.states);
     let Some(first) = test.states.first() else {
         return String::new();
@@ -281,7 +288,7 @@ pub fn write(test: &Test<'_>) -> String {
     let mut init = Vec::new();
     let ego = &first.ego;
     let mut ego_actions = vec![
-        teleport(ego.pos_m, ego.heading_rad),
+        teleport(g(ego.pos_m), ego.heading_rad),
         speed(w.ego.initial_speed_mps),
     ];
     if w.ego.route.len() >= 2 {
@@ -324,7 +331,7 @@ pub fn write(test: &Test<'_>) -> String {
                         .children(waypoints.iter().map(|&(q, h)| {
                             El::new("Waypoint")
                                 .attr("routeStrategy", "shortest")
-                                .child(world_position([q[0], 0.0, q[1]], h))
+                                .child(world_position(g([q[0], 0.0, q[1]]), h))
                         })),
                 ),
             ),
@@ -334,7 +341,7 @@ pub fn write(test: &Test<'_>) -> String {
     for (i, c) in first.cars.iter().enumerate() {
         init.push(private(
             &format!("car{}", i + 1),
-            vec![teleport(c.pos_m, c.heading_rad), speed(c.speed_mps)],
+            vec![teleport(g(c.pos_m), c.heading_rad), speed(c.speed_mps)],
         ));
     }
     for (i, p) in first.pedestrians.iter().enumerate() {
@@ -342,13 +349,13 @@ pub fn write(test: &Test<'_>) -> String {
         let h = (-(s.target[2] - s.start[2])).atan2(s.target[0] - s.start[0]);
         init.push(private(
             &format!("pedestrian{}", i + 1),
-            vec![teleport(p.pos_m, h)],
+            vec![teleport(g(p.pos_m), h)],
         ));
     }
     for (i, o) in first.obstacles.iter().enumerate() {
         init.push(private(
             &format!("obstacle{}", i + 1),
-            vec![teleport(o.base_m, o.heading_rad)],
+            vec![teleport(g(o.base_m), o.heading_rad)],
         ));
     }
 
@@ -358,7 +365,7 @@ pub fn write(test: &Test<'_>) -> String {
         let name = format!("car{}", i + 1);
         let points: Vec<(f64, [f64; 3], f64)> = frames
             .iter()
-            .filter_map(|s| s.cars.get(i).map(|c| (s.t_s, c.pos_m, c.heading_rad)))
+            .filter_map(|s| s.cars.get(i).map(|c| (s.t_s, g(c.pos_m), c.heading_rad)))
             .collect();
         groups.push(maneuver_group(
             &name,
@@ -412,7 +419,7 @@ pub fn write(test: &Test<'_>) -> String {
                             .num("value", d)
                             .attr("relativeDistanceType", "euclidianDistance")
                             .attr("coordinateSystem", "entity")
-                            .child(world_position(start, h)),
+                            .child(world_position(g(start), h)),
                     ),
                 ),
         );

@@ -131,6 +131,11 @@ impl MapLane {
 pub struct RoadMap {
     /// The file it was read from, as the program names it (for messages).
     pub source: String,
+    /// Where the map's origin lies in the file's own coordinates, OpenDRIVE `[x, y]` m: a map
+    /// far from the origin is simulated moved to it (`opendrive::RESOLVED_M`), and exports
+    /// add this back. `[0, 0]` for most maps.
+    #[serde(default)]
+    pub origin_m: [f64; 2],
     /// Its roads.
     pub roads: Vec<MapRoad>,
     /// Its lanes: every lane of every section with a positive width somewhere.

@@ -22,6 +22,16 @@ use roxmltree::{Document, Node};
 
 use super::map::{MapLane, MapRoad, RoadMap};
 
+mod numbers;
+mod overlaps;
+mod recentre;
+
+pub use numbers::{
+    MAX_COORDINATE_M, MAX_CURVATURE_PER_M, MAX_LANES_PER_SIDE, MAX_LANE_WIDTH_M, MAX_ROAD_LENGTH_M,
+};
+pub use overlaps::{END_MARGIN_M, INSIDE_MARGIN_M};
+pub use recentre::RESOLVED_M;
+
 /// Largest distance between consecutive geometry records' end and start, m, and between a
 /// baked centre line and its record's start, before the map is refused as having a gap.
 pub const GEOMETRY_GAP_M: f64 = 0.01;
@@ -34,12 +44,18 @@ pub const MAX_MAP_STATIONS: usize = 500_000;
 
 /// An OpenDRIVE document that cannot be used, with where.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}{}: {message}", .line.map(|l| format!(":{l}")).unwrap_or_default())]
+#[error(
+    "{file}{}{}: {message}",
+    .line.map(|l| format!(":{l}")).unwrap_or_default(),
+    .column.filter(|_| line.is_some()).map(|c| format!(":{c}")).unwrap_or_default()
+)]
 pub struct MapError {
     /// The file, as the program names it.
     pub file: String,
     /// The 1-based line of the element at fault, where known.
     pub line: Option<u32>,
+    /// The 1-based column of the element (or of the attribute's value) at fault, where known.
+    pub column: Option<u32>,
     /// What is wrong, naming the element.
     pub message: String,
 }
@@ -177,9 +193,11 @@ impl Reader<'_> {
     }
 
     fn error(&self, n: Option<Node>, message: String) -> MapError {
+        let pos = n.map(|n| self.doc.text_pos_at(n.range().start));
         MapError {
             file: self.file.to_owned(),
-            line: n.map(|n| self.line(n)),
+            line: pos.map(|p| p.row),
+            column: pos.map(|p| p.col),
             message,
         }
     }
@@ -209,7 +227,8 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
         MapError {
             file: file.to_owned(),
             line: Some(pos.row),
-            message: format!("malformed XML (column {}): {e}", pos.col),
+            column: Some(pos.col),
+            message: format!("malformed XML: {e}"),
         }
     })?;
     let r = Reader { file, doc: &doc };
@@ -224,12 +243,41 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
         ));
     }
     let mut warnings = check_elements(&r, root)?;
+    numbers::check(&r, root)?;
+    warnings.extend(numbers::lane_type_warnings(&r, root));
     check_references(&r)?;
     check_widths(&r)?;
+    // A map far from the origin is moved to it, in its text, before anything evaluates it.
+    let shift = recentre::shift(&r, root)?;
+    let moved;
+    let (doc, text) = match shift {
+        Some(by) => {
+            moved = recentre::apply(&doc, text, by);
+            warnings.push(format!(
+                "{file}: the map lies {:.1} km from the origin, where the f32 physics resolves {:.2} m; it is simulated moved by ({}, {}) m (exports write the file's own coordinates)",
+                by[0].hypot(by[1]) / 1e3,
+                f64::from(f32::EPSILON) * by[0].abs().max(by[1].abs()),
+                -by[0],
+                -by[1]
+            ));
+            let doc = Document::parse(&moved).map_err(|e| MapError {
+                file: file.to_owned(),
+                line: None,
+                column: None,
+                message: format!("the recentred map does not parse: {e}"),
+            })?;
+            (doc, moved.as_str())
+        }
+        None => (doc, text),
+    };
+    let r = Reader { file, doc: &doc };
     let (net, provenance) = xodr::load_str_with_provenance(text).map_err(|e| MapError {
         file: file.to_owned(),
         line: None,
-        message: format!("{e}"),
+        column: None,
+        message: format!(
+            "the xodr crate could not bake the map ({e}): every road was skipped, for a reason paracosm's own checks do not name"
+        ),
     })?;
     for w in &provenance.warnings {
         let debug = format!("{w:?}");
@@ -253,8 +301,11 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
             warnings.push(format!("{w}"));
         }
     }
+    check_self_links(&r, &net)?;
     check_gaps(&r, &net)?;
-    let map = bake(&r, &net, &provenance)?;
+    let mut map = bake(&r, &net, &provenance)?;
+    map.origin_m = shift.unwrap_or([0.0, 0.0]);
+    warnings.extend(overlaps::check(&r, &map)?);
     Ok(Imported {
         map: Arc::new(map),
         warnings,
@@ -404,6 +455,16 @@ fn check_widths(r: &Reader) -> Result<(), MapError> {
                     for j in 0..=16 {
                         let ds = (to - from).max(0.0) * f64::from(j) / 16.0;
                         let v = c[0] + ds * (c[1] + ds * (c[2] + ds * c[3]));
+                        if v > MAX_LANE_WIDTH_M {
+                            return Err(r.error(
+                                Some(*w),
+                                format!(
+                                    "<width> of lane {} on road \"{rid}\" reaches {v:.3e} m at {:.2} m into its stretch; a lane is at most {MAX_LANE_WIDTH_M} m wide",
+                                    lane.attribute("id").unwrap_or("?"),
+                                    ds
+                                ),
+                            ));
+                        }
                         if v < -1e-9 {
                             return Err(r.error(
                                 Some(*w),
@@ -461,6 +522,56 @@ fn check_gaps(r: &Reader, net: &xodr::RoadNetwork) -> Result<(), MapError> {
                         ),
                     ));
                 }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A road linked to itself (a ring) must close: its end meets its start.
+fn check_self_links(r: &Reader, net: &xodr::RoadNetwork) -> Result<(), MapError> {
+    for road in r.roads() {
+        let rid = road.attribute("id").unwrap_or("?");
+        let Some(link) = road.children().find(|n| n.has_tag_name("link")) else {
+            continue;
+        };
+        for end in link.children().filter(Node::is_element) {
+            if end.attribute("elementType") != Some("road")
+                || end.attribute("elementId") != Some(rid)
+            {
+                continue;
+            }
+            let which = end.tag_name().name();
+            let here = if which == "successor" { "end" } else { "start" };
+            let there = end.attribute("contactPoint").unwrap_or("?");
+            if there == here {
+                return Err(r.error(
+                    Some(end),
+                    format!("road \"{rid}\" is its own {which} at its {here}, the end it leaves from: a road cannot lead into itself there"),
+                ));
+            }
+            let Some(baked) = net.road_by_od_id(rid) else {
+                continue;
+            };
+            let at = |s: f64| {
+                net.road_point(xodr::RoadPosition {
+                    road: baked.id(),
+                    s,
+                    t: 0.0,
+                })
+            };
+            let (Some(a), Some(b)) = (at(0.0), at(baked.length())) else {
+                continue;
+            };
+            let gap = (f64::from(a.x) - f64::from(b.x)).hypot(f64::from(a.y) - f64::from(b.y));
+            if gap > 10.0 * GEOMETRY_GAP_M {
+                return Err(r.error(
+                    Some(end),
+                    format!(
+                        "road \"{rid}\" is its own {which}, but its end ({:.2}, {:.2}) is {gap:.2} m from its start ({:.2}, {:.2}): only a closed ring may lead into itself",
+                        b.x, b.y, a.x, a.y
+                    ),
+                ));
             }
         }
     }
@@ -586,6 +697,7 @@ fn bake(
     }
     Ok(RoadMap {
         source: r.file.to_owned(),
+        origin_m: [0.0, 0.0],
         roads,
         lanes,
     })
