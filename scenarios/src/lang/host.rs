@@ -29,6 +29,8 @@ pub struct StarHost<'a, 'v, 'b, 'e> {
     captured: Vec<(String, StreamId)>,
     /// The streams of `captured`, which lambdas read ([`Host::reads`]).
     reads: Vec<StreamId>,
+    /// Who is calling, for the hard heap limit's message ("a lambda, during a test,").
+    phase: &'static str,
 }
 
 impl<'a, 'v, 'b, 'e> StarHost<'a, 'v, 'b, 'e> {
@@ -58,7 +60,16 @@ impl<'a, 'v, 'b, 'e> StarHost<'a, 'v, 'b, 'e> {
             file,
             captured,
             reads,
+            phase: "a lambda, during a test,",
         }
+    }
+
+    /// The same host, calling at load (on sample values) rather than during a test: messages
+    /// say so.
+    #[must_use]
+    pub fn at_load(mut self) -> Self {
+        self.phase = "a lambda, called at load on sample values,";
+        self
     }
 }
 
@@ -140,7 +151,7 @@ impl Host for StarHost<'_, '_, '_, '_> {
             memory::MAX_LAMBDA_HEAP_BYTES,
             memory::HARD_LAMBDA_HEAP_BYTES,
             self.file,
-            "a lambda, during a test,",
+            self.phase,
         );
         let out = self.eval.eval_function(function, &args, &[]);
         let over_heap = memory::over_soft_limit();

@@ -347,7 +347,8 @@ fn lane_of(v: Value) -> anyhow::Result<Lane> {
     // A whole number, also as a float (`nlanes / 2`) or `Const(2)`.
     match number(v, "onLane(lane=)") {
         Ok(x) if x.fract() == 0.0 && x.abs() <= f64::from(i32::MAX) => Ok(Lane::Driving(x as i32)),
-        Ok(x) => bail!("a lane is a whole number, got {x}"),
+        Ok(x) if x.fract() != 0.0 || !x.is_finite() => bail!("a lane is a whole number, got {x}"),
+        Ok(x) => bail!("a lane number is at most {} in size, got {x}", i32::MAX),
         Err(e) if v.downcast_ref::<Stream>().is_some() => Err(e),
         Err(_) => bail!(
             "a lane is a lane number or r.SideWalk / -r.SideWalk, got {}",
@@ -415,8 +416,14 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
                 }
             };
             let lane = number(lane, "onLane(lane=)")?;
-            if lane.fract() != 0.0 || lane == 0.0 || lane.abs() > 100.0 {
+            if lane.fract() != 0.0 || lane == 0.0 {
                 bail!("onLane(lane=) on a map is an OpenDRIVE <lane id>: a whole number, not 0 (negative right of the reference line), got {lane}");
+            }
+            if lane.abs() > paracosm_engine::network::opendrive::MAX_LANES_PER_SIDE as f64 {
+                bail!(
+                    "onLane(lane=) on a map is an OpenDRIVE <lane id>, at most {} from the centre lane 0 (a map's section has at most that many lanes a side), got {lane}",
+                    paracosm_engine::network::opendrive::MAX_LANES_PER_SIDE
+                );
             }
             let s_m = number(s, "onLane(s=)")?;
             let PieceKind::Map { map, .. } = &b.roads.piece(piece).kind else {

@@ -28,7 +28,7 @@ use starlark::syntax::{AstModule, Dialect};
 use crate::{Scenario, ScenarioError};
 
 pub use host::MAX_LAMBDA_STEPS;
-pub use program::{MAX_CHECKED_WORLDS, MAX_CHECK_STEPS};
+pub use program::{MAX_CHECKED_WORLDS, MAX_CHECK_STEPS, MAX_LOAD_CHECK_STEPS, MAX_PARAMS};
 pub use values::OverTime;
 
 /// The length of a test when the program does not set one with `test(horizon=)`, seconds.
@@ -309,9 +309,70 @@ fn load_with_base(
         )));
     }
     program::load(file, source, name, ast, globals(), base).map_err(|e| match e {
-        ScenarioError::Language(m) => ScenarioError::Language(with_source_lines(&m, file, source)),
+        ScenarioError::Language(m) => {
+            ScenarioError::Language(cut_stack(&with_source_lines(&m, file, source), KEPT_FRAMES))
+        }
         other => other,
     })
+}
+
+/// Frames a Starlark traceback keeps at each end when a message is cut ([`cut_stack`]).
+pub const KEPT_FRAMES: usize = 3;
+
+/// `message` with its Starlark traceback ("Traceback (most recent call last):" and frames of
+/// `  * file:line, in f` with their source line) cut to its first and last `keep` frames and
+/// a line counting the rest: a recursion 400 frames deep reads as its reason and 7 frames.
+pub fn cut_stack(message: &str, keep: usize) -> String {
+    let Some(start) = message.find("Traceback (most recent call last):") else {
+        return message.to_owned();
+    };
+    let (head, tail) = message.split_at(start);
+    let mut lines = tail.lines();
+    let title = lines.next().unwrap_or_default();
+    // Frames: a `  * ` line and the indented lines after it; the first other line ends them.
+    let mut frames: Vec<Vec<&str>> = Vec::new();
+    let mut rest: Vec<&str> = Vec::new();
+    for line in lines {
+        if !rest.is_empty() {
+            rest.push(line);
+        } else if line.starts_with("  * ") {
+            frames.push(vec![line]);
+        } else if line.starts_with("    ") && !frames.is_empty() {
+            if let Some(f) = frames.last_mut() {
+                f.push(line);
+            }
+        } else {
+            rest.push(line);
+        }
+    }
+    if frames.len() <= 2 * keep + 1 {
+        return message.to_owned();
+    }
+    let mut out = format!("{head}{title}\n");
+    for f in &frames[..keep] {
+        for l in f {
+            out.push_str(l);
+            out.push('\n');
+        }
+    }
+    out.push_str(&format!(
+        "  ... {} more frames ...\n",
+        frames.len() - 2 * keep
+    ));
+    for f in &frames[frames.len() - keep..] {
+        for l in f {
+            out.push_str(l);
+            out.push('\n');
+        }
+    }
+    for l in rest {
+        out.push_str(l);
+        out.push('\n');
+    }
+    if !message.ends_with('\n') {
+        out.pop();
+    }
+    out
 }
 
 /// Adds a note to a syntax error on a line that writes `VarEnum({...})`, the paper's set

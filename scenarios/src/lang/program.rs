@@ -41,11 +41,26 @@ const MAX_PROBED_VALUES: usize = 64;
 /// to matter is varied again ([`Program::changes_elsewhere`]).
 const MAX_REPROBE_BASES: usize = 16;
 
+/// Most evaluations that varying all such parameters again takes together, spread evenly
+/// over them (each is varied from at least one combination).
+const REPROBE_EVALUATIONS: usize = 4096;
+
 /// Most values of such a parameter tried from each of those combinations.
 const MAX_REPROBED_VALUES: usize = 4;
 
 /// Most evaluation steps that varying one such parameter again may take.
 const MAX_REPROBE_STEPS: u64 = 5_000_000;
+
+/// Most evaluation steps that all the checks at load take together (the combinations, what
+/// each parameter changes, the second looks at parameters that seem unused, the monitors of
+/// constants), beyond the first evaluation: one budget, spent in that order. The combinations
+/// take at most [`MAX_CHECK_STEPS`] of it. A check the budget does not reach is named in a
+/// warning; a parameter whose effect was not probed counts as used.
+pub const MAX_LOAD_CHECK_STEPS: u64 = 2 * MAX_CHECK_STEPS;
+
+/// Most open parameters a program may declare: each one is a dimension of the test space
+/// and costs its own probes at load (10,000 parameters would take minutes to load).
+pub const MAX_PARAMS: usize = 500;
 
 /// Most evaluation steps (function calls and loop iterations, as starlark counts them) that
 /// checking the combinations at load may take in all. A program whose every evaluation is
@@ -108,6 +123,14 @@ pub struct Program {
     /// Whether what the program prints at load has been shown (the load evaluates it more
     /// than once with the representative values; its output is shown once).
     load_output_shown: std::sync::atomic::AtomicBool,
+    /// [`Program::combinations`], computed once.
+    combinations: std::sync::OnceLock<Vec<(Vec<ParamValue>, String)>>,
+    /// Evaluation steps the checks at load have taken ([`MAX_LOAD_CHECK_STEPS`]).
+    load_steps: std::sync::atomic::AtomicU64,
+    /// The worlds of the combinations that [`Program::changes_elsewhere`] varies parameters
+    /// from, by index in [`Program::combinations`], with their step counts.
+    #[allow(clippy::type_complexity)]
+    base_worlds: std::sync::Mutex<std::collections::BTreeMap<usize, Option<(Arc<WorldSpec>, u64)>>>,
 }
 
 fn lambda_values<'v>(b: &SceneBuilder, module: &Module<'v>) -> Result<Vec<Value<'v>>, String> {
@@ -594,7 +617,17 @@ impl Program {
     /// [`MAX_CHECKED_WORLDS`], else the rows of a pairwise covering array over them, or of
     /// one with each value once when a pairwise one would have more than 4 ×
     /// [`MAX_CHECKED_WORLDS`] rows.
-    fn combinations(&self) -> Vec<(Vec<ParamValue>, String)> {
+    fn combinations(&self) -> &[(Vec<ParamValue>, String)] {
+        self.combinations.get_or_init(|| self.make_combinations())
+    }
+
+    /// Whether the checks at load have steps left of [`MAX_LOAD_CHECK_STEPS`].
+    fn load_budget_left(&self) -> bool {
+        self.load_steps.load(std::sync::atomic::Ordering::Relaxed) < MAX_LOAD_CHECK_STEPS
+    }
+
+    /// [`Program::combinations`], computed.
+    fn make_combinations(&self) -> Vec<(Vec<ParamValue>, String)> {
         let options: Vec<Vec<(ParamValue, String)>> = (0..self.params.len())
             .map(|k| self.checked_values(k))
             .collect();
@@ -661,7 +694,7 @@ impl Program {
     /// stopping at the first change that can affect the ego. Worlds that fail are skipped
     /// (their tests report the error), and the probing stops after [`MAX_REPROBE_STEPS`]
     /// evaluation steps.
-    fn changes_elsewhere(&self, k: usize, base: &[ParamValue]) -> Vec<usage::Change> {
+    fn changes_elsewhere(&self, k: usize, base: &[ParamValue], bases: usize) -> Vec<usage::Change> {
         let mut out = Vec::new();
         let mut steps = 0u64;
         let spread = |n: usize, most: usize| -> Vec<usize> {
@@ -684,15 +717,34 @@ impl Program {
                 .enumerate()
                 .any(|(j, (a, b))| j != k && a != b)
         };
-        let rows: Vec<Vec<ParamValue>> = self
+        let rows: Vec<(usize, &Vec<ParamValue>)> = self
             .combinations()
-            .into_iter()
+            .iter()
             .map(|(v, _)| v)
-            .filter(|v| others(v))
+            .enumerate()
+            .filter(|(_, v)| others(v))
             .collect();
-        for r in spread(rows.len(), MAX_REPROBE_BASES) {
-            let row = &rows[r];
-            let Ok((from, s)) = self.world_counted(row.clone()) else {
+        for r in spread(rows.len(), bases.clamp(1, MAX_REPROBE_BASES)) {
+            let (index, row) = rows[r];
+            if !self.load_budget_left() {
+                break;
+            }
+            // The world of a combination is built once for all the parameters varied from it.
+            let from = {
+                let mut cache = self
+                    .base_worlds
+                    .lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner);
+                cache
+                    .entry(index)
+                    .or_insert_with(|| {
+                        self.world_counted(row.clone())
+                            .ok()
+                            .map(|(w, s)| (Arc::new(w), s))
+                    })
+                    .clone()
+            };
+            let Some((from, s)) = from else {
                 continue;
             };
             steps += s;
@@ -727,10 +779,15 @@ impl Program {
 
     /// [`Program::world_for`], also returning the evaluation's step count.
     fn world_counted(&self, values: Vec<ParamValue>) -> Result<(WorldSpec, u64), String> {
-        self.evaluate_counted(Some(values), |b, _| {
+        let out = self.evaluate_counted(Some(values), |b, _| {
             self.consistent(&b)?;
             scene::world(&b, self.horizon_s)
-        })
+        });
+        if let Ok((_, steps)) = &out {
+            self.load_steps
+                .fetch_add(*steps, std::sync::atomic::Ordering::Relaxed);
+        }
+        out
     }
 }
 
@@ -747,27 +804,33 @@ const VALUE_ERRORS: [&str; 4] = [
 impl Program {
     /// Calls every lambda of the world the first evaluation built once, on sample values of
     /// its streams at t = 0 ([`paracosm_engine::Simulation::check_streams`]), so that a type
-    /// error in a lambda is one error at load rather than one per test.
+    /// error in a lambda is one error at load rather than one per test: `b` and `module` are
+    /// that evaluation's builder and module, `horizon_s` the program's horizon, s.
     ///
     /// # Errors
     /// The lambda's error with its `file:line:col`, unless it is one of [`VALUE_ERRORS`].
-    fn check_lambdas(&self) -> Result<(), String> {
-        self.evaluate(None, |b, module| {
-            let spec = scene::world(&b, self.horizon_s)?;
+    fn check_lambdas_in(
+        &self,
+        b: &SceneBuilder,
+        module: &Module<'_>,
+        horizon_s: f64,
+    ) -> Result<(), String> {
+        {
+            let spec = scene::world(b, horizon_s)?;
             // A world that does not build is reported elsewhere, by the test that builds it.
             let Ok(sim) = paracosm_engine::Simulation::new(&spec) else {
                 return Ok(());
             };
-            let functions = lambda_values(&b, module)?;
+            let functions = lambda_values(b, module)?;
             let test = super::values::TestState::default();
             let limits = CallLimits::default();
             let mut eval = Evaluator::new(module);
             eval.extra = Some(&test);
             eval.set_print_handler(&test);
             limits.install(&mut eval).map_err(|e| e.to_string())?;
-            let mut host = StarHost::new(&mut eval, &functions, &limits, &self.file);
+            let mut host = StarHost::new(&mut eval, &functions, &limits, &self.file).at_load();
             match sim.check_streams(&mut host) {
-                Ok(samples) => judged_kinds(&b, &samples),
+                Ok(samples) => judged_kinds(b, &samples),
                 Err(e) => {
                     // A lambda's message has its own traceback and location, but for a call
                     // stopped by a limit: that one is located at the combinator.
@@ -797,7 +860,7 @@ impl Program {
                     ))
                 }
             }
-        })
+        }
     }
 }
 
@@ -995,11 +1058,18 @@ pub fn load(
         sut: SutConfig::builtin("aeb").map_err(lang)?,
         maps: Arc::new(super::map_files::MapFiles::new(base)),
         load_output_shown: false.into(),
+        combinations: std::sync::OnceLock::new(),
+        load_steps: 0.into(),
+        base_worlds: Default::default(),
     };
     // The first world, and the streams its top-level variables hold: a lambda reads those by
     // name (`lambda s: s > limit`), with no edge in the graph (host::StarHost's `captured`).
-    let (first, stream_variables) = program
+    // The lambdas are checked on this same evaluation; the result is reported after the
+    // checks that come before it.
+    let (first, stream_variables, lambdas) = program
         .evaluate(None, |b, module| {
+            let horizon_s = b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
+            let lambdas = program.check_lambdas_in(&b, module, horizon_s);
             let held: Vec<(String, usize)> = module
                 .names()
                 .filter_map(|name| {
@@ -1008,15 +1078,24 @@ pub fn load(
                     Some((name.as_str().to_owned(), s.id))
                 })
                 .collect();
-            Ok((b, held))
+            Ok((b, held, lambdas))
         })
         .map_err(lang)?;
+    if let Some(past) = first.params.get(MAX_PARAMS) {
+        return Err(lang(format!(
+            "error: the program declares {} open parameters; the limit is {MAX_PARAMS} (each is \
+             a dimension of the test space and is probed at load); this is parameter {}\n --> {}",
+            first.params.len(),
+            MAX_PARAMS + 1,
+            past.at
+        )));
+    }
     program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
     windows_within_horizon(&first, program.horizon_s).map_err(lang)?;
     one_walker_each(&first).map_err(lang)?;
     // Signals the monitors read exist (checked when the world is built).
     scene::check_signals(&first).map_err(lang)?;
-    program.check_lambdas().map_err(lang)?;
+    lambdas.map_err(lang)?;
     let syntax = &program.syntax;
 
     // Names: explicit, else from where the parameter stands, else by position.
@@ -1114,12 +1193,14 @@ pub fn load(
         let combinations = program.combinations();
         let total = combinations.len();
         let mut steps = 0u64;
-        for (done, (values, label)) in combinations.into_iter().enumerate() {
+        for (done, (values, label)) in combinations.iter().enumerate() {
             if steps > MAX_CHECK_STEPS || done >= MAX_CHECKED_WORLDS {
                 checked = Some((done, total, steps));
                 break;
             }
-            let (w, s) = program.world_counted(values).map_err(|m| with(&label, m))?;
+            let (w, s) = program
+                .world_counted(values.clone())
+                .map_err(|m| with(label, m))?;
             unread.push(usage::unread_streams(&w, &[]));
             steps += s;
         }
@@ -1142,7 +1223,14 @@ pub fn load(
         .map(|(_, d)| scene::representative(d, program.horizon_s))
         .collect();
     let mut changes = Vec::with_capacity(program.params.len());
+    // Parameters whose effect the budget left unprobed: they count as used.
+    let mut unprobed: Vec<usize> = Vec::new();
     for k in 0..program.params.len() {
+        if !program.load_budget_left() {
+            unprobed.push(k);
+            changes.push(Vec::new());
+            continue;
+        }
         let mut seen = Vec::new();
         // At most MAX_PROBED_VALUES of its values, spread over them (a VarEnum may have
         // thousands of levels, each one evaluation of the program).
@@ -1176,6 +1264,9 @@ pub fn load(
             values[k] = v;
             let other = program.world_for(values).map_err(|m| with(&label, m))?;
             seen.extend(usage::changes(&base, &other, program.horizon_s));
+            if !program.load_budget_left() {
+                break;
+            }
         }
         changes.push(seen);
     }
@@ -1295,11 +1386,18 @@ pub fn load(
     if constants.iter().any(|(_, c, _)| c.is_some()) {
         let rows = program.combinations();
         let n = rows.len();
-        for (i, (values, _)) in rows.into_iter().enumerate() {
+        for (i, (values, _)) in rows.iter().enumerate() {
             if n > 16 && !(0..16).any(|j| j * (n - 1) / 15 == i) {
                 continue;
             }
-            let Ok(w) = program.world_for(values) else {
+            if !program.load_budget_left() {
+                // Unchecked: the monitor's constant counts as varying (no warning).
+                for c in constants.iter_mut() {
+                    c.2 = true;
+                }
+                break;
+            }
+            let Ok(w) = program.world_for(values.clone()) else {
                 continue;
             };
             for (signal, c, varies) in constants.iter_mut() {
@@ -1359,23 +1457,69 @@ pub fn load(
     let read_in_code: Vec<bool> = program
         .params
         .iter()
-        .map(|(_, d)| {
-            syntax.site(&d.at).is_some_and(|s| {
-                [&s.variable, &s.container]
-                    .into_iter()
-                    .flatten()
-                    .any(|v| syntax.read_in_code(v))
-            })
+        .enumerate()
+        .map(|(k, (_, d))| {
+            // Unprobed, a parameter counts as read: it is neither warned of nor left out.
+            unprobed.contains(&k)
+                || syntax.site(&d.at).is_some_and(|s| {
+                    [&s.variable, &s.container]
+                        .into_iter()
+                        .flatten()
+                        .any(|v| syntax.read_in_code(v))
+                })
         })
         .collect();
     // A parameter that, from the first world, changes nothing or nothing the ego can meet may
     // still matter where the others take other values: a radius read only on one branch of an
     // `if`, a friction reached only from another start. Before a warning calls it unused, it
     // is varied again from other combinations of the others' values.
+    // The second looks share a budget of evaluations: with many such parameters, each is
+    // varied from fewer combinations (at least one).
+    let suspects = (0..changes.len())
+        .filter(|&k| {
+            !read_in_code[k] && changes[k].iter().all(|c| usage::inert(c, stl_reads_light))
+        })
+        .count();
+    let bases = REPROBE_EVALUATIONS / (suspects.max(1) * (1 + MAX_REPROBED_VALUES));
     for (k, seen) in changes.iter_mut().enumerate() {
         if !read_in_code[k] && seen.iter().all(|c| usage::inert(c, stl_reads_light)) {
-            seen.extend(program.changes_elsewhere(k, &base_values));
+            if program.load_budget_left() {
+                seen.extend(program.changes_elsewhere(k, &base_values, bases));
+            } else {
+                unprobed.push(k);
+            }
         }
+    }
+    let read_in_code: Vec<bool> = read_in_code
+        .iter()
+        .enumerate()
+        .map(|(k, r)| *r || unprobed.contains(&k))
+        .collect();
+    if !unprobed.is_empty() {
+        unprobed.sort_unstable();
+        unprobed.dedup();
+        let names: Vec<&str> = unprobed
+            .iter()
+            .take(8)
+            .map(|&k| program.params[k].0.as_str())
+            .collect();
+        warnings.push(Warning {
+            at: format!("{file}:1:1"),
+            message: format!(
+                "loading stopped probing what parameters change at its budget of \
+                 {MAX_LOAD_CHECK_STEPS} evaluation steps: {} parameter{} ({}{}) count as used, \
+                 unprobed (no warning says whether an object uses them, and coverage includes \
+                 them)",
+                unprobed.len(),
+                if unprobed.len() == 1 { "" } else { "s" },
+                names.join(", "),
+                if unprobed.len() > names.len() {
+                    ", ..."
+                } else {
+                    ""
+                }
+            ),
+        });
     }
     let found = usage::analyse(usage::Inputs {
         params: &program.params,

@@ -19,10 +19,10 @@ use super::*;
 pub(super) fn unique_monitor_name(b: &SceneBuilder, name: &str) -> anyhow::Result<()> {
     // A monitor's name keys its verdict in results.jsonl, the CSV columns and JUnit, as a
     // parameter's name does: the same rule.
-    if name.is_empty() || name.chars().any(|c| c.is_whitespace() || c.is_control()) {
+    if !super::streams::result_name_ok(name) {
         bail!(
-            "a monitor's name= must not be empty or hold spaces, got {name:?}: it keys the \
-             verdicts in results files, so it is written without spaces (letters, digits, _ . [ ])"
+            "a monitor's name= is made of letters, digits and _ . [ ] only, got {name:?}: it \
+             keys the verdicts in results files, CSV columns and JUnit"
         );
     }
     if b.monitors.iter().any(|m| m.name() == name) {

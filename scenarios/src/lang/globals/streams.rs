@@ -16,6 +16,15 @@ use crate::lang::values::{OverTimeVal, Stream};
 
 use super::*;
 
+/// Whether `n` follows the rule for a name that keys results (a parameter's, a monitor's):
+/// not empty, and only letters, digits and `_ . [ ]` (so it survives CSV columns, JUnit and
+/// `report --map a,b`).
+pub(crate) fn result_name_ok(n: &str) -> bool {
+    !n.is_empty()
+        && n.chars()
+            .all(|c| c.is_alphanumeric() || matches!(c, '_' | '.' | '[' | ']'))
+}
+
 /// Declares an open parameter; returns what the program sees: the test's value as a plain
 /// Starlark value (a float for an interval; an int, float, string or bool for a level), or,
 /// for one that varies over time, its stream.
@@ -24,10 +33,11 @@ pub(super) fn declare_param<'v>(
     decl: ParamDecl,
 ) -> anyhow::Result<Value<'v>> {
     if let Some(n) = &decl.name {
-        if n.is_empty() || n.chars().any(|c| c.is_whitespace() || c.is_control()) {
+        if !result_name_ok(n) {
             anyhow::bail!(
                 "name = {n:?} is no parameter name: a name keys results.jsonl's params, the CSV \
-                 columns and test(map=), so it is written without spaces (letters, digits, _ . [ ])"
+                 columns, test(map=) and report --map a,b, so it is made of letters, digits and \
+                 _ . [ ] only"
             );
         }
     }
