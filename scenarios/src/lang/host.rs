@@ -94,6 +94,18 @@ fn from_star(v: Value) -> Result<Rx, String> {
     if let Some(i) = v.unpack_i32() {
         return Ok(Rx::Num(f64::from(i)));
     }
+    if v.get_type() == "int" {
+        // Past i32: exact as an f64 up to 2^53; beyond, a rounding the program must ask for.
+        const EXACT: i64 = 1 << 53;
+        return match starlark::values::UnpackValue::unpack_value(v) {
+            Ok(Some(i)) if (-EXACT..=EXACT).contains(&i) => Ok(Rx::Num(i as f64)),
+            _ => Err(format!(
+                "a lambda returned the int {v}, too large for a stream's number: a float holds \
+                 whole numbers exactly only up to 2^53 = {EXACT}; write float(...) to accept \
+                 the rounding"
+            )),
+        };
+    }
     if let Some(f) = v.downcast_ref::<StarlarkFloat>() {
         return Ok(Rx::Num(f.0));
     }

@@ -1068,8 +1068,6 @@ pub fn load(
     // checks that come before it.
     let (first, stream_variables, lambdas) = program
         .evaluate(None, |b, module| {
-            let horizon_s = b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
-            let lambdas = program.check_lambdas_in(&b, module, horizon_s);
             let held: Vec<(String, usize)> = module
                 .names()
                 .filter_map(|name| {
@@ -1078,6 +1076,10 @@ pub fn load(
                     Some((name.as_str().to_owned(), s.id))
                 })
                 .collect();
+            // After `held`: calling the lambdas sets the variables that hold streams to their
+            // sample values.
+            let horizon_s = b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
+            let lambdas = program.check_lambdas_in(&b, module, horizon_s);
             Ok((b, held, lambdas))
         })
         .map_err(lang)?;

@@ -618,7 +618,7 @@ fn monitors_have_unique_names_and_the_default_offroad_monitor_yields_to_a_declar
         "{HEADER}w.place(r, v)\nStl(\"ego_speed_mps > 1\", name = \"offroad\")\n"
     ));
     assert!(m.contains("the name of the default OffRoadMonitor"), "{m}");
-    for bad in ["", "a b", "tab\\t"] {
+    for bad in ["", "a b", "tab\\t", "a,b"] {
         for monitor in [
             format!("Stl(\"G[0,10] (ego_speed_mps > 3)\", name = \"{bad}\")"),
             format!("CollisionMonitor(v, name = \"{bad}\")"),
@@ -626,7 +626,7 @@ fn monitors_have_unique_names_and_the_default_offroad_monitor_yields_to_a_declar
         ] {
             let m = err(&format!("{HEADER}w.place(r, v)\n{monitor}\n"));
             assert!(
-                m.contains("must not be empty or hold spaces"),
+                m.contains("is made of letters, digits and _ . [ ] only"),
                 "{monitor}: {m}"
             );
             assert!(m.contains("bad.star:5:1"), "{monitor}: {m}");
