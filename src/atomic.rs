@@ -57,6 +57,106 @@ pub fn with_temp<E: std::fmt::Display>(
     tmp_path.persist(path).map_err(|e| Error::write(path, e))
 }
 
+/// Opens `path` for writing without following a link and without blocking: a new file is
+/// created; an existing one must be a regular file with one name (a hard link elsewhere is
+/// refused too), and is then truncated, or appended to when `append`. The one way paracosm
+/// opens an output it writes in pieces (`results.jsonl`); whole files go through [`write`].
+///
+/// # Errors
+/// [`Error::BadInput`] naming `path` when it is a symbolic link, a directory, a FIFO, a device
+/// or a file with other names ([`check_target`]); [`Error::Write`] for the file system's other
+/// reasons.
+pub fn open_regular(path: &Path, append: bool) -> Result<std::fs::File, Error> {
+    check_target(path)?;
+    let mut options = std::fs::OpenOptions::new();
+    options.write(true).create(true).append(append);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // A link planted between the check and the open is not followed; a FIFO does not
+        // block the open (ENXIO without a reader), so it is named below, not waited on.
+        options.custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+    }
+    let refused = |what: &str| {
+        Error::BadInput(format!(
+            "`{}` is {what}: paracosm writes its outputs only to new or regular files; give \
+             another path",
+            path.display()
+        ))
+    };
+    let file = options.open(path).map_err(|e| match e.raw_os_error() {
+        #[cfg(unix)]
+        Some(libc::ELOOP) => refused("a symbolic link"),
+        #[cfg(unix)]
+        Some(libc::ENXIO) => refused("a FIFO"),
+        _ => Error::write(path, e),
+    })?;
+    let meta = file.metadata().map_err(|e| Error::write(path, e))?;
+    if let Some(what) = paracosm_engine::files::kind_of(&meta.file_type()) {
+        return Err(refused(what));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if meta.nlink() > 1 {
+            return Err(refused("a file with other names (a hard link)"));
+        }
+    }
+    if !append {
+        file.set_len(0).map_err(|e| Error::write(path, e))?;
+    }
+    Ok(file)
+}
+
+/// Checks every path of `names` in `dir` with [`check_target`]: for a command that will write
+/// them, before it does any work.
+///
+/// # Errors
+/// The first path that is not absent or a regular file, as [`check_target`].
+pub fn check_targets<'a>(
+    dir: &Path,
+    names: impl IntoIterator<Item = &'a str>,
+) -> Result<(), Error> {
+    for n in names {
+        check_target(&dir.join(n))?;
+    }
+    Ok(())
+}
+
+/// The files a campaign writes into its folder (beside the lock), every one through this
+/// module: a link, a directory or a FIFO planted at any of them is refused before a test runs.
+pub const CAMPAIGN_OUTPUTS: [&str; 10] = [
+    "results.jsonl",
+    "campaign.json",
+    "summary.json",
+    "report.html",
+    "failure_map.png",
+    "failure_map.svg",
+    "failure_rate.png",
+    "failure_rate.svg",
+    "pairs.png",
+    "pairs.svg",
+];
+
+/// Checks that `dir` (a folder that exists) takes new files: one of a fresh name is created
+/// exclusively (so a link planted in the folder is never followed) and removed at once.
+///
+/// # Errors
+/// [`Error::BadInput`] naming the folder and the reason (read-only, not a folder, no space):
+/// bad input, exit 2, before any work.
+pub fn probe_writable(dir: &Path) -> Result<(), Error> {
+    tempfile::Builder::new()
+        .prefix(".paracosm-probe-")
+        .tempfile_in(dir)
+        .map(drop)
+        .map_err(|e| {
+            Error::BadInput(format!(
+                "cannot write to the output folder `{}`: {e}",
+                dir.display()
+            ))
+        })
+}
+
 /// Removes the temporary files ([`with_temp`]'s `.paracosm-*`) that a writer of `dir` killed
 /// mid-write left there. Call it holding the folder's lock ([`crate::lock`]), so that no other
 /// writer's temporary file is taken. Only regular files are removed (a link planted under such

@@ -1,7 +1,7 @@
 //! The campaign runner: points from a generator, tests in parallel, results in order.
 
 use std::collections::BTreeMap;
-use std::fs::{File, OpenOptions};
+use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::ops::Range;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -650,17 +650,8 @@ impl Observer for ResultsFile {
         if let Some(dir) = self.path.parent() {
             std::fs::create_dir_all(dir).map_err(|e| Error::write(dir, e))?;
         }
-        let file = if self.append {
-            OpenOptions::new()
-                .append(true)
-                .create(true)
-                .open(&self.path)
-        } else {
-            File::create(&self.path)
-        };
-        self.out = Some(BufWriter::new(
-            file.map_err(|e| Error::write(&self.path, e))?,
-        ));
+        let file = crate::atomic::open_regular(&self.path, self.append)?;
+        self.out = Some(BufWriter::new(file));
         Ok(())
     }
 

@@ -224,21 +224,25 @@ fn write_error(path: &Path, e: impl std::fmt::Display) -> Error {
 
 /// Writes the three files of one frame under `out`, named by `stem`.
 fn write_frame(out: &Path, stem: &str, frame: &CameraFrame) -> Result<(), Error> {
+    // Each through a temporary file and a rename (`atomic::with_temp`): a link planted at a
+    // frame's name is refused, never followed.
     let image = out.join("images").join(format!("{stem}.png"));
-    frame
-        .to_image()
-        .save_with_format(&image, image::ImageFormat::Png)
-        .map_err(|e| write_error(&image, e))?;
+    crate::atomic::with_temp(&image, |tmp| {
+        frame
+            .to_image()
+            .save_with_format(tmp, image::ImageFormat::Png)
+    })?;
     let mask = out.join("masks").join(format!("{stem}.png"));
-    frame
-        .class_mask()
-        .save_with_format(&mask, image::ImageFormat::Png)
-        .map_err(|e| write_error(&mask, e))?;
+    crate::atomic::with_temp(&mask, |tmp| {
+        frame
+            .class_mask()
+            .save_with_format(tmp, image::ImageFormat::Png)
+    })?;
     let depth = out.join("depth").join(format!("{stem}.npy"));
     let shape = (frame.height as usize, frame.width as usize);
     let array =
         Array2::from_shape_vec(shape, frame.depth_m.clone()).map_err(|e| write_error(&depth, e))?;
-    ndarray_npy::write_npy(&depth, &array).map_err(|e| write_error(&depth, e))
+    crate::atomic::with_temp(&depth, |tmp| ndarray_npy::write_npy(tmp, &array))
 }
 
 /// Refuses a non-empty `out` unless `replace`, and creates the folders.
@@ -259,6 +263,15 @@ fn prepare(out: &Path, replace: bool) -> Result<(), Error> {
     if non_empty {
         std::fs::remove_dir_all(out).map_err(|e| write_error(out, e))?;
     }
+    // An output folder that cannot be made or written is bad input (exit 2), found before
+    // any test runs.
+    std::fs::create_dir_all(out).map_err(|e| {
+        Error::BadInput(format!(
+            "cannot create the output folder `{}`: {e}",
+            out.display()
+        ))
+    })?;
+    crate::atomic::probe_writable(out)?;
     for sub in ["images", "depth", "masks"] {
         let dir = out.join(sub);
         std::fs::create_dir_all(&dir).map_err(|e| write_error(&dir, e))?;

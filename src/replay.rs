@@ -159,7 +159,7 @@ pub fn replay_with(
     let mut on_frame = |f: &CameraFrame| {
         let Some(dir) = frames else { return };
         let path = dir.join(format!("frame_{:05}.png", written.len()));
-        match f.save_png(&path) {
+        match crate::atomic::with_temp(&path, |tmp| f.save_png(tmp)).map_err(|e| e.to_string()) {
             Ok(()) => {
                 written.push(path);
                 thumbnails.push((f.t_s, f.to_image()));
@@ -196,7 +196,9 @@ pub fn replay_with(
     let contact_sheet = match frames {
         Some(dir) if !thumbnails.is_empty() => {
             let path = dir.join("contact_sheet.png");
-            crate::plot::contact_sheet(&path, &thumbnails, &format!("test {id}")).map_err(input)?;
+            crate::atomic::with_temp(&path, |tmp| {
+                crate::plot::contact_sheet(tmp, &thumbnails, &format!("test {id}"))
+            })?;
             Some(path)
         }
         _ => None,

@@ -629,6 +629,13 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
         records: &existing.records,
         triage: summary.triage.as_ref(),
     };
+    // A folder that takes no new file is bad input, found before anything is drawn.
+    if redraw.map.is_some() || redraw.color.is_some() || redraw.pairs || redraw.html {
+        crate::atomic::probe_writable(dir)?;
+    }
+    if redraw.html {
+        crate::atomic::check_target(&dir.join(crate::html::REPORT_FILE))?;
+    }
     let mut drawn = redraw_plots(dir, &data, &scenario.map_axes, redraw)?;
     if redraw.html {
         let page = crate::html::write(&crate::html::Page {
@@ -688,6 +695,11 @@ fn redraw_plots(
     }
     if redraw.pairs {
         plots.push(("pairs".to_owned(), Plot::Pairs));
+    }
+    for (stem, _) in &plots {
+        for ext in ["png", "svg"] {
+            crate::atomic::check_target(&dir.join(format!("{stem}.{ext}")))?;
+        }
     }
     let mut drawn = Vec::new();
     for (stem, plot) in &plots {

@@ -45,10 +45,7 @@ pub fn load(
     let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
     let repaired_bytes = bytes.len() - whole;
     if repaired_bytes > 0 && repair {
-        let f = std::fs::OpenOptions::new()
-            .write(true)
-            .open(&path)
-            .map_err(|e| Error::write(&path, e))?;
+        let f = crate::atomic::open_regular(&path, true)?;
         f.set_len(whole as u64)
             .and_then(|()| f.sync_all())
             .map_err(|e| Error::write(&path, e))?;

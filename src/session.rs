@@ -724,18 +724,9 @@ pub fn prepare_out_dir(out: &Path, replace: bool, resume: bool) -> Result<(), Er
             out.display()
         ))
     })?;
-    // Probe writability now, before any test runs: a new file of a fresh name (created
-    // exclusively, so a link planted in the folder is never followed), removed at once.
-    tempfile::Builder::new()
-        .prefix(".paracosm-probe-")
-        .tempfile_in(out)
-        .map_err(|e| {
-            Error::BadInput(format!(
-                "cannot write to output folder `{}`: {e}",
-                out.display()
-            ))
-        })?;
-    Ok(())
+    // Probe writability now, before any test runs, and every file the campaign will write.
+    crate::atomic::probe_writable(out)?;
+    crate::atomic::check_targets(out, crate::atomic::CAMPAIGN_OUTPUTS)
 }
 
 /// The path of the results file in `out`, for messages.

@@ -362,25 +362,46 @@ fn three_shards_merge_into_the_single_machine_run() {
 fn a_full_disk_is_a_clear_error_and_keeps_what_was_written() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("full");
-    std::fs::create_dir(&out).unwrap();
-    // Every write to /dev/full fails with "No space left on device".
-    std::os::unix::fs::symlink("/dev/full", out.join("results.jsonl")).unwrap();
-    let o = fuzz(&[
-        "pedestrian-crossing",
-        "--budget",
-        "5",
-        "--force",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    // A file size limit of 16 KiB (`ulimit -f`, with SIGXFSZ ignored so that a write past it
+    // fails with EFBIG, as a full disk fails with ENOSPC): `results.jsonl` reaches it after
+    // some twenty records. (A link to /dev/full is now refused as a planted link, exit 2.)
+    let o = std::process::Command::new("bash")
+        .args([
+            "-c",
+            "trap '' XFSZ; ulimit -f 16; exec \"$0\" \"$@\"",
+            env!("CARGO_BIN_EXE_paracosm-fuzz"),
+            "pedestrian-crossing",
+            "--budget",
+            "60",
+            "--jobs",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
     // Not the user's input: the machine's (exit 3, `Error::Write`).
     expect_code(&o, 3);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(
-        stderr.contains("results.jsonl") && stderr.contains("No space left"),
+        stderr.contains("results.jsonl") && stderr.contains("File too large"),
         "{stderr}"
     );
     assert!(!stderr.contains("panicked"));
+    // What was written stays, whole records only, and resumes once there is room.
+    let text = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+    let kept = text.lines().count();
+    assert!(kept > 5 && kept < 60, "{kept} records kept");
+    let o = fuzz(&["--resume", "--out", out.to_str().unwrap()]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{o:?}");
+    assert_eq!(
+        std::fs::read_to_string(out.join("results.jsonl"))
+            .unwrap()
+            .lines()
+            .count(),
+        60
+    );
 }
 
 #[test]

@@ -358,6 +358,78 @@ fn a_wrapper_script_and_the_helper_it_starts_are_killed_with_their_test() {
     assert!(alive.is_empty(), "helpers left running: {alive:?}");
 }
 
+/// Hostile input, second round, requirement 5: a controller whose helpers leave its process
+/// group (`setsid`) or are orphaned by a double fork is still cleaned up: paracosm-fuzz adopts
+/// them (`PR_SET_CHILD_SUBREAPER`) and kills them with their system under test.
+#[test]
+fn helpers_that_leave_the_process_group_are_killed_with_their_test() {
+    let dir = tempfile::tempdir().unwrap();
+    let pids = dir.path().join("helpers.txt");
+    let wrapper = dir.path().join("wrapper.sh");
+    // One helper in a session (and group) of its own, one orphaned by a double fork that
+    // also leaves the group; each writes its own pid.
+    std::fs::write(
+        &wrapper,
+        format!(
+            "#!/bin/sh\n\
+             setsid sh -c 'echo $$ >> {p}; exec sleep 300' </dev/null >/dev/null 2>&1 &\n\
+             (setsid sh -c 'echo $$ >> {p}; exec sleep 300' </dev/null >/dev/null 2>&1 &)\n\
+             exec {}\n",
+            script("examples/python/paracosm_sut.py"),
+            p = pids.display(),
+        ),
+    )
+    .unwrap();
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    for (name, fresh) in [("fresh", true), ("reused", false)] {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "pedestrian-crossing",
+            "--budget",
+            "3",
+            "--jobs",
+            "1",
+            "--sut-cmd",
+            wrapper.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if fresh {
+            args.push("--sut-fresh");
+        }
+        fuzz(&args);
+        assert!(!statuses(&out).contains(&"error".to_owned()), "{name}");
+    }
+    let started: Vec<String> = std::fs::read_to_string(&pids)
+        .unwrap()
+        .lines()
+        .map(str::to_owned)
+        .collect();
+    assert!(
+        started.len() >= 8,
+        "2 helpers a start, 4 starts at least: {started:?}"
+    );
+    // They left the group: each is its own session leader.
+    let mut alive: Vec<&String> = started.iter().collect();
+    for _ in 0..100 {
+        alive.retain(|p| !gone(p));
+        if alive.is_empty() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    for p in &alive {
+        let _ = std::process::Command::new("kill").args(["-9", p]).status();
+    }
+    assert!(
+        alive.is_empty(),
+        "helpers outside the group left running: {alive:?}"
+    );
+}
+
 /// The children of process `pid` (every thread's, from `/proc`).
 fn children(pid: u32) -> Vec<String> {
     let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {

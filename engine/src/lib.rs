@@ -22,6 +22,7 @@ mod control;
 mod environment;
 mod error;
 pub mod files;
+pub mod memory;
 pub mod network;
 mod obstacle;
 mod pedestrian;

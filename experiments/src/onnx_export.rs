@@ -1,7 +1,7 @@
 //! Writing small feed-forward networks as ONNX files: the graph is assembled from the ONNX
 //! protobuf messages that `tract-onnx` ships (`tract_onnx::pb`, the ONNX IR's `onnx.proto`)
 //! and encoded with `prost`. Operators: `Conv`, `Relu`, `Tanh`, `Flatten`, `Gemm`, `Concat`,
-//! `Mul`, `Add`, `Div`, `Identity` (opset 13, the semantics of the ONNX operator documentation).
+//! `Mul`, `Add`, `Div`, `Expand`, `ReduceSum`, `Identity` (opset 13, the semantics of the ONNX operator documentation).
 
 use prost::Message;
 use tract_onnx::pb;
@@ -12,6 +12,9 @@ const IR_VERSION: i64 = 8;
 const OPSET: i64 = 13;
 /// `TensorProto.DataType.FLOAT`.
 const FLOAT: i32 = 1;
+
+/// `TensorProto.DataType.INT64`.
+const INT64: i32 = 7;
 
 /// A graph under construction: nodes in topological order, weights as initializers.
 #[derive(Debug, Default)]
@@ -175,6 +178,34 @@ impl Graph {
     /// Element-wise `Add` (broadcasting).
     pub fn add(&mut self, a: &str, b: &str) -> String {
         self.node("Add", &[a, b], vec![])
+    }
+
+    /// A constant `int64` tensor of `dims` (a shape or axes for `Expand`, `Reshape`);
+    /// returns its name.
+    ///
+    /// # Panics
+    /// If `data.len()` is not the product of `dims`.
+    pub fn int64_constant(&mut self, dims: &[usize], data: Vec<i64>) -> String {
+        assert_eq!(data.len(), dims.iter().product::<usize>(), "constant size");
+        let name = self.fresh("shape");
+        self.initializers.push(pb::TensorProto {
+            name: name.clone(),
+            dims: dims.iter().map(|&d| d as i64).collect(),
+            data_type: INT64,
+            raw_data: data.iter().flat_map(|v| v.to_le_bytes()).collect(),
+            ..Default::default()
+        });
+        name
+    }
+
+    /// `Expand`: `x` broadcast to the shape held by the `int64` tensor `shape`.
+    pub fn expand(&mut self, x: &str, shape: &str) -> String {
+        self.node("Expand", &[x, shape], vec![])
+    }
+
+    /// `ReduceSum` over every axis, keeping them (opset 13: no `axes` input).
+    pub fn reduce_sum(&mut self, x: &str) -> String {
+        self.node("ReduceSum", &[x], vec![int("keepdims", 1)])
     }
 
     /// Element-wise `Div` (broadcasting).

@@ -11,7 +11,7 @@
 
 mod error;
 pub mod lang;
-pub mod memory;
+pub use paracosm_engine::memory;
 pub mod reference;
 mod runner;
 mod scenario;

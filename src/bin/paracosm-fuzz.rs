@@ -323,6 +323,12 @@ fn main() -> ExitCode {
     runtime_dir();
     paracosm_scenarios::memory::set_tool_name("paracosm-fuzz");
     stop_on_signals();
+    // What an external system under test leaves outside its process group (a `setsid`
+    // helper, a double fork) is adopted by this process and killed with the program. Without
+    // it (an old kernel) such helpers are only killed with the group, as documented.
+    if let Err(e) = paracosm_engine::sut::track_orphans() {
+        tracing::debug!("PR_SET_CHILD_SUBREAPER: {e}");
+    }
     let cli = match paracosm::cli::parse_args::<Cli>("paracosm-fuzz") {
         Ok(cli) => cli,
         Err(code) => return code,

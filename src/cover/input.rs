@@ -195,9 +195,13 @@ fn csv_rows(
         .iter()
         .map(str::to_owned)
         .collect();
-    // A name twice would be read from one of its columns and the other ignored.
+    // A name twice would be read from one of its columns and the other ignored (a map of
+    // first columns: 10^6 columns are checked in linear time).
+    let mut first: std::collections::HashMap<&str, usize> =
+        std::collections::HashMap::with_capacity(header.len());
     for (j, h) in header.iter().enumerate() {
-        if let Some(i) = header[..j].iter().position(|g| g == h) {
+        if let std::collections::hash_map::Entry::Occupied(e) = first.entry(h.as_str()) {
+            let i = *e.get();
             return Err(err(
                 Some(1),
                 Some((j + 1, h.clone())),
@@ -208,13 +212,14 @@ fn csv_rows(
                 ),
             ));
         }
+        first.insert(h, j);
     }
     // Which CSV column feeds each parameter.
     let (names, columns): (Vec<String>, Vec<usize>) = match space {
         Some(s) => {
             let mut cols = Vec::new();
             for p in s.params() {
-                let c = header.iter().position(|h| h == &p.name).ok_or_else(|| {
+                let c = first.get(p.name.as_str()).copied().ok_or_else(|| {
                     err(
                         Some(1),
                         None,

@@ -47,6 +47,20 @@ pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
             out.display()
         )));
     }
+    // The folder and the two files are checked before the replay (exit 2, before any work).
+    std::fs::create_dir_all(out).map_err(|e| {
+        Error::BadInput(format!(
+            "cannot create the output folder `{}`: {e}",
+            out.display()
+        ))
+    })?;
+    crate::atomic::probe_writable(out)?;
+    crate::atomic::check_targets(
+        out,
+        [format!("test_{id}.xosc"), format!("test_{id}.xodr")]
+            .iter()
+            .map(String::as_str),
+    )?;
     let dir = results.parent().unwrap_or(Path::new("."));
     let campaign = CampaignFile::read(dir).map_err(input)?;
     let scenario = paracosm_scenarios::load(&campaign.scenario).map_err(input)?;
@@ -68,7 +82,6 @@ pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
             replayed.replayed.error.clone().unwrap_or_default()
         ))
     })?;
-    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
     let stem = format!("test_{id}");
     let xodr_name = format!("{stem}.xodr");
     // The network: the program's map as it is, or the pieces written out.

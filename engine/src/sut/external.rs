@@ -110,7 +110,15 @@ fn spawn_dying_with_us(mut command: Command) -> std::io::Result<Child> {
             .spawn(move || {
                 // Never returns while paracosm runs: the sender lives in the static.
                 for (mut command, reply) in rx {
-                    let _ = reply.send(command.spawn());
+                    // Registered under the lock the orphan scan takes: a child just started
+                    // is never taken for an orphan.
+                    let mut spawned = spawned_children();
+                    let child = command.spawn();
+                    if let Ok(c) = &child {
+                        spawned.insert(c.id());
+                    }
+                    drop(spawned);
+                    let _ = reply.send(child);
                 }
             })
             .expect("a thread to start the systems under test");
@@ -125,6 +133,77 @@ fn spawn_dying_with_us(mut command: Command) -> std::io::Result<Child> {
     started
         .recv()
         .map_err(|_| std::io::Error::other("the spawner thread is gone"))?
+}
+
+/// Whether this process adopts and kills what its systems under test leave behind
+/// ([`track_orphans`]).
+static TRACKING_ORPHANS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// The pids of the systems under test this process started and has not yet waited for.
+fn spawned_children() -> std::sync::MutexGuard<'static, std::collections::BTreeSet<u32>> {
+    static SPAWNED: Mutex<std::collections::BTreeSet<u32>> =
+        Mutex::new(std::collections::BTreeSet::new());
+    SPAWNED.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// Makes this process the reaper of whatever its systems under test start and leave
+/// (`PR_SET_CHILD_SUBREAPER`, Linux): a helper that double-forks or calls `setsid` leaves the
+/// program's process group, so killing the group misses it; as an orphan it is adopted by this
+/// process instead of init, and [`reap_orphans`] kills it when its system under test is done.
+/// For the command-line tools, which start nothing else: in a host process (Python) the
+/// orphans of unrelated children would be adopted too, so the package does not call it.
+///
+/// # Errors
+/// The error of `prctl(2)`.
+pub fn track_orphans() -> std::io::Result<()> {
+    // SAFETY: prctl(2) with PR_SET_CHILD_SUBREAPER reads only its integer arguments.
+    if unsafe { libc::prctl(libc::PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) } == -1 {
+        return Err(std::io::Error::last_os_error());
+    }
+    TRACKING_ORPHANS.store(true, std::sync::atomic::Ordering::SeqCst);
+    Ok(())
+}
+
+/// The parent pid of process `pid`, from `/proc/PID/stat` (the field after the command
+/// name, which is in parentheses and may hold spaces).
+fn parent_of(pid: u32) -> Option<u32> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let after = &stat[stat.rfind(')')? + 1..];
+    after.split_whitespace().nth(1)?.parse().ok()
+}
+
+/// Kills and waits for every process this one adopted ([`track_orphans`]): its children that
+/// it did not start itself. Returns how many. Does nothing unless tracking.
+pub fn reap_orphans() -> usize {
+    if !TRACKING_ORPHANS.load(std::sync::atomic::Ordering::SeqCst) {
+        return 0;
+    }
+    let me = std::process::id();
+    let spawned = spawned_children();
+    let Ok(entries) = std::fs::read_dir("/proc") else {
+        return 0;
+    };
+    let mut reaped = 0;
+    for e in entries.flatten() {
+        let Some(pid) = e.file_name().to_str().and_then(|n| n.parse::<u32>().ok()) else {
+            continue;
+        };
+        if spawned.contains(&pid) || parent_of(pid) != Some(me) {
+            continue;
+        }
+        let Ok(p) = libc::pid_t::try_from(pid) else {
+            continue;
+        };
+        // SAFETY: kill(2) and waitpid(2) on a child of this process; no memory is shared
+        // but the status integer.
+        unsafe {
+            libc::kill(p, libc::SIGKILL);
+            let mut status = 0;
+            libc::waitpid(p, &mut status, 0);
+        }
+        reaped += 1;
+    }
+    reaped
 }
 
 /// Kills every process of the process group `pgid` (the system under test and what it
@@ -197,20 +276,31 @@ impl Drop for Process {
         self.stdin = None;
         for _ in 0..10 {
             if let Ok(Some(_)) = self.child.try_wait() {
+                self.forget();
                 return;
             }
             std::thread::sleep(Duration::from_millis(10));
         }
         let _ = self.child.kill();
         let _ = self.child.wait();
+        self.forget();
+    }
+}
+
+impl Process {
+    /// Forgets the child's pid once it has been waited for (it may be reused).
+    fn forget(&self) {
+        spawned_children().remove(&self.child.id());
     }
 }
 
 impl Drop for GroupGuard {
     fn drop(&mut self) {
         // Whatever the program started (a wrapper script's child, a helper) is in its group:
-        // none of it outlives the test.
+        // none of it outlives the test. What left the group (`setsid`, a double fork) was
+        // adopted by paracosm when its parent died, and is killed now.
         kill_group(self.0);
+        reap_orphans();
     }
 }
 

@@ -17,7 +17,10 @@ mod vision;
 pub use aeb::{Aeb, AebConfig};
 pub use constant::ConstantControl;
 pub use cruise::Cruise;
-pub use external::{check_command, ExternalConfig, ExternalSut, ProcessPool, PROTOCOL_VERSION};
+pub use external::{
+    check_command, reap_orphans, track_orphans, ExternalConfig, ExternalSut, ProcessPool,
+    PROTOCOL_VERSION,
+};
 #[cfg(feature = "onnx")]
 pub use onnx::{
     manifest_path, preprocess, Channels, InputSpec, Layout, Manifest, OnnxConfig, OnnxSut,

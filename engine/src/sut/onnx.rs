@@ -354,7 +354,17 @@ impl OnnxConfig {
             )
         })?;
         let manifest = Manifest::parse(&text, &manifest_file)?;
-        Self::from_bytes(&model.display().to_string(), &bytes, manifest)
+        let source = model.display().to_string();
+        // tract allocates the tensors the model declares while it analyses and first runs
+        // it: one absurdly large is refused by the counting allocator (exit 2, naming the
+        // model) rather than attempted (an abort).
+        let _budget = crate::memory::Budget::start(
+            usize::MAX,
+            crate::memory::HARD_MODEL_BYTES,
+            &source,
+            "the ONNX model",
+        );
+        Self::from_bytes(&source, &bytes, manifest)
     }
 
     /// As [`OnnxConfig::load`], from the model's bytes and a parsed manifest.

@@ -1,4 +1,6 @@
-//! A heap budget for Starlark evaluation that holds even for one huge allocation.
+//! A heap budget that holds even for one huge allocation: for Starlark evaluation (the
+//! scenario language) and for loading an ONNX model (`sut::onnx`), whose declared tensor
+//! sizes tract allocates while it analyses the graph.
 //!
 //! starlark's own heap limit is checked every 1,000 evaluation steps, so one statement such
 //! as `[0] * 1000000000` (8 GB in one `Vec`), or a loop of forty string doublings, runs to an
@@ -28,6 +30,10 @@ pub const MAX_LAMBDA_HEAP_BYTES: usize = 64 << 20;
 /// bytes (1 GiB): an allocation that would pass it exits the process with code 2 and a
 /// message instead of being attempted.
 pub const HARD_HEAP_BYTES: usize = 1 << 30;
+/// Hard heap limit of loading an ONNX model and running it once, bytes (2 GiB): a model whose
+/// declared tensors (an intermediate of 10^10 elements) would pass it is refused, named, with
+/// exit 2, instead of aborting on an allocation failure.
+pub const HARD_MODEL_BYTES: usize = 2 << 30;
 /// Hard heap limit of one lambda call during a test, bytes (256 MiB; as [`HARD_HEAP_BYTES`]).
 /// Lower than the program's, so that a lambda squaring a big integer in a loop (whose
 /// multiplications take minutes near 1 GiB, with no step between) stops within seconds.
@@ -96,7 +102,7 @@ fn hard_limit_exceeded(hard: usize, request: usize) -> ! {
     let _ = write!(
         cursor,
         "{tool}: error: {what} exceeded the heap limit of {} MiB (its last allocation asked \
-         for {} MiB: a list, string or number too large)\n --> {file}\n\
+         for {} MiB: a value or tensor too large)\n --> {file}\n\
          (results already written are kept; nothing after this allocation ran)\n",
         hard >> 20,
         request >> 20
