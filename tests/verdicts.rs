@@ -437,7 +437,10 @@ fn a_plot_that_cannot_be_drawn_is_a_warning_and_costs_no_summary() {
     let s = summary(&out);
     assert_eq!(s["counts"]["pass"], 4);
     let outputs = s["outputs"].to_string();
-    assert!(outputs.contains("results.jsonl") && !outputs.contains("failure_map"), "{outputs}");
+    assert!(
+        outputs.contains("results.jsonl") && !outputs.contains("failure_map"),
+        "{outputs}"
+    );
     assert!(s["warnings"]
         .to_string()
         .contains("failure_map was not drawn"));

@@ -228,7 +228,7 @@ pub fn falsification_study(settings: &StudySettings<'_>, out: &Path) -> Result<S
         table.push('\n');
     }
     let table_path = dir.join("study.md");
-    std::fs::write(&table_path, &table).map_err(|e| Error::write(&table_path, e))?;
+    paracosm::atomic::write(&table_path, table.as_bytes())?;
 
     let panels: Vec<paracosm::plot::BoxPanel> = columns
         .iter()

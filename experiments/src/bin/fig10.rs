@@ -44,7 +44,7 @@ fn main() -> Result<()> {
     let jobs = paracosm_experiments::jobs_or_all_cores(cli.jobs);
     let copy = |from: &PathBuf, name: &str| -> Result<()> {
         if let Some(docs) = &cli.docs {
-            std::fs::copy(from, docs.join(name))?;
+            paracosm::atomic::write(&docs.join(name), &std::fs::read(from)?)?;
         }
         Ok(())
     };

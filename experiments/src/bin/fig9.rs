@@ -48,7 +48,7 @@ fn main() -> Result<()> {
         }
     };
     if let Some(docs) = &cli.docs {
-        std::fs::copy(&f.plots[0], docs)?;
+        paracosm::atomic::write(docs, &std::fs::read(&f.plots[0])?)?;
     }
     println!(
         "random: {} failed (dispersion {:.4}), halton: {} failed (dispersion {:.4}) in {} tests \

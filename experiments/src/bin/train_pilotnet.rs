@@ -274,8 +274,9 @@ fn main() -> Result<()> {
         std::fs::create_dir_all(dir)?;
     }
     let path = |ext: &str| args.out.with_extension(ext);
-    std::fs::write(path("onnx"), &onnx)?;
-    std::fs::write(path("toml"), pilotnet::MANIFEST)?;
+    // Through a temporary file and a rename: a link planted at a path is refused, not followed.
+    paracosm::atomic::write(&path("onnx"), &onnx)?;
+    paracosm::atomic::write(&path("toml"), pilotnet::MANIFEST.as_bytes())?;
     let stem = args
         .out
         .file_name()
@@ -345,7 +346,7 @@ fn main() -> Result<()> {
             String::new()
         },
     );
-    std::fs::write(path("md"), card)?;
+    paracosm::atomic::write(&path("md"), card.as_bytes())?;
     println!(
         "wrote {} ({} bytes), {} and {} in {:.0} s",
         path("onnx").display(),
