@@ -2,8 +2,8 @@
 //! ever written. A symbolic link (to a file outside), a directory and a FIFO planted at every
 //! path a campaign writes, in a fresh run (`--force`) and in `--resume`, are refused with
 //! exit 2 before any test runs, within seconds (a FIFO never blocks), and what the link points
-//! to is left as it was. The same for `export`'s, `report`'s and `dataset`'s files, and an
-//! output folder that cannot be made is exit 2 before any work in every subcommand.
+//! to is left as it was. The same for the files of `export`, `replay --frames` and `report`,
+//! and an output folder that cannot be made is exit 2 before any work in every subcommand.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -195,7 +195,7 @@ fn finished(dir: &Path, name: &str) -> PathBuf {
 }
 
 #[test]
-fn export_report_and_dataset_refuse_planted_files_before_any_work() {
+fn export_replay_and_report_refuse_planted_files() {
     let dir = tempfile::tempdir().unwrap();
     let outside = dir.path().join("outside.txt");
     std::fs::write(&outside, "keep me").unwrap();
@@ -218,6 +218,28 @@ fn export_report_and_dataset_refuse_planted_files_before_any_work() {
             ]);
             assert_refused(
                 &format!("export {file} {kind:?}"),
+                &run,
+                &target,
+                kind,
+                &outside,
+            );
+        }
+        // replay --frames: its frames and contact sheet.
+        for file in ["frame_00000.png", "contact_sheet.png"] {
+            let frames = dir.path().join(format!("frames-{file}-{kind:?}"));
+            std::fs::create_dir_all(&frames).unwrap();
+            let target = frames.join(file);
+            plant(kind, &target, &outside);
+            let run = fuzz(&[
+                "replay",
+                results.to_str().unwrap(),
+                "--id",
+                "0",
+                "--frames",
+                frames.to_str().unwrap(),
+            ]);
+            assert_refused(
+                &format!("replay {file} {kind:?}"),
                 &run,
                 &target,
                 kind,

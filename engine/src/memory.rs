@@ -60,6 +60,37 @@ thread_local! {
         const { Cell::new((std::ptr::null(), 0, "")) };
     /// Whether a hard limit parks this thread ([`park_on_hard_limit`]) instead of exiting.
     static PARK: Cell<bool> = const { Cell::new(false) };
+    /// The statement being evaluated under the active budget, as the evaluator's hook notes
+    /// it ([`note_statement`]): its file's source (pointer and length) and the statement's
+    /// byte offset in it; a null pointer when none was noted since the budget started.
+    static STATEMENT: Cell<(*const u8, usize, u32)> =
+        const { Cell::new((std::ptr::null(), 0, 0)) };
+}
+
+/// Notes the statement an evaluation is about to run, for the hard limit's message
+/// (`file:line:col`): `source` is the text of its file, which must outlive the active
+/// [`Budget`], and `offset` the statement's byte offset in it. Allocates nothing.
+pub fn note_statement(source: &str, offset: u32) {
+    STATEMENT.with(|s| s.set((source.as_ptr(), source.len(), offset)));
+}
+
+/// The 1-based line and column (in bytes) of the statement last noted, if any.
+fn noted_place() -> Option<(usize, usize)> {
+    let (ptr, len, offset) = STATEMENT.with(Cell::get);
+    let offset = offset as usize;
+    if ptr.is_null() || offset > len {
+        return None;
+    }
+    // SAFETY: noted by `note_statement` from a `&str` that outlives the active budget (the
+    // note is cleared when a budget starts and restored when it ends).
+    let text = unsafe { std::slice::from_raw_parts(ptr, len) };
+    let before = &text[..offset];
+    let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
+    let start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
+    Some((line, offset - start + 1))
 }
 
 /// The global allocator of the paracosm binaries: [`System`], counting the bytes of threads
@@ -102,10 +133,16 @@ fn hard_limit_exceeded(hard: usize, request: usize) -> ! {
     let _ = write!(
         cursor,
         "{tool}: error: {what} exceeded the heap limit of {} MiB (its last allocation asked \
-         for {} MiB: a value or tensor too large)\n --> {file}\n\
-         (results already written are kept; nothing after this allocation ran)\n",
+         for {} MiB: a value or tensor too large)\n --> {file}",
         hard >> 20,
         request >> 20
+    );
+    if let Some((line, column)) = noted_place() {
+        let _ = write!(cursor, ":{line}:{column} (the statement it was running)");
+    }
+    let _ = write!(
+        cursor,
+        "\n(results already written are kept; nothing after this allocation ran)\n"
     );
     let n = cursor.position() as usize;
     let _ = std::io::stderr().write_all(&buf[..n]);
@@ -168,6 +205,8 @@ unsafe impl GlobalAlloc for CountingAlloc {
 /// program's file name, which the hard limit's message shows.
 pub struct Budget<'a> {
     saved: (isize, usize, usize, (*const u8, usize, &'static str)),
+    /// The outer budget's noted statement ([`note_statement`]).
+    statement: (*const u8, usize, u32),
     _file: std::marker::PhantomData<&'a str>,
 }
 
@@ -184,6 +223,7 @@ impl<'a> Budget<'a> {
         );
         Budget {
             saved,
+            statement: STATEMENT.with(|s| s.replace((std::ptr::null(), 0, 0))),
             _file: std::marker::PhantomData,
         }
     }
@@ -202,6 +242,7 @@ impl Drop for Budget<'_> {
         HARD.with(|h| h.set(hard));
         SOFT.with(|s| s.set(soft));
         WHAT.with(|w| w.set(what));
+        STATEMENT.with(|s| s.set(self.statement));
     }
 }
 

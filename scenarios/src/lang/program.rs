@@ -380,6 +380,8 @@ impl Program {
             "the program",
         );
         eval.set_check_cancelled(Box::new(crate::memory::over_soft_limit));
+        // The statement running is noted for the hard limit's message (`file:line:col`).
+        eval.before_stmt_for_dap(starlark::eval::BeforeStmtFunc::Fn(&note_statement));
         // `tick` as a variable of the module, on its heap, rather than the frozen global
         // alone: starlark inlines a module variable that holds a frozen value into the lambdas
         // it compiles, so `ticks = tick` read in a lambda stayed a stream instead of reading as
@@ -700,6 +702,9 @@ impl Program {
         let spread = |n: usize, most: usize| -> Vec<usize> {
             if n <= most {
                 (0..n).collect()
+            } else if most <= 1 {
+                // One of them: the first (`j * (n - 1) / (most - 1)` needs two).
+                vec![0]
             } else {
                 let mut v: Vec<usize> = (0..most).map(|j| j * (n - 1) / (most - 1)).collect();
                 v.dedup();
@@ -789,6 +794,12 @@ impl Program {
         }
         out
     }
+}
+
+/// Notes the statement about to run for the hard heap limit's message
+/// ([`crate::memory::note_statement`]); the program's source outlives every evaluation.
+fn note_statement(at: starlark::codemap::FileSpanRef, _: bool, _: &mut Evaluator<'_, '_, '_>) {
+    crate::memory::note_statement(at.file.source(), at.span.begin().get());
 }
 
 /// Errors of a lambda that depend on the values it is given rather than on their types: a

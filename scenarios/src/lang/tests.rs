@@ -922,3 +922,30 @@ fn a_parameter_of_a_car_disabled_in_every_test_changes_nothing() {
     let s = load_source("some.star", &src, "some").unwrap();
     assert!(s.unused_params.is_empty(), "{:?}", s.unused_params);
 }
+
+/// Hostile input, second round, requirement 4: the most parameters a program may declare
+/// (none used, so every one is probed and looked at again from a shared budget of
+/// evaluations, one combination each) load and are each named unused; one more is refused
+/// with the limit and its place.
+#[test]
+fn the_most_parameters_a_program_may_declare_load_and_one_more_is_refused() {
+    let program = |n: usize| {
+        let mut s = format!("{HEADER}w.place(r, v)\nCollisionMonitor(v)\n");
+        for i in 0..n {
+            s.push_str(&format!("p{i} = VarInterval(0.0, 1.0)\n"));
+        }
+        s
+    };
+    let most = super::MAX_PARAMS;
+    let s = load_source("most.star", &program(most), "most").unwrap();
+    assert_eq!(s.space.params().len(), most);
+    assert_eq!(s.unused_params.len(), most, "none of them is used");
+    let m = err(&program(most + 1));
+    assert!(
+        m.contains(&format!(
+            "declares {} open parameters; the limit is {most}",
+            most + 1
+        )) && m.contains(&format!("bad.star:{}:", most + 6)),
+        "{m}"
+    );
+}
