@@ -125,18 +125,34 @@ pub fn check_targets<'a>(
 
 /// The files a campaign writes into its folder (beside the lock), every one through this
 /// module: a link, a directory or a FIFO planted at any of them is refused before a test runs.
+/// In the order `summary.json` lists them, `campaign.json` last (it is not listed there).
 pub const CAMPAIGN_OUTPUTS: [&str; 10] = [
     "results.jsonl",
-    "campaign.json",
     "summary.json",
-    "report.html",
     "failure_map.png",
     "failure_map.svg",
     "failure_rate.png",
     "failure_rate.svg",
     "pairs.png",
     "pairs.svg",
+    "report.html",
+    "campaign.json",
 ];
+
+/// Makes the output folder `dir` (and its parents) and checks that it takes new files
+/// ([`probe_writable`]): for a command's `--out`, before any work.
+///
+/// # Errors
+/// [`Error::BadInput`] (exit 2) naming the folder, when it cannot be made or written.
+pub fn make_output_folder(dir: &Path) -> Result<(), Error> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        Error::BadInput(format!(
+            "cannot create the output folder `{}`: {e}",
+            dir.display()
+        ))
+    })?;
+    probe_writable(dir)
+}
 
 /// Checks that `dir` (a folder that exists) takes new files: one of a fresh name is created
 /// exclusively (so a link planted in the folder is never followed) and removed at once.

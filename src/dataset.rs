@@ -265,13 +265,7 @@ fn prepare(out: &Path, replace: bool) -> Result<(), Error> {
     }
     // An output folder that cannot be made or written is bad input (exit 2), found before
     // any test runs.
-    std::fs::create_dir_all(out).map_err(|e| {
-        Error::BadInput(format!(
-            "cannot create the output folder `{}`: {e}",
-            out.display()
-        ))
-    })?;
-    crate::atomic::probe_writable(out)?;
+    crate::atomic::make_output_folder(out)?;
     for sub in ["images", "depth", "masks"] {
         let dir = out.join(sub);
         std::fs::create_dir_all(&dir).map_err(|e| write_error(&dir, e))?;

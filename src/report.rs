@@ -574,21 +574,12 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
         || existing.records.iter().map(|r| r.wall_ms).sum::<f64>() / 1e3,
         |s| s.wall_s,
     );
-    let outputs: Vec<String> = [
-        RESULTS_FILE,
-        SUMMARY_FILE,
-        "failure_map.png",
-        "failure_map.svg",
-        "failure_rate.png",
-        "failure_rate.svg",
-        "pairs.png",
-        "pairs.svg",
-        crate::html::REPORT_FILE,
-    ]
-    .iter()
-    .filter(|f| dir.join(f).exists())
-    .map(|f| f.to_string())
-    .collect();
+    let outputs: Vec<String> = crate::atomic::CAMPAIGN_OUTPUTS
+        .iter()
+        .filter(|f| **f != crate::campaign_file::CAMPAIGN_FILE)
+        .filter(|f| dir.join(f).exists())
+        .map(|f| f.to_string())
+        .collect();
     let summary = summarise(
         &Finished {
             out: dir,

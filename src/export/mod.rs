@@ -48,13 +48,7 @@ pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
         )));
     }
     // The folder and the two files are checked before the replay (exit 2, before any work).
-    std::fs::create_dir_all(out).map_err(|e| {
-        Error::BadInput(format!(
-            "cannot create the output folder `{}`: {e}",
-            out.display()
-        ))
-    })?;
-    crate::atomic::probe_writable(out)?;
+    crate::atomic::make_output_folder(out)?;
     crate::atomic::check_targets(
         out,
         [format!("test_{id}.xosc"), format!("test_{id}.xodr")]
