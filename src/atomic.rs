@@ -4,7 +4,7 @@
 //! A rename replaces whatever the target path names, so it is done only when the target is
 //! absent or a regular file. A symlink, a directory, a device (`/dev/full`, `/dev/null`) or a
 //! FIFO is refused with [`Error::BadInput`] (exit 2), before anything is written: paracosm
-//! never replaces what is not its own file (README, "Hostile input").
+//! never replaces what is not its own file (docs/limits.md).
 
 use std::io::Write;
 use std::path::Path;
@@ -174,7 +174,7 @@ pub fn probe_writable(dir: &Path) -> Result<(), Error> {
 }
 
 /// Removes the temporary files ([`with_temp`]'s `.paracosm-*`) that a writer of `dir` killed
-/// mid-write left there. Call it holding the folder's lock ([`crate::lock`]), so that no other
+/// mid-write left there. Call it holding the folder's lock ([`crate::campaign::lock`]), so that no other
 /// writer's temporary file is taken. Only regular files are removed (a link planted under such
 /// a name is left, and never followed); a file that cannot be removed is left as it is.
 pub fn remove_stale_temps(dir: &Path) {

@@ -158,7 +158,7 @@ pub struct Redraw {
     /// `robustness` (a diverging scale centred at 0, so near misses show; the file name ends
     /// in `-robustness`). Given alone, redraws the map over the scenario's map axes.
     #[arg(long, value_name = "outcome|robustness")]
-    pub color: Option<crate::plot::Coloring>,
+    pub color: Option<crate::report::plot::Coloring>,
     /// Redraw the scatterplot matrix of the parameters (`pairs.{png,svg}`).
     #[arg(long)]
     pub pairs: bool,

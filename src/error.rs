@@ -43,6 +43,10 @@ pub enum Error {
     /// A plot cannot be drawn (its file cannot be written): `PlotError`'s message.
     #[error("{0}")]
     Plot(String),
+    /// What a command prints cannot be written to its standard output (a full disk; a closed
+    /// pipe, which the tools take as the reader's choice and exit 0).
+    #[error("cannot write the output: {0}")]
+    Output(std::io::Error),
     /// A defect of paracosm or of its machine: a worker pool that does not start, a panic
     /// outside a test.
     #[error("internal error: {0}")]
@@ -57,7 +61,7 @@ impl Error {
             Error::BadInput(_) | Error::Input { .. } | Error::Scenario(_) | Error::Generator(_) => {
                 2
             }
-            Error::Write { .. } | Error::Plot(_) | Error::Internal(_) => 3,
+            Error::Write { .. } | Error::Output(_) | Error::Plot(_) | Error::Internal(_) => 3,
         }
     }
 

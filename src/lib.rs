@@ -9,27 +9,13 @@
 
 pub mod atomic;
 pub mod campaign;
-pub mod campaign_file;
 pub mod cli;
 pub mod cover;
-pub mod dataset;
 mod error;
 pub mod export;
 pub mod fuzz;
-pub mod html;
-pub mod junit;
-pub mod lock;
-pub mod merge;
-pub mod plot;
-pub mod progress;
 pub mod record;
-pub mod replay;
 pub mod report;
-pub mod results;
-pub mod seed;
-pub mod session;
-pub mod summary;
-pub mod triage;
 
 pub use campaign::{Campaign, CampaignReport, Observer, OnRecord, ResultsFile};
 pub use error::Error;

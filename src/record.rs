@@ -70,7 +70,7 @@ pub struct RunRecord {
     pub campaign: Option<String>,
     /// Test index in the campaign, `0..budget`.
     pub id: u64,
-    /// The test's own seed, derived from the campaign seed and `id` ([`crate::seed::test_seed`]).
+    /// The test's own seed, derived from the campaign seed and `id` ([`crate::campaign::seed::test_seed`]).
     pub seed: u64,
     /// The strategy that proposed the point.
     pub strategy: String,

@@ -54,7 +54,7 @@ fn the_report_page_loads_offline_draws_every_test_redraws_and_shows_a_replay_com
     );
     let id = seen["clickedId"].as_u64().unwrap();
     let replay = seen["replay"].as_str().unwrap();
-    assert_eq!(replay, paracosm::replay::replay_command(&out, id));
+    assert_eq!(replay, paracosm::export::replay::replay_command(&out, id));
     // The clicked test failed in the records.
     let line = std::fs::read_to_string(out.join("results.jsonl"))
         .unwrap()

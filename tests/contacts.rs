@@ -6,7 +6,7 @@
 
 mod common;
 
-use paracosm_engine::behaviour::{Actor, Output};
+use paracosm_engine::behaviour::{ActorRef, Output};
 use paracosm_engine::rx::Value;
 use paracosm_engine::sut::SutConfig;
 use paracosm_engine::Simulation;
@@ -48,14 +48,14 @@ fn trace<T>(source: &str, seconds: f64, mut f: impl FnMut(&Simulation) -> T) -> 
     out
 }
 
-fn x_of(sim: &Simulation, a: Actor) -> f64 {
+fn x_of(sim: &Simulation, a: ActorRef) -> f64 {
     match sim.read(a, Output::Pos) {
         Value::Vec3(p) => p[0],
         v => panic!("{v:?}"),
     }
 }
 
-fn flag(sim: &Simulation, a: Actor, o: Output) -> bool {
+fn flag(sim: &Simulation, a: ActorRef, o: Output) -> bool {
     matches!(sim.read(a, o), Value::Bool(true))
 }
 
@@ -79,9 +79,9 @@ test(horizon = 10.0, offroad = False)
     );
     let xs = trace(&program, 8.0, |s| {
         (
-            x_of(s, Actor::Car(0)),
-            flag(s, Actor::Car(0), Output::Collided),
-            s.read(Actor::Car(0), Output::Speed).as_num().unwrap(),
+            x_of(s, car(s, 0)),
+            flag(s, car(s, 0), Output::Collided),
+            s.read(car(s, 0), Output::Speed).as_num().unwrap(),
         )
     });
     let (x, collided, speed) = *xs.last().unwrap();
@@ -113,9 +113,9 @@ test(horizon = 12.0, offroad = False)
     );
     let xs = trace(&program, 12.0, |s| {
         (
-            x_of(s, Actor::Car(0)),
-            flag(s, Actor::Car(0), Output::Collided),
-            s.read(Actor::Car(0), Output::Separation).as_num().unwrap(),
+            x_of(s, car(s, 0)),
+            flag(s, car(s, 0), Output::Collided),
+            s.read(car(s, 0), Output::Separation).as_num().unwrap(),
         )
     });
     let (x, collided, gap) = *xs.last().unwrap();
@@ -148,10 +148,14 @@ test(horizon = 10.0, offroad = False)
     );
     let out = trace(&program, 9.0, |s| {
         (
-            x_of(s, Actor::Car(0)),
-            x_of(s, Actor::Car(1)),
-            [0, 1, 2].map(|i| flag(s, Actor::Car(i), Output::Collided)),
-            flag(s, Actor::Pedestrian(0), Output::Collided),
+            x_of(s, car(s, 0)),
+            x_of(s, car(s, 1)),
+            [0, 1, 2].map(|i| flag(s, car(s, i), Output::Collided)),
+            flag(
+                s,
+                ActorRef::Pedestrian(s.pedestrians().next().unwrap()),
+                Output::Collided,
+            ),
         )
     });
     let (a, b, cars, ped) = *out.last().unwrap();
@@ -179,11 +183,11 @@ test(horizon = 12.0, offroad = False)
 "#;
     let dt = 1.0 / 60.0;
     let out = trace(program, 12.0, |s| {
-        let p = match s.read(Actor::Car(0), Output::Pos) {
+        let p = match s.read(car(s, 0), Output::Pos) {
             Value::Vec3(p) => p,
             v => panic!("{v:?}"),
         };
-        (p, s.read(Actor::Car(0), Output::Speed).as_num().unwrap())
+        (p, s.read(car(s, 0), Output::Speed).as_num().unwrap())
     });
     let mut worst: f64 = 0.0;
     for w in out.windows(2).skip(1) {
@@ -314,7 +318,7 @@ test(horizon = 8.0)
     let (_, offroad) = &outcome.monitors[0];
     assert!(offroad.passed, "{offroad:?}");
     // It went round: more than a quarter of the ring from where it started.
-    let r = trace(program, 4.0, |s| match s.read(Actor::Ego, Output::Pos) {
+    let r = trace(program, 4.0, |s| match s.read(ActorRef::Ego, Output::Pos) {
         Value::Vec3(p) => (-p[2]).atan2(p[0]),
         v => panic!("{v:?}"),
     });
@@ -340,11 +344,11 @@ test(horizon = 10.0, offroad = False)
     );
     let out = trace(&program, 8.0, |s| {
         (
-            match s.read(Actor::Car(0), Output::Pos) {
+            match s.read(car(s, 0), Output::Pos) {
                 Value::Vec3(p) => p,
                 v => panic!("{v:?}"),
             },
-            s.read(Actor::Car(0), Output::Speed).as_num().unwrap(),
+            s.read(car(s, 0), Output::Speed).as_num().unwrap(),
         )
     });
     // From the second step on (the first sets the speed), at 5 m/s over the ground.
@@ -354,4 +358,9 @@ test(horizon = 10.0, offroad = False)
     // Into the other direction's lane 1: 3.5 m to the left of where it started (z = -1.75).
     let (p, _) = out.last().unwrap();
     assert!((p[2] + 1.75).abs() < 1e-6, "{p:?}");
+}
+
+/// The `i`-th car of the world `s` runs.
+fn car(s: &Simulation, i: usize) -> ActorRef {
+    ActorRef::Car(s.cars().nth(i).expect("the world has that car"))
 }

@@ -5,7 +5,7 @@ use std::io::Read;
 use std::process::{Command, Stdio};
 use std::sync::Arc;
 
-use paracosm::session::{Plan, Request};
+use paracosm::campaign::session::{Plan, Request};
 use paracosm::{CampaignReport, Error, Observer, RunRecord, Status};
 use paracosm_generators::Assignment;
 use paracosm_scenarios::{ScenarioError, Worlds};
@@ -48,7 +48,7 @@ fn a_campaign_runs_from_the_library_with_a_custom_observer() {
     request.jobs = Some(2);
     let mut tally = Tally::default();
     let mut planned = 0;
-    let outcome = paracosm::session::run(
+    let outcome = paracosm::campaign::session::run(
         &request,
         None,
         &mut |p: &Plan<'_>| planned = p.to_run,
@@ -65,9 +65,12 @@ fn a_campaign_runs_from_the_library_with_a_custom_observer() {
     let lines = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
     assert_eq!(lines.lines().count(), 40);
     // summary.json reads back as the summary that was written.
-    assert_eq!(&paracosm::summary::Summary::read(&out).unwrap(), summary);
+    assert_eq!(
+        &paracosm::report::summary::Summary::read(&out).unwrap(),
+        summary
+    );
     // The same folder again is refused with a typed error (exit code 2), keeping its files.
-    let again = paracosm::session::run(&request, None, &mut |_: &Plan<'_>| {}, &mut []);
+    let again = paracosm::campaign::session::run(&request, None, &mut |_: &Plan<'_>| {}, &mut []);
     let e = again.unwrap_err();
     assert!(matches!(e, Error::BadInput(_)), "{e}");
     assert_eq!(e.exit_code(), 2);

@@ -16,7 +16,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use paracosm_engine::behaviour::{Actor, Output};
+use paracosm_engine::behaviour::{ActorRef, Output};
 use paracosm_engine::network::{wrap, MIN_PATH_RADIUS_M};
 use paracosm_engine::rx::Value;
 use paracosm_engine::sut::SutConfig;
@@ -60,7 +60,7 @@ struct Reading {
     collided: bool,
 }
 
-fn read(sim: &Simulation, actor: Actor) -> Option<Reading> {
+fn read(sim: &Simulation, actor: ActorRef) -> Option<Reading> {
     let vec = |o| match sim.read(actor, o) {
         Value::Vec3(v) => Some(v),
         _ => None,
@@ -110,9 +110,9 @@ fn check_program(path: &Path, tests: usize) -> Worst {
                 let mut sut = SutConfig::builtin("aeb").unwrap().build();
                 sut.reset(0).unwrap();
                 let dt = spec.dt_s;
-                let actors: Vec<Actor> = std::iter::once(Actor::Ego)
-                    .chain((0..spec.pedestrians.len() as u32).map(Actor::Pedestrian))
-                    .chain((0..spec.cars.len() as u32).map(Actor::Car))
+                let actors: Vec<ActorRef> = std::iter::once(ActorRef::Ego)
+                    .chain(sim.pedestrians().map(ActorRef::Pedestrian))
+                    .chain(sim.cars().map(ActorRef::Car))
                     .collect();
                 let mut last: Vec<Option<Reading>> = vec![None; actors.len()];
                 let steps = ((CHECK_S.min(scenario.horizon_s)) / dt).round() as usize;
@@ -131,7 +131,7 @@ fn check_program(path: &Path, tests: usize) -> Worst {
                             || format!("{name} test {k} {assignment:?}: {actor:?} at step {step}");
                         let norm = r.vel[0].hypot(r.vel[1]).hypot(r.vel[2]);
                         let speed_ok = match actor {
-                            Actor::Ego => (r.speed.abs() - norm).abs() <= 1e-9 * norm.max(1.0),
+                            ActorRef::Ego => (r.speed.abs() - norm).abs() <= 1e-9 * norm.max(1.0),
                             _ => (r.speed - norm).abs() <= 1e-9 * norm.max(1.0),
                         };
                         assert!(speed_ok, "{}: speed {} but |vel| {norm}", at(), r.speed);
@@ -143,7 +143,7 @@ fn check_program(path: &Path, tests: usize) -> Worst {
                             .map(|e| e * e)
                             .sum::<f64>()
                             .sqrt();
-                        let tolerance = if actor == Actor::Ego { 0.05 } else { 1e-9 };
+                        let tolerance = if actor == ActorRef::Ego { 0.05 } else { 1e-9 };
                         assert!(
                             err <= tolerance,
                             "{}: vel {:?} but it moved {moved:?} m/s",
@@ -153,7 +153,7 @@ fn check_program(path: &Path, tests: usize) -> Worst {
                         worst.vel_error = worst.vel_error.max(err);
                         // A car moves the way it faces (to the chord of a 0.5 m leg of its
                         // tightest path, and a lane change's crab).
-                        if matches!(actor, Actor::Car(_)) && norm > 0.5 {
+                        if matches!(actor, ActorRef::Car(_)) && norm > 0.5 {
                             let course = (-r.vel[2]).atan2(r.vel[0]);
                             let off = wrap(course - r.heading).abs();
                             worst.slip = worst.slip.max(off);
@@ -167,12 +167,12 @@ fn check_program(path: &Path, tests: usize) -> Worst {
                         let yaw = wrap(r.heading - p.heading).abs() / dt;
                         let v = r.speed.abs().max(p.speed.abs());
                         let limit = match actor {
-                            Actor::Ego => v / EGO_MIN_RADIUS_M + 0.05,
-                            Actor::Pedestrian(_) => 0.0,
+                            ActorRef::Ego => v / EGO_MIN_RADIUS_M + 0.05,
+                            ActorRef::Pedestrian(_) | ActorRef::Obstacle(_) => 0.0,
                             // A lane change turns the car by atan(sideways / forward speed)
                             // on top of its path's curvature: at most 1 rad/s for the
                             // lane changes of these programs.
-                            Actor::Car(_) => v / MIN_PATH_RADIUS_M + 1.0,
+                            ActorRef::Car(_) => v / MIN_PATH_RADIUS_M + 1.0,
                         };
                         if limit > 0.0 {
                             worst.yaw_share = worst.yaw_share.max(yaw / limit);
@@ -263,11 +263,19 @@ test(horizon = 20.0, offroad = False)
             let mut last: Option<(f64, f64)> = None;
             for _ in 0..(15.0 / dt) as usize {
                 sim.evaluate(host).unwrap();
-                let Value::Vec3(p) = sim.read(Actor::Car(0), Output::Pos) else {
+                let Value::Vec3(p) =
+                    sim.read(ActorRef::Car(sim.cars().next().unwrap()), Output::Pos)
+                else {
                     panic!()
                 };
-                let h = sim.read(Actor::Car(0), Output::Heading).as_num().unwrap();
-                let v = sim.read(Actor::Car(0), Output::Speed).as_num().unwrap();
+                let h = sim
+                    .read(ActorRef::Car(sim.cars().next().unwrap()), Output::Heading)
+                    .as_num()
+                    .unwrap();
+                let v = sim
+                    .read(ActorRef::Car(sim.cars().next().unwrap()), Output::Speed)
+                    .as_num()
+                    .unwrap();
                 let r = (p[0] - centre.x).hypot(p[2] - centre.z);
                 if let Some((r0, h0)) = last {
                     // On the ring (16.75 m; the chords of its 0.5 m legs come 2 mm inside).

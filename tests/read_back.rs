@@ -6,7 +6,7 @@
 mod common;
 
 use common::{expect_code, fuzz};
-use paracosm::campaign_file::SutChoice;
+use paracosm::campaign::file::SutChoice;
 use paracosm_engine::rx::Value as StreamValue;
 use paracosm_engine::sut::{AebConfig, VisionConfig};
 use paracosm_generators::{Domain, Param, ParamSpace, Value};

@@ -65,16 +65,19 @@ pub struct VisibleBox {
     pub actor: usize,
 }
 
-/// A handle to an actor of type `T` in its [`Set`]: its index, typed so that a car's handle
-/// cannot name a pedestrian.
+/// A handle to an actor of kind `T` in its [`Set`]: its index, typed so that a car's handle
+/// cannot name a pedestrian. Handles are made only by a [`Set`] or a [`Roster`]; an actor's
+/// kind is named by its spec type ([`crate::CarSpec`], [`crate::PedestrianSpec`],
+/// [`crate::ObstacleSpec`]), so that a handle handed out when a scenario declares the actor
+/// names the same actor in the running simulation's set.
 pub struct Handle<T> {
     index: u32,
     kind: PhantomData<fn() -> T>,
 }
 
 impl<T> Handle<T> {
-    /// The handle of the `index`-th actor inserted.
-    pub fn from_index(index: usize) -> Self {
+    /// The handle of the `index`-th actor inserted (for [`Set`] and [`Roster`] only).
+    fn from_index(index: usize) -> Self {
         Handle {
             index: index as u32,
             kind: PhantomData,
@@ -110,44 +113,58 @@ impl<T> fmt::Debug for Handle<T> {
     }
 }
 
-/// A set of actors of one kind, in insertion order.
-pub struct Set<T> {
+/// A set of actors of one kind, in insertion order: items of type `T`, named by handles of
+/// kind `K` (by default `T` itself; the simulation's live actors are named by their spec's
+/// kind, so that a [`Roster`]'s handles reach them).
+pub struct Set<T, K = T> {
     items: Vec<T>,
+    kind: PhantomData<fn() -> K>,
 }
 
-impl<T> Default for Set<T> {
+impl<T, K> Default for Set<T, K> {
     fn default() -> Self {
-        Set { items: Vec::new() }
+        Set {
+            items: Vec::new(),
+            kind: PhantomData,
+        }
     }
 }
 
-impl<T> Set<T> {
+impl<T, K> Set<T, K> {
     /// Adds `item`; returns its handle.
-    pub fn insert(&mut self, item: T) -> Handle<T> {
+    pub fn insert(&mut self, item: T) -> Handle<K> {
         self.items.push(item);
         Handle::from_index(self.items.len() - 1)
     }
 
     /// The actor of handle `h`, if it is in the set.
-    pub fn get(&self, h: Handle<T>) -> Option<&T> {
+    pub fn get(&self, h: Handle<K>) -> Option<&T> {
         self.items.get(h.index())
     }
 
     /// The actor of handle `h`, mutably.
-    pub fn get_mut(&mut self, h: Handle<T>) -> Option<&mut T> {
+    pub fn get_mut(&mut self, h: Handle<K>) -> Option<&mut T> {
         self.items.get_mut(h.index())
     }
 
     /// Every actor with its handle, in insertion order.
-    pub fn iter(&self) -> impl Iterator<Item = (Handle<T>, &T)> {
+    pub fn iter(&self) -> impl Iterator<Item = (Handle<K>, &T)> {
         self.items
             .iter()
             .enumerate()
             .map(|(i, t)| (Handle::from_index(i), t))
     }
 
+    /// Every actor with its handle, mutably, in insertion order.
+    pub fn iter_mut(&mut self) -> impl Iterator<Item = (Handle<K>, &mut T)> {
+        self.items
+            .iter_mut()
+            .enumerate()
+            .map(|(i, t)| (Handle::from_index(i), t))
+    }
+
     /// Every actor, mutably, in insertion order.
-    pub fn iter_mut(&mut self) -> impl Iterator<Item = &mut T> {
+    pub fn values_mut(&mut self) -> impl Iterator<Item = &mut T> {
         self.items.iter_mut()
     }
 
@@ -167,6 +184,62 @@ impl<T> Set<T> {
     }
 }
 
+/// Hands out the handles of actors declared before their [`Set`] exists: a scenario declares
+/// its pedestrians, cars and obstacles (and streams read and act on them) before the
+/// simulation is built. The `i`-th handle handed out names the `i`-th actor a set of kind `K`
+/// inserts, so the world's specs are listed in the order their handles were handed out.
+pub struct Roster<K> {
+    count: u32,
+    kind: PhantomData<fn() -> K>,
+}
+
+impl<K> Default for Roster<K> {
+    fn default() -> Self {
+        Roster {
+            count: 0,
+            kind: PhantomData,
+        }
+    }
+}
+
+impl<K> Clone for Roster<K> {
+    fn clone(&self) -> Self {
+        Roster {
+            count: self.count,
+            kind: PhantomData,
+        }
+    }
+}
+
+impl<K> fmt::Debug for Roster<K> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Roster({})", self.count)
+    }
+}
+
+impl<K> Roster<K> {
+    /// The next actor's handle.
+    pub fn add(&mut self) -> Handle<K> {
+        self.count += 1;
+        Handle::from_index(self.count as usize - 1)
+    }
+
+    /// How many handles it has handed out.
+    pub fn len(&self) -> usize {
+        self.count as usize
+    }
+
+    /// Whether it has handed out none.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// The handle of the `index`-th actor declared, when there is one.
+    pub fn get(&self, index: usize) -> Option<Handle<K>> {
+        (index < self.len()).then(|| Handle::from_index(index))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -179,6 +252,10 @@ mod tests {
         assert_eq!((a.index(), b.index()), (0, 1));
         assert_eq!(s.get(b), Some(&"b"));
         assert_eq!(s.iter().map(|(h, _)| h).collect::<Vec<_>>(), [a, b]);
+        // A roster's handles name what a set of the same kind inserts, in order.
+        let mut r: Roster<&str> = Roster::default();
+        assert_eq!([r.add(), r.add()], [a, b]);
+        assert_eq!((r.len(), r.get(1), r.get(2)), (2, Some(b), None));
         assert!(Size::CAR.is_valid());
         assert!(!Size {
             length_m: 1.0,

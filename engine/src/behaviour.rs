@@ -1,24 +1,29 @@
 //! How the world and the stream graph meet: probes (physics outputs as streams), sinks
 //! (actions on actors), a graph builder, and the paper's pedestrian behaviour.
 
+use crate::actor::Handle;
 use crate::rx::{Func, Graph, Node, RxError, StreamId, Value};
+use crate::{CarSpec, ObstacleSpec, PedestrianSpec};
 
-/// An object whose outputs a probe reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Actor {
+/// An actor of a world, by its typed handle (paper §2: the reactive objects whose streams a
+/// program reads and acts on).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ActorRef {
     /// The ego vehicle.
     Ego,
-    /// Pedestrian `i`, in [`crate::WorldSpec::pedestrians`] order.
-    Pedestrian(u32),
-    /// NPC car `i`, in [`crate::WorldSpec::cars`] order.
-    Car(u32),
+    /// A pedestrian, named by its handle in [`crate::WorldSpec::pedestrians`]' order.
+    Pedestrian(Handle<PedestrianSpec>),
+    /// An NPC car, named by its handle in [`crate::WorldSpec::cars`]' order.
+    Car(Handle<CarSpec>),
+    /// A static obstacle, named by its handle in [`crate::WorldSpec::obstacles`]' order.
+    Obstacle(Handle<ObstacleSpec>),
 }
 
 /// What a probe reads from its actor, each step (paper §2: `rxout pos, vel, ...`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Output {
     /// Position `[x, y, z]` in metres (the ego's chassis centre, a pedestrian's feet, a car's
-    /// ground point).
+    /// centre, an obstacle's base).
     Pos,
     /// Velocity `[x, y, z]` in m/s.
     Vel,
@@ -38,81 +43,60 @@ pub enum Output {
     Separation,
 }
 
-const OUTPUTS: [Output; 7] = [
-    Output::Pos,
-    Output::Vel,
-    Output::Heading,
-    Output::Speed,
-    Output::Collision,
-    Output::Collided,
-    Output::Separation,
-];
-
-/// The probe number of `output` of `actor`, for [`Node::Probe`].
-pub fn probe(actor: Actor, output: Output) -> u32 {
-    let o = OUTPUTS.iter().position(|&x| x == output).expect("listed") as u32;
-    let a = match actor {
-        Actor::Ego => 0,
-        Actor::Pedestrian(i) => 1 + 2 * i,
-        Actor::Car(i) => 2 + 2 * i,
-    };
-    a * 8 + o
+impl Output {
+    /// Every output, in the order a program's actor lists them (`pos`, `vel`, `heading`,
+    /// `speed`, `collision`, `collided`, `separation`).
+    pub const ALL: [Output; 7] = [
+        Output::Pos,
+        Output::Vel,
+        Output::Heading,
+        Output::Speed,
+        Output::Collision,
+        Output::Collided,
+        Output::Separation,
+    ];
 }
 
-/// The inverse of [`probe`].
-pub fn decode_probe(p: u32) -> (Actor, Output) {
-    let (a, o) = (p / 8, p % 8);
-    let actor = match a {
-        0 => Actor::Ego,
-        a if a % 2 == 1 => Actor::Pedestrian((a - 1) / 2),
-        a => Actor::Car((a - 2) / 2),
-    };
-    (actor, OUTPUTS[(o as usize).min(OUTPUTS.len() - 1)])
+/// A physics output read each step: one output of one actor ([`Node::Probe`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Probe {
+    /// Whose output.
+    pub actor: ActorRef,
+    /// Which output.
+    pub output: Output,
+}
+
+impl Probe {
+    /// `output` of `actor`.
+    pub fn new(actor: ActorRef, output: Output) -> Self {
+        Probe { actor, output }
+    }
 }
 
 /// What a `foreach` sink does with each event (paper §2: `foreach(walk)`). The event's value
 /// is the action's argument.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Action {
-    /// Pedestrian `i` takes one walking step toward its target (the value is ignored).
-    Walk(u32),
-    /// Car `i` drives at the value, m/s (a number `>= 0`), from now on.
-    SetSpeed(u32),
-    /// Car `i` slows by the value times the step, m/s² (a number `> 0`), and keeps the
+    /// The pedestrian takes one walking step toward its target (the value is ignored).
+    Walk(Handle<PedestrianSpec>),
+    /// The car drives at the value, m/s (a number `>= 0`), from now on.
+    SetSpeed(Handle<CarSpec>),
+    /// The car slows by the value times the step, m/s² (a number `> 0`), and keeps the
     /// lower speed.
-    Brake(u32),
-    /// Car `i` changes to the lane the value names (a lane number of its start segment, or a
+    Brake(Handle<CarSpec>),
+    /// The car changes to the lane the value names (a lane number of its start segment, or a
     /// `(lane, duration_s)` tuple; 3 s by default).
-    ChangeLane(u32),
+    ChangeLane(Handle<CarSpec>),
 }
 
-const SINK_KIND_SHIFT: u32 = 24;
-
-/// The sink number of `action`, for [`Node::Foreach`]; [`walk_sink`]`(i)` is `i`.
-pub fn action_sink(action: Action) -> u32 {
-    let (kind, i) = match action {
-        Action::Walk(i) => (0, i),
-        Action::SetSpeed(i) => (1, i),
-        Action::Brake(i) => (2, i),
-        Action::ChangeLane(i) => (3, i),
-    };
-    (kind << SINK_KIND_SHIFT) | (i & ((1 << SINK_KIND_SHIFT) - 1))
-}
-
-/// The inverse of [`action_sink`].
-pub fn decode_sink(sink: u32) -> Action {
-    let i = sink & ((1 << SINK_KIND_SHIFT) - 1);
-    match sink >> SINK_KIND_SHIFT {
-        1 => Action::SetSpeed(i),
-        2 => Action::Brake(i),
-        3 => Action::ChangeLane(i),
-        _ => Action::Walk(i),
+impl Action {
+    /// The actor it acts on.
+    pub fn actor(self) -> ActorRef {
+        match self {
+            Action::Walk(p) => ActorRef::Pedestrian(p),
+            Action::SetSpeed(c) | Action::Brake(c) | Action::ChangeLane(c) => ActorRef::Car(c),
+        }
     }
-}
-
-/// The sink that makes pedestrian `i` take one walking step per event.
-pub fn walk_sink(i: u32) -> u32 {
-    action_sink(Action::Walk(i))
 }
 
 /// Collects nodes; each push returns the new stream's id.
@@ -170,7 +154,7 @@ impl GraphBuilder {
         Ok(Graph::new(self.nodes)?.with_sites(self.sites))
     }
 
-    /// The paper's pedestrian behaviour (§2, "Reactive Behaviors") for pedestrian `index`:
+    /// The paper's pedestrian behaviour (§2, "Reactive Behaviors") for `pedestrian`:
     ///
     /// ```text
     /// trigger = car.zip(dist).filter(|car - start| < dist)   // planar distance, m
@@ -183,7 +167,7 @@ impl GraphBuilder {
     /// not count. Returns the trigger stream.
     pub fn pedestrian(
         &mut self,
-        index: u32,
+        pedestrian: Handle<PedestrianSpec>,
         start: [f64; 3],
         target: [f64; 3],
         car: StreamId,
@@ -205,14 +189,20 @@ impl GraphBuilder {
                 )),
             }),
         });
-        self.pedestrian_with_trigger(index, target, trigger);
+        self.pedestrian_with_trigger(pedestrian, target, trigger);
         trigger
     }
 
-    /// `tick.skipUntil(trigger).takeUntil(done).foreach(walk)` for pedestrian `index`, with
-    /// any trigger stream (e.g. one a scenario computes with lambdas).
-    pub fn pedestrian_with_trigger(&mut self, index: u32, target: [f64; 3], trigger: StreamId) {
-        let pos = self.push(Node::Probe(probe(Actor::Pedestrian(index), Output::Pos)));
+    /// `tick.skipUntil(trigger).takeUntil(done).foreach(walk)` for `pedestrian`, with any
+    /// trigger stream (e.g. one a scenario computes with lambdas).
+    pub fn pedestrian_with_trigger(
+        &mut self,
+        pedestrian: Handle<PedestrianSpec>,
+        target: [f64; 3],
+        trigger: StreamId,
+    ) {
+        let actor = ActorRef::Pedestrian(pedestrian);
+        let pos = self.push(Node::Probe(Probe::new(actor, Output::Pos)));
         let done = self.push(Node::Filter {
             src: pos,
             pred: Func::native("_ == target", move |a| {
@@ -227,41 +217,7 @@ impl GraphBuilder {
         });
         self.push(Node::Foreach {
             src: take,
-            sink: walk_sink(index),
+            sink: Action::Walk(pedestrian),
         });
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sinks_round_trip() {
-        for a in [
-            Action::Walk(0),
-            Action::Walk(9),
-            Action::SetSpeed(0),
-            Action::Brake(3),
-            Action::ChangeLane(12),
-        ] {
-            assert_eq!(decode_sink(action_sink(a)), a);
-        }
-        assert_eq!(walk_sink(4), 4);
-    }
-
-    #[test]
-    fn probes_round_trip() {
-        for actor in [
-            Actor::Ego,
-            Actor::Pedestrian(0),
-            Actor::Pedestrian(7),
-            Actor::Car(0),
-            Actor::Car(3),
-        ] {
-            for output in OUTPUTS {
-                assert_eq!(decode_probe(probe(actor, output)), (actor, output));
-            }
-        }
     }
 }

@@ -2,7 +2,8 @@ use rapier3d::prelude::*;
 use serde::Serialize;
 
 use crate::actor::{Size, VisibleBox};
-use crate::contact::{Other, Solids};
+use crate::behaviour::ActorRef;
+use crate::contact::Solids;
 use crate::rx::StreamId;
 
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -507,8 +508,8 @@ impl Car {
         (t_s, dt_s): (f64, f64),
         zone: AwakeZone,
         solids: &Solids,
-        me: Other,
-    ) -> Option<Other> {
+        me: ActorRef,
+    ) -> Option<ActorRef> {
         let start = self.here;
         let end = self.stop_s.max(self.s);
         let braking = friction * GRAVITY_MPS2;
@@ -604,10 +605,10 @@ impl Car {
     fn first_contact(
         &self,
         solids: &Solids,
-        me: Other,
+        me: ActorRef,
         (from, to): (f64, f64),
         t_s: f64,
-    ) -> Option<(f64, Other)> {
+    ) -> Option<(f64, ActorRef)> {
         self.body?;
         let shape = self.shape();
         let reach = self.radius_m();
@@ -644,7 +645,7 @@ impl Car {
     /// How far (m, along its path) the car can drive from where it is before its box
     /// touches an object of `solids` (the ego included), looking `reach_m` ahead; `None`
     /// when nothing is within reach. Found in steps of 0.5 m, then to 1 cm.
-    fn free_ahead_m(&self, solids: &Solids, me: Other, t_s: f64, reach_m: f64) -> Option<f64> {
+    fn free_ahead_m(&self, solids: &Solids, me: ActorRef, t_s: f64, reach_m: f64) -> Option<f64> {
         self.body?;
         let shape = self.shape();
         let touches = |s: f64| {
@@ -859,7 +860,7 @@ mod tests {
                     (t, dt),
                     zone,
                     &Solids::new(),
-                    Other::Car(0),
+                    ActorRef::Car(crate::actor::Roster::default().add()),
                 );
                 let here = c.ground_m();
                 let moved = (here[0] - last[0]).hypot(here[1] - last[1]);

@@ -6,27 +6,15 @@
 //! collision ([`crate::behaviour::Output::Collided`]). The ego vehicle is a dynamic body:
 //! rapier resolves its contacts and reports them as collision events.
 
+use crate::behaviour::ActorRef;
 use rapier3d::parry::query;
 use rapier3d::prelude::*;
-
-/// Something a car or a pedestrian can touch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Other {
-    /// The ego vehicle (only for keeping a distance: its contacts are rapier's).
-    Ego,
-    /// NPC car `i` in the simulation's set.
-    Car(usize),
-    /// Pedestrian `i`.
-    Pedestrian(usize),
-    /// Obstacle `i`.
-    Obstacle(usize),
-}
 
 /// The colliders of a step's solid objects, each with its pose now and the radius of its
 /// bounding sphere about its pose's origin (m): two objects whose origins are farther apart
 /// than their radii together cannot touch, which most pairs are, so they skip parry's test.
 pub(crate) struct Solids {
-    items: Vec<(Other, Pose, SharedShape, f32)>,
+    items: Vec<(ActorRef, Pose, SharedShape, f32)>,
 }
 
 /// The radius of `shape`'s bounding sphere about its frame's origin, m.
@@ -48,7 +36,7 @@ impl Solids {
     }
 
     /// Adds `who` with `shape` at `pose`, or moves it there when it is in the set.
-    pub(crate) fn put(&mut self, who: Other, pose: Pose, shape: SharedShape) {
+    pub(crate) fn put(&mut self, who: ActorRef, pose: Pose, shape: SharedShape) {
         let r = reach(shape.as_ref());
         match self.items.iter_mut().find(|(o, ..)| *o == who) {
             Some(item) => *item = (who, pose, shape, r),
@@ -57,7 +45,7 @@ impl Solids {
     }
 
     /// Moves `who` to `pose` (nothing when it is not in the set).
-    pub(crate) fn move_to(&mut self, who: Other, pose: Pose) {
+    pub(crate) fn move_to(&mut self, who: ActorRef, pose: Pose) {
         if let Some(item) = self.items.iter_mut().find(|(o, ..)| *o == who) {
             item.1 = pose;
         }
@@ -67,15 +55,15 @@ impl Solids {
     /// `pose` touches or overlaps; `None` when it is free.
     pub(crate) fn first_hit(
         &self,
-        me: Other,
+        me: ActorRef,
         shape: &dyn Shape,
         pose: &Pose,
         with_ego: bool,
-    ) -> Option<Other> {
+    ) -> Option<ActorRef> {
         let r = reach(shape);
         self.items
             .iter()
-            .filter(|(o, ..)| *o != me && (with_ego || *o != Other::Ego))
+            .filter(|(o, ..)| *o != me && (with_ego || *o != ActorRef::Ego))
             .find(|(_, p, s, rs)| {
                 // A pair parry cannot test (no such pair among boxes and capsules) counts as
                 // touching: a contact is never assumed away.
@@ -91,14 +79,14 @@ impl Solids {
     /// touch a shape that reaches no farther than `radius_m` from it.
     pub(crate) fn any_near(
         &self,
-        me: Other,
+        me: ActorRef,
         centre: [f64; 3],
         radius_m: f64,
         with_ego: bool,
     ) -> bool {
         self.items
             .iter()
-            .filter(|(o, ..)| *o != me && (with_ego || *o != Other::Ego))
+            .filter(|(o, ..)| *o != me && (with_ego || *o != ActorRef::Ego))
             .any(|(_, p, _, r)| {
                 let t = p.translation;
                 let d = [
@@ -113,7 +101,7 @@ impl Solids {
 
     /// The smallest distance (m) from `shape` at `pose` to any object other than `me`, the
     /// ego included; `inf` when there is none, `0` when touching.
-    pub(crate) fn clearance_m(&self, me: Other, shape: &dyn Shape, pose: &Pose) -> f64 {
+    pub(crate) fn clearance_m(&self, me: ActorRef, shape: &dyn Shape, pose: &Pose) -> f64 {
         self.items
             .iter()
             .filter(|(o, ..)| *o != me)

@@ -23,6 +23,9 @@ pub(crate) struct Obstacle {
     pub(crate) albedo: [f32; 3],
     /// Whether it touches the ego vehicle now.
     pub(crate) touching: bool,
+    /// Whether anything solid (the ego, a car, a pedestrian) has touched it since the test
+    /// began.
+    pub(crate) collided: bool,
 }
 
 impl Obstacle {
@@ -58,6 +61,7 @@ impl Obstacle {
             },
             albedo,
             touching: false,
+            collided: false,
         }
     }
 

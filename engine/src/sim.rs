@@ -5,9 +5,9 @@ use rapier3d::prelude::*;
 use serde::Serialize;
 
 use crate::actor::{Handle, Set, Size, VisibleBox};
-use crate::behaviour::{decode_probe, decode_sink, Action, Actor, Output};
+use crate::behaviour::{Action, ActorRef, Output, Probe};
 use crate::car::{AwakeZone, Car, CarState, LaneChangeStart};
-use crate::contact::{Other, Solids};
+use crate::contact::Solids;
 use crate::network::{Lane, Network, PieceId, Surface};
 use crate::obstacle::{Obstacle, ObstacleState};
 use crate::pedestrian::{Pedestrian, PED_HALF_HEIGHT_M, PED_RADIUS_M};
@@ -16,8 +16,8 @@ use crate::sensor::{Reading, Scene, Sensor, Sensors};
 use crate::spec::EnvironmentSpec;
 use crate::vehicle::EgoVehicle;
 use crate::{
-    CameraFrame, CameraSpec, Control, EngineError, LidarReturn, PedestrianState, WorldSpec,
-    NOMINAL_LIGHT,
+    CameraFrame, CameraSpec, CarSpec, Control, EngineError, LidarReturn, ObstacleSpec,
+    PedestrianSpec, PedestrianState, WorldSpec, NOMINAL_LIGHT,
 };
 
 /// The ego vehicle's state.
@@ -134,9 +134,9 @@ impl ActorNames {
 /// Which actor a collider belongs to.
 #[derive(Debug, Clone, Copy)]
 enum Owner {
-    Pedestrian(Handle<Pedestrian>),
-    Car(Handle<Car>),
-    Obstacle(Handle<Obstacle>),
+    Pedestrian(Handle<PedestrianSpec>),
+    Car(Handle<CarSpec>),
+    Obstacle(Handle<ObstacleSpec>),
 }
 
 /// A running world: the physics, the actors in their sets, the stream graph that drives
@@ -147,9 +147,9 @@ pub struct Simulation {
     surface: Surface,
     ego: EgoVehicle,
     route: Vec<[f64; 2]>,
-    pedestrians: Set<Pedestrian>,
-    cars: Set<Car>,
-    obstacles: Set<Obstacle>,
+    pedestrians: Set<Pedestrian, PedestrianSpec>,
+    cars: Set<Car, CarSpec>,
+    obstacles: Set<Obstacle, ObstacleSpec>,
     /// The actor each actor collider belongs to.
     owners: HashMap<ColliderHandle, Owner>,
     environment: EnvironmentSpec,
@@ -159,7 +159,7 @@ pub struct Simulation {
     streams: Runtime,
     /// The step whose streams [`Simulation::evaluate`] has computed, if it has.
     evaluated: Option<u64>,
-    sinks: Vec<(u32, Value)>,
+    sinks: Vec<(Action, Value)>,
     /// Each car's lanes for `changeLane` ([`crate::CarSpec::lane_offsets_m`]).
     car_lanes: Vec<Vec<(i32, f64)>>,
     /// How messages name each car and each pedestrian ([`crate::CarSpec::name`]).
@@ -551,7 +551,7 @@ impl Simulation {
         self.ego.apply(control, dt);
         self.ego.grip(&self.physics, &self.surface);
         self.ego.update(&mut self.physics, dt);
-        for p in self.pedestrians.iter_mut() {
+        for p in self.pedestrians.values_mut() {
             p.rest();
         }
         self.act(t)?;
@@ -580,8 +580,9 @@ impl Simulation {
         } else {
             Solids::new()
         };
-        let handles: Vec<Handle<Car>> = self.cars.iter().map(|(h, _)| h).collect();
-        for (i, h) in handles.into_iter().enumerate() {
+        let handles: Vec<Handle<CarSpec>> = self.cars.iter().map(|(h, _)| h).collect();
+        for h in handles {
+            let i = h.index();
             let Some(car) = self.cars.get_mut(h) else {
                 continue;
             };
@@ -610,20 +611,25 @@ impl Simulation {
                 (t, dt),
                 zone,
                 &solids,
-                Other::Car(i),
+                ActorRef::Car(h),
             );
             if car.body.is_some() {
-                solids.move_to(Other::Car(i), car.pose());
+                solids.move_to(ActorRef::Car(h), car.pose());
             }
             match hit {
-                Some(Other::Car(j)) => {
-                    if let Some(c) = self.cars.get_mut(Handle::from_index(j)) {
+                Some(ActorRef::Car(j)) => {
+                    if let Some(c) = self.cars.get_mut(j) {
                         c.collided = true;
                     }
                 }
-                Some(Other::Pedestrian(j)) => {
-                    if let Some(p) = self.pedestrians.get_mut(Handle::from_index(j)) {
+                Some(ActorRef::Pedestrian(j)) => {
+                    if let Some(p) = self.pedestrians.get_mut(j) {
                         p.collided = true;
+                    }
+                }
+                Some(ActorRef::Obstacle(j)) => {
+                    if let Some(o) = self.obstacles.get_mut(j) {
+                        o.collided = true;
                     }
                 }
                 _ => {}
@@ -632,20 +638,22 @@ impl Simulation {
         // A pedestrian that walks into a car or an obstacle (rapier reports no contact
         // between two kinematic bodies): both record the collision.
         let capsule = Capsule::new_y(PED_HALF_HEIGHT_M, PED_RADIUS_M);
-        for (i, p) in self
-            .pedestrians
-            .iter_mut()
-            .enumerate()
-            .filter(|_| kinematic_contacts)
-        {
-            if let Some(o) =
-                solids.first_hit(Other::Pedestrian(i), &capsule, &p.collider_pose(), false)
-            {
+        for (h, p) in self.pedestrians.iter_mut().filter(|_| kinematic_contacts) {
+            let me = ActorRef::Pedestrian(h);
+            if let Some(o) = solids.first_hit(me, &capsule, &p.collider_pose(), false) {
                 p.collided = true;
-                if let Other::Car(j) = o {
-                    if let Some(c) = self.cars.get_mut(Handle::from_index(j)) {
-                        c.collided = true;
+                match o {
+                    ActorRef::Car(j) => {
+                        if let Some(c) = self.cars.get_mut(j) {
+                            c.collided = true;
+                        }
                     }
+                    ActorRef::Obstacle(j) => {
+                        if let Some(o) = self.obstacles.get_mut(j) {
+                            o.collided = true;
+                        }
+                    }
+                    _ => {}
                 }
             }
         }
@@ -654,7 +662,7 @@ impl Simulation {
             self.capture_all_named("lidar")?;
         }
         self.physics.step_with_events(&(), &self.collector);
-        for car in self.cars.iter_mut() {
+        for car in self.cars.values_mut() {
             car.settle();
         }
         while let Ok(event) = self.events.try_recv() {
@@ -685,6 +693,7 @@ impl Simulation {
                 Some(Owner::Obstacle(h)) => {
                     if let Some(o) = self.obstacles.get_mut(*h) {
                         o.touching = started;
+                        o.collided |= started;
                     }
                 }
                 None => {}
@@ -753,8 +762,24 @@ impl Simulation {
 
     /// What a program reads as `output` of `actor` now (the value its probe stream carries
     /// at this step): the one source of every actor's reported motion.
-    pub fn read(&self, actor: Actor, output: Output) -> Value {
-        self.inputs().probe(crate::behaviour::probe(actor, output))
+    pub fn read(&self, actor: ActorRef, output: Output) -> Value {
+        self.inputs().probe(Probe::new(actor, output))
+    }
+
+    /// The handles of the world's NPC cars, in [`WorldSpec::cars`]' order (a disabled car
+    /// included).
+    pub fn cars(&self) -> impl Iterator<Item = Handle<CarSpec>> + '_ {
+        self.cars.iter().map(|(h, _)| h)
+    }
+
+    /// The handles of the world's pedestrians, in [`WorldSpec::pedestrians`]' order.
+    pub fn pedestrians(&self) -> impl Iterator<Item = Handle<PedestrianSpec>> + '_ {
+        self.pedestrians.iter().map(|(h, _)| h)
+    }
+
+    /// The handles of the world's obstacles, in [`WorldSpec::obstacles`]' order.
+    pub fn obstacles(&self) -> impl Iterator<Item = Handle<ObstacleSpec>> + '_ {
+        self.obstacles.iter().map(|(h, _)| h)
     }
 
     /// The latest value of stream `id` (after [`Simulation::evaluate`] for this step), `None`
@@ -797,16 +822,16 @@ impl Simulation {
             .into()
         };
         for (sink, value) in &sinks {
-            match decode_sink(*sink) {
-                Action::Walk(i) => {
-                    if let Some(p) = self.pedestrians.get_mut(Handle::from_index(i as usize)) {
-                        let what = || format!("the speed of {}", self.names.pedestrian(i as usize));
+            match *sink {
+                Action::Walk(h) => {
+                    if let Some(p) = self.pedestrians.get_mut(h) {
+                        let what = || format!("the speed of {}", self.names.pedestrian(h.index()));
                         let v = number(&self.streams, p.speed_stream, t, what)?;
                         p.walk(&mut self.physics, t, dt, v);
                     }
                 }
-                Action::SetSpeed(i) => {
-                    let Some(car) = self.cars.get_mut(Handle::from_index(i as usize)) else {
+                Action::SetSpeed(h) => {
+                    let Some(car) = self.cars.get_mut(h) else {
                         continue;
                     };
                     match value.as_num() {
@@ -819,7 +844,7 @@ impl Simulation {
                             return Err(bad(
                                 format!(
                                     "the speed given to {}'s setSpeed",
-                                    self.names.car(i as usize)
+                                    self.names.car(h.index())
                                 ),
                                 value,
                                 "a finite number >= 0 (m/s)",
@@ -827,8 +852,8 @@ impl Simulation {
                         }
                     }
                 }
-                Action::Brake(i) => {
-                    let Some(car) = self.cars.get_mut(Handle::from_index(i as usize)) else {
+                Action::Brake(h) => {
+                    let Some(car) = self.cars.get_mut(h) else {
                         continue;
                     };
                     match value {
@@ -839,7 +864,7 @@ impl Simulation {
                             return Err(bad(
                                 format!(
                                     "the deceleration given to {}'s brake",
-                                    self.names.car(i as usize)
+                                    self.names.car(h.index())
                                 ),
                                 value,
                                 "a finite number > 0 (m/s²)",
@@ -847,7 +872,7 @@ impl Simulation {
                         }
                     }
                 }
-                Action::ChangeLane(i) => {
+                Action::ChangeLane(h) => {
                     let (lane, duration) = match value {
                         Value::Num(l) => (*l, 3.0),
                         Value::Tuple(v) if v.len() == 2 => match (&v[0], &v[1]) {
@@ -856,7 +881,7 @@ impl Simulation {
                         },
                         _ => (f64::NAN, f64::NAN),
                     };
-                    let lanes = self.car_lanes.get(i as usize).cloned().unwrap_or_default();
+                    let lanes = self.car_lanes.get(h.index()).cloned().unwrap_or_default();
                     let offset = lanes
                         .iter()
                         .find(|(l, _)| f64::from(*l) == lane)
@@ -867,7 +892,7 @@ impl Simulation {
                         return Err(bad(
                             format!(
                                 "the lane given to {}'s changeLane",
-                                self.names.car(i as usize)
+                                self.names.car(h.index())
                             ),
                             value,
                             &if known.is_empty() {
@@ -877,7 +902,7 @@ impl Simulation {
                             },
                         ));
                     };
-                    if let Some(car) = self.cars.get_mut(Handle::from_index(i as usize)) {
+                    if let Some(car) = self.cars.get_mut(h) {
                         car.change_lane_to(offset, duration, t);
                     }
                 }
@@ -1044,7 +1069,7 @@ impl Simulation {
     /// `None` for a car not in this test (for checking that the drawing and the collider
     /// agree).
     pub fn car_collider_half_extents_m(&self, car: usize) -> Option<[f64; 3]> {
-        let c = self.cars.get(Handle::from_index(car))?;
+        let (_, c) = self.cars.iter().nth(car)?;
         let (_, collider) = c.body?;
         let cuboid = self.physics.colliders[collider].shape().as_cuboid()?;
         let h = cuboid.half_extents;
@@ -1121,9 +1146,9 @@ struct WorldInputs<'a> {
     ego_collided: bool,
     /// Its velocity over the last step, m/s ([`Simulation::ego_velocity`]).
     ego_velocity: [f64; 3],
-    pedestrians: &'a Set<Pedestrian>,
-    cars: &'a Set<Car>,
-    obstacles: &'a Set<Obstacle>,
+    pedestrians: &'a Set<Pedestrian, PedestrianSpec>,
+    cars: &'a Set<Car, CarSpec>,
+    obstacles: &'a Set<Obstacle, ObstacleSpec>,
 }
 
 /// A heading from `atan2`, in `[-π, π]`, as one in `(-π, π]` (a location's and the ego's
@@ -1141,29 +1166,33 @@ impl WorldInputs<'_> {
     fn solids(&self) -> Solids {
         let mut solids = Solids::new();
         let ego = &self.physics.colliders[self.ego.collider];
-        solids.put(Other::Ego, *ego.position(), ego.shared_shape().clone());
-        for (i, (_, car)) in self.cars.iter().enumerate() {
+        solids.put(ActorRef::Ego, *ego.position(), ego.shared_shape().clone());
+        for (h, car) in self.cars.iter() {
             if car.body.is_some() {
-                solids.put(Other::Car(i), car.pose(), car.shape());
+                solids.put(ActorRef::Car(h), car.pose(), car.shape());
             }
         }
-        for (i, (_, p)) in self.pedestrians.iter().enumerate() {
+        for (h, p) in self.pedestrians.iter() {
             solids.put(
-                Other::Pedestrian(i),
+                ActorRef::Pedestrian(h),
                 p.collider_pose(),
                 SharedShape::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M),
             );
         }
-        for (i, (_, o)) in self.obstacles.iter().enumerate() {
+        for (h, o) in self.obstacles.iter() {
             let c = &self.physics.colliders[o.collider];
-            solids.put(Other::Obstacle(i), *c.position(), c.shared_shape().clone());
+            solids.put(
+                ActorRef::Obstacle(h),
+                *c.position(),
+                c.shared_shape().clone(),
+            );
         }
         solids
     }
 
     /// The smallest distance from `me`'s `shape` at `pose` to every other solid, m (`0`
     /// while `touching`).
-    fn separation(&self, me: Other, shape: &dyn Shape, pose: &Pose, touching: bool) -> Value {
+    fn separation(&self, me: ActorRef, shape: &dyn Shape, pose: &Pose, touching: bool) -> Value {
         if touching {
             return Value::Num(0.0);
         }
@@ -1172,10 +1201,10 @@ impl WorldInputs<'_> {
 }
 
 impl Inputs for WorldInputs<'_> {
-    fn probe(&self, id: u32) -> Value {
-        let (actor, output) = decode_probe(id);
-        match actor {
-            Actor::Ego => {
+    fn probe(&self, probe: Probe) -> Value {
+        let output = probe.output;
+        match probe.actor {
+            ActorRef::Ego => {
                 let s = ego_state(self.physics, self.ego);
                 let vel = self.ego_velocity;
                 match output {
@@ -1191,11 +1220,11 @@ impl Inputs for WorldInputs<'_> {
                     Output::Collided => Value::Bool(self.ego_collided),
                     Output::Separation => {
                         let c = &self.physics.colliders[self.ego.collider];
-                        self.separation(Other::Ego, c.shape(), c.position(), self.ego_touching)
+                        self.separation(ActorRef::Ego, c.shape(), c.position(), self.ego_touching)
                     }
                 }
             }
-            Actor::Pedestrian(i) => match self.pedestrians.get(Handle::from_index(i as usize)) {
+            ActorRef::Pedestrian(h) => match self.pedestrians.get(h) {
                 None => Value::Unit,
                 Some(p) => {
                     let v = p.velocity();
@@ -1207,7 +1236,7 @@ impl Inputs for WorldInputs<'_> {
                         Output::Collision => Value::Bool(p.touching),
                         Output::Collided => Value::Bool(p.collided),
                         Output::Separation => self.separation(
-                            Other::Pedestrian(i as usize),
+                            ActorRef::Pedestrian(h),
                             &Capsule::new_y(PED_HALF_HEIGHT_M, PED_RADIUS_M),
                             &p.collider_pose(),
                             p.touching,
@@ -1215,7 +1244,7 @@ impl Inputs for WorldInputs<'_> {
                     }
                 }
             },
-            Actor::Car(i) => match self.cars.get(Handle::from_index(i as usize)) {
+            ActorRef::Car(h) => match self.cars.get(h) {
                 // A disabled car is not in the test: its outputs have no events (it still
                 // moves along its path unseen, which nothing reads).
                 None => Value::Unit,
@@ -1231,11 +1260,30 @@ impl Inputs for WorldInputs<'_> {
                         Output::Collision => Value::Bool(c.touching),
                         Output::Collided => Value::Bool(c.collided),
                         Output::Separation => self.separation(
-                            Other::Car(i as usize),
+                            ActorRef::Car(h),
                             c.shape().as_ref(),
                             &c.pose(),
                             c.touching,
                         ),
+                    }
+                }
+            },
+            ActorRef::Obstacle(h) => match self.obstacles.get(h) {
+                None => Value::Unit,
+                Some(o) => {
+                    let s = o.state();
+                    match output {
+                        Output::Pos => Value::Vec3(s.base_m),
+                        Output::Vel => Value::Vec3([0.0; 3]),
+                        Output::Heading => Value::Num(s.heading_rad),
+                        Output::Speed => Value::Num(0.0),
+                        Output::Collision => Value::Bool(o.touching),
+                        Output::Collided => Value::Bool(o.collided),
+                        Output::Separation => {
+                            let c = &self.physics.colliders[o.collider];
+                            let me = ActorRef::Obstacle(h);
+                            self.separation(me, c.shape(), c.position(), o.touching)
+                        }
                     }
                 }
             },

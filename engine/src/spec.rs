@@ -1,6 +1,7 @@
 use serde::Serialize;
 
-use crate::behaviour::{probe, Actor, GraphBuilder, Output};
+use crate::actor::Roster;
+use crate::behaviour::{ActorRef, GraphBuilder, Output, Probe};
 use crate::network::{Lane, Location, Network, PieceId};
 use crate::rx::{Graph, Node, StreamId, Value};
 use crate::{EngineError, LidarSpec, VehicleParams};
@@ -101,7 +102,8 @@ pub struct WorldSpec {
     pub frictions: Vec<(PieceId, StreamId)>,
     /// The ego vehicle.
     pub ego: EgoSpec,
-    /// Pedestrians, in order; pedestrian `i` walks on sink [`crate::behaviour::walk_sink`]`(i)`.
+    /// Pedestrians, in the order of their handles ([`crate::actor::Roster`]): the `i`-th is
+    /// the one the `i`-th handle names in probes and actions ([`crate::behaviour::ActorRef`]).
     pub pedestrians: Vec<PedestrianSpec>,
     /// NPC cars, in order.
     pub cars: Vec<CarSpec>,
@@ -152,10 +154,11 @@ impl WorldSpec {
         let road = PieceId(0);
         let start = network.on_lane(road, Lane::Driving(1), ego_at_m)?;
         let mut g = GraphBuilder::new();
-        let ego_pos = g.push(Node::Probe(probe(Actor::Ego, Output::Pos)));
+        let ego_pos = g.push(Node::Probe(Probe::new(ActorRef::Ego, Output::Pos)));
         let light = g.push(Node::Const(Value::Num(1.0)));
         let fog = g.push(Node::Const(Value::Num(0.0)));
         let mut peds = Vec::with_capacity(pedestrians.len());
+        let mut roster = Roster::default();
         for (i, p) in pedestrians.iter().enumerate() {
             let ok = |v: f64| v.is_finite() && v > 0.0;
             if !ok(p.speed_mps) || !ok(p.trigger_distance_m) {
@@ -168,7 +171,7 @@ impl WorldSpec {
             let t = network.on_lane(road, p.target.0, p.target.1)?.pos_m;
             let dist = g.push(Node::Const(Value::Num(p.trigger_distance_m)));
             let speed = g.push(Node::Const(Value::Num(p.speed_mps)));
-            g.pedestrian(i as u32, s, t, ego_pos, dist);
+            g.pedestrian(roster.add(), s, t, ego_pos, dist);
             peds.push(PedestrianSpec {
                 start: s,
                 target: t,

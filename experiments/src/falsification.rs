@@ -230,7 +230,7 @@ pub fn falsification_study(settings: &StudySettings<'_>, out: &Path) -> Result<S
     let table_path = dir.join("study.md");
     paracosm::atomic::write(&table_path, table.as_bytes())?;
 
-    let panels: Vec<paracosm::plot::BoxPanel> = columns
+    let panels: Vec<paracosm::report::plot::BoxPanel> = columns
         .iter()
         .map(|s| {
             (
@@ -243,7 +243,7 @@ pub fn falsification_study(settings: &StudySettings<'_>, out: &Path) -> Result<S
             )
         })
         .collect();
-    let plots = paracosm::plot::box_plot(
+    let plots = paracosm::report::plot::box_plot(
         &dir.join("first_failure"),
         "simulations until the first failure",
         &panels,

@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use paracosm::plot::{self, Series, ValueMapLabels, ValuePoint, XyStyle};
+use paracosm::report::plot::{self, Series, ValueMapLabels, ValuePoint, XyStyle};
 use paracosm::{Campaign, Error, RunRecord};
 use paracosm_generators::{Strategy, Value};
 use paracosm_scenarios::{RunOptions, Sample, Scenario};

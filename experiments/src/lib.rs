@@ -54,7 +54,7 @@ pub fn figure9(budget: u64, seed: u64, jobs: usize, out: &Path) -> Result<Figure
 }
 
 /// As [`figure9`], into `dir`, with `sut` instead of the scenario's `aeb` (e.g. the shipped
-/// `pilotnet`: README, "Testing a learned driver").
+/// `pilotnet`: docs/experiments.md, "Learned drivers").
 ///
 /// # Errors
 /// When a campaign or a plot cannot be written.
@@ -114,12 +114,12 @@ pub fn figure9_with(
         .iter()
         .map(|(t, r, _)| (t.as_str(), r.as_slice()))
         .collect();
-    let plots = paracosm::plot::failure_map(
+    let plots = paracosm::report::plot::failure_map(
         &dir.join("figure9"),
         &scenario.space,
         &scenario.map_axes,
         &panels,
-        paracosm::plot::Coloring::Outcome,
+        paracosm::report::plot::Coloring::Outcome,
     )?;
     Ok(Figure9 {
         random_failures: runs[0].2,

@@ -39,7 +39,7 @@ pub const DENSE: [(&str, usize, usize); 3] =
     [("fc1", FEATURES + 1, 100), ("fc2", 100, 50), ("fc3", 50, 2)];
 
 /// The manifest shipped beside the model (`paracosm_engine::sut::Manifest`).
-pub const MANIFEST: &str = r#"# The input and outputs of pilotnet.onnx (README, "Testing a learned driver").
+pub const MANIFEST: &str = r#"# The input and outputs of pilotnet.onnx (docs/systems-under-test.md, "ONNX models").
 [camera]
 width = 320
 height = 240

@@ -260,8 +260,8 @@ fn the_shipped_pilotnet_gives_tract_the_outputs_candle_computes() {
         "the shipped manifest is MANIFEST"
     );
     let dir = tempfile::tempdir().unwrap();
-    let summary = paracosm::dataset::export(
-        &paracosm::dataset::DatasetRequest {
+    let summary = paracosm::export::dataset::export(
+        &paracosm::export::dataset::DatasetRequest {
             scenario: repo()
                 .join("experiments/scenarios/pilotnet_train.star")
                 .display()

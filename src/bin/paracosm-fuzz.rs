@@ -11,10 +11,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
-use paracosm::campaign_file::Shard;
+use paracosm::campaign::file::Shard;
+use paracosm::campaign::progress::Progress;
+use paracosm::campaign::session::{Plan, Request};
 use paracosm::cli::SutArgs;
-use paracosm::progress::Progress;
-use paracosm::session::{Plan, Request};
 use paracosm::Error;
 use paracosm_generators::Strategy;
 
@@ -184,7 +184,7 @@ struct DatasetArgs {
     #[arg(long)]
     force: bool,
     /// Steering noise added to what the vehicle applies, in steering units (1 = full lock),
-    /// so that the teacher's recorded answers show how to recover (DART; README).
+    /// so that the teacher's recorded answers show how to recover (DART; docs/experiments.md).
     #[arg(long, value_name = "AMPLITUDE", default_value_t = 0.0)]
     steer_noise: f64,
     /// Seconds each noise value is held.
@@ -237,8 +237,8 @@ struct ReplayArgs {
 }
 
 impl DatasetArgs {
-    fn request(&self) -> Result<paracosm::dataset::DatasetRequest, Error> {
-        Ok(paracosm::dataset::DatasetRequest {
+    fn request(&self) -> Result<paracosm::export::dataset::DatasetRequest, Error> {
+        Ok(paracosm::export::dataset::DatasetRequest {
             scenario: self.scenario.clone(),
             strategy: self.strategy,
             seed: self.seed,
@@ -343,13 +343,13 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Some(Sub::Replay(a)) => {
             let sut = a.sut.config();
-            sut.and_then(|s| paracosm::replay::replay(&a.results, a.id, a.frames.as_deref(), s))
+            sut.and_then(|s| paracosm::export::replay::replay(&a.results, a.id, a.frames.as_deref(), s))
                 .map_err(anyhow::Error::new)
                 .and_then(|r| say(&r.text(a.id, a.frames.as_deref())).map(|()| r))
                 .map(|r| if r.matches { 0 } else { 3 })
         }
         Some(Sub::Merge(a)) => {
-            paracosm::merge::merge_folders(&a.dirs, &a.out, a.force, a.junit.as_deref())
+            paracosm::campaign::merge::merge_folders(&a.dirs, &a.out, a.force, a.junit.as_deref())
                 .map_err(anyhow::Error::new)
                 .and_then(|(text, counts, warnings)| {
                     warnings
@@ -363,7 +363,7 @@ fn main() -> ExitCode {
             .and_then(|(text, counts)| say(&text).map(|()| counts.exit_code())),
         Some(Sub::Dataset(a)) => a
             .request()
-            .and_then(|r| paracosm::dataset::export(&r, Some(&STOP)))
+            .and_then(|r| paracosm::export::dataset::export(&r, Some(&STOP)))
             .map_err(anyhow::Error::new)
             .and_then(|s| say(&s.text()).map(|()| s.exit_code())),
         Some(Sub::Export(a)) => paracosm::export::export(&a.results, a.id, &a.out)
@@ -458,7 +458,7 @@ fn run(cli: &Cli) -> Result<u8> {
             .for_each(|n| paracosm::cli::to_stderr(&format!("paracosm-fuzz: {n}")));
         bar.start(p.to_run);
     };
-    let outcome = paracosm::session::run(
+    let outcome = paracosm::campaign::session::run(
         &cli.request()?,
         Some(&STOP),
         &mut plan,

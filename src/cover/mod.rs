@@ -1,6 +1,7 @@
 //! The library side of `paracosm-cover`: parameter-space specs, reading test sets from CSV or
 //! `results.jsonl`, coverage reports and budget plans.
 
+pub mod commands;
 mod input;
 mod pict;
 mod plan;

@@ -5,6 +5,8 @@
 //! its world and the states it went through are written out ([`xosc`]). The network is the
 //! program's OpenDRIVE map, copied as it is, or else written from its pieces ([`xodr`]).
 
+pub mod dataset;
+pub mod replay;
 pub mod xml;
 pub mod xodr;
 pub mod xosc;
@@ -14,7 +16,7 @@ use std::path::{Path, PathBuf};
 use paracosm_engine::network::PieceKind;
 use paracosm_engine::{Snapshot, WorldSpec};
 
-use crate::campaign_file::CampaignFile;
+use crate::campaign::file::CampaignFile;
 use crate::Error;
 
 /// What an export wrote.
@@ -36,7 +38,7 @@ fn input(e: impl std::fmt::Display) -> Error {
 /// and `test_ID.xodr`.
 ///
 /// # Errors
-/// [`Error::BadInput`] as for [`crate::replay::replay`], for a network that mixes an
+/// [`Error::BadInput`] as for [`crate::export::replay::replay`], for a network that mixes an
 /// OpenDRIVE map with pieces of the program, or a map that can no longer be read;
 /// [`Error::Write`] when `out` or a file cannot be written.
 pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
@@ -62,7 +64,7 @@ pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
     let mut states: Vec<Snapshot> = Vec::new();
     let mut on_world = |w: &WorldSpec| world = Some(w.clone());
     let mut on_step = |s: &Snapshot| states.push(s.clone());
-    let replayed = crate::replay::replay_with(
+    let replayed = crate::export::replay::replay_with(
         results,
         id,
         None,

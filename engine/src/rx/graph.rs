@@ -1,6 +1,8 @@
 use std::fmt;
 use std::sync::Arc;
 
+use crate::behaviour::{Action, Probe};
+
 use super::{OpenStream, RxError, Value};
 
 /// Index of a stream in its [`Graph`].
@@ -51,9 +53,9 @@ pub enum Node {
     Param(usize),
     /// A bound open input stream.
     Open(OpenStream),
-    /// Physics output number `n` (a position, a velocity, a contact flag...), read through
-    /// [`super::Inputs`] at every step.
-    Probe(u32),
+    /// A physics output of an actor (a position, a velocity, a contact flag...), read
+    /// through [`super::Inputs`] at every step.
+    Probe(Probe),
     /// `src.map(f)`.
     Map {
         /// Source.
@@ -102,12 +104,12 @@ pub enum Node {
         /// Fold `acc, v -> acc`; `None` adds.
         f: Option<Func>,
     },
-    /// `src.foreach(sink)`: each event goes to sink number `sink`, which acts on an object.
+    /// `src.foreach(sink)`: each event goes to the action `sink`, which acts on an actor.
     Foreach {
         /// Source.
         src: StreamId,
-        /// The sink's number, interpreted by the caller.
-        sink: u32,
+        /// The action, performed by the caller ([`super::Runtime::step`]'s sinks).
+        sink: Action,
     },
     /// `src.foreach(f)` with a host function: `f(v)` for each event, for the actions it
     /// performs ([`super::Host::performed`]); what it returns is dropped.

@@ -1,12 +1,13 @@
 use std::collections::VecDeque;
 
 use super::{Func, Graph, Node, RxError, StreamId, Value};
+use crate::behaviour::{Action, Probe};
 
 /// The physics outputs a graph's [`Node::Probe`]s read, supplied by the simulation each step.
 pub trait Inputs {
-    /// The current value of probe `id`; [`Value::Unit`] for an actor that is not in the test
+    /// The current value of `probe`; [`Value::Unit`] for an actor that is not in the test
     /// (a disabled car), whose probes then have no event.
-    fn probe(&self, id: u32) -> Value;
+    fn probe(&self, probe: Probe) -> Value;
 }
 
 /// Calls host functions (Starlark lambdas) for [`Func::Host`].
@@ -19,9 +20,9 @@ pub trait Host {
     fn call(&mut self, f: u32, args: &[Value], streams: &Runtime) -> Result<Value, String>;
 
     /// The actions host functions performed since the last call of this method, as
-    /// `(sink, value)` pairs in the order they were performed (a Starlark `def` given to
+    /// `(action, value)` pairs in the order they were performed (a Starlark `def` given to
     /// `foreach` that calls `car.brake(6)`). The default host performs none.
-    fn performed(&mut self) -> Vec<(u32, Value)> {
+    fn performed(&mut self) -> Vec<(Action, Value)> {
         Vec::new()
     }
 
@@ -176,7 +177,7 @@ impl Runtime {
         t_s: f64,
         inputs: &dyn Inputs,
         host: &mut dyn Host,
-        sinks: &mut Vec<(u32, Value)>,
+        sinks: &mut Vec<(Action, Value)>,
     ) -> Result<(), RxError> {
         if !self.host_reads_kept {
             self.host_reads_kept = true;
@@ -334,7 +335,7 @@ impl Runtime {
         t_s: f64,
         inputs: &dyn Inputs,
         host: &mut dyn Host,
-        sinks: &mut Vec<(u32, Value)>,
+        sinks: &mut Vec<(Action, Value)>,
     ) -> Result<Option<Value>, RxError> {
         if self.states[i].done {
             return Ok(None);

@@ -1,13 +1,40 @@
 //! Each combinator pinned on hand-made streams.
 
 use super::*;
+use crate::actor::{Handle, Roster};
+use crate::behaviour::{Action, ActorRef, Output, Probe};
+use crate::PedestrianSpec;
+
+/// The handle of the `i`-th pedestrian: these tests number their probes and sinks by it.
+fn handle(i: usize) -> Handle<PedestrianSpec> {
+    let mut roster = Roster::default();
+    (0..=i).map(|_| roster.add()).last().expect("at least one")
+}
+
+/// Probe number `i`: the position of pedestrian `i`, which the script answers.
+fn probe(i: usize) -> Node {
+    Node::Probe(Probe::new(ActorRef::Pedestrian(handle(i)), Output::Pos))
+}
+
+/// Sink number `i`: pedestrian `i` walks.
+fn sink(i: usize) -> Action {
+    Action::Walk(handle(i))
+}
+
+/// The number of a test probe.
+fn number(probe: Probe) -> usize {
+    match probe.actor {
+        ActorRef::Pedestrian(h) => h.index(),
+        other => panic!("no scripted probe {other:?}"),
+    }
+}
 
 /// Probe `p` at step `k` is `script[p][k]`; steps are 1 s apart, starting at `t = 0`.
 struct Script(Vec<Vec<Value>>);
 
 impl Inputs for Script {
-    fn probe(&self, id: u32) -> Value {
-        self.0[id as usize][STEP.with(|s| s.get())].clone()
+    fn probe(&self, probe: Probe) -> Value {
+        self.0[number(probe)][STEP.with(|s| s.get())].clone()
     }
 }
 
@@ -21,7 +48,7 @@ fn run(
     nodes: Vec<Node>,
     script: Vec<Vec<Value>>,
     steps: usize,
-) -> (Vec<Option<Value>>, Vec<(u32, Value)>) {
+) -> (Vec<Option<Value>>, Vec<(Action, Value)>) {
     let last = StreamId(nodes.len() - 1);
     let mut rt = Runtime::new(Graph::new(nodes).unwrap());
     let inputs = Script(script);
@@ -73,7 +100,7 @@ fn map_applies_the_function_to_each_event() {
 
 #[test]
 fn filter_passes_only_events_that_satisfy_the_predicate() {
-    let nodes = vec![Node::Probe(0), positive(0)];
+    let nodes = vec![probe(0), positive(0)];
     let script = vec![nums(&[1.0, -1.0, 0.0, 3.0])];
     assert_eq!(run(nodes, script, 4).0, vec![n(1.0), None, None, n(3.0)]);
 }
@@ -81,7 +108,7 @@ fn filter_passes_only_events_that_satisfy_the_predicate() {
 #[test]
 fn take_passes_the_first_n_events_then_completes() {
     let nodes = vec![
-        Node::Probe(0),
+        probe(0),
         positive(0),
         Node::Take {
             src: StreamId(1),
@@ -99,7 +126,7 @@ fn take_passes_the_first_n_events_then_completes() {
 fn skip_until_opens_at_the_first_trigger_inclusive_and_stays_open() {
     let nodes = vec![
         Node::Tick,
-        Node::Probe(0),
+        probe(0),
         positive(1),
         Node::SkipUntil {
             src: StreamId(0),
@@ -117,7 +144,7 @@ fn skip_until_opens_at_the_first_trigger_inclusive_and_stays_open() {
 fn take_until_closes_at_the_first_stop_exclusive_and_completes() {
     let nodes = vec![
         Node::Tick,
-        Node::Probe(0),
+        probe(0),
         positive(1),
         Node::TakeUntil {
             src: StreamId(0),
@@ -135,7 +162,7 @@ fn take_until_closes_at_the_first_stop_exclusive_and_completes() {
 fn zip_pairs_the_ith_events_of_both_sides() {
     let nodes = vec![
         Node::Tick,
-        Node::Probe(0),
+        probe(0),
         positive(1),
         Node::Zip(StreamId(0), StreamId(2)),
     ];
@@ -157,7 +184,7 @@ fn concat_emits_the_first_stream_then_the_second() {
             src: StreamId(0),
             n: 2,
         },
-        Node::Probe(0),
+        probe(0),
         Node::Concat(StreamId(1), StreamId(2)),
     ];
     let script = vec![nums(&[10.0, 11.0, 12.0, 13.0])];
@@ -170,7 +197,7 @@ fn concat_emits_the_first_stream_then_the_second() {
 #[test]
 fn sum_is_a_running_total_and_a_fold_with_a_function() {
     let nodes = vec![
-        Node::Probe(0),
+        probe(0),
         positive(0),
         Node::Sum {
             src: StreamId(1),
@@ -184,7 +211,7 @@ fn sum_is_a_running_total_and_a_fold_with_a_function() {
         vec![n(1.0), None, n(3.0), n(6.0)]
     );
     let nodes = vec![
-        Node::Probe(0),
+        probe(0),
         Node::Sum {
             src: StreamId(0),
             init: Value::Num(1.0),
@@ -204,17 +231,20 @@ fn sum_is_a_running_total_and_a_fold_with_a_function() {
 #[test]
 fn foreach_hands_each_event_to_its_sink() {
     let nodes = vec![
-        Node::Probe(0),
+        probe(0),
         positive(0),
         Node::Foreach {
             src: StreamId(1),
-            sink: 7,
+            sink: sink(7),
         },
     ];
     let script = vec![nums(&[1.0, -1.0, 2.0])];
     let (out, sinks) = run(nodes, script, 3);
     assert_eq!(out, vec![None, None, None], "a sink emits nothing");
-    assert_eq!(sinks, vec![(7, Value::Num(1.0)), (7, Value::Num(2.0))]);
+    assert_eq!(
+        sinks,
+        vec![(sink(7), Value::Num(1.0)), (sink(7), Value::Num(2.0))]
+    );
 }
 
 /// The paper's pedestrian (§2, "Reactive Behaviors"):
@@ -225,12 +255,12 @@ fn the_papers_pedestrian_walks_between_trigger_and_done() {
     // probe 0: car distance; probe 1: pedestrian at target (1) or not (0).
     let nodes = vec![
         Node::Tick,
-        Node::Probe(0),
+        probe(0),
         Node::Filter {
             src: StreamId(1),
             pred: Func::native("< 30", |a| Ok(Value::Bool(a[0].as_num().unwrap() < 30.0))),
         },
-        Node::Probe(1),
+        probe(1),
         positive(3),
         Node::SkipUntil {
             src: StreamId(0),
@@ -242,7 +272,7 @@ fn the_papers_pedestrian_walks_between_trigger_and_done() {
         },
         Node::Foreach {
             src: StreamId(6),
-            sink: 0,
+            sink: sink(0),
         },
     ];
     let script = vec![
@@ -269,7 +299,7 @@ fn the_papers_distance_monitor_sums_step_lengths() {
         v => Err(format!("got {v:?}")),
     });
     let nodes = vec![
-        Node::Probe(0),
+        probe(0),
         Node::Take {
             src: StreamId(0),
             n: 1,
@@ -373,7 +403,7 @@ fn open_streams_bind_and_vary_over_time() {
 struct Counting(std::cell::Cell<usize>);
 
 impl Inputs for Counting {
-    fn probe(&self, _: u32) -> Value {
+    fn probe(&self, _: Probe) -> Value {
         self.0.set(self.0.get() + 1);
         Value::Num(1.0)
     }
@@ -406,14 +436,14 @@ fn streams_nothing_reads_are_not_evaluated_and_change_nothing_else() {
     // 0, 1: probes nobody reads; 2: a probe the caller reads; 3: a zip of the unread ones;
     // 4: a probe feeding a sink; 5: the sink.
     let nodes = vec![
-        Node::Probe(0),
-        Node::Probe(1),
-        Node::Probe(2),
+        probe(0),
+        probe(1),
+        probe(2),
         Node::Zip(StreamId(0), StreamId(1)),
-        Node::Probe(3),
+        probe(3),
         Node::Foreach {
             src: StreamId(4),
-            sink: 9,
+            sink: sink(9),
         },
     ];
     let graph = Graph::new(nodes).unwrap();
@@ -451,7 +481,7 @@ fn a_function_whose_stream_nobody_reads_still_runs_and_fails() {
             src: StreamId(0),
             f: Func::Host(0),
         },
-        Node::Probe(0),
+        probe(0),
     ];
     let mut rt = Runtime::new(Graph::new(nodes).unwrap());
     rt.evaluate_only([]);

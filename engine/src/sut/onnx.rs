@@ -2,7 +2,7 @@
 //! ego camera's images through the preprocessing its manifest declares (feature `onnx`).
 //!
 //! The manifest is a TOML file beside the model with the same stem (`pilotnet.onnx` and
-//! `pilotnet.toml`); README, "Testing a learned driver", documents every key:
+//! `pilotnet.toml`); docs/systems-under-test.md, "ONNX models", documents every key:
 //!
 //! ```toml
 //! [camera]            # the camera the model sees (CameraSpec's keys; defaults as CameraSpec)
@@ -349,7 +349,7 @@ impl OnnxConfig {
         let text = std::fs::read_to_string(&manifest_file).map_err(|e| {
             format!(
                 "cannot read the model's manifest `{}` ({e}); every model needs a TOML \
-                 manifest beside it with the same stem (README, \"Testing a learned driver\")",
+                 manifest beside it with the same stem (docs/systems-under-test.md, \"ONNX models\")",
                 manifest_file.display()
             )
         })?;

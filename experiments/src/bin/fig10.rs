@@ -1,5 +1,5 @@
-//! `fig10`: the paper's Figure 10 studies with learned drivers (README, "Testing a learned
-//! driver").
+//! `fig10`: the paper's Figure 10 studies with learned drivers (docs/experiments.md,
+//! "Figure 10").
 //!
 //! `cargo run --release -p paracosm-experiments --bin fig10 -- --docs docs`
 

@@ -2,7 +2,7 @@
 //!
 //! `cargo run --release -p paracosm-experiments --bin fig9 -- --budget 500`
 //!
-//! With a learned driver (README, "Testing a learned driver"):
+//! With a learned driver (docs/experiments.md, "Learned drivers"):
 //! `cargo run --release -p paracosm-experiments --bin fig9 -- --budget 500 --sut pilotnet
 //! --docs docs/fig9_pilotnet.png`
 

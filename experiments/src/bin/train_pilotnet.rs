@@ -301,8 +301,8 @@ fn main() -> Result<()> {
          | training time | {secs:.0} s on {threads} threads |\n\
          | file | `{stem}.onnx`, {bytes} bytes, ONNX opset 13; manifest `{stem}.toml` |\n\n\
          Parameter ranges of the training data are those of the scenario (see its header). \
-         Outside them the network has seen nothing: that is what the studies in README, \
-         \"Testing a learned driver\", probe.\n\n\
+         Outside them the network has seen nothing: that is what the studies in \
+         docs/experiments.md, \"Learned drivers\", probe.\n\n\
          Training log:\n\n```\n{log}\n```\n",
         params = pilotnet::parameter_count(),
         scenario = dataset["scenario"].as_str().unwrap_or("?"),

@@ -204,7 +204,7 @@ impl Host for StarHost<'_, '_, '_, '_> {
         from_star(out)
     }
 
-    fn performed(&mut self) -> Vec<(u32, Rx)> {
+    fn performed(&mut self) -> Vec<(paracosm_engine::behaviour::Action, Rx)> {
         self.test()
             .map(|t| std::mem::take(&mut *t.performed.borrow_mut()))
             .unwrap_or_default()

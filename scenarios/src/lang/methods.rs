@@ -284,8 +284,8 @@ fn extreme(
 /// Checks at load that a bound `car.changeLane(lane)` names a lane of the segment the car
 /// starts on.
 fn check_lane(a: &Action, eval: &Evaluator<'_, '_, '_>) -> anyhow::Result<()> {
-    use paracosm_engine::behaviour::{decode_sink, Action as Act};
-    let (Act::ChangeLane(car), Some((lane, _))) = (decode_sink(a.sink), a.bound) else {
+    use paracosm_engine::behaviour::{Action as Act, ActorRef};
+    let (Act::ChangeLane(car), Some((lane, _))) = (a.sink, a.bound) else {
         return Ok(());
     };
     let at = super::globals::here(eval);
@@ -294,7 +294,7 @@ fn check_lane(a: &Action, eval: &Evaluator<'_, '_, '_>) -> anyhow::Result<()> {
     let Some(object) = b
         .objects
         .iter()
-        .find(|o| o.actor == Some(paracosm_engine::behaviour::Actor::Car(car)))
+        .find(|o| o.actor == Some(ActorRef::Car(car)))
         .cloned()
     else {
         return Ok(());

@@ -216,13 +216,17 @@ fn windows_within_horizon(b: &SceneBuilder, horizon_s: f64) -> Result<(), String
 /// pedestrian takes one walking step per step, so one of the two would only change when it
 /// walks, without a word.
 fn one_walker_each(b: &SceneBuilder) -> Result<(), String> {
-    use paracosm_engine::behaviour::{decode_sink, Action};
-    let mut walkers: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
+    use paracosm_engine::behaviour::{Action, ActorRef};
+    let mut walkers: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    let mut handles = std::collections::BTreeMap::new();
     for (i, node) in b.graph.nodes().iter().enumerate() {
-        if let Node::Foreach { sink, .. } = node {
-            if let Action::Walk(p) = decode_sink(*sink) {
-                walkers.entry(p).or_default().push(i);
-            }
+        if let Node::Foreach {
+            sink: Action::Walk(p),
+            ..
+        } = node
+        {
+            handles.insert(p.index(), *p);
+            walkers.entry(p.index()).or_default().push(i);
         }
     }
     for (p, nodes) in walkers {
@@ -232,7 +236,7 @@ fn one_walker_each(b: &SceneBuilder) -> Result<(), String> {
         let name = b
             .objects
             .iter()
-            .find(|o| o.actor == Some(paracosm_engine::behaviour::Actor::Pedestrian(p)))
+            .find(|o| o.actor == handles.get(&p).map(|&h| ActorRef::Pedestrian(h)))
             .map_or_else(|| format!("pedestrian {p}"), |o| o.name.clone());
         let site = |n: usize| b.graph.site(n).unwrap_or("?").to_owned();
         return Err(format!(
@@ -916,7 +920,7 @@ fn judged_kinds(
     // An action's argument from a lambda: its kind is known from the sample (a string given
     // to setSpeed would otherwise end each test where it first fires, or never be noticed).
     for (i, node) in b.graph.nodes().iter().enumerate() {
-        use paracosm_engine::behaviour::{decode_sink, Action};
+        use paracosm_engine::behaviour::Action;
         use paracosm_engine::rx::Value;
         let paracosm_engine::rx::Node::Foreach { src, sink } = node else {
             continue;
@@ -924,8 +928,10 @@ fn judged_kinds(
         let Some(v) = samples.get(src.0).and_then(Option::as_ref) else {
             continue;
         };
-        let car = |c: u32| b.car_names.get(c as usize).map_or("a Car", String::as_str);
-        let (what, ok, wanted) = match decode_sink(*sink) {
+        let car = |c: paracosm_engine::Handle<paracosm_engine::CarSpec>| {
+            b.car_names.get(c.index()).map_or("a Car", String::as_str)
+        };
+        let (what, ok, wanted) = match *sink {
             Action::Walk(_) => continue,
             Action::SetSpeed(c) => (
                 format!("setSpeed of {}", car(c)),

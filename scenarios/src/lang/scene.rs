@@ -3,7 +3,8 @@
 //! once per test, with that test's values of its open parameters (LANGUAGE.md, "A family of
 //! worlds"), and a few times when it loads, to learn its parameters and check its worlds.
 
-use paracosm_engine::behaviour::{probe, Actor, GraphBuilder, Output};
+use paracosm_engine::actor::Roster;
+use paracosm_engine::behaviour::{ActorRef, GraphBuilder, Output, Probe};
 use paracosm_engine::network::{Location, Network, PieceId, PieceKind, Turn};
 use paracosm_engine::rx::{Node, OpenStream, StreamId, Value};
 use paracosm_engine::sut::SutConfig;
@@ -205,7 +206,7 @@ pub struct ObjectDecl {
     /// the top level): its outputs are `Stl` signals `lead.speed`, `lead.pos.x`, ...
     pub variable: Option<String>,
     /// The actor it is (`None` for an obstacle).
-    pub actor: Option<Actor>,
+    pub actor: Option<ActorRef>,
     /// The declaration.
     pub pending: Pending,
     /// Whether `place` included it.
@@ -292,10 +293,11 @@ pub struct SceneBuilder {
     pub loc_table: super::position::LocTable,
     /// Declared actors, in declaration order.
     pub objects: Vec<ObjectDecl>,
-    /// Pedestrians declared so far (their index in the world).
-    pub n_pedestrians: u32,
-    /// Cars declared so far.
-    pub n_cars: u32,
+    /// The handles of the pedestrians declared so far, in declaration order (the order of
+    /// the world's [`WorldSpec::pedestrians`]).
+    pub pedestrian_handles: Roster<PedestrianSpec>,
+    /// The handles of the cars declared so far, in declaration order.
+    pub car_handles: Roster<CarSpec>,
 }
 
 /// The value a parameter takes when an evaluation gives it none: an interval's lower bound,
@@ -363,8 +365,8 @@ impl SceneBuilder {
             locs: Vec::new(),
             loc_table: Default::default(),
             objects: Vec::new(),
-            n_pedestrians: 0,
-            n_cars: 0,
+            pedestrian_handles: Roster::default(),
+            car_handles: Roster::default(),
         }
     }
 
@@ -392,8 +394,8 @@ impl SceneBuilder {
     }
 
     /// A probe stream.
-    pub fn probe(&mut self, actor: Actor, output: Output) -> StreamId {
-        self.graph.push(Node::Probe(probe(actor, output)))
+    pub fn probe(&mut self, actor: ActorRef, output: Output) -> StreamId {
+        self.graph.push(Node::Probe(Probe::new(actor, output)))
     }
 }
 
@@ -500,8 +502,8 @@ fn refuse_monitors_of_absent_cars(
     let mut reads: Vec<Option<usize>> = vec![None; nodes.len()];
     for (i, node) in nodes.iter().enumerate() {
         reads[i] = match node {
-            Node::Probe(p) => match paracosm_engine::behaviour::decode_probe(*p).0 {
-                Actor::Car(c) if absent.contains(&(c as usize)) => Some(c as usize),
+            Node::Probe(p) => match p.actor {
+                ActorRef::Car(c) if absent.contains(&c.index()) => Some(c.index()),
                 _ => None,
             },
             Node::TakeUntil { src, .. } => reads.get(src.0).copied().flatten(),
@@ -672,7 +674,7 @@ fn published(
             });
             match found {
                 Some((name, actor, output)) => {
-                    let id = graph.push(Node::Probe(probe(actor, output)));
+                    let id = graph.push(Node::Probe(Probe::new(actor, output)));
                     out.push((name.clone(), id));
                     vector.push(Some(matches!(output, Output::Pos | Output::Vel)));
                     if !known(&out, &vector, &s).map_err(located)? {
@@ -822,7 +824,6 @@ impl SceneBuilder {
             });
         }
         check(&placed, &self.roads).map_err(strip)?;
-        let mut ped_index = 0u32;
         for o in self.objects.clone() {
             let runtime_name = |kind: &str| o.runtime_name(kind);
             let (car_name, pedestrian_name) = (runtime_name("Car"), runtime_name("Pedestrian"));
@@ -879,12 +880,15 @@ impl SceneBuilder {
                 } => {
                     let s = resolve(self, start)?.pos_m;
                     let t = resolve(self, target)?.pos_m;
+                    let Some(ActorRef::Pedestrian(handle)) = o.actor else {
+                        return Err(format!("{}: a Pedestrian without its handle", o.name));
+                    };
                     match trigger {
                         PedTrigger::Near { car, dist } => {
-                            self.graph.pedestrian(ped_index, s, t, car, dist);
+                            self.graph.pedestrian(handle, s, t, car, dist);
                         }
                         PedTrigger::Stream(trigger) => {
-                            self.graph.pedestrian_with_trigger(ped_index, t, trigger);
+                            self.graph.pedestrian_with_trigger(handle, t, trigger);
                         }
                         PedTrigger::Never => {}
                     }
@@ -894,7 +898,6 @@ impl SceneBuilder {
                         let walk = paracosm_engine::rx::StreamId(self.graph.nodes().len() - 1);
                         self.graph.set_site(walk, o.at.clone());
                     }
-                    ped_index += 1;
                     self.pedestrians.push(PedestrianSpec {
                         start: s,
                         target: t,

@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use anyhow::bail;
-use paracosm_engine::behaviour::{decode_probe, Output};
+use paracosm_engine::behaviour::Output;
 use paracosm_engine::rx::{describe, Expect, Node, StreamId, Value as Rx};
 use paracosm_generators::Domain;
 
@@ -276,7 +276,7 @@ pub fn stream_types(b: &SceneBuilder) -> Vec<SType> {
             Node::Tick => SType::Num,
             Node::Param(p) => b.params.get(*p).map_or(SType::Any, of_param),
             Node::Open(_) => SType::Any,
-            Node::Probe(p) => match decode_probe(*p).1 {
+            Node::Probe(p) => match p.output {
                 Output::Pos | Output::Vel => SType::Vec3,
                 Output::Heading | Output::Speed | Output::Separation => SType::Num,
                 Output::Collision | Output::Collided => SType::Bool,

@@ -1,6 +1,7 @@
 //! The Starlark values of the scenario language. Each holds indices into the program's
 //! scene builder (`SceneBuilder`), never other Starlark values, so all are simple values.
 
+use paracosm_engine::behaviour::ActorRef;
 use std::fmt;
 
 use allocative::Allocative;
@@ -124,23 +125,13 @@ impl<'v> StarlarkValue<'v> for LaneSide {
     }
 }
 
-/// What kind of actor an [`ActorVal`] is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Allocative)]
-pub enum ActorKind {
-    /// `AutonomousVehicle`.
-    Ego,
-    /// `Pedestrian` number `i`.
-    Pedestrian(u32),
-    /// `Car` number `i`.
-    Car(u32),
-}
-
 /// An actor with its output streams (`pos`, `vel`, `heading`, `speed`, `collision`) and, for
 /// a pedestrian, its `walk` action.
 #[derive(Debug, Clone, Copy, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
 pub struct ActorVal {
-    /// Which actor.
-    pub kind: ActorKind,
+    /// Which actor: the ego, or a pedestrian's or a car's handle.
+    #[allocative(skip)]
+    pub kind: ActorRef,
     /// Output streams: pos, vel, heading, speed, collision, collided, separation.
     pub outputs: [usize; 7],
     /// Index in the placement list.
@@ -160,9 +151,10 @@ const OUTPUT_NAMES: [&str; 7] = [
 impl fmt::Display for ActorVal {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.kind {
-            ActorKind::Ego => f.write_str("AutonomousVehicle"),
-            ActorKind::Pedestrian(i) => write!(f, "Pedestrian({i})"),
-            ActorKind::Car(i) => write!(f, "Car({i})"),
+            ActorRef::Ego => f.write_str("AutonomousVehicle"),
+            ActorRef::Pedestrian(h) => write!(f, "Pedestrian({})", h.index()),
+            ActorRef::Car(h) => write!(f, "Car({})", h.index()),
+            ActorRef::Obstacle(h) => write!(f, "Obstacle({})", h.index()),
         }
     }
 }
@@ -172,17 +164,17 @@ starlark_simple_value!(ActorVal);
 #[starlark_value(type = "Actor")]
 impl<'v> StarlarkValue<'v> for ActorVal {
     fn get_attr(&self, attribute: &str, heap: Heap<'v>) -> Option<Value<'v>> {
-        use paracosm_engine::behaviour::{action_sink, Action as Act};
+        use paracosm_engine::behaviour::Action as Act;
         let action = match (self.kind, attribute) {
-            (ActorKind::Pedestrian(i), "walk") => Some((Act::Walk(i), "walk")),
-            (ActorKind::Car(i), "setSpeed") => Some((Act::SetSpeed(i), "setSpeed")),
-            (ActorKind::Car(i), "brake") => Some((Act::Brake(i), "brake")),
-            (ActorKind::Car(i), "changeLane") => Some((Act::ChangeLane(i), "changeLane")),
+            (ActorRef::Pedestrian(h), "walk") => Some((Act::Walk(h), "walk")),
+            (ActorRef::Car(h), "setSpeed") => Some((Act::SetSpeed(h), "setSpeed")),
+            (ActorRef::Car(h), "brake") => Some((Act::Brake(h), "brake")),
+            (ActorRef::Car(h), "changeLane") => Some((Act::ChangeLane(h), "changeLane")),
             _ => None,
         };
         if let Some((a, method)) = action {
             return Some(heap.alloc(Action {
-                sink: action_sink(a),
+                sink: a,
                 method,
                 bound: None,
             }));
@@ -194,9 +186,9 @@ impl<'v> StarlarkValue<'v> for ActorVal {
     fn dir_attr(&self) -> Vec<String> {
         let mut v: Vec<String> = OUTPUT_NAMES.iter().map(|s| s.to_string()).collect();
         match self.kind {
-            ActorKind::Pedestrian(_) => v.push("walk".into()),
-            ActorKind::Car(_) => v.extend(["setSpeed", "brake", "changeLane"].map(String::from)),
-            ActorKind::Ego => {}
+            ActorRef::Pedestrian(_) => v.push("walk".into()),
+            ActorRef::Car(_) => v.extend(["setSpeed", "brake", "changeLane"].map(String::from)),
+            ActorRef::Ego | ActorRef::Obstacle(_) => {}
         }
         v
     }
@@ -210,8 +202,9 @@ impl<'v> StarlarkValue<'v> for ActorVal {
 /// given to `foreach`), it is performed at once.
 #[derive(Debug, Clone, ProvidesStaticType, NoSerialize, StarlarkPagablePanic, Allocative)]
 pub struct Action {
-    /// The engine's sink number ([`paracosm_engine::behaviour::action_sink`]).
-    pub sink: u32,
+    /// What it does to which actor.
+    #[allocative(skip)]
+    pub sink: paracosm_engine::behaviour::Action,
     /// The method's name, for messages.
     pub method: &'static str,
     /// The arguments a call bound: a number (m/s, m/s², a lane), and for `changeLane` a
@@ -253,7 +246,12 @@ starlark_simple_value!(Action);
 #[derive(Debug, Default, ProvidesStaticType)]
 pub struct TestState {
     /// Actions performed since the host last drained them, `(sink, value)`.
-    pub performed: std::cell::RefCell<Vec<(u32, paracosm_engine::rx::Value)>>,
+    pub performed: std::cell::RefCell<
+        Vec<(
+            paracosm_engine::behaviour::Action,
+            paracosm_engine::rx::Value,
+        )>,
+    >,
     /// Lines printed, in order.
     pub log: std::cell::RefCell<Vec<String>>,
 }

@@ -5,7 +5,7 @@
 //! Actors: `AutonomousVehicle`, `Car`, `ChangeLane`, `Obstacle`, `Pedestrian`.
 
 use anyhow::{anyhow, bail};
-use paracosm_engine::behaviour::{Actor, Output};
+use paracosm_engine::behaviour::{ActorRef, Output};
 use paracosm_engine::rx::{StreamId, Value as Rx};
 use paracosm_engine::sut::{AebConfig, SutConfig};
 use starlark::environment::GlobalsBuilder;
@@ -17,7 +17,7 @@ use starlark::values::{UnpackValue, Value, ValueLike};
 use crate::lang::position::Loc;
 use crate::lang::scene::{turns, ObjectDecl, PedTrigger, Pending, SceneBuilder};
 use crate::lang::types;
-use crate::lang::values::{ActorKind, ActorVal, ChangeStart, LaneChangeVal, ObstacleVal, Stream};
+use crate::lang::values::{ActorVal, ChangeStart, LaneChangeVal, ObstacleVal, Stream};
 
 use super::*;
 
@@ -34,24 +34,10 @@ pub(super) fn declare(
     eval: &Evaluator,
     b: &mut SceneBuilder,
     what: &str,
-    kind: ActorKind,
+    actor: ActorRef,
     pending: Pending,
 ) -> ActorVal {
-    let actor = match kind {
-        ActorKind::Ego => Actor::Ego,
-        ActorKind::Pedestrian(i) => Actor::Pedestrian(i),
-        ActorKind::Car(i) => Actor::Car(i),
-    };
-    let outputs = [
-        Output::Pos,
-        Output::Vel,
-        Output::Heading,
-        Output::Speed,
-        Output::Collision,
-        Output::Collided,
-        Output::Separation,
-    ]
-    .map(|o| b.probe(actor, o).0);
+    let outputs = Output::ALL.map(|o| b.probe(actor, o).0);
     b.objects.push(ObjectDecl {
         name: object_name(eval, what),
         at: here(eval),
@@ -61,7 +47,7 @@ pub(super) fn declare(
         placed: false,
     });
     ActorVal {
-        kind,
+        kind: actor,
         outputs,
         object: b.objects.len() - 1,
     }
@@ -143,7 +129,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             eval,
             &mut b,
             "AutonomousVehicle",
-            ActorKind::Ego,
+            ActorRef::Ego,
             Pending::Ego {
                 loc,
                 route,
@@ -221,13 +207,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         )?
         .as_bool()
         .unwrap_or(true);
-        let i = b.n_cars;
-        b.n_cars += 1;
+        let car = ActorRef::Car(b.car_handles.add());
         Ok(declare(
             eval,
             &mut b,
             "Car",
-            ActorKind::Car(i),
+            car,
             Pending::Car {
                 loc,
                 route,
@@ -401,13 +386,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                  walks only when an action moves it: stream.foreach(p.walk))"
             ),
         };
-        let i = b.n_pedestrians;
-        b.n_pedestrians += 1;
+        let pedestrian = ActorRef::Pedestrian(b.pedestrian_handles.add());
         Ok(declare(
             eval,
             &mut b,
             "Pedestrian",
-            ActorKind::Pedestrian(i),
+            pedestrian,
             Pending::Pedestrian {
                 start,
                 target,

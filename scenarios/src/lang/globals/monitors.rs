@@ -11,8 +11,9 @@ use starlark::values::{Value, ValueLike};
 
 use crate::lang::scene::SceneBuilder;
 use crate::lang::types;
-use crate::lang::values::{ActorKind, ActorVal, MonitorVal};
+use crate::lang::values::{ActorVal, MonitorVal};
 use crate::MonitorSpec;
+use paracosm_engine::behaviour::ActorRef;
 
 use super::*;
 
@@ -95,9 +96,10 @@ pub(super) fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<Mon
 pub(super) fn ego_arg(v: Value, what: &str) -> anyhow::Result<()> {
     let got = match v.downcast_ref::<ActorVal>() {
         Some(a) => match a.kind {
-            ActorKind::Ego => return Ok(()),
-            ActorKind::Car(_) => "a Car".to_owned(),
-            ActorKind::Pedestrian(_) => "a Pedestrian".to_owned(),
+            ActorRef::Ego => return Ok(()),
+            ActorRef::Car(_) => "a Car".to_owned(),
+            ActorRef::Pedestrian(_) => "a Pedestrian".to_owned(),
+            ActorRef::Obstacle(_) => "an Obstacle".to_owned(),
         },
         None => crate::lang::a_type(v.get_type()),
     };
@@ -128,7 +130,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 crate::lang::a_type(v.get_type())
             )
         })?;
-        if actor.kind == ActorKind::Ego {
+        if actor.kind == ActorRef::Ego {
             return monitor(eval, MonitorSpec::Collision { name });
         }
         // Another actor: its separation, 0 from the step it first touched anything.

@@ -1,0 +1,735 @@
+//! A campaign from its settings to its files, as `paracosm-fuzz` runs it: the settings checked
+//! against the output folder, a resume, the loop with its observers, and `summary.json`, the
+//! plots and JUnit at the end. The binary parses arguments into a [`Request`] and maps the
+//! [`Error`] to an exit code; other front ends (the Python package) do the same.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use paracosm_engine::sut::SutConfig;
+use paracosm_generators::{GeneratorError, Point, Strategy};
+use paracosm_scenarios::Scenario;
+
+use crate::campaign::file::{CampaignFile, PointsFile, Settings, Shard, SutChoice, CAMPAIGN_FILE};
+use crate::campaign::{Campaign, CampaignReport, Observer, ResultsFile, RESULTS_FILE};
+use crate::record::RunRecord;
+use crate::report::summary::Summary;
+use crate::report::{warnings_of, write_outputs, Finished};
+use crate::Error;
+
+/// What to run: `paracosm-fuzz`'s arguments as data. `None` fields take the defaults (or,
+/// with `resume`, the stored campaign's values).
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// A built-in scenario's name or a `.star` path; `None` only with `resume` (taken from
+    /// the folder's `campaign.json`).
+    pub scenario: Option<String>,
+    /// The strategy [default: halton].
+    pub strategy: Option<Strategy>,
+    /// Campaign seed [default: 0].
+    pub seed: Option<u64>,
+    /// Tests of the whole campaign, `>= 1` [default: 100].
+    pub budget: Option<u64>,
+    /// Strength of the covering suites [default: 2].
+    pub strength: Option<usize>,
+    /// Only this shard of the campaign.
+    pub shard: Option<Shard>,
+    /// A system under test instead of the scenario's.
+    pub sut: Option<SutConfig>,
+    /// The campaign folder.
+    pub out: PathBuf,
+    /// Replace what `out` holds (`--force`).
+    pub replace: bool,
+    /// Finish the campaign in `out` (`--resume`).
+    pub resume: bool,
+    /// Worker threads [default: all cores]; results do not depend on it.
+    pub jobs: Option<usize>,
+    /// End at the first failed test.
+    pub stop_at_first_failure: bool,
+    /// Refuse a scenario that loads with warnings.
+    pub deny_warnings: bool,
+    /// Also write JUnit XML here.
+    pub junit: Option<PathBuf>,
+    /// Run the tests of this file (`--points`): a CSV with a header naming the parameters,
+    /// values in their units (levels as written), one test per row in file order, or the
+    /// `results.jsonl` of another campaign. Strategy `points`; the budget is the row count.
+    pub points: Option<PathBuf>,
+}
+
+impl Request {
+    /// A request for `scenario` into `out`, everything else by default.
+    pub fn new(scenario: &str, out: &Path) -> Self {
+        Request {
+            scenario: Some(scenario.to_owned()),
+            strategy: None,
+            seed: None,
+            budget: None,
+            strength: None,
+            shard: None,
+            sut: None,
+            out: out.to_path_buf(),
+            replace: false,
+            resume: false,
+            jobs: None,
+            stop_at_first_failure: false,
+            deny_warnings: false,
+            junit: None,
+            points: None,
+        }
+    }
+}
+
+/// What a session tells its observers before the first test: enough for a progress bar and
+/// the messages of a resume.
+#[derive(Debug)]
+pub struct Plan<'a> {
+    /// The scenario under test.
+    pub scenario: &'a Scenario,
+    /// The campaign's settings, as stored in `campaign.json`.
+    pub file: &'a CampaignFile,
+    /// The scenario's warnings for this system under test.
+    pub warnings: &'a [String],
+    /// Records already in the folder (a resume).
+    pub done: u64,
+    /// Tests this run will do at most.
+    pub to_run: u64,
+    /// Bytes of a half-written last line cut off `results.jsonl` (a resume after a kill).
+    pub repaired_bytes: u64,
+    /// Whether this run finishes an earlier one.
+    pub resumed: bool,
+}
+
+impl Plan<'_> {
+    /// What a front end tells the user before the first test: the warnings, a half-written
+    /// line cut off, how far a resumed campaign had got.
+    pub fn notes(&self) -> Vec<String> {
+        let mut notes = self.warnings.to_vec();
+        if self.repaired_bytes > 0 {
+            notes.push(format!(
+                "cut a half-written last line ({} bytes) off results.jsonl; that test runs again",
+                self.repaired_bytes
+            ));
+        }
+        if self.resumed {
+            notes.push(format!(
+                "resuming: {} of {} tests already done",
+                self.done,
+                self.done + self.to_run
+            ));
+        }
+        notes
+    }
+}
+
+/// A finished (or interrupted) session.
+#[derive(Debug)]
+pub struct Outcome {
+    /// The campaign's settings.
+    pub file: CampaignFile,
+    /// The scenario.
+    pub scenario: Scenario,
+    /// The folder.
+    pub out: PathBuf,
+    /// What the loop reported (this run's records only).
+    pub report: CampaignReport,
+    /// Records in the folder now (earlier and this run's).
+    pub done: u64,
+    /// Tests the folder should hold (the shard's or the campaign's).
+    pub expected: u64,
+    /// `summary.json` as written; `None` when interrupted (the folder is to be resumed).
+    pub summary: Option<Summary>,
+    /// Plots that could not be drawn (also in the summary's warnings).
+    pub plot_warnings: Vec<String>,
+}
+
+impl Outcome {
+    /// What a front end tells the user besides the summary: an interruption and how to
+    /// resume, a stop at the first failure, plots that could not be drawn.
+    pub fn notes(&self) -> Vec<String> {
+        let mut notes = Vec::new();
+        if self.summary.is_none() {
+            notes.push(format!(
+                "interrupted: {} of {} tests are in {}; finish the campaign with:\n    \
+                 paracosm-fuzz --resume --out {}",
+                self.done,
+                self.expected,
+                results_path(&self.out).display(),
+                self.out.display()
+            ));
+        }
+        if self.report.stopped_at_failure {
+            notes.push(format!(
+                "--stop-at-first-failure: stopped after {} of {} tests",
+                self.done, self.expected
+            ));
+        }
+        notes.extend(self.plot_warnings.iter().map(|w| format!("warning: {w}")));
+        notes
+    }
+
+    /// The human summary ([`crate::report::human`]), `None` when interrupted.
+    pub fn human(&self) -> Option<String> {
+        let summary = self.summary.as_ref()?;
+        Some(crate::report::human(
+            summary,
+            &self.scenario,
+            &self.out,
+            self.expected,
+            Some(self.report.records.len() as u64),
+        ))
+    }
+
+    /// The tools' exit code: 130 interrupted, 1 a test failed, 3 a test ended in an error, 0
+    /// otherwise.
+    pub fn exit_code(&self) -> u8 {
+        match &self.summary {
+            None => 130,
+            Some(s) if s.counts.fail > 0 => 1,
+            Some(s) if s.counts.error > 0 => 3,
+            Some(_) => 0,
+        }
+    }
+}
+
+/// Runs `request`: checks it (against the folder's campaign when resuming), prepares the
+/// folder, runs the tests it lacks with a [`ResultsFile`] and `observers`, and writes
+/// `summary.json`, the plots and JUnit. `started` is called with the [`Plan`] before any test
+/// runs; `stop` is the Ctrl-C flag.
+///
+/// # Errors
+/// [`Error::BadInput`] for settings that cannot be honoured (a non-empty folder without
+/// `replace` or `resume`, other settings than the stored campaign's, a budget past the
+/// strategy's capacity, a shard of an adaptive campaign, warnings with `deny_warnings`);
+/// [`Error::Scenario`] when it does not load; [`Error::Input`] for an unreadable campaign
+/// folder; [`Error::Write`] when a file cannot be written. Records already written stay.
+pub fn run(
+    request: &Request,
+    stop: Option<&AtomicBool>,
+    started: &mut dyn FnMut(&Plan<'_>),
+    observers: &mut [&mut dyn Observer],
+) -> Result<Outcome, Error> {
+    let out = &request.out;
+    if let Some(junit) = &request.junit {
+        crate::atomic::check_side_output(junit, "--junit", out)?;
+    }
+    let stored = if request.resume && out.join(CAMPAIGN_FILE).exists() {
+        Some(CampaignFile::read(out)?)
+    } else {
+        None
+    };
+    // Records without their campaign: nothing tells which campaign they belong to, and
+    // starting one here would replace them.
+    if request.resume && stored.is_none() && out.join(RESULTS_FILE).exists() {
+        return Err(Error::BadInput(format!(
+            "`{}` holds {RESULTS_FILE} but no {CAMPAIGN_FILE}: its records belong to no campaign \
+             that can be resumed, and a new one would replace them; move them away, or pass \
+             --force to replace them",
+            out.display()
+        )));
+    }
+    let (mut file, scenario, points) = settings(request, stored.as_ref())?;
+    // A campaign that stops at its first failure does so when resumed too.
+    let stop_at_first_failure = match &stored {
+        Some(s) => s.stop_at_first_failure || request.stop_at_first_failure,
+        None => request.stop_at_first_failure,
+    };
+    file.stop_at_first_failure = stop_at_first_failure;
+    let warnings = warnings_of(&scenario);
+    let strategy = refusals(request, &file, &warnings)?;
+    // A strength asked for that the space cannot have: with fewer discrete parameters there
+    // are no t-tuples (and a space with none has no covering array at all).
+    if let (Some(t), true) = (request.strength, Strategy::SUITES.contains(&strategy)) {
+        let nd = scenario.space.level_counts().len();
+        if t > nd {
+            return Err(Error::BadInput(format!(
+                "--strength {t}: a covering array of strength {t} needs {t} discrete parameters, \
+                 and {} has {nd}{}",
+                scenario.name,
+                if nd == 0 {
+                    " (its suite is Halton points alone: leave --strength out)"
+                } else {
+                    ""
+                }
+            )));
+        }
+    }
+    let jobs = request.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    });
+    prepare_out_dir(out, request.replace, request.resume)?;
+    // One writer per folder, from here to the end of the run (crate::campaign::lock).
+    let _lock = crate::campaign::lock::CampaignLock::acquire(out)?;
+    if request.resume {
+        // Ours alone now: what an earlier writer killed mid-write left is stale.
+        crate::atomic::remove_stale_temps(out);
+    }
+    if stored.is_none() {
+        file.write(out)?;
+    }
+    let ids = file.ids();
+    let existing = match stored {
+        Some(_) => crate::campaign::results::load(out, &scenario, ids.clone(), true)?,
+        None => crate::campaign::results::Existing {
+            records: Vec::new(),
+            repaired_bytes: 0,
+        },
+    };
+    let start = ids.start + existing.records.len() as u64;
+    let campaign = Campaign {
+        scenario: &scenario,
+        strategy,
+        seed: file.seed,
+        budget: file.budget,
+        strength: file.strength,
+        jobs,
+        stop_at_first_failure,
+        points: points.as_deref(),
+    };
+    campaign.check_origin(
+        &existing.records,
+        ids.start,
+        &out.join(RESULTS_FILE),
+        Some(&file.tag()),
+    )?;
+    started(&Plan {
+        scenario: &scenario,
+        file: &file,
+        warnings: &warnings,
+        done: existing.records.len() as u64,
+        to_run: ids.end - start,
+        repaired_bytes: existing.repaired_bytes as u64,
+        resumed: stored.is_some(),
+    });
+    let mut written = None;
+    let junit_path = request.junit.as_deref();
+    let mut chain = Chain {
+        results: ResultsFile::new(out, stored.is_some()).tagged(file.tag()),
+        others: observers,
+        // summary.json (counts, first failure, coverage of the points run) and the plots.
+        outputs: AtEnd::new(Box::new(
+            |records: &[RunRecord], report: &CampaignReport| {
+                written = Some(write_outputs(&Finished {
+                    out,
+                    scenario: &scenario,
+                    file: &file,
+                    records,
+                    jobs,
+                    wall_s: report.wall_s,
+                    junit: junit_path,
+                    warnings: warnings.clone(),
+                })?);
+                Ok(())
+            },
+        )),
+        junit: junit_path.map(|path| {
+            let name = scenario.name.clone();
+            AtEnd::new(Box::new(move |records: &[RunRecord], _: &CampaignReport| {
+                crate::report::junit::write(path, &name, records, out)
+            }) as AtEndFn<'_>)
+        }),
+    };
+    let prior = stored.is_some().then_some(existing.records.as_slice());
+    let report = campaign.run_ids(start..ids.end, prior, stop, &mut [&mut chain])?;
+    let done = chain.outputs.records.len() as u64;
+    drop(chain);
+    Ok(Outcome {
+        done,
+        expected: ids.end - ids.start,
+        plot_warnings: written
+            .as_ref()
+            .map(|w: &crate::report::Written| w.plot_warnings.clone())
+            .unwrap_or_default(),
+        summary: written.map(|w| w.summary),
+        report,
+        file,
+        scenario,
+        out: out.clone(),
+    })
+}
+
+/// The campaign's strategy, unless the campaign must be refused before anything is written:
+/// warnings under `deny_warnings`, a budget past the strategy's capacity, a shard of an
+/// adaptive strategy.
+fn refusals(
+    request: &Request,
+    file: &CampaignFile,
+    warnings: &[String],
+) -> Result<Strategy, Error> {
+    if request.deny_warnings && !warnings.is_empty() {
+        return Err(Error::BadInput(format!(
+            "--deny-warnings: the scenario loads with {} warning{}: {}",
+            warnings.len(),
+            if warnings.len() == 1 { "" } else { "s" },
+            warnings.join("; ")
+        )));
+    }
+    let strategy: Strategy = file.strategy.parse()?;
+    if let Some(cap) = strategy.capacity().filter(|&cap| file.budget > cap) {
+        return Err(Error::BadInput(format!(
+            "--budget {} is more than the {cap} points {strategy} can produce",
+            file.budget
+        )));
+    }
+    if file.shard.is_some() && strategy.method().is_some() {
+        return Err(Error::BadInput(format!(
+            "--shard cannot split a {strategy} campaign: each of its tests depends on all \
+             earlier ones. Run it whole (it is parallel inside: --jobs)"
+        )));
+    }
+    Ok(strategy)
+}
+
+/// The session's observers in their order: the results file first (a record reaches the
+/// others once it is on disk), the caller's, the summary with its coverage and plots, then
+/// JUnit.
+struct Chain<'a, 'b, 'c> {
+    results: ResultsFile,
+    others: &'a mut [&'b mut dyn Observer],
+    outputs: AtEnd<AtEndFn<'c>>,
+    junit: Option<AtEnd<AtEndFn<'c>>>,
+}
+
+impl Chain<'_, '_, '_> {
+    fn each(
+        &mut self,
+        mut f: impl FnMut(&mut dyn Observer) -> Result<(), Error>,
+    ) -> Result<(), Error> {
+        f(&mut self.results)?;
+        for o in self.others.iter_mut() {
+            f(&mut **o)?;
+        }
+        f(&mut self.outputs)?;
+        match self.junit.as_mut() {
+            Some(j) => f(j),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Observer for Chain<'_, '_, '_> {
+    fn started(&mut self, prior: &[RunRecord]) -> Result<(), Error> {
+        self.each(|o| o.started(prior))
+    }
+
+    fn record(&mut self, record: &RunRecord) -> Result<(), Error> {
+        self.each(|o| o.record(record))
+    }
+
+    fn finished(&mut self, report: &CampaignReport) -> Result<(), Error> {
+        self.each(|o| o.finished(report))
+    }
+}
+
+/// What an [`AtEnd`] does with the records when the campaign finishes.
+type AtEndFn<'a> = Box<dyn FnMut(&[RunRecord], &CampaignReport) -> Result<(), Error> + 'a>;
+
+/// An [`Observer`] that gathers every record of the folder (earlier ones included) and hands
+/// them to `then` when the campaign finishes: the summary and plots, JUnit XML. Nothing is
+/// written after an interruption: the folder is to be resumed.
+struct AtEnd<F> {
+    records: Vec<RunRecord>,
+    then: F,
+}
+
+impl<F> AtEnd<F> {
+    fn new(then: F) -> Self {
+        AtEnd {
+            records: Vec::new(),
+            then,
+        }
+    }
+}
+
+impl<F: FnMut(&[RunRecord], &CampaignReport) -> Result<(), Error>> Observer for AtEnd<F> {
+    fn started(&mut self, prior: &[RunRecord]) -> Result<(), Error> {
+        self.records = prior.to_vec();
+        Ok(())
+    }
+
+    fn record(&mut self, record: &RunRecord) -> Result<(), Error> {
+        self.records.push(record.clone());
+        Ok(())
+    }
+
+    fn finished(&mut self, report: &CampaignReport) -> Result<(), Error> {
+        if report.interrupted {
+            return Ok(());
+        }
+        (self.then)(&self.records, report)
+    }
+}
+
+/// The campaign's settings and scenario: from the request (checked against the folder's
+/// campaign when resuming), or from the folder's campaign alone (a resume without a scenario).
+fn settings(
+    request: &Request,
+    stored: Option<&CampaignFile>,
+) -> Result<(CampaignFile, Scenario, Option<Vec<Point>>), Error> {
+    let refuse = |diffs: Vec<String>| {
+        Error::BadInput(format!(
+            "refusing to resume: `{}` holds a campaign with other settings ({}); resume without \
+             those arguments, or start a new campaign with --force or another --out",
+            request.out.display(),
+            diffs.join("; ")
+        ))
+    };
+    let sut = request.sut.as_ref();
+    let load = |name: &str, choice: &SutChoice| -> Result<Scenario, Error> {
+        let mut scenario = paracosm_scenarios::load(name)?;
+        if let Some(s) = choice.config()? {
+            scenario.sut = s;
+        }
+        Ok(scenario)
+    };
+    match (&request.scenario, stored) {
+        (Some(name), _) => {
+            let choice = SutChoice::of(sut);
+            let scenario = load(name, &choice)?;
+            let given = match &request.points {
+                Some(path) => Some(read_points(path, request, &scenario)?),
+                None if request.strategy == Some(Strategy::Points) => {
+                    return Err(Error::Generator(GeneratorError::NeedsPoints))
+                }
+                None => None,
+            };
+            let file = CampaignFile::new(
+                name,
+                &scenario,
+                Settings {
+                    sut: choice,
+                    strategy: match given {
+                        Some(_) => Strategy::Points,
+                        None => request.strategy.unwrap_or(Strategy::Halton),
+                    }
+                    .name()
+                    .into(),
+                    seed: request.seed.unwrap_or(0),
+                    budget: match &given {
+                        Some((_, points)) => points.len() as u64,
+                        None => request.budget.unwrap_or(100),
+                    },
+                    // The default strength, 2, is lowered to the number of discrete
+                    // parameters when there are fewer (a strength asked for is kept, and
+                    // refused if too high).
+                    strength: request.strength.unwrap_or_else(|| {
+                        let suite = request
+                            .strategy
+                            .is_some_and(|s| Strategy::SUITES.contains(&s));
+                        match scenario.space.level_counts().len() {
+                            1 if suite => 1,
+                            _ => 2,
+                        }
+                    }),
+                    shard: request.shard,
+                    points: given.as_ref().map(|(f, _)| f.clone()),
+                },
+            );
+            match stored.map(|st| st.differences(&file)) {
+                Some(diffs) if !diffs.is_empty() => Err(refuse(diffs)),
+                _ => Ok((file, scenario, given.map(|(_, p)| p))),
+            }
+        }
+        (None, Some(st)) => {
+            // Settings given with a bare resume must agree with the stored campaign.
+            let mut diffs = Vec::new();
+            let mut check = |name: &str, given: Option<String>, stored: String| {
+                if let Some(g) = given.filter(|g| *g != stored) {
+                    diffs.push(format!("{name}: {stored} vs {g}"));
+                }
+            };
+            check(
+                "seed",
+                request.seed.map(|v| v.to_string()),
+                st.seed.to_string(),
+            );
+            check(
+                "budget",
+                request.budget.map(|v| v.to_string()),
+                st.budget.to_string(),
+            );
+            check(
+                "strength",
+                request.strength.map(|v| v.to_string()),
+                st.strength.to_string(),
+            );
+            check(
+                "strategy",
+                request.strategy.map(|s| s.name().to_owned()),
+                st.strategy.clone(),
+            );
+            let shard = |s: Option<Shard>| s.map_or("none".to_owned(), |s| s.to_string());
+            check(
+                "shard",
+                request.shard.map(|s| shard(Some(s))),
+                shard(st.shard),
+            );
+            if sut.is_some() && SutChoice::of(sut) != st.sut {
+                diffs.push("system under test differs".into());
+            }
+            if !diffs.is_empty() {
+                return Err(refuse(diffs));
+            }
+            let edited = st.edited_fields();
+            if !edited.is_empty() {
+                return Err(Error::BadInput(format!(
+                    "refusing to resume: {} was edited by hand: {} no longer match{} what the \
+                     campaign wrote. Put the value{} back, or start a new campaign with --force \
+                     or another --out",
+                    request.out.join(CAMPAIGN_FILE).display(),
+                    edited
+                        .iter()
+                        .map(|f| format!("`{f}`"))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    if edited.len() == 1 { "es" } else { "" },
+                    if edited.len() == 1 { "" } else { "s" },
+                )));
+            }
+            let scenario = load(&st.scenario, &st.sut)?;
+            let again = CampaignFile::new(&st.scenario, &scenario, st.settings());
+            if again.fingerprint != st.fingerprint {
+                // Name what differs: the program, its parameters, or campaign.json itself.
+                let why = if st
+                    .scenario_sha256
+                    .as_ref()
+                    .is_some_and(|h| Some(h) != again.scenario_sha256.as_ref())
+                {
+                    format!(
+                        "the scenario program `{}` changed since the campaign started (its \
+                         SHA-256 differs)",
+                        st.scenario
+                    )
+                } else if let Some((was, now)) = st
+                    .input_files
+                    .iter()
+                    .zip(&again.input_files)
+                    .find(|(a, b)| a != b)
+                {
+                    format!(
+                        "the file `{}` that the scenario program reads changed since the \
+                         campaign started (SHA-256 {} then, {} now)",
+                        now.path,
+                        &was.sha256[..12],
+                        &now.sha256[..12]
+                    )
+                } else if st.input_files.len() != again.input_files.len() {
+                    format!(
+                        "the scenario program `{}` reads other files than when the campaign \
+                         started",
+                        st.scenario
+                    )
+                } else if st.space != again.space {
+                    format!(
+                        "the parameters of `{}` differ from the `space` in {CAMPAIGN_FILE}",
+                        st.scenario
+                    )
+                } else if st.scenario_sha256.is_some() {
+                    format!(
+                        "{CAMPAIGN_FILE} was edited: its strategy, seed, budget, strength or \
+                         system under test no longer give its `fingerprint` (the scenario \
+                         program is unchanged)"
+                    )
+                } else {
+                    format!(
+                        "the scenario `{}` changed since the campaign started, or {CAMPAIGN_FILE} \
+                         was edited",
+                        st.scenario
+                    )
+                };
+                return Err(refuse(vec![why]));
+            }
+            let points = match &st.points {
+                Some(stored_file) => {
+                    let path = Path::new(&stored_file.path);
+                    let (now, points) = read_points(path, request, &scenario)?;
+                    if now.sha256 != stored_file.sha256 {
+                        return Err(refuse(vec![format!(
+                            "the points file `{}` changed since the campaign started",
+                            stored_file.path
+                        )]));
+                    }
+                    Some(points)
+                }
+                None => None,
+            };
+            Ok((st.clone(), scenario, points))
+        }
+        (None, None) => Err(Error::BadInput(format!(
+            "--resume without SCENARIO needs a campaign in `{}`, which has no {CAMPAIGN_FILE}",
+            request.out.display()
+        ))),
+    }
+}
+
+/// The tests of a `--points` file, read against the scenario's space, with the file's hash.
+/// Refuses `--strategy` other than `points` and a `--budget` other than the row count.
+fn read_points(
+    path: &Path,
+    request: &Request,
+    scenario: &Scenario,
+) -> Result<(PointsFile, Vec<Point>), Error> {
+    if let Some(s) = request.strategy.filter(|&s| s != Strategy::Points) {
+        return Err(Error::BadInput(format!(
+            "--points chooses the tests, so --strategy {s} cannot be used with it"
+        )));
+    }
+    paracosm_engine::files::regular_file(path).map_err(|e| Error::input(path, e))?;
+    let bytes = std::fs::read(path).map_err(|e| Error::input(path, e))?;
+    let text = String::from_utf8(bytes.clone())
+        .map_err(|e| Error::malformed(path, format!("{}: not UTF-8 text: {e}", path.display())))?;
+    let is_jsonl = path.extension().is_some_and(|e| e == "jsonl");
+    let set = crate::cover::parse_tests(
+        &path.display().to_string(),
+        &text,
+        is_jsonl,
+        Some(&scenario.space),
+    )
+    .map_err(|e| Error::malformed(path, e.to_string()))?;
+    if let Some(b) = request.budget.filter(|&b| b != set.points.len() as u64) {
+        return Err(Error::BadInput(format!(
+            "--budget {b} differs from the {} tests of --points `{}`; leave --budget out",
+            set.points.len(),
+            path.display()
+        )));
+    }
+    Ok((PointsFile::of(path, &bytes), set.points))
+}
+
+/// Creates `out`; refuses a non-empty folder unless `replace` or `resume`, and a folder that
+/// cannot be written.
+///
+/// # Errors
+/// [`Error::BadInput`] naming the folder.
+pub fn prepare_out_dir(out: &Path, replace: bool, resume: bool) -> Result<(), Error> {
+    // The lock file of this very run ([`crate::campaign::lock`]) does not make a folder non-empty.
+    let non_empty = std::fs::read_dir(out)
+        .map(|mut d| d.any(|e| e.is_ok_and(|e| e.file_name() != crate::campaign::lock::LOCK_FILE)))
+        .unwrap_or(false);
+    if out.exists() && !out.is_dir() {
+        return Err(Error::BadInput(format!(
+            "--out `{}` is not a folder",
+            out.display()
+        )));
+    }
+    if non_empty && !replace && !resume {
+        return Err(Error::BadInput(format!(
+            "`{}` is not empty; pass --resume to finish the campaign in it, --force to replace \
+             it, or choose another --out",
+            out.display()
+        )));
+    }
+    std::fs::create_dir_all(out).map_err(|e| {
+        Error::BadInput(format!(
+            "cannot create output folder `{}`: {e}",
+            out.display()
+        ))
+    })?;
+    // Probe writability now, before any test runs, and every file the campaign will write.
+    crate::atomic::probe_writable(out)?;
+    crate::atomic::check_targets(out, crate::atomic::CAMPAIGN_OUTPUTS)
+}
+
+/// The path of the results file in `out`, for messages.
+pub fn results_path(out: &Path) -> PathBuf {
+    out.join(RESULTS_FILE)
+}
