@@ -19,6 +19,212 @@ use super::values::{Action, ActorVal, LaneSide, Port, Road, Stream, WorldVal, PO
 use starlark::environment::Methods;
 use starlark::values::{starlark_value, Heap, StarlarkValue};
 
+use super::builtins::{named, positional, Builtin, Declares, Form};
+
+/// A stream method's spec: computes a stream, takes what it is given into code.
+const fn stream_method(
+    name: &'static str,
+    inputs: &'static [super::builtins::Arg],
+    takes_whole: bool,
+    doc: &'static str,
+) -> Builtin {
+    Builtin {
+        name,
+        form: Form::Method("stream"),
+        inputs,
+        declares: Declares::Nothing,
+        takes_whole,
+        doc,
+    }
+}
+
+/// An action's spec ([`super::values::Action`]).
+const fn action(
+    name: &'static str,
+    on: &'static str,
+    inputs: &'static [super::builtins::Arg],
+    doc: &'static str,
+) -> Builtin {
+    Builtin {
+        name,
+        form: Form::Action(on),
+        inputs,
+        declares: Declares::Nothing,
+        // `walk` takes nothing to follow.
+        takes_whole: !inputs.is_empty(),
+        doc,
+    }
+}
+
+/// The methods and actions of this file ([`super::builtins`]).
+pub(crate) const SPECS: &[Builtin] = &[
+    stream_method(
+        "map",
+        &[positional("f", "a function of the event")],
+        false,
+        "f(v) for each event v",
+    ),
+    stream_method(
+        "filter",
+        &[positional("p", "a predicate of the event")],
+        false,
+        "the events for which p(v) is true",
+    ),
+    stream_method(
+        "zip",
+        &[positional("other", "a stream")],
+        true,
+        "pairs (a_i, b_i)",
+    ),
+    stream_method(
+        "take",
+        &[positional("n", "whole number >= 0")],
+        false,
+        "the first n events",
+    ),
+    stream_method(
+        "skipUntil",
+        &[positional("trigger", "a stream")],
+        true,
+        "events from the first event of trigger on",
+    ),
+    stream_method(
+        "takeUntil",
+        &[positional("stop", "a stream")],
+        true,
+        "events until the first event of stop",
+    ),
+    stream_method(
+        "concat",
+        &[positional("second", "a stream")],
+        true,
+        "a's events, then b's",
+    ),
+    stream_method(
+        "sum",
+        &[
+            positional("init", "a number or a Vector").or("zero"),
+            positional("f", "a fold acc, v -> acc").or("None"),
+        ],
+        false,
+        "running total of numbers or vectors, or a fold",
+    ),
+    stream_method("min", &[], false, "the running minimum of a number stream"),
+    stream_method("max", &[], false, "the running maximum of a number stream"),
+    stream_method(
+        "foreach",
+        &[positional(
+            "action",
+            "an action, or a function that calls actions",
+        )],
+        false,
+        "each event performs the action",
+    ),
+    Builtin {
+        name: "onLane",
+        form: Form::Method("road"),
+        inputs: &[
+            positional(
+                "lane",
+                "a lane number or r.SideWalk (a segment); a port (a junction)",
+            ),
+            positional("at", "number, m along the lane or path").checked(super::types::number(
+                "at",
+                "m",
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                false,
+            )),
+            named("lane", "a lane from 1 (a junction's path)").or("1"),
+            named("turn", "\"straight\", \"left\", \"right\" (a junction)"),
+            named("road", "an OpenDRIVE <road id> (a map)"),
+            named("s", "number, m along the road's reference line (a map)"),
+            named("port", "a junction's port"),
+        ],
+        declares: Declares::Nothing,
+        takes_whole: true,
+        doc: "a location on a lane: where an actor starts or a pedestrian walks to",
+    },
+    Builtin {
+        name: "connect",
+        form: Form::Method("road"),
+        inputs: &[positional("links", "(parent.PORT, child, child.PORT), ...")],
+        declares: Declares::Nothing,
+        takes_whole: true,
+        doc: "joins each child to a port of this road or network, checked",
+    },
+    Builtin {
+        name: "place",
+        form: Form::Method("World"),
+        inputs: &[positional("objects", "roads and actors, ...")],
+        declares: Declares::Nothing,
+        takes_whole: true,
+        doc: "adds roads and actors to the scene and checks the placement",
+    },
+    action(
+        "walk",
+        "Pedestrian",
+        &[],
+        "one walking step toward the target",
+    ),
+    action(
+        "setSpeed",
+        "Car",
+        &[positional("v", "number").checked(super::types::number(
+            "v",
+            "m/s",
+            0.0,
+            f64::INFINITY,
+            false,
+        ))],
+        "drives at v from now on",
+    ),
+    action(
+        "brake",
+        "Car",
+        &[positional("decel", "number").checked(super::types::number(
+            "decel",
+            "m/s²",
+            0.0,
+            f64::INFINITY,
+            true,
+        ))],
+        "slows by decel times the step and keeps the lower speed",
+    ),
+    action(
+        "changeLane",
+        "Car",
+        &[
+            positional("lane", "a lane number of its start segment"),
+            positional("duration", "number")
+                .checked(super::types::number(
+                    "duration",
+                    "s",
+                    0.0,
+                    f64::INFINITY,
+                    true,
+                ))
+                .or("3.0"),
+        ],
+        "changes to another lane of its segment",
+    ),
+];
+
+/// The names of the methods registered on streams, roads and the world (for the test that
+/// every one has a spec).
+#[cfg(test)]
+pub(crate) fn registered_names() -> Vec<&'static str> {
+    let ty = starlark::typing::Ty::any();
+    let mut names = Vec::new();
+    for f in [stream_methods, road_methods, world_methods] {
+        let methods = MethodsBuilder::new().with(f).build();
+        for (name, _) in methods.documentation(ty.clone()).members {
+            names.push(&*String::leak(name));
+        }
+    }
+    names
+}
+
 /// Stores `f` as host function `n` and returns `Func::Host(n)`.
 fn lambda<'v>(f: Value<'v>, what: &str, eval: &mut Evaluator<'v, '_, '_>) -> anyhow::Result<Func> {
     if f.get_type() != "function" {

@@ -8,6 +8,7 @@
 //! value in the program (a number, string or bool), so every Starlark operation works on it
 //! and the program may branch on it.
 
+mod builtins;
 mod globals;
 mod host;
 pub mod map_files;
@@ -76,57 +77,6 @@ pub fn load_file(path: &Path) -> Result<Scenario, ScenarioError> {
     load_source(&path.display().to_string(), &source, &stem)
 }
 
-/// The keyword arguments of each builtin, for "did you mean" on a misspelled keyword
-/// (starlark reports the unknown keyword but suggests nothing).
-const KEYWORDS: &[(&str, &[&str])] = &[
-    ("World", &["light", "fog"]),
-    ("RoadSegment", &["len", "nlanes", "numLane", "friction"]),
-    ("Arc", &["radius", "angle", "nlanes", "numLane", "friction"]),
-    (
-        "Clothoid",
-        &[
-            "length",
-            "curv_start",
-            "curv_end",
-            "nlanes",
-            "numLane",
-            "friction",
-        ],
-    ),
-    ("TIntersection", &["nlanes", "numLane", "friction"]),
-    ("CrossIntersection", &["nlanes", "numLane", "friction"]),
-    ("Roundabout", &["nlanes", "numLane", "radius", "friction"]),
-    ("OpenDrive", &["friction"]),
-    ("onLane", &["lane", "road", "s"]),
-    ("AutonomousVehicle", &["loc", "sut", "route", "speed"]),
-    (
-        "Car",
-        &[
-            "loc",
-            "speed",
-            "route",
-            "color",
-            "enabled",
-            "lane_change",
-            "keep_distance",
-        ],
-    ),
-    ("ChangeLane", &["to", "at", "when", "duration"]),
-    ("Obstacle", &["loc", "size", "color"]),
-    (
-        "Pedestrian",
-        &["start", "target", "speed", "dist", "car", "trigger"],
-    ),
-    ("VarInterval", &["unit", "name", "over_time"]),
-    ("VarEnum", &["name"]),
-    ("CollisionMonitor", &["name"]),
-    ("OffRoadMonitor", &["name"]),
-    ("DistanceMonitor", &["minD", "name"]),
-    ("TimeToFailure", &["minT", "name"]),
-    ("Stl", &["name"]),
-    ("test", &["horizon", "map", "offroad"]),
-];
-
 /// A Starlark type name with its article, for messages: `an int`, `a list`, `an Arc`, and
 /// `None` for `NoneType`.
 pub(crate) fn a_type(type_name: &str) -> String {
@@ -151,15 +101,10 @@ pub(crate) fn suggest_keyword(message: &str) -> String {
     }) else {
         return message.to_owned();
     };
-    let best = KEYWORDS
-        .iter()
-        .find(|(f, _)| *f == function)
-        .and_then(|(_, keys)| {
-            keys.iter()
-                .map(|k| (strsim::levenshtein(k, wrong), *k))
-                .filter(|(d, _)| *d <= 3)
-                .min()
-        });
+    let best = builtins::keywords(function)
+        .map(|k| (strsim::levenshtein(k, wrong), k))
+        .filter(|(d, _)| *d <= 3)
+        .min();
     match best {
         Some((_, key)) => message.replacen(
             &format!("call to {function}"),

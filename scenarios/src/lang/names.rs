@@ -45,9 +45,6 @@ pub fn deepest_expression(ast: &AstModule, limit: usize) -> Option<(usize, Strin
     found.map(|(d, e)| (d, format!("{}", ast.file_span(e.span).resolve_span().begin)))
 }
 
-/// The builtins that declare open parameters.
-const DECLARERS: [&str; 2] = ["VarInterval", "VarEnum"];
-
 /// What the syntax says about one `VarInterval`/`VarEnum` call site.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Site {
@@ -171,7 +168,7 @@ fn method_position(method: &str, keyword: &str, keywords: &[&str]) -> Option<usi
 }
 
 fn is_declarer(e: &AstExpr) -> bool {
-    matches!(&e.node, ExprP::Call(f, _) if callee(f).is_some_and(|c| DECLARERS.contains(&c.as_str())))
+    matches!(&e.node, ExprP::Call(f, _) if callee(f).is_some_and(|c| super::builtins::declares_parameter(&c)))
 }
 
 struct Walker<'a> {
@@ -287,9 +284,9 @@ impl Walker<'_> {
                     let given = target.map(str::to_owned);
                     self.site(e, given.clone(), given, None);
                 }
-                let builtin = name
-                    .as_deref()
-                    .is_some_and(|n| self.builtins.contains(&n) && !DECLARERS.contains(&n));
+                let builtin = name.as_deref().is_some_and(|n| {
+                    self.builtins.contains(&n) && !super::builtins::declares_parameter(n)
+                });
                 // Open parameters among a method's positional arguments: one is named by the
                 // method, several by their positions too.
                 let open_positional = args

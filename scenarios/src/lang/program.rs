@@ -69,41 +69,6 @@ pub const MAX_PARAMS: usize = 500;
 /// warning says how many were checked.
 pub const MAX_CHECK_STEPS: u64 = 50_000_000;
 
-/// The names of paracosm's builtins and methods: a variable passed whole to one of them acts
-/// through the world, which the usage analysis sees.
-const BUILTINS: &[&str] = &[
-    "World",
-    "RoadSegment",
-    "Arc",
-    "Clothoid",
-    "TIntersection",
-    "CrossIntersection",
-    "Roundabout",
-    "OpenDrive",
-    "AutonomousVehicle",
-    "Car",
-    "Pedestrian",
-    "Obstacle",
-    "ChangeLane",
-    "Const",
-    "CollisionMonitor",
-    "DistanceMonitor",
-    "OffRoadMonitor",
-    "TimeToFailure",
-    "Stl",
-    "test",
-    "onLane",
-    "brake",
-    "setSpeed",
-    "changeLane",
-    "connect",
-    "place",
-    "zip",
-    "skipUntil",
-    "takeUntil",
-    "concat",
-];
-
 /// A program and what its first evaluation told about it.
 pub struct Program {
     file: String,
@@ -1054,7 +1019,7 @@ pub fn load(
     base: super::map_files::Base,
 ) -> Result<Scenario, ScenarioError> {
     let lang = ScenarioError::Language;
-    let syntax = Syntax::of(&ast, BUILTINS);
+    let syntax = Syntax::of(&ast, &super::builtins::taking_whole());
     if let Some((at, call)) = syntax.dropped_actions().first() {
         return Err(lang(format!(
             "error: `{call}` on a line of its own does nothing: an action is performed by \

@@ -46,7 +46,8 @@ pub struct Input {
     pub kind: Kind,
 }
 
-const fn number(
+/// A number input: `keyword` in `unit`, in `[min, max]` (`(min, max]` with `min_open`).
+pub(crate) const fn number(
     keyword: &'static str,
     unit: &'static str,
     min: f64,
@@ -98,57 +99,7 @@ pub const ENABLED: Input = Input {
 };
 
 /// The largest turn of a curved piece, rad (3π/2).
-const MAX_TURN: f64 = paracosm_engine::network::MAX_TURN_RAD;
-
-/// `Builtin(keyword=)`'s input, for the builtins whose inputs take numbers with a unit or a
-/// range (used to check the unit a parameter declares).
-pub fn input_of(builtin: &str, keyword: &str) -> Option<Input> {
-    Some(match (builtin, keyword) {
-        ("World", "light") => LIGHT,
-        ("World", "fog") => FOG,
-        (
-            "RoadSegment" | "Arc" | "Clothoid" | "TIntersection" | "CrossIntersection"
-            | "Roundabout" | "OpenDrive",
-            "friction",
-        ) => FRICTION,
-        // At most 100 km (a roundabout's plaza 2 km): the physics runs in f32, 8 mm apart at
-        // 100 km from the origin, and `len = 1e38` moved the road's colliders by metres.
-        ("RoadSegment", "len") => number(
-            "len",
-            "m",
-            0.0,
-            paracosm_engine::network::MAX_EXTENT_M,
-            true,
-        ),
-        ("Roundabout", "radius") => number("radius", "m", 0.0, 1_000.0, true),
-        ("Arc", "radius") => number(
-            "radius",
-            "m",
-            0.0,
-            paracosm_engine::network::MAX_EXTENT_M,
-            true,
-        ),
-        ("Arc", "angle") => number("angle", "rad", -MAX_TURN, MAX_TURN, false),
-        ("Clothoid", "length") => number("length", "m", 0.0, 10_000.0, true),
-        ("Clothoid", "curv_start") => number("curv_start", "1/m", -0.1, 0.1, false),
-        ("Clothoid", "curv_end") => number("curv_end", "1/m", -0.1, 0.1, false),
-        ("AutonomousVehicle", "speed") => number("speed", "m/s", 0.0, f64::INFINITY, false),
-        ("Car", "speed") => CAR_SPEED,
-        ("Car", "keep_distance") => number("keep_distance", "m", 0.0, f64::INFINITY, false),
-        ("Pedestrian", "speed") => PEDESTRIAN_SPEED,
-        ("Pedestrian", "dist") => TRIGGER_DISTANCE,
-        ("ChangeLane", "at") => number("at", "s", 0.0, f64::INFINITY, false),
-        ("ChangeLane", "duration") => number("duration", "s", 0.0, f64::INFINITY, true),
-        ("Obstacle", "size[0]" | "size[1]" | "size[2]") => {
-            number("size", "m", 0.0, f64::INFINITY, true)
-        }
-        ("onLane", "at") => number("at", "m", f64::NEG_INFINITY, f64::INFINITY, false),
-        ("brake", "decel") => number("decel", "m/s²", 0.0, f64::INFINITY, true),
-        ("setSpeed", "v") => number("v", "m/s", 0.0, f64::INFINITY, false),
-        ("changeLane", "duration") => number("duration", "s", 0.0, f64::INFINITY, true),
-        _ => return None,
-    })
-}
+pub(crate) const MAX_TURN: f64 = paracosm_engine::network::MAX_TURN_RAD;
 
 impl Kind {
     /// The run-time check of a number stream; `None` for kinds that are not numbers.

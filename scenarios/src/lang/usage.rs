@@ -414,7 +414,7 @@ pub fn unit_warnings(params: &[(String, ParamDecl)], syntax: &Syntax) -> Vec<War
             inputs.push((builtin, keyword));
         }
         for (builtin, keyword) in inputs {
-            if let Some(input) = types::input_of(builtin, keyword) {
+            if let Some(input) = super::builtins::input_of(builtin, keyword) {
                 if let types::Kind::Number { unit: theirs, .. } = input.kind {
                     // A dimensionless input: any unit but "1" or "-" says the program expects
                     // another scale (`unit = "%"` for a fog in [0, 1]).

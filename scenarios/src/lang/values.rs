@@ -296,12 +296,9 @@ impl<'v> StarlarkValue<'v> for Action {
                 })
         };
         // Each argument by position or by keyword (the names LANGUAGE.md's table gives), once.
-        let signature: &[&str] = match self.method {
-            "walk" => &[],
-            "changeLane" => &["lane", "duration"],
-            "brake" => &["decel"],
-            _ => &["v"],
-        };
+        let signature: Vec<&str> = crate::lang::builtins::find(self.method)
+            .map(|b| b.inputs.iter().map(|a| a.keyword).collect())
+            .unwrap_or_default();
         let usage = format!("{}({})", self.method, signature.join(", "));
         let mut given: Vec<Option<Value<'v>>> = vec![None; signature.len()];
         for (i, v) in args.positions(heap)?.enumerate() {

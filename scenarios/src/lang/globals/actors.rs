@@ -21,6 +21,113 @@ use crate::lang::values::{ActorVal, ChangeStart, LaneChangeVal, ObstacleVal, Str
 
 use super::*;
 
+use crate::lang::builtins::{named, Builtin, Declares, Form};
+
+/// `route=` of the ego vehicle and of a car.
+const ROUTE: crate::lang::builtins::Arg = named(
+    "route",
+    "a turn or a list of turns: \"straight\", \"left\", \"right\"",
+)
+.or("[]");
+/// `color=` of a car or an obstacle.
+const COLOUR: &str = "a colour name: red, white, black, blue, green, yellow, orange, silver, grey";
+
+/// The builtins of this file ([`crate::lang::builtins`]).
+pub(crate) const SPECS: &[Builtin] = &[
+    Builtin {
+        name: "AutonomousVehicle",
+        form: Form::Function,
+        inputs: &[
+            named("loc", "a location from onLane"),
+            named("sut", "\"aeb\", \"vision\", \"pilotnet\" or \"onnx:PATH\"").or("\"aeb\""),
+            ROUTE,
+            named("speed", "number, the speed at t = 0")
+                .checked(types::number("speed", "m/s", 0.0, f64::INFINITY, false))
+                .or("12.0"),
+        ],
+        declares: Declares::Actor,
+        takes_whole: true,
+        doc: "the ego vehicle, driven by the system under test",
+    },
+    Builtin {
+        name: "Car",
+        form: Form::Function,
+        inputs: &[
+            named("loc", "a location from onLane"),
+            named("speed", "number")
+                .checked(types::CAR_SPEED)
+                .or("10.0"),
+            ROUTE,
+            named("color", COLOUR).or("\"red\""),
+            named("enabled", "bool: whether the car is in the test").or("True"),
+            named("lane_change", "a ChangeLane").or("None"),
+            named(
+                "keep_distance",
+                "number: brakes to stop this far short of what is ahead",
+            )
+            .checked(types::number(
+                "keep_distance",
+                "m",
+                0.0,
+                f64::INFINITY,
+                false,
+            ))
+            .or("None"),
+        ],
+        declares: Declares::Actor,
+        takes_whole: true,
+        doc: "an NPC car that follows the lane graph and stops against whatever it meets",
+    },
+    Builtin {
+        name: "ChangeLane",
+        form: Form::Function,
+        inputs: &[
+            named("to", "a lane number of the car's segment"),
+            named("at", "number: when it starts")
+                .checked(types::number("at", "s", 0.0, f64::INFINITY, false))
+                .or("None"),
+            named("when", "any stream: its first event starts the change").or("None"),
+            named("duration", "number")
+                .checked(types::number("duration", "s", 0.0, f64::INFINITY, true))
+                .or("3.0"),
+        ],
+        declares: Declares::Nothing,
+        takes_whole: true,
+        doc: "a lane change for Car(lane_change=)",
+    },
+    Builtin {
+        name: "Obstacle",
+        form: Form::Function,
+        inputs: &[
+            named("loc", "a location from onLane"),
+            named("size", "(length, width, height)")
+                .each(types::number("size", "m", 0.0, f64::INFINITY, true))
+                .or("(4.5, 1.8, 1.5)"),
+            named("color", COLOUR).or("\"grey\""),
+        ],
+        declares: Declares::Actor,
+        takes_whole: true,
+        doc: "a static box (a parked car, a cone, a barrier)",
+    },
+    Builtin {
+        name: "Pedestrian",
+        form: Form::Function,
+        inputs: &[
+            named("start", "a location from onLane"),
+            named("target", "a location from onLane"),
+            named("speed", "number").checked(types::PEDESTRIAN_SPEED),
+            named("dist", "number: the trigger distance")
+                .checked(types::TRIGGER_DISTANCE)
+                .or("None"),
+            named("car", "a position stream or an actor").or("None"),
+            named("trigger", "any stream: its first event starts the walk").or("None"),
+        ],
+        declares: Declares::Actor,
+        takes_whole: true,
+        doc: "walks from start to target once car comes within dist of start (or trigger fires)",
+    },
+];
+
 pub(super) fn location(v: Value, what: &str) -> anyhow::Result<usize> {
     v.downcast_ref::<Loc>().map(|l| l.index).ok_or_else(|| {
         anyhow!(

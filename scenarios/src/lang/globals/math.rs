@@ -10,6 +10,59 @@ use starlark::values::Value;
 
 use crate::lang::values::stream_hint;
 
+use crate::lang::builtins::{positional, Builtin, Declares, Form};
+
+/// A number or a vector.
+const NUMBER: &str = "number";
+
+/// The builtins of this file ([`crate::lang::builtins`]).
+pub(crate) const SPECS: &[Builtin] = &[
+    Builtin {
+        name: "abs",
+        form: Form::Function,
+        inputs: &[positional("x", "a number or a Vector")],
+        declares: Declares::Nothing,
+        takes_whole: false,
+        doc: "the absolute value of a number, or the length of a vector",
+    },
+    Builtin {
+        name: "dist",
+        form: Form::Function,
+        inputs: &[positional("a", "a position"), positional("b", "a position")],
+        declares: Declares::Nothing,
+        takes_whole: false,
+        doc: "the distance between two positions in the ground plane, m",
+    },
+    Builtin {
+        name: "sqrt",
+        form: Form::Function,
+        inputs: &[positional("x", "number >= 0")],
+        declares: Declares::Nothing,
+        takes_whole: false,
+        doc: "the square root",
+    },
+    Builtin {
+        name: "hypot",
+        form: Form::Function,
+        inputs: &[positional("x", NUMBER), positional("y", NUMBER)],
+        declares: Declares::Nothing,
+        takes_whole: false,
+        doc: "sqrt(x² + y²) without overflow",
+    },
+    Builtin {
+        name: "clamp",
+        form: Form::Function,
+        inputs: &[
+            positional("x", NUMBER),
+            positional("lo", NUMBER),
+            positional("hi", NUMBER),
+        ],
+        declares: Declares::Nothing,
+        takes_whole: false,
+        doc: "x limited to [lo, hi]",
+    },
+];
+
 /// A number argument of a math builtin.
 pub(super) fn math_number(v: Value, what: &str) -> anyhow::Result<f64> {
     crate::lang::position::num(v).ok_or_else(|| {

@@ -2,12 +2,12 @@
 
 //! The global builtins of the scenario language (LANGUAGE.md documents each).
 
-mod actors;
-mod math;
-mod monitors;
-mod roads;
-mod settings;
-mod streams;
+pub(crate) mod actors;
+pub(crate) mod math;
+pub(crate) mod monitors;
+pub(crate) mod roads;
+pub(crate) mod settings;
+pub(crate) mod streams;
 
 use std::cell::RefCell;
 

@@ -17,6 +17,104 @@ use paracosm_engine::behaviour::ActorRef;
 
 use super::*;
 
+use crate::lang::builtins::{named, positional, Builtin, Declares, Form};
+
+/// The builtins of this file ([`crate::lang::builtins`]).
+pub(crate) const SPECS: &[Builtin] = &[
+    Builtin {
+        name: "CollisionMonitor",
+        form: Form::Function,
+        inputs: &[
+            positional("a", "an actor"),
+            named("name", "string").or("the variable, else \"collision\""),
+        ],
+        declares: Declares::Monitor,
+        takes_whole: true,
+        doc: "fails when the actor touches anything solid; robustness: its separation, m",
+    },
+    Builtin {
+        name: "OffRoadMonitor",
+        form: Form::Function,
+        inputs: &[
+            positional("v", "the AutonomousVehicle"),
+            named("name", "string").or("\"offroad\""),
+        ],
+        declares: Declares::Monitor,
+        takes_whole: true,
+        doc: "fails when the ego vehicle's footprint centre leaves the drivable surface",
+    },
+    Builtin {
+        name: "DistanceMonitor",
+        form: Form::Function,
+        inputs: &[
+            positional("v", "the AutonomousVehicle"),
+            named("minD", "number, m, >= 0"),
+            named("name", "string").or("\"distance\""),
+        ],
+        declares: Declares::Monitor,
+        takes_whole: true,
+        doc: "fails unless the ego vehicle travels at least minD metres",
+    },
+    Builtin {
+        name: "Stl",
+        form: Form::Function,
+        inputs: &[
+            positional("formula", "a signal temporal logic formula over the signals"),
+            named("name", "string").or("\"stl\""),
+        ],
+        declares: Declares::Monitor,
+        takes_whole: true,
+        doc: "a signal temporal logic requirement; robustness is the formula's",
+    },
+    Builtin {
+        name: "Monitor",
+        form: Form::Function,
+        inputs: &[
+            positional("stream", "a stream of numbers (robustness) or bools"),
+            named("name", "string").or("the variable, else \"monitor\""),
+            named("unit", "string").or("None"),
+            named("over", "\"always\", \"end\" or \"eventually\"").or("\"always\""),
+        ],
+        declares: Declares::Monitor,
+        takes_whole: false,
+        doc: "a monitor written as a stream: its robustness is the stream's minimum, last or largest value",
+    },
+    Builtin {
+        name: "Assert",
+        form: Form::Function,
+        inputs: &[
+            positional("stream", "any stream"),
+            named("name", "string").or("the variable, else \"assert\""),
+        ],
+        declares: Declares::Monitor,
+        takes_whole: false,
+        doc: "fails at the first event of the stream",
+    },
+    Builtin {
+        name: "Signal",
+        form: Form::Function,
+        inputs: &[
+            positional("name", "string"),
+            positional("stream", "a stream of numbers, bools or vectors"),
+        ],
+        declares: Declares::Setting,
+        takes_whole: false,
+        doc: "publishes a stream under a name, for Stl formulas and the results",
+    },
+    Builtin {
+        name: "TimeToFailure",
+        form: Form::Function,
+        inputs: &[
+            positional("m", "a monitor"),
+            named("minT", "number, s, >= 0").or("0.0"),
+            named("name", "string").or("the monitor's name"),
+        ],
+        declares: Declares::Monitor,
+        takes_whole: true,
+        doc: "wraps a monitor: fails when its first violation comes before minT seconds",
+    },
+];
+
 pub(super) fn unique_monitor_name(b: &SceneBuilder, name: &str) -> anyhow::Result<()> {
     // A monitor's name keys its verdict in results.jsonl, the CSV columns and JUnit, as a
     // parameter's name does: the same rule.

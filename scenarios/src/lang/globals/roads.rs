@@ -19,6 +19,150 @@ use crate::lang::values::{LaneSide, Road, WorldVal};
 
 use super::*;
 
+use crate::lang::builtins::{named, positional, Builtin, Declares, Form};
+
+/// `nlanes=` and its paper spelling `numLane=` (every piece takes either, not both).
+const NLANES: [crate::lang::builtins::Arg; 2] = [
+    named("nlanes", "even whole number, 2–16").or("2"),
+    named("numLane", "as nlanes (the paper's spelling)").or("2"),
+];
+/// `friction=` of every piece.
+const FRICTION: crate::lang::builtins::Arg = named("friction", "number")
+    .checked(types::FRICTION)
+    .or("0.8");
+
+/// The builtins of this file ([`crate::lang::builtins`]).
+pub(crate) const SPECS: &[Builtin] = &[
+    Builtin {
+        name: "World",
+        form: Form::Function,
+        inputs: &[
+            named("light", "number").checked(types::LIGHT).or("0.5"),
+            named("fog", "number").checked(types::FOG).or("0.0"),
+        ],
+        declares: Declares::Actor,
+        takes_whole: true,
+        doc: "global conditions as streams: illumination (0.5 nominal daylight) and fog",
+    },
+    Builtin {
+        name: "RoadSegment",
+        form: Form::Function,
+        inputs: &[
+            named("len", "number")
+                .checked(types::number(
+                    "len",
+                    "m",
+                    0.0,
+                    paracosm_engine::network::MAX_EXTENT_M,
+                    true,
+                ))
+                .or("200.0"),
+            NLANES[0],
+            NLANES[1],
+            FRICTION,
+        ],
+        declares: Declares::RoadPiece,
+        takes_whole: true,
+        doc: "a straight road with ports ONE and TWO",
+    },
+    Builtin {
+        name: "Arc",
+        form: Form::Function,
+        inputs: &[
+            named("radius", "number (of the centre line)")
+                .checked(types::number(
+                    "radius",
+                    "m",
+                    0.0,
+                    paracosm_engine::network::MAX_EXTENT_M,
+                    true,
+                ))
+                .or("50.0"),
+            named("angle", "number, positive to the left")
+                .checked(types::number(
+                    "angle",
+                    "rad",
+                    -types::MAX_TURN,
+                    types::MAX_TURN,
+                    false,
+                ))
+                .or("π/2"),
+            NLANES[0],
+            NLANES[1],
+            FRICTION,
+        ],
+        declares: Declares::RoadPiece,
+        takes_whole: true,
+        doc: "a bend of constant curvature",
+    },
+    Builtin {
+        name: "Clothoid",
+        form: Form::Function,
+        inputs: &[
+            named("length", "number")
+                .checked(types::number("length", "m", 0.0, 10_000.0, true))
+                .or("50.0"),
+            named("curv_start", "number, positive to the left")
+                .checked(types::number("curv_start", "1/m", -0.1, 0.1, false))
+                .or("0.0"),
+            named("curv_end", "number, positive to the left")
+                .checked(types::number("curv_end", "1/m", -0.1, 0.1, false))
+                .or("0.02"),
+            NLANES[0],
+            NLANES[1],
+            FRICTION,
+        ],
+        declares: Declares::RoadPiece,
+        takes_whole: true,
+        doc: "a road whose curvature changes linearly along its length",
+    },
+    Builtin {
+        name: "OpenDrive",
+        form: Form::Function,
+        inputs: &[
+            positional(
+                "path",
+                "a .xodr file relative to the program, or a VarEnum of them",
+            ),
+            FRICTION,
+        ],
+        declares: Declares::RoadPiece,
+        takes_whole: true,
+        doc: "every road, lane and junction of an OpenDRIVE map",
+    },
+    Builtin {
+        name: "TIntersection",
+        form: Form::Function,
+        inputs: &[NLANES[0], NLANES[1], FRICTION],
+        declares: Declares::RoadPiece,
+        takes_whole: true,
+        doc: "a T junction with ports ONE, TWO (the through road) and THREE (the stem)",
+    },
+    Builtin {
+        name: "CrossIntersection",
+        form: Form::Function,
+        inputs: &[NLANES[0], NLANES[1], FRICTION],
+        declares: Declares::RoadPiece,
+        takes_whole: true,
+        doc: "a four-way junction with ports ONE to FOUR",
+    },
+    Builtin {
+        name: "Roundabout",
+        form: Form::Function,
+        inputs: &[
+            NLANES[0],
+            NLANES[1],
+            named("radius", "number, at least the lanes' width plus an island")
+                .checked(types::number("radius", "m", 0.0, 1_000.0, true))
+                .or("20.0"),
+            FRICTION,
+        ],
+        declares: Declares::RoadPiece,
+        takes_whole: true,
+        doc: "a roundabout with ports ONE to FOUR",
+    },
+];
+
 pub(super) fn lanes(v: Option<Value>, b: &SceneBuilder, default: u32) -> anyhow::Result<u32> {
     let Some(v) = v else { return Ok(default) };
     let x = load_time_number(v, b, "nlanes=")?;

@@ -12,6 +12,22 @@ use starlark::values::{UnpackValue, Value};
 
 use super::*;
 
+use crate::lang::builtins::{named, Builtin, Declares, Form};
+
+/// The builtins of this file ([`crate::lang::builtins`]).
+pub(crate) const SPECS: &[Builtin] = &[Builtin {
+    name: "test",
+    form: Form::Function,
+    inputs: &[
+        named("horizon", "number, s, in (0, 3600]").or("15.0"),
+        named("map", "one or two parameter names: the failure map's axes").or("None"),
+        named("offroad", "bool: add the default OffRoadMonitor").or("True"),
+    ],
+    declares: Declares::Setting,
+    takes_whole: true,
+    doc: "the test's length, the failure map's axes and the default off-road monitor",
+}];
+
 /// The builtins of this topic.
 #[starlark_module]
 #[allow(non_snake_case)]

@@ -16,6 +16,61 @@ use crate::lang::values::{OverTimeVal, Stream};
 
 use super::*;
 
+use crate::lang::builtins::{named, positional, Builtin, Declares, Form};
+
+/// The builtins of this file ([`crate::lang::builtins`]).
+pub(crate) const SPECS: &[Builtin] = &[
+    Builtin {
+        name: "Const",
+        form: Form::Function,
+        inputs: &[positional("v", "a number, a bool or a string")],
+        declares: Declares::Nothing,
+        takes_whole: true,
+        doc: "the constant stream of a value",
+    },
+    Builtin {
+        name: "VarInterval",
+        form: Form::Function,
+        inputs: &[
+            positional("lo", "finite number"),
+            positional("hi", "finite number"),
+            named("unit", "string").or("None"),
+            named("name", "string").or("where it stands"),
+            named("over_time", "Piecewise(k) or Polynomial(deg)").or("None"),
+        ],
+        declares: Declares::Parameter,
+        takes_whole: false,
+        doc: "an open real parameter: the test's value in [lo, hi), or a stream of values",
+    },
+    Builtin {
+        name: "VarEnum",
+        form: Form::Function,
+        inputs: &[
+            positional("levels", "a list of numbers, strings or bools"),
+            named("name", "string").or("where it stands"),
+        ],
+        declares: Declares::Parameter,
+        takes_whole: false,
+        doc: "an open discrete parameter: the test's level",
+    },
+    Builtin {
+        name: "Piecewise",
+        form: Form::Function,
+        inputs: &[positional("k", "whole number >= 1")],
+        declares: Declares::Nothing,
+        takes_whole: false,
+        doc: "for over_time=: a stream held constant on k equal parts of the test",
+    },
+    Builtin {
+        name: "Polynomial",
+        form: Form::Function,
+        inputs: &[positional("deg", "whole number >= 1")],
+        declares: Declares::Nothing,
+        takes_whole: false,
+        doc: "for over_time=: a Bernstein polynomial of degree deg in time",
+    },
+];
+
 /// Whether `n` follows the rule for a name that keys results (a parameter's, a monitor's):
 /// not empty, and only letters, digits and `_ . [ ]` (so it survives CSV columns, JUnit and
 /// `report --map a,b`).
