@@ -215,13 +215,25 @@ mod error_text_tests {
 /// message becomes clap's usage error (exit code 2).
 ///
 /// # Errors
-/// A message naming the rule, for clap to report.
-pub fn positive(s: &str) -> Result<u64, String> {
+/// [`NotPositive`] naming the rule, for clap to report.
+pub fn positive(s: &str) -> Result<u64, NotPositive> {
     match s.parse::<u64>() {
-        Ok(0) => Err("must be at least 1".into()),
+        Ok(0) => Err(NotPositive::Zero),
         Ok(n) => Ok(n),
-        Err(e) => Err(format!("not a whole number ({e})")),
+        Err(e) => Err(NotPositive::NotANumber(e)),
     }
+}
+
+/// Why a count is refused by [`positive`]; clap prints the message after the value.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum NotPositive {
+    /// The count is 0.
+    #[error("must be at least 1")]
+    Zero,
+    /// Not a whole number (the parser's reason). Not a `#[source]`: the message already says
+    /// it, and a report that follows sources would say it twice.
+    #[error("not a whole number ({0})")]
+    NotANumber(std::num::ParseIntError),
 }
 
 /// A clap error as one line: its first paragraph with the lines joined and the `error: `
@@ -293,7 +305,12 @@ mod tests {
     #[test]
     fn positive_rejects_zero_and_garbage() {
         assert_eq!(positive("3"), Ok(3));
-        assert_eq!(positive("0"), Err("must be at least 1".into()));
+        assert_eq!(positive("0"), Err(NotPositive::Zero));
+        assert_eq!(positive("0").unwrap_err().to_string(), "must be at least 1");
+        assert_eq!(
+            positive("ten").unwrap_err().to_string(),
+            "not a whole number (invalid digit found in string)"
+        );
         assert!(positive("-1").is_err());
         assert!(positive("ten").is_err());
     }

@@ -50,7 +50,7 @@ fn worlds_with_2_4_and_6_lanes_really_differ() {
         // The cone on the left sidewalk: the nearest lidar return to the left.
         let obs = sim.observation();
         let cone = obs
-            .lidar
+            .lidar()
             .iter()
             .filter(|r| r.point_m[2] < -0.5)
             .min_by(|a, b| a.range_m.total_cmp(&b.range_m))
@@ -298,7 +298,7 @@ CollisionMonitor(v)
         // The obstacle stands in the ego's lane 40 m ahead; the lidar sees it.
         let ahead = sim
             .observation()
-            .lidar
+            .lidar()
             .iter()
             .filter(|r| r.point_m[2].abs() < 0.3)
             .map(|r| r.range_m)

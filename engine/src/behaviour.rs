@@ -2,7 +2,7 @@
 //! (actions on actors), a graph builder, and the paper's pedestrian behaviour.
 
 use crate::actor::Handle;
-use crate::rx::{Func, Graph, Node, RxError, StreamId, Value};
+use crate::rx::{Func, Graph, NativeError, Node, RxError, StreamId, Value};
 use crate::{CarSpec, ObstacleSpec, PedestrianSpec};
 
 /// An actor of a world, by its typed handle (paper §2: the reactive objects whose streams a
@@ -183,10 +183,10 @@ impl GraphBuilder {
                     }
                     _ => Err("the car stream must carry positions and dist numbers".into()),
                 },
-                v => Err(format!(
+                v => Err(NativeError(format!(
                     "expected a (position, distance) pair, got a {}",
                     v.kind()
-                )),
+                ))),
             }),
         });
         self.pedestrian_with_trigger(pedestrian, target, trigger);

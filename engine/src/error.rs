@@ -15,3 +15,33 @@ pub enum EngineError {
     #[error("sensor: {0}")]
     Sensor(String),
 }
+
+/// A rate (frames, scans or decisions per simulated second) that is not a whole number of
+/// physics steps per period ([`crate::steps_per_period`]). Its message names the rate and the
+/// nearest rates that are whole steps.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error(
+    "{name} {hz} is not a whole number of physics steps ({step_hz} per second) per period: \
+     use {step_hz} / k for a whole k{}",
+    such_as(near)
+)]
+pub struct RateError {
+    /// What the rate is, e.g. `camera rate_hz`.
+    pub name: String,
+    /// The rate asked for, Hz (any `f64`: NaN, negative and infinite ones included).
+    pub hz: f64,
+    /// The physics steps per second, `1 / dt_s`.
+    pub step_hz: f64,
+    /// The nearest rates that are whole steps per period, Hz, slower first: none, one or two.
+    pub near: Vec<f64>,
+}
+
+/// ", such as A or B" for the rates `near`; empty for none.
+fn such_as(near: &[f64]) -> String {
+    if near.is_empty() {
+        String::new()
+    } else {
+        let near: Vec<String> = near.iter().map(|hz| format!("{hz}")).collect();
+        format!(", such as {}", near.join(" or "))
+    }
+}

@@ -36,18 +36,27 @@ pub fn kind_of(t: &std::fs::FileType) -> Option<&'static str> {
     }
 }
 
+/// A path that is not a regular file ([`regular_file`]): what it is instead. The message
+/// leaves the path out (the caller adds it with its own location format).
+#[derive(Debug, thiserror::Error, Clone, Copy, PartialEq, Eq)]
+#[error(
+    "is {kind}, not a regular file: paracosm reads its inputs from files (a FIFO would block, \
+     a device never ends)"
+)]
+pub struct NotRegular {
+    /// What the path is ([`not_regular`]): `"a directory"`, `"a FIFO"`...
+    pub kind: &'static str,
+}
+
 /// Refuses `path` when it is not a regular file ([`not_regular`]).
 ///
 /// # Errors
-/// "is a FIFO, not a regular file: ..." (without the path, which the caller adds with its own
-/// location format).
-pub fn regular_file(path: &Path) -> Result<(), String> {
+/// [`NotRegular`]: "is a FIFO, not a regular file: ..." (without the path, which the caller
+/// adds with its own location format).
+pub fn regular_file(path: &Path) -> Result<(), NotRegular> {
     match not_regular(path) {
         None => Ok(()),
-        Some(kind) => Err(format!(
-            "is {kind}, not a regular file: paracosm reads its inputs from files (a FIFO would \
-             block, a device never ends)"
-        )),
+        Some(kind) => Err(NotRegular { kind }),
     }
 }
 
@@ -79,7 +88,10 @@ mod tests {
             .status()
             .unwrap()
             .success());
-        assert!(regular_file(&fifo).unwrap_err().starts_with("is a FIFO"));
+        assert!(regular_file(&fifo)
+            .unwrap_err()
+            .to_string()
+            .starts_with("is a FIFO"));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

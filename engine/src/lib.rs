@@ -14,7 +14,6 @@
 
 pub mod actor;
 pub mod behaviour;
-mod camera;
 mod car;
 pub mod colour;
 mod contact;
@@ -39,16 +38,19 @@ pub mod ttc;
 mod vehicle;
 
 pub use actor::{Handle, Set, Size, VisibleBox};
-pub use camera::{CameraFrame, CameraSpec, SENSOR_HEIGHT_MM, SENSOR_WIDTH_MM};
 pub use car::{CarState, LaneChangeSpec, LaneChangeStart};
 pub use control::Control;
 pub use environment::{visibility_m, FOG_EXTINCTION_PER_M, NOMINAL_LIGHT};
-pub use error::EngineError;
+pub use error::{EngineError, RateError};
 pub use network::{Lane, Location, Network, PieceId, PieceKind};
 pub use obstacle::ObstacleState;
 pub use pedestrian::{PedestrianPhase, PedestrianState};
 pub use segmentation::{ObjectBox, SemanticClass};
+pub use sensor::camera::{
+    CameraFrame, CameraSpec, SavePngError, SENSOR_HEIGHT_MM, SENSOR_WIDTH_MM,
+};
 pub use sensor::lidar::{LidarReturn, LidarSpec};
+pub use sensor::{SensorSpec, SettingError};
 pub use sim::{EgoState, Observation, Simulation, Snapshot, SnapshotParts};
 pub use spec::{
     CarSpec, EgoSpec, EnvironmentSpec, ObstacleSpec, PedestrianSpec, TriggeredPedestrian,
@@ -61,28 +63,25 @@ pub use vehicle::VehicleParams;
 /// (at 60 Hz: 60, 30, 20, 15, 12, 10, 7.5, 6, 5, ...), to a relative 1e-9.
 ///
 /// # Errors
-/// A message naming the rate and the nearest rates that are whole steps, for a rate that is
-/// not positive and finite, faster than the step, or between two whole periods (25 Hz ran as
-/// 30 Hz, 7 Hz as 6.67 Hz, 1,000 Hz as 60 Hz, each without a word).
-pub fn steps_per_period(name: &str, hz: f64, dt_s: f64) -> Result<u64, String> {
+/// A [`RateError`] naming the rate and the nearest rates that are whole steps, for a rate that
+/// is not positive and finite, faster than the step, or between two whole periods (25 Hz ran
+/// as 30 Hz, 7 Hz as 6.67 Hz, 1,000 Hz as 60 Hz, each without a word).
+pub fn steps_per_period(name: &str, hz: f64, dt_s: f64) -> Result<u64, RateError> {
     let steps = 1.0 / (hz * dt_s);
     let k = steps.round();
     if hz.is_finite() && hz > 0.0 && k >= 1.0 && (steps - k).abs() <= 1e-9 * k {
         return Ok(k as u64);
     }
     let step_hz = 1.0 / dt_s;
-    let near: Vec<String> = [steps.floor(), steps.ceil()]
+    let near: Vec<f64> = [steps.floor(), steps.ceil()]
         .into_iter()
         .filter(|k| k.is_finite() && *k >= 1.0)
-        .map(|k| format!("{}", step_hz / k))
+        .map(|k| step_hz / k)
         .collect();
-    Err(format!(
-        "{name} {hz} is not a whole number of physics steps ({step_hz} per second) per period: \
-         use {step_hz} / k for a whole k{}",
-        if near.is_empty() {
-            String::new()
-        } else {
-            format!(", such as {}", near.join(" or "))
-        }
-    ))
+    Err(RateError {
+        name: name.to_owned(),
+        hz,
+        step_hz,
+        near,
+    })
 }

@@ -11,13 +11,13 @@ use crate::contact::Solids;
 use crate::network::{Lane, Network, PieceId, Surface};
 use crate::obstacle::{Obstacle, ObstacleState};
 use crate::pedestrian::{Pedestrian, PED_HALF_HEIGHT_M, PED_RADIUS_M};
-use crate::rx::{Host, Inputs, Node, Runtime, StreamId, Value};
+use crate::rx::{Host, Inputs, Runtime, StreamId, Value};
 use crate::sensor::{Reading, Scene, Sensor, Sensors};
 use crate::spec::EnvironmentSpec;
 use crate::vehicle::EgoVehicle;
 use crate::{
-    CameraFrame, CameraSpec, CarSpec, Control, EngineError, LidarReturn, ObstacleSpec,
-    PedestrianSpec, PedestrianState, WorldSpec, NOMINAL_LIGHT,
+    CameraFrame, CameraSpec, CarSpec, Control, EngineError, ObstacleSpec, PedestrianSpec,
+    PedestrianState, WorldSpec, NOMINAL_LIGHT,
 };
 
 /// The ego vehicle's state.
@@ -40,16 +40,24 @@ pub struct Observation<'a> {
     pub dt_s: f64,
     /// The ego vehicle's own state (odometry).
     pub ego: EgoState,
-    /// The latest lidar scan, in the vehicle frame (empty without a lidar).
-    pub lidar: &'a [LidarReturn],
     /// The route to follow, world `[x, z]` in metres (navigation); empty: keep the lane.
     pub route: &'a [[f64; 2]],
-    /// The latest camera frame (RGB and depth), when a camera is attached
-    /// ([`Simulation::attach_camera`]) and has captured one.
-    pub camera: Option<&'a CameraFrame>,
     /// Every sensor's latest reading, by the sensor's name, in the order the sensors were
-    /// mounted (what an external system receives, SUT_PROTOCOL.md).
+    /// mounted (what an external system receives, SUT_PROTOCOL.md). Read one with
+    /// [`Observation::reading`], or typed: [`Observation::lidar`], [`Observation::camera`].
     pub readings: Vec<(&'static str, Reading<'a>)>,
+}
+
+impl<'a> Observation<'a> {
+    /// The latest reading of the sensor called `name` (`lidar`, `camera`, or a sensor's own
+    /// name; the first mounted when several share it), `None` when none is mounted or it has
+    /// not captured yet.
+    pub fn reading(&self, name: &str) -> Option<Reading<'a>> {
+        self.readings
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, reading)| *reading)
+    }
 }
 
 /// The world's state after a step: what monitors are computed from.
@@ -139,6 +147,180 @@ enum Owner {
     Obstacle(Handle<ObstacleSpec>),
 }
 
+/// Checks what [`Simulation::new`] checks before it builds anything: the step, the sensors'
+/// settings, and the ego vehicle's start lane and speed.
+///
+/// # Errors
+/// [`EngineError::InvalidWorld`] naming the first value out of range.
+fn check_ego_and_step(spec: &WorldSpec) -> Result<(), EngineError> {
+    let invalid = |m: String| EngineError::InvalidWorld(m);
+    if !(spec.dt_s.is_finite() && spec.dt_s > 0.0) {
+        return Err(invalid(format!(
+            "time step {} s is not positive",
+            spec.dt_s
+        )));
+    }
+    for sensor in &spec.sensors {
+        sensor.validate().map_err(|e| invalid(e.to_string()))?;
+    }
+    if !matches!(spec.ego.start.lane, Lane::Driving(_)) {
+        return Err(invalid(
+            "the ego vehicle must start on a driving lane".into(),
+        ));
+    }
+    if !(spec.ego.initial_speed_mps.is_finite() && spec.ego.initial_speed_mps >= 0.0) {
+        return Err(invalid(format!(
+            "ego initial speed {} m/s is negative or not finite",
+            spec.ego.initial_speed_mps
+        )));
+    }
+    Ok(())
+}
+
+/// The streams the world itself reads every step: each pedestrian's and car's speed, the
+/// varying frictions, the published streams, light and fog.
+fn read_streams(spec: &WorldSpec) -> impl Iterator<Item = StreamId> + Clone + '_ {
+    spec.pedestrians
+        .iter()
+        .map(|p| p.speed)
+        .chain(spec.cars.iter().map(|c| c.speed))
+        .chain(spec.frictions.iter().map(|f| f.1))
+        .chain(spec.published.iter().map(|p| p.1))
+        .chain([spec.environment.light, spec.environment.fog])
+}
+
+/// The runtime of `spec`'s stream graph, evaluating only what the world reads (`reads`, from
+/// [`read_streams`]), the streams that start a car's lane change, and what they need.
+fn world_runtime(spec: &WorldSpec, reads: impl Iterator<Item = StreamId>) -> Runtime {
+    // The streams the world reads; the rest of the graph is evaluated only where these, an
+    // action or a function need it (Runtime::evaluate_only).
+    let mut rt = Runtime::new(spec.streams.clone());
+    let when = spec.cars.iter().filter_map(|c| match c.lane_change?.start {
+        LaneChangeStart::When(s) => Some(s),
+        LaneChangeStart::At(_) => None,
+    });
+    rt.evaluate_only(reads.chain(when));
+    rt
+}
+
+/// Checks car `i` of a graph of `n` streams: its route, size, lane change and kept distance.
+///
+/// # Errors
+/// [`EngineError::InvalidWorld`] naming the car and the first value out of range.
+fn check_car(i: usize, c: &CarSpec, n: usize) -> Result<(), EngineError> {
+    let invalid = |m: String| EngineError::InvalidWorld(m);
+    if c.path.len() < 2 || c.path.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(invalid(format!(
+            "car {i} has no route of two or more points"
+        )));
+    }
+    if !c.size.is_valid() {
+        return Err(invalid(format!("car {i} has the size {:?}", c.size)));
+    }
+    if let Some(change) = c.lane_change {
+        let starts_ok = match change.start {
+            LaneChangeStart::At(t0) => t0.is_finite() && t0 >= 0.0,
+            LaneChangeStart::When(s) => s.0 < n,
+        };
+        if !(change.offset_m.is_finite()
+            && change.duration_s.is_finite()
+            && change.duration_s > 0.0
+            && starts_ok)
+        {
+            return Err(invalid(format!("car {i} has the lane change {change:?}")));
+        }
+    }
+    Ok(())
+}
+
+/// Builds `spec`'s NPC cars into `physics`, each car's collider recorded in `owners`.
+///
+/// # Errors
+/// [`EngineError::InvalidWorld`] for a car with an invalid route, size, lane change or kept
+/// distance ([`check_car`]).
+fn build_cars(
+    spec: &WorldSpec,
+    physics: &mut PhysicsWorld,
+    owners: &mut HashMap<ColliderHandle, Owner>,
+) -> Result<Set<Car, CarSpec>, EngineError> {
+    let n = spec.streams.nodes().len();
+    let mut cars = Set::default();
+    for (i, c) in spec.cars.iter().enumerate() {
+        check_car(i, c, n)?;
+        let mut car = Car::build(
+            physics,
+            c.path.clone(),
+            c.size,
+            c.enabled,
+            crate::colour::albedo(&c.color).unwrap_or([0.45, 0.45, 0.45]),
+            c.speed,
+        );
+        car.lane_change = c.lane_change;
+        if let Some(keep) = c.keep_distance_m {
+            if !(keep.is_finite() && keep >= 0.0) {
+                return Err(EngineError::InvalidWorld(format!(
+                    "car {i} keeps the distance {keep} m (finite and >= 0)"
+                )));
+            }
+        }
+        car.keep_distance_m = c.keep_distance_m;
+        // A car enters the test at its speed stream's first value, so at t = 0 (before a
+        // step has measured it) its speed is that value where it is known without running
+        // the program's code: a constant or an open parameter, also one varying over time.
+        if let Some(v) = constant(&spec.streams, c.speed).filter(|v| v.is_finite()) {
+            car.enter_at(v);
+        }
+        let collider = car.body.map(|(_, c)| c);
+        let h = cars.insert(car);
+        if let Some(collider) = collider {
+            owners.insert(collider, Owner::Car(h));
+        }
+    }
+    Ok(cars)
+}
+
+/// Builds `spec`'s static obstacles into `physics`, each collider recorded in `owners`.
+///
+/// # Errors
+/// [`EngineError::InvalidWorld`] for an obstacle with an invalid size or base.
+fn build_obstacles(
+    spec: &WorldSpec,
+    physics: &mut PhysicsWorld,
+    owners: &mut HashMap<ColliderHandle, Owner>,
+) -> Result<Set<Obstacle, ObstacleSpec>, EngineError> {
+    let mut obstacles = Set::default();
+    for (i, o) in spec.obstacles.iter().enumerate() {
+        if !o.size.is_valid() || o.base_m.iter().any(|v| !v.is_finite()) {
+            return Err(EngineError::InvalidWorld(format!(
+                "obstacle {i} has the size {:?} at {:?}",
+                o.size, o.base_m
+            )));
+        }
+        let obstacle = Obstacle::build(
+            physics,
+            o.base_m,
+            o.heading_rad,
+            o.size,
+            crate::colour::albedo(&o.color).unwrap_or([0.45, 0.45, 0.45]),
+        );
+        let collider = obstacle.collider;
+        owners.insert(collider, Owner::Obstacle(obstacles.insert(obstacle)));
+    }
+    Ok(obstacles)
+}
+
+/// The error for `value`, given at time `t_s` (s) to `name` (an action's argument), which
+/// is not `expected`.
+fn bad_input(t_s: f64, name: String, value: &Value, expected: &str) -> EngineError {
+    crate::rx::RxError::Input {
+        name,
+        t_s,
+        value: crate::rx::describe(value),
+        expected: expected.into(),
+    }
+    .into()
+}
+
 /// A running world: the physics, the actors in their sets, the stream graph that drives
 /// them, and the ego vehicle's sensors, advanced in fixed steps by [`Simulation::step`].
 pub struct Simulation {
@@ -179,31 +361,14 @@ pub struct Simulation {
 }
 
 impl Simulation {
-    /// Builds the world described by `spec`, with its lidar mounted.
+    /// Builds the world described by `spec`, with its sensors ([`WorldSpec::sensors`]) mounted.
     ///
     /// # Errors
-    /// [`EngineError::InvalidWorld`] when a position, a speed, a size, the lidar, the step or
-    /// a car's path is invalid; the message says which.
+    /// [`EngineError::InvalidWorld`] when a position, a speed, a size, a sensor's settings,
+    /// the step or a car's path is invalid; the message says which. [`EngineError::Sensor`]
+    /// when a sensor cannot be set up (a camera without a GPU adapter).
     pub fn new(spec: &WorldSpec) -> Result<Self, EngineError> {
-        let invalid = |m: String| EngineError::InvalidWorld(m);
-        if !(spec.dt_s.is_finite() && spec.dt_s > 0.0) {
-            return Err(invalid(format!(
-                "time step {} s is not positive",
-                spec.dt_s
-            )));
-        }
-        spec.lidar.validate().map_err(invalid)?;
-        if !matches!(spec.ego.start.lane, Lane::Driving(_)) {
-            return Err(invalid(
-                "the ego vehicle must start on a driving lane".into(),
-            ));
-        }
-        if !(spec.ego.initial_speed_mps.is_finite() && spec.ego.initial_speed_mps >= 0.0) {
-            return Err(invalid(format!(
-                "ego initial speed {} m/s is negative or not finite",
-                spec.ego.initial_speed_mps
-            )));
-        }
+        check_ego_and_step(spec)?;
         let mut physics = PhysicsWorld::new();
         physics.integration_parameters.dt = spec.dt_s as f32;
         // A test's world holds a few dozen colliders, most of them fixed: rapier's incremental
@@ -225,18 +390,14 @@ impl Simulation {
             friction,
         );
 
+        let ids = read_streams(spec);
         let n = spec.streams.nodes().len();
-        let ids = spec
-            .pedestrians
-            .iter()
-            .map(|p| p.speed)
-            .chain(spec.cars.iter().map(|c| c.speed))
-            .chain(spec.frictions.iter().map(|f| f.1))
-            .chain(spec.published.iter().map(|p| p.1))
-            .chain([spec.environment.light, spec.environment.fog]);
         for id in ids.clone() {
             if id.0 >= n {
-                return Err(invalid(format!("stream {} does not exist", id.0)));
+                return Err(EngineError::InvalidWorld(format!(
+                    "stream {} does not exist",
+                    id.0
+                )));
             }
         }
         let mut owners = HashMap::new();
@@ -246,89 +407,13 @@ impl Simulation {
             let collider = ped.collider;
             owners.insert(collider, Owner::Pedestrian(pedestrians.insert(ped)));
         }
-        let mut cars = Set::default();
-        for (i, c) in spec.cars.iter().enumerate() {
-            if c.path.len() < 2 || c.path.iter().flatten().any(|v| !v.is_finite()) {
-                return Err(invalid(format!(
-                    "car {i} has no route of two or more points"
-                )));
-            }
-            if !c.size.is_valid() {
-                return Err(invalid(format!("car {i} has the size {:?}", c.size)));
-            }
-            if let Some(change) = c.lane_change {
-                let starts_ok = match change.start {
-                    LaneChangeStart::At(t0) => t0.is_finite() && t0 >= 0.0,
-                    LaneChangeStart::When(s) => s.0 < n,
-                };
-                if !(change.offset_m.is_finite()
-                    && change.duration_s.is_finite()
-                    && change.duration_s > 0.0
-                    && starts_ok)
-                {
-                    return Err(invalid(format!("car {i} has the lane change {change:?}")));
-                }
-            }
-            let mut car = Car::build(
-                &mut physics,
-                c.path.clone(),
-                c.size,
-                c.enabled,
-                crate::colour::albedo(&c.color).unwrap_or([0.45, 0.45, 0.45]),
-                c.speed,
-            );
-            car.lane_change = c.lane_change;
-            if let Some(keep) = c.keep_distance_m {
-                if !(keep.is_finite() && keep >= 0.0) {
-                    return Err(invalid(format!(
-                        "car {i} keeps the distance {keep} m (finite and >= 0)"
-                    )));
-                }
-            }
-            car.keep_distance_m = c.keep_distance_m;
-            // A car enters the test at its speed stream's first value, so at t = 0 (before a
-            // step has measured it) its speed is that value where it is known without running
-            // the program's code: a constant or an open parameter, also one varying over time.
-            let first = match spec.streams.nodes().get(c.speed.0) {
-                Some(Node::Const(Value::Num(v))) => Some(*v),
-                Some(Node::Open(o)) => match o.at(0.0) {
-                    Value::Num(v) => Some(v),
-                    _ => None,
-                },
-                _ => None,
-            };
-            if let Some(v) = first.filter(|v| v.is_finite()) {
-                car.enter_at(v);
-            }
-            let collider = car.body.map(|(_, c)| c);
-            let h = cars.insert(car);
-            if let Some(collider) = collider {
-                owners.insert(collider, Owner::Car(h));
-            }
-        }
-        let mut obstacles = Set::default();
-        for (i, o) in spec.obstacles.iter().enumerate() {
-            if !o.size.is_valid() || o.base_m.iter().any(|v| !v.is_finite()) {
-                return Err(invalid(format!(
-                    "obstacle {i} has the size {:?} at {:?}",
-                    o.size, o.base_m
-                )));
-            }
-            let obstacle = Obstacle::build(
-                &mut physics,
-                o.base_m,
-                o.heading_rad,
-                o.size,
-                crate::colour::albedo(&o.color).unwrap_or([0.45, 0.45, 0.45]),
-            );
-            let collider = obstacle.collider;
-            owners.insert(collider, Owner::Obstacle(obstacles.insert(obstacle)));
-        }
+        let cars = build_cars(spec, &mut physics, &mut owners)?;
+        let obstacles = build_obstacles(spec, &mut physics, &mut owners)?;
 
         let (collision_tx, events) = channel();
         let (force_tx, _) = channel();
         let (tear_tx, _) = channel();
-        let sensors = crate::sensor::mounted(spec);
+        let sensors = crate::sensor::mounted(spec)?;
         let mut sim = Simulation {
             physics,
             network: spec.network.clone(),
@@ -347,17 +432,7 @@ impl Simulation {
                 constant(&spec.streams, spec.environment.light).unwrap_or(NOMINAL_LIGHT),
                 constant(&spec.streams, spec.environment.fog).unwrap_or(0.0),
             ),
-            streams: {
-                // The streams the world reads; the rest of the graph is evaluated only where
-                // these, an action or a function need it (Runtime::evaluate_only).
-                let mut rt = Runtime::new(spec.streams.clone());
-                let when = spec.cars.iter().filter_map(|c| match c.lane_change?.start {
-                    LaneChangeStart::When(s) => Some(s),
-                    LaneChangeStart::At(_) => None,
-                });
-                rt.evaluate_only(ids.clone().chain(when));
-                rt
-            },
+            streams: world_runtime(spec, ids),
             evaluated: None,
             sinks: Vec::new(),
             car_lanes: spec.cars.iter().map(|c| c.lane_offsets_m.clone()).collect(),
@@ -409,24 +484,11 @@ impl Simulation {
             .values()
             .filter_map(|s| s.reading().map(|r| (s.name(), r)))
             .collect();
-        let lidar = readings
-            .iter()
-            .find_map(|(_, r)| match r {
-                Reading::Lidar(l) => Some(*l),
-                _ => None,
-            })
-            .unwrap_or(&[]);
-        let camera = readings.iter().find_map(|(_, r)| match r {
-            Reading::Camera(f) => Some(*f),
-            _ => None,
-        });
         Observation {
             t_s: self.t_s(),
             dt_s: self.dt_s,
             ego: self.ego_state(),
-            lidar,
             route: &self.route,
-            camera,
             readings,
         }
     }
@@ -439,24 +501,8 @@ impl Simulation {
     /// [`EngineError::Sensor`] when the camera's values are out of range, no GPU adapter is
     /// found, or this build lacks the `render` feature.
     pub fn attach_camera(&mut self, camera: &CameraSpec, seed: u64) -> Result<(), EngineError> {
-        camera.validate().map_err(EngineError::Sensor)?;
-        #[cfg(feature = "render")]
-        {
-            let renderer = crate::render::Renderer::shared()
-                .map_err(|e| EngineError::Sensor(e.to_string()))?;
-            let rig =
-                crate::render::CameraRig::new(renderer, &self.network, camera, seed, self.dt_s)?;
-            self.mount(Box::new(rig))
-        }
-        #[cfg(not(feature = "render"))]
-        {
-            let _ = seed;
-            Err(EngineError::Sensor(
-                "this build has no camera: paracosm-engine was built without its `render` \
-                 feature"
-                    .into(),
-            ))
-        }
+        let sensor = crate::sensor::camera::sensor(&self.network, camera, seed, self.dt_s)?;
+        self.mount(sensor)
     }
 
     /// Mounts `sensor` on the ego vehicle beside those [`crate::sensor::mounted`] registers;
@@ -542,12 +588,7 @@ impl Simulation {
         let t = self.t_s();
         self.evaluate(host)?;
         let before = self.physics.bodies[self.ego.body].translation();
-        for &(piece, stream) in &self.frictions {
-            let network = &self.network;
-            let what = || format!("the friction of {}", network.piece(piece).name);
-            let mu = number(&self.streams, stream, t, what)?;
-            self.surface.set_friction(piece, mu);
-        }
+        self.set_frictions(t)?;
         self.ego.apply(control, dt);
         self.ego.grip(&self.physics, &self.surface);
         self.ego.update(&mut self.physics, dt);
@@ -555,6 +596,49 @@ impl Simulation {
             p.rest();
         }
         self.act(t)?;
+        self.move_kinematic_actors(t)?;
+        if self.tick == 0 {
+            // The sensors' first readings were taken before light and fog were known.
+            self.capture_again_before_first_step()?;
+        }
+        self.physics.step_with_events(&(), &self.collector);
+        for car in self.cars.values_mut() {
+            car.settle();
+        }
+        self.record_ego_contacts();
+        self.ego_collided |= self.ego_contact();
+        let after = self.physics.bodies[self.ego.body].translation();
+        self.ego_velocity = [
+            (f64::from(after.x) - f64::from(before.x)) / dt,
+            (f64::from(after.y) - f64::from(before.y)) / dt,
+            (f64::from(after.z) - f64::from(before.z)) / dt,
+        ];
+        self.tick += 1;
+        self.capture_due()
+    }
+
+    /// Sets the friction of each piece whose friction varies ([`WorldSpec::frictions`]) from
+    /// its stream at time `t` (s).
+    ///
+    /// # Errors
+    /// [`EngineError::Stream`] for a friction stream without a number now.
+    fn set_frictions(&mut self, t: f64) -> Result<(), EngineError> {
+        for &(piece, stream) in &self.frictions {
+            let network = &self.network;
+            let what = || format!("the friction of {}", network.piece(piece).name);
+            let mu = number(&self.streams, stream, t, what)?;
+            self.surface.set_friction(piece, mu);
+        }
+        Ok(())
+    }
+
+    /// Moves the kinematic actors for the step at time `t` (s): each NPC car along its path
+    /// (stopping short of, or against, what it meets; asleep when out of every sensor's
+    /// reach), then records the pedestrians that walked into a car or an obstacle.
+    ///
+    /// # Errors
+    /// [`EngineError::Stream`] for a car speed stream without a number now.
+    fn move_kinematic_actors(&mut self, t: f64) -> Result<(), EngineError> {
         // NPC cars beyond the reach of every sensor that reads the physics world, and of the
         // ego's body, sleep out of rapier's step (Car::advance).
         let reach_m = self
@@ -582,58 +666,8 @@ impl Simulation {
         };
         let handles: Vec<Handle<CarSpec>> = self.cars.iter().map(|(h, _)| h).collect();
         for h in handles {
-            let i = h.index();
-            let Some(car) = self.cars.get_mut(h) else {
-                continue;
-            };
-            let v = match car.speed_override {
-                Some(v) => v,
-                None => {
-                    let names = &self.names;
-                    let what = || format!("the speed of {}", names.car(i));
-                    number(&self.streams, car.speed_stream, t, what)?
-                }
-            };
-            match car.lane_change.map(|c| c.start) {
-                Some(LaneChangeStart::At(t0)) if t >= t0 => car.start_lane_change(t0),
-                Some(LaneChangeStart::When(s)) if self.streams.fired(s) => car.start_lane_change(t),
-                _ => {}
-            }
-            let friction = self.surface.friction_at(car.ground_m());
-            let zone = AwakeZone {
-                ego_m,
-                radius_m: reach_m + ego_radius_m + car.radius_m() + SLEEP_MARGIN_M,
-            };
-            let hit = car.advance(
-                &mut self.physics,
-                v,
-                friction,
-                (t, dt),
-                zone,
-                &solids,
-                ActorRef::Car(h),
-            );
-            if car.body.is_some() {
-                solids.move_to(ActorRef::Car(h), car.pose());
-            }
-            match hit {
-                Some(ActorRef::Car(j)) => {
-                    if let Some(c) = self.cars.get_mut(j) {
-                        c.collided = true;
-                    }
-                }
-                Some(ActorRef::Pedestrian(j)) => {
-                    if let Some(p) = self.pedestrians.get_mut(j) {
-                        p.collided = true;
-                    }
-                }
-                Some(ActorRef::Obstacle(j)) => {
-                    if let Some(o) = self.obstacles.get_mut(j) {
-                        o.collided = true;
-                    }
-                }
-                _ => {}
-            }
+            let hit = self.advance_car(h, t, &mut solids, (ego_m, reach_m, ego_radius_m))?;
+            self.mark_hit(hit);
         }
         // A pedestrian that walks into a car or an obstacle (rapier reports no contact
         // between two kinematic bodies): both record the collision.
@@ -657,14 +691,87 @@ impl Simulation {
                 }
             }
         }
-        if self.tick == 0 {
-            // The first lidar scan was taken before light and fog were known.
-            self.capture_all_named("lidar")?;
+        Ok(())
+    }
+
+    /// Advances car `h` over the step at time `t` (s) and moves it in `solids`; `awake` is the
+    /// ego's planar position `[x, z]` (m), the farthest reach of the sensors that read the
+    /// physics world (m) and the ego's bounding radius (m), from which the car's
+    /// [`AwakeZone`] is computed. Returns what it ran into, if anything.
+    ///
+    /// # Errors
+    /// [`EngineError::Stream`] for a speed stream without a number now.
+    fn advance_car(
+        &mut self,
+        h: Handle<CarSpec>,
+        t: f64,
+        solids: &mut Solids,
+        awake: ([f64; 2], f64, f64),
+    ) -> Result<Option<ActorRef>, EngineError> {
+        let dt = self.dt_s;
+        let (ego_m, reach_m, ego_radius_m) = awake;
+        let i = h.index();
+        let Some(car) = self.cars.get_mut(h) else {
+            return Ok(None);
+        };
+        let v = match car.speed_override {
+            Some(v) => v,
+            None => {
+                let names = &self.names;
+                let what = || format!("the speed of {}", names.car(i));
+                number(&self.streams, car.speed_stream, t, what)?
+            }
+        };
+        match car.lane_change.map(|c| c.start) {
+            Some(LaneChangeStart::At(t0)) if t >= t0 => car.start_lane_change(t0),
+            Some(LaneChangeStart::When(s)) if self.streams.fired(s) => car.start_lane_change(t),
+            _ => {}
         }
-        self.physics.step_with_events(&(), &self.collector);
-        for car in self.cars.values_mut() {
-            car.settle();
+        let friction = self.surface.friction_at(car.ground_m());
+        let zone = AwakeZone {
+            ego_m,
+            radius_m: reach_m + ego_radius_m + car.radius_m() + SLEEP_MARGIN_M,
+        };
+        let hit = car.advance(
+            &mut self.physics,
+            v,
+            friction,
+            (t, dt),
+            zone,
+            solids,
+            ActorRef::Car(h),
+        );
+        if car.body.is_some() {
+            solids.move_to(ActorRef::Car(h), car.pose());
         }
+        Ok(hit)
+    }
+
+    /// Records that `hit` (a car, a pedestrian or an obstacle that a car ran into) collided.
+    fn mark_hit(&mut self, hit: Option<ActorRef>) {
+        match hit {
+            Some(ActorRef::Car(j)) => {
+                if let Some(c) = self.cars.get_mut(j) {
+                    c.collided = true;
+                }
+            }
+            Some(ActorRef::Pedestrian(j)) => {
+                if let Some(p) = self.pedestrians.get_mut(j) {
+                    p.collided = true;
+                }
+            }
+            Some(ActorRef::Obstacle(j)) => {
+                if let Some(o) = self.obstacles.get_mut(j) {
+                    o.collided = true;
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// Reads this step's collision events between the ego vehicle and the actors: each actor
+    /// touching it now, and having collided since the start.
+    fn record_ego_contacts(&mut self) {
         while let Ok(event) = self.events.try_recv() {
             let (a, b, started) = match event {
                 CollisionEvent::Started(a, b, _) => (a, b, true),
@@ -699,14 +806,13 @@ impl Simulation {
                 None => {}
             }
         }
-        self.ego_collided |= self.ego_contact();
-        let after = self.physics.bodies[self.ego.body].translation();
-        self.ego_velocity = [
-            (f64::from(after.x) - f64::from(before.x)) / dt,
-            (f64::from(after.y) - f64::from(before.y)) / dt,
-            (f64::from(after.z) - f64::from(before.z)) / dt,
-        ];
-        self.tick += 1;
+    }
+
+    /// Captures every sensor due at this tick (one whose period divides it).
+    ///
+    /// # Errors
+    /// [`EngineError::Sensor`] when a sensor fails.
+    fn capture_due(&mut self) -> Result<(), EngineError> {
         let tick = self.tick;
         if self
             .sensors
@@ -812,15 +918,7 @@ impl Simulation {
     fn act(&mut self, t: f64) -> Result<(), EngineError> {
         let dt = self.dt_s;
         let sinks = std::mem::take(&mut self.sinks);
-        let bad = |name: String, v: &Value, expected: &str| -> EngineError {
-            crate::rx::RxError::Input {
-                name,
-                t_s: t,
-                value: crate::rx::describe(v),
-                expected: expected.into(),
-            }
-            .into()
-        };
+        let bad = |name: String, v: &Value, expected: &str| bad_input(t, name, v, expected);
         for (sink, value) in &sinks {
             match *sink {
                 Action::Walk(h) => {
@@ -872,43 +970,60 @@ impl Simulation {
                         }
                     }
                 }
-                Action::ChangeLane(h) => {
-                    let (lane, duration) = match value {
-                        Value::Num(l) => (*l, 3.0),
-                        Value::Tuple(v) if v.len() == 2 => match (&v[0], &v[1]) {
-                            (Value::Num(l), Value::Num(d)) => (*l, *d),
-                            _ => (f64::NAN, f64::NAN),
-                        },
-                        _ => (f64::NAN, f64::NAN),
-                    };
-                    let lanes = self.car_lanes.get(h.index()).cloned().unwrap_or_default();
-                    let offset = lanes
-                        .iter()
-                        .find(|(l, _)| f64::from(*l) == lane)
-                        .map(|(_, o)| *o);
-                    let Some(offset) = offset.filter(|_| duration.is_finite() && duration > 0.0)
-                    else {
-                        let known: Vec<String> = lanes.iter().map(|(l, _)| l.to_string()).collect();
-                        return Err(bad(
-                            format!(
-                                "the lane given to {}'s changeLane",
-                                self.names.car(h.index())
-                            ),
-                            value,
-                            &if known.is_empty() {
-                                "a lane of the segment the car starts on; it starts inside a junction, where there is none".to_owned()
-                            } else {
-                                format!("a lane of the segment the car starts on ({}), or (lane, duration > 0 s)", known.join(", "))
-                            },
-                        ));
-                    };
-                    if let Some(car) = self.cars.get_mut(h) {
-                        car.change_lane_to(offset, duration, t);
-                    }
-                }
+                Action::ChangeLane(h) => self.change_lane(h, value, t)?,
             }
         }
         self.sinks = sinks;
+        Ok(())
+    }
+
+    /// Performs a `changeLane` event of car `h` at time `t` (s): `value` is the lane, or
+    /// `(lane, duration in s)` (3 s when only the lane is given).
+    ///
+    /// # Errors
+    /// [`crate::rx::RxError::Input`] for a lane the car's segment lacks or a duration that is
+    /// not positive, naming the lanes it has.
+    fn change_lane(
+        &mut self,
+        h: Handle<CarSpec>,
+        value: &Value,
+        t: f64,
+    ) -> Result<(), EngineError> {
+        let (lane, duration) = match value {
+            Value::Num(l) => (*l, 3.0),
+            Value::Tuple(v) if v.len() == 2 => match (&v[0], &v[1]) {
+                (Value::Num(l), Value::Num(d)) => (*l, *d),
+                _ => (f64::NAN, f64::NAN),
+            },
+            _ => (f64::NAN, f64::NAN),
+        };
+        let lanes = self.car_lanes.get(h.index()).cloned().unwrap_or_default();
+        let offset = lanes
+            .iter()
+            .find(|(l, _)| f64::from(*l) == lane)
+            .map(|(_, o)| *o);
+        let Some(offset) = offset.filter(|_| duration.is_finite() && duration > 0.0) else {
+            let known: Vec<String> = lanes.iter().map(|(l, _)| l.to_string()).collect();
+            return Err(bad_input(
+                t,
+                format!(
+                    "the lane given to {}'s changeLane",
+                    self.names.car(h.index())
+                ),
+                value,
+                &if known.is_empty() {
+                    "a lane of the segment the car starts on; it starts inside a junction, where there is none".to_owned()
+                } else {
+                    format!(
+                        "a lane of the segment the car starts on ({}), or (lane, duration > 0 s)",
+                        known.join(", ")
+                    )
+                },
+            ));
+        };
+        if let Some(car) = self.cars.get_mut(h) {
+            car.change_lane_to(offset, duration, t);
+        }
         Ok(())
     }
 
@@ -918,9 +1033,15 @@ impl Simulation {
         self.inputs().solids()
     }
 
-    fn capture_all_named(&mut self, name: &str) -> Result<(), EngineError> {
-        let named: Vec<bool> = self.sensors.values().map(|s| s.name() == name).collect();
-        self.capture_all(|h| named[h.index()])
+    /// Captures again every sensor that asks to before the first physics step
+    /// ([`Sensor::recaptures_before_first_step`]).
+    fn capture_again_before_first_step(&mut self) -> Result<(), EngineError> {
+        let again: Vec<bool> = self
+            .sensors
+            .values()
+            .map(|s| s.recaptures_before_first_step())
+            .collect();
+        self.capture_all(|h| again[h.index()])
     }
 
     /// The physics outputs the stream graph reads now.
@@ -1116,11 +1237,17 @@ fn number(
     }
 }
 
-/// The value of stream `id` at t = 0 when it is a constant or a bound open stream.
+/// The number stream `id` carries at t = 0 when that is known without running the program's
+/// code: a constant or a bound open stream (also one varying over time). The one place the
+/// engine reads a constant from the graph; a bool or any other value is not a number here.
 fn constant(graph: &crate::rx::Graph, id: StreamId) -> Option<f64> {
-    match graph.nodes().get(id.0)? {
-        crate::rx::Node::Const(v) => v.as_num(),
-        crate::rx::Node::Open(open) => open.at(0.0).as_num(),
+    let value = match graph.nodes().get(id.0)? {
+        crate::rx::Node::Const(v) => v.clone(),
+        crate::rx::Node::Open(open) => open.at(0.0),
+        _ => return None,
+    };
+    match value {
+        Value::Num(v) => Some(v),
         _ => None,
     }
 }
@@ -1338,10 +1465,10 @@ mod tests {
             ),
             (
                 WorldSpec {
-                    lidar: LidarSpec {
+                    sensors: vec![crate::SensorSpec::Lidar(LidarSpec {
                         beams: 0,
                         ..LidarSpec::default()
-                    },
+                    })],
                     ..spec()
                 },
                 "lidar",
@@ -1379,7 +1506,7 @@ mod tests {
         let obs = sim.observation();
         assert_eq!(obs.readings.len(), 1, "the lidar alone");
         let ahead = obs
-            .lidar
+            .lidar()
             .iter()
             .filter(|r| r.point_m[2].abs() < 0.5)
             .map(|r| r.point_m[0])
@@ -1498,10 +1625,10 @@ mod tests {
                 format!("{:?}", sleepy.snapshot()),
                 format!("{:?}", awake.snapshot())
             );
-            assert_eq!(sleepy.observation().lidar, awake.observation().lidar);
+            assert_eq!(sleepy.observation().lidar(), awake.observation().lidar());
             let oncoming_seen = sleepy
                 .observation()
-                .lidar
+                .lidar()
                 .iter()
                 .any(|r| r.point_m[2] < -2.5);
             seen_oncoming |= oncoming_seen;
@@ -1614,7 +1741,10 @@ mod tests {
                 format!("{:?}", separate.snapshot()),
                 "step {k}"
             );
-            assert_eq!(compound.observation().lidar, separate.observation().lidar);
+            assert_eq!(
+                compound.observation().lidar(),
+                separate.observation().lidar()
+            );
         }
         // The ego crossed both junctions and reached the bend.
         assert!(
@@ -1644,6 +1774,6 @@ mod tests {
         let mut sim = Simulation::new(&s).unwrap();
         sim.step(Control::default(), &mut NoHost).unwrap();
         assert_eq!(sim.snapshot().fog, 1.0);
-        assert!(sim.observation().lidar.iter().all(|r| r.range_m < 7.9));
+        assert!(sim.observation().lidar().iter().all(|r| r.range_m < 7.9));
     }
 }

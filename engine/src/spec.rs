@@ -4,7 +4,7 @@ use crate::actor::Roster;
 use crate::behaviour::{ActorRef, GraphBuilder, Output, Probe};
 use crate::network::{Lane, Location, Network, PieceId};
 use crate::rx::{Graph, Node, StreamId, Value};
-use crate::{EngineError, LidarSpec, VehicleParams};
+use crate::{EngineError, SensorSpec, VehicleParams};
 
 /// The default physics step: 1/60 s (rapier's own default).
 pub const DEFAULT_DT_S: f64 = 1.0 / 60.0;
@@ -116,8 +116,10 @@ pub struct WorldSpec {
     /// Streams published by name for monitors and `Stl` formulas (`Monitor`, `Signal`, an
     /// actor's `lead.speed`): [`crate::Simulation::current`] reads each one's latest value.
     pub published: Vec<(String, StreamId)>,
-    /// The ego vehicle's lidar.
-    pub lidar: LidarSpec,
+    /// The sensors on the ego vehicle, with their settings, in the order they are mounted
+    /// (and their readings listed in [`crate::Observation::readings`]); usually
+    /// [`SensorSpec::defaults`], the lidar.
+    pub sensors: Vec<SensorSpec>,
 }
 
 /// A pedestrian of [`WorldSpec::straight_road`]: the paper's crossing pedestrian with constant
@@ -195,7 +197,7 @@ impl WorldSpec {
             environment: EnvironmentSpec { light, fog },
             streams: g.finish()?,
             published: vec![],
-            lidar: LidarSpec::default(),
+            sensors: SensorSpec::defaults(),
         })
     }
 }

@@ -541,7 +541,7 @@ fn standing_world(
         environment: paracosm_engine::EnvironmentSpec { light, fog },
         streams: g.finish().unwrap(),
         published: vec![],
-        lidar: paracosm_engine::LidarSpec::default(),
+        sensors: paracosm_engine::SensorSpec::defaults(),
         network,
     }
 }

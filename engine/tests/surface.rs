@@ -7,8 +7,8 @@ use paracosm_engine::rx::{Func, NoHost, Node, Value};
 use paracosm_engine::sut::ConstantControl;
 use paracosm_engine::sut::Sut;
 use paracosm_engine::{
-    CarSpec, Control, EgoSpec, EnvironmentSpec, Lane, LidarSpec, Network, PieceId, Simulation,
-    Size, VehicleParams, WorldSpec, DEFAULT_DT_S,
+    CarSpec, Control, EgoSpec, EnvironmentSpec, Lane, LidarSpec, Network, PieceId, SensorSpec,
+    Simulation, Size, VehicleParams, WorldSpec, DEFAULT_DT_S,
 };
 
 fn segment(length_m: f64, friction: f64) -> PieceKind {
@@ -83,7 +83,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
         environment: EnvironmentSpec { light, fog },
         streams: g.finish().unwrap(),
         published: vec![],
-        lidar: LidarSpec::default(),
+        sensors: vec![SensorSpec::Lidar(LidarSpec::default())],
     }
 }
 

@@ -124,6 +124,74 @@ pub fn synthetic_first_failure(strategy: Strategy, seed: u64, cap: u64) -> Resul
 /// When a campaign, the CSV, the table or the plot cannot be written.
 pub fn falsification_study(settings: &StudySettings<'_>, out: &Path) -> Result<Study> {
     let dir = out.join("falsify");
+    let mut trials = campaign_trials(settings, &dir)?;
+    // Every strategy meets every seed's problem here, Halton included.
+    for &strategy in settings.strategies {
+        for seed in 0..settings.seeds {
+            trials.push(Trial {
+                scenario: SYNTHETIC.to_owned(),
+                strategy: strategy.name().to_owned(),
+                seed,
+                sims_to_first_failure: synthetic_first_failure(strategy, seed, settings.cap)?,
+            });
+        }
+    }
+    let columns: Vec<&str> = settings
+        .scenarios
+        .iter()
+        .copied()
+        .chain([SYNTHETIC])
+        .collect();
+    std::fs::create_dir_all(&dir).map_err(|e| Error::write(&dir, e))?;
+    let csv_path = dir.join("trials.csv");
+    let written = |e: &dyn std::fmt::Display| Error::write(&csv_path, e);
+    let mut w = csv::Writer::from_path(&csv_path).map_err(|e| written(&e))?;
+    for t in &trials {
+        w.serialize(t).map_err(|e| written(&e))?;
+    }
+    w.flush().map_err(|e| written(&e))?;
+
+    let values = |scenario: &str, strategy: &str| -> Vec<f64> {
+        trials
+            .iter()
+            .filter(|t| t.scenario == scenario && t.strategy == strategy)
+            .map(|t| t.sims_to_first_failure.unwrap_or(settings.cap + 1) as f64)
+            .collect()
+    };
+    let table = median_table(settings, &columns, &values);
+    let table_path = dir.join("study.md");
+    paracosm::atomic::write(&table_path, table.as_bytes())?;
+
+    let panels: Vec<paracosm::report::plot::BoxPanel> = columns
+        .iter()
+        .map(|s| {
+            (
+                format!("{s}: tests to the first failure"),
+                settings
+                    .strategies
+                    .iter()
+                    .map(|st| (st.name().to_owned(), values(s, st.name())))
+                    .collect(),
+            )
+        })
+        .collect();
+    let plots = paracosm::report::plot::box_plot(
+        &dir.join("first_failure"),
+        "simulations until the first failure",
+        &panels,
+    )?;
+    let mut files = vec![csv_path, table_path];
+    files.extend(plots);
+    Ok(Study {
+        trials,
+        table,
+        files,
+    })
+}
+
+/// Runs every scenario × strategy × seed of `settings` as a campaign that stops at its first
+/// failure, into `dir/runs/<scenario>/<strategy>/seed-<k>/`; one trial each, in run order.
+fn campaign_trials(settings: &StudySettings<'_>, dir: &Path) -> Result<Vec<Trial>> {
     let mut trials = Vec::new();
     for &name in settings.scenarios {
         let scenario = paracosm_scenarios::builtin(name)?;
@@ -159,51 +227,29 @@ pub fn falsification_study(settings: &StudySettings<'_>, out: &Path) -> Result<S
             }
         }
     }
-    // Every strategy meets every seed's problem here, Halton included.
-    for &strategy in settings.strategies {
-        for seed in 0..settings.seeds {
-            trials.push(Trial {
-                scenario: SYNTHETIC.to_owned(),
-                strategy: strategy.name().to_owned(),
-                seed,
-                sims_to_first_failure: synthetic_first_failure(strategy, seed, settings.cap)?,
-            });
-        }
-    }
-    let columns: Vec<&str> = settings
-        .scenarios
-        .iter()
-        .copied()
-        .chain([SYNTHETIC])
-        .collect();
-    std::fs::create_dir_all(&dir).map_err(|e| Error::write(&dir, e))?;
-    let csv_path = dir.join("trials.csv");
-    let written = |e: &dyn std::fmt::Display| Error::write(&csv_path, e);
-    let mut w = csv::Writer::from_path(&csv_path).map_err(|e| written(&e))?;
-    for t in &trials {
-        w.serialize(t).map_err(|e| written(&e))?;
-    }
-    w.flush().map_err(|e| written(&e))?;
+    Ok(trials)
+}
 
-    let values = |scenario: &str, strategy: &str| -> Vec<f64> {
-        trials
-            .iter()
-            .filter(|t| t.scenario == scenario && t.strategy == strategy)
-            .map(|t| t.sims_to_first_failure.unwrap_or(settings.cap + 1) as f64)
-            .collect()
-    };
+/// The Markdown table of the study: per strategy and column (scenario), the median and
+/// quartiles of `values` (censored ones past `settings.cap` shown as `> cap`) and how many
+/// trials found a failure.
+fn median_table(
+    settings: &StudySettings<'_>,
+    columns: &[&str],
+    values: &dyn Fn(&str, &str) -> Vec<f64>,
+) -> String {
     let mut table = String::from("| strategy |");
-    for s in &columns {
+    for s in columns {
         let _ = write!(table, " {s}: median [quartiles] | found |");
     }
     table.push_str("\n|---|");
-    for _ in &columns {
+    for _ in columns {
         table.push_str("---|---|");
     }
     table.push('\n');
     for strategy in settings.strategies {
         let _ = write!(table, "| {} |", strategy.name());
-        for s in &columns {
+        for s in columns {
             let v = values(s, strategy.name());
             let found = v.iter().filter(|&&x| x <= settings.cap as f64).count();
             let shown = |x: f64| {
@@ -227,34 +273,7 @@ pub fn falsification_study(settings: &StudySettings<'_>, out: &Path) -> Result<S
         }
         table.push('\n');
     }
-    let table_path = dir.join("study.md");
-    paracosm::atomic::write(&table_path, table.as_bytes())?;
-
-    let panels: Vec<paracosm::report::plot::BoxPanel> = columns
-        .iter()
-        .map(|s| {
-            (
-                format!("{s}: tests to the first failure"),
-                settings
-                    .strategies
-                    .iter()
-                    .map(|st| (st.name().to_owned(), values(s, st.name())))
-                    .collect(),
-            )
-        })
-        .collect();
-    let plots = paracosm::report::plot::box_plot(
-        &dir.join("first_failure"),
-        "simulations until the first failure",
-        &panels,
-    )?;
-    let mut files = vec![csv_path, table_path];
-    files.extend(plots);
-    Ok(Study {
-        trials,
-        table,
-        files,
-    })
+    table
 }
 
 #[cfg(test)]

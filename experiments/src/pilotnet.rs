@@ -233,14 +233,40 @@ pub fn to_onnx(weights: &[Weight], doc: &str) -> Vec<u8> {
     g.encode("pilotnet", doc)
 }
 
+/// Why an ONNX file's weights cannot be read back ([`weights_of_onnx`], [`from_onnx`]).
+#[derive(Debug, thiserror::Error)]
+pub enum OnnxWeightsError {
+    /// The bytes are not an ONNX model.
+    #[error(transparent)]
+    Decode(#[from] prost::DecodeError),
+    /// The model has no graph.
+    #[error("the model has no graph")]
+    NoGraph,
+    /// A variable of [`variables`] has no initializer (its name).
+    #[error("no initializer `{0}`")]
+    Missing(String),
+    /// A variable's initializer holds the wrong number of values.
+    #[error("`{name}` holds {values} values")]
+    Size {
+        /// The variable.
+        name: String,
+        /// How many values it holds.
+        values: usize,
+    },
+    /// candle cannot build the network from the weights.
+    #[error(transparent)]
+    Candle(#[from] candle_core::Error),
+}
+
 /// The weights stored in an ONNX file written by [`to_onnx`], by variable name.
 ///
 /// # Errors
-/// A message when the bytes are not an ONNX model or a variable is missing.
-pub fn weights_of_onnx(bytes: &[u8]) -> Result<Vec<Weight>, String> {
+/// [`OnnxWeightsError`] when the bytes are not an ONNX model or a variable is missing or of
+/// the wrong size.
+pub fn weights_of_onnx(bytes: &[u8]) -> Result<Vec<Weight>, OnnxWeightsError> {
     use prost::Message;
-    let model = tract_onnx::pb::ModelProto::decode(bytes).map_err(|e| e.to_string())?;
-    let graph = model.graph.ok_or("the model has no graph")?;
+    let model = tract_onnx::pb::ModelProto::decode(bytes)?;
+    let graph = model.graph.ok_or(OnnxWeightsError::NoGraph)?;
     variables()
         .into_iter()
         .map(|(name, shape)| {
@@ -248,14 +274,17 @@ pub fn weights_of_onnx(bytes: &[u8]) -> Result<Vec<Weight>, String> {
                 .initializer
                 .iter()
                 .find(|t| t.name == name)
-                .ok_or_else(|| format!("no initializer `{name}`"))?;
+                .ok_or_else(|| OnnxWeightsError::Missing(name.clone()))?;
             let data: Vec<f32> = t
                 .raw_data
                 .chunks_exact(4)
                 .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
                 .collect();
             if data.len() != shape.iter().product::<usize>() {
-                return Err(format!("`{name}` holds {} values", data.len()));
+                return Err(OnnxWeightsError::Size {
+                    name,
+                    values: data.len(),
+                });
             }
             Ok((name, shape, data))
         })
@@ -265,11 +294,11 @@ pub fn weights_of_onnx(bytes: &[u8]) -> Result<Vec<Weight>, String> {
 /// The network with the weights of an ONNX file written by [`to_onnx`], on the CPU.
 ///
 /// # Errors
-/// As [`weights_of_onnx`], and candle's.
-pub fn from_onnx(bytes: &[u8]) -> Result<PilotNet, String> {
+/// As [`weights_of_onnx`], and [`OnnxWeightsError::Candle`] for candle's.
+pub fn from_onnx(bytes: &[u8]) -> Result<PilotNet, OnnxWeightsError> {
     let weights = weights_of_onnx(bytes)?;
     let device = Device::Cpu;
-    let map = tensors(&weights, &device).map_err(|e| e.to_string())?;
+    let map = tensors(&weights, &device)?;
     let vb = VarBuilder::from_tensors(map, DType::F32, &device);
-    PilotNet::new(&vb).map_err(|e| e.to_string())
+    Ok(PilotNet::new(&vb)?)
 }

@@ -153,7 +153,7 @@ fn a_model_drives_the_ego_and_a_nan_answer_ends_only_its_test() {
 #[test]
 fn bad_models_and_manifests_are_refused_with_the_file() {
     let dir = tempfile::tempdir().unwrap();
-    let err = |path: &Path| SutConfig::onnx(path).unwrap_err();
+    let err = |path: &Path| SutConfig::onnx(path).unwrap_err().to_string();
     // No manifest beside the model.
     let lone = write_model(dir.path(), "lone", &constant_model([0.0; 2], 8, 16), None);
     let e = err(&lone);

@@ -27,6 +27,10 @@ pub enum ScenarioError {
     /// column, with the source line and a caret.
     #[error("{0}")]
     Language(String),
+    /// A program does not load, or a world of it cannot be built: a diagnostic naming the
+    /// file, line and column, typed by the phase that refused it.
+    #[error(transparent)]
+    Load(#[from] crate::lang::LoadError),
     /// A scenario file cannot be read.
     #[error("cannot read {path}: {message}")]
     Io {

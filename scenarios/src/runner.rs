@@ -326,36 +326,7 @@ impl Scenario {
             .iter()
             .map(|m| m.build(self.horizon_s))
             .collect();
-        let mut watch = Watch {
-            settled: vec![false; monitors.len()],
-            monitors,
-            signals: Signals::new(),
-            published: spec
-                .published
-                .iter()
-                .map(|(name, id)| Published {
-                    components: [".x", ".y", ".z"].map(|c| format!("{name}{c}")),
-                    name: name.clone(),
-                    id: *id,
-                    judged: self
-                        .monitors
-                        .iter()
-                        .filter_map(MonitorSpec::judged_stream)
-                        .find(|(_, signal, _)| *signal == name)
-                        .map(|(_, _, bools)| bools),
-                })
-                .collect(),
-            parts: SnapshotParts {
-                ttc: self
-                    .monitors
-                    .iter()
-                    .any(|m| m.reads_runner_signal(signal::EGO_TTC_S)),
-                lane_offset: self
-                    .monitors
-                    .iter()
-                    .any(|m| m.reads_runner_signal(signal::EGO_LANE_OFFSET_M)),
-            },
-        };
+        let mut watch = self.watch(spec, monitors);
         // Whole steps covering the horizon: a horizon between two steps is rounded up (a
         // horizon of 0.005 s is one step, not none), within 1e-9 of a step it is that step.
         let ticks = ((self.horizon_s / spec.dt_s - 1e-9).ceil() as u64).max(1);
@@ -376,7 +347,6 @@ impl Scenario {
                 let mut obs = sim.observation();
                 if !sut_sees {
                     // A viewing camera's frames are for people, not for the system.
-                    obs.camera = None;
                     obs.readings.retain(|(name, _)| *name != "camera");
                 }
                 control = sut.act(&obs)?;
@@ -406,53 +376,100 @@ impl Scenario {
             stopped = watch.observe(&sim, options.on_step.as_mut())?;
         }
 
-        if tick < ticks {
-            // Stopped early: a monitor that checks only every few frames may already be
-            // decided by the frames it saw (an `Stl` violation since its last check).
-            for (m, settled) in watch.monitors.iter_mut().zip(&mut watch.settled) {
-                if !*settled && m.settle_now() {
-                    *settled = true;
-                }
+        Ok(outcome(watch, tick < ticks, sim.t_s(), host.log()))
+    }
+
+    /// The monitors of one test and what they read: the published streams, and the runner's
+    /// signals that only some monitors need.
+    fn watch(&self, spec: &WorldSpec, monitors: Vec<Box<dyn Monitor>>) -> Watch {
+        Watch {
+            settled: vec![false; monitors.len()],
+            monitors,
+            signals: Signals::new(),
+            published: spec
+                .published
+                .iter()
+                .map(|(name, id)| Published {
+                    components: [".x", ".y", ".z"].map(|c| format!("{name}{c}")),
+                    name: name.clone(),
+                    id: *id,
+                    judged: self
+                        .monitors
+                        .iter()
+                        .filter_map(MonitorSpec::judged_stream)
+                        .find(|(_, signal, _)| *signal == name)
+                        .map(|(_, _, bools)| bools),
+                })
+                .collect(),
+            parts: SnapshotParts {
+                ttc: self
+                    .monitors
+                    .iter()
+                    .any(|m| m.reads_runner_signal(signal::EGO_TTC_S)),
+                lane_offset: self
+                    .monitors
+                    .iter()
+                    .any(|m| m.reads_runner_signal(signal::EGO_LANE_OFFSET_M)),
+            },
+        }
+    }
+}
+
+/// The test's outcome from its monitors: `stopped_early` when a monitor ended it before the
+/// horizon (a monitor not yet decided then is cut short), `simulated_s` the simulated time,
+/// s, `log` what the program printed.
+fn outcome(
+    mut watch: Watch,
+    stopped_early: bool,
+    simulated_s: f64,
+    log: Vec<String>,
+) -> TestOutcome {
+    if stopped_early {
+        // Stopped early: a monitor that checks only every few frames may already be
+        // decided by the frames it saw (an `Stl` violation since its last check).
+        for (m, settled) in watch.monitors.iter_mut().zip(&mut watch.settled) {
+            if !*settled && m.settle_now() {
+                *settled = true;
             }
         }
-        let cut_short: Vec<String> = if tick < ticks {
-            watch
-                .monitors
-                .iter()
-                .zip(&watch.settled)
-                .filter(|(_, &settled)| !settled)
-                .map(|(m, _)| m.name().to_owned())
-                .collect()
-        } else {
-            Vec::new()
-        };
-        let monitors: Vec<(String, Verdict)> = watch
+    }
+    let cut_short: Vec<String> = if stopped_early {
+        watch
             .monitors
             .iter()
-            .map(|m| (m.name().to_owned(), m.verdict()))
-            .collect();
-        let mut metrics: Vec<(&'static str, f64)> = monitors
-            .iter()
-            .flat_map(|(_, v)| v.metrics.iter().copied())
-            .collect();
-        // The test's failure time: the earliest of the monitors that failed it. A monitor that
-        // passed may still carry a time (a `TimeToFailure` whose monitor failed after `minT`),
-        // and one cut short did not fail the test.
-        if let Some(ttf) = monitors
-            .iter()
-            .filter(|(n, v)| !v.passed && !cut_short.contains(n))
-            .filter_map(|(_, v)| v.first_violation_s)
-            .reduce(f64::min)
-        {
-            metrics.push(("time_to_failure_s", ttf));
-        }
-        metrics.push(("simulated_s", sim.t_s()));
-        Ok(TestOutcome {
-            monitors,
-            cut_short,
-            metrics,
-            log: host.log(),
-        })
+            .zip(&watch.settled)
+            .filter(|(_, &settled)| !settled)
+            .map(|(m, _)| m.name().to_owned())
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let monitors: Vec<(String, Verdict)> = watch
+        .monitors
+        .iter()
+        .map(|m| (m.name().to_owned(), m.verdict()))
+        .collect();
+    let mut metrics: Vec<(&'static str, f64)> = monitors
+        .iter()
+        .flat_map(|(_, v)| v.metrics.iter().copied())
+        .collect();
+    // The test's failure time: the earliest of the monitors that failed it. A monitor that
+    // passed may still carry a time (a `TimeToFailure` whose monitor failed after `minT`),
+    // and one cut short did not fail the test.
+    if let Some(ttf) = monitors
+        .iter()
+        .filter(|(n, v)| !v.passed && !cut_short.contains(n))
+        .filter_map(|(_, v)| v.first_violation_s)
+        .reduce(f64::min)
+    {
+        metrics.push(("time_to_failure_s", ttf));
+    }
+    metrics.push(("simulated_s", simulated_s));
+    TestOutcome {
+        monitors,
+        cut_short,
+        metrics,
+        log,
     }
 }
 

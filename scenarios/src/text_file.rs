@@ -13,24 +13,37 @@ pub const MAX_DATA_BYTES: u64 = 1 << 30;
 /// (a FIFO, which would block; a device; a directory) is refused before it is opened.
 ///
 /// # Errors
-/// A message (without the path, which the caller adds with its own location format):
-/// "is a FIFO, not a regular file" ([`paracosm_engine::files::regular_file`]); the I/O
-/// error; "larger than the limit of N MiB"; or "not UTF-8: the first bad byte (0xNN) is at
-/// line L, column C".
-pub fn read_text(path: &Path, limit: u64) -> Result<String, String> {
+/// A [`TextError`], whose message names no path (the caller adds it with its own location
+/// format).
+pub fn read_text(path: &Path, limit: u64) -> Result<String, TextError> {
     paracosm_engine::files::regular_file(path)?;
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let file = std::fs::File::open(path)?;
     let mut bytes = Vec::new();
-    file.take(limit + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| e.to_string())?;
+    file.take(limit + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
-        return Err(format!(
-            "larger than the limit of {} MiB for this kind of file",
-            limit >> 20
-        ));
+        return Err(TextError::TooLarge { mib: limit >> 20 });
     }
-    String::from_utf8(bytes).map_err(|e| not_utf8(e.as_bytes(), e.utf8_error()))
+    String::from_utf8(bytes).map_err(|e| TextError::NotUtf8(not_utf8(e.as_bytes(), e.utf8_error())))
+}
+
+/// Why a text input cannot be read ([`read_text`]).
+#[derive(Debug, thiserror::Error)]
+pub enum TextError {
+    /// "is a FIFO, not a regular file" ([`paracosm_engine::files::regular_file`]).
+    #[error(transparent)]
+    NotRegular(#[from] paracosm_engine::files::NotRegular),
+    /// The operating system's error.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    /// Larger than the limit for its kind of file.
+    #[error("larger than the limit of {mib} MiB for this kind of file")]
+    TooLarge {
+        /// The limit, MiB.
+        mib: u64,
+    },
+    /// "not UTF-8 text: the first bad byte (0xNN) is at line L, column C" ([`not_utf8`]).
+    #[error("{0}")]
+    NotUtf8(String),
 }
 
 /// "not UTF-8 text: the first bad byte (0xNN) is at line L, column C" for `bytes`, whose
@@ -62,10 +75,10 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let f = dir.join("bad.star");
         std::fs::write(&f, b"x = 1\ny = \"\xc3\xa9\xff\"\n").unwrap();
-        let e = read_text(&f, MAX_SOURCE_BYTES).unwrap_err();
+        let e = read_text(&f, MAX_SOURCE_BYTES).unwrap_err().to_string();
         assert!(e.contains("(0xff) is at line 2, column 7"), "{e}");
         std::fs::write(&f, b"0123456789").unwrap();
-        let e = read_text(&f, 4).unwrap_err();
+        let e = read_text(&f, 4).unwrap_err().to_string();
         assert!(e.contains("larger than the limit"), "{e}");
         assert_eq!(read_text(&f, 10).unwrap(), "0123456789");
         std::fs::remove_dir_all(&dir).unwrap();

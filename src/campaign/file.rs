@@ -90,7 +90,7 @@ impl SutChoice {
             SutChoice::Scenario => Ok(None),
             SutChoice::Builtin { name } => SutConfig::builtin(name)
                 .map(Some)
-                .map_err(crate::Error::BadInput),
+                .map_err(|e| crate::Error::BadInput(e.to_string())),
             SutChoice::Command {
                 command,
                 timeout_s,
@@ -101,7 +101,8 @@ impl SutChoice {
                 *reuse,
             )))),
             SutChoice::Onnx { model, sha256 } => {
-                let config = SutConfig::onnx(Path::new(model)).map_err(crate::Error::BadInput)?;
+                let config = SutConfig::onnx(Path::new(model))
+                    .map_err(|e| crate::Error::BadInput(e.to_string()))?;
                 match config.model_sha256() {
                     Some(now) if now != sha256 => Err(crate::Error::BadInput(format!(
                         "the model `{model}` changed since the campaign ran (SHA-256 {now}, \
@@ -124,13 +125,18 @@ pub struct Shard {
     pub count: u64,
 }
 
+/// A `--shard` value that is not `I/N` with `0 <= I < N`: the value as given.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("`{0}` is not a shard I/N with 0 <= I < N (e.g. 0/4)")]
+pub struct NotAShard(pub String);
+
 impl Shard {
     /// Parses `I/N`.
     ///
     /// # Errors
-    /// A message when it is not two whole numbers with `N >= 1` and `I < N`.
-    pub fn parse(s: &str) -> Result<Shard, String> {
-        let bad = || format!("`{s}` is not a shard I/N with 0 <= I < N (e.g. 0/4)");
+    /// [`NotAShard`] when it is not two whole numbers with `N >= 1` and `I < N`.
+    pub fn parse(s: &str) -> Result<Shard, NotAShard> {
+        let bad = || NotAShard(s.to_owned());
         let (i, n) = s.split_once('/').ok_or_else(bad)?;
         let (index, count) = (
             i.trim().parse::<u64>().map_err(|_| bad())?,
@@ -498,6 +504,10 @@ mod tests {
         for bad in ["4/4", "1/0", "x/2", "1", "-1/2", ""] {
             assert!(Shard::parse(bad).is_err(), "{bad}");
         }
+        assert_eq!(
+            Shard::parse("4/4").unwrap_err().to_string(),
+            "`4/4` is not a shard I/N with 0 <= I < N (e.g. 0/4)"
+        );
     }
 
     #[test]

@@ -30,8 +30,52 @@ pub struct Merged {
 /// (fingerprints), one is missing, given twice or incomplete; [`Error::Input`] when a file
 /// cannot be read; [`Error::Write`] when the merged folder cannot be written.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
+    let (template, shards) = read_shards(dirs)?;
+    let mut scenario = paracosm_scenarios::load(&template.scenario)?;
+    if let Some(sut) = template.sut.config()? {
+        scenario.sut = sut;
+    }
+    let mut records = Vec::with_capacity(template.budget as usize);
+    for (dir, file) in shards.values() {
+        records.extend(shard_records(dir, file, &scenario)?);
+    }
+    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
+    let mut whole = CampaignFile {
+        shard: None,
+        ..template
+    }
+    .checked();
+    whole.tool = format!("paracosm {}", env!("CARGO_PKG_VERSION"));
+    let results = out.join(RESULTS_FILE);
+    let lines: Vec<Vec<u8>> = shards
+        .values()
+        .map(|(dir, _)| crate::campaign::results::whole_lines(dir))
+        .collect::<Result<_, _>>()?;
+    crate::atomic::with_temp(&results, |tmp| -> std::io::Result<()> {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(tmp)?);
+        for bytes in &lines {
+            f.write_all(bytes)?;
+        }
+        f.flush()
+    })?;
+    whole.write(out)?;
+    Ok(Merged {
+        file: whole,
+        records,
+        scenario,
+    })
+}
+
+/// Shard folders by shard index, with their settings.
+type Shards = BTreeMap<u64, (PathBuf, CampaignFile)>;
+
+/// The shards of one campaign in `dirs`, by index, with the first one's settings.
+///
+/// # Errors
+/// As [`merge`], for the folders and their `campaign.json`.
+fn read_shards(dirs: &[PathBuf]) -> Result<(CampaignFile, Shards), Error> {
     let bad = |m: String| Error::BadInput(m);
-    let mut shards: BTreeMap<u64, (PathBuf, CampaignFile)> = BTreeMap::new();
+    let mut shards: Shards = BTreeMap::new();
     let mut first: Option<(PathBuf, CampaignFile)> = None;
     for dir in dirs {
         let file = CampaignFile::read(dir)?;
@@ -92,71 +136,53 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
             if missing.len() == 1 { "is" } else { "are" }
         )));
     }
-    let mut scenario = paracosm_scenarios::load(&template.scenario)?;
-    if let Some(sut) = template.sut.config()? {
-        scenario.sut = sut;
-    }
-    let mut records = Vec::with_capacity(template.budget as usize);
-    for (dir, file) in shards.values() {
-        let ids = file.ids();
-        let existing = crate::campaign::results::load(dir, &scenario, ids.clone(), false)?;
-        let strategy: paracosm_generators::Strategy =
-            file.strategy.parse().map_err(|e| bad(format!("{e}")))?;
-        let campaign = crate::campaign::Campaign {
-            scenario: &scenario,
-            strategy,
-            seed: file.seed,
-            budget: file.budget,
-            strength: file.strength,
-            jobs: 1,
-            stop_at_first_failure: false,
-            points: None,
-        };
-        campaign.check_origin(
-            &existing.records,
-            ids.start,
-            &dir.join(RESULTS_FILE),
-            Some(&file.tag()),
-        )?;
-        let done = existing.records.len() as u64;
-        if done != ids.end - ids.start {
-            return Err(bad(format!(
-                "shard {} in `{}` is incomplete: {} of {} tests; finish it with \
-                 `paracosm-fuzz --resume --out {}`",
-                file.shard.expect("checked"),
-                dir.display(),
-                done,
-                ids.end - ids.start,
-                dir.display()
-            )));
-        }
-        records.extend(existing.records);
-    }
-    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
-    let mut whole = CampaignFile {
-        shard: None,
-        ..template
-    }
-    .checked();
-    whole.tool = format!("paracosm {}", env!("CARGO_PKG_VERSION"));
-    let results = out.join(RESULTS_FILE);
-    let lines: Vec<Vec<u8>> = shards
-        .values()
-        .map(|(dir, _)| crate::campaign::results::whole_lines(dir))
-        .collect::<Result<_, _>>()?;
-    crate::atomic::with_temp(&results, |tmp| -> std::io::Result<()> {
-        let mut f = std::io::BufWriter::new(std::fs::File::create(tmp)?);
-        for bytes in &lines {
-            f.write_all(bytes)?;
-        }
-        f.flush()
-    })?;
-    whole.write(out)?;
-    Ok(Merged {
-        file: whole,
-        records,
+    Ok((template, shards))
+}
+
+/// The records of the shard in `dir` with settings `file`, checked to be the complete shard
+/// of its campaign.
+///
+/// # Errors
+/// As [`merge`], for the shard's records.
+fn shard_records(
+    dir: &Path,
+    file: &CampaignFile,
+    scenario: &paracosm_scenarios::Scenario,
+) -> Result<Vec<RunRecord>, Error> {
+    let bad = |m: String| Error::BadInput(m);
+    let ids = file.ids();
+    let existing = crate::campaign::results::load(dir, scenario, ids.clone(), false)?;
+    let strategy: paracosm_generators::Strategy =
+        file.strategy.parse().map_err(|e| bad(format!("{e}")))?;
+    let campaign = crate::campaign::Campaign {
         scenario,
-    })
+        strategy,
+        seed: file.seed,
+        budget: file.budget,
+        strength: file.strength,
+        jobs: 1,
+        stop_at_first_failure: false,
+        points: None,
+    };
+    campaign.check_origin(
+        &existing.records,
+        ids.start,
+        &dir.join(RESULTS_FILE),
+        Some(&file.tag()),
+    )?;
+    let done = existing.records.len() as u64;
+    if done != ids.end - ids.start {
+        return Err(bad(format!(
+            "shard {} in `{}` is incomplete: {} of {} tests; finish it with \
+             `paracosm-fuzz --resume --out {}`",
+            file.shard.expect("checked"),
+            dir.display(),
+            done,
+            ids.end - ids.start,
+            dir.display()
+        )));
+    }
+    Ok(existing.records)
 }
 
 /// `paracosm-fuzz merge`: [`merge`]s `dirs` into `out` (which must be empty unless

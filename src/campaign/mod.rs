@@ -336,91 +336,15 @@ impl Campaign<'_> {
             }
             return Ok(report);
         }
-        // Everything that can be refused is refused before the output folder is touched. A
-        // non-adaptive strategy's points are asked for in chunks as the tests run, so memory
-        // does not grow with the budget: the first chunk here.
-        let upfront = match generator.batch() {
-            None => {
-                // Points are asked for in chunks as the tests run: a budget past what the
-                // strategy can produce is refused now, before anything runs.
-                let capacity = match self.strategy {
-                    Strategy::Points => self.points.map(|p| p.len() as u64),
-                    s => s.capacity(),
-                };
-                if let Some(limit) = capacity.filter(|&c| ids.end > c) {
-                    return Err(paracosm_generators::GeneratorError::CapacityExceeded {
-                        generator: generator.name(),
-                        what: "points",
-                        limit,
-                        requested: ids.end,
-                    }
-                    .into());
-                }
-                generator.skip(ids.start)?;
-                let n = POINT_CHUNK.min(ids.end - ids.start) as usize;
-                Some(generator.ask(n)?)
-            }
-            Some(_) if ids.start != prior_len || ids.end != self.budget => {
-                return Err(Error::BadInput(format!(
-                    "{} adapts each test to all earlier ones, so it runs whole campaigns \
-                     only, not a shard",
-                    self.strategy
-                )));
-            }
-            Some(_) => None,
-        };
+        // Everything that can be refused is refused before the output folder is touched.
+        let upfront = self.first_chunk(&mut *generator, &ids, prior_len)?;
         for o in observers.iter_mut() {
             o.started(prior.unwrap_or(&[]))?;
         }
         let mut run = Run::open(self, stop)?;
-        if let Some(first) = upfront {
-            let mut next = ids.start;
-            let mut points = first;
-            loop {
-                run.execute(next, &points, observers)?;
-                next += points.len() as u64;
-                if next >= ids.end || run.halted() {
-                    break;
-                }
-                points = generator.ask(POINT_CHUNK.min(ids.end - next) as usize)?;
-            }
-        } else {
-            let prior = prior.unwrap_or(&[]);
-            let passive = self.scenario.passive_monitors();
-            let batch = generator.batch().unwrap_or(1);
-            let mut next = 0u64;
-            while next < ids.end && !run.halted() {
-                let n = (batch as u64).min(ids.end - next) as usize;
-                let points = generator.ask(n)?;
-                if points.is_empty() {
-                    return Err(Error::BadInput(format!(
-                        "{} proposed no point at test {next}",
-                        self.strategy
-                    )));
-                }
-                // The part of the batch that an earlier run already simulated.
-                let known = ((ids.start - next.min(ids.start)) as usize).min(points.len());
-                let mut told: Vec<(Point, f64)> = Vec::with_capacity(points.len());
-                for (j, p) in points[..known].iter().enumerate() {
-                    let r = &prior[next as usize + j];
-                    if &r.point != p {
-                        return Err(Error::BadInput(format!(
-                            "test {} in the results is not the point {} proposes; the \
-                             results were not written by this campaign",
-                            r.id, self.strategy
-                        )));
-                    }
-                    told.push((p.clone(), r.cost(&passive)));
-                }
-                let fresh = run.execute(next + known as u64, &points[known..], observers)?;
-                told.extend(
-                    run.records[fresh]
-                        .iter()
-                        .map(|r| (r.point.clone(), r.cost(&passive))),
-                );
-                generator.tell(&told);
-                next += points.len() as u64;
-            }
+        match upfront {
+            Some(first) => run.chunks(&mut *generator, &ids, first, observers)?,
+            None => run.batches(&mut *generator, &ids, prior.unwrap_or(&[]), observers)?,
         }
         let records = run.records;
         let asked = ids.end - ids.start;
@@ -438,6 +362,52 @@ impl Campaign<'_> {
             o.finished(&report)?;
         }
         Ok(report)
+    }
+}
+
+impl Campaign<'_> {
+    /// The first chunk of a non-adaptive strategy's points for the tests `ids` (its points
+    /// are asked for in chunks as the tests run, so memory does not grow with the budget);
+    /// `None` for an adaptive strategy, which asks batch by batch.
+    ///
+    /// # Errors
+    /// [`Error::Generator`] for a budget past what the strategy can produce (refused now,
+    /// before anything runs) or points it cannot give; [`Error::BadInput`] for a shard of an
+    /// adaptive strategy (`ids` other than all tests after the `prior_len` earlier ones).
+    fn first_chunk(
+        &self,
+        generator: &mut dyn paracosm_generators::Generator,
+        ids: &Range<u64>,
+        prior_len: u64,
+    ) -> Result<Option<Vec<Point>>, Error> {
+        match generator.batch() {
+            None => {
+                let capacity = match self.strategy {
+                    Strategy::Points => self.points.map(|p| p.len() as u64),
+                    s => s.capacity(),
+                };
+                if let Some(limit) = capacity.filter(|&c| ids.end > c) {
+                    return Err(paracosm_generators::GeneratorError::CapacityExceeded {
+                        generator: generator.name(),
+                        what: "points",
+                        limit,
+                        requested: ids.end,
+                    }
+                    .into());
+                }
+                generator.skip(ids.start)?;
+                let n = POINT_CHUNK.min(ids.end - ids.start) as usize;
+                Ok(Some(generator.ask(n)?))
+            }
+            Some(_) if ids.start != prior_len || ids.end != self.budget => {
+                Err(Error::BadInput(format!(
+                    "{} adapts each test to all earlier ones, so it runs whole campaigns \
+                     only, not a shard",
+                    self.strategy
+                )))
+            }
+            Some(_) => Ok(None),
+        }
     }
 }
 
@@ -477,6 +447,75 @@ impl<'c, 'a> Run<'c, 'a> {
             stopped_by_user: false,
             records: Vec::new(),
         })
+    }
+
+    /// Runs the tests `ids` of a non-adaptive strategy, `first` the points of the first chunk,
+    /// asking `generator` for the next chunk as each is done, until the end or a halt.
+    fn chunks(
+        &mut self,
+        generator: &mut dyn paracosm_generators::Generator,
+        ids: &Range<u64>,
+        first: Vec<Point>,
+        observers: &mut [&mut dyn Observer],
+    ) -> Result<(), Error> {
+        let mut next = ids.start;
+        let mut points = first;
+        loop {
+            self.execute(next, &points, observers)?;
+            next += points.len() as u64;
+            if next >= ids.end || self.halted() {
+                return Ok(());
+            }
+            points = generator.ask(POINT_CHUNK.min(ids.end - next) as usize)?;
+        }
+    }
+
+    /// Runs the tests up to `ids.end` of an adaptive strategy batch by batch: ask, simulate,
+    /// tell. The tests before `ids.start` are not simulated again: `prior` (an earlier run's
+    /// records) tells their robustness, after checking that they are the points proposed.
+    fn batches(
+        &mut self,
+        generator: &mut dyn paracosm_generators::Generator,
+        ids: &Range<u64>,
+        prior: &[RunRecord],
+        observers: &mut [&mut dyn Observer],
+    ) -> Result<(), Error> {
+        let strategy = self.campaign.strategy;
+        let passive = self.campaign.scenario.passive_monitors();
+        let batch = generator.batch().unwrap_or(1);
+        let mut next = 0u64;
+        while next < ids.end && !self.halted() {
+            let n = (batch as u64).min(ids.end - next) as usize;
+            let points = generator.ask(n)?;
+            if points.is_empty() {
+                return Err(Error::BadInput(format!(
+                    "{strategy} proposed no point at test {next}"
+                )));
+            }
+            // The part of the batch that an earlier run already simulated.
+            let known = ((ids.start - next.min(ids.start)) as usize).min(points.len());
+            let mut told: Vec<(Point, f64)> = Vec::with_capacity(points.len());
+            for (j, p) in points[..known].iter().enumerate() {
+                let r = &prior[next as usize + j];
+                if &r.point != p {
+                    return Err(Error::BadInput(format!(
+                        "test {} in the results is not the point {strategy} proposes; the \
+                         results were not written by this campaign",
+                        r.id
+                    )));
+                }
+                told.push((p.clone(), r.cost(&passive)));
+            }
+            let fresh = self.execute(next + known as u64, &points[known..], observers)?;
+            told.extend(
+                self.records[fresh]
+                    .iter()
+                    .map(|r| (r.point.clone(), r.cost(&passive))),
+            );
+            generator.tell(&told);
+            next += points.len() as u64;
+        }
+        Ok(())
     }
 
     /// Whether no new test may start: the user's stop, or the first failure.

@@ -209,24 +209,7 @@ pub fn run(
     observers: &mut [&mut dyn Observer],
 ) -> Result<Outcome, Error> {
     let out = &request.out;
-    if let Some(junit) = &request.junit {
-        crate::atomic::check_side_output(junit, "--junit", out)?;
-    }
-    let stored = if request.resume && out.join(CAMPAIGN_FILE).exists() {
-        Some(CampaignFile::read(out)?)
-    } else {
-        None
-    };
-    // Records without their campaign: nothing tells which campaign they belong to, and
-    // starting one here would replace them.
-    if request.resume && stored.is_none() && out.join(RESULTS_FILE).exists() {
-        return Err(Error::BadInput(format!(
-            "`{}` holds {RESULTS_FILE} but no {CAMPAIGN_FILE}: its records belong to no campaign \
-             that can be resumed, and a new one would replace them; move them away, or pass \
-             --force to replace them",
-            out.display()
-        )));
-    }
+    let stored = stored_campaign(request)?;
     let (mut file, scenario, points) = settings(request, stored.as_ref())?;
     // A campaign that stops at its first failure does so when resumed too.
     let stop_at_first_failure = match &stored {
@@ -236,36 +219,12 @@ pub fn run(
     file.stop_at_first_failure = stop_at_first_failure;
     let warnings = warnings_of(&scenario);
     let strategy = refusals(request, &file, &warnings)?;
-    // A strength asked for that the space cannot have: with fewer discrete parameters there
-    // are no t-tuples (and a space with none has no covering array at all).
-    if let (Some(t), true) = (request.strength, Strategy::SUITES.contains(&strategy)) {
-        let nd = scenario.space.level_counts().len();
-        if t > nd {
-            return Err(Error::BadInput(format!(
-                "--strength {t}: a covering array of strength {t} needs {t} discrete parameters, \
-                 and {} has {nd}{}",
-                scenario.name,
-                if nd == 0 {
-                    " (its suite is Halton points alone: leave --strength out)"
-                } else {
-                    ""
-                }
-            )));
-        }
-    }
+    check_strength(request, &scenario, strategy)?;
     let jobs = request.jobs.unwrap_or_else(|| {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
-    prepare_out_dir(out, request.replace, request.resume)?;
     // One writer per folder, from here to the end of the run (crate::campaign::lock).
-    let _lock = crate::campaign::lock::CampaignLock::acquire(out)?;
-    if request.resume {
-        // Ours alone now: what an earlier writer killed mid-write left is stale.
-        crate::atomic::remove_stale_temps(out);
-    }
-    if stored.is_none() {
-        file.write(out)?;
-    }
+    let _lock = claim_folder(request, &file, stored.is_some())?;
     let ids = file.ids();
     let existing = match stored {
         Some(_) => crate::campaign::results::load(out, &scenario, ids.clone(), true)?,
@@ -321,12 +280,7 @@ pub fn run(
                 Ok(())
             },
         )),
-        junit: junit_path.map(|path| {
-            let name = scenario.name.clone();
-            AtEnd::new(Box::new(move |records: &[RunRecord], _: &CampaignReport| {
-                crate::report::junit::write(path, &name, records, out)
-            }) as AtEndFn<'_>)
-        }),
+        junit: junit_path.map(|path| junit_at_end(path, scenario.name.clone(), out)),
     };
     let prior = stored.is_some().then_some(existing.records.as_slice());
     let report = campaign.run_ids(start..ids.end, prior, stop, &mut [&mut chain])?;
@@ -345,6 +299,87 @@ pub fn run(
         scenario,
         out: out.clone(),
     })
+}
+
+/// Prepares the campaign folder (`replace`, `resume`), takes its lock, and writes `file` into
+/// it unless the campaign is `resumed`. Returns the lock: the caller holds it to the end of the
+/// run.
+fn claim_folder(
+    request: &Request,
+    file: &CampaignFile,
+    resumed: bool,
+) -> Result<crate::campaign::lock::CampaignLock, Error> {
+    let out = &request.out;
+    prepare_out_dir(out, request.replace, request.resume)?;
+    let lock = crate::campaign::lock::CampaignLock::acquire(out)?;
+    if request.resume {
+        // Ours alone now: what an earlier writer killed mid-write left is stale.
+        crate::atomic::remove_stale_temps(out);
+    }
+    if !resumed {
+        file.write(out)?;
+    }
+    Ok(lock)
+}
+
+/// The observer that writes JUnit XML for scenario `name` to `path` when the campaign in `out`
+/// finishes.
+fn junit_at_end<'c>(path: &'c Path, name: String, out: &'c Path) -> AtEnd<AtEndFn<'c>> {
+    AtEnd::new(Box::new(
+        move |records: &[RunRecord], _: &CampaignReport| {
+            crate::report::junit::write(path, &name, records, out)
+        },
+    ))
+}
+
+/// The campaign in the folder that `request` resumes, if any (a `--junit` path inside the
+/// folder is refused first).
+///
+/// # Errors
+/// [`Error::BadInput`] for a `--junit` path that is no side output, or for a resume of a folder
+/// that holds records without their `campaign.json`; [`Error::Input`] for an unreadable one.
+fn stored_campaign(request: &Request) -> Result<Option<CampaignFile>, Error> {
+    let out = &request.out;
+    if let Some(junit) = &request.junit {
+        crate::atomic::check_side_output(junit, "--junit", out)?;
+    }
+    let stored = if request.resume && out.join(CAMPAIGN_FILE).exists() {
+        Some(CampaignFile::read(out)?)
+    } else {
+        None
+    };
+    // Records without their campaign: nothing tells which campaign they belong to, and
+    // starting one here would replace them.
+    if request.resume && stored.is_none() && out.join(RESULTS_FILE).exists() {
+        return Err(Error::BadInput(format!(
+            "`{}` holds {RESULTS_FILE} but no {CAMPAIGN_FILE}: its records belong to no campaign \
+             that can be resumed, and a new one would replace them; move them away, or pass \
+             --force to replace them",
+            out.display()
+        )));
+    }
+    Ok(stored)
+}
+
+/// Refuses a strength asked for that the space cannot have: with fewer discrete parameters
+/// there are no t-tuples (and a space with none has no covering array at all).
+fn check_strength(request: &Request, scenario: &Scenario, strategy: Strategy) -> Result<(), Error> {
+    if let (Some(t), true) = (request.strength, Strategy::SUITES.contains(&strategy)) {
+        let nd = scenario.space.level_counts().len();
+        if t > nd {
+            return Err(Error::BadInput(format!(
+                "--strength {t}: a covering array of strength {t} needs {t} discrete parameters, \
+                 and {} has {nd}{}",
+                scenario.name,
+                if nd == 0 {
+                    " (its suite is Halton points alone: leave --strength out)"
+                } else {
+                    ""
+                }
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The campaign's strategy, unless the campaign must be refused before anything is written:
@@ -465,199 +500,232 @@ fn settings(
     request: &Request,
     stored: Option<&CampaignFile>,
 ) -> Result<(CampaignFile, Scenario, Option<Vec<Point>>), Error> {
-    let refuse = |diffs: Vec<String>| {
-        Error::BadInput(format!(
-            "refusing to resume: `{}` holds a campaign with other settings ({}); resume without \
-             those arguments, or start a new campaign with --force or another --out",
-            request.out.display(),
-            diffs.join("; ")
-        ))
-    };
-    let sut = request.sut.as_ref();
-    let load = |name: &str, choice: &SutChoice| -> Result<Scenario, Error> {
-        let mut scenario = paracosm_scenarios::load(name)?;
-        if let Some(s) = choice.config()? {
-            scenario.sut = s;
-        }
-        Ok(scenario)
-    };
     match (&request.scenario, stored) {
-        (Some(name), _) => {
-            let choice = SutChoice::of(sut);
-            let scenario = load(name, &choice)?;
-            let given = match &request.points {
-                Some(path) => Some(read_points(path, request, &scenario)?),
-                None if request.strategy == Some(Strategy::Points) => {
-                    return Err(Error::Generator(GeneratorError::NeedsPoints))
-                }
-                None => None,
-            };
-            let file = CampaignFile::new(
-                name,
-                &scenario,
-                Settings {
-                    sut: choice,
-                    strategy: match given {
-                        Some(_) => Strategy::Points,
-                        None => request.strategy.unwrap_or(Strategy::Halton),
-                    }
-                    .name()
-                    .into(),
-                    seed: request.seed.unwrap_or(0),
-                    budget: match &given {
-                        Some((_, points)) => points.len() as u64,
-                        None => request.budget.unwrap_or(100),
-                    },
-                    // The default strength, 2, is lowered to the number of discrete
-                    // parameters when there are fewer (a strength asked for is kept, and
-                    // refused if too high).
-                    strength: request.strength.unwrap_or_else(|| {
-                        let suite = request
-                            .strategy
-                            .is_some_and(|s| Strategy::SUITES.contains(&s));
-                        match scenario.space.level_counts().len() {
-                            1 if suite => 1,
-                            _ => 2,
-                        }
-                    }),
-                    shard: request.shard,
-                    points: given.as_ref().map(|(f, _)| f.clone()),
-                },
-            );
-            match stored.map(|st| st.differences(&file)) {
-                Some(diffs) if !diffs.is_empty() => Err(refuse(diffs)),
-                _ => Ok((file, scenario, given.map(|(_, p)| p))),
-            }
-        }
-        (None, Some(st)) => {
-            // Settings given with a bare resume must agree with the stored campaign.
-            let mut diffs = Vec::new();
-            let mut check = |name: &str, given: Option<String>, stored: String| {
-                if let Some(g) = given.filter(|g| *g != stored) {
-                    diffs.push(format!("{name}: {stored} vs {g}"));
-                }
-            };
-            check(
-                "seed",
-                request.seed.map(|v| v.to_string()),
-                st.seed.to_string(),
-            );
-            check(
-                "budget",
-                request.budget.map(|v| v.to_string()),
-                st.budget.to_string(),
-            );
-            check(
-                "strength",
-                request.strength.map(|v| v.to_string()),
-                st.strength.to_string(),
-            );
-            check(
-                "strategy",
-                request.strategy.map(|s| s.name().to_owned()),
-                st.strategy.clone(),
-            );
-            let shard = |s: Option<Shard>| s.map_or("none".to_owned(), |s| s.to_string());
-            check(
-                "shard",
-                request.shard.map(|s| shard(Some(s))),
-                shard(st.shard),
-            );
-            if sut.is_some() && SutChoice::of(sut) != st.sut {
-                diffs.push("system under test differs".into());
-            }
-            if !diffs.is_empty() {
-                return Err(refuse(diffs));
-            }
-            let edited = st.edited_fields();
-            if !edited.is_empty() {
-                return Err(Error::BadInput(format!(
-                    "refusing to resume: {} was edited by hand: {} no longer match{} what the \
-                     campaign wrote. Put the value{} back, or start a new campaign with --force \
-                     or another --out",
-                    request.out.join(CAMPAIGN_FILE).display(),
-                    edited
-                        .iter()
-                        .map(|f| format!("`{f}`"))
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                    if edited.len() == 1 { "es" } else { "" },
-                    if edited.len() == 1 { "" } else { "s" },
-                )));
-            }
-            let scenario = load(&st.scenario, &st.sut)?;
-            let again = CampaignFile::new(&st.scenario, &scenario, st.settings());
-            if again.fingerprint != st.fingerprint {
-                // Name what differs: the program, its parameters, or campaign.json itself.
-                let why = if st
-                    .scenario_sha256
-                    .as_ref()
-                    .is_some_and(|h| Some(h) != again.scenario_sha256.as_ref())
-                {
-                    format!(
-                        "the scenario program `{}` changed since the campaign started (its \
-                         SHA-256 differs)",
-                        st.scenario
-                    )
-                } else if let Some((was, now)) = st
-                    .input_files
-                    .iter()
-                    .zip(&again.input_files)
-                    .find(|(a, b)| a != b)
-                {
-                    format!(
-                        "the file `{}` that the scenario program reads changed since the \
-                         campaign started (SHA-256 {} then, {} now)",
-                        now.path,
-                        &was.sha256[..12],
-                        &now.sha256[..12]
-                    )
-                } else if st.input_files.len() != again.input_files.len() {
-                    format!(
-                        "the scenario program `{}` reads other files than when the campaign \
-                         started",
-                        st.scenario
-                    )
-                } else if st.space != again.space {
-                    format!(
-                        "the parameters of `{}` differ from the `space` in {CAMPAIGN_FILE}",
-                        st.scenario
-                    )
-                } else if st.scenario_sha256.is_some() {
-                    format!(
-                        "{CAMPAIGN_FILE} was edited: its strategy, seed, budget, strength or \
-                         system under test no longer give its `fingerprint` (the scenario \
-                         program is unchanged)"
-                    )
-                } else {
-                    format!(
-                        "the scenario `{}` changed since the campaign started, or {CAMPAIGN_FILE} \
-                         was edited",
-                        st.scenario
-                    )
-                };
-                return Err(refuse(vec![why]));
-            }
-            let points = match &st.points {
-                Some(stored_file) => {
-                    let path = Path::new(&stored_file.path);
-                    let (now, points) = read_points(path, request, &scenario)?;
-                    if now.sha256 != stored_file.sha256 {
-                        return Err(refuse(vec![format!(
-                            "the points file `{}` changed since the campaign started",
-                            stored_file.path
-                        )]));
-                    }
-                    Some(points)
-                }
-                None => None,
-            };
-            Ok((st.clone(), scenario, points))
-        }
+        (Some(name), _) => requested_settings(request, stored, name),
+        (None, Some(st)) => stored_settings(request, st),
         (None, None) => Err(Error::BadInput(format!(
             "--resume without SCENARIO needs a campaign in `{}`, which has no {CAMPAIGN_FILE}",
             request.out.display()
         ))),
+    }
+}
+
+/// The refusal to resume the campaign in `out` whose settings differ from the request's.
+fn refuse(out: &Path, diffs: Vec<String>) -> Error {
+    Error::BadInput(format!(
+        "refusing to resume: `{}` holds a campaign with other settings ({}); resume without \
+         those arguments, or start a new campaign with --force or another --out",
+        out.display(),
+        diffs.join("; ")
+    ))
+}
+
+/// Scenario `name`, under the system under test of `choice` when it names one.
+fn load_scenario(name: &str, choice: &SutChoice) -> Result<Scenario, Error> {
+    let mut scenario = paracosm_scenarios::load(name)?;
+    if let Some(s) = choice.config()? {
+        scenario.sut = s;
+    }
+    Ok(scenario)
+}
+
+/// The settings of a request that names scenario `name`, which must equal `stored`'s when
+/// resuming.
+fn requested_settings(
+    request: &Request,
+    stored: Option<&CampaignFile>,
+    name: &str,
+) -> Result<(CampaignFile, Scenario, Option<Vec<Point>>), Error> {
+    let choice = SutChoice::of(request.sut.as_ref());
+    let scenario = load_scenario(name, &choice)?;
+    let given = match &request.points {
+        Some(path) => Some(read_points(path, request, &scenario)?),
+        None if request.strategy == Some(Strategy::Points) => {
+            return Err(Error::Generator(GeneratorError::NeedsPoints))
+        }
+        None => None,
+    };
+    let file = CampaignFile::new(
+        name,
+        &scenario,
+        Settings {
+            sut: choice,
+            strategy: match given {
+                Some(_) => Strategy::Points,
+                None => request.strategy.unwrap_or(Strategy::Halton),
+            }
+            .name()
+            .into(),
+            seed: request.seed.unwrap_or(0),
+            budget: match &given {
+                Some((_, points)) => points.len() as u64,
+                None => request.budget.unwrap_or(100),
+            },
+            // The default strength, 2, is lowered to the number of discrete
+            // parameters when there are fewer (a strength asked for is kept, and
+            // refused if too high).
+            strength: request.strength.unwrap_or_else(|| {
+                let suite = request
+                    .strategy
+                    .is_some_and(|s| Strategy::SUITES.contains(&s));
+                match scenario.space.level_counts().len() {
+                    1 if suite => 1,
+                    _ => 2,
+                }
+            }),
+            shard: request.shard,
+            points: given.as_ref().map(|(f, _)| f.clone()),
+        },
+    );
+    match stored.map(|st| st.differences(&file)) {
+        Some(diffs) if !diffs.is_empty() => Err(refuse(&request.out, diffs)),
+        _ => Ok((file, scenario, given.map(|(_, p)| p))),
+    }
+}
+
+/// The settings of a bare resume: the stored campaign `st`'s, once the request's settings,
+/// the campaign file, the scenario and its points file are found to agree with it.
+fn stored_settings(
+    request: &Request,
+    st: &CampaignFile,
+) -> Result<(CampaignFile, Scenario, Option<Vec<Point>>), Error> {
+    check_bare_resume(request, st)?;
+    let scenario = load_scenario(&st.scenario, &st.sut)?;
+    let again = CampaignFile::new(&st.scenario, &scenario, st.settings());
+    if again.fingerprint != st.fingerprint {
+        return Err(refuse(&request.out, vec![what_changed(st, &again)]));
+    }
+    let points = match &st.points {
+        Some(stored_file) => {
+            let path = Path::new(&stored_file.path);
+            let (now, points) = read_points(path, request, &scenario)?;
+            if now.sha256 != stored_file.sha256 {
+                return Err(refuse(
+                    &request.out,
+                    vec![format!(
+                        "the points file `{}` changed since the campaign started",
+                        stored_file.path
+                    )],
+                ));
+            }
+            Some(points)
+        }
+        None => None,
+    };
+    Ok((st.clone(), scenario, points))
+}
+
+/// Refuses a bare resume whose settings differ from the stored campaign `st`'s, or whose
+/// `campaign.json` was edited by hand.
+fn check_bare_resume(request: &Request, st: &CampaignFile) -> Result<(), Error> {
+    // Settings given with a bare resume must agree with the stored campaign.
+    let mut diffs = Vec::new();
+    let mut check = |name: &str, given: Option<String>, stored: String| {
+        if let Some(g) = given.filter(|g| *g != stored) {
+            diffs.push(format!("{name}: {stored} vs {g}"));
+        }
+    };
+    check(
+        "seed",
+        request.seed.map(|v| v.to_string()),
+        st.seed.to_string(),
+    );
+    check(
+        "budget",
+        request.budget.map(|v| v.to_string()),
+        st.budget.to_string(),
+    );
+    check(
+        "strength",
+        request.strength.map(|v| v.to_string()),
+        st.strength.to_string(),
+    );
+    check(
+        "strategy",
+        request.strategy.map(|s| s.name().to_owned()),
+        st.strategy.clone(),
+    );
+    let shard = |s: Option<Shard>| s.map_or("none".to_owned(), |s| s.to_string());
+    check(
+        "shard",
+        request.shard.map(|s| shard(Some(s))),
+        shard(st.shard),
+    );
+    let sut = request.sut.as_ref();
+    if sut.is_some() && SutChoice::of(sut) != st.sut {
+        diffs.push("system under test differs".into());
+    }
+    if !diffs.is_empty() {
+        return Err(refuse(&request.out, diffs));
+    }
+    let edited = st.edited_fields();
+    if !edited.is_empty() {
+        return Err(Error::BadInput(format!(
+            "refusing to resume: {} was edited by hand: {} no longer match{} what the \
+             campaign wrote. Put the value{} back, or start a new campaign with --force \
+             or another --out",
+            request.out.join(CAMPAIGN_FILE).display(),
+            edited
+                .iter()
+                .map(|f| format!("`{f}`"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            if edited.len() == 1 { "es" } else { "" },
+            if edited.len() == 1 { "" } else { "s" },
+        )));
+    }
+    Ok(())
+}
+
+/// Why the stored campaign `st` has another fingerprint than the same settings give now
+/// (`again`): the program, a file it reads, its parameters, or `campaign.json` itself.
+fn what_changed(st: &CampaignFile, again: &CampaignFile) -> String {
+    if st
+        .scenario_sha256
+        .as_ref()
+        .is_some_and(|h| Some(h) != again.scenario_sha256.as_ref())
+    {
+        format!(
+            "the scenario program `{}` changed since the campaign started (its \
+             SHA-256 differs)",
+            st.scenario
+        )
+    } else if let Some((was, now)) = st
+        .input_files
+        .iter()
+        .zip(&again.input_files)
+        .find(|(a, b)| a != b)
+    {
+        format!(
+            "the file `{}` that the scenario program reads changed since the \
+             campaign started (SHA-256 {} then, {} now)",
+            now.path,
+            &was.sha256[..12],
+            &now.sha256[..12]
+        )
+    } else if st.input_files.len() != again.input_files.len() {
+        format!(
+            "the scenario program `{}` reads other files than when the campaign \
+             started",
+            st.scenario
+        )
+    } else if st.space != again.space {
+        format!(
+            "the parameters of `{}` differ from the `space` in {CAMPAIGN_FILE}",
+            st.scenario
+        )
+    } else if st.scenario_sha256.is_some() {
+        format!(
+            "{CAMPAIGN_FILE} was edited: its strategy, seed, budget, strength or \
+             system under test no longer give its `fingerprint` (the scenario \
+             program is unchanged)"
+        )
+    } else {
+        format!(
+            "the scenario `{}` changed since the campaign started, or {CAMPAIGN_FILE} \
+             was edited",
+            st.scenario
+        )
     }
 }
 

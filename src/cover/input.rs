@@ -319,53 +319,7 @@ fn jsonl_rows(
                     )),
                 })
                 .collect::<Result<_, _>>()?,
-            None => {
-                // Discrete coordinates are level indices: without the space they cannot be
-                // named or counted, and dropping them would report the coverage of a smaller
-                // space than the one tested.
-                if v["point"]["discrete"]
-                    .as_array()
-                    .is_some_and(|d| !d.is_empty())
-                {
-                    return Err(err(
-                        Some(ln),
-                        None,
-                        "the tests have discrete parameters (`point.discrete`); give --space \
-                         with the scenario they were run on to read them by name"
-                            .into(),
-                    ));
-                }
-                let coords = v["point"]["continuous"]
-                    .as_array()
-                    .ok_or_else(|| err(Some(ln), None, "no `point.continuous` array".into()))?;
-                if names.is_empty() {
-                    names = (0..coords.len()).map(|j| format!("u{j}")).collect();
-                }
-                if coords.len() != names.len() {
-                    return Err(err(
-                        Some(ln),
-                        None,
-                        format!(
-                            "{} coordinates where earlier lines have {}",
-                            coords.len(),
-                            names.len()
-                        ),
-                    ));
-                }
-                coords
-                    .iter()
-                    .enumerate()
-                    .map(|(j, c)| {
-                        c.as_f64().map(Cell::Number).ok_or_else(|| {
-                            err(
-                                Some(ln),
-                                Some((j + 1, names[j].clone())),
-                                format!("`{c}` in `point.continuous` is not a number"),
-                            )
-                        })
-                    })
-                    .collect::<Result<_, _>>()?
-            }
+            None => unit_cells(&v, ln, &mut names, err)?,
         };
         rows.push((ln, cells));
     }
@@ -374,6 +328,61 @@ fn jsonl_rows(
     }
     let positions = (1..=names.len()).collect();
     Ok((names, positions, rows))
+}
+
+/// The cells of results line `ln` (`v`) read without a space: its unit-cube coordinates
+/// (`point.continuous`), named `u0, u1, ...` in `names` from the first line on.
+fn unit_cells(
+    v: &serde_json::Value,
+    ln: u64,
+    names: &mut Vec<String>,
+    err: &dyn Fn(Option<u64>, Option<(usize, String)>, String) -> InputError,
+) -> Result<Vec<Cell>, InputError> {
+    // Discrete coordinates are level indices: without the space they cannot be named or
+    // counted, and dropping them would report the coverage of a smaller space than the one
+    // tested.
+    if v["point"]["discrete"]
+        .as_array()
+        .is_some_and(|d| !d.is_empty())
+    {
+        return Err(err(
+            Some(ln),
+            None,
+            "the tests have discrete parameters (`point.discrete`); give --space \
+             with the scenario they were run on to read them by name"
+                .into(),
+        ));
+    }
+    let coords = v["point"]["continuous"]
+        .as_array()
+        .ok_or_else(|| err(Some(ln), None, "no `point.continuous` array".into()))?;
+    if names.is_empty() {
+        *names = (0..coords.len()).map(|j| format!("u{j}")).collect();
+    }
+    if coords.len() != names.len() {
+        return Err(err(
+            Some(ln),
+            None,
+            format!(
+                "{} coordinates where earlier lines have {}",
+                coords.len(),
+                names.len()
+            ),
+        ));
+    }
+    coords
+        .iter()
+        .enumerate()
+        .map(|(j, c)| {
+            c.as_f64().map(Cell::Number).ok_or_else(|| {
+                err(
+                    Some(ln),
+                    Some((j + 1, names[j].clone())),
+                    format!("`{c}` in `point.continuous` is not a number"),
+                )
+            })
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -10,6 +10,6 @@ mod spec;
 
 pub use input::{parse_tests, read_tests, InputError, TestSet};
 pub use pict::{parse_pict, read_seeds, PictError, PictModel};
-pub use plan::{plan, suite_per_row, Plan, MAX_PLANNED};
+pub use plan::{plan, suite_per_row, Plan, PlanError, MAX_PLANNED};
 pub use report::{estimate, Estimate, Metric};
 pub use spec::{load_space, parse_space, SpecError};

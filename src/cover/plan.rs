@@ -4,8 +4,62 @@ use std::fmt;
 
 use serde::Serialize;
 
-use paracosm_generators::coverage::{dispersion, subset_products, DispersionOptions};
+use paracosm_generators::coverage::{
+    dispersion, subset_products, CoverageError, DispersionOptions,
+};
+use paracosm_generators::covering::CoveringError;
 use paracosm_generators::{Halton, ParamSpace};
+
+/// Why [`plan`] or [`suite_per_row`] cannot count a test set.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanError {
+    /// `ε` so small that a discrete group would need [`MAX_PLANNED`] Halton points or more.
+    #[error(
+        "ε = {epsilon:e} needs about {points:.3e} Halton points per discrete group, more than \
+         the {max} a plan counts; give a larger --epsilon",
+        max = MAX_PLANNED
+    )]
+    PointsPerGroup {
+        /// The target dispersion.
+        epsilon: f64,
+        /// The points per group it needs, `ceil(C / ε)`.
+        points: f64,
+    },
+    /// Rows × points per group reach [`MAX_PLANNED`] tests.
+    #[error(
+        "the plan needs {rows} rows × {points} points, more than the {max} tests a \
+         plan counts; give a larger --epsilon or --delta",
+        max = MAX_PLANNED
+    )]
+    Tests {
+        /// Rows of the random k-wise family.
+        rows: u64,
+        /// Halton points per row.
+        points: u64,
+    },
+    /// The suite would write more than the command's limit.
+    #[error(
+        "a suite with every row's dispersion at most ε = {epsilon:e} needs {rows} rows \
+         × {per_row} points or more, past the {max_points} this command writes; give a \
+         larger --epsilon"
+    )]
+    Suite {
+        /// The target dispersion.
+        epsilon: f64,
+        /// Rows of the covering array.
+        rows: u64,
+        /// Points per row tried.
+        per_row: u64,
+        /// The most points the command writes.
+        max_points: u64,
+    },
+    /// The covering array cannot be built (a strength out of range).
+    #[error(transparent)]
+    Covering(#[from] CoveringError),
+    /// A block's dispersion cannot be measured.
+    #[error(transparent)]
+    Coverage(#[from] CoverageError),
+}
 
 /// A test budget plan for a space.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -40,8 +94,14 @@ pub struct Plan {
 /// `C = max_n n · dispersion(E_n)` (Proposition 3.3: dispersion is `O(1/n)`).
 ///
 /// # Errors
-/// A message when the plan would count [`MAX_PLANNED`] tests or more (a tiny `ε`).
-pub fn plan(space: &ParamSpace, strength: usize, epsilon: f64, delta: f64) -> Result<Plan, String> {
+/// [`PlanError::PointsPerGroup`] or [`PlanError::Tests`] when the plan would count
+/// [`MAX_PLANNED`] tests or more (a tiny `ε`).
+pub fn plan(
+    space: &ParamSpace,
+    strength: usize,
+    epsilon: f64,
+    delta: f64,
+) -> Result<Plan, PlanError> {
     let levels = space.level_counts();
     let nd = levels.len();
     let k = strength.min(nd);
@@ -89,10 +149,7 @@ pub fn plan(space: &ParamSpace, strength: usize, epsilon: f64, delta: f64) -> Re
         constant = Some(c);
         let n = (c / epsilon).ceil().max(1.0);
         if n >= MAX_PLANNED as f64 {
-            return Err(format!(
-                "ε = {epsilon:e} needs about {n:.3e} Halton points per discrete group, more than \
-                 the {MAX_PLANNED} a plan counts; give a larger --epsilon"
-            ));
+            return Err(PlanError::PointsPerGroup { epsilon, points: n });
         }
         per_group = Some(n as u64);
     }
@@ -100,12 +157,9 @@ pub fn plan(space: &ParamSpace, strength: usize, epsilon: f64, delta: f64) -> Re
     let total = rows
         .checked_mul(per_group.unwrap_or(1))
         .filter(|&t| t < MAX_PLANNED)
-        .ok_or_else(|| {
-            format!(
-                "the plan needs {rows} rows × {} points, more than the {MAX_PLANNED} tests a \
-                 plan counts; give a larger --epsilon or --delta",
-                per_group.unwrap_or(1)
-            )
+        .ok_or(PlanError::Tests {
+            rows,
+            points: per_group.unwrap_or(1),
         })?;
     Ok(Plan {
         strength: k,
@@ -132,8 +186,9 @@ pub const MAX_PLANNED: u64 = 1 << 53;
 /// at the sequence's start). Returns the points per row and the largest block dispersion.
 ///
 /// # Errors
-/// A message when the plan overflows, the covering array cannot be built (a strength out of
-/// range), or the suite would need more than `max_points` points.
+/// As [`plan`] when the plan overflows; [`PlanError::Covering`] when the covering array cannot
+/// be built (a strength out of range); [`PlanError::Suite`] when the suite would need more
+/// than `max_points` points.
 pub fn suite_per_row(
     space: &ParamSpace,
     strength: usize,
@@ -141,7 +196,7 @@ pub fn suite_per_row(
     epsilon: f64,
     seed: u64,
     max_points: u64,
-) -> Result<(u64, f64), String> {
+) -> Result<(u64, f64), PlanError> {
     use paracosm_generators::covering::CoveringSuite;
     let nc = space.continuous_dims();
     let mut per_row = plan(space, strength, epsilon, 0.01)?
@@ -151,23 +206,22 @@ pub fn suite_per_row(
         return Ok((1, 0.0));
     }
     loop {
-        let suite =
-            CoveringSuite::new(space, strength, kind, per_row, seed).map_err(|e| e.to_string())?;
+        let suite = CoveringSuite::new(space, strength, kind, per_row, seed)?;
         let rows = suite.rows() as u64;
         if rows.saturating_mul(per_row) > max_points {
-            return Err(format!(
-                "a suite with every row's dispersion at most ε = {epsilon:e} needs {rows} rows \
-                 × {per_row} points or more, past the {max_points} this command writes; give a \
-                 larger --epsilon"
-            ));
+            return Err(PlanError::Suite {
+                epsilon,
+                rows,
+                per_row,
+                max_points,
+            });
         }
         let mut worst: f64 = 0.0;
         for r in 0..rows {
             let block: Vec<f64> = (0..per_row)
                 .flat_map(|i| suite.point(r + rows * i).continuous)
                 .collect();
-            let d =
-                dispersion(&block, nc, &DispersionOptions::default()).map_err(|e| e.to_string())?;
+            let d = dispersion(&block, nc, &DispersionOptions::default())?;
             worst = worst.max(d.upper);
         }
         if worst <= epsilon {

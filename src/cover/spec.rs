@@ -86,7 +86,7 @@ pub fn load_space(spec: &str) -> Result<ParamSpace, SpecError> {
         path,
         paracosm_scenarios::text_file::MAX_SOURCE_BYTES,
     )
-    .map_err(|e| SpecError::Unreadable(spec.to_owned(), e))?;
+    .map_err(|e| SpecError::Unreadable(spec.to_owned(), e.to_string()))?;
     parse_space(spec, &text)
 }
 

@@ -480,90 +480,7 @@ fn write_index(
         .iter()
         .map(|p| p.name.clone())
         .collect();
-    let frames_path = out.join(FRAMES_FILE);
-    let mut csv = csv::Writer::from_path(&frames_path).map_err(|e| write_error(&frames_path, e))?;
-    let mut header: Vec<String> = ["test", "frame", "t_s", "status"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    header.extend(names.iter().cloned());
-    header.extend(
-        [
-            "image",
-            "depth",
-            "mask",
-            "ego_x_m",
-            "ego_z_m",
-            "ego_heading_rad",
-            "ego_speed_mps",
-            "throttle",
-            "steering",
-            "applied_steering",
-        ]
-        .map(String::from),
-    );
-    csv.write_record(&header)
-        .map_err(|e| write_error(&frames_path, e))?;
-    let (mut images, mut annotations) = (Vec::new(), Vec::new());
-    for t in done {
-        for r in &t.rows {
-            let mut row = vec![
-                r.test.to_string(),
-                r.frame.to_string(),
-                r.t_s.to_string(),
-                status_name(t.record.status).to_owned(),
-            ];
-            row.extend(
-                names
-                    .iter()
-                    .map(|n| cell(t.record.params.as_ref().and_then(|a| a.get(n)))),
-            );
-            let files = [
-                format!("images/{}.png", r.stem),
-                format!("depth/{}.npy", r.stem),
-                format!("masks/{}.png", r.stem),
-            ];
-            row.extend(files.iter().cloned());
-            row.extend(
-                [
-                    r.ego.pos_m[0],
-                    r.ego.pos_m[2],
-                    r.ego.heading_rad,
-                    r.ego.speed_mps,
-                    r.throttle,
-                    r.steering,
-                    r.applied_steering,
-                ]
-                .map(|v| v.to_string()),
-            );
-            csv.write_record(&row)
-                .map_err(|e| write_error(&frames_path, e))?;
-            let image_id = images.len();
-            for b in &r.boxes {
-                annotations.push(CocoAnnotation {
-                    id: annotations.len() + 1,
-                    image_id,
-                    category_id: b.class.id(),
-                    bbox: [b.x0, b.y0, b.x1 - b.x0, b.y1 - b.y0],
-                    area: b.pixels,
-                    iscrowd: 0,
-                    actor: b.actor,
-                });
-            }
-            let [image, depth, mask] = files;
-            images.push(CocoImage {
-                id: image_id,
-                file_name: image,
-                width: r.width,
-                height: r.height,
-                test: r.test,
-                t_s: r.t_s,
-                depth_file: depth,
-                mask_file: mask,
-            });
-        }
-    }
-    csv.flush().map_err(|e| write_error(&frames_path, e))?;
+    let (images, annotations) = write_frames_csv(&out.join(FRAMES_FILE), &names, done)?;
     let categories: Vec<CocoCategory> = SemanticClass::ALL
         .iter()
         .map(|c| CocoCategory {
@@ -597,7 +514,136 @@ fn write_index(
         .filter(|t| t.record.status == Status::Error)
         .count();
     let frames: usize = done.iter().map(|t| t.rows.len()).sum();
-    let manifest = serde_json::json!({
+    let counts = (errors, frames, annotations.len());
+    let manifest = manifest(req, scenario, camera, done, counts, interrupted);
+    let manifest_path = out.join(MANIFEST_FILE);
+    crate::atomic::write(
+        &manifest_path,
+        serde_json::to_string_pretty(&manifest)
+            .expect("a JSON value serialises")
+            .as_bytes(),
+    )?;
+    Ok(DatasetSummary {
+        tests: done.len(),
+        errors,
+        frames,
+        boxes: annotations.len(),
+        interrupted,
+        wall_s: started.elapsed().as_secs_f64(),
+        out: out.clone(),
+    })
+}
+
+/// Writes `frames.csv` to `frames_path`: a row per frame of `done`, with the test's
+/// parameters `names`; returns the frames as COCO images and their boxes as annotations.
+fn write_frames_csv(
+    frames_path: &Path,
+    names: &[String],
+    done: &[TestData],
+) -> Result<(Vec<CocoImage>, Vec<CocoAnnotation>), Error> {
+    let mut csv = csv::Writer::from_path(frames_path).map_err(|e| write_error(frames_path, e))?;
+    let mut header: Vec<String> = ["test", "frame", "t_s", "status"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    header.extend(names.iter().cloned());
+    header.extend(
+        [
+            "image",
+            "depth",
+            "mask",
+            "ego_x_m",
+            "ego_z_m",
+            "ego_heading_rad",
+            "ego_speed_mps",
+            "throttle",
+            "steering",
+            "applied_steering",
+        ]
+        .map(String::from),
+    );
+    csv.write_record(&header)
+        .map_err(|e| write_error(frames_path, e))?;
+    let (mut images, mut annotations) = (Vec::new(), Vec::new());
+    for t in done {
+        for r in &t.rows {
+            let files = [
+                format!("images/{}.png", r.stem),
+                format!("depth/{}.npy", r.stem),
+                format!("masks/{}.png", r.stem),
+            ];
+            csv.write_record(frame_row(t, r, names, &files))
+                .map_err(|e| write_error(frames_path, e))?;
+            let image_id = images.len();
+            for b in &r.boxes {
+                annotations.push(CocoAnnotation {
+                    id: annotations.len() + 1,
+                    image_id,
+                    category_id: b.class.id(),
+                    bbox: [b.x0, b.y0, b.x1 - b.x0, b.y1 - b.y0],
+                    area: b.pixels,
+                    iscrowd: 0,
+                    actor: b.actor,
+                });
+            }
+            let [image, depth, mask] = files;
+            images.push(CocoImage {
+                id: image_id,
+                file_name: image,
+                width: r.width,
+                height: r.height,
+                test: r.test,
+                t_s: r.t_s,
+                depth_file: depth,
+                mask_file: mask,
+            });
+        }
+    }
+    csv.flush().map_err(|e| write_error(frames_path, e))?;
+    Ok((images, annotations))
+}
+
+/// The `frames.csv` row of frame `r` of test `t`: its test, frame, time and status, the
+/// test's parameters `names`, its `files` and the ego's state and controls.
+fn frame_row(t: &TestData, r: &FrameRow, names: &[String], files: &[String; 3]) -> Vec<String> {
+    let mut row = vec![
+        r.test.to_string(),
+        r.frame.to_string(),
+        r.t_s.to_string(),
+        status_name(t.record.status).to_owned(),
+    ];
+    row.extend(
+        names
+            .iter()
+            .map(|n| cell(t.record.params.as_ref().and_then(|a| a.get(n)))),
+    );
+    row.extend(files.iter().cloned());
+    row.extend(
+        [
+            r.ego.pos_m[0],
+            r.ego.pos_m[2],
+            r.ego.heading_rad,
+            r.ego.speed_mps,
+            r.throttle,
+            r.steering,
+            r.applied_steering,
+        ]
+        .map(|v| v.to_string()),
+    );
+    row
+}
+
+/// `dataset.json`: the settings, the camera, the counts (`(errors, frames, boxes)`) and what
+/// the files hold.
+fn manifest(
+    req: &DatasetRequest,
+    scenario: &paracosm_scenarios::Scenario,
+    camera: &CameraSpec,
+    done: &[TestData],
+    (errors, frames, boxes): (usize, usize, usize),
+    interrupted: bool,
+) -> serde_json::Value {
+    serde_json::json!({
         "scenario": req.scenario,
         "strategy": req.strategy.name(),
         "seed": req.seed,
@@ -617,27 +663,11 @@ fn write_index(
         "tests": done.len(),
         "tests_in_error": errors,
         "frames": frames,
-        "boxes": annotations.len(),
+        "boxes": boxes,
         "interrupted": interrupted,
         "depth": "z-depth along the optical axis in metres, float32 .npy, height x width; inf where only sky",
         "mask": "8-bit PNG, each pixel a class id",
         "classes": SemanticClass::ALL.iter().map(|c| (c.name(), c.id())).collect::<std::collections::BTreeMap<_, _>>(),
         "control": "throttle in [-1, 1] (negative: brake), steering in [-1, 1] (positive: left), as the teacher answered for the frame's step; applied_steering: what the vehicle applied (the answer plus the injected steer_noise)",
-    });
-    let manifest_path = out.join(MANIFEST_FILE);
-    crate::atomic::write(
-        &manifest_path,
-        serde_json::to_string_pretty(&manifest)
-            .expect("a JSON value serialises")
-            .as_bytes(),
-    )?;
-    Ok(DatasetSummary {
-        tests: done.len(),
-        errors,
-        frames,
-        boxes: annotations.len(),
-        interrupted,
-        wall_s: started.elapsed().as_secs_f64(),
-        out: out.clone(),
     })
 }

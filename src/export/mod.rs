@@ -34,6 +34,40 @@ fn input(e: impl std::fmt::Display) -> Error {
     Error::BadInput(e.to_string())
 }
 
+/// The OpenDRIVE document of `world`'s network: its pieces written out when it holds no map
+/// (`maps`), the map's own file (read again from the program `program`) when it is a single
+/// map.
+///
+/// # Errors
+/// [`Error::BadInput`] for a network that mixes a map with other pieces, a map that is not
+/// among the files the program read or can no longer be read, or pieces [`xodr::write`]
+/// refuses.
+fn network_document(
+    world: &WorldSpec,
+    scenario: &paracosm_scenarios::Scenario,
+    program: &str,
+    maps: &[&PieceKind],
+) -> Result<String, Error> {
+    if maps.is_empty() {
+        xodr::write(&world.network, &scenario.name).map_err(input)
+    } else if maps.len() == 1 && world.network.pieces().len() == 1 {
+        let read = scenario
+            .input_files
+            .iter()
+            .find(|f| {
+                matches!(maps[0], PieceKind::Map { map, .. }
+                    if map.0.source.ends_with(f.path.trim_start_matches("./")))
+            })
+            .or(scenario.input_files.first())
+            .ok_or_else(|| input("the program's map is not among the files it read"))?;
+        paracosm_scenarios::lang::map_files::read_input_file(program, &read.path).map_err(input)
+    } else {
+        Err(input(
+            "the test's network mixes an OpenDRIVE map with other pieces, which cannot be exported as one OpenDRIVE file",
+        ))
+    }
+}
+
 /// Writes test `id` of the campaign whose results are `results` into `out` as `test_ID.xosc`
 /// and `test_ID.xodr`.
 ///
@@ -88,25 +122,7 @@ pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
         .map(|p| &p.kind)
         .filter(|k| matches!(k, PieceKind::Map { .. }))
         .collect();
-    let network = if maps.is_empty() {
-        xodr::write(&world.network, &scenario.name).map_err(input)?
-    } else if maps.len() == 1 && world.network.pieces().len() == 1 {
-        let read = scenario
-            .input_files
-            .iter()
-            .find(|f| {
-                matches!(maps[0], PieceKind::Map { map, .. }
-                    if map.0.source.ends_with(f.path.trim_start_matches("./")))
-            })
-            .or(scenario.input_files.first())
-            .ok_or_else(|| input("the program's map is not among the files it read"))?;
-        paracosm_scenarios::lang::map_files::read_input_file(&campaign.scenario, &read.path)
-            .map_err(input)?
-    } else {
-        return Err(input(
-            "the test's network mixes an OpenDRIVE map with other pieces, which cannot be exported as one OpenDRIVE file",
-        ));
-    };
+    let network = network_document(&world, &scenario, &campaign.scenario, &maps)?;
     let origin_m = maps
         .first()
         .and_then(|k| match k {

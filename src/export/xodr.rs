@@ -14,10 +14,24 @@
 //!
 //! paracosm's `(x, z)` is OpenDRIVE's `(x, -y)`, so headings agree.
 
-use paracosm_engine::network::{Network, PieceKind, LANE_WIDTH_M, SIDEWALK_WIDTH_M};
+use paracosm_engine::network::{LanePath, Network, PieceKind, LANE_WIDTH_M, SIDEWALK_WIDTH_M};
 use paracosm_engine::PieceId;
 
 use super::xml::El;
+
+/// Why a network cannot be written as OpenDRIVE.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum XodrError {
+    /// The network holds an OpenDRIVE map: its own file is exported instead, and a network
+    /// that mixes one with pieces of the program cannot be.
+    #[error(
+        "{0} is an OpenDRIVE map: its own file is exported, and a network that mixes it with pieces of the program cannot be"
+    )]
+    Map(String),
+    /// A road piece of a kind this writer does not know (its type name).
+    #[error("no OpenDRIVE road for a {0}")]
+    UnknownRoad(&'static str),
+}
 
 /// The `<road id>` of road piece `i` (by piece index).
 pub fn road_id(i: usize) -> String {
@@ -103,9 +117,9 @@ fn is_road(kind: &PieceKind) -> bool {
 /// The document for `network`.
 ///
 /// # Errors
-/// A message for a network holding an OpenDRIVE map (its own file is exported instead) or a
-/// piece kind this writer does not know.
-pub fn write(network: &Network, name: &str) -> Result<String, String> {
+/// [`XodrError::Map`] for a network holding an OpenDRIVE map (its own file is exported
+/// instead), [`XodrError::UnknownRoad`] for a piece kind this writer does not know.
+pub fn write(network: &Network, name: &str) -> Result<String, XodrError> {
     let mut root = El::new("OpenDRIVE").child(
         El::new("header")
             .attr("revMajor", 1)
@@ -118,10 +132,7 @@ pub fn write(network: &Network, name: &str) -> Result<String, String> {
     for (i, p) in network.pieces().iter().enumerate() {
         let kind = &p.kind;
         if let PieceKind::Map { .. } = kind {
-            return Err(format!(
-                "{} is an OpenDRIVE map: its own file is exported, and a network that mixes it with pieces of the program cannot be",
-                p.name
-            ));
+            return Err(XodrError::Map(p.name.clone()));
         }
         if is_road(kind) {
             root = root.child(road(network, i)?);
@@ -135,7 +146,7 @@ pub fn write(network: &Network, name: &str) -> Result<String, String> {
 }
 
 /// The road of segment or curve `i`.
-fn road(network: &Network, i: usize) -> Result<El, String> {
+fn road(network: &Network, i: usize) -> Result<El, XodrError> {
     let p = &network.pieces()[i];
     let kind = &p.kind;
     let length = kind.road_length_m().expect("a road piece");
@@ -153,7 +164,7 @@ fn road(network: &Network, i: usize) -> Result<El, String> {
         } => El::new("spiral")
             .num("curvStart", *curv_start)
             .num("curvEnd", *curv_end),
-        other => return Err(format!("no OpenDRIVE road for a {}", other.type_name())),
+        other => return Err(XodrError::UnknownRoad(other.type_name())),
     };
     // Port ONE sits at the piece's local origin, the road heading along local +x.
     let [x, z] = p.pose.apply([0.0, 0.0]);
@@ -217,6 +228,44 @@ fn road(network: &Network, i: usize) -> Result<El, String> {
         .child(El::new("lanes").child(section)))
 }
 
+/// The `<planView>` of a junction's lane path, and its length: the path's own lines and arcs
+/// (`LanePath::curve`), so a simulator reading the map drives the same G1 curve; the polyline
+/// where a path has none.
+fn path_plan(path: &LanePath) -> (El, f64) {
+    let mut plan = El::new("planView");
+    let mut s = 0.0;
+    for (pose, line) in &path.curve {
+        if line.length_m < 1e-6 {
+            continue;
+        }
+        let shape = if line.curv_start == 0.0 {
+            El::new("line")
+        } else {
+            El::new("arc").num("curvature", line.curv_start)
+        };
+        plan = plan.child(geometry(
+            s,
+            pose.x,
+            -pose.z,
+            pose.heading_rad,
+            line.length_m,
+            shape,
+        ));
+        s += line.length_m;
+    }
+    for w in path.points.windows(2).filter(|_| path.curve.is_empty()) {
+        let (a, b) = (w[0], w[1]);
+        let length = (b[0] - a[0]).hypot(b[1] - a[1]);
+        if length < 1e-6 {
+            continue;
+        }
+        let hdg = (-(b[1] - a[1])).atan2(b[0] - a[0]);
+        plan = plan.child(geometry(s, a[0], -a[1], hdg, length, El::new("line")));
+        s += length;
+    }
+    (plan, s)
+}
+
 /// The connecting roads and the `<junction>` of junction piece `i`.
 fn junction(network: &Network, i: usize) -> (Vec<El>, El) {
     let p = &network.pieces()[i];
@@ -226,39 +275,7 @@ fn junction(network: &Network, i: usize) -> (Vec<El>, El) {
         .attr("name", &p.name);
     for (n, path) in network.lane_paths(PieceId(i)).iter().enumerate() {
         let id = 1000 * (i + 1) + n;
-        // The path's own lines and arcs (`LanePath::curve`), so a simulator reading the map
-        // drives the same G1 curve; the polyline where a path has none.
-        let mut plan = El::new("planView");
-        let mut s = 0.0;
-        for (pose, line) in &path.curve {
-            if line.length_m < 1e-6 {
-                continue;
-            }
-            let shape = if line.curv_start == 0.0 {
-                El::new("line")
-            } else {
-                El::new("arc").num("curvature", line.curv_start)
-            };
-            plan = plan.child(geometry(
-                s,
-                pose.x,
-                -pose.z,
-                pose.heading_rad,
-                line.length_m,
-                shape,
-            ));
-            s += line.length_m;
-        }
-        for w in path.points.windows(2).filter(|_| path.curve.is_empty()) {
-            let (a, b) = (w[0], w[1]);
-            let length = (b[0] - a[0]).hypot(b[1] - a[1]);
-            if length < 1e-6 {
-                continue;
-            }
-            let hdg = (-(b[1] - a[1])).atan2(b[0] - a[0]);
-            plan = plan.child(geometry(s, a[0], -a[1], hdg, length, El::new("line")));
-            s += length;
-        }
+        let (plan, s) = path_plan(path);
         let j = path.entry.1 as i32;
         // Where the path comes from and goes to: the road across each port, and the lane
         // there (a lane driving into the junction from a road's end is -j; from its start, j).

@@ -226,17 +226,54 @@ fn sampled(states: &[Snapshot]) -> Vec<&Snapshot> {
     out
 }
 
+/// A simulated world position `[x, y, z]` in the file's frame, where the network's origin lies
+/// at `origin` (OpenDRIVE y is -z).
+fn in_file(origin: [f64; 2], p: [f64; 3]) -> [f64; 3] {
+    [p[0] + origin[0], p[1], p[2] - origin[1]]
+}
+
 /// The document.
 pub fn write(test: &Test<'_>) -> String {
-    let w = test.world;
-    // A simulated world position `[x, y, z]` in the file's frame (OpenDRIVE y is -z).
-    let origin = test.origin_m;
-    let g = |p: [f64; 3]| [p[0] + origin[0], p[1], p[2] - origin[1]];
     let frames = sampled(test.states);
     let Some(first) = test.states.first() else {
         return String::new();
     };
-    let params = El::new("ParameterDeclarations").children(test.params.iter().map(|(n, v)| {
+    let params = parameter_declarations(&test.params);
+    let entities = entities(test.world);
+    let init = init(test, first);
+    let story = story(test, &frames, first);
+    El::new("OpenSCENARIO")
+        .child(
+            El::new("FileHeader")
+                .attr("revMajor", 1)
+                .attr("revMinor", 2)
+                .attr("date", "1970-01-01T00:00:00")
+                .attr("description", &test.description)
+                .attr("author", "paracosm"),
+        )
+        .child(params)
+        .child(El::new("CatalogLocations"))
+        .child(
+            El::new("RoadNetwork").child(El::new("LogicFile").attr("filepath", &test.network_file)),
+        )
+        .child(El::new("Entities").children(entities))
+        .child(
+            El::new("Storyboard")
+                .child(El::new("Init").child(El::new("Actions").children(init)))
+                .child(story)
+                .child(El::new("StopTrigger").child(time_condition(
+                    "horizon",
+                    "rising",
+                    "greaterThan",
+                    test.horizon_s,
+                ))),
+        )
+        .document()
+}
+
+/// The test's parameters: numbers as `double`, the others as `string`.
+fn parameter_declarations(params: &[(String, serde_json::Value)]) -> El {
+    El::new("ParameterDeclarations").children(params.iter().map(|(n, v)| {
         let (kind, value) = match v {
             serde_json::Value::Number(x) => ("double", x.to_string()),
             serde_json::Value::String(s) => ("string", s.clone()),
@@ -246,7 +283,11 @@ pub fn write(test: &Test<'_>) -> String {
             .attr("name", n)
             .attr("parameterType", kind)
             .attr("value", value)
-    }));
+    }))
+}
+
+/// The scenario objects: the ego, the cars, the pedestrians and the obstacles of `w`.
+fn entities(w: &WorldSpec) -> Vec<El> {
     let mut entities = vec![El::new("ScenarioObject")
         .attr("name", "ego")
         .child(vehicle("ego", w.ego.vehicle.size))];
@@ -283,8 +324,13 @@ pub fn write(test: &Test<'_>) -> String {
             ),
         );
     }
+    entities
+}
 
-    // Init: where everything starts.
+/// Init: where everything starts (`first`), the ego's and the cars' speeds, the ego's route.
+fn init(test: &Test<'_>, first: &Snapshot) -> Vec<El> {
+    let w = test.world;
+    let g = |p: [f64; 3]| in_file(test.origin_m, p);
     let mut init = Vec::new();
     let ego = &first.ego;
     let mut ego_actions = vec![
@@ -292,50 +338,7 @@ pub fn write(test: &Test<'_>) -> String {
         speed(w.ego.initial_speed_mps),
     ];
     if w.ego.route.len() >= 2 {
-        let route = &w.ego.route;
-        // Indices of the route's points that become waypoints: the first, one every
-        // WAYPOINT_EVERY_M, the last.
-        let mut picked = vec![0];
-        let mut walked = 0.0;
-        for (i, pair) in route.windows(2).enumerate() {
-            walked += (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1]);
-            if walked >= WAYPOINT_EVERY_M {
-                picked.push(i + 1);
-                walked = 0.0;
-            }
-        }
-        if picked.last() != Some(&(route.len() - 1)) {
-            picked.push(route.len() - 1);
-        }
-        // Each waypoint heads along the route there (a simulator matches a waypoint to the
-        // lane of that direction): toward the next distinct point, the last from the one
-        // before it.
-        let heading = |i: usize| {
-            let ahead = route[i + 1..].iter().find(|q| **q != route[i]);
-            let behind = route[..i].iter().rev().find(|q| **q != route[i]);
-            let (a, b) = match (ahead, behind) {
-                (Some(n), _) => (route[i], *n),
-                (None, Some(p)) => (*p, route[i]),
-                (None, None) => return 0.0,
-            };
-            (-(b[1] - a[1])).atan2(b[0] - a[0])
-        };
-        let waypoints: Vec<([f64; 2], f64)> =
-            picked.iter().map(|&i| (route[i], heading(i))).collect();
-        ego_actions.push(
-            El::new("RoutingAction").child(
-                El::new("AssignRouteAction").child(
-                    El::new("Route")
-                        .attr("name", "ego route")
-                        .attr("closed", "false")
-                        .children(waypoints.iter().map(|&(q, h)| {
-                            El::new("Waypoint")
-                                .attr("routeStrategy", "shortest")
-                                .child(world_position(g([q[0], 0.0, q[1]]), h))
-                        })),
-                ),
-            ),
-        );
+        ego_actions.push(assign_route(&w.ego.route, test.origin_m));
     }
     init.push(private("ego", ego_actions));
     for (i, c) in first.cars.iter().enumerate() {
@@ -358,8 +361,63 @@ pub fn write(test: &Test<'_>) -> String {
             vec![teleport(g(o.base_m), o.heading_rad)],
         ));
     }
+    init
+}
 
-    // The story: cars drive their trajectories; pedestrians walk when the ego comes near.
+/// The ego's route (at least 2 points) as an `AssignRouteAction`: waypoints at the first
+/// point, one every [`WAYPOINT_EVERY_M`], and the last, each heading along the route there.
+fn assign_route(route: &[[f64; 2]], origin: [f64; 2]) -> El {
+    let waypoints = route_waypoints(route);
+    El::new("RoutingAction").child(
+        El::new("AssignRouteAction").child(
+            El::new("Route")
+                .attr("name", "ego route")
+                .attr("closed", "false")
+                .children(waypoints.iter().map(|&(q, h)| {
+                    El::new("Waypoint")
+                        .attr("routeStrategy", "shortest")
+                        .child(world_position(in_file(origin, [q[0], 0.0, q[1]]), h))
+                })),
+        ),
+    )
+}
+
+/// The waypoints of a route of at least 2 points, `(point, heading)`.
+fn route_waypoints(route: &[[f64; 2]]) -> Vec<([f64; 2], f64)> {
+    // Indices of the route's points that become waypoints: the first, one every
+    // WAYPOINT_EVERY_M, the last.
+    let mut picked = vec![0];
+    let mut walked = 0.0;
+    for (i, pair) in route.windows(2).enumerate() {
+        walked += (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1]);
+        if walked >= WAYPOINT_EVERY_M {
+            picked.push(i + 1);
+            walked = 0.0;
+        }
+    }
+    if picked.last() != Some(&(route.len() - 1)) {
+        picked.push(route.len() - 1);
+    }
+    // Each waypoint heads along the route there (a simulator matches a waypoint to the
+    // lane of that direction): toward the next distinct point, the last from the one
+    // before it.
+    let heading = |i: usize| {
+        let ahead = route[i + 1..].iter().find(|q| **q != route[i]);
+        let behind = route[..i].iter().rev().find(|q| **q != route[i]);
+        let (a, b) = match (ahead, behind) {
+            (Some(n), _) => (route[i], *n),
+            (None, Some(p)) => (*p, route[i]),
+            (None, None) => return 0.0,
+        };
+        (-(b[1] - a[1])).atan2(b[0] - a[0])
+    };
+    picked.iter().map(|&i| (route[i], heading(i))).collect()
+}
+
+/// The story: cars drive their trajectories; pedestrians walk when the ego comes near.
+fn story(test: &Test<'_>, frames: &[&Snapshot], first: &Snapshot) -> El {
+    let w = test.world;
+    let g = |p: [f64; 3]| in_file(test.origin_m, p);
     let mut groups = Vec::new();
     for i in 0..w.cars.len() {
         let name = format!("car{}", i + 1);
@@ -377,60 +435,7 @@ pub fn write(test: &Test<'_>) -> String {
         ));
     }
     for i in 0..w.pedestrians.len() {
-        let name = format!("pedestrian{}", i + 1);
-        let Some(started) = test
-            .states
-            .iter()
-            .find_map(|s| s.pedestrians.get(i).and_then(|p| p.triggered_at_s))
-        else {
-            continue; // It never walked.
-        };
-        let at = test
-            .states
-            .iter()
-            .find(|s| s.t_s >= started - 1e-9)
-            .unwrap_or(first);
-        let start = w.pedestrians[i].start;
-        let d = (at.ego.pos_m[0] - start[0]).hypot(at.ego.pos_m[2] - start[2]);
-        let target = w.pedestrians[i].target;
-        let h = (-(target[2] - start[2])).atan2(target[0] - start[0]);
-        let walk: Vec<(f64, [f64; 3], f64)> = frames
-            .iter()
-            .filter(|s| s.t_s >= started - 1e-9)
-            .filter_map(|s| s.pedestrians.get(i).map(|p| (s.t_s - started, p.pos_m, h)))
-            .collect();
-        if walk.len() < 2 {
-            continue;
-        }
-        let trigger = condition(
-            &format!("ego within {d:.2} m"),
-            "rising",
-            El::new("ByEntityCondition")
-                .child(
-                    El::new("TriggeringEntities")
-                        .attr("triggeringEntitiesRule", "any")
-                        .child(El::new("EntityRef").attr("entityRef", "ego")),
-                )
-                .child(
-                    El::new("EntityCondition").child(
-                        El::new("DistanceCondition")
-                            .attr("freespace", "false")
-                            .attr("rule", "lessOrEqual")
-                            .num("value", d)
-                            .attr("relativeDistanceType", "euclidianDistance")
-                            .attr("coordinateSystem", "entity")
-                            .child(world_position(g(start), h)),
-                    ),
-                ),
-        );
-        groups.push(maneuver_group(
-            &name,
-            event(
-                &format!("{name} walks"),
-                follow(&format!("{name} as walked"), &walk, false),
-                trigger,
-            ),
-        ));
+        groups.extend(pedestrian_group(test, frames, first, i));
     }
     if groups.is_empty() {
         // An act holds at least one group: the ego's, with nothing to do.
@@ -445,7 +450,7 @@ pub fn write(test: &Test<'_>) -> String {
                 ),
         );
     }
-    let story = El::new("Story").attr("name", "test").child(
+    El::new("Story").attr("name", "test").child(
         El::new("Act")
             .attr("name", "actors")
             .children(groups)
@@ -455,32 +460,68 @@ pub fn write(test: &Test<'_>) -> String {
                 "greaterOrEqual",
                 0.0,
             ))),
+    )
+}
+
+/// Pedestrian `i`'s walk, started when the ego comes within the distance at which it started
+/// walking in the test; `None` when it never walked (or walked for less than two frames).
+fn pedestrian_group(
+    test: &Test<'_>,
+    frames: &[&Snapshot],
+    first: &Snapshot,
+    i: usize,
+) -> Option<El> {
+    let w = test.world;
+    let name = format!("pedestrian{}", i + 1);
+    // None: it never walked.
+    let started = test
+        .states
+        .iter()
+        .find_map(|s| s.pedestrians.get(i).and_then(|p| p.triggered_at_s))?;
+    let at = test
+        .states
+        .iter()
+        .find(|s| s.t_s >= started - 1e-9)
+        .unwrap_or(first);
+    let start = w.pedestrians[i].start;
+    let d = (at.ego.pos_m[0] - start[0]).hypot(at.ego.pos_m[2] - start[2]);
+    let target = w.pedestrians[i].target;
+    let h = (-(target[2] - start[2])).atan2(target[0] - start[0]);
+    let walk: Vec<(f64, [f64; 3], f64)> = frames
+        .iter()
+        .filter(|s| s.t_s >= started - 1e-9)
+        .filter_map(|s| s.pedestrians.get(i).map(|p| (s.t_s - started, p.pos_m, h)))
+        .collect();
+    if walk.len() < 2 {
+        return None;
+    }
+    let trigger = condition(
+        &format!("ego within {d:.2} m"),
+        "rising",
+        El::new("ByEntityCondition")
+            .child(
+                El::new("TriggeringEntities")
+                    .attr("triggeringEntitiesRule", "any")
+                    .child(El::new("EntityRef").attr("entityRef", "ego")),
+            )
+            .child(
+                El::new("EntityCondition").child(
+                    El::new("DistanceCondition")
+                        .attr("freespace", "false")
+                        .attr("rule", "lessOrEqual")
+                        .num("value", d)
+                        .attr("relativeDistanceType", "euclidianDistance")
+                        .attr("coordinateSystem", "entity")
+                        .child(world_position(in_file(test.origin_m, start), h)),
+                ),
+            ),
     );
-    El::new("OpenSCENARIO")
-        .child(
-            El::new("FileHeader")
-                .attr("revMajor", 1)
-                .attr("revMinor", 2)
-                .attr("date", "1970-01-01T00:00:00")
-                .attr("description", &test.description)
-                .attr("author", "paracosm"),
-        )
-        .child(params)
-        .child(El::new("CatalogLocations"))
-        .child(
-            El::new("RoadNetwork").child(El::new("LogicFile").attr("filepath", &test.network_file)),
-        )
-        .child(El::new("Entities").children(entities))
-        .child(
-            El::new("Storyboard")
-                .child(El::new("Init").child(El::new("Actions").children(init)))
-                .child(story)
-                .child(El::new("StopTrigger").child(time_condition(
-                    "horizon",
-                    "rising",
-                    "greaterThan",
-                    test.horizon_s,
-                ))),
-        )
-        .document()
+    Some(maneuver_group(
+        &name,
+        event(
+            &format!("{name} walks"),
+            follow(&format!("{name} as walked"), &walk, false),
+            trigger,
+        ),
+    ))
 }

@@ -130,6 +130,39 @@ fn data(page: &Page<'_>) -> Json {
             }
         }
     }
+    let tests = tests_data(page, &monitors);
+    let mut summary = serde_json::to_value(page.summary).expect("summaries serialise");
+    if let Some(o) = summary.as_object_mut() {
+        o.remove("failures");
+    }
+    let map_axes: Vec<usize> = page
+        .map_axes
+        .iter()
+        .filter_map(|a| page.space.params().iter().position(|p| &p.name == a))
+        .collect();
+    let pairs = std::fs::read(page.out.join("pairs.png"))
+        .ok()
+        .and_then(|b| small_enough(b, PAIRS_LIMIT))
+        .map(|b| data_uri(&b));
+    json!({
+        "title": title(page.summary),
+        "summary": summary,
+        "params": params,
+        "monitors": monitors,
+        "tests": tests,
+        "map_axes": map_axes,
+        "robustness_span": crate::report::plot::robustness_span(records),
+        "replay": crate::export::replay::replay_command_for(page.out, "{id}"),
+        "pairs": pairs,
+        "sheets": sheets(page.out),
+    })
+}
+
+/// The page's tests by column: status, parameter values (intervals in [`STEPS`] steps,
+/// levels by index), robustness, and per monitor of `monitors` whether it failed and its
+/// robustness; the ids as the first one when they are contiguous.
+fn tests_data(page: &Page<'_>, monitors: &[String]) -> Json {
+    let records = page.records;
     let status: String = records
         .iter()
         .map(|r| match r.status {
@@ -205,31 +238,7 @@ fn data(page: &Page<'_>) -> Json {
     } else {
         tests["ids"] = json!(records.iter().map(|r| r.id).collect::<Vec<_>>());
     }
-    let mut summary = serde_json::to_value(page.summary).expect("summaries serialise");
-    if let Some(o) = summary.as_object_mut() {
-        o.remove("failures");
-    }
-    let map_axes: Vec<usize> = page
-        .map_axes
-        .iter()
-        .filter_map(|a| page.space.params().iter().position(|p| &p.name == a))
-        .collect();
-    let pairs = std::fs::read(page.out.join("pairs.png"))
-        .ok()
-        .and_then(|b| small_enough(b, PAIRS_LIMIT))
-        .map(|b| data_uri(&b));
-    json!({
-        "title": title(page.summary),
-        "summary": summary,
-        "params": params,
-        "monitors": monitors,
-        "tests": tests,
-        "map_axes": map_axes,
-        "robustness_span": crate::report::plot::robustness_span(records),
-        "replay": crate::export::replay::replay_command_for(page.out, "{id}"),
-        "pairs": pairs,
-        "sheets": sheets(page.out),
-    })
+    tests
 }
 
 /// The PNG `png` if it has at most `limit` bytes, else scaled down (by 3/4 at a time) until

@@ -453,62 +453,11 @@ pub fn human(
         if speed.starts_with("in ") { " " } else { "; " },
     )];
     if let Some(f) = &summary.first_failure {
-        let values: Vec<String> = f
-            .params
-            .iter()
-            .map(|(n, v)| {
-                let unit = scenario
-                    .space
-                    .param(n)
-                    .and_then(|p| p.unit.as_ref())
-                    .map(|u| format!(" {u}"))
-                    .unwrap_or_default();
-                match v {
-                    paracosm_generators::Value::Real(x) => format!("{n} = {x:.3}{unit}"),
-                    _ => format!("{n} = {v}{unit}"),
-                }
-            })
-            .collect();
-        let values = if values.is_empty() {
-            String::new()
-        } else {
-            format!(" ({})", values.join(", "))
-        };
-        lines.push(format!(
-            "first failure: test {}{values}, monitors failed: {}",
-            f.id,
-            f.failed_monitors.join(", ")
-        ));
+        lines.push(first_failure_line(f, scenario));
         lines.push(format!("replay it: {}", replay_command(out, f.id)));
     }
     if let Some(cov) = &summary.coverage {
-        let mut parts = Vec::new();
-        if let Some(d) = &cov.dispersion {
-            parts.push(if d.exact {
-                format!("dispersion {:.4}", d.lower)
-            } else {
-                format!("dispersion in [{:.4}, {:.4}]", d.lower, d.upper)
-            });
-        }
-        if let Some(star) = &cov.star {
-            parts.push(if star.exact {
-                format!("star discrepancy {:.4}", star.lower)
-            } else {
-                format!("star discrepancy in [{:.4}, {:.4}]", star.lower, star.upper)
-            });
-        }
-        for note in &cov.skipped {
-            parts.push(note.clone());
-        }
-        for k in &cov.kwise {
-            parts.push(format!(
-                "{}-wise coverage {}/{}",
-                k.strength, k.covered, k.total
-            ));
-        }
-        if !parts.is_empty() {
-            lines.push(format!("coverage: {}", parts.join(", ")));
-        }
+        lines.extend(coverage_line(cov));
     }
     if let Some(t) = &summary.triage {
         lines.extend(triage_lines(t));
@@ -523,6 +472,67 @@ pub fn human(
             .join(", ")
     ));
     lines.join("\n")
+}
+
+/// The human summary's line on the first failure `f`: its id, its parameters with their units
+/// (reals to 3 decimals), and the monitors that failed.
+fn first_failure_line(f: &FirstFailure, scenario: &Scenario) -> String {
+    let values: Vec<String> = f
+        .params
+        .iter()
+        .map(|(n, v)| {
+            let unit = scenario
+                .space
+                .param(n)
+                .and_then(|p| p.unit.as_ref())
+                .map(|u| format!(" {u}"))
+                .unwrap_or_default();
+            match v {
+                paracosm_generators::Value::Real(x) => format!("{n} = {x:.3}{unit}"),
+                _ => format!("{n} = {v}{unit}"),
+            }
+        })
+        .collect();
+    let values = if values.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", values.join(", "))
+    };
+    format!(
+        "first failure: test {}{values}, monitors failed: {}",
+        f.id,
+        f.failed_monitors.join(", ")
+    )
+}
+
+/// The human summary's coverage line: dispersion, star discrepancy, what was skipped, k-wise
+/// coverage; `None` when there is nothing to say.
+fn coverage_line(cov: &crate::cover::Estimate) -> Option<String> {
+    let mut parts = Vec::new();
+    if let Some(d) = &cov.dispersion {
+        parts.push(if d.exact {
+            format!("dispersion {:.4}", d.lower)
+        } else {
+            format!("dispersion in [{:.4}, {:.4}]", d.lower, d.upper)
+        });
+    }
+    if let Some(star) = &cov.star {
+        parts.push(if star.exact {
+            format!("star discrepancy {:.4}", star.lower)
+        } else {
+            format!("star discrepancy in [{:.4}, {:.4}]", star.lower, star.upper)
+        });
+    }
+    for note in &cov.skipped {
+        parts.push(note.clone());
+    }
+    for k in &cov.kwise {
+        parts.push(format!(
+            "{}-wise coverage {}/{}",
+            k.strength, k.covered, k.total
+        ));
+    }
+    (!parts.is_empty()).then(|| format!("coverage: {}", parts.join(", ")))
 }
 
 /// Rules shown on the console; the others are in `summary.json`.

@@ -268,9 +268,22 @@ pub fn triage(space: &ParamSpace, records: &[RunRecord]) -> Option<Triage> {
         leaves: Vec::new(),
     };
     walk.visit(&tree, &all, &mut Vec::new());
+    let rules = failure_rules(params, walk.leaves);
+    let ranking = relevance(params, &samples, &walk.importance);
+    Some(Triage {
+        tests: n as u64,
+        failed,
+        max_depth: MAX_DEPTH,
+        rules,
+        ranking,
+    })
+}
 
-    let mut leaves: Vec<_> = walk
-        .leaves
+/// The rules of the failure regions among `leaves` (`(path, failed, tests)`): the leaves where
+/// most tests failed, or else the one with the highest failure rate (then the most failures);
+/// the most failures first, then the fewest passes.
+fn failure_rules(params: &[Param], leaves: Vec<(Vec<Step>, u64, u64)>) -> Vec<Rule> {
+    let mut leaves: Vec<_> = leaves
         .into_iter()
         .filter(|(_, f, t)| *t > 0 && *f > 0)
         .collect();
@@ -300,8 +313,13 @@ pub fn triage(space: &ParamSpace, records: &[RunRecord]) -> Option<Triage> {
             .cmp(&a.failed)
             .then((a.tests - a.failed).cmp(&(b.tests - b.failed)))
     });
+    rules
+}
 
-    let total: f64 = walk.importance.iter().sum();
+/// Every parameter's relevance, most relevant first: its share of the tree's `importance`,
+/// then the size of its association with the outcome, then its order.
+fn relevance(params: &[Param], samples: &[Sample], importance: &[f64]) -> Vec<Relevance> {
+    let total: f64 = importance.iter().sum();
     let mut ranking: Vec<(usize, Relevance)> = params
         .iter()
         .enumerate()
@@ -312,11 +330,11 @@ pub fn triage(space: &ParamSpace, records: &[RunRecord]) -> Option<Triage> {
                 Relevance {
                     param: p.name.clone(),
                     importance: if total > 0.0 {
-                        walk.importance[j] / total
+                        importance[j] / total
                     } else {
                         0.0
                     },
-                    association: association(&samples, j, discrete),
+                    association: association(samples, j, discrete),
                     association_kind: if discrete { "eta" } else { "spearman" }.into(),
                 },
             )
@@ -332,13 +350,7 @@ pub fn triage(space: &ParamSpace, records: &[RunRecord]) -> Option<Triage> {
             )
             .then(i.cmp(j))
     });
-    Some(Triage {
-        tests: n as u64,
-        failed,
-        max_depth: MAX_DEPTH,
-        rules,
-        ranking: ranking.into_iter().map(|(_, r)| r).collect(),
-    })
+    ranking.into_iter().map(|(_, r)| r).collect()
 }
 
 /// Fits the tree: Gini, depth [`MAX_DEPTH`], leaves of at least 1 % of the tests (at least 3);

@@ -216,66 +216,8 @@ impl Network {
         let j = k.unsigned_abs();
         let (mut path, mut points) = match start.through {
             // Inside a junction: the rest of the lane path it is on.
-            Some((entry, exit)) => {
-                let path = self
-                    .lane_paths(start.piece)
-                    .into_iter()
-                    .find(|l| l.entry == (entry, j) && l.exit.0 == exit)
-                    .ok_or_else(|| {
-                        EngineError::InvalidWorld("a junction location off its lane path".into())
-                    })?;
-                let mut points = vec![[start.pos_m[0], start.pos_m[2]]];
-                let mut walked = 0.0;
-                for w in path.points.windows(2) {
-                    walked += dist(w[0], w[1]);
-                    if walked > start.at_m {
-                        points.push(w[1]);
-                    }
-                }
-                if points.len() < 2 {
-                    points.push(*path.points.last().expect("two points"));
-                }
-                (path, points)
-            }
-            None => {
-                let entry = if k > 0 { 0 } else { 1 };
-                let path = self
-                    .lane_paths(start.piece)
-                    .into_iter()
-                    .find(|l| l.entry == (entry, j))
-                    .expect("a segment has both directions of each lane");
-                let mut points = vec![[start.pos_m[0], start.pos_m[2]]];
-                match self.pieces[start.piece.0].kind.ref_line() {
-                    // A curved piece: the lane's points beyond the start, in driving order.
-                    Some(line) => {
-                        let stations = line.stations(LANE_STEP_M);
-                        let ahead = |s: f64| {
-                            if k > 0 {
-                                s > start.at_m
-                            } else {
-                                s < start.at_m
-                            }
-                        };
-                        let order: Vec<f64> = if k > 0 {
-                            stations
-                        } else {
-                            stations.into_iter().rev().collect()
-                        };
-                        points.extend(
-                            order
-                                .iter()
-                                .zip(&path.points)
-                                .filter(|(s, _)| ahead(**s))
-                                .map(|(_, q)| *q),
-                        );
-                        if points.len() < 2 {
-                            points.push(*path.points.last().expect("two points"));
-                        }
-                    }
-                    None => points.push(*path.points.last().expect("two points")),
-                }
-                (path, points)
-            }
+            Some((entry, exit)) => self.junction_start(start, j, entry, exit)?,
+            None => self.segment_start(start, k, j),
         };
         let mut length = points.windows(2).map(|w| dist(w[0], w[1])).sum::<f64>();
         // A route of kilometres passes the same pieces again and again: each piece's lane
@@ -309,43 +251,11 @@ impl Network {
             } else {
                 None
             };
-            let pick = match wanted {
-                Some(t) => {
-                    let Some(c) = candidates.iter().find(|c| c.turn == t) else {
-                        let offered: Vec<String> = [Turn::Straight, Turn::Left, Turn::Right]
-                            .into_iter()
-                            .filter(|o| candidates.iter().any(|c| c.turn == *o))
-                            .map(|o| format!("\"{}\"", o.name()))
-                            .collect();
-                        return Err(EngineError::InvalidWorld(format!(
-                            "the route's turn {} (\"{}\") is not possible at {}, entered by {}: \
-                             it offers {} there",
-                            used + 1,
-                            t.name(),
-                            self.pieces[next.0 .0].name,
-                            self.port_name(next),
-                            offered.join(" and ")
-                        )));
-                    };
-                    used += 1;
-                    Some(c)
-                }
-                // No turn left to take: exits that lead on into the network before dead ends,
-                // then straight, right, left.
-                None => {
-                    let linked = |l: &&LanePath| {
-                        let end = (l.piece, l.exit.0);
-                        self.links.iter().any(|k| k.a == end || k.b == end)
-                    };
-                    if candidates.iter().any(linked) {
-                        candidates.retain(linked);
-                    }
-                    [Turn::Straight, Turn::Right, Turn::Left]
-                        .into_iter()
-                        .find_map(|t| candidates.iter().find(|c| c.turn == t))
-                }
-            };
-            let Some(pick) = pick.map(|&c| c.clone()) else {
+            let pick = self.choose_exit(&mut candidates, wanted, used, next)?;
+            if wanted.is_some() {
+                used += 1;
+            }
+            let Some(pick) = pick else {
                 break;
             };
             for &q in &pick.points[1..] {
@@ -355,6 +265,136 @@ impl Network {
             path = pick;
         }
         Ok(resample(&points, ROUTE_SPACING_M))
+    }
+
+    /// The start of a route from `start`, inside a junction on lane `j` of the lane path from
+    /// port `entry` to port `exit`: that path, and the route's first points (`start`, then
+    /// the path's points beyond it), world `[x, z]` m.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] when the junction has no such lane path.
+    fn junction_start(
+        &self,
+        start: &Location,
+        j: u32,
+        entry: usize,
+        exit: usize,
+    ) -> Result<(LanePath, Vec<[f64; 2]>), EngineError> {
+        let path = self
+            .lane_paths(start.piece)
+            .into_iter()
+            .find(|l| l.entry == (entry, j) && l.exit.0 == exit)
+            .ok_or_else(|| {
+                EngineError::InvalidWorld("a junction location off its lane path".into())
+            })?;
+        let mut points = vec![[start.pos_m[0], start.pos_m[2]]];
+        let mut walked = 0.0;
+        for w in path.points.windows(2) {
+            walked += dist(w[0], w[1]);
+            if walked > start.at_m {
+                points.push(w[1]);
+            }
+        }
+        if points.len() < 2 {
+            points.push(*path.points.last().expect("two points"));
+        }
+        Ok((path, points))
+    }
+
+    /// The start of a route from `start` on driving lane `k` (`j = |k|`) of a segment: the
+    /// lane's path in its driving direction, and the route's first points (`start`, then the
+    /// lane's points ahead of it), world `[x, z]` m.
+    fn segment_start(&self, start: &Location, k: i32, j: u32) -> (LanePath, Vec<[f64; 2]>) {
+        let entry = if k > 0 { 0 } else { 1 };
+        let path = self
+            .lane_paths(start.piece)
+            .into_iter()
+            .find(|l| l.entry == (entry, j))
+            .expect("a segment has both directions of each lane");
+        let mut points = vec![[start.pos_m[0], start.pos_m[2]]];
+        match self.pieces[start.piece.0].kind.ref_line() {
+            // A curved piece: the lane's points beyond the start, in driving order.
+            Some(line) => {
+                let stations = line.stations(LANE_STEP_M);
+                let ahead = |s: f64| {
+                    if k > 0 {
+                        s > start.at_m
+                    } else {
+                        s < start.at_m
+                    }
+                };
+                let order: Vec<f64> = if k > 0 {
+                    stations
+                } else {
+                    stations.into_iter().rev().collect()
+                };
+                points.extend(
+                    order
+                        .iter()
+                        .zip(&path.points)
+                        .filter(|(s, _)| ahead(**s))
+                        .map(|(_, q)| *q),
+                );
+                if points.len() < 2 {
+                    points.push(*path.points.last().expect("two points"));
+                }
+            }
+            None => points.push(*path.points.last().expect("two points")),
+        }
+        (path, points)
+    }
+
+    /// The lane path a route takes among `candidates`, the paths from the port `next` that it
+    /// enters by: the turn `wanted` (the route's turn number `used + 1`), or, with none, an
+    /// exit that leads on into the network before a dead end, then straight, right, left.
+    /// `None`: no candidate.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] when no candidate makes the turn `wanted`, naming the
+    /// junction, the port and the turns it offers.
+    fn choose_exit(
+        &self,
+        candidates: &mut Vec<&LanePath>,
+        wanted: Option<Turn>,
+        used: usize,
+        next: (PieceId, usize),
+    ) -> Result<Option<LanePath>, EngineError> {
+        let pick = match wanted {
+            Some(t) => {
+                let Some(c) = candidates.iter().find(|c| c.turn == t) else {
+                    let offered: Vec<String> = [Turn::Straight, Turn::Left, Turn::Right]
+                        .into_iter()
+                        .filter(|o| candidates.iter().any(|c| c.turn == *o))
+                        .map(|o| format!("\"{}\"", o.name()))
+                        .collect();
+                    return Err(EngineError::InvalidWorld(format!(
+                        "the route's turn {} (\"{}\") is not possible at {}, entered by {}: \
+                         it offers {} there",
+                        used + 1,
+                        t.name(),
+                        self.pieces[next.0 .0].name,
+                        self.port_name(next),
+                        offered.join(" and ")
+                    )));
+                };
+                Some(c)
+            }
+            // No turn left to take: exits that lead on into the network before dead ends,
+            // then straight, right, left.
+            None => {
+                let linked = |l: &&LanePath| {
+                    let end = (l.piece, l.exit.0);
+                    self.links.iter().any(|k| k.a == end || k.b == end)
+                };
+                if candidates.iter().any(linked) {
+                    candidates.retain(linked);
+                }
+                [Turn::Straight, Turn::Right, Turn::Left]
+                    .into_iter()
+                    .find_map(|t| candidates.iter().find(|c| c.turn == t))
+            }
+        };
+        Ok(pick.map(|&c| c.clone()))
     }
 }
 

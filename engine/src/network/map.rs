@@ -126,6 +126,50 @@ impl MapLane {
     }
 }
 
+/// Why [`RoadMap::lane_at`] finds no lane; each message names the map's file.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum LaneAtError {
+    /// The map has no road of that id.
+    #[error("{map} has no road \"{road}\" (its roads: {})", .roads.join(", "))]
+    NoRoad {
+        /// The map's file ([`RoadMap::source`]).
+        map: String,
+        /// The road asked for, its `<road id>`.
+        road: String,
+        /// The map's first 20 road ids.
+        roads: Vec<String>,
+    },
+    /// The station lies outside the road.
+    #[error("s = {s_m} m is outside road \"{road}\" of {map}, [0, {length_m:.2}] m")]
+    OffRoad {
+        /// The map's file ([`RoadMap::source`]).
+        map: String,
+        /// The road, its `<road id>`.
+        road: String,
+        /// The station asked for, m.
+        s_m: f64,
+        /// The road's length, m.
+        length_m: f64,
+    },
+    /// The road has no lane of that id at the station.
+    #[error(
+        "road \"{road}\" of {map} has no lane {lane} at s = {s_m} m; its lanes there: {}",
+        .lanes.join(", ")
+    )]
+    NoLane {
+        /// The map's file ([`RoadMap::source`]).
+        map: String,
+        /// The road, its `<road id>`.
+        road: String,
+        /// The lane asked for, its OpenDRIVE id.
+        lane: i32,
+        /// The station, m.
+        s_m: f64,
+        /// The road's lanes at the station: `id (kind)`.
+        lanes: Vec<String>,
+    },
+}
+
 /// A map's roads and lanes (see the module documentation).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RoadMap {
@@ -177,24 +221,26 @@ impl RoadMap {
     /// The lane `od_id` of road `road` (its `<road id>`) at station `s` (m).
     ///
     /// # Errors
-    /// A message naming the roads (for an unknown road), the lanes of the road at `s` (for a
-    /// lane it lacks there), or the road's length (for `s` outside it).
-    pub fn lane_at(&self, road: &str, od_id: i32, s: f64) -> Result<usize, String> {
+    /// A [`LaneAtError`] naming the roads (for an unknown road), the lanes of the road at `s`
+    /// (for a lane it lacks there), or the road's length (for `s` outside it).
+    pub fn lane_at(&self, road: &str, od_id: i32, s: f64) -> Result<usize, LaneAtError> {
         let Some(r) = self.roads.iter().position(|r| r.od_id == road) else {
-            let mut ids: Vec<&str> = self.roads.iter().map(|r| r.od_id.as_str()).collect();
-            ids.truncate(20);
-            return Err(format!(
-                "{} has no road \"{road}\" (its roads: {})",
-                self.source,
-                ids.join(", ")
-            ));
+            let mut roads: Vec<String> = self.roads.iter().map(|r| r.od_id.clone()).collect();
+            roads.truncate(20);
+            return Err(LaneAtError::NoRoad {
+                map: self.source.clone(),
+                road: road.to_owned(),
+                roads,
+            });
         };
         let length = self.roads[r].length_m;
         if !(0.0..=length).contains(&s) {
-            return Err(format!(
-                "s = {s} m is outside road \"{road}\" of {}, [0, {length:.2}] m",
-                self.source
-            ));
+            return Err(LaneAtError::OffRoad {
+                map: self.source.clone(),
+                road: road.to_owned(),
+                s_m: s,
+                length_m: length,
+            });
         }
         let here: Vec<usize> = (0..self.lanes.len())
             .filter(|&i| {
@@ -207,15 +253,17 @@ impl RoadMap {
             .copied()
             .find(|&i| self.lanes[i].od_id == od_id)
             .ok_or_else(|| {
-                let ids: Vec<String> = here
+                let lanes: Vec<String> = here
                     .iter()
                     .map(|&i| format!("{} ({})", self.lanes[i].od_id, self.lanes[i].kind))
                     .collect();
-                format!(
-                    "road \"{road}\" of {} has no lane {od_id} at s = {s} m; its lanes there: {}",
-                    self.source,
-                    ids.join(", ")
-                )
+                LaneAtError::NoLane {
+                    map: self.source.clone(),
+                    road: road.to_owned(),
+                    lane: od_id,
+                    s_m: s,
+                    lanes,
+                }
             })
     }
 

@@ -24,7 +24,7 @@ pub(crate) use lanes::{heading_between, tangent_at};
 #[cfg(test)]
 pub(crate) use lanes::{heading_on_leg, vertex_tangents};
 pub use lanes::{LanePath, Turn, MIN_PATH_RADIUS_M};
-pub use map::{MapIndex, MapLane, MapRef, MapRoad, RoadMap};
+pub use map::{LaneAtError, MapIndex, MapLane, MapRef, MapRoad, RoadMap};
 pub use piece::{
     Piece, PieceKind, PortGeometry, JUNCTION_APRON_M, LANE_WIDTH_M, MAX_EXTENT_M, MAX_TURN_RAD,
     MIN_CURVE_RADIUS_M, PORT_NAMES, SIDEWALK_WIDTH_M,
@@ -187,7 +187,7 @@ impl Network {
         let k = map
             .0
             .lane_at(road, lane, s_m)
-            .map_err(EngineError::InvalidWorld)?;
+            .map_err(|e| EngineError::InvalidWorld(e.to_string()))?;
         let l = &map.0.lanes[k];
         let (q, heading_rad) = l.pose(s_m);
         let [x, z] = p.pose.apply(q);

@@ -7,8 +7,8 @@ use wgpu::util::DeviceExt;
 use super::mesh::{albedo, Mesh, Vertex};
 use super::post;
 use super::RenderError;
-use crate::camera::{CameraFrame, CameraSpec};
 use crate::network::Network;
+use crate::sensor::camera::{CameraFrame, CameraSpec};
 
 use crate::NOMINAL_LIGHT;
 

@@ -23,11 +23,8 @@
 mod gpu;
 mod mesh;
 mod post;
-mod rig;
 
-pub(crate) use rig::CameraRig;
-
-pub use crate::camera::{CameraFrame, CameraSpec};
+pub use crate::sensor::camera::{CameraFrame, CameraSpec};
 pub use crate::NOMINAL_LIGHT;
 pub use gpu::{CameraPose, RenderJob, RenderObject, Renderer, SceneGeometry, View};
 pub use mesh::color_albedo;
@@ -49,7 +46,7 @@ pub enum RenderError {
     Device(String),
     /// A camera setting is out of range.
     #[error("{0}")]
-    Camera(String),
+    Camera(crate::SettingError),
     /// Rendering or reading a frame back failed.
     #[error("cannot read a camera frame back from the GPU: {0}")]
     Readback(String),

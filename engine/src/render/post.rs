@@ -4,7 +4,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
-use crate::camera::{CameraFrame, CameraSpec};
+use crate::sensor::camera::{CameraFrame, CameraSpec};
 
 /// Applies the camera's blur (`image`'s Gaussian blur, σ in pixels) and additive noise (σ in
 /// 8-bit levels, drawn from ChaCha8 seeded with `seed`, clipped to `[0, 255]`). The depth map

@@ -11,8 +11,26 @@ use super::{OpenStream, RxError, Value};
 )]
 pub struct StreamId(pub usize);
 
-/// A native function on stream values: arguments in, a value or an error message out.
-pub type NativeFn = Arc<dyn Fn(&[Value]) -> Result<Value, String> + Send + Sync>;
+/// A native function on stream values: arguments in, a value or its refusal out.
+pub type NativeFn = Arc<dyn Fn(&[Value]) -> Result<Value, NativeError> + Send + Sync>;
+
+/// Why a native function refused its arguments (values of a kind it does not take); the
+/// runtime reports it as [`super::RxError::Type`] at the node that called it.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct NativeError(pub String);
+
+impl From<String> for NativeError {
+    fn from(message: String) -> Self {
+        NativeError(message)
+    }
+}
+
+impl From<&str> for NativeError {
+    fn from(message: &str) -> Self {
+        NativeError(message.to_owned())
+    }
+}
 
 /// A function a combinator applies.
 #[derive(Clone)]
@@ -27,7 +45,7 @@ impl Func {
     /// A named native function.
     pub fn native(
         name: &'static str,
-        f: impl Fn(&[Value]) -> Result<Value, String> + Send + Sync + 'static,
+        f: impl Fn(&[Value]) -> Result<Value, NativeError> + Send + Sync + 'static,
     ) -> Self {
         Func::Native(name, Arc::new(f))
     }

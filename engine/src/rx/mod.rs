@@ -37,9 +37,9 @@ mod tests;
 mod value;
 
 pub use expect::{describe, Expect};
-pub use graph::{Func, Graph, NativeFn, Node, StreamId};
+pub use graph::{Func, Graph, NativeError, NativeFn, Node, StreamId};
 pub use open::OpenStream;
-pub use runtime::{Host, Inputs, NoHost, Runtime};
+pub use runtime::{Host, HostError, Inputs, NoHost, Runtime};
 pub use value::Value;
 
 use thiserror::Error;

@@ -1,6 +1,6 @@
 use std::collections::VecDeque;
 
-use super::{Func, Graph, Node, RxError, StreamId, Value};
+use super::{Func, Graph, NativeError, Node, RxError, StreamId, Value};
 use crate::behaviour::{Action, Probe};
 
 /// The physics outputs a graph's [`Node::Probe`]s read, supplied by the simulation each step.
@@ -10,14 +10,26 @@ pub trait Inputs {
     fn probe(&self, probe: Probe) -> Value;
 }
 
+/// A host function's failure ([`Host::call`]): its message, as the program's author reads it
+/// (a Starlark error with its located frames, a limit the call ran into).
+#[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
+#[error("{0}")]
+pub struct HostError(pub String);
+
+impl From<String> for HostError {
+    fn from(message: String) -> Self {
+        HostError(message)
+    }
+}
+
 /// Calls host functions (Starlark lambdas) for [`Func::Host`].
 pub trait Host {
     /// Calls host function `f` with `args`. `streams` gives the latest value of every stream
     /// of the graph (see [`Runtime::current`]), for functions that read streams they captured.
     ///
     /// # Errors
-    /// The function's own failure, as a message.
-    fn call(&mut self, f: u32, args: &[Value], streams: &Runtime) -> Result<Value, String>;
+    /// The function's own failure, as a [`HostError`] carrying its message.
+    fn call(&mut self, f: u32, args: &[Value], streams: &Runtime) -> Result<Value, HostError>;
 
     /// The actions host functions performed since the last call of this method, as
     /// `(action, value)` pairs in the order they were performed (a Starlark `def` given to
@@ -46,8 +58,8 @@ pub trait Host {
 pub struct NoHost;
 
 impl Host for NoHost {
-    fn call(&mut self, f: u32, _args: &[Value], _streams: &Runtime) -> Result<Value, String> {
-        Err(format!("no host function {f} in this world"))
+    fn call(&mut self, f: u32, _args: &[Value], _streams: &Runtime) -> Result<Value, HostError> {
+        Err(HostError(format!("no host function {f} in this world")))
     }
 }
 
@@ -348,135 +360,20 @@ impl Runtime {
             }
             Node::Map { src, f } => {
                 let f = f.clone();
-                let src = *src;
-                let out = match self.event(src).cloned() {
-                    Some(v) => Some(call(i, &f, &[v], host, self)?),
-                    None => None,
-                };
-                self.states[i].done = done(self, src);
-                out
+                self.map(i, *src, &f, host)?
             }
             Node::Filter { src, pred } => {
-                let (pred, src) = (pred.clone(), *src);
-                let out = match self.event(src).cloned() {
-                    Some(v) => {
-                        let keep = call(i, &pred, std::slice::from_ref(&v), host, self)?;
-                        match keep.as_bool() {
-                            Some(true) => Some(v),
-                            Some(false) => None,
-                            None => {
-                                return Err(type_error(
-                                    &self.graph,
-                                    i,
-                                    "filter predicate",
-                                    "bool",
-                                    &keep,
-                                ))
-                            }
-                        }
-                    }
-                    None => None,
-                };
-                self.states[i].done = done(self, src);
-                out
+                let pred = pred.clone();
+                self.filter(i, *src, &pred, host)?
             }
-            Node::Zip(a, b) => {
-                let (a, b) = (*a, *b);
-                let (ea, eb) = (self.event(a).cloned(), self.event(b).cloned());
-                let (da, db) = (done(self, a), done(self, b));
-                let s = &mut self.states[i];
-                s.queue_a.extend(ea);
-                s.queue_b.extend(eb);
-                let out = if !s.queue_a.is_empty() && !s.queue_b.is_empty() {
-                    let pair = vec![s.queue_a.pop_front(), s.queue_b.pop_front()];
-                    Some(Value::Tuple(pair.into_iter().flatten().collect()))
-                } else {
-                    None
-                };
-                s.done = (da && s.queue_a.is_empty()) || (db && s.queue_b.is_empty());
-                out
-            }
-            Node::Take { src, n } => {
-                let (src, n) = (*src, *n);
-                let e = self.event(src).cloned();
-                let d = done(self, src);
-                let s = &mut self.states[i];
-                let out = if s.count < n { e } else { None };
-                if out.is_some() {
-                    s.count += 1;
-                }
-                s.done = s.count >= n || d;
-                out
-            }
-            Node::SkipUntil { src, trigger } => {
-                let (src, trigger) = (*src, *trigger);
-                let opened = self.states[trigger.0].fired;
-                let e = self.event(src).cloned();
-                let d = done(self, src);
-                let s = &mut self.states[i];
-                s.open |= opened;
-                s.done = d;
-                if s.open {
-                    e
-                } else {
-                    None
-                }
-            }
-            Node::TakeUntil { src, stop } => {
-                let (src, stop) = (*src, *stop);
-                let closed = self.states[stop.0].fired;
-                let e = self.event(src).cloned();
-                let d = done(self, src);
-                let s = &mut self.states[i];
-                s.done = closed || d;
-                if closed {
-                    None
-                } else {
-                    e
-                }
-            }
-            Node::Concat(a, b) => {
-                let (a, b) = (*a, *b);
-                let a_done = done(self, a);
-                let ea = self.event(a).cloned();
-                let eb = self.event(b).cloned();
-                let b_done = done(self, b);
-                let s = &mut self.states[i];
-                // `a`'s own flag: `open` marks that `a` had completed before this step.
-                if !s.open {
-                    s.queue_a.extend(ea);
-                }
-                if a_done {
-                    s.open = true;
-                    s.queue_a.extend(eb);
-                }
-                let out = s.queue_a.pop_front();
-                s.done = a_done && b_done && s.queue_a.is_empty();
-                out
-            }
+            Node::Zip(a, b) => self.zip(i, *a, *b),
+            Node::Take { src, n } => self.take(i, *src, *n),
+            Node::SkipUntil { src, trigger } => self.skip_until(i, *src, *trigger),
+            Node::TakeUntil { src, stop } => self.take_until(i, *src, *stop),
+            Node::Concat(a, b) => self.concat(i, *a, *b),
             Node::Sum { src, init, f } => {
-                let (src, f) = (*src, f.clone());
-                let init = init.clone();
-                let out = match self.event(src).cloned() {
-                    Some(v) => {
-                        let acc = self.states[i].value.clone().unwrap_or(init);
-                        Some(match &f {
-                            Some(f) => call(i, f, &[acc, v], host, self)?,
-                            None => total(&acc, &v).ok_or_else(|| {
-                                type_error(
-                                    &self.graph,
-                                    i,
-                                    "sum",
-                                    "numbers or vectors of one kind",
-                                    &v,
-                                )
-                            })?,
-                        })
-                    }
-                    None => None,
-                };
-                self.states[i].done = done(self, src);
-                out
+                let (f, init) = (f.clone(), init.clone());
+                self.sum(i, *src, init, f.as_ref(), host)?
             }
             Node::Check { src, expect, name } => {
                 let src = *src;
@@ -495,13 +392,8 @@ impl Runtime {
                 out
             }
             Node::Perform { src, f } => {
-                let (src, f) = (*src, f.clone());
-                if let Some(v) = self.event(src).cloned() {
-                    call_acting(i, &f, &[v], host, self)?;
-                    sinks.extend(host.performed());
-                }
-                self.states[i].done = done(self, src);
-                None
+                let f = f.clone();
+                self.perform(i, *src, &f, host, sinks)?
             }
             Node::Foreach { src, sink } => {
                 let (src, sink) = (*src, *sink);
@@ -513,6 +405,194 @@ impl Runtime {
             }
         };
         Ok(out)
+    }
+
+    /// Whether stream `id` has completed.
+    fn done(&self, id: StreamId) -> bool {
+        self.states[id.0].done
+    }
+
+    /// `src.map(f)`, node `i`: `f` of `src`'s event.
+    ///
+    /// # Errors
+    /// `f`'s failure ([`RxError::Type`], [`RxError::Host`]).
+    fn map(
+        &mut self,
+        i: usize,
+        src: StreamId,
+        f: &Func,
+        host: &mut dyn Host,
+    ) -> Result<Option<Value>, RxError> {
+        let out = match self.event(src).cloned() {
+            Some(v) => Some(call(i, f, &[v], host, self)?),
+            None => None,
+        };
+        self.states[i].done = self.done(src);
+        Ok(out)
+    }
+
+    /// `src.filter(pred)`, node `i`: `src`'s event where `pred` of it is true.
+    ///
+    /// # Errors
+    /// `pred`'s failure, or a predicate that gives no bool ([`RxError::Type`]).
+    fn filter(
+        &mut self,
+        i: usize,
+        src: StreamId,
+        pred: &Func,
+        host: &mut dyn Host,
+    ) -> Result<Option<Value>, RxError> {
+        let out = match self.event(src).cloned() {
+            Some(v) => {
+                let keep = call(i, pred, std::slice::from_ref(&v), host, self)?;
+                match keep.as_bool() {
+                    Some(true) => Some(v),
+                    Some(false) => None,
+                    None => {
+                        return Err(type_error(
+                            &self.graph,
+                            i,
+                            "filter predicate",
+                            "bool",
+                            &keep,
+                        ))
+                    }
+                }
+            }
+            None => None,
+        };
+        self.states[i].done = self.done(src);
+        Ok(out)
+    }
+
+    /// `a.zip(b)`, node `i`: pairs of the two streams' events, in order, each kept until the
+    /// other side has one.
+    fn zip(&mut self, i: usize, a: StreamId, b: StreamId) -> Option<Value> {
+        let (ea, eb) = (self.event(a).cloned(), self.event(b).cloned());
+        let (da, db) = (self.done(a), self.done(b));
+        let s = &mut self.states[i];
+        s.queue_a.extend(ea);
+        s.queue_b.extend(eb);
+        let out = if !s.queue_a.is_empty() && !s.queue_b.is_empty() {
+            let pair = vec![s.queue_a.pop_front(), s.queue_b.pop_front()];
+            Some(Value::Tuple(pair.into_iter().flatten().collect()))
+        } else {
+            None
+        };
+        s.done = (da && s.queue_a.is_empty()) || (db && s.queue_b.is_empty());
+        out
+    }
+
+    /// `src.take(n)`, node `i`: `src`'s first `n` events.
+    fn take(&mut self, i: usize, src: StreamId, n: u64) -> Option<Value> {
+        let e = self.event(src).cloned();
+        let d = self.done(src);
+        let s = &mut self.states[i];
+        let out = if s.count < n { e } else { None };
+        if out.is_some() {
+            s.count += 1;
+        }
+        s.done = s.count >= n || d;
+        out
+    }
+
+    /// `src.skipUntil(trigger)`, node `i`: `src`'s events once `trigger` has fired.
+    fn skip_until(&mut self, i: usize, src: StreamId, trigger: StreamId) -> Option<Value> {
+        let opened = self.states[trigger.0].fired;
+        let e = self.event(src).cloned();
+        let d = self.done(src);
+        let s = &mut self.states[i];
+        s.open |= opened;
+        s.done = d;
+        if s.open {
+            e
+        } else {
+            None
+        }
+    }
+
+    /// `src.takeUntil(stop)`, node `i`: `src`'s events until `stop` fires.
+    fn take_until(&mut self, i: usize, src: StreamId, stop: StreamId) -> Option<Value> {
+        let closed = self.states[stop.0].fired;
+        let e = self.event(src).cloned();
+        let d = self.done(src);
+        let s = &mut self.states[i];
+        s.done = closed || d;
+        if closed {
+            None
+        } else {
+            e
+        }
+    }
+
+    /// `a.concat(b)`, node `i`: `a`'s events, then, once `a` has completed, `b`'s.
+    fn concat(&mut self, i: usize, a: StreamId, b: StreamId) -> Option<Value> {
+        let a_done = self.done(a);
+        let ea = self.event(a).cloned();
+        let eb = self.event(b).cloned();
+        let b_done = self.done(b);
+        let s = &mut self.states[i];
+        // `a`'s own flag: `open` marks that `a` had completed before this step.
+        if !s.open {
+            s.queue_a.extend(ea);
+        }
+        if a_done {
+            s.open = true;
+            s.queue_a.extend(eb);
+        }
+        let out = s.queue_a.pop_front();
+        s.done = a_done && b_done && s.queue_a.is_empty();
+        out
+    }
+
+    /// `src.sum(init, f)`, node `i`: the running total of `src`'s events from `init`, by `f`
+    /// or, without one, by adding numbers or vectors.
+    ///
+    /// # Errors
+    /// `f`'s failure, or events that cannot be added ([`RxError::Type`]).
+    fn sum(
+        &mut self,
+        i: usize,
+        src: StreamId,
+        init: Value,
+        f: Option<&Func>,
+        host: &mut dyn Host,
+    ) -> Result<Option<Value>, RxError> {
+        let out = match self.event(src).cloned() {
+            Some(v) => {
+                let acc = self.states[i].value.clone().unwrap_or(init);
+                Some(match f {
+                    Some(f) => call(i, f, &[acc, v], host, self)?,
+                    None => total(&acc, &v).ok_or_else(|| {
+                        type_error(&self.graph, i, "sum", "numbers or vectors of one kind", &v)
+                    })?,
+                })
+            }
+            None => None,
+        };
+        self.states[i].done = self.done(src);
+        Ok(out)
+    }
+
+    /// A `foreach` given a host function, node `i`: calls `f` on `src`'s event and collects
+    /// the actions it performed into `sinks`.
+    ///
+    /// # Errors
+    /// `f`'s failure ([`RxError::Host`]).
+    fn perform(
+        &mut self,
+        i: usize,
+        src: StreamId,
+        f: &Func,
+        host: &mut dyn Host,
+        sinks: &mut Vec<(Action, Value)>,
+    ) -> Result<Option<Value>, RxError> {
+        if let Some(v) = self.event(src).cloned() {
+            call_acting(i, f, &[v], host, self)?;
+            sinks.extend(host.performed());
+        }
+        self.states[i].done = self.done(src);
+        Ok(None)
     }
 }
 
@@ -593,14 +673,14 @@ fn call_acting(
     streams: &Runtime,
 ) -> Result<Value, RxError> {
     match f {
-        Func::Native(_, f) => f(args).map_err(|message| RxError::Type {
+        Func::Native(_, f) => f(args).map_err(|NativeError(message)| RxError::Type {
             node,
             at: streams.graph.site(node),
             message,
         }),
         Func::Host(n) => host
             .call(*n, args, streams)
-            .map_err(|message| RxError::Host {
+            .map_err(|HostError(message)| RxError::Host {
                 node,
                 at: streams.graph.site(node),
                 message,

@@ -296,7 +296,7 @@ fn the_papers_distance_monitor_sums_step_lengths() {
                 (0..3).map(|i| (x[i] - y[i]).powi(2)).sum::<f64>().sqrt(),
             ))
         }
-        v => Err(format!("got {v:?}")),
+        v => Err(NativeError(format!("got {v:?}"))),
     });
     let nodes = vec![
         probe(0),
@@ -417,12 +417,12 @@ struct Reading {
 }
 
 impl Host for Reading {
-    fn call(&mut self, _: u32, args: &[Value], streams: &Runtime) -> Result<Value, String> {
+    fn call(&mut self, _: u32, args: &[Value], streams: &Runtime) -> Result<Value, HostError> {
         for id in &self.reads {
             self.seen.push(streams.current(*id).cloned());
         }
         match args[0].as_num() {
-            Some(t) if t >= 2.0 => Err(format!("failed at {t}")),
+            Some(t) if t >= 2.0 => Err(HostError(format!("failed at {t}"))),
             _ => Ok(Value::Num(0.0)),
         }
     }

@@ -87,8 +87,20 @@ impl<'de> Deserialize<'de> for Value {
     }
 }
 
-fn from_json(j: Json) -> Result<Value, String> {
-    let number = |n: &serde_json::Number| n.as_f64().ok_or(format!("{n} is not a number"));
+/// Why a JSON value is no stream value ([`Value`]'s `Deserialize`).
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+enum NotAValue {
+    /// A number `f64` cannot hold (its text).
+    #[error("{0} is not a number")]
+    Number(String),
+    /// An object: stream values are numbers, bools, strings and tuples.
+    #[error("a stream value is not an object")]
+    Object,
+}
+
+fn from_json(j: Json) -> Result<Value, NotAValue> {
+    let number =
+        |n: &serde_json::Number| n.as_f64().ok_or_else(|| NotAValue::Number(n.to_string()));
     Ok(match j {
         Json::Null => Value::Unit,
         Json::Bool(b) => Value::Bool(b),
@@ -100,7 +112,7 @@ fn from_json(j: Json) -> Result<Value, String> {
             }
             _ => Value::Tuple(a.into_iter().map(from_json).collect::<Result<_, _>>()?),
         },
-        Json::Object(_) => return Err("a stream value is not an object".into()),
+        Json::Object(_) => return Err(NotAValue::Object),
     })
 }
 

@@ -1,5 +1,10 @@
+//! The ray-cast lidar: its settings ([`LidarSpec`]), its returns ([`LidarReturn`]) and the
+//! lidar as a [`crate::sensor::Sensor`].
+
 use rapier3d::prelude::*;
 use serde::{Deserialize, Serialize};
+
+use super::SettingError;
 
 /// A spinning ray-cast lidar mounted on the ego vehicle.
 ///
@@ -89,27 +94,25 @@ impl LidarSpec {
     }
 
     /// Checks the ranges documented on the fields.
-    pub(crate) fn validate(&self) -> Result<(), String> {
+    ///
+    /// # Errors
+    /// The first [`SettingError`] of the lidar's: no channel or beam, a range, rate or
+    /// horizontal field of view that is not positive, a field of view too wide.
+    pub(crate) fn validate(&self) -> Result<(), SettingError> {
         if self.channels == 0 || self.beams == 0 {
-            return Err("lidar needs at least one channel and one beam".into());
+            return Err(SettingError::LidarWithoutBeams);
         }
         let ok = |v: f64| v.is_finite() && v > 0.0;
         if !ok(self.range_m) || !ok(self.rate_hz) || !ok(self.horizontal_fov_rad) {
-            return Err("lidar range, rate and horizontal field of view must be positive".into());
+            return Err(SettingError::LidarNotPositive);
         }
         if self.horizontal_fov_rad > std::f64::consts::TAU {
-            return Err(format!(
-                "lidar horizontal field of view {} rad is more than a full turn (2π)",
-                self.horizontal_fov_rad
-            ));
+            return Err(SettingError::LidarOverFullTurn(self.horizontal_fov_rad));
         }
         if !(self.vertical_fov_rad.is_finite()
             && (0.0..=std::f64::consts::PI).contains(&self.vertical_fov_rad))
         {
-            return Err(format!(
-                "lidar vertical field of view {} rad is not in [0, π]",
-                self.vertical_fov_rad
-            ));
+            return Err(SettingError::LidarVertical(self.vertical_fov_rad));
         }
         Ok(())
     }
@@ -157,11 +160,6 @@ impl LidarSpec {
         range_m: f64,
         out: &mut Vec<LidarReturn>,
     ) {
-        let Seen {
-            physics,
-            own_body,
-            asleep,
-        } = *seen;
         out.clear();
         let mount_local = Vector::new(
             self.mount_m[0] as f32,
@@ -170,82 +168,8 @@ impl LidarSpec {
         );
         let origin = chassis.transform_point(mount_local);
         let max_toi = range_m as f32;
-        // Every collider the query pipeline's filter would keep, with its world bounding box,
-        // unless it lies beyond the range.
-        let mut scratch: Vec<Candidate<'_>> = Vec::new();
-        let to_chassis = chassis.rotation.inverse();
-        let (by_azimuth, fov, planar) = (beams.by_azimuth, beams.fov, beams.planar);
         let normal = chassis.rotation * Vector::Y;
-        let stale = beams.known_colliders != Some(physics.colliders.len())
-            || beams.fixed.iter().any(|&(h, ..)| {
-                physics
-                    .colliders
-                    .get(h)
-                    .is_none_or(|c| c.parent().is_some())
-            });
-        if stale {
-            beams.gather(physics, own_body);
-        }
-        let fixed = beams.fixed.iter().filter_map(|&(h, mins, maxs)| {
-            let co = &physics.colliders[h];
-            co.is_enabled().then(|| (co, *co.position(), mins, maxs))
-        });
-        let moving = beams.moving.iter().filter_map(|&h| {
-            let co = physics.colliders.get(h)?;
-            // The query pipeline holds only enabled colliders, and none of a disabled body.
-            // An NPC car taken out of the step is seen where it would be awake.
-            let enabled =
-                co.is_enabled() && co.parent().is_none_or(|b| physics.bodies[b].is_enabled());
-            let pose = if enabled {
-                *co.position()
-            } else {
-                asleep.iter().find(|&&(a, _)| a == h)?.1
-            };
-            let (mins, maxs) = widened_box(co.shape(), &pose);
-            Some((co, pose, mins, maxs))
-        });
-        for (co, pose, mins, maxs) in fixed.chain(moving) {
-            let nearest = origin.clamp(mins, maxs);
-            if (nearest - origin).length() > max_toi {
-                continue;
-            }
-            // Every hit within range lies in the cube of half side `max_toi` round the
-            // origin: clipping the box to it lets the plane test skip a ground that only
-            // meets the channel's plane out of range.
-            let reach = Vector::splat(max_toi);
-            let (mins, maxs) = (mins.max(origin - reach), maxs.min(origin + reach));
-            if planar && !meets_plane(normal, origin, mins, maxs) {
-                continue;
-            }
-            let mut arcs = [(-f64::INFINITY, f64::INFINITY), EMPTY_ARC, EMPTY_ARC];
-            if by_azimuth {
-                let centre = to_chassis * ((mins + maxs) * 0.5 - origin);
-                let radius = f64::from((maxs - mins).length() * 0.5);
-                let across = f64::from(centre.x).hypot(f64::from(centre.z));
-                if across > radius {
-                    let az = f64::from(-centre.z).atan2(f64::from(centre.x));
-                    let half = (radius / across).asin() + AZIMUTH_MARGIN_RAD;
-                    let tau = std::f64::consts::TAU;
-                    arcs = [
-                        (az - half, az + half),
-                        (az - half - tau, az + half - tau),
-                        (az - half + tau, az + half + tau),
-                    ];
-                }
-            }
-            // A box outside the field of view is seen by no beam.
-            if !arcs.iter().any(|&(lo, hi)| lo <= fov.1 && fov.0 <= hi) {
-                continue;
-            }
-            scratch.push(Candidate {
-                mins,
-                maxs,
-                shape: co.shape(),
-                pose,
-                in_plane: true,
-                arcs,
-            });
-        }
+        let mut scratch = candidates(seen, chassis, beams, origin, max_toi);
         let mut channel_el = f64::NAN;
         for (&(az, el), &local) in beams.directions.iter().zip(&beams.local) {
             if el != channel_el {
@@ -280,6 +204,111 @@ impl LidarSpec {
             }
         }
     }
+}
+
+/// The colliders a scan from `origin` (world, m) out to `max_toi` metres may see, for the
+/// chassis at `chassis`: every collider the query pipeline's filter would keep, except those
+/// out of range, off the plane of a horizontal channel, or outside the field of view, each
+/// with its widened bounding box and the azimuths that can reach it. Sorts `beams`' colliders
+/// again when the world's changed ([`Beams::gather`]).
+fn candidates<'a>(
+    seen: &Seen<'a>,
+    chassis: &Pose,
+    beams: &mut Beams,
+    origin: Vector,
+    max_toi: f32,
+) -> Vec<Candidate<'a>> {
+    let Seen {
+        physics,
+        own_body,
+        asleep,
+    } = *seen;
+    let normal = chassis.rotation * Vector::Y;
+    // Every collider the query pipeline's filter would keep, with its world bounding box,
+    // unless it lies beyond the range.
+    let mut scratch: Vec<Candidate<'_>> = Vec::new();
+    let to_chassis = chassis.rotation.inverse();
+    let (by_azimuth, fov, planar) = (beams.by_azimuth, beams.fov, beams.planar);
+    let stale = beams.known_colliders != Some(physics.colliders.len())
+        || beams.fixed.iter().any(|&(h, ..)| {
+            physics
+                .colliders
+                .get(h)
+                .is_none_or(|c| c.parent().is_some())
+        });
+    if stale {
+        beams.gather(physics, own_body);
+    }
+    let fixed = beams.fixed.iter().filter_map(|&(h, mins, maxs)| {
+        let co = &physics.colliders[h];
+        co.is_enabled().then(|| (co, *co.position(), mins, maxs))
+    });
+    let moving = beams.moving.iter().filter_map(|&h| {
+        let co = physics.colliders.get(h)?;
+        // The query pipeline holds only enabled colliders, and none of a disabled body.
+        // An NPC car taken out of the step is seen where it would be awake.
+        let enabled = co.is_enabled() && co.parent().is_none_or(|b| physics.bodies[b].is_enabled());
+        let pose = if enabled {
+            *co.position()
+        } else {
+            asleep.iter().find(|&&(a, _)| a == h)?.1
+        };
+        let (mins, maxs) = widened_box(co.shape(), &pose);
+        Some((co, pose, mins, maxs))
+    });
+    for (co, pose, mins, maxs) in fixed.chain(moving) {
+        let nearest = origin.clamp(mins, maxs);
+        if (nearest - origin).length() > max_toi {
+            continue;
+        }
+        // Every hit within range lies in the cube of half side `max_toi` round the
+        // origin: clipping the box to it lets the plane test skip a ground that only
+        // meets the channel's plane out of range.
+        let reach = Vector::splat(max_toi);
+        let (mins, maxs) = (mins.max(origin - reach), maxs.min(origin + reach));
+        if planar && !meets_plane(normal, origin, mins, maxs) {
+            continue;
+        }
+        let arcs = if by_azimuth {
+            azimuth_arcs(to_chassis * ((mins + maxs) * 0.5 - origin), mins, maxs)
+        } else {
+            [(-f64::INFINITY, f64::INFINITY), EMPTY_ARC, EMPTY_ARC]
+        };
+        // A box outside the field of view is seen by no beam.
+        if !arcs.iter().any(|&(lo, hi)| lo <= fov.1 && fov.0 <= hi) {
+            continue;
+        }
+        scratch.push(Candidate {
+            mins,
+            maxs,
+            shape: co.shape(),
+            pose,
+            in_plane: true,
+            arcs,
+        });
+    }
+    scratch
+}
+
+/// The beam azimuths (rad, chassis frame) that can reach the box `[mins, maxs]` whose centre
+/// is at `centre` from the lidar's origin (chassis frame, m): an arc round the centre's
+/// azimuth, and the same arc shifted by ∓2π; every azimuth when the origin is inside the
+/// box's bounding sphere.
+fn azimuth_arcs(centre: Vector, mins: Vector, maxs: Vector) -> [(f64, f64); 3] {
+    let mut arcs = [(-f64::INFINITY, f64::INFINITY), EMPTY_ARC, EMPTY_ARC];
+    let radius = f64::from((maxs - mins).length() * 0.5);
+    let across = f64::from(centre.x).hypot(f64::from(centre.z));
+    if across > radius {
+        let az = f64::from(-centre.z).atan2(f64::from(centre.x));
+        let half = (radius / across).asin() + AZIMUTH_MARGIN_RAD;
+        let tau = std::f64::consts::TAU;
+        arcs = [
+            (az - half, az + half),
+            (az - half - tau, az + half - tau),
+            (az - half + tau, az + half + tau),
+        ];
+    }
+    arcs
 }
 
 /// What a scan sees: the physics world but the scanning vehicle's own body, and the colliders
@@ -435,6 +464,17 @@ fn ray_meets_box(
     true
 }
 
+impl<'a> crate::Observation<'a> {
+    /// The latest scan of the sensor named `lidar`, in the vehicle frame; empty when no lidar
+    /// is mounted ([`crate::SensorSpec::Lidar`]).
+    pub fn lidar(&self) -> &'a [LidarReturn] {
+        match self.reading("lidar") {
+            Some(crate::sensor::Reading::Lidar(returns)) => returns,
+            _ => &[],
+        }
+    }
+}
+
 /// The lidar as a [`crate::sensor::Sensor`]: scans at its rate, its range capped by the fog's
 /// visibility ([`crate::visibility_m`]); light does not affect it.
 pub(crate) struct Lidar {
@@ -469,6 +509,11 @@ impl crate::sensor::Sensor for Lidar {
         // It sees an asleep car where it would be awake (`Scene::asleep`), so no car needs
         // to stay in the physics step for it.
         0.0
+    }
+
+    fn recaptures_before_first_step(&self) -> bool {
+        // Its scan when mounted was taken before the fog was known.
+        true
     }
 
     fn capture(&mut self, scene: &crate::sensor::Scene<'_>) -> Result<(), crate::EngineError> {

@@ -1,19 +1,26 @@
-//! Sensors on the ego vehicle, behind one trait: the ray-cast lidar ([`crate::LidarSpec`]) and
-//! the camera (feature `render`). A simulation keeps its sensors in a [`Set`] and captures
-//! each at its rate; a system under test gets their readings in its
-//! [`crate::Observation`], and an external one receives each as named arrays
-//! (SUT_PROTOCOL.md).
+//! Sensors on the ego vehicle, behind one trait: the ray-cast lidar ([`lidar`]) and the camera
+//! ([`camera`], rendered with the feature `render`). A world lists the sensors it mounts with
+//! their settings ([`crate::WorldSpec::sensors`], [`SensorSpec`]); a simulation keeps them in
+//! a [`Set`] and captures each at its rate; a system under test gets their readings in its
+//! [`crate::Observation`], by the sensor's name ([`crate::Observation::reading`]), and an
+//! external one receives each as named arrays (SUT_PROTOCOL.md).
 //!
-//! A new sensor is its own file in this folder implementing [`Sensor`] (its reading is
-//! [`Reading::Arrays`], the named arrays SUT_PROTOCOL.md sends), a `mod` line and its
-//! registration in [`mounted`] (this file), and a paragraph in SUT_PROTOCOL.md: three files.
+//! A new configured sensor is its own file in this folder (its settings, and a type
+//! implementing [`Sensor`] whose reading is [`Reading::Arrays`], the named arrays
+//! SUT_PROTOCOL.md sends), its `mod` line and its variant of [`SensorSpec`] (this file), and a
+//! paragraph in SUT_PROTOCOL.md: three files.
 
-pub(crate) mod lidar;
+pub mod camera;
+pub mod lidar;
 
 use rapier3d::prelude::*;
 
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
 use crate::actor::{Set, VisibleBox};
-use crate::{CameraFrame, EgoState, EngineError, LidarReturn};
+use crate::network::Network;
+use crate::{CameraFrame, CameraSpec, EgoState, EngineError, LidarReturn, LidarSpec, RateError};
 
 /// What a sensor sees the world through when it captures.
 pub struct Scene<'a> {
@@ -127,6 +134,12 @@ pub trait Sensor: Send {
     fn physics_reach_m(&self) -> f64 {
         f64::INFINITY
     }
+    /// Whether it captures once more just before the first physics step, when the stream
+    /// graph has given light and fog (its reading when it was mounted was taken before they
+    /// were known). Default false; the lidar: true.
+    fn recaptures_before_first_step(&self) -> bool {
+        false
+    }
     /// Captures a reading of `scene`.
     ///
     /// # Errors
@@ -139,11 +152,100 @@ pub trait Sensor: Send {
 /// The sensors of one simulation.
 pub type Sensors = Set<Box<dyn Sensor>>;
 
-/// The sensors every simulation of `spec` mounts: the lidar. (A camera is mounted when a
-/// system under test asks for one, [`crate::Simulation::attach_camera`].) A new sensor is
-/// registered here.
-pub fn mounted(spec: &crate::WorldSpec) -> Sensors {
+/// A sensor setting out of its documented range ([`SensorSpec::validate`]); the message
+/// names the setting and its value.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SettingError {
+    /// A lidar without a channel or without a beam ([`LidarSpec::channels`],
+    /// [`LidarSpec::beams`]).
+    #[error("lidar needs at least one channel and one beam")]
+    LidarWithoutBeams,
+    /// A lidar range, rate or horizontal field of view that is not positive and finite.
+    #[error("lidar range, rate and horizontal field of view must be positive")]
+    LidarNotPositive,
+    /// A lidar horizontal field of view over 2π, in rad.
+    #[error("lidar horizontal field of view {0} rad is more than a full turn (2π)")]
+    LidarOverFullTurn(f64),
+    /// A lidar vertical field of view outside `[0, π]`, in rad.
+    #[error("lidar vertical field of view {0} rad is not in [0, π]")]
+    LidarVertical(f64),
+    /// A camera image size outside `1..=4096` pixels, width × height.
+    #[error("camera resolution {width}x{height} is outside 1..=4096")]
+    CameraResolution {
+        /// Width asked for, pixels.
+        width: u32,
+        /// Height asked for, pixels.
+        height: u32,
+    },
+    /// A camera setting outside its range ([`CameraSpec`]'s fields), or not finite.
+    #[error("camera {name} {value} is out of range")]
+    CameraOutOfRange {
+        /// The setting: `focal_mm`, `pitch_rad`, `rate_hz`, `noise_sigma`, `blur_sigma_px`,
+        /// `far_m`, `mount_m`.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// A rate that is not a whole number of physics steps per period.
+    #[error(transparent)]
+    Rate(#[from] RateError),
+}
+
+/// A sensor a world mounts on its ego vehicle ([`crate::WorldSpec::sensors`]), with its
+/// settings. In JSON, externally tagged: `{"lidar": {...}}`, `{"camera": {...}}`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SensorSpec {
+    /// The ray-cast lidar, named `lidar` in observations.
+    Lidar(LidarSpec),
+    /// A camera (RGB, depth and labels; feature `render`), named `camera` in observations.
+    /// Mounted from the world, its pixel noise has the seed 0; a system under test's camera,
+    /// seeded per test, is mounted by [`crate::Simulation::attach_camera`].
+    Camera(CameraSpec),
+}
+
+impl SensorSpec {
+    /// The sensors a world mounts unless it says otherwise: the lidar, with its default
+    /// settings ([`LidarSpec::default`]).
+    pub fn defaults() -> Vec<SensorSpec> {
+        vec![SensorSpec::Lidar(LidarSpec::default())]
+    }
+
+    /// Checks the ranges its settings document.
+    ///
+    /// # Errors
+    /// A [`SettingError`] naming the first value out of range ([`LidarSpec`],
+    /// [`CameraSpec::validate`]).
+    pub fn validate(&self) -> Result<(), SettingError> {
+        match self {
+            SensorSpec::Lidar(spec) => spec.validate(),
+            SensorSpec::Camera(spec) => spec.validate(),
+        }
+    }
+
+    /// The sensor, for a world on `network` whose physics step is `dt_s` seconds.
+    ///
+    /// # Errors
+    /// [`EngineError::Sensor`] when it cannot be set up (a camera without a GPU adapter, or in
+    /// a build without the `render` feature).
+    fn build(&self, network: &Network, dt_s: f64) -> Result<Box<dyn Sensor>, EngineError> {
+        match self {
+            SensorSpec::Lidar(spec) => Ok(Box::new(lidar::Lidar::new(spec, dt_s))),
+            SensorSpec::Camera(spec) => camera::sensor(network, spec, 0, dt_s),
+        }
+    }
+}
+
+/// The sensors every simulation of `spec` mounts: those of [`crate::WorldSpec::sensors`], in
+/// their order. (A system under test's camera is mounted when it asks for one,
+/// [`crate::Simulation::attach_camera`].)
+///
+/// # Errors
+/// As [`SensorSpec`]'s sensors are set up: [`EngineError::Sensor`].
+pub fn mounted(spec: &crate::WorldSpec) -> Result<Sensors, EngineError> {
     let mut sensors = Sensors::default();
-    sensors.insert(Box::new(lidar::Lidar::new(&spec.lidar, spec.dt_s)));
-    sensors
+    for s in &spec.sensors {
+        sensors.insert(s.build(&spec.network, spec.dt_s)?);
+    }
+    Ok(sensors)
 }

@@ -151,7 +151,7 @@ impl Aeb {
     /// corridor ahead, if any.
     pub fn nearest_obstacle_m(&self, obs: &Observation<'_>) -> Option<f64> {
         let c = &self.config;
-        obs.lidar
+        obs.lidar()
             .iter()
             .filter(|r| {
                 r.point_m[0] > 0.0
@@ -313,9 +313,7 @@ mod tests {
             t_s: 0.0,
             dt_s: 1.0 / 60.0,
             ego,
-            lidar: &lidar,
             route: &[],
-            camera: None,
             readings: vec![("lidar", crate::sensor::Reading::Lidar(&lidar))],
         })
         .unwrap()

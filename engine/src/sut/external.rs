@@ -11,8 +11,10 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use serde_json::{json, Value as Json};
+use thiserror::Error;
 
 use super::{Sensors, Sut, SutError};
+use crate::sensor::Payload;
 use crate::{CameraSpec, Control, Observation};
 
 /// The protocol version sent in the `hello` message.
@@ -34,15 +36,65 @@ pub struct ExternalConfig {
     pub pool: Arc<ProcessPool>,
 }
 
+/// Why a command cannot be started ([`check_command`]).
+#[derive(Debug, Error, Clone, PartialEq, Eq)]
+pub enum CommandError {
+    /// No program: the command has no words.
+    #[error("the command is empty")]
+    Empty,
+    /// A path (with a `/`) that names no executable file.
+    #[error(
+        "cannot start `{program}`: no executable file there (relative paths are from the \
+         current folder)"
+    )]
+    NotExecutable {
+        /// The program as given.
+        program: String,
+    },
+    /// A bare name that is no executable file in a folder of `PATH`.
+    #[error("cannot start `{program}`: no executable of that name in a folder of PATH")]
+    NotOnPath {
+        /// The program as given.
+        program: String,
+    },
+}
+
+/// How an external system under test broke the protocol or failed: [`SutError::Failed`]'s
+/// message after the command.
+#[derive(Debug, Error, Clone, PartialEq)]
+enum Broke {
+    /// Its command cannot be started.
+    #[error(transparent)]
+    Command(#[from] CommandError),
+    /// Its output ended.
+    #[error("closed its output")]
+    Closed,
+    /// A frame it sent cannot be read: malformed, truncated, too large, or its output failed.
+    #[error("{0}")]
+    Frame(String),
+    /// Its hello asked for what cannot be honoured.
+    #[error("{0}")]
+    Hello(String),
+    /// Its hello's `control_hz` is no whole number of physics steps per decision.
+    #[error(transparent)]
+    Rate(#[from] crate::RateError),
+    /// Its process failed: it could not start, died, stopped reading, or did not answer in
+    /// time (the message carries the end of its stderr).
+    #[error("{0}")]
+    Process(String),
+    /// An answer that is no control: a value missing, not a number, or outside `[-1, 1]`.
+    #[error("{0}")]
+    Answer(String),
+}
+
 /// Checks that `command`'s program can be started: a path (with a `/`) names an executable
 /// file, a bare name is an executable file in a folder of `PATH`. Nothing is run.
 ///
 /// # Errors
-/// "the command is empty", or "cannot start `P`: ..." naming what is missing.
-pub fn check_command(command: &[String]) -> Result<(), String> {
-    let program = command
-        .first()
-        .ok_or_else(|| "the command is empty".to_string())?;
+/// [`CommandError`]: "the command is empty", or "cannot start `P`: ..." naming what is
+/// missing.
+pub fn check_command(command: &[String]) -> Result<(), CommandError> {
+    let program = command.first().ok_or(CommandError::Empty)?;
     let executable = |p: &std::path::Path| {
         use std::os::unix::fs::PermissionsExt;
         std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
@@ -51,18 +103,17 @@ pub fn check_command(command: &[String]) -> Result<(), String> {
         if executable(std::path::Path::new(program)) {
             return Ok(());
         }
-        return Err(format!(
-            "cannot start `{program}`: no executable file there (relative paths are from the \
-             current folder)"
-        ));
+        return Err(CommandError::NotExecutable {
+            program: program.clone(),
+        });
     }
     let path = std::env::var_os("PATH").unwrap_or_default();
     if std::env::split_paths(&path).any(|dir| executable(&dir.join(program))) {
         return Ok(());
     }
-    Err(format!(
-        "cannot start `{program}`: no executable of that name in a folder of PATH"
-    ))
+    Err(CommandError::NotOnPath {
+        program: program.clone(),
+    })
 }
 
 /// A command to start and where to send the started child.
@@ -260,7 +311,7 @@ struct Process {
     child: Child,
     /// `None` once closed (when the process is dropped).
     stdin: Option<ChildStdin>,
-    replies: Receiver<Result<Message, String>>,
+    replies: Receiver<Result<Message, Broke>>,
     stderr: Arc<Mutex<String>>,
     sensors: Sensors,
     wants_depth: bool,
@@ -309,24 +360,24 @@ impl Drop for GroupGuard {
 #[derive(Debug)]
 struct GroupGuard(u32);
 
-fn read_message(r: &mut impl Read) -> Result<Option<Message>, String> {
+fn read_message(r: &mut impl Read) -> Result<Option<Message>, Broke> {
     let mut len = [0u8; 4];
     match r.read_exact(&mut len) {
         Ok(()) => {}
         Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => return Ok(None),
-        Err(e) => return Err(format!("cannot read its output: {e}")),
+        Err(e) => return Err(Broke::Frame(format!("cannot read its output: {e}"))),
     }
     let len = u32::from_le_bytes(len);
     if len > MAX_HEADER_BYTES {
-        return Err(format!(
+        return Err(Broke::Frame(format!(
             "sent a malformed frame: header length {len} bytes is over the {MAX_HEADER_BYTES}-byte \
              limit (bytes {:02x?}; is it printing to stdout?)",
             len.to_le_bytes()
-        ));
+        )));
     }
     let mut header = vec![0u8; len as usize];
     r.read_exact(&mut header)
-        .map_err(|e| format!("sent a truncated frame: {e}"))?;
+        .map_err(|e| Broke::Frame(format!("sent a truncated frame: {e}")))?;
     let header: Json = serde_json::from_slice(&header).map_err(|e| {
         let text = String::from_utf8_lossy(&header[..header.len().min(80)]);
         let hint = if text.contains("NaN") || text.contains("Infinity") {
@@ -334,20 +385,23 @@ fn read_message(r: &mut impl Read) -> Result<Option<Message>, String> {
         } else {
             ""
         };
-        format!("sent a malformed frame: the header is not JSON ({e}){hint}: {text:?}")
+        Broke::Frame(format!(
+            "sent a malformed frame: the header is not JSON ({e}){hint}: {text:?}"
+        ))
     })?;
     if let Some(list) = header.get("buffers").and_then(Json::as_array) {
         for b in list {
-            let n = b
-                .get("nbytes")
-                .and_then(Json::as_u64)
-                .ok_or_else(|| "sent a malformed frame: a buffer has no `nbytes`".to_string())?;
+            let n = b.get("nbytes").and_then(Json::as_u64).ok_or_else(|| {
+                Broke::Frame("sent a malformed frame: a buffer has no `nbytes`".into())
+            })?;
             if n > 1 << 30 {
-                return Err(format!("sent a malformed frame: buffer of {n} bytes"));
+                return Err(Broke::Frame(format!(
+                    "sent a malformed frame: buffer of {n} bytes"
+                )));
             }
             let mut data = vec![0u8; n as usize];
             r.read_exact(&mut data)
-                .map_err(|e| format!("sent a truncated buffer: {e}"))?;
+                .map_err(|e| Broke::Frame(format!("sent a truncated buffer: {e}")))?;
         }
     }
     Ok(Some(Message { header }))
@@ -364,11 +418,8 @@ fn write_message(w: &mut impl Write, header: &Json, buffers: &[&[u8]]) -> std::i
 }
 
 impl Process {
-    fn spawn(config: &ExternalConfig, dt_s: f64) -> Result<Process, String> {
-        let (program, args) = config
-            .command
-            .split_first()
-            .ok_or_else(|| "the command is empty".to_string())?;
+    fn spawn(config: &ExternalConfig, dt_s: f64) -> Result<Process, Broke> {
+        let (program, args) = config.command.split_first().ok_or(CommandError::Empty)?;
         use std::os::unix::process::CommandExt;
         // Its own process group, so that it and everything it starts can be killed at once.
         let mut command = Command::new(program);
@@ -378,8 +429,8 @@ impl Process {
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .process_group(0);
-        let mut child =
-            spawn_dying_with_us(command).map_err(|e| format!("cannot start `{program}`: {e}"))?;
+        let mut child = spawn_dying_with_us(command)
+            .map_err(|e| Broke::Process(format!("cannot start `{program}`: {e}")))?;
         let stdin = child.stdin.take().expect("piped");
         let stdout = child.stdout.take().expect("piped");
         let mut err_pipe = child.stderr.take().expect("piped");
@@ -389,7 +440,7 @@ impl Process {
             loop {
                 let m = read_message(&mut r);
                 let stop = !matches!(m, Ok(Some(_)));
-                let m = m.and_then(|m| m.ok_or_else(|| "closed its output".to_string()));
+                let m = m.and_then(|m| m.ok_or(Broke::Closed));
                 if tx.send(m).is_err() || stop {
                     break;
                 }
@@ -433,9 +484,11 @@ impl Process {
         Ok(p)
     }
 
-    fn accept_hello(&mut self, h: &Json) -> Result<(), String> {
+    fn accept_hello(&mut self, h: &Json) -> Result<(), Broke> {
         if h.get("type").and_then(Json::as_str) != Some("hello") {
-            return Err(format!("answered the hello with {h} instead of a hello"));
+            return Err(Broke::Hello(format!(
+                "answered the hello with {h} instead of a hello"
+            )));
         }
         let sensors = h.get("sensors").cloned().unwrap_or(Json::Null);
         match &sensors {
@@ -445,17 +498,17 @@ impl Process {
                 // (which may be an object) is asked for with true or false.
                 for (name, v) in m {
                     if name != "camera" && !v.is_boolean() {
-                        return Err(format!(
+                        return Err(Broke::Hello(format!(
                             "declared sensor `{name}` as {v}; a sensor is asked for with true \
                              or false (the camera also with an object)"
-                        ));
+                        )));
                     }
                 }
             }
             other => {
-                return Err(format!(
+                return Err(Broke::Hello(format!(
                     "declared sensors {other}; need an object such as {{\"lidar\": true}}"
-                ))
+                )))
             }
         }
         self.wants_depth = sensors
@@ -476,9 +529,9 @@ impl Process {
             Some(Json::Bool(true)) => Some(CameraSpec::default()),
             Some(spec) => {
                 let c: CameraSpec = serde_json::from_value(spec.clone())
-                    .map_err(|e| format!("declared an invalid camera {spec}: {e}"))?;
+                    .map_err(|e| Broke::Hello(format!("declared an invalid camera {spec}: {e}")))?;
                 c.validate()
-                    .map_err(|e| format!("declared an invalid camera: {e}"))?;
+                    .map_err(|e| Broke::Hello(format!("declared an invalid camera: {e}")))?;
                 Some(c)
             }
         };
@@ -493,11 +546,52 @@ impl Process {
                     crate::steps_per_period("declared control_hz", hz, crate::DEFAULT_DT_S)?;
                     Some(hz)
                 }
-                _ => return Err(format!("declared control_hz {v}; need a positive number")),
+                _ => {
+                    return Err(Broke::Hello(format!(
+                        "declared control_hz {v}; need a positive number"
+                    )))
+                }
             },
         };
         self.sensors = Sensors { camera, control_hz };
         Ok(())
+    }
+
+    /// The arrays of every reading in `obs` this program declared (SUT_PROTOCOL.md), in the
+    /// order of the sensors' names.
+    ///
+    /// # Errors
+    /// [`Broke::Hello`] for a sensor it asked for by a name the simulation does not mount
+    /// (`"lidr": true`), naming the ones it mounts, rather than sending nothing.
+    fn declared_readings(&self, obs: &Observation<'_>) -> Result<Vec<Payload>, Broke> {
+        // A sensor asked for by a name the simulation does not mount (`"lidr": true`) ends
+        // the test, naming the ones it mounts, rather than sending nothing.
+        if let Some(unknown) = self.wanted.iter().find(|w| {
+            !matches!(w.as_str(), "camera" | "depth") && !obs.readings.iter().any(|(n, _)| n == w)
+        }) {
+            let mut mounted: Vec<&str> = obs.readings.iter().map(|(n, _)| *n).collect();
+            mounted.extend(["camera", "depth"]);
+            mounted.sort_unstable();
+            mounted.dedup();
+            let message = format!(
+                "declared sensor `{unknown}`, which the simulation does not mount (it mounts: {})",
+                mounted.join(", ")
+            );
+            return Err(Broke::Hello(message));
+        }
+        let mut readings: Vec<_> = obs.readings.iter().collect();
+        readings.sort_by_key(|(name, _)| *name);
+        let mut sent = Vec::new();
+        for (name, reading) in readings {
+            let wanted = match *name {
+                "camera" => self.sensors.camera.is_some(),
+                other => self.wanted.iter().any(|w| w == other),
+            };
+            if wanted {
+                sent.extend(reading.payloads(self.wants_depth));
+            }
+        }
+        Ok(sent)
     }
 
     /// Sends one message and waits for the answer.
@@ -506,7 +600,7 @@ impl Process {
         header: &Json,
         buffers: &[&[u8]],
         timeout_s: f64,
-    ) -> Result<Message, String> {
+    ) -> Result<Message, Broke> {
         let written = match self.stdin.as_mut() {
             Some(stdin) => write_message(stdin, header, buffers),
             None => Err(std::io::Error::other("stdin closed")),
@@ -519,19 +613,21 @@ impl Process {
             .recv_timeout(Duration::from_secs_f64(timeout_s))
         {
             Ok(Ok(m)) => Ok(m),
-            Ok(Err(e)) => Err(self.died(&e)),
+            Ok(Err(e)) => Err(self.died(&e.to_string())),
             Err(RecvTimeoutError::Timeout) => {
                 kill_group(self.child.id());
-                Err(format!(
+                Err(Broke::Process(format!(
                     "did not answer within {timeout_s} s (--sut-timeout); killed it{}",
                     self.stderr_tail()
-                ))
+                )))
             }
             Err(RecvTimeoutError::Disconnected) => Err(self.died("closed its output")),
         }
     }
 
-    fn died(&mut self, what: &str) -> String {
+    /// How the process ended, after `what` went wrong: its exit status and the end of its
+    /// stderr.
+    fn died(&mut self, what: &str) -> Broke {
         // Give a crashing process a moment to finish writing its traceback and exit.
         let mut status = None;
         for _ in 0..50 {
@@ -546,7 +642,7 @@ impl Process {
             || "the process was still running (killed)".to_string(),
             |s| format!("process {s}"),
         );
-        format!("{what}; {status}{}", self.stderr_tail())
+        Broke::Process(format!("{what}; {status}{}", self.stderr_tail()))
     }
 
     fn stderr_tail(&self) -> String {
@@ -586,7 +682,7 @@ impl ExternalSut {
         }
     }
 
-    fn fail(&mut self, message: String) -> SutError {
+    fn fail(&mut self, message: impl std::fmt::Display) -> SutError {
         self.healthy = false;
         self.process = None; // kills it
         SutError::Failed(format!(
@@ -656,7 +752,7 @@ impl Sut for ExternalSut {
     fn act(&mut self, obs: &Observation<'_>) -> Result<Control, SutError> {
         let timeout = self.config.timeout_s;
         let Some(p) = self.process.as_mut() else {
-            return Err(self.fail("was not started (no reset)".into()));
+            return Err(self.fail("was not started (no reset)"));
         };
         let step = self.step;
         self.step += 1;
@@ -672,33 +768,10 @@ impl Sut for ExternalSut {
         });
         // Every reading the program declared, as named arrays (SUT_PROTOCOL.md), in the
         // order of their names.
-        // A sensor asked for by a name the simulation does not mount (`"lidr": true`) ends
-        // the test, naming the ones it mounts, rather than sending nothing.
-        if let Some(unknown) = p.wanted.iter().find(|w| {
-            !matches!(w.as_str(), "camera" | "depth") && !obs.readings.iter().any(|(n, _)| n == w)
-        }) {
-            let mut mounted: Vec<&str> = obs.readings.iter().map(|(n, _)| *n).collect();
-            mounted.extend(["camera", "depth"]);
-            mounted.sort_unstable();
-            mounted.dedup();
-            let message = format!(
-                "declared sensor `{unknown}`, which the simulation does not mount (it mounts: {})",
-                mounted.join(", ")
-            );
-            return Err(self.fail(message));
-        }
-        let mut readings: Vec<_> = obs.readings.iter().collect();
-        readings.sort_by_key(|(name, _)| *name);
-        let mut sent = Vec::new();
-        for (name, reading) in readings {
-            let wanted = match *name {
-                "camera" => p.sensors.camera.is_some(),
-                other => p.wanted.iter().any(|w| w == other),
-            };
-            if wanted {
-                sent.extend(reading.payloads(p.wants_depth));
-            }
-        }
+        let sent = match p.declared_readings(obs) {
+            Ok(sent) => sent,
+            Err(e) => return Err(self.fail(e)),
+        };
         let descriptors: Vec<Json> = sent
             .iter()
             .map(|b| {
@@ -716,18 +789,20 @@ impl Sut for ExternalSut {
             Ok(m) => m,
             Err(e) => return Err(self.fail(e)),
         };
-        let value = |k: &str| -> Result<f64, String> {
+        let value = |k: &str| -> Result<f64, Broke> {
             let v = reply
                 .header
                 .get(k)
-                .ok_or_else(|| format!("answered {} without `{k}`", reply.header))?;
+                .ok_or_else(|| Broke::Answer(format!("answered {} without `{k}`", reply.header)))?;
             // JSON has no NaN: clients that write `NaN` send a string or a bare token the
             // parser rejects; both end here or in the frame reader.
-            let x = v
-                .as_f64()
-                .ok_or_else(|| format!("answered {k} = {v}; controls must be numbers"))?;
+            let x = v.as_f64().ok_or_else(|| {
+                Broke::Answer(format!("answered {k} = {v}; controls must be numbers"))
+            })?;
             if !x.is_finite() || !(-1.0..=1.0).contains(&x) {
-                return Err(format!("answered {k} = {x}, outside [-1, 1]"));
+                return Err(Broke::Answer(format!(
+                    "answered {k} = {x}, outside [-1, 1]"
+                )));
             }
             Ok(x)
         };

@@ -18,13 +18,13 @@ pub use aeb::{Aeb, AebConfig};
 pub use constant::ConstantControl;
 pub use cruise::Cruise;
 pub use external::{
-    check_command, reap_orphans, track_orphans, ExternalConfig, ExternalSut, ProcessPool,
-    PROTOCOL_VERSION,
+    check_command, reap_orphans, track_orphans, CommandError, ExternalConfig, ExternalSut,
+    ProcessPool, PROTOCOL_VERSION,
 };
 #[cfg(feature = "onnx")]
 pub use onnx::{
-    manifest_path, preprocess, Channels, InputSpec, Layout, Manifest, OnnxConfig, OnnxSut,
-    OutputSpec,
+    manifest_path, preprocess, Channels, InputSpec, Layout, Manifest, ModelError, OnnxConfig,
+    OnnxSut, OutputSpec,
 };
 pub use vision::{Perception, Vision, VisionConfig};
 
@@ -94,13 +94,41 @@ pub const PILOTNET: &str = "pilotnet";
 /// Names of the built-in systems under test, for `--sut` and `AutonomousVehicle(sut=)`.
 pub const BUILTIN_SUTS: [&str; 3] = ["aeb", "vision", PILOTNET];
 
+/// Why a system under test cannot be configured ([`SutConfig::named`], [`SutConfig::onnx`]).
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SutConfigError {
+    /// A name that is no built-in system ([`BUILTIN_SUTS`]).
+    #[error("unknown system under test `{0}`; built in: {known}", known = BUILTIN_SUTS.join(", "))]
+    Unknown(String),
+    /// An ONNX model or its manifest that cannot be used; the message names the file.
+    #[cfg(feature = "onnx")]
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// `pilotnet` in a build without the ONNX runtime (cargo feature `onnx`).
+    #[error(
+        "`pilotnet` is an ONNX model: this build of paracosm has no ONNX runtime (cargo \
+         feature `onnx`)"
+    )]
+    PilotnetWithoutOnnx,
+    /// An ONNX model in a build without the ONNX runtime (cargo feature `onnx`).
+    #[error(
+        "cannot run the ONNX model `{}`: this build of paracosm has no ONNX runtime (cargo \
+         feature `onnx`)",
+        .0.display()
+    )]
+    WithoutOnnx(std::path::PathBuf),
+}
+
 /// The shipped network (`assets/models/pilotnet.onnx` and its manifest, compiled in), loaded
 /// once per process.
-fn pilotnet() -> Result<SutConfig, String> {
+///
+/// # Errors
+/// The compiled-in model's [`ModelError`], or [`SutConfigError::PilotnetWithoutOnnx`].
+fn pilotnet() -> Result<SutConfig, SutConfigError> {
     #[cfg(feature = "onnx")]
     {
         use std::sync::OnceLock;
-        static MODEL: OnceLock<Result<OnnxConfig, String>> = OnceLock::new();
+        static MODEL: OnceLock<Result<OnnxConfig, ModelError>> = OnceLock::new();
         MODEL
             .get_or_init(|| {
                 let manifest = Manifest::parse(
@@ -115,14 +143,11 @@ fn pilotnet() -> Result<SutConfig, String> {
             })
             .clone()
             .map(|c| SutConfig::Onnx(Box::new(c)))
+            .map_err(SutConfigError::from)
     }
     #[cfg(not(feature = "onnx"))]
     {
-        Err(
-            "`pilotnet` is an ONNX model: this build of paracosm has no ONNX runtime (cargo \
-             feature `onnx`)"
-                .into(),
-        )
+        Err(SutConfigError::PilotnetWithoutOnnx)
     }
 }
 
@@ -130,17 +155,24 @@ impl SutConfig {
     /// The built-in system called `name` (see [`BUILTIN_SUTS`]) with default settings.
     ///
     /// # Errors
-    /// A message listing the known names.
-    pub fn builtin(name: &str) -> Result<SutConfig, String> {
+    /// [`SutConfigError::Unknown`] (its message lists the known names), or the shipped
+    /// model's error.
+    fn lookup(name: &str) -> Result<SutConfig, SutConfigError> {
         match name {
             "aeb" => Ok(SutConfig::Aeb(AebConfig::default())),
             "vision" => Ok(SutConfig::Vision(VisionConfig::default())),
             PILOTNET => pilotnet(),
-            _ => Err(format!(
-                "unknown system under test `{name}`; built in: {}",
-                BUILTIN_SUTS.join(", ")
-            )),
+            _ => Err(SutConfigError::Unknown(name.to_owned())),
         }
+    }
+
+    /// The built-in system called `name` (see [`BUILTIN_SUTS`]) with default settings.
+    ///
+    /// # Errors
+    /// [`SutConfigError::Unknown`] for a name that is not built in (its message lists the
+    /// known names), or the shipped model's problem.
+    pub fn builtin(name: &str) -> Result<SutConfig, SutConfigError> {
+        Self::lookup(name)
     }
 
     /// The system a scenario names: a built-in name, or `onnx:PATH` with `PATH` relative to
@@ -148,30 +180,28 @@ impl SutConfig {
     ///
     /// # Errors
     /// As [`SutConfig::builtin`] and [`SutConfig::onnx`].
-    pub fn named(spec: &str, base: &std::path::Path) -> Result<SutConfig, String> {
+    pub fn named(spec: &str, base: &std::path::Path) -> Result<SutConfig, SutConfigError> {
         match spec.strip_prefix("onnx:") {
             Some(path) => SutConfig::onnx(&base.join(path)),
-            None => SutConfig::builtin(spec),
+            None => SutConfig::lookup(spec),
         }
     }
 
     /// The ONNX model at `path` with its manifest beside it (`--sut-onnx`).
     ///
     /// # Errors
-    /// The model's or the manifest's problem, naming the file; or that this build has no
-    /// ONNX runtime (cargo feature `onnx`).
-    pub fn onnx(path: &std::path::Path) -> Result<SutConfig, String> {
+    /// The model's or the manifest's problem, naming the file ([`SutConfigError::Model`]);
+    /// or that this build has no ONNX runtime ([`SutConfigError::WithoutOnnx`]).
+    pub fn onnx(path: &std::path::Path) -> Result<SutConfig, SutConfigError> {
         #[cfg(feature = "onnx")]
         {
-            onnx::cached(path).map(|c| SutConfig::Onnx(Box::new(c)))
+            onnx::cached(path)
+                .map(|c| SutConfig::Onnx(Box::new(c)))
+                .map_err(SutConfigError::from)
         }
         #[cfg(not(feature = "onnx"))]
         {
-            Err(format!(
-                "cannot run the ONNX model `{}`: this build of paracosm has no ONNX runtime \
-                 (cargo feature `onnx`)",
-                path.display()
-            ))
+            Err(SutConfigError::WithoutOnnx(path.to_owned()))
         }
     }
 

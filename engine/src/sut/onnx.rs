@@ -37,10 +37,30 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
+use thiserror::Error;
 use tract_onnx::prelude::*;
 
 use super::{Sensors, Sut, SutError};
 use crate::{CameraFrame, CameraSpec, Control, Observation};
+
+/// Why an ONNX model cannot be loaded or run; the message names the file or the model.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ModelError {
+    /// A manifest that is not valid TOML or has a value out of range: `path[:line:col]:` and
+    /// what is wrong (the key, its value).
+    #[error("{0}")]
+    Manifest(String),
+    /// A model or manifest file that cannot be read (missing, not a regular file,
+    /// unreadable).
+    #[error("{0}")]
+    Read(String),
+    /// A model tract cannot load, or whose inputs or outputs do not fit its manifest.
+    #[error("{0}")]
+    Model(String),
+    /// A run of the model failed: tract's message.
+    #[error("{0}")]
+    Run(String),
+}
 
 /// Channel order of the model's image input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -150,9 +170,9 @@ impl Manifest {
     /// Reads and checks a manifest.
     ///
     /// # Errors
-    /// A message naming `path` and the key: TOML syntax (with line and column), an unknown
-    /// key, a value out of range, no way to set the throttle.
-    pub fn parse(text: &str, path: &Path) -> Result<Manifest, String> {
+    /// [`ModelError::Manifest`] naming `path` and the key: TOML syntax (with line and
+    /// column), an unknown key, a value out of range, no way to set the throttle.
+    pub fn parse(text: &str, path: &Path) -> Result<Manifest, ModelError> {
         let m: Manifest = toml::from_str(text).map_err(|e| {
             let at = e
                 .span()
@@ -163,62 +183,81 @@ impl Manifest {
                     format!(":{line}:{col}")
                 })
                 .unwrap_or_default();
-            format!("{}{at}: {}", path.display(), e.message())
+            ModelError::Manifest(format!("{}{at}: {}", path.display(), e.message()))
         })?;
-        m.check().map_err(|e| format!("{}: {e}", path.display()))?;
+        m.check()
+            .map_err(|e| ModelError::Manifest(format!("{}: {e}", path.display())))?;
         Ok(m)
     }
 
-    fn check(&self) -> Result<(), String> {
-        self.camera.validate()?;
+    /// Checks the ranges the manifest's keys document.
+    ///
+    /// # Errors
+    /// [`ModelError::Manifest`] naming the first key out of range (without the file).
+    fn check(&self) -> Result<(), ModelError> {
+        self.camera
+            .validate()
+            .map_err(|e| ModelError::Manifest(e.to_string()))?;
         let i = &self.input;
         let [top, bottom, left, right] = i.crop;
         if u64::from(top) + u64::from(bottom) >= u64::from(self.camera.height)
             || u64::from(left) + u64::from(right) >= u64::from(self.camera.width)
         {
-            return Err(format!(
+            return Err(ModelError::Manifest(format!(
                 "input.crop {:?} leaves nothing of the {}x{} camera image",
                 i.crop, self.camera.width, self.camera.height
-            ));
+            )));
         }
         if !(1..=4096).contains(&i.width) || !(1..=4096).contains(&i.height) {
-            return Err(format!(
+            return Err(ModelError::Manifest(format!(
                 "input size {}x{} is outside 1..=4096",
                 i.width, i.height
-            ));
+            )));
         }
         if !(1..=16).contains(&i.frames) {
-            return Err(format!("input.frames {} is outside 1..=16", i.frames));
+            return Err(ModelError::Manifest(format!(
+                "input.frames {} is outside 1..=16",
+                i.frames
+            )));
         }
         let c = i.channels.count();
         for (name, v) in [("mean", &i.mean), ("std", &i.std)] {
             if !v.is_empty() && v.len() != c {
-                return Err(format!(
+                return Err(ModelError::Manifest(format!(
                     "input.{name} has {} values for {c} channels",
                     v.len()
-                ));
+                )));
             }
             if v.iter().any(|x| !x.is_finite()) {
-                return Err(format!("input.{name} {v:?} is not finite"));
+                return Err(ModelError::Manifest(format!(
+                    "input.{name} {v:?} is not finite"
+                )));
             }
         }
         if i.std.iter().any(|&s| s <= 0.0) {
-            return Err(format!("input.std {:?} must be > 0", i.std));
+            return Err(ModelError::Manifest(format!(
+                "input.std {:?} must be > 0",
+                i.std
+            )));
         }
         let o = &self.output;
         match (o.throttle, o.cruise_mps) {
             (None, None) => {
-                return Err(
+                return Err(ModelError::Manifest(
                     "output needs `throttle` (an index) or `cruise_mps` (a speed to hold)".into(),
-                )
+                ))
             }
             (_, Some(v)) if !(v.is_finite() && v >= 0.0) => {
-                return Err(format!("output.cruise_mps {v} must be >= 0"))
+                return Err(ModelError::Manifest(format!(
+                    "output.cruise_mps {v} must be >= 0"
+                )))
             }
             _ => {}
         }
         if !o.brake_threshold.is_finite() {
-            return Err("output.brake_threshold is not finite".into());
+            return Err(ModelError::Manifest(
+                "output.brake_threshold is not finite".into(),
+            ));
         }
         Ok(())
     }
@@ -335,23 +374,25 @@ impl OnnxConfig {
     /// checks that the model takes the manifest's input and has the outputs it reads.
     ///
     /// # Errors
-    /// A message naming the file: missing or unreadable model or manifest, a manifest
-    /// error, a model tract cannot load, an input shape the model does not take, too few
-    /// outputs.
-    pub fn load(model: &Path) -> Result<OnnxConfig, String> {
+    /// A [`ModelError`] naming the file: missing or unreadable model or manifest
+    /// ([`ModelError::Read`]), a manifest error ([`ModelError::Manifest`]), a model tract cannot
+    /// load, an input shape the model does not take, too few outputs ([`ModelError::Model`]),
+    /// a failed trial run ([`ModelError::Run`]).
+    pub fn load(model: &Path) -> Result<OnnxConfig, ModelError> {
         let manifest_file = manifest_path(model);
         for f in [model, manifest_file.as_path()] {
             crate::files::regular_file(f)
-                .map_err(|e| format!("cannot read `{}`: {e}", f.display()))?;
+                .map_err(|e| ModelError::Read(format!("cannot read `{}`: {e}", f.display())))?;
         }
-        let bytes = std::fs::read(model)
-            .map_err(|e| format!("cannot read the model `{}`: {e}", model.display()))?;
+        let bytes = std::fs::read(model).map_err(|e| {
+            ModelError::Read(format!("cannot read the model `{}`: {e}", model.display()))
+        })?;
         let text = std::fs::read_to_string(&manifest_file).map_err(|e| {
-            format!(
+            ModelError::Read(format!(
                 "cannot read the model's manifest `{}` ({e}); every model needs a TOML \
                  manifest beside it with the same stem (docs/systems-under-test.md, \"ONNX models\")",
                 manifest_file.display()
-            )
+            ))
         })?;
         let manifest = Manifest::parse(&text, &manifest_file)?;
         let source = model.display().to_string();
@@ -371,8 +412,10 @@ impl OnnxConfig {
     ///
     /// # Errors
     /// As [`OnnxConfig::load`].
-    pub fn from_bytes(source: &str, bytes: &[u8], manifest: Manifest) -> Result<Self, String> {
-        let fail = |what: &str, e: TractError| format!("model `{source}`: {what}: {e:#}");
+    pub fn from_bytes(source: &str, bytes: &[u8], manifest: Manifest) -> Result<Self, ModelError> {
+        let fail = |what: &str, e: TractError| {
+            ModelError::Model(format!("model `{source}`: {what}: {e:#}"))
+        };
         let shape = manifest.input_shape();
         let mut model = tract_onnx::onnx()
             .model_for_read(&mut &bytes[..])
@@ -380,7 +423,7 @@ impl OnnxConfig {
         let inputs = model.inputs.len();
         let wanted = 1 + usize::from(manifest.input.speed);
         if inputs != wanted {
-            return Err(format!(
+            return Err(ModelError::Model(format!(
                 "model `{source}` has {inputs} inputs; its manifest describes {wanted} (the \
                  image{})",
                 if manifest.input.speed {
@@ -388,7 +431,7 @@ impl OnnxConfig {
                 } else {
                     ""
                 }
-            ));
+            )));
         }
         declared_input_matches(&model, source, &shape)?;
         model = model
@@ -417,10 +460,10 @@ impl OnnxConfig {
         // One run on a grey image: the outputs the manifest reads exist.
         let n = config.run(&vec![0.0; shape.iter().product()], 0.0)?.len();
         if config.manifest.max_index() >= n {
-            return Err(format!(
+            return Err(ModelError::Model(format!(
                 "model `{source}` has {n} outputs; its manifest reads index {}",
                 config.manifest.max_index()
-            ));
+            )));
         }
         Ok(config)
     }
@@ -429,22 +472,27 @@ impl OnnxConfig {
     /// and returns its first output, flattened.
     ///
     /// # Errors
-    /// tract's message.
-    pub fn run(&self, image: &[f32], speed_mps: f32) -> Result<Vec<f32>, String> {
+    /// [`ModelError::Run`] with tract's message.
+    pub fn run(&self, image: &[f32], speed_mps: f32) -> Result<Vec<f32>, ModelError> {
         let shape = self.manifest.input_shape();
-        let tensor = Tensor::from_shape(&shape, image).map_err(|e| format!("{e:#}"))?;
+        let tensor =
+            Tensor::from_shape(&shape, image).map_err(|e| ModelError::Run(format!("{e:#}")))?;
         let mut inputs: TVec<TValue> = tvec!(tensor.into());
         if self.manifest.input.speed {
-            let s = Tensor::from_shape(&[1, 1], &[speed_mps]).map_err(|e| format!("{e:#}"))?;
+            let s = Tensor::from_shape(&[1, 1], &[speed_mps])
+                .map_err(|e| ModelError::Run(format!("{e:#}")))?;
             inputs.push(s.into());
         }
-        let out = self.plan.run(inputs).map_err(|e| format!("{e:#}"))?;
+        let out = self
+            .plan
+            .run(inputs)
+            .map_err(|e| ModelError::Run(format!("{e:#}")))?;
         let first = out
             .first()
-            .ok_or_else(|| "the model has no output".to_owned())?;
+            .ok_or_else(|| ModelError::Run("the model has no output".to_owned()))?;
         let view = first
             .to_plain_array_view::<f32>()
-            .map_err(|e| format!("its first output is not f32: {e:#}"))?;
+            .map_err(|e| ModelError::Run(format!("its first output is not f32: {e:#}")))?;
         Ok(view.iter().copied().collect())
     }
 
@@ -484,7 +532,7 @@ type Stamps = [Option<(std::time::SystemTime, u64)>; 2];
 ///
 /// # Errors
 /// As [`OnnxConfig::load`].
-pub(crate) fn cached(path: &Path) -> Result<OnnxConfig, String> {
+pub(crate) fn cached(path: &Path) -> Result<OnnxConfig, ModelError> {
     use std::collections::HashMap;
     use std::sync::{Mutex, OnceLock};
     static CACHE: OnceLock<Mutex<HashMap<PathBuf, (Stamps, OnnxConfig)>>> = OnceLock::new();
@@ -585,19 +633,19 @@ fn declared_input_matches(
     model: &tract_onnx::prelude::InferenceModel,
     source: &str,
     shape: &[usize],
-) -> Result<(), String> {
+) -> Result<(), ModelError> {
     use tract_onnx::prelude::DatumType;
     use tract_onnx::tract_core::internal::DimLike;
     use tract_onnx::tract_hir::infer::Factoid;
     let fact = model
         .input_fact(0)
-        .map_err(|e| format!("model `{source}`: no input: {e:#}"))?;
+        .map_err(|e| ModelError::Model(format!("model `{source}`: no input: {e:#}")))?;
     if let Some(t) = fact.datum_type.concretize() {
         if t != DatumType::F32 {
-            return Err(format!(
+            return Err(ModelError::Model(format!(
                 "model `{source}` declares its input of type {t:?}; paracosm feeds it f32 \
                  images (its manifest's [input])"
-            ));
+            )));
         }
     }
     if fact.shape.is_open() {
@@ -620,11 +668,11 @@ fn declared_input_matches(
             .iter()
             .map(|d| d.map_or("?".to_owned(), |d| d.to_string()))
             .collect();
-        Err(format!(
+        Err(ModelError::Model(format!(
             "model `{source}` declares its input of shape [{}], and its manifest describes \
              {shape:?} (camera, crop and channels): they must agree",
             show.join(", ")
-        ))
+        )))
     }
 }
 
@@ -644,7 +692,7 @@ impl Sut for OnnxSut {
     }
 
     fn act(&mut self, obs: &Observation<'_>) -> Result<Control, SutError> {
-        let frame = obs.camera.ok_or_else(|| {
+        let frame = obs.camera().ok_or_else(|| {
             SutError::Failed(
                 "an ONNX model needs camera frames but the observation has none".into(),
             )

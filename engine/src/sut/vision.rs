@@ -326,7 +326,7 @@ impl Sut for Vision {
     }
 
     fn act(&mut self, obs: &Observation<'_>) -> Result<Control, SutError> {
-        let frame = obs.camera.ok_or_else(|| {
+        let frame = obs.camera().ok_or_else(|| {
             SutError::Failed("vision needs camera frames but the observation has none".into())
         })?;
         // Decide once per frame; hold the decision between frames.

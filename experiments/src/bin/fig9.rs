@@ -42,7 +42,7 @@ fn main() -> Result<()> {
     let f = match &cli.sut {
         None => paracosm_experiments::figure9(cli.budget, cli.seed, jobs, &cli.out)?,
         Some(name) => {
-            let sut = paracosm_engine::sut::SutConfig::builtin(name).map_err(anyhow::Error::msg)?;
+            let sut = paracosm_engine::sut::SutConfig::builtin(name)?;
             let dir = cli.out.join(format!("fig9-{name}"));
             paracosm_experiments::figure9_with(cli.budget, cli.seed, jobs, &dir, Some(sut))?
         }

@@ -219,38 +219,14 @@ fn main() -> Result<()> {
             ..Default::default()
         },
     )?;
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
-    let mut order = train.clone();
-    let mut log = Vec::new();
-    let weight = Tensor::new(&[1.0f32, args.steering_weight], &dev)?.reshape((1, 2))?;
-    for epoch in 0..args.epochs {
-        order.shuffle(&mut rng);
-        let mut total = 0.0;
-        for chunk in order.chunks(args.batch) {
-            let (x, s, y) = batch(&frames, chunk, &dev)?;
-            let loss = if args.steering_weight == 1.0 {
-                candle_nn::loss::mse(&net.forward(&x, &s)?, &y)?
-            } else {
-                (net.forward(&x, &s)? - &y)?
-                    .sqr()?
-                    .broadcast_mul(&weight)?
-                    .mean_all()?
-            };
-            opt.backward_step(&loss)?;
-            total += f64::from(loss.to_scalar::<f32>()?) * chunk.len() as f64;
-        }
-        let [t, st, agree] = evaluate(&net, &frames, &valid, &dev)?;
-        let line = format!(
-            "epoch {}: training MSE {:.4}; validation MSE throttle {t:.4}, steering {st:.5}, \
-             braking agreement {:.1} % ({:.0} s)",
-            epoch + 1,
-            total / train.len() as f64,
-            100.0 * agree,
-            started.elapsed().as_secs_f64()
-        );
-        eprintln!("{line}");
-        log.push(line);
-    }
+    let log = train_epochs(
+        &args,
+        (&net, &mut opt),
+        &frames,
+        (&train, &valid),
+        &dev,
+        started,
+    )?;
     // The trained weights, in the order of `pilotnet::variables`.
     let vars = varmap.data().lock().expect("training is over");
     let weights: Vec<pilotnet::Weight> = pilotnet::variables()
@@ -261,7 +237,7 @@ fn main() -> Result<()> {
         })
         .collect::<Result<_>>()?;
     drop(vars);
-    let [t, st, agree] = evaluate(&net, &frames, &valid, &dev)?;
+    let validation = evaluate(&net, &frames, &valid, &dev)?;
     let dataset: serde_json::Value = serde_json::from_slice(
         &std::fs::read(args.data.join("dataset.json")).context("reading dataset.json")?,
     )?;
@@ -277,12 +253,93 @@ fn main() -> Result<()> {
     // Through a temporary file and a rename: a link planted at a path is refused, not followed.
     paracosm::atomic::write(&path("onnx"), &onnx)?;
     paracosm::atomic::write(&path("toml"), pilotnet::MANIFEST.as_bytes())?;
+    let card = model_card(
+        &args,
+        &dataset,
+        (train.len(), valid.len()),
+        validation,
+        onnx.len(),
+        &log,
+        started,
+    );
+    paracosm::atomic::write(&path("md"), card.as_bytes())?;
+    println!(
+        "wrote {} ({} bytes), {} and {} in {:.0} s",
+        path("onnx").display(),
+        onnx.len(),
+        path("toml").display(),
+        path("md").display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// Trains `net` with `opt` for `args.epochs` passes over the `train` frames (shuffled by a
+/// ChaCha8 seeded with `args.seed`), evaluating on `valid` after each; prints and returns
+/// the log, a line per epoch.
+fn train_epochs(
+    args: &Args,
+    (net, opt): (&PilotNet, &mut AdamW),
+    frames: &Frames,
+    (train, valid): (&[usize], &[usize]),
+    dev: &Device,
+    started: Instant,
+) -> Result<Vec<String>> {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
+    let mut order = train.to_vec();
+    let mut log = Vec::new();
+    let weight = Tensor::new(&[1.0f32, args.steering_weight], dev)?.reshape((1, 2))?;
+    for epoch in 0..args.epochs {
+        order.shuffle(&mut rng);
+        let mut total = 0.0;
+        for chunk in order.chunks(args.batch) {
+            let (x, s, y) = batch(frames, chunk, dev)?;
+            let loss = if args.steering_weight == 1.0 {
+                candle_nn::loss::mse(&net.forward(&x, &s)?, &y)?
+            } else {
+                (net.forward(&x, &s)? - &y)?
+                    .sqr()?
+                    .broadcast_mul(&weight)?
+                    .mean_all()?
+            };
+            opt.backward_step(&loss)?;
+            total += f64::from(loss.to_scalar::<f32>()?) * chunk.len() as f64;
+        }
+        let [t, st, agree] = evaluate(net, frames, valid, dev)?;
+        let line = format!(
+            "epoch {}: training MSE {:.4}; validation MSE throttle {t:.4}, steering {st:.5}, \
+             braking agreement {:.1} % ({:.0} s)",
+            epoch + 1,
+            total / train.len() as f64,
+            100.0 * agree,
+            started.elapsed().as_secs_f64()
+        );
+        eprintln!("{line}");
+        log.push(line);
+    }
+    Ok(log)
+}
+
+/// The model card (Markdown): the network, the data set it was trained on (`dataset`, its
+/// `dataset.json`), the training and validation frame counts (`split`), the settings, the
+/// `[throttle MSE, steering MSE, braking agreement]` on the validation frames, the ONNX file's
+/// size in bytes and the training `log`.
+fn model_card(
+    args: &Args,
+    dataset: &serde_json::Value,
+    (ntrain, nvalid): (usize, usize),
+    [t, st, agree]: [f64; 3],
+    bytes: usize,
+    log: &[String],
+    started: Instant,
+) -> String {
+    let n = ntrain + nvalid;
     let stem = args
         .out
         .file_name()
         .map_or("pilotnet".into(), |n| n.to_string_lossy().into_owned());
     let noise = dataset["steer_noise"].as_f64().unwrap_or(0.0);
-    let card = format!(
+    format!(
         "# Model card: {stem}\n\n\
          A PilotNet-style network (Bojarski et al. 2016, the system PARACOSM §4.2.2 tests), \
          scaled down for CPU: 4 convolutions, 3 dense layers, {params} parameters; input a \
@@ -311,8 +368,6 @@ fn main() -> Result<()> {
         strategy = dataset["strategy"].as_str().unwrap_or("?"),
         dseed = dataset["seed"],
         rate = dataset["rate_hz"],
-        ntrain = train.len(),
-        nvalid = valid.len(),
         h = args.holdout_every,
         hl = args.holdout_every - 1,
         cv = "0.11",
@@ -323,7 +378,6 @@ fn main() -> Result<()> {
         agree = 100.0 * agree,
         secs = started.elapsed().as_secs_f64(),
         threads = rayon::current_num_threads(),
-        bytes = onnx.len(),
         log = log.join("\n"),
         noise = if noise > 0.0 {
             format!(
@@ -345,15 +399,5 @@ fn main() -> Result<()> {
         } else {
             String::new()
         },
-    );
-    paracosm::atomic::write(&path("md"), card.as_bytes())?;
-    println!(
-        "wrote {} ({} bytes), {} and {} in {:.0} s",
-        path("onnx").display(),
-        onnx.len(),
-        path("toml").display(),
-        path("md").display(),
-        started.elapsed().as_secs_f64()
-    );
-    Ok(())
+    )
 }

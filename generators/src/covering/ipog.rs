@@ -153,49 +153,16 @@ fn repack(
     keep_first: usize,
     cons: &Constraints,
 ) -> Vec<Vec<u32>> {
-    let k = levels.len();
     let n = rows.len();
-    let subsets = subsets(k, t);
-    let mut by_column: Vec<Vec<usize>> = vec![Vec::new(); k];
-    for (s, cols) in subsets.iter().enumerate() {
-        for &c in cols {
-            by_column[c].push(s);
-        }
-    }
-    let index = |cols: &[usize], row: &[u32]| -> Option<usize> {
-        cols.iter().try_fold(0usize, |acc, &c| {
-            (row[c] != OPEN).then(|| acc * levels[c] as usize + row[c] as usize)
-        })
-    };
-    let mut counts: Vec<Vec<u32>> = subsets
-        .iter()
-        .map(|cols| vec![0u32; cols.iter().map(|&c| levels[c] as usize).product()])
-        .collect();
-    for row in &rows {
-        for (cols, cnt) in subsets.iter().zip(&mut counts) {
-            if let Some(x) = index(cols, row) {
-                cnt[x] += 1;
-            }
-        }
-    }
+    let mut tally = Tally::new(levels, t, &rows);
     let mut flexible: Vec<usize> = (0..n).filter(|&r| rows[r].contains(&OPEN)).collect();
     let mut deleted = vec![false; n];
     for r in (keep_first..n).rev() {
-        let unique: Vec<Vec<(usize, u32)>> = subsets
-            .iter()
-            .zip(&counts)
-            .filter_map(|(cols, cnt)| {
-                let x = index(cols, &rows[r])?;
-                (cnt[x] == 1).then(|| cols.iter().map(|&c| (c, rows[r][c])).collect())
-            })
-            .collect();
+        let unique = tally.unique(&rows[r]);
         let mut log: Vec<(usize, usize)> = Vec::new();
         let mut moved_all = true;
         for u in &unique {
-            let cols: Vec<usize> = u.iter().map(|&(c, _)| c).collect();
-            let x = index(&cols, &rows[r]).expect("assigned");
-            let s = subsets.iter().position(|c| *c == cols).expect("a subset");
-            if counts[s][x] >= 2 {
+            if !tally.still_unique(u, &rows[r]) {
                 continue; // an earlier move covered it too
             }
             let target = flexible.iter().copied().find(|&q| {
@@ -219,28 +186,16 @@ fn repack(
                 if rows[q][c] == OPEN {
                     rows[q][c] = v;
                     log.push((q, c));
-                    for &s in &by_column[c] {
-                        if let Some(x) = index(&subsets[s], &rows[q]) {
-                            counts[s][x] += 1;
-                        }
-                    }
+                    tally.count_column(&rows[q], c, true);
                 }
             }
         }
         if moved_all {
             deleted[r] = true;
-            for (cols, cnt) in subsets.iter().zip(&mut counts) {
-                if let Some(x) = index(cols, &rows[r]) {
-                    cnt[x] -= 1;
-                }
-            }
+            tally.remove(&rows[r]);
         } else {
             for &(q, c) in log.iter().rev() {
-                for &s in &by_column[c] {
-                    if let Some(x) = index(&subsets[s], &rows[q]) {
-                        counts[s][x] -= 1;
-                    }
-                }
+                tally.count_column(&rows[q], c, false);
                 rows[q][c] = OPEN;
             }
         }
@@ -251,6 +206,103 @@ fn repack(
         .filter(|(_, d)| !d)
         .map(|(r, _)| r)
         .collect()
+}
+
+/// How often each level combination of each t-subset of the columns occurs in the rows (for
+/// [`repack`]).
+struct Tally<'a> {
+    levels: &'a [u32],
+    /// The t-subsets of the columns.
+    subsets: Vec<Vec<usize>>,
+    /// The subsets (by index) that hold each column.
+    by_column: Vec<Vec<usize>>,
+    /// Per subset, the occurrences of each combination (by mixed-radix index).
+    counts: Vec<Vec<u32>>,
+}
+
+impl<'a> Tally<'a> {
+    /// The tally of `rows`.
+    fn new(levels: &'a [u32], t: usize, rows: &[Vec<u32>]) -> Self {
+        let k = levels.len();
+        let subsets = subsets(k, t);
+        let mut by_column: Vec<Vec<usize>> = vec![Vec::new(); k];
+        for (s, cols) in subsets.iter().enumerate() {
+            for &c in cols {
+                by_column[c].push(s);
+            }
+        }
+        let counts: Vec<Vec<u32>> = subsets
+            .iter()
+            .map(|cols| vec![0u32; cols.iter().map(|&c| levels[c] as usize).product()])
+            .collect();
+        let mut tally = Tally {
+            levels,
+            subsets,
+            by_column,
+            counts,
+        };
+        for row in rows {
+            for (cols, cnt) in tally.subsets.iter().zip(&mut tally.counts) {
+                if let Some(x) = combo_index(levels, cols, row) {
+                    cnt[x] += 1;
+                }
+            }
+        }
+        tally
+    }
+
+    /// The t-tuples `(column, level)` that `row` alone holds.
+    fn unique(&self, row: &[u32]) -> Vec<Vec<(usize, u32)>> {
+        self.subsets
+            .iter()
+            .zip(&self.counts)
+            .filter_map(|(cols, cnt)| {
+                let x = combo_index(self.levels, cols, row)?;
+                (cnt[x] == 1).then(|| cols.iter().map(|&c| (c, row[c])).collect())
+            })
+            .collect()
+    }
+
+    /// Whether tuple `u` of `row` is still held by fewer than two rows.
+    fn still_unique(&self, u: &[(usize, u32)], row: &[u32]) -> bool {
+        let cols: Vec<usize> = u.iter().map(|&(c, _)| c).collect();
+        let x = combo_index(self.levels, &cols, row).expect("assigned");
+        let s = self
+            .subsets
+            .iter()
+            .position(|c| *c == cols)
+            .expect("a subset");
+        self.counts[s][x] < 2
+    }
+
+    /// Counts (`add`) or uncounts the combinations of `row` on the subsets holding column `c`.
+    fn count_column(&mut self, row: &[u32], c: usize, add: bool) {
+        for &s in &self.by_column[c] {
+            if let Some(x) = combo_index(self.levels, &self.subsets[s], row) {
+                if add {
+                    self.counts[s][x] += 1;
+                } else {
+                    self.counts[s][x] -= 1;
+                }
+            }
+        }
+    }
+
+    /// Uncounts every combination of `row`.
+    fn remove(&mut self, row: &[u32]) {
+        for (cols, cnt) in self.subsets.iter().zip(&mut self.counts) {
+            if let Some(x) = combo_index(self.levels, cols, row) {
+                cnt[x] -= 1;
+            }
+        }
+    }
+}
+
+/// Mixed-radix index of `row`'s levels on columns `cols`, `None` if one is open.
+fn combo_index(levels: &[u32], cols: &[usize], row: &[u32]) -> Option<usize> {
+    cols.iter().try_fold(0usize, |acc, &c| {
+        (row[c] != OPEN).then(|| acc * levels[c] as usize + row[c] as usize)
+    })
 }
 
 /// Whether `row` (a prefix of the columns, open cells allowed) extends to an allowed full row.
@@ -317,47 +369,20 @@ fn extend(
     cons: &Constraints,
     seeds: &[Vec<u32>],
 ) {
-    // Tie-break key: 0 for run 0 (lowest row and level win), a SplitMix64 hash otherwise.
-    let key = |r: usize, v: u64| -> u64 {
-        if run == 0 {
-            return 0;
-        }
-        let mut z = run
-            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-            .wrapping_add((r as u64) << 8 | v)
-            .wrapping_add(i as u64 * 0xD1B5_4A32_D192_ED03);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+    let growth = Growth {
+        levels,
+        i,
+        vi: u64::from(levels[i]),
+        run,
+        cons,
     };
-    let vi = u64::from(levels[i]);
     // The (t−1)-subsets of the earlier columns (one empty subset when t = 1).
     let earlier = if t == 1 {
         vec![Vec::new()]
     } else {
         subsets(i, t - 1)
     };
-    let mut blocks: Vec<Block> = earlier
-        .into_iter()
-        .map(|cols| {
-            let mut strides = vec![0u64; cols.len()];
-            let mut size = 1u64;
-            for (s, &c) in strides.iter_mut().zip(&cols).rev() {
-                *s = size;
-                size *= u64::from(levels[c]);
-            }
-            let bits = size * vi;
-            let mut uncovered = vec![u64::MAX; bits.div_ceil(64) as usize];
-            if !bits.is_multiple_of(64) {
-                *uncovered.last_mut().expect("at least one word") = (1u64 << (bits % 64)) - 1;
-            }
-            Block {
-                cols,
-                strides,
-                uncovered,
-            }
-        })
-        .collect();
+    let mut blocks: Vec<Block> = earlier.into_iter().map(|cols| growth.block(cols)).collect();
     for (r, row) in rows.iter_mut().enumerate() {
         row.push(seeds.get(r).map_or(OPEN, |s| s[i]));
     }
@@ -365,20 +390,75 @@ fn extend(
     for b in &mut blocks {
         if !cons.is_empty() {
             for bit in 0..(b.uncovered.len() as u64 * 64) {
-                if b.is_uncovered(bit) && !cons.completable(levels, &b.cells(bit, vi, i)) {
+                if b.is_uncovered(bit) && !cons.completable(levels, &b.cells(bit, growth.vi, i)) {
                     b.cover(bit);
                 }
             }
         }
         for row in &rows[..seeds.len()] {
             if let (Some(base), true) = (b.base(row), row[i] != OPEN) {
-                b.cover(base * vi + u64::from(row[i]));
+                b.cover(base * growth.vi + u64::from(row[i]));
             }
         }
     }
+    growth.horizontal(rows, &mut blocks);
+    growth.vertical(rows, &blocks);
+}
 
-    // Horizontal growth, IPOG-F: the globally best (row, level) first, by lazy greedy.
-    let best = |r: usize, row: &[u32], blocks: &[Block]| -> (u64, u32) {
+/// What adding column `i` to the rows ([`extend`]) works with.
+struct Growth<'a> {
+    /// Every column's level count.
+    levels: &'a [u32],
+    /// The column being added.
+    i: usize,
+    /// Its level count.
+    vi: u64,
+    /// The run: 0 breaks ties by the lowest row and level, later runs by a hash.
+    run: u64,
+    cons: &'a Constraints,
+}
+
+impl Growth<'_> {
+    /// Tie-break key: 0 for run 0 (lowest row and level win), a SplitMix64 hash otherwise.
+    fn key(&self, r: usize, v: u64) -> u64 {
+        if self.run == 0 {
+            return 0;
+        }
+        let mut z = self
+            .run
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .wrapping_add((r as u64) << 8 | v)
+            .wrapping_add(self.i as u64 * 0xD1B5_4A32_D192_ED03);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// The block of subset `cols`, every combination uncovered.
+    fn block(&self, cols: Vec<usize>) -> Block {
+        let mut strides = vec![0u64; cols.len()];
+        let mut size = 1u64;
+        for (s, &c) in strides.iter_mut().zip(&cols).rev() {
+            *s = size;
+            size *= u64::from(self.levels[c]);
+        }
+        let bits = size * self.vi;
+        let mut uncovered = vec![u64::MAX; bits.div_ceil(64) as usize];
+        if !bits.is_multiple_of(64) {
+            *uncovered.last_mut().expect("at least one word") = (1u64 << (bits % 64)) - 1;
+        }
+        Block {
+            cols,
+            strides,
+            uncovered,
+        }
+    }
+
+    /// Row `r`'s best level for column `i`, `(gain, level)`: the most uncovered tuples it
+    /// covers (0 when none, for a disallowed row, or for a seed's cell), the lowest level (or
+    /// key) on ties.
+    fn best(&self, r: usize, row: &[u32], blocks: &[Block]) -> (u64, u32) {
+        let (i, vi) = (self.i, self.vi);
         if row[i] != OPEN {
             return (0, 0); // a seed's cell
         }
@@ -390,19 +470,19 @@ fn extend(
                 }
             }
         }
-        if !cons.is_empty() {
+        if !self.cons.is_empty() {
             let mut probe = row.to_vec();
             for (v, g) in gains.iter_mut().enumerate() {
                 probe[i] = v as u32;
-                if *g > 0 && !allowed(levels, cons, &probe) {
+                if *g > 0 && !allowed(self.levels, self.cons, &probe) {
                     *g = 0;
                 }
             }
         }
         // Highest gain, lowest level on ties.
         let (v, g) = gains.iter().enumerate().fold((0, 0), |acc, (v, &g)| {
-            let wins =
-                g > acc.1 || (g == acc.1 && g > 0 && key(r, v as u64) < key(r, acc.0 as u64));
+            let wins = g > acc.1
+                || (g == acc.1 && g > 0 && self.key(r, v as u64) < self.key(r, acc.0 as u64));
             if wins {
                 (v, g)
             } else {
@@ -410,72 +490,81 @@ fn extend(
             }
         });
         (g, v as u32)
-    };
-    let initial: Vec<(u64, u32)> = rows
-        .par_iter()
-        .enumerate()
-        .map(|(r, row)| best(r, row, &blocks))
-        .collect();
-    let mut heap: BinaryHeap<(u64, Reverse<(u64, usize)>)> = initial
-        .iter()
-        .enumerate()
-        .filter(|(_, (g, _))| *g > 0)
-        .map(|(r, &(g, _))| (g, Reverse((key(r, 0), r))))
-        .collect();
-    while let Some((g, Reverse((kr, r)))) = heap.pop() {
-        let (now, v) = best(r, &rows[r], &blocks);
-        if now == 0 {
-            continue;
-        }
-        let still_best = heap
-            .peek()
-            .is_none_or(|&(top, Reverse(tk))| now > top || (now == top && (kr, r) < tk));
-        if now < g && !still_best {
-            heap.push((now, Reverse((kr, r))));
-            continue;
-        }
-        rows[r][i] = v;
-        for b in &mut blocks {
-            if let Some(base) = b.base(&rows[r]) {
-                b.cover(base * vi + u64::from(v));
+    }
+
+    /// Horizontal growth, IPOG-F: the globally best (row, level) first, by lazy greedy.
+    fn horizontal(&self, rows: &mut [Vec<u32>], blocks: &mut [Block]) {
+        let (i, vi) = (self.i, self.vi);
+        let initial: Vec<(u64, u32)> = rows
+            .par_iter()
+            .enumerate()
+            .map(|(r, row)| self.best(r, row, blocks))
+            .collect();
+        let mut heap: BinaryHeap<(u64, Reverse<(u64, usize)>)> = initial
+            .iter()
+            .enumerate()
+            .filter(|(_, (g, _))| *g > 0)
+            .map(|(r, &(g, _))| (g, Reverse((self.key(r, 0), r))))
+            .collect();
+        while let Some((g, Reverse((kr, r)))) = heap.pop() {
+            let (now, v) = self.best(r, &rows[r], blocks);
+            if now == 0 {
+                continue;
+            }
+            let still_best = heap
+                .peek()
+                .is_none_or(|&(top, Reverse(tk))| now > top || (now == top && (kr, r) < tk));
+            if now < g && !still_best {
+                heap.push((now, Reverse((kr, r))));
+                continue;
+            }
+            rows[r][i] = v;
+            for b in blocks.iter_mut() {
+                if let Some(base) = b.base(&rows[r]) {
+                    b.cover(base * vi + u64::from(v));
+                }
             }
         }
     }
 
-    // Vertical growth: every tuple still uncovered goes into a row with matching or open cells.
-    let mut flexible: Vec<usize> = (0..rows.len())
-        .filter(|&r| rows[r].contains(&OPEN))
-        .collect();
-    for b in &blocks {
-        let size = b.uncovered.len() as u64 * 64;
-        for bit in 0..size {
-            if !b.is_uncovered(bit) {
-                continue;
-            }
-            let want = b.cells(bit, vi, i);
-            let fits = |row: &[u32]| {
-                want.iter().all(|&(c, v)| row[c] == v || row[c] == OPEN)
-                    && (cons.is_empty() || {
-                        let mut probe = row.to_vec();
-                        for &(c, v) in &want {
-                            probe[c] = v;
-                        }
-                        allowed(levels, cons, &probe)
-                    })
-            };
-            match flexible.iter().copied().find(|&r| fits(&rows[r])) {
-                Some(r) => {
-                    for &(c, v) in &want {
-                        rows[r][c] = v;
-                    }
+    /// Vertical growth: every tuple still uncovered goes into a row with matching or open
+    /// cells, or a new row.
+    fn vertical(&self, rows: &mut Vec<Vec<u32>>, blocks: &[Block]) {
+        let (levels, cons, i, vi) = (self.levels, self.cons, self.i, self.vi);
+        let mut flexible: Vec<usize> = (0..rows.len())
+            .filter(|&r| rows[r].contains(&OPEN))
+            .collect();
+        for b in blocks {
+            let size = b.uncovered.len() as u64 * 64;
+            for bit in 0..size {
+                if !b.is_uncovered(bit) {
+                    continue;
                 }
-                None => {
-                    let mut row = vec![OPEN; i + 1];
-                    for &(c, v) in &want {
-                        row[c] = v;
+                let want = b.cells(bit, vi, i);
+                let fits = |row: &[u32]| {
+                    want.iter().all(|&(c, v)| row[c] == v || row[c] == OPEN)
+                        && (cons.is_empty() || {
+                            let mut probe = row.to_vec();
+                            for &(c, v) in &want {
+                                probe[c] = v;
+                            }
+                            allowed(levels, cons, &probe)
+                        })
+                };
+                match flexible.iter().copied().find(|&r| fits(&rows[r])) {
+                    Some(r) => {
+                        for &(c, v) in &want {
+                            rows[r][c] = v;
+                        }
                     }
-                    flexible.push(rows.len());
-                    rows.push(row);
+                    None => {
+                        let mut row = vec![OPEN; i + 1];
+                        for &(c, v) in &want {
+                            row[c] = v;
+                        }
+                        flexible.push(rows.len());
+                        rows.push(row);
+                    }
                 }
             }
         }

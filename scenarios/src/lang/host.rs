@@ -1,7 +1,7 @@
 //! Calling a program's lambdas from the stream graph during a test, with the evaluator of the
 //! test's own evaluation of the program.
 
-use paracosm_engine::rx::{Host, Runtime, StreamId, Value as Rx};
+use paracosm_engine::rx::{Host, HostError, Runtime, StreamId, Value as Rx};
 
 use std::cell::Cell;
 
@@ -84,7 +84,11 @@ fn to_star<'v>(v: &Rx, heap: Heap<'v>) -> Value<'v> {
     }
 }
 
-fn from_star(v: Value) -> Result<Rx, String> {
+/// What a lambda returned, as a stream carries it.
+///
+/// # Errors
+/// [`HostError`] for a value no stream carries, or an int too large to be a number.
+fn from_star(v: Value) -> Result<Rx, HostError> {
     if v.is_none() {
         return Ok(Rx::Unit);
     }
@@ -99,11 +103,11 @@ fn from_star(v: Value) -> Result<Rx, String> {
         const EXACT: i64 = 1 << 53;
         return match starlark::values::UnpackValue::unpack_value(v) {
             Ok(Some(i)) if (-EXACT..=EXACT).contains(&i) => Ok(Rx::Num(i as f64)),
-            _ => Err(format!(
+            _ => Err(HostError(format!(
                 "a lambda returned the int {v}, too large for a stream's number: a float holds \
                  whole numbers exactly only up to 2^53 = {EXACT}; write float(...) to accept \
                  the rounding"
-            )),
+            ))),
         };
     }
     if let Some(f) = v.downcast_ref::<StarlarkFloat>() {
@@ -132,14 +136,14 @@ fn from_star(v: Value) -> Result<Rx, String> {
         }
         return Ok(Rx::Tuple(items));
     }
-    Err(format!(
+    Err(HostError(format!(
         "a lambda returned {}; streams carry numbers, bools, strings and tuples",
         crate::lang::a_type(v.get_type())
-    ))
+    )))
 }
 
 impl Host for StarHost<'_, '_, '_, '_> {
-    fn call(&mut self, f: u32, args: &[Rx], streams: &Runtime) -> Result<Rx, String> {
+    fn call(&mut self, f: u32, args: &[Rx], streams: &Runtime) -> Result<Rx, HostError> {
         let heap = self.eval.heap();
         for (name, id) in &self.captured {
             let now = match streams.current(*id) {
@@ -169,13 +173,14 @@ impl Host for StarHost<'_, '_, '_, '_> {
         let over_heap = memory::over_soft_limit();
         drop(budget);
         let out = match (out, self.limits.exceeded.get()) {
-            (Err(e), Some(limit)) => return Err(limit.message(&e)),
+            (Err(e), Some(limit)) => return Err(limit.message(&e).into()),
             (_, _) if over_heap => {
                 return Err(format!(
                     "heap limit: a lambda allocated more than {} MiB in one call (limit per \
                      call, LANGUAGE.md \"Limits\")",
                     memory::MAX_LAMBDA_HEAP_BYTES >> 20
-                ))
+                )
+                .into())
             }
             // starlark's header says nothing here (the call comes from the engine, "File
             // <builtin>"); the frames of the program's own functions and the located error

@@ -8,6 +8,7 @@
 //! SHA-256 enters the campaign's fingerprint ([`crate::Scenario::input_files`]), so
 //! `--resume` refuses a campaign whose map has changed since.
 
+use super::load_error::{refused, LoadError, LoadErrorKind};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -63,9 +64,11 @@ impl Base {
 /// `paracosm-fuzz export` copies beside the test it writes.
 ///
 /// # Errors
-/// A message naming the file when it cannot be read, is larger than [`MAX_MAP_BYTES`] or is
-/// not UTF-8, or when a built-in scenario has no such map.
-pub fn read_input_file(scenario: &str, path: &str) -> Result<String, String> {
+/// [`LoadError`] of kind [`LoadErrorKind::Files`], naming the file, when it cannot be read,
+/// is larger than [`MAX_MAP_BYTES`] or is not UTF-8, or when a built-in scenario has no such
+/// map.
+pub fn read_input_file(scenario: &str, path: &str) -> Result<String, LoadError> {
+    let files = refused(LoadErrorKind::Files);
     let program = Path::new(scenario);
     let builtin = !(scenario.ends_with(".star") || program.exists());
     let base = Base::of(scenario, builtin);
@@ -74,11 +77,11 @@ pub fn read_input_file(scenario: &str, path: &str) -> Result<String, String> {
             .iter()
             .find(|(p, _)| *p == path)
             .map(|(_, t)| (*t).to_owned())
-            .ok_or_else(|| format!("no built-in map \"{path}\"")),
+            .ok_or_else(|| files(format!("no built-in map \"{path}\""))),
         Base::Folder(dir) => {
             let full = dir.join(path);
             crate::text_file::read_text(&full, MAX_MAP_BYTES)
-                .map_err(|e| format!("cannot read {}: {e}", full.display()))
+                .map_err(|e| files(format!("cannot read {}: {e}", full.display())))
         }
     }
 }
@@ -116,10 +119,15 @@ impl MapFiles {
     /// same map after.
     ///
     /// # Errors
-    /// A message naming the file: it cannot be read, is larger than [`MAX_MAP_BYTES`], is not
-    /// UTF-8, or is no usable OpenDRIVE map ([`opendrive::import`]'s message, with the line).
-    pub(crate) fn load(&self, path: &str) -> Result<Arc<RoadMap>, String> {
-        let mut loaded = self.loaded.lock().map_err(|_| "a map load panicked")?;
+    /// [`LoadError`] of kind [`LoadErrorKind::Files`], naming the file: it cannot be read, is
+    /// larger than [`MAX_MAP_BYTES`], is not UTF-8, or is no usable OpenDRIVE map
+    /// ([`opendrive::import`]'s message, with the line).
+    pub(crate) fn load(&self, path: &str) -> Result<Arc<RoadMap>, LoadError> {
+        let files = refused(LoadErrorKind::Files);
+        let mut loaded = self
+            .loaded
+            .lock()
+            .map_err(|_| files("a map load panicked".to_owned()))?;
         if let Some(l) = loaded.get(path) {
             return Ok(l.map.clone());
         }
@@ -131,10 +139,10 @@ impl MapFiles {
                     .map(|(_, t)| (*t).to_owned())
                     .ok_or_else(|| {
                         let known: Vec<&str> = BUILTIN_MAPS.iter().map(|(p, _)| *p).collect();
-                        format!(
+                        files(format!(
                             "no built-in map \"{path}\" (the built-in maps: {})",
                             known.join(", ")
-                        )
+                        ))
                     })?;
                 (format!("scenarios/{path}"), text)
             }
@@ -142,12 +150,12 @@ impl MapFiles {
                 let full = dir.join(path);
                 let shown = full.display().to_string();
                 let text = crate::text_file::read_text(&full, MAX_MAP_BYTES)
-                    .map_err(|e| format!("cannot read the OpenDRIVE map {shown}: {e}"))?;
+                    .map_err(|e| files(format!("cannot read the OpenDRIVE map {shown}: {e}")))?;
                 (shown, text)
             }
         };
-        let imported =
-            opendrive::import(&shown, &text).map_err(|e| format!("the OpenDRIVE map {e}"))?;
+        let imported = opendrive::import(&shown, &text)
+            .map_err(|e| files(format!("the OpenDRIVE map {e}")))?;
         loaded.insert(
             path.to_owned(),
             Loaded {

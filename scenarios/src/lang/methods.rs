@@ -5,7 +5,7 @@
 
 use anyhow::{anyhow, bail};
 use paracosm_engine::network::{Lane, PieceId, PieceKind, Turn};
-use paracosm_engine::rx::{Func, Node, StreamId, Value as Rx};
+use paracosm_engine::rx::{Func, NativeError, Node, StreamId, Value as Rx};
 use starlark::environment::MethodsBuilder;
 use starlark::eval::Evaluator;
 use starlark::starlark_module;
@@ -14,7 +14,7 @@ use starlark::values::{none::NoneType, Value, ValueLike};
 
 use super::globals::{here, number, state, stream_arg};
 use super::position::Loc;
-use super::scene::LaneRef;
+use super::scene::{LaneRef, SceneBuilder};
 use super::values::{Action, ActorVal, LaneSide, Port, Road, Stream, WorldVal, PORTS};
 use starlark::environment::Methods;
 use starlark::values::{starlark_value, Heap, StarlarkValue};
@@ -259,9 +259,15 @@ fn other<'v>(
     stream_arg(v, &mut b, what)
 }
 
-/// The stream combinators (paper §2), see `engine::rx` for their semantics.
-#[starlark_module]
+/// The stream methods (paper §2; `engine::rx` gives their semantics): the combinators ([`stream_combinators`]) and folds ([`stream_folds`]).
 pub(crate) fn stream_methods(builder: &mut MethodsBuilder) {
+    stream_combinators(builder);
+    stream_folds(builder);
+}
+
+/// Stream methods: the combinators.
+#[starlark_module]
+fn stream_combinators(builder: &mut MethodsBuilder) {
     /// `s.map(f)`: `f(v)` for each event `v`.
     fn map<'v>(
         this: &Stream,
@@ -359,7 +365,11 @@ pub(crate) fn stream_methods(builder: &mut MethodsBuilder) {
         let b = other(second, "concat", eval)?;
         push(eval, Node::Concat(StreamId(this.id), b))
     }
+}
 
+/// Stream methods, continued: the folds and `foreach`.
+#[starlark_module]
+fn stream_folds(builder: &mut MethodsBuilder) {
     /// `s.sum(init=0.0, f=None)`: running total of numbers or vectors (from zero of the
     /// stream's kind, or from `init`: a number or a `Vector`), or running fold
     /// `acc = f(acc, v)` (from `init`, default 0.0).
@@ -472,10 +482,10 @@ fn extreme(
 ) -> anyhow::Result<Stream> {
     let f = Func::native(name, move |a| match (&a[0], &a[1]) {
         (Rx::Num(acc), Rx::Num(v)) => Ok(Rx::Num(pick(*acc, *v))),
-        (_, v) => Err(format!(
+        (_, v) => Err(NativeError(format!(
             "{name}() needs a stream of numbers, got a {}",
             v.kind()
-        )),
+        ))),
     });
     push(
         eval,
@@ -505,7 +515,7 @@ fn check_lane(a: &Action, eval: &Evaluator<'_, '_, '_>) -> anyhow::Result<()> {
     else {
         return Ok(());
     };
-    let super::scene::Pending::Car { loc, .. } = &object.pending else {
+    let super::scene::Pending::Car(super::scene::PendingCar { loc, .. }) = &object.pending else {
         return Ok(());
     };
     let Some(start) = b.locs.get(*loc).and_then(|r| r.resolve(&b.roads).ok()) else {
@@ -563,6 +573,173 @@ fn lane_of(v: Value) -> anyhow::Result<Lane> {
     }
 }
 
+/// The arguments of `onLane`, by position or by keyword: a segment's `(lane, at)`, a
+/// junction's `(port, turn, at, lane=)`, a map's `(road=, lane=, s=)`.
+struct OnLaneArgs<'v> {
+    first: Option<Value<'v>>,
+    second: Option<Value<'v>>,
+    at: Option<Value<'v>>,
+    lane: Option<Value<'v>>,
+    port: Option<Value<'v>>,
+    turn: Option<Value<'v>>,
+    road: Option<Value<'v>>,
+    s: Option<Value<'v>>,
+}
+
+/// An argument that may be given by position or by name, once.
+fn once<'v>(
+    pos: Option<Value<'v>>,
+    named: Option<Value<'v>>,
+    what: &str,
+) -> anyhow::Result<Option<Value<'v>>> {
+    match (pos, named) {
+        (Some(_), Some(_)) => Err(anyhow!(
+            "onLane: {what} is given twice, by position and as {what}="
+        )),
+        (p, n) => Ok(p.or(n)),
+    }
+}
+
+impl<'v> OnLaneArgs<'v> {
+    /// A map's onLane takes `road=`, `lane=`, `s=` and nothing else; a piece's takes no
+    /// `road=` or `s=`.
+    fn check_form(&self, this: &Road) -> anyhow::Result<()> {
+        let positional = self.first.is_some()
+            || self.second.is_some()
+            || self.at.is_some()
+            || self.port.is_some()
+            || self.turn.is_some();
+        if this.map != (self.road.is_some() || self.s.is_some()) || (this.map && positional) {
+            if this.map {
+                bail!("an OpenDrive map's onLane takes road=, lane= and s= by name: m.onLane(road = \"1\", lane = -1, s = 20.0)");
+            }
+            bail!("onLane(road=, lane=, s=) is for an OpenDrive map; this is a road piece");
+        }
+        Ok(())
+    }
+
+    /// `m.onLane(road=, lane=, s=)` on the map `piece`.
+    fn on_map(&self, this: &Road, piece: PieceId, b: &SceneBuilder) -> anyhow::Result<LaneRef> {
+        let (Some(road), Some(lane), Some(s)) = (self.road, self.lane, self.s) else {
+            bail!("an OpenDrive map's onLane needs road=, lane= and s=: m.onLane(road = \"1\", lane = -1, s = 20.0)");
+        };
+        let road = match super::globals::text_value(road, b) {
+            Some(t) => t,
+            None => {
+                let x = number(road, "onLane(road=)").map_err(|_| {
+                    anyhow!("onLane(road=) is a <road id>, a string such as \"1\", got {road}")
+                })?;
+                if x.fract() != 0.0 {
+                    bail!("onLane(road=) is a <road id>, a string such as \"1\", got {x}");
+                }
+                format!("{x:.0}")
+            }
+        };
+        let lane = number(lane, "onLane(lane=)")?;
+        if lane.fract() != 0.0 || lane == 0.0 {
+            bail!("onLane(lane=) on a map is an OpenDRIVE <lane id>: a whole number, not 0 (negative right of the reference line), got {lane}");
+        }
+        if lane.abs() > paracosm_engine::network::opendrive::MAX_LANES_PER_SIDE as f64 {
+            bail!(
+                "onLane(lane=) on a map is an OpenDRIVE <lane id>, at most {} from the centre lane 0 (a map's section has at most that many lanes a side), got {lane}",
+                paracosm_engine::network::opendrive::MAX_LANES_PER_SIDE
+            );
+        }
+        let s_m = number(s, "onLane(s=)")?;
+        let PieceKind::Map { map, .. } = &b.roads.piece(piece).kind else {
+            bail!("{this} is no map");
+        };
+        match map.0.roads.iter().position(|r| r.od_id == road) {
+            Some(index) => Ok(LaneRef::Map {
+                piece,
+                road: index,
+                lane: lane as i32,
+                s_m,
+            }),
+            // The map's message lists its roads.
+            None => Err(anyhow!(map.0.lane_at(&road, lane as i32, s_m).unwrap_err())),
+        }
+    }
+
+    /// `r.onLane(lane, at)` on the segment `piece`.
+    fn on_segment(&self, piece: PieceId) -> anyhow::Result<LaneRef> {
+        if self.port.is_some() || self.turn.is_some() {
+            bail!("a RoadSegment's onLane takes (lane, at); port= and turn= are for junctions: j.onLane(port, turn, at, lane=)");
+        }
+        let (lane, at) = match (self.first, self.second, self.at) {
+            (_, Some(_), Some(_)) => bail!(
+                "a RoadSegment's onLane takes (lane, at), each once; onLane(port, turn, at, lane=) is for junctions"
+            ),
+            (first, second, at) => (once(first, self.lane, "lane")?, second.or(at)),
+        };
+        let (Some(lane), Some(at)) = (lane, at) else {
+            bail!("a RoadSegment's onLane needs a lane and how far along it: r.onLane(lane, at), or r.onLane(lane = 1, at = 20.0)");
+        };
+        Ok(LaneRef::Segment {
+            piece,
+            lane: lane_of(lane)?,
+            at_m: number(at, "onLane(at=)")?,
+        })
+    }
+
+    /// `j.onLane(port, turn, at, lane=1)` in the junction or roundabout `piece`.
+    fn in_junction(
+        &self,
+        this: &Road,
+        piece: PieceId,
+        b: &SceneBuilder,
+    ) -> anyhow::Result<LaneRef> {
+        let (Some(first), Some(second)) = (
+            once(self.first, self.port, "port")?,
+            once(self.second, self.turn, "turn")?,
+        ) else {
+            bail!("a junction's onLane takes (port, turn, at, lane=): j.onLane(j.ONE, \"left\", 5.0), or j.onLane(port = j.ONE, turn = \"left\", at = 5.0)");
+        };
+        let port = match first.downcast_ref::<Port>() {
+            Some(p) if p.piece == this.piece => p.index,
+            Some(p) => bail!(
+                "a junction's onLane takes one of its own ports first (such as j.ONE), got {}.{}, a port of another piece",
+                b.roads.piece(PieceId(p.piece)).name,
+                crate::lang::values::PORTS[p.index]
+            ),
+            None => bail!(
+                "a junction's onLane takes one of its ports first (such as j.ONE), got {}",
+                crate::lang::a_type(first.get_type())
+            ),
+        };
+        let turn = super::globals::text_value(second, b)
+            .as_deref()
+            .and_then(Turn::parse)
+            .ok_or_else(|| {
+                if second.downcast_ref::<Stream>().is_some() {
+                    anyhow!("a junction's onLane takes one turn for the whole test (the start is placed when the world is built): \"straight\", \"left\", \"right\" or an open VarEnum of them, not a stream")
+                } else {
+                    anyhow!("a junction's onLane takes a turn second: \"straight\", \"left\" or \"right\", got {second}")
+                }
+            })?;
+        let at = self
+            .at
+            .ok_or_else(|| anyhow!("a junction's onLane needs how far along its path, at="))?;
+        let lane = match self.lane {
+            Some(v) => {
+                let x = number(v, "onLane(lane=)")?;
+                if x.fract() != 0.0 || x < 1.0 {
+                    bail!("onLane(lane=) is a lane number from 1, got {x}");
+                }
+                x as u32
+            }
+            None => 1,
+        };
+        Ok(LaneRef::Junction {
+            piece,
+            entry: port,
+            turn,
+            lane,
+            at_m: number(at, "onLane(at=)")?,
+        })
+    }
+}
+
 /// Road methods: `onLane` and `connect`.
 #[starlark_module]
 pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
@@ -591,144 +768,24 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
         }
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
-        let piece = PieceId(this.piece);
-        if this.map != (road.is_some() || s.is_some())
-            || (this.map
-                && (first.is_some()
-                    || second.is_some()
-                    || at.is_some()
-                    || port.is_some()
-                    || turn.is_some()))
-        {
-            if this.map {
-                bail!("an OpenDrive map's onLane takes road=, lane= and s= by name: m.onLane(road = \"1\", lane = -1, s = 20.0)");
-            }
-            bail!("onLane(road=, lane=, s=) is for an OpenDrive map; this is a road piece");
-        }
-        if this.map {
-            let (Some(road), Some(lane), Some(s)) = (road, lane, s) else {
-                bail!("an OpenDrive map's onLane needs road=, lane= and s=: m.onLane(road = \"1\", lane = -1, s = 20.0)");
-            };
-            let road = match super::globals::text_value(road, &b) {
-                Some(t) => t,
-                None => {
-                    let x = number(road, "onLane(road=)").map_err(|_| {
-                        anyhow!("onLane(road=) is a <road id>, a string such as \"1\", got {road}")
-                    })?;
-                    if x.fract() != 0.0 {
-                        bail!("onLane(road=) is a <road id>, a string such as \"1\", got {x}");
-                    }
-                    format!("{x:.0}")
-                }
-            };
-            let lane = number(lane, "onLane(lane=)")?;
-            if lane.fract() != 0.0 || lane == 0.0 {
-                bail!("onLane(lane=) on a map is an OpenDRIVE <lane id>: a whole number, not 0 (negative right of the reference line), got {lane}");
-            }
-            if lane.abs() > paracosm_engine::network::opendrive::MAX_LANES_PER_SIDE as f64 {
-                bail!(
-                    "onLane(lane=) on a map is an OpenDRIVE <lane id>, at most {} from the centre lane 0 (a map's section has at most that many lanes a side), got {lane}",
-                    paracosm_engine::network::opendrive::MAX_LANES_PER_SIDE
-                );
-            }
-            let s_m = number(s, "onLane(s=)")?;
-            let PieceKind::Map { map, .. } = &b.roads.piece(piece).kind else {
-                bail!("{this} is no map");
-            };
-            let index = map.0.roads.iter().position(|r| r.od_id == road);
-            let r = match index {
-                Some(index) => LaneRef::Map {
-                    piece,
-                    road: index,
-                    lane: lane as i32,
-                    s_m,
-                },
-                // The map's message lists its roads.
-                None => return Err(anyhow!(map.0.lane_at(&road, lane as i32, s_m).unwrap_err())),
-            };
-            let at = r.resolve(&b.roads).map_err(|e| anyhow!(e))?;
-            b.locs.push(r);
-            if let Ok(mut t) = b.loc_table.write() {
-                t.push(Some(at));
-            }
-            return Ok(Loc {
-                index: b.locs.len() - 1,
-                table: b.loc_table.clone(),
-            });
-        }
-        // Each argument may be given by position or by name, once.
-        let once = |pos: Option<Value<'v>>, named: Option<Value<'v>>, what: &str| match (pos, named)
-        {
-            (Some(_), Some(_)) => Err(anyhow!(
-                "onLane: {what} is given twice, by position and as {what}="
-            )),
-            (p, n) => Ok(p.or(n)),
+        let args = OnLaneArgs {
+            first,
+            second,
+            at,
+            lane,
+            port,
+            turn,
+            road,
+            s,
         };
-        let r = if this.segment {
-            if port.is_some() || turn.is_some() {
-                bail!("a RoadSegment's onLane takes (lane, at); port= and turn= are for junctions: j.onLane(port, turn, at, lane=)");
-            }
-            let (lane, at) = match (first, second, at) {
-                (_, Some(_), Some(_)) => bail!(
-                    "a RoadSegment's onLane takes (lane, at), each once; onLane(port, turn, at, lane=) is for junctions"
-                ),
-                (first, second, at) => (once(first, lane, "lane")?, second.or(at)),
-            };
-            let (Some(lane), Some(at)) = (lane, at) else {
-                bail!("a RoadSegment's onLane needs a lane and how far along it: r.onLane(lane, at), or r.onLane(lane = 1, at = 20.0)");
-            };
-            LaneRef::Segment {
-                piece,
-                lane: lane_of(lane)?,
-                at_m: number(at, "onLane(at=)")?,
-            }
+        args.check_form(this)?;
+        let piece = PieceId(this.piece);
+        let r = if this.map {
+            args.on_map(this, piece, &b)?
+        } else if this.segment {
+            args.on_segment(piece)?
         } else {
-            let (Some(first), Some(second)) =
-                (once(first, port, "port")?, once(second, turn, "turn")?)
-            else {
-                bail!("a junction's onLane takes (port, turn, at, lane=): j.onLane(j.ONE, \"left\", 5.0), or j.onLane(port = j.ONE, turn = \"left\", at = 5.0)");
-            };
-            let port = match first.downcast_ref::<Port>() {
-                Some(p) if p.piece == this.piece => p.index,
-                Some(p) => bail!(
-                    "a junction's onLane takes one of its own ports first (such as j.ONE), got {}.{}, a port of another piece",
-                    b.roads.piece(PieceId(p.piece)).name,
-                    crate::lang::values::PORTS[p.index]
-                ),
-                None => bail!(
-                    "a junction's onLane takes one of its ports first (such as j.ONE), got {}",
-                    crate::lang::a_type(first.get_type())
-                ),
-            };
-            let turn = super::globals::text_value(second, &b)
-                .as_deref()
-                .and_then(Turn::parse)
-                .ok_or_else(|| {
-                    if second.downcast_ref::<Stream>().is_some() {
-                        anyhow!("a junction's onLane takes one turn for the whole test (the start is placed when the world is built): \"straight\", \"left\", \"right\" or an open VarEnum of them, not a stream")
-                    } else {
-                        anyhow!("a junction's onLane takes a turn second: \"straight\", \"left\" or \"right\", got {second}")
-                    }
-                })?;
-            let at =
-                at.ok_or_else(|| anyhow!("a junction's onLane needs how far along its path, at="))?;
-            let lane = match lane {
-                Some(v) => {
-                    let x = number(v, "onLane(lane=)")?;
-                    if x.fract() != 0.0 || x < 1.0 {
-                        bail!("onLane(lane=) is a lane number from 1, got {x}");
-                    }
-                    x as u32
-                }
-                None => 1,
-            };
-            LaneRef::Junction {
-                piece,
-                entry: port,
-                turn,
-                lane,
-                at_m: number(at, "onLane(at=)")?,
-            }
+            args.in_junction(this, piece, &b)?
         };
         let at = r.resolve(&b.roads).map_err(|e| anyhow!(e))?;
         b.locs.push(r);

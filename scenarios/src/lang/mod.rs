@@ -11,6 +11,7 @@
 mod builtins;
 mod globals;
 mod host;
+pub mod load_error;
 pub mod map_files;
 mod methods;
 mod names;
@@ -29,6 +30,7 @@ use starlark::syntax::{AstModule, Dialect};
 use crate::{Scenario, ScenarioError};
 
 pub use host::MAX_LAMBDA_STEPS;
+pub use load_error::{LoadError, LoadErrorKind, Site};
 pub use program::{MAX_CHECKED_WORLDS, MAX_CHECK_STEPS, MAX_LOAD_CHECK_STEPS, MAX_PARAMS};
 pub use values::OverTime;
 
@@ -60,16 +62,17 @@ fn lambda_name(n: u32) -> String {
 /// # Errors
 /// [`ScenarioError::Io`] when the file cannot be read, is larger than
 /// [`crate::text_file::MAX_SOURCE_BYTES`] or is not UTF-8 (naming the line and column of the
-/// first bad byte); [`ScenarioError::Language`] with a
-/// diagnostic naming the file, line and column (and a caret under the source) for any error
-/// in the program.
+/// first bad byte); [`ScenarioError::Load`] with a diagnostic naming the file, line and
+/// column (and a caret under the source) for any error in the program, typed by the phase of
+/// the load that refused it ([`LoadErrorKind`]).
 pub fn load_file(path: &Path) -> Result<Scenario, ScenarioError> {
-    let source = crate::text_file::read_text(path, crate::text_file::MAX_SOURCE_BYTES).map_err(
-        |message| ScenarioError::Io {
-            path: path.display().to_string(),
-            message,
-        },
-    )?;
+    let source =
+        crate::text_file::read_text(path, crate::text_file::MAX_SOURCE_BYTES).map_err(|e| {
+            ScenarioError::Io {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            }
+        })?;
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().replace('_', "-"))
@@ -207,7 +210,7 @@ fn check_nesting(source: &str) -> Result<(), (usize, usize)> {
 /// evaluates it again with its own values.
 ///
 /// # Errors
-/// [`ScenarioError::Language`] as for [`load_file`]; an error that only some values cause
+/// [`ScenarioError::Load`] as for [`load_file`]; an error that only some values cause
 /// names them.
 pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, ScenarioError> {
     load_with_base(file, source, name, map_files::Base::of(file, false))
@@ -228,7 +231,7 @@ fn load_with_base(
     name: &str,
     base: map_files::Base,
 ) -> Result<Scenario, ScenarioError> {
-    let lang = |m: String| ScenarioError::Language(m);
+    let lang = |m: String| ScenarioError::Load(LoadError::new(LoadErrorKind::Syntax, m));
     let dialect = Dialect {
         enable_load: false,
         enable_top_level_stmt: true,
@@ -257,6 +260,10 @@ fn load_with_base(
         ScenarioError::Language(m) => {
             ScenarioError::Language(cut_stack(&with_source_lines(&m, file, source), KEPT_FRAMES))
         }
+        ScenarioError::Load(e) => ScenarioError::Load(LoadError {
+            message: cut_stack(&with_source_lines(&e.message, file, source), KEPT_FRAMES),
+            ..e
+        }),
         other => other,
     })
 }

@@ -7,7 +7,8 @@ use std::collections::HashMap;
 
 use starlark::syntax::AstModule;
 use starlark_syntax::syntax::ast::{
-    ArgumentP, AssignTargetP, AstExpr, AstStmt, BinOp, ExprP, StmtP,
+    ArgumentP, AssignTargetP, AstArgument, AstExpr, AstNoPayload, AstStmt, BinOp, CallArgsP, ExprP,
+    StmtP,
 };
 use starlark_syntax::syntax::uniplate::Visit;
 
@@ -171,6 +172,28 @@ fn is_declarer(e: &AstExpr) -> bool {
     matches!(&e.node, ExprP::Call(f, _) if callee(f).is_some_and(|c| super::builtins::declares_parameter(&c)))
 }
 
+/// What the walk knows of a call while it walks its arguments.
+struct Call<'a> {
+    /// The callee.
+    f: &'a AstExpr,
+    /// Its name (a function's, or a method's without the object).
+    name: Option<String>,
+    /// Whether it is a builtin that takes its arguments whole (not a declarer).
+    builtin: bool,
+    /// How many positional arguments are open parameters.
+    open_positional: usize,
+    /// How many keyword arguments are open parameters.
+    open_named: usize,
+    /// `(object, method)` for a method of an object named by a variable.
+    method_of: Option<(String, String)>,
+    /// The call's keywords.
+    keywords: Vec<&'a str>,
+    /// The variable the call is assigned to, if any.
+    target: Option<&'a str>,
+    /// Whether the call is read by code.
+    in_code: bool,
+}
+
 struct Walker<'a> {
     ast: &'a AstModule,
     builtins: &'a [&'a str],
@@ -278,166 +301,7 @@ impl Walker<'_> {
     /// identifiers here are read by code rather than passed whole to a builtin.
     fn expr(&mut self, e: &AstExpr, target: Option<&str>, in_code: bool) {
         match &e.node {
-            ExprP::Call(f, args) => {
-                let name = callee(f);
-                if is_declarer(e) {
-                    let given = target.map(str::to_owned);
-                    self.site(e, given.clone(), given, None);
-                }
-                let builtin = name.as_deref().is_some_and(|n| {
-                    self.builtins.contains(&n) && !super::builtins::declares_parameter(n)
-                });
-                // Open parameters among a method's positional arguments: one is named by the
-                // method, several by their positions too.
-                let open_positional = args
-                    .args
-                    .iter()
-                    .filter(|a| {
-                        matches!(a.node, ArgumentP::Positional(_)) && is_declarer(a.node.expr())
-                    })
-                    .count();
-                // A method of an object named by a variable (`r.onLane(...)`): its open
-                // arguments are named after the object and the method, by keyword as by
-                // position (`r.onLane(lane = 1, at = x)` is `r.onLane(1, x)`).
-                let method_of = match &f.node {
-                    ExprP::Dot(obj, method) => match &obj.node {
-                        ExprP::Identifier(o) => Some((o.node.ident.clone(), method.node.clone())),
-                        _ => None,
-                    },
-                    _ => None,
-                };
-                let keywords: Vec<&str> = args
-                    .args
-                    .iter()
-                    .filter_map(|a| match &a.node {
-                        ArgumentP::Named(kw, _) => Some(kw.node.as_str()),
-                        _ => None,
-                    })
-                    .collect();
-                let open_named = args
-                    .args
-                    .iter()
-                    .filter(|a| {
-                        matches!(a.node, ArgumentP::Named(..)) && is_declarer(a.node.expr())
-                    })
-                    .count();
-                for (position, a) in args.args.iter().enumerate() {
-                    let value = a.node.expr();
-                    let signature_position = match (&a.node, &method_of) {
-                        (ArgumentP::Named(kw, _), Some((_, m))) => {
-                            method_position(m, &kw.node, &keywords)
-                        }
-                        _ => None,
-                    };
-                    if let (ArgumentP::Named(kw, _), true, Some(i), Some((o, m))) =
-                        (&a.node, is_declarer(value), signature_position, &method_of)
-                    {
-                        let n = if open_named + open_positional > 1 {
-                            format!("{o}.{m}[{i}]")
-                        } else {
-                            format!("{o}.{m}")
-                        };
-                        let argument_of = name
-                            .clone()
-                            .filter(|_| builtin)
-                            .map(|b| (b, kw.node.clone()));
-                        self.site(value, Some(n), None, argument_of);
-                    } else if let (ArgumentP::Named(kw, _), true) = (&a.node, is_declarer(value)) {
-                        let owner = target.map(str::to_owned).or_else(|| name.clone());
-                        let n = owner.map(|o| format!("{o}.{}", kw.node));
-                        let argument_of = name
-                            .clone()
-                            .filter(|_| builtin)
-                            .map(|b| (b, kw.node.clone()));
-                        self.site(value, n, None, argument_of);
-                    }
-                    // An item of a tuple or list argument: `o = Obstacle(size = (VarInterval(
-                    // ...), 1, 1))` is `o.size[0]`, `route = [VarEnum(...)]` of `v` is
-                    // `v.route[0]`.
-                    if let (ArgumentP::Named(kw, _), ExprP::Tuple(items) | ExprP::List(items)) =
-                        (&a.node, &value.node)
-                    {
-                        let owner = target.map(str::to_owned).or_else(|| name.clone());
-                        for (i, x) in items.iter().enumerate() {
-                            // A variable as an item (`size = (sz, 1, 1)`): passed whole to
-                            // that item's input, for its unit.
-                            if let (ExprP::Identifier(id), true, Some(b)) =
-                                (&x.node, builtin, &name)
-                            {
-                                self.out.passed.push((
-                                    b.clone(),
-                                    format!("{}[{i}]", kw.node),
-                                    id.node.ident.clone(),
-                                ));
-                            }
-                            if is_declarer(x) {
-                                let n = owner.as_ref().map(|o| format!("{o}.{}[{i}]", kw.node));
-                                let argument_of = name
-                                    .clone()
-                                    .filter(|_| builtin)
-                                    .map(|b| (b, format!("{}[{i}]", kw.node)));
-                                self.site(x, n, None, argument_of);
-                            }
-                        }
-                    }
-                    // A positional argument of a method: `lead.brake(VarEnum(...))` is
-                    // `lead.brake`; with several, `r.onLane(VarEnum(...), VarInterval(...))`
-                    // gives `r.onLane[0]` and `r.onLane[1]`.
-                    if let (ArgumentP::Positional(_), true, ExprP::Dot(obj, method)) =
-                        (&a.node, is_declarer(value), &f.node)
-                    {
-                        if let ExprP::Identifier(o) = &obj.node {
-                            let n = if open_positional + open_named > 1 {
-                                format!("{}.{}[{position}]", o.node.ident, method.node)
-                            } else {
-                                format!("{}.{}", o.node.ident, method.node)
-                            };
-                            // The input it feeds, for its unit: `onLane(lane, at)`'s `at`.
-                            let argument_of = positional_keyword(&method.node, position)
-                                .map(|k| (method.node.to_string(), k.to_owned()));
-                            self.site(value, Some(n), None, argument_of);
-                        }
-                    }
-                    // The keyword of the input the argument feeds: its own, or a method's
-                    // by position (`r.onLane(1, x)`'s `at`).
-                    let keyword = match (&a.node, &method_of) {
-                        (ArgumentP::Named(kw, _), _) => Some(kw.node.clone()),
-                        (ArgumentP::Positional(_), Some((_, m))) => {
-                            positional_keyword(m, position).map(str::to_owned)
-                        }
-                        _ => None,
-                    };
-                    match (&value.node, builtin) {
-                        // A variable passed whole to a builtin: the world shows its effect.
-                        (ExprP::Identifier(id), true) => {
-                            if let (Some(kw), Some(n)) = (keyword, &name) {
-                                self.out.passed.push((n.clone(), kw, id.node.ident.clone()));
-                            }
-                            if in_code {
-                                *self
-                                    .out
-                                    .used_in_code
-                                    .entry(id.node.ident.clone())
-                                    .or_default() += 1;
-                            }
-                        }
-                        // A sum or difference (`10.0 + gap`): each variable added whole
-                        // carries its unit into the sum, so it is checked against the input's.
-                        (ExprP::Op(_, BinOp::Add | BinOp::Subtract, _) | ExprP::Minus(_), true) => {
-                            if let (Some(kw), Some(n)) = (keyword, &name) {
-                                let mut terms = Vec::new();
-                                summed_variables(value, &mut terms);
-                                for v in terms {
-                                    self.out.summed.push((n.clone(), kw.clone(), v));
-                                }
-                            }
-                            self.expr(value, None, true);
-                        }
-                        _ => self.expr(value, None, in_code || !builtin),
-                    }
-                }
-                self.expr(f, None, in_code);
-            }
+            ExprP::Call(f, args) => self.call(e, f, args, target, in_code),
             ExprP::Identifier(id) => {
                 if in_code {
                     *self
@@ -459,6 +323,190 @@ impl Walker<'_> {
                 }
             }
             _ => e.visit_expr(|x| self.expr(x, None, true)),
+        }
+    }
+
+    /// A call: names the open parameters among its arguments and notes the variables it
+    /// takes whole, then walks the callee.
+    fn call(
+        &mut self,
+        e: &AstExpr,
+        f: &AstExpr,
+        args: &CallArgsP<AstNoPayload>,
+        target: Option<&str>,
+        in_code: bool,
+    ) {
+        let name = callee(f);
+        if is_declarer(e) {
+            let given = target.map(str::to_owned);
+            self.site(e, given.clone(), given, None);
+        }
+        let builtin = name
+            .as_deref()
+            .is_some_and(|n| self.builtins.contains(&n) && !super::builtins::declares_parameter(n));
+        // Open parameters among a method's positional arguments: one is named by the
+        // method, several by their positions too.
+        let open_positional = args
+            .args
+            .iter()
+            .filter(|a| matches!(a.node, ArgumentP::Positional(_)) && is_declarer(a.node.expr()))
+            .count();
+        // A method of an object named by a variable (`r.onLane(...)`): its open
+        // arguments are named after the object and the method, by keyword as by
+        // position (`r.onLane(lane = 1, at = x)` is `r.onLane(1, x)`).
+        let method_of = match &f.node {
+            ExprP::Dot(obj, method) => match &obj.node {
+                ExprP::Identifier(o) => Some((o.node.ident.clone(), method.node.clone())),
+                _ => None,
+            },
+            _ => None,
+        };
+        let keywords: Vec<&str> = args
+            .args
+            .iter()
+            .filter_map(|a| match &a.node {
+                ArgumentP::Named(kw, _) => Some(kw.node.as_str()),
+                _ => None,
+            })
+            .collect();
+        let open_named = args
+            .args
+            .iter()
+            .filter(|a| matches!(a.node, ArgumentP::Named(..)) && is_declarer(a.node.expr()))
+            .count();
+        let c = Call {
+            f,
+            name,
+            builtin,
+            open_positional,
+            open_named,
+            method_of,
+            keywords,
+            target,
+            in_code,
+        };
+        for (position, a) in args.args.iter().enumerate() {
+            self.argument(&c, position, a);
+        }
+        self.expr(f, None, in_code);
+    }
+
+    /// Argument number `position` of the call `c`.
+    fn argument(&mut self, c: &Call<'_>, position: usize, a: &AstArgument) {
+        let value = a.node.expr();
+        let signature_position = match (&a.node, &c.method_of) {
+            (ArgumentP::Named(kw, _), Some((_, m))) => method_position(m, &kw.node, &c.keywords),
+            _ => None,
+        };
+        if let (ArgumentP::Named(kw, _), true, Some(i), Some((o, m))) = (
+            &a.node,
+            is_declarer(value),
+            signature_position,
+            &c.method_of,
+        ) {
+            let n = if c.open_named + c.open_positional > 1 {
+                format!("{o}.{m}[{i}]")
+            } else {
+                format!("{o}.{m}")
+            };
+            let argument_of = c
+                .name
+                .clone()
+                .filter(|_| c.builtin)
+                .map(|b| (b, kw.node.clone()));
+            self.site(value, Some(n), None, argument_of);
+        } else if let (ArgumentP::Named(kw, _), true) = (&a.node, is_declarer(value)) {
+            let owner = c.target.map(str::to_owned).or_else(|| c.name.clone());
+            let n = owner.map(|o| format!("{o}.{}", kw.node));
+            let argument_of = c
+                .name
+                .clone()
+                .filter(|_| c.builtin)
+                .map(|b| (b, kw.node.clone()));
+            self.site(value, n, None, argument_of);
+        }
+        // An item of a tuple or list argument: `o = Obstacle(size = (VarInterval(
+        // ...), 1, 1))` is `o.size[0]`, `route = [VarEnum(...)]` of `v` is
+        // `v.route[0]`.
+        if let (ArgumentP::Named(kw, _), ExprP::Tuple(items) | ExprP::List(items)) =
+            (&a.node, &value.node)
+        {
+            let owner = c.target.map(str::to_owned).or_else(|| c.name.clone());
+            for (i, x) in items.iter().enumerate() {
+                // A variable as an item (`size = (sz, 1, 1)`): passed whole to
+                // that item's input, for its unit.
+                if let (ExprP::Identifier(id), true, Some(b)) = (&x.node, c.builtin, &c.name) {
+                    self.out.passed.push((
+                        b.clone(),
+                        format!("{}[{i}]", kw.node),
+                        id.node.ident.clone(),
+                    ));
+                }
+                if is_declarer(x) {
+                    let n = owner.as_ref().map(|o| format!("{o}.{}[{i}]", kw.node));
+                    let argument_of = c
+                        .name
+                        .clone()
+                        .filter(|_| c.builtin)
+                        .map(|b| (b, format!("{}[{i}]", kw.node)));
+                    self.site(x, n, None, argument_of);
+                }
+            }
+        }
+        // A positional argument of a method: `lead.brake(VarEnum(...))` is
+        // `lead.brake`; with several, `r.onLane(VarEnum(...), VarInterval(...))`
+        // gives `r.onLane[0]` and `r.onLane[1]`.
+        if let (ArgumentP::Positional(_), true, ExprP::Dot(obj, method)) =
+            (&a.node, is_declarer(value), &c.f.node)
+        {
+            if let ExprP::Identifier(o) = &obj.node {
+                let n = if c.open_positional + c.open_named > 1 {
+                    format!("{}.{}[{position}]", o.node.ident, method.node)
+                } else {
+                    format!("{}.{}", o.node.ident, method.node)
+                };
+                // The input it feeds, for its unit: `onLane(lane, at)`'s `at`.
+                let argument_of = positional_keyword(&method.node, position)
+                    .map(|k| (method.node.to_string(), k.to_owned()));
+                self.site(value, Some(n), None, argument_of);
+            }
+        }
+        // The keyword of the input the argument feeds: its own, or a method's
+        // by position (`r.onLane(1, x)`'s `at`).
+        let keyword = match (&a.node, &c.method_of) {
+            (ArgumentP::Named(kw, _), _) => Some(kw.node.clone()),
+            (ArgumentP::Positional(_), Some((_, m))) => {
+                positional_keyword(m, position).map(str::to_owned)
+            }
+            _ => None,
+        };
+        match (&value.node, c.builtin) {
+            // A variable passed whole to a builtin: the world shows its effect.
+            (ExprP::Identifier(id), true) => {
+                if let (Some(kw), Some(n)) = (keyword, &c.name) {
+                    self.out.passed.push((n.clone(), kw, id.node.ident.clone()));
+                }
+                if c.in_code {
+                    *self
+                        .out
+                        .used_in_code
+                        .entry(id.node.ident.clone())
+                        .or_default() += 1;
+                }
+            }
+            // A sum or difference (`10.0 + gap`): each variable added whole
+            // carries its unit into the sum, so it is checked against the input's.
+            (ExprP::Op(_, BinOp::Add | BinOp::Subtract, _) | ExprP::Minus(_), true) => {
+                if let (Some(kw), Some(n)) = (keyword, &c.name) {
+                    let mut terms = Vec::new();
+                    summed_variables(value, &mut terms);
+                    for v in terms {
+                        self.out.summed.push((n.clone(), kw.clone(), v));
+                    }
+                }
+                self.expr(value, None, true);
+            }
+            _ => self.expr(value, None, c.in_code || !c.builtin),
         }
     }
 }

@@ -3,14 +3,15 @@
 //! once per test, with that test's values of its open parameters (LANGUAGE.md, "A family of
 //! worlds"), and a few times when it loads, to learn its parameters and check its worlds.
 
+use super::load_error::{LoadError, LoadErrorKind};
 use paracosm_engine::actor::Roster;
 use paracosm_engine::behaviour::{ActorRef, GraphBuilder, Output, Probe};
 use paracosm_engine::network::{Location, Network, PieceId, PieceKind, Turn};
 use paracosm_engine::rx::{Node, OpenStream, StreamId, Value};
 use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{
-    CarSpec, EgoSpec, EnvironmentSpec, LidarSpec, ObstacleSpec, PedestrianSpec, Size,
-    VehicleParams, WorldSpec, DEFAULT_DT_S,
+    CarSpec, EgoSpec, EnvironmentSpec, ObstacleSpec, PedestrianSpec, Size, VehicleParams,
+    WorldSpec, DEFAULT_DT_S,
 };
 use paracosm_generators::{Domain, Value as Level};
 
@@ -54,6 +55,15 @@ pub enum ParamValue {
     Level(Level),
     /// A parameter that varies over the test: the stream of its values.
     Over(OpenStream),
+}
+
+/// What a program sees of an open parameter it declares ([`SceneBuilder::param`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Seen {
+    /// A parameter constant over the test: its value.
+    Level(Level),
+    /// A parameter that varies over the test: the stream of its values.
+    Stream(StreamId),
 }
 
 /// What starts a pedestrian walking.
@@ -115,7 +125,7 @@ impl LaneRef {
     ///
     /// # Errors
     /// The network's message when the location does not exist.
-    pub fn resolve(&self, roads: &Network) -> Result<Location, String> {
+    pub fn resolve(&self, roads: &Network) -> Result<Location, LoadError> {
         match *self {
             LaneRef::Segment { piece, lane, at_m } => roads.on_lane(piece, lane, at_m),
             LaneRef::Junction {
@@ -132,13 +142,16 @@ impl LaneRef {
                 s_m,
             } => {
                 let PieceKind::Map { map, .. } = &roads.piece(piece).kind else {
-                    return Err("onLane(road=, lane=, s=) on a piece that is no map".into());
+                    return Err(LoadError::new(
+                        LoadErrorKind::Declarations,
+                        "onLane(road=, lane=, s=) on a piece that is no map",
+                    ));
                 };
                 let od_id = map.0.roads[road].od_id.clone();
                 roads.on_map_lane(piece, &od_id, lane, s_m)
             }
         }
-        .map_err(strip)
+        .map_err(|e| LoadError::new(LoadErrorKind::Declarations, strip(e)))
     }
 }
 
@@ -168,22 +181,7 @@ pub enum Pending {
         trigger: PedTrigger,
     },
     /// `Car`.
-    Car {
-        /// Start location.
-        loc: usize,
-        /// Turns.
-        route: Vec<Turn>,
-        /// Speed stream.
-        speed: StreamId,
-        /// Colour name.
-        color: String,
-        /// Presence.
-        enabled: bool,
-        /// Its lane change, if any.
-        lane_change: Option<super::values::LaneChangeVal>,
-        /// The gap it keeps to what is ahead, m (`Car(keep_distance=)`).
-        keep_distance_m: Option<f64>,
-    },
+    Car(PendingCar),
     /// `Obstacle`.
     Obstacle {
         /// Where its base's centre stands.
@@ -193,6 +191,25 @@ pub enum Pending {
         /// Colour name.
         color: String,
     },
+}
+
+/// A `Car` as declared, before `place` resolves its location and route.
+#[derive(Debug, Clone)]
+pub struct PendingCar {
+    /// Start location.
+    pub loc: usize,
+    /// Turns.
+    pub route: Vec<Turn>,
+    /// Speed stream.
+    pub speed: StreamId,
+    /// Colour name.
+    pub color: String,
+    /// Presence.
+    pub enabled: bool,
+    /// Its lane change, if any.
+    pub lane_change: Option<super::values::LaneChangeVal>,
+    /// The gap it keeps to what is ahead, m (`Car(keep_distance=)`).
+    pub keep_distance_m: Option<f64>,
 }
 
 /// A declared actor: what it is, where it was declared, and whether `place` saw it.
@@ -371,12 +388,10 @@ impl SceneBuilder {
     }
 
     /// Declares an open parameter; returns what the program sees: its value, or for one
-    /// that varies over time, its stream.
-    ///
-    /// # Errors
-    /// A message when this evaluation has no value for it (the program declared more
-    /// parameters than with other values).
-    pub fn param(&mut self, decl: ParamDecl) -> Result<Result<Level, StreamId>, String> {
+    /// that varies over time, its stream. A parameter only these values declare (the program
+    /// declared more parameters than with other values) gets its representative value, so that
+    /// the run goes on and the load reports it, naming it.
+    pub fn param(&mut self, decl: ParamDecl) -> Seen {
         let k = self.params.len();
         let value = match &self.values {
             None => representative(&decl, self.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S)),
@@ -387,10 +402,10 @@ impl SceneBuilder {
             }),
         };
         self.params.push(decl);
-        Ok(match value {
-            ParamValue::Level(l) => Ok(l),
-            ParamValue::Over(_) => Err(self.graph.push(Node::Param(k))),
-        })
+        match value {
+            ParamValue::Level(l) => Seen::Level(l),
+            ParamValue::Over(_) => Seen::Stream(self.graph.push(Node::Param(k))),
+        }
     }
 
     /// A probe stream.
@@ -441,26 +456,31 @@ fn declared(name: &str, at: &str) -> String {
 }
 
 /// A message when the program placed nothing or no ego vehicle, or its graph is invalid.
-pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
+pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, LoadError> {
+    let worlds = |message: &str| LoadError::new(LoadErrorKind::Worlds, message);
     let ego = b
         .ego
         .as_ref()
-        .ok_or("the program places no AutonomousVehicle: nothing to test")?;
-    let (light, fog) = b.world.ok_or("the program has no World(...)")?;
+        .ok_or_else(|| worlds("the program places no AutonomousVehicle: nothing to test"))?;
+    let (light, fog) = b
+        .world
+        .ok_or_else(|| worlds("the program has no World(...)"))?;
     let mut nodes = b.graph.clone();
     let published = published(b, &mut nodes)?;
     refuse_monitors_of_absent_cars(b, nodes.nodes(), &published)?;
-    let graph = nodes.finish().map_err(|e| e.to_string())?;
+    let graph = nodes.finish().map_err(|e| worlds(&e.to_string()))?;
     let streams = graph
         .bind(&over_time_streams(b, horizon_s))
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| worlds(&e.to_string()))?;
     // Pieces whose friction is constant carry it; the others get it from their stream each
     // step.
     let mut network = b.roads.clone();
     let mut friction_streams = Vec::new();
     for &(piece, stream) in &b.frictions {
         match streams.nodes().get(stream.0) {
-            Some(Node::Const(Value::Num(mu))) => network.set_friction(piece, *mu).map_err(strip)?,
+            Some(Node::Const(Value::Num(mu))) => network
+                .set_friction(piece, *mu)
+                .map_err(|e| LoadError::new(LoadErrorKind::Worlds, strip(e)))?,
             _ => friction_streams.push((piece, stream)),
         }
     }
@@ -475,7 +495,7 @@ pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, String> {
         environment: EnvironmentSpec { light, fog },
         streams,
         published,
-        lidar: LidarSpec::default(),
+        sensors: paracosm_engine::SensorSpec::defaults(),
     })
 }
 
@@ -492,7 +512,7 @@ fn refuse_monitors_of_absent_cars(
     b: &SceneBuilder,
     nodes: &[Node],
     published: &[(String, StreamId)],
-) -> Result<(), String> {
+) -> Result<(), LoadError> {
     let absent: Vec<usize> = (0..b.cars.len()).filter(|&i| !b.cars[i].enabled).collect();
     if absent.is_empty() {
         return Ok(());
@@ -527,7 +547,9 @@ fn refuse_monitors_of_absent_cars(
         if let Some((k, m)) = reader {
             let at = b.monitors_at.get(k).map(String::as_str).unwrap_or("");
             let car_name = b.car_names.get(car).map(String::as_str).unwrap_or("a Car");
-            return Err(format!(
+            return Err(LoadError::new(
+                LoadErrorKind::Declarations,
+                format!(
                 "monitor `{}` reads {car_name}, which this world leaves out (enabled = False): \
                  the car is not in the test, its outputs have no events, and the monitor \
                  would have nothing to judge. For a car that is in some tests only, read it \
@@ -535,6 +557,7 @@ fn refuse_monitors_of_absent_cars(
                  is None while the car is absent, and judge a stream that always fires \
                  (`tick.map(...)`)\n --> {at}",
                 m.name()
+            ),
             ));
         }
     }
@@ -546,7 +569,7 @@ fn refuse_monitors_of_absent_cars(
 ///
 /// # Errors
 /// A message naming the signal, what is published, and the monitor's `file:line:col`.
-pub fn check_signals(b: &SceneBuilder) -> Result<(), String> {
+pub fn check_signals(b: &SceneBuilder) -> Result<(), LoadError> {
     published(b, &mut b.graph.clone()).map(|_| ())
 }
 
@@ -561,17 +584,10 @@ const ACTOR_SIGNALS: [(&str, Output); 7] = [
     ("separation", Output::Separation),
 ];
 
-/// The streams published to the monitors: those the program published (`Monitor`, `Assert`,
-/// `Signal`), then each actor output a monitor reads by name (`lead.speed`, `p.pos.x`), as a
-/// probe added to `graph`.
-///
-/// # Errors
-/// A message naming a signal a monitor reads that is neither the runner's, the program's nor
-/// an actor's.
-fn published(
-    b: &SceneBuilder,
-    graph: &mut GraphBuilder,
-) -> Result<Vec<(String, StreamId)>, String> {
+/// Refuses a `Signal` named as an actor's output (`Signal("lead.speed", ...)`: a formula
+/// reading `lead.speed` would read the Signal in the car's place) or as a component another
+/// `Signal` gives itself (`Signal("lp", lead.pos)` publishes `lp.x`, `lp.y` and `lp.z`).
+fn check_signal_names(b: &SceneBuilder) -> Result<(), LoadError> {
     // A Signal may not take an actor output's name (`Signal("lead.speed", ...)`): a formula
     // reading `lead.speed` would read the Signal in the car's place.
     for (name, at) in &b.signals_at {
@@ -584,10 +600,13 @@ fn published(
             .iter()
             .find(|o| o.actor.is_some() && o.variable.as_deref() == Some(var));
         if let (Some(o), true) = (actor, ACTOR_SIGNALS.iter().any(|(n, _)| *n == field)) {
-            return Err(format!(
-                "Signal `{name}` takes the name of an output of {} (`{var}.{field}`), which \
+            return Err(LoadError::new(
+                LoadErrorKind::Declarations,
+                format!(
+                    "Signal `{name}` takes the name of an output of {} (`{var}.{field}`), which \
                  monitors read as that actor's; give the Signal another name\n --> {at}",
-                o.name
+                    o.name
+                ),
             ));
         }
     }
@@ -605,13 +624,75 @@ fn published(
             } else {
                 (name, other)
             };
-            return Err(format!(
-                "Signal `{name}` and Signal `{other}` (declared at {first}) clash: a vector \
+            return Err(LoadError::new(
+                LoadErrorKind::Declarations,
+                format!(
+                    "Signal `{name}` and Signal `{other}` (declared at {first}) clash: a vector \
                  Signal `{vector}` is published as `{vector}.x`, `{vector}.y` and `{vector}.z`, \
                  so `{component}` would read one of them; give one another name\n --> {at}"
+                ),
             ));
         }
     }
+    Ok(())
+}
+
+/// Whether `s` names a published signal of `out` (whose streams carry vectors as `vector`
+/// says): a stream of numbers or bools by its name, a vector's component by `name.x`, `.y`,
+/// `.z`.
+///
+/// # Errors
+/// A vector named whole, or a component of a number.
+fn known_signal(
+    out: &[(String, StreamId)],
+    vector: &[Option<bool>],
+    s: &str,
+) -> Result<bool, LoadError> {
+    if crate::runner::signal::ALL.contains(&s) {
+        return Ok(true);
+    }
+    for ((n, _), v) in out.iter().zip(vector) {
+        let component = s
+            .strip_prefix(n.as_str())
+            .is_some_and(|c| [".x", ".y", ".z"].contains(&c));
+        match (n == s, component, v) {
+            (true, _, Some(true)) => {
+                return Err(LoadError::new(
+                    LoadErrorKind::Declarations,
+                    format!(
+                        "`{s}` is a vector: a formula compares numbers, so write `{s}.x`, \
+                     `{s}.y` or `{s}.z`"
+                    ),
+                ))
+            }
+            (false, true, Some(false)) => {
+                return Err(LoadError::new(
+                    LoadErrorKind::Declarations,
+                    format!(
+                        "`{n}` is a number, with no component `{}`: write `{n}`",
+                        &s[n.len() + 1..]
+                    ),
+                ))
+            }
+            (true, _, _) | (_, true, _) => return Ok(true),
+            _ => {}
+        }
+    }
+    Ok(false)
+}
+
+/// The streams published to the monitors: those the program published (`Monitor`, `Assert`,
+/// `Signal`), then each actor output a monitor reads by name (`lead.speed`, `p.pos.x`), as a
+/// probe added to `graph`.
+///
+/// # Errors
+/// A message naming a signal a monitor reads that is neither the runner's, the program's nor
+/// an actor's.
+fn published(
+    b: &SceneBuilder,
+    graph: &mut GraphBuilder,
+) -> Result<Vec<(String, StreamId)>, LoadError> {
+    check_signal_names(b)?;
     let mut out = b.published.clone();
     // Whether each published stream carries vectors: `Some(true)` it does, `Some(false)` it
     // carries numbers or bools, `None` unknown until the test runs (a lambda's values; the
@@ -628,38 +709,17 @@ fn published(
     // Whether `s` names a published signal: a stream of numbers or bools by its name, a
     // vector's component by `name.x`, `.y`, `.z`; a vector named whole, or a component of a
     // number, is an error.
-    let known = |out: &[(String, StreamId)], vector: &[Option<bool>], s: &str| {
-        if crate::runner::signal::ALL.contains(&s) {
-            return Ok(true);
-        }
-        for ((n, _), v) in out.iter().zip(vector) {
-            let component = s
-                .strip_prefix(n.as_str())
-                .is_some_and(|c| [".x", ".y", ".z"].contains(&c));
-            match (n == s, component, v) {
-                (true, _, Some(true)) => {
-                    return Err(format!(
-                        "`{s}` is a vector: a formula compares numbers, so write `{s}.x`, \
-                         `{s}.y` or `{s}.z`"
-                    ))
-                }
-                (false, true, Some(false)) => {
-                    return Err(format!(
-                        "`{n}` is a number, with no component `{}`: write `{n}`",
-                        &s[n.len() + 1..]
-                    ))
-                }
-                (true, _, _) | (_, true, _) => return Ok(true),
-                _ => {}
-            }
-        }
-        Ok(false)
-    };
+    let known = known_signal;
     for (k, m) in b.monitors.iter().enumerate() {
         let at = b.monitors_at.get(k).map(String::as_str).unwrap_or("");
-        let located = |e: String| format!("{} reads the signal: {e}\n --> {at}", m.name());
+        let located = |e: String| {
+            LoadError::new(
+                LoadErrorKind::Declarations,
+                format!("{} reads the signal: {e}\n --> {at}", m.name()),
+            )
+        };
         for s in m.signals() {
-            if known(&out, &vector, &s).map_err(located)? {
+            if known(&out, &vector, &s).map_err(|e| located(e.message))? {
                 continue;
             }
             let found = s.split_once('.').and_then(|(var, rest)| {
@@ -677,7 +737,7 @@ fn published(
                     let id = graph.push(Node::Probe(Probe::new(actor, output)));
                     out.push((name.clone(), id));
                     vector.push(Some(matches!(output, Output::Pos | Output::Vel)));
-                    if !known(&out, &vector, &s).map_err(located)? {
+                    if !known(&out, &vector, &s).map_err(|e| located(e.message))? {
                         return Err(located(format!(
                             "`{s}` is no output of `{name}`; an actor's outputs are .pos.x, \
                              .pos.y, .pos.z, .vel.x, .vel.y, .vel.z, .speed, .heading, \
@@ -698,7 +758,9 @@ fn published(
                         .map(|(n, _)| n.as_str())
                         .filter(|n| !n.starts_with("monitor:"))
                         .collect();
-                    return Err(format!(
+                    return Err(LoadError::new(
+                        LoadErrorKind::Declarations,
+                        format!(
                         "monitor `{}` reads the signal `{s}`, which nothing publishes. The runner \
                          publishes {}; the program's Signal(...)s: {}; each actor assigned to a \
                          variable at the top level publishes <variable>.pos.x/.y/.z, .vel.x/.y/.z, \
@@ -715,6 +777,7 @@ fn published(
                         } else {
                             actors.join(", ")
                         },
+                    ),
                     ));
                 }
             }
@@ -724,12 +787,17 @@ fn published(
 }
 
 /// Parses a route list of turns.
-pub fn turns(names: &[String]) -> Result<Vec<Turn>, String> {
+pub fn turns(names: &[String]) -> Result<Vec<Turn>, LoadError> {
     names
         .iter()
         .map(|n| {
             Turn::parse(n).ok_or_else(|| {
-                format!("route entry `{n}` is not a turn; use \"straight\", \"left\" or \"right\"")
+                LoadError::new(
+                    LoadErrorKind::Declarations,
+                    format!(
+                        "route entry `{n}` is not a turn; use \"straight\", \"left\" or \"right\""
+                    ),
+                )
             })
         })
         .collect()
@@ -768,30 +836,35 @@ impl SceneBuilder {
     ///
     /// # Errors
     /// A message naming the offending pieces or objects.
-    pub fn place(&mut self, objects: &[usize]) -> Result<(), String> {
+    pub fn place(&mut self, objects: &[usize]) -> Result<(), LoadError> {
         use paracosm_engine::placement::{check, Footprint, Placed};
         if self.placed {
-            return Err("place(...) may be called only once".into());
+            return Err(LoadError::new(
+                LoadErrorKind::Worlds,
+                "place(...) may be called only once",
+            ));
         }
         if let Some((a, b)) = self.roads.first_overlap() {
             let named = |p: PieceId| {
                 let name = &self.roads.piece(p).name;
                 declared(name, self.pieces_at.get(p.0).map_or("", String::as_str))
             };
-            return Err(format!(
-                "road pieces overlap: {} and {}",
-                named(a),
-                named(b)
+            return Err(LoadError::new(
+                LoadErrorKind::Worlds,
+                format!("road pieces overlap: {} and {}", named(a), named(b)),
             ));
         }
         for &o in objects {
             self.objects[o].placed = true;
         }
         if let Some(o) = self.objects.iter().find(|o| !o.placed) {
-            return Err(format!(
-                "{} is not in this place(...): place(...) is called once, and lists every \
+            return Err(LoadError::new(
+                LoadErrorKind::Worlds,
+                format!(
+                    "{} is not in this place(...): place(...) is called once, and lists every \
                  actor and obstacle",
-                o.name
+                    o.name
+                ),
             ));
         }
         let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(&b.roads);
@@ -800,12 +873,12 @@ impl SceneBuilder {
         for o in &self.objects {
             // A disabled car is not in the test: nothing can start in collision with it, and
             // where it would stand does not matter.
-            if matches!(o.pending, Pending::Car { enabled: false, .. }) {
+            if matches!(o.pending, Pending::Car(PendingCar { enabled: false, .. })) {
                 continue;
             }
             let (loc, footprint, on_road) = match &o.pending {
                 Pending::Ego { loc, .. } => (*loc, Some(VehicleParams::default().size), true),
-                Pending::Car { loc, .. } => (*loc, Some(Size::CAR), true),
+                Pending::Car(PendingCar { loc, .. }) => (*loc, Some(Size::CAR), true),
                 Pending::Obstacle { loc, size, .. } => (*loc, Some(*size), false),
                 Pending::Pedestrian { start, .. } => (*start, None, false),
             };
@@ -823,147 +896,22 @@ impl SceneBuilder {
                 on_road,
             });
         }
-        check(&placed, &self.roads).map_err(strip)?;
+        check(&placed, &self.roads).map_err(|e| LoadError::new(LoadErrorKind::Worlds, strip(e)))?;
         for o in self.objects.clone() {
-            let runtime_name = |kind: &str| o.runtime_name(kind);
-            let (car_name, pedestrian_name) = (runtime_name("Car"), runtime_name("Pedestrian"));
-            match o.pending {
+            match o.pending.clone() {
                 Pending::Ego {
                     loc,
                     route,
                     initial_speed_mps,
                     sut,
-                } => {
-                    let start = resolve(self, loc)?;
-                    let route = match route {
-                        Some(turns) => self
-                            .roads
-                            .route(&start, &turns, self.route_m)
-                            .map_err(|e| format!("{}: {}", o.name, strip(e)))?,
-                        // Without a route the ego keeps its lane: the lane's path (straight on
-                        // through junctions where it can, round a roundabout's ring, into a
-                        // T's turn from its stem), or, where that path is the start line
-                        // itself (straight roads), the start line.
-                        None if self.roads.group_of(start.piece).iter().any(|&id| {
-                            let kind = &self.roads.piece(id).kind;
-                            kind.ref_line().is_some() || matches!(kind, PieceKind::Map { .. })
-                        }) =>
-                        {
-                            self.roads.route(&start, &[], self.route_m).map_err(strip)?
-                        }
-                        None => {
-                            let lane =
-                                self.roads.route(&start, &[], self.route_m).map_err(strip)?;
-                            if on_start_line(&start, &lane) {
-                                vec![]
-                            } else {
-                                lane
-                            }
-                        }
-                    };
-                    if self.ego.is_some() {
-                        return Err(format!("{}: a scenario has one AutonomousVehicle", o.name));
-                    }
-                    self.ego = Some(EgoSpec {
-                        start,
-                        initial_speed_mps,
-                        vehicle: VehicleParams::default(),
-                        route,
-                    });
-                    self.sut = Some(sut);
-                }
+                } => self.place_ego(&o, loc, route, initial_speed_mps, sut)?,
                 Pending::Pedestrian {
                     start,
                     target,
                     speed,
                     trigger,
-                } => {
-                    let s = resolve(self, start)?.pos_m;
-                    let t = resolve(self, target)?.pos_m;
-                    let Some(ActorRef::Pedestrian(handle)) = o.actor else {
-                        return Err(format!("{}: a Pedestrian without its handle", o.name));
-                    };
-                    match trigger {
-                        PedTrigger::Near { car, dist } => {
-                            self.graph.pedestrian(handle, s, t, car, dist);
-                        }
-                        PedTrigger::Stream(trigger) => {
-                            self.graph.pedestrian_with_trigger(handle, t, trigger);
-                        }
-                        PedTrigger::Never => {}
-                    }
-                    if !matches!(trigger, PedTrigger::Never) {
-                        // The behaviour's `foreach(walk)` is named by the Pedestrian's
-                        // declaration, for the check of two behaviours walking it.
-                        let walk = paracosm_engine::rx::StreamId(self.graph.nodes().len() - 1);
-                        self.graph.set_site(walk, o.at.clone());
-                    }
-                    self.pedestrians.push(PedestrianSpec {
-                        start: s,
-                        target: t,
-                        speed,
-                        name: pedestrian_name,
-                    });
-                }
-                Pending::Car {
-                    loc,
-                    route,
-                    speed,
-                    color,
-                    enabled,
-                    lane_change,
-                    keep_distance_m,
-                } => {
-                    let start = resolve(self, loc)?;
-                    let path = match self.roads.route(&start, &route, self.route_m) {
-                        Ok(path) => path,
-                        // A disabled car is not in the test: where it would drive does not
-                        // matter (it may stand on a sidewalk); one metre ahead stands in.
-                        Err(_) if !enabled => {
-                            let (p, h) = (start.pos_m, start.heading_rad);
-                            vec![[p[0], p[2]], [p[0] + h.cos(), p[2] - h.sin()]]
-                        }
-                        Err(e) => return Err(format!("{}: {}", o.name, strip(e))),
-                    };
-                    let lane_change = match lane_change {
-                        Some(c) => {
-                            // Into a lane of the other direction: allowed (an overtaking
-                            // manoeuvre), but the car keeps its own direction there.
-                            if let paracosm_engine::Lane::Driving(k) = start.lane {
-                                if k.signum() != c.to.signum() {
-                                    self.warnings.push(Warning {
-                                        at: o.at.clone(),
-                                        message: format!(
-                                            "{}: ChangeLane(to = {}) moves it from lane {k} into \
-                                             a lane of the other direction, where it goes on \
-                                             driving its own way (against the traffic there)",
-                                            o.name, c.to
-                                        ),
-                                    });
-                                }
-                            }
-                            match self.lane_change(&o.name, &start, c) {
-                                Ok(change) => Some(change),
-                                Err(_) if !enabled => None,
-                                Err(e) => return Err(e),
-                            }
-                        }
-                        None => None,
-                    };
-                    let lane_offsets_m = self.lane_offsets(&start);
-                    self.cars.push(CarSpec {
-                        path,
-                        speed,
-                        color,
-                        size: Size::CAR,
-                        enabled,
-                        lane_change,
-                        lane_offsets_m,
-                        name: car_name,
-                        keep_distance_m,
-                    });
-                    self.car_names.push(o.name.clone());
-                }
+                } => self.place_pedestrian(&o, start, target, speed, trigger)?,
+                Pending::Car(car) => self.place_car(&o, car)?,
                 Pending::Obstacle { loc, size, color } => {
                     let at = resolve(self, loc)?;
                     self.obstacles.push(ObstacleSpec {
@@ -977,6 +925,178 @@ impl SceneBuilder {
             }
         }
         self.placed = true;
+        Ok(())
+    }
+
+    /// Places the ego vehicle declared by `o`: its start, route, speed and system under test.
+    fn place_ego(
+        &mut self,
+        o: &ObjectDecl,
+        loc: usize,
+        route: Option<Vec<Turn>>,
+        initial_speed_mps: f64,
+        sut: SutConfig,
+    ) -> Result<(), LoadError> {
+        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(&b.roads);
+        let start = resolve(self, loc)?;
+        let route = match route {
+            Some(turns) => self
+                .roads
+                .route(&start, &turns, self.route_m)
+                .map_err(|e| {
+                    LoadError::new(LoadErrorKind::Worlds, format!("{}: {}", o.name, strip(e)))
+                })?,
+            // Without a route the ego keeps its lane: the lane's path (straight on
+            // through junctions where it can, round a roundabout's ring, into a
+            // T's turn from its stem), or, where that path is the start line
+            // itself (straight roads), the start line.
+            None if self.roads.group_of(start.piece).iter().any(|&id| {
+                let kind = &self.roads.piece(id).kind;
+                kind.ref_line().is_some() || matches!(kind, PieceKind::Map { .. })
+            }) =>
+            {
+                self.roads
+                    .route(&start, &[], self.route_m)
+                    .map_err(|e| LoadError::new(LoadErrorKind::Worlds, strip(e)))?
+            }
+            None => {
+                let lane = self
+                    .roads
+                    .route(&start, &[], self.route_m)
+                    .map_err(|e| LoadError::new(LoadErrorKind::Worlds, strip(e)))?;
+                if on_start_line(&start, &lane) {
+                    vec![]
+                } else {
+                    lane
+                }
+            }
+        };
+        if self.ego.is_some() {
+            return Err(LoadError::new(
+                LoadErrorKind::Worlds,
+                format!("{}: a scenario has one AutonomousVehicle", o.name),
+            ));
+        }
+        self.ego = Some(EgoSpec {
+            start,
+            initial_speed_mps,
+            vehicle: VehicleParams::default(),
+            route,
+        });
+        self.sut = Some(sut);
+        Ok(())
+    }
+
+    /// Places the pedestrian declared by `o` and its walking behaviour.
+    fn place_pedestrian(
+        &mut self,
+        o: &ObjectDecl,
+        start: usize,
+        target: usize,
+        speed: StreamId,
+        trigger: PedTrigger,
+    ) -> Result<(), LoadError> {
+        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(&b.roads);
+        let pedestrian_name = o.runtime_name("Pedestrian");
+        let s = resolve(self, start)?.pos_m;
+        let t = resolve(self, target)?.pos_m;
+        let Some(ActorRef::Pedestrian(handle)) = o.actor else {
+            return Err(LoadError::new(
+                LoadErrorKind::Worlds,
+                format!("{}: a Pedestrian without its handle", o.name),
+            ));
+        };
+        match trigger {
+            PedTrigger::Near { car, dist } => {
+                self.graph.pedestrian(handle, s, t, car, dist);
+            }
+            PedTrigger::Stream(trigger) => {
+                self.graph.pedestrian_with_trigger(handle, t, trigger);
+            }
+            PedTrigger::Never => {}
+        }
+        if !matches!(trigger, PedTrigger::Never) {
+            // The behaviour's `foreach(walk)` is named by the Pedestrian's
+            // declaration, for the check of two behaviours walking it.
+            let walk = paracosm_engine::rx::StreamId(self.graph.nodes().len() - 1);
+            self.graph.set_site(walk, o.at.clone());
+        }
+        self.pedestrians.push(PedestrianSpec {
+            start: s,
+            target: t,
+            speed,
+            name: pedestrian_name,
+        });
+        Ok(())
+    }
+
+    /// Places the NPC car declared by `o`: its path along its route and its lane change.
+    fn place_car(&mut self, o: &ObjectDecl, car: PendingCar) -> Result<(), LoadError> {
+        let PendingCar {
+            loc,
+            route,
+            speed,
+            color,
+            enabled,
+            lane_change,
+            keep_distance_m,
+        } = car;
+        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(&b.roads);
+        let car_name = o.runtime_name("Car");
+        let start = resolve(self, loc)?;
+        let path = match self.roads.route(&start, &route, self.route_m) {
+            Ok(path) => path,
+            // A disabled car is not in the test: where it would drive does not
+            // matter (it may stand on a sidewalk); one metre ahead stands in.
+            Err(_) if !enabled => {
+                let (p, h) = (start.pos_m, start.heading_rad);
+                vec![[p[0], p[2]], [p[0] + h.cos(), p[2] - h.sin()]]
+            }
+            Err(e) => {
+                return Err(LoadError::new(
+                    LoadErrorKind::Worlds,
+                    format!("{}: {}", o.name, strip(e)),
+                ))
+            }
+        };
+        let lane_change = match lane_change {
+            Some(c) => {
+                // Into a lane of the other direction: allowed (an overtaking
+                // manoeuvre), but the car keeps its own direction there.
+                if let paracosm_engine::Lane::Driving(k) = start.lane {
+                    if k.signum() != c.to.signum() {
+                        self.warnings.push(Warning {
+                            at: o.at.clone(),
+                            message: format!(
+                                "{}: ChangeLane(to = {}) moves it from lane {k} into \
+                                     a lane of the other direction, where it goes on \
+                                     driving its own way (against the traffic there)",
+                                o.name, c.to
+                            ),
+                        });
+                    }
+                }
+                match self.lane_change(&o.name, &start, c) {
+                    Ok(change) => Some(change),
+                    Err(_) if !enabled => None,
+                    Err(e) => return Err(e),
+                }
+            }
+            None => None,
+        };
+        let lane_offsets_m = self.lane_offsets(&start);
+        self.cars.push(CarSpec {
+            path,
+            speed,
+            color,
+            size: Size::CAR,
+            enabled,
+            lane_change,
+            lane_offsets_m,
+            name: car_name,
+            keep_distance_m,
+        });
+        self.car_names.push(o.name.clone());
         Ok(())
     }
 }
@@ -1026,16 +1146,19 @@ impl SceneBuilder {
         name: &str,
         start: &Location,
         c: super::values::LaneChangeVal,
-    ) -> Result<paracosm_engine::LaneChangeSpec, String> {
+    ) -> Result<paracosm_engine::LaneChangeSpec, LoadError> {
         if start.through.is_some() {
-            return Err(format!(
-                "{name}: a lane change starts on a RoadSegment's lane, not inside a junction"
+            return Err(LoadError::new(
+                LoadErrorKind::Declarations,
+                format!(
+                    "{name}: a lane change starts on a RoadSegment's lane, not inside a junction"
+                ),
             ));
         }
         if start.map_lane.is_some() {
-            return Err(format!(
+            return Err(LoadError::new(LoadErrorKind::Declarations, format!(
                 "{name}: ChangeLane is not available on an OpenDRIVE map (start the car in the lane it should drive, or give it a route)"
-            ));
+            )));
         }
         let target = self
             .roads
@@ -1044,7 +1167,12 @@ impl SceneBuilder {
                 paracosm_engine::Lane::Driving(c.to),
                 start.at_m,
             )
-            .map_err(|e| format!("{name}: ChangeLane(to = {}): {}", c.to, strip(e)))?;
+            .map_err(|e| {
+                LoadError::new(
+                    LoadErrorKind::Declarations,
+                    format!("{name}: ChangeLane(to = {}): {}", c.to, strip(e)),
+                )
+            })?;
         let h = start.heading_rad;
         let right = [h.sin(), h.cos()];
         let d = [
@@ -1053,9 +1181,9 @@ impl SceneBuilder {
         ];
         let offset_m = d[0] * right[0] + d[1] * right[1];
         if offset_m.abs() < 1e-6 {
-            return Err(format!(
-                "{name}: ChangeLane(to = {}) is the lane it starts on",
-                c.to
+            return Err(LoadError::new(
+                LoadErrorKind::Declarations,
+                format!("{name}: ChangeLane(to = {}) is the lane it starts on", c.to),
             ));
         }
         Ok(paracosm_engine::LaneChangeSpec {

@@ -196,7 +196,7 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
         differ(&a.environment, &b.environment) || a.dt_s != b.dt_s,
         &mut out,
     );
-    other(differ(&a.lidar, &b.lidar), &mut out);
+    other(differ(&a.sensors, &b.sensors), &mut out);
     other(differ(&a.frictions, &b.frictions), &mut out);
     // A car disabled in both worlds is not in either test (nothing collides with it or sees
     // it): what else differs about it changes nothing.

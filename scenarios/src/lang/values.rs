@@ -263,6 +263,82 @@ impl starlark::PrintHandler for TestState {
     }
 }
 
+impl Action {
+    /// A number argument of the action (an int or a float; a bool is no number).
+    fn number_arg<'v>(&self, v: Value<'v>, what: &str) -> starlark::Result<f64> {
+        v.unpack_i32()
+            .map(f64::from)
+            .or_else(|| {
+                starlark::values::ValueLike::downcast_ref::<starlark::values::float::StarlarkFloat>(
+                    v,
+                )
+                .map(|f| f.0)
+            })
+            .ok_or_else(|| {
+                starlark::Error::new_other(anyhow::anyhow!(
+                    "{}: {what} is a number, got {}",
+                    self.method,
+                    crate::lang::a_type(v.get_type())
+                ))
+            })
+    }
+
+    /// The arguments a call binds, checked: `given` by position in the action's signature,
+    /// `required(i)` argument `i` or the error that it is missing.
+    fn bind<'v>(
+        &self,
+        given: &[Option<Value<'v>>],
+        required: &dyn Fn(usize) -> starlark::Result<Value<'v>>,
+    ) -> starlark::Result<Option<(f64, Option<f64>)>> {
+        let fail = |m: String| starlark::Error::new_other(anyhow::anyhow!(m));
+        Ok(match self.method {
+            "walk" => None,
+            "changeLane" => {
+                let lane = self.number_arg(required(0)?, "the lane")?;
+                let duration = match given[1] {
+                    Some(v) => Some(self.number_arg(v, "duration (s)")?),
+                    None => None,
+                };
+                if lane.fract() != 0.0 || lane == 0.0 {
+                    return Err(fail(format!(
+                        "changeLane: a lane is a whole number other than 0, got {lane}"
+                    )));
+                }
+                if duration.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
+                    return Err(fail("changeLane(duration=) is a time > 0 in s".into()));
+                }
+                Some((lane, duration))
+            }
+            method => {
+                let v = self.number_arg(
+                    required(0)?,
+                    if method == "brake" {
+                        "the deceleration (m/s²)"
+                    } else {
+                        "the speed (m/s)"
+                    },
+                )?;
+                let ok = if method == "brake" {
+                    v.is_finite() && v > 0.0
+                } else {
+                    v.is_finite() && v >= 0.0
+                };
+                if !ok {
+                    return Err(fail(format!(
+                        "{method} needs {}, got {v}",
+                        if method == "brake" {
+                            "a deceleration > 0 m/s²"
+                        } else {
+                            "a speed >= 0 m/s"
+                        }
+                    )));
+                }
+                Some((v, None))
+            }
+        })
+    }
+}
+
 #[starlark_value(type = "Action")]
 impl<'v> StarlarkValue<'v> for Action {
     fn invoke(
@@ -278,23 +354,6 @@ impl<'v> StarlarkValue<'v> for Action {
             )));
         }
         let heap = eval.heap();
-        let number = |v: Value<'v>, what: &str| -> starlark::Result<f64> {
-            v.unpack_i32()
-                .map(f64::from)
-                .or_else(|| {
-                    starlark::values::ValueLike::downcast_ref::<
-                        starlark::values::float::StarlarkFloat,
-                    >(v)
-                    .map(|f| f.0)
-                })
-                .ok_or_else(|| {
-                    fail(format!(
-                        "{}: {what} is a number, got {}",
-                        self.method,
-                        crate::lang::a_type(v.get_type())
-                    ))
-                })
-        };
         // Each argument by position or by keyword (the names LANGUAGE.md's table gives), once.
         let signature: Vec<&str> = crate::lang::builtins::find(self.method)
             .map(|b| b.inputs.iter().map(|a| a.keyword).collect())
@@ -328,51 +387,7 @@ impl<'v> StarlarkValue<'v> for Action {
         let required = |i: usize| {
             given[i].ok_or_else(|| fail(format!("{self} needs `{}`: it is {usage}", signature[i])))
         };
-        let bound = match self.method {
-            "walk" => None,
-            "changeLane" => {
-                let lane = number(required(0)?, "the lane")?;
-                let duration = match given[1] {
-                    Some(v) => Some(number(v, "duration (s)")?),
-                    None => None,
-                };
-                if lane.fract() != 0.0 || lane == 0.0 {
-                    return Err(fail(format!(
-                        "changeLane: a lane is a whole number other than 0, got {lane}"
-                    )));
-                }
-                if duration.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
-                    return Err(fail("changeLane(duration=) is a time > 0 in s".into()));
-                }
-                Some((lane, duration))
-            }
-            method => {
-                let v = number(
-                    required(0)?,
-                    if method == "brake" {
-                        "the deceleration (m/s²)"
-                    } else {
-                        "the speed (m/s)"
-                    },
-                )?;
-                let ok = if method == "brake" {
-                    v.is_finite() && v > 0.0
-                } else {
-                    v.is_finite() && v >= 0.0
-                };
-                if !ok {
-                    return Err(fail(format!(
-                        "{method} needs {}, got {v}",
-                        if method == "brake" {
-                            "a deceleration > 0 m/s²"
-                        } else {
-                            "a speed >= 0 m/s"
-                        }
-                    )));
-                }
-                Some((v, None))
-            }
-        };
+        let bound = self.bind(&given, &required)?;
         let action = Action {
             bound,
             ..self.clone()

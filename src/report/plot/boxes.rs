@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{png_and_svg, register_font, PlotError, FAMILY};
+use super::{png_and_svg, register_font, DrawError, PlotError, FAMILY};
 
 /// One panel of [`box_plot`]: a title and, per box, its label and its values.
 pub type BoxPanel = (String, Vec<(String, Vec<f64>)>);
@@ -35,8 +35,8 @@ fn draw_boxes<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     y_label: &str,
     panels: &[BoxPanel],
-) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+) -> Result<(), DrawError> {
+    root.fill(&WHITE)?;
     let areas = root.split_evenly((1, panels.len().max(1)));
     let top = panels
         .iter()
@@ -50,8 +50,7 @@ fn draw_boxes<DB: DrawingBackend>(
             .margin(12)
             .x_label_area_size(50)
             .y_label_area_size(60)
-            .build_cartesian_2d(-0.5f64..n as f64 - 0.5, (0.8f64..top * 1.5).log_scale())
-            .map_err(|e| e.to_string())?;
+            .build_cartesian_2d(-0.5f64..n as f64 - 0.5, (0.8f64..top * 1.5).log_scale())?;
         let label_of = |x: &f64| {
             let i = x.round();
             match boxes.get(i as usize) {
@@ -69,8 +68,7 @@ fn draw_boxes<DB: DrawingBackend>(
             .axis_desc_style((FAMILY, 16))
             .light_line_style(WHITE.mix(0.0))
             .disable_x_mesh()
-            .draw()
-            .map_err(|e| e.to_string())?;
+            .draw()?;
         for (i, (_, values)) in boxes.iter().enumerate() {
             let mut v = values.clone();
             v.sort_by(f64::total_cmp);
@@ -100,16 +98,13 @@ fn draw_boxes<DB: DrawingBackend>(
                 line(vec![(x - 0.1, hi), (x + 0.1, hi)]),
                 line(vec![(x - 0.1, lo), (x + 0.1, lo)]),
             ];
-            chart
-                .draw_series(shapes.drain(..))
-                .map_err(|e| e.to_string())?;
-            chart
-                .draw_series(
-                    v.iter()
-                        .map(|&y| Circle::new((x + 0.28, y), 2, BLACK.mix(0.35).filled())),
-                )
-                .map_err(|e| e.to_string())?;
+            chart.draw_series(shapes.drain(..))?;
+            chart.draw_series(
+                v.iter()
+                    .map(|&y| Circle::new((x + 0.28, y), 2, BLACK.mix(0.35).filled())),
+            )?;
         }
     }
-    root.present().map_err(|e| e.to_string())
+    root.present()?;
+    Ok(())
 }

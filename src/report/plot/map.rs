@@ -13,7 +13,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use paracosm_generators::ParamSpace;
 
 use super::axis::Axis;
-use super::{png_and_svg, register_font, PlotError, FAMILY};
+use super::{png_and_svg, register_font, DrawError, PlotError, FAMILY};
 use crate::record::{RunRecord, Status};
 
 /// The axes of a map over `names`: one name gives the parameter against the outcome (a strip
@@ -53,15 +53,14 @@ fn chart_on<'a, DB: DrawingBackend>(
     y: &Axis,
     title: &str,
     grid: bool,
-) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, DrawError> {
     let ((x_lo, x_hi), (y_lo, y_hi)) = (x.range(), y.range());
     let mut chart = ChartBuilder::on(area)
         .caption(title, (FAMILY, 20))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d(x_lo..x_hi, y_lo..y_hi)
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d(x_lo..x_hi, y_lo..y_hi)?;
     let (x_cats, y_cats) = (x.categories(), y.categories());
     let fx = |v: &f64| category_label(x_cats.as_deref().unwrap_or_default(), *v);
     let fy = |v: &f64| category_label(y_cats.as_deref().unwrap_or_default(), *v);
@@ -84,7 +83,7 @@ fn chart_on<'a, DB: DrawingBackend>(
     if !grid {
         mesh.disable_mesh();
     }
-    mesh.draw().map_err(|e| e.to_string())?;
+    mesh.draw()?;
     Ok(chart)
 }
 
@@ -100,15 +99,18 @@ pub enum Coloring {
     Robustness,
 }
 
+/// A name that is no [`Coloring`] (`--color`'s value): the name as given.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("`{0}` is not a colouring: use `outcome` or `robustness`")]
+pub struct UnknownColoring(pub String);
+
 impl std::str::FromStr for Coloring {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownColoring;
+    fn from_str(s: &str) -> Result<Self, UnknownColoring> {
         match s {
             "outcome" => Ok(Coloring::Outcome),
             "robustness" => Ok(Coloring::Robustness),
-            other => Err(format!(
-                "`{other}` is not a colouring: use `outcome` or `robustness`"
-            )),
+            other => Err(UnknownColoring(other.to_owned())),
         }
     }
 }
@@ -159,7 +161,7 @@ fn draw_panel<DB: DrawingBackend>(
     title: &str,
     color: Coloring,
     span: f64,
-) -> Result<(), String> {
+) -> Result<(), DrawError> {
     let mut chart = chart_on(area, x, y, title, true)?;
     let at = |r: &RunRecord| -> Option<(f64, f64)> { Some((x.coord(r, 1)?, y.coord(r, 2)?)) };
     let of = |status: Status| -> Vec<((f64, f64), RGBColor)> {
@@ -192,16 +194,14 @@ fn draw_panel<DB: DrawingBackend>(
         .draw_series(
             pass.iter()
                 .map(|&(p, c)| Circle::new(p, 3, c.stroke_width(1))),
-        )
-        .map_err(|e| e.to_string())?
+        )?
         .label(format!("pass ({})", pass.len()))
         .legend(move |p| Circle::new(p, 3, pass_key.stroke_width(1)));
     chart
         .draw_series(
             fail.iter()
                 .map(|&(p, c)| Cross::new(p, 4, c.stroke_width(2))),
-        )
-        .map_err(|e| e.to_string())?
+        )?
         .label(format!("fail ({})", fail.len()))
         .legend(move |p| Cross::new(p, 4, fail_key.stroke_width(2)));
     if !error.is_empty() {
@@ -210,8 +210,7 @@ fn draw_panel<DB: DrawingBackend>(
                 error
                     .iter()
                     .map(|&(p, _)| TriangleMarker::new(p, 4, BLACK.mix(0.5))),
-            )
-            .map_err(|e| e.to_string())?
+            )?
             .label(format!("error ({})", error.len()))
             .legend(|p| TriangleMarker::new(p, 4, BLACK.mix(0.5)));
     }
@@ -223,15 +222,14 @@ fn draw_panel<DB: DrawingBackend>(
 fn draw_color_bar<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     span: f64,
-) -> Result<(), String> {
+) -> Result<(), DrawError> {
     let mut chart = ChartBuilder::on(area)
         .margin_top(50)
         .margin_bottom(57)
         .margin_right(8)
         .y_label_area_size(0)
         .right_y_label_area_size(52)
-        .build_cartesian_2d(0.0..1.0, -span..span)
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d(0.0..1.0, -span..span)?;
     chart
         .configure_mesh()
         .disable_mesh()
@@ -239,19 +237,16 @@ fn draw_color_bar<DB: DrawingBackend>(
         .y_desc("robustness (smallest over monitors)")
         .label_style((FAMILY, 12))
         .axis_desc_style((FAMILY, 13))
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .draw()?;
     let steps = 60;
-    chart
-        .draw_series((0..steps).map(|k| {
-            let lo = -span + 2.0 * span * k as f64 / steps as f64;
-            let hi = -span + 2.0 * span * (k + 1) as f64 / steps as f64;
-            Rectangle::new(
-                [(0.0, lo), (1.0, hi)],
-                diverging((lo + hi) / 2.0, span).filled(),
-            )
-        }))
-        .map_err(|e| e.to_string())?;
+    chart.draw_series((0..steps).map(|k| {
+        let lo = -span + 2.0 * span * k as f64 / steps as f64;
+        let hi = -span + 2.0 * span * (k + 1) as f64 / steps as f64;
+        Rectangle::new(
+            [(0.0, lo), (1.0, hi)],
+            diverging((lo + hi) / 2.0, span).filled(),
+        )
+    }))?;
     Ok(())
 }
 
@@ -299,8 +294,8 @@ fn render<DB: DrawingBackend>(
     color: Coloring,
     span: f64,
     bar: u32,
-) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+) -> Result<(), DrawError> {
+    root.fill(&WHITE)?;
     let (w, _) = root.dim_in_pixel();
     let (maps, scale) = root.split_horizontally(w - bar);
     let areas = maps.split_evenly((1, panels.len().max(1)));
@@ -310,7 +305,8 @@ fn render<DB: DrawingBackend>(
     if bar > 0 {
         draw_color_bar(&scale, span)?;
     }
-    root.present().map_err(|e| e.to_string())
+    root.present()?;
+    Ok(())
 }
 
 /// Cells along each continuous axis of a failure-rate grid over `axes` for `tests` tests, so
@@ -409,8 +405,8 @@ fn draw_rates<DB: DrawingBackend>(
     (x, y): (&Axis, &Axis),
     title: &str,
     g: &RateGrid,
-) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+) -> Result<(), DrawError> {
+    root.fill(&WHITE)?;
     let mut chart = chart_on(&root, x, y, title, false)?;
     let span = |i: usize| {
         let (x0, x1) = x.bin_span(i % g.columns, g.columns);
@@ -429,13 +425,13 @@ fn draw_rates<DB: DrawingBackend>(
         };
         Rectangle::new([(x0, y0), (x1, y1)], color.filled())
     });
-    chart.draw_series(rects).map_err(|e| e.to_string())?;
+    chart.draw_series(rects)?;
     // White lines between the cells, so neighbours of one colour stay apart.
     let borders = (0..g.cells.len()).map(|i| {
         let (x0, x1, y0, y1) = span(i);
         Rectangle::new([(x0, y0), (x1, y1)], WHITE.stroke_width(2))
     });
-    chart.draw_series(borders).map_err(|e| e.to_string())?;
+    chart.draw_series(borders)?;
     let labels = g
         .cells
         .iter()
@@ -450,8 +446,9 @@ fn draw_rates<DB: DrawingBackend>(
                 (FAMILY, 13).into_font().color(&BLACK).pos(centred),
             )
         });
-    chart.draw_series(labels).map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())
+    chart.draw_series(labels)?;
+    root.present()?;
+    Ok(())
 }
 
 #[cfg(test)]
@@ -679,6 +676,9 @@ mod tests {
             "slightly red: {near:?}"
         );
         assert_eq!("robustness".parse::<Coloring>(), Ok(Coloring::Robustness));
-        assert!("blue".parse::<Coloring>().is_err());
+        assert_eq!(
+            "blue".parse::<Coloring>().unwrap_err().to_string(),
+            "`blue` is not a colouring: use `outcome` or `robustness`"
+        );
     }
 }

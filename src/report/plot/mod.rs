@@ -22,7 +22,10 @@ use thiserror::Error;
 
 pub use boxes::{box_plot, BoxPanel};
 pub(crate) use map::robustness_span;
-pub use map::{adaptive_bins, failure_map, failure_rate_map, failure_rates, Coloring, RateGrid};
+pub use map::{
+    adaptive_bins, failure_map, failure_rate_map, failure_rates, Coloring, RateGrid,
+    UnknownColoring,
+};
 pub use pairs::{pairs_plot, MAX_PAIRS};
 pub use series::{value_map, xy_plot, Series, ValueMapLabels, ValuePoint, XyStyle};
 pub use sheet::contact_sheet;
@@ -71,19 +74,45 @@ impl From<PlotError> for crate::Error {
     }
 }
 
+/// Why drawing a figure onto a backend failed, before [`png_and_svg`] names the file
+/// ([`PlotError::Draw`]).
+#[derive(Debug, Error)]
+enum DrawError {
+    /// The backend's reason, as it words it (its error type is the backend's own, which the
+    /// drawing code is generic over).
+    #[error("{0}")]
+    Backend(String),
+    /// Cell `(row, column)` of a scatterplot matrix could not be drawn.
+    #[error("cell ({row}, {column}): {source}")]
+    Cell {
+        /// The cell's row.
+        row: usize,
+        /// The cell's column.
+        column: usize,
+        /// Why.
+        source: Box<DrawError>,
+    },
+}
+
+impl<E: std::error::Error + Send + Sync> From<DrawingAreaErrorKind<E>> for DrawError {
+    fn from(e: DrawingAreaErrorKind<E>) -> Self {
+        DrawError::Backend(e.to_string())
+    }
+}
+
 /// Draws a chart's series legend the one way every plot here draws it: upper right, on a
 /// translucent white box with a black border.
 fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
     chart: &mut ChartContext<'a, DB, CT>,
-) -> Result<(), String> {
+) -> Result<(), DrawError> {
     chart
         .configure_series_labels()
         .label_font((FAMILY, 14))
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| e.to_string())
+        .draw()?;
+    Ok(())
 }
 
 fn register_font() {
@@ -100,8 +129,8 @@ fn register_font() {
 fn png_and_svg(
     stem: &Path,
     size: (u32, u32),
-    png: impl Fn(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
-    svg: impl Fn(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
+    png: impl Fn(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), DrawError>,
+    svg: impl Fn(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), DrawError>,
 ) -> Result<[PathBuf; 2], PlotError> {
     let (png_path, svg_path) = (stem.with_extension("png"), stem.with_extension("svg"));
     let failed = |path: &Path| {
@@ -114,10 +143,10 @@ fn png_and_svg(
     // Drawn into memory, then encoded with the best compression (plots are mostly flat
     // colour; this halves a busy pairs plot, which the web report embeds).
     let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
-    png(BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area()).map_err(|reason| {
+    png(BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area()).map_err(|e| {
         PlotError::Draw {
             path: png_path.clone(),
-            reason,
+            reason: e.to_string(),
         }
     })?;
     let mut encoded = Vec::new();

@@ -13,7 +13,7 @@ use paracosm_generators::ParamSpace;
 
 use super::axis::Axis;
 use super::map::adaptive_bins;
-use super::{png_and_svg, register_font, PlotError, FAMILY};
+use super::{png_and_svg, register_font, DrawError, PlotError, FAMILY};
 use crate::record::{RunRecord, Status};
 
 /// At most this many parameters are drawn; the others are named in a note on the figure.
@@ -117,9 +117,8 @@ struct Layout<'a> {
 }
 
 impl Layout<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String> {
-        let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-        root.fill(&WHITE).map_err(e)?;
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), DrawError> {
+        root.fill(&WHITE)?;
         let (w, h) = root.dim_in_pixel();
         let (left, bottom, top) = self.margins;
         let d = self.axes.len();
@@ -137,8 +136,7 @@ impl Layout<'_> {
             self.title.to_owned(),
             (left as i32, 14),
             (FAMILY, 19).into_font(),
-        ))
-        .map_err(e)?;
+        ))?;
         root.draw(&Text::new(
             format!(
                 "× failed ({fail})   ○ passed ({pass})   diagonal: failure rate per bin   above: failure rate per cell"
@@ -146,27 +144,30 @@ impl Layout<'_> {
             (left as i32, 42),
             (FAMILY, 14).into_font().color(&BLACK.mix(0.8)),
         ))
-        .map_err(e)?;
+        ?;
         if !self.note.is_empty() {
             root.draw(&Text::new(
                 self.note.to_owned(),
                 (left as i32, h as i32 - 22),
                 (FAMILY, 14).into_font().color(&BLACK.mix(0.8)),
-            ))
-            .map_err(e)?;
+            ))?;
         }
         let right = w - left - d as u32 * self.cell;
         let matrix = root.margin(top, bottom, left, right);
         let cells = matrix.split_evenly((d, d));
         for (k, area) in cells.iter().enumerate() {
             let (i, j) = (k / d, k % d);
-            self.cell(area, i, j)
-                .map_err(|m| format!("cell ({i}, {j}): {m}"))?;
+            self.cell(area, i, j).map_err(|m| DrawError::Cell {
+                row: i,
+                column: j,
+                source: Box::new(m),
+            })?;
         }
         let cw = f64::from(self.cell);
         let ch = f64::from(h - top - bottom) / d as f64;
         self.edges(&root, (f64::from(left), f64::from(top)), (cw, ch))?;
-        root.present().map_err(e)
+        root.present()?;
+        Ok(())
     }
 
     /// Tick labels and axis titles along the bottom row and the left column, in the figure's
@@ -177,7 +178,7 @@ impl Layout<'_> {
         root: &DrawingArea<DB, Shift>,
         origin: (f64, f64),
         cell: (f64, f64),
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         let d = self.axes.len();
         let small = (FAMILY, 12).into_font().color(&BLACK);
         let title = (FAMILY, 14).into_font().color(&BLACK);
@@ -188,7 +189,7 @@ impl Layout<'_> {
                 (at.0.round() as i32, at.1.round() as i32),
                 style,
             ))
-            .map_err(|e| e.to_string())
+            .map_err(DrawError::from)
         };
         for (j, x) in self.axes.iter().enumerate() {
             let (x0, x1) = x.range();
@@ -258,17 +259,12 @@ impl Layout<'_> {
         area: &DrawingArea<DB, Shift>,
         i: usize,
         j: usize,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         let (x, y) = (&self.axes[j], &self.axes[i]);
         let ((x0, x1), (y0, y1)) = (x.range(), if i == j { (0.0, 1.0) } else { y.range() });
         let inner = area.margin(4, 4, 4, 4);
-        let mut chart = ChartBuilder::on(&inner)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| e.to_string())?;
-        chart
-            .plotting_area()
-            .fill(&RGBColor(250, 250, 250))
-            .map_err(|e| e.to_string())?;
+        let mut chart = ChartBuilder::on(&inner).build_cartesian_2d(x0..x1, y0..y1)?;
+        chart.plotting_area().fill(&RGBColor(250, 250, 250))?;
         if i == j {
             self.histogram(&mut chart, x)?;
         } else if i > j {
@@ -277,21 +273,17 @@ impl Layout<'_> {
             self.rates(&mut chart, x, y, (self.pair_bins)(i, j))?;
         }
         // Frame.
-        chart
-            .draw_series(std::iter::once(Rectangle::new(
-                [(x0, y0), (x1, y1)],
-                BLACK.mix(0.5).stroke_width(1),
-            )))
-            .map_err(|e| e.to_string())?;
+        chart.draw_series(std::iter::once(Rectangle::new(
+            [(x0, y0), (x1, y1)],
+            BLACK.mix(0.5).stroke_width(1),
+        )))?;
         // The diagonal names its parameter inside the cell.
         if i == j {
-            inner
-                .draw(&Text::new(
-                    x.label(),
-                    (6, 6),
-                    (FAMILY, 13).into_font().color(&BLACK),
-                ))
-                .map_err(|e| e.to_string())?;
+            inner.draw(&Text::new(
+                x.label(),
+                (6, 6),
+                (FAMILY, 13).into_font().color(&BLACK),
+            ))?;
         }
         Ok(())
     }
@@ -308,7 +300,7 @@ impl Layout<'_> {
         >,
         x: &Axis,
         y: &Axis,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         let at = |r: &RunRecord| -> Option<(f64, f64)> { Some((x.coord(r, 1)?, y.coord(r, 2)?)) };
         let of = |s: Status| -> Vec<(f64, f64)> {
             self.records
@@ -320,20 +312,16 @@ impl Layout<'_> {
         // Dense campaigns get smaller, lighter marks so that the cells do not fill up.
         let dense = self.records.len() > 2000;
         let (r_pass, r_fail, a_pass) = if dense { (1, 2, 0.35) } else { (2, 3, 0.8) };
-        chart
-            .draw_series(
-                of(Status::Pass)
-                    .into_iter()
-                    .map(|p| Circle::new(p, r_pass, BLUE.mix(a_pass).stroke_width(1))),
-            )
-            .map_err(|e| e.to_string())?;
-        chart
-            .draw_series(
-                of(Status::Fail)
-                    .into_iter()
-                    .map(|p| Cross::new(p, r_fail, RED.stroke_width(1))),
-            )
-            .map_err(|e| e.to_string())?;
+        chart.draw_series(
+            of(Status::Pass)
+                .into_iter()
+                .map(|p| Circle::new(p, r_pass, BLUE.mix(a_pass).stroke_width(1))),
+        )?;
+        chart.draw_series(
+            of(Status::Fail)
+                .into_iter()
+                .map(|p| Cross::new(p, r_fail, RED.stroke_width(1))),
+        )?;
         Ok(())
     }
 
@@ -348,7 +336,7 @@ impl Layout<'_> {
             >,
         >,
         x: &Axis,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         let bins = x.bins(self.diag_bins);
         let mut cells = vec![(0u32, 0u32); bins];
         for r in self.records {
@@ -357,28 +345,24 @@ impl Layout<'_> {
                 cells[b].1 += 1;
             }
         }
-        chart
-            .draw_series(cells.iter().enumerate().map(|(k, &(f, n))| {
-                let (a, b) = x.bin_span(k, bins);
-                let rate = if n == 0 {
-                    0.0
-                } else {
-                    f64::from(f) / f64::from(n)
-                };
-                Rectangle::new([(a, 0.0), (b, rate)], RED.mix(0.75).filled())
-            }))
-            .map_err(|e| e.to_string())?;
-        chart
-            .draw_series(cells.iter().enumerate().map(|(k, &(f, n))| {
-                let (a, b) = x.bin_span(k, bins);
-                let rate = if n == 0 {
-                    0.0
-                } else {
-                    f64::from(f) / f64::from(n)
-                };
-                Rectangle::new([(a, 0.0), (b, rate)], WHITE.stroke_width(1))
-            }))
-            .map_err(|e| e.to_string())?;
+        chart.draw_series(cells.iter().enumerate().map(|(k, &(f, n))| {
+            let (a, b) = x.bin_span(k, bins);
+            let rate = if n == 0 {
+                0.0
+            } else {
+                f64::from(f) / f64::from(n)
+            };
+            Rectangle::new([(a, 0.0), (b, rate)], RED.mix(0.75).filled())
+        }))?;
+        chart.draw_series(cells.iter().enumerate().map(|(k, &(f, n))| {
+            let (a, b) = x.bin_span(k, bins);
+            let rate = if n == 0 {
+                0.0
+            } else {
+                f64::from(f) / f64::from(n)
+            };
+            Rectangle::new([(a, 0.0), (b, rate)], WHITE.stroke_width(1))
+        }))?;
         Ok(())
     }
 
@@ -395,7 +379,7 @@ impl Layout<'_> {
         x: &Axis,
         y: &Axis,
         bins: usize,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         let (columns, rows) = (x.bins(bins), y.bins(bins));
         let mut cells = vec![(0u32, 0u32); columns * rows];
         for r in self.records {
@@ -404,13 +388,11 @@ impl Layout<'_> {
                 cells[cy * columns + cx].1 += 1;
             }
         }
-        chart
-            .draw_series(cells.iter().enumerate().map(|(k, &(f, n))| {
-                let (a, b) = x.bin_span(k % columns, columns);
-                let (c, e) = y.bin_span(k / columns, rows);
-                Rectangle::new([(a, c), (b, e)], rate_color(f, n).filled())
-            }))
-            .map_err(|e| e.to_string())?;
+        chart.draw_series(cells.iter().enumerate().map(|(k, &(f, n))| {
+            let (a, b) = x.bin_span(k % columns, columns);
+            let (c, e) = y.bin_span(k / columns, rows);
+            Rectangle::new([(a, c), (b, e)], rate_color(f, n).filled())
+        }))?;
         Ok(())
     }
 }

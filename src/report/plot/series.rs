@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{png_and_svg, register_font, PlotError, FAMILY};
+use super::{png_and_svg, register_font, DrawError, PlotError, FAMILY};
 
 /// One point of a [`value_map`]: its place `(x, y)`, the value its colour shows, and whether
 /// it is marked (drawn as a red cross over the colour: a collision, say).
@@ -98,16 +98,15 @@ fn draw_value_map<DB: DrawingBackend>(
     labels: &ValueMapLabels,
     (x_range, y_range, (v0, v1)): ((f64, f64), (f64, f64), (f64, f64)),
     points: &[ValuePoint],
-) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+) -> Result<(), DrawError> {
+    root.fill(&WHITE)?;
     let (main, bar) = root.split_horizontally(750);
     let mut chart = ChartBuilder::on(&main)
         .caption(&labels.title, (FAMILY, 18))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(55)
-        .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)?;
     chart
         .configure_mesh()
         .x_desc(&labels.x)
@@ -115,8 +114,7 @@ fn draw_value_map<DB: DrawingBackend>(
         .label_style((FAMILY, 13))
         .axis_desc_style((FAMILY, 15))
         .light_line_style(WHITE.mix(0.0))
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .draw()?;
     let colour = |v: f64| {
         if v.is_nan() {
             RGBColor(160, 160, 160)
@@ -124,13 +122,11 @@ fn draw_value_map<DB: DrawingBackend>(
             sequential((v - v0) / (v1 - v0))
         }
     };
-    chart
-        .draw_series(
-            points
-                .iter()
-                .map(|p| Circle::new((p.x, p.y), 5, colour(p.value).filled())),
-        )
-        .map_err(|e| e.to_string())?;
+    chart.draw_series(
+        points
+            .iter()
+            .map(|p| Circle::new((p.x, p.y), 5, colour(p.value).filled())),
+    )?;
     let marked: Vec<&ValuePoint> = points.iter().filter(|p| p.marked).collect();
     let red = RGBColor(214, 39, 40);
     chart
@@ -138,8 +134,7 @@ fn draw_value_map<DB: DrawingBackend>(
             marked
                 .iter()
                 .map(|p| Cross::new((p.x, p.y), 5, red.stroke_width(2))),
-        )
-        .map_err(|e| e.to_string())?
+        )?
         .label(format!("{} ({})", labels.marked, marked.len()))
         .legend(move |p| Cross::new(p, 5, red.stroke_width(2)));
     super::draw_legend(&mut chart)?;
@@ -149,8 +144,7 @@ fn draw_value_map<DB: DrawingBackend>(
         .margin_right(8)
         .y_label_area_size(0)
         .right_y_label_area_size(60)
-        .build_cartesian_2d(0.0..1.0, v0..v1)
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d(0.0..1.0, v0..v1)?;
     scale
         .configure_mesh()
         .disable_mesh()
@@ -158,20 +152,18 @@ fn draw_value_map<DB: DrawingBackend>(
         .y_desc(&labels.value)
         .label_style((FAMILY, 12))
         .axis_desc_style((FAMILY, 13))
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .draw()?;
     let steps = 60;
-    scale
-        .draw_series((0..steps).map(|k| {
-            let lo = v0 + (v1 - v0) * k as f64 / steps as f64;
-            let hi = v0 + (v1 - v0) * (k + 1) as f64 / steps as f64;
-            Rectangle::new(
-                [(0.0, lo), (1.0, hi)],
-                sequential((k as f64 + 0.5) / steps as f64).filled(),
-            )
-        }))
-        .map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())
+    scale.draw_series((0..steps).map(|k| {
+        let lo = v0 + (v1 - v0) * k as f64 / steps as f64;
+        let hi = v0 + (v1 - v0) * (k + 1) as f64 / steps as f64;
+        Rectangle::new(
+            [(0.0, lo), (1.0, hi)],
+            sequential((k as f64 + 0.5) / steps as f64).filled(),
+        )
+    }))?;
+    root.present()?;
+    Ok(())
 }
 
 /// How [`xy_plot`] draws its series.
@@ -226,15 +218,14 @@ fn draw_xy<DB: DrawingBackend>(
     (x_range, y_range): ((f64, f64), (f64, f64)),
     series: &[Series],
     style: XyStyle,
-) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+) -> Result<(), DrawError> {
+    root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, (FAMILY, 18))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(55)
-        .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)?;
     chart
         .configure_mesh()
         .x_desc(x_label)
@@ -242,24 +233,24 @@ fn draw_xy<DB: DrawingBackend>(
         .label_style((FAMILY, 13))
         .axis_desc_style((FAMILY, 15))
         .light_line_style(WHITE.mix(0.0))
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .draw()?;
     for (k, (name, pairs)) in series.iter().enumerate() {
         let c = PALETTE[k % PALETTE.len()];
         let drawn = match style {
-            XyStyle::Lines => chart
-                .draw_series(LineSeries::new(pairs.iter().copied(), c.stroke_width(2)))
-                .map_err(|e| e.to_string())?,
-            XyStyle::Points => chart
-                .draw_series(pairs.iter().map(|&p| Circle::new(p, 4, c.filled())))
-                .map_err(|e| e.to_string())?,
+            XyStyle::Lines => {
+                chart.draw_series(LineSeries::new(pairs.iter().copied(), c.stroke_width(2)))?
+            }
+            XyStyle::Points => {
+                chart.draw_series(pairs.iter().map(|&p| Circle::new(p, 4, c.filled())))?
+            }
         };
         drawn
             .label(name.as_str())
             .legend(move |(x, y)| Rectangle::new([(x, y - 4), (x + 14, y + 4)], c.filled()));
     }
     super::draw_legend(&mut chart)?;
-    root.present().map_err(|e| e.to_string())
+    root.present()?;
+    Ok(())
 }
 
 #[cfg(test)]

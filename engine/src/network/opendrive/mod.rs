@@ -587,17 +587,7 @@ fn bake(
     let mut roads: Vec<MapRoad> = Vec::new();
     let mut road_index: BTreeMap<String, usize> = BTreeMap::new();
     // Section ranges from the document: road id -> starts, and the road's length.
-    let mut sections: BTreeMap<String, (Vec<f64>, f64)> = BTreeMap::new();
-    for road in r.roads() {
-        let id = road.attribute("id").unwrap_or("").to_owned();
-        let length = attr_f64(road, "length").unwrap_or(0.0);
-        let starts = road
-            .descendants()
-            .filter(|n| n.has_tag_name("laneSection"))
-            .filter_map(|n| attr_f64(n, "s"))
-            .collect();
-        sections.insert(id, (starts, length));
-    }
+    let sections = section_ranges(r);
     let mut lanes: Vec<MapLane> = Vec::new();
     let mut by_id: BTreeMap<usize, usize> = BTreeMap::new();
     let mut stations = 0usize;
@@ -635,35 +625,7 @@ fn bake(
                 ),
             ));
         }
-        let (mut ss, mut centre, mut width) = (Vec::new(), Vec::new(), Vec::new());
-        for i in 0..=n {
-            let s = if i == n {
-                s1
-            } else {
-                s0 + (s1 - s0) * i as f64 / n as f64
-            };
-            let at = xodr::LanePosition {
-                lane: p.lane,
-                s,
-                offset: 0.0,
-            };
-            let (Some(c), Some(cs)) = (net.lane_point(at), net.centerline_s(at)) else {
-                continue;
-            };
-            let w = f64::from(lane.width_at(cs));
-            if !(c.x.is_finite() && c.y.is_finite() && w.is_finite()) {
-                return Err(r.error(
-                    r.road_node(&p.road_id),
-                    format!(
-                        "lane {} of road \"{}\" is not finite at s = {s:.2} m",
-                        p.od_id, p.road_id
-                    ),
-                ));
-            }
-            ss.push(s);
-            centre.push([f64::from(c.x), -f64::from(c.y)]);
-            width.push(w.max(0.0));
-        }
+        let (ss, centre, width) = sample_lane(r, net, p, lane, (s0, s1), n)?;
         if ss.len() < 2 || width.iter().all(|w| *w <= 0.0) {
             continue;
         }
@@ -681,6 +643,93 @@ fn bake(
             successors: Vec::new(),
         });
     }
+    link_successors(&mut lanes, &by_id, net, provenance);
+    if !lanes.iter().any(|l| l.drivable) {
+        return Err(r.error(None, "the map has no driving lane".into()));
+    }
+    Ok(RoadMap {
+        source: r.file.to_owned(),
+        origin_m: [0.0, 0.0],
+        roads,
+        lanes,
+    })
+}
+
+/// Each road's lane section starts (m), from the document, and the road's length (m), by
+/// road id.
+fn section_ranges(r: &Reader) -> BTreeMap<String, (Vec<f64>, f64)> {
+    let mut sections: BTreeMap<String, (Vec<f64>, f64)> = BTreeMap::new();
+    for road in r.roads() {
+        let id = road.attribute("id").unwrap_or("").to_owned();
+        let length = attr_f64(road, "length").unwrap_or(0.0);
+        let starts = road
+            .descendants()
+            .filter(|n| n.has_tag_name("laneSection"))
+            .filter_map(|n| attr_f64(n, "s"))
+            .collect();
+        sections.insert(id, (starts, length));
+    }
+    sections
+}
+
+/// A lane's stations: each one's `s` (m), the lane's centre there (world `[x, z]`, m) and its
+/// width (m).
+type Stations = (Vec<f64>, Vec<[f64; 2]>, Vec<f64>);
+
+/// The `n + 1` stations of lane `lane` (`p`) from `s0` to `s1` (m, its section's range),
+/// evenly spread: each station's `s` (m), the lane's centre there (world `[x, z]`, m) and
+/// its width (m, `>= 0`). A station where the lane has no point is left out.
+///
+/// # Errors
+/// A lane whose centre or width is not finite at a station.
+fn sample_lane(
+    r: &Reader,
+    net: &xodr::RoadNetwork,
+    p: &xodr::LaneProvenance,
+    lane: &xodr::Lane,
+    (s0, s1): (f64, f64),
+    n: usize,
+) -> Result<Stations, MapError> {
+    let (mut ss, mut centre, mut width) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..=n {
+        let s = if i == n {
+            s1
+        } else {
+            s0 + (s1 - s0) * i as f64 / n as f64
+        };
+        let at = xodr::LanePosition {
+            lane: p.lane,
+            s,
+            offset: 0.0,
+        };
+        let (Some(c), Some(cs)) = (net.lane_point(at), net.centerline_s(at)) else {
+            continue;
+        };
+        let w = f64::from(lane.width_at(cs));
+        if !(c.x.is_finite() && c.y.is_finite() && w.is_finite()) {
+            return Err(r.error(
+                r.road_node(&p.road_id),
+                format!(
+                    "lane {} of road \"{}\" is not finite at s = {s:.2} m",
+                    p.od_id, p.road_id
+                ),
+            ));
+        }
+        ss.push(s);
+        centre.push([f64::from(c.x), -f64::from(c.y)]);
+        width.push(w.max(0.0));
+    }
+    Ok((ss, centre, width))
+}
+
+/// Sets each baked lane's successors (`by_id`: baked lane index by the network's lane id):
+/// the drivable lanes it leads into.
+fn link_successors(
+    lanes: &mut [MapLane],
+    by_id: &BTreeMap<usize, usize>,
+    net: &xodr::RoadNetwork,
+    provenance: &xodr::Provenance,
+) {
     for p in &provenance.lanes {
         let (Some(&k), Some(lane)) = (by_id.get(&p.lane.0), net.lane(p.lane)) else {
             continue;
@@ -692,13 +741,4 @@ fn bake(
             .filter(|&n| lanes[n].drivable)
             .collect();
     }
-    if !lanes.iter().any(|l| l.drivable) {
-        return Err(r.error(None, "the map has no driving lane".into()));
-    }
-    Ok(RoadMap {
-        source: r.file.to_owned(),
-        origin_m: [0.0, 0.0],
-        roads,
-        lanes,
-    })
 }

@@ -165,164 +165,194 @@ impl Reader<'_> {
 /// element and its line and column.
 pub(super) fn check(r: &Reader, root: Node) -> Result<(), MapError> {
     for n in root.descendants().filter(Node::is_element) {
-        let name = n.tag_name().name();
-        if let Some(missing) = required(name).iter().find(|a| n.attribute(**a).is_none()) {
-            let road = n
-                .ancestors()
-                .find(|a| a.has_tag_name("road"))
-                .and_then(|a| a.attribute("id"))
-                .map(|id| format!(" of road \"{id}\""))
-                .unwrap_or_default();
-            return Err(r.error(
-                Some(n),
-                format!("<{name}>{road} has no `{missing}`, which OpenDRIVE requires"),
-            ));
-        }
-        if name == "lane"
-            && n.attribute("id").is_some_and(|id| id.trim() != "0")
-            && !n
-                .children()
-                .any(|c| c.has_tag_name("width") || c.has_tag_name("border"))
-        {
-            return Err(r.error(
-                Some(n),
-                format!(
-                    "lane {} of road \"{}\" has no <width> (nor <border>): it has no extent",
-                    n.attribute("id").unwrap_or("?"),
-                    road_id(n)
-                ),
-            ));
-        }
-        for &(attr, rule) in rules(n) {
-            let Some(text) = n.attribute(attr) else {
-                continue;
-            };
-            if let Err(why) = judge(text.trim(), rule) {
-                let road = n
-                    .ancestors()
-                    .find(|a| a.has_tag_name("road"))
-                    .and_then(|a| a.attribute("id"))
-                    .map(|id| format!(" of road \"{id}\""))
-                    .unwrap_or_default();
-                return Err(r.at_attribute(
-                    n,
-                    attr,
-                    format!("<{name} {attr}=\"{text}\">{road}: {why}"),
-                ));
-            }
-        }
-        if name == "geometry" {
-            let records: Vec<Node> = n.children().filter(Node::is_element).collect();
-            if records.len() != 1 {
-                return Err(r.error(
-                    Some(n),
-                    format!(
-                        "<geometry s=\"{}\"> of road \"{}\" holds {} records; it holds exactly one of <line>, <arc>, <spiral>, <poly3>, <paramPoly3>",
-                        n.attribute("s").unwrap_or("?"),
-                        road_id(n),
-                        records.len()
-                    ),
-                ));
-            }
-        }
-        if name == "laneSection" {
-            for side in n
-                .children()
-                .filter(|c| c.has_tag_name("left") || c.has_tag_name("right"))
-            {
-                let count = side.children().filter(|c| c.has_tag_name("lane")).count();
-                if count as i64 > MAX_LANES_PER_SIDE {
-                    return Err(r.error(
-                        Some(side),
-                        format!(
-                            "<{}> of the section at s = {} of road \"{}\" has {count} lanes; a side has at most {MAX_LANES_PER_SIDE}",
-                            side.tag_name().name(),
-                            n.attribute("s").unwrap_or("?"),
-                            road_id(n)
-                        ),
-                    ));
-                }
-            }
-            let lanes: Vec<Node> = n.descendants().filter(|c| c.has_tag_name("lane")).collect();
-            let place = format!(
-                " in the section at s = {} of road \"{}\"",
-                n.attribute("s").unwrap_or("?"),
-                road_id(n)
-            );
-            unique(r, &lanes, "id", "lane id", &place)?;
-        }
-        if name == "planView" && !n.children().any(|c| c.has_tag_name("geometry")) {
-            return Err(r.error(
-                Some(n),
-                format!(
-                    "<planView> of road \"{}\" has no <geometry>: the road has no reference line",
-                    road_id(n)
-                ),
-            ));
-        }
-        if name == "junction" {
-            let connections: Vec<Node> = n
-                .children()
-                .filter(|c| c.has_tag_name("connection"))
-                .collect();
-            unique(
-                r,
-                &connections,
-                "id",
-                "connection id",
-                &format!(" in junction \"{}\"", n.attribute("id").unwrap_or("?")),
-            )?;
-        }
+        check_values(r, n)?;
+        check_children(r, n)?;
     }
     let roads: Vec<Node> = root.children().filter(|c| c.has_tag_name("road")).collect();
     unique(r, &roads, "id", "road id", "")?;
     for road in &roads {
-        let sections: Vec<Node> = road
-            .children()
-            .filter(|c| c.has_tag_name("lanes"))
-            .flat_map(|l| l.children().filter(|c| c.has_tag_name("laneSection")))
-            .collect();
-        if sections.is_empty() {
-            return Err(r.error(
-                Some(*road),
-                format!(
-                    "<road id=\"{}\"> has no <lanes> with a <laneSection>: it has no lane",
-                    road_id(*road)
-                ),
-            ));
-        }
-        let lanes = sections
-            .iter()
-            .flat_map(|s| s.descendants())
-            .filter(|c| {
-                c.has_tag_name("lane") && c.attribute("id").is_some_and(|id| id.trim() != "0")
-            })
-            .count();
-        if lanes == 0 {
-            return Err(r.error(
-                Some(*road),
-                format!(
-                    "<road id=\"{}\"> has no lane besides its centre lane 0",
-                    road_id(*road)
-                ),
-            ));
-        }
-        if !road.children().any(|c| c.has_tag_name("planView")) {
-            return Err(r.error(
-                Some(*road),
-                format!(
-                    "<road id=\"{}\"> has no <planView>: the road has no reference line",
-                    road_id(*road)
-                ),
-            ));
-        }
-        check_stations(r, *road)?;
+        check_road(r, *road)?;
     }
     let junctions: Vec<Node> = root
         .children()
         .filter(|c| c.has_tag_name("junction"))
         .collect();
     unique(r, &junctions, "id", "junction id", "")?;
+    Ok(())
+}
+
+/// Checks element `n`'s own attributes: those OpenDRIVE requires are there, a lane has a
+/// width, and each numeric attribute is in its range ([`judge`]).
+///
+/// # Errors
+/// The first missing or out-of-range attribute, naming the element and its line and column.
+fn check_values(r: &Reader, n: Node) -> Result<(), MapError> {
+    let name = n.tag_name().name();
+    if let Some(missing) = required(name).iter().find(|a| n.attribute(**a).is_none()) {
+        let road = n
+            .ancestors()
+            .find(|a| a.has_tag_name("road"))
+            .and_then(|a| a.attribute("id"))
+            .map(|id| format!(" of road \"{id}\""))
+            .unwrap_or_default();
+        return Err(r.error(
+            Some(n),
+            format!("<{name}>{road} has no `{missing}`, which OpenDRIVE requires"),
+        ));
+    }
+    if name == "lane"
+        && n.attribute("id").is_some_and(|id| id.trim() != "0")
+        && !n
+            .children()
+            .any(|c| c.has_tag_name("width") || c.has_tag_name("border"))
+    {
+        return Err(r.error(
+            Some(n),
+            format!(
+                "lane {} of road \"{}\" has no <width> (nor <border>): it has no extent",
+                n.attribute("id").unwrap_or("?"),
+                road_id(n)
+            ),
+        ));
+    }
+    for &(attr, rule) in rules(n) {
+        let Some(text) = n.attribute(attr) else {
+            continue;
+        };
+        if let Err(why) = judge(text.trim(), rule) {
+            let road = n
+                .ancestors()
+                .find(|a| a.has_tag_name("road"))
+                .and_then(|a| a.attribute("id"))
+                .map(|id| format!(" of road \"{id}\""))
+                .unwrap_or_default();
+            return Err(r.at_attribute(
+                n,
+                attr,
+                format!("<{name} {attr}=\"{text}\">{road}: {why}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks what element `n` holds: a `<geometry>` one record, a `<laneSection>` at most
+/// [`MAX_LANES_PER_SIDE`] lanes a side with unique ids, a `<planView>` a geometry, a
+/// `<junction>` connections with unique ids.
+///
+/// # Errors
+/// The first problem, naming the element and its line and column.
+fn check_children(r: &Reader, n: Node) -> Result<(), MapError> {
+    let name = n.tag_name().name();
+    if name == "geometry" {
+        let records: Vec<Node> = n.children().filter(Node::is_element).collect();
+        if records.len() != 1 {
+            return Err(r.error(
+                Some(n),
+                format!(
+                    "<geometry s=\"{}\"> of road \"{}\" holds {} records; it holds exactly one of <line>, <arc>, <spiral>, <poly3>, <paramPoly3>",
+                    n.attribute("s").unwrap_or("?"),
+                    road_id(n),
+                    records.len()
+                ),
+            ));
+        }
+    }
+    if name == "laneSection" {
+        for side in n
+            .children()
+            .filter(|c| c.has_tag_name("left") || c.has_tag_name("right"))
+        {
+            let count = side.children().filter(|c| c.has_tag_name("lane")).count();
+            if count as i64 > MAX_LANES_PER_SIDE {
+                return Err(r.error(
+                    Some(side),
+                    format!(
+                        "<{}> of the section at s = {} of road \"{}\" has {count} lanes; a side has at most {MAX_LANES_PER_SIDE}",
+                        side.tag_name().name(),
+                        n.attribute("s").unwrap_or("?"),
+                        road_id(n)
+                    ),
+                ));
+            }
+        }
+        let lanes: Vec<Node> = n.descendants().filter(|c| c.has_tag_name("lane")).collect();
+        let place = format!(
+            " in the section at s = {} of road \"{}\"",
+            n.attribute("s").unwrap_or("?"),
+            road_id(n)
+        );
+        unique(r, &lanes, "id", "lane id", &place)?;
+    }
+    if name == "planView" && !n.children().any(|c| c.has_tag_name("geometry")) {
+        return Err(r.error(
+            Some(n),
+            format!(
+                "<planView> of road \"{}\" has no <geometry>: the road has no reference line",
+                road_id(n)
+            ),
+        ));
+    }
+    if name == "junction" {
+        let connections: Vec<Node> = n
+            .children()
+            .filter(|c| c.has_tag_name("connection"))
+            .collect();
+        unique(
+            r,
+            &connections,
+            "id",
+            "connection id",
+            &format!(" in junction \"{}\"", n.attribute("id").unwrap_or("?")),
+        )?;
+    }
+    Ok(())
+}
+
+/// Checks `<road>` `road`: it has a lane section with a lane besides the centre lane, a
+/// `<planView>`, and no record starting past its end ([`check_stations`]).
+///
+/// # Errors
+/// The first problem, naming the road and its line and column.
+fn check_road(r: &Reader, road: Node) -> Result<(), MapError> {
+    let sections: Vec<Node> = road
+        .children()
+        .filter(|c| c.has_tag_name("lanes"))
+        .flat_map(|l| l.children().filter(|c| c.has_tag_name("laneSection")))
+        .collect();
+    if sections.is_empty() {
+        return Err(r.error(
+            Some(road),
+            format!(
+                "<road id=\"{}\"> has no <lanes> with a <laneSection>: it has no lane",
+                road_id(road)
+            ),
+        ));
+    }
+    let lanes = sections
+        .iter()
+        .flat_map(|s| s.descendants())
+        .filter(|c| c.has_tag_name("lane") && c.attribute("id").is_some_and(|id| id.trim() != "0"))
+        .count();
+    if lanes == 0 {
+        return Err(r.error(
+            Some(road),
+            format!(
+                "<road id=\"{}\"> has no lane besides its centre lane 0",
+                road_id(road)
+            ),
+        ));
+    }
+    if !road.children().any(|c| c.has_tag_name("planView")) {
+        return Err(r.error(
+            Some(road),
+            format!(
+                "<road id=\"{}\"> has no <planView>: the road has no reference line",
+                road_id(road)
+            ),
+        ));
+    }
+    check_stations(r, road)?;
     Ok(())
 }
 
@@ -450,34 +480,61 @@ fn unique(r: &Reader, nodes: &[Node], attr: &str, what: &str, place: &str) -> Re
     Ok(())
 }
 
+/// How an attribute's text breaks its [`Rule`].
+#[derive(Debug, thiserror::Error, Clone, Copy, PartialEq)]
+enum Broken {
+    /// A lane id that is not a whole number.
+    #[error("a lane id is a whole number")]
+    LaneIdNotWhole,
+    /// A lane id farther than [`MAX_LANES_PER_SIDE`] from the centre lane.
+    #[error(
+        "a lane id is at most {MAX_LANES_PER_SIDE} from the centre lane 0 (a section has at most {MAX_LANES_PER_SIDE} lanes a side)"
+    )]
+    LaneIdTooFar,
+    /// Text that is not a number.
+    #[error("not a number")]
+    NotANumber,
+    /// A number that is not finite.
+    #[error("not finite")]
+    NotFinite,
+    /// A number outside `[lo, hi]` (`(lo, hi]` when `open_lo`), in `unit`.
+    #[error("out of range: it must lie in {}{lo}, {hi}] {unit}", if *.open_lo { "(" } else { "[" })]
+    OutOfRange {
+        lo: f64,
+        hi: f64,
+        open_lo: bool,
+        unit: &'static str,
+    },
+}
+
 /// Why `text` breaks `rule`, if it does.
-fn judge(text: &str, rule: Rule) -> Result<(), String> {
+fn judge(text: &str, rule: Rule) -> Result<(), Broken> {
     if let Rule::LaneId = rule {
         let Ok(id) = text.parse::<i64>() else {
-            return Err("a lane id is a whole number".into());
+            return Err(Broken::LaneIdNotWhole);
         };
         if id.abs() > MAX_LANES_PER_SIDE {
-            return Err(format!(
-                "a lane id is at most {MAX_LANES_PER_SIDE} from the centre lane 0 (a section has at most {MAX_LANES_PER_SIDE} lanes a side)"
-            ));
+            return Err(Broken::LaneIdTooFar);
         }
         return Ok(());
     }
     let Ok(v) = text.parse::<f64>() else {
-        return Err("not a number".into());
+        return Err(Broken::NotANumber);
     };
     if !v.is_finite() {
-        return Err("not finite".into());
+        return Err(Broken::NotFinite);
     }
-    let within = |lo: f64, hi: f64, open_lo: bool, unit: &str| {
+    let within = |lo: f64, hi: f64, open_lo: bool, unit: &'static str| {
         let low_ok = if open_lo { v > lo } else { v >= lo };
         if low_ok && v <= hi {
             Ok(())
         } else {
-            Err(format!(
-                "out of range: it must lie in {}{lo}, {hi}] {unit}",
-                if open_lo { "(" } else { "[" }
-            ))
+            Err(Broken::OutOfRange {
+                lo,
+                hi,
+                open_lo,
+                unit,
+            })
         }
     };
     match rule {

@@ -30,6 +30,10 @@ const SELF_GAP_M: f64 = 30.0;
 /// The most crossings named one by one; the rest are counted.
 const NAMED: usize = 5;
 
+/// Pairs of roads `(smaller, larger)` whose lanes lie on each other: the first point found
+/// (world `[x, z]`, m) and how many stations did.
+type Crossings = BTreeMap<(usize, usize), ([f64; 2], usize)>;
+
 /// A lane's segment: `(lane, station index)`.
 type Segment = GeomWithData<Line<[f64; 2]>, (usize, usize)>;
 
@@ -38,72 +42,14 @@ type Segment = GeomWithData<Line<[f64; 2]>, (usize, usize)>;
 /// # Errors
 /// A flat road whose lanes lie on themselves, naming the road, its line and the point.
 pub(super) fn check(r: &Reader, map: &RoadMap) -> Result<Vec<String>, MapError> {
-    let judged = |l: usize| {
-        let lane = &map.lanes[l];
-        lane.drivable && map.roads[lane.road].junction.is_none()
-    };
-    let mut segments = Vec::new();
-    let mut widest: f64 = 0.0;
-    for (l, lane) in map.lanes.iter().enumerate() {
-        if !judged(l) {
-            continue;
-        }
-        for i in 0..lane.centre.len() - 1 {
-            segments.push(Segment::new(
-                Line::new(lane.centre[i], lane.centre[i + 1]),
-                (l, i),
-            ));
-            widest = widest.max(lane.width[i]);
-        }
-    }
+    let (segments, widest) = segments(map);
     if segments.is_empty() {
         return Ok(Vec::new());
     }
     let tree = RTree::bulk_load(segments);
     let links = linked(map);
     let reach = widest / 2.0;
-    // (road, road) -> (point, count); the first point found.
-    let mut crossings: BTreeMap<(usize, usize), ([f64; 2], usize)> = BTreeMap::new();
-    let mut folds: BTreeSet<usize> = BTreeSet::new();
-    for (l, lane) in map.lanes.iter().enumerate() {
-        if !judged(l) {
-            continue;
-        }
-        let (first, last) = lane.s_range();
-        let mut next_s = f64::NEG_INFINITY;
-        for (i, p) in lane.centre.iter().enumerate() {
-            let s = lane.s[i];
-            if s < next_s || s - first < END_MARGIN_M || last - s < END_MARGIN_M {
-                continue;
-            }
-            next_s = s + 1.0;
-            for seg in tree.locate_within_distance(*p, reach * reach) {
-                let (m, j) = seg.data;
-                let other = &map.lanes[m];
-                let (o_first, o_last) = other.s_range();
-                let t = other.s[j];
-                if t - o_first < END_MARGIN_M || o_last - other.s[j + 1] < END_MARGIN_M {
-                    continue;
-                }
-                let half = other.width[j].min(other.width[j + 1]) / 2.0;
-                if seg.geom().distance_2(p).sqrt() > half - INSIDE_MARGIN_M {
-                    continue;
-                }
-                let (a, b) = (lane.road, other.road);
-                if a == b {
-                    if (s - t).abs() > SELF_GAP_M {
-                        folds.insert(a);
-                    }
-                    continue;
-                }
-                if links.contains(&(a.min(b), a.max(b))) {
-                    continue;
-                }
-                let e = crossings.entry((a.min(b), a.max(b))).or_insert((*p, 0));
-                e.1 += 1;
-            }
-        }
-    }
+    let (crossings, folds) = overlaps(map, &tree, &links, reach);
     let line = |road: usize| {
         r.road_node(&map.roads[road].od_id)
             .map(|n| r.line(n).to_string())
@@ -157,6 +103,88 @@ pub(super) fn check(r: &Reader, map: &RoadMap) -> Result<Vec<String>, MapError> 
         ));
     }
     Ok(warnings)
+}
+
+/// Whether lane `l` of `map` is checked: a driving lane outside any junction.
+fn judged(map: &RoadMap, l: usize) -> bool {
+    let lane = &map.lanes[l];
+    lane.drivable && map.roads[lane.road].junction.is_none()
+}
+
+/// The segments of every checked lane's centre line ([`judged`]), and the widest such lane's
+/// width, m.
+fn segments(map: &RoadMap) -> (Vec<Segment>, f64) {
+    let mut segments = Vec::new();
+    let mut widest: f64 = 0.0;
+    for (l, lane) in map.lanes.iter().enumerate() {
+        if !judged(map, l) {
+            continue;
+        }
+        for i in 0..lane.centre.len() - 1 {
+            segments.push(Segment::new(
+                Line::new(lane.centre[i], lane.centre[i + 1]),
+                (l, i),
+            ));
+            widest = widest.max(lane.width[i]);
+        }
+    }
+    (segments, widest)
+}
+
+/// Where the checked lanes lie on each other, from each lane's stations (one a metre, away
+/// from its ends) to the segments of `tree` within `reach` metres: the pairs of different
+/// roads `(smaller, larger)` not linked to each other (`links`), each with the first point
+/// found (world `[x, z]`, m) and how many were; and the roads that fold over themselves
+/// (their lanes lie on each other more than [`SELF_GAP_M`] apart along the road).
+fn overlaps(
+    map: &RoadMap,
+    tree: &RTree<Segment>,
+    links: &BTreeSet<(usize, usize)>,
+    reach: f64,
+) -> (Crossings, BTreeSet<usize>) {
+    // (road, road) -> (point, count); the first point found.
+    let mut crossings: Crossings = BTreeMap::new();
+    let mut folds: BTreeSet<usize> = BTreeSet::new();
+    for (l, lane) in map.lanes.iter().enumerate() {
+        if !judged(map, l) {
+            continue;
+        }
+        let (first, last) = lane.s_range();
+        let mut next_s = f64::NEG_INFINITY;
+        for (i, p) in lane.centre.iter().enumerate() {
+            let s = lane.s[i];
+            if s < next_s || s - first < END_MARGIN_M || last - s < END_MARGIN_M {
+                continue;
+            }
+            next_s = s + 1.0;
+            for seg in tree.locate_within_distance(*p, reach * reach) {
+                let (m, j) = seg.data;
+                let other = &map.lanes[m];
+                let (o_first, o_last) = other.s_range();
+                let t = other.s[j];
+                if t - o_first < END_MARGIN_M || o_last - other.s[j + 1] < END_MARGIN_M {
+                    continue;
+                }
+                let half = other.width[j].min(other.width[j + 1]) / 2.0;
+                if seg.geom().distance_2(p).sqrt() > half - INSIDE_MARGIN_M {
+                    continue;
+                }
+                let (a, b) = (lane.road, other.road);
+                if a == b {
+                    if (s - t).abs() > SELF_GAP_M {
+                        folds.insert(a);
+                    }
+                    continue;
+                }
+                if links.contains(&(a.min(b), a.max(b))) {
+                    continue;
+                }
+                let e = crossings.entry((a.min(b), a.max(b))).or_insert((*p, 0));
+                e.1 += 1;
+            }
+        }
+    }
+    (crossings, folds)
 }
 
 /// The pairs of roads `(smaller, larger)` where a lane of one leads into a lane of the other.

@@ -117,34 +117,7 @@ pub(super) fn grow(points: &[f64], d: usize, mut b: EmptyBox, axes: &[usize]) ->
 /// box corners for a proven upper bound (see [`super::dispersion`]).
 pub(super) fn bracket(points: &[f64], d: usize, options: &DispersionOptions) -> Bracket {
     let n = points.len() / d;
-    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let mut best = EmptyBox::unit(d);
-    let mut best_v = -1.0;
-    let mut axes: Vec<usize> = (0..d).collect();
-    for _ in 0..options.greedy_starts_per_dim * d {
-        let c: Vec<f64> = (0..d).map(|_| rng.random::<f64>()).collect();
-        axes.shuffle(&mut rng);
-        let start = EmptyBox {
-            lo: c.clone(),
-            hi: c,
-        };
-        let cand = grow(points, d, start, &axes);
-        let v = cand.volume();
-        if better(&cand, v, &best, best_v) {
-            best = cand;
-            best_v = v;
-        }
-    }
-
-    // The exact sweep, each walk cut short, usually finds the largest box or close to it.
-    if let Some(cand) = super::sweep::capped_lower_bound(points, d, 32) {
-        let v = cand.volume();
-        if better(&cand, v, &best, best_v) {
-            best = cand;
-            best_v = v;
-        }
-    }
-
+    let (mut best, mut best_v) = lower_bound(points, d, options);
     let mut heap = BinaryHeap::new();
     heap.push(Region {
         a: vec![0.0; d],
@@ -185,20 +158,72 @@ pub(super) fn bracket(points: &[f64], d: usize, options: &DispersionOptions) -> 
                 best_v = v;
             }
         }
-        // Split the widest corner interval at its middle.
-        let (mut axis, mut upper_face, mut width) = (0, false, -1.0);
-        for k in 0..d {
-            if r.b[k] - r.a[k] > width {
-                (axis, upper_face, width) = (k, false, r.b[k] - r.a[k]);
+        for child in split(&r, points, d) {
+            if child.bound <= best_v {
+                continue;
             }
-            if r.e[k] - r.c[k] > width {
-                (axis, upper_face, width) = (k, true, r.e[k] - r.c[k]);
-            }
+            heap.push(child);
         }
-        if width <= 0.0 {
-            continue; // a single box, already handled above
+    }
+    let upper = heap.peek().map_or(best_v, |r| r.bound.max(best_v));
+    Bracket {
+        witness: best,
+        upper,
+        regions,
+    }
+}
+
+/// The largest empty box found by greedy growth from random starts (seeded by
+/// `options.seed`), and by the exact sweep cut short, with its volume.
+fn lower_bound(points: &[f64], d: usize, options: &DispersionOptions) -> (EmptyBox, f64) {
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let mut best = EmptyBox::unit(d);
+    let mut best_v = -1.0;
+    let mut axes: Vec<usize> = (0..d).collect();
+    for _ in 0..options.greedy_starts_per_dim * d {
+        let c: Vec<f64> = (0..d).map(|_| rng.random::<f64>()).collect();
+        axes.shuffle(&mut rng);
+        let start = EmptyBox {
+            lo: c.clone(),
+            hi: c,
+        };
+        let cand = grow(points, d, start, &axes);
+        let v = cand.volume();
+        if better(&cand, v, &best, best_v) {
+            best = cand;
+            best_v = v;
         }
-        for half in 0..2 {
+    }
+
+    // The exact sweep, each walk cut short, usually finds the largest box or close to it.
+    if let Some(cand) = super::sweep::capped_lower_bound(points, d, 32) {
+        let v = cand.volume();
+        if better(&cand, v, &best, best_v) {
+            best = cand;
+            best_v = v;
+        }
+    }
+    (best, best_v)
+}
+
+/// The two halves of region `r` split at the middle of its widest corner interval, each with
+/// its points and bound; none when every interval is a point (a single box).
+fn split(r: &Region, points: &[f64], d: usize) -> Vec<Region> {
+    let (mut axis, mut upper_face, mut width) = (0, false, -1.0);
+    for k in 0..d {
+        if r.b[k] - r.a[k] > width {
+            (axis, upper_face, width) = (k, false, r.b[k] - r.a[k]);
+        }
+        if r.e[k] - r.c[k] > width {
+            (axis, upper_face, width) = (k, true, r.e[k] - r.c[k]);
+        }
+    }
+    if width <= 0.0 {
+        return Vec::new(); // a single box, already handled by the caller
+    }
+    let pt = |i: u32| &points[i as usize * d..(i as usize + 1) * d];
+    (0..2)
+        .map(|half| {
             let mut child = Region {
                 a: r.a.clone(),
                 b: r.b.clone(),
@@ -232,16 +257,7 @@ pub(super) fn bracket(points: &[f64], d: usize, options: &DispersionOptions) -> 
                 })
                 .collect();
             child.bound = region_bound(&child, points, d);
-            if child.bound <= best_v {
-                continue;
-            }
-            heap.push(child);
-        }
-    }
-    let upper = heap.peek().map_or(best_v, |r| r.bound.max(best_v));
-    Bracket {
-        witness: best,
-        upper,
-        regions,
-    }
+            child
+        })
+        .collect()
 }

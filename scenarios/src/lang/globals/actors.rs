@@ -15,7 +15,7 @@ use starlark::values::list::UnpackList;
 use starlark::values::{UnpackValue, Value, ValueLike};
 
 use crate::lang::position::Loc;
-use crate::lang::scene::{turns, ObjectDecl, PedTrigger, Pending, SceneBuilder};
+use crate::lang::scene::{turns, ObjectDecl, PedTrigger, Pending, PendingCar, SceneBuilder};
 use crate::lang::types;
 use crate::lang::values::{ActorVal, ChangeStart, LaneChangeVal, ObstacleVal, Stream};
 
@@ -245,7 +245,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             },
         ))
     }
+}
 
+/// The builtins of this topic, continued.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register_cars(builder: &mut GlobalsBuilder) {
     /// `Car(loc=, speed=10.0, route=[], color="red", enabled=True, lane_change=None,
     /// keep_distance=None)`: an NPC car that follows the lane graph, may change lanes once
     /// (`ChangeLane`), stops against whatever it meets, and with `keep_distance` (m, `>= 0`)
@@ -320,7 +325,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             &mut b,
             "Car",
             car,
-            Pending::Car {
+            Pending::Car(PendingCar {
                 loc,
                 route,
                 speed,
@@ -328,10 +333,15 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 enabled,
                 lane_change,
                 keep_distance_m,
-            },
+            }),
         ))
     }
+}
 
+/// The builtins of this topic, continued.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register_lane_changes_and_obstacles(builder: &mut GlobalsBuilder) {
     /// `ChangeLane(to=, at=None, when=None, duration=3.0)`: a lane change for
     /// `Car(lane_change=)`: to lane `to` of the car's segment, starting `at` seconds into the
     /// test or at the first event of the stream `when`, over `duration` seconds.
@@ -448,7 +458,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             object: b.objects.len() - 1,
         })
     }
+}
 
+/// The builtins of this topic, continued.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register_pedestrians(builder: &mut GlobalsBuilder) {
     /// `Pedestrian(start=, target=, speed=, dist=None, car=None, trigger=None)`: walks from
     /// `start` to `target` once `car` comes within `dist` metres of `start` (or once
     /// `trigger` fires).

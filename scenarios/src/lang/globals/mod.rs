@@ -256,9 +256,17 @@ pub(crate) fn text_value(v: Value, b: &SceneBuilder) -> Option<String> {
 /// The builtins, by topic (LANGUAGE.md documents each).
 pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
     streams::register(builder);
+    streams::register_levels(builder);
     math::register(builder);
     roads::register(builder);
+    roads::register_curves_and_maps(builder);
+    roads::register_junctions(builder);
     actors::register(builder);
+    actors::register_cars(builder);
+    actors::register_lane_changes_and_obstacles(builder);
+    actors::register_pedestrians(builder);
     monitors::register(builder);
+    monitors::register_stream_monitors(builder);
+    monitors::register_time_to_failure(builder);
     settings::register(builder);
 }

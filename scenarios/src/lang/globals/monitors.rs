@@ -250,10 +250,10 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                         (Rx::Bool(false), Some(d)) => Ok(Rx::Num(d)),
                         _ => Err("expected (collided, separation)".into()),
                     },
-                    v => Err(format!(
+                    v => Err(paracosm_engine::rx::NativeError(format!(
                         "expected a (collided, separation) pair, got a {}",
                         v.kind()
-                    )),
+                    ))),
                 }),
             });
             let signal = format!("monitor:{name}");
@@ -314,7 +314,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             },
         )
     }
+}
 
+/// The builtins of this topic, continued.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register_stream_monitors(builder: &mut GlobalsBuilder) {
     /// `Stl(formula, name="stl")`: a signal temporal logic property over the runner's
     /// signals ([`crate::signal::ALL`]), judged at the start of the test; robustness in the
     /// formula's units. The formula is parsed when the program loads: a syntax error shows a
@@ -418,7 +423,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         b.signals_at.push((name.to_owned(), here(eval)));
         Ok(NoneType)
     }
+}
 
+/// The builtins of this topic, continued.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register_time_to_failure(builder: &mut GlobalsBuilder) {
     /// `TimeToFailure(m, minT=0.0)`: wraps monitor `m`; reports the time of its first
     /// violation and fails when it comes before `minT` seconds (`minT >= 0`, finite, or an
     /// error).

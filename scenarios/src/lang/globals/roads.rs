@@ -339,7 +339,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             })
         })
     }
+}
 
+/// The builtins of this topic, continued.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register_curves_and_maps(builder: &mut GlobalsBuilder) {
     /// `Clothoid(length=50.0, curv_start=0.0, curv_end=0.02, nlanes=2, friction=0.8)`: a
     /// road whose curvature (1/m, positive to the left) changes linearly along its `length`
     /// (m), the transition between a straight and a bend.
@@ -399,7 +404,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         let road = add_piece(eval, "OpenDrive", kind, stream)?;
         Ok(Road { map: true, ..road })
     }
+}
 
+/// The builtins of this topic, continued.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register_junctions(builder: &mut GlobalsBuilder) {
     /// `TIntersection(nlanes=2, friction=0.8)`; `numLane=` is the paper's spelling.
     fn TIntersection<'v>(
         #[starlark(require = named)] nlanes: Option<Value<'v>>,

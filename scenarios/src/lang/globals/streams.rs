@@ -2,6 +2,7 @@
 
 //! Open parameters and streams: `tick`, `Const`, `VarInterval`, `VarEnum`, `Piecewise`, `Polynomial` (paper §2, "A Family of Worlds"; §3.3).
 
+use crate::lang::scene::Seen;
 use anyhow::{anyhow, bail};
 use paracosm_engine::rx::{Node, Value as Rx};
 use paracosm_generators::{Domain, Value as Level};
@@ -98,17 +99,13 @@ pub(super) fn declare_param<'v>(
     }
     let heap = eval.heap();
     let st = state(eval)?;
-    let got = st
-        .scene
-        .borrow_mut()
-        .param(decl)
-        .map_err(anyhow::Error::msg)?;
-    Ok(match got {
-        Ok(Level::Int(i)) => heap.alloc(i),
-        Ok(Level::Real(x)) => heap.alloc(x),
-        Ok(Level::Bool(b)) => Value::new_bool(b),
-        Ok(Level::Text(t)) => heap.alloc(t.as_str()),
-        Err(id) => heap.alloc(Stream::of(id.0)),
+    let seen = st.scene.borrow_mut().param(decl);
+    Ok(match seen {
+        Seen::Level(Level::Int(i)) => heap.alloc(i),
+        Seen::Level(Level::Real(x)) => heap.alloc(x),
+        Seen::Level(Level::Bool(b)) => Value::new_bool(b),
+        Seen::Level(Level::Text(t)) => heap.alloc(t.as_str()),
+        Seen::Stream(id) => heap.alloc(Stream::of(id.0)),
     })
 }
 
@@ -188,7 +185,12 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             },
         )
     }
+}
 
+/// The builtins of this topic, continued.
+#[starlark_module]
+#[allow(non_snake_case)]
+pub(super) fn register_levels(builder: &mut GlobalsBuilder) {
     /// `VarEnum([levels...], name=None)`: an open discrete parameter: the test's level.
     fn VarEnum<'v>(
         levels: Value<'v>,

@@ -4,6 +4,10 @@
 //! parameters, to check its worlds over the levels and corners of its parameters, and to find
 //! which inputs each parameter changes.
 
+mod load;
+
+use super::load_error::{LoadError, LoadErrorKind};
+pub use load::load;
 use std::io::Write;
 use std::sync::Arc;
 
@@ -98,20 +102,26 @@ pub struct Program {
     base_worlds: std::sync::Mutex<std::collections::BTreeMap<usize, Option<(Arc<WorldSpec>, u64)>>>,
 }
 
-fn lambda_values<'v>(b: &SceneBuilder, module: &Module<'v>) -> Result<Vec<Value<'v>>, String> {
+fn lambda_values<'v>(b: &SceneBuilder, module: &Module<'v>) -> Result<Vec<Value<'v>>, LoadError> {
     (0..b.lambdas)
         .map(|n| {
-            module
-                .get(&super::lambda_name(n))
-                .ok_or_else(|| format!("lambda {n} is missing from the program's module"))
+            module.get(&super::lambda_name(n)).ok_or_else(|| {
+                LoadError::new(
+                    LoadErrorKind::Evaluation,
+                    format!("lambda {n} is missing from the program's module"),
+                )
+            })
         })
         .collect()
 }
 
 /// Checks what every evaluation must have declared once the program has run; the error is
 /// the whole message, pointing at the declaration at fault, else at `file`.
-fn finished(b: &SceneBuilder, file: &str) -> Result<(), String> {
-    finished_message(b).map_err(|(m, at)| format!("error: {m}\n --> {}", at.unwrap_or(file)))
+fn finished(b: &SceneBuilder, file: &str) -> Result<(), LoadError> {
+    finished_message(b).map_err(|(m, at)| {
+        let message = format!("error: {m}\n --> {}", at.unwrap_or(file));
+        LoadError::new(LoadErrorKind::Declarations, message)
+    })
 }
 
 /// What [`finished`] finds wrong, and where, when one declaration is at fault.
@@ -148,7 +158,7 @@ fn finished_message(b: &SceneBuilder) -> Result<(), (String, Option<&str>)> {
 /// test's horizon ([`paracosm_oracles::stl::Formula::windows_after`]): no frame of a test is
 /// in it, so its verdict is the same in every test (an `F` always fails, a `G` always
 /// passes on it).
-fn windows_within_horizon(b: &SceneBuilder, horizon_s: f64) -> Result<(), String> {
+fn windows_within_horizon(b: &SceneBuilder, horizon_s: f64) -> Result<(), LoadError> {
     for (m, at) in b.monitors.iter().zip(&b.monitors_at) {
         let mut spec = m;
         while let MonitorSpec::TimeToFailure { inner, .. } = spec {
@@ -165,11 +175,14 @@ fn windows_within_horizon(b: &SceneBuilder, horizon_s: f64) -> Result<(), String
                 'G' => "it can never fail (nothing to check)",
                 _ => "it can never be satisfied, and fails every test",
             };
-            return Err(format!(
-                "error: Stl monitor `{name}`: the window {op}[{lo},{hi}] starts at {start} s, \
+            return Err(LoadError::new(
+                LoadErrorKind::Declarations,
+                format!(
+                    "error: Stl monitor `{name}`: the window {op}[{lo},{hi}] starts at {start} s, \
                  after the test's horizon of {horizon_s} s: no frame of a test falls in it, so \
                  {verdict}; make the horizon longer (test(horizon = ...)) or the window \
                  earlier\n --> {at}"
+                ),
             ));
         }
     }
@@ -180,7 +193,7 @@ fn windows_within_horizon(b: &SceneBuilder, horizon_s: f64) -> Result<(), String
 /// `foreach(p.walk)`, or two `foreach(p.walk)`): each walks it when it fires, and a
 /// pedestrian takes one walking step per step, so one of the two would only change when it
 /// walks, without a word.
-fn one_walker_each(b: &SceneBuilder) -> Result<(), String> {
+fn one_walker_each(b: &SceneBuilder) -> Result<(), LoadError> {
     use paracosm_engine::behaviour::{Action, ActorRef};
     let mut walkers: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
     let mut handles = std::collections::BTreeMap::new();
@@ -204,7 +217,9 @@ fn one_walker_each(b: &SceneBuilder) -> Result<(), String> {
             .find(|o| o.actor == handles.get(&p).map(|&h| ActorRef::Pedestrian(h)))
             .map_or_else(|| format!("pedestrian {p}"), |o| o.name.clone());
         let site = |n: usize| b.graph.site(n).unwrap_or("?").to_owned();
-        return Err(format!(
+        return Err(LoadError::new(
+            LoadErrorKind::Declarations,
+            format!(
             "error: {name} is walked by two behaviours, at {} and at {}: a pedestrian takes one \
              walking step per step, so the second would change only when it walks; keep one \
              (a Pedestrian given dist= and car=, or trigger=, walks by itself: drop the \
@@ -212,6 +227,7 @@ fn one_walker_each(b: &SceneBuilder) -> Result<(), String> {
             site(first),
             site(second),
             site(second)
+        ),
         ));
     }
     Ok(())
@@ -224,8 +240,8 @@ impl Program {
     fn evaluate<R>(
         &self,
         values: Option<Vec<ParamValue>>,
-        then: impl FnOnce(SceneBuilder, &Module) -> Result<R, String>,
-    ) -> Result<R, String> {
+        then: impl FnOnce(SceneBuilder, &Module) -> Result<R, LoadError>,
+    ) -> Result<R, LoadError> {
         self.evaluate_counted(values, then).map(|(r, _)| r)
     }
 
@@ -233,8 +249,8 @@ impl Program {
     fn evaluate_counted<R>(
         &self,
         values: Option<Vec<ParamValue>>,
-        then: impl FnOnce(SceneBuilder, &Module) -> Result<R, String>,
-    ) -> Result<(R, u64), String> {
+        then: impl FnOnce(SceneBuilder, &Module) -> Result<R, LoadError>,
+    ) -> Result<(R, u64), LoadError> {
         let again = values.clone();
         Module::with_temp_heap(|module| {
             let state = LoadState::new(values, self.objects.clone(), self.maps.clone());
@@ -274,7 +290,7 @@ impl Program {
                     };
                     // The first evaluation: say which values it ran with.
                     let b = state.scene.borrow();
-                    if b.values.is_none() && !b.params.is_empty() {
+                    let message = if b.values.is_none() && !b.params.is_empty() {
                         let values: Vec<String> = b
                             .params
                             .iter()
@@ -299,7 +315,8 @@ impl Program {
                         )
                     } else {
                         message
-                    }
+                    };
+                    LoadError::new(LoadErrorKind::Evaluation, message)
                 })?;
                 steps = eval.get_total_tick_count();
             }
@@ -332,13 +349,13 @@ impl Program {
         &self,
         module: &Module<'v>,
         eval: &mut Evaluator<'v, '_, '_>,
-    ) -> Result<crate::memory::Budget<'_>, String> {
+    ) -> Result<crate::memory::Budget<'_>, LoadError> {
         for limit in [
             eval.set_max_tick_count(super::MAX_LOAD_STEPS),
             eval.set_max_heap_size(super::MAX_LOAD_HEAP_BYTES),
             eval.set_max_callstack_size(super::MAX_CALL_DEPTH),
         ] {
-            limit.map_err(|e| e.to_string())?;
+            limit.map_err(|e| LoadError::new(LoadErrorKind::Evaluation, e.to_string()))?;
         }
         // starlark checks its own heap every 1,000 steps; the budget also counts what one
         // statement allocates ([`crate::memory`]).
@@ -402,7 +419,7 @@ impl Program {
 
     /// Checks that the parameters an evaluation declared so far are the first ones the first
     /// evaluation declared, and no more.
-    fn same_params_so_far(&self, b: &SceneBuilder) -> Result<(), String> {
+    fn same_params_so_far(&self, b: &SceneBuilder) -> Result<(), LoadError> {
         for (k, d) in b.params.iter().enumerate() {
             match self.params.get(k) {
                 Some((_, decl)) if d == decl => {}
@@ -430,20 +447,26 @@ impl Program {
                     } else {
                         "another over_time or name for some values".to_owned()
                     };
-                    return Err(format!(
-                        "error: the open parameters depend on their values: `{name}` has \
+                    return Err(LoadError::new(
+                        LoadErrorKind::Worlds,
+                        format!(
+                            "error: the open parameters depend on their values: `{name}` has \
                          {differs}; its range, levels, unit and over_time must be the same in \
                          every test (compute with the value instead: `base + m`)\n --> {}",
-                        d.at
+                            d.at
+                        ),
                     ));
                 }
                 Some((name, decl)) => {
-                    return Err(format!(
+                    return Err(LoadError::new(
+                        LoadErrorKind::Worlds,
+                        format!(
                     "error: the open parameters depend on their values: parameter {k} is `{name}` \
                          (declared at {}) for some values and the one declared at {} for \
                          others\n --> {}",
                     decl.at, d.at, d.at
-                ))
+                ),
+                    ))
                 }
                 None => break,
             }
@@ -455,25 +478,25 @@ impl Program {
                 .or_else(|| self.syntax.site(&extra.at).and_then(|s| s.name.clone()))
                 .map(|n| format!("`{n}` "))
                 .unwrap_or_default();
-            return Err(format!(
+            return Err(LoadError::new(LoadErrorKind::Worlds, format!(
                 "error: the open parameters depend on their values: {name}(declared at {}) exists only \
                  for some values\n --> {}",
                 extra.at, extra.at
-            ));
+            )));
         }
         Ok(())
     }
 
     /// Checks that an evaluation declared what the first one did: the same open parameters,
     /// monitors, horizon and system under test.
-    fn consistent(&self, b: &SceneBuilder) -> Result<(), String> {
+    fn consistent(&self, b: &SceneBuilder) -> Result<(), LoadError> {
         self.same_params_so_far(b)?;
         if let Some((name, decl)) = self.params.get(b.params.len()) {
-            return Err(format!(
+            return Err(LoadError::new(LoadErrorKind::Worlds, format!(
                 "error: the open parameters depend on their values: `{name}` (declared at {}) is not \
                  declared for these values\n --> {}",
                 decl.at, decl.at
-            ));
+            )));
         }
         if b.monitors != self.monitors {
             // The first monitor that differs, or the first one missing or extra.
@@ -485,17 +508,20 @@ impl Program {
                 .get(k)
                 .map(|a| format!("\n --> {a}"))
                 .unwrap_or_else(|| format!("\n --> {}", self.file));
-            return Err(format!(
+            return Err(LoadError::new(LoadErrorKind::Worlds, format!(
                 "error: the monitors depend on the open parameters' values: declare the same monitors, \
                  with the same settings, for every test (a verdict must mean the same in every \
                  test of a campaign){at}"
-            ));
+            )));
         }
         if b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S) != self.horizon_s {
-            return Err(format!(
+            return Err(LoadError::new(
+                LoadErrorKind::Worlds,
+                format!(
                 "error: test(horizon=) depends on the open parameters' values: every test of a \
                  campaign has one length\n --> {}",
                 b.test_at.as_deref().unwrap_or(&self.file)
+            ),
             ));
         }
         if b.sut.as_ref() != Some(&self.sut) {
@@ -505,10 +531,10 @@ impl Program {
                 .find(|o| matches!(o.pending, super::scene::Pending::Ego { .. }))
                 .map(|o| o.at.clone())
                 .unwrap_or_else(|| self.file.clone());
-            return Err(format!(
+            return Err(LoadError::new(LoadErrorKind::Worlds, format!(
                 "error: AutonomousVehicle(sut=) depends on the open parameters' values: one system is \
                  under test in a campaign\n --> {at}"
-            ));
+            )));
         }
         Ok(())
     }
@@ -747,12 +773,12 @@ impl Program {
     }
 
     /// The world of one evaluation with `values`, checked for consistency.
-    fn world_for(&self, values: Vec<ParamValue>) -> Result<WorldSpec, String> {
+    fn world_for(&self, values: Vec<ParamValue>) -> Result<WorldSpec, LoadError> {
         self.world_counted(values).map(|(w, _)| w)
     }
 
     /// [`Program::world_for`], also returning the evaluation's step count.
-    fn world_counted(&self, values: Vec<ParamValue>) -> Result<(WorldSpec, u64), String> {
+    fn world_counted(&self, values: Vec<ParamValue>) -> Result<(WorldSpec, u64), LoadError> {
         let out = self.evaluate_counted(Some(values), |b, _| {
             self.consistent(&b)?;
             scene::world(&b, self.horizon_s)
@@ -794,7 +820,7 @@ impl Program {
         b: &SceneBuilder,
         module: &Module<'_>,
         horizon_s: f64,
-    ) -> Result<(), String> {
+    ) -> Result<(), LoadError> {
         {
             let spec = scene::world(b, horizon_s)?;
             // A world that does not build is reported elsewhere, by the test that builds it.
@@ -807,7 +833,9 @@ impl Program {
             let mut eval = Evaluator::new(module);
             eval.extra = Some(&test);
             eval.set_print_handler(&test);
-            limits.install(&mut eval).map_err(|e| e.to_string())?;
+            limits
+                .install(&mut eval)
+                .map_err(|e| LoadError::new(LoadErrorKind::Evaluation, e.to_string()))?;
             let mut host = StarHost::new(&mut eval, &functions, &limits, &self.file).at_load();
             match sim.check_streams(&mut host) {
                 Ok(samples) => judged_kinds(b, &samples),
@@ -828,7 +856,9 @@ impl Program {
                     if VALUE_ERRORS.iter().any(|v| lower.contains(v)) {
                         return Ok(());
                     }
-                    Err(format!(
+                    Err(LoadError::new(
+                        LoadErrorKind::Evaluation,
+                        format!(
                         "{message}{}\n(found when loading: every lambda and combinator is called \
                          once on sample values of its stream's type, those of the first test's \
                          world at t = 0)",
@@ -837,6 +867,7 @@ impl Program {
                         } else {
                             ""
                         }
+                    ),
                     ))
                 }
             }
@@ -860,15 +891,8 @@ const STREAM_IN_LAMBDA: &str = "\nhint: inside a lambda, a stream reads as its c
 fn judged_kinds(
     b: &SceneBuilder,
     samples: &[Option<paracosm_engine::rx::Value>],
-) -> Result<(), String> {
-    // The sample value of the stream published as `signal`, if it had one.
-    let sample_of = |signal: &str| {
-        b.published
-            .iter()
-            .find(|(name, _)| name == signal)
-            .and_then(|(_, id)| samples.get(id.0))
-            .and_then(Option::as_ref)
-    };
+) -> Result<(), LoadError> {
+    let sample_of = |signal: &str| sample_of(b, samples, signal);
     for (m, at) in b.monitors.iter().zip(&b.monitors_at) {
         let Some((name, signal, bools)) = m.judged_stream() else {
             continue;
@@ -876,14 +900,54 @@ fn judged_kinds(
         if let Some(why) =
             sample_of(signal).and_then(|v| crate::scenario::judged_kind_error(v, bools))
         {
-            return Err(format!(
+            return Err(LoadError::new(
+                LoadErrorKind::Declarations,
+                format!(
                 "error: monitor `{name}`: {why} (found when loading, from the sample value its \
                  stream gives in the first test's world at t = 0)\n --> {at}"
+            ),
             ));
         }
     }
-    // An action's argument from a lambda: its kind is known from the sample (a string given
-    // to setSpeed would otherwise end each test where it first fires, or never be noticed).
+    action_kinds(b, samples)?;
+    formula_kinds(b, samples)?;
+    for (name, at) in &b.signals_at {
+        use paracosm_engine::rx::Value;
+        if let Some(v @ (Value::Unit | Value::Tuple(_) | Value::Text(_))) = sample_of(name) {
+            return Err(LoadError::new(
+                LoadErrorKind::Declarations,
+                format!(
+                    "error: Signal `{name}` carried {}; a signal is a number, a bool or a vector \
+                 (found when loading, from the sample value its stream gives in the first \
+                 test's world at t = 0)\n --> {at}",
+                    paracosm_engine::rx::describe(v)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The sample value of the stream published as `signal`, if it had one.
+fn sample_of<'a>(
+    b: &SceneBuilder,
+    samples: &'a [Option<paracosm_engine::rx::Value>],
+    signal: &str,
+) -> Option<&'a paracosm_engine::rx::Value> {
+    b.published
+        .iter()
+        .find(|(name, _)| name == signal)
+        .and_then(|(_, id)| samples.get(id.0))
+        .and_then(Option::as_ref)
+}
+
+/// [`judged_kinds`] for the actions' arguments: an argument from a lambda has its kind from
+/// the sample (a string given to setSpeed would otherwise end each test where it first fires,
+/// or never be noticed).
+fn action_kinds(
+    b: &SceneBuilder,
+    samples: &[Option<paracosm_engine::rx::Value>],
+) -> Result<(), LoadError> {
     for (i, node) in b.graph.nodes().iter().enumerate() {
         use paracosm_engine::behaviour::Action;
         use paracosm_engine::rx::Value;
@@ -920,16 +984,27 @@ fn judged_kinds(
         };
         if !ok {
             let at = b.graph.site(i).unwrap_or("");
-            return Err(format!(
-                "error: {what} is given {} by its stream; it takes {wanted} (found when \
+            return Err(LoadError::new(
+                LoadErrorKind::Declarations,
+                format!(
+                    "error: {what} is given {} by its stream; it takes {wanted} (found when \
                  loading, from the sample value the stream gives in the first test's world at \
                  t = 0)\n --> {at}",
-                paracosm_engine::rx::describe(v)
+                    paracosm_engine::rx::describe(v)
+                ),
             ));
         }
     }
-    // A formula reads numbers: a vector Signal named whole, or a component of a number, is
-    // known from the sample where a lambda computes the stream.
+    Ok(())
+}
+
+/// [`judged_kinds`] for the signals formulas read: a vector Signal named whole, or a
+/// component of a number, is known from the sample where a lambda computes the stream.
+fn formula_kinds(
+    b: &SceneBuilder,
+    samples: &[Option<paracosm_engine::rx::Value>],
+) -> Result<(), LoadError> {
+    let sample_of = |signal: &str| sample_of(b, samples, signal);
     for (m, at) in b.monitors.iter().zip(&b.monitors_at) {
         use paracosm_engine::rx::Value;
         for s in m.signals() {
@@ -952,23 +1027,15 @@ fn judged_kinds(
                     ),
                     _ => continue,
                 };
-                return Err(format!(
-                    "error: {} reads the signal: {why} (found when loading, from the sample \
+                return Err(LoadError::new(
+                    LoadErrorKind::Declarations,
+                    format!(
+                        "error: {} reads the signal: {why} (found when loading, from the sample \
                      value its stream gives in the first test's world at t = 0)\n --> {at}",
-                    m.name()
+                        m.name()
+                    ),
                 ));
             }
-        }
-    }
-    for (name, at) in &b.signals_at {
-        use paracosm_engine::rx::Value;
-        if let Some(v @ (Value::Unit | Value::Tuple(_) | Value::Text(_))) = sample_of(name) {
-            return Err(format!(
-                "error: Signal `{name}` carried {}; a signal is a number, a bool or a vector \
-                 (found when loading, from the sample value its stream gives in the first \
-                 test's world at t = 0)\n --> {at}",
-                paracosm_engine::rx::describe(v)
-            ));
         }
     }
     Ok(())
@@ -991,558 +1058,18 @@ impl crate::Worlds for Program {
             let mut eval = Evaluator::new(module);
             eval.extra = Some(&test);
             eval.set_print_handler(&test);
-            limits.install(&mut eval).map_err(|e| e.to_string())?;
+            limits
+                .install(&mut eval)
+                .map_err(|e| LoadError::new(LoadErrorKind::Evaluation, e.to_string()))?;
             let mut host = StarHost::new(&mut eval, &functions, &limits, &self.file);
             run(&spec, &mut host);
             Ok(())
         })
-        .map_err(|m| {
-            ScenarioError::Language(format!("the program failed for this test's values: {m}"))
-        })
-    }
-}
-
-/// Loads a program: the first evaluation (representative values) declares the parameters,
-/// monitors and settings; then every combination of the parameters' levels and interval ends
-/// is evaluated and must build a valid world with the same declarations; then each
-/// parameter's other values show which inputs it changes (for warnings and coverage).
-///
-/// # Errors
-/// A diagnostic naming the file, line and column, and for a world that fails only for some
-/// values, those values.
-pub fn load(
-    file: &str,
-    source: &str,
-    name: &str,
-    ast: AstModule,
-    globals: Globals,
-    base: super::map_files::Base,
-) -> Result<Scenario, ScenarioError> {
-    let lang = ScenarioError::Language;
-    let syntax = Syntax::of(&ast, &super::builtins::taking_whole());
-    if let Some((at, call)) = syntax.dropped_actions().first() {
-        return Err(lang(format!(
-            "error: `{call}` on a line of its own does nothing: an action is performed by \
-             foreach, at the events of a stream (`tick.take(1).foreach({call})` performs it at \
-             t = 0; `tick.filter(lambda t: t > 5).take(1).foreach({call})` after 5 s)\n --> \
-             {file}:{at}"
-        )));
-    }
-    let mut program = Program {
-        objects: Arc::new(syntax.objects()),
-        syntax,
-        file: file.to_owned(),
-        ast,
-        globals,
-        params: Vec::new(),
-        monitors: Vec::new(),
-        horizon_s: super::DEFAULT_HORIZON_S,
-        sut: SutConfig::builtin("aeb").map_err(lang)?,
-        maps: Arc::new(super::map_files::MapFiles::new(base)),
-        load_output_shown: false.into(),
-        combinations: std::sync::OnceLock::new(),
-        load_steps: 0.into(),
-        base_worlds: Default::default(),
-    };
-    // The first world, and the streams its top-level variables hold: a lambda reads those by
-    // name (`lambda s: s > limit`), with no edge in the graph (host::StarHost's `captured`).
-    // The lambdas are checked on this same evaluation; the result is reported after the
-    // checks that come before it.
-    let (first, stream_variables, lambdas) = program
-        .evaluate(None, |b, module| {
-            let held: Vec<(String, usize)> = module
-                .names()
-                .filter_map(|name| {
-                    let v = module.get(name.as_str())?;
-                    let s = starlark::values::ValueLike::downcast_ref::<super::values::Stream>(v)?;
-                    Some((name.as_str().to_owned(), s.id))
-                })
-                .collect();
-            // After `held`: calling the lambdas sets the variables that hold streams to their
-            // sample values.
-            let horizon_s = b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
-            let lambdas = program.check_lambdas_in(&b, module, horizon_s);
-            Ok((b, held, lambdas))
-        })
-        .map_err(lang)?;
-    if let Some(past) = first.params.get(MAX_PARAMS) {
-        return Err(lang(format!(
-            "error: the program declares {} open parameters; the limit is {MAX_PARAMS} (each is \
-             a dimension of the test space and is probed at load); this is parameter {}\n --> {}",
-            first.params.len(),
-            MAX_PARAMS + 1,
-            past.at
-        )));
-    }
-    program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
-    windows_within_horizon(&first, program.horizon_s).map_err(lang)?;
-    one_walker_each(&first).map_err(lang)?;
-    // Signals the monitors read exist (checked when the world is built).
-    scene::check_signals(&first).map_err(lang)?;
-    lambdas.map_err(lang)?;
-    let syntax = &program.syntax;
-
-    // Names: explicit, else from where the parameter stands, else by position.
-    let explicit: Vec<Option<String>> = first.params.iter().map(|p| p.name.clone()).collect();
-    let derived: Vec<Option<String>> = first
-        .params
-        .iter()
-        .map(|p| syntax.site(&p.at).and_then(|s| s.name.clone()))
-        .collect();
-    for (i, a) in explicit.iter().enumerate() {
-        if let Some(a) = a {
-            if let Some(j) = (0..i).find(|&j| explicit[j].as_deref() == Some(a)) {
-                return Err(lang(format!(
-                    "error: two open parameters are named `{a}` (declared at {} and {}); give \
-                     one another name=\n --> {}",
-                    first.params[j].at, first.params[i].at, first.params[i].at
-                )));
-            }
-        }
-    }
-    // An explicit name that another parameter takes from where it stands (`b = VarInterval(
-    // ..., name = "a")` beside `a = VarInterval(...)`) would file one under the other's name.
-    for (i, a) in explicit.iter().enumerate() {
-        let Some(a) = a else { continue };
-        // What parameter `j` is named from where it stands: its derived name, else its
-        // position (`param3`, as `names::final_names` gives it).
-        let standing = |j: usize| derived[j].clone().unwrap_or_else(|| format!("param{j}"));
-        if let Some(j) =
-            (0..explicit.len()).find(|&j| j != i && explicit[j].is_none() && standing(j) == *a)
-        {
-            return Err(lang(format!(
-                "error: name = \"{a}\" (declared at {}) is the name the open parameter declared \
-                 at {} takes from where it stands; give one another name=\n --> {}",
-                first.params[i].at, first.params[j].at, first.params[i].at
-            )));
-        }
-    }
-    let names = final_names(&explicit, &derived);
-    program.params = names.iter().cloned().zip(first.params.clone()).collect();
-    // Every coordinate of the space has its own name: an explicit `name = "f[0]"` or
-    // `"a_1"` must not meet a coordinate of a parameter that varies over time or a suffix.
-    let mut coordinates: std::collections::HashMap<String, usize> = Default::default();
-    for (k, (name, p)) in program.params.iter().enumerate() {
-        for c in coordinate_names(name, p.over_time) {
-            if let Some(&j) = coordinates.get(&c) {
-                let (a, b) = (&program.params[j], &program.params[k]);
-                // Point at the parameter whose name was written out, if one was.
-                let at = if explicit[j].is_some() && explicit[k].is_none() {
-                    &a.1.at
-                } else {
-                    &b.1.at
-                };
-                return Err(lang(format!(
-                    "error: two open parameters give a coordinate the name `{c}`: `{}` (declared \
-                     at {}) and `{}` (declared at {}); give one another name=\n --> {at}",
-                    a.0, a.1.at, b.0, b.1.at
-                )));
-            }
-            coordinates.insert(c, k);
-        }
-    }
-    program.monitors = first.monitors.clone();
-    program.horizon_s = first.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S);
-    program.sut = first
-        .sut
-        .clone()
-        .ok_or_else(|| lang("the program places no AutonomousVehicle".into()))?;
-
-    let mut space = Vec::new();
-    for (name, p) in &program.params {
-        for coordinate in coordinate_names(name, p.over_time) {
-            space.push(Param {
-                name: coordinate,
-                domain: p.domain.clone(),
-                unit: p.unit.clone(),
-            });
-        }
-    }
-    let space = ParamSpace::new(space).map_err(|e| lang(e.to_string()))?;
-
-    // Every combination of levels and interval ends builds a valid world.
-    let with = |label: &str, m: String| {
-        if label.is_empty() {
-            lang(m)
-        } else {
-            lang(format!(
-                "{m}\n(the world fails for the test values {label})"
-            ))
-        }
-    };
-    let mut checked = None;
-    // Streams nothing reads in any world checked: each world's, intersected.
-    let mut unread: Vec<std::collections::BTreeSet<String>> = Vec::new();
-    if !program.params.is_empty() {
-        let combinations = program.combinations();
-        let total = combinations.len();
-        let mut steps = 0u64;
-        for (done, (values, label)) in combinations.iter().enumerate() {
-            if steps > MAX_CHECK_STEPS || done >= MAX_CHECKED_WORLDS {
-                checked = Some((done, total, steps));
-                break;
-            }
-            let (w, s) = program
-                .world_counted(values.clone())
-                .map_err(|m| with(label, m))?;
-            unread.push(usage::unread_streams(&w, &[]));
-            steps += s;
-        }
-    }
-
-    // What each parameter changes: its other checked values against the first evaluation.
-    let base = scene::world(&first, program.horizon_s).map_err(lang)?;
-    let read_by_name: Vec<usize> = stream_variables
-        .iter()
-        .filter(|(name, _)| syntax.read_in_code(name))
-        .map(|&(_, id)| id)
-        .collect();
-    let mut unread_everywhere = usage::unread_streams(&base, &read_by_name);
-    for other in &unread {
-        unread_everywhere.retain(|site| other.contains(site));
-    }
-    let base_values: Vec<ParamValue> = program
-        .params
-        .iter()
-        .map(|(_, d)| scene::representative(d, program.horizon_s))
-        .collect();
-    let mut changes = Vec::with_capacity(program.params.len());
-    // Parameters whose effect the budget left unprobed: they count as used.
-    let mut unprobed: Vec<usize> = Vec::new();
-    for k in 0..program.params.len() {
-        if !program.load_budget_left() {
-            unprobed.push(k);
-            changes.push(Vec::new());
-            continue;
-        }
-        let mut seen = Vec::new();
-        // At most MAX_PROBED_VALUES of its values, spread over them (a VarEnum may have
-        // thousands of levels, each one evaluation of the program).
-        let mut all = program.checked_values(k);
-        // And a value inside an interval, not a round one: a world that takes only whole
-        // numbers (`nlanes`, a lane) fails there, though both ends may be whole.
-        if let (name, Domain::Interval { lo, hi }) =
-            (&program.params[k].0, &program.params[k].1.domain)
-        {
-            let x = lo + (hi - lo) * INTERIOR_FRACTION;
-            let values = program.checked_values_at(k, x);
-            all.push((
-                values,
-                format!(
-                    "{name} = {x}, inside its interval [{lo}, {hi}): every value of a \
-                     VarInterval must build a valid world; an input of whole numbers takes a \
-                     VarEnum of them"
-                ),
-            ));
-        }
-        let n = all.len();
-        let probed = all.into_iter().enumerate().filter(|(i, _)| {
-            n <= MAX_PROBED_VALUES
-                || (0..MAX_PROBED_VALUES).any(|j| j * (n - 1) / (MAX_PROBED_VALUES - 1) == *i)
-        });
-        for (_, (v, label)) in probed {
-            if v == base_values[k] {
-                continue;
-            }
-            let mut values = base_values.clone();
-            values[k] = v;
-            let other = program.world_for(values).map_err(|m| with(&label, m))?;
-            seen.extend(usage::changes(&base, &other, program.horizon_s));
-            if !program.load_budget_left() {
-                break;
-            }
-        }
-        changes.push(seen);
-    }
-
-    let mut monitors = program.monitors.clone();
-    let declared = monitors.len();
-    let has_off_road = monitors.iter().any(MonitorSpec::judges_off_road);
-    if first.offroad.unwrap_or(true) && !has_off_road {
-        let implicit = MonitorSpec::implicit_off_road();
-        if let Some(k) = monitors.iter().position(|m| m.name() == implicit.name()) {
-            let at = first.monitors_at.get(k).map_or(file, String::as_str);
-            return Err(lang(format!(
-                "error: a monitor is named `{}`, the name of the default OffRoadMonitor: rename \
-                 it, declare OffRoadMonitor(v) yourself, or opt out with test(offroad = False)\n \
-                 --> {at}",
-                implicit.name()
-            )));
-        }
-        monitors.push(implicit);
-    }
-    let map_axes = match &first.map_axes {
-        Some(axes) => {
-            if let [a, b] = &axes[..] {
-                if a == b {
-                    return Err(lang(format!(
-                        "error: test(map=...) names `{a}` twice: a failure map needs two \
-                         different parameters\n --> {}",
-                        first.test_at.as_deref().unwrap_or(file),
-                    )));
-                }
-            }
-            for a in axes {
-                if space.param(a).is_none() {
-                    let known: Vec<&str> = space.params().iter().map(|p| p.name.as_str()).collect();
-                    return Err(lang(format!(
-                        "error: test(map=...) names `{a}`, which is not a parameter (the \
-                         parameters: {})\n --> {}",
-                        if known.is_empty() {
-                            "none".to_owned()
-                        } else {
-                            known.join(", ")
-                        },
-                        first.test_at.as_deref().unwrap_or(file),
-                    )));
-                }
-            }
-            axes.clone()
-        }
-        None => space
-            .params()
-            .iter()
-            .take(2)
-            .map(|p| p.name.clone())
-            .collect(),
-    };
-
-    let mut warnings = first.warnings.clone();
-    let place_at = first.placed_at.clone().unwrap_or_default();
-    for site in unread_everywhere {
-        warnings.push(Warning {
-            at: site,
-            message: "nothing uses this stream's values (no object's input, monitor, Signal \
-                      or foreach, directly, through other streams or by its name in a lambda): \
-                      the parameters only its functions read change no verdict (its functions \
-                      still run every step; for an effect such as print, use foreach)"
-                .to_owned(),
-        });
-    }
-    if let Some((done, total, steps)) = checked {
-        warnings.push(Warning {
-            at: format!("{file}:1:1"),
-            message: format!(
-                "loading checked {done} of the {total} combinations of levels and interval ends \
-                 ({steps} evaluation steps; the budget is {MAX_CHECK_STEPS} steps and \
-                 {MAX_CHECKED_WORLDS} worlds); a test whose values break the world among the \
-                 others ends with status `error`"
-            ),
-        });
-    }
-    if declared == 0 {
-        warnings.push(Warning {
-            at: place_at,
-            message: if monitors.is_empty() {
-                "the program declares no monitor and opts out of the default OffRoadMonitor: \
-                 every test passes whatever happens"
-                    .to_owned()
-            } else {
-                "the program declares no monitor: only the default OffRoadMonitor judges its \
-                 tests, so a test passes whatever else happens (add CollisionMonitor(v), \
-                 DistanceMonitor(v, minD = ...) or Stl(...))"
-                    .to_owned()
-            },
-        });
-    }
-    // The constant a published signal holds in a world, if it is one.
-    let constant_of = |published: &[(String, StreamId)], nodes: &[Node], signal: &str| {
-        published
-            .iter()
-            .find(|(n, _)| n == signal)
-            .and_then(|(_, id)| nodes.get(id.0))
-            .and_then(|n| match n {
-                Node::Const(v) => Some(format!("{v:?}")),
-                _ => None,
+        .map_err(|e| {
+            ScenarioError::Load(LoadError {
+                message: format!("the program failed for this test's values: {}", e.message),
+                ..e
             })
-    };
-    // Monitors of a constant in the first world, and whether that constant is an open
-    // parameter's (`Monitor(k)`): then it differs between the worlds of some combinations.
-    let mut constants: Vec<(String, Option<String>, bool)> = first
-        .monitors
-        .iter()
-        .filter_map(|m| m.judged_stream())
-        .map(|(_, signal, _)| {
-            let c = constant_of(&first.published, first.graph.nodes(), signal);
-            (signal.to_owned(), c, false)
         })
-        .collect();
-    if constants.iter().any(|(_, c, _)| c.is_some()) {
-        let rows = program.combinations();
-        let n = rows.len();
-        for (i, (values, _)) in rows.iter().enumerate() {
-            if n > 16 && !(0..16).any(|j| j * (n - 1) / 15 == i) {
-                continue;
-            }
-            if !program.load_budget_left() {
-                // Unchecked: the monitor's constant counts as varying (no warning).
-                for c in constants.iter_mut() {
-                    c.2 = true;
-                }
-                break;
-            }
-            let Ok(w) = program.world_for(values.clone()) else {
-                continue;
-            };
-            for (signal, c, varies) in constants.iter_mut() {
-                if c.is_some() && constant_of(&w.published, w.streams.nodes(), signal) != *c {
-                    *varies = true;
-                }
-            }
-        }
     }
-    for (m, at) in first.monitors.iter().zip(&first.monitors_at) {
-        // A Monitor or Assert of a constant (`Monitor(5.0)`) judges nothing of the world.
-        if let Some((name, signal, _)) = m.judged_stream() {
-            let constant = constants
-                .iter()
-                .any(|(s, c, varies)| s == signal && c.is_some() && !varies);
-            if constant {
-                warnings.push(Warning {
-                    at: at.clone(),
-                    message: format!(
-                        "monitor `{name}` judges a constant stream: its verdict is the same in \
-                         every test, whatever the world does"
-                    ),
-                });
-            }
-        }
-        let MonitorSpec::Stl { name, formula } = m else {
-            continue;
-        };
-        if paracosm_oracles::stl::parse(formula).is_ok_and(|f| f.signals().is_empty()) {
-            warnings.push(Warning {
-                at: at.clone(),
-                message: format!(
-                    "Stl monitor `{name}` reads no signal: its verdict is the same in every test, \
-                     whatever the world does"
-                ),
-            });
-        }
-        let clamped = paracosm_oracles::stl::parse(formula)
-            .map(|f| f.clamped(program.horizon_s).1)
-            .unwrap_or(false);
-        if clamped {
-            warnings.push(Warning {
-                at: at.clone(),
-                message: format!(
-                    "Stl monitor `{name}`: time bounds past the test's horizon of {h} s are \
-                     lowered to {c} s, which changes no verdict (a window is cut at the end of \
-                     the test) and keeps its memory to the horizon's samples",
-                    h = program.horizon_s,
-                    c = program.horizon_s + 1.0
-                ),
-            });
-        }
-    }
-    let stl_reads_light = monitors
-        .iter()
-        .any(|m| m.reads_signal(crate::signal::LIGHT));
-    let read_in_code: Vec<bool> = program
-        .params
-        .iter()
-        .enumerate()
-        .map(|(k, (_, d))| {
-            // Unprobed, a parameter counts as read: it is neither warned of nor left out.
-            unprobed.contains(&k)
-                || syntax.site(&d.at).is_some_and(|s| {
-                    [&s.variable, &s.container]
-                        .into_iter()
-                        .flatten()
-                        .any(|v| syntax.read_in_code(v))
-                })
-        })
-        .collect();
-    // A parameter that, from the first world, changes nothing or nothing the ego can meet may
-    // still matter where the others take other values: a radius read only on one branch of an
-    // `if`, a friction reached only from another start. Before a warning calls it unused, it
-    // is varied again from other combinations of the others' values.
-    // The second looks share a budget of evaluations: with many such parameters, each is
-    // varied from fewer combinations (at least one).
-    let suspects = (0..changes.len())
-        .filter(|&k| {
-            !read_in_code[k] && changes[k].iter().all(|c| usage::inert(c, stl_reads_light))
-        })
-        .count();
-    let bases = REPROBE_EVALUATIONS / (suspects.max(1) * (1 + MAX_REPROBED_VALUES));
-    for (k, seen) in changes.iter_mut().enumerate() {
-        if !read_in_code[k] && seen.iter().all(|c| usage::inert(c, stl_reads_light)) {
-            if program.load_budget_left() {
-                seen.extend(program.changes_elsewhere(k, &base_values, bases));
-            } else {
-                unprobed.push(k);
-            }
-        }
-    }
-    let read_in_code: Vec<bool> = read_in_code
-        .iter()
-        .enumerate()
-        .map(|(k, r)| *r || unprobed.contains(&k))
-        .collect();
-    if !unprobed.is_empty() {
-        unprobed.sort_unstable();
-        unprobed.dedup();
-        let names: Vec<&str> = unprobed
-            .iter()
-            .take(8)
-            .map(|&k| program.params[k].0.as_str())
-            .collect();
-        warnings.push(Warning {
-            at: format!("{file}:1:1"),
-            message: format!(
-                "loading stopped probing what parameters change at its budget of \
-                 {MAX_LOAD_CHECK_STEPS} evaluation steps: {} parameter{} ({}{}) count as used, \
-                 unprobed (no warning says whether an object uses them, and coverage includes \
-                 them)",
-                unprobed.len(),
-                if unprobed.len() == 1 { "" } else { "s" },
-                names.join(", "),
-                if unprobed.len() > names.len() {
-                    ", ..."
-                } else {
-                    ""
-                }
-            ),
-        });
-    }
-    let found = usage::analyse(usage::Inputs {
-        params: &program.params,
-        changes: &changes,
-        read_in_code: &read_in_code,
-        stl_reads_light,
-        world: &first,
-    });
-    warnings.extend(found.warnings);
-    warnings.extend(usage::unit_warnings(&program.params, syntax));
-    for message in program.maps.warnings() {
-        // "file:line: what": the map's own place.
-        let (at, what) = match message.split_once(": ") {
-            Some((at, what)) if at.contains(':') => (at.to_owned(), what.to_owned()),
-            _ => (file.to_owned(), message.clone()),
-        };
-        warnings.push(Warning { at, message: what });
-    }
-    let unused_params: Vec<String> = found
-        .unused
-        .iter()
-        .flat_map(|&k| coordinate_names(&program.params[k].0, program.params[k].1.over_time))
-        .collect();
-
-    let horizon_s = program.horizon_s;
-    let sut = program.sut.clone();
-    Ok(Scenario {
-        name: name.to_owned(),
-        description: super::header(source),
-        space,
-        horizon_s,
-        sut,
-        monitors,
-        map_axes,
-        warnings,
-        unused_params,
-        camera_only: found.camera_only,
-        source: Arc::from(source),
-        input_files: program.maps.inputs(),
-        worlds: Arc::new(program),
-    })
 }

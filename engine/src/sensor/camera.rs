@@ -1,6 +1,12 @@
-//! The pinhole camera model and the frames it produces.
+//! The camera: its pinhole model ([`CameraSpec`]), the frames it produces ([`CameraFrame`]),
+//! and, with the `render` feature, the camera as a [`Sensor`] of one simulation (its renderer,
+//! the world's uploaded geometry and its targets).
 
 use serde::{Deserialize, Serialize};
+
+use super::{Reading, Sensor, SettingError};
+use crate::network::Network;
+use crate::{EngineError, Observation};
 
 /// Width of the camera's sensor in millimetres (a full-frame 36 × 24 mm sensor).
 pub const SENSOR_WIDTH_MM: f64 = 36.0;
@@ -63,21 +69,21 @@ impl CameraSpec {
     /// Checks the documented ranges.
     ///
     /// # Errors
-    /// A message naming the first value out of range, or a `rate_hz` that is not a whole
-    /// number of physics steps per frame.
-    pub fn validate(&self) -> Result<(), String> {
-        let range = |name: &str, v: f64, ok: bool| {
-            if ok && v.is_finite() {
+    /// A [`SettingError`] naming the first value out of range, or a `rate_hz` that is not a
+    /// whole number of physics steps per frame ([`SettingError::Rate`]).
+    pub fn validate(&self) -> Result<(), SettingError> {
+        let range = |name: &'static str, value: f64, ok: bool| {
+            if ok && value.is_finite() {
                 Ok(())
             } else {
-                Err(format!("camera {name} {v} is out of range"))
+                Err(SettingError::CameraOutOfRange { name, value })
             }
         };
         if !(1..=4096).contains(&self.width) || !(1..=4096).contains(&self.height) {
-            return Err(format!(
-                "camera resolution {}x{} is outside 1..=4096",
-                self.width, self.height
-            ));
+            return Err(SettingError::CameraResolution {
+                width: self.width,
+                height: self.height,
+            });
         }
         range(
             "focal_mm",
@@ -239,11 +245,172 @@ impl CameraFrame {
     /// Writes the RGB image as PNG.
     ///
     /// # Errors
-    /// The encoder's or the file system's message.
-    pub fn save_png(&self, path: &std::path::Path) -> Result<(), String> {
+    /// [`SavePngError`]: the encoder's or the file system's message, naming the file.
+    pub fn save_png(&self, path: &std::path::Path) -> Result<(), SavePngError> {
         self.to_image()
             .save_with_format(path, image::ImageFormat::Png)
-            .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+            .map_err(|e| SavePngError {
+                path: path.to_owned(),
+                message: e.to_string(),
+            })
+    }
+}
+
+/// A frame that cannot be written as PNG ([`CameraFrame::save_png`]).
+#[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
+#[error("cannot write `{}`: {message}", .path.display())]
+pub struct SavePngError {
+    /// The file.
+    pub path: std::path::PathBuf,
+    /// The encoder's or the file system's message.
+    pub message: String,
+}
+
+impl<'a> Observation<'a> {
+    /// The latest frame of the sensor named `camera` (RGB and depth), `None` when no camera
+    /// is mounted ([`crate::Simulation::attach_camera`], [`crate::SensorSpec::Camera`]) or it
+    /// has not captured one.
+    pub fn camera(&self) -> Option<&'a CameraFrame> {
+        match self.reading("camera") {
+            Some(Reading::Camera(frame)) => Some(frame),
+            _ => None,
+        }
+    }
+}
+
+/// The camera `spec` as a sensor of a world on `network` whose physics step is `dt_s`
+/// seconds, rendering through the process's shared [`crate::render::Renderer`]; `seed`
+/// drives its pixel noise.
+///
+/// # Errors
+/// [`EngineError::Sensor`] when the camera's values are out of range, no GPU adapter is
+/// found, or this build lacks the `render` feature.
+pub(crate) fn sensor(
+    network: &Network,
+    spec: &CameraSpec,
+    seed: u64,
+    dt_s: f64,
+) -> Result<Box<dyn Sensor>, EngineError> {
+    spec.validate()
+        .map_err(|e| EngineError::Sensor(e.to_string()))?;
+    #[cfg(feature = "render")]
+    {
+        let renderer =
+            crate::render::Renderer::shared().map_err(|e| EngineError::Sensor(e.to_string()))?;
+        let rig = rig::CameraRig::new(renderer, network, spec, seed, dt_s)?;
+        Ok(Box::new(rig))
+    }
+    #[cfg(not(feature = "render"))]
+    {
+        let _ = (network, seed, dt_s);
+        Err(EngineError::Sensor(
+            "this build has no camera: paracosm-engine was built without its `render` \
+             feature"
+                .into(),
+        ))
+    }
+}
+
+/// A camera mounted on one simulation's ego vehicle.
+#[cfg(feature = "render")]
+mod rig {
+    use std::sync::Arc;
+
+    use super::{CameraFrame, CameraSpec};
+    use crate::network::Network;
+    use crate::render::{CameraPose, RenderJob, RenderObject, Renderer, SceneGeometry, View};
+    use crate::EngineError;
+
+    /// The renderer, the world's uploaded geometry and the camera's targets, for one simulation:
+    /// the camera as a [`crate::sensor::Sensor`].
+    pub(crate) struct CameraRig {
+        renderer: Arc<Renderer>,
+        scene: SceneGeometry,
+        view: View,
+        seed: u64,
+        frames: u64,
+        period: u64,
+        frame: Option<CameraFrame>,
+    }
+
+    impl crate::sensor::Sensor for CameraRig {
+        fn name(&self) -> &'static str {
+            "camera"
+        }
+
+        fn period_ticks(&self) -> u64 {
+            self.period
+        }
+
+        fn draws(&self) -> bool {
+            true
+        }
+
+        fn physics_reach_m(&self) -> f64 {
+            // It draws the scene's boxes; it casts nothing into the physics world.
+            0.0
+        }
+
+        fn capture(&mut self, scene: &crate::sensor::Scene<'_>) -> Result<(), EngineError> {
+            let pose = CameraPose {
+                chassis_m: scene.ego.pos_m,
+                heading_rad: scene.ego.heading_rad,
+            };
+            let frame = self.render(pose, scene.boxes, (scene.light, scene.fog), scene.t_s)?;
+            self.frame = Some(frame);
+            Ok(())
+        }
+
+        fn reading(&self) -> Option<crate::sensor::Reading<'_>> {
+            self.frame.as_ref().map(crate::sensor::Reading::Camera)
+        }
+    }
+
+    impl CameraRig {
+        pub(crate) fn new(
+            renderer: Arc<Renderer>,
+            network: &Network,
+            camera: &CameraSpec,
+            seed: u64,
+            dt_s: f64,
+        ) -> Result<Self, EngineError> {
+            let view = renderer
+                .view(camera)
+                .map_err(|e| EngineError::Sensor(e.to_string()))?;
+            Ok(CameraRig {
+                scene: renderer.scene(network),
+                renderer,
+                view,
+                seed,
+                frames: 0,
+                period: ((1.0 / (camera.rate_hz * dt_s)).round() as u64).max(1),
+                frame: None,
+            })
+        }
+
+        fn render(
+            &mut self,
+            pose: CameraPose,
+            objects: &[RenderObject],
+            light_fog: (f64, f64),
+            t_s: f64,
+        ) -> Result<CameraFrame, EngineError> {
+            // Each frame's noise has its own stream: (test seed, frame number).
+            let noise_seed = self.seed ^ self.frames.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            self.frames += 1;
+            self.renderer
+                .render_one(RenderJob {
+                    scene: &self.scene,
+                    view: &mut self.view,
+                    pose,
+                    objects,
+                    light: light_fog.0,
+                    fog: light_fog.1,
+                    t_s,
+                    noise_seed,
+                })
+                .map_err(|e| EngineError::Sensor(e.to_string()))
+        }
     }
 }
 
