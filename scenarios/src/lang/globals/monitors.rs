@@ -70,7 +70,7 @@ pub(crate) const SPECS: &[Builtin] = &[
         name: "Monitor",
         form: Form::Function,
         inputs: &[
-            positional("stream", "a stream of numbers (robustness) or bools"),
+            positional("stream", "a stream of numbers, its robustness"),
             named("name", "string").or("the variable, else \"monitor\""),
             named("unit", "string").or("None"),
             named("over", "\"always\", \"end\" or \"eventually\"").or("\"always\""),
@@ -83,12 +83,12 @@ pub(crate) const SPECS: &[Builtin] = &[
         name: "Assert",
         form: Form::Function,
         inputs: &[
-            positional("stream", "any stream"),
+            positional("stream", "a stream of bools"),
             named("name", "string").or("the variable, else \"assert\""),
         ],
         declares: Declares::Monitor,
         takes_whole: false,
-        doc: "fails at the first event of the stream",
+        doc: "fails at the first event that is false; robustness +1 or -1",
     },
     Builtin {
         name: "Signal",
