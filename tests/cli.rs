@@ -537,8 +537,9 @@ fn ipog_suites_cover_every_pair_and_give_each_row_its_own_halton_block() {
 }
 
 /// Issue 5, requirement 6: the Starlark `pedestrian_crossing.star` gives the results the Rust
-/// definition gives (`paracosm_scenarios::reference`), byte for byte apart from wall time; by
-/// path and by built-in name. The fixture was first written by the Rust version before the
+/// definition gives (`paracosm_scenarios::reference`, a typed `Scene` declared in plain Rust
+/// through the scene model's methods, with no Starlark), byte for byte apart from wall time;
+/// by path and by built-in name. The fixture was first written by the Rust version before the
 /// language existed; issue 14 added the default `offroad` monitor to both (every other field
 /// of every line stayed as it was), and this test checks the Rust definition against it too.
 #[test]

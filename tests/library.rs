@@ -85,10 +85,10 @@ fn a_campaign_runs_from_the_library_with_a_custom_observer() {
 struct Defective;
 
 impl Worlds for Defective {
-    fn with_world(
+    fn with_scene(
         &self,
         assignment: &Assignment,
-        run: &mut dyn FnMut(&paracosm_engine::WorldSpec, &mut dyn paracosm_engine::rx::Host),
+        run: &mut dyn FnMut(&paracosm_scenarios::scene::Scene, &mut dyn paracosm_engine::rx::Host),
     ) -> Result<(), ScenarioError> {
         if assignment.real("walking_speed").unwrap() > 1.5 {
             panic!(
@@ -96,8 +96,8 @@ impl Worlds for Defective {
                 assignment.real("walking_speed")
             );
         }
-        paracosm_scenarios::RustWorlds(paracosm_scenarios::reference::world)
-            .with_world(assignment, run)
+        paracosm_scenarios::RustWorlds(paracosm_scenarios::reference::scene)
+            .with_scene(assignment, run)
     }
 }
 

@@ -400,7 +400,8 @@ fn vision_keeps_its_lane_round_the_map_bend() {
 }
 
 /// A route's turn that a fork of the map lacks is an error at load naming the turn, the
-/// road and lane that end there and the turns the fork offers, as on paracosm's own pieces
+/// road and lane that end there and the turns the fork offers (with their connecting roads and
+/// angles), as on paracosm's own pieces
 /// (the ring's forks offer straight on and an exit to the right: `left` was taken as
 /// straight on without a word). The turns it offers load.
 #[test]
@@ -423,7 +424,9 @@ fn a_turn_a_map_fork_lacks_is_refused() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(
         stderr.contains("Car c: the route's turn 1 (\"left\") is not possible at the fork")
-            && stderr.contains("roundabout.xodr ends: it offers \"straight\" and \"right\" there")
+            && stderr.contains(
+                "roundabout.xodr ends: it offers \"straight\" (road:21, +45°) and \"right\" (road:41, -66°) there"
+            )
             && stderr.contains("left.star:5:1"),
         "{stderr}"
     );
@@ -538,5 +541,52 @@ fn a_map_far_from_the_origin_gives_the_verdicts_it_gives_at_the_origin() {
         );
         assert!((num("x") - shift[0] + 51.0).abs() < 8.0, "{el}");
         assert!((num("y") - shift[1]).abs() < 8.0, "{el}");
+    }
+}
+
+/// Issue 48, requirement 2, end to end: on CARLA's Town01 (`tests/data/maps/carla`), the ego
+/// coming along lane -1 of road 0 into junction 43 turns left onto road 16 with
+/// `route = ["left"]` or `route = ["road:56"]` (the connecting road's id), and goes straight on
+/// onto road 1 with `["straight"]`: paracosm offered "straight" alone there before.
+#[test]
+fn the_ego_takes_every_turn_a_carla_junction_gives() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("maps")).unwrap();
+    std::fs::copy(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/maps/carla/Town01.xodr"),
+        dir.path().join("maps/Town01.xodr"),
+    )
+    .unwrap();
+    let src = |route: &str| {
+        format!(
+            r#"m = OpenDrive("maps/Town01.xodr")
+w = World()
+v = AutonomousVehicle(loc = m.onLane(road = "0", lane = -1, s = 20.0), route = {route}, speed = 6.0)
+w.place(m, v)
+on16 = m.onLane(road = "16", lane = -1, s = 10.0)
+on1 = m.onLane(road = "1", lane = -1, s = 10.0)
+Monitor(v.pos.map(lambda p: 3.0 - dist(p, on16)), name = "road16", over = "eventually")
+Monitor(v.pos.map(lambda p: 3.0 - dist(p, on1)), name = "road1", over = "eventually")
+test(horizon = 10.0)
+"#
+        )
+    };
+    for (k, (route, onto)) in [
+        ("[\"left\"]", "road16"),
+        ("[\"road:56\"]", "road16"),
+        ("[\"straight\"]", "road1"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let file = dir.path().join(format!("turn{k}.star"));
+        std::fs::write(&file, src(route)).unwrap();
+        let out = dir.path().join(format!("out{k}"));
+        let o = campaign(&file, "1", &out);
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{route}: {o:?}");
+        let r = &records(&out)[0];
+        for m in ["road16", "road1"] {
+            assert_eq!(r["monitors"][m]["passed"], m == onto, "{route}: {m}: {r}");
+        }
     }
 }

@@ -121,6 +121,21 @@ pub struct Set<T, K = T> {
     kind: PhantomData<fn() -> K>,
 }
 
+impl<T: Clone, K> Clone for Set<T, K> {
+    fn clone(&self) -> Self {
+        Set {
+            items: self.items.clone(),
+            kind: PhantomData,
+        }
+    }
+}
+
+impl<T: fmt::Debug, K> fmt::Debug for Set<T, K> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_list().entries(&self.items).finish()
+    }
+}
+
 impl<T, K> Default for Set<T, K> {
     fn default() -> Self {
         Set {

@@ -152,7 +152,7 @@ pub(crate) struct Car {
     /// How the camera draws it.
     pub(crate) albedo: [f32; 3],
     /// Its speed stream, m/s.
-    pub(crate) speed_stream: StreamId,
+    pub(crate) speed_stream: crate::sim::Input,
     /// Whether it touches the ego vehicle now.
     pub(crate) touching: bool,
     /// Whether it has touched anything since the test began (the ego, a car, a pedestrian,
@@ -182,7 +182,7 @@ impl Car {
         size: Size,
         enabled: bool,
         albedo: [f32; 3],
-        speed_stream: StreamId,
+        speed_stream: crate::sim::Input,
     ) -> Self {
         let mut cumulative = vec![0.0];
         for w in path.windows(2) {
@@ -789,7 +789,7 @@ mod tests {
             size,
             false,
             [0.5; 3],
-            StreamId(0),
+            crate::sim::Input::Stream(StreamId(0)),
         )
     }
 

@@ -39,7 +39,7 @@ pub(crate) struct Pedestrian {
     pub(crate) body: RigidBodyHandle,
     pub(crate) collider: ColliderHandle,
     /// Its walking speed stream, m/s.
-    pub(crate) speed_stream: crate::rx::StreamId,
+    pub(crate) speed_stream: crate::sim::Input,
     /// Whether it touches the ego vehicle now.
     pub(crate) touching: bool,
     /// Whether it has touched anything since the test began (the ego, a car, an obstacle).
@@ -61,7 +61,7 @@ impl Pedestrian {
         physics: &mut PhysicsWorld,
         start: [f64; 3],
         target: [f64; 3],
-        speed_stream: crate::rx::StreamId,
+        speed_stream: crate::sim::Input,
     ) -> Self {
         let body = RigidBodyBuilder::kinematic_position_based().translation(centre(start));
         let collider = ColliderBuilder::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M)
@@ -201,7 +201,7 @@ mod tests {
             &mut physics,
             [100.0, 0.0, 4.0],
             [100.0, 0.0, -4.0],
-            crate::rx::StreamId(0),
+            crate::sim::Input::Stream(crate::rx::StreamId(0)),
         );
         let dt = 0.1;
         assert_eq!(p.state().phase, PedestrianPhase::Waiting);

@@ -13,7 +13,6 @@ use crate::obstacle::{Obstacle, ObstacleState};
 use crate::pedestrian::{Pedestrian, PED_HALF_HEIGHT_M, PED_RADIUS_M};
 use crate::rx::{Host, Inputs, Runtime, StreamId, Value};
 use crate::sensor::{Reading, Scene, Sensor, Sensors};
-use crate::spec::EnvironmentSpec;
 use crate::vehicle::EgoVehicle;
 use crate::{
     CameraFrame, CameraSpec, CarSpec, Control, EngineError, ObstacleSpec, PedestrianSpec,
@@ -177,6 +176,35 @@ fn check_ego_and_step(spec: &WorldSpec) -> Result<(), EngineError> {
     Ok(())
 }
 
+/// A number the world reads each step: a constant, known when the world is built and never
+/// read back from the stream graph, or a stream read each step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Input {
+    /// A finite constant.
+    Const(f64),
+    /// A stream, read at each step.
+    Stream(StreamId),
+}
+
+impl Input {
+    /// What `id` of `graph` is as an input: a constant when its node is a finite number
+    /// (anything else, a non-finite constant included, is read each step and judged then).
+    pub(crate) fn of(graph: &crate::rx::Graph, id: StreamId) -> Input {
+        match graph.nodes().get(id.0) {
+            Some(crate::rx::Node::Const(Value::Num(v))) if v.is_finite() => Input::Const(*v),
+            _ => Input::Stream(id),
+        }
+    }
+
+    /// The stream, for an input read each step.
+    fn stream(self) -> Option<StreamId> {
+        match self {
+            Input::Const(_) => None,
+            Input::Stream(id) => Some(id),
+        }
+    }
+}
+
 /// The streams the world itself reads every step: each pedestrian's and car's speed, the
 /// varying frictions, the published streams, light and fog.
 fn read_streams(spec: &WorldSpec) -> impl Iterator<Item = StreamId> + Clone + '_ {
@@ -195,11 +223,19 @@ fn world_runtime(spec: &WorldSpec, reads: impl Iterator<Item = StreamId>) -> Run
     // The streams the world reads; the rest of the graph is evaluated only where these, an
     // action or a function need it (Runtime::evaluate_only).
     let mut rt = Runtime::new(spec.streams.clone());
+    // A constant input is read once, when the world is built (`Input::Const`), never from
+    // the runtime.
+    let reads: Vec<StreamId> = reads
+        .filter(|&id| {
+            spec.published.iter().any(|p| p.1 == id)
+                || Input::of(&spec.streams, id).stream().is_some()
+        })
+        .collect();
     let when = spec.cars.iter().filter_map(|c| match c.lane_change?.start {
         LaneChangeStart::When(s) => Some(s),
         LaneChangeStart::At(_) => None,
     });
-    rt.evaluate_only(reads.chain(when));
+    rt.evaluate_only(reads.into_iter().chain(when));
     rt
 }
 
@@ -253,7 +289,7 @@ fn build_cars(
             c.size,
             c.enabled,
             crate::colour::albedo(&c.color).unwrap_or([0.45, 0.45, 0.45]),
-            c.speed,
+            Input::of(&spec.streams, c.speed),
         );
         car.lane_change = c.lane_change;
         if let Some(keep) = c.keep_distance_m {
@@ -334,7 +370,8 @@ pub struct Simulation {
     obstacles: Set<Obstacle, ObstacleSpec>,
     /// The actor each actor collider belongs to.
     owners: HashMap<ColliderHandle, Owner>,
-    environment: EnvironmentSpec,
+    /// The light and the fog density, each `[0, 1]`.
+    light_fog_inputs: (Input, Input),
     light_fog: (f64, f64),
     /// Pieces whose friction varies over the test, and their streams.
     frictions: Vec<(PieceId, StreamId)>,
@@ -403,7 +440,8 @@ impl Simulation {
         let mut owners = HashMap::new();
         let mut pedestrians = Set::default();
         for p in &spec.pedestrians {
-            let ped = Pedestrian::build(&mut physics, p.start, p.target, p.speed);
+            let speed = Input::of(&spec.streams, p.speed);
+            let ped = Pedestrian::build(&mut physics, p.start, p.target, speed);
             let collider = ped.collider;
             owners.insert(collider, Owner::Pedestrian(pedestrians.insert(ped)));
         }
@@ -424,7 +462,10 @@ impl Simulation {
             cars,
             obstacles,
             owners,
-            environment: spec.environment,
+            light_fog_inputs: (
+                Input::of(&spec.streams, spec.environment.light),
+                Input::of(&spec.streams, spec.environment.fog),
+            ),
             frictions: spec.frictions.clone(),
             // Known before the first step when they are constants (a camera frame at t = 0
             // needs them); time-varying ones are set by the first step.
@@ -626,7 +667,7 @@ impl Simulation {
         for &(piece, stream) in &self.frictions {
             let network = &self.network;
             let what = || format!("the friction of {}", network.piece(piece).name);
-            let mu = number(&self.streams, stream, t, what)?;
+            let mu = number(&self.streams, Input::Stream(stream), t, what)?;
             self.surface.set_friction(piece, mu);
         }
         Ok(())
@@ -858,10 +899,12 @@ impl Simulation {
         self.evaluated = Some(self.tick);
         // Light and fog now: the step from here uses them, and a snapshot shows them.
         self.light_fog = (
-            number(&self.streams, self.environment.light, t, || {
+            number(&self.streams, self.light_fog_inputs.0, t, || {
                 "the light".into()
             })?,
-            number(&self.streams, self.environment.fog, t, || "the fog".into())?,
+            number(&self.streams, self.light_fog_inputs.1, t, || {
+                "the fog".into()
+            })?,
         );
         Ok(())
     }
@@ -1202,7 +1245,7 @@ impl Simulation {
 /// than the car and the ego can close in one step at any speed the engine models.
 const SLEEP_MARGIN_M: f64 = 10.0;
 
-/// The number stream `id` holds now (its latest event).
+/// The number `input` holds now: a constant's value, or its stream's latest event.
 ///
 /// # Errors
 /// [`crate::rx::RxError::Input`] naming `what` when the stream has no value yet (it has not
@@ -1210,10 +1253,14 @@ const SLEEP_MARGIN_M: f64 = 10.0;
 /// as 0 in its place.
 fn number(
     rt: &Runtime,
-    id: StreamId,
+    input: Input,
     t_s: f64,
     what: impl FnOnce() -> String,
 ) -> Result<f64, EngineError> {
+    let id = match input {
+        Input::Const(v) => return Ok(v),
+        Input::Stream(id) => id,
+    };
     match rt.current(id) {
         // Never a default in place of a value the program's stream did not give.
         None => Err(crate::rx::RxError::Input {
@@ -1762,6 +1809,32 @@ mod tests {
         }
         assert!((sim.t_s() - 1.0).abs() < 1e-12);
         assert_eq!(sim.snapshot().t_s, sim.t_s());
+    }
+
+    #[test]
+    fn constant_inputs_are_read_once_and_streams_each_step() {
+        let s = spec();
+        let sim = Simulation::new(&s).unwrap();
+        // The study's light, fog and walking speed are constants: known when the world is
+        // built, never read back from the graph.
+        assert!(matches!(
+            sim.light_fog_inputs,
+            (Input::Const(_), Input::Const(_))
+        ));
+        let walker = sim.pedestrians.values().next().unwrap();
+        assert_eq!(walker.speed_stream, Input::Const(1.0));
+        // A light that varies over the test stays a stream, read each step.
+        let mut nodes = s.streams.nodes().to_vec();
+        nodes[s.environment.light.0] = crate::rx::Node::Tick;
+        let varying = crate::rx::Graph::new(nodes).unwrap();
+        assert_eq!(
+            Input::of(&varying, s.environment.light),
+            Input::Stream(s.environment.light)
+        );
+        // A constant that is no finite number is read each step, and refused there.
+        let nan =
+            crate::rx::Graph::new(vec![crate::rx::Node::Const(Value::Num(f64::NAN))]).unwrap();
+        assert_eq!(Input::of(&nan, StreamId(0)), Input::Stream(StreamId(0)));
     }
 
     #[test]

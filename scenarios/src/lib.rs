@@ -15,6 +15,7 @@ pub use paracosm_engine::memory;
 pub mod reference;
 mod runner;
 mod scenario;
+pub mod scene;
 pub mod text_file;
 
 use std::path::Path;
@@ -22,8 +23,6 @@ use std::path::Path;
 pub use error::ScenarioError;
 pub use runner::{signal, RunOptions, Sample, TestOutcome};
 pub use scenario::{CameraOnly, InputFile, MonitorSpec, RustWorlds, Scenario, Warning, Worlds};
-
-use paracosm_generators::Assignment;
 
 /// The shipped scenario programs: `(file name, source)`.
 pub const BUILTIN_SOURCES: [(&str, &str); 11] = [
@@ -93,13 +92,4 @@ pub fn load(name_or_path: &str) -> Result<Scenario, ScenarioError> {
     } else {
         builtin(name_or_path)
     }
-}
-
-/// The real value of `name` in `a`.
-///
-/// # Errors
-/// [`ScenarioError::MissingParam`] if absent or not numeric.
-pub(crate) fn real(a: &Assignment, name: &str) -> Result<f64, ScenarioError> {
-    a.real(name)
-        .ok_or_else(|| ScenarioError::MissingParam(name.to_owned()))
 }

@@ -11,13 +11,17 @@
 //! walking speed `VarInterval(0.5, 10)` m/s and the trigger distance `VarInterval(5, 60)` m.
 //! Monitors: no collision, and at least 60 m travelled in the 15 s horizon.
 
+use paracosm_engine::behaviour::{ActorRef, Output};
+use paracosm_engine::network::{PieceId, PieceKind};
+use paracosm_engine::rx::{Node, Value};
 use paracosm_engine::sut::{AebConfig, SutConfig};
-use std::sync::Arc;
+use paracosm_engine::{EgoSpec, Lane, PedestrianSpec, VehicleParams};
+use paracosm_generators::{Domain, Value as Level};
 
-use paracosm_engine::{Lane, TriggeredPedestrian, WorldSpec};
-use paracosm_generators::{Assignment, Param, ParamSpace};
-
-use crate::{real, MonitorSpec, Scenario, ScenarioError};
+use crate::scene::{
+    LoadError, LoadErrorKind, OverTime, ParamDecl, ParamValue, Scene, Site, TestSettings,
+};
+use crate::{MonitorSpec, Scenario, ScenarioError};
 
 /// The scenario's name on the command line.
 pub const NAME: &str = "pedestrian-crossing";
@@ -38,60 +42,147 @@ pub const CROSSING_AT_M: f64 = 100.0;
 /// `minD` of the distance monitor, m.
 pub const MIN_DISTANCE_M: f64 = 60.0;
 
-/// The scenario, ready to run.
+/// The scenario, ready to run: [`scene`]'s declarations read as a front end's load reads a
+/// program's ([`Scenario::from_scenes`]).
 pub fn scenario() -> Scenario {
-    let space = ParamSpace::new(vec![
-        Param::interval(
-            WALKING_SPEED,
-            WALKING_SPEED_RANGE_MPS.0,
-            WALKING_SPEED_RANGE_MPS.1,
-            "m/s",
-        ),
-        Param::interval(
-            TRIGGER_DISTANCE,
-            TRIGGER_DISTANCE_RANGE_M.0,
-            TRIGGER_DISTANCE_RANGE_M.1,
-            "m",
-        ),
-    ])
-    .expect("the built-in space is valid");
-    Scenario {
-        name: NAME.to_owned(),
-        description: "a pedestrian crosses in front of the ego vehicle once it comes within a \
-                      trigger distance (PARACOSM §4.2.2, Figure 9)"
-            .to_owned(),
-        space,
-        horizon_s: HORIZON_S,
-        sut: SutConfig::Aeb(AebConfig::default()),
-        monitors: vec![
-            MonitorSpec::collision(),
-            MonitorSpec::distance(MIN_DISTANCE_M),
-            MonitorSpec::implicit_off_road(),
-        ],
-        map_axes: vec![WALKING_SPEED.to_owned(), TRIGGER_DISTANCE.to_owned()],
-        warnings: vec![],
-        unused_params: vec![],
-        camera_only: vec![],
-        worlds: Arc::new(crate::scenario::RustWorlds(world)),
-        source: Arc::from(""),
-        input_files: Vec::new(),
+    Scenario::from_scenes(
+        NAME,
+        "a pedestrian crosses in front of the ego vehicle once it comes within a trigger \
+         distance (PARACOSM §4.2.2, Figure 9)",
+        scene,
+    )
+    .expect("the reference scene declares a valid scenario")
+}
+
+/// Where a declaration of this file stands, naming the variable `pedestrian_crossing.star`
+/// assigns it to.
+fn here(line: u32, variable: &str) -> Site {
+    Site {
+        file: file!().to_owned(),
+        line,
+        col: 5,
+        variable: Some(variable.to_owned()),
     }
 }
 
-/// The study's world for one assignment (walking speed, m/s; trigger distance, m).
+/// Declares the study into `scene` (an empty scene whose parameters take the test's values
+/// by name), as `pedestrian_crossing.star` does, in plain Rust: the two open parameters, a
+/// 200 m two-lane road of friction 0.8, the ego vehicle under `aeb` 10 m along lane 1 at the
+/// system's cruise speed, the pedestrian 100 m along from the right sidewalk to the left one,
+/// walking once the ego comes within the trigger distance, a collision monitor, a distance
+/// monitor (60 m) and a 15 s horizon.
 ///
 /// # Errors
-/// [`ScenarioError::MissingParam`] when the assignment lacks either parameter.
-pub fn world(a: &Assignment) -> Result<WorldSpec, ScenarioError> {
-    Ok(WorldSpec::straight_road(
-        200.0,
-        EGO_START_M,
-        AebConfig::default().cruise.target_speed_mps,
-        &[TriggeredPedestrian {
-            start: (Lane::SideWalk, CROSSING_AT_M),
-            target: (Lane::OppositeSideWalk, CROSSING_AT_M),
-            trigger_distance_m: real(a, TRIGGER_DISTANCE)?,
-            speed_mps: real(a, WALKING_SPEED)?,
-        }],
-    )?)
+/// [`ScenarioError::Load`] if a location is off the road or a declaration is repeated
+/// (neither happens for the study's ranges).
+pub fn scene(mut scene: Scene) -> Result<Scene, ScenarioError> {
+    let worlds = |e: String| ScenarioError::Load(LoadError::new(LoadErrorKind::Worlds, e));
+    let number = |scene: &mut Scene, name: &str, (lo, hi): (f64, f64), unit: &str, line| {
+        let decl = ParamDecl {
+            name: Some(name.to_owned()),
+            domain: Domain::Interval { lo, hi },
+            unit: Some(unit.to_owned()),
+            over_time: OverTime::Constant,
+            site: here(line, name),
+        };
+        match scene.declare_param(decl).0 {
+            ParamValue::Level(Level::Real(x)) => Ok(x),
+            other => Err(worlds(format!(
+                "{name}: a number was expected, got {other:?}"
+            ))),
+        }
+    };
+    let walking_speed = number(
+        &mut scene,
+        WALKING_SPEED,
+        WALKING_SPEED_RANGE_MPS,
+        "m/s",
+        line!(),
+    )?;
+    let trigger = number(
+        &mut scene,
+        TRIGGER_DISTANCE,
+        TRIGGER_DISTANCE_RANGE_M,
+        "m",
+        line!(),
+    )?;
+    let light = scene.push(Node::Const(Value::Num(0.5)));
+    let fog = scene.push(Node::Const(Value::Num(0.0)));
+    scene
+        .set_environment(light, fog, here(line!(), "w"))
+        .map_err(|e| worlds(e.to_string()))?;
+    let friction = scene.push(Node::Const(Value::Num(0.8)));
+    let road: PieceId = scene
+        .add_road(
+            |n| {
+                n.add(
+                    "r",
+                    PieceKind::Segment {
+                        length_m: 200.0,
+                        lanes: 2,
+                        friction: 0.8,
+                    },
+                )
+            },
+            friction,
+            here(line!(), "r"),
+        )
+        .map_err(|e| worlds(e.to_string()))?;
+    let on = |scene: &Scene, lane, at_m| {
+        scene
+            .roads()
+            .on_lane(road, lane, at_m)
+            .map_err(|e| worlds(e.to_string()))
+    };
+    let start = on(&scene, Lane::Driving(1), EGO_START_M)?;
+    let ego = scene.declare_ego("v".to_owned(), here(line!(), "v"));
+    let ego_pos = scene.probe(ego, Output::Pos);
+    let pedestrian = scene.declare_pedestrian("p".to_owned(), here(line!(), "p"));
+    let from = on(&scene, Lane::SideWalk, CROSSING_AT_M)?.pos_m;
+    let to = on(&scene, Lane::OppositeSideWalk, CROSSING_AT_M)?.pos_m;
+    let dist = scene.push(Node::Const(Value::Num(trigger)));
+    let speed = scene.push(Node::Const(Value::Num(walking_speed)));
+    let ActorRef::Pedestrian(handle) = pedestrian else {
+        unreachable!("declare_pedestrian declares a pedestrian")
+    };
+    scene
+        .graph_mut()
+        .pedestrian(handle, from, to, ego_pos, dist);
+    let aeb = AebConfig::default();
+    scene
+        .place_ego(
+            EgoSpec {
+                start,
+                initial_speed_mps: aeb.cruise.target_speed_mps,
+                vehicle: VehicleParams::default(),
+                route: vec![],
+            },
+            SutConfig::Aeb(aeb),
+        )
+        .map_err(|e| worlds(e.to_string()))?;
+    scene
+        .place_pedestrian(
+            pedestrian,
+            PedestrianSpec {
+                start: from,
+                target: to,
+                speed,
+                name: "Pedestrian p".to_owned(),
+            },
+        )
+        .map_err(|e| worlds(e.to_string()))?;
+    scene.add_monitor(MonitorSpec::collision(), here(line!(), "collision"));
+    scene.add_monitor(
+        MonitorSpec::distance(MIN_DISTANCE_M),
+        here(line!(), "distance"),
+    );
+    scene
+        .set_settings(TestSettings {
+            site: Some(here(line!(), "test")),
+            horizon_s: Some(HORIZON_S),
+            map_axes: Some(vec![WALKING_SPEED.to_owned(), TRIGGER_DISTANCE.to_owned()]),
+            offroad: None,
+        })
+        .map_err(|e| worlds(e.to_string()))?;
+    Ok(scene)
 }

@@ -288,8 +288,11 @@ impl Scenario {
         options: &mut RunOptions<'_>,
     ) -> Result<TestOutcome, ScenarioError> {
         let mut out = None;
-        self.worlds.with_world(assignment, &mut |spec, host| {
-            out = Some(self.run_world(spec, seed, host, options));
+        self.worlds.with_scene(assignment, &mut |scene, host| {
+            out = Some(
+                crate::scenario::world_of(scene)
+                    .and_then(|spec| self.run_world(&spec, seed, host, options)),
+            );
         })?;
         out.ok_or_else(|| ScenarioError::Language("no world was built".into()))?
     }

@@ -10,6 +10,7 @@ use paracosm_oracles::{
 };
 
 use crate::runner::signal;
+use crate::scene::{LoadError, Scene};
 use crate::ScenarioError;
 
 /// A monitor a scenario asks for, built fresh for each test.
@@ -302,52 +303,153 @@ impl Scenario {
     /// itself (to read every actor's outputs each step, as `tests/motion.rs` does).
     ///
     /// # Errors
-    /// As [`Worlds::with_world`].
+    /// As [`Worlds::with_scene`], and [`ScenarioError::Load`] when the test's scene builds
+    /// no world ([`Scene::world`]).
     pub fn with_world(
         &self,
         assignment: &Assignment,
         run: &mut dyn FnMut(&WorldSpec, &mut dyn Host),
     ) -> Result<(), ScenarioError> {
-        self.worlds.with_world(assignment, run)
+        let mut built = Ok(());
+        self.worlds.with_scene(assignment, &mut |scene, host| {
+            built = world_of(scene).map(|spec| run(&spec, host));
+        })?;
+        built
     }
 
-    /// The scenario with its worlds built by `worlds` instead: for a library user's own
-    /// world builder (or a test's), keeping the space, monitors and system under test.
+    /// The scenario with its scenes built by `worlds` instead: for a library user's own
+    /// scene builder (or a test's), keeping the space, monitors and system under test.
     pub fn with_worlds(mut self, worlds: Arc<dyn Worlds>) -> Self {
         self.worlds = worlds;
         self
     }
 }
 
-/// Builds the world of each test (paper §3.1: a test case closes every open stream).
+/// The engine's world of a test's scene.
+///
+/// # Errors
+/// [`ScenarioError::Load`] naming the test's values as the cause.
+pub(crate) fn world_of(scene: &Scene) -> Result<WorldSpec, ScenarioError> {
+    scene.world().map_err(|e| {
+        ScenarioError::Load(LoadError {
+            message: format!("this test's values build no world: {}", e.message),
+            ..e
+        })
+    })
+}
+
+/// Builds the scene of each test (paper §3.1: a test case closes every open stream).
 pub trait Worlds: Send + Sync {
-    /// Builds the world for `assignment` and calls `run` with it and a host for its lambdas
+    /// Builds the scene for `assignment` and calls `run` with it and a host for its lambdas
     /// (a Starlark program's: each test gets its own evaluation of the program, heap and
     /// evaluator), for the duration of the test.
     ///
     /// # Errors
     /// [`ScenarioError::MissingParam`] for an assignment that lacks a parameter;
-    /// [`ScenarioError::Language`] or [`ScenarioError::Engine`] when these values give an
-    /// impossible world.
-    fn with_world(
+    /// [`ScenarioError::Load`] or [`ScenarioError::Engine`] when these values give an
+    /// impossible scene.
+    fn with_scene(
         &self,
         assignment: &Assignment,
-        run: &mut dyn FnMut(&WorldSpec, &mut dyn Host),
+        run: &mut dyn FnMut(&Scene, &mut dyn Host),
     ) -> Result<(), ScenarioError>;
 }
 
-/// Worlds built by a Rust function, whose streams call no lambda.
-pub struct RustWorlds(pub fn(&Assignment) -> Result<WorldSpec, ScenarioError>);
+/// Scenes declared by a Rust function, whose streams call no lambda: it receives an empty
+/// scene whose open parameters take the test's values by name ([`Scene::for_assignment`])
+/// and declares the test into it.
+pub struct RustWorlds(pub SceneFn);
+
+/// A Rust function that declares a scenario's scene into the empty scene it receives.
+pub type SceneFn = fn(Scene) -> Result<Scene, ScenarioError>;
 
 impl Worlds for RustWorlds {
-    fn with_world(
+    fn with_scene(
         &self,
         assignment: &Assignment,
-        run: &mut dyn FnMut(&WorldSpec, &mut dyn Host),
+        run: &mut dyn FnMut(&Scene, &mut dyn Host),
     ) -> Result<(), ScenarioError> {
-        let spec = (self.0)(assignment)?;
-        run(&spec, &mut paracosm_engine::rx::NoHost);
+        let scene = (self.0)(Scene::for_assignment(assignment))?;
+        run(&scene, &mut paracosm_engine::rx::NoHost);
         Ok(())
+    }
+}
+
+impl Scenario {
+    /// The scenario whose tests `build` declares, in plain Rust: its space, monitors, horizon,
+    /// system under test and failure map are read from the scene `build` declares with
+    /// representative values, as a front end's load does (the default `OffRoadMonitor` is
+    /// added unless the scene judges leaving the road or opts out).
+    ///
+    /// # Errors
+    /// What `build` returns; [`ScenarioError::Language`] for an open parameter without a
+    /// name, one that varies over time (a Rust scene declares constant parameters), or a
+    /// scene without an ego vehicle; [`ScenarioError::Space`] for an invalid space.
+    pub fn from_scenes(
+        name: &str,
+        description: &str,
+        build: SceneFn,
+    ) -> Result<Self, ScenarioError> {
+        let probe = build(Scene::new(None))?;
+        let mut params = Vec::new();
+        for d in probe.params() {
+            let bad = |why: &str| {
+                ScenarioError::Language(format!("the parameter declared at {}: {why}", d.site))
+            };
+            let name = d.name.as_deref().ok_or_else(|| bad("it has no name"))?;
+            if d.over_time != crate::scene::OverTime::Constant {
+                return Err(bad(
+                    "it varies over time, which a Rust scene does not declare",
+                ));
+            }
+            params.push(match &d.domain {
+                paracosm_generators::Domain::Interval { lo, hi } => {
+                    paracosm_generators::Param::interval(
+                        name,
+                        *lo,
+                        *hi,
+                        d.unit.as_deref().unwrap_or(""),
+                    )
+                }
+                paracosm_generators::Domain::Levels(levels) => {
+                    paracosm_generators::Param::levels(name, levels.clone())
+                }
+            });
+        }
+        let space = ParamSpace::new(params)?;
+        let mut monitors = probe.monitor_specs();
+        if probe.settings().offroad.unwrap_or(true)
+            && !monitors.iter().any(MonitorSpec::judges_off_road)
+        {
+            monitors.push(MonitorSpec::implicit_off_road());
+        }
+        let sut = probe
+            .ego()
+            .map(|(_, sut)| sut.clone())
+            .ok_or_else(|| ScenarioError::Language("the scene places no ego vehicle".into()))?;
+        let map_axes = probe.settings().map_axes.clone().unwrap_or_else(|| {
+            space
+                .params()
+                .iter()
+                .take(2)
+                .map(|p| p.name.clone())
+                .collect()
+        });
+        Ok(Scenario {
+            name: name.to_owned(),
+            description: description.to_owned(),
+            space,
+            horizon_s: probe.horizon_s(),
+            sut,
+            monitors,
+            map_axes,
+            warnings: vec![],
+            unused_params: vec![],
+            camera_only: vec![],
+            source: Arc::from(""),
+            input_files: Vec::new(),
+            worlds: Arc::new(RustWorlds(build)),
+        })
     }
 }
 
@@ -395,8 +497,8 @@ impl Scenario {
     pub fn instantiate(&self, assignment: &Assignment) -> Result<WorldSpec, ScenarioError> {
         let mut out = None;
         self.worlds
-            .with_world(assignment, &mut |spec, _| out = Some(spec.clone()))?;
-        out.ok_or_else(|| ScenarioError::Language("no world was built".into()))
+            .with_scene(assignment, &mut |scene, _| out = Some(world_of(scene)))?;
+        out.ok_or_else(|| ScenarioError::Language("no world was built".into()))?
     }
 }
 

@@ -5,36 +5,201 @@ use super::geometry::{direction, wrap, Pose2};
 use super::{Location, Network, PieceId, PieceKind, LANE_WIDTH_M};
 use crate::EngineError;
 
-/// A choice at a junction, relative to the direction of arrival.
+/// A choice at a junction, relative to the direction of arrival: a way out named by the
+/// heading change it makes (its angle, [`Turn::of_heading`]), or, on an OpenDRIVE map, by the
+/// connecting road it takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Turn {
-    /// Leave on the opposite side.
+    /// Leave on the opposite side: a heading change within 45° of none.
     Straight,
-    /// Leave a quarter turn to the left (counter-clockwise).
+    /// Leave a quarter turn to the left (counter-clockwise): a heading change of 45° to 135°
+    /// to the left.
     Left,
-    /// Leave a quarter turn to the right.
+    /// Leave a quarter turn to the right: a heading change of 45° to 135° to the right.
     Right,
+    /// Leave back the way it came: a heading change of more than 135° either way.
+    #[serde(rename = "uturn")]
+    UTurn,
+    /// Leave through the OpenDRIVE map's connecting road of this `<road id>` (written
+    /// `"road:ID"` in programs): the way to pick one of two ways out with one name.
+    Road(RoadName),
+}
+
+/// The heading change a turn is named for, rad, positive to the left: `0`, `π/2`, `-π/2`,
+/// `π`; `None` for [`Turn::Road`].
+fn nominal_rad(t: Turn) -> Option<f64> {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    match t {
+        Turn::Straight => Some(0.0),
+        Turn::Left => Some(FRAC_PI_2),
+        Turn::Right => Some(-FRAC_PI_2),
+        Turn::UTurn => Some(PI),
+        Turn::Road(_) => None,
+    }
 }
 
 impl Turn {
-    /// The turn's name in programs: `"straight"`, `"left"` or `"right"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Turn::Straight => "straight",
-            Turn::Left => "left",
-            Turn::Right => "right",
-        }
+    /// The turns named by their angle, in the order messages list them.
+    pub const NAMED: [Turn; 4] = [Turn::Straight, Turn::Left, Turn::Right, Turn::UTurn];
+
+    /// The turn's name in programs: `"straight"`, `"left"`, `"right"`, `"uturn"` or
+    /// `"road:ID"`.
+    pub fn name(self) -> String {
+        self.to_string()
     }
 
-    /// Parses `"straight"`, `"left"` or `"right"`.
+    /// Parses `"straight"`, `"left"`, `"right"`, `"uturn"` or `"road:ID"` (a connecting road's
+    /// `<road id>`, 1 to [`RoadName::MAX_BYTES`] bytes); `None` for anything else.
     pub fn parse(s: &str) -> Option<Turn> {
         match s {
             "straight" => Some(Turn::Straight),
             "left" => Some(Turn::Left),
             "right" => Some(Turn::Right),
-            _ => None,
+            "uturn" => Some(Turn::UTurn),
+            _ => s
+                .strip_prefix("road:")
+                .and_then(RoadName::new)
+                .map(Turn::Road),
         }
+    }
+
+    /// The turn a heading change of `delta_rad` (positive to the left, any angle) is named
+    /// by: the nearest of straight (0), left (`π/2`), right (`-π/2`) and uturn (`π`), so that
+    /// each names 90° of changes; a change of ±45° (to [`Turn::EDGE_RAD`]) is straight, of
+    /// ±135° left or right.
+    pub fn of_heading(delta_rad: f64) -> Turn {
+        use std::f64::consts::FRAC_PI_4;
+        let d = wrap(delta_rad);
+        if d.abs() <= FRAC_PI_4 + Turn::EDGE_RAD {
+            Turn::Straight
+        } else if d.abs() <= 3.0 * FRAC_PI_4 + Turn::EDGE_RAD {
+            if d > 0.0 {
+                Turn::Left
+            } else {
+                Turn::Right
+            }
+        } else {
+            Turn::UTurn
+        }
+    }
+
+    /// How far past 45° or 135° a heading change may be and still count as on the gentler
+    /// side of it, rad (0.57°): a map's roundabout drawn with its ring continuing 45° through
+    /// each junction continues straight, whatever the rounding of its sampled lanes.
+    pub const EDGE_RAD: f64 = 0.01;
+
+    /// The names of the ways out of one fork, from their heading changes (rad, positive to
+    /// the left): each way's [`Turn::of_heading`]; where several share a name, the one nearest
+    /// the name's angle keeps it and each other takes the next name on its side (from
+    /// straight, left or right; from left, uturn or straight; from right, straight or uturn;
+    /// from uturn, right or left) where no way has that one, the nearest to its angle first;
+    /// `None` for a way left without a name (a route takes it by its road, [`Turn::Road`]).
+    pub fn name_ways(deltas: &[f64]) -> Vec<Option<Turn>> {
+        let by_angle: Vec<Turn> = deltas.iter().map(|&d| Turn::of_heading(d)).collect();
+        let off = |i: usize, t: Turn| t.off_nominal_rad(deltas[i]);
+        let mut names: Vec<Option<Turn>> = vec![None; deltas.len()];
+        let mut movers: Vec<(usize, Turn)> = Vec::new();
+        for t in Turn::NAMED {
+            let mut holders: Vec<usize> = (0..deltas.len()).filter(|&i| by_angle[i] == t).collect();
+            holders.sort_by(|&a, &b| off(a, t).total_cmp(&off(b, t)));
+            let Some(&keeper) = holders.first() else {
+                continue;
+            };
+            names[keeper] = Some(t);
+            for &i in &holders[1..] {
+                let left_of_keeper = wrap(deltas[i] - deltas[keeper]) > 0.0;
+                let next = match (t, left_of_keeper) {
+                    (Turn::Straight, true) | (Turn::UTurn, false) => Turn::Left,
+                    (Turn::Straight, false) | (Turn::UTurn, true) => Turn::Right,
+                    (Turn::Left, true) | (Turn::Right, false) => Turn::UTurn,
+                    _ => Turn::Straight,
+                };
+                movers.push((i, next));
+            }
+        }
+        movers.sort_by(|a, b| off(a.0, a.1).total_cmp(&off(b.0, b.1)));
+        for (i, next) in movers {
+            if !names.contains(&Some(next)) && !by_angle.contains(&next) {
+                names[i] = Some(next);
+            }
+        }
+        names
+    }
+
+    /// How far a heading change of `delta_rad` is from the one this turn is named for, rad
+    /// (`0` for [`Turn::Road`], which names no angle).
+    pub fn off_nominal_rad(self, delta_rad: f64) -> f64 {
+        nominal_rad(self).map_or(0.0, |n| wrap(delta_rad - n).abs())
+    }
+}
+
+impl std::fmt::Display for Turn {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Turn::Straight => f.write_str("straight"),
+            Turn::Left => f.write_str("left"),
+            Turn::Right => f.write_str("right"),
+            Turn::UTurn => f.write_str("uturn"),
+            Turn::Road(r) => write!(f, "road:{}", r.as_str()),
+        }
+    }
+}
+
+/// An OpenDRIVE `<road id>` held inline, so that a [`Turn`] stays `Copy`: 1 to
+/// [`RoadName::MAX_BYTES`] bytes of UTF-8.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct RoadName {
+    len: u8,
+    bytes: [u8; RoadName::MAX_BYTES],
+}
+
+impl RoadName {
+    /// The longest road id a route can name, bytes.
+    pub const MAX_BYTES: usize = 30;
+
+    /// `id` as a road name; `None` when it is empty or longer than [`RoadName::MAX_BYTES`].
+    pub fn new(id: &str) -> Option<RoadName> {
+        let n = id.len();
+        if n == 0 || n > RoadName::MAX_BYTES {
+            return None;
+        }
+        let mut bytes = [0u8; RoadName::MAX_BYTES];
+        bytes[..n].copy_from_slice(id.as_bytes());
+        Some(RoadName {
+            len: n as u8,
+            bytes,
+        })
+    }
+
+    /// The road id.
+    pub fn as_str(&self) -> &str {
+        // Built from a `&str` cut at its own length: valid UTF-8.
+        std::str::from_utf8(&self.bytes[..usize::from(self.len)]).unwrap_or("")
+    }
+}
+
+impl std::fmt::Debug for RoadName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:?}", self.as_str())
+    }
+}
+
+impl Serialize for RoadName {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.as_str())
+    }
+}
+
+impl<'de> Deserialize<'de> for RoadName {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let id = String::deserialize(d)?;
+        RoadName::new(&id).ok_or_else(|| {
+            serde::de::Error::custom(format!(
+                "a road id of 1 to {} bytes, got {id:?}",
+                RoadName::MAX_BYTES
+            ))
+        })
     }
 }
 
@@ -139,15 +304,11 @@ impl Network {
                 }
                 let inward = wrap(pa.heading_rad + std::f64::consts::PI);
                 let delta = wrap(pb.heading_rad - inward);
-                let turn = if delta.abs() < 0.1 {
-                    Turn::Straight
-                } else if (delta - std::f64::consts::FRAC_PI_2).abs() < 0.1 {
-                    Turn::Left
-                } else if (delta + std::f64::consts::FRAC_PI_2).abs() < 0.1 {
-                    Turn::Right
-                } else {
+                // Named by its angle as a map's turns are; ports only at those angles.
+                let turn = Turn::of_heading(delta);
+                if turn.off_nominal_rad(delta) >= 0.1 {
                     continue;
-                };
+                }
                 for j in 1..=half {
                     // Incoming lanes lie left of the port's outward direction, outgoing right.
                     let left = direction(pa.heading_rad + std::f64::consts::FRAC_PI_2);
@@ -210,7 +371,7 @@ impl Network {
             let points = map
                 .0
                 .route(lane, start.at_m, turns, max_len_m)
-                .map_err(EngineError::InvalidWorld)?;
+                .map_err(|e| EngineError::InvalidWorld(e.to_string()))?;
             return Ok(resample(&points, ROUTE_SPACING_M));
         }
         let j = k.unsigned_abs();
@@ -362,7 +523,7 @@ impl Network {
         let pick = match wanted {
             Some(t) => {
                 let Some(c) = candidates.iter().find(|c| c.turn == t) else {
-                    let offered: Vec<String> = [Turn::Straight, Turn::Left, Turn::Right]
+                    let offered: Vec<String> = Turn::NAMED
                         .into_iter()
                         .filter(|o| candidates.iter().any(|c| c.turn == *o))
                         .map(|o| format!("\"{}\"", o.name()))

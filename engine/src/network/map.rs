@@ -170,6 +170,28 @@ pub enum LaneAtError {
     },
 }
 
+/// A route's turn that a fork of a map does not offer ([`RoadMap::route`]).
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+#[error(
+    "the route's turn {number} (\"{turn}\") is not possible at the fork where lane {lane} of road {road} of {map} ends: it offers {} there",
+    .offered.join(" and ")
+)]
+pub struct RouteError {
+    /// The turn's place in the route's list, from 1.
+    pub number: usize,
+    /// The turn.
+    pub turn: Turn,
+    /// The `<lane id>` of the lane that ends at the fork.
+    pub lane: i32,
+    /// Its `<road id>`.
+    pub road: String,
+    /// The map's file ([`RoadMap::source`]).
+    pub map: String,
+    /// The ways out: each one's name, connecting road and heading change, as
+    /// `"left" (road:56, +90°)`.
+    pub offered: Vec<String>,
+}
+
 /// A map's roads and lanes (see the module documentation).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RoadMap {
@@ -267,34 +289,142 @@ impl RoadMap {
             })
     }
 
-    /// The heading change from the end of lane `from`'s travel to the end of lane `to`'s,
-    /// rad, positive to the left.
-    fn turn_between(&self, from: usize, to: usize) -> f64 {
-        let travel_end = |l: &MapLane| {
-            let (a, b) = l.s_range();
-            l.pose(if l.forward { b } else { a }).1
-        };
-        wrap(travel_end(&self.lanes[to]) - travel_end(&self.lanes[from]))
+    /// The direction of travel at the end of lane `k`'s travel, rad.
+    fn travel_end_heading(&self, k: usize) -> f64 {
+        let l = &self.lanes[k];
+        let (a, b) = l.s_range();
+        l.pose(if l.forward { b } else { a }).1
+    }
+
+    /// The lane where a car that enters lane `to` leaves the road `to` belongs to, when that
+    /// road is a junction's connecting road (following `to`'s successors on that road, through
+    /// its lane sections); `to` itself otherwise.
+    fn through_junction(&self, to: usize) -> usize {
+        let mut k = to;
+        if self.roads[self.lanes[k].road].junction.is_none() {
+            return k;
+        }
+        for _ in 0..self.lanes.len() {
+            let l = &self.lanes[k];
+            match l.successors.iter().find(|&&n| self.lanes[n].road == l.road) {
+                Some(&n) if n != to => k = n,
+                _ => break,
+            }
+        }
+        k
+    }
+
+    /// The ways out of the fork where lane `at`'s travel ends: each successor lane with the
+    /// heading change it makes (rad, positive to the left: from the end of `at` to where the
+    /// car leaves the successor's connecting road, or the successor's own end outside
+    /// junctions) and the turn it is named by ([`Turn::name_ways`]; `None` for a way that
+    /// only its road names).
+    pub fn ways_out(&self, at: usize) -> Vec<(usize, f64, Option<Turn>)> {
+        let from = self.travel_end_heading(at);
+        let next = &self.lanes[at].successors;
+        let deltas: Vec<f64> = next
+            .iter()
+            .map(|&n| wrap(self.travel_end_heading(self.through_junction(n)) - from))
+            .collect();
+        let names = Turn::name_ways(&deltas);
+        next.iter()
+            .zip(deltas)
+            .zip(names)
+            .map(|((&n, d), t)| (n, d, t))
+            .collect()
+    }
+
+    /// The successor lane a route takes at the fork where lane `at` ends: the turn `wanted`
+    /// (by name, the way [`RoadMap::ways_out`] names so; by road id, the way through that
+    /// road), or, with none, straight on (the least heading change).
+    ///
+    /// # Errors
+    /// A [`RouteError`] (with `number` 0, for the caller to fill) when no way out makes the
+    /// turn.
+    fn choose(&self, at: usize, wanted: Option<Turn>) -> Result<usize, RouteError> {
+        let ways = self.ways_out(at);
+        // Among the ways `wanted` names, the one that turns least.
+        let pick = ways
+            .iter()
+            .filter(|w| match wanted {
+                None => true,
+                Some(Turn::Road(id)) => self.roads[self.lanes[w.0].road].od_id == id.as_str(),
+                Some(t) => w.2 == Some(t),
+            })
+            .min_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+            .map(|w| w.0);
+        pick.ok_or_else(|| {
+            let here = &self.lanes[at];
+            RouteError {
+                number: 0,
+                turn: wanted.unwrap_or(Turn::Straight),
+                lane: here.od_id,
+                road: self.roads[here.road].od_id.clone(),
+                map: self.source.clone(),
+                offered: ways
+                    .iter()
+                    .map(|w| {
+                        let road = &self.roads[self.lanes[w.0].road].od_id;
+                        let angle = w.1.to_degrees();
+                        match w.2 {
+                            Some(t) => format!("\"{t}\" (road:{road}, {angle:+.0}°)"),
+                            None => format!("\"road:{road}\" ({angle:+.0}°)"),
+                        }
+                    })
+                    .collect(),
+            }
+        })
     }
 
     /// The route from road station `s` of lane `lane` in its direction of travel, then on
     /// through its successors until the lanes end or the route is `max_len_m` long. At a
-    /// fork it takes the next turn of `turns` (straight on when the list is used up):
-    /// straight on is the successor whose heading at its end differs least from the lane's
-    /// at its end, left and right the ones that turn most to either side of it. World
+    /// fork (a lane with more than one drivable successor) it takes the next turn of `turns`
+    /// (straight on, the least heading change, when the list is used up). A fork's ways out
+    /// are named by the heading change from the end of the lane to where the car leaves the
+    /// junction's connecting road ([`RoadMap::ways_out`], [`Turn::name_ways`]): straight,
+    /// left, right or uturn, or [`Turn::Road`] for the way through a connecting road. World
     /// `[x, z]` m.
     ///
     /// # Errors
-    /// A message when a fork lacks the turn the list gives it (naming the turn, its place in
-    /// the list, the road and lane that end there and the turns the fork offers): a turn is
-    /// never replaced by another. Turns left over where the lanes end are not an error.
+    /// A [`RouteError`] when a fork lacks the turn the list gives it (naming the turn, its
+    /// place in the list, the road and lane that end there and the ways out it offers): a
+    /// turn is never replaced by another. Turns left over where the lanes end are not an
+    /// error.
     pub fn route(
         &self,
         lane: usize,
         s: f64,
         turns: &[Turn],
         max_len_m: f64,
-    ) -> Result<Vec<[f64; 2]>, String> {
+    ) -> Result<Vec<[f64; 2]>, RouteError> {
+        self.follow(lane, s, turns, max_len_m)
+            .map(|(_, points)| points)
+    }
+
+    /// The lanes (indices into [`RoadMap::lanes`]) that [`RoadMap::route`] drives, in order,
+    /// `lane` first.
+    ///
+    /// # Errors
+    /// As [`RoadMap::route`].
+    pub fn route_lanes(
+        &self,
+        lane: usize,
+        s: f64,
+        turns: &[Turn],
+        max_len_m: f64,
+    ) -> Result<Vec<usize>, RouteError> {
+        self.follow(lane, s, turns, max_len_m)
+            .map(|(lanes, _)| lanes)
+    }
+
+    /// [`RoadMap::route`]'s lanes and points.
+    fn follow(
+        &self,
+        lane: usize,
+        s: f64,
+        turns: &[Turn],
+        max_len_m: f64,
+    ) -> Result<(Vec<usize>, Vec<[f64; 2]>), RouteError> {
         let l = &self.lanes[lane];
         let mut points = vec![l.pose(s).0];
         let ahead =
@@ -314,56 +444,20 @@ impl RoadMap {
             .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
             .sum();
         let mut turns = turns.iter().enumerate();
+        let mut lanes = vec![lane];
         let mut at = lane;
-        let mut visits = 0usize;
-        while length < max_len_m && visits < 10_000 {
-            visits += 1;
+        while length < max_len_m && lanes.len() <= 10_000 {
             let next = &self.lanes[at].successors;
             let pick = match next.len() {
                 0 => break,
                 1 => next[0],
                 _ => {
-                    // Straight on is the successor that turns least; left and right, the ones
-                    // that turn most either way of it.
-                    let turn: Vec<f64> = next.iter().map(|&n| self.turn_between(at, n)).collect();
-                    let by = |key: &dyn Fn(f64) -> f64| {
-                        (0..next.len())
-                            .min_by(|&a, &b| key(turn[a]).total_cmp(&key(turn[b])))
-                            .expect("two or more")
-                    };
-                    let straight = by(&|t: f64| t.abs());
-                    let left = Some(by(&|t: f64| -t)).filter(|&i| turn[i] > turn[straight]);
-                    let right = Some(by(&|t: f64| t)).filter(|&i| turn[i] < turn[straight]);
-                    let of = |t: Turn| match t {
-                        Turn::Straight => Some(straight),
-                        Turn::Left => left,
-                        Turn::Right => right,
-                    };
-                    match turns.next() {
-                        None => next[straight],
-                        Some((k, &t)) => match of(t) {
-                            Some(i) => next[i],
-                            None => {
-                                let offered: Vec<String> =
-                                    [Turn::Straight, Turn::Left, Turn::Right]
-                                        .into_iter()
-                                        .filter(|&o| of(o).is_some())
-                                        .map(|o| format!("\"{}\"", o.name()))
-                                        .collect();
-                                let here = &self.lanes[at];
-                                return Err(format!(
-                                    "the route's turn {} (\"{}\") is not possible at the fork \
-                                     where lane {} of road {} of {} ends: it offers {} there",
-                                    k + 1,
-                                    t.name(),
-                                    here.od_id,
-                                    self.roads[here.road].od_id,
-                                    self.source,
-                                    offered.join(" and ")
-                                ));
-                            }
-                        },
-                    }
+                    let wanted = turns.next();
+                    self.choose(at, wanted.map(|(_, &t)| t))
+                        .map_err(|e| RouteError {
+                            number: wanted.map_or(0, |(k, _)| k + 1),
+                            ..e
+                        })?
                 }
             };
             for q in self.lanes[pick].travel_points() {
@@ -374,13 +468,14 @@ impl RoadMap {
                     points.push(q);
                 }
             }
+            lanes.push(pick);
             at = pick;
         }
         if points.len() < 2 {
             let (p, h) = l.pose(s);
             points.push([p[0] + h.cos() * 0.5, p[1] - h.sin() * 0.5]);
         }
-        Ok(points)
+        Ok((lanes, points))
     }
 
     /// Every lane's strip as triangles: vertices (world `[x, z]` m, the left and right

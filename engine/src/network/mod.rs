@@ -23,8 +23,8 @@ pub use geometry::{direction, wrap, Pose2};
 pub(crate) use lanes::{heading_between, tangent_at};
 #[cfg(test)]
 pub(crate) use lanes::{heading_on_leg, vertex_tangents};
-pub use lanes::{LanePath, Turn, MIN_PATH_RADIUS_M};
-pub use map::{LaneAtError, MapIndex, MapLane, MapRef, MapRoad, RoadMap};
+pub use lanes::{LanePath, RoadName, Turn, MIN_PATH_RADIUS_M};
+pub use map::{LaneAtError, MapIndex, MapLane, MapRef, MapRoad, RoadMap, RouteError};
 pub use piece::{
     Piece, PieceKind, PortGeometry, JUNCTION_APRON_M, LANE_WIDTH_M, MAX_EXTENT_M, MAX_TURN_RAD,
     MIN_CURVE_RADIUS_M, PORT_NAMES, SIDEWALK_WIDTH_M,

@@ -579,3 +579,108 @@ fn a_location_at_a_port_faces_the_arm() {
         }
     }
 }
+
+#[test]
+fn turns_are_named_by_their_angle_and_a_road_id_is_a_turn() {
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+    for (delta, turn) in [
+        (0.0, Turn::Straight),
+        (FRAC_PI_4, Turn::Straight),
+        (-FRAC_PI_4, Turn::Straight),
+        (0.8, Turn::Left),
+        (FRAC_PI_2, Turn::Left),
+        (3.0 * FRAC_PI_4, Turn::Left),
+        (-FRAC_PI_2, Turn::Right),
+        (-3.0 * FRAC_PI_4, Turn::Right),
+        (2.4, Turn::UTurn),
+        (PI, Turn::UTurn),
+        (-PI, Turn::UTurn),
+        (2.0 * PI + 0.1, Turn::Straight),
+    ] {
+        assert_eq!(Turn::of_heading(delta), turn, "{delta} rad");
+    }
+    assert!(Turn::Left.off_nominal_rad(1.4) < Turn::Left.off_nominal_rad(0.9));
+    // Ways out that share a name: the nearest keeps it, the next takes the free name on its
+    // side, or none (then only its road names it).
+    let deg = |d: &[f64]| Turn::name_ways(&d.iter().map(|x| x.to_radians()).collect::<Vec<_>>());
+    let (s, l, r, u) = (
+        Some(Turn::Straight),
+        Some(Turn::Left),
+        Some(Turn::Right),
+        Some(Turn::UTurn),
+    );
+    assert_eq!(deg(&[29.0, -42.0]), [s, r]);
+    assert_eq!(deg(&[-90.0, 90.0]), [r, l]);
+    assert_eq!(deg(&[0.0, 90.0, 130.0]), [s, l, u]);
+    assert_eq!(deg(&[0.0, -90.0, -44.0]), [s, r, None]);
+    assert_eq!(deg(&[45.0, -66.0]), [s, r]);
+    assert_eq!(deg(&[10.0, -10.0, 0.0]), [l, r, s]);
+    for name in [
+        "straight",
+        "left",
+        "right",
+        "uturn",
+        "road:56",
+        "road:ring.3-a",
+    ] {
+        let t = Turn::parse(name).unwrap();
+        assert_eq!(t.name(), name);
+    }
+    assert_eq!(
+        Turn::parse("road:56"),
+        Some(Turn::Road(RoadName::new("56").unwrap()))
+    );
+    let long = format!("road:{}", "x".repeat(RoadName::MAX_BYTES + 1));
+    for bad in ["", "road:", "Left", "u-turn", "56", long.as_str()] {
+        assert_eq!(Turn::parse(bad), None, "{bad:?}");
+    }
+    let road = Turn::Road(RoadName::new("56").unwrap());
+    assert_eq!(serde_json::to_string(&road).unwrap(), r#"{"road":"56"}"#);
+    assert_eq!(serde_json::to_string(&Turn::UTurn).unwrap(), r#""uturn""#);
+    assert_eq!(
+        serde_json::from_str::<Turn>(r#"{"road":"56"}"#).unwrap(),
+        road
+    );
+}
+
+#[test]
+fn a_t_intersections_stem_offers_left_and_right_and_no_uturn_or_road() {
+    let mut n = Network::new();
+    let t = n
+        .add(
+            "t",
+            PieceKind::TIntersection {
+                lanes: 2,
+                friction: 0.8,
+            },
+        )
+        .unwrap();
+    let paths = n.lane_paths(t);
+    let turns = |port: usize| {
+        let mut v: Vec<String> = paths
+            .iter()
+            .filter(|p| p.entry.0 == port)
+            .map(|p| p.turn.name())
+            .collect();
+        v.sort();
+        v
+    };
+    let all: Vec<Vec<String>> = (0..3).map(turns).collect();
+    assert!(
+        all.contains(&vec!["left".to_owned(), "right".to_owned()]),
+        "{all:?}"
+    );
+    assert_eq!(
+        all.iter()
+            .filter(|v| v.contains(&"straight".to_owned()))
+            .count(),
+        2
+    );
+    for turn in [Turn::UTurn, Turn::parse("road:1").unwrap()] {
+        let e = n
+            .on_junction_lane(t, ONE, turn, 1, 0.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(&format!("no \"{}\" turn", turn.name())), "{e}");
+    }
+}

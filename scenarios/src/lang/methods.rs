@@ -245,7 +245,12 @@ fn lambda<'v>(f: Value<'v>, what: &str, eval: &mut Evaluator<'v, '_, '_>) -> any
 
 fn push(eval: &Evaluator<'_, '_, '_>, node: Node) -> anyhow::Result<Stream> {
     let st = state(eval)?;
-    let id = st.scene.borrow_mut().graph.push_at(node, here(eval));
+    let id = st
+        .scene
+        .borrow_mut()
+        .scene
+        .graph_mut()
+        .push_at(node, here(eval));
     Ok(Stream::of(id.0))
 }
 
@@ -518,7 +523,11 @@ fn check_lane(a: &Action, eval: &Evaluator<'_, '_, '_>) -> anyhow::Result<()> {
     let super::scene::Pending::Car(super::scene::PendingCar { loc, .. }) = &object.pending else {
         return Ok(());
     };
-    let Some(start) = b.locs.get(*loc).and_then(|r| r.resolve(&b.roads).ok()) else {
+    let Some(start) = b
+        .locs
+        .get(*loc)
+        .and_then(|r| r.resolve(b.scene.roads()).ok())
+    else {
         return Ok(());
     };
     let lanes = b.lane_offsets(&start);
@@ -646,7 +655,7 @@ impl<'v> OnLaneArgs<'v> {
             );
         }
         let s_m = number(s, "onLane(s=)")?;
-        let PieceKind::Map { map, .. } = &b.roads.piece(piece).kind else {
+        let PieceKind::Map { map, .. } = &b.scene.roads().piece(piece).kind else {
             bail!("{this} is no map");
         };
         match map.0.roads.iter().position(|r| r.od_id == road) {
@@ -699,7 +708,7 @@ impl<'v> OnLaneArgs<'v> {
             Some(p) if p.piece == this.piece => p.index,
             Some(p) => bail!(
                 "a junction's onLane takes one of its own ports first (such as j.ONE), got {}.{}, a port of another piece",
-                b.roads.piece(PieceId(p.piece)).name,
+                b.scene.roads().piece(PieceId(p.piece)).name,
                 crate::lang::values::PORTS[p.index]
             ),
             None => bail!(
@@ -787,7 +796,7 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
         } else {
             args.in_junction(this, piece, &b)?
         };
-        let at = r.resolve(&b.roads).map_err(|e| anyhow!(e))?;
+        let at = r.resolve(b.scene.roads()).map_err(|e| anyhow!(e))?;
         b.locs.push(r);
         if let Ok(mut t) = b.loc_table.write() {
             t.push(Some(at));
@@ -811,48 +820,7 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
             bail!("connect after place(...): the world is already placed");
         }
         for link in links.items {
-            let t = TupleRef::from_value(link)
-                .filter(|t| t.len() == 3)
-                .ok_or_else(|| {
-                    anyhow!("connect takes tuples (port, child, child_port), got {link}")
-                })?;
-            let items = t.content();
-            let port = |v: Value<'v>| {
-                v.downcast_ref::<Port>().copied().ok_or_else(|| {
-                    anyhow!(
-                        "connect's tuples name ports first and last (such as t.ONE), got {}",
-                        crate::lang::a_type(v.get_type())
-                    )
-                })
-            };
-            let (p, c) = (port(items[0])?, port(items[2])?);
-            let child = items[1].downcast_ref::<Road>().ok_or_else(|| {
-                anyhow!(
-                    "connect's tuples name a road piece second, got {}",
-                    crate::lang::a_type(items[1].get_type())
-                )
-            })?;
-            let port_name = |q: Port| b.roads.port_name((PieceId(q.piece), q.index));
-            let piece_name = |i: usize| b.roads.piece(PieceId(i)).name.clone();
-            if c.piece != child.piece {
-                bail!(
-                    "the child port {} is not a port of the child {}: the third item of each \
-                     tuple is a port of the second",
-                    port_name(c),
-                    piece_name(child.piece),
-                );
-            }
-            if b.roads.group_of(PieceId(p.piece)) != b.roads.group_of(PieceId(this.piece)) {
-                bail!(
-                    "the port {} belongs to neither {} nor a piece already connected to it: \
-                     connect it from its own piece or network",
-                    port_name(p),
-                    piece_name(this.piece)
-                );
-            }
-            b.roads
-                .connect(PieceId(p.piece), p.index, PieceId(c.piece), c.index)
-                .map_err(|e| anyhow!(super::scene::strip(e)))?;
+            connect_one(&mut b, this, link)?;
         }
         // Pieces moved: every location stands where the network now puts it.
         b.resolve_locations();
@@ -861,6 +829,57 @@ pub(crate) fn road_methods(builder: &mut MethodsBuilder) {
             ..*this
         })
     }
+}
+
+/// One `(port, child, child_port)` tuple of `parent.connect(...)`: joins the child to the
+/// port of `this` road or network.
+///
+/// # Errors
+/// A tuple of another shape, a child port not of the child, a port outside this network, or
+/// the network's refusal (overlap, mismatched lanes).
+fn connect_one<'v>(b: &mut SceneBuilder, this: &Road, link: Value<'v>) -> anyhow::Result<()> {
+    let t = TupleRef::from_value(link)
+        .filter(|t| t.len() == 3)
+        .ok_or_else(|| anyhow!("connect takes tuples (port, child, child_port), got {link}"))?;
+    let items = t.content();
+    let port = |v: Value<'v>| {
+        v.downcast_ref::<Port>().copied().ok_or_else(|| {
+            anyhow!(
+                "connect's tuples name ports first and last (such as t.ONE), got {}",
+                crate::lang::a_type(v.get_type())
+            )
+        })
+    };
+    let (p, c) = (port(items[0])?, port(items[2])?);
+    let child = items[1].downcast_ref::<Road>().ok_or_else(|| {
+        anyhow!(
+            "connect's tuples name a road piece second, got {}",
+            crate::lang::a_type(items[1].get_type())
+        )
+    })?;
+    let port_name = |q: Port| b.scene.roads().port_name((PieceId(q.piece), q.index));
+    let piece_name = |i: usize| b.scene.roads().piece(PieceId(i)).name.clone();
+    if c.piece != child.piece {
+        bail!(
+            "the child port {} is not a port of the child {}: the third item of each \
+             tuple is a port of the second",
+            port_name(c),
+            piece_name(child.piece),
+        );
+    }
+    if b.scene.roads().group_of(PieceId(p.piece)) != b.scene.roads().group_of(PieceId(this.piece)) {
+        bail!(
+            "the port {} belongs to neither {} nor a piece already connected to it: \
+             connect it from its own piece or network",
+            port_name(p),
+            piece_name(this.piece)
+        );
+    }
+    b.scene
+        .roads_mut()
+        .connect(PieceId(p.piece), p.index, PieceId(c.piece), c.index)
+        .map_err(|e| anyhow!(super::scene::strip(e)))?;
+    Ok(())
 }
 
 /// World methods: `place`.

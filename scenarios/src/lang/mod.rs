@@ -11,7 +11,6 @@
 mod builtins;
 mod globals;
 mod host;
-pub mod load_error;
 pub mod map_files;
 mod methods;
 mod names;
@@ -29,13 +28,17 @@ use starlark::syntax::{AstModule, Dialect};
 
 use crate::{Scenario, ScenarioError};
 
+pub use crate::scene::{LoadError, LoadErrorKind, Site};
 pub use host::MAX_LAMBDA_STEPS;
-pub use load_error::{LoadError, LoadErrorKind, Site};
+/// Where the language's refusals come from: the scene model's typed load errors.
+pub mod load_error {
+    pub use crate::scene::{refused, LoadError, LoadErrorKind, Site};
+}
 pub use program::{MAX_CHECKED_WORLDS, MAX_CHECK_STEPS, MAX_LOAD_CHECK_STEPS, MAX_PARAMS};
 pub use values::OverTime;
 
 /// The length of a test when the program does not set one with `test(horizon=)`, seconds.
-pub const DEFAULT_HORIZON_S: f64 = 15.0;
+pub use crate::scene::DEFAULT_HORIZON_S;
 /// Most evaluation steps (function calls and loop iterations) a program may take to load.
 pub const MAX_LOAD_STEPS: u64 = 10_000_000;
 /// Most heap a program may use to load, in bytes.

@@ -4,58 +4,19 @@
 //! worlds"), and a few times when it loads, to learn its parameters and check its worlds.
 
 use super::load_error::{LoadError, LoadErrorKind};
-use paracosm_engine::actor::Roster;
-use paracosm_engine::behaviour::{ActorRef, GraphBuilder, Output, Probe};
+use paracosm_engine::behaviour::{ActorRef, Output};
 use paracosm_engine::network::{Location, Network, PieceId, PieceKind, Turn};
-use paracosm_engine::rx::{Node, OpenStream, StreamId, Value};
+use paracosm_engine::rx::{Node, StreamId};
 use paracosm_engine::sut::SutConfig;
-use paracosm_engine::{
-    CarSpec, EgoSpec, EnvironmentSpec, ObstacleSpec, PedestrianSpec, Size, VehicleParams,
-    WorldSpec, DEFAULT_DT_S,
-};
-use paracosm_generators::{Domain, Value as Level};
+use paracosm_engine::{CarSpec, EgoSpec, ObstacleSpec, PedestrianSpec, Size, VehicleParams};
+use paracosm_generators::Value as Level;
 
-use super::values::OverTime;
 use crate::scenario::Warning;
-use crate::MonitorSpec;
 
-/// A level as the stream carries it: numbers as numbers, bools as bools, texts as strings.
-pub fn level_value(l: &Level) -> Value {
-    match l {
-        Level::Int(i) => Value::Num(*i as f64),
-        Level::Real(x) => Value::Num(*x),
-        Level::Bool(b) => Value::Bool(*b),
-        Level::Text(t) => Value::Text(t.clone()),
-    }
-}
-
-/// The `tick` stream: the first node of every program's graph.
-pub const TICK: StreamId = StreamId(0);
-
-/// A `VarInterval` or `VarEnum` as declared.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParamDecl {
-    /// `name=`, if given.
-    pub name: Option<String>,
-    /// Range or levels.
-    pub domain: Domain,
-    /// `unit=`.
-    pub unit: Option<String>,
-    /// `over_time=`.
-    pub over_time: OverTime,
-    /// Where it was declared, `file:line:col`.
-    pub at: String,
-}
-
-/// What an open parameter is in one evaluation of the program.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ParamValue {
-    /// A parameter constant over the test: its value, which the program sees as a plain
-    /// number, string or bool.
-    Level(Level),
-    /// A parameter that varies over the test: the stream of its values.
-    Over(OpenStream),
-}
+pub use crate::scene::{
+    coordinate_names, level_value, representative, ParamDecl, ParamValue, TICK,
+};
+use crate::scene::{Scene, Site};
 
 /// What a program sees of an open parameter it declares ([`SceneBuilder::param`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -241,66 +202,23 @@ impl ObjectDecl {
     }
 }
 
-/// Everything one evaluation of a program declares.
+/// Everything one evaluation of a program declares: the typed [`Scene`] it builds, and what
+/// only the language needs on the way (actors not yet placed, `onLane` locations that move
+/// with `connect`, the lambdas stored, what the program printed).
 #[derive(Debug)]
 pub struct SceneBuilder {
-    /// The stream graph.
-    pub graph: GraphBuilder,
-    /// Open parameters, in declaration order.
-    pub params: Vec<ParamDecl>,
-    /// The values this evaluation gives the parameters, by declaration index; `None`: each
-    /// parameter's representative value (an interval's lower bound, the first level).
-    pub values: Option<Vec<ParamValue>>,
-    /// The road pieces.
-    pub roads: Network,
-    /// Each piece's friction stream.
-    pub frictions: Vec<(PieceId, StreamId)>,
-    /// Where each road piece was declared (`file:line:col`), by piece.
-    pub pieces_at: Vec<String>,
+    /// The scene this evaluation builds.
+    pub scene: Scene,
     /// How far routes are planned, m ([`route_length_m`] of the horizon).
     pub route_m: f64,
-    /// The ego vehicle, once placed: the engine's spec (an actor goes from its declaration,
-    /// [`Pending`], straight to the engine's spec when `place` resolves its locations).
-    pub ego: Option<EgoSpec>,
-    /// The ego vehicle's system under test (`AutonomousVehicle(sut=)`), once placed.
-    pub sut: Option<SutConfig>,
-    /// Pedestrians.
-    pub pedestrians: Vec<PedestrianSpec>,
-    /// Cars.
-    pub cars: Vec<CarSpec>,
-    /// Static obstacles.
-    pub obstacles: Vec<ObstacleSpec>,
-    /// `World(light=, fog=)`.
-    pub world: Option<(StreamId, StreamId)>,
     /// Whether `place` ran.
     pub placed: bool,
-    /// Monitors.
-    pub monitors: Vec<MonitorSpec>,
-    /// Where each monitor was declared (or last wrapped), `file:line:col`, in the order of
-    /// [`SceneBuilder::monitors`].
-    pub monitors_at: Vec<String>,
-    /// Where `test(...)` was called, `file:line:col`.
-    pub test_at: Option<String>,
-    /// `test(horizon=)`, seconds.
-    pub horizon_s: Option<f64>,
-    /// `test(map=)`: one or two parameter names.
-    pub map_axes: Option<Vec<String>>,
-    /// `test(offroad=)`: whether the default `OffRoadMonitor` is added (default true).
-    pub offroad: Option<bool>,
     /// Where `place(...)` was called, `file:line:col`.
     pub placed_at: Option<String>,
     /// Warnings so far.
     pub warnings: Vec<Warning>,
-    /// The cars' names for messages, in the order of [`SceneBuilder::cars`].
-    pub car_names: Vec<String>,
-    /// The obstacles' names for messages, in the order of [`SceneBuilder::obstacles`].
-    pub obstacle_names: Vec<String>,
     /// Number of lambdas stored so far.
     pub lambdas: u32,
-    /// Streams published by name to monitors (`Monitor`, `Assert`, `Signal`).
-    pub published: Vec<(String, StreamId)>,
-    /// Each `Signal(name, ...)`'s name and where it was called, `file:line:col`.
-    pub signals_at: Vec<(String, String)>,
     /// What the program printed while this evaluation ran (the start of a test's log).
     pub log: Vec<String>,
     /// `onLane` results, by index.
@@ -308,82 +226,25 @@ pub struct SceneBuilder {
     /// Where each of `locs` stands on the network as it is now, shared with the `Location`
     /// values of the program.
     pub loc_table: super::position::LocTable,
-    /// Declared actors, in declaration order.
+    /// Declared objects, in declaration order, until `place` places them.
     pub objects: Vec<ObjectDecl>,
-    /// The handles of the pedestrians declared so far, in declaration order (the order of
-    /// the world's [`WorldSpec::pedestrians`]).
-    pub pedestrian_handles: Roster<PedestrianSpec>,
-    /// The handles of the cars declared so far, in declaration order.
-    pub car_handles: Roster<CarSpec>,
-}
-
-/// The value a parameter takes when an evaluation gives it none: an interval's lower bound,
-/// the first level (constant over time, or the same as coefficients over time).
-pub fn representative(decl: &ParamDecl, horizon_s: f64) -> ParamValue {
-    let lowest = match &decl.domain {
-        Domain::Interval { lo, .. } => Level::Real(*lo),
-        Domain::Levels(levels) => levels[0].clone(),
-    };
-    match decl.over_time {
-        OverTime::Constant => ParamValue::Level(lowest),
-        over => {
-            let lo = lowest.as_f64().unwrap_or(0.0);
-            let n = coordinate_names("p", over).len();
-            ParamValue::Over(match over {
-                OverTime::Piecewise(_) => OpenStream::Piecewise {
-                    values: vec![lo; n],
-                    horizon_s,
-                },
-                _ => OpenStream::Polynomial {
-                    coefficients: vec![lo; n],
-                    horizon_s,
-                },
-            })
-        }
-    }
 }
 
 impl SceneBuilder {
-    /// A builder with the `tick` stream as stream [`TICK`], for an evaluation that gives the
-    /// parameters `values` (by declaration index; `None`: representative values).
+    /// A builder of a scene for an evaluation that gives the parameters `values` (by
+    /// declaration index; `None`: representative values).
     pub fn new(values: Option<Vec<ParamValue>>) -> Self {
-        let mut graph = GraphBuilder::new();
-        let tick = graph.push(Node::Tick);
-        debug_assert_eq!(tick, TICK);
         SceneBuilder {
-            graph,
-            params: Vec::new(),
-            values,
-            roads: Network::new(),
-            frictions: Vec::new(),
-            pieces_at: Vec::new(),
+            scene: Scene::new(values),
             route_m: MAX_ROUTE_M,
-            ego: None,
-            sut: None,
-            pedestrians: Vec::new(),
-            cars: Vec::new(),
-            obstacles: Vec::new(),
-            world: None,
             placed: false,
-            monitors: Vec::new(),
-            horizon_s: None,
-            map_axes: None,
-            offroad: None,
             placed_at: None,
-            monitors_at: Vec::new(),
-            test_at: None,
             warnings: Vec::new(),
-            car_names: Vec::new(),
-            obstacle_names: Vec::new(),
             lambdas: 0,
-            published: Vec::new(),
-            signals_at: Vec::new(),
             log: Vec::new(),
             locs: Vec::new(),
             loc_table: Default::default(),
             objects: Vec::new(),
-            pedestrian_handles: Roster::default(),
-            car_handles: Roster::default(),
         }
     }
 
@@ -392,59 +253,18 @@ impl SceneBuilder {
     /// declared more parameters than with other values) gets its representative value, so that
     /// the run goes on and the load reports it, naming it.
     pub fn param(&mut self, decl: ParamDecl) -> Seen {
-        let k = self.params.len();
-        let value = match &self.values {
-            None => representative(&decl, self.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S)),
-            // A parameter only these values declare: its representative value, so that the
-            // run goes on and the program reports it, naming it.
-            Some(values) => values.get(k).cloned().unwrap_or_else(|| {
-                representative(&decl, self.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S))
-            }),
-        };
-        self.params.push(decl);
-        match value {
-            ParamValue::Level(l) => Seen::Level(l),
-            ParamValue::Over(_) => Seen::Stream(self.graph.push(Node::Param(k))),
+        match self.scene.declare_param(decl) {
+            (ParamValue::Level(l), _) => Seen::Level(l),
+            (ParamValue::Over(_), k) => Seen::Stream(self.scene.push(Node::Param(k))),
         }
     }
 
     /// A probe stream.
     pub fn probe(&mut self, actor: ActorRef, output: Output) -> StreamId {
-        self.graph.push(Node::Probe(Probe::new(actor, output)))
+        self.scene.probe(actor, output)
     }
 }
 
-/// The names of the coordinates a parameter adds to the space.
-pub fn coordinate_names(name: &str, over_time: OverTime) -> Vec<String> {
-    match over_time {
-        OverTime::Constant => vec![name.to_owned()],
-        OverTime::Piecewise(k) => (0..k).map(|i| format!("{name}[{i}]")).collect(),
-        OverTime::Polynomial(d) => (0..=d).map(|i| format!("{name}.c{i}")).collect(),
-    }
-}
-
-/// The streams of the parameters that vary over time, by declaration index, for
-/// [`paracosm_engine::rx::Graph::bind`]; constant ones get an unused placeholder.
-fn over_time_streams(b: &SceneBuilder, horizon_s: f64) -> Vec<OpenStream> {
-    b.params
-        .iter()
-        .enumerate()
-        .map(|(k, decl)| {
-            let v = match &b.values {
-                Some(values) => values[k].clone(),
-                None => representative(decl, horizon_s),
-            };
-            match v {
-                ParamValue::Over(s) => s,
-                ParamValue::Level(l) => OpenStream::Constant(level_value(&l)),
-            }
-        })
-        .collect()
-}
-
-/// The test's world from a finished, placed evaluation.
-///
-/// # Errors
 /// An object's name with where it was declared, `Car c (f.star:4:5)`, unless the name already
 /// says it (`Car at f.star:2:12 (called from ...)`).
 fn declared(name: &str, at: &str) -> String {
@@ -453,337 +273,6 @@ fn declared(name: &str, at: &str) -> String {
     } else {
         format!("{name} ({at})")
     }
-}
-
-/// A message when the program placed nothing or no ego vehicle, or its graph is invalid.
-pub fn world(b: &SceneBuilder, horizon_s: f64) -> Result<WorldSpec, LoadError> {
-    let worlds = |message: &str| LoadError::new(LoadErrorKind::Worlds, message);
-    let ego = b
-        .ego
-        .as_ref()
-        .ok_or_else(|| worlds("the program places no AutonomousVehicle: nothing to test"))?;
-    let (light, fog) = b
-        .world
-        .ok_or_else(|| worlds("the program has no World(...)"))?;
-    let mut nodes = b.graph.clone();
-    let published = published(b, &mut nodes)?;
-    refuse_monitors_of_absent_cars(b, nodes.nodes(), &published)?;
-    let graph = nodes.finish().map_err(|e| worlds(&e.to_string()))?;
-    let streams = graph
-        .bind(&over_time_streams(b, horizon_s))
-        .map_err(|e| worlds(&e.to_string()))?;
-    // Pieces whose friction is constant carry it; the others get it from their stream each
-    // step.
-    let mut network = b.roads.clone();
-    let mut friction_streams = Vec::new();
-    for &(piece, stream) in &b.frictions {
-        match streams.nodes().get(stream.0) {
-            Some(Node::Const(Value::Num(mu))) => network
-                .set_friction(piece, *mu)
-                .map_err(|e| LoadError::new(LoadErrorKind::Worlds, strip(e)))?,
-            _ => friction_streams.push((piece, stream)),
-        }
-    }
-    Ok(WorldSpec {
-        dt_s: DEFAULT_DT_S,
-        network,
-        frictions: friction_streams,
-        ego: ego.clone(),
-        pedestrians: b.pedestrians.clone(),
-        cars: b.cars.clone(),
-        obstacles: b.obstacles.clone(),
-        environment: EnvironmentSpec { light, fog },
-        streams,
-        published,
-        sensors: paracosm_engine::SensorSpec::defaults(),
-    })
-}
-
-/// Refuses a world in which a monitor reads the outputs of a car this world leaves out
-/// (`Car(enabled = False)`): such a car is not in the test, its outputs carry no events, and
-/// the monitor would have nothing to judge. A stream depends on a car when the car's probe
-/// feeds it through any input but a `takeUntil`'s stop (a stop that never fires cuts
-/// nothing).
-///
-/// # Errors
-/// A message naming the monitor, the car, how to read an optional car, and the monitor's
-/// `file:line:col`.
-fn refuse_monitors_of_absent_cars(
-    b: &SceneBuilder,
-    nodes: &[Node],
-    published: &[(String, StreamId)],
-) -> Result<(), LoadError> {
-    let absent: Vec<usize> = (0..b.cars.len()).filter(|&i| !b.cars[i].enabled).collect();
-    if absent.is_empty() {
-        return Ok(());
-    }
-    // The absent car each stream depends on, in topological order (a node's inputs come
-    // before it).
-    let mut reads: Vec<Option<usize>> = vec![None; nodes.len()];
-    for (i, node) in nodes.iter().enumerate() {
-        reads[i] = match node {
-            Node::Probe(p) => match p.actor {
-                ActorRef::Car(c) if absent.contains(&c.index()) => Some(c.index()),
-                _ => None,
-            },
-            Node::TakeUntil { src, .. } => reads.get(src.0).copied().flatten(),
-            other => other
-                .inputs()
-                .iter()
-                .find_map(|s| reads.get(s.0).copied().flatten()),
-        };
-    }
-    for (name, id) in published {
-        let Some(car) = reads.get(id.0).copied().flatten() else {
-            continue;
-        };
-        let reader = b.monitors.iter().enumerate().find(|(_, m)| {
-            m.signals().iter().any(|s| {
-                s == name
-                    || s.strip_prefix(name.as_str())
-                        .is_some_and(|c| [".x", ".y", ".z"].contains(&c))
-            })
-        });
-        if let Some((k, m)) = reader {
-            let at = b.monitors_at.get(k).map(String::as_str).unwrap_or("");
-            let car_name = b.car_names.get(car).map(String::as_str).unwrap_or("a Car");
-            return Err(LoadError::new(
-                LoadErrorKind::Declarations,
-                format!(
-                "monitor `{}` reads {car_name}, which this world leaves out (enabled = False): \
-                 the car is not in the test, its outputs have no events, and the monitor \
-                 would have nothing to judge. For a car that is in some tests only, read it \
-                 in a lambda through a top-level variable (`lead_speed = lead.speed`), which \
-                 is None while the car is absent, and judge a stream that always fires \
-                 (`tick.map(...)`)\n --> {at}",
-                m.name()
-            ),
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// Checks that every signal a monitor reads is published by the runner, the program or an
-/// actor (see [`world`]).
-///
-/// # Errors
-/// A message naming the signal, what is published, and the monitor's `file:line:col`.
-pub fn check_signals(b: &SceneBuilder) -> Result<(), LoadError> {
-    published(b, &mut b.graph.clone()).map(|_| ())
-}
-
-/// The outputs of an actor that `Stl` formulas may read as `<variable>.<output>`.
-const ACTOR_SIGNALS: [(&str, Output); 7] = [
-    ("pos", Output::Pos),
-    ("vel", Output::Vel),
-    ("speed", Output::Speed),
-    ("heading", Output::Heading),
-    ("collision", Output::Collision),
-    ("collided", Output::Collided),
-    ("separation", Output::Separation),
-];
-
-/// Refuses a `Signal` named as an actor's output (`Signal("lead.speed", ...)`: a formula
-/// reading `lead.speed` would read the Signal in the car's place) or as a component another
-/// `Signal` gives itself (`Signal("lp", lead.pos)` publishes `lp.x`, `lp.y` and `lp.z`).
-fn check_signal_names(b: &SceneBuilder) -> Result<(), LoadError> {
-    // A Signal may not take an actor output's name (`Signal("lead.speed", ...)`): a formula
-    // reading `lead.speed` would read the Signal in the car's place.
-    for (name, at) in &b.signals_at {
-        let mut parts = name.split('.');
-        let (Some(var), Some(field)) = (parts.next(), parts.next()) else {
-            continue;
-        };
-        let actor = b
-            .objects
-            .iter()
-            .find(|o| o.actor.is_some() && o.variable.as_deref() == Some(var));
-        if let (Some(o), true) = (actor, ACTOR_SIGNALS.iter().any(|(n, _)| *n == field)) {
-            return Err(LoadError::new(
-                LoadErrorKind::Declarations,
-                format!(
-                    "Signal `{name}` takes the name of an output of {} (`{var}.{field}`), which \
-                 monitors read as that actor's; give the Signal another name\n --> {at}",
-                    o.name
-                ),
-            ));
-        }
-    }
-    // Nor the name of a component another Signal gives itself (`Signal("lp", lead.pos)`
-    // publishes `lp.x`, `lp.y` and `lp.z`): one would hide the other.
-    for (k, (name, at)) in b.signals_at.iter().enumerate() {
-        let whole = b.signals_at[..k].iter().find(|(other, _)| {
-            [".x", ".y", ".z"]
-                .iter()
-                .any(|c| *name == format!("{other}{c}") || *other == format!("{name}{c}"))
-        });
-        if let Some((other, first)) = whole {
-            let (vector, component) = if name.len() > other.len() {
-                (other, name)
-            } else {
-                (name, other)
-            };
-            return Err(LoadError::new(
-                LoadErrorKind::Declarations,
-                format!(
-                    "Signal `{name}` and Signal `{other}` (declared at {first}) clash: a vector \
-                 Signal `{vector}` is published as `{vector}.x`, `{vector}.y` and `{vector}.z`, \
-                 so `{component}` would read one of them; give one another name\n --> {at}"
-                ),
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// Whether `s` names a published signal of `out` (whose streams carry vectors as `vector`
-/// says): a stream of numbers or bools by its name, a vector's component by `name.x`, `.y`,
-/// `.z`.
-///
-/// # Errors
-/// A vector named whole, or a component of a number.
-fn known_signal(
-    out: &[(String, StreamId)],
-    vector: &[Option<bool>],
-    s: &str,
-) -> Result<bool, LoadError> {
-    if crate::runner::signal::ALL.contains(&s) {
-        return Ok(true);
-    }
-    for ((n, _), v) in out.iter().zip(vector) {
-        let component = s
-            .strip_prefix(n.as_str())
-            .is_some_and(|c| [".x", ".y", ".z"].contains(&c));
-        match (n == s, component, v) {
-            (true, _, Some(true)) => {
-                return Err(LoadError::new(
-                    LoadErrorKind::Declarations,
-                    format!(
-                        "`{s}` is a vector: a formula compares numbers, so write `{s}.x`, \
-                     `{s}.y` or `{s}.z`"
-                    ),
-                ))
-            }
-            (false, true, Some(false)) => {
-                return Err(LoadError::new(
-                    LoadErrorKind::Declarations,
-                    format!(
-                        "`{n}` is a number, with no component `{}`: write `{n}`",
-                        &s[n.len() + 1..]
-                    ),
-                ))
-            }
-            (true, _, _) | (_, true, _) => return Ok(true),
-            _ => {}
-        }
-    }
-    Ok(false)
-}
-
-/// The streams published to the monitors: those the program published (`Monitor`, `Assert`,
-/// `Signal`), then each actor output a monitor reads by name (`lead.speed`, `p.pos.x`), as a
-/// probe added to `graph`.
-///
-/// # Errors
-/// A message naming a signal a monitor reads that is neither the runner's, the program's nor
-/// an actor's.
-fn published(
-    b: &SceneBuilder,
-    graph: &mut GraphBuilder,
-) -> Result<Vec<(String, StreamId)>, LoadError> {
-    check_signal_names(b)?;
-    let mut out = b.published.clone();
-    // Whether each published stream carries vectors: `Some(true)` it does, `Some(false)` it
-    // carries numbers or bools, `None` unknown until the test runs (a lambda's values; the
-    // check at load looks at its sample, `program::judged_kinds`).
-    let types = super::types::stream_types(b);
-    let mut vector: Vec<Option<bool>> = out
-        .iter()
-        .map(|(_, id)| match types.get(id.0) {
-            Some(super::types::SType::Vec3) => Some(true),
-            Some(super::types::SType::Any) | None => None,
-            Some(_) => Some(false),
-        })
-        .collect();
-    // Whether `s` names a published signal: a stream of numbers or bools by its name, a
-    // vector's component by `name.x`, `.y`, `.z`; a vector named whole, or a component of a
-    // number, is an error.
-    let known = known_signal;
-    for (k, m) in b.monitors.iter().enumerate() {
-        let at = b.monitors_at.get(k).map(String::as_str).unwrap_or("");
-        let located = |e: String| {
-            LoadError::new(
-                LoadErrorKind::Declarations,
-                format!("{} reads the signal: {e}\n --> {at}", m.name()),
-            )
-        };
-        for s in m.signals() {
-            if known(&out, &vector, &s).map_err(|e| located(e.message))? {
-                continue;
-            }
-            let found = s.split_once('.').and_then(|(var, rest)| {
-                let object = b
-                    .objects
-                    .iter()
-                    .find(|o| o.variable.as_deref() == Some(var))?;
-                let actor = object.actor?;
-                let field = rest.split('.').next()?;
-                let (_, output) = ACTOR_SIGNALS.iter().find(|(n, _)| *n == field)?;
-                Some((format!("{var}.{field}"), actor, *output))
-            });
-            match found {
-                Some((name, actor, output)) => {
-                    let id = graph.push(Node::Probe(Probe::new(actor, output)));
-                    out.push((name.clone(), id));
-                    vector.push(Some(matches!(output, Output::Pos | Output::Vel)));
-                    if !known(&out, &vector, &s).map_err(|e| located(e.message))? {
-                        return Err(located(format!(
-                            "`{s}` is no output of `{name}`; an actor's outputs are .pos.x, \
-                             .pos.y, .pos.z, .vel.x, .vel.y, .vel.z, .speed, .heading, \
-                             .collision, .collided and .separation"
-                        )));
-                    }
-                }
-                None => {
-                    let actors: Vec<&str> = b
-                        .objects
-                        .iter()
-                        .filter(|o| o.actor.is_some())
-                        .filter_map(|o| o.variable.as_deref())
-                        .collect();
-                    let mine: Vec<&str> = b
-                        .published
-                        .iter()
-                        .map(|(n, _)| n.as_str())
-                        .filter(|n| !n.starts_with("monitor:"))
-                        .collect();
-                    return Err(LoadError::new(
-                        LoadErrorKind::Declarations,
-                        format!(
-                        "monitor `{}` reads the signal `{s}`, which nothing publishes. The runner \
-                         publishes {}; the program's Signal(...)s: {}; each actor assigned to a \
-                         variable at the top level publishes <variable>.pos.x/.y/.z, .vel.x/.y/.z, \
-                         .speed, .heading and .collision (actors: {})\n --> {at}",
-                        m.name(),
-                        crate::runner::signal::ALL.join(", "),
-                        if mine.is_empty() {
-                            "none".to_owned()
-                        } else {
-                            mine.join(", ")
-                        },
-                        if actors.is_empty() {
-                            "none".to_owned()
-                        } else {
-                            actors.join(", ")
-                        },
-                    ),
-                    ));
-                }
-            }
-        }
-    }
-    Ok(out)
 }
 
 /// Parses a route list of turns.
@@ -795,7 +284,8 @@ pub fn turns(names: &[String]) -> Result<Vec<Turn>, LoadError> {
                 LoadError::new(
                     LoadErrorKind::Declarations,
                     format!(
-                        "route entry `{n}` is not a turn; use \"straight\", \"left\" or \"right\""
+                        "route entry `{n}` is not a turn; use \"straight\", \"left\", \"right\", \"uturn\" \
+                         or, on a map, \"road:ID\" (a connecting road's <road id>)"
                     ),
                 )
             })
@@ -823,7 +313,7 @@ impl SceneBuilder {
         let now: Vec<_> = self
             .locs
             .iter()
-            .map(|l| l.resolve(&self.roads).ok())
+            .map(|l| l.resolve(self.scene.roads()).ok())
             .collect();
         if let Ok(mut t) = self.loc_table.write() {
             *t = now;
@@ -844,10 +334,11 @@ impl SceneBuilder {
                 "place(...) may be called only once",
             ));
         }
-        if let Some((a, b)) = self.roads.first_overlap() {
+        if let Some((a, b)) = self.scene.roads().first_overlap() {
             let named = |p: PieceId| {
-                let name = &self.roads.piece(p).name;
-                declared(name, self.pieces_at.get(p.0).map_or("", String::as_str))
+                let name = &self.scene.roads().piece(p).name;
+                let site = self.scene.road_site(p).map(Site::to_string);
+                declared(name, site.as_deref().unwrap_or(""))
             };
             return Err(LoadError::new(
                 LoadErrorKind::Worlds,
@@ -867,7 +358,7 @@ impl SceneBuilder {
                 ),
             ));
         }
-        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(&b.roads);
+        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(b.scene.roads());
         // Check the starting positions before anything depends on them (routes, behaviours).
         let mut placed = Vec::new();
         for o in &self.objects {
@@ -896,7 +387,8 @@ impl SceneBuilder {
                 on_road,
             });
         }
-        check(&placed, &self.roads).map_err(|e| LoadError::new(LoadErrorKind::Worlds, strip(e)))?;
+        check(&placed, self.scene.roads())
+            .map_err(|e| LoadError::new(LoadErrorKind::Worlds, strip(e)))?;
         for o in self.objects.clone() {
             match o.pending.clone() {
                 Pending::Ego {
@@ -914,13 +406,16 @@ impl SceneBuilder {
                 Pending::Car(car) => self.place_car(&o, car)?,
                 Pending::Obstacle { loc, size, color } => {
                     let at = resolve(self, loc)?;
-                    self.obstacles.push(ObstacleSpec {
-                        base_m: at.pos_m,
-                        heading_rad: at.heading_rad,
-                        size,
-                        color,
-                    });
-                    self.obstacle_names.push(o.name.clone());
+                    self.scene.place_obstacle(
+                        ObstacleSpec {
+                            base_m: at.pos_m,
+                            heading_rad: at.heading_rad,
+                            size,
+                            color,
+                        },
+                        o.name.clone(),
+                        Site::of(&o.at).with_variable(o.variable.clone()),
+                    );
                 }
             }
         }
@@ -937,11 +432,12 @@ impl SceneBuilder {
         initial_speed_mps: f64,
         sut: SutConfig,
     ) -> Result<(), LoadError> {
-        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(&b.roads);
+        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(b.scene.roads());
         let start = resolve(self, loc)?;
         let route = match route {
             Some(turns) => self
-                .roads
+                .scene
+                .roads()
                 .route(&start, &turns, self.route_m)
                 .map_err(|e| {
                     LoadError::new(LoadErrorKind::Worlds, format!("{}: {}", o.name, strip(e)))
@@ -950,18 +446,20 @@ impl SceneBuilder {
             // through junctions where it can, round a roundabout's ring, into a
             // T's turn from its stem), or, where that path is the start line
             // itself (straight roads), the start line.
-            None if self.roads.group_of(start.piece).iter().any(|&id| {
-                let kind = &self.roads.piece(id).kind;
+            None if self.scene.roads().group_of(start.piece).iter().any(|&id| {
+                let kind = &self.scene.roads().piece(id).kind;
                 kind.ref_line().is_some() || matches!(kind, PieceKind::Map { .. })
             }) =>
             {
-                self.roads
+                self.scene
+                    .roads()
                     .route(&start, &[], self.route_m)
                     .map_err(|e| LoadError::new(LoadErrorKind::Worlds, strip(e)))?
             }
             None => {
                 let lane = self
-                    .roads
+                    .scene
+                    .roads()
                     .route(&start, &[], self.route_m)
                     .map_err(|e| LoadError::new(LoadErrorKind::Worlds, strip(e)))?;
                 if on_start_line(&start, &lane) {
@@ -971,20 +469,22 @@ impl SceneBuilder {
                 }
             }
         };
-        if self.ego.is_some() {
-            return Err(LoadError::new(
-                LoadErrorKind::Worlds,
-                format!("{}: a scenario has one AutonomousVehicle", o.name),
-            ));
-        }
-        self.ego = Some(EgoSpec {
-            start,
-            initial_speed_mps,
-            vehicle: VehicleParams::default(),
-            route,
-        });
-        self.sut = Some(sut);
-        Ok(())
+        self.scene
+            .place_ego(
+                EgoSpec {
+                    start,
+                    initial_speed_mps,
+                    vehicle: VehicleParams::default(),
+                    route,
+                },
+                sut,
+            )
+            .map_err(|_| {
+                LoadError::new(
+                    LoadErrorKind::Worlds,
+                    format!("{}: a scenario has one AutonomousVehicle", o.name),
+                )
+            })
     }
 
     /// Places the pedestrian declared by `o` and its walking behaviour.
@@ -996,11 +496,11 @@ impl SceneBuilder {
         speed: StreamId,
         trigger: PedTrigger,
     ) -> Result<(), LoadError> {
-        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(&b.roads);
+        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(b.scene.roads());
         let pedestrian_name = o.runtime_name("Pedestrian");
         let s = resolve(self, start)?.pos_m;
         let t = resolve(self, target)?.pos_m;
-        let Some(ActorRef::Pedestrian(handle)) = o.actor else {
+        let Some(actor @ ActorRef::Pedestrian(handle)) = o.actor else {
             return Err(LoadError::new(
                 LoadErrorKind::Worlds,
                 format!("{}: a Pedestrian without its handle", o.name),
@@ -1008,26 +508,32 @@ impl SceneBuilder {
         };
         match trigger {
             PedTrigger::Near { car, dist } => {
-                self.graph.pedestrian(handle, s, t, car, dist);
+                self.scene.graph_mut().pedestrian(handle, s, t, car, dist);
             }
             PedTrigger::Stream(trigger) => {
-                self.graph.pedestrian_with_trigger(handle, t, trigger);
+                self.scene
+                    .graph_mut()
+                    .pedestrian_with_trigger(handle, t, trigger);
             }
             PedTrigger::Never => {}
         }
         if !matches!(trigger, PedTrigger::Never) {
             // The behaviour's `foreach(walk)` is named by the Pedestrian's
             // declaration, for the check of two behaviours walking it.
-            let walk = paracosm_engine::rx::StreamId(self.graph.nodes().len() - 1);
-            self.graph.set_site(walk, o.at.clone());
+            let walk = paracosm_engine::rx::StreamId(self.scene.nodes().len() - 1);
+            self.scene.graph_mut().set_site(walk, o.at.clone());
         }
-        self.pedestrians.push(PedestrianSpec {
-            start: s,
-            target: t,
-            speed,
-            name: pedestrian_name,
-        });
-        Ok(())
+        self.scene
+            .place_pedestrian(
+                actor,
+                PedestrianSpec {
+                    start: s,
+                    target: t,
+                    speed,
+                    name: pedestrian_name,
+                },
+            )
+            .map_err(|e| LoadError::new(LoadErrorKind::Worlds, format!("{}: {e}", o.name)))
     }
 
     /// Places the NPC car declared by `o`: its path along its route and its lane change.
@@ -1041,10 +547,10 @@ impl SceneBuilder {
             lane_change,
             keep_distance_m,
         } = car;
-        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(&b.roads);
+        let resolve = |b: &SceneBuilder, i: usize| b.locs[i].resolve(b.scene.roads());
         let car_name = o.runtime_name("Car");
         let start = resolve(self, loc)?;
-        let path = match self.roads.route(&start, &route, self.route_m) {
+        let path = match self.scene.roads().route(&start, &route, self.route_m) {
             Ok(path) => path,
             // A disabled car is not in the test: where it would drive does not
             // matter (it may stand on a sidewalk); one metre ahead stands in.
@@ -1085,19 +591,28 @@ impl SceneBuilder {
             None => None,
         };
         let lane_offsets_m = self.lane_offsets(&start);
-        self.cars.push(CarSpec {
-            path,
-            speed,
-            color,
-            size: Size::CAR,
-            enabled,
-            lane_change,
-            lane_offsets_m,
-            name: car_name,
-            keep_distance_m,
-        });
-        self.car_names.push(o.name.clone());
-        Ok(())
+        let Some(actor) = o.actor else {
+            return Err(LoadError::new(
+                LoadErrorKind::Worlds,
+                format!("{}: a Car without its handle", o.name),
+            ));
+        };
+        self.scene
+            .place_car(
+                actor,
+                CarSpec {
+                    path,
+                    speed,
+                    color,
+                    size: Size::CAR,
+                    enabled,
+                    lane_change,
+                    lane_offsets_m,
+                    name: car_name,
+                    keep_distance_m,
+                },
+            )
+            .map_err(|e| LoadError::new(LoadErrorKind::Worlds, format!("{}: {e}", o.name)))
     }
 }
 
@@ -1121,12 +636,13 @@ impl SceneBuilder {
         }
         let h = start.heading_rad;
         let right = [h.sin(), h.cos()];
-        let half = (self.roads.piece(start.piece).kind.lanes() / 2) as i32;
+        let half = (self.scene.roads().piece(start.piece).kind.lanes() / 2) as i32;
         (-half..=half)
             .filter(|&l| l != 0)
             .filter_map(|l| {
                 let at = self
-                    .roads
+                    .scene
+                    .roads()
                     .on_lane(start.piece, paracosm_engine::Lane::Driving(l), start.at_m)
                     .ok()?;
                 let d = [at.pos_m[0] - start.pos_m[0], at.pos_m[2] - start.pos_m[2]];
@@ -1161,7 +677,8 @@ impl SceneBuilder {
             )));
         }
         let target = self
-            .roads
+            .scene
+            .roads()
             .on_lane(
                 start.piece,
                 paracosm_engine::Lane::Driving(c.to),

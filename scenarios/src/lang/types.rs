@@ -6,11 +6,11 @@
 use std::sync::Arc;
 
 use anyhow::bail;
-use paracosm_engine::behaviour::Output;
 use paracosm_engine::rx::{describe, Expect, Node, StreamId, Value as Rx};
 use paracosm_generators::Domain;
 
-use super::scene::{level_value, ParamDecl, SceneBuilder};
+use super::scene::{level_value, SceneBuilder};
+pub use crate::scene::SType;
 
 /// What an input accepts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -158,115 +158,16 @@ impl std::fmt::Display for Kind {
     }
 }
 
-/// The kind of values a stream carries, as far as the graph tells before a test runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SType {
-    /// Numbers.
-    Num,
-    /// Bools.
-    Bool,
-    /// Strings.
-    Text,
-    /// Positions or velocities `(x, y, z)`.
-    Vec3,
-    /// Tuples (from `zip`).
-    Tuple,
-    /// Events without a value.
-    Unit,
-    /// Unknown until the test runs (a lambda's result), or mixed.
-    Any,
-}
-
-impl SType {
-    /// The kind in words, for messages: `numbers`, `bools`...
-    pub fn name(self) -> &'static str {
-        match self {
-            SType::Num => "numbers",
-            SType::Bool => "bools",
-            SType::Text => "strings",
-            SType::Vec3 => "positions",
-            SType::Tuple => "tuples",
-            SType::Unit => "events without a value",
-            SType::Any => "values of any kind",
-        }
-    }
-}
-
-fn of_value(v: &Rx) -> SType {
-    match v {
-        Rx::Num(_) => SType::Num,
-        Rx::Bool(_) => SType::Bool,
-        Rx::Text(_) => SType::Text,
-        Rx::Vec3(_) => SType::Vec3,
-        Rx::Tuple(_) => SType::Tuple,
-        Rx::Unit => SType::Unit,
-    }
-}
-
-fn of_param(p: &ParamDecl) -> SType {
-    match &p.domain {
-        Domain::Interval { .. } => SType::Num,
-        Domain::Levels(levels) => {
-            let kinds: Vec<SType> = levels.iter().map(|l| of_value(&level_value(l))).collect();
-            match kinds.split_first() {
-                Some((k, rest)) if rest.iter().all(|r| r == k) => *k,
-                _ => SType::Any,
-            }
-        }
-    }
-}
-
-/// The static kind of every stream of the program so far, by [`StreamId`]. Nodes only read
-/// streams declared before them, so one pass in index order suffices.
-pub fn stream_types(b: &SceneBuilder) -> Vec<SType> {
-    let mut out: Vec<SType> = Vec::with_capacity(b.graph.nodes().len());
-    for node in b.graph.nodes() {
-        let of = |s: &StreamId| out.get(s.0).copied().unwrap_or(SType::Any);
-        let t = match node {
-            Node::Const(v) => of_value(v),
-            Node::Tick => SType::Num,
-            Node::Param(p) => b.params.get(*p).map_or(SType::Any, of_param),
-            Node::Open(_) => SType::Any,
-            Node::Probe(p) => match p.output {
-                Output::Pos | Output::Vel => SType::Vec3,
-                Output::Heading | Output::Speed | Output::Separation => SType::Num,
-                Output::Collision | Output::Collided => SType::Bool,
-            },
-            Node::Map { .. } => SType::Any,
-            Node::Filter { src, .. }
-            | Node::Take { src, .. }
-            | Node::SkipUntil { src, .. }
-            | Node::TakeUntil { src, .. }
-            | Node::Check { src, .. } => of(src),
-            Node::Zip(..) => SType::Tuple,
-            Node::Concat(a, c) => {
-                if of(a) == of(c) {
-                    of(a)
-                } else {
-                    SType::Any
-                }
-            }
-            Node::Sum { src, f, .. } => match f {
-                None => of(src),
-                Some(_) => SType::Any,
-            },
-            Node::Foreach { .. } | Node::Perform { .. } => SType::Unit,
-        };
-        out.push(t);
-    }
-    out
-}
-
 /// How a program names an open parameter in messages: `` `speed` (VarInterval at f.star:3:9) ``.
 fn param_label(b: &SceneBuilder, p: usize) -> String {
-    let d = &b.params[p];
+    let d = &b.scene.params()[p];
     let what = match d.domain {
         Domain::Interval { .. } => "VarInterval",
         Domain::Levels(_) => "VarEnum",
     };
     match &d.name {
-        Some(n) => format!("`{n}` ({what} at {})", d.at),
-        None => format!("the {what} at {}", d.at),
+        Some(n) => format!("`{n}` ({what} at {})", d.site),
+        None => format!("the {what} at {}", d.site),
     }
 }
 
@@ -282,7 +183,7 @@ pub fn check_param(
     owner: &str,
 ) -> anyhow::Result<()> {
     let label = param_label(b, p);
-    let d = b.params[p].clone();
+    let d = b.scene.params()[p].clone();
     let kind = input.kind;
     match (&d.domain, kind) {
         (_, Kind::Event) => {}
@@ -353,7 +254,7 @@ pub fn typed_stream(
     if input.kind == Kind::Event {
         return Ok(id);
     }
-    match b.graph.nodes().get(id.0) {
+    match b.scene.nodes().get(id.0) {
         Some(Node::Const(v)) => {
             let v = v.clone();
             check_const(&v, input, owner)?;
@@ -366,7 +267,7 @@ pub fn typed_stream(
         }
         _ => {}
     }
-    let types = stream_types(b);
+    let types = b.scene.stream_types();
     let carried = types.get(id.0).copied().unwrap_or(SType::Any);
     let wanted = input.kind.stream_kind();
     if carried != SType::Any && carried != wanted {
@@ -386,7 +287,7 @@ pub fn typed_stream(
         return Ok(id);
     };
     let name: Arc<str> = Arc::from(format!("the {} of {owner} {at}", input.keyword));
-    Ok(b.graph.push(Node::Check {
+    Ok(b.scene.push(Node::Check {
         src: id,
         expect,
         name,

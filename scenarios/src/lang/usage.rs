@@ -323,7 +323,7 @@ pub fn analyse(i: Inputs<'_>) -> Usage {
         if changes.is_empty() {
             usage.unused.push(k);
             usage.warnings.push(Warning {
-                at: decl.at.clone(),
+                at: decl.site.to_string(),
                 message: format!(
                     "`{name}` is sampled but no object uses it: every value builds the same \
                      world, so coverage leaves it out (summary.json lists it under unused_params)"
@@ -341,7 +341,7 @@ pub fn analyse(i: Inputs<'_>) -> Usage {
                 })
                 .collect();
             usage.warnings.push(Warning {
-                at: decl.at.clone(),
+                at: decl.site.to_string(),
                 message: format!(
                     "`{name}` sets the friction of {}, where no vehicle can be during a test (the \
                      ego cannot get there within the horizon even at full throttle, and no car's \
@@ -358,14 +358,11 @@ pub fn analyse(i: Inputs<'_>) -> Usage {
                     Change::Light => "the light".to_owned(),
                     Change::Colour(car) => format!(
                         "the colour of {}",
-                        i.world.car_names.get(*car).map_or("a car", String::as_str)
+                        i.world.scene.car_name(*car).unwrap_or("a car")
                     ),
                     Change::ObstacleColour(k) => format!(
                         "the colour of {}",
-                        i.world
-                            .obstacle_names
-                            .get(*k)
-                            .map_or("an obstacle", String::as_str)
+                        i.world.scene.obstacle_name(*k).unwrap_or("an obstacle")
                     ),
                     _ => continue,
                 };
@@ -375,7 +372,7 @@ pub fn analyse(i: Inputs<'_>) -> Usage {
             }
             usage.camera_only.push(CameraOnly {
                 param: name.clone(),
-                at: decl.at.clone(),
+                at: decl.site.to_string(),
                 sets: sets.join(" and "),
             });
         }
@@ -396,7 +393,7 @@ pub fn unit_warnings(params: &[(String, ParamDecl)], syntax: &Syntax) -> Vec<War
     };
     let mut out = Vec::new();
     for (name, decl) in params {
-        let (Some(unit), Some(site)) = (&decl.unit, syntax.site(&decl.at)) else {
+        let (Some(unit), Some(site)) = (&decl.unit, syntax.site(&decl.site.to_string())) else {
             continue;
         };
         // Where it is passed whole: through its variable, or written inline in the call; or
@@ -431,7 +428,7 @@ pub fn unit_warnings(params: &[(String, ParamDecl)], syntax: &Syntax) -> Vec<War
                             format!("in {theirs}")
                         };
                         out.push(Warning {
-                            at: decl.at.clone(),
+                            at: decl.site.to_string(),
                             message: format!(
                                 "`{name}` is declared in {unit} but feeds {builtin}({keyword}=), \
                                  which is {theirs}"

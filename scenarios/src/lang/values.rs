@@ -11,16 +11,7 @@ use starlark::values::{
 };
 use starlark::StarlarkPagablePanic;
 
-/// How an open stream varies over a test (paper §3.3).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum OverTime {
-    /// One value for the whole test.
-    Constant,
-    /// `Piecewise(k)`: `k` values, each held for `T / k`.
-    Piecewise(usize),
-    /// `Polynomial(deg)`: a Bernstein polynomial with `deg + 1` coefficients.
-    Polynomial(usize),
-}
+pub use crate::scene::OverTime;
 
 /// A stream (paper §2): `tick`, `Const(...)`, an open parameter, an output of an object, or a
 /// combinator over streams.

@@ -4,6 +4,7 @@
 
 //! Actors: `AutonomousVehicle`, `Car`, `ChangeLane`, `Obstacle`, `Pedestrian`.
 
+use crate::scene::{Scene, Site};
 use anyhow::{anyhow, bail};
 use paracosm_engine::behaviour::{ActorRef, Output};
 use paracosm_engine::rx::{StreamId, Value as Rx};
@@ -26,7 +27,7 @@ use crate::lang::builtins::{named, Builtin, Declares, Form};
 /// `route=` of the ego vehicle and of a car.
 const ROUTE: crate::lang::builtins::Arg = named(
     "route",
-    "a turn or a list of turns: \"straight\", \"left\", \"right\"",
+    "a turn or a list of turns: \"straight\", \"left\", \"right\", \"uturn\", or \"road:ID\" on a map",
 )
 .or("[]");
 /// `color=` of a car or an obstacle.
@@ -141,14 +142,19 @@ pub(super) fn declare(
     eval: &Evaluator,
     b: &mut SceneBuilder,
     what: &str,
-    actor: ActorRef,
+    declare_as: fn(&mut Scene, String, Site) -> ActorRef,
     pending: Pending,
 ) -> ActorVal {
+    let name = object_name(eval, what);
+    let at = here(eval);
+    let variable = variable_here(eval);
+    let site = Site::of(&at).with_variable(variable.clone());
+    let actor = declare_as(&mut b.scene, name.clone(), site);
     let outputs = Output::ALL.map(|o| b.probe(actor, o).0);
     b.objects.push(ObjectDecl {
-        name: object_name(eval, what),
-        at: here(eval),
-        variable: variable_here(eval),
+        name,
+        at,
+        variable,
         actor: Some(actor),
         pending,
         placed: false,
@@ -236,7 +242,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             eval,
             &mut b,
             "AutonomousVehicle",
-            ActorRef::Ego,
+            Scene::declare_ego,
             Pending::Ego {
                 loc,
                 route,
@@ -319,12 +325,11 @@ pub(super) fn register_cars(builder: &mut GlobalsBuilder) {
         )?
         .as_bool()
         .unwrap_or(true);
-        let car = ActorRef::Car(b.car_handles.add());
         Ok(declare(
             eval,
             &mut b,
             "Car",
-            car,
+            Scene::declare_car,
             Pending::Car(PendingCar {
                 loc,
                 route,
@@ -508,12 +513,11 @@ pub(super) fn register_pedestrians(builder: &mut GlobalsBuilder) {
                  walks only when an action moves it: stream.foreach(p.walk))"
             ),
         };
-        let pedestrian = ActorRef::Pedestrian(b.pedestrian_handles.add());
         Ok(declare(
             eval,
             &mut b,
             "Pedestrian",
-            pedestrian,
+            Scene::declare_pedestrian,
             Pending::Pedestrian {
                 start,
                 target,

@@ -170,7 +170,7 @@ pub fn stream_arg(v: Value, b: &mut SceneBuilder, what: &str) -> anyhow::Result<
         return Ok(StreamId(s.id));
     }
     match constant(v) {
-        Some(c) => Ok(b.graph.push(Node::Const(c))),
+        Some(c) => Ok(b.scene.push(Node::Const(c))),
         None => bail!(
             "{what} must be a stream or a constant, got {}",
             crate::lang::a_type(v.get_type())
@@ -204,7 +204,7 @@ pub(super) fn fixed_typed(
     owner: &str,
 ) -> anyhow::Result<Rx> {
     let c = match v.downcast_ref::<Stream>() {
-        Some(s) => match b.graph.nodes().get(s.id) {
+        Some(s) => match b.scene.nodes().get(s.id) {
             Some(Node::Const(c)) => c.clone(),
             _ => bail!(
                 "{owner}({}=) is fixed for a test: give it a constant or an open parameter that \
@@ -229,7 +229,7 @@ pub(super) fn fixed_typed(
 /// parameter constant over time (its value in this test).
 pub(super) fn load_time_number(v: Value, b: &SceneBuilder, what: &str) -> anyhow::Result<f64> {
     if let Some(s) = v.downcast_ref::<Stream>() {
-        if let Some(Node::Const(c)) = b.graph.nodes().get(s.id) {
+        if let Some(Node::Const(c)) = b.scene.nodes().get(s.id) {
             return c
                 .as_num()
                 .filter(|_| matches!(c, Rx::Num(_)))
@@ -246,7 +246,7 @@ pub(crate) fn text_value(v: Value, b: &SceneBuilder) -> Option<String> {
     }
     match v
         .downcast_ref::<Stream>()
-        .map(|s| b.graph.nodes().get(s.id))
+        .map(|s| b.scene.nodes().get(s.id))
     {
         Some(Some(Node::Const(Rx::Text(t)))) => Some(t.clone()),
         _ => None,

@@ -2,6 +2,7 @@
 
 //! Monitors: the built-in ones, `Stl`, and the program's own (`Monitor`, `Assert`, `Signal`, paper §2, "Invariants and Monitors").
 
+use crate::scene::Site;
 use anyhow::{anyhow, bail};
 use starlark::environment::GlobalsBuilder;
 use starlark::eval::Evaluator;
@@ -124,7 +125,7 @@ pub(super) fn unique_monitor_name(b: &SceneBuilder, name: &str) -> anyhow::Resul
              keys the verdicts in results files, CSV columns and JUnit"
         );
     }
-    if b.monitors.iter().any(|m| m.name() == name) {
+    if b.scene.monitors().any(|(m, _)| m.name() == name) {
         bail!(
             "two monitors are named `{name}`: results are keyed by monitor name, so give one \
              another name="
@@ -152,7 +153,7 @@ pub(super) fn publish_monitored(
             crate::lang::a_type(stream.get_type())
         )
     })?;
-    let kind = types::stream_types(&b)[id.0];
+    let kind = b.scene.stream_types()[id.0];
     if kind != want && kind != types::SType::Any {
         bail!(
             "{what} needs a stream of {}, and this one carries {}{}",
@@ -166,7 +167,7 @@ pub(super) fn publish_monitored(
         );
     }
     let signal = format!("monitor:{name}");
-    b.published.push((signal.clone(), id));
+    b.scene.publish(signal.clone(), id, None);
     Ok(signal)
 }
 
@@ -183,10 +184,9 @@ pub(super) fn monitor(eval: &Evaluator, spec: MonitorSpec) -> anyhow::Result<Mon
     let st = state(eval)?;
     let mut b = st.scene.borrow_mut();
     unique_monitor_name(&b, spec.name())?;
-    b.monitors.push(spec);
-    b.monitors_at.push(here(eval));
+    let site = Site::of(&here(eval)).with_variable(variable_here(eval));
     Ok(MonitorVal {
-        index: b.monitors.len() - 1,
+        index: b.scene.add_monitor(spec, site),
         wraps: 0,
     })
 }
@@ -238,11 +238,11 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             let mut b = st.scene.borrow_mut();
             unique_monitor_name(&b, &name)?;
             // outputs: pos, vel, heading, speed, collision, collided, separation.
-            let pair = b.graph.push(Node::Zip(
+            let pair = b.scene.push(Node::Zip(
                 StreamId(actor.outputs[5]),
                 StreamId(actor.outputs[6]),
             ));
-            let clearance = b.graph.push(Node::Map {
+            let clearance = b.scene.push(Node::Map {
                 src: pair,
                 f: Func::native("collided ? 0 : separation", |a| match &a[0] {
                     Rx::Tuple(p) => match (&p[0], p[1].as_num()) {
@@ -257,7 +257,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 }),
             });
             let signal = format!("monitor:{name}");
-            b.published.push((signal.clone(), clearance));
+            b.scene.publish(signal.clone(), clearance, None);
             signal
         };
         monitor(
@@ -405,11 +405,11 @@ pub(super) fn register_stream_monitors(builder: &mut GlobalsBuilder) {
         }
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
-        if b.published.iter().any(|(n, _)| n == name) {
+        if b.scene.signals().iter().any(|s| s.name == name) {
             bail!("Signal: `{name}` is published twice");
         }
         let id = stream_arg(stream, &mut b, "Signal")?;
-        let kind = types::stream_types(&b)[id.0];
+        let kind = b.scene.stream_types()[id.0];
         if matches!(
             kind,
             types::SType::Text | types::SType::Tuple | types::SType::Unit
@@ -419,8 +419,8 @@ pub(super) fn register_stream_monitors(builder: &mut GlobalsBuilder) {
                 kind.name()
             );
         }
-        b.published.push((name.to_owned(), id));
-        b.signals_at.push((name.to_owned(), here(eval)));
+        b.scene
+            .publish(name.to_owned(), id, Some(Site::of(&here(eval))));
         Ok(NoneType)
     }
 }
@@ -458,9 +458,10 @@ pub(super) fn register_time_to_failure(builder: &mut GlobalsBuilder) {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
         let wrapped = b
-            .monitors
-            .get(inner)
-            .cloned()
+            .scene
+            .monitors()
+            .nth(inner)
+            .map(|(m, _)| m.clone())
             .ok_or_else(|| anyhow!("no such monitor"))?;
         // The slot holds the outermost wrapper: a monitor wrapped once already is not there
         // any more, and wrapping it again would wrap that wrapper in its name.
@@ -482,7 +483,14 @@ pub(super) fn register_time_to_failure(builder: &mut GlobalsBuilder) {
                 }
             }
             let at = if depth - m.wraps == 1 {
-                format!(" ({})", b.monitors_at[inner])
+                format!(
+                    " ({})",
+                    b.scene
+                        .monitors()
+                        .nth(inner)
+                        .map(|(_, s)| s.to_string())
+                        .unwrap_or_default()
+                )
             } else {
                 String::new()
             };
@@ -502,12 +510,16 @@ pub(super) fn register_time_to_failure(builder: &mut GlobalsBuilder) {
         if wrapped.name() != name {
             unique_monitor_name(&b, name)?;
         }
-        b.monitors_at[inner] = here(eval);
-        b.monitors[inner] = MonitorSpec::TimeToFailure {
-            name: name.to_owned(),
-            inner: Box::new(wrapped),
-            min_s,
-        };
+        let site = Site::of(&here(eval)).with_variable(variable_here(eval));
+        b.scene.replace_monitor(
+            inner,
+            MonitorSpec::TimeToFailure {
+                name: name.to_owned(),
+                inner: Box::new(wrapped),
+                min_s,
+            },
+            site,
+        );
         Ok(MonitorVal {
             index: inner,
             wraps: depth + 1,

@@ -189,12 +189,11 @@ pub(super) fn add_piece(
     let segment = kind.road_length_m().is_some();
     let ports = kind.ports().len();
     let name = object_name(eval, what);
+    let site = crate::scene::Site::of(&super::here(eval));
     let id = b
-        .roads
-        .add(&name, kind)
+        .scene
+        .add_road(|roads| roads.add(&name, kind), friction, site)
         .map_err(|e| anyhow!(crate::lang::scene::strip(e)))?;
-    b.frictions.push((id, friction));
-    b.pieces_at.push(super::here(eval));
     Ok(Road {
         piece: id.0,
         ports,
@@ -221,9 +220,9 @@ pub(super) fn road_piece(
         let mut b = st.scene.borrow_mut();
         let stream = match friction {
             Some(v) => typed_arg(v, &mut b, &types::FRICTION, what, &at)?,
-            None => b.graph.push(Node::Const(Rx::Num(0.8))),
+            None => b.scene.push(Node::Const(Rx::Num(0.8))),
         };
-        let mu = match b.graph.nodes().get(stream.0) {
+        let mu = match b.scene.nodes().get(stream.0) {
             Some(Node::Const(Rx::Num(mu))) => *mu,
             _ => 0.8,
         };
@@ -265,7 +264,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
     ) -> anyhow::Result<WorldVal> {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
-        if b.world.is_some() {
+        if b.scene.environment().is_some() {
             bail!("a program has one World");
         }
         let heap = eval.heap();
@@ -284,7 +283,9 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             "World",
             &at,
         )?;
-        b.world = Some((light, fog));
+        b.scene
+            .set_environment(light, fog, crate::scene::Site::of(&at))
+            .map_err(|e| anyhow!("a program has one World: {e}"))?;
         Ok(WorldVal {
             light: light.0,
             fog: fog.0,
@@ -387,9 +388,9 @@ pub(super) fn register_curves_and_maps(builder: &mut GlobalsBuilder) {
             let map = st.maps.load(&file).map_err(|e| anyhow!(e))?;
             let stream = match friction {
                 Some(v) => typed_arg(v, &mut b, &types::FRICTION, "OpenDrive", &at)?,
-                None => b.graph.push(Node::Const(Rx::Num(0.8))),
+                None => b.scene.push(Node::Const(Rx::Num(0.8))),
             };
-            let mu = match b.graph.nodes().get(stream.0) {
+            let mu = match b.scene.nodes().get(stream.0) {
                 Some(Node::Const(Rx::Num(mu))) => *mu,
                 _ => 0.8,
             };

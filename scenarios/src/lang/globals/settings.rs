@@ -44,17 +44,20 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
     ) -> anyhow::Result<NoneType> {
         let st = state(eval)?;
         let mut b = st.scene.borrow_mut();
-        if let Some(first) = &b.test_at {
+        if let Some(first) = &b.scene.settings().site {
             // A second call would silently replace the first one's horizon and map.
             bail!("test(...) is called once per program; it was already called at {first}");
         }
-        b.test_at = Some(here(eval));
+        let mut settings = crate::scene::TestSettings {
+            site: Some(crate::scene::Site::of(&here(eval))),
+            ..Default::default()
+        };
         if let Some(h) = horizon {
             let h = number(h, "horizon")?;
             if !(h.is_finite() && h > 0.0 && h <= 3600.0) {
                 bail!("horizon {h} s must be in (0, 3600]");
             }
-            b.horizon_s = Some(h);
+            settings.horizon_s = Some(h);
         }
         if let Some(m) = map {
             let axes: Vec<String> = if let Some(one) = m.unpack_str() {
@@ -80,11 +83,10 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                     ),
                 }
             };
-            b.map_axes = Some(axes);
+            settings.map_axes = Some(axes);
         }
-        if let Some(o) = offroad {
-            b.offroad = Some(o);
-        }
+        settings.offroad = offroad;
+        b.scene.set_settings(settings).map_err(|e| anyhow!("{e}"))?;
         Ok(NoneType)
     }
 }

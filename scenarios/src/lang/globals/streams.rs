@@ -130,7 +130,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             _ => None,
         };
         let st = state(eval)?;
-        let id = st.scene.borrow_mut().graph.push(Node::Const(c));
+        let id = st.scene.borrow_mut().scene.push(Node::Const(c));
         Ok(Stream { id: id.0, number })
     }
 
@@ -181,7 +181,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
                 domain: Domain::Interval { lo, hi },
                 unit: unit.map(str::to_owned),
                 over_time,
-                at,
+                site: crate::scene::Site::of(&at).with_variable(super::variable_here(eval)),
             },
         )
     }
@@ -247,7 +247,7 @@ pub(super) fn register_levels(builder: &mut GlobalsBuilder) {
                 domain: Domain::Levels(out),
                 unit: None,
                 over_time: OverTime::Constant,
-                at,
+                site: crate::scene::Site::of(&at).with_variable(super::variable_here(eval)),
             },
         )
     }

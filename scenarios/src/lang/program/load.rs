@@ -171,28 +171,31 @@ fn first_look(program: &mut Program) -> Result<FirstLook, LoadError> {
             .collect();
         // After `held`: calling the lambdas sets the variables that hold streams to their
         // sample values.
-        let horizon_s = b.horizon_s.unwrap_or(crate::lang::DEFAULT_HORIZON_S);
-        let lambdas = program.check_lambdas_in(&b, module, horizon_s);
+        let lambdas = program.check_lambdas_in(&b, module);
         Ok((b, held, lambdas))
     })?;
-    if let Some(past) = first.params.get(MAX_PARAMS) {
+    if let Some(past) = first.scene.params().get(MAX_PARAMS) {
         return Err(LoadError::new(
             LoadErrorKind::Parameters,
             format!(
                 "error: the program declares {} open parameters; the limit is {MAX_PARAMS} \
                  (each is a dimension of the test space and is probed at load); this is \
                  parameter {}\n --> {}",
-                first.params.len(),
+                first.scene.params().len(),
                 MAX_PARAMS + 1,
-                past.at
+                past.site
             ),
         ));
     }
-    program.horizon_s = first.horizon_s.unwrap_or(crate::lang::DEFAULT_HORIZON_S);
+    program.horizon_s = first
+        .scene
+        .settings()
+        .horizon_s
+        .unwrap_or(crate::lang::DEFAULT_HORIZON_S);
     windows_within_horizon(&first, program.horizon_s)?;
     one_walker_each(&first)?;
     // Signals the monitors read exist (checked when the world is built).
-    scene::check_signals(&first)?;
+    first.scene.check_signals()?;
     lambdas?;
     Ok(FirstLook {
         world: first,
@@ -204,11 +207,21 @@ fn first_look(program: &mut Program) -> Result<FirstLook, LoadError> {
 /// parameters may not share one, nor two coordinates. Sets the program's parameters.
 fn name_parameters(program: &mut Program, first: &SceneBuilder) -> Result<(), LoadError> {
     let syntax = &program.syntax;
-    let explicit: Vec<Option<String>> = first.params.iter().map(|p| p.name.clone()).collect();
-    let derived: Vec<Option<String>> = first
-        .params
+    let explicit: Vec<Option<String>> = first
+        .scene
+        .params()
         .iter()
-        .map(|p| syntax.site(&p.at).and_then(|s| s.name.clone()))
+        .map(|p| p.name.clone())
+        .collect();
+    let derived: Vec<Option<String>> = first
+        .scene
+        .params()
+        .iter()
+        .map(|p| {
+            syntax
+                .site(&p.site.to_string())
+                .and_then(|s| s.name.clone())
+        })
         .collect();
     let named = |message: String| LoadError::new(LoadErrorKind::Parameters, message);
     for (i, a) in explicit.iter().enumerate() {
@@ -217,7 +230,9 @@ fn name_parameters(program: &mut Program, first: &SceneBuilder) -> Result<(), Lo
                 return Err(named(format!(
                     "error: two open parameters are named `{a}` (declared at {} and {}); give \
                      one another name=\n --> {}",
-                    first.params[j].at, first.params[i].at, first.params[i].at
+                    first.scene.params()[j].site,
+                    first.scene.params()[i].site,
+                    first.scene.params()[i].site
                 )));
             }
         }
@@ -235,12 +250,18 @@ fn name_parameters(program: &mut Program, first: &SceneBuilder) -> Result<(), Lo
             return Err(named(format!(
                 "error: name = \"{a}\" (declared at {}) is the name the open parameter declared \
                  at {} takes from where it stands; give one another name=\n --> {}",
-                first.params[i].at, first.params[j].at, first.params[i].at
+                first.scene.params()[i].site,
+                first.scene.params()[j].site,
+                first.scene.params()[i].site
             )));
         }
     }
     let names = final_names(&explicit, &derived);
-    program.params = names.iter().cloned().zip(first.params.clone()).collect();
+    program.params = names
+        .iter()
+        .cloned()
+        .zip(first.scene.params().iter().cloned())
+        .collect();
     // Every coordinate of the space has its own name: an explicit `name = "f[0]"` or
     // `"a_1"` must not meet a coordinate of a parameter that varies over time or a suffix.
     let mut coordinates: std::collections::HashMap<String, usize> = Default::default();
@@ -250,15 +271,15 @@ fn name_parameters(program: &mut Program, first: &SceneBuilder) -> Result<(), Lo
                 let (a, b) = (&program.params[j], &program.params[k]);
                 // Point at the parameter whose name was written out, if one was.
                 let at = if explicit[j].is_some() && explicit[k].is_none() {
-                    &a.1.at
+                    &a.1.site
                 } else {
-                    &b.1.at
+                    &b.1.site
                 };
                 return Err(named(format!(
                     "error: two open parameters give a coordinate the name `{c}`: `{}` \
                      (declared at {}) and `{}` (declared at {}); give one another name=\n --> \
                      {at}",
-                    a.0, a.1.at, b.0, b.1.at
+                    a.0, a.1.site, b.0, b.1.site
                 )));
             }
             coordinates.insert(c, k);
@@ -269,14 +290,22 @@ fn name_parameters(program: &mut Program, first: &SceneBuilder) -> Result<(), Lo
 
 /// Phase 4a: the monitors, horizon and system under test every test shares.
 fn settle_declarations(program: &mut Program, first: &SceneBuilder) -> Result<(), LoadError> {
-    program.monitors = first.monitors.clone();
-    program.horizon_s = first.horizon_s.unwrap_or(crate::lang::DEFAULT_HORIZON_S);
-    program.sut = first.sut.clone().ok_or_else(|| {
-        LoadError::new(
-            LoadErrorKind::Declarations,
-            "the program places no AutonomousVehicle",
-        )
-    })?;
+    program.monitors = first.scene.monitor_specs();
+    program.horizon_s = first
+        .scene
+        .settings()
+        .horizon_s
+        .unwrap_or(crate::lang::DEFAULT_HORIZON_S);
+    program.sut = first
+        .scene
+        .ego()
+        .map(|(_, sut)| sut.clone())
+        .ok_or_else(|| {
+            LoadError::new(
+                LoadErrorKind::Declarations,
+                "the program places no AutonomousVehicle",
+            )
+        })?;
     Ok(())
 }
 
@@ -338,7 +367,7 @@ fn probe_effects(
     unread: &[BTreeSet<String>],
 ) -> Result<Effects, LoadError> {
     let syntax = &program.syntax;
-    let base = scene::world(&first.world, program.horizon_s)?;
+    let base = first.world.scene.world()?;
     let read_by_name: Vec<usize> = first
         .stream_variables
         .iter()
@@ -427,12 +456,16 @@ fn monitors_and_map(
     file: &str,
 ) -> Result<(Vec<MonitorSpec>, Vec<String>), LoadError> {
     let settings = |message: String| LoadError::new(LoadErrorKind::Settings, message);
-    let mut monitors = first.monitors.clone();
+    let mut monitors = first.scene.monitor_specs();
     let has_off_road = monitors.iter().any(MonitorSpec::judges_off_road);
-    if first.offroad.unwrap_or(true) && !has_off_road {
+    if first.scene.settings().offroad.unwrap_or(true) && !has_off_road {
         let implicit = MonitorSpec::implicit_off_road();
         if let Some(k) = monitors.iter().position(|m| m.name() == implicit.name()) {
-            let at = first.monitors_at.get(k).map_or(file, String::as_str);
+            let at = first
+                .scene
+                .monitors()
+                .nth(k)
+                .map_or(file.to_owned(), |(_, s)| s.to_string());
             return Err(settings(format!(
                 "error: a monitor is named `{}`, the name of the default OffRoadMonitor: rename \
                  it, declare OffRoadMonitor(v) yourself, or opt out with test(offroad = False)\n \
@@ -442,14 +475,19 @@ fn monitors_and_map(
         }
         monitors.push(implicit);
     }
-    let map_axes = match &first.map_axes {
+    // Where `test(map=)` was given, else the program's file.
+    let test_at = || {
+        let site = first.scene.settings().site.as_ref();
+        site.map_or(file.to_owned(), ToString::to_string)
+    };
+    let map_axes = match &first.scene.settings().map_axes {
         Some(axes) => {
             if let [a, b] = &axes[..] {
                 if a == b {
                     return Err(settings(format!(
                         "error: test(map=...) names `{a}` twice: a failure map needs two \
                          different parameters\n --> {}",
-                        first.test_at.as_deref().unwrap_or(file),
+                        test_at(),
                     )));
                 }
             }
@@ -464,7 +502,7 @@ fn monitors_and_map(
                         } else {
                             known.join(", ")
                         },
-                        first.test_at.as_deref().unwrap_or(file),
+                        test_at(),
                     )));
                 }
             }
@@ -511,7 +549,7 @@ fn load_warnings(
             ),
         });
     }
-    if first.monitors.is_empty() {
+    if first.scene.monitors().len() == 0 {
         warnings.push(Warning {
             at: first.placed_at.clone().unwrap_or_default(),
             message: if monitors.is_empty() {
@@ -545,12 +583,18 @@ fn constant_of(published: &[(String, StreamId)], nodes: &[Node], signal: &str) -
 fn monitor_warnings(program: &Program, first: &SceneBuilder, warnings: &mut Vec<Warning>) {
     // Monitors of a constant in the first world, and whether that constant is an open
     // parameter's (`Monitor(k)`): then it differs between the worlds of some combinations.
-    let mut constants: Vec<(String, Option<String>, bool)> = first
-        .monitors
+    let published: Vec<(String, StreamId)> = first
+        .scene
+        .signals()
         .iter()
-        .filter_map(|m| m.judged_stream())
+        .map(|s| (s.name.clone(), s.stream))
+        .collect();
+    let mut constants: Vec<(String, Option<String>, bool)> = first
+        .scene
+        .monitors()
+        .filter_map(|(m, _)| m.judged_stream())
         .map(|(_, signal, _)| {
-            let c = constant_of(&first.published, first.graph.nodes(), signal);
+            let c = constant_of(&published, first.scene.nodes(), signal);
             (signal.to_owned(), c, false)
         })
         .collect();
@@ -578,7 +622,7 @@ fn monitor_warnings(program: &Program, first: &SceneBuilder, warnings: &mut Vec<
             }
         }
     }
-    for (m, at) in first.monitors.iter().zip(&first.monitors_at) {
+    for (m, at) in first.scene.monitors() {
         // A Monitor or Assert of a constant (`Monitor(5.0)`) judges nothing of the world.
         if let Some((name, signal, _)) = m.judged_stream() {
             let constant = constants
@@ -586,7 +630,7 @@ fn monitor_warnings(program: &Program, first: &SceneBuilder, warnings: &mut Vec<
                 .any(|(s, c, varies)| s == signal && c.is_some() && !varies);
             if constant {
                 warnings.push(Warning {
-                    at: at.clone(),
+                    at: at.to_string(),
                     message: format!(
                         "monitor `{name}` judges a constant stream: its verdict is the same in \
                          every test, whatever the world does"
@@ -594,7 +638,7 @@ fn monitor_warnings(program: &Program, first: &SceneBuilder, warnings: &mut Vec<
                 });
             }
         }
-        stl_warnings(m, at, program.horizon_s, warnings);
+        stl_warnings(m, &at.to_string(), program.horizon_s, warnings);
     }
 }
 
@@ -660,7 +704,7 @@ fn second_looks(
         .map(|(k, (_, d))| {
             // Unprobed, a parameter counts as read: it is neither warned of nor left out.
             unprobed.contains(&k)
-                || syntax.site(&d.at).is_some_and(|s| {
+                || syntax.site(&d.site.to_string()).is_some_and(|s| {
                     [&s.variable, &s.container]
                         .into_iter()
                         .flatten()

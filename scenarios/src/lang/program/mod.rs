@@ -142,13 +142,13 @@ fn finished_message(b: &SceneBuilder) -> Result<(), (String, Option<&str>)> {
             Some(&o.at),
         ));
     }
-    if b.ego.is_none() {
+    if b.scene.ego().is_none() {
         return Err((
             "the program places no AutonomousVehicle: nothing to test".into(),
             b.placed_at.as_deref(),
         ));
     }
-    if b.world.is_none() {
+    if b.scene.environment().is_none() {
         return Err(("the program has no World(...)".into(), None));
     }
     Ok(())
@@ -159,7 +159,7 @@ fn finished_message(b: &SceneBuilder) -> Result<(), (String, Option<&str>)> {
 /// in it, so its verdict is the same in every test (an `F` always fails, a `G` always
 /// passes on it).
 fn windows_within_horizon(b: &SceneBuilder, horizon_s: f64) -> Result<(), LoadError> {
-    for (m, at) in b.monitors.iter().zip(&b.monitors_at) {
+    for (m, at) in b.scene.monitors() {
         let mut spec = m;
         while let MonitorSpec::TimeToFailure { inner, .. } = spec {
             spec = inner;
@@ -197,7 +197,7 @@ fn one_walker_each(b: &SceneBuilder) -> Result<(), LoadError> {
     use paracosm_engine::behaviour::{Action, ActorRef};
     let mut walkers: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
     let mut handles = std::collections::BTreeMap::new();
-    for (i, node) in b.graph.nodes().iter().enumerate() {
+    for (i, node) in b.scene.nodes().iter().enumerate() {
         if let Node::Foreach {
             sink: Action::Walk(p),
             ..
@@ -216,7 +216,7 @@ fn one_walker_each(b: &SceneBuilder) -> Result<(), LoadError> {
             .iter()
             .find(|o| o.actor == handles.get(&p).map(|&h| ActorRef::Pedestrian(h)))
             .map_or_else(|| format!("pedestrian {p}"), |o| o.name.clone());
-        let site = |n: usize| b.graph.site(n).unwrap_or("?").to_owned();
+        let site = |n: usize| b.scene.graph().site(n).unwrap_or("?").to_owned();
         return Err(LoadError::new(
             LoadErrorKind::Declarations,
             format!(
@@ -272,7 +272,7 @@ impl Program {
                     r => r,
                 };
                 drop(budget);
-                if result.is_err() && state.scene.borrow().values.is_some() {
+                if result.is_err() && state.scene.borrow().scene.has_values() {
                     // A parameter that only these values declare explains the failure first.
                     self.same_params_so_far(&state.scene.borrow())?;
                 }
@@ -290,9 +290,10 @@ impl Program {
                     };
                     // The first evaluation: say which values it ran with.
                     let b = state.scene.borrow();
-                    let message = if b.values.is_none() && !b.params.is_empty() {
+                    let message = if !b.scene.has_values() && !b.scene.params().is_empty() {
                         let values: Vec<String> = b
-                            .params
+                            .scene
+                            .params()
                             .iter()
                             .enumerate()
                             .map(|(k, d)| {
@@ -300,7 +301,9 @@ impl Program {
                                     .name
                                     .clone()
                                     .or_else(|| {
-                                        self.syntax.site(&d.at).and_then(|s| s.name.clone())
+                                        self.syntax
+                                            .site(&d.site.to_string())
+                                            .and_then(|s| s.name.clone())
                                     })
                                     .unwrap_or_else(|| format!("param{k}"));
                                 match &d.domain {
@@ -322,7 +325,7 @@ impl Program {
             }
             let printed = std::mem::take(&mut *state.log.borrow_mut());
             let mut b = state.scene.into_inner();
-            if b.values.is_none()
+            if !b.scene.has_values()
                 && !self
                     .load_output_shown
                     .swap(true, std::sync::atomic::Ordering::Relaxed)
@@ -420,10 +423,10 @@ impl Program {
     /// Checks that the parameters an evaluation declared so far are the first ones the first
     /// evaluation declared, and no more.
     fn same_params_so_far(&self, b: &SceneBuilder) -> Result<(), LoadError> {
-        for (k, d) in b.params.iter().enumerate() {
+        for (k, d) in b.scene.params().iter().enumerate() {
             match self.params.get(k) {
                 Some((_, decl)) if d == decl => {}
-                Some((name, decl)) if decl.at == d.at => {
+                Some((name, decl)) if decl.site == d.site => {
                     // The same declaration, evaluated to another range, levels, unit or
                     // over_time.
                     let what = |p: &ParamDecl| match &p.domain {
@@ -453,7 +456,7 @@ impl Program {
                             "error: the open parameters depend on their values: `{name}` has \
                          {differs}; its range, levels, unit and over_time must be the same in \
                          every test (compute with the value instead: `base + m`)\n --> {}",
-                            d.at
+                            d.site
                         ),
                     ));
                 }
@@ -464,24 +467,28 @@ impl Program {
                     "error: the open parameters depend on their values: parameter {k} is `{name}` \
                          (declared at {}) for some values and the one declared at {} for \
                          others\n --> {}",
-                    decl.at, d.at, d.at
+                    decl.site, d.site, d.site
                 ),
                     ))
                 }
                 None => break,
             }
         }
-        if let Some(extra) = b.params.get(self.params.len()) {
+        if let Some(extra) = b.scene.params().get(self.params.len()) {
             let name = extra
                 .name
                 .clone()
-                .or_else(|| self.syntax.site(&extra.at).and_then(|s| s.name.clone()))
+                .or_else(|| {
+                    self.syntax
+                        .site(&extra.site.to_string())
+                        .and_then(|s| s.name.clone())
+                })
                 .map(|n| format!("`{n}` "))
                 .unwrap_or_default();
             return Err(LoadError::new(LoadErrorKind::Worlds, format!(
                 "error: the open parameters depend on their values: {name}(declared at {}) exists only \
                  for some values\n --> {}",
-                extra.at, extra.at
+                extra.site, extra.site
             )));
         }
         Ok(())
@@ -491,22 +498,24 @@ impl Program {
     /// monitors, horizon and system under test.
     fn consistent(&self, b: &SceneBuilder) -> Result<(), LoadError> {
         self.same_params_so_far(b)?;
-        if let Some((name, decl)) = self.params.get(b.params.len()) {
+        if let Some((name, decl)) = self.params.get(b.scene.params().len()) {
             return Err(LoadError::new(LoadErrorKind::Worlds, format!(
                 "error: the open parameters depend on their values: `{name}` (declared at {}) is not \
                  declared for these values\n --> {}",
-                decl.at, decl.at
+                decl.site, decl.site
             )));
         }
-        if b.monitors != self.monitors {
+        let monitors = b.scene.monitor_specs();
+        if monitors != self.monitors {
             // The first monitor that differs, or the first one missing or extra.
-            let k = (0..b.monitors.len().max(self.monitors.len()))
-                .find(|&k| b.monitors.get(k) != self.monitors.get(k))
+            let k = (0..monitors.len().max(self.monitors.len()))
+                .find(|&k| monitors.get(k) != self.monitors.get(k))
                 .unwrap_or(0);
             let at = b
-                .monitors_at
-                .get(k)
-                .map(|a| format!("\n --> {a}"))
+                .scene
+                .monitors()
+                .nth(k)
+                .map(|(_, a)| format!("\n --> {a}"))
                 .unwrap_or_else(|| format!("\n --> {}", self.file));
             return Err(LoadError::new(LoadErrorKind::Worlds, format!(
                 "error: the monitors depend on the open parameters' values: declare the same monitors, \
@@ -514,17 +523,22 @@ impl Program {
                  test of a campaign){at}"
             )));
         }
-        if b.horizon_s.unwrap_or(super::DEFAULT_HORIZON_S) != self.horizon_s {
+        if b.scene
+            .settings()
+            .horizon_s
+            .unwrap_or(super::DEFAULT_HORIZON_S)
+            != self.horizon_s
+        {
             return Err(LoadError::new(
                 LoadErrorKind::Worlds,
                 format!(
                 "error: test(horizon=) depends on the open parameters' values: every test of a \
                  campaign has one length\n --> {}",
-                b.test_at.as_deref().unwrap_or(&self.file)
+                b.scene.settings().site.as_ref().map_or(self.file.clone(), |s| s.to_string())
             ),
             ));
         }
-        if b.sut.as_ref() != Some(&self.sut) {
+        if b.scene.ego().map(|(_, sut)| sut) != Some(&self.sut) {
             let at = b
                 .objects
                 .iter()
@@ -781,7 +795,7 @@ impl Program {
     fn world_counted(&self, values: Vec<ParamValue>) -> Result<(WorldSpec, u64), LoadError> {
         let out = self.evaluate_counted(Some(values), |b, _| {
             self.consistent(&b)?;
-            scene::world(&b, self.horizon_s)
+            b.scene.world()
         });
         if let Ok((_, steps)) = &out {
             self.load_steps
@@ -811,18 +825,13 @@ impl Program {
     /// Calls every lambda of the world the first evaluation built once, on sample values of
     /// its streams at t = 0 ([`paracosm_engine::Simulation::check_streams`]), so that a type
     /// error in a lambda is one error at load rather than one per test: `b` and `module` are
-    /// that evaluation's builder and module, `horizon_s` the program's horizon, s.
+    /// that evaluation's builder and module.
     ///
     /// # Errors
     /// The lambda's error with its `file:line:col`, unless it is one of [`VALUE_ERRORS`].
-    fn check_lambdas_in(
-        &self,
-        b: &SceneBuilder,
-        module: &Module<'_>,
-        horizon_s: f64,
-    ) -> Result<(), LoadError> {
+    fn check_lambdas_in(&self, b: &SceneBuilder, module: &Module<'_>) -> Result<(), LoadError> {
         {
-            let spec = scene::world(b, horizon_s)?;
+            let spec = b.scene.world()?;
             // A world that does not build is reported elsewhere, by the test that builds it.
             let Ok(sim) = paracosm_engine::Simulation::new(&spec) else {
                 return Ok(());
@@ -893,7 +902,7 @@ fn judged_kinds(
     samples: &[Option<paracosm_engine::rx::Value>],
 ) -> Result<(), LoadError> {
     let sample_of = |signal: &str| sample_of(b, samples, signal);
-    for (m, at) in b.monitors.iter().zip(&b.monitors_at) {
+    for (m, at) in b.scene.monitors() {
         let Some((name, signal, bools)) = m.judged_stream() else {
             continue;
         };
@@ -911,7 +920,12 @@ fn judged_kinds(
     }
     action_kinds(b, samples)?;
     formula_kinds(b, samples)?;
-    for (name, at) in &b.signals_at {
+    for (name, at) in b
+        .scene
+        .signals()
+        .iter()
+        .filter_map(|s| Some((&s.name, s.site.as_ref()?)))
+    {
         use paracosm_engine::rx::Value;
         if let Some(v @ (Value::Unit | Value::Tuple(_) | Value::Text(_))) = sample_of(name) {
             return Err(LoadError::new(
@@ -934,10 +948,11 @@ fn sample_of<'a>(
     samples: &'a [Option<paracosm_engine::rx::Value>],
     signal: &str,
 ) -> Option<&'a paracosm_engine::rx::Value> {
-    b.published
+    b.scene
+        .signals()
         .iter()
-        .find(|(name, _)| name == signal)
-        .and_then(|(_, id)| samples.get(id.0))
+        .find(|s| s.name == signal)
+        .and_then(|s| samples.get(s.stream.0))
         .and_then(Option::as_ref)
 }
 
@@ -948,7 +963,7 @@ fn action_kinds(
     b: &SceneBuilder,
     samples: &[Option<paracosm_engine::rx::Value>],
 ) -> Result<(), LoadError> {
-    for (i, node) in b.graph.nodes().iter().enumerate() {
+    for (i, node) in b.scene.nodes().iter().enumerate() {
         use paracosm_engine::behaviour::Action;
         use paracosm_engine::rx::Value;
         let paracosm_engine::rx::Node::Foreach { src, sink } = node else {
@@ -958,7 +973,7 @@ fn action_kinds(
             continue;
         };
         let car = |c: paracosm_engine::Handle<paracosm_engine::CarSpec>| {
-            b.car_names.get(c.index()).map_or("a Car", String::as_str)
+            b.scene.car_name(c.index()).unwrap_or("a Car")
         };
         let (what, ok, wanted) = match *sink {
             Action::Walk(_) => continue,
@@ -983,7 +998,7 @@ fn action_kinds(
             ),
         };
         if !ok {
-            let at = b.graph.site(i).unwrap_or("");
+            let at = b.scene.graph().site(i).unwrap_or("");
             return Err(LoadError::new(
                 LoadErrorKind::Declarations,
                 format!(
@@ -1005,13 +1020,15 @@ fn formula_kinds(
     samples: &[Option<paracosm_engine::rx::Value>],
 ) -> Result<(), LoadError> {
     let sample_of = |signal: &str| sample_of(b, samples, signal);
-    for (m, at) in b.monitors.iter().zip(&b.monitors_at) {
+    for (m, at) in b.scene.monitors() {
         use paracosm_engine::rx::Value;
         for s in m.signals() {
-            for (n, _) in b
-                .published
+            for n in b
+                .scene
+                .signals()
                 .iter()
-                .filter(|(n, _)| !n.starts_with("monitor:"))
+                .map(|s| &s.name)
+                .filter(|n| !n.starts_with("monitor:"))
             {
                 let component = s
                     .strip_prefix(n.as_str())
@@ -1042,15 +1059,14 @@ fn formula_kinds(
 }
 
 impl crate::Worlds for Program {
-    fn with_world(
+    fn with_scene(
         &self,
         assignment: &Assignment,
-        run: &mut dyn FnMut(&WorldSpec, &mut dyn Host),
+        run: &mut dyn FnMut(&crate::scene::Scene, &mut dyn Host),
     ) -> Result<(), ScenarioError> {
         let values = self.values(assignment)?;
         self.evaluate(Some(values), |b, module| {
             self.consistent(&b)?;
-            let spec = scene::world(&b, self.horizon_s)?;
             let functions = lambda_values(&b, module)?;
             let test = super::values::TestState::default();
             test.log.borrow_mut().extend(b.log.iter().cloned());
@@ -1062,7 +1078,7 @@ impl crate::Worlds for Program {
                 .install(&mut eval)
                 .map_err(|e| LoadError::new(LoadErrorKind::Evaluation, e.to_string()))?;
             let mut host = StarHost::new(&mut eval, &functions, &limits, &self.file);
-            run(&spec, &mut host);
+            run(&b.scene, &mut host);
             Ok(())
         })
         .map_err(|e| {

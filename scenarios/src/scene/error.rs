@@ -1,6 +1,7 @@
-//! What a program's load (and the worlds it builds) can refuse, typed by the phase that
+//! What a scene's load (and the worlds it builds) can refuse, typed by the phase that
 //! refuses it ([`LoadErrorKind`]) and located where the declaration at fault stands
-//! ([`Site`]). The message is the whole diagnostic, as the tools print it.
+//! ([`Site`]). The message is the whole diagnostic, as the tools print it. Front ends (the
+//! Starlark language, a scenario file) report their refusals with the same type.
 
 use std::fmt;
 
@@ -34,6 +35,24 @@ impl Site {
         })
     }
 
+    /// The site `at` names (`file:line:col`), or, for text of another form (`?` where a
+    /// front end knows no position), a site of that text at line 0, column 0, which
+    /// displays as the text alone.
+    pub fn of(at: &str) -> Site {
+        Site::parse(at).unwrap_or_else(|| Site {
+            file: at.to_owned(),
+            line: 0,
+            col: 0,
+            variable: None,
+        })
+    }
+
+    /// The same site, naming the variable its declaration was assigned to.
+    pub fn with_variable(mut self, variable: Option<String>) -> Site {
+        self.variable = variable;
+        self
+    }
+
     /// The site a diagnostic points at: the `file:line:col` after its last ` --> `.
     pub fn of_message(message: &str) -> Option<Site> {
         let (_, rest) = message.rsplit_once("--> ")?;
@@ -43,7 +62,11 @@ impl Site {
 
 impl fmt::Display for Site {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}", self.file, self.line, self.col)
+        if self.line == 0 {
+            write!(f, "{}", self.file)
+        } else {
+            write!(f, "{}:{}:{}", self.file, self.line, self.col)
+        }
     }
 }
 

@@ -1,0 +1,95 @@
+use paracosm_engine::behaviour::ActorRef;
+use paracosm_engine::rx::{Node, Value};
+use paracosm_generators::{Param, ParamSpace, Point};
+
+use super::*;
+use crate::reference;
+
+fn assignment(walking_speed: f64, trigger_distance: f64) -> Assignment {
+    let space = ParamSpace::new(vec![
+        Param::interval(reference::WALKING_SPEED, 0.5, 10.0, "m/s"),
+        Param::interval(reference::TRIGGER_DISTANCE, 5.0, 60.0, "m"),
+    ])
+    .unwrap();
+    let unit = |x: f64, lo: f64, hi: f64| (x - lo) / (hi - lo);
+    space
+        .decode(&Point {
+            discrete: vec![],
+            continuous: vec![
+                unit(walking_speed, 0.5, 10.0),
+                unit(trigger_distance, 5.0, 60.0),
+            ],
+        })
+        .unwrap()
+}
+
+#[test]
+fn a_scene_declared_in_rust_carries_its_sites_and_takes_values_by_name() {
+    let scene = reference::scene(Scene::for_assignment(&assignment(3.0, 20.0))).unwrap();
+    let names: Vec<_> = scene
+        .params()
+        .iter()
+        .map(|p| p.name.clone().unwrap())
+        .collect();
+    assert_eq!(names, ["walking_speed", "trigger_distance"]);
+    for p in scene.params() {
+        assert!(
+            p.site.file.ends_with("reference.rs") && p.site.line > 0,
+            "{:?}",
+            p.site
+        );
+        assert_eq!(p.site.variable.as_deref(), p.name.as_deref());
+    }
+    // The values by name, as the world reads them: the pedestrian's speed stream is the
+    // walking speed.
+    let world = scene.world().unwrap();
+    let speed = world.pedestrians[0].speed;
+    assert!(matches!(world.streams.nodes()[speed.0], Node::Const(Value::Num(v)) if v == 3.0));
+    let actors: Vec<_> = scene
+        .actors()
+        .iter()
+        .map(|a| (a.actor, a.site.variable.clone().unwrap()))
+        .collect();
+    assert_eq!(actors[0], (ActorRef::Ego, "v".to_owned()));
+    assert!(matches!(actors[1], (ActorRef::Pedestrian(_), ref v) if v == "p"));
+    let monitors: Vec<_> = scene
+        .monitors()
+        .map(|(m, s)| (m.name().to_owned(), s.line))
+        .collect();
+    assert_eq!(monitors.len(), 2);
+    assert!(monitors.iter().all(|(_, line)| *line > 0));
+    assert_eq!(scene.horizon_s(), reference::HORIZON_S);
+    // Without values, each parameter takes its representative value (an interval's lower end).
+    let probe = reference::scene(Scene::new(None)).unwrap();
+    let speed = probe.world().unwrap().pedestrians[0].speed;
+    let nodes = probe.world().unwrap().streams;
+    assert!(matches!(nodes.nodes()[speed.0], Node::Const(Value::Num(v)) if v == 0.5));
+}
+
+#[test]
+fn a_scene_refuses_what_it_cannot_hold_twice_or_out_of_order() {
+    let mut scene = reference::scene(Scene::new(None)).unwrap();
+    let light = scene.push(Node::Const(Value::Num(1.0)));
+    let e = scene
+        .set_environment(light, light, Site::of("x.star:3:1"))
+        .unwrap_err();
+    assert!(e.to_string().contains("reference.rs:"), "{e}");
+    let e = scene.set_settings(TestSettings::default()).unwrap_err();
+    assert!(matches!(e, SceneError::SecondSettings { .. }), "{e}");
+    // A pedestrian declared but placed under another's handle.
+    let first = scene.declare_pedestrian("a".into(), Site::of("x.star:4:1"));
+    let _second = scene.declare_pedestrian("b".into(), Site::of("x.star:5:1"));
+    let spec = scene.pedestrians().values().next().unwrap().clone();
+    assert!(scene.place_pedestrian(_second, spec.clone()).is_err());
+    assert!(scene.place_pedestrian(first, spec).is_ok());
+    let spec = scene.pedestrians().values().next().unwrap().clone();
+    assert!(scene.place_pedestrian(ActorRef::Ego, spec).is_err());
+}
+
+#[test]
+fn a_scene_without_an_ego_builds_no_world_and_says_so() {
+    let scene = Scene::new(None);
+    let e = scene.world().unwrap_err();
+    assert_eq!(e.kind, LoadErrorKind::Worlds);
+    assert!(e.message.contains("AutonomousVehicle"), "{}", e.message);
+}
