@@ -165,6 +165,12 @@ pub struct Redraw {
     /// Write the campaign's web page again (`report.html`).
     #[arg(long)]
     pub html: bool,
+    /// Draw the tests over the road map (`failure_map-road.{png,svg}`): each test where the
+    /// actor its parameters place (the one whose start moves most between tests, e.g. with an
+    /// `onLane(s=...)` parameter) started, red for a failure, blue for a pass. Refused when no
+    /// parameter places an actor or a parameter shapes the roads.
+    #[arg(long)]
+    pub on_map: bool,
 }
 
 /// The text a tool prints on stderr for an error whose message is `message`: the first line

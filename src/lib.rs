@@ -14,6 +14,7 @@ pub mod cover;
 mod error;
 pub mod export;
 pub mod fuzz;
+pub mod map;
 pub mod record;
 pub mod report;
 

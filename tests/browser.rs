@@ -47,6 +47,12 @@ fn the_report_page_loads_offline_draws_every_test_redraws_and_shows_a_replay_com
     let seen: serde_json::Value = serde_json::from_str(seen.trim()).unwrap();
     assert_eq!(seen["domPoints"], 150);
     assert_eq!(seen["consoleErrors"].as_array().unwrap().len(), 0);
+    // The page names the system under test that ran (pedestrian-crossing's own aeb).
+    let settings = seen["settings"].as_str().unwrap();
+    assert!(
+        settings.contains("system under test") && settings.contains("aeb (built in)"),
+        "{settings}"
+    );
     assert_eq!(
         seen["requests"].as_array().unwrap().len(),
         1,

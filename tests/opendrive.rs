@@ -238,7 +238,7 @@ fn wrong_roads_lanes_and_calls_on_a_map_are_refused_with_the_program_s_place() {
     let cases = [
         (
             "m.onLane(road = \"9\", lane = -1, s = 10.0)",
-            "has no road \"9\" (its roads: 1)",
+            "has no road \"9\": it has 1 road (1); run `paracosm-fuzz map",
         ),
         (
             "m.onLane(road = \"1\", lane = -3, s = 10.0)",
@@ -589,4 +589,124 @@ test(horizon = 10.0)
             assert_eq!(r["monitors"][m]["passed"], m == onto, "{route}: {m}: {r}");
         }
     }
+}
+
+/// Left-hand traffic (`rule="LHT"`, documented in docs/maps.md with
+/// `examples/left_hand_traffic.star`): on esmini's three-way junction, whose roads all say
+/// `rule="LHT"`, lane 1 of road 0 drives along increasing `s` (towards the junction, where
+/// the ego turns left into road 2), and lane -1 of road 2 towards the junction. The same
+/// program on the same map with the rule taken out drives each lane the other way.
+#[test]
+fn left_hand_traffic_drives_each_lane_the_other_way() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let lht = std::fs::read_to_string(
+        root.join("tests/data/maps/esmini/simple_3way_intersection_lht.xodr"),
+    )
+    .unwrap();
+    assert_eq!(lht.matches("rule=\"LHT\"").count(), 6);
+    let dir = tempfile::tempdir().unwrap();
+    // The ego's first and last route points, world [x, z] m, and the car's first two.
+    let drive = |map: &str, route: &str| {
+        std::fs::write(dir.path().join("m.xodr"), map).unwrap();
+        let p = dir.path().join("p.star");
+        std::fs::write(
+            &p,
+            format!(
+                "w = World()\nm = OpenDrive(\"m.xodr\")\n\
+                 v = AutonomousVehicle(loc = m.onLane(road = \"0\", lane = 1, s = 50.0), \
+                 route = {route})\n\
+                 c = Car(loc = m.onLane(road = \"2\", lane = -1, s = 50.0), speed = 5.0)\n\
+                 w.place(m, v, c)\ntest(horizon = 5.0)\n"
+            ),
+        )
+        .unwrap();
+        let s = paracosm_scenarios::load(p.to_str().unwrap()).unwrap();
+        let a = s
+            .space
+            .decode(&paracosm_generators::Point::default())
+            .unwrap();
+        let w = s.instantiate(&a).unwrap();
+        let route = &w.ego.route;
+        (
+            route[0],
+            route[route.len() - 1],
+            w.cars[0].path[0],
+            w.cars[0].path[1],
+        )
+    };
+    // Road 0 runs along +x from the origin to the junction at x = 100.
+    let (first, last, car0, car1) = drive(&lht, "[\"left\"]");
+    assert!(
+        first[0] < last[0] && last[0] > 100.0,
+        "{first:?} -> {last:?}"
+    );
+    // Road 2 leaves the junction: its lane -1 comes back towards it, so the car's path
+    // approaches the junction's centre.
+    let junction = [105.0, 0.0];
+    let dist = |p: [f64; 2]| (p[0] - junction[0]).hypot(p[1] - junction[1]);
+    assert!(dist(car1) < dist(car0), "{car0:?} -> {car1:?}");
+    // Right-hand traffic: lane 1 of road 0 drives away from the junction, to x < 50.
+    let rht = lht.replace(" rule=\"LHT\"", "");
+    let (first, last, car0, car1) = drive(&rht, "None");
+    assert!(
+        last[0] < first[0] && last[0] < 50.0,
+        "{first:?} -> {last:?}"
+    );
+    assert!(dist(car1) > dist(car0), "{car0:?} -> {car1:?}");
+}
+
+/// One world per campaign: a map's query index and collision mesh are built once per program
+/// and shared by its tests (`MapRef`'s cache, docs/performance.md), read-only, so a campaign
+/// on a map written by others (CARLA's Town01, 7 tests at a time on two workers) gives the
+/// same records with one worker and with two, and the same as each test run alone.
+#[test]
+fn a_map_campaign_gives_the_same_records_for_any_number_of_workers() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        root.join("tests/data/maps/carla/Town01.xodr"),
+        dir.path().join("Town01.xodr"),
+    )
+    .unwrap();
+    let p = dir.path().join("town.star");
+    std::fs::write(
+        &p,
+        "speed = VarInterval(4.0, 14.0, unit = \"m/s\")\n\
+         lead_at = VarInterval(8.0, 30.0, unit = \"m\")\n\
+         w = World()\nm = OpenDrive(\"Town01.xodr\")\n\
+         v = AutonomousVehicle(loc = m.onLane(road = \"0\", lane = -1, s = 2.0), \
+         route = [\"left\"], speed = speed)\n\
+         lead = Car(loc = m.onLane(road = \"0\", lane = -1, s = lead_at), speed = 3.0, \
+         route = [\"left\"])\n\
+         w.place(m, v, lead)\nCollisionMonitor(v)\ntest(horizon = 6.0)\n",
+    )
+    .unwrap();
+    let run = |jobs: &str, budget: &str, name: &str| {
+        let out = dir.path().join(name);
+        let o = fuzz(&[
+            p.to_str().unwrap(),
+            "--budget",
+            budget,
+            "--jobs",
+            jobs,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{o:?}");
+        records(&out)
+            .into_iter()
+            .map(|mut r| {
+                r.as_object_mut().unwrap().remove("wall_ms");
+                r
+            })
+            .collect::<Vec<_>>()
+    };
+    let one = run("1", "14", "one");
+    let two = run("2", "14", "two");
+    assert_eq!(one.len(), 14);
+    assert_eq!(one, two);
+    // Some tests end in a collision with the lead car and some do not: the shared map is
+    // the same world for every test, and the actors are each test's own.
+    let failed = one.iter().filter(|r| r["status"] == "fail").count();
+    assert!(0 < failed && failed < 14, "{failed} of 14 failed");
 }

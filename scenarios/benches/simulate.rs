@@ -10,6 +10,13 @@
 //! `long_horizons/*` runs one whole test of `grid-world` (40 s, four NPC cars) and of
 //! `t-loop` (200 s): with `safe_15s/star` they give the cost per simulated second that issue
 //! 23 compares (`experiments/bench/long_horizons.py` measures whole campaigns).
+//!
+//! `maps/*` runs one test on three OpenDRIVE maps written by others (`tests/data/maps/`):
+//! esmini's straight 500 m road, CARLA's Town07 and esmini's `multi_intersections` (63
+//! roads), for 0.1 s and 15 s, the ego under `aeb` at 8.5 m/s. The map's query index and
+//! collision mesh are built once per program and shared by its tests (`MapRef`'s cache):
+//! a test on a city map should cost about what one on a straight map of the same horizon
+//! does.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use paracosm_generators::Point;
@@ -91,6 +98,50 @@ fn bench(c: &mut Criterion) {
         group.bench_function(format!("{name}_{simulated}s"), |b| {
             b.iter(|| s.run(&a, 0).unwrap())
         });
+    }
+    group.finish();
+    maps(c);
+}
+
+/// One test on each of three maps, for two horizons (see the module's documentation).
+fn maps(c: &mut Criterion) {
+    let mut group = c.benchmark_group("maps");
+    group.sample_size(20);
+    for (name, file, road) in [
+        ("straight_500m", "esmini/straight_500m.xodr", "1"),
+        ("town07", "carla/Town07.xodr", "0"),
+        (
+            "multi_intersections",
+            "esmini/multi_intersections.xodr",
+            "196",
+        ),
+    ] {
+        for horizon in ["0.1", "15.0"] {
+            // Paths in a program given as text are relative to the current folder: the
+            // bench runs in `scenarios/`.
+            let text = format!(
+                "speed = VarInterval(5.0, 12.0, unit = \"m/s\")\n\
+                 w = World(light = 0.5, fog = 0.0)\n\
+                 m = OpenDrive(\"../tests/data/maps/{file}\")\n\
+                 v = AutonomousVehicle(loc = m.onLane(road = \"{road}\", lane = -1, s = 5.0), \
+                 sut = \"aeb\", speed = speed)\n\
+                 w.place(m, v)\n\
+                 CollisionMonitor(v)\n\
+                 test(horizon = {horizon})\n"
+            );
+            let s = lang::load_source(&format!("{name}.star"), &text, name).unwrap();
+            let a = s
+                .space
+                .decode(&Point {
+                    discrete: vec![],
+                    continuous: vec![0.5],
+                })
+                .unwrap();
+            assert!(s.run(&a, 0).unwrap().passed(), "{name} {horizon}");
+            group.bench_function(format!("{name}_{horizon}s"), |b| {
+                b.iter(|| s.run(&a, 0).unwrap())
+            });
+        }
     }
     group.finish();
 }

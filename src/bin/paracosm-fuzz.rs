@@ -118,7 +118,8 @@ enum Sub {
     /// fingerprint and that none is missing, given twice or incomplete.
     Merge(MergeArgs),
     /// Reprint the summary of a finished or partial campaign folder: counts, first failure,
-    /// coverage, where failures are, and plot paths; redraw plots on other parameters.
+    /// coverage, where failures are, and plot paths; redraw plots on other parameters, or the
+    /// tests over the road map (--on-map).
     Report(ReportArgs),
     /// Export training data: run a campaign with a teacher (the scenario's system under test
     /// or --sut) and write, per recorded frame, the camera image, depth (.npy), segmentation
@@ -131,6 +132,24 @@ enum Sub {
     /// ego that triggered it. Exit 0, or 3 when the replayed verdict differs from the recorded
     /// one.
     Export(ExportArgs),
+    /// List an OpenDRIVE map's roads (id, length, junction, lane sections with their range of
+    /// s and their lanes as id:type), and its junctions with each connection (incoming ->
+    /// connecting -> outgoing road, contact point, turn), to pick onLane(road=, lane=, s=);
+    /// with --png/--svg, also draw it top-down with road ids, lane directions and junctions.
+    /// Exit 0, or 2 for a map that does not load (naming file:line:col).
+    Map(MapArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct MapArgs {
+    /// The OpenDRIVE file (.xodr).
+    file: PathBuf,
+    /// Draw the map into this PNG file.
+    #[arg(long, value_name = "PATH")]
+    png: Option<PathBuf>,
+    /// Draw the map into this SVG file.
+    #[arg(long, value_name = "PATH")]
+    svg: Option<PathBuf>,
 }
 
 #[derive(Debug, clap::Args)]
@@ -381,6 +400,7 @@ fn main() -> ExitCode {
                 );
                 say(&text).map(|()| if e.matches { 0 } else { 3 })
             }),
+        Some(Sub::Map(a)) => map(a),
         None => run(&cli),
     };
     let code = match result {
@@ -431,6 +451,27 @@ fn say(text: &str) -> Result<()> {
         }
         other => other.context("cannot write to stdout"),
     }
+}
+
+/// `paracosm-fuzz map`: the listing on stdout, the importer's warnings on stderr, then the
+/// drawings.
+fn map(a: &MapArgs) -> Result<u8> {
+    let listing = paracosm::map::read(&a.file)?;
+    for w in &listing.warnings {
+        paracosm::cli::to_stderr(&format!("paracosm-fuzz: warning: {w}"));
+    }
+    let mut wrote = Vec::new();
+    if let Some(p) = &a.png {
+        wrote.push(listing.draw_png(p)?.display().to_string());
+    }
+    if let Some(p) = &a.svg {
+        wrote.push(listing.draw_svg(p)?.display().to_string());
+    }
+    say(&listing.text())?;
+    if !wrote.is_empty() {
+        say(&format!("wrote: {}", wrote.join(", ")))?;
+    }
+    Ok(0)
 }
 
 /// Set by Ctrl-C or SIGTERM ([`stop_on_signals`]): no new test starts.

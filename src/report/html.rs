@@ -273,10 +273,20 @@ fn small_enough(png: Vec<u8>, limit: usize) -> Option<Vec<u8>> {
     }
 }
 
+/// The page's title: the scenario, the system under test (where the summary names it), the
+/// strategy, seed and counts.
 fn title(s: &Summary) -> String {
     format!(
-        "{}: {}, seed {}, {} tests, {} failed",
-        s.scenario, s.strategy, s.seed, s.tests_run, s.counts.fail
+        "{}{}: {}, seed {}, {} tests, {} failed",
+        s.scenario,
+        s.sut
+            .as_ref()
+            .map(|sut| format!(" under {}", sut.name))
+            .unwrap_or_default(),
+        s.strategy,
+        s.seed,
+        s.tests_run,
+        s.counts.fail
     )
 }
 

@@ -3,6 +3,7 @@
 
 pub mod html;
 pub mod junit;
+pub mod on_map;
 pub mod plot;
 pub mod summary;
 pub mod triage;
@@ -390,6 +391,10 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
         failures: failures(f.records, f.out),
         tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
         scenario: scenario.name.clone(),
+        sut: Some(crate::report::summary::SutSummary::of(
+            &scenario.sut,
+            &f.file.sut,
+        )),
         strategy: f.file.strategy.clone(),
         seed: f.file.seed,
         budget: f.file.budget,
@@ -452,6 +457,9 @@ pub fn human(
         c.error,
         if speed.starts_with("in ") { " " } else { "; " },
     )];
+    if let Some(sut) = &summary.sut {
+        lines.push(format!("system under test: {}", sut.text()));
+    }
     if let Some(f) = &summary.first_failure {
         lines.push(first_failure_line(f, scenario));
         lines.push(format!("replay it: {}", replay_command(out, f.id)));
@@ -643,7 +651,12 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
         triage: summary.triage.as_ref(),
     };
     // A folder that takes no new file is bad input, found before anything is drawn.
-    if redraw.map.is_some() || redraw.color.is_some() || redraw.pairs || redraw.html {
+    if redraw.map.is_some()
+        || redraw.color.is_some()
+        || redraw.pairs
+        || redraw.html
+        || redraw.on_map
+    {
         crate::atomic::probe_writable(dir)?;
     }
     if redraw.html {
@@ -659,6 +672,11 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
             map_axes: &scenario.map_axes,
         })?;
         drawn.push(page.display().to_string());
+    }
+    if redraw.on_map {
+        let (files, line) = on_map::draw(dir, &scenario, &existing.records)?;
+        text.push_str(&format!("\n{line}"));
+        drawn.extend(files);
     }
     if !drawn.is_empty() {
         text.push_str(&format!("\nwrote: {}", drawn.join(", ")));

@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use paracosm_generators::{Assignment, Param};
 
+use crate::campaign::file::SutChoice;
 use crate::record::{RunRecord, Status};
 
 /// File name of the summary in the output folder.
@@ -89,6 +90,79 @@ pub struct FailureEntry {
     pub replay: String,
 }
 
+/// The system under test a campaign ran, as `summary.json` and the report page name it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SutSummary {
+    /// `builtin` (`aeb`, `vision`, `pilotnet`, `constant`), `onnx` (a model) or `command` (an
+    /// external program speaking SUT_PROTOCOL.md).
+    pub kind: String,
+    /// The built-in's name, the model's path as given, or the command line (its words as a
+    /// shell would take them).
+    pub name: String,
+    /// SHA-256 (hex) of the ONNX model's bytes, for `onnx` and for `pilotnet`; absent for the
+    /// others.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sha256: Option<String>,
+    /// Who chose it: `scenario` (the program's `AutonomousVehicle(sut=...)` or its default),
+    /// `--sut`, `--sut-onnx` or `--sut-cmd`.
+    pub chosen_by: String,
+}
+
+impl SutSummary {
+    /// The system `sut` that ran, chosen as `choice` records.
+    pub fn of(sut: &paracosm_engine::sut::SutConfig, choice: &SutChoice) -> SutSummary {
+        use paracosm_engine::sut::SutConfig;
+        let chosen_by = match choice {
+            SutChoice::Scenario => "scenario",
+            SutChoice::Builtin { .. } => "--sut",
+            SutChoice::Onnx { .. } => "--sut-onnx",
+            SutChoice::Command { .. } => "--sut-cmd",
+        }
+        .to_owned();
+        let sha256 = sut.model_sha256().map(str::to_owned);
+        let (kind, name) = match sut {
+            SutConfig::External(e) => (
+                "command",
+                shlex::try_join(e.command.iter().map(String::as_str))
+                    .unwrap_or_else(|_| e.command.join(" ")),
+            ),
+            other => {
+                let name = other.name();
+                match name.strip_prefix("onnx:") {
+                    Some(model) if sha256.is_some() => ("onnx", model.to_owned()),
+                    _ => ("builtin", name),
+                }
+            }
+        };
+        SutSummary {
+            kind: kind.to_owned(),
+            name,
+            sha256,
+            chosen_by,
+        }
+    }
+
+    /// One line for people: `aeb (built in, the scenario's)`, `onnx model m.onnx (SHA-256
+    /// ...)`, `command "python3 sut.py" (--sut-cmd)`.
+    pub fn text(&self) -> String {
+        let by = if self.chosen_by == "scenario" {
+            "the scenario's".to_owned()
+        } else {
+            self.chosen_by.clone()
+        };
+        let hash = self
+            .sha256
+            .as_ref()
+            .map(|h| format!(", SHA-256 {h}"))
+            .unwrap_or_default();
+        match self.kind.as_str() {
+            "onnx" => format!("ONNX model {} ({by}{hash})", self.name),
+            "command" => format!("external command `{}` ({by})", self.name),
+            _ => format!("{} (built in, {by}{hash})", self.name),
+        }
+    }
+}
+
 /// The contents of `summary.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
@@ -99,6 +173,9 @@ pub struct Summary {
     pub tool: String,
     /// Scenario name.
     pub scenario: String,
+    /// The system under test that ran; `null` in summaries written before it was recorded.
+    #[serde(default)]
+    pub sut: Option<SutSummary>,
     /// Strategy name.
     pub strategy: String,
     /// Campaign seed.

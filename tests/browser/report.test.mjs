@@ -2,7 +2,7 @@
 //   node tests/browser/report.test.mjs REPORT_HTML EXPECTED_TESTS SCREENSHOT_PNG [--load-only]
 // (--load-only: the load, request and point checks, then the screenshot)
 // - the page loads with no console error and no request besides the file itself;
-// - the map draws one point per test;
+// - the map draws one point per test, and the settings name the system under test;
 // - changing the x-axis menu redraws the map on the new parameter;
 // - the robustness colouring draws the diverging scale's legend;
 // - clicking a failed point, and a row of the failure table, shows that test's replay command;
@@ -53,6 +53,9 @@ try {
   seen.scenePoints = await page.evaluate(() => window.paracosmReport.pointsDrawn());
   check(seen.domPoints === expected, `points drawn ${seen.domPoints} != tests ${expected}`);
   check(seen.scenePoints === expected, `scene points ${seen.scenePoints} != tests ${expected}`);
+  // The settings name the system under test that ran.
+  seen.settings = await page.locator("#settings").textContent();
+  check(seen.settings.includes("system under test"), "the settings do not name the system under test");
   if (loadOnly) {
     await page.screenshot({ path: screenshot, fullPage: true });
     console.log(JSON.stringify(seen));

@@ -78,16 +78,23 @@ impl Network {
                 PieceKind::Map { map, .. } => {
                     // One triangle mesh of every lane's strip at the surface y = 0 (maps are
                     // flat and have no curbs).
-                    let (vertices, indices) = map.0.strip_triangles();
-                    let vertices = vertices
-                        .iter()
-                        .map(|q| {
-                            let [x, z] = p.pose.apply(*q);
-                            Vector::new(x as f32, 0.0, z as f32)
-                        })
-                        .collect();
-                    if let Ok(c) = ColliderBuilder::trimesh(vertices, indices) {
-                        physics.insert_collider(c.friction(mu), None);
+                    // Built once per map and pose, shared by every test (`MapRef::mesh`):
+                    // the mesh's BVH is most of a map world's cost to build.
+                    let pose = &p.pose;
+                    let key = [pose.x, pose.z, pose.heading_rad].map(f64::to_bits);
+                    let mesh = map.mesh(key, || {
+                        let (vertices, indices) = map.0.strip_triangles();
+                        let vertices = vertices
+                            .iter()
+                            .map(|q| {
+                                let [x, z] = pose.apply(*q);
+                                Vector::new(x as f32, 0.0, z as f32)
+                            })
+                            .collect();
+                        SharedShape::trimesh(vertices, indices).ok()
+                    });
+                    if let Some(mesh) = mesh {
+                        physics.insert_collider(ColliderBuilder::new(mesh).friction(mu), None);
                     }
                 }
                 PieceKind::Arc { .. } | PieceKind::Clothoid { .. } => {

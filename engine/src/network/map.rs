@@ -126,11 +126,26 @@ impl MapLane {
     }
 }
 
+/// `, and N more` when a list shows `shown` of `count` items, else nothing.
+fn more_roads(count: usize, shown: usize) -> String {
+    if count > shown {
+        format!(", and {} more", count - shown)
+    } else {
+        String::new()
+    }
+}
+
 /// Why [`RoadMap::lane_at`] finds no lane; each message names the map's file.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum LaneAtError {
     /// The map has no road of that id.
-    #[error("{map} has no road \"{road}\" (its roads: {})", .roads.join(", "))]
+    #[error(
+        "{map} has no road \"{road}\": it has {count} road{} ({}{}); run `paracosm-fuzz map \
+         {map}` to list them with their lanes",
+        if *.count == 1 { "" } else { "s" },
+        .roads.join(", "),
+        more_roads(*.count, .roads.len())
+    )]
     NoRoad {
         /// The map's file ([`RoadMap::source`]).
         map: String,
@@ -138,6 +153,8 @@ pub enum LaneAtError {
         road: String,
         /// The map's first 20 road ids.
         roads: Vec<String>,
+        /// How many roads the map has.
+        count: usize,
     },
     /// The station lies outside the road.
     #[error("s = {s_m} m is outside road \"{road}\" of {map}, [0, {length_m:.2}] m")]
@@ -208,9 +225,82 @@ pub struct RoadMap {
     pub lanes: Vec<MapLane>,
 }
 
-/// A shared, immutable [`RoadMap`]: cloning a network clones the handle, not the map.
+/// A shared, immutable [`RoadMap`]: cloning a network clones the handle, not the map, nor
+/// what is derived from the map once and shared by every test that uses it (its query
+/// index, its collision mesh: [`MapCache`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct MapRef(pub Arc<RoadMap>);
+pub struct MapRef(pub Arc<RoadMap>, Arc<MapCache>);
+
+impl MapRef {
+    /// A handle of `map` with an empty cache.
+    pub fn new(map: Arc<RoadMap>) -> Self {
+        MapRef(map, Arc::default())
+    }
+
+    /// [`RoadMap::bounds_m`], computed at the first call and kept.
+    pub fn bounds_m(&self) -> ([f64; 2], [f64; 2]) {
+        *self.1.bounds.get_or_init(|| self.0.bounds_m())
+    }
+
+    /// The map's query index ([`MapIndex`]), built at the first call and shared by every
+    /// later one (and every clone of this handle).
+    pub fn index(&self) -> MapIndex {
+        let trees = self
+            .1
+            .trees
+            .get_or_init(|| Arc::new(MapTrees::new(&self.0)));
+        MapIndex {
+            map: self.0.clone(),
+            trees: trees.clone(),
+            recent: no_recent_hits(),
+        }
+    }
+
+    /// The collision mesh of the map's lane strips placed by `pose_key` (the bits of the
+    /// piece's pose), built by `build` at the first call for that pose and shared after.
+    pub(crate) fn mesh<T: Clone + Send + Sync + 'static>(
+        &self,
+        pose_key: [u64; 3],
+        build: impl FnOnce() -> Option<T>,
+    ) -> Option<T> {
+        let mut slot = self.1.mesh.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((key, shape)) = slot.as_ref() {
+            if *key == pose_key {
+                return shape.downcast_ref::<T>().cloned();
+            }
+        }
+        let shape = build()?;
+        *slot = Some((pose_key, Box::new(shape.clone())));
+        Some(shape)
+    }
+}
+
+/// A map's collision mesh and the bits of the pose it was built for.
+type CachedMesh = ([u64; 3], Box<dyn std::any::Any + Send + Sync>);
+
+/// What is derived from a [`RoadMap`] once per map, for every test that uses it: the key is
+/// the map itself (one per file a program reads, [`MapRef`]'s `Arc`) and, for the mesh, the
+/// pose it is placed at. A test's world reads it; nothing writes it after it is built, so
+/// every test sees the same bits whichever worker built it.
+#[derive(Default)]
+pub struct MapCache {
+    bounds: std::sync::OnceLock<([f64; 2], [f64; 2])>,
+    trees: std::sync::OnceLock<Arc<MapTrees>>,
+    mesh: std::sync::Mutex<Option<CachedMesh>>,
+}
+
+impl std::fmt::Debug for MapCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("MapCache")
+    }
+}
+
+/// Derived data compares equal: two handles of equal maps are equal.
+impl PartialEq for MapCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
 
 impl Serialize for MapRef {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
@@ -220,7 +310,7 @@ impl Serialize for MapRef {
 
 impl<'de> Deserialize<'de> for MapRef {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        RoadMap::deserialize(d).map(|m| MapRef(Arc::new(m)))
+        RoadMap::deserialize(d).map(|m| MapRef::new(Arc::new(m)))
     }
 }
 
@@ -248,11 +338,13 @@ impl RoadMap {
     pub fn lane_at(&self, road: &str, od_id: i32, s: f64) -> Result<usize, LaneAtError> {
         let Some(r) = self.roads.iter().position(|r| r.od_id == road) else {
             let mut roads: Vec<String> = self.roads.iter().map(|r| r.od_id.clone()).collect();
+            let count = roads.len();
             roads.truncate(20);
             return Err(LaneAtError::NoRoad {
                 map: self.source.clone(),
                 road: road.to_owned(),
                 roads,
+                count,
             });
         };
         let length = self.roads[r].length_m;
@@ -594,21 +686,60 @@ fn beyond_ends(l: &MapLane, p: [f64; 2]) -> bool {
 
 type Segment = GeomWithData<Line<[f64; 2]>, (usize, usize)>;
 
-/// Point queries on a map, precomputed once per world: R-trees of the lanes' centre-line
-/// segments and of the driving surface's edges.
-#[derive(Debug, Clone)]
+/// Point queries on a map: R-trees of the lanes' centre-line segments and of the driving
+/// surface's edges, built once per map ([`MapRef::index`]) and shared.
+#[derive(Debug)]
 pub struct MapIndex {
     map: Arc<RoadMap>,
+    trees: Arc<MapTrees>,
+    /// The centre-line segments that last held a point ([`MapIndex::on_any_lane`]), packed
+    /// `lane << 32 | segment` (`u64::MAX`: none), tried before the tree: a wheel stays on one
+    /// strip for many steps. Only a shortcut to the same answer.
+    recent: [std::sync::atomic::AtomicU64; RECENT_HITS],
+}
+
+/// How many recent hits a [`MapIndex`] keeps: one per wheel and a few more.
+const RECENT_HITS: usize = 8;
+
+impl Clone for MapIndex {
+    fn clone(&self) -> Self {
+        MapIndex {
+            map: self.map.clone(),
+            trees: self.trees.clone(),
+            recent: no_recent_hits(),
+        }
+    }
+}
+
+fn no_recent_hits() -> [std::sync::atomic::AtomicU64; RECENT_HITS] {
+    std::array::from_fn(|_| std::sync::atomic::AtomicU64::new(u64::MAX))
+}
+
+/// The R-trees of a [`MapIndex`], derived from its map alone and shared by every index of
+/// that map ([`MapRef::index`]).
+#[derive(Debug)]
+pub struct MapTrees {
     centres: RTree<Segment>,
     edges: RTree<GeomWithData<Line<[f64; 2]>, ()>>,
     widest_m: f64,
 }
 
 impl MapIndex {
-    /// Indexes `map`. The edges of the driving surface are the borders of drivable lanes
+    /// Indexes `map`, building its trees ([`MapRef::index`] shares them between tests).
+    pub fn new(map: Arc<RoadMap>) -> MapIndex {
+        MapIndex {
+            trees: Arc::new(MapTrees::new(&map)),
+            map,
+            recent: no_recent_hits(),
+        }
+    }
+}
+
+impl MapTrees {
+    /// The trees of `map`. The edges of the driving surface are the borders of drivable lanes
     /// with no drivable lane beyond them (probed 0.2 m outside), and the ends of drivable
     /// lanes that nothing continues.
-    pub fn new(map: Arc<RoadMap>) -> MapIndex {
+    fn new(map: &Arc<RoadMap>) -> MapTrees {
         let mut segments = Vec::new();
         let mut widest = 0.0f64;
         for (k, l) in map.lanes.iter().enumerate() {
@@ -620,11 +751,15 @@ impl MapIndex {
                 widest = widest.max(l.width[i]).max(l.width[i + 1]);
             }
         }
-        let mut index = MapIndex {
+        // The centre lines first: finding the edges asks which points are on a lane.
+        let index = MapIndex {
             map: map.clone(),
-            centres: RTree::bulk_load(segments),
-            edges: RTree::new(),
-            widest_m: widest,
+            recent: no_recent_hits(),
+            trees: Arc::new(MapTrees {
+                centres: RTree::bulk_load(segments),
+                edges: RTree::new(),
+                widest_m: widest,
+            }),
         };
         let mut has_predecessor = vec![false; map.lanes.len()];
         for l in &map.lanes {
@@ -680,8 +815,17 @@ impl MapIndex {
                 }
             }
         }
-        index.edges = RTree::bulk_load(edges);
-        index
+        let MapIndex { trees, .. } = index;
+        let mut trees = Arc::try_unwrap(trees).expect("the trees are not shared yet");
+        trees.edges = RTree::bulk_load(edges);
+        trees
+    }
+}
+
+impl MapIndex {
+    /// Whether `other` reads the very same trees (one map's shared cache).
+    pub fn shares_trees_with(&self, other: &MapIndex) -> bool {
+        Arc::ptr_eq(&self.trees, &other.trees)
     }
 
     /// The map.
@@ -692,8 +836,9 @@ impl MapIndex {
     /// The lanes whose strips hold `p`, with `p`'s lateral offset from their centre line
     /// (m, positive to the right of increasing `s`).
     fn strips_at(&self, p: [f64; 2]) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let r = self.widest_m / 2.0 + 1e-9;
-        self.centres
+        let r = self.trees.widest_m / 2.0 + 1e-9;
+        self.trees
+            .centres
             .locate_within_distance(p, r * r)
             .filter_map(move |seg| {
                 let (k, i) = seg.data;
@@ -708,17 +853,50 @@ impl MapIndex {
 
     /// Whether the world point `[x, z]` lies on any lane of the map (driving or not).
     pub fn on_any_lane(&self, p: [f64; 2]) -> bool {
-        self.strips_at(p).next().is_some()
+        self.held(p, |_| true)
+    }
+
+    /// Whether a lane that `wanted` accepts (by index) holds `p`: the recent hits first,
+    /// then the tree, whose hit becomes the newest recent one. The same answer as a search
+    /// of the tree alone.
+    fn held(&self, p: [f64; 2], wanted: impl Fn(usize) -> bool) -> bool {
+        use std::sync::atomic::Ordering::Relaxed;
+        let holds =
+            |(k, i): (usize, usize)| wanted(k) && strip_offset(&self.map.lanes[k], i, p).is_some();
+        let unpack = |packed: u64| ((packed >> 32) as usize, (packed & 0xffff_ffff) as usize);
+        let recent = self.recent.iter().map(|r| r.load(Relaxed));
+        if recent.filter(|&r| r != u64::MAX).any(|r| holds(unpack(r))) {
+            return true;
+        }
+        let r = self.trees.widest_m / 2.0 + 1e-9;
+        let hit = self
+            .trees
+            .centres
+            .locate_within_distance(p, r * r)
+            .find(|seg| holds(seg.data));
+        if let Some(seg) = hit {
+            let (k, i) = seg.data;
+            // The oldest slot goes: slots shift by one, the newest hit first.
+            for j in (1..RECENT_HITS).rev() {
+                self.recent[j].store(self.recent[j - 1].load(Relaxed), Relaxed);
+            }
+            self.recent[0].store(((k as u64) << 32) | i as u64, Relaxed);
+        }
+        hit.is_some()
     }
 
     /// Signed distance from the world point `[x, z]` to the edge of the map's driving
     /// surface, m: `> 0` on it, `<= 0` off it (see [`super::Surface::edge_distance_m`]).
     pub fn edge_distance_m(&self, p: [f64; 2]) -> f64 {
-        let d = self.edges.nearest_neighbor(p).map_or(f64::INFINITY, |e| {
-            let l = e.geom();
-            segment_projection(p, l.from, l.to).0
-        });
-        if self.drivable_at(p, None) {
+        let d = self
+            .trees
+            .edges
+            .nearest_neighbor(p)
+            .map_or(f64::INFINITY, |e| {
+                let l = e.geom();
+                segment_projection(p, l.from, l.to).0
+            });
+        if self.held(p, |k| self.map.lanes[k].drivable) {
             d
         } else {
             -d

@@ -157,7 +157,7 @@ impl Network {
         self.add(
             name,
             PieceKind::Map {
-                map: MapRef(map),
+                map: MapRef::new(map),
                 friction,
             },
         )

@@ -369,7 +369,7 @@ impl PieceKind {
                 ([length_m / 2.0, self.half_width_m()], [length_m / 2.0, 0.0])
             }
             PieceKind::Map { map, .. } => {
-                let (lo, hi) = map.0.bounds_m();
+                let (lo, hi) = map.bounds_m();
                 (
                     [(hi[0] - lo[0]) / 2.0 + 0.1, (hi[1] - lo[1]) / 2.0 + 0.1],
                     [(hi[0] + lo[0]) / 2.0, (hi[1] + lo[1]) / 2.0],

@@ -396,9 +396,7 @@ impl Surface {
                 pose: p.pose,
                 sin_cos: p.pose.heading_rad.sin_cos(),
                 shape: match &p.kind {
-                    PieceKind::Map { map, .. } => {
-                        Shape::Map(Box::new(MapIndex::new(map.0.clone())))
-                    }
+                    PieceKind::Map { map, .. } => Shape::Map(Box::new(map.index())),
                     &PieceKind::Segment { length_m, .. } => Shape::Segment {
                         length_m,
                         half_road_m: p.kind.half_road_m(),

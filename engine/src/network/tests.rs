@@ -684,3 +684,44 @@ fn a_t_intersections_stem_offers_left_and_right_and_no_uturn_or_road() {
         assert!(e.contains(&format!("no \"{}\" turn", turn.name())), "{e}");
     }
 }
+
+#[test]
+fn a_maps_index_and_mesh_are_built_once_and_shared_by_every_world() {
+    let text = include_str!("../../../scenarios/maps/junction.xodr");
+    let map = crate::network::opendrive::import("junction.xodr", text)
+        .unwrap()
+        .map;
+    let shared = MapRef::new(map);
+    // Two tests' networks clone the handle: both read one index, built once.
+    let (a, b) = (shared.clone(), shared.clone());
+    assert!(a.index().shares_trees_with(&b.index()));
+    // A handle of the same map made anew has a cache of its own.
+    let fresh = MapRef::new(shared.0.clone());
+    assert!(!fresh.index().shares_trees_with(&a.index()));
+    // The mesh is built at the first call for a pose, then handed out; another pose builds
+    // its own.
+    let builds = std::cell::Cell::new(0);
+    let build = || {
+        builds.set(builds.get() + 1);
+        Some(7u32)
+    };
+    assert_eq!(a.mesh([0, 0, 0], build), Some(7));
+    assert_eq!(b.mesh([0, 0, 0], build), Some(7));
+    assert_eq!(builds.get(), 1);
+    assert_eq!(b.mesh([1, 0, 0], build), Some(7));
+    assert_eq!(builds.get(), 2);
+    // Queries through the shared index answer as through one built alone.
+    let alone = MapIndex::new(shared.0.clone());
+    let index = a.index();
+    for x in (-60..=60).step_by(3) {
+        for z in (-60..=60).step_by(3) {
+            let p = [f64::from(x) + 0.25, f64::from(z) - 0.5];
+            assert_eq!(index.on_any_lane(p), alone.on_any_lane(p), "{p:?}");
+            assert_eq!(
+                index.edge_distance_m(p).to_bits(),
+                alone.edge_distance_m(p).to_bits(),
+                "{p:?}"
+            );
+        }
+    }
+}

@@ -11,10 +11,10 @@
 use super::load_error::{refused, LoadError, LoadErrorKind};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::Mutex;
 
 use paracosm_engine::network::opendrive;
-use paracosm_engine::network::RoadMap;
+use paracosm_engine::network::MapRef;
 use sha2::{Digest, Sha256};
 
 use crate::scenario::InputFile;
@@ -88,7 +88,8 @@ pub fn read_input_file(scenario: &str, path: &str) -> Result<String, LoadError> 
 
 #[derive(Debug, Clone)]
 struct Loaded {
-    map: Arc<RoadMap>,
+    /// The map with what is derived from it once for every test ([`MapRef`]'s cache).
+    map: MapRef,
     warnings: Vec<String>,
     sha256: String,
 }
@@ -116,13 +117,14 @@ impl MapFiles {
     }
 
     /// The map at `path` (as the program writes it): read and checked the first time, the
-    /// same map after.
+    /// same map after, with the same cache of what is derived from it (its query index and
+    /// collision mesh are built once per program, not once per test).
     ///
     /// # Errors
     /// [`LoadError`] of kind [`LoadErrorKind::Files`], naming the file: it cannot be read, is
     /// larger than [`MAX_MAP_BYTES`], is not UTF-8, or is no usable OpenDRIVE map
     /// ([`opendrive::import`]'s message, with the line).
-    pub(crate) fn load(&self, path: &str) -> Result<Arc<RoadMap>, LoadError> {
+    pub(crate) fn load(&self, path: &str) -> Result<MapRef, LoadError> {
         let files = refused(LoadErrorKind::Files);
         let mut loaded = self
             .loaded
@@ -156,15 +158,16 @@ impl MapFiles {
         };
         let imported = opendrive::import(&shown, &text)
             .map_err(|e| files(format!("the OpenDRIVE map {e}")))?;
+        let map = MapRef::new(imported.map);
         loaded.insert(
             path.to_owned(),
             Loaded {
-                map: imported.map.clone(),
+                map: map.clone(),
                 warnings: imported.warnings,
                 sha256: sha256_hex(text.as_bytes()),
             },
         );
-        Ok(imported.map)
+        Ok(map)
     }
 
     /// Every file read so far, in order of path, with its SHA-256.

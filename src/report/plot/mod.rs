@@ -9,6 +9,7 @@ mod axis;
 mod boxes;
 mod map;
 mod pairs;
+mod road_map;
 mod series;
 mod sheet;
 
@@ -27,6 +28,7 @@ pub use map::{
     UnknownColoring,
 };
 pub use pairs::{pairs_plot, MAX_PAIRS};
+pub use road_map::{road_map_png, road_map_svg, MapMark, RoadMapDrawing};
 pub use series::{value_map, xy_plot, Series, ValueMapLabels, ValuePoint, XyStyle};
 pub use sheet::contact_sheet;
 
@@ -133,22 +135,27 @@ fn png_and_svg(
     svg: impl Fn(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), DrawError>,
 ) -> Result<[PathBuf; 2], PlotError> {
     let (png_path, svg_path) = (stem.with_extension("png"), stem.with_extension("svg"));
-    let failed = |path: &Path| {
-        let path = path.to_path_buf();
-        move |e: crate::Error| PlotError::Draw {
-            path,
-            reason: e.to_string(),
-        }
+    write_png(&png_path, size, png)?;
+    write_svg(&svg_path, size, svg)?;
+    Ok([png_path, svg_path])
+}
+
+/// Draws one figure of `size` pixels with `draw` into the PNG file `path`, through a
+/// temporary file and a rename.
+fn write_png(
+    path: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), DrawError>,
+) -> Result<(), PlotError> {
+    let failed = |reason: String| PlotError::Draw {
+        path: path.to_path_buf(),
+        reason,
     };
     // Drawn into memory, then encoded with the best compression (plots are mostly flat
     // colour; this halves a busy pairs plot, which the web report embeds).
     let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
-    png(BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area()).map_err(|e| {
-        PlotError::Draw {
-            path: png_path.clone(),
-            reason: e.to_string(),
-        }
-    })?;
+    draw(BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area())
+        .map_err(|e| failed(e.to_string()))?;
     let mut encoded = Vec::new();
     image::codecs::png::PngEncoder::new_with_quality(
         &mut encoded,
@@ -156,14 +163,22 @@ fn png_and_svg(
         image::codecs::png::FilterType::Adaptive,
     )
     .write_image(&pixels, size.0, size.1, image::ColorType::Rgb8)
-    .map_err(|e| PlotError::Draw {
-        path: png_path.clone(),
-        reason: e.to_string(),
-    })?;
-    crate::atomic::write(&png_path, &encoded).map_err(failed(&png_path))?;
-    crate::atomic::with_temp(&svg_path, |tmp| {
-        svg(SVGBackend::new(tmp, size).into_drawing_area())
+    .map_err(|e| failed(e.to_string()))?;
+    crate::atomic::write(path, &encoded).map_err(|e| failed(e.to_string()))
+}
+
+/// Draws one figure of `size` pixels with `draw` into the SVG file `path`, through a
+/// temporary file and a rename.
+fn write_svg(
+    path: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), DrawError>,
+) -> Result<(), PlotError> {
+    crate::atomic::with_temp(path, |tmp| {
+        draw(SVGBackend::new(tmp, size).into_drawing_area())
     })
-    .map_err(failed(&svg_path))?;
-    Ok([png_path, svg_path])
+    .map_err(|e| PlotError::Draw {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })
 }

@@ -394,13 +394,7 @@ pub(super) fn register_curves_and_maps(builder: &mut GlobalsBuilder) {
                 Some(Node::Const(Rx::Num(mu))) => *mu,
                 _ => 0.8,
             };
-            (
-                PieceKind::Map {
-                    map: paracosm_engine::network::MapRef(map),
-                    friction: mu,
-                },
-                stream,
-            )
+            (PieceKind::Map { map, friction: mu }, stream)
         };
         let road = add_piece(eval, "OpenDrive", kind, stream)?;
         Ok(Road { map: true, ..road })
