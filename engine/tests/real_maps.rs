@@ -144,8 +144,10 @@ fn every_carla_town_loads_with_the_file_s_roads_lanes_and_lengths() {
     assert!(roads.iter().all(|&n| n > 60), "{roads:?}");
 }
 
-/// esmini's maps with faults of their own, and the phrase each refusal names.
-const REFUSED: &[(&str, &str)] = &[
+/// esmini's maps with faults of their own, which load (as esmini and libOpenDRIVE read them)
+/// with a warning naming the fault: a link to a road the map lacks leads nowhere, and a road
+/// longer than its plan view is baked to its length, its last geometry running on.
+const WARNED: &[(&str, &str)] = &[
     (
         "stationary_objects.xodr",
         "<successor> of road \"0\" names road \"1\", which the map does not have",
@@ -161,17 +163,22 @@ fn esmini_s_maps_load_with_the_file_s_roads_lanes_and_lengths() {
     let mut loaded = 0;
     for path in maps("esmini") {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        if let Some((_, phrase)) = REFUSED.iter().find(|(f, _)| *f == name) {
+        if let Some((_, phrase)) = WARNED.iter().find(|(f, _)| *f == name) {
             let text = std::fs::read_to_string(&path).unwrap();
-            let e = import(&name, &text).unwrap_err().to_string();
-            assert!(e.contains(phrase), "{name}: {e}");
-            continue;
+            let warnings = import(&name, &text).unwrap().warnings;
+            assert!(
+                warnings.iter().any(|w| w.contains(phrase)),
+                "{name}: {warnings:?}"
+            );
         }
         check(&path);
         loaded += 1;
     }
-    assert!(loaded >= 20, "{loaded} esmini maps");
-    println!("{loaded} esmini maps load; {} are refused", REFUSED.len());
+    assert_eq!(loaded, 76, "every esmini map loads");
+    println!(
+        "{loaded} esmini maps load; {} of them with a fault named",
+        WARNED.len()
+    );
 }
 
 /// A lane's `(road id, section, lane id)`.

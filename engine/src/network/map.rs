@@ -225,6 +225,11 @@ pub struct RoadMap {
     pub lanes: Vec<MapLane>,
 }
 
+/// Where a route joins two lanes, how close the next lane's first station may lie to the last
+/// point and still be that point, m (a link that meets leaves a gap of well under this; one
+/// that does not is refused or warned of at load, `links.rs`).
+pub const JOIN_SAME_M: f64 = 0.01;
+
 /// A shared, immutable [`RoadMap`]: cloning a network clones the handle, not the map, nor
 /// what is derived from the map once and shared by every test that uses it (its query
 /// index, its collision mesh: [`MapCache`]).
@@ -509,7 +514,9 @@ impl RoadMap {
             .map(|(lanes, _)| lanes)
     }
 
-    /// [`RoadMap::route`]'s lanes and points.
+    /// [`RoadMap::route`]'s lanes and points: the start lane's stations ahead of `s`, then
+    /// each next lane's, a next lane's first station left out where it is the join itself
+    /// (within [`JOIN_SAME_M`] of the last point, or behind it).
     fn follow(
         &self,
         lane: usize,
@@ -552,10 +559,25 @@ impl RoadMap {
                         })?
                 }
             };
-            for q in self.lanes[pick].travel_points() {
+            for (i, q) in self.lanes[pick].travel_points().into_iter().enumerate() {
                 let last = *points.last().expect("non-empty");
                 let d = (q[0] - last[0]).hypot(q[1] - last[1]);
-                if d > 1e-6 {
+                // Where two lanes join, the next lane's first station lies on the last one's
+                // end up to the link's gap (a fraction of a millimetre on most maps, once
+                // rounded to f32): one within a centimetre, or one behind the way the path
+                // goes, is the same place, and a leg to it would turn the path back on itself
+                // for an instant (a car's heading follows its path's legs).
+                let behind = i == 0 && points.len() >= 2 && {
+                    let prev = points[points.len() - 2];
+                    let dir = [last[0] - prev[0], last[1] - prev[1]];
+                    (q[0] - last[0]) * dir[0] + (q[1] - last[1]) * dir[1] < 0.0
+                };
+                let same = if i == 0 {
+                    d <= JOIN_SAME_M || behind
+                } else {
+                    d <= 1e-6
+                };
+                if !same {
                     length += d;
                     points.push(q);
                 }

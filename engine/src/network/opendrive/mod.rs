@@ -177,7 +177,6 @@ const FAULTS: &[&str] = &[
     "ConnectionDropped",
     "LaneLinkDropped",
     "JunctionLinkMissing",
-    "RoadLengthMismatch",
     "RecordDropped",
     "RecordValueUnreadable",
     "LaneSectionDropped",
@@ -251,7 +250,7 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
     let mut warnings = check_elements(&r, root)?;
     numbers::check(&r, root)?;
     warnings.extend(numbers::lane_type_warnings(&r, root));
-    check_references(&r)?;
+    warnings.extend(check_references(&r)?);
     check_widths(&r)?;
     // A map far from the origin is moved to it, in its text, before anything evaluates it.
     let shift = recentre::shift(&r, root)?;
@@ -306,7 +305,13 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
         // The crate's link gaps come from its own reading of the links; paracosm reads and
         // measures them itself (`links.rs`).
         if !w.is_ignored() && variant != "LinkGap" {
-            warnings.push(format!("{w}"));
+            let done = if variant == "RoadLengthMismatch" {
+                ": the road is baked to its length, its last geometry running on (as \
+                 libOpenDRIVE and the xodr crate read it)"
+            } else {
+                ""
+            };
+            warnings.push(format!("{w}{done}"));
         }
     }
     check_self_links(&r, &net)?;
@@ -379,8 +384,11 @@ fn check_elements(r: &Reader, root: Node) -> Result<Vec<String>, MapError> {
     Ok(out.into_iter().map(|(_, w)| w).collect())
 }
 
-/// Roads and junctions that links and connections name must exist.
-fn check_references(r: &Reader) -> Result<(), MapError> {
+/// Roads and junctions that junction connections name must exist. A road's `<link>` to a
+/// road or junction the map lacks leads nowhere: the road ends there (as esmini reads it),
+/// with a warning naming the link and its line.
+fn check_references(r: &Reader) -> Result<Vec<String>, MapError> {
+    let mut warnings = Vec::new();
     let root = r.doc.root_element();
     let has = |tag: &str, id: &str| {
         root.children()
@@ -396,12 +404,11 @@ fn check_references(r: &Reader) -> Result<(), MapError> {
                     continue;
                 };
                 if (kind == "road" || kind == "junction") && !has(kind, id) {
-                    return Err(r.error(
-                        Some(end),
-                        format!(
-                            "<{}> of road \"{rid}\" names {kind} \"{id}\", which the map does not have",
-                            end.tag_name().name()
-                        ),
+                    warnings.push(format!(
+                        "{}:{}: <{}> of road \"{rid}\" names {kind} \"{id}\", which the map does not have: the road ends there",
+                        r.file,
+                        r.line(end),
+                        end.tag_name().name()
                     ));
                 }
             }
@@ -424,7 +431,7 @@ fn check_references(r: &Reader) -> Result<(), MapError> {
             }
         }
     }
-    Ok(())
+    Ok(warnings)
 }
 
 /// Every lane `<width>` polynomial stays at or above zero over its stretch.
