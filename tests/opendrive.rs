@@ -710,3 +710,42 @@ fn a_map_campaign_gives_the_same_records_for_any_number_of_workers() {
     let failed = one.iter().filter(|r| r["status"] == "fail").count();
     assert!(0 < failed && failed < 14, "{failed} of 14 failed");
 }
+
+/// A road `<link>` naming a road the map lacks loads with a warning that names the link and
+/// its line, and the road ends there (as esmini reads it): the ego's route stops at the road's
+/// end, and the campaign runs.
+#[test]
+fn a_link_to_a_road_the_map_lacks_is_a_warning_and_the_road_ends_there() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        root.join("tests/data/maps/faults/missing_link_target.xodr"),
+        dir.path().join("m.xodr"),
+    )
+    .unwrap();
+    let p = dir.path().join("p.star");
+    std::fs::write(
+        &p,
+        "w = World()\nm = OpenDrive(\"m.xodr\")\n\
+         v = AutonomousVehicle(loc = m.onLane(road = \"1\", lane = -1, s = 10.0))\n\
+         w.place(m, v)\nCollisionMonitor(v)\ntest(horizon = 2.0)\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = campaign(&p, "1", &out);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{stderr}");
+    assert!(
+        stderr.contains("<successor> of road \"1\" names road \"42\", which the map does not have: the road ends there")
+            && stderr.contains("m.xodr:5"),
+        "{stderr}"
+    );
+    let s = paracosm_scenarios::load(p.to_str().unwrap()).unwrap();
+    let a = s
+        .space
+        .decode(&paracosm_generators::Point::default())
+        .unwrap();
+    let route = s.instantiate(&a).unwrap().ego.route;
+    let last = route[route.len() - 1];
+    assert!((last[0] - 100.0).abs() < 0.01, "the route ends at {last:?}");
+}

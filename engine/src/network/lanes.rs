@@ -368,11 +368,14 @@ impl Network {
         if let (Some(lane), super::PieceKind::Map { map, .. }) =
             (start.map_lane, &self.pieces[start.piece.0].kind)
         {
-            let points = map
-                .0
-                .route(lane, start.at_m, turns, max_len_m)
-                .map_err(|e| EngineError::InvalidWorld(e.to_string()))?;
-            return Ok(resample(&points, ROUTE_SPACING_M));
+            let route = map.route((lane, start.at_m, turns, max_len_m), || {
+                let points = map
+                    .0
+                    .route(lane, start.at_m, turns, max_len_m)
+                    .map_err(|e| EngineError::InvalidWorld(e.to_string()))?;
+                Ok::<_, EngineError>(resample(&points, ROUTE_SPACING_M))
+            })?;
+            return Ok(route.to_vec());
         }
         let j = k.unsigned_abs();
         let (mut path, mut points) = match start.through {

@@ -242,6 +242,42 @@ impl MapRef {
         MapRef(map, Arc::default())
     }
 
+    /// `plan(lane, s, turns, max_len_m)` ([`RoadMap::route`], resampled by the caller),
+    /// planned at the first call for these arguments and kept: tests that start an actor at
+    /// the same place with the same turns share one plan (a route of kilometres through a
+    /// town costs more than a short test's simulation).
+    ///
+    /// # Errors
+    /// What `plan` returns.
+    pub fn route<E>(
+        &self,
+        (lane, s, turns, max_len_m): (usize, f64, &[Turn], f64),
+        plan: impl FnOnce() -> Result<Vec<[f64; 2]>, E>,
+    ) -> Result<Arc<Vec<[f64; 2]>>, E> {
+        let key: RouteKey = (lane, s.to_bits(), format!("{turns:?}"), max_len_m.to_bits());
+        let lock = || self.1.routes.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, r)) = lock().iter().find(|(k, _)| *k == key) {
+            return Ok(r.clone());
+        }
+        let route = Arc::new(plan()?);
+        let mut routes = lock();
+        if routes.len() >= CACHED_ROUTES {
+            routes.remove(0);
+        }
+        routes.push((key, route.clone()));
+        Ok(route)
+    }
+
+    /// Each drivable lane's centre line in its direction of travel ([`MapIndex::lane_lines`])
+    /// with the boxes of its runs of legs, for the lane offset queries of
+    /// [`super::Surface`]: computed at the first call and kept.
+    pub(crate) fn lane_lines(&self) -> super::surface::LaneLines {
+        self.1
+            .lane_lines
+            .get_or_init(|| super::surface::lane_lines(self.index().lane_lines()))
+            .clone()
+    }
+
     /// [`RoadMap::bounds_m`], computed at the first call and kept.
     pub fn bounds_m(&self) -> ([f64; 2], [f64; 2]) {
         *self.1.bounds.get_or_init(|| self.0.bounds_m())
@@ -280,6 +316,17 @@ impl MapRef {
     }
 }
 
+/// What a route is planned from: the start lane, the bits of its station, the turns (as
+/// written) and the bits of the length planned.
+type RouteKey = (usize, u64, String, u64);
+
+/// A planned route, world `[x, z]` m, shared by the tests that plan it.
+type SharedRoute = Arc<Vec<[f64; 2]>>;
+
+/// How many routes a map's cache keeps (one per distinct start and turns a campaign plans;
+/// past this many, the oldest goes).
+const CACHED_ROUTES: usize = 64;
+
 /// A map's collision mesh and the bits of the pose it was built for.
 type CachedMesh = ([u64; 3], Box<dyn std::any::Any + Send + Sync>);
 
@@ -290,6 +337,8 @@ type CachedMesh = ([u64; 3], Box<dyn std::any::Any + Send + Sync>);
 #[derive(Default)]
 pub struct MapCache {
     bounds: std::sync::OnceLock<([f64; 2], [f64; 2])>,
+    lane_lines: std::sync::OnceLock<super::surface::LaneLines>,
+    routes: std::sync::Mutex<Vec<(RouteKey, SharedRoute)>>,
     trees: std::sync::OnceLock<Arc<MapTrees>>,
     mesh: std::sync::Mutex<Option<CachedMesh>>,
 }

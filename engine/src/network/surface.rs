@@ -12,6 +12,7 @@
 
 use super::geometry::{direction, Pose2};
 use super::{MapIndex, Network, PieceId, PieceKind, SampledLine, PORT_NAMES};
+use std::sync::Arc;
 
 /// Friction coefficient of the ground beside and beyond the road network (grass), used for a
 /// wheel or a car on no road piece. Dry grass and earth are commonly given 0.35–0.55; 0.5 is
@@ -196,11 +197,20 @@ pub struct Surface {
     grid: PieceGrid,
     /// Each piece's lane centre lines: polylines in world `[x, z]` metres, in their direction
     /// of travel.
-    lanes: Vec<Vec<Vec<[f64; 2]>>>,
+    lanes: Vec<Arc<Vec<Vec<[f64; 2]>>>>,
     /// For each lane line of `lanes`, the bounding box `[min x, max x, min z, max z]` (m) of
     /// each run of [`LEGS_PER_BOX`] legs: [`Surface::lane_offset_m`] skips a run whose box is
     /// farther than the nearest leg found so far.
-    lane_boxes: Vec<Vec<Vec<[f64; 4]>>>,
+    lane_boxes: Vec<Arc<Vec<Vec<[f64; 4]>>>>,
+}
+
+/// A piece's lane centre lines and their runs' boxes ([`Surface`]'s `lanes`, `lane_boxes`).
+pub(crate) type LaneLines = (Arc<Vec<Vec<[f64; 2]>>>, Arc<Vec<Vec<[f64; 4]>>>);
+
+/// `lines` with the boxes of their runs of legs.
+pub(crate) fn lane_lines(lines: Vec<Vec<[f64; 2]>>) -> LaneLines {
+    let boxes = lines.iter().map(|l| leg_boxes(l)).collect();
+    (Arc::new(lines), Arc::new(boxes))
 }
 
 /// Legs of a lane line per bounding box of [`Surface`]'s `lane_boxes`.
@@ -421,21 +431,23 @@ impl Surface {
                 connected,
             })
             .collect::<Vec<PieceShape>>();
-        let lanes: Vec<Vec<Vec<[f64; 2]>>> = (0..network.pieces().len())
-            .map(|i| match &pieces[i].shape {
-                Shape::Map(index) => index.lane_lines(),
-                _ => network
-                    .lane_paths(PieceId(i))
-                    .into_iter()
-                    .map(|l| l.points)
-                    .collect(),
-            })
-            .collect();
-        debug_assert!(PORT_NAMES.len() == 4);
-        let lane_boxes = lanes
+        // A map's lines and boxes are its cache's, built once per program.
+        let (lanes, lane_boxes): (Vec<_>, Vec<_>) = network
+            .pieces()
             .iter()
-            .map(|lines| lines.iter().map(|l| leg_boxes(l)).collect())
-            .collect();
+            .enumerate()
+            .map(|(i, p)| match &p.kind {
+                PieceKind::Map { map, .. } => map.lane_lines(),
+                _ => lane_lines(
+                    network
+                        .lane_paths(PieceId(i))
+                        .into_iter()
+                        .map(|l| l.points)
+                        .collect(),
+                ),
+            })
+            .unzip();
+        debug_assert!(PORT_NAMES.len() == 4);
         let grid = PieceGrid::new(&pieces.iter().map(near_box).collect::<Vec<_>>());
         Surface {
             pieces,
@@ -517,7 +529,7 @@ impl Surface {
         let h = direction(heading_rad);
         let (mut agreeing, mut any) = ((f64::INFINITY, f64::NAN), (f64::INFINITY, f64::NAN));
         let mut visit = |i: usize| {
-            for (line, boxes) in self.lanes[i].iter().zip(&self.lane_boxes[i]) {
+            for (line, boxes) in self.lanes[i].iter().zip(self.lane_boxes[i].iter()) {
                 for (k, b) in boxes.iter().enumerate() {
                     // No leg of the run is nearer than its box: when the box is farther than
                     // the nearest agreeing leg (no farther than the nearest of any
@@ -782,7 +794,11 @@ mod tests {
         n.connect(x, 0, bend, 0).unwrap();
         n.connect(x, 1, o, 3).unwrap();
         let s = Surface::new(&n);
-        assert!(s.lane_boxes.iter().flatten().any(|b| b.len() > 1));
+        assert!(s
+            .lane_boxes
+            .iter()
+            .flat_map(|b| b.iter())
+            .any(|b| b.len() > 1));
         // The grid has more than one cell, and cells that list fewer pieces than the network.
         assert!(s.grid.dims[0] * s.grid.dims[1] > 1);
         assert!((0..s.grid.starts.len() - 1)
