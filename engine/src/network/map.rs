@@ -297,21 +297,33 @@ impl MapRef {
         }
     }
 
-    /// The collision mesh of the map's lane strips placed by `pose_key` (the bits of the
-    /// piece's pose), built by `build` at the first call for that pose and shared after.
+    /// A mesh of the map placed by `pose_key` (the bits of the piece's pose), one per type
+    /// `T` (the collision mesh, the render mesh): built by `build` at the first call for that
+    /// type and pose and shared after (a call for another pose replaces it).
     pub(crate) fn mesh<T: Clone + Send + Sync + 'static>(
         &self,
         pose_key: [u64; 3],
         build: impl FnOnce() -> Option<T>,
     ) -> Option<T> {
-        let mut slot = self.1.mesh.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((key, shape)) = slot.as_ref() {
-            if *key == pose_key {
-                return shape.downcast_ref::<T>().cloned();
-            }
+        let kind = std::any::TypeId::of::<T>();
+        let mut slots = self.1.meshes.lock().unwrap_or_else(|e| e.into_inner());
+        let slot = slots.iter().position(|(t, _, _)| *t == kind);
+        if let Some(shape) = slot.and_then(|k| {
+            let (_, key, shape) = &slots[k];
+            (*key == pose_key).then(|| shape.downcast_ref::<T>().cloned())?
+        }) {
+            return Some(shape);
         }
         let shape = build()?;
-        *slot = Some((pose_key, Box::new(shape.clone())));
+        let entry = (
+            kind,
+            pose_key,
+            Box::new(shape.clone()) as Box<dyn std::any::Any + Send + Sync>,
+        );
+        match slot {
+            Some(k) => slots[k] = entry,
+            None => slots.push(entry),
+        }
         Some(shape)
     }
 }
@@ -327,8 +339,13 @@ type SharedRoute = Arc<Vec<[f64; 2]>>;
 /// past this many, the oldest goes).
 const CACHED_ROUTES: usize = 64;
 
-/// A map's collision mesh and the bits of the pose it was built for.
-type CachedMesh = ([u64; 3], Box<dyn std::any::Any + Send + Sync>);
+/// A mesh of a map ([`MapRef::mesh`]): its type, the bits of the pose it was built for, and
+/// the mesh.
+type CachedMesh = (
+    std::any::TypeId,
+    [u64; 3],
+    Box<dyn std::any::Any + Send + Sync>,
+);
 
 /// What is derived from a [`RoadMap`] once per map, for every test that uses it: the key is
 /// the map itself (one per file a program reads, [`MapRef`]'s `Arc`) and, for the mesh, the
@@ -340,7 +357,7 @@ pub struct MapCache {
     lane_lines: std::sync::OnceLock<super::surface::LaneLines>,
     routes: std::sync::Mutex<Vec<(RouteKey, SharedRoute)>>,
     trees: std::sync::OnceLock<Arc<MapTrees>>,
-    mesh: std::sync::Mutex<Option<CachedMesh>>,
+    meshes: std::sync::Mutex<Vec<CachedMesh>>,
 }
 
 impl std::fmt::Debug for MapCache {

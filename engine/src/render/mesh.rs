@@ -91,6 +91,13 @@ pub(crate) struct Mesh {
 }
 
 impl Mesh {
+    /// Adds `other`'s triangles after this mesh's, as if they had been built into it.
+    fn append(&mut self, other: &Mesh) {
+        let base = self.vertices.len() as u32;
+        self.vertices.extend_from_slice(&other.vertices);
+        self.indices.extend(other.indices.iter().map(|i| base + i));
+    }
+
     fn quad(&mut self, corners: [[f64; 3]; 4], normal: [f32; 3], m: Material) {
         let base = self.vertices.len() as u32;
         for c in corners {
@@ -490,7 +497,19 @@ impl Mesh {
         let mut mesh = Mesh::default();
         for piece in network.pieces() {
             match &piece.kind {
-                PieceKind::Map { map, .. } => mesh.map(piece, &map.0),
+                PieceKind::Map { map, .. } => {
+                    // Built once per map and pose, shared by every test that renders it.
+                    let pose = &piece.pose;
+                    let key = [pose.x, pose.z, pose.heading_rad].map(f64::to_bits);
+                    let part = map.mesh(key, || {
+                        let mut part = Mesh::default();
+                        part.map(piece, &map.0);
+                        Some(std::sync::Arc::new(part))
+                    });
+                    if let Some(part) = part {
+                        mesh.append(&part);
+                    }
+                }
                 &PieceKind::Segment { length_m, .. } => mesh.segment(piece, length_m),
                 PieceKind::Arc { .. } | PieceKind::Clothoid { .. } => {
                     let line = piece.kind.ref_line().expect("curved");
@@ -568,5 +587,40 @@ mod tests {
         );
         assert_eq!(count(albedo::PAINT_YELLOW), 8);
         assert_eq!(Mesh::unit_cube().indices.len(), 36);
+    }
+
+    #[test]
+    fn a_maps_render_mesh_is_built_once_and_gives_the_same_buffers() {
+        let text = include_str!("../../../scenarios/maps/junction.xodr");
+        let map = crate::network::opendrive::import("junction.xodr", text)
+            .unwrap()
+            .map;
+        let shared = crate::network::MapRef::new(map);
+        let mut n = Network::new();
+        n.add(
+            "m",
+            PieceKind::Map {
+                map: shared.clone(),
+                friction: 0.8,
+            },
+        )
+        .unwrap();
+        // The map's part built in place, as before the cache.
+        let mut direct = Mesh::default();
+        direct.map(&n.pieces()[0], &shared.0);
+        let first = Mesh::world(&n);
+        let again = Mesh::world(&n.clone());
+        assert_eq!(first.indices, again.indices);
+        assert_eq!(first.vertices, again.vertices);
+        assert_eq!(&first.indices[..direct.indices.len()], &direct.indices[..]);
+        assert_eq!(
+            &first.vertices[..direct.vertices.len()],
+            &direct.vertices[..]
+        );
+        // The second world's map part came from the cache: the same Arc.
+        let key = [0.0f64, 0.0, 0.0].map(f64::to_bits);
+        let a = shared.mesh::<std::sync::Arc<Mesh>>(key, || None).unwrap();
+        let b = shared.mesh::<std::sync::Arc<Mesh>>(key, || None).unwrap();
+        assert!(std::sync::Arc::ptr_eq(&a, &b));
     }
 }
