@@ -297,15 +297,8 @@ impl Program {
                             .iter()
                             .enumerate()
                             .map(|(k, d)| {
-                                let name = d
-                                    .name
-                                    .clone()
-                                    .or_else(|| {
-                                        self.syntax
-                                            .site(&d.site.to_string())
-                                            .and_then(|s| s.name.clone())
-                                    })
-                                    .unwrap_or_else(|| format!("param{k}"));
+                                let name =
+                                    self.param_name(d).unwrap_or_else(|| format!("param{k}"));
                                 match &d.domain {
                                     Domain::Interval { lo, .. } => format!("{name} = {lo}"),
                                     Domain::Levels(l) => format!("{name} = {}", l[0]),
@@ -420,6 +413,16 @@ impl Program {
         ))
     }
 
+    /// A parameter's name: `name=`, else the one it takes from where it stands (the variable
+    /// it is assigned to); `None` for neither.
+    fn param_name(&self, d: &ParamDecl) -> Option<String> {
+        d.name.clone().or_else(|| {
+            self.syntax
+                .site(&d.site.to_string())
+                .and_then(|s| s.name.clone())
+        })
+    }
+
     /// Checks that the parameters an evaluation declared so far are the first ones the first
     /// evaluation declared, and no more.
     fn same_params_so_far(&self, b: &SceneBuilder) -> Result<(), LoadError> {
@@ -475,14 +478,8 @@ impl Program {
             }
         }
         if let Some(extra) = b.scene.params().get(self.params.len()) {
-            let name = extra
-                .name
-                .clone()
-                .or_else(|| {
-                    self.syntax
-                        .site(&extra.site.to_string())
-                        .and_then(|s| s.name.clone())
-                })
+            let name = self
+                .param_name(extra)
                 .map(|n| format!("`{n}` "))
                 .unwrap_or_default();
             return Err(LoadError::new(LoadErrorKind::Worlds, format!(
