@@ -11,9 +11,10 @@
 //! `t-loop` (200 s): with `safe_15s/star` they give the cost per simulated second that issue
 //! 23 compares (`experiments/bench/long_horizons.py` measures whole campaigns).
 //!
-//! `maps/*` runs one test on three OpenDRIVE maps written by others (`tests/data/maps/`):
-//! esmini's straight 500 m road, CARLA's Town07 and esmini's `multi_intersections` (63
-//! roads), for 0.1 s and 15 s, the ego under `aeb` at 8.5 m/s. The map's query index and
+//! `maps/*` runs one test on paracosm's own straight road (a 500 m `RoadSegment`, the
+//! baseline) and on three OpenDRIVE maps written by others (`tests/data/maps/`): esmini's
+//! straight 500 m road, CARLA's Town07 and esmini's `multi_intersections` (63 roads), for
+//! 0.1 s and 15 s, the ego under `aeb` at 8.5 m/s. The map's query index and
 //! collision mesh are built once per program and shared by its tests (`MapRef`'s cache):
 //! a test on a city map should cost about what one on a straight map of the same horizon
 //! does.
@@ -108,6 +109,7 @@ fn maps(c: &mut Criterion) {
     let mut group = c.benchmark_group("maps");
     group.sample_size(20);
     for (name, file, road) in [
+        ("segment", "", ""),
         ("straight_500m", "esmini/straight_500m.xodr", "1"),
         ("town07", "carla/Town07.xodr", "0"),
         (
@@ -119,12 +121,23 @@ fn maps(c: &mut Criterion) {
         for horizon in ["0.1", "15.0"] {
             // Paths in a program given as text are relative to the current folder: the
             // bench runs in `scenarios/`.
+            // The segment is paracosm's own straight road, for the baseline.
+            let (road_line, loc) = if file.is_empty() {
+                (
+                    "m = RoadSegment(len = 500.0, nlanes = 2)".to_string(),
+                    "m.onLane(1, 5.0)".to_string(),
+                )
+            } else {
+                (
+                    format!("m = OpenDrive(\"../tests/data/maps/{file}\")"),
+                    format!("m.onLane(road = \"{road}\", lane = -1, s = 5.0)"),
+                )
+            };
             let text = format!(
                 "speed = VarInterval(5.0, 12.0, unit = \"m/s\")\n\
                  w = World(light = 0.5, fog = 0.0)\n\
-                 m = OpenDrive(\"../tests/data/maps/{file}\")\n\
-                 v = AutonomousVehicle(loc = m.onLane(road = \"{road}\", lane = -1, s = 5.0), \
-                 sut = \"aeb\", speed = speed)\n\
+                 {road_line}\n\
+                 v = AutonomousVehicle(loc = {loc}, sut = \"aeb\", speed = speed)\n\
                  w.place(m, v)\n\
                  CollisionMonitor(v)\n\
                  test(horizon = {horizon})\n"

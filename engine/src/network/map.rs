@@ -659,19 +659,32 @@ impl RoadMap {
     }
 
     /// Every lane's strip as triangles: vertices (world `[x, z]` m, the left and right
-    /// border at each station) and index triples, two triangles per step of each lane.
+    /// border at each kept station) and index triples, two triangles per pair of kept
+    /// stations. Stations are kept as [`strip_stations`] picks them: a straight lane of
+    /// constant width is a few long quads rather than one per 0.5 m step, which keeps the
+    /// collision mesh's tree (every wheel casts a ray into it every step) and the render
+    /// mesh small; each border departs from the sampled one by at most
+    /// [`STRIP_CHORD_TOL_M`].
     pub fn strip_triangles(&self) -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
         let (mut vertices, mut indices) = (Vec::new(), Vec::new());
         for l in &self.lanes {
             let base = vertices.len() as u32;
-            for i in 0..l.s.len() {
-                let r = l.right(i);
-                let h = l.width[i] / 2.0;
-                let c = l.centre[i];
-                vertices.push([c[0] - h * r[0], c[1] - h * r[1]]);
-                vertices.push([c[0] + h * r[0], c[1] + h * r[1]]);
+            let borders: Vec<[[f64; 2]; 2]> = (0..l.s.len())
+                .map(|i| {
+                    let r = l.right(i);
+                    let h = l.width[i] / 2.0;
+                    let c = l.centre[i];
+                    [
+                        [c[0] - h * r[0], c[1] - h * r[1]],
+                        [c[0] + h * r[0], c[1] + h * r[1]],
+                    ]
+                })
+                .collect();
+            let kept = strip_stations(&borders);
+            for &i in &kept {
+                vertices.extend(borders[i]);
             }
-            for i in 0..l.s.len() as u32 - 1 {
+            for i in 0..kept.len() as u32 - 1 {
                 let (a, b, c, d) = (
                     base + 2 * i,
                     base + 2 * i + 1,
@@ -735,12 +748,19 @@ fn strip_offset(l: &MapLane, i: usize, p: [f64; 2]) -> Option<f64> {
     if same_station(a, b) {
         return None;
     }
-    let (d, lateral, raw) = segment_projection(p, a, b);
+    // `segment_projection` with the distance compared squared: every wheel of every car asks
+    // this every step, and `hypot` was most of its cost.
+    let dir = [b[0] - a[0], b[1] - a[1]];
+    let rel = [p[0] - a[0], p[1] - a[1]];
+    let len2 = dir[0] * dir[0] + dir[1] * dir[1];
+    let raw = (rel[0] * dir[0] + rel[1] * dir[1]) / len2;
     let u = raw.clamp(0.0, 1.0);
+    let e = [rel[0] - u * dir[0], rel[1] - u * dir[1]];
     let w = l.width[i] + u * (l.width[i + 1] - l.width[i]);
-    if !(d <= w / 2.0 && w > 0.0) {
+    if !(e[0] * e[0] + e[1] * e[1] <= (w / 2.0) * (w / 2.0) && w > 0.0) {
         return None;
     }
+    let lateral = (rel[1] * dir[0] - rel[0] * dir[1]) / len2.sqrt();
     // Beside the segment, the point is between the lane's ends; beyond it, in a disc, it may
     // not be.
     if (0.0..=1.0).contains(&raw) || !beyond_ends(l, p) {
@@ -752,7 +772,7 @@ fn strip_offset(l: &MapLane, i: usize, p: [f64; 2]) -> Option<f64> {
 
 /// Stations closer than a micrometre are one.
 fn same_station(a: [f64; 2], b: [f64; 2]) -> bool {
-    (a[0] - b[0]).hypot(a[1] - b[1]) < 1e-6
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) < 1e-12
 }
 
 /// Whether `p` lies past the line across lane `l` at its last station, or before the line
@@ -797,6 +817,45 @@ impl Clone for MapIndex {
             recent: no_recent_hits(),
         }
     }
+}
+
+/// Most a border of [`RoadMap::strip_triangles`] departs from the lane's sampled border, m
+/// (the 1 cm of a curved piece's slices).
+pub const STRIP_CHORD_TOL_M: f64 = 0.01;
+
+/// Most stations one quad of [`RoadMap::strip_triangles`] spans (8 m at the 0.5 m step), so
+/// that its triangles' boxes stay tight for the collision tree.
+const STRIP_MAX_RUN: usize = 16;
+
+/// The stations of a lane strip, given its `[left, right]` border points at each sampled
+/// station, that [`RoadMap::strip_triangles`] keeps: the first, the last, and greedily the
+/// farthest next one such that every skipped station's border points lie within
+/// [`STRIP_CHORD_TOL_M`] of the chords between the kept ones (at most [`STRIP_MAX_RUN`]
+/// stations apart).
+fn strip_stations(borders: &[[[f64; 2]; 2]]) -> Vec<usize> {
+    let n = borders.len();
+    let mut kept = vec![0];
+    let mut from = 0;
+    while from + 1 < n {
+        let mut to = from + 1;
+        let limit = (from + STRIP_MAX_RUN).min(n - 1);
+        while to < limit {
+            let next = to + 1;
+            let fits = (from + 1..next).all(|m| {
+                (0..2).all(|side| {
+                    segment_projection(borders[m][side], borders[from][side], borders[next][side]).0
+                        <= STRIP_CHORD_TOL_M
+                })
+            });
+            if !fits {
+                break;
+            }
+            to = next;
+        }
+        kept.push(to);
+        from = to;
+    }
+    kept
 }
 
 fn no_recent_hits() -> [std::sync::atomic::AtomicU64; RECENT_HITS] {
@@ -999,5 +1058,74 @@ impl MapIndex {
             .filter(|l| l.drivable)
             .map(MapLane::travel_points)
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod strip_tests {
+    use super::*;
+
+    fn load(path: &str) -> Arc<RoadMap> {
+        let path = format!("{}/../tests/data/maps/{path}", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(&path).unwrap();
+        super::super::opendrive::import(&path, &text).unwrap().map
+    }
+
+    /// Distance from `p` to the polyline through `line`, m.
+    fn to_polyline(p: [f64; 2], line: &[[f64; 2]]) -> f64 {
+        line.windows(2)
+            .map(|w| segment_projection(p, w[0], w[1]).0)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn a_lanes_strip_keeps_its_borders_within_a_centimetre_with_far_fewer_quads() {
+        for (file, most) in [
+            ("esmini/straight_500m.xodr", 0.05),
+            ("carla/Town07.xodr", 0.6),
+        ] {
+            let map = load(file);
+            let (vertices, triangles) = map.strip_triangles();
+            let stations: usize = map.lanes.iter().map(|l| l.s.len() - 1).sum();
+            // Two triangles per kept step, and far fewer steps than stations.
+            assert!(triangles.len() % 2 == 0);
+            let quads = triangles.len() / 2;
+            assert!(
+                (quads as f64) < most * stations as f64,
+                "{file}: {quads} quads for {stations} steps"
+            );
+            // Every sampled border point lies within the tolerance of its kept border.
+            let mut base = 0;
+            for l in &map.lanes {
+                let kept = strip_stations(
+                    &(0..l.s.len())
+                        .map(|i| {
+                            let (r, h, c) = (l.right(i), l.width[i] / 2.0, l.centre[i]);
+                            [
+                                [c[0] - h * r[0], c[1] - h * r[1]],
+                                [c[0] + h * r[0], c[1] + h * r[1]],
+                            ]
+                        })
+                        .collect::<Vec<_>>(),
+                );
+                assert_eq!(kept[0], 0);
+                assert_eq!(*kept.last().unwrap(), l.s.len() - 1);
+                let sides: [Vec<[f64; 2]>; 2] = std::array::from_fn(|side| {
+                    (0..kept.len())
+                        .map(|k| vertices[base + 2 * k + side])
+                        .collect()
+                });
+                for i in 0..l.s.len() {
+                    let (r, h, c) = (l.right(i), l.width[i] / 2.0, l.centre[i]);
+                    for (side, sign) in [(0, -1.0), (1, 1.0)] {
+                        let p = [c[0] + sign * h * r[0], c[1] + sign * h * r[1]];
+                        let d = to_polyline(p, &sides[side]);
+                        assert!(d <= STRIP_CHORD_TOL_M + 1e-12, "{file}: {d} m off");
+                    }
+                }
+                base += 2 * kept.len();
+            }
+            assert_eq!(base, vertices.len());
+        }
     }
 }

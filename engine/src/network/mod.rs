@@ -400,14 +400,14 @@ impl Network {
 
     /// The piece's footprint as convex parts in world coordinates, shrunk by
     /// [`TOUCH_MARGIN_M`] (a map's lanes are not): one box for a segment or junction; for an
-    /// OpenDRIVE map, one prism per 0.5 m step of each lane; for a curved piece, one
+    /// OpenDRIVE map, one prism per quad of each lane's strip ([`map::RoadMap::strip_triangles`]); for a curved piece, one
     /// quadrilateral prism per slice of at most 2 m, whose ends lie across the reference line
     /// (so the first and last end exactly at the ports).
     fn footprint_parts(&self, id: PieceId) -> Vec<(Pose, SharedShape)> {
         let p = &self.pieces[id.0];
         let shrink = |h: f64| (h - TOUCH_MARGIN_M).max(0.001);
         if let PieceKind::Map { map, .. } = &p.kind {
-            // One quadrilateral prism per step of each lane (the map's pose is the identity).
+            // One quadrilateral prism per quad of each lane (the map's pose is the identity).
             let (vertices, triangles) = map.0.strip_triangles();
             return triangles
                 .chunks(2)

@@ -95,6 +95,17 @@ const MAX_CELLS: f64 = 4096.0;
 impl PieceGrid {
     /// The grid over `boxes`, each piece's world box `[min x, max x, min z, max z]` (m).
     fn new(boxes: &[[f64; 4]]) -> Self {
+        if boxes.len() < GRID_FROM {
+            // A query tests every piece, so no cells (a map's box would fill them all).
+            return PieceGrid {
+                origin: [0.0; 2],
+                cell_m: 1.0,
+                dims: [0, 0],
+                starts: vec![0],
+                pieces: Vec::new(),
+                all: Some((0..boxes.len()).collect()),
+            };
+        }
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for b in boxes {
             lo = [lo[0].min(b[0]), lo[1].min(b[2])];
@@ -119,7 +130,7 @@ impl PieceGrid {
             dims: [count(hi[0] - lo[0]), count(hi[1] - lo[1])],
             starts: Vec::new(),
             pieces: Vec::new(),
-            all: (boxes.len() < GRID_FROM).then(|| (0..boxes.len()).collect()),
+            all: None,
         };
         let mut cells = vec![Vec::new(); grid.dims[0] * grid.dims[1]];
         for (i, b) in boxes.iter().enumerate() {

@@ -64,12 +64,13 @@ pub struct Aeb {
     line: Option<(f64, f64, f64)>,
     /// Index of the route vertex reached so far.
     progress: usize,
-    /// [`curvature`] of the route being followed, and that route's address (cleared by
-    /// `reset`).
+    /// [`curvature_at`] of the route being followed, from its start as far as `act` has read
+    /// it, and that route's address (cleared by `reset`): a route on a map runs kilometres
+    /// ahead, and a short test reads only its first metres.
     curves: Vec<(f64, f64)>,
     curves_of: usize,
     /// The bounding box `[min x, max x, min z, max z]` (m) of each run of [`RUN`] route
-    /// points of that route, for [`nearest_vertex`].
+    /// points of that route, for [`nearest_vertex`], as far as it has looked.
     boxes: Vec<[f64; 4]>,
 }
 
@@ -84,6 +85,7 @@ const WINDOW: usize = 64;
 /// points whose box is farther than the nearest point found so far is skipped: each point's
 /// squared distance is at least its box's (floating-point subtraction, squaring and addition
 /// are monotone), so it could not be smaller.
+/// `boxes` holds [`run_boxes`] at least up to the run of the window's last point.
 fn nearest_vertex(route: &[[f64; 2]], boxes: &[[f64; 4]], from: usize, x: f64, z: f64) -> usize {
     let d2 = |p: [f64; 2]| (p[0] - x).powi(2) + (p[1] - z).powi(2);
     let end = route.len().min(from + WINDOW);
@@ -110,28 +112,37 @@ fn nearest_vertex(route: &[[f64; 2]], boxes: &[[f64; 4]], from: usize, x: f64, z
 }
 
 /// The bounding boxes of `route`'s runs of [`RUN`] points.
+#[cfg(test)]
 fn run_boxes(route: &[[f64; 2]]) -> Vec<[f64; 4]> {
-    route
-        .chunks(RUN)
-        .map(|run| {
-            run.iter().fold(
+    let mut boxes = Vec::new();
+    extend_boxes(&mut boxes, route, route.len());
+    boxes
+}
+
+/// Extends `boxes`, the bounding boxes of `route`'s runs of [`RUN`] points from the first,
+/// until it covers the run of point `upto - 1` (or the whole route).
+fn extend_boxes(boxes: &mut Vec<[f64; 4]>, route: &[[f64; 2]], upto: usize) {
+    let runs = upto.min(route.len()).div_ceil(RUN);
+    while boxes.len() < runs {
+        let k = boxes.len();
+        let run = &route[k * RUN..((k + 1) * RUN).min(route.len())];
+        boxes.push(run.iter().fold(
+            [
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+            ],
+            |b, p| {
                 [
-                    f64::INFINITY,
-                    f64::NEG_INFINITY,
-                    f64::INFINITY,
-                    f64::NEG_INFINITY,
-                ],
-                |b, p| {
-                    [
-                        b[0].min(p[0]),
-                        b[1].max(p[0]),
-                        b[2].min(p[1]),
-                        b[3].max(p[1]),
-                    ]
-                },
-            )
-        })
-        .collect()
+                    b[0].min(p[0]),
+                    b[1].max(p[0]),
+                    b[2].min(p[1]),
+                    b[3].max(p[1]),
+                ]
+            },
+        ));
+    }
 }
 
 impl Aeb {
@@ -174,6 +185,8 @@ impl Sut for Aeb {
         self.line = None;
         self.progress = 0;
         self.curves.clear();
+        self.boxes.clear();
+        self.curves_of = 0;
         Ok(())
     }
 
@@ -216,12 +229,13 @@ impl Aeb {
         let route = obs.route;
         let (x, z) = (obs.ego.pos_m[0], obs.ego.pos_m[2]);
         let d2 = |p: [f64; 2]| (p[0] - x).powi(2) + (p[1] - z).powi(2);
-        if self.curves.len() != route.len() || self.curves_of != route.as_ptr() as usize {
-            self.curves = curvature(route);
-            self.boxes = run_boxes(route);
+        if self.curves_of != route.as_ptr() as usize || self.curves.len() > route.len() {
+            self.curves.clear();
+            self.boxes.clear();
             self.curves_of = route.as_ptr() as usize;
         }
         if self.progress < route.len() {
+            extend_boxes(&mut self.boxes, route, self.progress + WINDOW);
             self.progress = nearest_vertex(route, &self.boxes, self.progress, x, z);
         }
         let v = obs.ego.speed_mps.max(0.0);
@@ -249,8 +263,8 @@ impl Aeb {
         let mut speed = c.cruise.target_speed_mps;
         let mut ahead = 0.0;
         let horizon = v * v / (2.0 * c.curve_decel_mps2) + 20.0;
-        let pts = &self.curves[self.progress..];
-        for &(l1, kappa) in pts.iter().skip(1).take(pts.len().saturating_sub(2)) {
+        for i in self.progress + 1..route.len().saturating_sub(1) {
+            let (l1, kappa) = curvature_at(&mut self.curves, route, i);
             ahead += l1;
             if ahead > horizon {
                 break;
@@ -264,19 +278,23 @@ impl Aeb {
     }
 }
 
-/// For each point `i` of `route` with neighbours on both sides: the length of the leg into it
-/// (m) and the curvature there (1/m), the turn between its legs over their mean length;
-/// `(0, 0)` at the ends. Computed once per route, since `act` reads it every step.
-fn curvature(route: &[[f64; 2]]) -> Vec<(f64, f64)> {
-    let mut out = vec![(0.0, 0.0); route.len()];
-    for i in 1..route.len().saturating_sub(1) {
-        let (a, b, d) = (route[i - 1], route[i], route[i + 1]);
+/// For point `i` of `route`, which has neighbours on both sides: the length of the leg into
+/// it (m) and the curvature there (1/m), the turn between its legs over their mean length.
+/// `curves` holds these for the points before `i` (`(0, 0)` for the first) and is extended
+/// to `i`, since `act` reads them every step.
+fn curvature_at(curves: &mut Vec<(f64, f64)>, route: &[[f64; 2]], i: usize) -> (f64, f64) {
+    if curves.is_empty() {
+        curves.push((0.0, 0.0));
+    }
+    while curves.len() <= i {
+        let k = curves.len();
+        let (a, b, d) = (route[k - 1], route[k], route[k + 1]);
         let l1 = (b[0] - a[0]).hypot(b[1] - a[1]);
         let l2 = (d[0] - b[0]).hypot(d[1] - b[1]);
         let turn = wrap((-(d[1] - b[1])).atan2(d[0] - b[0]) - (-(b[1] - a[1])).atan2(b[0] - a[0]));
-        out[i] = (l1, turn.abs() / ((l1 + l2) / 2.0).max(1e-6));
+        curves.push((l1, turn.abs() / ((l1 + l2) / 2.0).max(1e-6)));
     }
-    out
+    curves[i]
 }
 
 fn wrap(a: f64) -> f64 {
