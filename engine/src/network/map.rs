@@ -1081,13 +1081,14 @@ mod strip_tests {
     #[test]
     fn a_lanes_strip_keeps_its_borders_within_a_centimetre_with_far_fewer_quads() {
         for (file, most) in [
-            ("esmini/straight_500m.xodr", 0.05),
+            ("esmini/straight_500m.xodr", 0.07),
             ("carla/Town07.xodr", 0.6),
         ] {
             let map = load(file);
             let (vertices, triangles) = map.strip_triangles();
             let stations: usize = map.lanes.iter().map(|l| l.s.len() - 1).sum();
-            // Two triangles per kept step, and far fewer steps than stations.
+            // Two triangles per kept step, and far fewer steps than stations (a straight lane
+            // keeps one station in 16, the most one quad spans).
             assert!(triangles.len() % 2 == 0);
             let quads = triangles.len() / 2;
             assert!(

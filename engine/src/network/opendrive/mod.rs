@@ -190,19 +190,44 @@ fn attr_f64(n: Node, name: &str) -> Option<f64> {
 struct Reader<'a> {
     file: &'a str,
     doc: &'a Document<'a>,
+    /// Byte offset of each line's start: `roxmltree`'s `text_pos_at` walks the text from its
+    /// start at every call, which was most of loading a town.
+    line_starts: Vec<usize>,
 }
 
-impl Reader<'_> {
+impl<'a> Reader<'a> {
+    fn new(file: &'a str, doc: &'a Document<'a>) -> Self {
+        let text = doc.input_text();
+        let mut line_starts = vec![0];
+        line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
+        Reader {
+            file,
+            doc,
+            line_starts,
+        }
+    }
+
+    /// Line and column (from 1; columns in characters) of byte `offset`, as `text_pos_at`.
+    fn pos_at(&self, offset: usize) -> (u32, u32) {
+        let line = self.line_starts.partition_point(|&s| s <= offset).max(1);
+        let start = self.line_starts[line - 1];
+        let text = self.doc.input_text();
+        let col = text
+            .get(start..offset.min(text.len()))
+            .map_or(1, |s| s.chars().count() + 1);
+        (line as u32, col as u32)
+    }
+
     fn line(&self, n: Node) -> u32 {
-        self.doc.text_pos_at(n.range().start).row
+        self.pos_at(n.range().start).0
     }
 
     fn error(&self, n: Option<Node>, message: String) -> MapError {
-        let pos = n.map(|n| self.doc.text_pos_at(n.range().start));
+        let pos = n.map(|n| self.pos_at(n.range().start));
         MapError {
             file: self.file.to_owned(),
-            line: pos.map(|p| p.row),
-            column: pos.map(|p| p.col),
+            line: pos.map(|p| p.0),
+            column: pos.map(|p| p.1),
             message,
         }
     }
@@ -236,7 +261,7 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
             message: format!("malformed XML: {e}"),
         }
     })?;
-    let r = Reader { file, doc: &doc };
+    let r = Reader::new(file, &doc);
     let root = doc.root_element();
     if !root.has_tag_name("OpenDRIVE") {
         return Err(r.error(
@@ -275,7 +300,7 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
         }
         None => (doc, text),
     };
-    let r = Reader { file, doc: &doc };
+    let r = Reader::new(file, &doc);
     let (net, provenance) = xodr::load_str_with_provenance(text).map_err(|e| MapError {
         file: file.to_owned(),
         line: None,

@@ -146,11 +146,11 @@ impl Reader<'_> {
         let pos = n
             .attribute_node(name)
             .map_or(n.range().start, |a| a.range_value().start);
-        let p = self.doc.text_pos_at(pos);
+        let (line, column) = self.pos_at(pos);
         MapError {
             file: self.file.to_owned(),
-            line: Some(p.row),
-            column: Some(p.col),
+            line: Some(line),
+            column: Some(column),
             message,
         }
     }
