@@ -78,3 +78,25 @@ pub fn opendrive(data: &[u8]) {
         let _ = map.route(i, 0.5 * (first + last), &turns[i % 3..i % 3 + 1], 200.0);
     }
 }
+
+/// An OpenSCENARIO file as `paracosm-fuzz xosc` reads it: as a parameter value distribution
+/// when it is one, else as a scenario (its relative paths from an empty folder, so catalogs
+/// and maps are not found); it returns errors, never panics, loops or overflows the stack
+/// (the `openscenario` fuzz target; the ALKS suite and the hostile files are its seeds).
+pub fn openscenario(data: &[u8]) {
+    let Some(s) = text(data) else { return };
+    let text = paracosm_openscenario::Text::new("fuzz.xosc", s);
+    let is_variation = match text.parse() {
+        Ok(doc) => paracosm_openscenario::distribution::is_variation(&doc),
+        Err(_) => return,
+    };
+    if is_variation {
+        if let Ok(v) = paracosm_openscenario::distribution::read_variation(&text) {
+            for p in &v.params {
+                let _ = p.dist.levels();
+            }
+        }
+    } else {
+        let _ = paracosm_openscenario::read_scenario_text(&text, std::path::Path::new(""), &[]);
+    }
+}

@@ -17,6 +17,7 @@ pub mod fuzz;
 pub mod map;
 pub mod record;
 pub mod report;
+pub mod xosc;
 
 pub use campaign::{Campaign, CampaignReport, Observer, OnRecord, ResultsFile};
 pub use error::Error;

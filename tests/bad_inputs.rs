@@ -325,3 +325,44 @@ fn a_long_expression_under_the_depth_limit_runs_on_the_workers() {
     let lines = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
     assert_eq!(lines.lines().count(), 4);
 }
+
+/// OpenSCENARIO files (`tests/bad_inputs/xosc/`): `paracosm-fuzz xosc FILE` refuses each
+/// with exit 2, the file's name with a line and column, and the phrase its first line
+/// `<!-- expect: PHRASE -->` gives; and a file past the size limit is refused unread.
+#[test]
+fn bad_openscenario_files() {
+    let mut failures = Vec::new();
+    let at = regex::Regex::new(r"\.xosc:\d+:\d+").unwrap();
+    for f in files("xosc") {
+        let o = run("fuzz", &["xosc".into(), f.display().to_string()]);
+        let text = std::fs::read_to_string(&f).unwrap();
+        let expect = text
+            .lines()
+            .next()
+            .and_then(|l| l.strip_prefix("<!-- expect: "))
+            .and_then(|l| l.strip_suffix(" -->"))
+            .unwrap_or_else(|| panic!("{} has no expect line", rel(&f)))
+            .to_owned();
+        let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+        // file:line:col of the element at fault (the missing scenario is named by path).
+        let located = at.is_match(&stderr);
+        if let Err(e) = std::panic::catch_unwind(|| {
+            assert_refused(&rel(&f), &o, &[&name(&f), &expect]);
+            assert!(located, "{}: no file:line:col in\n{stderr}", rel(&f));
+        }) {
+            failures.push(
+                e.downcast_ref::<String>()
+                    .cloned()
+                    .unwrap_or_else(|| rel(&f)),
+            );
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+    let tmp = tempfile::tempdir().unwrap();
+    let huge = tmp.path().join("huge.xosc");
+    let f = std::fs::File::create(&huge).unwrap();
+    f.set_len(paracosm_openscenario::text::MAX_FILE_BYTES + 1)
+        .unwrap();
+    let o = run("fuzz", &["xosc".into(), huge.display().to_string()]);
+    assert_refused("huge.xosc", &o, &["huge.xosc", "bytes, more than"]);
+}

@@ -8,11 +8,12 @@ use std::path::Path;
 fn kept_fuzz_inputs_no_longer_crash() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions");
     type Target = fn(&[u8]);
-    let targets: [(&str, Target); 4] = [
+    let targets: [(&str, Target); 5] = [
         ("inputs", paracosm::fuzz::inputs),
         ("results", paracosm::fuzz::results),
         ("scenario", paracosm::fuzz::scenario),
         ("opendrive", paracosm::fuzz::opendrive),
+        ("openscenario", paracosm::fuzz::openscenario),
     ];
     let mut n = 0;
     for (target, run) in targets {

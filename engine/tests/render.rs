@@ -781,3 +781,37 @@ fn golden_left_bend_with_curved_markings() {
         "the far centre line at column {bend} on the bend, {ahead} on a straight road"
     );
 }
+
+/// A campaign on one OpenDRIVE map uploads the map's world once: a second test's network
+/// (a clone of the first's, as each test builds) draws from the same GPU buffers, and a map
+/// loaded anew has its own.
+#[test]
+fn a_maps_world_is_uploaded_once_and_shared_by_every_test() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenarios/maps/junction.xodr");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let map = paracosm_engine::network::opendrive::import("junction.xodr", &text)
+        .unwrap()
+        .map;
+    let mut first = Network::new();
+    first.add_map("OpenDrive m", map.clone(), 0.8).unwrap();
+    let second = first.clone();
+    let r = renderer();
+    let a = r.scene(&first);
+    let b = r.scene(&second);
+    assert!(a.shares_buffers_with(&b));
+    let mut fresh = Network::new();
+    fresh.add_map("OpenDrive m", map, 0.8).unwrap();
+    assert!(!r.scene(&fresh).shares_buffers_with(&a));
+    // A network of paracosm's own pieces uploads per call.
+    let mut own = Network::new();
+    own.add(
+        "RoadSegment r",
+        PieceKind::Segment {
+            length_m: 50.0,
+            lanes: 2,
+            friction: 0.8,
+        },
+    )
+    .unwrap();
+    assert!(!r.scene(&own).shares_buffers_with(&r.scene(&own)));
+}

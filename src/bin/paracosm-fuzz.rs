@@ -138,6 +138,25 @@ enum Sub {
     /// with --png/--svg, also draw it top-down with road ids, lane directions and junctions.
     /// Exit 0, or 2 for a map that does not load (naming file:line:col).
     Map(MapArgs),
+    /// Read an OpenSCENARIO logical scenario (a ParameterValueDistribution file and the
+    /// scenario it names, or a scenario alone) and list paracosm's space for it (each varied
+    /// parameter, and each --open), the file's own grid, the entities, Init, the storyboard
+    /// and everything read but not honoured as written. Exit 0, or 2 for a file that does
+    /// not read (naming file:line:col and what is supported).
+    Xosc(XoscArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct XoscArgs {
+    /// The variation file or scenario (.xosc).
+    file: PathBuf,
+    /// Open a declared parameter the file does not vary: Name=lo..hi (an interval) or
+    /// Name=a,b,c (levels), checked against its constraint groups. Repeatable.
+    #[arg(long, value_name = "NAME=RANGE")]
+    open: Vec<String>,
+    /// A DistributionRange becomes an interval over its range instead of its levels.
+    #[arg(long)]
+    continuous: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -401,6 +420,9 @@ fn main() -> ExitCode {
                 say(&text).map(|()| if e.matches { 0 } else { 3 })
             }),
         Some(Sub::Map(a)) => map(a),
+        Some(Sub::Xosc(a)) => paracosm::xosc::inspect(&a.file, &a.open, a.continuous)
+            .map_err(anyhow::Error::from)
+            .and_then(|i| say(&i.text()).map(|()| 0)),
         None => run(&cli),
     };
     let code = match result {

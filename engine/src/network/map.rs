@@ -306,21 +306,33 @@ impl MapRef {
         build: impl FnOnce() -> Option<T>,
     ) -> Option<T> {
         let kind = std::any::TypeId::of::<T>();
-        let mut slots = self.1.meshes.lock().unwrap_or_else(|e| e.into_inner());
-        let slot = slots.iter().position(|(t, _, _)| *t == kind);
-        if let Some(shape) = slot.and_then(|k| {
-            let (_, key, shape) = &slots[k];
-            (*key == pose_key).then(|| shape.downcast_ref::<T>().cloned())?
-        }) {
-            return Some(shape);
+        let lookup = |slots: &[CachedMesh]| {
+            slots.iter().find_map(|(t, key, shape)| {
+                (*t == kind && *key == pose_key)
+                    .then(|| shape.downcast_ref::<T>().cloned())
+                    .flatten()
+            })
+        };
+        {
+            let slots = self.1.meshes.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(shape) = lookup(&slots) {
+                return Some(shape);
+            }
         }
+        // Built without the lock, so that a build may itself read another type's mesh (the
+        // GPU buffers upload the render mesh); two workers that start together may both
+        // build, and the first to finish is kept (the builds are equal).
         let shape = build()?;
+        let mut slots = self.1.meshes.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(first) = lookup(&slots) {
+            return Some(first);
+        }
         let entry = (
             kind,
             pose_key,
             Box::new(shape.clone()) as Box<dyn std::any::Any + Send + Sync>,
         );
-        match slot {
+        match slots.iter().position(|(t, _, _)| *t == kind) {
             Some(k) => slots[k] = entry,
             None => slots.push(entry),
         }

@@ -91,10 +91,18 @@ pub struct CameraPose {
 }
 
 /// The static geometry of one road network, uploaded to the GPU once per world.
+#[derive(Clone)]
 pub struct SceneGeometry {
-    vertices: wgpu::Buffer,
-    indices: wgpu::Buffer,
+    vertices: Arc<wgpu::Buffer>,
+    indices: Arc<wgpu::Buffer>,
     index_count: u32,
+}
+
+impl SceneGeometry {
+    /// Whether `self` and `other` draw from the same GPU buffers (one upload shared).
+    pub fn shares_buffers_with(&self, other: &SceneGeometry) -> bool {
+        Arc::ptr_eq(&self.vertices, &other.vertices) && Arc::ptr_eq(&self.indices, &other.indices)
+    }
 }
 
 /// One camera's render targets and readback buffer. Each view renders one frame at a time;
@@ -316,8 +324,21 @@ impl Renderer {
         &self.adapter
     }
 
-    /// Uploads the static world of `network`.
+    /// Uploads the static world of `network`. A network that is one OpenDRIVE map keeps
+    /// its uploaded buffers in the map's cache (`MapRef::mesh`, by the map's pose): every
+    /// test of a campaign on that map draws from the same GPU buffers (the renderer's device
+    /// is the process's), and only the first uploads them.
     pub fn scene(&self, network: &Network) -> SceneGeometry {
+        if let [piece] = network.pieces() {
+            if let crate::network::PieceKind::Map { map, .. } = &piece.kind {
+                let pose = &piece.pose;
+                let key = [pose.x, pose.z, pose.heading_rad].map(f64::to_bits);
+                if let Some(g) = map.mesh(key, || Some(upload(&self.device, &Mesh::world(network))))
+                {
+                    return g;
+                }
+            }
+        }
         upload(&self.device, &Mesh::world(network))
     }
 
@@ -587,8 +608,8 @@ fn upload(device: &wgpu::Device, mesh: &Mesh) -> SceneGeometry {
         usage: wgpu::BufferUsages::INDEX,
     });
     SceneGeometry {
-        vertices,
-        indices,
+        vertices: Arc::new(vertices),
+        indices: Arc::new(indices),
         index_count: mesh.indices.len() as u32,
     }
 }

@@ -1,0 +1,579 @@
+//! The typed model of an OpenSCENARIO scenario as paracosm reads it (OpenSCENARIO 1.3 User
+//! Guide: "Entities", "Storyboard", "Positions", "Actions", "Conditions"). Every value is
+//! resolved (parameters and expressions evaluated); every entity reference is an index into
+//! [`Scenario::entities`]; every item keeps where it was written.
+//!
+//! Units as the standard's: metres, seconds, m/s, m/s², radians; positions in the map's
+//! inertial frame (x east, y north, heading counter-clockwise from x).
+
+use crate::error::Pos;
+use crate::params::{ParamDecl, Scope};
+use crate::Value;
+
+/// An item with where it was written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Located<T> {
+    /// The element.
+    pub pos: Pos,
+    /// What it holds.
+    pub item: T,
+}
+
+/// Something read but not honoured as written, said once at load (a warning).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Note {
+    /// The element.
+    pub pos: Pos,
+    /// What is not honoured, and what paracosm does instead.
+    pub text: String,
+}
+
+/// A scenario file, resolved for one assignment of its parameters.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    /// The file.
+    pub file: String,
+    /// `FileHeader`'s `revMajor.revMinor` (1.0 to 1.3).
+    pub version: (u32, u32),
+    /// The declared parameters (in order) and the value each had.
+    pub params: Vec<(ParamDecl, Value)>,
+    /// The scope they were evaluated in (for checking other values against their
+    /// constraint groups, [`Scope::check_constraints`]).
+    pub scope: Scope,
+    /// `RoadNetwork/LogicFile`'s path, resolved against the scenario's folder.
+    pub road_network: Option<Located<String>>,
+    /// The scenario objects.
+    pub entities: Vec<Entity>,
+    /// `Init`'s private actions: (entity, action).
+    pub init: Vec<(usize, NamedAction)>,
+    /// The stories.
+    pub stories: Vec<Story>,
+    /// The storyboard's stop trigger.
+    pub stop: Option<Trigger>,
+    /// What was read but is not honoured as written.
+    pub notes: Vec<Note>,
+}
+
+/// What kind of object an entity is.
+#[derive(Debug, Clone, PartialEq)]
+pub enum EntityKind {
+    /// A `Vehicle` with its `vehicleCategory` (`car`, `truck`, `bus`, `bicycle`, ...).
+    Vehicle(String),
+    /// A `Pedestrian` with its `pedestrianCategory` (`pedestrian`, `wheelchair`, `animal`).
+    Pedestrian(String),
+    /// A `MiscObject` with its `miscObjectCategory`.
+    MiscObject(String),
+}
+
+/// A scenario object.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Entity {
+    /// Its name, unique in the file.
+    pub name: String,
+    /// What it is.
+    pub kind: EntityKind,
+    /// Bounding box `[length, width, height]`, m.
+    pub dimensions_m: [f64; 3],
+    /// Bounding box centre in the entity's frame `[x, y, z]`, m (x forward from the rear
+    /// axle, the standard's reference point for vehicles).
+    pub centre_m: [f64; 3],
+    /// The name of the controller its `ObjectController` assigns, if any.
+    pub controller: Option<String>,
+    /// Where it is declared.
+    pub pos: Pos,
+}
+
+/// A story.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Story {
+    /// Its name.
+    pub name: String,
+    /// Its acts.
+    pub acts: Vec<Act>,
+}
+
+/// An act: maneuver groups that start together.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Act {
+    /// Its name.
+    pub name: String,
+    /// When it starts; none: at once.
+    pub start: Option<Trigger>,
+    /// When it stops, if ever.
+    pub stop: Option<Trigger>,
+    /// Its maneuver groups.
+    pub groups: Vec<ManeuverGroup>,
+}
+
+/// A maneuver group: maneuvers for a set of actors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ManeuverGroup {
+    /// Its name.
+    pub name: String,
+    /// `maximumExecutionCount`, at least 1.
+    pub max_count: u32,
+    /// The actors (entity indices).
+    pub actors: Vec<usize>,
+    /// `selectTriggeringEntities`.
+    pub select_triggering: bool,
+    /// Its maneuvers.
+    pub maneuvers: Vec<Maneuver>,
+}
+
+/// A maneuver: events.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Maneuver {
+    /// Its name.
+    pub name: String,
+    /// Its events.
+    pub events: Vec<Event>,
+}
+
+/// An event's `priority`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Priority {
+    /// `override` (1.0–1.1: `overwrite`): stops the maneuver's running events.
+    Override,
+    /// `skip`: does not start while another event of the maneuver runs.
+    Skip,
+    /// `parallel`: runs beside the others.
+    Parallel,
+}
+
+/// An event: actions started together by a trigger.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Event {
+    /// Its name.
+    pub name: String,
+    /// Its priority.
+    pub priority: Priority,
+    /// `maximumExecutionCount`, at least 1.
+    pub max_count: u32,
+    /// Its actions.
+    pub actions: Vec<NamedAction>,
+    /// When it starts; none: as soon as its act has started.
+    pub start: Option<Trigger>,
+}
+
+/// An action with its name.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedAction {
+    /// Its name (`""` for an `Init` action).
+    pub name: String,
+    /// Where it is written.
+    pub pos: Pos,
+    /// What it does.
+    pub action: Action,
+}
+
+/// A transition's shape (`DynamicsShape`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shape {
+    /// Jumps at once.
+    Step,
+    /// Changes at a constant rate.
+    Linear,
+    /// A cubic with zero slope at both ends.
+    Cubic,
+    /// Half a cosine period.
+    Sinusoidal,
+}
+
+/// What a transition's value measures (`DynamicsDimension`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dimension {
+    /// Its duration, s.
+    Time,
+    /// The distance it takes, m.
+    Distance,
+    /// Its rate (m/s² for speed, m/s for a lane change's lateral speed).
+    Rate,
+}
+
+/// How an action's value changes over time (`TransitionDynamics`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dynamics {
+    /// The shape.
+    pub shape: Shape,
+    /// What `value` measures.
+    pub dimension: Dimension,
+    /// The duration (s), distance (m) or rate, `>= 0`.
+    pub value: f64,
+}
+
+/// A speed target.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SpeedTarget {
+    /// m/s.
+    Absolute(f64),
+    /// Relative to another entity's speed: `delta` adds `value` m/s, `factor` multiplies.
+    Relative {
+        /// The entity.
+        entity: usize,
+        /// The delta (m/s) or factor.
+        value: f64,
+        /// `true`: factor; `false`: delta.
+        factor: bool,
+        /// Whether the target follows the entity's speed after it is reached.
+        continuous: bool,
+    },
+}
+
+/// A lane change's target lane.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LaneTarget {
+    /// A lane id of the road the entity is on.
+    Absolute(i32),
+    /// Lanes counted from another entity's lane, positive to the left (the standard's
+    /// `RelativeTargetLane`, which counts in the entity's driving direction).
+    Relative {
+        /// The entity.
+        entity: usize,
+        /// Lanes to the left (negative: right).
+        lanes: i32,
+    },
+}
+
+/// A lane offset's target.
+#[derive(Debug, Clone, PartialEq)]
+pub enum OffsetTarget {
+    /// m from the lane centre, positive to the left.
+    Absolute(f64),
+    /// m from another entity's lane offset.
+    Relative {
+        /// The entity.
+        entity: usize,
+        /// m.
+        value: f64,
+    },
+}
+
+/// An action paracosm reads.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// `SpeedAction`.
+    Speed {
+        /// Target.
+        target: SpeedTarget,
+        /// Transition.
+        dynamics: Dynamics,
+    },
+    /// `LaneChangeAction`.
+    LaneChange {
+        /// Target lane.
+        target: LaneTarget,
+        /// Transition (lateral).
+        dynamics: Dynamics,
+        /// `targetLaneOffset`, m.
+        offset_m: f64,
+    },
+    /// `LaneOffsetAction`.
+    LaneOffset {
+        /// Target offset.
+        target: OffsetTarget,
+        /// Shape of the transition.
+        shape: Shape,
+        /// `maxLateralAcc`, m/s², if given.
+        max_lateral_acc: Option<f64>,
+        /// Whether the offset is held after it is reached.
+        continuous: bool,
+    },
+    /// `LongitudinalDistanceAction`: keep a distance or time gap to an entity.
+    LongitudinalDistance {
+        /// The entity kept at a distance.
+        entity: usize,
+        /// Distance, m, or
+        distance_m: Option<f64>,
+        /// time gap, s (one of the two).
+        time_gap_s: Option<f64>,
+        /// Whether the distance is between bounding boxes.
+        freespace: bool,
+        /// Whether it is kept after it is reached.
+        continuous: bool,
+        /// `displacement`: `trailingReferencedEntity` (default), `leadingReferencedEntity`
+        /// or `any`.
+        displacement: String,
+    },
+    /// `TeleportAction`.
+    Teleport(Position),
+    /// `FollowTrajectoryAction` with a polyline.
+    FollowTrajectory {
+        /// Vertices with their times, s (none without timing).
+        vertices: Vec<(Option<f64>, Position)>,
+        /// `Timing`: `(absolute, scale, offset_s)`; none: follow at the entity's speed.
+        timing: Option<(bool, f64, f64)>,
+    },
+    /// `AssignRouteAction`: a route through waypoints (the first is where the entity is
+    /// routed from), each with its `routeStrategy`.
+    AssignRoute {
+        /// The waypoints, at least two.
+        waypoints: Vec<(Position, String)>,
+    },
+    /// `ActivateControllerAction`: the system under test takes the entity over.
+    ActivateController {
+        /// Lateral control, when said.
+        lateral: Option<bool>,
+        /// Longitudinal control, when said.
+        longitudinal: Option<bool>,
+    },
+}
+
+/// An orientation given with a position.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Orientation {
+    /// Heading, rad.
+    pub h: f64,
+    /// `type="relative"` (to the road's or lane's direction, or the entity's heading):
+    /// the standard's default for road and lane positions.
+    pub relative: bool,
+}
+
+/// A position.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Position {
+    /// `WorldPosition`: `x`, `y` (m), heading `h` (rad).
+    World {
+        /// m.
+        x: f64,
+        /// m.
+        y: f64,
+        /// rad, if given.
+        h: Option<f64>,
+    },
+    /// `RelativeWorldPosition`.
+    RelativeWorld {
+        /// The entity.
+        entity: usize,
+        /// m.
+        dx: f64,
+        /// m.
+        dy: f64,
+    },
+    /// `RelativeObjectPosition` (in the entity's frame).
+    RelativeObject {
+        /// The entity.
+        entity: usize,
+        /// m, forward.
+        dx: f64,
+        /// m, left.
+        dy: f64,
+    },
+    /// `RoadPosition`.
+    Road {
+        /// Road id.
+        road: String,
+        /// m along the road.
+        s: f64,
+        /// m left of the reference line.
+        t: f64,
+        /// Orientation.
+        orientation: Option<Orientation>,
+    },
+    /// `LanePosition`.
+    Lane {
+        /// Road id.
+        road: String,
+        /// Lane id.
+        lane: i32,
+        /// m along the road.
+        s: f64,
+        /// m left of the lane centre.
+        offset: f64,
+        /// Orientation.
+        orientation: Option<Orientation>,
+    },
+    /// `RelativeLanePosition`.
+    RelativeLane {
+        /// The entity.
+        entity: usize,
+        /// Lanes to the left.
+        d_lane: i32,
+        /// m along the road (`ds`) from the entity.
+        ds: f64,
+        /// m left of the target lane's centre.
+        offset: f64,
+    },
+}
+
+/// A comparison (`Rule`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rule {
+    /// `greaterThan`.
+    Gt,
+    /// `lessThan`.
+    Lt,
+    /// `equalTo`.
+    Eq,
+    /// `greaterOrEqual`.
+    Ge,
+    /// `lessOrEqual`.
+    Le,
+    /// `notEqualTo`.
+    Ne,
+}
+
+impl Rule {
+    /// Whether `a rule b` holds (`equalTo` within 1e-9 relative).
+    pub fn holds(self, a: f64, b: f64) -> bool {
+        let eq = (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0);
+        match self {
+            Rule::Gt => a > b,
+            Rule::Lt => a < b,
+            Rule::Eq => eq,
+            Rule::Ge => a >= b || eq,
+            Rule::Le => a <= b || eq,
+            Rule::Ne => !eq,
+        }
+    }
+}
+
+/// When a condition's value counts (`conditionEdge`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Edge {
+    /// Whenever it holds.
+    None,
+    /// When it turns true.
+    Rising,
+    /// When it turns false.
+    Falling,
+    /// When it changes.
+    RisingOrFalling,
+}
+
+/// A trigger: condition groups, of which any one whose conditions all hold fires it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trigger(pub Vec<Vec<Condition>>);
+
+/// A condition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Condition {
+    /// Its name.
+    pub name: String,
+    /// `delay`, s: the condition reports what held this long ago.
+    pub delay_s: f64,
+    /// `conditionEdge`.
+    pub edge: Edge,
+    /// What it tests.
+    pub kind: ConditionKind,
+    /// Where it is written.
+    pub pos: Pos,
+}
+
+/// What a condition tests.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ConditionKind {
+    /// `SimulationTimeCondition`: time (s) `rule` value.
+    SimulationTime {
+        /// Comparison.
+        rule: Rule,
+        /// s.
+        value: f64,
+    },
+    /// `StoryboardElementStateCondition`.
+    ElementState {
+        /// `storyboardElementType` (`story`, `act`, `maneuverGroup`, `maneuver`, `event`,
+        /// `action`).
+        element_type: String,
+        /// The element's name.
+        element: String,
+        /// `state` (`startTransition`, `endTransition`, `completeState`, `runningState`, ...).
+        state: String,
+    },
+    /// `ParameterCondition`.
+    Parameter {
+        /// The parameter.
+        name: String,
+        /// Comparison.
+        rule: Rule,
+        /// The value as written.
+        value: String,
+    },
+    /// A `ByEntityCondition`: the triggering entities and what each is tested for.
+    Entity {
+        /// The triggering entities.
+        entities: Vec<usize>,
+        /// `triggeringEntitiesRule="all"` (else `any`).
+        all: bool,
+        /// The test.
+        test: EntityTest,
+    },
+}
+
+/// An entity condition's test (the standard's `EntityCondition` choices paracosm reads).
+#[derive(Debug, Clone, PartialEq)]
+pub enum EntityTest {
+    /// `TimeHeadwayCondition`: time (s) to reach `entity` at the current speed.
+    TimeHeadway {
+        /// The entity ahead.
+        entity: usize,
+        /// Comparison.
+        rule: Rule,
+        /// s.
+        value: f64,
+        /// Between bounding boxes.
+        freespace: bool,
+    },
+    /// `TimeToCollisionCondition` to an entity.
+    TimeToCollision {
+        /// The other entity.
+        entity: usize,
+        /// Comparison.
+        rule: Rule,
+        /// s.
+        value: f64,
+        /// Between bounding boxes.
+        freespace: bool,
+    },
+    /// `RelativeDistanceCondition`.
+    RelativeDistance {
+        /// The other entity.
+        entity: usize,
+        /// Comparison.
+        rule: Rule,
+        /// m.
+        value: f64,
+        /// Between bounding boxes.
+        freespace: bool,
+        /// `relativeDistanceType`: `longitudinal`, `lateral` or `euclidianDistance`.
+        kind: String,
+    },
+    /// `ReachPositionCondition` (or 1.2+'s `DistanceCondition` to a position with
+    /// `lessThan`).
+    ReachPosition {
+        /// The position.
+        position: Position,
+        /// m.
+        tolerance: f64,
+    },
+    /// `SpeedCondition`, m/s.
+    Speed {
+        /// Comparison.
+        rule: Rule,
+        /// m/s.
+        value: f64,
+    },
+    /// `RelativeSpeedCondition`: own speed minus `entity`'s, m/s.
+    RelativeSpeed {
+        /// The other entity.
+        entity: usize,
+        /// Comparison.
+        rule: Rule,
+        /// m/s.
+        value: f64,
+    },
+    /// `AccelerationCondition`, m/s².
+    Acceleration {
+        /// Comparison.
+        rule: Rule,
+        /// m/s².
+        value: f64,
+    },
+    /// `StandStillCondition`: still for this long, s.
+    Standstill(f64),
+    /// `TraveledDistanceCondition`, m.
+    TraveledDistance(f64),
+    /// `EndOfRoadCondition`: off the road's end for this long, s.
+    EndOfRoad(f64),
+    /// `CollisionCondition`: with this entity, or with anything.
+    Collision(Option<usize>),
+}

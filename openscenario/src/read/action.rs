@@ -1,0 +1,361 @@
+//! Private actions (OpenSCENARIO 1.3 User Guide, "Actions"): speed, longitudinal distance,
+//! lane change, lane offset, teleport, follow trajectory (polyline) and activate controller.
+//! Every other action is refused with what is supported.
+
+use roxmltree::Node;
+
+use super::{position, Reader};
+use crate::error::XoscError;
+use crate::model::{Action, Dimension, Dynamics, LaneTarget, OffsetTarget, Shape, SpeedTarget};
+use crate::xml::{child, choice, elements, need};
+
+/// A `<PrivateAction>`.
+pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
+    let (a, tag) = choice(
+        r.text,
+        node,
+        &[
+            "LongitudinalAction",
+            "LateralAction",
+            "TeleportAction",
+            "RoutingAction",
+            "ControllerAction",
+            "ActivateControllerAction",
+        ],
+    )?;
+    match tag {
+        // OpenSCENARIO 1.0 puts it directly under <PrivateAction>.
+        "ActivateControllerAction" => Ok(Action::ActivateController {
+            lateral: r.scope.opt_bool(r.text, a, "lateral")?,
+            longitudinal: r.scope.opt_bool(r.text, a, "longitudinal")?,
+        }),
+        "LongitudinalAction" => {
+            let (l, tag) = choice(r.text, a, &["SpeedAction", "LongitudinalDistanceAction"])?;
+            if tag == "SpeedAction" {
+                speed(r, l)
+            } else {
+                distance(r, l)
+            }
+        }
+        "LateralAction" => {
+            let (l, tag) = choice(r.text, a, &["LaneChangeAction", "LaneOffsetAction"])?;
+            if tag == "LaneChangeAction" {
+                lane_change(r, l)
+            } else {
+                lane_offset(r, l)
+            }
+        }
+        "TeleportAction" => Ok(Action::Teleport(position::read(
+            r,
+            need(r.text, a, "Position")?,
+        )?)),
+        "RoutingAction" => {
+            let (f, tag) = choice(r.text, a, &["FollowTrajectoryAction", "AssignRouteAction"])?;
+            if tag == "AssignRouteAction" {
+                assign_route(r, f)
+            } else {
+                follow_trajectory(r, f)
+            }
+        }
+        _ => {
+            let Some(c) = child(a, "ActivateControllerAction") else {
+                let what = elements(a)
+                    .map(|e| e.tag_name().name().to_string())
+                    .collect::<Vec<_>>();
+                return Err(r.text.unsupported(
+                    a,
+                    format!(
+                        "{} in <ControllerAction> is not supported; paracosm reads <ActivateControllerAction>",
+                        what.iter().map(|w| format!("<{w}>")).collect::<Vec<_>>().join(", ")
+                    ),
+                ));
+            };
+            Ok(Action::ActivateController {
+                lateral: r.scope.opt_bool(r.text, c, "lateral")?,
+                longitudinal: r.scope.opt_bool(r.text, c, "longitudinal")?,
+            })
+        }
+    }
+}
+
+/// A `TransitionDynamics` element.
+fn dynamics(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Dynamics, XoscError> {
+    let shape = shape(r, node)?;
+    let dimension = match r.scope.string(r.text, node, "dynamicsDimension")?.as_str() {
+        "time" => Dimension::Time,
+        "distance" => Dimension::Distance,
+        "rate" => Dimension::Rate,
+        other => {
+            return Err(XoscError::Invalid {
+                pos: r.text.attr_pos(node, "dynamicsDimension"),
+                reason: format!("dynamicsDimension is time, distance or rate, not {other:?}"),
+            })
+        }
+    };
+    let mut value = r.scope.num(r.text, node, "value")?;
+    if dimension == Dimension::Rate && value < 0.0 {
+        // The standard's value is >= 0; files (the ALKS cut-in) write a deceleration as a
+        // negative rate. The target gives the direction, so the rate is its magnitude.
+        r.note(
+            node,
+            format!(
+                "a transition's rate of {value} is read as {}: the target gives the direction",
+                -value
+            ),
+        );
+        value = -value;
+    }
+    if value.is_nan() || value < 0.0 {
+        return Err(XoscError::Invalid {
+            pos: r.text.attr_pos(node, "value"),
+            reason: format!("a transition's value must be >= 0, not {value}"),
+        });
+    }
+    Ok(Dynamics {
+        shape,
+        dimension,
+        value,
+    })
+}
+
+fn shape(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Shape, XoscError> {
+    Ok(match r.scope.string(r.text, node, "dynamicsShape")?.as_str() {
+        "step" => Shape::Step,
+        "linear" => Shape::Linear,
+        "cubic" => Shape::Cubic,
+        "sinusoidal" => Shape::Sinusoidal,
+        other => {
+            return Err(XoscError::Unsupported {
+                pos: r.text.attr_pos(node, "dynamicsShape"),
+                reason: format!("dynamicsShape {other:?} is not supported; paracosm reads step, linear, cubic and sinusoidal"),
+            })
+        }
+    })
+}
+
+fn speed(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
+    let dynamics = dynamics(r, need(r.text, node, "SpeedActionDynamics")?)?;
+    let (t, tag) = choice(
+        r.text,
+        need(r.text, node, "SpeedActionTarget")?,
+        &["AbsoluteTargetSpeed", "RelativeTargetSpeed"],
+    )?;
+    let target = if tag == "AbsoluteTargetSpeed" {
+        SpeedTarget::Absolute(r.scope.num(r.text, t, "value")?)
+    } else {
+        let factor = match r.scope.string(r.text, t, "speedTargetValueType")?.as_str() {
+            "delta" => false,
+            "factor" => true,
+            other => {
+                return Err(XoscError::Invalid {
+                    pos: r.text.attr_pos(t, "speedTargetValueType"),
+                    reason: format!("speedTargetValueType is delta or factor, not {other:?}"),
+                })
+            }
+        };
+        SpeedTarget::Relative {
+            entity: r.entity(t, "entityRef")?,
+            value: r.scope.num(r.text, t, "value")?,
+            factor,
+            continuous: r.scope.bool(r.text, t, "continuous")?,
+        }
+    };
+    Ok(Action::Speed { target, dynamics })
+}
+
+fn distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
+    let distance_m = r.scope.opt_num(r.text, node, "distance")?;
+    let time_gap_s = r.scope.opt_num(r.text, node, "timeGap")?;
+    if distance_m.is_some() == time_gap_s.is_some() {
+        return Err(r.text.invalid(
+            node,
+            "a longitudinal distance action gives either distance or timeGap",
+        ));
+    }
+    if let Some(c) = child(node, "DynamicConstraints") {
+        r.note(c, "a longitudinal distance action's dynamic constraints are not applied: the gap is held kinematically");
+    }
+    Ok(Action::LongitudinalDistance {
+        entity: r.entity(node, "entityRef")?,
+        distance_m,
+        time_gap_s,
+        freespace: r.scope.bool(r.text, node, "freespace")?,
+        continuous: r.scope.bool(r.text, node, "continuous")?,
+        displacement: r
+            .scope
+            .opt_string(r.text, node, "displacement")?
+            .unwrap_or_else(|| "trailingReferencedEntity".into()),
+    })
+}
+
+fn lane_change(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
+    let dynamics = dynamics(r, need(r.text, node, "LaneChangeActionDynamics")?)?;
+    let (t, tag) = choice(
+        r.text,
+        need(r.text, node, "LaneChangeTarget")?,
+        &["AbsoluteTargetLane", "RelativeTargetLane"],
+    )?;
+    let whole = |attr: &str| -> Result<i32, XoscError> {
+        let v = r.scope.num(r.text, t, attr)?;
+        if v.fract() != 0.0 || v.abs() > 1000.0 {
+            return Err(XoscError::Invalid {
+                pos: r.text.attr_pos(t, attr),
+                reason: format!("a lane is a whole number, not {v}"),
+            });
+        }
+        Ok(v as i32)
+    };
+    let target = if tag == "AbsoluteTargetLane" {
+        LaneTarget::Absolute(whole("value")?)
+    } else {
+        LaneTarget::Relative {
+            entity: r.entity(t, "entityRef")?,
+            lanes: whole("value")?,
+        }
+    };
+    Ok(Action::LaneChange {
+        target,
+        dynamics,
+        offset_m: r
+            .scope
+            .opt_num(r.text, node, "targetLaneOffset")?
+            .unwrap_or(0.0),
+    })
+}
+
+fn lane_offset(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
+    let d = need(r.text, node, "LaneOffsetActionDynamics")?;
+    let (t, tag) = choice(
+        r.text,
+        need(r.text, node, "LaneOffsetTarget")?,
+        &["AbsoluteTargetLaneOffset", "RelativeTargetLaneOffset"],
+    )?;
+    let target = if tag == "AbsoluteTargetLaneOffset" {
+        OffsetTarget::Absolute(r.scope.num(r.text, t, "value")?)
+    } else {
+        OffsetTarget::Relative {
+            entity: r.entity(t, "entityRef")?,
+            value: r.scope.num(r.text, t, "value")?,
+        }
+    };
+    Ok(Action::LaneOffset {
+        target,
+        shape: shape(r, d)?,
+        max_lateral_acc: r.scope.opt_num(r.text, d, "maxLateralAcc")?,
+        continuous: r.scope.bool(r.text, node, "continuous")?,
+    })
+}
+
+fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
+    let traj = match child(node, "TrajectoryRef") {
+        Some(t) => need(r.text, t, "Trajectory")?,
+        None => need(r.text, node, "Trajectory").map_err(|_| {
+            r.text.unsupported(node, "a trajectory is read from <TrajectoryRef><Trajectory> or <Trajectory> (catalog references are not supported)")
+        })?,
+    };
+    if r.scope.opt_bool(r.text, traj, "closed")? == Some(true) {
+        return Err(r
+            .text
+            .unsupported(traj, "a closed trajectory is not supported"));
+    }
+    if child(traj, "ParameterDeclarations").is_some_and(|p| elements(p).next().is_some()) {
+        return Err(r.text.unsupported(
+            traj,
+            "a trajectory's own parameter declarations are not supported",
+        ));
+    }
+    let (shape, _) = choice(r.text, need(r.text, traj, "Shape")?, &["Polyline"])?;
+    let mut vertices = Vec::new();
+    for v in elements(shape) {
+        if v.tag_name().name() != "Vertex" {
+            return Err(r
+                .text
+                .unsupported(v, "a polyline holds <Vertex> elements only"));
+        }
+        let time = r.scope.opt_num(r.text, v, "time")?;
+        vertices.push((time, position::read(r, need(r.text, v, "Position")?)?));
+    }
+    if vertices.len() < 2 {
+        return Err(r
+            .text
+            .invalid(shape, "a polyline needs at least two vertices"));
+    }
+    let timing = match child(node, "TimeReference").and_then(|t| child(t, "Timing")) {
+        None => None,
+        Some(t) => {
+            let absolute = match r
+                .scope
+                .string(r.text, t, "domainAbsoluteRelative")?
+                .as_str()
+            {
+                "absolute" => true,
+                "relative" => false,
+                other => {
+                    return Err(XoscError::Invalid {
+                        pos: r.text.attr_pos(t, "domainAbsoluteRelative"),
+                        reason: format!(
+                            "domainAbsoluteRelative is absolute or relative, not {other:?}"
+                        ),
+                    })
+                }
+            };
+            Some((
+                absolute,
+                r.scope.num(r.text, t, "scale")?,
+                r.scope.num(r.text, t, "offset")?,
+            ))
+        }
+    };
+    if let Some(m) = child(node, "TrajectoryFollowingMode") {
+        let mode = r.scope.string(r.text, m, "followingMode")?;
+        if mode != "position" {
+            r.note(m, format!("followingMode {mode:?} is followed as \"position\": the entity is placed on the trajectory"));
+        }
+    }
+    Ok(Action::FollowTrajectory { vertices, timing })
+}
+
+fn assign_route(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
+    let route = child(node, "Route").ok_or_else(|| {
+        r.text.unsupported(
+            node,
+            "a route is read from <Route> (catalog references are not supported)",
+        )
+    })?;
+    if child(route, "ParameterDeclarations").is_some_and(|p| elements(p).next().is_some()) {
+        return Err(r.text.unsupported(
+            route,
+            "a route's own parameter declarations are not supported",
+        ));
+    }
+    let mut waypoints = Vec::new();
+    for w in elements(route) {
+        match w.tag_name().name() {
+            "Waypoint" => {
+                let strategy = r.scope.string(r.text, w, "routeStrategy")?;
+                if !["fastest", "shortest", "leastIntersections", "random"]
+                    .contains(&strategy.as_str())
+                {
+                    return Err(XoscError::Invalid {
+                        pos: r.text.attr_pos(w, "routeStrategy"),
+                        reason: format!("routeStrategy is fastest, shortest, leastIntersections or random, not {strategy:?}"),
+                    });
+                }
+                waypoints.push((position::read(r, need(r.text, w, "Position")?)?, strategy));
+            }
+            "ParameterDeclarations" => {}
+            other => {
+                return Err(r.text.unsupported(
+                    w,
+                    format!("<{other}> in <Route> is not supported; paracosm reads <Waypoint>"),
+                ))
+            }
+        }
+    }
+    if waypoints.len() < 2 {
+        return Err(r
+            .text
+            .invalid(route, "a route needs at least two waypoints"));
+    }
+    Ok(Action::AssignRoute { waypoints })
+}

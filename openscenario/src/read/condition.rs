@@ -1,0 +1,266 @@
+//! Triggers and conditions (OpenSCENARIO 1.3 User Guide, "Conditions and triggers").
+
+use roxmltree::Node;
+
+use super::{position, Reader};
+use crate::error::XoscError;
+use crate::model::{Condition, ConditionKind, Edge, EntityTest, Rule, Trigger};
+use crate::xml::{choice, elements, need};
+
+/// A `StartTrigger` or `StopTrigger`: its condition groups.
+pub(super) fn trigger(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Trigger, XoscError> {
+    let mut groups = Vec::new();
+    for g in elements(node) {
+        if g.tag_name().name() != "ConditionGroup" {
+            return Err(r
+                .text
+                .unsupported(g, "a trigger holds <ConditionGroup> elements only"));
+        }
+        let mut conditions = Vec::new();
+        for c in elements(g) {
+            if c.tag_name().name() != "Condition" {
+                return Err(r
+                    .text
+                    .unsupported(c, "a condition group holds <Condition> elements only"));
+            }
+            conditions.push(condition(r, c)?);
+        }
+        if conditions.is_empty() {
+            return Err(r
+                .text
+                .invalid(g, "a condition group needs at least one condition"));
+        }
+        groups.push(conditions);
+    }
+    Ok(Trigger(groups))
+}
+
+fn condition(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Condition, XoscError> {
+    let delay_s = r.scope.num(r.text, c, "delay")?;
+    if delay_s.is_nan() || delay_s < 0.0 {
+        return Err(XoscError::Invalid {
+            pos: r.text.attr_pos(c, "delay"),
+            reason: format!("a condition's delay must be >= 0 s, not {delay_s}"),
+        });
+    }
+    let edge = match r.scope.string(r.text, c, "conditionEdge")?.as_str() {
+        "none" => Edge::None,
+        "rising" => Edge::Rising,
+        "falling" => Edge::Falling,
+        "risingOrFalling" => Edge::RisingOrFalling,
+        other => {
+            return Err(XoscError::Invalid {
+                pos: r.text.attr_pos(c, "conditionEdge"),
+                reason: format!(
+                    "conditionEdge is none, rising, falling or risingOrFalling, not {other:?}"
+                ),
+            })
+        }
+    };
+    let (by, tag) = choice(r.text, c, &["ByValueCondition", "ByEntityCondition"])?;
+    let kind = if tag == "ByValueCondition" {
+        by_value(r, by)?
+    } else {
+        by_entity(r, by)?
+    };
+    Ok(Condition {
+        name: r.scope.opt_string(r.text, c, "name")?.unwrap_or_default(),
+        delay_s,
+        edge,
+        kind,
+        pos: r.text.pos(c),
+    })
+}
+
+/// A `rule` attribute.
+pub(super) fn rule(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Rule, XoscError> {
+    Ok(match r.scope.string(r.text, node, "rule")?.as_str() {
+        "greaterThan" => Rule::Gt,
+        "lessThan" => Rule::Lt,
+        "equalTo" => Rule::Eq,
+        "greaterOrEqual" => Rule::Ge,
+        "lessOrEqual" => Rule::Le,
+        "notEqualTo" => Rule::Ne,
+        other => {
+            return Err(XoscError::Invalid {
+                pos: r.text.attr_pos(node, "rule"),
+                reason: format!(
+                    "a rule is greaterThan, lessThan, equalTo, greaterOrEqual, lessOrEqual or notEqualTo, not {other:?}"
+                ),
+            })
+        }
+    })
+}
+
+fn by_value(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError> {
+    let (v, tag) = choice(
+        r.text,
+        by,
+        &[
+            "SimulationTimeCondition",
+            "StoryboardElementStateCondition",
+            "ParameterCondition",
+        ],
+    )?;
+    Ok(match tag {
+        "SimulationTimeCondition" => ConditionKind::SimulationTime {
+            rule: rule(r, v)?,
+            value: r.scope.num(r.text, v, "value")?,
+        },
+        "StoryboardElementStateCondition" => ConditionKind::ElementState {
+            element_type: r.scope.string(r.text, v, "storyboardElementType")?,
+            element: r.scope.string(r.text, v, "storyboardElementRef")?,
+            state: r.scope.string(r.text, v, "state")?,
+        },
+        _ => {
+            let name = r.scope.string(r.text, v, "parameterRef")?;
+            let name = name.trim_start_matches('$').to_string();
+            if r.scope.get(&name).is_none() {
+                return Err(XoscError::Invalid {
+                    pos: r.text.attr_pos(v, "parameterRef"),
+                    reason: format!("parameter {name:?} is not declared"),
+                });
+            }
+            ConditionKind::Parameter {
+                name,
+                rule: rule(r, v)?,
+                value: r.scope.string(r.text, v, "value")?,
+            }
+        }
+    })
+}
+
+/// The entity conditions paracosm reads.
+const ENTITY_CONDITIONS: &[&str] = &[
+    "TimeHeadwayCondition",
+    "TimeToCollisionCondition",
+    "RelativeDistanceCondition",
+    "ReachPositionCondition",
+    "SpeedCondition",
+    "RelativeSpeedCondition",
+    "AccelerationCondition",
+    "StandStillCondition",
+    "TraveledDistanceCondition",
+    "EndOfRoadCondition",
+    "CollisionCondition",
+];
+
+fn by_entity(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError> {
+    let t = need(r.text, by, "TriggeringEntities")?;
+    let all = match r
+        .scope
+        .string(r.text, t, "triggeringEntitiesRule")?
+        .as_str()
+    {
+        "any" => false,
+        "all" => true,
+        other => {
+            return Err(XoscError::Invalid {
+                pos: r.text.attr_pos(t, "triggeringEntitiesRule"),
+                reason: format!("triggeringEntitiesRule is any or all, not {other:?}"),
+            })
+        }
+    };
+    let mut entities = Vec::new();
+    for e in elements(t) {
+        if e.tag_name().name() != "EntityRef" {
+            return Err(r
+                .text
+                .unsupported(e, "triggering entities are <EntityRef> elements"));
+        }
+        entities.push(r.entity(e, "entityRef")?);
+    }
+    if entities.is_empty() {
+        return Err(r.text.invalid(t, "no triggering entity is named"));
+    }
+    let (c, tag) = choice(
+        r.text,
+        need(r.text, by, "EntityCondition")?,
+        ENTITY_CONDITIONS,
+    )?;
+    Ok(ConditionKind::Entity {
+        entities,
+        all,
+        test: entity_test(r, c, tag)?,
+    })
+}
+
+fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest, XoscError> {
+    let (s, t) = (&r.scope, r.text);
+    let freespace = || s.opt_bool(t, c, "freespace").map(|f| f.unwrap_or(false));
+    Ok(match tag {
+        "TimeHeadwayCondition" => EntityTest::TimeHeadway {
+            entity: r.entity(c, "entityRef")?,
+            rule: rule(r, c)?,
+            value: s.num(t, c, "value")?,
+            freespace: freespace()?,
+        },
+        "TimeToCollisionCondition" => {
+            let (target, _) = choice(
+                t,
+                need(t, c, "TimeToCollisionConditionTarget")?,
+                &["EntityRef"],
+            )?;
+            EntityTest::TimeToCollision {
+                entity: r.entity(target, "entityRef")?,
+                rule: rule(r, c)?,
+                value: s.num(t, c, "value")?,
+                freespace: freespace()?,
+            }
+        }
+        "RelativeDistanceCondition" => EntityTest::RelativeDistance {
+            entity: r.entity(c, "entityRef")?,
+            rule: rule(r, c)?,
+            value: s.num(t, c, "value")?,
+            freespace: freespace()?,
+            kind: {
+                let kind = s.string(t, c, "relativeDistanceType")?;
+                // 1.0 names the euclidean distance cartesianDistance.
+                if ![
+                    "longitudinal",
+                    "lateral",
+                    "euclidianDistance",
+                    "cartesianDistance",
+                ]
+                .contains(&kind.as_str())
+                {
+                    return Err(XoscError::Invalid {
+                        pos: t.attr_pos(c, "relativeDistanceType"),
+                        reason: format!(
+                            "relativeDistanceType is longitudinal, lateral, euclidianDistance or cartesianDistance, not {kind:?}"
+                        ),
+                    });
+                }
+                kind
+            },
+        },
+        "ReachPositionCondition" => EntityTest::ReachPosition {
+            position: position::read(r, need(t, c, "Position")?)?,
+            tolerance: s.num(t, c, "tolerance")?,
+        },
+        "SpeedCondition" => EntityTest::Speed {
+            rule: rule(r, c)?,
+            value: s.num(t, c, "value")?,
+        },
+        "RelativeSpeedCondition" => EntityTest::RelativeSpeed {
+            entity: r.entity(c, "entityRef")?,
+            rule: rule(r, c)?,
+            value: s.num(t, c, "value")?,
+        },
+        "AccelerationCondition" => EntityTest::Acceleration {
+            rule: rule(r, c)?,
+            value: s.num(t, c, "value")?,
+        },
+        "StandStillCondition" => EntityTest::Standstill(s.num(t, c, "duration")?),
+        "TraveledDistanceCondition" => EntityTest::TraveledDistance(s.num(t, c, "value")?),
+        "EndOfRoadCondition" => EntityTest::EndOfRoad(s.num(t, c, "duration")?),
+        _ => {
+            let (target, tag) = choice(t, c, &["EntityRef", "ByType"])?;
+            if tag == "ByType" {
+                EntityTest::Collision(None)
+            } else {
+                EntityTest::Collision(Some(r.entity(target, "entityRef")?))
+            }
+        }
+    })
+}

@@ -1,0 +1,236 @@
+//! The storyboard (OpenSCENARIO 1.3 User Guide, "Storyboard"): `Init`, stories, acts,
+//! maneuver groups, maneuvers, events and their triggers.
+
+use roxmltree::Node;
+
+use super::{action, condition, Reader};
+use crate::error::XoscError;
+use crate::model::{
+    Act, ConditionKind, Event, Maneuver, ManeuverGroup, NamedAction, Priority, Story, Trigger,
+};
+use crate::xml::{child, elements, need};
+
+type Storyboard = (Vec<(usize, NamedAction)>, Vec<Story>, Option<Trigger>);
+
+/// The `Storyboard` element: `Init`'s private actions, the stories and the stop trigger.
+pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Storyboard, XoscError> {
+    let mut init = Vec::new();
+    let actions = need(r.text, need(r.text, node, "Init")?, "Actions")?;
+    for a in elements(actions) {
+        if a.tag_name().name() != "Private" {
+            return Err(r.text.unsupported(
+                a,
+                format!(
+                    "<{}> in <Init> is not supported; paracosm reads <Private> actions",
+                    a.tag_name().name()
+                ),
+            ));
+        }
+        let entity = r.entity(a, "entityRef")?;
+        for p in elements(a) {
+            init.push((
+                entity,
+                NamedAction {
+                    name: String::new(),
+                    pos: r.text.pos(p),
+                    action: action::private(r, p)?,
+                },
+            ));
+        }
+    }
+    let mut stories = Vec::new();
+    for s in elements(node).filter(|s| s.tag_name().name() == "Story") {
+        let r = &r.scoped(s)?;
+        let mut acts = Vec::new();
+        for a in elements(s) {
+            match a.tag_name().name() {
+                "Act" => acts.push(act(r, a)?),
+                "ParameterDeclarations" => {}
+                other => {
+                    return Err(r
+                        .text
+                        .unsupported(a, format!("<{other}> in <Story> is not supported")))
+                }
+            }
+        }
+        stories.push(Story {
+            name: name(r, s)?,
+            acts,
+        });
+    }
+    let stop = match child(node, "StopTrigger") {
+        Some(t) => Some(condition::trigger(r, t)?),
+        None => None,
+    };
+    check_references(&stories, stop.as_ref())?;
+    Ok((init, stories, stop))
+}
+
+fn name(r: &Reader<'_>, node: Node<'_, '_>) -> Result<String, XoscError> {
+    r.scope.string(r.text, node, "name")
+}
+
+fn count(r: &Reader<'_>, node: Node<'_, '_>) -> Result<u32, XoscError> {
+    let v = r.scope.num(r.text, node, "maximumExecutionCount")?;
+    if !(1.0..=1e6).contains(&v) || v.fract() != 0.0 {
+        return Err(XoscError::Invalid {
+            pos: r.text.attr_pos(node, "maximumExecutionCount"),
+            reason: format!("maximumExecutionCount is a whole number from 1, not {v}"),
+        });
+    }
+    Ok(v as u32)
+}
+
+fn act(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Act, XoscError> {
+    let mut groups = Vec::new();
+    for g in elements(a).filter(|g| g.tag_name().name() == "ManeuverGroup") {
+        let actors_node = need(r.text, g, "Actors")?;
+        let mut actors = Vec::new();
+        for e in elements(actors_node) {
+            if e.tag_name().name() != "EntityRef" {
+                return Err(r.text.unsupported(e, "actors are <EntityRef> elements"));
+            }
+            actors.push(r.entity(e, "entityRef")?);
+        }
+        let mut maneuvers = Vec::new();
+        for m in elements(g) {
+            match m.tag_name().name() {
+                "Actors" => {}
+                "Maneuver" => maneuvers.push(maneuver(r, m)?),
+                other => {
+                    return Err(r.text.unsupported(
+                        m,
+                        format!("<{other}> in <ManeuverGroup> is not supported (maneuver catalogs are not read); paracosm reads <Maneuver>"),
+                    ))
+                }
+            }
+        }
+        groups.push(ManeuverGroup {
+            name: name(r, g)?,
+            max_count: count(r, g)?,
+            actors,
+            select_triggering: r
+                .scope
+                .bool(r.text, actors_node, "selectTriggeringEntities")?,
+            maneuvers,
+        });
+    }
+    // Required by the 1.0 schema, optional since: an act without one starts at once.
+    let start = match child(a, "StartTrigger") {
+        Some(t) => Some(condition::trigger(r, t)?),
+        None => None,
+    };
+    let stop = match child(a, "StopTrigger") {
+        Some(t) => Some(condition::trigger(r, t)?),
+        None => None,
+    };
+    Ok(Act {
+        name: name(r, a)?,
+        start,
+        stop,
+        groups,
+    })
+}
+
+fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
+    let r = &r.scoped(m)?;
+    let mut events = Vec::new();
+    for e in elements(m).filter(|e| e.tag_name().name() == "Event") {
+        let priority = match r.scope.string(r.text, e, "priority")?.as_str() {
+            "override" | "overwrite" => Priority::Override,
+            "skip" => Priority::Skip,
+            "parallel" => Priority::Parallel,
+            other => {
+                return Err(XoscError::Invalid {
+                    pos: r.text.attr_pos(e, "priority"),
+                    reason: format!("priority is override, skip or parallel, not {other:?}"),
+                })
+            }
+        };
+        let mut actions = Vec::new();
+        for a in elements(e).filter(|a| a.tag_name().name() == "Action") {
+            let Some(p) = child(a, "PrivateAction") else {
+                let what = elements(a).next().map_or("nothing".to_string(), |c| {
+                    format!("<{}>", c.tag_name().name())
+                });
+                return Err(r.text.unsupported(
+                    a,
+                    format!(
+                        "an action holding {what} is not supported; paracosm reads <PrivateAction>"
+                    ),
+                ));
+            };
+            actions.push(NamedAction {
+                name: name(r, a)?,
+                pos: r.text.pos(a),
+                action: action::private(r, p)?,
+            });
+        }
+        let max_count = match e.attribute("maximumExecutionCount") {
+            Some(_) => count(r, e)?,
+            None => 1,
+        };
+        events.push(Event {
+            name: name(r, e)?,
+            priority,
+            max_count,
+            actions,
+            start: match child(e, "StartTrigger") {
+                Some(t) => Some(condition::trigger(r, t)?),
+                None => None,
+            },
+        });
+    }
+    Ok(Maneuver {
+        name: name(r, m)?,
+        events,
+    })
+}
+
+/// Every `StoryboardElementStateCondition` names an element of the storyboard.
+fn check_references(stories: &[Story], stop: Option<&Trigger>) -> Result<(), XoscError> {
+    let mut names: Vec<&str> = Vec::new();
+    for s in stories {
+        names.push(&s.name);
+        for a in &s.acts {
+            names.push(&a.name);
+            for g in &a.groups {
+                names.push(&g.name);
+                for m in &g.maneuvers {
+                    names.push(&m.name);
+                    for e in &m.events {
+                        names.push(&e.name);
+                        names.extend(e.actions.iter().map(|a| a.name.as_str()));
+                    }
+                }
+            }
+        }
+    }
+    let mut triggers: Vec<&Trigger> = stop.into_iter().collect();
+    for s in stories {
+        for a in &s.acts {
+            triggers.extend(a.start.iter());
+            triggers.extend(a.stop.iter());
+            for g in &a.groups {
+                for m in &g.maneuvers {
+                    triggers.extend(m.events.iter().filter_map(|e| e.start.as_ref()));
+                }
+            }
+        }
+    }
+    for t in triggers {
+        for c in t.0.iter().flatten() {
+            if let ConditionKind::ElementState { element, .. } = &c.kind {
+                // 1.1+ may qualify a name with its parents (`Event::Action`).
+                let last = element.rsplit("::").next().unwrap_or(element);
+                if !names.contains(&element.as_str()) && !names.contains(&last) {
+                    return Err(crate::error::XoscError::Invalid {
+                        pos: c.pos.clone(),
+                        reason: format!("no storyboard element is named {element:?}"),
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,78 @@
+//! Small helpers over `roxmltree` nodes.
+
+use roxmltree::Node;
+
+use crate::error::XoscError;
+use crate::text::Text;
+
+/// `node`'s element children.
+pub fn elements<'a, 'i>(node: Node<'a, 'i>) -> impl Iterator<Item = Node<'a, 'i>> {
+    node.children().filter(Node::is_element)
+}
+
+/// `node`'s first element child named `name`.
+pub fn child<'a, 'i>(node: Node<'a, 'i>, name: &str) -> Option<Node<'a, 'i>> {
+    elements(node).find(|c| c.tag_name().name() == name)
+}
+
+/// `node`'s element child named `name`, required.
+///
+/// # Errors
+/// [`XoscError::Invalid`] at `node` when it has none.
+pub fn need<'a, 'i>(
+    text: &Text,
+    node: Node<'a, 'i>,
+    name: &str,
+) -> Result<Node<'a, 'i>, XoscError> {
+    child(node, name).ok_or_else(|| {
+        text.invalid(
+            node,
+            format!("<{}> needs a <{name}>", node.tag_name().name()),
+        )
+    })
+}
+
+/// `node`'s single element child, which must be one of `choices` (the standard's choice
+/// groups), with its name.
+///
+/// # Errors
+/// [`XoscError::Invalid`] when it has none; [`XoscError::Unsupported`] for another element,
+/// naming what is supported.
+pub fn choice<'a, 'i>(
+    text: &Text,
+    node: Node<'a, 'i>,
+    choices: &[&str],
+) -> Result<(Node<'a, 'i>, &'a str), XoscError> {
+    let Some(c) = elements(node).next() else {
+        return Err(text.invalid(
+            node,
+            format!(
+                "<{}> is empty; it needs one of {}",
+                node.tag_name().name(),
+                list(choices)
+            ),
+        ));
+    };
+    let name = c.tag_name().name();
+    match choices.iter().position(|&k| k == name) {
+        Some(_) => Ok((c, name)),
+        None => Err(text.unsupported(
+            c,
+            format!(
+                "<{name}> in <{}> is not supported; paracosm reads {}",
+                node.tag_name().name(),
+                list(choices)
+            ),
+        )),
+    }
+}
+
+/// `<A>, <B> or <C>`.
+pub fn list(names: &[&str]) -> String {
+    let tags: Vec<String> = names.iter().map(|n| format!("<{n}>")).collect();
+    match tags.len() {
+        0 => String::new(),
+        1 => tags[0].clone(),
+        n => format!("{} or {}", tags[..n - 1].join(", "), tags[n - 1]),
+    }
+}

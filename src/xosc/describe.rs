@@ -1,0 +1,321 @@
+//! The text `paracosm-fuzz xosc` prints.
+
+use std::fmt::Write;
+
+use paracosm_generators::{Domain, Value};
+use paracosm_openscenario::model::{
+    Action, ConditionKind, EntityKind, EntityTest, LaneTarget, OffsetTarget, Position, Scenario,
+    SpeedTarget, Trigger,
+};
+
+use super::Inspection;
+
+impl Inspection {
+    /// The listing: the space, the grid, the entities, `Init`, the storyboard and the notes.
+    pub fn text(&self) -> String {
+        let s = &self.scenario;
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            "{} (OpenSCENARIO {}.{})",
+            s.file, s.version.0, s.version.1
+        );
+        if let Some(r) = &s.road_network {
+            let _ = writeln!(out, "road network: {}", r.item);
+        }
+        let _ = writeln!(out, "parameters ({} declared):", s.params.len());
+        for (d, v) in &s.params {
+            let open = self.space.iter().find(|p| p.name == d.name);
+            let _ = writeln!(
+                out,
+                "  {} = {}{}",
+                d.name,
+                v.to_text(),
+                open.map_or(String::new(), |p| format!("   -> {}", domain(&p.domain)))
+            );
+        }
+        match self.grid_runs {
+            Some(n) => {
+                let _ = writeln!(out, "the file's own grid: {n} runs");
+            }
+            None if self.variation.is_some() => {
+                let _ = writeln!(out, "the file's distribution is stochastic");
+            }
+            None => {}
+        }
+        let _ = writeln!(out, "entities:");
+        for e in &s.entities {
+            let kind = match &e.kind {
+                EntityKind::Vehicle(c) => format!("vehicle ({c})"),
+                EntityKind::Pedestrian(c) => format!("pedestrian ({c})"),
+                EntityKind::MiscObject(c) => format!("object ({c})"),
+            };
+            let [l, w, h] = e.dimensions_m;
+            let _ = writeln!(
+                out,
+                "  {}: {kind}, {l} x {w} x {h} m{}",
+                e.name,
+                e.controller
+                    .as_ref()
+                    .map_or(String::new(), |c| format!(", controller {c}"))
+            );
+        }
+        let _ = writeln!(out, "init:");
+        for (e, a) in &s.init {
+            let _ = writeln!(out, "  {}: {}", s.entities[*e].name, action(s, &a.action));
+        }
+        for story in &s.stories {
+            let _ = writeln!(out, "story {}:", story.name);
+            for act in &story.acts {
+                let start = act
+                    .start
+                    .as_ref()
+                    .map_or("at once".to_string(), |t| trigger(s, t));
+                let _ = writeln!(out, "  act {} starts {start}", act.name);
+                for g in &act.groups {
+                    let actors: Vec<&str> = g
+                        .actors
+                        .iter()
+                        .map(|&a| s.entities[a].name.as_str())
+                        .collect();
+                    for m in &g.maneuvers {
+                        for e in &m.events {
+                            let when = e
+                                .start
+                                .as_ref()
+                                .map_or("with its act".to_string(), |t| trigger(s, t));
+                            let _ = writeln!(
+                                out,
+                                "    event {} ({}) starts {when}:",
+                                e.name,
+                                actors.join(", ")
+                            );
+                            for a in &e.actions {
+                                let _ = writeln!(out, "      {}: {}", a.name, action(s, &a.action));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if let Some(t) = &s.stop {
+            let _ = writeln!(out, "stops {}", trigger(s, t));
+        }
+        for n in &s.notes {
+            let _ = writeln!(out, "note: {}: {}", n.pos, n.text);
+        }
+        for l in &self.limits {
+            let _ = writeln!(out, "note: {l}");
+        }
+        out
+    }
+}
+
+fn domain(d: &Domain) -> String {
+    match d {
+        Domain::Interval { lo, hi } => format!("interval [{lo}, {hi}]"),
+        Domain::Levels(l) => {
+            let t: Vec<String> = l
+                .iter()
+                .map(|v| match v {
+                    Value::Int(i) => i.to_string(),
+                    Value::Real(r) => r.to_string(),
+                    Value::Bool(b) => b.to_string(),
+                    Value::Text(s) => s.clone(),
+                })
+                .collect();
+            format!("{} levels {{{}}}", l.len(), t.join(", "))
+        }
+    }
+}
+
+fn name(s: &Scenario, e: usize) -> &str {
+    s.entities.get(e).map_or("?", |e| e.name.as_str())
+}
+
+/// One line for a position.
+fn position(s: &Scenario, p: &Position) -> String {
+    match p {
+        Position::World { x, y, h } => format!(
+            "world ({x}, {y}){}",
+            h.map_or(String::new(), |h| format!(" heading {h} rad"))
+        ),
+        Position::RelativeWorld { entity, dx, dy } => {
+            format!("{} + ({dx}, {dy}) m", name(s, *entity))
+        }
+        Position::RelativeObject { entity, dx, dy } => {
+            format!("{dx} m ahead, {dy} m left of {}", name(s, *entity))
+        }
+        Position::Road { road, s: st, t, .. } => format!("road {road} s {st} t {t}"),
+        Position::Lane {
+            road,
+            lane,
+            s: st,
+            offset,
+            ..
+        } => format!("road {road} lane {lane} s {st} offset {offset}"),
+        Position::RelativeLane {
+            entity,
+            d_lane,
+            ds,
+            offset,
+        } => {
+            format!(
+                "{ds} m along, {d_lane} lanes left of {} (offset {offset})",
+                name(s, *entity)
+            )
+        }
+    }
+}
+
+/// One line for an action.
+fn action(s: &Scenario, a: &Action) -> String {
+    match a {
+        Action::Speed { target, dynamics } => {
+            let t = match target {
+                SpeedTarget::Absolute(v) => format!("{v} m/s"),
+                SpeedTarget::Relative {
+                    entity,
+                    value,
+                    factor: true,
+                    ..
+                } => format!("{value} x {}'s speed", name(s, *entity)),
+                SpeedTarget::Relative { entity, value, .. } => {
+                    format!("{}'s speed + {value} m/s", name(s, *entity))
+                }
+            };
+            format!(
+                "speed to {t} ({:?} by {:?} {})",
+                dynamics.shape, dynamics.dimension, dynamics.value
+            )
+        }
+        Action::LaneChange {
+            target, dynamics, ..
+        } => {
+            let t = match target {
+                LaneTarget::Absolute(l) => format!("lane {l}"),
+                LaneTarget::Relative { entity, lanes } => {
+                    format!("{lanes} lanes left of {}'s", name(s, *entity))
+                }
+            };
+            format!(
+                "lane change to {t} ({:?} by {:?} {})",
+                dynamics.shape, dynamics.dimension, dynamics.value
+            )
+        }
+        Action::LaneOffset { target, .. } => match target {
+            OffsetTarget::Absolute(v) => format!("lane offset to {v} m"),
+            OffsetTarget::Relative { entity, value } => {
+                format!("lane offset to {}'s + {value} m", name(s, *entity))
+            }
+        },
+        Action::LongitudinalDistance {
+            entity,
+            distance_m,
+            time_gap_s,
+            ..
+        } => match (distance_m, time_gap_s) {
+            (Some(d), _) => format!("keep {d} m behind {}", name(s, *entity)),
+            (_, Some(t)) => format!("keep {t} s behind {}", name(s, *entity)),
+            _ => String::new(),
+        },
+        Action::Teleport(p) => format!("at {}", position(s, p)),
+        Action::FollowTrajectory { vertices, .. } => format!(
+            "follow a polyline of {} vertices to {}",
+            vertices.len(),
+            vertices
+                .last()
+                .map_or(String::new(), |(_, p)| position(s, p))
+        ),
+        Action::AssignRoute { waypoints } => format!(
+            "route through {} waypoints to {}",
+            waypoints.len(),
+            waypoints
+                .last()
+                .map_or(String::new(), |(p, _)| position(s, p))
+        ),
+        Action::ActivateController { .. } => "the system under test takes over".into(),
+    }
+}
+
+/// One line for a trigger: `when A and B, or C`.
+fn trigger(s: &Scenario, t: &Trigger) -> String {
+    let groups: Vec<String> =
+        t.0.iter()
+            .map(|g| {
+                g.iter()
+                    .map(|c| {
+                        let delay = if c.delay_s > 0.0 {
+                            format!(" (then {} s later)", c.delay_s)
+                        } else {
+                            String::new()
+                        };
+                        format!("{}{delay}", condition(s, &c.kind))
+                    })
+                    .collect::<Vec<_>>()
+                    .join(" and ")
+            })
+            .collect();
+    format!("when {}", groups.join(", or "))
+}
+
+fn condition(s: &Scenario, c: &ConditionKind) -> String {
+    match c {
+        ConditionKind::SimulationTime { rule, value } => format!("time {rule:?} {value} s"),
+        ConditionKind::ElementState {
+            element_type,
+            element,
+            state,
+        } => format!("{element_type} {element} {state}"),
+        ConditionKind::Parameter { name, rule, value } => format!("${name} {rule:?} {value}"),
+        ConditionKind::Entity { entities, test, .. } => {
+            let who: Vec<&str> = entities.iter().map(|&e| name(s, e)).collect();
+            let what = match test {
+                EntityTest::TimeHeadway {
+                    entity,
+                    rule,
+                    value,
+                    ..
+                } => format!("headway to {} {rule:?} {value} s", name(s, *entity)),
+                EntityTest::TimeToCollision {
+                    entity,
+                    rule,
+                    value,
+                    ..
+                } => format!(
+                    "time to collision with {} {rule:?} {value} s",
+                    name(s, *entity)
+                ),
+                EntityTest::RelativeDistance {
+                    entity,
+                    rule,
+                    value,
+                    kind,
+                    ..
+                } => format!("{kind} distance to {} {rule:?} {value} m", name(s, *entity)),
+                EntityTest::ReachPosition {
+                    position: p,
+                    tolerance,
+                } => format!("within {tolerance} m of {}", position(s, p)),
+                EntityTest::Speed { rule, value } => format!("speed {rule:?} {value} m/s"),
+                EntityTest::RelativeSpeed {
+                    entity,
+                    rule,
+                    value,
+                } => format!(
+                    "speed relative to {} {rule:?} {value} m/s",
+                    name(s, *entity)
+                ),
+                EntityTest::Acceleration { rule, value } => {
+                    format!("acceleration {rule:?} {value} m/s2")
+                }
+                EntityTest::Standstill(d) => format!("still for {d} s"),
+                EntityTest::TraveledDistance(d) => format!("travelled {d} m"),
+                EntityTest::EndOfRoad(d) => format!("past the road's end for {d} s"),
+                EntityTest::Collision(Some(e)) => format!("touches {}", name(s, *e)),
+                EntityTest::Collision(None) => "touches anything".into(),
+            };
+            format!("{}: {what}", who.join("/"))
+        }
+    }
+}

@@ -1,0 +1,122 @@
+//! `paracosm-fuzz xosc`: an OpenSCENARIO logical scenario as paracosm reads it (issue "The
+//! industry's logical scenarios as campaigns"). Given a parameter value distribution file
+//! (or a scenario file), it reads the scenario it names with `paracosm-openscenario`, turns
+//! each varied parameter into a parameter of paracosm's space, and lists the scenario's
+//! entities, `Init` and storyboard, and everything read but not honoured as written.
+
+mod describe;
+mod space;
+
+use std::path::{Path, PathBuf};
+
+use paracosm_generators::Param;
+use paracosm_openscenario::distribution::{read_variation, VariationFile};
+use paracosm_openscenario::model::Scenario;
+use paracosm_openscenario::{read_scenario, Text, XoscError};
+
+use crate::Error;
+
+pub use space::{open_param, varied_param};
+
+/// A logical scenario read for listing ([`inspect`]).
+#[derive(Debug, Clone)]
+pub struct Inspection {
+    /// The file given (a variation file or a scenario).
+    pub file: PathBuf,
+    /// The variation file, when one was given.
+    pub variation: Option<VariationFile>,
+    /// The scenario, read with its parameters' declared values.
+    pub scenario: Scenario,
+    /// paracosm's space: one parameter per varied parameter, then one per `--open`.
+    pub space: Vec<Param>,
+    /// How many runs the variation file's own deterministic grid has (the product of its
+    /// parameters' level counts), when it is deterministic.
+    pub grid_runs: Option<u64>,
+    /// What paracosm does not yet honour of the distributions (one line each).
+    pub limits: Vec<String>,
+}
+
+/// Reads `path` (a `ParameterValueDistribution` file, or a scenario) and opens the declared
+/// parameters `opens` names (`Name=lo..hi` or `Name=a,b,c`). With `continuous`, a
+/// `DistributionRange` becomes an interval over its range instead of its levels.
+///
+/// # Errors
+/// [`Error::Input`] naming the file, line and column: a file that is not OpenSCENARIO, a
+/// variation whose scenario does not read, an `--open` of a parameter that is not declared,
+/// is varied already, or whose range breaks its constraint groups.
+pub fn inspect(path: &Path, opens: &[String], continuous: bool) -> Result<Inspection, Error> {
+    let input = |e: XoscError| Error::Input {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let text = Text::read(path).map_err(input)?;
+    let doc = text.parse().map_err(input)?;
+    let is_variation = paracosm_openscenario::distribution::is_variation(&doc);
+    drop(doc);
+    let (variation, scenario_path) = if is_variation {
+        let v = read_variation(&text).map_err(input)?;
+        let dir = path.parent().unwrap_or(Path::new(""));
+        let p: PathBuf = dir
+            .join(&v.scenario_file)
+            .components()
+            .filter(|c| !matches!(c, std::path::Component::CurDir))
+            .collect();
+        if !p.is_file() {
+            return Err(Error::Input {
+                path: path.to_path_buf(),
+                message: format!(
+                    "{}: the scenario file {} is not there",
+                    v.scenario_pos,
+                    p.display()
+                ),
+            });
+        }
+        (Some(v), p)
+    } else {
+        (None, path.to_path_buf())
+    };
+    let scenario = read_scenario(&scenario_path, &[]).map_err(input)?;
+    let mut space = Vec::new();
+    let mut limits = Vec::new();
+    let mut grid_runs = Some(1u64);
+    if let Some(v) = &variation {
+        if !matches!(
+            v.kind,
+            paracosm_openscenario::distribution::Kind::Deterministic
+        ) {
+            grid_runs = None;
+        }
+        for p in &v.params {
+            let declared = scenario.params.iter().any(|(d, _)| d.name == p.name);
+            if !declared {
+                return Err(Error::Input {
+                    path: path.to_path_buf(),
+                    message: format!(
+                        "{}: parameter {:?} is varied but {} does not declare it",
+                        p.pos,
+                        p.name,
+                        scenario_path.display()
+                    ),
+                });
+            }
+            let (param, levels, limit) = varied_param(p, continuous);
+            grid_runs = grid_runs.and_then(|g| levels.and_then(|n| g.checked_mul(n)));
+            limits.extend(limit);
+            space.push(param);
+        }
+    } else {
+        grid_runs = None;
+    }
+    for o in opens {
+        let param = open_param(o, &scenario, &space)?;
+        space.push(param);
+    }
+    Ok(Inspection {
+        file: path.to_path_buf(),
+        variation,
+        scenario,
+        space,
+        grid_runs,
+        limits,
+    })
+}
