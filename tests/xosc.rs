@@ -176,7 +176,7 @@ fn a_scenario_in_the_older_forms_reads() {
         "Hero: the system under test takes over",
         "Walker: at 60 m ahead, -4 m left of Hero",
         "act A starts at once",
-        "distance to Walker Lt 40 m",
+        "euclidianDistance distance to Walker Lt 40 m",
         "speed to 0.1 x Hero's speed (Linear by Time 1)",
         "stops when action Go::Walk endTransition (then 2 s later)",
         "v's <Performance> limits are not applied",

@@ -279,16 +279,7 @@ fn elements<'a, 'i>(node: Node<'a, 'i>) -> impl Iterator<Item = Node<'a, 'i>> {
 /// `UserDefinedDistribution`, unknown elements and attributes.
 pub fn read_variation(text: &Text) -> Result<VariationFile, XoscError> {
     let doc = text.parse()?;
-    let root = doc.root_element();
-    if root.tag_name().name() != "OpenSCENARIO" {
-        return Err(text.invalid(
-            root,
-            format!(
-                "the root element is <{}>; an OpenSCENARIO file's is <OpenSCENARIO>",
-                root.tag_name().name()
-            ),
-        ));
-    }
+    let root = text.open_root(&doc)?;
     if elements(root).any(|c| c.has_tag_name("Storyboard")) {
         return Err(text.invalid(
             root,

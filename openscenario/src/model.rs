@@ -293,6 +293,8 @@ pub enum Action {
         /// `displacement`: `trailingReferencedEntity` (default), `leadingReferencedEntity`
         /// or `any`.
         displacement: String,
+        /// `coordinateSystem`: `entity` (default), `lane`, `road` or `trajectory`.
+        frame: String,
     },
     /// `TeleportAction`.
     Teleport(Position),
@@ -323,8 +325,8 @@ pub enum Action {
 pub struct Orientation {
     /// Heading, rad.
     pub h: f64,
-    /// `type="relative"` (to the road's or lane's direction, or the entity's heading):
-    /// the standard's default for road and lane positions.
+    /// `type="relative"` (to the road's or lane's direction, or the entity's heading);
+    /// a missing `type` is absolute.
     pub relative: bool,
 }
 
@@ -348,6 +350,8 @@ pub enum Position {
         dx: f64,
         /// m.
         dy: f64,
+        /// Orientation (relative: to the entity's heading).
+        orientation: Option<Orientation>,
     },
     /// `RelativeObjectPosition` (in the entity's frame).
     RelativeObject {
@@ -357,6 +361,8 @@ pub enum Position {
         dx: f64,
         /// m, left.
         dy: f64,
+        /// Orientation (relative: to the entity's heading).
+        orientation: Option<Orientation>,
     },
     /// `RoadPosition`.
     Road {
@@ -377,7 +383,8 @@ pub enum Position {
         lane: i32,
         /// m along the road.
         s: f64,
-        /// m left of the lane centre.
+        /// m from the lane centre along +t (left of the road's reference line direction,
+        /// which is the driver's right on a lane driven against `s`).
         offset: f64,
         /// Orientation.
         orientation: Option<Orientation>,
@@ -386,11 +393,11 @@ pub enum Position {
     RelativeLane {
         /// The entity.
         entity: usize,
-        /// Lanes to the left.
+        /// Lanes counted along +t (toward positive lane ids' side).
         d_lane: i32,
         /// m along the road (`ds`) from the entity.
         ds: f64,
-        /// m left of the target lane's centre.
+        /// m from the target lane's centre along +t.
         offset: f64,
     },
 }
@@ -499,46 +506,36 @@ pub enum ConditionKind {
     },
 }
 
+/// What a headway, time to collision or relative distance condition compares: to which
+/// entity, how, and measured where.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gap {
+    /// The other entity.
+    pub entity: usize,
+    /// Comparison.
+    pub rule: Rule,
+    /// s (headway, time to collision) or m (distance).
+    pub value: f64,
+    /// Between bounding boxes.
+    pub freespace: bool,
+    /// `coordinateSystem`: `entity` (default), `lane`, `road` or `trajectory` (1.0's
+    /// `alongRoute="true"` is `road`).
+    pub frame: String,
+    /// `relativeDistanceType`: `longitudinal`, `lateral` or `euclidianDistance` (the default;
+    /// 1.0's `cartesianDistance`).
+    pub kind: String,
+}
+
 /// An entity condition's test (the standard's `EntityCondition` choices paracosm reads).
 #[derive(Debug, Clone, PartialEq)]
 pub enum EntityTest {
-    /// `TimeHeadwayCondition`: time (s) to reach `entity` at the current speed.
-    TimeHeadway {
-        /// The entity ahead.
-        entity: usize,
-        /// Comparison.
-        rule: Rule,
-        /// s.
-        value: f64,
-        /// Between bounding boxes.
-        freespace: bool,
-    },
-    /// `TimeToCollisionCondition` to an entity.
-    TimeToCollision {
-        /// The other entity.
-        entity: usize,
-        /// Comparison.
-        rule: Rule,
-        /// s.
-        value: f64,
-        /// Between bounding boxes.
-        freespace: bool,
-    },
-    /// `RelativeDistanceCondition`.
-    RelativeDistance {
-        /// The other entity.
-        entity: usize,
-        /// Comparison.
-        rule: Rule,
-        /// m.
-        value: f64,
-        /// Between bounding boxes.
-        freespace: bool,
-        /// `relativeDistanceType`: `longitudinal`, `lateral` or `euclidianDistance`.
-        kind: String,
-    },
-    /// `ReachPositionCondition` (or 1.2+'s `DistanceCondition` to a position with
-    /// `lessThan`).
+    /// `TimeHeadwayCondition`: time (s) to reach the entity at the current speed.
+    TimeHeadway(Gap),
+    /// `TimeToCollisionCondition` to an entity, s.
+    TimeToCollision(Gap),
+    /// `RelativeDistanceCondition`, m.
+    RelativeDistance(Gap),
+    /// `ReachPositionCondition`.
     ReachPosition {
         /// The position.
         position: Position,
@@ -574,6 +571,7 @@ pub enum EntityTest {
     TraveledDistance(f64),
     /// `EndOfRoadCondition`: off the road's end for this long, s.
     EndOfRoad(f64),
-    /// `CollisionCondition`: with this entity, or with anything.
+    /// `CollisionCondition` with this entity (`ByType` is refused; `None` is kept for a
+    /// collision with anything).
     Collision(Option<usize>),
 }

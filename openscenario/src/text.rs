@@ -108,6 +108,24 @@ impl Text {
         })
     }
 
+    /// The root element of `doc` (this text parsed), which must be `<OpenSCENARIO>`.
+    ///
+    /// # Errors
+    /// [`XoscError::Invalid`] at the root for any other element.
+    pub fn open_root<'a, 'i>(&self, doc: &'a Document<'i>) -> Result<Node<'a, 'i>, XoscError> {
+        let root = doc.root_element();
+        if root.tag_name().name() != "OpenSCENARIO" {
+            return Err(self.invalid(
+                root,
+                format!(
+                    "the root element is <{}>; an OpenSCENARIO file's is <OpenSCENARIO>",
+                    root.tag_name().name()
+                ),
+            ));
+        }
+        Ok(root)
+    }
+
     /// An [`XoscError::Invalid`] at `node`.
     pub fn invalid(&self, node: Node<'_, '_>, reason: impl Into<String>) -> XoscError {
         XoscError::Invalid {

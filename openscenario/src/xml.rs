@@ -36,8 +36,8 @@ pub fn need<'a, 'i>(
 /// groups), with its name.
 ///
 /// # Errors
-/// [`XoscError::Invalid`] when it has none; [`XoscError::Unsupported`] for another element,
-/// naming what is supported.
+/// [`XoscError::Invalid`] when it has none or more than one; [`XoscError::Unsupported`] for
+/// another element, naming what is supported.
 pub fn choice<'a, 'i>(
     text: &Text,
     node: Node<'a, 'i>,
@@ -53,6 +53,17 @@ pub fn choice<'a, 'i>(
             ),
         ));
     };
+    if let Some(second) = elements(node).nth(1) {
+        return Err(text.invalid(
+            second,
+            format!(
+                "<{}> holds one element, not <{}> and <{}>",
+                node.tag_name().name(),
+                c.tag_name().name(),
+                second.tag_name().name()
+            ),
+        ));
+    }
     let name = c.tag_name().name();
     match choices.iter().position(|&k| k == name) {
         Some(_) => Ok((c, name)),
@@ -74,5 +85,25 @@ pub fn list(names: &[&str]) -> String {
         0 => String::new(),
         1 => tags[0].clone(),
         n => format!("{} or {}", tags[..n - 1].join(", "), tags[n - 1]),
+    }
+}
+
+/// Refuses any element child of `node` that is not one of `allowed` (the standard's
+/// sequence there), so that a misspelt or unsupported element is never passed over.
+///
+/// # Errors
+/// [`XoscError::Unsupported`] at the first other child, naming what is read there.
+pub fn only(text: &Text, node: Node<'_, '_>, allowed: &[&str]) -> Result<(), XoscError> {
+    match elements(node).find(|c| !allowed.contains(&c.tag_name().name())) {
+        None => Ok(()),
+        Some(c) => Err(text.unsupported(
+            c,
+            format!(
+                "<{}> in <{}> is not supported; paracosm reads {} there",
+                c.tag_name().name(),
+                node.tag_name().name(),
+                list(allowed)
+            ),
+        )),
     }
 }

@@ -140,10 +140,10 @@ fn position(s: &Scenario, p: &Position) -> String {
             "world ({x}, {y}){}",
             h.map_or(String::new(), |h| format!(" heading {h} rad"))
         ),
-        Position::RelativeWorld { entity, dx, dy } => {
+        Position::RelativeWorld { entity, dx, dy, .. } => {
             format!("{} + ({dx}, {dy}) m", name(s, *entity))
         }
-        Position::RelativeObject { entity, dx, dy } => {
+        Position::RelativeObject { entity, dx, dy, .. } => {
             format!("{dx} m ahead, {dy} m left of {}", name(s, *entity))
         }
         Position::Road { road, s: st, t, .. } => format!("road {road} s {st} t {t}"),
@@ -271,28 +271,27 @@ fn condition(s: &Scenario, c: &ConditionKind) -> String {
         ConditionKind::Entity { entities, test, .. } => {
             let who: Vec<&str> = entities.iter().map(|&e| name(s, e)).collect();
             let what = match test {
-                EntityTest::TimeHeadway {
-                    entity,
-                    rule,
-                    value,
-                    ..
-                } => format!("headway to {} {rule:?} {value} s", name(s, *entity)),
-                EntityTest::TimeToCollision {
-                    entity,
-                    rule,
-                    value,
-                    ..
-                } => format!(
-                    "time to collision with {} {rule:?} {value} s",
-                    name(s, *entity)
+                EntityTest::TimeHeadway(g) => {
+                    format!(
+                        "headway to {} {:?} {} s",
+                        name(s, g.entity),
+                        g.rule,
+                        g.value
+                    )
+                }
+                EntityTest::TimeToCollision(g) => format!(
+                    "time to collision with {} {:?} {} s",
+                    name(s, g.entity),
+                    g.rule,
+                    g.value
                 ),
-                EntityTest::RelativeDistance {
-                    entity,
-                    rule,
-                    value,
-                    kind,
-                    ..
-                } => format!("{kind} distance to {} {rule:?} {value} m", name(s, *entity)),
+                EntityTest::RelativeDistance(g) => format!(
+                    "{} distance to {} {:?} {} m",
+                    g.kind,
+                    name(s, g.entity),
+                    g.rule,
+                    g.value
+                ),
                 EntityTest::ReachPosition {
                     position: p,
                     tolerance,

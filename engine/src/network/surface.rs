@@ -93,18 +93,23 @@ const GRID_FROM: usize = 4;
 const MAX_CELLS: f64 = 4096.0;
 
 impl PieceGrid {
+    /// A grid of no cells: a query finds `all` (every piece), or nothing.
+    fn without_cells(all: Option<Vec<usize>>) -> Self {
+        PieceGrid {
+            origin: [0.0; 2],
+            cell_m: 1.0,
+            dims: [0, 0],
+            starts: vec![0],
+            pieces: Vec::new(),
+            all,
+        }
+    }
+
     /// The grid over `boxes`, each piece's world box `[min x, max x, min z, max z]` (m).
     fn new(boxes: &[[f64; 4]]) -> Self {
         if boxes.len() < GRID_FROM {
             // A query tests every piece, so no cells (a map's box would fill them all).
-            return PieceGrid {
-                origin: [0.0; 2],
-                cell_m: 1.0,
-                dims: [0, 0],
-                starts: vec![0],
-                pieces: Vec::new(),
-                all: Some((0..boxes.len()).collect()),
-            };
+            return PieceGrid::without_cells(Some((0..boxes.len()).collect()));
         }
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for b in boxes {
@@ -112,14 +117,7 @@ impl PieceGrid {
             hi = [hi[0].max(b[1]), hi[1].max(b[3])];
         }
         if !(lo[0].is_finite() && lo[1].is_finite() && hi[0].is_finite() && hi[1].is_finite()) {
-            return PieceGrid {
-                origin: [0.0; 2],
-                cell_m: 1.0,
-                dims: [0, 0],
-                starts: vec![0],
-                pieces: Vec::new(),
-                all: None,
-            };
+            return PieceGrid::without_cells(None);
         }
         let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(1.0);
         let cell_m = (area / MAX_CELLS).sqrt().max(5.0);

@@ -7,7 +7,7 @@ use roxmltree::Node;
 use super::{position, Reader};
 use crate::error::XoscError;
 use crate::model::{Action, Dimension, Dynamics, LaneTarget, OffsetTarget, Shape, SpeedTarget};
-use crate::xml::{child, choice, elements, need};
+use crate::xml::{child, choice, elements, need, only};
 
 /// A `<PrivateAction>`.
 pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
@@ -25,10 +25,7 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
     )?;
     match tag {
         // OpenSCENARIO 1.0 puts it directly under <PrivateAction>.
-        "ActivateControllerAction" => Ok(Action::ActivateController {
-            lateral: r.scope.opt_bool(r.text, a, "lateral")?,
-            longitudinal: r.scope.opt_bool(r.text, a, "longitudinal")?,
-        }),
+        "ActivateControllerAction" => activate(r, a),
         "LongitudinalAction" => {
             let (l, tag) = choice(r.text, a, &["SpeedAction", "LongitudinalDistanceAction"])?;
             if tag == "SpeedAction" {
@@ -58,24 +55,31 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
             }
         }
         _ => {
-            let Some(c) = child(a, "ActivateControllerAction") else {
-                let what = elements(a)
-                    .map(|e| e.tag_name().name().to_string())
-                    .collect::<Vec<_>>();
-                return Err(r.text.unsupported(
-                    a,
-                    format!(
-                        "{} in <ControllerAction> is not supported; paracosm reads <ActivateControllerAction>",
-                        what.iter().map(|w| format!("<{w}>")).collect::<Vec<_>>().join(", ")
-                    ),
-                ));
-            };
-            Ok(Action::ActivateController {
-                lateral: r.scope.opt_bool(r.text, c, "lateral")?,
-                longitudinal: r.scope.opt_bool(r.text, c, "longitudinal")?,
-            })
+            only(r.text, a, &["ActivateControllerAction"])?;
+            let c = need(r.text, a, "ActivateControllerAction")?;
+            activate(r, c)
         }
     }
+}
+
+/// An `ActivateControllerAction`: 1.3's `animation` and `lighting` are refused when set;
+/// a named controller must be the entity's (paracosm reads one per entity).
+fn activate(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Action, XoscError> {
+    for a in ["animation", "lighting"] {
+        if r.scope.opt_bool(r.text, c, a)? == Some(true) {
+            return Err(XoscError::Unsupported {
+                pos: r.text.attr_pos(c, a),
+                reason: format!("activating a controller's {a} is not supported"),
+            });
+        }
+    }
+    if c.attribute("objectControllerRef").is_some() || c.attribute("controllerRef").is_some() {
+        r.note(c, "the controller named here is the entity's one controller: paracosm reads one per entity");
+    }
+    Ok(Action::ActivateController {
+        lateral: r.scope.opt_bool(r.text, c, "lateral")?,
+        longitudinal: r.scope.opt_bool(r.text, c, "longitudinal")?,
+    })
 }
 
 /// A `TransitionDynamics` element.
@@ -92,6 +96,11 @@ fn dynamics(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Dynamics, XoscError> {
             })
         }
     };
+    if let Some(mode) = r.scope.opt_string(r.text, node, "followingMode")? {
+        if mode != "position" {
+            r.note(node, format!("followingMode {mode:?} is followed as \"position\": the value follows the shape exactly"));
+        }
+    }
     let mut value = r.scope.num(r.text, node, "value")?;
     if dimension == Dimension::Rate && value < 0.0 {
         // The standard's value is >= 0; files (the ALKS cut-in) write a deceleration as a
@@ -181,11 +190,36 @@ fn distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
         time_gap_s,
         freespace: r.scope.bool(r.text, node, "freespace")?,
         continuous: r.scope.bool(r.text, node, "continuous")?,
-        displacement: r
-            .scope
-            .opt_string(r.text, node, "displacement")?
-            .unwrap_or_else(|| "trailingReferencedEntity".into()),
+        displacement: one_of(
+            r,
+            node,
+            "displacement",
+            &["trailingReferencedEntity", "leadingReferencedEntity", "any"],
+        )?,
+        frame: one_of(
+            r,
+            node,
+            "coordinateSystem",
+            &["entity", "lane", "road", "trajectory"],
+        )?,
     })
+}
+
+/// Attribute `attr`, one of `allowed`; the first when absent (the standard's default).
+fn one_of(
+    r: &Reader<'_>,
+    node: Node<'_, '_>,
+    attr: &str,
+    allowed: &[&str],
+) -> Result<String, XoscError> {
+    match r.scope.opt_string(r.text, node, attr)? {
+        None => Ok(allowed[0].to_string()),
+        Some(v) if allowed.contains(&v.as_str()) => Ok(v),
+        Some(v) => Err(XoscError::Invalid {
+            pos: r.text.attr_pos(node, attr),
+            reason: format!("{attr} is one of {}, not {v:?}", allowed.join(", ")),
+        }),
+    }
 }
 
 fn lane_change(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
@@ -247,13 +281,20 @@ fn lane_offset(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> 
 }
 
 fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
-    let traj = match child(node, "TrajectoryRef") {
-        Some(t) => need(r.text, t, "Trajectory")?,
-        None => need(r.text, node, "Trajectory").map_err(|_| {
-            r.text.unsupported(node, "a trajectory is read from <TrajectoryRef><Trajectory> or <Trajectory> (catalog references are not supported)")
-        })?,
-    };
-    if r.scope.opt_bool(r.text, traj, "closed")? == Some(true) {
+    let holder = child(node, "TrajectoryRef").unwrap_or(node);
+    let traj = child(holder, "Trajectory").ok_or_else(|| {
+        r.text.unsupported(node, "a trajectory is read from <TrajectoryRef><Trajectory> or <Trajectory> (trajectory catalogs are not supported)")
+    })?;
+    if r.scope
+        .opt_num(r.text, node, "initialDistanceOffset")?
+        .is_some_and(|d| d != 0.0)
+    {
+        return Err(XoscError::Unsupported {
+            pos: r.text.attr_pos(node, "initialDistanceOffset"),
+            reason: "a trajectory's initialDistanceOffset is not supported".into(),
+        });
+    }
+    if r.scope.bool(r.text, traj, "closed")? {
         return Err(r
             .text
             .unsupported(traj, "a closed trajectory is not supported"));
@@ -280,7 +321,8 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
             .text
             .invalid(shape, "a polyline needs at least two vertices"));
     }
-    let timing = match child(node, "TimeReference").and_then(|t| child(t, "Timing")) {
+    let time_ref = need(r.text, node, "TimeReference")?;
+    let timing = match child(time_ref, "Timing") {
         None => None,
         Some(t) => {
             let absolute = match r
@@ -306,6 +348,28 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
             ))
         }
     };
+    if let Some((_, scale, _)) = timing {
+        if scale.is_nan() || scale <= 0.0 {
+            return Err(r.text.invalid(
+                time_ref,
+                format!("a timing's scale must be > 0, not {scale}"),
+            ));
+        }
+        let times: Option<Vec<f64>> = vertices.iter().map(|(t, _)| *t).collect();
+        match times {
+            None => {
+                return Err(r
+                    .text
+                    .invalid(shape, "with a <Timing>, every vertex needs a time"))
+            }
+            Some(t) if t.windows(2).any(|w| w[1] <= w[0]) => {
+                return Err(r
+                    .text
+                    .invalid(shape, "a polyline's vertex times must increase"))
+            }
+            Some(_) => {}
+        }
+    }
     if let Some(m) = child(node, "TrajectoryFollowingMode") {
         let mode = r.scope.string(r.text, m, "followingMode")?;
         if mode != "position" {
@@ -327,6 +391,9 @@ fn assign_route(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError>
             route,
             "a route's own parameter declarations are not supported",
         ));
+    }
+    if r.scope.bool(r.text, route, "closed")? {
+        return Err(r.text.unsupported(route, "a closed route is not supported"));
     }
     let mut waypoints = Vec::new();
     for w in elements(route) {

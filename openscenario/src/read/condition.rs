@@ -4,7 +4,7 @@ use roxmltree::Node;
 
 use super::{position, Reader};
 use crate::error::XoscError;
-use crate::model::{Condition, ConditionKind, Edge, EntityTest, Rule, Trigger};
+use crate::model::{Condition, ConditionKind, Edge, EntityTest, Gap, Rule, Trigger};
 use crate::xml::{choice, elements, need};
 
 /// A `StartTrigger` or `StopTrigger`: its condition groups.
@@ -64,7 +64,7 @@ fn condition(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Condition, XoscError> {
         by_entity(r, by)?
     };
     Ok(Condition {
-        name: r.scope.opt_string(r.text, c, "name")?.unwrap_or_default(),
+        name: r.scope.string(r.text, c, "name")?,
         delay_s,
         edge,
         kind,
@@ -107,11 +107,45 @@ fn by_value(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError
             rule: rule(r, v)?,
             value: r.scope.num(r.text, v, "value")?,
         },
-        "StoryboardElementStateCondition" => ConditionKind::ElementState {
-            element_type: r.scope.string(r.text, v, "storyboardElementType")?,
-            element: r.scope.string(r.text, v, "storyboardElementRef")?,
-            state: r.scope.string(r.text, v, "state")?,
-        },
+        "StoryboardElementStateCondition" => {
+            let one_of = |attr: &str, allowed: &[&str]| -> Result<String, XoscError> {
+                let v_ = r.scope.string(r.text, v, attr)?;
+                if allowed.contains(&v_.as_str()) {
+                    Ok(v_)
+                } else {
+                    Err(XoscError::Invalid {
+                        pos: r.text.attr_pos(v, attr),
+                        reason: format!("{attr} is one of {}, not {v_:?}", allowed.join(", ")),
+                    })
+                }
+            };
+            ConditionKind::ElementState {
+                element_type: one_of(
+                    "storyboardElementType",
+                    &[
+                        "story",
+                        "act",
+                        "maneuverGroup",
+                        "maneuver",
+                        "event",
+                        "action",
+                    ],
+                )?,
+                element: r.scope.string(r.text, v, "storyboardElementRef")?,
+                state: one_of(
+                    "state",
+                    &[
+                        "startTransition",
+                        "endTransition",
+                        "stopTransition",
+                        "skipTransition",
+                        "completeState",
+                        "runningState",
+                        "standbyState",
+                    ],
+                )?,
+            }
+        }
         _ => {
             let name = r.scope.string(r.text, v, "parameterRef")?;
             let name = name.trim_start_matches('$').to_string();
@@ -185,55 +219,105 @@ fn by_entity(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscErro
     })
 }
 
+/// Where a distance is measured (`coordinateSystem`, 1.1+; 1.0's `alongRoute="true"` is
+/// `road`) and what distance (`relativeDistanceType`; 1.0's `cartesianDistance` is
+/// `euclidianDistance`), with the standard's defaults (`entity`, `euclidianDistance`).
+fn measure(r: &Reader<'_>, c: Node<'_, '_>) -> Result<(String, String), XoscError> {
+    let (s, t) = (&r.scope, r.text);
+    let one_of = |attr: &str, v: String, allowed: &[&str]| -> Result<String, XoscError> {
+        if allowed.contains(&v.as_str()) {
+            Ok(v)
+        } else {
+            Err(XoscError::Invalid {
+                pos: t.attr_pos(c, attr),
+                reason: format!("{attr} is one of {}, not {v:?}", allowed.join(", ")),
+            })
+        }
+    };
+    let frame = match (
+        s.opt_string(t, c, "coordinateSystem")?,
+        s.opt_bool(t, c, "alongRoute")?,
+    ) {
+        (Some(f), _) => one_of(
+            "coordinateSystem",
+            f,
+            &["entity", "lane", "road", "trajectory"],
+        )?,
+        (None, Some(true)) => "road".to_string(),
+        (None, _) => "entity".to_string(),
+    };
+    let kind = match s.opt_string(t, c, "relativeDistanceType")? {
+        Some(k) if k == "cartesianDistance" => "euclidianDistance".to_string(),
+        Some(k) => one_of(
+            "relativeDistanceType",
+            k,
+            &["longitudinal", "lateral", "euclidianDistance"],
+        )?,
+        None => "euclidianDistance".to_string(),
+    };
+    if let Some(a) = s.opt_string(t, c, "routingAlgorithm")? {
+        if a != "undefined" {
+            return Err(XoscError::Unsupported {
+                pos: t.attr_pos(c, "routingAlgorithm"),
+                reason: format!("routingAlgorithm {a:?} is not supported: paracosm measures along the road the entity is on"),
+            });
+        }
+    }
+    Ok((frame, kind))
+}
+
+/// Refuses 1.2's `direction` on speed and acceleration conditions: paracosm compares the
+/// whole speed or acceleration.
+fn no_direction(r: &Reader<'_>, c: Node<'_, '_>) -> Result<(), XoscError> {
+    match c.attribute("direction") {
+        None => Ok(()),
+        Some(_) => Err(XoscError::Unsupported {
+            pos: r.text.attr_pos(c, "direction"),
+            reason: "a speed or acceleration condition's direction is not supported: paracosm compares the whole speed or acceleration".into(),
+        }),
+    }
+}
+
+/// The [`Gap`] of condition `c`, whose other entity `target` names.
+fn gap(r: &Reader<'_>, c: Node<'_, '_>, target: Node<'_, '_>) -> Result<Gap, XoscError> {
+    let (frame, kind) = measure(r, c)?;
+    Ok(Gap {
+        entity: r.entity(target, "entityRef")?,
+        rule: rule(r, c)?,
+        value: r.scope.num(r.text, c, "value")?,
+        freespace: r.scope.bool(r.text, c, "freespace")?,
+        frame,
+        kind,
+    })
+}
+
 fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest, XoscError> {
     let (s, t) = (&r.scope, r.text);
-    let freespace = || s.opt_bool(t, c, "freespace").map(|f| f.unwrap_or(false));
+    if matches!(
+        tag,
+        "SpeedCondition" | "RelativeSpeedCondition" | "AccelerationCondition"
+    ) {
+        no_direction(r, c)?;
+    }
     Ok(match tag {
-        "TimeHeadwayCondition" => EntityTest::TimeHeadway {
-            entity: r.entity(c, "entityRef")?,
-            rule: rule(r, c)?,
-            value: s.num(t, c, "value")?,
-            freespace: freespace()?,
-        },
+        "TimeHeadwayCondition" => EntityTest::TimeHeadway(gap(r, c, c)?),
         "TimeToCollisionCondition" => {
             let (target, _) = choice(
                 t,
                 need(t, c, "TimeToCollisionConditionTarget")?,
                 &["EntityRef"],
             )?;
-            EntityTest::TimeToCollision {
-                entity: r.entity(target, "entityRef")?,
-                rule: rule(r, c)?,
-                value: s.num(t, c, "value")?,
-                freespace: freespace()?,
-            }
+            EntityTest::TimeToCollision(gap(r, c, target)?)
         }
-        "RelativeDistanceCondition" => EntityTest::RelativeDistance {
-            entity: r.entity(c, "entityRef")?,
-            rule: rule(r, c)?,
-            value: s.num(t, c, "value")?,
-            freespace: freespace()?,
-            kind: {
-                let kind = s.string(t, c, "relativeDistanceType")?;
-                // 1.0 names the euclidean distance cartesianDistance.
-                if ![
-                    "longitudinal",
-                    "lateral",
-                    "euclidianDistance",
-                    "cartesianDistance",
-                ]
-                .contains(&kind.as_str())
-                {
-                    return Err(XoscError::Invalid {
-                        pos: t.attr_pos(c, "relativeDistanceType"),
-                        reason: format!(
-                            "relativeDistanceType is longitudinal, lateral, euclidianDistance or cartesianDistance, not {kind:?}"
-                        ),
-                    });
-                }
-                kind
-            },
-        },
+        "RelativeDistanceCondition" => {
+            if c.attribute("relativeDistanceType").is_none() {
+                return Err(t.invalid(
+                    c,
+                    "a relative distance condition needs relativeDistanceType",
+                ));
+            }
+            EntityTest::RelativeDistance(gap(r, c, c)?)
+        }
         "ReachPositionCondition" => EntityTest::ReachPosition {
             position: position::read(r, need(t, c, "Position")?)?,
             tolerance: s.num(t, c, "tolerance")?,
@@ -255,12 +339,8 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
         "TraveledDistanceCondition" => EntityTest::TraveledDistance(s.num(t, c, "value")?),
         "EndOfRoadCondition" => EntityTest::EndOfRoad(s.num(t, c, "duration")?),
         _ => {
-            let (target, tag) = choice(t, c, &["EntityRef", "ByType"])?;
-            if tag == "ByType" {
-                EntityTest::Collision(None)
-            } else {
-                EntityTest::Collision(Some(r.entity(target, "entityRef")?))
-            }
+            let (target, _) = choice(t, c, &["EntityRef"])?;
+            EntityTest::Collision(Some(r.entity(target, "entityRef")?))
         }
     })
 }

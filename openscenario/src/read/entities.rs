@@ -7,7 +7,7 @@ use crate::error::XoscError;
 use crate::model::{Entity, EntityKind, Located};
 use crate::params::Scope;
 use crate::text::Text;
-use crate::xml::{child, choice, elements, need};
+use crate::xml::{child, choice, elements, need, only};
 
 /// `RoadNetwork`: the `LogicFile` path, resolved against the scenario's folder.
 pub(super) fn road_network(
@@ -59,11 +59,30 @@ pub(super) fn read(
                 .text
                 .invalid(obj, format!("a second entity is named {name:?}")));
         }
-        let (body, tag) = choice(
-            r.text,
-            obj,
-            &["CatalogReference", "Vehicle", "Pedestrian", "MiscObject"],
-        )?;
+        const BODIES: [&str; 4] = ["CatalogReference", "Vehicle", "Pedestrian", "MiscObject"];
+        only(r.text, obj, &[&BODIES[..], &["ObjectController"]].concat())?;
+        let bodies: Vec<Node<'_, '_>> = elements(obj)
+            .filter(|c| BODIES.contains(&c.tag_name().name()))
+            .collect();
+        let [body] = bodies[..] else {
+            return Err(r.text.invalid(
+                obj,
+                format!(
+                    "a scenario object holds one of {}",
+                    crate::xml::list(&BODIES)
+                ),
+            ));
+        };
+        let tag = body.tag_name().name();
+        let controllers: Vec<Node<'_, '_>> = elements(obj)
+            .filter(|c| c.has_tag_name("ObjectController"))
+            .collect();
+        if controllers.len() > 1 {
+            return Err(r.text.unsupported(
+                controllers[1],
+                "more than one <ObjectController> per entity is not supported",
+            ));
+        }
         let (kind, dimensions_m, centre_m, notes) = if tag == "CatalogReference" {
             catalogs.with_entry(r, body, &["Vehicle", "Pedestrian", "MiscObject"], object)?
         } else {

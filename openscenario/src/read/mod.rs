@@ -106,22 +106,25 @@ pub fn read_scenario_text(
     overrides: &[(String, String)],
 ) -> Result<Scenario, XoscError> {
     let doc = text.parse()?;
-    let root = doc.root_element();
-    if root.tag_name().name() != "OpenSCENARIO" {
-        return Err(text.invalid(
-            root,
-            format!(
-                "the root element is <{}>, not <OpenSCENARIO>",
-                root.tag_name().name()
-            ),
-        ));
-    }
+    let root = text.open_root(&doc)?;
     if child(root, "ParameterValueDistribution").is_some() {
         return Err(text.invalid(
             root,
             "this is a parameter value distribution, not a scenario: read it as a variation file",
         ));
     }
+    crate::xml::only(
+        text,
+        root,
+        &[
+            "FileHeader",
+            "ParameterDeclarations",
+            "CatalogLocations",
+            "RoadNetwork",
+            "Entities",
+            "Storyboard",
+        ],
+    )?;
     let version = read_version(text, root)?;
     let storyboard = need(text, root, "Storyboard")?;
     let decls = read_declarations(text, child(root, "ParameterDeclarations"))?;

@@ -50,16 +50,35 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscE
                 h: s.opt_num(t, p, "h")?,
             }
         }
-        "RelativeWorldPosition" => Position::RelativeWorld {
-            entity: r.entity(p, "entityRef")?,
-            dx: s.num(t, p, "dx")?,
-            dy: s.num(t, p, "dy")?,
-        },
-        "RelativeObjectPosition" => Position::RelativeObject {
-            entity: r.entity(p, "entityRef")?,
-            dx: s.num(t, p, "dx")?,
-            dy: s.num(t, p, "dy")?,
-        },
+        "RelativeWorldPosition" | "RelativeObjectPosition" => {
+            if s.opt_num(t, p, "dz")?.is_some_and(|v| v != 0.0) {
+                r.note(
+                    p,
+                    "a relative position's dz is not honoured: paracosm's roads are flat",
+                );
+            }
+            let (entity, dx, dy) = (
+                r.entity(p, "entityRef")?,
+                s.num(t, p, "dx")?,
+                s.num(t, p, "dy")?,
+            );
+            let orientation = orientation(r, p)?;
+            if tag == "RelativeWorldPosition" {
+                Position::RelativeWorld {
+                    entity,
+                    dx,
+                    dy,
+                    orientation,
+                }
+            } else {
+                Position::RelativeObject {
+                    entity,
+                    dx,
+                    dy,
+                    orientation,
+                }
+            }
+        }
         "RoadPosition" => Position::Road {
             road: s.string(t, p, "roadId")?,
             s: s.num(t, p, "s")?,
@@ -81,7 +100,7 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscE
                 ));
             }
             let ds = s.opt_num(t, p, "ds")?;
-            if ds.is_none() {
+            if ds.is_none() || p.attribute("dsLane").is_some() {
                 return Err(r.text.unsupported(
                     p,
                     "a relative lane position needs ds (dsLane is not supported)",
@@ -97,15 +116,15 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscE
     })
 }
 
-/// A position's `<Orientation>`, if any (`type` defaults to relative, the standard's
-/// default for road and lane positions).
+/// A position's `<Orientation>`, if any (a missing `type` is absolute, as the standard's
+/// schema says).
 fn orientation(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Option<Orientation>, XoscError> {
     let Some(o) = child(p, "Orientation") else {
         return Ok(None);
     };
     let relative = match r.scope.opt_string(r.text, o, "type")?.as_deref() {
-        None | Some("relative") => true,
-        Some("absolute") => false,
+        Some("relative") => true,
+        None | Some("absolute") => false,
         Some(other) => {
             return Err(XoscError::Invalid {
                 pos: r.text.attr_pos(o, "type"),

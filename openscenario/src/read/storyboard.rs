@@ -8,12 +8,13 @@ use crate::error::XoscError;
 use crate::model::{
     Act, ConditionKind, Event, Maneuver, ManeuverGroup, NamedAction, Priority, Story, Trigger,
 };
-use crate::xml::{child, elements, need};
+use crate::xml::{child, elements, need, only};
 
 type Storyboard = (Vec<(usize, NamedAction)>, Vec<Story>, Option<Trigger>);
 
 /// The `Storyboard` element: `Init`'s private actions, the stories and the stop trigger.
 pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Storyboard, XoscError> {
+    only(r.text, node, &["Init", "Story", "StopTrigger"])?;
     let mut init = Vec::new();
     let actions = need(r.text, need(r.text, node, "Init")?, "Actions")?;
     for a in elements(actions) {
@@ -27,6 +28,7 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Storyboard, Xos
             ));
         }
         let entity = r.entity(a, "entityRef")?;
+        only(r.text, a, &["PrivateAction"])?;
         for p in elements(a) {
             init.push((
                 entity,
@@ -82,6 +84,7 @@ fn count(r: &Reader<'_>, node: Node<'_, '_>) -> Result<u32, XoscError> {
 }
 
 fn act(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Act, XoscError> {
+    only(r.text, a, &["ManeuverGroup", "StartTrigger", "StopTrigger"])?;
     let mut groups = Vec::new();
     for g in elements(a).filter(|g| g.tag_name().name() == "ManeuverGroup") {
         let actors_node = need(r.text, g, "Actors")?;
@@ -91,6 +94,16 @@ fn act(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Act, XoscError> {
                 return Err(r.text.unsupported(e, "actors are <EntityRef> elements"));
             }
             actors.push(r.entity(e, "entityRef")?);
+        }
+        if actors.is_empty()
+            && !r
+                .scope
+                .bool(r.text, actors_node, "selectTriggeringEntities")?
+        {
+            r.note(
+                actors_node,
+                "this maneuver group names no actor (and selectTriggeringEntities is false): its private actions act on nobody",
+            );
         }
         let mut maneuvers = Vec::new();
         for m in elements(g) {
@@ -115,10 +128,17 @@ fn act(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Act, XoscError> {
             maneuvers,
         });
     }
-    // Required by the 1.0 schema, optional since: an act without one starts at once.
+    // The schema requires one; esmini starts an act without one at once, and so does
+    // paracosm, with a note.
     let start = match child(a, "StartTrigger") {
         Some(t) => Some(condition::trigger(r, t)?),
-        None => None,
+        None => {
+            r.note(
+                a,
+                "this act has no <StartTrigger>, which the standard requires: it starts at once",
+            );
+            None
+        }
     };
     let stop = match child(a, "StopTrigger") {
         Some(t) => Some(condition::trigger(r, t)?),
@@ -134,8 +154,10 @@ fn act(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Act, XoscError> {
 
 fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
     let r = &r.scoped(m)?;
+    only(r.text, m, &["ParameterDeclarations", "Event"])?;
     let mut events = Vec::new();
     for e in elements(m).filter(|e| e.tag_name().name() == "Event") {
+        only(r.text, e, &["Action", "StartTrigger"])?;
         let priority = match r.scope.string(r.text, e, "priority")?.as_str() {
             "override" | "overwrite" => Priority::Override,
             "skip" => Priority::Skip,
@@ -166,6 +188,9 @@ fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
                 action: action::private(r, p)?,
             });
         }
+        if actions.is_empty() {
+            return Err(r.text.invalid(e, "an event needs at least one <Action>"));
+        }
         let max_count = match e.attribute("maximumExecutionCount") {
             Some(_) => count(r, e)?,
             None => 1,
@@ -187,20 +212,21 @@ fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
     })
 }
 
-/// Every `StoryboardElementStateCondition` names an element of the storyboard.
+/// Every `StoryboardElementStateCondition` names an element of the storyboard of the type it
+/// says.
 fn check_references(stories: &[Story], stop: Option<&Trigger>) -> Result<(), XoscError> {
-    let mut names: Vec<&str> = Vec::new();
+    let mut names: Vec<(&str, &str)> = Vec::new();
     for s in stories {
-        names.push(&s.name);
+        names.push(("story", &s.name));
         for a in &s.acts {
-            names.push(&a.name);
+            names.push(("act", &a.name));
             for g in &a.groups {
-                names.push(&g.name);
+                names.push(("maneuverGroup", &g.name));
                 for m in &g.maneuvers {
-                    names.push(&m.name);
+                    names.push(("maneuver", &m.name));
                     for e in &m.events {
-                        names.push(&e.name);
-                        names.extend(e.actions.iter().map(|a| a.name.as_str()));
+                        names.push(("event", &e.name));
+                        names.extend(e.actions.iter().map(|a| ("action", a.name.as_str())));
                     }
                 }
             }
@@ -220,13 +246,21 @@ fn check_references(stories: &[Story], stop: Option<&Trigger>) -> Result<(), Xos
     }
     for t in triggers {
         for c in t.0.iter().flatten() {
-            if let ConditionKind::ElementState { element, .. } = &c.kind {
+            if let ConditionKind::ElementState {
+                element_type,
+                element,
+                ..
+            } = &c.kind
+            {
                 // 1.1+ may qualify a name with its parents (`Event::Action`).
                 let last = element.rsplit("::").next().unwrap_or(element);
-                if !names.contains(&element.as_str()) && !names.contains(&last) {
-                    return Err(crate::error::XoscError::Invalid {
+                let found = names
+                    .iter()
+                    .any(|&(t, n)| t == element_type && (n == element || n == last));
+                if !found {
+                    return Err(XoscError::Invalid {
                         pos: c.pos.clone(),
-                        reason: format!("no storyboard element is named {element:?}"),
+                        reason: format!("no {element_type} of the storyboard is named {element:?}"),
                     });
                 }
             }
