@@ -184,3 +184,59 @@ fn a_scenario_in_the_older_forms_reads() {
         assert!(out.contains(want), "`{want}` not in\n{out}");
     }
 }
+
+/// A variation file with a `ValueSetDistribution` (parameters assigned together) beside a
+/// single-parameter one: the sets become one discrete parameter and the grid multiplies.
+#[test]
+fn value_sets_become_one_parameter_of_their_sets() {
+    let dir = tempfile::tempdir().unwrap();
+    let alks = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xosc/alks");
+    let template =
+        alks.join("concrete_scenarios/alks_scenario_4_2_3_crossing_pedestrian_template.xosc");
+    let variation = dir.path().join("sets.xosc");
+    std::fs::write(
+        &variation,
+        format!(
+            r#"<?xml version="1.0" encoding="utf-8"?>
+<OpenSCENARIO>
+  <FileHeader revMajor="1" revMinor="2" date="2026-11-26T00:00:00" description="sets" author="paracosm"/>
+  <ParameterValueDistribution>
+    <ScenarioFile filepath="{}"/>
+    <Deterministic>
+      <DeterministicSingleParameterDistribution parameterName="Ego_InitSpeed_Ve0_kph">
+        <DistributionSet><Element value="30"/><Element value="50"/></DistributionSet>
+      </DeterministicSingleParameterDistribution>
+      <DeterministicMultiParameterDistribution>
+        <ValueSetDistribution>
+          <ParameterValueSet>
+            <ParameterAssignment parameterRef="TargetBlocking_Speed_kph" value="4"/>
+            <ParameterAssignment parameterRef="TargetBlocking_InitPosition_LateralOffset_m" value="-6"/>
+          </ParameterValueSet>
+          <ParameterValueSet>
+            <ParameterAssignment parameterRef="TargetBlocking_Speed_kph" value="9"/>
+            <ParameterAssignment parameterRef="TargetBlocking_InitPosition_LateralOffset_m" value="-3"/>
+          </ParameterValueSet>
+          <ParameterValueSet>
+            <ParameterAssignment parameterRef="TargetBlocking_Speed_kph" value="12"/>
+            <ParameterAssignment parameterRef="TargetBlocking_InitPosition_LateralOffset_m" value="-2"/>
+          </ParameterValueSet>
+        </ValueSetDistribution>
+      </DeterministicMultiParameterDistribution>
+    </Deterministic>
+  </ParameterValueDistribution>
+</OpenSCENARIO>
+"#,
+            template.display()
+        ),
+    )
+    .unwrap();
+    let (code, out, err) = xosc(&[variation.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    for want in [
+        "Ego_InitSpeed_Ve0_kph = 60   -> 2 levels {30, 50}",
+        "value_set_0 (a ValueSetDistribution)   -> 3 levels {TargetBlocking_Speed_kph=4, TargetBlocking_InitPosition_LateralOffset_m=-6, TargetBlocking_Speed_kph=9, TargetBlocking_InitPosition_LateralOffset_m=-3, TargetBlocking_Speed_kph=12, TargetBlocking_InitPosition_LateralOffset_m=-2}",
+        "the file's own grid: 6 runs",
+    ] {
+        assert!(out.contains(want), "`{want}` not in\n{out}");
+    }
+}

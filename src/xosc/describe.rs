@@ -34,6 +34,18 @@ impl Inspection {
                 open.map_or(String::new(), |p| format!("   -> {}", domain(&p.domain)))
             );
         }
+        for p in self
+            .space
+            .iter()
+            .filter(|p| p.name.starts_with("value_set_"))
+        {
+            let _ = writeln!(
+                out,
+                "  {} (a ValueSetDistribution)   -> {}",
+                p.name,
+                domain(&p.domain)
+            );
+        }
         match self.grid_runs {
             Some(n) => {
                 let _ = writeln!(out, "the file's own grid: {n} runs");

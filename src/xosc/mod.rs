@@ -16,7 +16,7 @@ use paracosm_openscenario::{read_scenario, Text, XoscError};
 
 use crate::Error;
 
-pub use space::{open_param, varied_param};
+pub use space::{open_param, value_sets_param, varied_param};
 
 /// A logical scenario read for listing ([`inspect`]).
 #[derive(Debug, Clone)]
@@ -102,6 +102,11 @@ pub fn inspect(path: &Path, opens: &[String], continuous: bool) -> Result<Inspec
             let (param, levels, limit) = varied_param(p, continuous);
             grid_runs = grid_runs.and_then(|g| levels.and_then(|n| g.checked_mul(n)));
             limits.extend(limit);
+            space.push(param);
+        }
+        for (k, sets) in v.multi.iter().enumerate() {
+            let (param, runs) = value_sets_param(path, k, sets, &scenario)?;
+            grid_runs = grid_runs.and_then(|g| g.checked_mul(runs));
             space.push(param);
         }
     } else {

@@ -1,7 +1,7 @@
 //! Varied and opened OpenSCENARIO parameters as parameters of paracosm's space.
 
 use paracosm_generators::{Param, Value};
-use paracosm_openscenario::distribution::{Dist, Varied};
+use paracosm_openscenario::distribution::{Dist, ValueSets, Varied};
 use paracosm_openscenario::model::Scenario;
 use paracosm_openscenario::params::ValueError;
 
@@ -137,4 +137,40 @@ fn open_levels(text: &str, scenario: &Scenario, space: &[Param]) -> Result<Param
         check(v)?;
     }
     Ok(Param::levels(name, levels_of(&texts)))
+}
+
+/// The parameter for the `k`-th `ValueSetDistribution` of a variation file: one level per
+/// value set, named `value_set_K` and written `Name=value, Name=value` (the assignments the
+/// set makes together), with the number of sets the file's grid has for it.
+///
+/// # Errors
+/// [`Error::Input`] naming the variation file's position when a set assigns a parameter the
+/// scenario does not declare.
+pub fn value_sets_param(
+    file: &std::path::Path,
+    k: usize,
+    sets: &ValueSets,
+    scenario: &Scenario,
+) -> Result<(Param, u64), Error> {
+    let mut levels = Vec::new();
+    for set in &sets.sets {
+        for a in set {
+            if !scenario.params.iter().any(|(d, _)| d.name == a.name) {
+                return Err(Error::Input {
+                    path: file.to_path_buf(),
+                    message: format!(
+                        "{}: parameter {:?} is assigned but the scenario does not declare it",
+                        a.pos, a.name
+                    ),
+                });
+            }
+        }
+        let text: Vec<String> = set
+            .iter()
+            .map(|a| format!("{}={}", a.name, a.value))
+            .collect();
+        levels.push(Value::Text(text.join(", ")));
+    }
+    let n = levels.len() as u64;
+    Ok((Param::levels(&format!("value_set_{k}"), levels), n))
 }
