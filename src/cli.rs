@@ -25,12 +25,14 @@ fn strategy_parser_of(
     keep: fn(Strategy) -> bool,
 ) -> impl clap::builder::TypedValueParser<Value = Strategy> {
     use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-    PossibleValuesParser::new(
-        Strategy::LIST
-            .into_iter()
-            .filter(|&s| keep(s))
-            .map(|s| PossibleValue::new(s.name()).help(s.help())),
-    )
+    PossibleValuesParser::new(Strategy::LIST.into_iter().filter(|&s| keep(s)).map(|s| {
+        let v = PossibleValue::new(s.name()).help(s.help());
+        if s == Strategy::FullFactorial {
+            v.alias("variation")
+        } else {
+            v
+        }
+    }))
     .map(|name| name.parse::<Strategy>().expect("a name of Strategy::LIST"))
 }
 

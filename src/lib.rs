@@ -22,3 +22,16 @@ pub mod xosc;
 pub use campaign::{Campaign, CampaignReport, Observer, OnRecord, ResultsFile};
 pub use error::Error;
 pub use record::{RunRecord, Status};
+
+/// The scenario a campaign names: a built-in scenario, a `.star` program, or an OpenSCENARIO
+/// file with its options ([`xosc::campaign_name`]).
+///
+/// # Errors
+/// What [`paracosm_scenarios::load`] or [`xosc::campaign_scenario`] returns.
+pub fn load_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Error> {
+    if xosc::is_xosc(name) {
+        xosc::campaign_scenario(name)
+    } else {
+        Ok(paracosm_scenarios::load(name)?)
+    }
+}

@@ -240,3 +240,213 @@ fn value_sets_become_one_parameter_of_their_sets() {
         assert!(out.contains(want), "`{want}` not in\n{out}");
     }
 }
+
+/// The crossing pedestrian on the straight road, the ego at 36 km/h in lane -4, the
+/// pedestrian 100 m ahead (its longitudinal offset opened): with `aeb` the ego stops short
+/// of it; with an `aeb` that never brakes (`ttc_brake_s` 0), the pedestrian the storyboard
+/// sends across meets the ego's front, as the template's trigger intends.
+#[test]
+fn the_crossing_pedestrian_runs_on_the_storyboard_and_meets_an_ego_that_does_not_brake() {
+    use paracosm_engine::sut::{AebConfig, SutConfig};
+    use paracosm_generators::{Point, Value};
+    let name = paracosm::xosc::campaign_name(
+        &format!("{}/{CROSSING}", env!("CARGO_MANIFEST_DIR")),
+        &["TargetBlocking_InitPosition_LongitudinalOffset_m=80..120".to_owned()],
+        false,
+    );
+    let mut scenario = paracosm::load_scenario(&name).expect("the campaign's scenario builds");
+    let names: Vec<&str> = scenario
+        .space
+        .params()
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "Road",
+            "Ego_InitSpeed_Ve0_kph",
+            "Ego_InitPosition_LaneId",
+            "TargetBlocking_InitPosition_LongitudinalOffset_m"
+        ]
+    );
+    let point = Point {
+        discrete: vec![0, 6, 1],
+        continuous: vec![0.5],
+    };
+    let a = scenario.space.decode(&point).expect("decodes");
+    assert_eq!(a.get("Ego_InitSpeed_Ve0_kph"), Some(&Value::Int(35)));
+    assert_eq!(a.get("Ego_InitPosition_LaneId"), Some(&Value::Int(-4)));
+    let braking = scenario.run(&a, 1).expect("the test runs");
+    assert!(braking.passed(), "{:?}", braking.monitors);
+    let metric = |o: &paracosm_scenarios::TestOutcome, k: &str| {
+        o.metrics.iter().find(|(n, _)| *n == k).map(|(_, v)| *v)
+    };
+    let gap = metric(&braking, "min_distance_m").expect("min distance");
+    assert!(
+        gap > 0.5 && gap < 5.0,
+        "it stops short of the pedestrian: {gap} m"
+    );
+    // The storyboard's stop trigger: 100 m at 35 km/h, plus 10 s.
+    let end = metric(&braking, "simulated_s").expect("simulated");
+    assert!(
+        (end - (100.0 / (35.0 / 3.6) + 10.0)).abs() < 0.05,
+        "ended at {end} s"
+    );
+    let mut blind = AebConfig::default();
+    blind.cruise.ttc_brake_s = 0.0;
+    scenario.sut = SutConfig::Aeb(blind);
+    let hit = scenario.run(&a, 1).expect("the test runs");
+    let collision = hit
+        .monitors
+        .iter()
+        .find(|(n, _)| n == "collision")
+        .expect("a collision monitor");
+    assert!(
+        !collision.1.passed,
+        "the pedestrian meets the ego: {:?}",
+        hit.monitors
+    );
+}
+
+/// A scenario written here (not shipped, not ALKS): a lead car placed 30 m ahead of the ego
+/// by a `LongitudinalDistanceAction`, braking at an opened rate after 3 s, on the ALKS
+/// straight road. Its campaign runs every test to the storyboard's stop trigger (15 s); the
+/// same file with a continuous distance action is refused at load with its line and column.
+#[test]
+fn a_scenario_written_here_runs_as_a_campaign_and_a_continuous_distance_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let road = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/xosc/alks/concrete_scenarios/road_networks/alks_road_straight.xodr");
+    let scenario = |continuous: &str| {
+        format!(
+            r#"<?xml version="1.0" encoding="UTF-8"?>
+<OpenSCENARIO>
+  <FileHeader revMajor="1" revMinor="2" date="2026-11-26T00:00:00" description="brake" author="paracosm"/>
+  <ParameterDeclarations>
+    <ParameterDeclaration name="LeadBrake" parameterType="double" value="6"/>
+  </ParameterDeclarations>
+  <RoadNetwork><LogicFile filepath="{road}"/></RoadNetwork>
+  <Entities>
+    <ScenarioObject name="Ego">
+      <Vehicle name="v" vehicleCategory="car">
+        <BoundingBox><Center x="1.4" y="0" z="0.8"/><Dimensions width="1.8" length="4.5" height="1.5"/></BoundingBox>
+        <Performance maxSpeed="50" maxAcceleration="5" maxDeceleration="9"/>
+        <Axles>
+          <FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/>
+          <RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/>
+        </Axles>
+        <Properties/>
+      </Vehicle>
+    </ScenarioObject>
+    <ScenarioObject name="Lead">
+      <MiscObject name="box" miscObjectCategory="obstacle" mass="500">
+        <BoundingBox><Center x="0" y="0" z="0.75"/><Dimensions width="1.8" length="4" height="1.5"/></BoundingBox>
+        <Properties/>
+      </MiscObject>
+    </ScenarioObject>
+  </Entities>
+  <Storyboard>
+    <Init>
+      <Actions>
+        <Private entityRef="Ego">
+          <PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction>
+          <PrivateAction><LongitudinalAction><SpeedAction>
+            <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
+            <SpeedActionTarget><AbsoluteTargetSpeed value="12"/></SpeedActionTarget>
+          </SpeedAction></LongitudinalAction></PrivateAction>
+        </Private>
+        <Private entityRef="Lead">
+          <PrivateAction><LongitudinalAction>
+            <LongitudinalDistanceAction entityRef="Ego" distance="30" freespace="true" continuous="{continuous}" displacement="leadingReferencedEntity"/>
+          </LongitudinalAction></PrivateAction>
+          <PrivateAction><LongitudinalAction><SpeedAction>
+            <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
+            <SpeedActionTarget><AbsoluteTargetSpeed value="12"/></SpeedActionTarget>
+          </SpeedAction></LongitudinalAction></PrivateAction>
+        </Private>
+      </Actions>
+    </Init>
+    <Story name="S">
+      <Act name="A">
+        <ManeuverGroup maximumExecutionCount="1" name="G">
+          <Actors selectTriggeringEntities="false"><EntityRef entityRef="Lead"/></Actors>
+          <Maneuver name="M">
+            <Event name="Brake" priority="override">
+              <Action name="BrakeAction">
+                <PrivateAction><LongitudinalAction><SpeedAction>
+                  <SpeedActionDynamics dynamicsShape="linear" value="$LeadBrake" dynamicsDimension="rate"/>
+                  <SpeedActionTarget><AbsoluteTargetSpeed value="0"/></SpeedActionTarget>
+                </SpeedAction></LongitudinalAction></PrivateAction>
+              </Action>
+              <StartTrigger><ConditionGroup>
+                <Condition name="T" delay="0" conditionEdge="rising">
+                  <ByValueCondition><SimulationTimeCondition value="3" rule="greaterThan"/></ByValueCondition>
+                </Condition>
+              </ConditionGroup></StartTrigger>
+            </Event>
+          </Maneuver>
+        </ManeuverGroup>
+        <StartTrigger><ConditionGroup>
+          <Condition name="Go" delay="0" conditionEdge="none">
+            <ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition>
+          </Condition>
+        </ConditionGroup></StartTrigger>
+      </Act>
+    </Story>
+    <StopTrigger><ConditionGroup>
+      <Condition name="End" delay="0" conditionEdge="rising">
+        <ByValueCondition><SimulationTimeCondition value="15" rule="greaterOrEqual"/></ByValueCondition>
+      </Condition>
+    </ConditionGroup></StopTrigger>
+  </Storyboard>
+</OpenSCENARIO>
+"#,
+            road = road.display()
+        )
+    };
+    let file = dir.path().join("brake.xosc");
+    std::fs::write(&file, scenario("false")).unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args(["--open", "LeadBrake=2..9", "--budget", "4", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    let results = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+    let records: Vec<serde_json::Value> = results
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(records.len(), 4);
+    for r in &records {
+        assert_ne!(r["status"], "error", "{r}");
+        assert!(r["monitors"]["collision"].is_object(), "{r}");
+        let end = r["metrics"]["simulated_s"].as_f64().unwrap();
+        assert!(
+            (end - 15.0).abs() < 0.02,
+            "the stop trigger ends the test: {end} s"
+        );
+        let gap = r["metrics"]["min_distance_m"].as_f64().unwrap();
+        assert!(
+            gap < 30.0,
+            "the ego closes in on the braking lead car: {gap} m"
+        );
+    }
+    std::fs::write(&file, scenario("true")).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args(["--budget", "1", "--force", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("brake.xosc:38:") && err.contains("continuous LongitudinalDistanceAction"),
+        "{err}"
+    );
+}

@@ -87,14 +87,25 @@ pub enum Action {
     /// The car changes to the lane the value names (a lane number of its start segment, or a
     /// `(lane, duration_s)` tuple; 3 s by default).
     ChangeLane(Handle<CarSpec>),
+    /// The car is put at the value, `(Vec3 [x, y, z] m, heading rad)`, for this step, off its
+    /// path: a scripted car (an OpenSCENARIO storyboard's) whose motion its script computes.
+    /// Its reported velocity is the move it makes over the step. It stops for nothing, but
+    /// what it touches at the new pose is recorded as a collision of both.
+    PlaceCar(Handle<CarSpec>),
+    /// The pedestrian is put at the value, `(Vec3 [x, y, z] m of its feet, heading rad)`, for
+    /// this step, as [`Action::PlaceCar`].
+    PlacePedestrian(Handle<PedestrianSpec>),
 }
 
 impl Action {
     /// The actor it acts on.
     pub fn actor(self) -> ActorRef {
         match self {
-            Action::Walk(p) => ActorRef::Pedestrian(p),
-            Action::SetSpeed(c) | Action::Brake(c) | Action::ChangeLane(c) => ActorRef::Car(c),
+            Action::Walk(p) | Action::PlacePedestrian(p) => ActorRef::Pedestrian(p),
+            Action::SetSpeed(c)
+            | Action::Brake(c)
+            | Action::ChangeLane(c)
+            | Action::PlaceCar(c) => ActorRef::Car(c),
         }
     }
 }

@@ -171,6 +171,9 @@ pub(crate) struct Car {
     /// The speed an action set (`setSpeed`, `brake`), m/s: it then drives at this instead of
     /// its speed stream's value.
     pub(crate) speed_override: Option<f64>,
+    /// The pose a place action gave it for this step (`[x, z]` m, heading rad): it goes
+    /// there instead of along its path ([`Car::place`]).
+    pub(crate) script: Option<([f64; 2], f64)>,
 }
 
 impl Car {
@@ -219,6 +222,7 @@ impl Car {
             change_started_s: None,
             change_from_m: 0.0,
             speed_override: None,
+            script: None,
         };
         car.here = car.at(0.0);
         car.placed = car.here;
@@ -564,6 +568,46 @@ impl Car {
             rolling
         });
         self.here = self.place_at(self.s, next_t);
+        self.moved_from(physics, start, dt_s, zone);
+        hit.map(|(_, o)| o)
+    }
+
+    /// Puts the car at `pose` (`[x, z]` m, heading rad) for this step, off its path (a
+    /// scripted car): its velocity is the move over the step. It stops for nothing; returns
+    /// the first object of `solids` its box touches there, which it records as collided.
+    pub(crate) fn place(
+        &mut self,
+        physics: &mut PhysicsWorld,
+        pose: ([f64; 2], f64),
+        dt_s: f64,
+        zone: AwakeZone,
+        solids: &Solids,
+        me: ActorRef,
+    ) -> Option<ActorRef> {
+        let start = self.here;
+        self.here = pose;
+        self.rolling = Some(0.0);
+        self.moved_from(physics, start, dt_s, zone);
+        self.body?;
+        let [x, z] = pose.0;
+        let centre = [x, CLEARANCE_M + self.size.height_m / 2.0, z];
+        if !solids.any_near(me, centre, self.radius_m(), false) {
+            return None;
+        }
+        let hit = solids.first_hit(me, self.shape().as_ref(), &self.pose_at(pose), false);
+        self.collided |= hit.is_some();
+        hit
+    }
+
+    /// Sets the velocity and speed from the move from `start` to where the car is now over
+    /// `dt_s`, and moves its body there (or puts it to sleep outside `zone`).
+    fn moved_from(
+        &mut self,
+        physics: &mut PhysicsWorld,
+        start: ([f64; 2], f64),
+        dt_s: f64,
+        zone: AwakeZone,
+    ) {
         self.velocity = [
             (self.here.0[0] - start.0[0]) / dt_s,
             (self.here.0[1] - start.0[1]) / dt_s,
@@ -580,7 +624,7 @@ impl Car {
                     rb.set_enabled(false);
                     physics.colliders[collider].set_enabled(false);
                 }
-                return hit.map(|(_, o)| o);
+                return;
             }
             if !rb.is_enabled() {
                 rb.set_enabled(true);
@@ -589,7 +633,6 @@ impl Car {
             }
             physics.bodies[body].set_next_kinematic_position(self.pose());
         }
-        hit.map(|(_, o)| o)
     }
 
     /// Its collider's shape: a box of its size.

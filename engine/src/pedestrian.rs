@@ -122,6 +122,18 @@ impl Pedestrian {
         physics.bodies[self.body].set_next_kinematic_translation(centre(self.pos));
     }
 
+    /// Puts the pedestrian at `pose` (`[x, y, z]` m of its feet, heading rad) for this step
+    /// (a scripted pedestrian): its velocity is the move over the step and it faces `pose`'s
+    /// heading. A pedestrian placed does not also walk in the same step.
+    pub(crate) fn place(&mut self, physics: &mut PhysicsWorld, pose: ([f64; 3], f64), dt_s: f64) {
+        self.walked = true;
+        let before = self.step_start;
+        self.pos = pose.0;
+        self.heading_rad = pose.1;
+        self.velocity = [0, 1, 2].map(|i| (self.pos[i] - before[i]) / dt_s);
+        physics.bodies[self.body].set_next_kinematic_translation(centre(self.pos));
+    }
+
     /// Starts a step: until a walk event moves it, it stands still (velocity 0).
     pub(crate) fn rest(&mut self) {
         self.velocity = [0.0; 3];
@@ -129,7 +141,8 @@ impl Pedestrian {
         self.walked = false;
     }
 
-    /// The way it faces, rad: toward its target, all the test long.
+    /// The way it faces, rad: toward its target, all the test long (a placed pedestrian: the
+    /// heading it was placed with).
     pub(crate) fn heading_rad(&self) -> f64 {
         self.heading_rad
     }

@@ -41,6 +41,9 @@ pub struct Observation<'a> {
     pub ego: EgoState,
     /// The route to follow, world `[x, z]` in metres (navigation); empty: keep the lane.
     pub route: &'a [[f64; 2]],
+    /// The speed the scenario asks the system to keep, m/s ([`EgoSpec::set_speed_mps`]);
+    /// `None`: its own.
+    pub set_speed_mps: Option<f64>,
     /// Every sensor's latest reading, by the sensor's name, in the order the sensors were
     /// mounted (what an external system receives, SUT_PROTOCOL.md). Read one with
     /// [`Observation::reading`], or typed: [`Observation::lidar`], [`Observation::camera`].
@@ -347,6 +350,20 @@ fn build_obstacles(
 
 /// The error for `value`, given at time `t_s` (s) to `name` (an action's argument), which
 /// is not `expected`.
+/// The pose a place action's value gives: `(Vec3 [x, y, z] m, heading rad)`, every number
+/// finite; `None` for anything else.
+fn placed_pose(value: &Value) -> Option<([f64; 3], f64)> {
+    match value {
+        Value::Tuple(t) => match t.as_slice() {
+            [Value::Vec3(p), Value::Num(h)] if p.iter().all(|x| x.is_finite()) && h.is_finite() => {
+                Some((*p, *h))
+            }
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
 fn bad_input(t_s: f64, name: String, value: &Value, expected: &str) -> EngineError {
     crate::rx::RxError::Input {
         name,
@@ -365,6 +382,8 @@ pub struct Simulation {
     surface: Surface,
     ego: EgoVehicle,
     route: Vec<[f64; 2]>,
+    /// [`EgoSpec::set_speed_mps`].
+    set_speed_mps: Option<f64>,
     pedestrians: Set<Pedestrian, PedestrianSpec>,
     cars: Set<Car, CarSpec>,
     obstacles: Set<Obstacle, ObstacleSpec>,
@@ -457,6 +476,7 @@ impl Simulation {
             network: spec.network.clone(),
             surface,
             route: spec.ego.route.clone(),
+            set_speed_mps: spec.ego.set_speed_mps,
             ego,
             pedestrians,
             cars,
@@ -530,6 +550,7 @@ impl Simulation {
             dt_s: self.dt_s,
             ego: self.ego_state(),
             route: &self.route,
+            set_speed_mps: self.set_speed_mps,
             readings,
         }
     }
@@ -755,6 +776,17 @@ impl Simulation {
         let Some(car) = self.cars.get_mut(h) else {
             return Ok(None);
         };
+        if let Some(pose) = car.script.take() {
+            let zone = AwakeZone {
+                ego_m,
+                radius_m: reach_m + ego_radius_m + car.radius_m() + SLEEP_MARGIN_M,
+            };
+            let hit = car.place(&mut self.physics, pose, dt, zone, solids, ActorRef::Car(h));
+            if car.body.is_some() {
+                solids.move_to(ActorRef::Car(h), car.pose());
+            }
+            return Ok(hit);
+        }
         let v = match car.speed_override {
             Some(v) => v,
             None => {
@@ -1014,6 +1046,30 @@ impl Simulation {
                     }
                 }
                 Action::ChangeLane(h) => self.change_lane(h, value, t)?,
+                Action::PlaceCar(h) => {
+                    let pose = placed_pose(value).ok_or_else(|| {
+                        bad(
+                            format!("the pose given to {}", self.names.car(h.index())),
+                            value,
+                            "a (Vec3 [x, y, z] m, heading rad) pair of finite numbers",
+                        )
+                    })?;
+                    if let Some(car) = self.cars.get_mut(h) {
+                        car.script = Some(([pose.0[0], pose.0[2]], pose.1));
+                    }
+                }
+                Action::PlacePedestrian(h) => {
+                    let pose = placed_pose(value).ok_or_else(|| {
+                        bad(
+                            format!("the pose given to {}", self.names.pedestrian(h.index())),
+                            value,
+                            "a (Vec3 [x, y, z] m, heading rad) pair of finite numbers",
+                        )
+                    })?;
+                    if let Some(p) = self.pedestrians.get_mut(h) {
+                        p.place(&mut self.physics, pose, dt);
+                    }
+                }
             }
         }
         self.sinks = sinks;

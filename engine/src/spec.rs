@@ -21,6 +21,9 @@ pub struct EgoSpec {
     /// The route the system under test is asked to follow, world `[x, z]` in metres (a
     /// navigation plan from the lane graph); empty: keep the start lane.
     pub route: Vec<[f64; 2]>,
+    /// The speed the scenario asks the system under test to keep, m/s (an OpenSCENARIO
+    /// ego's initial speed: ALKS's set speed); `None`: the system's own cruise speed.
+    pub set_speed_mps: Option<f64>,
 }
 
 /// A pedestrian (paper §2, `Pedestrian`): a kinematic capsule that walks in a straight line
@@ -190,6 +193,7 @@ impl WorldSpec {
                 initial_speed_mps,
                 vehicle: VehicleParams::default(),
                 route: vec![],
+                set_speed_mps: None,
             },
             pedestrians: peds,
             cars: vec![],

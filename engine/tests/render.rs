@@ -534,6 +534,7 @@ fn standing_world(
             initial_speed_mps: 0.0,
             vehicle: paracosm_engine::VehicleParams::default(),
             route: vec![],
+            set_speed_mps: None,
         },
         pedestrians: vec![],
         cars,

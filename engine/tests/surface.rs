@@ -76,6 +76,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
             initial_speed_mps: speed_mps,
             vehicle: VehicleParams::default(),
             route: vec![],
+            set_speed_mps: None,
         },
         pedestrians: vec![],
         cars: specs,

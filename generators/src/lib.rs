@@ -17,6 +17,7 @@
 pub mod coverage;
 pub mod covering;
 mod error;
+mod factorial;
 pub mod falsify;
 mod generator;
 mod given;
@@ -28,6 +29,7 @@ mod space;
 mod strategy;
 
 pub use error::GeneratorError;
+pub use factorial::FullFactorial;
 pub use generator::Generator;
 pub use given::GivenPoints;
 pub use halton::{first_primes, radical_inverse, Halton};

@@ -1,7 +1,9 @@
 use std::str::FromStr;
 
 use crate::falsify::{Falsifier, Method};
-use crate::{Generator, GeneratorError, GivenPoints, Halton, ParamSpace, Sobol, UniformRandom};
+use crate::{
+    FullFactorial, Generator, GeneratorError, GivenPoints, Halton, ParamSpace, Sobol, UniformRandom,
+};
 
 /// The test-generation strategies by name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -30,6 +32,9 @@ pub enum Strategy {
     /// [`GivenPoints`]: points chosen outside paracosm (`paracosm-fuzz --points FILE`, an
     /// array from Python), in their order; built by [`Strategy::build_given`].
     Points,
+    /// [`FullFactorial`]: every combination of the discrete parameters' levels (an
+    /// OpenSCENARIO variation file's own grid); `variation` names it too.
+    FullFactorial,
 }
 
 impl Strategy {
@@ -48,7 +53,7 @@ impl Strategy {
 
     /// Every strategy, in the order the command line lists them: the one list from which
     /// names, help, parsing and error messages are derived.
-    pub const LIST: [Strategy; 11] = [
+    pub const LIST: [Strategy; 12] = [
         Strategy::Random,
         Strategy::Halton,
         Strategy::ScrambledHalton,
@@ -60,6 +65,7 @@ impl Strategy {
         Strategy::FalsifySa,
         Strategy::FalsifyCe,
         Strategy::Points,
+        Strategy::FullFactorial,
     ];
 
     /// Every point generator that needs no budget, in the order the CLI lists them.
@@ -84,6 +90,7 @@ impl Strategy {
             Strategy::FalsifySa => "falsify-sa",
             Strategy::FalsifyCe => "falsify-ce",
             Strategy::Points => "points",
+            Strategy::FullFactorial => "full-factorial",
         }
     }
 
@@ -119,6 +126,11 @@ impl Strategy {
                 "The points of a CSV file, in file order (chosen by --points FILE, which sets \
                  the budget to the file's row count)"
             }
+            Strategy::FullFactorial => {
+                "Every combination of the discrete parameters' levels once (an OpenSCENARIO \
+                 variation file's own grid; `variation` names it too); the budget is at most \
+                 their product"
+            }
         }
     }
 
@@ -151,7 +163,8 @@ impl Strategy {
             | Strategy::FalsifyPso
             | Strategy::FalsifySa
             | Strategy::FalsifyCe
-            | Strategy::Points => None,
+            | Strategy::Points
+            | Strategy::FullFactorial => None,
         }
     }
 
@@ -177,6 +190,7 @@ impl Strategy {
                 return Err(GeneratorError::NeedsBudget(self.name()))
             }
             Strategy::Points => return Err(GeneratorError::NeedsPoints),
+            Strategy::FullFactorial => Box::new(FullFactorial::new(space)?),
             Strategy::FalsifyNm
             | Strategy::FalsifyPso
             | Strategy::FalsifySa
@@ -237,6 +251,9 @@ impl FromStr for Strategy {
     type Err = GeneratorError;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s == "variation" {
+            return Ok(Strategy::FullFactorial);
+        }
         Strategy::LIST
             .into_iter()
             .find(|st| st.name() == s)
@@ -268,14 +285,18 @@ mod tests {
         {
             assert!(Strategy::LIST.contains(&s));
         }
-        // ... and with the given points, the whole list.
+        // ... and with the given points and the full-factorial design, the whole list.
         assert_eq!(
-            Strategy::ALL.len() + Strategy::SUITES.len() + Strategy::FALSIFIERS.len() + 1,
+            Strategy::ALL.len() + Strategy::SUITES.len() + Strategy::FALSIFIERS.len() + 2,
             Strategy::LIST.len()
         );
         assert_eq!(
+            "variation".parse::<Strategy>().unwrap(),
+            Strategy::FullFactorial
+        );
+        assert_eq!(
             "annealing".parse::<Strategy>().unwrap_err().to_string(),
-            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise, falsify-nm, falsify-pso, falsify-sa, falsify-ce, points)"
+            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise, falsify-nm, falsify-pso, falsify-sa, falsify-ce, points, full-factorial)"
         );
     }
 }

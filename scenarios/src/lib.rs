@@ -17,6 +17,7 @@ mod runner;
 mod scenario;
 pub mod scene;
 pub mod text_file;
+pub mod xosc;
 
 use std::path::Path;
 

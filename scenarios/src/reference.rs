@@ -156,6 +156,7 @@ pub fn scene(mut scene: Scene) -> Result<Scene, ScenarioError> {
                 initial_speed_mps: aeb.cruise.target_speed_mps,
                 vehicle: VehicleParams::default(),
                 route: vec![],
+                set_speed_mps: None,
             },
             SutConfig::Aeb(aeb),
         )

@@ -377,6 +377,11 @@ impl Scenario {
             tick += 1;
             sim.evaluate(host)?;
             stopped = watch.observe(&sim, options.on_step.as_mut())?;
+            if host.ended() {
+                // The scenario's own end (a storyboard's stop trigger): the monitors judge
+                // the run as at a horizon.
+                return Ok(outcome(watch, false, sim.t_s(), host.log()));
+            }
         }
 
         Ok(outcome(watch, tick < ticks, sim.t_s(), host.log()))

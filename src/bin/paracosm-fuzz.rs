@@ -43,6 +43,15 @@ struct Cli {
     /// List the built-in scenarios and exit.
     #[arg(long)]
     list: bool,
+    /// With an OpenSCENARIO scenario (.xosc): open a declared parameter the file does not
+    /// vary, Name=lo..hi (an interval) or Name=a,b,c (levels), checked against its
+    /// constraint groups. Repeatable.
+    #[arg(long, value_name = "NAME=RANGE")]
+    open: Vec<String>,
+    /// With an OpenSCENARIO variation file: a DistributionRange becomes an interval over its
+    /// range instead of its levels.
+    #[arg(long)]
+    continuous: bool,
     /// How test points are chosen [default: halton].
     #[arg(long, value_parser = paracosm::cli::strategy_parser())]
     strategy: Option<Strategy>,
@@ -544,8 +553,21 @@ impl Cli {
         let strategy = self
             .strategy
             .map(|s| paracosm::cli::strategy(s, self.scramble));
+        let scenario = match &self.scenario {
+            Some(s) if paracosm::xosc::is_xosc(s) => Some(paracosm::xosc::campaign_name(
+                s,
+                &self.open,
+                self.continuous,
+            )),
+            Some(_) if !self.open.is_empty() || self.continuous => {
+                return Err(Error::BadInput(
+                    "--open and --continuous are for an OpenSCENARIO scenario (.xosc)".into(),
+                ))
+            }
+            other => other.clone(),
+        };
         Ok(Request {
-            scenario: self.scenario.clone(),
+            scenario,
             strategy: strategy.transpose()?,
             seed: self.seed,
             budget: self.budget,

@@ -522,7 +522,7 @@ fn refuse(out: &Path, diffs: Vec<String>) -> Error {
 
 /// Scenario `name`, under the system under test of `choice` when it names one.
 fn load_scenario(name: &str, choice: &SutChoice) -> Result<Scenario, Error> {
-    let mut scenario = paracosm_scenarios::load(name)?;
+    let mut scenario = crate::load_scenario(name)?;
     if let Some(s) = choice.config()? {
         scenario.sut = s;
     }

@@ -296,7 +296,7 @@ pub fn export(req: &DatasetRequest, stop: Option<&AtomicBool>) -> Result<Dataset
     camera
         .validate()
         .map_err(|e| Error::BadInput(format!("dataset camera: {e}")))?;
-    let mut scenario = paracosm_scenarios::load(&req.scenario)?;
+    let mut scenario = crate::load_scenario(&req.scenario)?;
     if let Some(sut) = &req.sut {
         scenario.sut = sut.clone();
     }

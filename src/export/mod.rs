@@ -93,7 +93,7 @@ pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
     )?;
     let dir = results.parent().unwrap_or(Path::new("."));
     let campaign = CampaignFile::read(dir).map_err(input)?;
-    let scenario = paracosm_scenarios::load(&campaign.scenario).map_err(input)?;
+    let scenario = crate::load_scenario(&campaign.scenario)?;
     let mut world: Option<WorldSpec> = None;
     let mut states: Vec<Snapshot> = Vec::new();
     let mut on_world = |w: &WorldSpec| world = Some(w.clone());

@@ -124,7 +124,7 @@ pub fn replay_with(
     let dir = results.parent().unwrap_or(Path::new("."));
     let (line_no, line) = find_record(results, id)?;
     let campaign_file = CampaignFile::read(dir).map_err(input)?;
-    let mut scenario = paracosm_scenarios::load(&campaign_file.scenario).map_err(input)?;
+    let mut scenario = crate::load_scenario(&campaign_file.scenario)?;
     let changed = changed_since(&campaign_file, &scenario);
     let record = RunRecord::from_line(&line, &scenario.space).map_err(|e| {
         input(format!(

@@ -593,7 +593,7 @@ fn triage_lines(t: &crate::report::triage::Triage) -> Vec<String> {
 /// or two; [`crate::Error::Plot`] when a plot cannot be written.
 pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts), crate::Error> {
     let file = CampaignFile::read(dir)?;
-    let mut scenario = paracosm_scenarios::load(&file.scenario)?;
+    let mut scenario = crate::load_scenario(&file.scenario)?;
     if let Some(s) = file.sut.config()? {
         scenario.sut = s;
     }

@@ -125,3 +125,97 @@ pub fn inspect(path: &Path, opens: &[String], continuous: bool) -> Result<Inspec
         limits,
     })
 }
+
+/// The separator between an OpenSCENARIO file and its options in a campaign's scenario name:
+/// `file.xosc#open=Name=lo..hi;open=Name=a,b;continuous` (what `campaign.json` keeps, so that
+/// resume, report, replay and export build the same space).
+pub const OPTIONS_MARK: char = '#';
+
+/// The campaign scenario name of `path` with `opens` (`Name=lo..hi` or `Name=a,b,c`) and
+/// `continuous`: the path alone without options.
+pub fn campaign_name(path: &str, opens: &[String], continuous: bool) -> String {
+    let mut options: Vec<String> = opens.iter().map(|o| format!("open={o}")).collect();
+    if continuous {
+        options.push("continuous".into());
+    }
+    if options.is_empty() {
+        path.to_owned()
+    } else {
+        format!("{path}{OPTIONS_MARK}{}", options.join(";"))
+    }
+}
+
+/// Whether a campaign's scenario name is an OpenSCENARIO file (with or without options).
+pub fn is_xosc(name: &str) -> bool {
+    let path = name.split(OPTIONS_MARK).next().unwrap_or(name);
+    path.to_ascii_lowercase().ends_with(".xosc")
+}
+
+/// The scenario a campaign over an OpenSCENARIO file runs (name as [`campaign_name`] writes
+/// it): its space is the variation file's varied parameters then the `--open`ed ones, each
+/// test re-reads the scenario with its values (a value set expands to its parameters).
+///
+/// # Errors
+/// [`Error::Input`] or [`Error::BadInput`] as [`inspect`]; a scenario that does not build
+/// (`paracosm_scenarios::xosc::scenario`).
+pub fn campaign_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Error> {
+    let (path, options) = match name.split_once(OPTIONS_MARK) {
+        Some((p, o)) => (p, o),
+        None => (name, ""),
+    };
+    let mut opens = Vec::new();
+    let mut continuous = false;
+    for o in options.split(';').filter(|o| !o.is_empty()) {
+        match o.split_once('=') {
+            Some(("open", spec)) => opens.push(spec.to_owned()),
+            None if o == "continuous" => continuous = true,
+            _ => {
+                return Err(Error::BadInput(format!(
+                "{name}: unknown option {o:?} after {OPTIONS_MARK} (open=Name=lo..hi, continuous)"
+            )))
+            }
+        }
+    }
+    let found = inspect(Path::new(path), &opens, continuous)?;
+    let space = paracosm_generators::ParamSpace::new(found.space.clone())
+        .map_err(|e| Error::BadInput(format!("{path}: {e}")))?;
+    let sets: Vec<String> = (0..found.variation.as_ref().map_or(0, |v| v.multi.len()))
+        .map(|k| format!("value_set_{k}"))
+        .collect();
+    let overrides: paracosm_scenarios::xosc::Overrides = std::sync::Arc::new(move |a| {
+        let mut out = Vec::new();
+        for (name, value) in a.iter() {
+            let text = match value {
+                paracosm_generators::Value::Int(i) => i.to_string(),
+                paracosm_generators::Value::Real(x) => format!("{x}"),
+                paracosm_generators::Value::Bool(b) => b.to_string(),
+                paracosm_generators::Value::Text(t) => t.clone(),
+            };
+            if sets.iter().any(|s| s == name) {
+                for pair in text.split(", ") {
+                    let (n, v) = pair.split_once('=').ok_or_else(|| {
+                        format!("{name}: the value set {text:?} is not Name=value")
+                    })?;
+                    out.push((n.to_owned(), v.to_owned()));
+                }
+            } else {
+                out.push((name.to_owned(), text));
+            }
+        }
+        Ok(out)
+    });
+    let template = PathBuf::from(&found.scenario.file);
+    let mut scenario = paracosm_scenarios::xosc::scenario(paracosm_scenarios::xosc::Source {
+        template,
+        name: name.to_owned(),
+        space,
+        overrides,
+    })?;
+    scenario
+        .warnings
+        .extend(found.limits.iter().map(|l| paracosm_scenarios::Warning {
+            at: path.to_owned(),
+            message: l.clone(),
+        }));
+    Ok(scenario)
+}

@@ -1005,6 +1005,32 @@ impl MapIndex {
             })
     }
 
+    /// The lanes (indices into [`RoadMap::lanes`]) whose strips hold the world point `[x, z]`
+    /// (m), each with the station `i` of the segment (stations `i`, `i + 1`) that holds it and
+    /// the point's lateral offset from the centre line (m, positive to the right of
+    /// increasing `s`), nearest centre first, one segment a lane.
+    pub fn lanes_at(&self, p: [f64; 2]) -> Vec<(usize, usize, f64)> {
+        let r = self.trees.widest_m / 2.0 + 1e-9;
+        let mut out: Vec<(usize, usize, f64)> = self
+            .trees
+            .centres
+            .locate_within_distance(p, r * r)
+            .filter_map(|seg| {
+                let (k, i) = seg.data;
+                strip_offset(&self.map.lanes[k], i, p).map(|t| (k, i, t))
+            })
+            .collect();
+        out.sort_by(|a, b| {
+            a.2.abs()
+                .total_cmp(&b.2.abs())
+                .then(a.0.cmp(&b.0))
+                .then(a.1.cmp(&b.1))
+        });
+        let mut seen = std::collections::BTreeSet::new();
+        out.retain(|x| seen.insert(x.0));
+        out
+    }
+
     fn drivable_at(&self, p: [f64; 2], except: Option<usize>) -> bool {
         self.strips_at(p)
             .any(|(k, _)| Some(k) != except && self.map.lanes[k].drivable)

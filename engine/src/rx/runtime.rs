@@ -51,6 +51,13 @@ pub trait Host {
     fn reads(&self) -> &[StreamId] {
         &[]
     }
+
+    /// Whether the test is over by the host's own account (an OpenSCENARIO storyboard's stop
+    /// trigger has fired): the runner then ends it as if its horizon had come. The default
+    /// host never ends a test.
+    fn ended(&self) -> bool {
+        false
+    }
 }
 
 /// A [`Host`] without functions: every call is an error. For graphs built in Rust.

@@ -194,7 +194,11 @@ impl Sut for Aeb {
         let (steering, target_speed) = if obs.route.len() >= 2 {
             self.pursue(obs)
         } else {
-            (self.keep_line(obs), self.config.cruise.target_speed_mps)
+            (
+                self.keep_line(obs),
+                obs.set_speed_mps
+                    .unwrap_or(self.config.cruise.target_speed_mps),
+            )
         };
         let throttle = self.config.cruise.throttle(
             obs.ego.speed_mps,
@@ -260,7 +264,7 @@ impl Aeb {
         let steer = (2.0 * c.wheelbase_m * alpha.sin() / ld).atan() / c.max_steer_rad;
 
         // Speed allowed by each curve ahead, less what braking at curve_decel covers.
-        let mut speed = c.cruise.target_speed_mps;
+        let mut speed = obs.set_speed_mps.unwrap_or(c.cruise.target_speed_mps);
         let mut ahead = 0.0;
         let horizon = v * v / (2.0 * c.curve_decel_mps2) + 20.0;
         for i in self.progress + 1..route.len().saturating_sub(1) {
@@ -332,6 +336,7 @@ mod tests {
             dt_s: 1.0 / 60.0,
             ego,
             route: &[],
+            set_speed_mps: None,
             readings: vec![("lidar", crate::sensor::Reading::Lidar(&lidar))],
         })
         .unwrap()

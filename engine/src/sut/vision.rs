@@ -215,7 +215,7 @@ impl Vision {
         let seen = self.perceive_on_curve(frame, obs.ego.pos_m[1], kappa);
         let throttle = c.cruise.throttle(
             obs.ego.speed_mps,
-            c.cruise.target_speed_mps,
+            obs.set_speed_mps.unwrap_or(c.cruise.target_speed_mps),
             seen.obstacle_m,
         );
         let steering = seen.lane_centre_m.map_or(0.0, |y| {

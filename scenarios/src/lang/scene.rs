@@ -476,6 +476,7 @@ impl SceneBuilder {
                     initial_speed_mps,
                     vehicle: VehicleParams::default(),
                     route,
+                    set_speed_mps: None,
                 },
                 sut,
             )

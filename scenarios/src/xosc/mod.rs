@@ -1,0 +1,534 @@
+//! OpenSCENARIO front end: a scenario file read by `paracosm-openscenario` becomes a
+//! [`Scenario`] whose tests each re-read the file with the test's parameter values and build
+//! a [`Scene`]: the map of its `RoadNetwork`, the ego vehicle (driven by the system under
+//! test) and every other entity as a scripted car or pedestrian, whose motion the storyboard
+//! runtime ([`story`]) computes step by step and hands to the engine as place actions.
+//!
+//! Published signals (for `Stl` and `Monitor`): [`HEADWAY_SIGNAL`], [`GAP_SIGNAL`] and
+//! [`LANE_EDGE_SIGNAL`], the R157-style measures of the ego.
+
+pub mod motion;
+pub mod road;
+pub mod story;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use paracosm_engine::behaviour::{Action as Sink, ActorRef, Output};
+use paracosm_engine::network::{Lane, Location, PieceId};
+use paracosm_engine::rx::{Func, Host, HostError, Node, Runtime, StreamId, Value};
+use paracosm_engine::sut::{AebConfig, SutConfig};
+use paracosm_engine::{CarSpec, EgoSpec, PedestrianSpec, Size, VehicleParams, DEFAULT_DT_S};
+use paracosm_generators::{Assignment, ParamSpace};
+use paracosm_openscenario::model::{self as m, Action, EntityKind};
+use paracosm_openscenario::read_scenario;
+
+use crate::lang::map_files::{Base, MapFiles};
+use crate::scenario::{Warning, Worlds};
+use crate::scene::{LoadError, LoadErrorKind, Scene, Site, TestSettings};
+use crate::{MonitorSpec, Scenario, ScenarioError};
+
+use story::Storyboard;
+
+/// The ego's time headway to the nearest entity ahead in its lane, s (`inf` with none).
+pub const HEADWAY_SIGNAL: &str = "ego_headway_s";
+/// The ego's following distance to the nearest entity ahead in its lane, between bounding
+/// boxes, m (`inf` with none).
+pub const GAP_SIGNAL: &str = "ego_gap_m";
+/// The distance from the ego's side to its lane's nearer edge, m (negative once over it).
+pub const LANE_EDGE_SIGNAL: &str = "ego_lane_edge_m";
+/// The longest test, s: a storyboard ends at its stop trigger, or here.
+pub const HORIZON_CAP_S: f64 = 3600.0;
+/// How far ahead the ego's route is planned, m.
+const ROUTE_M: f64 = 3000.0;
+
+/// The parameter values of one test as OpenSCENARIO overrides (`name`, value text), from the
+/// test's assignment (a value set's index expands to its parameters, for example).
+pub type Overrides =
+    Arc<dyn Fn(&Assignment) -> Result<Vec<(String, String)>, String> + Send + Sync>;
+
+/// What a campaign over an OpenSCENARIO scenario needs.
+pub struct Source {
+    /// The scenario file (`Storyboard`), read again for every test.
+    pub template: PathBuf,
+    /// The campaign's name for it (the file given on the command line).
+    pub name: String,
+    /// The space of the test's parameters.
+    pub space: ParamSpace,
+    /// The overrides of one test.
+    pub overrides: Overrides,
+}
+
+/// An OpenSCENARIO error as a load error.
+fn xosc_error(e: paracosm_openscenario::XoscError) -> ScenarioError {
+    ScenarioError::Load(LoadError::new(LoadErrorKind::Files, e.to_string()))
+}
+
+fn worlds_error(message: String) -> ScenarioError {
+    ScenarioError::Load(LoadError::new(LoadErrorKind::Worlds, message))
+}
+
+/// The entity the system under test drives: the one whose controller the storyboard
+/// activates, else one named `Ego` or `hero` (any case), else the first vehicle.
+///
+/// # Errors
+/// [`ScenarioError::Load`] for a scenario without vehicles.
+pub fn ego_of(s: &m::Scenario) -> Result<usize, ScenarioError> {
+    let activated = s
+        .stories
+        .iter()
+        .flat_map(|st| &st.acts)
+        .flat_map(|a| &a.groups)
+        .find_map(|g| {
+            let activates = g.maneuvers.iter().flat_map(|mv| &mv.events).any(|ev| {
+                ev.actions
+                    .iter()
+                    .any(|na| matches!(na.action, Action::ActivateController { .. }))
+            });
+            activates.then(|| g.actors.first().copied()).flatten()
+        });
+    let vehicle = |i: &usize| matches!(s.entities[*i].kind, EntityKind::Vehicle(_));
+    activated
+        .filter(vehicle)
+        .or_else(|| {
+            (0..s.entities.len()).find(|&i| {
+                vehicle(&i)
+                    && ["ego", "hero"].contains(&s.entities[i].name.to_ascii_lowercase().as_str())
+            })
+        })
+        .or_else(|| (0..s.entities.len()).find(vehicle))
+        .ok_or_else(|| {
+            worlds_error(format!(
+                "{}: the scenario has no vehicle for the system under test to drive",
+                s.file
+            ))
+        })
+}
+
+/// What paracosm refuses in `s` (an action it cannot perform as written), and what it
+/// performs otherwise than written (as warnings): the ego's storyboard actions (the system
+/// under test drives it), controllers of other entities, the model's own notes.
+///
+/// # Errors
+/// [`ScenarioError::Load`] naming the element's line and column.
+pub fn check(s: &m::Scenario, ego: usize) -> Result<Vec<Warning>, ScenarioError> {
+    let mut warnings: Vec<Warning> = s
+        .notes
+        .iter()
+        .map(|n| Warning {
+            at: n.pos.to_string(),
+            message: n.text.clone(),
+        })
+        .collect();
+    let name = |i: usize| s.entities[i].name.clone();
+    let mut each = |who: &[usize], na: &m::NamedAction, init: bool| -> Result<(), ScenarioError> {
+        if let Action::LongitudinalDistance {
+            continuous: true, ..
+        } = na.action
+        {
+            return Err(worlds_error(format!(
+                "{}: a continuous LongitudinalDistanceAction is not supported (paracosm places \
+                 the entity at the distance once: continuous=\"false\")",
+                na.pos
+            )));
+        }
+        for &e in who {
+            let ignored = match &na.action {
+                Action::ActivateController { .. } if e == ego => None,
+                Action::ActivateController { .. } => Some(format!(
+                    "{} has no controller in paracosm: the storyboard moves it, and its \
+                     ActivateControllerAction does nothing",
+                    name(e)
+                )),
+                Action::Teleport(_) | Action::Speed { .. } if init && e == ego => None,
+                _ if e == ego => Some(format!(
+                    "the system under test drives {}: this action of the storyboard is not \
+                     performed",
+                    name(e)
+                )),
+                _ => None,
+            };
+            if let Some(message) = ignored {
+                warnings.push(Warning {
+                    at: na.pos.to_string(),
+                    message,
+                });
+            }
+        }
+        Ok(())
+    };
+    for (e, na) in &s.init {
+        each(&[*e], na, true)?;
+    }
+    for g in s
+        .stories
+        .iter()
+        .flat_map(|st| &st.acts)
+        .flat_map(|a| &a.groups)
+    {
+        for na in g
+            .maneuvers
+            .iter()
+            .flat_map(|mv| &mv.events)
+            .flat_map(|e| &e.actions)
+        {
+            each(&g.actors, na, false)?;
+        }
+    }
+    if s.stop.is_none() {
+        warnings.push(Warning {
+            at: s.file.clone(),
+            message: format!(
+                "the storyboard has no stop trigger: each test runs {HORIZON_CAP_S} s"
+            ),
+        });
+    }
+    Ok(warnings)
+}
+
+/// The scenario of `source`: its space, the `aeb` system under test (which keeps the ego's
+/// initial speed as its set speed), a collision monitor and the off-road monitor, and a
+/// horizon of [`HORIZON_CAP_S`] that the storyboard's stop trigger cuts short.
+///
+/// # Errors
+/// [`ScenarioError::Load`] naming the file, line and column: the file does not read with its
+/// declared values, its map does not load, the scene cannot be built, or it holds an action
+/// paracosm does not perform ([`check`]).
+pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
+    let model = read_scenario(&source.template, &[]).map_err(xosc_error)?;
+    let ego = ego_of(&model)?;
+    let mut warnings = check(&model, ego)?;
+    // The model's LogicFile path is already joined with the scenario's folder.
+    let dir = PathBuf::new();
+    let worlds = XoscWorlds {
+        template: source.template.clone(),
+        overrides: source.overrides,
+        maps: MapFiles::new(Base::Folder(dir)),
+    };
+    // The scene of the declared values: the map loads, the Init places every entity.
+    let (scene, _) = worlds.build(&model)?;
+    drop(scene);
+    warnings.extend(worlds.maps.warnings().into_iter().map(|w| Warning {
+        at: model.file.clone(),
+        message: w,
+    }));
+    let input_files = worlds.maps.inputs();
+    // The failure map's axes: the intervals first, then the parameters with most levels.
+    let mut axes: Vec<&paracosm_generators::Param> = source.space.params().iter().collect();
+    axes.sort_by_key(|p| match &p.domain {
+        paracosm_generators::Domain::Interval { .. } => 0,
+        paracosm_generators::Domain::Levels(l) => usize::MAX - l.len(),
+    });
+    let map_axes = axes.iter().take(2).map(|p| p.name.clone()).collect();
+    Ok(Scenario {
+        name: source.name,
+        description: format!(
+            "OpenSCENARIO {}.{} scenario {}",
+            model.version.0, model.version.1, model.file
+        ),
+        space: source.space,
+        horizon_s: HORIZON_CAP_S,
+        sut: SutConfig::Aeb(AebConfig::default()),
+        monitors: vec![MonitorSpec::collision(), MonitorSpec::implicit_off_road()],
+        map_axes,
+        warnings,
+        unused_params: vec![],
+        camera_only: vec![],
+        source: Arc::from(
+            crate::text_file::read_text(
+                &source.template,
+                paracosm_openscenario::text::MAX_FILE_BYTES,
+            )
+            .unwrap_or_default(),
+        ),
+        input_files,
+        worlds: Arc::new(worlds),
+    })
+}
+
+/// The worlds of an OpenSCENARIO scenario: the file read with each test's values.
+struct XoscWorlds {
+    template: PathBuf,
+    overrides: Overrides,
+    maps: MapFiles,
+}
+
+impl Worlds for XoscWorlds {
+    fn with_scene(
+        &self,
+        assignment: &Assignment,
+        run: &mut dyn FnMut(&Scene, &mut dyn Host),
+    ) -> Result<(), ScenarioError> {
+        let overrides = (self.overrides)(assignment).map_err(worlds_error)?;
+        let model = read_scenario(&self.template, &overrides).map_err(xosc_error)?;
+        let (scene, mut host) = self.build(&model)?;
+        run(&scene, &mut host);
+        Ok(())
+    }
+}
+
+fn here(pos: &paracosm_openscenario::Pos, variable: &str) -> Site {
+    Site {
+        file: pos.file.clone(),
+        line: pos.line,
+        col: pos.col,
+        variable: Some(variable.to_owned()),
+    }
+}
+
+impl XoscWorlds {
+    /// The scene of `model` and the host that runs its storyboard.
+    fn build(&self, model: &m::Scenario) -> Result<(Scene, StoryHost), ScenarioError> {
+        let ego = ego_of(model)?;
+        let Some(road) = &model.road_network else {
+            return Err(worlds_error(format!(
+                "{}: the scenario has no RoadNetwork LogicFile: paracosm needs its OpenDRIVE map",
+                model.file
+            )));
+        };
+        let map = self
+            .maps
+            .load(&road.item)
+            .map_err(|e| ScenarioError::Load(e.with_context(&format!("\n --> {}", road.pos))))?;
+        let roads = road::Roads::new(&map);
+        let sb =
+            Storyboard::new(model, roads, Some(ego)).map_err(|e| worlds_error(e.to_string()))?;
+        let mut scene = Scene::new(None);
+        let site = here(&road.pos, "RoadNetwork");
+        let light = scene.push(Node::Const(Value::Num(1.0)));
+        let fog = scene.push(Node::Const(Value::Num(0.0)));
+        scene
+            .set_environment(light, fog, site.clone())
+            .map_err(|e| worlds_error(e.to_string()))?;
+        let friction = scene.push(Node::Const(Value::Num(0.8)));
+        let piece: PieceId = scene
+            .add_road(
+                |n| n.add_map("map", map.0.clone(), 0.8),
+                friction,
+                site.clone(),
+            )
+            .map_err(|e| worlds_error(e.to_string()))?;
+        let zero = scene.push(Node::Const(Value::Num(0.0)));
+        let mut sinks = Vec::new();
+        let mut probes = Vec::new();
+        let mut ego_actor = None;
+        for (i, ent) in model.entities.iter().enumerate() {
+            let name = ent.name.clone();
+            let at = here(&ent.pos, &name);
+            let (pos, heading) = sb.engine_pose(i);
+            let size = Size {
+                length_m: ent.dimensions_m[0].max(0.1),
+                width_m: ent.dimensions_m[1].max(0.1),
+                height_m: ent.dimensions_m[2].max(0.1),
+            };
+            let actor = if i == ego {
+                let a = scene.declare_ego(name.clone(), at);
+                ego_actor = Some(a);
+                a
+            } else if matches!(ent.kind, EntityKind::Pedestrian(_)) {
+                let a = scene.declare_pedestrian(name.clone(), at);
+                scene
+                    .place_pedestrian(
+                        a,
+                        PedestrianSpec {
+                            start: pos,
+                            target: pos,
+                            speed: zero,
+                            name: format!("Pedestrian {name} ({})", ent.pos),
+                        },
+                    )
+                    .map_err(|e| worlds_error(e.to_string()))?;
+                a
+            } else {
+                let a = scene.declare_car(name.clone(), at);
+                let ahead = [pos[0] + 0.5 * heading.cos(), pos[2] - 0.5 * heading.sin()];
+                scene
+                    .place_car(
+                        a,
+                        CarSpec {
+                            path: vec![[pos[0], pos[2]], ahead],
+                            speed: zero,
+                            color: "white".to_owned(),
+                            size,
+                            enabled: true,
+                            lane_change: None,
+                            lane_offsets_m: vec![],
+                            name: format!("Car {name} ({})", ent.pos),
+                            keep_distance_m: None,
+                        },
+                    )
+                    .map_err(|e| worlds_error(e.to_string()))?;
+                a
+            };
+            sinks.push(match actor {
+                ActorRef::Car(h) => Some(Sink::PlaceCar(h)),
+                ActorRef::Pedestrian(h) => Some(Sink::PlacePedestrian(h)),
+                _ => None,
+            });
+            probes.push(scene.probe(actor, Output::Collided));
+        }
+        let Some(ego_actor) = ego_actor else {
+            return Err(worlds_error("no ego".into()));
+        };
+        let ego_probes =
+            [Output::Pos, Output::Heading, Output::Speed].map(|o| scene.probe(ego_actor, o));
+        self.place_ego(&mut scene, &sb, ego, piece)?;
+        let tick = scene.push(Node::Tick);
+        scene.push(Node::Perform {
+            src: tick,
+            f: Func::Host(0),
+        });
+        for (k, signal) in [HEADWAY_SIGNAL, GAP_SIGNAL, LANE_EDGE_SIGNAL]
+            .into_iter()
+            .enumerate()
+        {
+            let id = scene.push(Node::Map {
+                src: tick,
+                f: Func::Host(k as u32 + 1),
+            });
+            scene.publish(signal.to_owned(), id, None);
+        }
+        scene.add_monitor(MonitorSpec::collision(), site.clone());
+        scene
+            .set_settings(TestSettings {
+                site: Some(site),
+                horizon_s: Some(HORIZON_CAP_S),
+                map_axes: None,
+                offroad: None,
+            })
+            .map_err(|e| worlds_error(e.to_string()))?;
+        let mut reads: Vec<StreamId> = probes.clone();
+        reads.extend(ego_probes);
+        let host = StoryHost {
+            sb,
+            ego,
+            sinks,
+            collided: probes,
+            ego_probes,
+            reads,
+            performed: Vec::new(),
+            measures: (f64::INFINITY, f64::INFINITY, f64::NAN),
+        };
+        Ok((scene, host))
+    }
+
+    /// Places the ego where the storyboard's `Init` put it, at its initial speed, which the
+    /// system under test keeps as its set speed, with a route along its lanes.
+    fn place_ego(
+        &self,
+        scene: &mut Scene,
+        sb: &Storyboard,
+        ego: usize,
+        piece: PieceId,
+    ) -> Result<(), ScenarioError> {
+        let a = &sb.actors[ego];
+        let Some(lp) = a.state.lane else {
+            return Err(worlds_error(format!(
+                "{}: the ego {} does not start on a lane of the map",
+                self.template.display(),
+                a.name
+            )));
+        };
+        let (pos, heading) = sb.engine_pose(ego);
+        let (id, _) = sb.roads().ids(lp.lane);
+        let start = Location {
+            pos_m: pos,
+            heading_rad: heading,
+            piece,
+            lane: Lane::Driving(id),
+            at_m: lp.s,
+            through: None,
+            map_lane: Some(lp.lane),
+        };
+        // Along its lanes the way it faces (against a lane's travel too, as the storyboard
+        // moves entities), a point every 2 m.
+        let mut route = vec![[pos[0], pos[2]]];
+        let mut at = lp;
+        let prefer = |_: usize| false;
+        for _ in 0..(ROUTE_M / 2.0) as usize {
+            let more = sb.roads().advance(&mut at, 2.0, &prefer);
+            let (p, _) = sb.roads().to_engine(sb.roads().pose_of(&at));
+            route.push([p[0], p[2]]);
+            if !more {
+                break;
+            }
+        }
+        let speed = a.state.speed.max(0.0);
+        scene
+            .place_ego(
+                EgoSpec {
+                    start,
+                    initial_speed_mps: speed,
+                    vehicle: VehicleParams::default(),
+                    route,
+                    set_speed_mps: Some(speed),
+                },
+                SutConfig::Aeb(AebConfig::default()),
+            )
+            .map_err(|e| worlds_error(e.to_string()))
+    }
+}
+
+/// Runs the storyboard: host function 0, on every step, reads the ego and every entity's
+/// contact, steps the storyboard and performs the place actions of the scripted entities;
+/// functions 1–3 give the ego's measures.
+struct StoryHost {
+    sb: Storyboard,
+    ego: usize,
+    sinks: Vec<Option<Sink>>,
+    collided: Vec<StreamId>,
+    ego_probes: [StreamId; 3],
+    reads: Vec<StreamId>,
+    performed: Vec<(Sink, Value)>,
+    measures: (f64, f64, f64),
+}
+
+impl Host for StoryHost {
+    fn call(&mut self, f: u32, args: &[Value], streams: &Runtime) -> Result<Value, HostError> {
+        match f {
+            0 => {
+                let t = args.first().and_then(Value::as_num).unwrap_or(0.0);
+                let num = |id: StreamId| streams.current(id).and_then(Value::as_num);
+                let pos = match streams.current(self.ego_probes[0]) {
+                    Some(Value::Vec3(p)) => *p,
+                    _ => return Err(HostError("the ego's position is not known".into())),
+                };
+                let heading = num(self.ego_probes[1]).unwrap_or(0.0);
+                let speed = num(self.ego_probes[2]).unwrap_or(0.0);
+                self.sb.observe(self.ego, pos, heading, speed, DEFAULT_DT_S);
+                for (e, id) in self.collided.iter().enumerate() {
+                    let hit = matches!(streams.current(*id), Some(Value::Bool(true)));
+                    self.sb.set_collided(e, hit);
+                }
+                self.sb
+                    .step(t, DEFAULT_DT_S)
+                    .map_err(|e| HostError(e.to_string()))?;
+                for (e, sink) in self.sinks.iter().enumerate() {
+                    if let Some(sink) = sink {
+                        let (p, h) = self.sb.engine_pose(e);
+                        self.performed
+                            .push((*sink, Value::Tuple(vec![Value::Vec3(p), Value::Num(h)])));
+                    }
+                }
+                self.measures = self.sb.measures(self.ego);
+                Ok(Value::Unit)
+            }
+            1 => Ok(Value::Num(self.measures.0)),
+            2 => Ok(Value::Num(self.measures.1)),
+            3 => Ok(Value::Num(self.measures.2)),
+            _ => Err(HostError(format!("no host function {f}"))),
+        }
+    }
+
+    fn performed(&mut self) -> Vec<(Sink, Value)> {
+        std::mem::take(&mut self.performed)
+    }
+
+    fn reads(&self) -> &[StreamId] {
+        &self.reads
+    }
+
+    fn ended(&self) -> bool {
+        self.sb.ended
+    }
+}

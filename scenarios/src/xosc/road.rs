@@ -1,0 +1,361 @@
+//! Where OpenSCENARIO positions lie on an OpenDRIVE map, and how an entity moves along its
+//! lanes. Poses here are in the OpenSCENARIO (OpenDRIVE) frame: x east, y north (m), heading
+//! counter-clockwise from x (rad); [`Roads::to_engine`] turns one into the engine's world
+//! (`[x, y, z]`, z = −(y − origin)).
+
+use std::f64::consts::PI;
+
+use std::sync::Arc;
+
+use paracosm_engine::network::{MapIndex, MapRef, RoadMap};
+
+/// A pose in the OpenSCENARIO frame: `x`, `y` in m, heading `h` in rad.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    /// East, m.
+    pub x: f64,
+    /// North, m.
+    pub y: f64,
+    /// Heading, rad, counter-clockwise from east.
+    pub h: f64,
+}
+
+/// Where an entity stands on a lane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LanePos {
+    /// The lane, an index into [`RoadMap::lanes`].
+    pub lane: usize,
+    /// Station along the road's reference line, m.
+    pub s: f64,
+    /// Lateral offset from the lane's centre line, m, positive to the left of increasing `s`
+    /// (OpenDRIVE's `t` direction).
+    pub d: f64,
+    /// Whether the entity faces and moves against the lane's direction of travel (a lane
+    /// position's heading is along the road's reference line unless its orientation says
+    /// otherwise, so an entity placed on a left lane of a right-hand-traffic road without
+    /// an orientation drives along increasing `s`, as esmini has it).
+    pub rev: bool,
+}
+
+impl LanePos {
+    /// Whether the entity moves along increasing `s`.
+    pub fn along_s(&self, roads: &Roads) -> bool {
+        roads.forward(self.lane) != self.rev
+    }
+}
+
+/// `a` wrapped to `(−π, π]`.
+pub fn wrap(a: f64) -> f64 {
+    let mut x = (a + PI).rem_euclid(2.0 * PI) - PI;
+    if x <= -PI {
+        x += 2.0 * PI;
+    }
+    x
+}
+
+/// A map as the storyboard reads it.
+#[derive(Clone)]
+pub struct Roads {
+    map: Arc<RoadMap>,
+    index: MapIndex,
+}
+
+impl std::fmt::Debug for Roads {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Roads({})", self.map.source)
+    }
+}
+
+impl Roads {
+    /// The storyboard's view of `map`, with its query index (built once per map and shared
+    /// by every test).
+    pub fn new(map: &MapRef) -> Self {
+        Roads {
+            index: map.index(),
+            map: map.0.clone(),
+        }
+    }
+
+    /// The map.
+    pub fn map(&self) -> &RoadMap {
+        &self.map
+    }
+
+    fn to_od(&self, p: [f64; 2]) -> [f64; 2] {
+        [p[0] + self.map.origin_m[0], -p[1] + self.map.origin_m[1]]
+    }
+
+    fn od_to_engine(&self, x: f64, y: f64) -> [f64; 2] {
+        [x - self.map.origin_m[0], -(y - self.map.origin_m[1])]
+    }
+
+    /// `pose` in the engine's world: `[x, y, z]` m on the road surface, heading rad.
+    pub fn to_engine(&self, pose: Pose) -> ([f64; 3], f64) {
+        let [x, z] = self.od_to_engine(pose.x, pose.y);
+        ([x, 0.0, z], wrap(pose.h))
+    }
+
+    /// The centre of lane `k` at station `s` (OpenSCENARIO frame) and the direction of
+    /// increasing `s` there, rad.
+    fn frame(&self, k: usize, s: f64) -> ([f64; 2], f64) {
+        let l = &self.map.lanes[k];
+        let (p, h) = l.pose(s);
+        let along = if l.forward { h } else { wrap(h + PI) };
+        (self.to_od(p), along)
+    }
+
+    /// Whether lane `k`'s traffic runs along increasing `s`.
+    pub fn forward(&self, k: usize) -> bool {
+        self.map.lanes[k].forward
+    }
+
+    /// The pose of `lp`, facing the lane's direction of travel.
+    pub fn pose_of(&self, lp: &LanePos) -> Pose {
+        let (c, along) = self.frame(lp.lane, lp.s);
+        let left = [-along.sin(), along.cos()];
+        Pose {
+            x: c[0] + left[0] * lp.d,
+            y: c[1] + left[1] * lp.d,
+            h: if lp.along_s(self) {
+                along
+            } else {
+                wrap(along + PI)
+            },
+        }
+    }
+
+    /// The direction of increasing `s` at `lp`, rad.
+    pub fn along_heading(&self, lp: &LanePos) -> f64 {
+        self.frame(lp.lane, lp.s).1
+    }
+
+    /// The direction of travel of `lp`'s lane at its station, rad.
+    pub fn travel_heading(&self, lp: &LanePos) -> f64 {
+        self.pose_of(&LanePos { d: 0.0, ..*lp }).h
+    }
+
+    /// The lane `lane` (`<lane id>`) of road `road` at station `s` with offset `offset`.
+    ///
+    /// # Errors
+    /// The map's refusal, naming the roads or lanes it has.
+    pub fn lane_pos(&self, road: &str, lane: i32, s: f64, offset: f64) -> Result<LanePos, String> {
+        let k = self.map.lane_at(road, lane, s).map_err(|e| e.to_string())?;
+        Ok(LanePos {
+            lane: k,
+            s,
+            d: offset,
+            rev: false,
+        })
+    }
+
+    /// The lane `d_lane` lanes to the left (in the road's `t` direction; `<lane id>` 0 is
+    /// skipped) of `lp`'s, `ds` further along the road, `offset` from its centre.
+    ///
+    /// # Errors
+    /// When the road has no such lane there.
+    pub fn relative_lane(
+        &self,
+        lp: &LanePos,
+        d_lane: i32,
+        ds: f64,
+        offset: f64,
+    ) -> Result<LanePos, String> {
+        let l = &self.map.lanes[lp.lane];
+        let mut id = l.od_id;
+        for _ in 0..d_lane.unsigned_abs() {
+            id += d_lane.signum();
+            if id == 0 {
+                id += d_lane.signum();
+            }
+        }
+        let road = self.map.roads[l.road].od_id.clone();
+        let mut to = self.lane_pos(&road, id, lp.s + ds, offset)?;
+        // Facing the way the reference faces.
+        to.rev = self.forward(to.lane) != lp.along_s(self);
+        Ok(to)
+    }
+
+    /// The point `t` (m, left of the reference line) across road `road` at station `s`, on
+    /// the lane that holds it (or the nearest lane).
+    ///
+    /// # Errors
+    /// When the road is unknown or has no lane at `s`.
+    pub fn road_pos(&self, road: &str, s: f64, t: f64) -> Result<LanePos, String> {
+        // The reference line lies on the inner border of lane −1 (or +1).
+        let inner = [-1, 1]
+            .into_iter()
+            .find_map(|id| self.lane_pos(road, id, s, 0.0).ok().map(|lp| (id, lp)));
+        let Some((id, lp)) = inner else {
+            // The map's own message for the road.
+            self.lane_pos(road, -1, s, 0.0)?;
+            return Err(format!("road {road} has no lane −1 or 1 at s = {s} m"));
+        };
+        let (c, along) = self.frame(lp.lane, s);
+        let left = [-along.sin(), along.cos()];
+        let w = self.lane_width(lp.lane, s);
+        let sign = if id < 0 { 1.0 } else { -1.0 };
+        let reference = [
+            c[0] + left[0] * sign * w / 2.0,
+            c[1] + left[1] * sign * w / 2.0,
+        ];
+        let road_index = self.map.lanes[lp.lane].road;
+        let mut best: Option<(f64, LanePos)> = None;
+        for (k, l) in self.map.lanes.iter().enumerate() {
+            let (a, b) = l.s_range();
+            if l.road != road_index || s < a - 1e-9 || s > b + 1e-9 {
+                continue;
+            }
+            let (ck, _) = self.frame(k, s);
+            let tc = (ck[0] - reference[0]) * left[0] + (ck[1] - reference[1]) * left[1];
+            let miss = ((t - tc).abs() - self.lane_width(k, s) / 2.0).max(0.0);
+            if best.as_ref().is_none_or(|(m, _)| miss < *m) {
+                best = Some((
+                    miss,
+                    LanePos {
+                        lane: k,
+                        s,
+                        d: t - tc,
+                        rev: false,
+                    },
+                ));
+            }
+        }
+        best.map(|(_, lp)| lp)
+            .ok_or_else(|| format!("road {road} has no lane at s = {s} m"))
+    }
+
+    /// The width of lane `k` at station `s`, m.
+    pub fn lane_width(&self, k: usize, s: f64) -> f64 {
+        let l = &self.map.lanes[k];
+        let i = l.s.partition_point(|&x| x <= s).clamp(1, l.s.len()) - 1;
+        l.width[i]
+    }
+
+    /// The lane under the point `(x, y)` and where on it, nearest centre line first; `None`
+    /// off every lane.
+    pub fn anchor(&self, x: f64, y: f64) -> Option<LanePos> {
+        let p = self.od_to_engine(x, y);
+        let (k, i, _) = *self.index.lanes_at(p).first()?;
+        let l = &self.map.lanes[k];
+        // The station: the point's projection on the nearest of the segment that holds it and
+        // its neighbours (a point past a segment's end is still held by its strip).
+        let mut best = (f64::INFINITY, l.s[i]);
+        for j in i.saturating_sub(1)..=(i + 1).min(l.centre.len() - 2) {
+            let (a, b) = (l.centre[j], l.centre[j + 1]);
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let len2 = d[0] * d[0] + d[1] * d[1];
+            let u = if len2 > 0.0 {
+                (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let q = [a[0] + u * d[0], a[1] + u * d[1]];
+            let e = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
+            if e < best.0 {
+                best = (e, l.s[j] + u * (l.s[j + 1] - l.s[j]));
+            }
+        }
+        let s = best.1;
+        let (c, along) = self.frame(k, s);
+        let left = [-along.sin(), along.cos()];
+        let d = (x - c[0]) * left[0] + (y - c[1]) * left[1];
+        Some(LanePos {
+            lane: k,
+            s,
+            d,
+            rev: false,
+        })
+    }
+
+    /// `lp` facing heading `h` (rad): against its lane's travel when `h` points against it.
+    pub fn facing(&self, mut lp: LanePos, h: f64) -> LanePos {
+        let along = self.along_heading(&lp);
+        let with_s = (h - along).cos() >= 0.0;
+        lp.rev = with_s != self.forward(lp.lane);
+        lp
+    }
+
+    /// The lateral distance from lane `from`'s centre to lane `to`'s at station `s`, m,
+    /// positive to the left of increasing `s` (`to` on the same road).
+    pub fn lateral_between(&self, from: usize, to: usize, s: f64) -> f64 {
+        let (a, along) = self.frame(from, s);
+        let (b, _) = self.frame(to, s);
+        let left = [-along.sin(), along.cos()];
+        (b[0] - a[0]) * left[0] + (b[1] - a[1]) * left[1]
+    }
+
+    /// The lane beside lane `k` at its station `s` with `<lane id>` `id` on the same road.
+    pub fn lane_with_id(&self, k: usize, id: i32, s: f64) -> Option<usize> {
+        let l = &self.map.lanes[k];
+        self.map.lane_at(&self.map.roads[l.road].od_id, id, s).ok()
+    }
+
+    /// The `<lane id>` and road of lane `k`.
+    pub fn ids(&self, k: usize) -> (i32, usize) {
+        let l = &self.map.lanes[k];
+        (l.od_id, l.road)
+    }
+
+    /// Moves `lp` `dist` metres (≥ 0, along its lane's centre line) in the lane's direction
+    /// of travel, into a successor lane where the lane ends: the first that `prefer` accepts,
+    /// else the first. Returns `false` when the lanes end before: `lp` then stands at the
+    /// end.
+    pub fn advance(&self, lp: &mut LanePos, mut dist: f64, prefer: &dyn Fn(usize) -> bool) -> bool {
+        for _ in 0..self.map.lanes.len().max(1) {
+            let l = &self.map.lanes[lp.lane];
+            let (a, b) = l.s_range();
+            // Metres of the centre line per metre of station, here.
+            let i = l.s.partition_point(|&x| x <= lp.s).clamp(1, l.s.len() - 1) - 1;
+            let span = l.s[i + 1] - l.s[i];
+            let chord =
+                (l.centre[i + 1][0] - l.centre[i][0]).hypot(l.centre[i + 1][1] - l.centre[i][1]);
+            let ratio = if span > 1e-9 {
+                (chord / span).max(1e-6)
+            } else {
+                1.0
+            };
+            let up = l.forward != lp.rev;
+            let left_m = if up { b - lp.s } else { lp.s - a } * ratio;
+            if dist <= left_m {
+                let ds = dist / ratio;
+                lp.s += if up { ds } else { -ds };
+                return true;
+            }
+            dist -= left_m.max(0.0);
+            // Against the lane's travel, the way on is a lane this one succeeds.
+            let ways: Vec<usize> = if lp.rev {
+                (0..self.map.lanes.len())
+                    .filter(|&p| self.map.lanes[p].successors.contains(&lp.lane))
+                    .collect()
+            } else {
+                l.successors.clone()
+            };
+            let next = ways
+                .iter()
+                .copied()
+                .find(|&n| prefer(n))
+                .or_else(|| ways.first().copied());
+            let Some(n) = next else {
+                lp.s = if up { b } else { a };
+                return false;
+            };
+            let nl = &self.map.lanes[n];
+            let (na, nb) = nl.s_range();
+            lp.lane = n;
+            lp.s = if nl.forward != lp.rev { na } else { nb };
+        }
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wrap_keeps_angles_in_range() {
+        assert!((wrap(3.0 * PI) - PI).abs() < 1e-12);
+        assert!((wrap(-PI) - PI).abs() < 1e-12);
+        assert!((wrap(0.5) - 0.5).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,1392 @@
+//! The storyboard runtime: an OpenSCENARIO storyboard (OpenSCENARIO 1.3 User Guide,
+//! "Storyboard and entities", "Conditions and triggers") run step by step over the test's
+//! world. Stories, acts, maneuver groups, maneuvers, events and actions move through the
+//! standard's states (standby, running, complete) on their triggers: condition groups (an OR
+//! of ANDs), each condition with its edge and delay; event priorities (override, skip,
+//! parallel) and execution counts. Scripted entities (every entity but the ego, which the
+//! system under test drives) move as their actions say, on the map's lanes.
+
+use std::collections::VecDeque;
+
+use paracosm_openscenario::model::{
+    self as m, Action, ConditionKind, Edge, EntityTest, Gap, LaneTarget, OffsetTarget, Position,
+    Priority, Rule, SpeedTarget,
+};
+
+use super::motion::{duration_s, offset_duration_s, Timed, Transition, Untimed};
+use super::road::{wrap, LanePos, Pose, Roads};
+
+/// The largest lateral acceleration of a `LaneOffsetAction` without `maxLateralAcc`, m/s².
+pub const DEFAULT_LATERAL_ACC_MPS2: f64 = 0.5;
+
+/// One entity as the storyboard sees it.
+#[derive(Debug, Clone)]
+pub struct Actor {
+    /// Its name in the file.
+    pub name: String,
+    /// Length, width, height of its bounding box, m.
+    pub size_m: [f64; 3],
+    /// The bounding box's centre relative to the entity's reference point, m (x forward, y
+    /// left, z up).
+    pub centre_m: [f64; 3],
+    /// Whether the storyboard moves it (every entity but the ego).
+    pub scripted: bool,
+    /// Its state now.
+    pub state: State,
+}
+
+/// Where an entity is and how it moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct State {
+    /// Its reference point's pose (the rear axle's centre for a vehicle).
+    pub pose: Pose,
+    /// Speed along its heading, m/s.
+    pub speed: f64,
+    /// Acceleration over the last step, m/s².
+    pub accel: f64,
+    /// Where it is on the map's lanes, when it follows them.
+    pub lane: Option<LanePos>,
+    /// Distance travelled since the start, m.
+    pub travelled_m: f64,
+    /// How long it has stood still, s.
+    pub still_s: f64,
+    /// How long it has stood at the end of its lanes, s.
+    pub at_end_s: f64,
+    /// Whether it has touched anything solid.
+    pub collided: bool,
+}
+
+impl State {
+    fn at(pose: Pose, lane: Option<LanePos>) -> Self {
+        State {
+            pose,
+            speed: 0.0,
+            accel: 0.0,
+            lane,
+            travelled_m: 0.0,
+            still_s: 0.0,
+            at_end_s: 0.0,
+            collided: false,
+        }
+    }
+}
+
+/// Why the storyboard cannot go on (an action that cannot be performed where it stands).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{at}: {message}")]
+pub struct StoryError {
+    /// Where the action or condition is written, `file:line:col`.
+    pub at: String,
+    /// What went wrong.
+    pub message: String,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Story,
+    Act,
+    Group,
+    Maneuver,
+    Event,
+    Action,
+}
+
+impl Kind {
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Story => "story",
+            Kind::Act => "act",
+            Kind::Group => "maneuverGroup",
+            Kind::Maneuver => "maneuver",
+            Kind::Event => "event",
+            Kind::Action => "action",
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    Standby,
+    Running,
+    Complete,
+}
+
+/// The transitions an element made in one step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct Moves {
+    start: bool,
+    end: bool,
+    stop: bool,
+    skip: bool,
+}
+
+#[derive(Debug, Clone)]
+struct Elem {
+    kind: Kind,
+    name: String,
+    children: Vec<usize>,
+    phase: Phase,
+    runs: u32,
+    max_runs: u32,
+    /// Entity tasks of an action still in flight.
+    pending: usize,
+    start: Option<usize>,
+    stop: Option<usize>,
+    priority: Priority,
+    /// An action's action and the entities it acts on.
+    action: Option<(m::NamedAction, Vec<usize>)>,
+    moves: Moves,
+    last: Moves,
+}
+
+#[derive(Debug, Clone)]
+struct Cond {
+    cond: m::Condition,
+    prev: bool,
+    history: VecDeque<(f64, bool)>,
+}
+
+/// A speed target that follows another entity: its index, the value, whether a factor.
+type Track = Option<(usize, f64, bool)>;
+
+/// A lane change's target: the lane and the offset from its centre there, m.
+type ToLane = Option<(usize, f64)>;
+
+/// A scripted entity's motion in progress, each with the action it belongs to.
+#[derive(Debug, Clone, Default)]
+struct Drive {
+    /// The speed transition, a target that follows another entity, the action.
+    speed: Option<(Transition, Track, usize)>,
+    /// The lateral transition, the lane it changes to, the action, whether it goes on.
+    lateral: Option<(Transition, ToLane, usize, bool)>,
+    path: Option<(Path, usize)>,
+    prefer_roads: Vec<usize>,
+}
+
+#[derive(Debug, Clone)]
+enum Path {
+    Timed(Timed),
+    Untimed(Untimed),
+}
+
+/// The storyboard of one test and the entities it moves.
+#[derive(Debug, Clone)]
+pub struct Storyboard {
+    roads: Roads,
+    /// The entities, in the file's order.
+    pub actors: Vec<Actor>,
+    drives: Vec<Drive>,
+    elems: Vec<Elem>,
+    roots: Vec<usize>,
+    triggers: Vec<Vec<Vec<Cond>>>,
+    trigger_now: Vec<bool>,
+    stop: Option<usize>,
+    params: Vec<(String, String)>,
+    /// Whether the storyboard's stop trigger has fired.
+    pub ended: bool,
+    started: bool,
+}
+
+fn site(pos: &paracosm_openscenario::Pos) -> String {
+    pos.to_string()
+}
+
+impl Storyboard {
+    /// The storyboard of `scenario` on `roads`, its `Init` performed: every entity placed and
+    /// given its initial speed. `ego` is the entity the system under test drives (not
+    /// scripted); with `None`, the storyboard moves every entity (the ego too, at the speed
+    /// its `Init` gives it).
+    ///
+    /// # Errors
+    /// [`StoryError`] for an `Init` action that cannot be performed (a position off the map,
+    /// a relative position to an entity not yet placed).
+    pub fn new(
+        scenario: &m::Scenario,
+        roads: Roads,
+        ego: Option<usize>,
+    ) -> Result<Self, StoryError> {
+        let actors = scenario
+            .entities
+            .iter()
+            .enumerate()
+            .map(|(i, e)| Actor {
+                name: e.name.clone(),
+                size_m: e.dimensions_m,
+                centre_m: e.centre_m,
+                scripted: Some(i) != ego,
+                state: State::at(
+                    Pose {
+                        x: 0.0,
+                        y: 0.0,
+                        h: 0.0,
+                    },
+                    None,
+                ),
+            })
+            .collect();
+        let mut sb = Storyboard {
+            roads,
+            drives: vec![Drive::default(); scenario.entities.len()],
+            actors,
+            elems: Vec::new(),
+            roots: Vec::new(),
+            triggers: Vec::new(),
+            trigger_now: Vec::new(),
+            stop: None,
+            params: scenario
+                .params
+                .iter()
+                .map(|(d, v)| (d.name.clone(), v.to_text()))
+                .collect(),
+            ended: false,
+            started: false,
+        };
+        sb.stop = scenario.stop.as_ref().map(|t| sb.add_trigger(t));
+        for story in &scenario.stories {
+            let s = sb.push(Kind::Story, &story.name, 1);
+            sb.roots.push(s);
+            for act in &story.acts {
+                let a = sb.push(Kind::Act, &act.name, 1);
+                sb.elems[s].children.push(a);
+                sb.elems[a].start = act.start.as_ref().map(|t| sb.add_trigger(t));
+                sb.elems[a].stop = act.stop.as_ref().map(|t| sb.add_trigger(t));
+                for g in &act.groups {
+                    let gi = sb.push(Kind::Group, &g.name, g.max_count);
+                    sb.elems[a].children.push(gi);
+                    for man in &g.maneuvers {
+                        let mi = sb.push(Kind::Maneuver, &man.name, 1);
+                        sb.elems[gi].children.push(mi);
+                        for ev in &man.events {
+                            let ei = sb.push(Kind::Event, &ev.name, ev.max_count);
+                            sb.elems[mi].children.push(ei);
+                            sb.elems[ei].priority = ev.priority;
+                            sb.elems[ei].start = ev.start.as_ref().map(|t| sb.add_trigger(t));
+                            for na in &ev.actions {
+                                let ai = sb.push(Kind::Action, &na.name, 1);
+                                sb.elems[ei].children.push(ai);
+                                sb.elems[ai].action = Some((na.clone(), g.actors.clone()));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        sb.trigger_now = vec![false; sb.triggers.len()];
+        // Init: positions first, in the file's order, then the rest (a relative position may
+        // name an entity placed later in the file).
+        let (places, rest): (Vec<_>, Vec<_>) = scenario
+            .init
+            .iter()
+            .partition(|(_, a)| matches!(a.action, Action::Teleport(_)));
+        for (e, a) in places.into_iter().chain(rest) {
+            sb.start_task(*e, a, None, 0.0)?;
+        }
+        // Init's transitions run from the start.
+        Ok(sb)
+    }
+
+    fn push(&mut self, kind: Kind, name: &str, max_runs: u32) -> usize {
+        self.elems.push(Elem {
+            kind,
+            name: name.to_owned(),
+            children: Vec::new(),
+            phase: Phase::Standby,
+            runs: 0,
+            max_runs: max_runs.max(1),
+            pending: 0,
+            start: None,
+            stop: None,
+            priority: Priority::Override,
+            action: None,
+            moves: Moves::default(),
+            last: Moves::default(),
+        });
+        self.elems.len() - 1
+    }
+
+    fn add_trigger(&mut self, t: &m::Trigger) -> usize {
+        self.triggers.push(
+            t.0.iter()
+                .map(|g| {
+                    g.iter()
+                        .map(|c| Cond {
+                            cond: c.clone(),
+                            prev: false,
+                            history: VecDeque::new(),
+                        })
+                        .collect()
+                })
+                .collect(),
+        );
+        self.triggers.len() - 1
+    }
+
+    /// The map the storyboard moves its entities on.
+    pub fn roads(&self) -> &Roads {
+        &self.roads
+    }
+
+    /// Entity `e`'s reference point and the centre of its bounding box, engine world
+    /// coordinates: `([x, y, z] m of the box's base centre, heading rad)`.
+    pub fn engine_pose(&self, e: usize) -> ([f64; 3], f64) {
+        let a = &self.actors[e];
+        let p = a.state.pose;
+        let (c, s) = (p.h.cos(), p.h.sin());
+        let centre = Pose {
+            x: p.x + c * a.centre_m[0] - s * a.centre_m[1],
+            y: p.y + s * a.centre_m[0] + c * a.centre_m[1],
+            h: p.h,
+        };
+        self.roads.to_engine(centre)
+    }
+
+    /// Sets the state of an entity the storyboard does not move (the ego) from what the
+    /// simulation shows: its box centre `[x, y, z]` (engine world, m), heading (rad), speed
+    /// along its heading (m/s); `dt` is the step (s).
+    pub fn observe(&mut self, e: usize, centre: [f64; 3], heading: f64, speed: f64, dt: f64) {
+        let a = &mut self.actors[e];
+        let o = self.roads.map().origin_m;
+        let (x, y) = (centre[0] + o[0], -centre[2] + o[1]);
+        let (c, s) = (heading.cos(), heading.sin());
+        let pose = Pose {
+            x: x - c * a.centre_m[0] + s * a.centre_m[1],
+            y: y - s * a.centre_m[0] - c * a.centre_m[1],
+            h: heading,
+        };
+        let st = &mut a.state;
+        let moved = (pose.x - st.pose.x).hypot(pose.y - st.pose.y);
+        if self.started {
+            st.accel = (speed - st.speed) / dt;
+            st.travelled_m += moved;
+        }
+        st.speed = speed;
+        st.pose = pose;
+        st.lane = self
+            .roads
+            .anchor(pose.x, pose.y)
+            .map(|lp| self.roads.facing(lp, heading));
+        st.still_s = if speed.abs() < 1e-3 {
+            st.still_s + dt
+        } else {
+            0.0
+        };
+    }
+
+    /// Records whether entity `e` has touched anything solid.
+    pub fn set_collided(&mut self, e: usize, collided: bool) {
+        self.actors[e].state.collided = collided;
+    }
+
+    /// One step at time `t` (s) of length `dt` (s): the triggers read the world as it is at
+    /// `t`, the elements move through their states, and every scripted entity moves to where
+    /// it is at `t + dt`.
+    ///
+    /// # Errors
+    /// [`StoryError`] for an action that cannot be performed where its entity stands.
+    pub fn step(&mut self, t: f64, dt: f64) -> Result<(), StoryError> {
+        for k in 0..self.triggers.len() {
+            self.trigger_now[k] = self.evaluate(k, t);
+        }
+        for e in &mut self.elems {
+            e.last = std::mem::take(&mut e.moves);
+        }
+        if !self.started {
+            self.started = true;
+            for r in self.roots.clone() {
+                self.start_elem(r, t)?;
+            }
+        }
+        if let Some(k) = self.stop {
+            if self.trigger_now[k] {
+                self.ended = true;
+            }
+        }
+        for r in self.roots.clone() {
+            self.run_story(r, t)?;
+        }
+        for e in 0..self.actors.len() {
+            if self.actors[e].scripted {
+                self.drive(e, t, dt)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn run_story(&mut self, s: usize, t: f64) -> Result<(), StoryError> {
+        for a in self.elems[s].children.clone() {
+            match self.elems[a].phase {
+                Phase::Standby => {
+                    let go = self.elems[a].start.is_none_or(|k| self.trigger_now[k]);
+                    if go {
+                        self.start_elem(a, t)?;
+                        for g in self.elems[a].children.clone() {
+                            self.start_group(g, t)?;
+                        }
+                    }
+                }
+                Phase::Running => {
+                    if self.elems[a].stop.is_some_and(|k| self.trigger_now[k]) {
+                        self.stop_elem(a);
+                        continue;
+                    }
+                    let mut all = true;
+                    for g in self.elems[a].children.clone() {
+                        self.run_group(g, t)?;
+                        all &= self.elems[g].phase == Phase::Complete;
+                    }
+                    if all {
+                        self.end_elem(a);
+                    }
+                }
+                Phase::Complete => {}
+            }
+        }
+        if self.elems[s]
+            .children
+            .iter()
+            .all(|&a| self.elems[a].phase == Phase::Complete)
+            && self.elems[s].phase == Phase::Running
+        {
+            self.end_elem(s);
+        }
+        Ok(())
+    }
+
+    fn start_group(&mut self, g: usize, t: f64) -> Result<(), StoryError> {
+        self.start_elem(g, t)?;
+        for man in self.elems[g].children.clone() {
+            self.start_elem(man, t)?;
+            for ev in self.elems[man].children.clone() {
+                let e = &mut self.elems[ev];
+                e.phase = Phase::Standby;
+                e.runs = 0;
+            }
+        }
+        Ok(())
+    }
+
+    fn run_group(&mut self, g: usize, t: f64) -> Result<(), StoryError> {
+        if self.elems[g].phase != Phase::Running {
+            return Ok(());
+        }
+        let mut all = true;
+        for man in self.elems[g].children.clone() {
+            self.run_maneuver(man, t)?;
+            all &= self.elems[man].phase == Phase::Complete;
+        }
+        if all {
+            self.elems[g].runs += 1;
+            if self.elems[g].runs < self.elems[g].max_runs {
+                let runs = self.elems[g].runs;
+                self.start_group(g, t)?;
+                self.elems[g].runs = runs;
+            } else {
+                self.end_elem(g);
+            }
+        }
+        Ok(())
+    }
+
+    fn run_maneuver(&mut self, man: usize, t: f64) -> Result<(), StoryError> {
+        if self.elems[man].phase != Phase::Running {
+            return Ok(());
+        }
+        let events = self.elems[man].children.clone();
+        for &ev in &events {
+            if self.elems[ev].phase != Phase::Standby {
+                continue;
+            }
+            if !self.elems[ev].start.is_none_or(|k| self.trigger_now[k]) {
+                continue;
+            }
+            let others: Vec<usize> = events
+                .iter()
+                .copied()
+                .filter(|&o| o != ev && self.elems[o].phase == Phase::Running)
+                .collect();
+            match self.elems[ev].priority {
+                Priority::Skip if !others.is_empty() => {
+                    self.elems[ev].moves.skip = true;
+                    continue;
+                }
+                Priority::Override => {
+                    for o in others {
+                        self.stop_elem(o);
+                    }
+                }
+                _ => {}
+            }
+            self.start_elem(ev, t)?;
+            self.elems[ev].runs += 1;
+            for a in self.elems[ev].children.clone() {
+                self.start_action(a, t)?;
+            }
+        }
+        for &ev in &events {
+            if self.elems[ev].phase == Phase::Running
+                && self.elems[ev]
+                    .children
+                    .iter()
+                    .all(|&a| self.elems[a].phase == Phase::Complete)
+            {
+                self.end_elem(ev);
+                if self.elems[ev].runs < self.elems[ev].max_runs {
+                    self.elems[ev].phase = Phase::Standby;
+                }
+            }
+        }
+        if events
+            .iter()
+            .all(|&ev| self.elems[ev].phase == Phase::Complete)
+        {
+            self.end_elem(man);
+        }
+        Ok(())
+    }
+
+    fn start_elem(&mut self, i: usize, _t: f64) -> Result<(), StoryError> {
+        let e = &mut self.elems[i];
+        e.phase = Phase::Running;
+        e.moves.start = true;
+        Ok(())
+    }
+
+    fn end_elem(&mut self, i: usize) {
+        let e = &mut self.elems[i];
+        if e.phase != Phase::Complete {
+            e.phase = Phase::Complete;
+            e.moves.end = true;
+        }
+    }
+
+    /// Stops element `i` and everything running below it (their entity tasks end).
+    fn stop_elem(&mut self, i: usize) {
+        for c in self.elems[i].children.clone() {
+            if self.elems[c].phase != Phase::Complete {
+                self.stop_elem(c);
+            }
+        }
+        if self.elems[i].kind == Kind::Action {
+            for d in &mut self.drives {
+                if d.speed.as_ref().is_some_and(|s| s.2 == i) {
+                    d.speed = None;
+                }
+                if d.lateral.as_ref().is_some_and(|s| s.2 == i) {
+                    d.lateral = None;
+                }
+                if d.path.as_ref().is_some_and(|s| s.1 == i) {
+                    d.path = None;
+                }
+            }
+            self.elems[i].pending = 0;
+        }
+        let e = &mut self.elems[i];
+        e.phase = Phase::Complete;
+        e.moves.stop = true;
+    }
+
+    fn start_action(&mut self, a: usize, t: f64) -> Result<(), StoryError> {
+        self.start_elem(a, t)?;
+        let Some((action, actors)) = self.elems[a].action.clone() else {
+            return Ok(());
+        };
+        for e in actors {
+            self.start_task(e, &action, Some(a), t)?;
+        }
+        if self.elems[a].pending == 0 {
+            self.end_elem(a);
+        }
+        Ok(())
+    }
+
+    /// A task of action `a` (an element, `None` in `Init`) ended.
+    fn task_done(&mut self, a: Option<usize>) {
+        if let Some(a) = a {
+            let e = &mut self.elems[a];
+            e.pending = e.pending.saturating_sub(1);
+            if e.pending == 0 && e.phase == Phase::Running {
+                self.end_elem(a);
+            }
+        }
+    }
+
+    /// Where `p` is now: its pose and its place on the lanes.
+    ///
+    /// # Errors
+    /// [`StoryError`] for a position off the map.
+    pub fn resolve(
+        &self,
+        p: &Position,
+        at: &paracosm_openscenario::Pos,
+    ) -> Result<(Pose, Option<LanePos>), StoryError> {
+        let bad = |message: String| StoryError {
+            at: site(at),
+            message,
+        };
+        let orient = |o: &Option<m::Orientation>, base: f64| match o {
+            Some(o) if o.relative => wrap(base + o.h),
+            Some(o) => wrap(o.h),
+            None => base,
+        };
+        Ok(match p {
+            Position::World { x, y, h } => {
+                let pose = Pose {
+                    x: *x,
+                    y: *y,
+                    h: h.unwrap_or(0.0),
+                };
+                (pose, self.facing(self.roads.anchor(*x, *y), pose.h))
+            }
+            Position::RelativeWorld {
+                entity,
+                dx,
+                dy,
+                orientation,
+            } => {
+                let r = self.actors[*entity].state.pose;
+                let (x, y) = (r.x + dx, r.y + dy);
+                let pose = Pose {
+                    x,
+                    y,
+                    h: orient(orientation, r.h),
+                };
+                (pose, self.facing(self.roads.anchor(x, y), pose.h))
+            }
+            Position::RelativeObject {
+                entity,
+                dx,
+                dy,
+                orientation,
+            } => {
+                let r = self.actors[*entity].state.pose;
+                let (c, s) = (r.h.cos(), r.h.sin());
+                let (x, y) = (r.x + c * dx - s * dy, r.y + s * dx + c * dy);
+                let pose = Pose {
+                    x,
+                    y,
+                    h: orient(orientation, r.h),
+                };
+                (pose, self.facing(self.roads.anchor(x, y), pose.h))
+            }
+            Position::Road {
+                road,
+                s,
+                t,
+                orientation,
+            } => {
+                let lp = self.roads.road_pos(road, *s, *t).map_err(bad)?;
+                let h = orient(orientation, self.roads.along_heading(&lp));
+                let lp = self.roads.facing(lp, h);
+                let pose = Pose {
+                    h,
+                    ..self.roads.pose_of(&lp)
+                };
+                (pose, Some(lp))
+            }
+            Position::Lane {
+                road,
+                lane,
+                s,
+                offset,
+                orientation,
+            } => {
+                let lp = self.roads.lane_pos(road, *lane, *s, *offset).map_err(bad)?;
+                // Without an orientation, along the road's reference line (esmini's reading).
+                let h = orient(orientation, self.roads.along_heading(&lp));
+                let lp = self.roads.facing(lp, h);
+                let pose = Pose {
+                    h,
+                    ..self.roads.pose_of(&lp)
+                };
+                (pose, Some(lp))
+            }
+            Position::RelativeLane {
+                entity,
+                d_lane,
+                ds,
+                offset,
+            } => {
+                let r = &self.actors[*entity];
+                let Some(lp) = r.state.lane else {
+                    return Err(bad(format!(
+                        "a RelativeLanePosition to {}, which is not on a lane",
+                        r.name
+                    )));
+                };
+                let lp = self
+                    .roads
+                    .relative_lane(&lp, *d_lane, *ds, *offset)
+                    .map_err(bad)?;
+                (self.roads.pose_of(&lp), Some(lp))
+            }
+        })
+    }
+
+    /// Starts action `action` on entity `e` at `t` (s), for action element `a` (`None` in
+    /// `Init`).
+    fn start_task(
+        &mut self,
+        e: usize,
+        action: &m::NamedAction,
+        a: Option<usize>,
+        t: f64,
+    ) -> Result<(), StoryError> {
+        let bad = |message: String| StoryError {
+            at: site(&action.pos),
+            message,
+        };
+        let scripted = self.actors[e].scripted;
+        let begin = |sb: &mut Storyboard| {
+            if let Some(a) = a {
+                sb.elems[a].pending += 1;
+            }
+        };
+        match &action.action {
+            Action::Teleport(p) => {
+                if scripted || a.is_none() {
+                    let (pose, lane) = self.resolve(p, &action.pos)?;
+                    let st = &mut self.actors[e].state;
+                    st.pose = pose;
+                    st.lane = lane;
+                    let d = &mut self.drives[e];
+                    d.path = None;
+                    d.lateral = None;
+                }
+            }
+            Action::Speed { target, dynamics } => {
+                let v0 = self.actors[e].state.speed;
+                let (to, track) = match target {
+                    SpeedTarget::Absolute(v) => (*v, None),
+                    SpeedTarget::Relative {
+                        entity,
+                        value,
+                        factor,
+                        continuous,
+                    } => {
+                        let r = self.actors[*entity].state.speed;
+                        let v = if *factor { r * value } else { r + value };
+                        (v, continuous.then_some((*entity, *value, *factor)))
+                    }
+                };
+                if !scripted {
+                    // The ego's initial speed; later, the system under test drives it.
+                    if a.is_none() {
+                        self.actors[e].state.speed = to.max(0.0);
+                    }
+                    return Ok(());
+                }
+                let tr = Transition {
+                    from: v0,
+                    to: to.max(0.0),
+                    start_s: t,
+                    duration_s: duration_s(dynamics, to - v0, 0.5 * (v0 + to).abs()),
+                    shape: dynamics.shape,
+                };
+                if a.is_none() && tr.duration_s == 0.0 {
+                    self.actors[e].state.speed = tr.to;
+                    return Ok(());
+                }
+                let old = self.drives[e].speed.take().map(|s| s.2);
+                self.override_task(old);
+                begin(self);
+                self.drives[e].speed = Some((tr, track, a.unwrap_or(usize::MAX)));
+            }
+            Action::LaneChange {
+                target,
+                dynamics,
+                offset_m,
+            } => {
+                if !scripted {
+                    return Ok(());
+                }
+                let st = self.actors[e].state;
+                let Some(lp) = st.lane else {
+                    return Err(bad(format!(
+                        "a LaneChangeAction for {}, which is not on a lane",
+                        self.actors[e].name
+                    )));
+                };
+                let id = match target {
+                    LaneTarget::Absolute(id) => *id,
+                    LaneTarget::Relative { entity, lanes } => {
+                        let Some(rl) = self.actors[*entity].state.lane else {
+                            return Err(bad(format!(
+                                "a lane change relative to {}, which is not on a lane",
+                                self.actors[*entity].name
+                            )));
+                        };
+                        let mut id = self.roads.ids(rl.lane).0;
+                        for _ in 0..lanes.unsigned_abs() {
+                            id += lanes.signum();
+                            if id == 0 {
+                                id += lanes.signum();
+                            }
+                        }
+                        id
+                    }
+                };
+                let to_lane = self.roads.lane_with_id(lp.lane, id, lp.s).ok_or_else(|| {
+                    bad(format!(
+                        "{}'s road has no lane {id} at s = {:.1} m",
+                        self.actors[e].name, lp.s
+                    ))
+                })?;
+                let target_d = self.roads.lateral_between(lp.lane, to_lane, lp.s) + offset_m;
+                let tr = Transition {
+                    from: lp.d,
+                    to: target_d,
+                    start_s: t,
+                    duration_s: duration_s(dynamics, target_d - lp.d, st.speed.abs()),
+                    shape: dynamics.shape,
+                };
+                let old = self.drives[e].lateral.take().map(|s| s.2);
+                self.override_task(old);
+                begin(self);
+                self.drives[e].lateral = Some((
+                    tr,
+                    Some((to_lane, *offset_m)),
+                    a.unwrap_or(usize::MAX),
+                    false,
+                ));
+            }
+            Action::LaneOffset {
+                target,
+                shape,
+                max_lateral_acc,
+                continuous,
+            } => {
+                if !scripted {
+                    return Ok(());
+                }
+                let Some(lp) = self.actors[e].state.lane else {
+                    return Err(bad(format!(
+                        "a LaneOffsetAction for {}, which is not on a lane",
+                        self.actors[e].name
+                    )));
+                };
+                let to = match target {
+                    OffsetTarget::Absolute(v) => *v,
+                    OffsetTarget::Relative { entity, value } => {
+                        self.actors[*entity].state.lane.map_or(0.0, |l| l.d) + value
+                    }
+                };
+                let acc = max_lateral_acc.unwrap_or(DEFAULT_LATERAL_ACC_MPS2);
+                let tr = Transition {
+                    from: lp.d,
+                    to,
+                    start_s: t,
+                    duration_s: offset_duration_s(*shape, to - lp.d, acc),
+                    shape: *shape,
+                };
+                let old = self.drives[e].lateral.take().map(|s| s.2);
+                self.override_task(old);
+                begin(self);
+                self.drives[e].lateral = Some((tr, None, a.unwrap_or(usize::MAX), *continuous));
+            }
+            Action::LongitudinalDistance {
+                entity,
+                distance_m,
+                time_gap_s,
+                freespace,
+                displacement,
+                ..
+            } => {
+                if !scripted {
+                    return Ok(());
+                }
+                self.place_at_distance(
+                    e,
+                    *entity,
+                    (*distance_m, *time_gap_s, *freespace),
+                    displacement,
+                )
+                .map_err(bad)?;
+            }
+            Action::FollowTrajectory { vertices, timing } => {
+                if !scripted {
+                    return Ok(());
+                }
+                let mut poses = Vec::new();
+                for (_, p) in vertices {
+                    poses.push(self.resolve(p, &action.pos)?.0);
+                }
+                let timed = vertices.iter().all(|(time, _)| time.is_some());
+                let path = match timing {
+                    Some((absolute, scale, offset)) if timed => {
+                        let base = if *absolute { 0.0 } else { t };
+                        Path::Timed(Timed {
+                            vertices: vertices
+                                .iter()
+                                .zip(poses)
+                                .map(|((time, _), p)| {
+                                    (base + time.unwrap_or(0.0) * scale + offset, p)
+                                })
+                                .collect(),
+                        })
+                    }
+                    _ => Path::Untimed(Untimed {
+                        vertices: poses,
+                        gone_m: 0.0,
+                    }),
+                };
+                let d = &mut self.drives[e];
+                let old = [d.path.take().map(|p| p.1), d.lateral.take().map(|l| l.2)];
+                for o in old {
+                    self.override_task(o);
+                }
+                begin(self);
+                self.drives[e].path = Some((path, a.unwrap_or(usize::MAX)));
+            }
+            Action::AssignRoute { waypoints } => {
+                let mut roads = Vec::new();
+                for (p, _) in waypoints {
+                    if let (_, Some(lp)) = self.resolve(p, &action.pos)? {
+                        roads.push(self.roads.ids(lp.lane).1);
+                    }
+                }
+                self.drives[e].prefer_roads = roads;
+            }
+            Action::ActivateController { .. } => {}
+        }
+        Ok(())
+    }
+
+    /// `lp` (if any) facing `h`.
+    fn facing(&self, lp: Option<LanePos>, h: f64) -> Option<LanePos> {
+        lp.map(|lp| self.roads.facing(lp, h))
+    }
+
+    /// A task replaced by a new one of the same kind on the same entity ends (its action
+    /// completes once all its tasks have).
+    fn override_task(&mut self, a: Option<usize>) {
+        if let Some(a) = a.filter(|&a| a != usize::MAX) {
+            self.task_done(Some(a));
+        }
+    }
+
+    /// Puts entity `e` on `reference`'s lane at a distance `(distance, time gap, freespace)`
+    /// ahead of it (`leadingReferencedEntity`, or `any` when ahead now) or behind it.
+    fn place_at_distance(
+        &mut self,
+        e: usize,
+        reference: usize,
+        (distance, gap_s, freespace): (Option<f64>, Option<f64>, bool),
+        displacement: &str,
+    ) -> Result<(), String> {
+        let r = self.actors[reference].clone();
+        let me = self.actors[e].clone();
+        let Some(rl) = r.state.lane else {
+            return Err(format!(
+                "a LongitudinalDistanceAction to {}, which is not on a lane",
+                r.name
+            ));
+        };
+        let gap = match (distance, gap_s) {
+            (Some(d), _) => d,
+            (None, Some(g)) => g * r.state.speed.abs(),
+            (None, None) => 0.0,
+        };
+        let ahead = match displacement {
+            "trailingReferencedEntity" => false,
+            "leadingReferencedEntity" => true,
+            _ => {
+                let p = me.state.pose;
+                let (dx, dy) = (p.x - r.state.pose.x, p.y - r.state.pose.y);
+                dx * r.state.pose.h.cos() + dy * r.state.pose.h.sin() >= 0.0
+            }
+        };
+        let ds = match (freespace, ahead) {
+            (false, true) => gap,
+            (false, false) => -gap,
+            (true, true) => {
+                gap + (r.centre_m[0] + r.size_m[0] / 2.0) - (me.centre_m[0] - me.size_m[0] / 2.0)
+            }
+            (true, false) => {
+                -(gap + (me.centre_m[0] + me.size_m[0] / 2.0) - (r.centre_m[0] - r.size_m[0] / 2.0))
+            }
+        };
+        let mut lp = rl;
+        if ds >= 0.0 {
+            let prefer = |_: usize| false;
+            self.roads.advance(&mut lp, ds, &prefer);
+        } else {
+            let up = lp.along_s(&self.roads);
+            let s = lp.s + if up { ds } else { -ds };
+            let (id, road) = self.roads.ids(lp.lane);
+            let road = self.roads.map().roads[road].od_id.clone();
+            let rev = lp.rev;
+            lp = self.roads.lane_pos(&road, id, s, lp.d)?;
+            lp.rev = rev;
+        }
+        let st = &mut self.actors[e].state;
+        st.pose = self.roads.pose_of(&lp);
+        st.lane = Some(lp);
+        Ok(())
+    }
+
+    /// Moves scripted entity `e` from `t` to `t + dt`.
+    fn drive(&mut self, e: usize, t: f64, dt: f64) -> Result<(), StoryError> {
+        let t1 = t + dt;
+        let st = self.actors[e].state;
+        // Speed.
+        let mut v1 = st.speed;
+        let mut done = Vec::new();
+        if let Some((tr, track, a)) = self.drives[e].speed {
+            let (v, over) = tr.at(t1);
+            v1 = v;
+            if over {
+                match track {
+                    Some((r, value, factor)) => {
+                        let rv = self.actors[r].state.speed;
+                        v1 = if factor { rv * value } else { rv + value };
+                    }
+                    None => {
+                        self.drives[e].speed = None;
+                        done.push(a);
+                    }
+                }
+            }
+        }
+        v1 = v1.max(0.0);
+        let dist = 0.5 * (st.speed + v1) * dt;
+        let mut pose = st.pose;
+        let mut lane = st.lane;
+        let mut at_end = false;
+        let mut speed_now = v1;
+        if let Some((path, a)) = &mut self.drives[e].path {
+            let (p, over) = match path {
+                Path::Timed(p) => p.at(t1),
+                Path::Untimed(u) => u.advance(dist),
+            };
+            let timed = matches!(path, Path::Timed(_));
+            let a = *a;
+            if timed {
+                speed_now = (p.x - pose.x).hypot(p.y - pose.y) / dt;
+            }
+            pose = p;
+            lane = self.facing(self.roads.anchor(p.x, p.y), p.h);
+            if over {
+                self.drives[e].path = None;
+                if timed {
+                    speed_now = 0.0;
+                }
+                done.push(a);
+            }
+        } else if let Some(mut lp) = lane {
+            let prefer_roads = self.drives[e].prefer_roads.clone();
+            let prefer = |n: usize| prefer_roads.contains(&self.roads.ids(n).1);
+            at_end = !self.roads.advance(&mut lp, dist, &prefer);
+            let d0 = lp.d;
+            if let Some((tr, to_lane, a, continuous)) = self.drives[e].lateral {
+                let (d, over) = tr.at(t1);
+                lp.d = d;
+                if over {
+                    if let Some((k, offset)) = to_lane {
+                        // Re-anchored on the target lane when it is beside the entity here.
+                        if self.roads.ids(k).1 == self.roads.ids(lp.lane).1 {
+                            let id = self.roads.ids(k).0;
+                            if let Some(k2) = self.roads.lane_with_id(lp.lane, id, lp.s) {
+                                let up = lp.along_s(&self.roads);
+                                lp.lane = k2;
+                                lp.rev = self.roads.forward(k2) != up;
+                                lp.d = offset;
+                            }
+                        }
+                    }
+                    if !continuous {
+                        self.drives[e].lateral = None;
+                        done.push(a);
+                    }
+                }
+            }
+            let travel = self.roads.travel_heading(&lp);
+            let side = if lp.along_s(&self.roads) { 1.0 } else { -1.0 };
+            let slip = if dist > 1e-9 {
+                (side * (lp.d - d0)).atan2(dist)
+            } else {
+                0.0
+            };
+            let turning = dist > 1e-9 || (lp.d - d0).abs() > 1e-12;
+            let h = if turning { wrap(travel + slip) } else { pose.h };
+            pose = self.roads.pose_of(&lp);
+            // Standing still, it keeps the way it faces.
+            pose.h = h;
+            lane = Some(lp);
+        } else {
+            pose.x += dist * pose.h.cos();
+            pose.y += dist * pose.h.sin();
+        }
+        let moved = (pose.x - st.pose.x).hypot(pose.y - st.pose.y);
+        let s = &mut self.actors[e].state;
+        s.accel = (speed_now - s.speed) / dt;
+        s.speed = speed_now;
+        s.pose = pose;
+        s.lane = lane;
+        s.travelled_m += moved;
+        s.still_s = if speed_now.abs() < 1e-3 {
+            s.still_s + dt
+        } else {
+            0.0
+        };
+        s.at_end_s = if at_end { s.at_end_s + dt } else { 0.0 };
+        for a in done {
+            self.override_task(Some(a));
+        }
+        Ok(())
+    }
+
+    fn evaluate(&mut self, k: usize, t: f64) -> bool {
+        let mut any = false;
+        for g in 0..self.triggers[k].len() {
+            let mut all = true;
+            for c in 0..self.triggers[k][g].len() {
+                let raw = self.condition(&self.triggers[k][g][c].cond.kind, t);
+                let cond = &mut self.triggers[k][g][c];
+                let edged = match cond.cond.edge {
+                    Edge::None => raw,
+                    Edge::Rising => raw && !cond.prev,
+                    Edge::Falling => !raw && cond.prev,
+                    Edge::RisingOrFalling => raw != cond.prev,
+                };
+                cond.prev = raw;
+                // With a delay, the condition's value `delay` seconds ago.
+                let value = if cond.cond.delay_s > 0.0 {
+                    cond.history.push_back((t, edged));
+                    let cut = t - cond.cond.delay_s + 1e-9;
+                    let mut v = false;
+                    while let Some(&(ts, e)) = cond.history.front() {
+                        if ts <= cut {
+                            v |= e;
+                            cond.history.pop_front();
+                        } else {
+                            break;
+                        }
+                    }
+                    v
+                } else {
+                    edged
+                };
+                all &= value;
+            }
+            any |= all;
+        }
+        any
+    }
+
+    fn condition(&self, kind: &ConditionKind, t: f64) -> bool {
+        match kind {
+            ConditionKind::SimulationTime { rule, value } => rule.holds(t, *value),
+            ConditionKind::ElementState {
+                element_type,
+                element,
+                state,
+            } => self.elems.iter().any(|e| {
+                e.kind.name().eq_ignore_ascii_case(element_type)
+                    && e.name == *element
+                    && match state.as_str() {
+                        "startTransition" => e.last.start,
+                        "endTransition" => e.last.end,
+                        "stopTransition" => e.last.stop,
+                        "skipTransition" => e.last.skip,
+                        "completeState" => e.phase == Phase::Complete,
+                        "runningState" => e.phase == Phase::Running,
+                        "standbyState" => e.phase == Phase::Standby,
+                        _ => false,
+                    }
+            }),
+            ConditionKind::Parameter { name, rule, value } => {
+                let Some((_, v)) = self.params.iter().find(|(n, _)| n == name) else {
+                    return false;
+                };
+                match (v.trim().parse::<f64>(), value.trim().parse::<f64>()) {
+                    (Ok(a), Ok(b)) => rule.holds(a, b),
+                    _ => match rule {
+                        Rule::Eq => v == value,
+                        Rule::Ne => v != value,
+                        _ => false,
+                    },
+                }
+            }
+            ConditionKind::Entity {
+                entities,
+                all,
+                test,
+            } => {
+                let mut hits = entities.iter().map(|&e| self.entity_test(e, test));
+                if *all {
+                    hits.all(|h| h)
+                } else {
+                    hits.any(|h| h)
+                }
+            }
+        }
+    }
+
+    fn entity_test(&self, e: usize, test: &EntityTest) -> bool {
+        let st = &self.actors[e].state;
+        match test {
+            EntityTest::TimeHeadway(g) => {
+                let (long, _, _) = self.gap(e, g);
+                let h = if long > 0.0 && st.speed > 1e-9 {
+                    long / st.speed
+                } else {
+                    f64::INFINITY
+                };
+                g.rule.holds(h, g.value)
+            }
+            EntityTest::TimeToCollision(g) => {
+                let (long, _, closing) = self.gap(e, g);
+                let ttc = if long >= 0.0 && closing > 1e-9 {
+                    long / closing
+                } else {
+                    f64::INFINITY
+                };
+                g.rule.holds(ttc, g.value)
+            }
+            EntityTest::RelativeDistance(g) => {
+                let (long, lat, _) = self.gap(e, g);
+                let d = match g.kind.as_str() {
+                    "longitudinal" => long.abs(),
+                    "lateral" => lat.abs(),
+                    _ => long.hypot(lat),
+                };
+                g.rule.holds(d, g.value)
+            }
+            EntityTest::ReachPosition {
+                position,
+                tolerance,
+            } => {
+                let at = paracosm_openscenario::Pos {
+                    file: String::new(),
+                    line: 0,
+                    col: 0,
+                };
+                self.resolve(position, &at)
+                    .is_ok_and(|(p, _)| (p.x - st.pose.x).hypot(p.y - st.pose.y) <= *tolerance)
+            }
+            EntityTest::Speed { rule, value } => rule.holds(st.speed, *value),
+            EntityTest::RelativeSpeed {
+                entity,
+                rule,
+                value,
+            } => rule.holds(st.speed - self.actors[*entity].state.speed, *value),
+            EntityTest::Acceleration { rule, value } => rule.holds(st.accel, *value),
+            EntityTest::Standstill(d) => st.still_s >= *d - 1e-9,
+            EntityTest::TraveledDistance(d) => st.travelled_m >= *d,
+            EntityTest::EndOfRoad(d) => st.at_end_s > 0.0 && st.at_end_s >= *d - 1e-9,
+            EntityTest::Collision(other) => match other {
+                Some(o) => st.collided && self.touching(e, *o),
+                None => st.collided,
+            },
+        }
+    }
+
+    /// The longitudinal and lateral distances from entity `e` to `g`'s entity in `e`'s frame
+    /// (m; between bounding boxes with `freespace`, between reference points otherwise) and
+    /// the speed at which `e` closes in on it along its heading (m/s).
+    fn gap(&self, e: usize, g: &Gap) -> (f64, f64, f64) {
+        let (a, b) = (&self.actors[e], &self.actors[g.entity]);
+        let h = a.state.pose.h;
+        let (c, s) = (h.cos(), h.sin());
+        let centre = |x: &Actor| {
+            let p = x.state.pose;
+            let (cc, ss) = (p.h.cos(), p.h.sin());
+            (
+                p.x + cc * x.centre_m[0] - ss * x.centre_m[1],
+                p.y + ss * x.centre_m[0] + cc * x.centre_m[1],
+            )
+        };
+        let (pa, pb) = if g.freespace {
+            (centre(a), centre(b))
+        } else {
+            (
+                (a.state.pose.x, a.state.pose.y),
+                (b.state.pose.x, b.state.pose.y),
+            )
+        };
+        let (dx, dy) = (pb.0 - pa.0, pb.1 - pa.1);
+        let mut long = dx * c + dy * s;
+        let mut lat = -dx * s + dy * c;
+        if g.freespace {
+            // Half the extent of each box along and across `e`'s heading.
+            let rel = b.state.pose.h - h;
+            let half_long_b = 0.5 * (b.size_m[0] * rel.cos().abs() + b.size_m[1] * rel.sin().abs());
+            let half_lat_b = 0.5 * (b.size_m[0] * rel.sin().abs() + b.size_m[1] * rel.cos().abs());
+            let shrink = |d: f64, half: f64| d.signum() * (d.abs() - half).max(0.0);
+            long = shrink(long, a.size_m[0] / 2.0 + half_long_b);
+            lat = shrink(lat, a.size_m[1] / 2.0 + half_lat_b);
+        }
+        let vb = b.state.speed * (b.state.pose.h - h).cos();
+        let closing = if long >= 0.0 {
+            a.state.speed - vb
+        } else {
+            vb - a.state.speed
+        };
+        (long, lat, closing)
+    }
+
+    /// Whether the bounding boxes of `a` and `b` touch (within 5 cm).
+    fn touching(&self, a: usize, b: usize) -> bool {
+        let g = Gap {
+            entity: b,
+            rule: Rule::Lt,
+            value: 0.0,
+            freespace: true,
+            frame: "entity".into(),
+            kind: "euclidianDistance".into(),
+        };
+        let (long, lat, _) = self.gap(a, &g);
+        long.abs() <= 0.05 && lat.abs() <= 0.05
+    }
+
+    /// The R157-style measures of entity `e`: its time headway (s) and following distance (m,
+    /// between bounding boxes) to the nearest entity ahead of it in its lane (within the two
+    /// half-widths sideways), `inf` with none; and the distance from its box's side to its
+    /// lane's nearer edge (m, negative once over it; `nan` off every lane).
+    pub fn measures(&self, e: usize) -> (f64, f64, f64) {
+        let a = &self.actors[e];
+        let mut gap_m = f64::INFINITY;
+        for (j, b) in self.actors.iter().enumerate() {
+            if j == e {
+                continue;
+            }
+            let g = Gap {
+                entity: j,
+                rule: Rule::Lt,
+                value: 0.0,
+                freespace: true,
+                frame: "entity".into(),
+                kind: "longitudinal".into(),
+            };
+            let (long, lat, _) = self.gap(e, &g);
+            let _ = b;
+            if long >= 0.0 && lat == 0.0 {
+                gap_m = gap_m.min(long);
+            }
+        }
+        let headway_s = if a.state.speed > 1e-9 {
+            gap_m / a.state.speed
+        } else {
+            f64::INFINITY
+        };
+        let edge_m = match a.state.lane {
+            Some(lp) => {
+                let w = self.roads.lane_width(lp.lane, lp.s);
+                w / 2.0 - lp.d.abs() - a.size_m[1] / 2.0
+            }
+            None => f64::NAN,
+        };
+        (headway_s, gap_m, edge_m)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_are_named_as_the_standard_names_them() {
+        assert_eq!(Kind::Group.name(), "maneuverGroup");
+        assert!(Kind::Action.name().eq_ignore_ascii_case("ACTION"));
+    }
+}
