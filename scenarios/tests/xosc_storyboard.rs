@@ -83,14 +83,17 @@ fn the_crossing_pedestrian_crosses_at_its_speed_when_the_ego_is_its_headway_away
     // Lateral offset -5 m (right of the lane), 5 km/h, crossing 10 m: 7.2 s, starting when the
     // ego's time headway to it drops below 5 / (5 / 3.6) = 3.6 s.
     let mut started = None;
+    let mut arrived = None;
     let mut headway_then = 0.0;
     let end = run(&mut sb, 60.0, |t, sb| {
         let p = sb.actors[ped].state.pose;
         if started.is_none() && (p.y - start.y).abs() > 1e-6 {
             started = Some(t);
             let e = &sb.actors[ego].state;
-            // Freespace: from the ego's front bumper to the pedestrian's box.
             headway_then = (p.x - e.pose.x) / e.speed;
+        }
+        if arrived.is_none() && (p.y - (lane_y + 5.0)).abs() < 1e-6 {
+            arrived = Some((t, p));
         }
     });
     let t0 = started.expect("the pedestrian starts to cross");
@@ -100,22 +103,20 @@ fn the_crossing_pedestrian_crosses_at_its_speed_when_the_ego_is_its_headway_away
         (3.55..4.2).contains(&headway_then),
         "the crossing started at a headway of {headway_then} s"
     );
-    let p = sb.actors[ped].state.pose;
-    assert!(
-        (p.y - (lane_y + 5.0)).abs() < 0.05,
-        "it ends 5 m on the other side of the lane centre: {} vs {}",
-        p.y,
-        lane_y + 5.0
-    );
+    let (t1, p) = arrived.expect("it reaches 5 m on the other side of the lane centre");
     assert!(
         (p.x - start.x).abs() < 1e-6,
         "it crosses straight: from {start:?} to {p:?}"
     );
-    // The stop trigger: 200 m at 10 m/s plus 10 s.
-    assert!((end - 30.0).abs() < 2.0 * DT, "ended at {end} s");
     // 10 m at 5 km/h.
     let crossing = 10.0 / (5.0 / 3.6);
-    assert!(t0 + crossing < end);
+    assert!(
+        ((t1 - t0) - crossing).abs() < 2.0 * DT,
+        "crossed in {} s, not {crossing} s",
+        t1 - t0
+    );
+    // The stop trigger: 200 m at 10 m/s plus 10 s.
+    assert!((end - 30.0).abs() < 2.0 * DT, "ended at {end} s");
 }
 
 #[test]
@@ -208,4 +209,117 @@ fn every_alks_template_runs_to_its_stop_trigger() {
         ran += 1;
     }
     assert_eq!(ran, 15);
+}
+
+/// A start trigger counts only while its element waits: an event whose condition
+/// (`SimulationTime > 5`, `delay` 3 s) holds from the start, in an act that starts at 10 s,
+/// starts at 13 s, not at 10 s; and an element-state condition sees the transition of the
+/// step before (a second event starts on the first's `endTransition`).
+#[test]
+fn a_delay_counts_from_when_the_element_waits_and_transitions_are_seen_next_step() {
+    let road = alks("road_networks/alks_road_straight.xodr");
+    let file = std::env::temp_dir().join(format!("paracosm-delay-{}.xosc", std::process::id()));
+    let speed = |v: f64| {
+        format!(
+            r#"<PrivateAction><LongitudinalAction><SpeedAction>
+              <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
+              <SpeedActionTarget><AbsoluteTargetSpeed value="{v}"/></SpeedActionTarget>
+            </SpeedAction></LongitudinalAction></PrivateAction>"#
+        )
+    };
+    let vehicle = |name: &str| {
+        format!(
+            r#"<ScenarioObject name="{name}"><MiscObject name="box" miscObjectCategory="obstacle" mass="500">
+        <BoundingBox><Center x="0" y="0" z="0.75"/><Dimensions width="1.8" length="4" height="1.5"/></BoundingBox>
+        <Properties/></MiscObject></ScenarioObject>"#
+        )
+    };
+    let text = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<OpenSCENARIO>
+  <FileHeader revMajor="1" revMinor="2" date="2026-11-26T00:00:00" description="delay" author="paracosm"/>
+  <RoadNetwork><LogicFile filepath="{road}"/></RoadNetwork>
+  <Entities>{a}{b}</Entities>
+  <Storyboard>
+    <Init><Actions>
+      <Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>
+      <Private entityRef="B"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-3" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>
+    </Actions></Init>
+    <Story name="S">
+      <Act name="Late">
+        <ManeuverGroup maximumExecutionCount="1" name="G">
+          <Actors selectTriggeringEntities="false"><EntityRef entityRef="A"/><EntityRef entityRef="B"/></Actors>
+          <Maneuver name="M">
+            <Event name="First" priority="parallel">
+              <Action name="Go">{go}</Action>
+              <StartTrigger><ConditionGroup>
+                <Condition name="C" delay="3" conditionEdge="none">
+                  <ByValueCondition><SimulationTimeCondition value="5" rule="greaterThan"/></ByValueCondition>
+                </Condition>
+              </ConditionGroup></StartTrigger>
+            </Event>
+            <Event name="Second" priority="parallel">
+              <Action name="Faster">{faster}</Action>
+              <StartTrigger><ConditionGroup>
+                <Condition name="D" delay="0" conditionEdge="none">
+                  <ByValueCondition><StoryboardElementStateCondition storyboardElementType="event" storyboardElementRef="First" state="endTransition"/></ByValueCondition>
+                </Condition>
+              </ConditionGroup></StartTrigger>
+            </Event>
+          </Maneuver>
+        </ManeuverGroup>
+        <StartTrigger><ConditionGroup>
+          <Condition name="T" delay="0" conditionEdge="none">
+            <ByValueCondition><SimulationTimeCondition value="10" rule="greaterOrEqual"/></ByValueCondition>
+          </Condition>
+        </ConditionGroup></StartTrigger>
+      </Act>
+    </Story>
+    <StopTrigger><ConditionGroup>
+      <Condition name="End" delay="0" conditionEdge="none">
+        <ByValueCondition><SimulationTimeCondition value="20" rule="greaterOrEqual"/></ByValueCondition>
+      </Condition>
+    </ConditionGroup></StopTrigger>
+  </Storyboard>
+</OpenSCENARIO>
+"#,
+        road = road.display(),
+        a = vehicle("A"),
+        b = vehicle("B"),
+        go = speed(5.0),
+        faster = speed(10.0),
+    );
+    std::fs::write(&file, text).unwrap();
+    let model = read_scenario(&file, &[]).expect("reads");
+    std::fs::remove_file(&file).ok();
+    let road = model.road_network.as_ref().expect("a road network");
+    let map = MapRef::new(
+        opendrive::import(&road.item, &std::fs::read_to_string(&road.item).unwrap())
+            .unwrap()
+            .map,
+    );
+    let mut sb = Storyboard::new(&model, Roads::new(&map), None).expect("Init performs");
+    let (mut went, mut faster) = (None, None);
+    run(&mut sb, 30.0, |t, sb| {
+        let v = sb.actors[0].state.speed;
+        if went.is_none() && v > 0.0 {
+            went = Some(t);
+        }
+        if faster.is_none() && v > 5.0 {
+            faster = Some(t);
+        }
+    });
+    let went = went.expect("the first event starts");
+    // The act starts at 10 s; its event's trigger waits from the next step, true at once,
+    // and reports 3 s later.
+    assert!(
+        (13.0..13.1).contains(&went),
+        "the first event started at {went} s"
+    );
+    let faster = faster.expect("the second event starts");
+    assert!(
+        faster > went && faster - went < 4.0 * DT,
+        "the second event started {} s after the first",
+        faster - went
+    );
 }

@@ -194,7 +194,9 @@ pub fn campaign_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Err
             if sets.iter().any(|s| s == name) {
                 for pair in text.split(", ") {
                     let (n, v) = pair.split_once('=').ok_or_else(|| {
-                        format!("{name}: the value set {text:?} is not Name=value")
+                        paracosm_scenarios::xosc::OverrideError(format!(
+                            "{name}: the value set {text:?} is not Name=value"
+                        ))
                     })?;
                     out.push((n.to_owned(), v.to_owned()));
                 }

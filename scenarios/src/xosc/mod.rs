@@ -45,7 +45,13 @@ const ROUTE_M: f64 = 3000.0;
 /// The parameter values of one test as OpenSCENARIO overrides (`name`, value text), from the
 /// test's assignment (a value set's index expands to its parameters, for example).
 pub type Overrides =
-    Arc<dyn Fn(&Assignment) -> Result<Vec<(String, String)>, String> + Send + Sync>;
+    Arc<dyn Fn(&Assignment) -> Result<Vec<(String, String)>, OverrideError> + Send + Sync>;
+
+/// Why a test's values cannot be written as overrides (a value set that is not
+/// `Name=value, ...`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct OverrideError(pub String);
 
 /// What a campaign over an OpenSCENARIO scenario needs.
 pub struct Source {
@@ -166,6 +172,14 @@ pub fn check(s: &m::Scenario, ego: usize) -> Result<Vec<Warning>, ScenarioError>
         .flat_map(|st| &st.acts)
         .flat_map(|a| &a.groups)
     {
+        if g.select_triggering {
+            return Err(worlds_error(format!(
+                "{}: maneuver group {:?} selects its actors from the triggering entities \
+                 (selectTriggeringEntities=\"true\"), which paracosm does not support: name \
+                 the actors with EntityRef",
+                s.file, g.name
+            )));
+        }
         for na in g
             .maneuvers
             .iter()
@@ -259,7 +273,7 @@ impl Worlds for XoscWorlds {
         assignment: &Assignment,
         run: &mut dyn FnMut(&Scene, &mut dyn Host),
     ) -> Result<(), ScenarioError> {
-        let overrides = (self.overrides)(assignment).map_err(worlds_error)?;
+        let overrides = (self.overrides)(assignment).map_err(|e| worlds_error(e.0))?;
         let model = read_scenario(&self.template, &overrides).map_err(xosc_error)?;
         let (scene, mut host) = self.build(&model)?;
         run(&scene, &mut host);
@@ -308,65 +322,7 @@ impl XoscWorlds {
                 site.clone(),
             )
             .map_err(|e| worlds_error(e.to_string()))?;
-        let zero = scene.push(Node::Const(Value::Num(0.0)));
-        let mut sinks = Vec::new();
-        let mut probes = Vec::new();
-        let mut ego_actor = None;
-        for (i, ent) in model.entities.iter().enumerate() {
-            let name = ent.name.clone();
-            let at = here(&ent.pos, &name);
-            let (pos, heading) = sb.engine_pose(i);
-            let size = Size {
-                length_m: ent.dimensions_m[0].max(0.1),
-                width_m: ent.dimensions_m[1].max(0.1),
-                height_m: ent.dimensions_m[2].max(0.1),
-            };
-            let actor = if i == ego {
-                let a = scene.declare_ego(name.clone(), at);
-                ego_actor = Some(a);
-                a
-            } else if matches!(ent.kind, EntityKind::Pedestrian(_)) {
-                let a = scene.declare_pedestrian(name.clone(), at);
-                scene
-                    .place_pedestrian(
-                        a,
-                        PedestrianSpec {
-                            start: pos,
-                            target: pos,
-                            speed: zero,
-                            name: format!("Pedestrian {name} ({})", ent.pos),
-                        },
-                    )
-                    .map_err(|e| worlds_error(e.to_string()))?;
-                a
-            } else {
-                let a = scene.declare_car(name.clone(), at);
-                let ahead = [pos[0] + 0.5 * heading.cos(), pos[2] - 0.5 * heading.sin()];
-                scene
-                    .place_car(
-                        a,
-                        CarSpec {
-                            path: vec![[pos[0], pos[2]], ahead],
-                            speed: zero,
-                            color: "white".to_owned(),
-                            size,
-                            enabled: true,
-                            lane_change: None,
-                            lane_offsets_m: vec![],
-                            name: format!("Car {name} ({})", ent.pos),
-                            keep_distance_m: None,
-                        },
-                    )
-                    .map_err(|e| worlds_error(e.to_string()))?;
-                a
-            };
-            sinks.push(match actor {
-                ActorRef::Car(h) => Some(Sink::PlaceCar(h)),
-                ActorRef::Pedestrian(h) => Some(Sink::PlacePedestrian(h)),
-                _ => None,
-            });
-            probes.push(scene.probe(actor, Output::Collided));
-        }
+        let (sinks, probes, ego_actor) = place_entities(&mut scene, model, &sb, ego)?;
         let Some(ego_actor) = ego_actor else {
             return Err(worlds_error("no ego".into()));
         };
@@ -500,6 +456,8 @@ impl Host for StoryHost {
                     let hit = matches!(streams.current(*id), Some(Value::Bool(true)));
                     self.sb.set_collided(e, hit);
                 }
+                // The measures of the world at `t`, before the storyboard moves it on.
+                self.measures = self.sb.measures(self.ego);
                 self.sb
                     .step(t, DEFAULT_DT_S)
                     .map_err(|e| HostError(e.to_string()))?;
@@ -510,7 +468,6 @@ impl Host for StoryHost {
                             .push((*sink, Value::Tuple(vec![Value::Vec3(p), Value::Num(h)])));
                     }
                 }
-                self.measures = self.sb.measures(self.ego);
                 Ok(Value::Unit)
             }
             1 => Ok(Value::Num(self.measures.0)),
@@ -531,4 +488,82 @@ impl Host for StoryHost {
     fn ended(&self) -> bool {
         self.sb.ended
     }
+}
+
+/// The sinks that move each entity (none for the ego), each entity's `Collided` probe, and
+/// the ego's actor.
+type Placed = (Vec<Option<Sink>>, Vec<StreamId>, Option<ActorRef>);
+
+/// Declares every entity of `model` into `scene` where the storyboard's `Init` put it: the
+/// ego as the ego vehicle (placed later), pedestrians as pedestrians, other entities as cars,
+/// each standing still until the storyboard moves it.
+///
+/// # Errors
+/// [`ScenarioError::Load`] when the scene refuses an actor.
+fn place_entities(
+    scene: &mut Scene,
+    model: &m::Scenario,
+    sb: &Storyboard,
+    ego: usize,
+) -> Result<Placed, ScenarioError> {
+    let zero = scene.push(Node::Const(Value::Num(0.0)));
+    let mut sinks = Vec::new();
+    let mut probes = Vec::new();
+    let mut ego_actor = None;
+    for (i, ent) in model.entities.iter().enumerate() {
+        let name = ent.name.clone();
+        let at = here(&ent.pos, &name);
+        let (pos, heading) = sb.engine_pose(i);
+        let size = Size {
+            length_m: ent.dimensions_m[0].max(0.1),
+            width_m: ent.dimensions_m[1].max(0.1),
+            height_m: ent.dimensions_m[2].max(0.1),
+        };
+        let actor = if i == ego {
+            let a = scene.declare_ego(name.clone(), at);
+            ego_actor = Some(a);
+            a
+        } else if matches!(ent.kind, EntityKind::Pedestrian(_)) {
+            let a = scene.declare_pedestrian(name.clone(), at);
+            scene
+                .place_pedestrian(
+                    a,
+                    PedestrianSpec {
+                        start: pos,
+                        target: pos,
+                        speed: zero,
+                        name: format!("Pedestrian {name} ({})", ent.pos),
+                    },
+                )
+                .map_err(|e| worlds_error(e.to_string()))?;
+            a
+        } else {
+            let a = scene.declare_car(name.clone(), at);
+            let ahead = [pos[0] + 0.5 * heading.cos(), pos[2] - 0.5 * heading.sin()];
+            scene
+                .place_car(
+                    a,
+                    CarSpec {
+                        path: vec![[pos[0], pos[2]], ahead],
+                        speed: zero,
+                        color: "white".to_owned(),
+                        size,
+                        enabled: true,
+                        lane_change: None,
+                        lane_offsets_m: vec![],
+                        name: format!("Car {name} ({})", ent.pos),
+                        keep_distance_m: None,
+                    },
+                )
+                .map_err(|e| worlds_error(e.to_string()))?;
+            a
+        };
+        sinks.push(match actor {
+            ActorRef::Car(h) => Some(Sink::PlaceCar(h)),
+            ActorRef::Pedestrian(h) => Some(Sink::PlacePedestrian(h)),
+            _ => None,
+        });
+        probes.push(scene.probe(actor, Output::Collided));
+    }
+    Ok((sinks, probes, ego_actor))
 }

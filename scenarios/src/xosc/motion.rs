@@ -101,7 +101,15 @@ impl Timed {
         let n = self.vertices.len();
         let last = self.vertices[n - 1];
         if t >= last.0 {
-            return (last.1, true);
+            // Facing the way the last leg went (a vertex's own heading where it has none).
+            let mut end = last.1;
+            if n >= 2 {
+                let a = self.vertices[n - 2].1;
+                if (end.x - a.x).hypot(end.y - a.y) > 1e-9 {
+                    end.h = (end.y - a.y).atan2(end.x - a.x);
+                }
+            }
+            return (end, true);
         }
         let first = self.vertices[0];
         if t <= first.0 {

@@ -44,6 +44,12 @@ impl LanePos {
     }
 }
 
+/// Why a position is not on the map: the road or lane it names is not there (the map's own
+/// message, naming the roads or lanes it has).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct RoadError(pub String);
+
 /// `a` wrapped to `(−π, π]`.
 pub fn wrap(a: f64) -> f64 {
     let mut x = (a + PI).rem_euclid(2.0 * PI) - PI;
@@ -138,8 +144,17 @@ impl Roads {
     ///
     /// # Errors
     /// The map's refusal, naming the roads or lanes it has.
-    pub fn lane_pos(&self, road: &str, lane: i32, s: f64, offset: f64) -> Result<LanePos, String> {
-        let k = self.map.lane_at(road, lane, s).map_err(|e| e.to_string())?;
+    pub fn lane_pos(
+        &self,
+        road: &str,
+        lane: i32,
+        s: f64,
+        offset: f64,
+    ) -> Result<LanePos, RoadError> {
+        let k = self
+            .map
+            .lane_at(road, lane, s)
+            .map_err(|e| RoadError(e.to_string()))?;
         Ok(LanePos {
             lane: k,
             s,
@@ -159,7 +174,7 @@ impl Roads {
         d_lane: i32,
         ds: f64,
         offset: f64,
-    ) -> Result<LanePos, String> {
+    ) -> Result<LanePos, RoadError> {
         let l = &self.map.lanes[lp.lane];
         let mut id = l.od_id;
         for _ in 0..d_lane.unsigned_abs() {
@@ -180,7 +195,7 @@ impl Roads {
     ///
     /// # Errors
     /// When the road is unknown or has no lane at `s`.
-    pub fn road_pos(&self, road: &str, s: f64, t: f64) -> Result<LanePos, String> {
+    pub fn road_pos(&self, road: &str, s: f64, t: f64) -> Result<LanePos, RoadError> {
         // The reference line lies on the inner border of lane −1 (or +1).
         let inner = [-1, 1]
             .into_iter()
@@ -188,7 +203,9 @@ impl Roads {
         let Some((id, lp)) = inner else {
             // The map's own message for the road.
             self.lane_pos(road, -1, s, 0.0)?;
-            return Err(format!("road {road} has no lane −1 or 1 at s = {s} m"));
+            return Err(RoadError(format!(
+                "road {road} has no lane −1 or 1 at s = {s} m"
+            )));
         };
         let (c, along) = self.frame(lp.lane, s);
         let left = [-along.sin(), along.cos()];
@@ -221,7 +238,7 @@ impl Roads {
             }
         }
         best.map(|(_, lp)| lp)
-            .ok_or_else(|| format!("road {road} has no lane at s = {s} m"))
+            .ok_or_else(|| RoadError(format!("road {road} has no lane at s = {s} m")))
     }
 
     /// The width of lane `k` at station `s`, m.
@@ -290,6 +307,24 @@ impl Roads {
         self.map.lane_at(&self.map.roads[l.road].od_id, id, s).ok()
     }
 
+    /// The road a car in lane `k` drives on to when `k` is on a junction's connecting road
+    /// (following its successors off that road); `k`'s own road otherwise.
+    pub fn exit_road(&self, k: usize) -> usize {
+        let mut at = k;
+        let road = self.map.lanes[k].road;
+        if self.map.roads[road].junction.is_none() {
+            return road;
+        }
+        for _ in 0..self.map.lanes.len() {
+            match self.map.lanes[at].successors.first() {
+                Some(&n) if self.map.lanes[n].road == road => at = n,
+                Some(&n) => return self.map.lanes[n].road,
+                None => break,
+            }
+        }
+        road
+    }
+
     /// The `<lane id>` and road of lane `k`.
     pub fn ids(&self, k: usize) -> (i32, usize) {
         let l = &self.map.lanes[k];
@@ -341,6 +376,11 @@ impl Roads {
             };
             let nl = &self.map.lanes[n];
             let (na, nb) = nl.s_range();
+            // Into a road whose reference line runs the other way: the same side of the
+            // motion is the other side of `s`.
+            if nl.road != l.road && nl.forward != l.forward {
+                lp.d = -lp.d;
+            }
             lp.lane = n;
             lp.s = if nl.forward != lp.rev { na } else { nb };
         }

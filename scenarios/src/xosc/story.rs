@@ -14,7 +14,7 @@ use paracosm_openscenario::model::{
 };
 
 use super::motion::{duration_s, offset_duration_s, Timed, Transition, Untimed};
-use super::road::{wrap, LanePos, Pose, Roads};
+use super::road::{wrap, LanePos, Pose, RoadError, Roads};
 
 /// The largest lateral acceleration of a `LaneOffsetAction` without `maxLateralAcc`, m/s².
 pub const DEFAULT_LATERAL_ACC_MPS2: f64 = 0.5;
@@ -139,6 +139,16 @@ struct Elem {
     last: Moves,
 }
 
+/// Whose trigger a trigger is, which says when it is evaluated: a start trigger while its
+/// element waits in standby under a running parent, a stop trigger while its element runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Owner {
+    Storyboard,
+    ActStart(usize),
+    ActStop(usize),
+    EventStart { event: usize, maneuver: usize },
+}
+
 #[derive(Debug, Clone)]
 struct Cond {
     cond: m::Condition,
@@ -179,6 +189,7 @@ pub struct Storyboard {
     elems: Vec<Elem>,
     roots: Vec<usize>,
     triggers: Vec<Vec<Vec<Cond>>>,
+    owners: Vec<Owner>,
     trigger_now: Vec<bool>,
     stop: Option<usize>,
     params: Vec<(String, String)>,
@@ -231,6 +242,7 @@ impl Storyboard {
             elems: Vec::new(),
             roots: Vec::new(),
             triggers: Vec::new(),
+            owners: Vec::new(),
             trigger_now: Vec::new(),
             stop: None,
             params: scenario
@@ -241,15 +253,24 @@ impl Storyboard {
             ended: false,
             started: false,
         };
-        sb.stop = scenario.stop.as_ref().map(|t| sb.add_trigger(t));
+        sb.stop = scenario
+            .stop
+            .as_ref()
+            .map(|t| sb.add_trigger(t, Owner::Storyboard));
         for story in &scenario.stories {
             let s = sb.push(Kind::Story, &story.name, 1);
             sb.roots.push(s);
             for act in &story.acts {
                 let a = sb.push(Kind::Act, &act.name, 1);
                 sb.elems[s].children.push(a);
-                sb.elems[a].start = act.start.as_ref().map(|t| sb.add_trigger(t));
-                sb.elems[a].stop = act.stop.as_ref().map(|t| sb.add_trigger(t));
+                sb.elems[a].start = act
+                    .start
+                    .as_ref()
+                    .map(|t| sb.add_trigger(t, Owner::ActStart(a)));
+                sb.elems[a].stop = act
+                    .stop
+                    .as_ref()
+                    .map(|t| sb.add_trigger(t, Owner::ActStop(a)));
                 for g in &act.groups {
                     let gi = sb.push(Kind::Group, &g.name, g.max_count);
                     sb.elems[a].children.push(gi);
@@ -260,7 +281,15 @@ impl Storyboard {
                             let ei = sb.push(Kind::Event, &ev.name, ev.max_count);
                             sb.elems[mi].children.push(ei);
                             sb.elems[ei].priority = ev.priority;
-                            sb.elems[ei].start = ev.start.as_ref().map(|t| sb.add_trigger(t));
+                            sb.elems[ei].start = ev.start.as_ref().map(|t| {
+                                sb.add_trigger(
+                                    t,
+                                    Owner::EventStart {
+                                        event: ei,
+                                        maneuver: mi,
+                                    },
+                                )
+                            });
                             for na in &ev.actions {
                                 let ai = sb.push(Kind::Action, &na.name, 1);
                                 sb.elems[ei].children.push(ai);
@@ -304,7 +333,8 @@ impl Storyboard {
         self.elems.len() - 1
     }
 
-    fn add_trigger(&mut self, t: &m::Trigger) -> usize {
+    fn add_trigger(&mut self, t: &m::Trigger, owner: Owner) -> usize {
+        self.owners.push(owner);
         self.triggers.push(
             t.0.iter()
                 .map(|g| {
@@ -384,9 +414,7 @@ impl Storyboard {
     /// # Errors
     /// [`StoryError`] for an action that cannot be performed where its entity stands.
     pub fn step(&mut self, t: f64, dt: f64) -> Result<(), StoryError> {
-        for k in 0..self.triggers.len() {
-            self.trigger_now[k] = self.evaluate(k, t);
-        }
+        // The transitions of the last step, for this step's conditions.
         for e in &mut self.elems {
             e.last = std::mem::take(&mut e.moves);
         }
@@ -394,6 +422,18 @@ impl Storyboard {
             self.started = true;
             for r in self.roots.clone() {
                 self.start_elem(r, t)?;
+            }
+        }
+        for k in 0..self.triggers.len() {
+            if self.waits(k) {
+                self.trigger_now[k] = self.evaluate(k, t);
+            } else {
+                // Not waiting: its conditions start afresh (edges, delays) when it waits again.
+                self.trigger_now[k] = false;
+                for c in self.triggers[k].iter_mut().flatten() {
+                    c.prev = false;
+                    c.history.clear();
+                }
             }
         }
         if let Some(k) = self.stop {
@@ -409,7 +449,37 @@ impl Storyboard {
                 self.drive(e, t, dt)?;
             }
         }
+        // An event whose actions ended in this step's motion ends in this step.
+        for ev in 0..self.elems.len() {
+            let e = &self.elems[ev];
+            if e.kind == Kind::Event
+                && e.phase == Phase::Running
+                && e.children
+                    .iter()
+                    .all(|&a| self.elems[a].phase == Phase::Complete)
+            {
+                self.end_elem(ev);
+                if self.elems[ev].runs < self.elems[ev].max_runs {
+                    self.elems[ev].phase = Phase::Standby;
+                }
+            }
+        }
         Ok(())
+    }
+
+    /// Whether trigger `k` is evaluated now: the storyboard's stop trigger always, a start
+    /// trigger while its element waits in standby under a running parent, an act's stop
+    /// trigger while the act runs.
+    fn waits(&self, k: usize) -> bool {
+        match self.owners[k] {
+            Owner::Storyboard => true,
+            Owner::ActStart(a) => self.elems[a].phase == Phase::Standby,
+            Owner::ActStop(a) => self.elems[a].phase == Phase::Running,
+            Owner::EventStart { event, maneuver } => {
+                self.elems[event].phase == Phase::Standby
+                    && self.elems[maneuver].phase == Phase::Running
+            }
+        }
     }
 
     fn run_story(&mut self, s: usize, t: f64) -> Result<(), StoryError> {
@@ -674,7 +744,10 @@ impl Storyboard {
                 t,
                 orientation,
             } => {
-                let lp = self.roads.road_pos(road, *s, *t).map_err(bad)?;
+                let lp = self
+                    .roads
+                    .road_pos(road, *s, *t)
+                    .map_err(|e| bad(e.to_string()))?;
                 let h = orient(orientation, self.roads.along_heading(&lp));
                 let lp = self.roads.facing(lp, h);
                 let pose = Pose {
@@ -690,7 +763,10 @@ impl Storyboard {
                 offset,
                 orientation,
             } => {
-                let lp = self.roads.lane_pos(road, *lane, *s, *offset).map_err(bad)?;
+                let lp = self
+                    .roads
+                    .lane_pos(road, *lane, *s, *offset)
+                    .map_err(|e| bad(e.to_string()))?;
                 // Without an orientation, along the road's reference line (esmini's reading).
                 let h = orient(orientation, self.roads.along_heading(&lp));
                 let lp = self.roads.facing(lp, h);
@@ -716,7 +792,7 @@ impl Storyboard {
                 let lp = self
                     .roads
                     .relative_lane(&lp, *d_lane, *ds, *offset)
-                    .map_err(bad)?;
+                    .map_err(|e| bad(e.to_string()))?;
                 (self.roads.pose_of(&lp), Some(lp))
             }
         })
@@ -736,11 +812,6 @@ impl Storyboard {
             message,
         };
         let scripted = self.actors[e].scripted;
-        let begin = |sb: &mut Storyboard| {
-            if let Some(a) = a {
-                sb.elems[a].pending += 1;
-            }
-        };
         match &action.action {
             Action::Teleport(p) => {
                 if scripted || a.is_none() {
@@ -749,105 +820,27 @@ impl Storyboard {
                     st.pose = pose;
                     st.lane = lane;
                     let d = &mut self.drives[e];
-                    d.path = None;
-                    d.lateral = None;
+                    // The motion it was making ends (and its action with it).
+                    let old = [d.path.take().map(|p| p.1), d.lateral.take().map(|l| l.2)];
+                    for o in old {
+                        self.override_task(o);
+                    }
                 }
             }
             Action::Speed { target, dynamics } => {
-                let v0 = self.actors[e].state.speed;
-                let (to, track) = match target {
-                    SpeedTarget::Absolute(v) => (*v, None),
-                    SpeedTarget::Relative {
-                        entity,
-                        value,
-                        factor,
-                        continuous,
-                    } => {
-                        let r = self.actors[*entity].state.speed;
-                        let v = if *factor { r * value } else { r + value };
-                        (v, continuous.then_some((*entity, *value, *factor)))
-                    }
-                };
-                if !scripted {
-                    // The ego's initial speed; later, the system under test drives it.
-                    if a.is_none() {
-                        self.actors[e].state.speed = to.max(0.0);
-                    }
-                    return Ok(());
-                }
-                let tr = Transition {
-                    from: v0,
-                    to: to.max(0.0),
-                    start_s: t,
-                    duration_s: duration_s(dynamics, to - v0, 0.5 * (v0 + to).abs()),
-                    shape: dynamics.shape,
-                };
-                if a.is_none() && tr.duration_s == 0.0 {
-                    self.actors[e].state.speed = tr.to;
-                    return Ok(());
-                }
-                let old = self.drives[e].speed.take().map(|s| s.2);
-                self.override_task(old);
-                begin(self);
-                self.drives[e].speed = Some((tr, track, a.unwrap_or(usize::MAX)));
+                return self.start_speed(e, (target, dynamics), a, t);
             }
             Action::LaneChange {
                 target,
                 dynamics,
                 offset_m,
             } => {
-                if !scripted {
-                    return Ok(());
-                }
-                let st = self.actors[e].state;
-                let Some(lp) = st.lane else {
-                    return Err(bad(format!(
-                        "a LaneChangeAction for {}, which is not on a lane",
-                        self.actors[e].name
-                    )));
-                };
-                let id = match target {
-                    LaneTarget::Absolute(id) => *id,
-                    LaneTarget::Relative { entity, lanes } => {
-                        let Some(rl) = self.actors[*entity].state.lane else {
-                            return Err(bad(format!(
-                                "a lane change relative to {}, which is not on a lane",
-                                self.actors[*entity].name
-                            )));
-                        };
-                        let mut id = self.roads.ids(rl.lane).0;
-                        for _ in 0..lanes.unsigned_abs() {
-                            id += lanes.signum();
-                            if id == 0 {
-                                id += lanes.signum();
-                            }
-                        }
-                        id
-                    }
-                };
-                let to_lane = self.roads.lane_with_id(lp.lane, id, lp.s).ok_or_else(|| {
-                    bad(format!(
-                        "{}'s road has no lane {id} at s = {:.1} m",
-                        self.actors[e].name, lp.s
-                    ))
-                })?;
-                let target_d = self.roads.lateral_between(lp.lane, to_lane, lp.s) + offset_m;
-                let tr = Transition {
-                    from: lp.d,
-                    to: target_d,
-                    start_s: t,
-                    duration_s: duration_s(dynamics, target_d - lp.d, st.speed.abs()),
-                    shape: dynamics.shape,
-                };
-                let old = self.drives[e].lateral.take().map(|s| s.2);
-                self.override_task(old);
-                begin(self);
-                self.drives[e].lateral = Some((
-                    tr,
-                    Some((to_lane, *offset_m)),
-                    a.unwrap_or(usize::MAX),
-                    false,
-                ));
+                return self.start_lane_change(
+                    e,
+                    (target, dynamics, offset_m),
+                    (a, &action.pos),
+                    t,
+                );
             }
             Action::LaneOffset {
                 target,
@@ -855,33 +848,12 @@ impl Storyboard {
                 max_lateral_acc,
                 continuous,
             } => {
-                if !scripted {
-                    return Ok(());
-                }
-                let Some(lp) = self.actors[e].state.lane else {
-                    return Err(bad(format!(
-                        "a LaneOffsetAction for {}, which is not on a lane",
-                        self.actors[e].name
-                    )));
-                };
-                let to = match target {
-                    OffsetTarget::Absolute(v) => *v,
-                    OffsetTarget::Relative { entity, value } => {
-                        self.actors[*entity].state.lane.map_or(0.0, |l| l.d) + value
-                    }
-                };
-                let acc = max_lateral_acc.unwrap_or(DEFAULT_LATERAL_ACC_MPS2);
-                let tr = Transition {
-                    from: lp.d,
-                    to,
-                    start_s: t,
-                    duration_s: offset_duration_s(*shape, to - lp.d, acc),
-                    shape: *shape,
-                };
-                let old = self.drives[e].lateral.take().map(|s| s.2);
-                self.override_task(old);
-                begin(self);
-                self.drives[e].lateral = Some((tr, None, a.unwrap_or(usize::MAX), *continuous));
+                return self.start_lane_offset(
+                    e,
+                    (target, shape, max_lateral_acc, continuous),
+                    (a, &action.pos),
+                    t,
+                );
             }
             Action::LongitudinalDistance {
                 entity,
@@ -900,42 +872,10 @@ impl Storyboard {
                     (*distance_m, *time_gap_s, *freespace),
                     displacement,
                 )
-                .map_err(bad)?;
+                .map_err(|e| bad(e.to_string()))?;
             }
             Action::FollowTrajectory { vertices, timing } => {
-                if !scripted {
-                    return Ok(());
-                }
-                let mut poses = Vec::new();
-                for (_, p) in vertices {
-                    poses.push(self.resolve(p, &action.pos)?.0);
-                }
-                let timed = vertices.iter().all(|(time, _)| time.is_some());
-                let path = match timing {
-                    Some((absolute, scale, offset)) if timed => {
-                        let base = if *absolute { 0.0 } else { t };
-                        Path::Timed(Timed {
-                            vertices: vertices
-                                .iter()
-                                .zip(poses)
-                                .map(|((time, _), p)| {
-                                    (base + time.unwrap_or(0.0) * scale + offset, p)
-                                })
-                                .collect(),
-                        })
-                    }
-                    _ => Path::Untimed(Untimed {
-                        vertices: poses,
-                        gone_m: 0.0,
-                    }),
-                };
-                let d = &mut self.drives[e];
-                let old = [d.path.take().map(|p| p.1), d.lateral.take().map(|l| l.2)];
-                for o in old {
-                    self.override_task(o);
-                }
-                begin(self);
-                self.drives[e].path = Some((path, a.unwrap_or(usize::MAX)));
+                return self.start_trajectory(e, (vertices, timing), (a, &action.pos), t);
             }
             Action::AssignRoute { waypoints } => {
                 let mut roads = Vec::new();
@@ -948,6 +888,248 @@ impl Storyboard {
             }
             Action::ActivateController { .. } => {}
         }
+        Ok(())
+    }
+
+    /// Starts a `SpeedAction` on `e` (see [`Storyboard::start_task`]).
+    fn start_speed(
+        &mut self,
+        e: usize,
+        (target, dynamics): (&SpeedTarget, &m::Dynamics),
+        a: Option<usize>,
+        t: f64,
+    ) -> Result<(), StoryError> {
+        let scripted = self.actors[e].scripted;
+        let begin = |sb: &mut Storyboard| {
+            if let Some(a) = a {
+                sb.elems[a].pending += 1;
+            }
+        };
+
+        let v0 = self.actors[e].state.speed;
+        let (to, track) = match target {
+            SpeedTarget::Absolute(v) => (*v, None),
+            SpeedTarget::Relative {
+                entity,
+                value,
+                factor,
+                continuous,
+            } => {
+                let r = self.actors[*entity].state.speed;
+                let v = if *factor { r * value } else { r + value };
+                (v, continuous.then_some((*entity, *value, *factor)))
+            }
+        };
+        if !scripted {
+            // The ego's initial speed; later, the system under test drives it.
+            if a.is_none() {
+                self.actors[e].state.speed = to.max(0.0);
+            }
+            return Ok(());
+        }
+        let tr = Transition {
+            from: v0,
+            to: to.max(0.0),
+            start_s: t,
+            duration_s: duration_s(dynamics, to - v0, 0.5 * (v0 + to).abs()),
+            shape: dynamics.shape,
+        };
+        if a.is_none() && tr.duration_s == 0.0 {
+            self.actors[e].state.speed = tr.to;
+            return Ok(());
+        }
+        let old = self.drives[e].speed.take().map(|s| s.2);
+        self.override_task(old);
+        begin(self);
+        self.drives[e].speed = Some((tr, track, a.unwrap_or(usize::MAX)));
+
+        Ok(())
+    }
+
+    /// Starts a `LaneChangeAction` on `e`.
+    fn start_lane_change(
+        &mut self,
+        e: usize,
+        (target, dynamics, offset_m): (&LaneTarget, &m::Dynamics, &f64),
+        (a, pos): (Option<usize>, &paracosm_openscenario::Pos),
+        t: f64,
+    ) -> Result<(), StoryError> {
+        let bad = |message: String| StoryError {
+            at: site(pos),
+            message,
+        };
+        let scripted = self.actors[e].scripted;
+        let begin = |sb: &mut Storyboard| {
+            if let Some(a) = a {
+                sb.elems[a].pending += 1;
+            }
+        };
+
+        if !scripted {
+            return Ok(());
+        }
+        let st = self.actors[e].state;
+        let Some(lp) = st.lane else {
+            return Err(bad(format!(
+                "a LaneChangeAction for {}, which is not on a lane",
+                self.actors[e].name
+            )));
+        };
+        let id = match target {
+            LaneTarget::Absolute(id) => *id,
+            LaneTarget::Relative { entity, lanes } => {
+                let Some(rl) = self.actors[*entity].state.lane else {
+                    return Err(bad(format!(
+                        "a lane change relative to {}, which is not on a lane",
+                        self.actors[*entity].name
+                    )));
+                };
+                // Counted to the reference's left as it drives: +t along s.
+                let step = if rl.along_s(&self.roads) {
+                    lanes.signum()
+                } else {
+                    -lanes.signum()
+                };
+                let mut id = self.roads.ids(rl.lane).0;
+                for _ in 0..lanes.unsigned_abs() {
+                    id += step;
+                    if id == 0 {
+                        id += step;
+                    }
+                }
+                id
+            }
+        };
+        let to_lane = self.roads.lane_with_id(lp.lane, id, lp.s).ok_or_else(|| {
+            bad(format!(
+                "{}'s road has no lane {id} at s = {:.1} m",
+                self.actors[e].name, lp.s
+            ))
+        })?;
+        let target_d = self.roads.lateral_between(lp.lane, to_lane, lp.s) + offset_m;
+        let tr = Transition {
+            from: lp.d,
+            to: target_d,
+            start_s: t,
+            duration_s: duration_s(dynamics, target_d - lp.d, st.speed.abs()),
+            shape: dynamics.shape,
+        };
+        let old = self.drives[e].lateral.take().map(|s| s.2);
+        self.override_task(old);
+        begin(self);
+        self.drives[e].lateral = Some((
+            tr,
+            Some((to_lane, *offset_m)),
+            a.unwrap_or(usize::MAX),
+            false,
+        ));
+
+        Ok(())
+    }
+
+    /// Starts a `LaneOffsetAction` on `e`.
+    fn start_lane_offset(
+        &mut self,
+        e: usize,
+        (target, shape, max_lateral_acc, continuous): (
+            &OffsetTarget,
+            &m::Shape,
+            &Option<f64>,
+            &bool,
+        ),
+        (a, pos): (Option<usize>, &paracosm_openscenario::Pos),
+        t: f64,
+    ) -> Result<(), StoryError> {
+        let bad = |message: String| StoryError {
+            at: site(pos),
+            message,
+        };
+        let scripted = self.actors[e].scripted;
+        let begin = |sb: &mut Storyboard| {
+            if let Some(a) = a {
+                sb.elems[a].pending += 1;
+            }
+        };
+
+        if !scripted {
+            return Ok(());
+        }
+        let Some(lp) = self.actors[e].state.lane else {
+            return Err(bad(format!(
+                "a LaneOffsetAction for {}, which is not on a lane",
+                self.actors[e].name
+            )));
+        };
+        let to = match target {
+            OffsetTarget::Absolute(v) => *v,
+            OffsetTarget::Relative { entity, value } => {
+                self.actors[*entity].state.lane.map_or(0.0, |l| l.d) + value
+            }
+        };
+        let acc = max_lateral_acc.unwrap_or(DEFAULT_LATERAL_ACC_MPS2);
+        let tr = Transition {
+            from: lp.d,
+            to,
+            start_s: t,
+            duration_s: offset_duration_s(*shape, to - lp.d, acc),
+            shape: *shape,
+        };
+        let old = self.drives[e].lateral.take().map(|s| s.2);
+        self.override_task(old);
+        begin(self);
+        self.drives[e].lateral = Some((tr, None, a.unwrap_or(usize::MAX), *continuous));
+
+        Ok(())
+    }
+
+    /// Starts a `FollowTrajectoryAction` on `e`.
+    #[allow(clippy::type_complexity)]
+    fn start_trajectory(
+        &mut self,
+        e: usize,
+        (vertices, timing): (&[(Option<f64>, Position)], &Option<(bool, f64, f64)>),
+        (a, pos): (Option<usize>, &paracosm_openscenario::Pos),
+        t: f64,
+    ) -> Result<(), StoryError> {
+        let scripted = self.actors[e].scripted;
+        let begin = |sb: &mut Storyboard| {
+            if let Some(a) = a {
+                sb.elems[a].pending += 1;
+            }
+        };
+
+        if !scripted {
+            return Ok(());
+        }
+        let mut poses = Vec::new();
+        for (_, p) in vertices {
+            poses.push(self.resolve(p, pos)?.0);
+        }
+        let timed = vertices.iter().all(|(time, _)| time.is_some());
+        let path = match timing {
+            Some((absolute, scale, offset)) if timed => {
+                let base = if *absolute { 0.0 } else { t };
+                Path::Timed(Timed {
+                    vertices: vertices
+                        .iter()
+                        .zip(poses)
+                        .map(|((time, _), p)| (base + time.unwrap_or(0.0) * scale + offset, p))
+                        .collect(),
+                })
+            }
+            _ => Path::Untimed(Untimed {
+                vertices: poses,
+                gone_m: 0.0,
+            }),
+        };
+        let d = &mut self.drives[e];
+        let old = [d.path.take().map(|p| p.1), d.lateral.take().map(|l| l.2)];
+        for o in old {
+            self.override_task(o);
+        }
+        begin(self);
+        self.drives[e].path = Some((path, a.unwrap_or(usize::MAX)));
+
         Ok(())
     }
 
@@ -972,14 +1154,14 @@ impl Storyboard {
         reference: usize,
         (distance, gap_s, freespace): (Option<f64>, Option<f64>, bool),
         displacement: &str,
-    ) -> Result<(), String> {
+    ) -> Result<(), RoadError> {
         let r = self.actors[reference].clone();
         let me = self.actors[e].clone();
         let Some(rl) = r.state.lane else {
-            return Err(format!(
+            return Err(RoadError(format!(
                 "a LongitudinalDistanceAction to {}, which is not on a lane",
                 r.name
-            ));
+            )));
         };
         let gap = match (distance, gap_s) {
             (Some(d), _) => d,
@@ -1018,9 +1200,23 @@ impl Storyboard {
             lp = self.roads.lane_pos(&road, id, s, lp.d)?;
             lp.rev = rev;
         }
+        // On a lane of the same road, it keeps its own lane and offset there (esmini moves
+        // it along `s`); elsewhere it takes the reference's.
+        if let Some(own) = me.state.lane {
+            let (id, road) = self.roads.ids(own.lane);
+            if road == self.roads.ids(lp.lane).1 {
+                let name = self.roads.map().roads[road].od_id.clone();
+                if let Ok(mut mine) = self.roads.lane_pos(&name, id, lp.s, own.d) {
+                    mine.rev = own.rev;
+                    lp = mine;
+                }
+            }
+        }
         let st = &mut self.actors[e].state;
         st.pose = self.roads.pose_of(&lp);
         st.lane = Some(lp);
+        // And it takes the reference's speed.
+        st.speed = r.state.speed;
         Ok(())
     }
 
@@ -1061,57 +1257,25 @@ impl Storyboard {
             let timed = matches!(path, Path::Timed(_));
             let a = *a;
             if timed {
-                speed_now = (p.x - pose.x).hypot(p.y - pose.y) / dt;
+                let moved = (p.x - pose.x).hypot(p.y - pose.y);
+                if moved > 1e-9 || !over {
+                    speed_now = moved / dt;
+                }
             }
             pose = p;
             lane = self.facing(self.roads.anchor(p.x, p.y), p.h);
             if over {
+                // It goes on at the speed it had, the way the last leg went (esmini's
+                // reading).
                 self.drives[e].path = None;
-                if timed {
-                    speed_now = 0.0;
-                }
                 done.push(a);
             }
-        } else if let Some(mut lp) = lane {
-            let prefer_roads = self.drives[e].prefer_roads.clone();
-            let prefer = |n: usize| prefer_roads.contains(&self.roads.ids(n).1);
-            at_end = !self.roads.advance(&mut lp, dist, &prefer);
-            let d0 = lp.d;
-            if let Some((tr, to_lane, a, continuous)) = self.drives[e].lateral {
-                let (d, over) = tr.at(t1);
-                lp.d = d;
-                if over {
-                    if let Some((k, offset)) = to_lane {
-                        // Re-anchored on the target lane when it is beside the entity here.
-                        if self.roads.ids(k).1 == self.roads.ids(lp.lane).1 {
-                            let id = self.roads.ids(k).0;
-                            if let Some(k2) = self.roads.lane_with_id(lp.lane, id, lp.s) {
-                                let up = lp.along_s(&self.roads);
-                                lp.lane = k2;
-                                lp.rev = self.roads.forward(k2) != up;
-                                lp.d = offset;
-                            }
-                        }
-                    }
-                    if !continuous {
-                        self.drives[e].lateral = None;
-                        done.push(a);
-                    }
-                }
-            }
-            let travel = self.roads.travel_heading(&lp);
-            let side = if lp.along_s(&self.roads) { 1.0 } else { -1.0 };
-            let slip = if dist > 1e-9 {
-                (side * (lp.d - d0)).atan2(dist)
-            } else {
-                0.0
-            };
-            let turning = dist > 1e-9 || (lp.d - d0).abs() > 1e-12;
-            let h = if turning { wrap(travel + slip) } else { pose.h };
-            pose = self.roads.pose_of(&lp);
-            // Standing still, it keeps the way it faces.
-            pose.h = h;
-            lane = Some(lp);
+        } else if let Some(lp) = lane {
+            let (p, l, end, ended) = self.drive_on_lane(e, lp, (dist, t1, pose.h));
+            pose = p;
+            lane = Some(l);
+            at_end = end;
+            done.extend(ended);
         } else {
             pose.x += dist * pose.h.cos();
             pose.y += dist * pose.h.sin();
@@ -1133,6 +1297,81 @@ impl Storyboard {
             self.override_task(Some(a));
         }
         Ok(())
+    }
+
+    /// Moves scripted entity `e`, on lane position `lp` facing `h0`, `dist` metres along its
+    /// lanes to time `t1` with its lateral move: its pose, lane position, whether its lanes
+    /// ended, and the action whose lateral move ended (if any).
+    fn drive_on_lane(
+        &mut self,
+        e: usize,
+        mut lp: LanePos,
+        (dist, t1, h0): (f64, f64, f64),
+    ) -> (Pose, LanePos, bool, Option<usize>) {
+        let mut ended = None;
+        let prefer_roads = self.drives[e].prefer_roads.clone();
+        // A route names the roads it takes; a junction's connecting road is preferred by
+        // the road it leads to.
+        let prefer = |n: usize| {
+            prefer_roads.contains(&self.roads.ids(n).1)
+                || prefer_roads.contains(&self.roads.exit_road(n))
+        };
+        let up_before = lp.along_s(&self.roads);
+        let at_end = !self.roads.advance(&mut lp, dist, &prefer);
+        if lp.along_s(&self.roads) != up_before {
+            // Its lane runs on in a road of the other direction: a lateral move in
+            // progress keeps its side of the motion.
+            if let Some((tr, to_lane, _, _)) = &mut self.drives[e].lateral {
+                tr.from = -tr.from;
+                tr.to = -tr.to;
+                if let Some((_, offset)) = to_lane {
+                    *offset = -*offset;
+                }
+            }
+        }
+        let d0 = lp.d;
+        if let Some((tr, to_lane, a, continuous)) = self.drives[e].lateral {
+            let (d, over) = tr.at(t1);
+            lp.d = d;
+            if over {
+                if let Some((k, offset)) = to_lane {
+                    let up = lp.along_s(&self.roads);
+                    let beside = (self.roads.ids(k).1 == self.roads.ids(lp.lane).1)
+                        .then(|| self.roads.lane_with_id(lp.lane, self.roads.ids(k).0, lp.s))
+                        .flatten();
+                    if let Some(k2) = beside {
+                        // Re-anchored on the target lane beside it here.
+                        lp.lane = k2;
+                        lp.rev = self.roads.forward(k2) != up;
+                        lp.d = offset;
+                    } else {
+                        // The change ended on another road: the lane under it now.
+                        let p = self.roads.pose_of(&lp);
+                        let h = self.roads.travel_heading(&lp);
+                        if let Some(a) = self.facing(self.roads.anchor(p.x, p.y), h) {
+                            lp = a;
+                        }
+                    }
+                }
+                if !continuous {
+                    self.drives[e].lateral = None;
+                    ended = Some(a);
+                }
+            }
+        }
+        let travel = self.roads.travel_heading(&lp);
+        let side = if lp.along_s(&self.roads) { 1.0 } else { -1.0 };
+        let slip = if dist > 1e-9 {
+            (side * (lp.d - d0)).atan2(dist)
+        } else {
+            0.0
+        };
+        let turning = dist > 1e-9 || (lp.d - d0).abs() > 1e-12;
+        let h = if turning { wrap(travel + slip) } else { h0 };
+        let mut pose = self.roads.pose_of(&lp);
+        // Standing still, it keeps the way it faces.
+        pose.h = h;
+        (pose, lp, at_end, ended)
     }
 
     fn evaluate(&mut self, k: usize, t: f64) -> bool {
