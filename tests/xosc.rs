@@ -316,97 +316,12 @@ fn the_crossing_pedestrian_runs_on_the_storyboard_and_meets_an_ego_that_does_not
 #[test]
 fn a_scenario_written_here_runs_as_a_campaign_and_a_continuous_distance_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let road = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/xosc/alks/concrete_scenarios/road_networks/alks_road_straight.xodr");
-    let scenario = |continuous: &str| {
-        format!(
-            r#"<?xml version="1.0" encoding="UTF-8"?>
-<OpenSCENARIO>
-  <FileHeader revMajor="1" revMinor="2" date="2026-11-26T00:00:00" description="brake" author="paracosm"/>
-  <ParameterDeclarations>
-    <ParameterDeclaration name="LeadBrake" parameterType="double" value="6"/>
-  </ParameterDeclarations>
-  <RoadNetwork><LogicFile filepath="{road}"/></RoadNetwork>
-  <Entities>
-    <ScenarioObject name="Ego">
-      <Vehicle name="v" vehicleCategory="car">
-        <BoundingBox><Center x="1.4" y="0" z="0.8"/><Dimensions width="1.8" length="4.5" height="1.5"/></BoundingBox>
-        <Performance maxSpeed="50" maxAcceleration="5" maxDeceleration="9"/>
-        <Axles>
-          <FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/>
-          <RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/>
-        </Axles>
-        <Properties/>
-      </Vehicle>
-    </ScenarioObject>
-    <ScenarioObject name="Lead">
-      <MiscObject name="box" miscObjectCategory="obstacle" mass="500">
-        <BoundingBox><Center x="0" y="0" z="0.75"/><Dimensions width="1.8" length="4" height="1.5"/></BoundingBox>
-        <Properties/>
-      </MiscObject>
-    </ScenarioObject>
-  </Entities>
-  <Storyboard>
-    <Init>
-      <Actions>
-        <Private entityRef="Ego">
-          <PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction>
-          <PrivateAction><LongitudinalAction><SpeedAction>
-            <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
-            <SpeedActionTarget><AbsoluteTargetSpeed value="12"/></SpeedActionTarget>
-          </SpeedAction></LongitudinalAction></PrivateAction>
-        </Private>
-        <Private entityRef="Lead">
-          <PrivateAction><LongitudinalAction>
-            <LongitudinalDistanceAction entityRef="Ego" distance="30" freespace="true" continuous="{continuous}" displacement="leadingReferencedEntity"/>
-          </LongitudinalAction></PrivateAction>
-          <PrivateAction><LongitudinalAction><SpeedAction>
-            <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
-            <SpeedActionTarget><AbsoluteTargetSpeed value="12"/></SpeedActionTarget>
-          </SpeedAction></LongitudinalAction></PrivateAction>
-        </Private>
-      </Actions>
-    </Init>
-    <Story name="S">
-      <Act name="A">
-        <ManeuverGroup maximumExecutionCount="1" name="G">
-          <Actors selectTriggeringEntities="false"><EntityRef entityRef="Lead"/></Actors>
-          <Maneuver name="M">
-            <Event name="Brake" priority="override">
-              <Action name="BrakeAction">
-                <PrivateAction><LongitudinalAction><SpeedAction>
-                  <SpeedActionDynamics dynamicsShape="linear" value="$LeadBrake" dynamicsDimension="rate"/>
-                  <SpeedActionTarget><AbsoluteTargetSpeed value="0"/></SpeedActionTarget>
-                </SpeedAction></LongitudinalAction></PrivateAction>
-              </Action>
-              <StartTrigger><ConditionGroup>
-                <Condition name="T" delay="0" conditionEdge="rising">
-                  <ByValueCondition><SimulationTimeCondition value="3" rule="greaterThan"/></ByValueCondition>
-                </Condition>
-              </ConditionGroup></StartTrigger>
-            </Event>
-          </Maneuver>
-        </ManeuverGroup>
-        <StartTrigger><ConditionGroup>
-          <Condition name="Go" delay="0" conditionEdge="none">
-            <ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition>
-          </Condition>
-        </ConditionGroup></StartTrigger>
-      </Act>
-    </Story>
-    <StopTrigger><ConditionGroup>
-      <Condition name="End" delay="0" conditionEdge="rising">
-        <ByValueCondition><SimulationTimeCondition value="15" rule="greaterOrEqual"/></ByValueCondition>
-      </Condition>
-    </ConditionGroup></StopTrigger>
-  </Storyboard>
-</OpenSCENARIO>
-"#,
-            road = road.display()
-        )
-    };
     let file = dir.path().join("brake.xosc");
-    std::fs::write(&file, scenario("false")).unwrap();
+    std::fs::write(
+        &file,
+        brake_scenario("false", 20.0, "leadingReferencedEntity"),
+    )
+    .unwrap();
     let out = dir.path().join("out");
     let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
         .arg(&file)
@@ -436,7 +351,11 @@ fn a_scenario_written_here_runs_as_a_campaign_and_a_continuous_distance_is_refus
             "the ego closes in on the braking lead car: {gap} m"
         );
     }
-    std::fs::write(&file, scenario("true")).unwrap();
+    std::fs::write(
+        &file,
+        brake_scenario("true", 20.0, "leadingReferencedEntity"),
+    )
+    .unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
         .arg(&file)
         .args(["--budget", "1", "--force", "--out"])
@@ -448,5 +367,131 @@ fn a_scenario_written_here_runs_as_a_campaign_and_a_continuous_distance_is_refus
     assert!(
         err.contains("brake.xosc:38:") && err.contains("continuous LongitudinalDistanceAction"),
         "{err}"
+    );
+}
+
+/// A scenario written here: the ego at `ego_s` m of lane −4 of the ALKS straight road at
+/// 12 m/s, a lead box placed 30 m from it (`displacement`) by a LongitudinalDistanceAction
+/// (`continuous`) at 12 m/s that brakes at `$LeadBrake` after 3 s; the test stops at 15 s.
+fn brake_scenario(continuous: &str, ego_s: f64, displacement: &str) -> String {
+    let road = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/xosc/alks/concrete_scenarios/road_networks/alks_road_straight.xodr");
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<OpenSCENARIO>
+  <FileHeader revMajor="1" revMinor="2" date="2026-11-26T00:00:00" description="brake" author="paracosm"/>
+  <ParameterDeclarations>
+<ParameterDeclaration name="LeadBrake" parameterType="double" value="6"/>
+  </ParameterDeclarations>
+  <RoadNetwork><LogicFile filepath="{road}"/></RoadNetwork>
+  <Entities>
+<ScenarioObject name="Ego">
+  <Vehicle name="v" vehicleCategory="car">
+    <BoundingBox><Center x="1.4" y="0" z="0.8"/><Dimensions width="1.8" length="4.5" height="1.5"/></BoundingBox>
+    <Performance maxSpeed="50" maxAcceleration="5" maxDeceleration="9"/>
+    <Axles>
+      <FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/>
+      <RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/>
+    </Axles>
+    <Properties/>
+  </Vehicle>
+</ScenarioObject>
+<ScenarioObject name="Lead">
+  <MiscObject name="box" miscObjectCategory="obstacle" mass="500">
+    <BoundingBox><Center x="0" y="0" z="0.75"/><Dimensions width="1.8" length="4" height="1.5"/></BoundingBox>
+    <Properties/>
+  </MiscObject>
+</ScenarioObject>
+  </Entities>
+  <Storyboard>
+<Init>
+  <Actions>
+    <Private entityRef="Ego">
+      <PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="{ego_s}" offset="0"/></Position></TeleportAction></PrivateAction>
+      <PrivateAction><LongitudinalAction><SpeedAction>
+        <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
+        <SpeedActionTarget><AbsoluteTargetSpeed value="12"/></SpeedActionTarget>
+      </SpeedAction></LongitudinalAction></PrivateAction>
+    </Private>
+    <Private entityRef="Lead">
+      <PrivateAction><LongitudinalAction>
+        <LongitudinalDistanceAction entityRef="Ego" distance="30" freespace="true" continuous="{continuous}" displacement="{displacement}"/>
+      </LongitudinalAction></PrivateAction>
+      <PrivateAction><LongitudinalAction><SpeedAction>
+        <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
+        <SpeedActionTarget><AbsoluteTargetSpeed value="12"/></SpeedActionTarget>
+      </SpeedAction></LongitudinalAction></PrivateAction>
+    </Private>
+  </Actions>
+</Init>
+<Story name="S">
+  <Act name="A">
+    <ManeuverGroup maximumExecutionCount="1" name="G">
+      <Actors selectTriggeringEntities="false"><EntityRef entityRef="Lead"/></Actors>
+      <Maneuver name="M">
+        <Event name="Brake" priority="override">
+          <Action name="BrakeAction">
+            <PrivateAction><LongitudinalAction><SpeedAction>
+              <SpeedActionDynamics dynamicsShape="linear" value="$LeadBrake" dynamicsDimension="rate"/>
+              <SpeedActionTarget><AbsoluteTargetSpeed value="0"/></SpeedActionTarget>
+            </SpeedAction></LongitudinalAction></PrivateAction>
+          </Action>
+          <StartTrigger><ConditionGroup>
+            <Condition name="T" delay="0" conditionEdge="rising">
+              <ByValueCondition><SimulationTimeCondition value="3" rule="greaterThan"/></ByValueCondition>
+            </Condition>
+          </ConditionGroup></StartTrigger>
+        </Event>
+      </Maneuver>
+    </ManeuverGroup>
+    <StartTrigger><ConditionGroup>
+      <Condition name="Go" delay="0" conditionEdge="none">
+        <ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition>
+      </Condition>
+    </ConditionGroup></StartTrigger>
+  </Act>
+</Story>
+<StopTrigger><ConditionGroup>
+  <Condition name="End" delay="0" conditionEdge="rising">
+    <ByValueCondition><SimulationTimeCondition value="15" rule="greaterOrEqual"/></ByValueCondition>
+  </Condition>
+</ConditionGroup></StopTrigger>
+  </Storyboard>
+</OpenSCENARIO>
+"#,
+        road = road.display()
+    )
+}
+
+/// An ego that reaches the end of its road before the storyboard's stop trigger: the test
+/// ends there and says so in its log, rather than failing off-road as the ego leaves the map.
+#[test]
+fn a_test_ends_where_the_egos_road_ends() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("end.xosc");
+    std::fs::write(
+        &file,
+        brake_scenario("false", 9950.0, "trailingReferencedEntity"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args(["--budget", "1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let line = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+    let r: serde_json::Value = serde_json::from_str(line.lines().next().unwrap()).unwrap();
+    assert_eq!(r["status"], "pass", "{r}");
+    let end = r["metrics"]["simulated_s"].as_f64().unwrap();
+    // 10,000 m − 9,950 m, less the ego's front and the 2 m margin, at 12 m/s: under 4 s.
+    assert!(end > 2.0 && end < 4.0, "ended at {end} s");
+    assert!(
+        r.to_string()
+            .contains("the ego reached the end of its road"),
+        "the log says why: {r}"
     );
 }

@@ -364,6 +364,8 @@ impl XoscWorlds {
             reads,
             performed: Vec::new(),
             measures: (f64::INFINITY, f64::INFINITY, f64::NAN),
+            road_end: None,
+            log: Vec::new(),
         };
         Ok((scene, host))
     }
@@ -437,7 +439,13 @@ struct StoryHost {
     reads: Vec<StreamId>,
     performed: Vec<(Sink, Value)>,
     measures: (f64, f64, f64),
+    /// When the ego's road ended before the storyboard did, s.
+    road_end: Option<f64>,
+    log: Vec<String>,
 }
+
+/// How close to the end of its lanes the ego's front may come before a test ends there, m.
+pub const ROAD_END_MARGIN_M: f64 = 2.0;
 
 impl Host for StoryHost {
     fn call(&mut self, f: u32, args: &[Value], streams: &Runtime) -> Result<Value, HostError> {
@@ -452,6 +460,15 @@ impl Host for StoryHost {
                 let heading = num(self.ego_probes[1]).unwrap_or(0.0);
                 let speed = num(self.ego_probes[2]).unwrap_or(0.0);
                 self.sb.observe(self.ego, pos, heading, speed, DEFAULT_DT_S);
+                if self.road_end.is_none() && self.sb.road_ends_ahead(self.ego, ROAD_END_MARGIN_M) {
+                    // Past here the ego could only leave the map, which would read as its
+                    // failure: the test ends, and says why.
+                    self.road_end = Some(t);
+                    self.log.push(format!(
+                        "t = {t:.2} s: the ego reached the end of its road before the \
+                         storyboard's stop trigger; the test ends here"
+                    ));
+                }
                 for (e, id) in self.collided.iter().enumerate() {
                     let hit = matches!(streams.current(*id), Some(Value::Bool(true)));
                     self.sb.set_collided(e, hit);
@@ -486,7 +503,11 @@ impl Host for StoryHost {
     }
 
     fn ended(&self) -> bool {
-        self.sb.ended
+        self.sb.ended || self.road_end.is_some()
+    }
+
+    fn log(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.log)
     }
 }
 

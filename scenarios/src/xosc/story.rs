@@ -402,6 +402,17 @@ impl Storyboard {
         };
     }
 
+    /// Whether the lanes entity `e` follows end within `margin_m` (m) of its bounding box's
+    /// front: there is no lane for it to drive on beyond. `false` off every lane.
+    pub fn road_ends_ahead(&self, e: usize, margin_m: f64) -> bool {
+        let a = &self.actors[e];
+        let Some(mut lp) = a.state.lane else {
+            return false;
+        };
+        let reach = (a.centre_m[0] + a.size_m[0] / 2.0).max(0.0) + margin_m;
+        !self.roads.advance(&mut lp, reach, &|_| false)
+    }
+
     /// Records whether entity `e` has touched anything solid.
     pub fn set_collided(&mut self, e: usize, collided: bool) {
         self.actors[e].state.collided = collided;
