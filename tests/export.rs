@@ -15,14 +15,22 @@ mod common;
 use common::{campaign, fuzz, records};
 
 fn export(results: &Path, id: u64, out: &Path) -> (String, String) {
-    let o = fuzz(&[
+    export_with(results, id, out, &[])
+}
+
+/// [`export`] with more arguments.
+fn export_with(results: &Path, id: u64, out: &Path, more: &[&str]) -> (String, String) {
+    let id_text = id.to_string();
+    let mut args = vec![
         "export",
         results.to_str().unwrap(),
         "--id",
-        &id.to_string(),
+        &id_text,
         "--out",
         out.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(more);
+    let o = fuzz(&args);
     assert_eq!(o.status.code(), Some(0), "{o:?}");
     let xosc = std::fs::read_to_string(out.join(format!("test_{id}.xosc"))).unwrap();
     let xodr = std::fs::read_to_string(out.join(format!("test_{id}.xodr"))).unwrap();
@@ -127,8 +135,54 @@ fn cars_follow_the_trajectories_they_drove() {
     );
 }
 
-/// The ego's route exports as waypoints that head along the route (every one had `h = 0`,
-/// and a simulator matches a waypoint to the lane of its heading).
+/// By default the ego exports as the trajectory it drove (no route): a timed polyline whose
+/// vertices, every 0.1 s, follow the ego from its start; with `--ego-route`, as its route.
+#[test]
+fn the_ego_exports_as_the_trajectory_it_drove() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("g");
+    let o = fuzz(&[
+        "grid-world",
+        "--budget",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{o:?}");
+    let (xosc, _) = export(&out.join("results.jsonl"), 0, &dir.path().join("x"));
+    assert!(!xosc.contains("<Route "), "no route by default");
+    let traj = &xosc[xosc
+        .find("<Trajectory name=\"ego as driven\"")
+        .expect("the ego's trajectory")..];
+    let traj = &traj[..traj.find("</Trajectory>").unwrap()];
+    // Its first vertex is where Init puts the ego.
+    let init = &xosc[xosc.find("<Private entityRef=\"ego\"").unwrap()..];
+    for key in ["x", "y", "h"] {
+        let (a, b) = (
+            attr(traj, "WorldPosition", key),
+            attr(init, "WorldPosition", key),
+        );
+        assert!((a - b).abs() < 1e-9, "{key}: {a} vs {b}");
+    }
+    let r = &records(&out)[0];
+    let simulated = r["metrics"]["simulated_s"].as_f64().unwrap();
+    let vertices = traj.matches("<Vertex ").count();
+    let expected = (simulated / 0.1).round() as usize + 1;
+    assert!(
+        vertices.abs_diff(expected) <= 1,
+        "{vertices} vertices for {simulated} s"
+    );
+    let (routed, _) = export_with(
+        &out.join("results.jsonl"),
+        0,
+        &dir.path().join("y"),
+        &["--ego-route"],
+    );
+    assert!(routed.contains("<Route ") && !routed.contains("ego as driven"));
+}
+
+/// The ego's route exports (`--ego-route`) as waypoints that head along the route (every one
+/// had `h = 0`, and a simulator matches a waypoint to the lane of its heading).
 #[test]
 fn the_egos_route_waypoints_head_along_the_route() {
     let dir = tempfile::tempdir().unwrap();
@@ -141,7 +195,12 @@ fn the_egos_route_waypoints_head_along_the_route() {
         out.to_str().unwrap(),
     ]);
     assert!(matches!(o.status.code(), Some(0 | 1)), "{o:?}");
-    let (xosc, _) = export(&out.join("results.jsonl"), 0, &dir.path().join("x"));
+    let (xosc, _) = export_with(
+        &out.join("results.jsonl"),
+        0,
+        &dir.path().join("x"),
+        &["--ego-route"],
+    );
     let route = &xosc[xosc.find("<Route ").unwrap()..xosc.find("</Route>").unwrap()];
     let points: Vec<(f64, f64, f64)> = route
         .split("<Waypoint ")

@@ -26,21 +26,25 @@ fn a_space_with_levels_of_every_kind_reads_back() {
             name: "friction".into(),
             domain: Domain::Levels(vec![Value::Real(0.4), Value::Real(0.8)]),
             unit: None,
+            density: None,
         },
         Param {
             name: "lanes".into(),
             domain: Domain::Levels(vec![Value::Int(2), Value::Int(-4)]),
             unit: None,
+            density: None,
         },
         Param {
             name: "colour".into(),
             domain: Domain::Levels(vec![Value::Text("red".into()), Value::Text("true".into())]),
             unit: None,
+            density: None,
         },
         Param {
             name: "oncoming".into(),
             domain: Domain::Levels(vec![Value::Bool(true), Value::Bool(false)]),
             unit: None,
+            density: None,
         },
         Param::interval("speed", 0.5, 2.5, "m/s"),
     ])

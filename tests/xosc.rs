@@ -495,3 +495,86 @@ fn a_test_ends_where_the_egos_road_ends() {
         "the log says why: {r}"
     );
 }
+
+/// A stochastic variation file's distributions shape the `random` strategy's draws: the lead's
+/// deceleration from a normal distribution N(3, 0.5²) truncated to [2, 8] has a sample mean
+/// near 3 (uniform draws would give 5), and a probability set with weights 0 and 1 picks only
+/// the weighted value. Coverage strategies keep covering the whole range.
+#[test]
+fn stochastic_distributions_weight_random_draws() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("brake.xosc");
+    let scenario = brake_scenario("false", 20.0, "leadingReferencedEntity").replace(
+        r#"<ParameterDeclaration name="LeadBrake" parameterType="double" value="6"/>"#,
+        r#"<ParameterDeclaration name="LeadBrake" parameterType="double" value="6"/>
+<ParameterDeclaration name="LeadSpeed" parameterType="double" value="12"/>"#,
+    );
+    std::fs::write(&file, scenario).unwrap();
+    let variation = dir.path().join("brake_variation.xosc");
+    std::fs::write(
+        &variation,
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<OpenSCENARIO>
+  <FileHeader revMajor="1" revMinor="2" date="2026-11-26T00:00:00" description="weights" author="paracosm"/>
+  <ParameterValueDistribution>
+    <ScenarioFile filepath="brake.xosc"/>
+    <Stochastic numberOfTestRuns="20" randomSeed="1">
+      <StochasticDistribution parameterName="LeadBrake">
+        <NormalDistribution expectedValue="3" variance="0.25">
+          <Range lowerLimit="2" upperLimit="8"/>
+        </NormalDistribution>
+      </StochasticDistribution>
+      <StochasticDistribution parameterName="LeadSpeed">
+        <ProbabilityDistributionSet>
+          <Element value="10" weight="0"/>
+          <Element value="12" weight="1"/>
+        </ProbabilityDistributionSet>
+      </StochasticDistribution>
+    </Stochastic>
+  </ParameterValueDistribution>
+</OpenSCENARIO>
+"#,
+    )
+    .unwrap();
+    let run = |strategy: &str, out: &str| -> Vec<serde_json::Value> {
+        let out = dir.path().join(out);
+        let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+            .arg(&variation)
+            .args(["--strategy", strategy, "--budget", "30", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+        assert!(
+            !err.contains("not yet applied"),
+            "the weights are applied: {err}"
+        );
+        std::fs::read_to_string(out.join("results.jsonl"))
+            .unwrap()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
+    };
+    let brake = |rs: &[serde_json::Value]| -> Vec<f64> {
+        rs.iter()
+            .map(|r| r["params"]["LeadBrake"].as_f64().unwrap())
+            .collect()
+    };
+    let random = run("random", "random");
+    assert_eq!(random.len(), 30);
+    let b = brake(&random);
+    let mean = b.iter().sum::<f64>() / b.len() as f64;
+    assert!((mean - 3.0).abs() < 0.35, "a normal around 3: mean {mean}");
+    assert!(b.iter().all(|&x| (2.0..8.0).contains(&x)), "{b:?}");
+    for r in &random {
+        assert_eq!(r["params"]["LeadSpeed"].as_i64(), Some(12), "{r}");
+    }
+    // Halton covers the range: its mean sits near the middle, 5.
+    let halton = brake(&run("halton", "halton"));
+    let mean = halton.iter().sum::<f64>() / halton.len() as f64;
+    assert!(
+        (mean - 5.0).abs() < 0.35,
+        "Halton covers [2, 8): mean {mean}"
+    );
+}

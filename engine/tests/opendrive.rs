@@ -388,3 +388,32 @@ fn the_junction_maps_dead_ends_end_the_road() {
         }
     }
 }
+
+/// ALKS's left road of radius 250 m is one arc of 1,500 m: its lanes turn 6 rad, so that
+/// their ends look back at their starts. Every point of lane -4, across its width and from
+/// 10 m to 110 m (at its stations and between them), is on the driving surface: points on
+/// the outside of the bend, in the wedge between two centre-line segments, once fell off it
+/// (4.25 m "off-road" in the middle of the lane).
+#[test]
+fn the_outside_of_a_bend_that_turns_almost_full_circle_is_on_the_road() {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/xosc/alks/concrete_scenarios/road_networks")
+        .join("alks_road_left_radius_250m.xodr");
+    let text = std::fs::read_to_string(p).unwrap();
+    let (net, _, map) = map_network("alks_road_left_radius_250m.xodr", &text);
+    let surface = Surface::new(&net);
+    // Lane -4 spans t in [-9.75, -6.25]; the drivable lanes -3..-5 span [-13.25, -2.75].
+    // From 10 m on: before, the nearest edge may be the road's start.
+    for k in 0..400 {
+        let s = 10.0 + 0.25 * k as f64;
+        let a = s / 250.0;
+        for t in [-6.5, -7.0, -8.0, -9.0, -9.5] {
+            let r = 250.0 - t;
+            let od = [r * a.sin(), 250.0 - r * a.cos()];
+            let q = [od[0] - map.origin_m[0], -(od[1] - map.origin_m[1])];
+            let e = surface.edge_distance_m(q);
+            let want = (t + 13.25f64).min(-2.75 - t);
+            assert!((e - want).abs() < 0.01, "s {s} t {t}: {e} (want {want})");
+        }
+    }
+}

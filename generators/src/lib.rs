@@ -16,6 +16,7 @@
 
 pub mod coverage;
 pub mod covering;
+mod density;
 mod error;
 mod factorial;
 pub mod falsify;
@@ -28,6 +29,7 @@ mod sobol;
 mod space;
 mod strategy;
 
+pub use density::Density;
 pub use error::GeneratorError;
 pub use factorial::FullFactorial;
 pub use generator::Generator;

@@ -88,6 +88,10 @@ pub struct Param {
     pub domain: Domain,
     /// Unit of the values (`m`, `m/s`, ...), `None` for unitless levels.
     pub unit: Option<String>,
+    /// Where its values are likely, for random sampling ([`crate::UniformRandom`]); `None`:
+    /// uniform over the domain. Coverage generators ignore it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<crate::Density>,
 }
 
 impl Param {
@@ -97,6 +101,7 @@ impl Param {
             name: name.to_owned(),
             domain: Domain::Interval { lo, hi },
             unit: Some(unit.to_owned()),
+            density: None,
         }
     }
 
@@ -106,6 +111,7 @@ impl Param {
             name: name.to_owned(),
             domain: Domain::Levels(levels),
             unit: None,
+            density: None,
         }
     }
 
@@ -131,7 +137,9 @@ impl ParamSpace {
     ///
     /// # Errors
     /// [`GeneratorError::InvalidDomain`] for an interval with `lo >= hi`, a non-finite bound
-    /// or a width `hi - lo` that overflows, or an empty level list; [`GeneratorError::DuplicateParam`] for a repeated name.
+    /// or a width `hi - lo` that overflows, an empty level list, or a density that does not
+    /// fit its parameter ([`crate::Density::check`]); [`GeneratorError::DuplicateParam`] for a
+    /// repeated name.
     pub fn new(params: Vec<Param>) -> Result<Self, GeneratorError> {
         // Linear, not quadratic: a CSV may have a million columns.
         let mut names = std::collections::HashSet::with_capacity(params.len());
@@ -161,6 +169,15 @@ impl ParamSpace {
                     return Err(bad("VarEnum has no levels".into()))
                 }
                 Domain::Levels(_) => {}
+            }
+            if let Some(d) = &p.density {
+                let (interval, levels) = match &p.domain {
+                    Domain::Interval { lo, hi } => (Some((*lo, *hi)), None),
+                    Domain::Levels(l) => (None, Some(l.len())),
+                };
+                if let Some(reason) = d.check(interval, levels) {
+                    return Err(bad(reason));
+                }
             }
         }
         Ok(ParamSpace { params })

@@ -190,6 +190,10 @@ struct ExportArgs {
     /// Folder for test_ID.xosc and test_ID.xodr (created if missing).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
+    /// Write the ego's route (an AssignRouteAction, for another system under test to drive)
+    /// instead of the trajectory it drove (a timed FollowTrajectoryAction, the default).
+    #[arg(long)]
+    ego_route: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -413,7 +417,16 @@ fn main() -> ExitCode {
             .and_then(|r| paracosm::export::dataset::export(&r, Some(&STOP)))
             .map_err(anyhow::Error::new)
             .and_then(|s| say(&s.text()).map(|()| s.exit_code())),
-        Some(Sub::Export(a)) => paracosm::export::export(&a.results, a.id, &a.out)
+        Some(Sub::Export(a)) => paracosm::export::export(
+            &a.results,
+            a.id,
+            &a.out,
+            if a.ego_route {
+                paracosm::export::xosc::EgoMotion::Route
+            } else {
+                paracosm::export::xosc::EgoMotion::Trajectory
+            },
+        )
             .map_err(anyhow::Error::new)
             .and_then(|e| {
                 let text = format!(

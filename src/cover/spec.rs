@@ -180,6 +180,7 @@ pub fn parse_space(file: &str, text: &str) -> Result<ParamSpace, SpecError> {
             name,
             domain,
             unit: p.unit,
+            density: None,
         });
     }
     ParamSpace::new(params).map_err(|e| invalid(e.to_string()))

@@ -69,13 +69,18 @@ fn network_document(
 }
 
 /// Writes test `id` of the campaign whose results are `results` into `out` as `test_ID.xosc`
-/// and `test_ID.xodr`.
+/// and `test_ID.xodr`, the ego's motion as `ego` says (its trajectory, or its route).
 ///
 /// # Errors
 /// [`Error::BadInput`] as for [`crate::export::replay::replay`], for a network that mixes an
 /// OpenDRIVE map with pieces of the program, or a map that can no longer be read;
 /// [`Error::Write`] when `out` or a file cannot be written.
-pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
+pub fn export(
+    results: &Path,
+    id: u64,
+    out: &Path,
+    ego: xosc::EgoMotion,
+) -> Result<Exported, Error> {
     // A file where the folder should be is the user's mistake, refused before the replay.
     if out.exists() && !out.is_dir() {
         return Err(Error::BadInput(format!(
@@ -142,6 +147,7 @@ pub fn export(results: &Path, id: u64, out: &Path) -> Result<Exported, Error> {
         replayed.recorded["status"].as_str().unwrap_or("?")
     );
     let document = xosc::write(&xosc::Test {
+        ego,
         description,
         params,
         network_file: xodr_name.clone(),

@@ -6,10 +6,12 @@
 //!   Positions are the centre of each actor's footprint on the road surface; OpenSCENARIO's
 //!   `(x, y, z)` is paracosm's `(x, -z, y)`, headings agree.
 //! - **Init.** Every entity is placed where the test starts it (`TeleportAction`); the ego and
-//!   the cars get their initial speed (`AbsoluteTargetSpeed`); the ego gets its route as an
-//!   `AssignRouteAction` (waypoints every 10 m): the system under test drives it.
+//!   the cars get their initial speed (`AbsoluteTargetSpeed`). With [`EgoMotion::Route`], the
+//!   ego gets its route as an `AssignRouteAction` (waypoints every 10 m) for a system under
+//!   test to drive.
 //! - **Story.** Each car follows the trajectory it drove in the test, timed (`Polyline`
-//!   vertices every 0.1 s, absolute time), from the start. Each pedestrian that walked starts
+//!   vertices every 0.1 s, absolute time), from the start; so does the ego with
+//!   [`EgoMotion::Trajectory`] (the default): what the system under test did is in the file. Each pedestrian that walked starts
 //!   on a `DistanceCondition`: when the ego comes within the distance at which it started
 //!   walking in the test (its trigger, measured from the recording); it then follows its walk
 //!   as a trajectory timed from that moment.
@@ -27,8 +29,21 @@ pub const VERTEX_EVERY_S: f64 = 0.1;
 /// Longest distance between two waypoints of the ego's route, m.
 pub const WAYPOINT_EVERY_M: f64 = 10.0;
 
+/// How the ego's motion is written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EgoMotion {
+    /// The trajectory it drove, timed (vertices every [`VERTEX_EVERY_S`]): another simulator
+    /// replays what the system under test did.
+    #[default]
+    Trajectory,
+    /// Its route as an `AssignRouteAction`, for another system under test to drive.
+    Route,
+}
+
 /// What the export writes about one test: what it is, and what it went through.
 pub struct Test<'a> {
+    /// How the ego's motion is written.
+    pub ego: EgoMotion,
     /// One line describing the test (campaign, id, verdict).
     pub description: String,
     /// The test's parameters, `(name, value as written)`, numbers first.
@@ -337,7 +352,7 @@ fn init(test: &Test<'_>, first: &Snapshot) -> Vec<El> {
         teleport(g(ego.pos_m), ego.heading_rad),
         speed(w.ego.initial_speed_mps),
     ];
-    if w.ego.route.len() >= 2 {
+    if test.ego == EgoMotion::Route && w.ego.route.len() >= 2 {
         ego_actions.push(assign_route(&w.ego.route, test.origin_m));
     }
     init.push(private("ego", ego_actions));
@@ -414,11 +429,26 @@ fn route_waypoints(route: &[[f64; 2]]) -> Vec<([f64; 2], f64)> {
     picked.iter().map(|&i| (route[i], heading(i))).collect()
 }
 
-/// The story: cars drive their trajectories; pedestrians walk when the ego comes near.
+/// The story: cars (and with [`EgoMotion::Trajectory`] the ego) drive their trajectories;
+/// pedestrians walk when the ego comes near.
 fn story(test: &Test<'_>, frames: &[&Snapshot], first: &Snapshot) -> El {
     let w = test.world;
     let g = |p: [f64; 3]| in_file(test.origin_m, p);
     let mut groups = Vec::new();
+    if test.ego == EgoMotion::Trajectory {
+        let points: Vec<(f64, [f64; 3], f64)> = frames
+            .iter()
+            .map(|s| (s.t_s, g(s.ego.pos_m), s.ego.heading_rad))
+            .collect();
+        groups.push(maneuver_group(
+            "ego",
+            event(
+                "ego drives",
+                follow("ego as driven", &points, true),
+                time_condition("start", "none", "greaterOrEqual", 0.0),
+            ),
+        ));
+    }
     for i in 0..w.cars.len() {
         let name = format!("car{}", i + 1);
         let points: Vec<(f64, [f64; 3], f64)> = frames

@@ -1,6 +1,6 @@
 //! Varied and opened OpenSCENARIO parameters as parameters of paracosm's space.
 
-use paracosm_generators::{Param, Value};
+use paracosm_generators::{Density, Param, Value};
 use paracosm_openscenario::distribution::{Dist, ValueSets, Varied};
 use paracosm_openscenario::model::Scenario;
 use paracosm_openscenario::params::ValueError;
@@ -25,17 +25,18 @@ fn levels_of(texts: &[String]) -> Vec<Value> {
 }
 
 /// The parameter of paracosm's space for a varied parameter, the number of levels it has in
-/// the file's own grid (none for a stochastic distribution), and what paracosm does not yet
+/// the file's own grid (none for a stochastic distribution), and what paracosm does not
 /// honour of its distribution. A set becomes its levels; a range with a step its levels, or
 /// with `continuous` the interval over its range; a stochastic distribution the interval of
-/// its range (random sampling draws uniformly over it).
+/// its range (its levels for a probability set) with its density for random sampling
+/// (normal and log-normal truncated to the range, a histogram's bins, a set's weights;
+/// coverage strategies cover the whole range). A Poisson distribution is drawn uniformly over
+/// its range, with a note.
 pub fn varied_param(v: &Varied, continuous: bool) -> (Param, Option<u64>, Option<String>) {
     let name = v.name.as_str();
-    let limit = |what: &str| {
-        Some(format!(
-            "{}: {name}'s {what} gives its range; paracosm's random strategies draw uniformly over it (its weights are not yet applied)",
-            v.pos
-        ))
+    let interval = |lo: f64, hi: f64, density: Option<Density>| Param {
+        density,
+        ..Param::interval(name, lo, hi, "")
     };
     match &v.dist {
         Dist::Set(texts) => (
@@ -54,20 +55,72 @@ pub fn varied_param(v: &Varied, continuous: bool) -> (Param, Option<u64>, Option
         }
         Dist::ProbabilitySet(pairs) => {
             let texts: Vec<String> = pairs.iter().map(|(t, _)| t.clone()).collect();
+            let weights = pairs.iter().map(|(_, w)| *w).collect();
+            let p = Param {
+                density: Some(Density::Weights(weights)),
+                ..Param::levels(name, levels_of(&texts))
+            };
+            (p, None, None)
+        }
+        Dist::Normal { mean, variance, .. } => {
+            let sd = variance.sqrt();
+            let (lo, hi, note) = bounds(v, (mean - SPREAD * sd, mean + SPREAD * sd));
+            let d = Density::Normal { mean: *mean, sd };
+            (interval(lo, hi, Some(d)), None, note)
+        }
+        Dist::LogNormal { mu, sigma, .. } => {
+            let (lo, hi, note) = bounds(
+                v,
+                ((mu - SPREAD * sigma).exp(), (mu + SPREAD * sigma).exp()),
+            );
+            let d = Density::LogNormal {
+                mu: *mu,
+                sigma: *sigma,
+            };
+            (interval(lo, hi, Some(d)), None, note)
+        }
+        Dist::Histogram(bins) => {
+            let (lo, hi) = v.dist.range().unwrap_or((0.0, 0.0));
             (
-                Param::levels(name, levels_of(&texts)),
+                interval(lo, hi, Some(Density::Histogram(bins.clone()))),
                 None,
-                limit("probability set"),
+                None,
             )
+        }
+        Dist::Poisson { expected, .. } => {
+            let (lo, hi, _) = bounds(v, (0.0, expected + SPREAD * expected.sqrt() + 1.0));
+            let note = format!(
+                "{}: {name}'s Poisson distribution gives its range [{lo}, {hi}]; paracosm's \
+                 random strategies draw uniformly over it (as real numbers)",
+                v.pos
+            );
+            (interval(lo, hi, None), None, Some(note))
         }
         other => {
             let (lo, hi) = other.range().unwrap_or((0.0, 0.0));
-            (
-                Param::interval(name, lo, hi, ""),
-                None,
-                limit("distribution"),
-            )
+            (interval(lo, hi, None), None, None)
         }
+    }
+}
+
+/// How many standard deviations either side of the mean cover a distribution that its file
+/// does not truncate with a `Range`.
+const SPREAD: f64 = 6.0;
+
+/// The range of `v`'s values: its truncating `Range`, else `wide` (the distribution's bulk),
+/// with a note saying so.
+fn bounds(v: &Varied, wide: (f64, f64)) -> (f64, f64, Option<String>) {
+    match v.dist.range() {
+        Some((lo, hi)) => (lo, hi, None),
+        None => (
+            wide.0,
+            wide.1,
+            Some(format!(
+                "{}: {}'s distribution has no <Range>: paracosm covers [{}, {}] ({SPREAD} \
+                 standard deviations either side of its mean), and draws it truncated there",
+                v.pos, v.name, wide.0, wide.1
+            )),
+        ),
     }
 }
 

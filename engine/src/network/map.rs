@@ -773,13 +773,20 @@ fn strip_offset(l: &MapLane, i: usize, p: [f64; 2]) -> Option<f64> {
         return None;
     }
     let lateral = (rel[1] * dir[0] - rel[0] * dir[1]) / len2.sqrt();
-    // Beside the segment, the point is between the lane's ends; beyond it, in a disc, it may
-    // not be.
-    if (0.0..=1.0).contains(&raw) || !beyond_ends(l, p) {
-        Some(lateral)
+    // Beside the segment, the point is between the lane's ends. Before it (after it), in the
+    // disc around its first (last) station, it may not be: it is beyond the lane's start (end)
+    // when it lies before the line across the lane's first (last) segment and is within the
+    // lane's width of that end. The distance keeps a lane that turns almost full circle, whose
+    // end looks back at its start, from losing the points near its start.
+    let near = |x: [f64; 2]| (x[0] - p[0]).hypot(x[1] - p[1]) <= w;
+    let beyond = if raw < 0.0 {
+        near(l.centre[0]) && beyond_ends(l, p).0
+    } else if raw > 1.0 {
+        near(l.centre[l.centre.len() - 1]) && beyond_ends(l, p).1
     } else {
-        None
-    }
+        false
+    };
+    (!beyond).then_some(lateral)
 }
 
 /// Stations closer than a micrometre are one.
@@ -787,9 +794,9 @@ fn same_station(a: [f64; 2], b: [f64; 2]) -> bool {
     (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) < 1e-12
 }
 
-/// Whether `p` lies past the line across lane `l` at its last station, or before the line
-/// across it at its first (each across the segment that ends there).
-fn beyond_ends(l: &MapLane, p: [f64; 2]) -> bool {
+/// Whether `p` lies before the line across lane `l` at its first station, and whether past
+/// the line across it at its last (each across the segment that ends there).
+fn beyond_ends(l: &MapLane, p: [f64; 2]) -> (bool, bool) {
     let c = &l.centre;
     let (start, end) = (c[0], c[c.len() - 1]);
     let past_end = c
@@ -801,7 +808,7 @@ fn beyond_ends(l: &MapLane, p: [f64; 2]) -> bool {
         .iter()
         .find(|&&x| !same_station(x, start))
         .is_some_and(|&x| segment_projection(p, start, x).2 < 0.0);
-    past_end || before_start
+    (before_start, past_end)
 }
 
 type Segment = GeomWithData<Line<[f64; 2]>, (usize, usize)>;

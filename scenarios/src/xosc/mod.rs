@@ -461,6 +461,16 @@ impl Host for StoryHost {
                 let speed = num(self.ego_probes[2]).unwrap_or(0.0);
                 self.sb.observe(self.ego, pos, heading, speed, DEFAULT_DT_S);
                 if self.road_end.is_none() && self.sb.road_ends_ahead(self.ego, ROAD_END_MARGIN_M) {
+                    if !self.sb.any_event_started() {
+                        // Nothing happened yet, and nothing can: the test did not test what
+                        // the file describes, and must not read as a pass.
+                        return Err(HostError(format!(
+                            "t = {t:.2} s: the ego reached the end of its road before any \
+                             event of the storyboard started, so the scenario cannot play \
+                             out (does the ego start facing the way its lane leads off the \
+                             map?)"
+                        )));
+                    }
                     // Past here the ego could only leave the map, which would read as its
                     // failure: the test ends, and says why.
                     self.road_end = Some(t);

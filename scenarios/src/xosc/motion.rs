@@ -58,6 +58,18 @@ pub fn offset_duration_s(shape: Shape, delta: f64, max_acc: f64) -> f64 {
     }
 }
 
+/// The slope of [`progress`] at `tau` (`[0, 1]`): linear 1, cubic `6τ(1 − τ)`, sinusoidal
+/// `(π/2)·sin πτ`, step 0.
+pub fn progress_slope(shape: Shape, tau: f64) -> f64 {
+    let tau = tau.clamp(0.0, 1.0);
+    match shape {
+        Shape::Step => 0.0,
+        Shape::Linear => 1.0,
+        Shape::Cubic => 6.0 * tau * (1.0 - tau),
+        Shape::Sinusoidal => std::f64::consts::FRAC_PI_2 * (std::f64::consts::PI * tau).sin(),
+    }
+}
+
 /// A value moving from `from` to `to` between `start_s` and `start_s + duration_s`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Transition {
@@ -84,6 +96,16 @@ impl Transition {
             self.from + (self.to - self.from) * progress(self.shape, tau),
             false,
         )
+    }
+
+    /// The value's rate of change at `t` (per s, or per unit of whatever `start_s` and
+    /// `duration_s` count); 0 for a step and outside the transition.
+    pub fn slope(&self, t: f64) -> f64 {
+        if self.duration_s <= 0.0 || t >= self.start_s + self.duration_s || t < self.start_s {
+            return 0.0;
+        }
+        let tau = (t - self.start_s) / self.duration_s;
+        (self.to - self.from) / self.duration_s * progress_slope(self.shape, tau)
     }
 }
 

@@ -31,9 +31,8 @@ pub struct LanePos {
     /// (OpenDRIVE's `t` direction).
     pub d: f64,
     /// Whether the entity faces and moves against the lane's direction of travel (a lane
-    /// position's heading is along the road's reference line unless its orientation says
-    /// otherwise, so an entity placed on a left lane of a right-hand-traffic road without
-    /// an orientation drives along increasing `s`, as esmini has it).
+    /// position faces the lane's direction of travel unless its orientation says otherwise,
+    /// as esmini has it; an entity placed facing the other way drives against the lane).
     pub rev: bool,
 }
 
@@ -331,9 +330,9 @@ impl Roads {
         (l.od_id, l.road)
     }
 
-    /// Moves `lp` `dist` metres (≥ 0, along its lane's centre line) in the lane's direction
-    /// of travel, into a successor lane where the lane ends: the first that `prefer` accepts,
-    /// else the first. Returns `false` when the lanes end before: `lp` then stands at the
+    /// Moves `lp` `dist` metres (≥ 0, along the path at its offset from its lane's centre
+    /// line) in the lane's direction of travel, into a successor lane where the lane ends:
+    /// the first that `prefer` accepts, else the first. Returns `false` when the lanes end before: `lp` then stands at the
     /// end.
     pub fn advance(&self, lp: &mut LanePos, mut dist: f64, prefer: &dyn Fn(usize) -> bool) -> bool {
         for _ in 0..self.map.lanes.len().max(1) {
@@ -344,8 +343,20 @@ impl Roads {
             let span = l.s[i + 1] - l.s[i];
             let chord =
                 (l.centre[i + 1][0] - l.centre[i][0]).hypot(l.centre[i + 1][1] - l.centre[i][1]);
+            // Off the centre line by `d` (left of increasing `s`), a path bends with the lane:
+            // its length per metre of the centre line is `1 − κ·d`, `κ` the centre line's
+            // curvature there (esmini's `DistanceToDS` at the entity's own offset).
+            let tangent = |j: usize| {
+                let r = l.right(j);
+                r[0].atan2(r[1])
+            };
+            let kappa = if chord > 1e-9 {
+                wrap(tangent(i + 1) - tangent(i)) / chord
+            } else {
+                0.0
+            };
             let ratio = if span > 1e-9 {
-                (chord / span).max(1e-6)
+                (chord / span * (1.0 - kappa * lp.d)).max(1e-6)
             } else {
                 1.0
             };

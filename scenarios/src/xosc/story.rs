@@ -167,10 +167,35 @@ type ToLane = Option<(usize, f64)>;
 struct Drive {
     /// The speed transition, a target that follows another entity, the action.
     speed: Option<(Transition, Track, usize)>,
-    /// The lateral transition, the lane it changes to, the action, whether it goes on.
-    lateral: Option<(Transition, ToLane, usize, bool)>,
+    /// The lateral move in progress.
+    lateral: Option<Lateral>,
     path: Option<(Path, usize)>,
     prefer_roads: Vec<usize>,
+    /// Its heading relative to its lane's travel, rad, kept as it moves along the lane
+    /// (esmini's relative heading): set where it is placed or where its trajectory ends,
+    /// 0 after a lateral move.
+    rel_h: f64,
+}
+
+/// A lateral move (`LaneChangeAction`, `LaneOffsetAction`) as esmini performs it: the offset
+/// `d` (m, left of increasing `s`) over a parameter that counts time (s) or, for a lane change
+/// by distance, the path along the lane (m), from 0; stepped only while the entity moves.
+#[derive(Debug, Clone, Copy)]
+struct Lateral {
+    /// The offset over the parameter (`start_s` 0).
+    tr: Transition,
+    /// The parameter so far.
+    param: f64,
+    /// Whether the parameter is the path along the lane (a lane change by distance).
+    by_distance: bool,
+    /// A `LaneOffsetAction`: the offset lags one step and the lane motion is not slowed.
+    offset: bool,
+    /// The lane it changes to.
+    to_lane: ToLane,
+    /// Its action.
+    action: usize,
+    /// Whether it goes on after its transition (`continuous`).
+    continuous: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -256,6 +281,7 @@ impl Storyboard {
         sb.stop = scenario
             .stop
             .as_ref()
+            .filter(|t| !t.0.is_empty())
             .map(|t| sb.add_trigger(t, Owner::Storyboard));
         for story in &scenario.stories {
             let s = sb.push(Kind::Story, &story.name, 1);
@@ -263,13 +289,17 @@ impl Storyboard {
             for act in &story.acts {
                 let a = sb.push(Kind::Act, &act.name, 1);
                 sb.elems[s].children.push(a);
+                // An empty trigger (`<StartTrigger/>`) is no trigger: the act starts with
+                // its story (esmini's reading); an empty stop trigger never fires.
                 sb.elems[a].start = act
                     .start
                     .as_ref()
+                    .filter(|t| !t.0.is_empty())
                     .map(|t| sb.add_trigger(t, Owner::ActStart(a)));
                 sb.elems[a].stop = act
                     .stop
                     .as_ref()
+                    .filter(|t| !t.0.is_empty())
                     .map(|t| sb.add_trigger(t, Owner::ActStop(a)));
                 for g in &act.groups {
                     let gi = sb.push(Kind::Group, &g.name, g.max_count);
@@ -281,15 +311,16 @@ impl Storyboard {
                             let ei = sb.push(Kind::Event, &ev.name, ev.max_count);
                             sb.elems[mi].children.push(ei);
                             sb.elems[ei].priority = ev.priority;
-                            sb.elems[ei].start = ev.start.as_ref().map(|t| {
-                                sb.add_trigger(
-                                    t,
-                                    Owner::EventStart {
-                                        event: ei,
-                                        maneuver: mi,
-                                    },
-                                )
-                            });
+                            sb.elems[ei].start =
+                                ev.start.as_ref().filter(|t| !t.0.is_empty()).map(|t| {
+                                    sb.add_trigger(
+                                        t,
+                                        Owner::EventStart {
+                                            event: ei,
+                                            maneuver: mi,
+                                        },
+                                    )
+                                });
                             for na in &ev.actions {
                                 let ai = sb.push(Kind::Action, &na.name, 1);
                                 sb.elems[ei].children.push(ai);
@@ -411,6 +442,13 @@ impl Storyboard {
         };
         let reach = (a.centre_m[0] + a.size_m[0] / 2.0).max(0.0) + margin_m;
         !self.roads.advance(&mut lp, reach, &|_| false)
+    }
+
+    /// Whether any event of the storyboard has started (run at least once, or runs now).
+    pub fn any_event_started(&self) -> bool {
+        self.elems
+            .iter()
+            .any(|e| e.kind == Kind::Event && (e.runs > 0 || e.phase != Phase::Standby))
     }
 
     /// Records whether entity `e` has touched anything solid.
@@ -652,7 +690,7 @@ impl Storyboard {
                 if d.speed.as_ref().is_some_and(|s| s.2 == i) {
                     d.speed = None;
                 }
-                if d.lateral.as_ref().is_some_and(|s| s.2 == i) {
+                if d.lateral.as_ref().is_some_and(|l| l.action == i) {
                     d.lateral = None;
                 }
                 if d.path.as_ref().is_some_and(|s| s.1 == i) {
@@ -778,8 +816,10 @@ impl Storyboard {
                     .roads
                     .lane_pos(road, *lane, *s, *offset)
                     .map_err(|e| bad(e.to_string()))?;
-                // Without an orientation, along the road's reference line (esmini's reading).
-                let h = orient(orientation, self.roads.along_heading(&lp));
+                // Without an orientation, or relative to it, the lane's driving direction
+                // (esmini's reading: a left lane of right-hand traffic faces against `s`).
+                let travel = self.roads.travel_heading(&LanePos { rev: false, ..lp });
+                let h = orient(orientation, travel);
                 let lp = self.roads.facing(lp, h);
                 let pose = Pose {
                     h,
@@ -830,9 +870,13 @@ impl Storyboard {
                     let st = &mut self.actors[e].state;
                     st.pose = pose;
                     st.lane = lane;
+                    self.drives[e].rel_h = self.relative_heading(pose.h, lane);
                     let d = &mut self.drives[e];
                     // The motion it was making ends (and its action with it).
-                    let old = [d.path.take().map(|p| p.1), d.lateral.take().map(|l| l.2)];
+                    let old = [
+                        d.path.take().map(|p| p.1),
+                        d.lateral.take().map(|l| l.action),
+                    ];
                     for o in old {
                         self.override_task(o);
                     }
@@ -846,12 +890,7 @@ impl Storyboard {
                 dynamics,
                 offset_m,
             } => {
-                return self.start_lane_change(
-                    e,
-                    (target, dynamics, offset_m),
-                    (a, &action.pos),
-                    t,
-                );
+                return self.start_lane_change(e, (target, dynamics, offset_m), (a, &action.pos));
             }
             Action::LaneOffset {
                 target,
@@ -863,7 +902,6 @@ impl Storyboard {
                     e,
                     (target, shape, max_lateral_acc, continuous),
                     (a, &action.pos),
-                    t,
                 );
             }
             Action::LongitudinalDistance {
@@ -963,19 +1001,12 @@ impl Storyboard {
         e: usize,
         (target, dynamics, offset_m): (&LaneTarget, &m::Dynamics, &f64),
         (a, pos): (Option<usize>, &paracosm_openscenario::Pos),
-        t: f64,
     ) -> Result<(), StoryError> {
         let bad = |message: String| StoryError {
             at: site(pos),
             message,
         };
         let scripted = self.actors[e].scripted;
-        let begin = |sb: &mut Storyboard| {
-            if let Some(a) = a {
-                sb.elems[a].pending += 1;
-            }
-        };
-
         if !scripted {
             return Ok(());
         }
@@ -1018,24 +1049,50 @@ impl Storyboard {
             ))
         })?;
         let target_d = self.roads.lateral_between(lp.lane, to_lane, lp.s) + offset_m;
+        // By distance, the parameter is the path along the lane; by time or rate, time.
+        let by_distance = dynamics.dimension == m::Dimension::Distance;
+        let duration = if by_distance {
+            dynamics.value.abs()
+        } else {
+            duration_s(dynamics, target_d - lp.d, st.speed.abs())
+        };
         let tr = Transition {
             from: lp.d,
             to: target_d,
-            start_s: t,
-            duration_s: duration_s(dynamics, target_d - lp.d, st.speed.abs()),
+            start_s: 0.0,
+            duration_s: if dynamics.shape == m::Shape::Step {
+                0.0
+            } else {
+                duration
+            },
             shape: dynamics.shape,
         };
-        let old = self.drives[e].lateral.take().map(|s| s.2);
-        self.override_task(old);
-        begin(self);
-        self.drives[e].lateral = Some((
-            tr,
-            Some((to_lane, *offset_m)),
-            a.unwrap_or(usize::MAX),
-            false,
-        ));
-
+        self.begin_lateral(
+            e,
+            Lateral {
+                tr,
+                param: 0.0,
+                by_distance,
+                offset: false,
+                to_lane: Some((to_lane, *offset_m)),
+                action: a.unwrap_or(usize::MAX),
+                continuous: false,
+            },
+            a,
+        );
         Ok(())
+    }
+
+    /// Starts lateral move `l` of `e` for action `a`, ending the one it replaces.
+    fn begin_lateral(&mut self, e: usize, l: Lateral, a: Option<usize>) {
+        let old = self.drives[e].lateral.take().map(|s| s.action);
+        self.override_task(old);
+        if let Some(a) = a {
+            self.elems[a].pending += 1;
+        }
+        // It aligns with the road as it starts (esmini's reading).
+        self.drives[e].rel_h = 0.0;
+        self.drives[e].lateral = Some(l);
     }
 
     /// Starts a `LaneOffsetAction` on `e`.
@@ -1049,19 +1106,12 @@ impl Storyboard {
             &bool,
         ),
         (a, pos): (Option<usize>, &paracosm_openscenario::Pos),
-        t: f64,
     ) -> Result<(), StoryError> {
         let bad = |message: String| StoryError {
             at: site(pos),
             message,
         };
         let scripted = self.actors[e].scripted;
-        let begin = |sb: &mut Storyboard| {
-            if let Some(a) = a {
-                sb.elems[a].pending += 1;
-            }
-        };
-
         if !scripted {
             return Ok(());
         }
@@ -1081,15 +1131,23 @@ impl Storyboard {
         let tr = Transition {
             from: lp.d,
             to,
-            start_s: t,
+            start_s: 0.0,
             duration_s: offset_duration_s(*shape, to - lp.d, acc),
             shape: *shape,
         };
-        let old = self.drives[e].lateral.take().map(|s| s.2);
-        self.override_task(old);
-        begin(self);
-        self.drives[e].lateral = Some((tr, None, a.unwrap_or(usize::MAX), *continuous));
-
+        self.begin_lateral(
+            e,
+            Lateral {
+                tr,
+                param: 0.0,
+                by_distance: false,
+                offset: true,
+                to_lane: None,
+                action: a.unwrap_or(usize::MAX),
+                continuous: *continuous,
+            },
+            a,
+        );
         Ok(())
     }
 
@@ -1134,7 +1192,10 @@ impl Storyboard {
             }),
         };
         let d = &mut self.drives[e];
-        let old = [d.path.take().map(|p| p.1), d.lateral.take().map(|l| l.2)];
+        let old = [
+            d.path.take().map(|p| p.1),
+            d.lateral.take().map(|l| l.action),
+        ];
         for o in old {
             self.override_task(o);
         }
@@ -1147,6 +1208,11 @@ impl Storyboard {
     /// `lp` (if any) facing `h`.
     fn facing(&self, lp: Option<LanePos>, h: f64) -> Option<LanePos> {
         lp.map(|lp| self.roads.facing(lp, h))
+    }
+
+    /// Heading `h` relative to the travel of lane position `lp`, rad (0 off the lanes).
+    fn relative_heading(&self, h: f64, lp: Option<LanePos>) -> f64 {
+        lp.map_or(0.0, |lp| wrap(h - self.roads.travel_heading(&lp)))
     }
 
     /// A task replaced by a new one of the same kind on the same entity ends (its action
@@ -1255,7 +1321,9 @@ impl Storyboard {
             }
         }
         v1 = v1.max(0.0);
-        let dist = 0.5 * (st.speed + v1) * dt;
+        // At the new speed over the step (esmini's integration: the speed first, then the
+        // move).
+        let dist = v1 * dt;
         let mut pose = st.pose;
         let mut lane = st.lane;
         let mut at_end = false;
@@ -1276,13 +1344,14 @@ impl Storyboard {
             pose = p;
             lane = self.facing(self.roads.anchor(p.x, p.y), p.h);
             if over {
-                // It goes on at the speed it had, the way the last leg went (esmini's
-                // reading).
+                // It goes on at the speed it had, along its lane facing the way the last leg
+                // went (esmini's reading).
+                self.drives[e].rel_h = self.relative_heading(p.h, lane);
                 self.drives[e].path = None;
                 done.push(a);
             }
         } else if let Some(lp) = lane {
-            let (p, l, end, ended) = self.drive_on_lane(e, lp, (dist, t1, pose.h));
+            let (p, l, end, ended) = self.drive_on_lane(e, lp, (dist, dt, pose.h));
             pose = p;
             lane = Some(l);
             at_end = end;
@@ -1310,42 +1379,54 @@ impl Storyboard {
         Ok(())
     }
 
-    /// Moves scripted entity `e`, on lane position `lp` facing `h0`, `dist` metres along its
-    /// lanes to time `t1` with its lateral move: its pose, lane position, whether its lanes
-    /// ended, and the action whose lateral move ended (if any).
+    /// Moves scripted entity `e`, on lane position `lp` facing `h0`, a step of `dt` s in which
+    /// it travels `dist` m, along its lanes with its lateral move: its pose, lane position,
+    /// whether its lanes ended, and the action whose lateral move ended (if any).
+    ///
+    /// A lateral move is esmini's (`LatLaneChangeAction`, `LatLaneOffsetAction`): a lane
+    /// change takes its lateral step out of the step's travel (by time, `√(dist² − lat²)` along
+    /// the lane; by distance, `dist / √(1 + r²)` with `r` the offset's slope per metre) and
+    /// faces the way it moves; a lane offset lags one step and faces `atan(rate / speed)`.
     fn drive_on_lane(
         &mut self,
         e: usize,
         mut lp: LanePos,
-        (dist, t1, h0): (f64, f64, f64),
+        (dist, dt, h0): (f64, f64, f64),
     ) -> (Pose, LanePos, bool, Option<usize>) {
         let mut ended = None;
-        let prefer_roads = self.drives[e].prefer_roads.clone();
-        // A route names the roads it takes; a junction's connecting road is preferred by
-        // the road it leads to.
-        let prefer = |n: usize| {
-            prefer_roads.contains(&self.roads.ids(n).1)
-                || prefer_roads.contains(&self.roads.exit_road(n))
-        };
-        let up_before = lp.along_s(&self.roads);
-        let at_end = !self.roads.advance(&mut lp, dist, &prefer);
-        if lp.along_s(&self.roads) != up_before {
-            // Its lane runs on in a road of the other direction: a lateral move in
-            // progress keeps its side of the motion.
-            if let Some((tr, to_lane, _, _)) = &mut self.drives[e].lateral {
-                tr.from = -tr.from;
-                tr.to = -tr.to;
-                if let Some((_, offset)) = to_lane {
-                    *offset = -*offset;
-                }
-            }
-        }
-        let d0 = lp.d;
-        if let Some((tr, to_lane, a, continuous)) = self.drives[e].lateral {
-            let (d, over) = tr.at(t1);
+        let mut along = dist;
+        // The heading relative to the lane's travel, as a slope against the travel.
+        let mut slip = 0.0;
+        if let Some(mut l) = self.drives[e].lateral {
+            let moving = dist > 1e-12;
+            let (d, over) = if l.offset {
+                let (d, over) = l.tr.at(l.param);
+                slip = (l.tr.slope(l.param) * dt).atan2(dist);
+                l.param += dt;
+                (d, over)
+            } else if !moving {
+                // Standing, a lane change waits (esmini steps it only while moving).
+                (lp.d, false)
+            } else if l.tr.duration_s <= 0.0 {
+                (l.tr.to, true)
+            } else if l.by_distance {
+                let r = l.tr.slope(l.param);
+                along = dist / (1.0 + r * r).sqrt();
+                l.param += along;
+                slip = r.atan();
+                l.tr.at(l.param)
+            } else {
+                let lat = (l.tr.slope(l.param) * dt).abs().min(dist);
+                along = (dist * dist - lat * lat).sqrt();
+                slip = (l.tr.slope(l.param) * dt).signum() * lat.atan2(along);
+                l.param += dt;
+                l.tr.at(l.param)
+            };
             lp.d = d;
+            self.drives[e].lateral = Some(l);
             if over {
-                if let Some((k, offset)) = to_lane {
+                slip = 0.0;
+                if let Some((k, offset)) = l.to_lane {
                     let up = lp.along_s(&self.roads);
                     let beside = (self.roads.ids(k).1 == self.roads.ids(lp.lane).1)
                         .then(|| self.roads.lane_with_id(lp.lane, self.roads.ids(k).0, lp.s))
@@ -1355,30 +1436,42 @@ impl Storyboard {
                         lp.lane = k2;
                         lp.rev = self.roads.forward(k2) != up;
                         lp.d = offset;
-                    } else {
-                        // The change ended on another road: the lane under it now.
-                        let p = self.roads.pose_of(&lp);
-                        let h = self.roads.travel_heading(&lp);
-                        if let Some(a) = self.facing(self.roads.anchor(p.x, p.y), h) {
-                            lp = a;
-                        }
                     }
                 }
-                if !continuous {
+                if !l.continuous {
                     self.drives[e].lateral = None;
-                    ended = Some(a);
+                    ended = Some(l.action);
+                }
+            }
+        }
+        let prefer_roads = self.drives[e].prefer_roads.clone();
+        // A route names the roads it takes; a junction's connecting road is preferred by
+        // the road it leads to.
+        let prefer = |n: usize| {
+            prefer_roads.contains(&self.roads.ids(n).1)
+                || prefer_roads.contains(&self.roads.exit_road(n))
+        };
+        let up_before = lp.along_s(&self.roads);
+        let at_end = !self.roads.advance(&mut lp, along, &prefer);
+        if lp.along_s(&self.roads) != up_before {
+            // Its lane runs on in a road of the other direction: a lateral move in
+            // progress keeps its side of the motion.
+            if let Some(l) = &mut self.drives[e].lateral {
+                l.tr.from = -l.tr.from;
+                l.tr.to = -l.tr.to;
+                if let Some((_, offset)) = &mut l.to_lane {
+                    *offset = -*offset;
                 }
             }
         }
         let travel = self.roads.travel_heading(&lp);
+        // `d` is left of increasing `s`: against `s`, the same move turns the other way.
         let side = if lp.along_s(&self.roads) { 1.0 } else { -1.0 };
-        let slip = if dist > 1e-9 {
-            (side * (lp.d - d0)).atan2(dist)
+        let h = if dist > 1e-12 {
+            wrap(travel + side * slip + self.drives[e].rel_h)
         } else {
-            0.0
+            h0
         };
-        let turning = dist > 1e-9 || (lp.d - d0).abs() > 1e-12;
-        let h = if turning { wrap(travel + slip) } else { h0 };
         let mut pose = self.roads.pose_of(&lp);
         // Standing still, it keeps the way it faces.
         pose.h = h;

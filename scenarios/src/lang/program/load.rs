@@ -319,6 +319,7 @@ fn parameter_space(program: &Program) -> Result<ParamSpace, LoadError> {
                 name: coordinate,
                 domain: p.domain.clone(),
                 unit: p.unit.clone(),
+                density: None,
             });
         }
     }
