@@ -316,12 +316,7 @@ fn the_crossing_pedestrian_runs_on_the_storyboard_and_meets_an_ego_that_does_not
 #[test]
 fn a_scenario_written_here_runs_as_a_campaign_and_a_continuous_distance_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("brake.xosc");
-    std::fs::write(
-        &file,
-        brake_scenario("false", 20.0, "leadingReferencedEntity"),
-    )
-    .unwrap();
+    let file = brake_file(dir.path());
     let out = dir.path().join("out");
     let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
         .arg(&file)
@@ -368,6 +363,17 @@ fn a_scenario_written_here_runs_as_a_campaign_and_a_continuous_distance_is_refus
         err.contains("brake.xosc:38:") && err.contains("continuous LongitudinalDistanceAction"),
         "{err}"
     );
+}
+
+/// `dir/brake.xosc`: [`brake_scenario`] placed once, not continuously, 20 m along the road.
+fn brake_file(dir: &std::path::Path) -> std::path::PathBuf {
+    let file = dir.join("brake.xosc");
+    std::fs::write(
+        &file,
+        brake_scenario("false", 20.0, "leadingReferencedEntity"),
+    )
+    .unwrap();
+    file
 }
 
 /// A scenario written here: the ego at `ego_s` m of lane −4 of the ALKS straight road at
@@ -577,4 +583,54 @@ fn stochastic_distributions_weight_random_draws() {
         (mean - 5.0).abs() < 0.35,
         "Halton covers [2, 8): mean {mean}"
     );
+}
+
+/// An external system under test (`--sut-cmd`, SUT_PROTOCOL.md) is told the speed the
+/// scenario gives the ego to keep: the brake scenario's `Init` speed, 12 m/s, arrives as
+/// `ego.set_speed_mps` in every observation.
+#[test]
+fn an_external_system_under_test_is_told_the_egos_set_speed() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = brake_file(dir.path());
+    let seen = dir.path().join("seen.txt");
+    let script = dir.path().join("record.py");
+    let lib = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/python");
+    std::fs::write(
+        &script,
+        format!(
+            r#"import sys
+sys.path.insert(0, {lib:?})
+from paracosm_sut import LidarBrake, serve
+
+class Recording(LidarBrake):
+    def act(self, obs):
+        with open({seen:?}, "a") as f:
+            f.write(repr(obs.ego.get("set_speed_mps")) + "\n")
+        return LidarBrake.act(self, obs)
+
+serve(Recording())
+"#,
+            lib = lib.to_str().unwrap(),
+            seen = seen.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args(["--budget", "1", "--sut-cmd"])
+        .arg(format!("python3 {}", script.display()))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    let lines: Vec<String> = std::fs::read_to_string(&seen)
+        .unwrap()
+        .lines()
+        .map(str::to_owned)
+        .collect();
+    assert!(lines.len() > 100, "{} observations", lines.len());
+    assert!(lines.iter().all(|l| l == "12.0"), "{:?}", &lines[..3]);
 }

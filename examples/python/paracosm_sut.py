@@ -64,7 +64,8 @@ def write_frame(stream, header, buffers=()):
 class Observation:
     """One control step's observation.
 
-    ``t_s`` (s), ``ego`` (``pos_m`` [x, y, z] in m, ``heading_rad``, ``speed_mps``), and the
+    ``t_s`` (s), ``ego`` (``pos_m`` [x, y, z] in m, ``heading_rad``, ``speed_mps``, and
+    ``set_speed_mps`` when the scenario gives the ego a speed to keep), and the
     sensors asked for in the handshake: ``camera()`` (height x width x 3, uint8, row-major,
     top-left origin), ``depth()`` (height x width float32 metres along the optical axis, inf
     for sky), ``lidar()`` (n x 3 float32 points [forward, up, right] in m, vehicle frame).
@@ -144,9 +145,10 @@ def serve(controller, stdin=None, stdout=None):
 
 
 class LidarBrake(Controller):
-    """The example controller: cruise at 12 m/s and brake at full force when a lidar return in
-    the 1.3 m corridor ahead is closer than the 1.4 s time headway plus 2 m, like the built-in
-    ``aeb`` on a straight road (no lane keeping)."""
+    """The example controller: cruise at the scenario's set speed (12 m/s without one) and
+    brake at full force when a lidar return in the 1.3 m corridor ahead is closer than the
+    1.4 s time headway plus 2 m, like the built-in ``aeb`` on a straight road (no lane
+    keeping)."""
 
     sensors = {"lidar": True}
 
@@ -156,7 +158,8 @@ class LidarBrake(Controller):
                        if p[0] > 0.0 and abs(p[2]) <= 1.3 and p[1] >= -0.6), default=None)
         if nearest is not None and nearest - 2.0 < max(speed, 0.0) * 1.4:
             return -1.0, 0.0
-        return max(-1.0, min(1.0, 0.5 * (12.0 - speed))), 0.0
+        target = obs.ego.get("set_speed_mps", 12.0)
+        return max(-1.0, min(1.0, 0.5 * (target - speed))), 0.0
 
 
 if __name__ == "__main__":

@@ -766,6 +766,11 @@ impl Sut for ExternalSut {
                 "speed_mps": obs.ego.speed_mps,
             },
         });
+        // The speed the scenario asks the ego to keep (an OpenSCENARIO `Init` speed), when it
+        // asks one.
+        if let Some(v) = obs.set_speed_mps {
+            header["ego"]["set_speed_mps"] = json!(v);
+        }
         // Every reading the program declared, as named arrays (SUT_PROTOCOL.md), in the
         // order of their names.
         let sent = match p.declared_readings(obs) {
