@@ -76,11 +76,14 @@ fn a_failing_pedestrian_test_exports_with_its_trigger_as_a_distance_condition() 
     .unwrap();
     assert_eq!(xodr, bend);
     assert!(xosc.contains("<LogicFile filepath=\"test_"), "{xosc}");
-    // The walk starts when the ego comes within the drawn trigger distance (measured from
-    // the ego's centre in the recording, at the step the walk began: within a step's travel).
+    // The walk starts when the ego comes within the drawn trigger distance, measured in the
+    // recording from the ego's centre and written from its rear axle (the file's reference
+    // point), 0.3 × 4.5 m behind: farther from a pedestrian ahead by up to that (within a
+    // step's travel).
     let d = attr(&xosc, "DistanceCondition", "value");
+    let behind = 0.3 * 4.5;
     assert!(
-        (d - trigger).abs() < 0.5,
+        d > trigger - 0.5 && d < trigger + behind + 0.5,
         "condition at {d} m, trigger {trigger} m"
     );
     assert!(xosc.contains("<EntityRef entityRef=\"ego\"/>"));
@@ -91,8 +94,9 @@ fn a_failing_pedestrian_test_exports_with_its_trigger_as_a_distance_condition() 
         )),
         "{xosc}"
     );
-    // The ego starts where the program puts it: road 1, lane -1, s = 10 (y = -1.75).
-    assert_eq!(attr(&xosc, "WorldPosition", "x"), 10.0);
+    // The ego starts where the program puts it: road 1, lane -1, s = 10 (y = -1.75), its
+    // rear axle 1.35 m behind.
+    assert!((attr(&xosc, "WorldPosition", "x") - (10.0 - behind)).abs() < 1e-9);
     assert_eq!(attr(&xosc, "WorldPosition", "y"), -1.75);
     // Exporting again gives the same bytes.
     let (again, _) = export(&out.join("results.jsonl"), id, &dir.path().join("y"));
@@ -115,12 +119,18 @@ fn cars_follow_the_trajectories_they_drove() {
     let at = r["params"]["oncoming_at"].as_f64().unwrap();
     let (xosc, _) = export(&out.join("results.jsonl"), 3, &dir.path().join("x"));
     // car1 is the oncoming car: it starts on the east arm (road 1 runs east from x = 12),
-    // lane 1 (y = +1.75), `oncoming_at` m out, and its trajectory's first vertex is there.
+    // lane 1 (y = +1.75), `oncoming_at` m out, and its trajectory's first vertex is there:
+    // its rear axle (the file's reference point of a vehicle), which for a car facing west
+    // lies east of its centre by its bounding box's offset.
+    let car1 = &xosc[xosc.find("<ScenarioObject name=\"car1\"").unwrap()..];
+    let ahead = attr(car1, "Center", "x");
+    assert!((ahead - 0.3 * attr(car1, "Dimensions", "length")).abs() < 1e-9);
+    assert_eq!(attr(car1, "RearAxle", "positionX"), 0.0);
     let traj = &xosc[xosc.find("<Trajectory name=\"car1 as driven\"").unwrap()..];
     let x = attr(traj, "WorldPosition", "x");
     let y = attr(traj, "WorldPosition", "y");
     assert!(
-        (x - (12.0 + at)).abs() < 0.05 && (y - 1.75).abs() < 0.05,
+        (x - (12.0 + at + ahead)).abs() < 0.05 && (y - 1.75).abs() < 0.05,
         "({x}, {y}) vs at {at}"
     );
     let vertices = traj[..traj.find("</Trajectory>").unwrap()]

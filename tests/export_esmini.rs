@@ -13,27 +13,12 @@ use common::{fuzz, records};
 /// The largest difference between esmini's and paracosm's collision times, s.
 const AGREE_S: f64 = 0.2;
 
-/// Studies whose esmini collision differs from paracosm's by more than [`AGREE_S`], with what
-/// was measured: exported boxes are checked by esmini as boxes, and paracosm's collisions are
-/// contacts of its physics shapes.
-const DIFFER: [(&str, &str); 2] = [
-    (
-        "curve-pedestrian",
-        "esmini 0.23 s earlier (not diagnosed; esmini checks the pedestrian's box, paracosm its capsule)",
-    ),
-    (
-        "opendrive-junction",
-        "esmini reports the collision 0.38 s earlier, while its own log has the two boxes 7 m apart (not diagnosed)",
-    ),
-];
-
 #[test]
 fn the_first_collisions_of_the_shipped_studies_happen_in_esmini_too() {
     let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data/xosc/esmini-collisions.csv");
     let mut rd = csv::Reader::from_path(&fixture).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let mut agreeing = 0;
     let mut report = Vec::new();
     for rec in rd.records() {
         let rec = rec.unwrap();
@@ -73,20 +58,8 @@ fn the_first_collisions_of_the_shipped_studies_happen_in_esmini_too() {
         report.push(format!(
             "{study}: paracosm {t_paracosm:.3} s, esmini {t_esmini:.3} s ({gap:+.3} s)"
         ));
-        match DIFFER.iter().find(|(s, _)| *s == study) {
-            None => {
-                assert!(gap.abs() <= AGREE_S, "{}", report.join("\n"));
-                agreeing += 1;
-            }
-            Some((_, why)) => {
-                // Still as measured: a change in either simulator shows here.
-                assert!(
-                    gap.abs() > AGREE_S,
-                    "{study} now agrees ({gap:+.3} s): drop it from DIFFER ({why})"
-                );
-            }
-        }
+        assert!(gap.abs() <= AGREE_S, "{}", report.join("\n"));
     }
     println!("{}", report.join("\n"));
-    assert_eq!(agreeing, 4, "{}", report.join("\n"));
+    assert_eq!(report.len(), 6, "the six studies of the fixture");
 }

@@ -3,8 +3,11 @@
 //!
 //! - **Entities.** The ego vehicle (`ego`), the NPC cars (`car1`, ...), the pedestrians
 //!   (`pedestrian1`, ...) and the obstacles (`obstacle1`, ...), with their bounding boxes.
-//!   Positions are the centre of each actor's footprint on the road surface; OpenSCENARIO's
-//!   `(x, y, z)` is paracosm's `(x, -z, y)`, headings agree.
+//!   A vehicle's position is its rear axle's centre (OpenSCENARIO's reference point of a
+//!   vehicle, which esmini assumes), [`REAR_AXLE_SHARE`] of its length behind the centre of
+//!   its footprint, and its bounding box lies ahead of it; a pedestrian's and an obstacle's is
+//!   the centre of its footprint. OpenSCENARIO's `(x, y, z)` is paracosm's `(x, -z, y)`,
+//!   headings agree.
 //! - **Init.** Every entity is placed where the test starts it (`TeleportAction`); the ego and
 //!   the cars get their initial speed (`AbsoluteTargetSpeed`). With [`EgoMotion::Route`], the
 //!   ego gets its route as an `AssignRouteAction` (waypoints every 10 m) for a system under
@@ -28,6 +31,17 @@ use super::xml::El;
 pub const VERTEX_EVERY_S: f64 = 0.1;
 /// Longest distance between two waypoints of the ego's route, m.
 pub const WAYPOINT_EVERY_M: f64 = 10.0;
+/// How far behind the centre of a vehicle's footprint its rear axle lies, as a share of its
+/// length (its front axle lies as far ahead).
+pub const REAR_AXLE_SHARE: f64 = 0.3;
+
+/// The rear axle's centre of a vehicle of `size` whose footprint's centre is at `p` (paracosm
+/// world `[x, y, z]`, m) facing `h` (rad): its reference point in the file.
+fn rear_axle(p: [f64; 3], h: f64, size: Size) -> [f64; 3] {
+    let k = REAR_AXLE_SHARE * size.length_m;
+    // Heading h points along (cos h, -sin h) in paracosm's (x, z).
+    [p[0] - k * h.cos(), p[1], p[2] + k * h.sin()]
+}
 
 /// How the ego's motion is written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -72,11 +86,12 @@ fn world_position(p: [f64; 3], h: f64) -> El {
     )
 }
 
-fn bounding_box(size: Size) -> El {
+/// A bounding box of `size` whose centre lies `ahead` m in front of the reference point.
+fn bounding_box(size: Size, ahead: f64) -> El {
     El::new("BoundingBox")
         .child(
             El::new("Center")
-                .num("x", 0.0)
+                .num("x", ahead)
                 .num("y", 0.0)
                 .num("z", size.height_m / 2.0),
         )
@@ -100,7 +115,7 @@ fn vehicle(name: &str, size: Size) -> El {
     El::new("Vehicle")
         .attr("name", name)
         .attr("vehicleCategory", "car")
-        .child(bounding_box(size))
+        .child(bounding_box(size, REAR_AXLE_SHARE * size.length_m))
         .child(
             El::new("Performance")
                 .num("maxSpeed", 60.0)
@@ -109,8 +124,12 @@ fn vehicle(name: &str, size: Size) -> El {
         )
         .child(
             El::new("Axles")
-                .child(axle("FrontAxle", size.length_m * 0.3, 0.6))
-                .child(axle("RearAxle", -size.length_m * 0.3, 0.0)),
+                .child(axle(
+                    "FrontAxle",
+                    2.0 * REAR_AXLE_SHARE * size.length_m,
+                    0.6,
+                ))
+                .child(axle("RearAxle", 0.0, 0.0)),
         )
         .child(El::new("Properties"))
 }
@@ -321,7 +340,7 @@ fn entities(w: &WorldSpec) -> Vec<El> {
                     .attr("name", &name)
                     .num("mass", 75.0)
                     .attr("pedestrianCategory", "pedestrian")
-                    .child(bounding_box(Size::PEDESTRIAN))
+                    .child(bounding_box(Size::PEDESTRIAN, 0.0))
                     .child(El::new("Properties")),
             ),
         );
@@ -334,7 +353,7 @@ fn entities(w: &WorldSpec) -> Vec<El> {
                     .attr("name", &name)
                     .num("mass", 500.0)
                     .attr("miscObjectCategory", "obstacle")
-                    .child(bounding_box(o.size))
+                    .child(bounding_box(o.size, 0.0))
                     .child(El::new("Properties")),
             ),
         );
@@ -348,8 +367,12 @@ fn init(test: &Test<'_>, first: &Snapshot) -> Vec<El> {
     let g = |p: [f64; 3]| in_file(test.origin_m, p);
     let mut init = Vec::new();
     let ego = &first.ego;
+    let ego_size = w.ego.vehicle.size;
     let mut ego_actions = vec![
-        teleport(g(ego.pos_m), ego.heading_rad),
+        teleport(
+            g(rear_axle(ego.pos_m, ego.heading_rad, ego_size)),
+            ego.heading_rad,
+        ),
         speed(w.ego.initial_speed_mps),
     ];
     if test.ego == EgoMotion::Route && w.ego.route.len() >= 2 {
@@ -359,7 +382,13 @@ fn init(test: &Test<'_>, first: &Snapshot) -> Vec<El> {
     for (i, c) in first.cars.iter().enumerate() {
         init.push(private(
             &format!("car{}", i + 1),
-            vec![teleport(g(c.pos_m), c.heading_rad), speed(c.speed_mps)],
+            vec![
+                teleport(
+                    g(rear_axle(c.pos_m, c.heading_rad, w.cars[i].size)),
+                    c.heading_rad,
+                ),
+                speed(c.speed_mps),
+            ],
         ));
     }
     for (i, p) in first.pedestrians.iter().enumerate() {
@@ -438,7 +467,10 @@ fn story(test: &Test<'_>, frames: &[&Snapshot], first: &Snapshot) -> El {
     if test.ego == EgoMotion::Trajectory {
         let points: Vec<(f64, [f64; 3], f64)> = frames
             .iter()
-            .map(|s| (s.t_s, g(s.ego.pos_m), s.ego.heading_rad))
+            .map(|s| {
+                let p = rear_axle(s.ego.pos_m, s.ego.heading_rad, w.ego.vehicle.size);
+                (s.t_s, g(p), s.ego.heading_rad)
+            })
             .collect();
         groups.push(maneuver_group(
             "ego",
@@ -453,7 +485,12 @@ fn story(test: &Test<'_>, frames: &[&Snapshot], first: &Snapshot) -> El {
         let name = format!("car{}", i + 1);
         let points: Vec<(f64, [f64; 3], f64)> = frames
             .iter()
-            .filter_map(|s| s.cars.get(i).map(|c| (s.t_s, g(c.pos_m), c.heading_rad)))
+            .filter_map(|s| {
+                s.cars.get(i).map(|c| {
+                    let p = rear_axle(c.pos_m, c.heading_rad, w.cars[i].size);
+                    (s.t_s, g(p), c.heading_rad)
+                })
+            })
             .collect();
         groups.push(maneuver_group(
             &name,
@@ -514,7 +551,9 @@ fn pedestrian_group(
         .find(|s| s.t_s >= started - 1e-9)
         .unwrap_or(first);
     let start = w.pedestrians[i].start;
-    let d = (at.ego.pos_m[0] - start[0]).hypot(at.ego.pos_m[2] - start[2]);
+    // From the ego's reference point, its rear axle, as a simulator measures it.
+    let ego = rear_axle(at.ego.pos_m, at.ego.heading_rad, w.ego.vehicle.size);
+    let d = (ego[0] - start[0]).hypot(ego[2] - start[2]);
     let target = w.pedestrians[i].target;
     let h = (-(target[2] - start[2])).atan2(target[0] - start[0]);
     let walk: Vec<(f64, [f64; 3], f64)> = frames
