@@ -389,6 +389,18 @@ pub enum Position {
         /// Orientation.
         orientation: Option<Orientation>,
     },
+    /// `RelativeRoadPosition`: `ds` along the entity's road and `dt` across it from the
+    /// entity's own road coordinates.
+    RelativeRoad {
+        /// The entity.
+        entity: usize,
+        /// m along the road's reference line (increasing `s`).
+        ds: f64,
+        /// m along +t (left of the reference line).
+        dt: f64,
+        /// Orientation (relative: to the road's reference line there).
+        orientation: Option<Orientation>,
+    },
     /// `RelativeLanePosition`.
     RelativeLane {
         /// The entity.

@@ -157,11 +157,12 @@ fn check_all(files: &[PathBuf]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 11] = [
+const ESMINI_EXAMPLES: [&str; 12] = [
     "alks_cut-in",
     "alks_cut-out",
     "alks_decelerate",
     "alks_r157_cut_in_quick_brake",
+    "cut-in_simple",
     "drive_when_close",
     "highway_driver",
     "override_bb",
@@ -177,5 +178,20 @@ fn esminis_own_examples_move_their_entities_as_esmini_does() {
         .iter()
         .map(|n| data("esmini/xosc").join(format!("{n}.xosc")))
         .collect();
+    check_all(&files);
+}
+
+/// Scenarios written here in forms the shipped suites do not use
+/// (`tests/data/xosc/written/README.md`).
+#[test]
+fn scenarios_written_here_move_as_in_esmini() {
+    let dir = data("written");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "xosc"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty());
     check_all(&files);
 }

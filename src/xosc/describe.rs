@@ -166,6 +166,12 @@ fn position(s: &Scenario, p: &Position) -> String {
             offset,
             ..
         } => format!("road {road} lane {lane} s {st} offset {offset}"),
+        Position::RelativeRoad { entity, ds, dt, .. } => {
+            format!(
+                "{ds} m along, {dt} m across the road from {}",
+                name(s, *entity)
+            )
+        }
         Position::RelativeLane {
             entity,
             d_lane,

@@ -1,5 +1,5 @@
 //! Positions (OpenSCENARIO 1.3 User Guide, "Positions"): world, relative world, relative
-//! object, road, lane and relative lane positions; the others are refused.
+//! object, road, relative road, lane and relative lane positions; the others are refused.
 
 use roxmltree::Node;
 
@@ -14,6 +14,7 @@ const POSITIONS: &[&str] = &[
     "RelativeWorldPosition",
     "RelativeObjectPosition",
     "RoadPosition",
+    "RelativeRoadPosition",
     "LanePosition",
     "RelativeLanePosition",
 ];
@@ -83,6 +84,12 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscE
             road: s.string(t, p, "roadId")?,
             s: s.num(t, p, "s")?,
             t: s.num(t, p, "t")?,
+            orientation: orientation(r, p)?,
+        },
+        "RelativeRoadPosition" => Position::RelativeRoad {
+            entity: r.entity(p, "entityRef")?,
+            ds: s.num(t, p, "ds")?,
+            dt: s.num(t, p, "dt")?,
             orientation: orientation(r, p)?,
         },
         "LanePosition" => Position::Lane {

@@ -240,6 +240,19 @@ impl Roads {
             .ok_or_else(|| RoadError(format!("road {road} has no lane at s = {s} m")))
     }
 
+    /// The road (its OpenDRIVE id) and the lateral coordinate `t` (m, left of the reference
+    /// line) of `lp`: the inverse of [`Roads::road_pos`].
+    ///
+    /// # Errors
+    /// When the road has no lane −1 or 1 at the station.
+    pub fn road_t(&self, lp: &LanePos) -> Result<(String, f64), RoadError> {
+        let road = self.map.roads[self.map.lanes[lp.lane].road].od_id.clone();
+        // The point at t = 0 on the same road and station, relative to its lane's centre.
+        let zero = self.road_pos(&road, lp.s, 0.0)?;
+        let t = self.lateral_between(zero.lane, lp.lane, lp.s) + lp.d - zero.d;
+        Ok((road, t))
+    }
+
     /// The width of lane `k` at station `s`, m.
     pub fn lane_width(&self, k: usize, s: f64) -> f64 {
         let l = &self.map.lanes[k];

@@ -19,6 +19,16 @@ use super::road::{wrap, LanePos, Pose, RoadError, Roads};
 /// The largest lateral acceleration of a `LaneOffsetAction` without `maxLateralAcc`, m/s².
 pub const DEFAULT_LATERAL_ACC_MPS2: f64 = 0.5;
 
+/// Orientation `o` against `base` (rad): a relative one added to it, an absolute one as
+/// written, `base` without one.
+fn orient(o: &Option<m::Orientation>, base: f64) -> f64 {
+    match o {
+        Some(o) if o.relative => wrap(base + o.h),
+        Some(o) => wrap(o.h),
+        None => base,
+    }
+}
+
 /// One entity as the storyboard sees it.
 #[derive(Debug, Clone)]
 pub struct Actor {
@@ -729,6 +739,34 @@ impl Storyboard {
         }
     }
 
+    /// Lane position `lp` facing `h` (rad): its pose, and its place on the lanes the way it
+    /// faces.
+    fn placed(&self, lp: LanePos, h: f64) -> (Pose, Option<LanePos>) {
+        let lp = self.roads.facing(lp, h);
+        let pose = Pose {
+            h,
+            ..self.roads.pose_of(&lp)
+        };
+        (pose, Some(lp))
+    }
+
+    /// Where entity `e` is on the lanes, for a position of kind `what` relative to it.
+    ///
+    /// # Errors
+    /// [`StoryError`] at `at` when `e` is on no lane.
+    fn lane_of(
+        &self,
+        e: usize,
+        what: &str,
+        at: &paracosm_openscenario::Pos,
+    ) -> Result<LanePos, StoryError> {
+        let r = &self.actors[e];
+        r.state.lane.ok_or_else(|| StoryError {
+            at: site(at),
+            message: format!("a {what} to {}, which is not on a lane", r.name),
+        })
+    }
+
     /// Where `p` is now: its pose and its place on the lanes.
     ///
     /// # Errors
@@ -741,11 +779,6 @@ impl Storyboard {
         let bad = |message: String| StoryError {
             at: site(at),
             message,
-        };
-        let orient = |o: &Option<m::Orientation>, base: f64| match o {
-            Some(o) if o.relative => wrap(base + o.h),
-            Some(o) => wrap(o.h),
-            None => base,
         };
         Ok(match p {
             Position::World { x, y, h } => {
@@ -798,12 +831,7 @@ impl Storyboard {
                     .road_pos(road, *s, *t)
                     .map_err(|e| bad(e.to_string()))?;
                 let h = orient(orientation, self.roads.along_heading(&lp));
-                let lp = self.roads.facing(lp, h);
-                let pose = Pose {
-                    h,
-                    ..self.roads.pose_of(&lp)
-                };
-                (pose, Some(lp))
+                self.placed(lp, h)
             }
             Position::Lane {
                 road,
@@ -820,12 +848,22 @@ impl Storyboard {
                 // (esmini's reading: a left lane of right-hand traffic faces against `s`).
                 let travel = self.roads.travel_heading(&LanePos { rev: false, ..lp });
                 let h = orient(orientation, travel);
-                let lp = self.roads.facing(lp, h);
-                let pose = Pose {
-                    h,
-                    ..self.roads.pose_of(&lp)
-                };
-                (pose, Some(lp))
+                self.placed(lp, h)
+            }
+            Position::RelativeRoad {
+                entity,
+                ds,
+                dt,
+                orientation,
+            } => {
+                let lp = self.lane_of(*entity, "RelativeRoadPosition", at)?;
+                let (road, t) = self.roads.road_t(&lp).map_err(|e| bad(e.to_string()))?;
+                let lp = self
+                    .roads
+                    .road_pos(&road, lp.s + ds, t + dt)
+                    .map_err(|e| bad(e.to_string()))?;
+                let h = orient(orientation, self.roads.along_heading(&lp));
+                self.placed(lp, h)
             }
             Position::RelativeLane {
                 entity,
@@ -833,13 +871,7 @@ impl Storyboard {
                 ds,
                 offset,
             } => {
-                let r = &self.actors[*entity];
-                let Some(lp) = r.state.lane else {
-                    return Err(bad(format!(
-                        "a RelativeLanePosition to {}, which is not on a lane",
-                        r.name
-                    )));
-                };
+                let lp = self.lane_of(*entity, "RelativeLanePosition", at)?;
                 let lp = self
                     .roads
                     .relative_lane(&lp, *d_lane, *ds, *offset)
@@ -1568,23 +1600,16 @@ impl Storyboard {
     fn entity_test(&self, e: usize, test: &EntityTest) -> bool {
         let st = &self.actors[e].state;
         match test {
+            // Undefined (the reference behind, or the entity standing; not closing in) is
+            // false whatever the rule, as esmini has it: an "infinite" headway must not
+            // satisfy `greaterThan`.
             EntityTest::TimeHeadway(g) => {
                 let (long, _, _) = self.gap(e, g);
-                let h = if long > 0.0 && st.speed > 1e-9 {
-                    long / st.speed
-                } else {
-                    f64::INFINITY
-                };
-                g.rule.holds(h, g.value)
+                long >= 0.0 && st.speed > 1e-9 && g.rule.holds(long / st.speed, g.value)
             }
             EntityTest::TimeToCollision(g) => {
                 let (long, _, closing) = self.gap(e, g);
-                let ttc = if long >= 0.0 && closing > 1e-9 {
-                    long / closing
-                } else {
-                    f64::INFINITY
-                };
-                g.rule.holds(ttc, g.value)
+                long >= 0.0 && closing > 1e-9 && g.rule.holds(long / closing, g.value)
             }
             EntityTest::RelativeDistance(g) => {
                 let (long, lat, _) = self.gap(e, g);
