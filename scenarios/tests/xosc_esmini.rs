@@ -117,15 +117,20 @@ fn compare(scenario: &Path, fixtures: &Path) -> Worst {
 
 #[test]
 fn every_alks_template_moves_its_entities_as_esmini_does() {
-    let dir = data("alks/concrete_scenarios");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_string_lossy().ends_with("_template.xosc"))
-        .collect();
-    files.sort();
+    let files = files_ending(&data("alks/concrete_scenarios"), "_template.xosc");
     assert_eq!(files.len(), 15, "the suite's 15 templates");
     check_all(&files);
+}
+
+/// The files of `dir` whose names end with `suffix`, sorted.
+fn files_ending(dir: &Path, suffix: &str) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with(suffix))
+        .collect();
+    files.sort();
+    files
 }
 
 /// Compares every file of `files` with its fixture; fails naming each that differs.
@@ -185,13 +190,7 @@ fn esminis_own_examples_move_their_entities_as_esmini_does() {
 /// (`tests/data/xosc/written/README.md`).
 #[test]
 fn scenarios_written_here_move_as_in_esmini() {
-    let dir = data("written");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "xosc"))
-        .collect();
-    files.sort();
+    let files = files_ending(&data("written"), ".xosc");
     assert!(!files.is_empty());
     check_all(&files);
 }

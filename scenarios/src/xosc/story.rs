@@ -1206,6 +1206,20 @@ impl Storyboard {
         for (_, p) in vertices {
             poses.push(self.resolve(p, pos)?.0);
         }
+        // A world vertex without a heading faces along its leg (the next vertex; the last, from
+        // the one before), as esmini aligns what a file omits.
+        for k in 0..poses.len() {
+            if matches!(vertices[k].1, Position::World { h: None, .. }) {
+                let (a, b) = match (poses.get(k), poses.get(k + 1)) {
+                    (Some(a), Some(b)) => (*a, *b),
+                    _ if k > 0 => (poses[k - 1], poses[k]),
+                    _ => continue,
+                };
+                if (b.x - a.x).hypot(b.y - a.y) > 1e-9 {
+                    poses[k].h = (b.y - a.y).atan2(b.x - a.x);
+                }
+            }
+        }
         let timed = vertices.iter().all(|(time, _)| time.is_some());
         let path = match timing {
             Some((absolute, scale, offset)) if timed => {
@@ -1223,6 +1237,19 @@ impl Storyboard {
                 gone_m: 0.0,
             }),
         };
+        // On the trajectory from the start (esmini's reading): a timed one where it is at `t`,
+        // one started in `Init` at its first vertex.
+        let here = match &path {
+            Path::Timed(p) => Some(p.at(t).0),
+            Path::Untimed(u) if a.is_none() => u.vertices.first().copied(),
+            Path::Untimed(_) => None,
+        };
+        if let Some(p) = here {
+            let lane = self.facing(self.roads.anchor(p.x, p.y), p.h);
+            let st = &mut self.actors[e].state;
+            st.pose = p;
+            st.lane = lane;
+        }
         let d = &mut self.drives[e];
         let old = [
             d.path.take().map(|p| p.1),
