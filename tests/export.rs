@@ -145,12 +145,9 @@ fn cars_follow_the_trajectories_they_drove() {
     );
 }
 
-/// By default the ego exports as the trajectory it drove (no route): a timed polyline whose
-/// vertices, every 0.1 s, follow the ego from its start; with `--ego-route`, as its route.
-#[test]
-fn the_ego_exports_as_the_trajectory_it_drove() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("g");
+/// `dir/g`: a one-test campaign of `grid-world` (the ego turns at its junctions).
+fn grid_world_test(dir: &Path) -> std::path::PathBuf {
+    let out = dir.join("g");
     let o = fuzz(&[
         "grid-world",
         "--budget",
@@ -159,6 +156,15 @@ fn the_ego_exports_as_the_trajectory_it_drove() {
         out.to_str().unwrap(),
     ]);
     assert!(matches!(o.status.code(), Some(0 | 1)), "{o:?}");
+    out
+}
+
+/// By default the ego exports as the trajectory it drove (no route): a timed polyline whose
+/// vertices, every 0.1 s, follow the ego from its start; with `--ego-route`, as its route.
+#[test]
+fn the_ego_exports_as_the_trajectory_it_drove() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = grid_world_test(dir.path());
     let (xosc, _) = export(&out.join("results.jsonl"), 0, &dir.path().join("x"));
     assert!(!xosc.contains("<Route "), "no route by default");
     let traj = &xosc[xosc
@@ -196,15 +202,7 @@ fn the_ego_exports_as_the_trajectory_it_drove() {
 #[test]
 fn the_egos_route_waypoints_head_along_the_route() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("g");
-    let o = fuzz(&[
-        "grid-world",
-        "--budget",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(matches!(o.status.code(), Some(0 | 1)), "{o:?}");
+    let out = grid_world_test(dir.path());
     let (xosc, _) = export_with(
         &out.join("results.jsonl"),
         0,
