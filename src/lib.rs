@@ -35,3 +35,20 @@ pub fn load_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Error> 
         Ok(paracosm_scenarios::load(name)?)
     }
 }
+
+/// Refuses a system under test for a scenario whose ego a script places (`--scripted-ego`):
+/// its control would never be read, and the test would not test it.
+///
+/// # Errors
+/// [`Error::BadInput`] when `scenario`'s system under test is
+/// [`paracosm_engine::sut::SutConfig::Scripted`].
+pub fn refuse_sut_for_scripted_ego(scenario: &paracosm_scenarios::Scenario) -> Result<(), Error> {
+    if matches!(scenario.sut, paracosm_engine::sut::SutConfig::Scripted) {
+        return Err(Error::BadInput(format!(
+            "{}: the storyboard moves the ego (--scripted-ego), so no system under test drives \
+             it: leave out --sut, --sut-cmd and --sut-onnx, or --scripted-ego",
+            scenario.name
+        )));
+    }
+    Ok(())
+}

@@ -136,13 +136,10 @@ fn cars_follow_the_trajectories_they_drove() {
     let vertices = traj[..traj.find("</Trajectory>").unwrap()]
         .matches("<Vertex ")
         .count();
-    // Every 0.1 s over the test (10 s, or until a collision stopped it).
+    // At every step of the test (10 s, or until a collision stopped it), and the start.
     let simulated = r["metrics"]["simulated_s"].as_f64().unwrap();
-    let expected = (simulated / 0.1).round() as usize + 1;
-    assert!(
-        vertices.abs_diff(expected) <= 1,
-        "{vertices} vertices for {simulated} s"
-    );
+    let expected = (simulated / paracosm_engine::DEFAULT_DT_S).round() as usize + 1;
+    assert_eq!(vertices, expected, "{vertices} vertices for {simulated} s");
 }
 
 /// `dir/g`: a one-test campaign of `grid-world` (the ego turns at its junctions).
@@ -160,7 +157,8 @@ fn grid_world_test(dir: &Path) -> std::path::PathBuf {
 }
 
 /// By default the ego exports as the trajectory it drove (no route): a timed polyline whose
-/// vertices, every 0.1 s, follow the ego from its start; with `--ego-route`, as its route.
+/// vertices, one at every step, follow the ego from its start; with `--ego-route`, as its
+/// route.
 #[test]
 fn the_ego_exports_as_the_trajectory_it_drove() {
     let dir = tempfile::tempdir().unwrap();
@@ -183,11 +181,8 @@ fn the_ego_exports_as_the_trajectory_it_drove() {
     let r = &records(&out)[0];
     let simulated = r["metrics"]["simulated_s"].as_f64().unwrap();
     let vertices = traj.matches("<Vertex ").count();
-    let expected = (simulated / 0.1).round() as usize + 1;
-    assert!(
-        vertices.abs_diff(expected) <= 1,
-        "{vertices} vertices for {simulated} s"
-    );
+    let expected = (simulated / paracosm_engine::DEFAULT_DT_S).round() as usize + 1;
+    assert_eq!(vertices, expected, "{vertices} vertices for {simulated} s");
     let (routed, _) = export_with(
         &out.join("results.jsonl"),
         0,

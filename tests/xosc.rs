@@ -251,8 +251,10 @@ fn the_crossing_pedestrian_runs_on_the_storyboard_and_meets_an_ego_that_does_not
     use paracosm_generators::{Point, Value};
     let name = paracosm::xosc::campaign_name(
         &format!("{}/{CROSSING}", env!("CARGO_MANIFEST_DIR")),
-        &["TargetBlocking_InitPosition_LongitudinalOffset_m=80..120".to_owned()],
-        false,
+        &paracosm::xosc::XoscOptions {
+            open: vec!["TargetBlocking_InitPosition_LongitudinalOffset_m=80..120".to_owned()],
+            ..Default::default()
+        },
     );
     let mut scenario = paracosm::load_scenario(&name).expect("the campaign's scenario builds");
     let names: Vec<&str> = scenario

@@ -95,6 +95,11 @@ pub enum Action {
     /// The pedestrian is put at the value, `(Vec3 [x, y, z] m of its feet, heading rad)`, for
     /// this step, as [`Action::PlaceCar`].
     PlacePedestrian(Handle<PedestrianSpec>),
+    /// The ego is put at the value, `(Vec3 [x, y, z] m of its footprint's centre on the
+    /// ground, heading rad)`, for this step, as [`Action::PlaceCar`]: only for an ego whose
+    /// [`crate::EgoSpec::scripted`] is set (a storyboard replays it; no system under test
+    /// drives it).
+    PlaceEgo,
 }
 
 impl Action {
@@ -106,6 +111,7 @@ impl Action {
             | Action::Brake(c)
             | Action::ChangeLane(c)
             | Action::PlaceCar(c) => ActorRef::Car(c),
+            Action::PlaceEgo => ActorRef::Ego,
         }
     }
 }

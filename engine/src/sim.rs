@@ -440,10 +440,9 @@ impl Simulation {
         let ego = EgoVehicle::build(
             &mut physics,
             &spec.ego.vehicle,
-            start.pos_m,
-            start.heading_rad,
-            spec.ego.initial_speed_mps,
+            (start.pos_m, start.heading_rad, spec.ego.initial_speed_mps),
             friction,
+            spec.ego.scripted,
         );
 
         let ids = read_streams(spec);
@@ -651,9 +650,11 @@ impl Simulation {
         self.evaluate(host)?;
         let before = self.physics.bodies[self.ego.body].translation();
         self.set_frictions(t)?;
-        self.ego.apply(control, dt);
-        self.ego.grip(&self.physics, &self.surface);
-        self.ego.update(&mut self.physics, dt);
+        if !self.ego.scripted {
+            self.ego.apply(control, dt);
+            self.ego.grip(&self.physics, &self.surface);
+            self.ego.update(&mut self.physics, dt);
+        }
         for p in self.pedestrians.values_mut() {
             p.rest();
         }
@@ -1069,6 +1070,25 @@ impl Simulation {
                     if let Some(p) = self.pedestrians.get_mut(h) {
                         p.place(&mut self.physics, pose, dt);
                     }
+                }
+                Action::PlaceEgo => {
+                    let pose = placed_pose(value).ok_or_else(|| {
+                        bad(
+                            "the pose given to the ego".into(),
+                            value,
+                            "a (Vec3 [x, y, z] m, heading rad) pair of finite numbers",
+                        )
+                    })?;
+                    if !self.ego.scripted {
+                        return Err(bad(
+                            "a pose given to the ego, which the system under test drives \
+                             (EgoSpec::scripted is not set)"
+                                .into(),
+                            value,
+                            "no pose",
+                        ));
+                    }
+                    self.ego.place(&mut self.physics, pose.0, pose.1);
                 }
             }
         }

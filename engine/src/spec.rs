@@ -24,6 +24,11 @@ pub struct EgoSpec {
     /// The speed the scenario asks the system under test to keep, m/s (an OpenSCENARIO
     /// ego's initial speed: ALKS's set speed); `None`: the system's own cruise speed.
     pub set_speed_mps: Option<f64>,
+    /// Whether a script places the ego at every step ([`crate::behaviour::Action::PlaceEgo`],
+    /// an OpenSCENARIO storyboard's trajectory) instead of the system under test driving it:
+    /// its chassis is then a kinematic body, its velocity the move it makes over each step,
+    /// and every contact with another actor is recorded as when it drives.
+    pub scripted: bool,
 }
 
 /// A pedestrian (paper §2, `Pedestrian`): a kinematic capsule that walks in a straight line
@@ -194,6 +199,7 @@ impl WorldSpec {
                 vehicle: VehicleParams::default(),
                 route: vec![],
                 set_speed_mps: None,
+                scripted: false,
             },
             pedestrians: peds,
             cars: vec![],

@@ -60,18 +60,24 @@ pub(crate) struct EgoVehicle {
     /// asked of the four together (N·s), before [`EgoVehicle::hold_to_grip`] shares and caps
     /// them.
     asked: ([f32; 4], f32),
+    /// Whether a script places it ([`crate::EgoSpec::scripted`]): a kinematic chassis that
+    /// neither the controller nor the physics moves.
+    pub(crate) scripted: bool,
+    /// How far above the ground its chassis' centre rides, m (as built, at rest).
+    ride_m: f32,
 }
 
 impl EgoVehicle {
     /// Builds the vehicle with its wheels on the ground at `pos` (surface point, metres),
-    /// heading `heading_rad`, moving forward at `speed_mps`.
+    /// heading `heading_rad`, moving forward at `speed_mps`; `scripted`: a kinematic chassis
+    /// that [`EgoVehicle::place`] moves, whose contacts with the other kinematic actors
+    /// (pedestrians, NPC cars, obstacles) are detected as a dynamic chassis' are.
     pub(crate) fn build(
         physics: &mut PhysicsWorld,
         params: &VehicleParams,
-        pos: [f64; 3],
-        heading_rad: f64,
-        speed_mps: f64,
+        (pos, heading_rad, speed_mps): ([f64; 3], f64, f64),
         friction: f64,
+        scripted: bool,
     ) -> Self {
         let (len, wid, hei) = (
             params.size.length_m as f32,
@@ -80,10 +86,16 @@ impl EgoVehicle {
         );
         let radius = params.wheel_radius_m as f32;
         // Chassis centre so that the wheels rest with a little compression at the start.
-        let y = pos[1] as f32 + radius + SUSPENSION_REST_M + HARD_POINT_DROP_M - 0.05;
+        let ride_m = radius + SUSPENSION_REST_M + HARD_POINT_DROP_M - 0.05;
+        let y = pos[1] as f32 + ride_m;
         let rotation = Rotation::from_rotation_y(heading_rad as f32);
         let forward = rotation * Vector::X;
-        let body = RigidBodyBuilder::dynamic()
+        let body = if scripted {
+            RigidBodyBuilder::kinematic_position_based()
+        } else {
+            RigidBodyBuilder::dynamic()
+        };
+        let body = body
             .pose(Pose::from_parts(
                 Vector::new(pos[0] as f32, y, pos[2] as f32),
                 rotation,
@@ -93,7 +105,10 @@ impl EgoVehicle {
             .can_sleep(false);
         let collider = ColliderBuilder::cuboid(len / 2.0, hei / 2.0, wid / 2.0)
             .mass(params.mass_kg as f32)
-            .active_events(ActiveEvents::COLLISION_EVENTS);
+            .active_events(ActiveEvents::COLLISION_EVENTS)
+            .active_collision_types(
+                ActiveCollisionTypes::default() | ActiveCollisionTypes::KINEMATIC_KINEMATIC,
+            );
         let (body, collider) = physics.insert(body, collider);
 
         // Suspension stiffness and damping are per unit of chassis mass in rapier's model
@@ -126,7 +141,20 @@ impl EgoVehicle {
             controller,
             params: params.clone(),
             asked: ([0.0; 4], 0.0),
+            scripted,
+            ride_m,
         }
+    }
+
+    /// Puts a scripted vehicle's chassis at the end of this step where its footprint's
+    /// centre on the ground is `pos` (m) and it faces `heading_rad` (yaw only), at the height
+    /// it was built to ride at. rapier gives it the velocity of that move.
+    pub(crate) fn place(&self, physics: &mut PhysicsWorld, pos: [f64; 3], heading_rad: f64) {
+        let pose = Pose::from_parts(
+            Vector::new(pos[0] as f32, pos[1] as f32 + self.ride_m, pos[2] as f32),
+            Rotation::from_rotation_y(heading_rad as f32),
+        );
+        physics.bodies[self.body].set_next_kinematic_position(pose);
     }
 
     /// Sets engine, brake and steering from `control` (clamped), as documented on [`Control`].
@@ -235,7 +263,13 @@ mod tests {
     fn control_maps_to_engine_brake_and_steering_within_limits() {
         let mut physics = PhysicsWorld::new();
         let params = VehicleParams::default();
-        let mut v = EgoVehicle::build(&mut physics, &params, [0.0, 0.0, 0.0], 0.0, 0.0, 0.8);
+        let mut v = EgoVehicle::build(
+            &mut physics,
+            &params,
+            ([0.0, 0.0, 0.0], 0.0, 0.0),
+            0.8,
+            false,
+        );
         let dt = 1.0 / 60.0;
         v.apply(
             Control {

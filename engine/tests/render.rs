@@ -535,6 +535,7 @@ fn standing_world(
             vehicle: paracosm_engine::VehicleParams::default(),
             route: vec![],
             set_speed_mps: None,
+            scripted: false,
         },
         pedestrians: vec![],
         cars,

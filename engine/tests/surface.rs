@@ -77,6 +77,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
             vehicle: VehicleParams::default(),
             route: vec![],
             set_speed_mps: None,
+            scripted: false,
         },
         pedestrians: vec![],
         cars: specs,

@@ -547,6 +547,20 @@ pub enum EntityTest {
     TimeToCollision(Gap),
     /// `RelativeDistanceCondition`, m.
     RelativeDistance(Gap),
+    /// `DistanceCondition`: the distance from the entity to a position, m (in the entity's
+    /// frame: `coordinateSystem` `entity`; from its bounding box with `freespace`).
+    Distance {
+        /// The position.
+        position: Position,
+        /// Comparison.
+        rule: Rule,
+        /// m.
+        value: f64,
+        /// From the entity's bounding box (its reference point otherwise).
+        freespace: bool,
+        /// `relativeDistanceType`: `longitudinal`, `lateral` or `euclidianDistance`.
+        kind: String,
+    },
     /// `ReachPositionCondition`.
     ReachPosition {
         /// The position.

@@ -157,6 +157,7 @@ pub fn scene(mut scene: Scene) -> Result<Scene, ScenarioError> {
                 vehicle: VehicleParams::default(),
                 route: vec![],
                 set_speed_mps: None,
+                scripted: false,
             },
             SutConfig::Aeb(aeb),
         )

@@ -323,3 +323,52 @@ fn a_delay_counts_from_when_the_element_waits_and_transitions_are_seen_next_step
         faster - went
     );
 }
+
+/// A point on a lane anchors at its own station, wherever it lies between the lane's
+/// stations: an entity put by a world position and then driven along its lane starts where
+/// it was put. (The station used to be one the map's index named near the point, up to
+/// 1.15 m back: an exported test read back started its cars there.)
+#[test]
+fn a_point_on_a_lane_anchors_at_its_own_station() {
+    // On a bend, within the sagitta of the map's 0.5 m chords (0.5² / (8 · 250) m).
+    for (road, within) in [
+        ("alks_road_straight.xodr", 1e-6),
+        ("alks_road_left_radius_250m.xodr", 1e-3),
+        ("alks_road_right_radius_1000m.xodr", 1e-3),
+    ] {
+        let path = alks("road_networks").join(road);
+        let text = std::fs::read_to_string(&path).expect("the map reads");
+        let map = MapRef::new(
+            opendrive::import(path.to_str().unwrap(), &text)
+                .expect("the map imports")
+                .map,
+        );
+        let roads = Roads::new(&map);
+        let mut worst = 0.0f64;
+        for (k, lane) in roads
+            .map()
+            .lanes
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.drivable)
+        {
+            let (s0, s1) = (lane.s[0], lane.s[lane.s.len() - 1]);
+            let mut s = s0 + 0.5;
+            while s < s1 - 0.5 {
+                let lp = paracosm_scenarios::xosc::road::LanePos {
+                    lane: k,
+                    s,
+                    d: 0.3,
+                    rev: false,
+                };
+                let p = roads.pose_of(&lp);
+                let at = roads.anchor(p.x, p.y).expect("on a lane");
+                assert_eq!(at.lane, k, "{road}: lane at s = {s}");
+                worst = worst.max((at.s - s).abs()).max((at.d - 0.3).abs());
+                s += 0.37;
+            }
+        }
+        assert!(worst < within, "{road}: anchored {worst} m off");
+        println!("{road}: anchored within {worst:.2e} m");
+    }
+}

@@ -52,6 +52,11 @@ struct Cli {
     /// range instead of its levels.
     #[arg(long)]
     continuous: bool,
+    /// With an OpenSCENARIO scenario (.xosc): the storyboard moves the ego as it moves every
+    /// other entity (its Init, trajectories and actions), and no system under test drives it;
+    /// replays a test that `export` wrote. Not with --sut, --sut-cmd or --sut-onnx.
+    #[arg(long)]
+    scripted_ego: bool,
     /// How test points are chosen [default: halton].
     #[arg(long, value_parser = paracosm::cli::strategy_parser())]
     strategy: Option<Strategy>,
@@ -429,7 +434,7 @@ fn main() -> ExitCode {
         )
             .map_err(anyhow::Error::new)
             .and_then(|e| {
-                let text = format!(
+                let mut text = format!(
                     "wrote {} (OpenSCENARIO 1.2) and {} (OpenDRIVE){}",
                     e.xosc.display(),
                     e.xodr.display(),
@@ -439,6 +444,15 @@ fn main() -> ExitCode {
                         "\nwarning: the replayed verdict differs from the recorded one; the files describe the replay"
                     }
                 );
+                if !e.not_in_file.is_empty() {
+                    text.push_str(&format!(
+                        "\nnote: OpenSCENARIO has no monitors: read back (paracosm-fuzz {} \
+                         --scripted-ego), the test is judged by collision and leaving the road; \
+                         its monitors {} are not in the file",
+                        e.xosc.display(),
+                        e.not_in_file.join(", ")
+                    ));
+                }
                 say(&text).map(|()| if e.matches { 0 } else { 3 })
             }),
         Some(Sub::Map(a)) => map(a),
@@ -569,12 +583,17 @@ impl Cli {
         let scenario = match &self.scenario {
             Some(s) if paracosm::xosc::is_xosc(s) => Some(paracosm::xosc::campaign_name(
                 s,
-                &self.open,
-                self.continuous,
+                &paracosm::xosc::XoscOptions {
+                    open: self.open.clone(),
+                    continuous: self.continuous,
+                    scripted_ego: self.scripted_ego,
+                },
             )),
-            Some(_) if !self.open.is_empty() || self.continuous => {
+            Some(_) if !self.open.is_empty() || self.continuous || self.scripted_ego => {
                 return Err(Error::BadInput(
-                    "--open and --continuous are for an OpenSCENARIO scenario (.xosc)".into(),
+                    "--open, --continuous and --scripted-ego are for an OpenSCENARIO scenario \
+                     (.xosc)"
+                        .into(),
                 ))
             }
             other => other.clone(),

@@ -524,6 +524,7 @@ fn refuse(out: &Path, diffs: Vec<String>) -> Error {
 fn load_scenario(name: &str, choice: &SutChoice) -> Result<Scenario, Error> {
     let mut scenario = crate::load_scenario(name)?;
     if let Some(s) = choice.config()? {
+        crate::refuse_sut_for_scripted_ego(&scenario)?;
         scenario.sut = s;
     }
     Ok(scenario)

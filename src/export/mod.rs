@@ -28,6 +28,10 @@ pub struct Exported {
     pub xodr: PathBuf,
     /// Whether the replayed verdict equals the recorded one (the export is of the replay).
     pub matches: bool,
+    /// The test's monitors that the file cannot carry (OpenSCENARIO has none): read back
+    /// (`paracosm-fuzz FILE.xosc --scripted-ego`), a test is judged by collision and leaving
+    /// the road only. Their names, in the scenario's order.
+    pub not_in_file: Vec<String>,
 }
 
 fn input(e: impl std::fmt::Display) -> Error {
@@ -60,7 +64,16 @@ fn network_document(
             })
             .or(scenario.input_files.first())
             .ok_or_else(|| input("the program's map is not among the files it read"))?;
-        paracosm_scenarios::lang::map_files::read_input_file(program, &read.path).map_err(input)
+        if crate::xosc::is_xosc(program) {
+            // An OpenSCENARIO scenario's map path is already joined with its folder.
+            paracosm_scenarios::text_file::read_text(
+                Path::new(&read.path),
+                paracosm_scenarios::lang::map_files::MAX_MAP_BYTES,
+            )
+            .map_err(|e| input(format!("cannot read {}: {e}", read.path)))
+        } else {
+            paracosm_scenarios::lang::map_files::read_input_file(program, &read.path).map_err(input)
+        }
     } else {
         Err(input(
             "the test's network mixes an OpenDRIVE map with other pieces, which cannot be exported as one OpenDRIVE file",
@@ -161,9 +174,22 @@ pub fn export(
     for (path, text) in [(&xodr_path, &network), (&xosc_path, &document)] {
         crate::atomic::write(path, text.as_bytes())?;
     }
+    let not_in_file = scenario
+        .monitors
+        .iter()
+        .filter(|m| {
+            !matches!(
+                m,
+                paracosm_scenarios::MonitorSpec::Collision { .. }
+                    | paracosm_scenarios::MonitorSpec::OffRoad { .. }
+            )
+        })
+        .map(|m| m.name().to_owned())
+        .collect();
     Ok(Exported {
         xosc: xosc_path,
         xodr: xodr_path,
         matches: replayed.matches,
+        not_in_file,
     })
 }

@@ -136,6 +136,7 @@ pub fn replay_with(
         serde_json::from_str(&line).expect("from_line parsed it as JSON");
     let point: Point = record.point;
     if let Some(s) = sut.or(campaign_file.sut.config().map_err(input)?) {
+        crate::refuse_sut_for_scripted_ego(&scenario)?;
         scenario.sut = s;
     }
     let strategy: Strategy = campaign_file.strategy.parse().map_err(input)?;

@@ -39,6 +39,13 @@ impl El {
         self.attr(key, text)
     }
 
+    /// `self` with a number attribute written exactly: the shortest text that reads back as
+    /// the same `f64` (a replay places each entity where the test had it, bit for bit).
+    pub fn exact(self, key: &str, value: f64) -> El {
+        let value = if value == 0.0 { 0.0 } else { value };
+        self.attr(key, format!("{value}"))
+    }
+
     /// `self` with `child` appended.
     pub fn child(mut self, child: El) -> El {
         self.children.push(child);

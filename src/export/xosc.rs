@@ -13,7 +13,8 @@
 //!   ego gets its route as an `AssignRouteAction` (waypoints every 10 m) for a system under
 //!   test to drive.
 //! - **Story.** Each car follows the trajectory it drove in the test, timed (`Polyline`
-//!   vertices every 0.1 s, absolute time), from the start; so does the ego with
+//!   vertices at every step of the test, absolute time, written exactly: read back, each
+//!   entity is where the test had it at every step), from the start; so does the ego with
 //!   [`EgoMotion::Trajectory`] (the default): what the system under test did is in the file. Each pedestrian that walked starts
 //!   on a `DistanceCondition`: when the ego comes within the distance at which it started
 //!   walking in the test (its trigger, measured from the recording); it then follows its walk
@@ -27,10 +28,12 @@ use paracosm_engine::{Size, WorldSpec};
 
 use super::xml::El;
 
-/// Every how many seconds a trajectory has a vertex.
-pub const VERTEX_EVERY_S: f64 = 0.1;
 /// Longest distance between two waypoints of the ego's route, m.
 pub const WAYPOINT_EVERY_M: f64 = 10.0;
+/// How much farther than the recorded distance a pedestrian's trigger reaches, m: read
+/// back, the ego's reference point is where it was, to the last bits, and the walk starts at
+/// the step it started in the test, not one step later for a rounding.
+pub const TRIGGER_SLACK_M: f64 = 1e-9;
 /// How far behind the centre of a vehicle's footprint its rear axle lies, as a share of its
 /// length (its front axle lies as far ahead).
 pub const REAR_AXLE_SHARE: f64 = 0.3;
@@ -46,8 +49,9 @@ fn rear_axle(p: [f64; 3], h: f64, size: Size) -> [f64; 3] {
 /// How the ego's motion is written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum EgoMotion {
-    /// The trajectory it drove, timed (vertices every [`VERTEX_EVERY_S`]): another simulator
-    /// replays what the system under test did.
+    /// The trajectory it drove, timed (a vertex at every step): another simulator replays
+    /// what the system under test did, and `paracosm-fuzz FILE.xosc --scripted-ego` replays
+    /// the test itself.
     #[default]
     Trajectory,
     /// Its route as an `AssignRouteAction`, for another system under test to drive.
@@ -79,10 +83,10 @@ pub struct Test<'a> {
 fn world_position(p: [f64; 3], h: f64) -> El {
     El::new("Position").child(
         El::new("WorldPosition")
-            .num("x", p[0])
-            .num("y", -p[2])
+            .exact("x", p[0])
+            .exact("y", -p[2])
             .num("z", 0.0)
-            .num("h", h),
+            .exact("h", h),
     )
 }
 
@@ -188,7 +192,7 @@ fn time_condition(name: &str, edge: &str, rule: &str, t: f64) -> El {
 fn follow(name: &str, points: &[(f64, [f64; 3], f64)], absolute: bool) -> El {
     let vertices = points.iter().map(|(t, p, h)| {
         El::new("Vertex")
-            .num("time", *t)
+            .exact("time", *t)
             .child(world_position(*p, *h))
     });
     El::new("RoutingAction").child(
@@ -241,25 +245,6 @@ fn event(name: &str, action: El, trigger: El) -> El {
         .child(El::new("StartTrigger").child(trigger))
 }
 
-/// The states every [`VERTEX_EVERY_S`], and the last one.
-fn sampled(states: &[Snapshot]) -> Vec<&Snapshot> {
-    let mut out: Vec<&Snapshot> = Vec::new();
-    for s in states {
-        if out
-            .last()
-            .is_none_or(|l| s.t_s - l.t_s >= VERTEX_EVERY_S - 1e-9)
-        {
-            out.push(s);
-        }
-    }
-    if let (Some(last), Some(end)) = (out.last(), states.last()) {
-        if last.t_s < end.t_s {
-            out.push(end);
-        }
-    }
-    out
-}
-
 /// A simulated world position `[x, y, z]` in the file's frame, where the network's origin lies
 /// at `origin` (OpenDRIVE y is -z).
 fn in_file(origin: [f64; 2], p: [f64; 3]) -> [f64; 3] {
@@ -268,7 +253,7 @@ fn in_file(origin: [f64; 2], p: [f64; 3]) -> [f64; 3] {
 
 /// The document.
 pub fn write(test: &Test<'_>) -> String {
-    let frames = sampled(test.states);
+    let frames: Vec<&Snapshot> = test.states.iter().collect();
     let Some(first) = test.states.first() else {
         return String::new();
     };
@@ -325,7 +310,8 @@ fn entities(w: &WorldSpec) -> Vec<El> {
     let mut entities = vec![El::new("ScenarioObject")
         .attr("name", "ego")
         .child(vehicle("ego", w.ego.vehicle.size))];
-    for (i, c) in w.cars.iter().enumerate() {
+    // A car not in this test (`enabled` false) is not in the file either.
+    for (i, c) in w.cars.iter().enumerate().filter(|(_, c)| c.enabled) {
         entities.push(
             El::new("ScenarioObject")
                 .attr("name", format!("car{}", i + 1))
@@ -380,6 +366,9 @@ fn init(test: &Test<'_>, first: &Snapshot) -> Vec<El> {
     }
     init.push(private("ego", ego_actions));
     for (i, c) in first.cars.iter().enumerate() {
+        if !w.cars[i].enabled {
+            continue;
+        }
         init.push(private(
             &format!("car{}", i + 1),
             vec![
@@ -387,7 +376,10 @@ fn init(test: &Test<'_>, first: &Snapshot) -> Vec<El> {
                     g(rear_axle(c.pos_m, c.heading_rad, w.cars[i].size)),
                     c.heading_rad,
                 ),
-                speed(c.speed_mps),
+                // The speed of its first step (a car's speed is measured over a step, and
+                // the first state has none yet): the storyboard starts its trajectory one
+                // step after the start, and moves it at this speed until then.
+                speed(first_step_speed(test, i).unwrap_or(c.speed_mps)),
             ],
         ));
     }
@@ -406,6 +398,14 @@ fn init(test: &Test<'_>, first: &Snapshot) -> Vec<El> {
         ));
     }
     init
+}
+
+/// How fast car `i` moved over the test's first step, m/s; `None` for a test without one.
+fn first_step_speed(test: &Test<'_>, i: usize) -> Option<f64> {
+    let (a, b) = (test.states.first()?, test.states.get(1)?);
+    let (p, q) = (a.cars.get(i)?.pos_m, b.cars.get(i)?.pos_m);
+    let dt = b.t_s - a.t_s;
+    (dt > 0.0).then(|| (q[0] - p[0]).hypot(q[2] - p[2]) / dt)
 }
 
 /// The ego's route (at least 2 points) as an `AssignRouteAction`: waypoints at the first
@@ -481,7 +481,7 @@ fn story(test: &Test<'_>, frames: &[&Snapshot], first: &Snapshot) -> El {
             ),
         ));
     }
-    for i in 0..w.cars.len() {
+    for i in (0..w.cars.len()).filter(|&i| w.cars[i].enabled) {
         let name = format!("car{}", i + 1);
         let points: Vec<(f64, [f64; 3], f64)> = frames
             .iter()
@@ -540,11 +540,15 @@ fn pedestrian_group(
 ) -> Option<El> {
     let w = test.world;
     let name = format!("pedestrian{}", i + 1);
-    // None: it never walked.
-    let started = test
+    let Some(started) = test
         .states
         .iter()
-        .find_map(|s| s.pedestrians.get(i).and_then(|p| p.triggered_at_s))?;
+        .find_map(|s| s.pedestrians.get(i).and_then(|p| p.triggered_at_s))
+    else {
+        // It never walked, or a script placed it (an OpenSCENARIO storyboard's): what it did
+        // is a trajectory from the start, as a car's, when it moved at all.
+        return placed_pedestrian_group(test, frames, first, i);
+    };
     let at = test
         .states
         .iter()
@@ -578,7 +582,7 @@ fn pedestrian_group(
                     El::new("DistanceCondition")
                         .attr("freespace", "false")
                         .attr("rule", "lessOrEqual")
-                        .num("value", d)
+                        .exact("value", d + TRIGGER_SLACK_M)
                         .attr("relativeDistanceType", "euclidianDistance")
                         .attr("coordinateSystem", "entity")
                         .child(world_position(in_file(test.origin_m, start), h)),
@@ -591,6 +595,35 @@ fn pedestrian_group(
             &format!("{name} walks"),
             follow(&format!("{name} as walked"), &walk, false),
             trigger,
+        ),
+    ))
+}
+
+/// Pedestrian `i`'s motion as a trajectory timed from the start, facing the way it moved
+/// from its first to its last position; `None` when it stayed where it started.
+fn placed_pedestrian_group(
+    test: &Test<'_>,
+    frames: &[&Snapshot],
+    first: &Snapshot,
+    i: usize,
+) -> Option<El> {
+    let name = format!("pedestrian{}", i + 1);
+    let at = |s: &Snapshot| s.pedestrians.get(i).map(|p| p.pos_m);
+    let (start, end) = (at(first)?, frames.iter().rev().find_map(|s| at(s))?);
+    if start == end && frames.iter().all(|s| at(s).is_none_or(|p| p == start)) {
+        return None;
+    }
+    let h = (-(end[2] - start[2])).atan2(end[0] - start[0]);
+    let points: Vec<(f64, [f64; 3], f64)> = frames
+        .iter()
+        .filter_map(|s| at(s).map(|p| (s.t_s, in_file(test.origin_m, p), h)))
+        .collect();
+    Some(maneuver_group(
+        &name,
+        event(
+            &format!("{name} moves"),
+            follow(&format!("{name} as placed"), &points, true),
+            time_condition("start", "none", "greaterOrEqual", 0.0),
         ),
     ))
 }

@@ -314,6 +314,17 @@ fn condition(s: &Scenario, c: &ConditionKind) -> String {
                     position: p,
                     tolerance,
                 } => format!("within {tolerance} m of {}", position(s, p)),
+                EntityTest::Distance {
+                    position: p,
+                    rule,
+                    value,
+                    freespace,
+                    kind,
+                } => format!(
+                    "{kind} distance{} to {} {rule:?} {value} m",
+                    if *freespace { " from its box" } else { "" },
+                    position(s, p)
+                ),
                 EntityTest::Speed { rule, value } => format!("speed {rule:?} {value} m/s"),
                 EntityTest::RelativeSpeed {
                     entity,

@@ -127,17 +127,33 @@ pub fn inspect(path: &Path, opens: &[String], continuous: bool) -> Result<Inspec
 }
 
 /// The separator between an OpenSCENARIO file and its options in a campaign's scenario name:
-/// `file.xosc#open=Name=lo..hi;open=Name=a,b;continuous` (what `campaign.json` keeps, so that
-/// resume, report, replay and export build the same space).
+/// `file.xosc#open=Name=lo..hi;open=Name=a,b;continuous;scripted-ego` (what `campaign.json`
+/// keeps, so that resume, report, replay and export build the same space and world).
 pub const OPTIONS_MARK: char = '#';
 
-/// The campaign scenario name of `path` with `opens` (`Name=lo..hi` or `Name=a,b,c`) and
-/// `continuous`: the path alone without options.
-pub fn campaign_name(path: &str, opens: &[String], continuous: bool) -> String {
-    let mut options: Vec<String> = opens.iter().map(|o| format!("open={o}")).collect();
+/// How a campaign reads an OpenSCENARIO file (`paracosm-fuzz FILE.xosc` options).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct XoscOptions {
+    /// `--open`: declared parameters opened, `Name=lo..hi` or `Name=a,b,c`.
+    pub open: Vec<String>,
+    /// `--continuous`: a `DistributionRange` becomes an interval over its range.
+    pub continuous: bool,
+    /// `--scripted-ego`: the storyboard moves the ego as every other entity (no system under
+    /// test), to replay an exported test ([`paracosm_scenarios::xosc::Source::scripted_ego`]).
+    pub scripted_ego: bool,
+}
+
+/// The campaign scenario name of `path` with `options`: the path alone without options.
+pub fn campaign_name(path: &str, options: &XoscOptions) -> String {
+    let (opens, continuous) = (&options.open, options.continuous);
+    let mut options_text: Vec<String> = opens.iter().map(|o| format!("open={o}")).collect();
     if continuous {
-        options.push("continuous".into());
+        options_text.push("continuous".into());
     }
+    if options.scripted_ego {
+        options_text.push("scripted-ego".into());
+    }
+    let options = options_text;
     if options.is_empty() {
         path.to_owned()
     } else {
@@ -165,13 +181,15 @@ pub fn campaign_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Err
     };
     let mut opens = Vec::new();
     let mut continuous = false;
+    let mut scripted_ego = false;
     for o in options.split(';').filter(|o| !o.is_empty()) {
         match o.split_once('=') {
             Some(("open", spec)) => opens.push(spec.to_owned()),
             None if o == "continuous" => continuous = true,
+            None if o == "scripted-ego" => scripted_ego = true,
             _ => {
                 return Err(Error::BadInput(format!(
-                "{name}: unknown option {o:?} after {OPTIONS_MARK} (open=Name=lo..hi, continuous)"
+                "{name}: unknown option {o:?} after {OPTIONS_MARK} (open=Name=lo..hi, continuous, scripted-ego)"
             )))
             }
         }
@@ -212,6 +230,7 @@ pub fn campaign_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Err
         name: name.to_owned(),
         space,
         overrides,
+        scripted_ego,
     })?;
     scenario
         .warnings

@@ -81,6 +81,10 @@ pub enum SutConfig {
     Vision(VisionConfig),
     /// Open-loop constant control.
     Constant(Control),
+    /// No system under test: a script places the ego at every step (an OpenSCENARIO
+    /// storyboard replaying an exported test, [`crate::EgoSpec::scripted`]); its control is
+    /// never read.
+    Scripted,
     /// A program in another process (`--sut-cmd`).
     External(ExternalConfig),
     /// An ONNX model run in process (`--sut-onnx`, `sut = "onnx:PATH"`).
@@ -214,13 +218,14 @@ impl SutConfig {
         }
     }
 
-    /// A short name for reports: `aeb`, `vision`, `constant`, the external command line, or
+    /// A short name for reports: `aeb`, `vision`, `constant`, `scripted`, the external command line, or
     /// `onnx:PATH`.
     pub fn name(&self) -> String {
         match self {
             SutConfig::Aeb(_) => "aeb".into(),
             SutConfig::Vision(_) => "vision".into(),
             SutConfig::Constant(_) => "constant".into(),
+            SutConfig::Scripted => "scripted".into(),
             SutConfig::External(e) => e.command.join(" "),
             #[cfg(feature = "onnx")]
             SutConfig::Onnx(c) if c.source == PILOTNET => PILOTNET.into(),
@@ -234,7 +239,7 @@ impl SutConfig {
     /// its handshake, when a test starts).
     pub fn has_camera(&self) -> Option<bool> {
         match self {
-            SutConfig::Aeb(_) | SutConfig::Constant(_) => Some(false),
+            SutConfig::Aeb(_) | SutConfig::Constant(_) | SutConfig::Scripted => Some(false),
             SutConfig::Vision(_) => Some(true),
             #[cfg(feature = "onnx")]
             SutConfig::Onnx(_) => Some(true),
@@ -248,6 +253,7 @@ impl SutConfig {
             SutConfig::Aeb(c) => Box::new(Aeb::new(c.clone())),
             SutConfig::Vision(c) => Box::new(Vision::new(c.clone())),
             SutConfig::Constant(c) => Box::new(ConstantControl(*c)),
+            SutConfig::Scripted => Box::new(ConstantControl(Control::default())),
             SutConfig::External(c) => Box::new(ExternalSut::new(c.clone())),
             #[cfg(feature = "onnx")]
             SutConfig::Onnx(c) => Box::new(OnnxSut::new((**c).clone())),

@@ -170,6 +170,7 @@ const ENTITY_CONDITIONS: &[&str] = &[
     "TimeToCollisionCondition",
     "RelativeDistanceCondition",
     "ReachPositionCondition",
+    "DistanceCondition",
     "SpeedCondition",
     "RelativeSpeedCondition",
     "AccelerationCondition",
@@ -317,6 +318,26 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
                 ));
             }
             EntityTest::RelativeDistance(gap(r, c, c)?)
+        }
+        "DistanceCondition" => {
+            let (frame, kind) = measure(r, c)?;
+            if frame != "entity" {
+                return Err(XoscError::Unsupported {
+                    pos: t.attr_pos(c, "coordinateSystem"),
+                    reason: format!(
+                        "a distance condition in the {frame:?} coordinate system is not \
+                         supported: paracosm measures it in the entity's (coordinateSystem \
+                         \"entity\")"
+                    ),
+                });
+            }
+            EntityTest::Distance {
+                position: position::read(r, need(t, c, "Position")?)?,
+                rule: rule(r, c)?,
+                value: s.num(t, c, "value")?,
+                freespace: s.bool(t, c, "freespace")?,
+                kind,
+            }
         }
         "ReachPositionCondition" => EntityTest::ReachPosition {
             position: position::read(r, need(t, c, "Position")?)?,

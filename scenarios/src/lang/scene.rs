@@ -477,6 +477,7 @@ impl SceneBuilder {
                     vehicle: VehicleParams::default(),
                     route,
                     set_speed_mps: None,
+                    scripted: false,
                 },
                 sut,
             )

@@ -63,6 +63,10 @@ pub struct Source {
     pub space: ParamSpace,
     /// The overrides of one test.
     pub overrides: Overrides,
+    /// Whether the storyboard moves the ego as it moves every other entity (its `Init`, its
+    /// trajectories and actions; no system under test drives it): to replay a test exported
+    /// by `paracosm-fuzz export`, or to run a file as esmini does with its controllers off.
+    pub scripted_ego: bool,
 }
 
 /// An OpenSCENARIO error as a load error.
@@ -117,7 +121,7 @@ pub fn ego_of(s: &m::Scenario) -> Result<usize, ScenarioError> {
 ///
 /// # Errors
 /// [`ScenarioError::Load`] naming the element's line and column.
-pub fn check(s: &m::Scenario, ego: usize) -> Result<Vec<Warning>, ScenarioError> {
+pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, ScenarioError> {
     let mut warnings: Vec<Warning> = s
         .notes
         .iter()
@@ -140,14 +144,14 @@ pub fn check(s: &m::Scenario, ego: usize) -> Result<Vec<Warning>, ScenarioError>
         }
         for &e in who {
             let ignored = match &na.action {
-                Action::ActivateController { .. } if e == ego => None,
+                Action::ActivateController { .. } if Some(e) == ego => None,
                 Action::ActivateController { .. } => Some(format!(
                     "{} has no controller in paracosm: the storyboard moves it, and its \
                      ActivateControllerAction does nothing",
                     name(e)
                 )),
-                Action::Teleport(_) | Action::Speed { .. } if init && e == ego => None,
-                _ if e == ego => Some(format!(
+                Action::Teleport(_) | Action::Speed { .. } if init && Some(e) == ego => None,
+                _ if Some(e) == ego => Some(format!(
                     "the system under test drives {}: this action of the storyboard is not \
                      performed",
                     name(e)
@@ -211,13 +215,14 @@ pub fn check(s: &m::Scenario, ego: usize) -> Result<Vec<Warning>, ScenarioError>
 pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
     let model = read_scenario(&source.template, &[]).map_err(xosc_error)?;
     let ego = ego_of(&model)?;
-    let mut warnings = check(&model, ego)?;
+    let mut warnings = check(&model, (!source.scripted_ego).then_some(ego))?;
     // The model's LogicFile path is already joined with the scenario's folder.
     let dir = PathBuf::new();
     let worlds = XoscWorlds {
         template: source.template.clone(),
         overrides: source.overrides,
         maps: MapFiles::new(Base::Folder(dir)),
+        scripted_ego: source.scripted_ego,
     };
     // The scene of the declared values: the map loads, the Init places every entity.
     let (scene, _) = worlds.build(&model)?;
@@ -242,7 +247,11 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
         ),
         space: source.space,
         horizon_s: HORIZON_CAP_S,
-        sut: SutConfig::Aeb(AebConfig::default()),
+        sut: if source.scripted_ego {
+            SutConfig::Scripted
+        } else {
+            SutConfig::Aeb(AebConfig::default())
+        },
         monitors: vec![MonitorSpec::collision(), MonitorSpec::implicit_off_road()],
         map_axes,
         warnings,
@@ -265,6 +274,8 @@ struct XoscWorlds {
     template: PathBuf,
     overrides: Overrides,
     maps: MapFiles,
+    /// [`Source::scripted_ego`].
+    scripted_ego: bool,
 }
 
 impl Worlds for XoscWorlds {
@@ -305,8 +316,8 @@ impl XoscWorlds {
             .load(&road.item)
             .map_err(|e| ScenarioError::Load(e.with_context(&format!("\n --> {}", road.pos))))?;
         let roads = road::Roads::new(&map);
-        let sb =
-            Storyboard::new(model, roads, Some(ego)).map_err(|e| worlds_error(e.to_string()))?;
+        let driven = (!self.scripted_ego).then_some(ego);
+        let sb = Storyboard::new(model, roads, driven).map_err(|e| worlds_error(e.to_string()))?;
         let mut scene = Scene::new(None);
         let site = here(&road.pos, "RoadNetwork");
         let light = scene.push(Node::Const(Value::Num(1.0)));
@@ -322,7 +333,10 @@ impl XoscWorlds {
                 site.clone(),
             )
             .map_err(|e| worlds_error(e.to_string()))?;
-        let (sinks, probes, ego_actor) = place_entities(&mut scene, model, &sb, ego)?;
+        let (mut sinks, probes, ego_actor) = place_entities(&mut scene, model, &sb, ego)?;
+        if self.scripted_ego {
+            sinks[ego] = Some(Sink::PlaceEgo);
+        }
         let Some(ego_actor) = ego_actor else {
             return Err(worlds_error("no ego".into()));
         };
@@ -358,6 +372,7 @@ impl XoscWorlds {
         let host = StoryHost {
             sb,
             ego,
+            scripted_ego: self.scripted_ego,
             sinks,
             collided: probes,
             ego_probes,
@@ -419,9 +434,14 @@ impl XoscWorlds {
                     initial_speed_mps: speed,
                     vehicle: VehicleParams::default(),
                     route,
-                    set_speed_mps: Some(speed),
+                    set_speed_mps: (!self.scripted_ego).then_some(speed),
+                    scripted: self.scripted_ego,
                 },
-                SutConfig::Aeb(AebConfig::default()),
+                if self.scripted_ego {
+                    SutConfig::Scripted
+                } else {
+                    SutConfig::Aeb(AebConfig::default())
+                },
             )
             .map_err(|e| worlds_error(e.to_string()))
     }
@@ -433,6 +453,9 @@ impl XoscWorlds {
 struct StoryHost {
     sb: Storyboard,
     ego: usize,
+    /// [`Source::scripted_ego`]: the storyboard moves the ego too, and nothing ends the test
+    /// at the end of its road but the storyboard.
+    scripted_ego: bool,
     sinks: Vec<Option<Sink>>,
     collided: Vec<StreamId>,
     ego_probes: [StreamId; 3],
@@ -459,8 +482,13 @@ impl Host for StoryHost {
                 };
                 let heading = num(self.ego_probes[1]).unwrap_or(0.0);
                 let speed = num(self.ego_probes[2]).unwrap_or(0.0);
-                self.sb.observe(self.ego, pos, heading, speed, DEFAULT_DT_S);
-                if self.road_end.is_none() && self.sb.road_ends_ahead(self.ego, ROAD_END_MARGIN_M) {
+                if !self.scripted_ego {
+                    self.sb.observe(self.ego, pos, heading, speed, DEFAULT_DT_S);
+                }
+                if !self.scripted_ego
+                    && self.road_end.is_none()
+                    && self.sb.road_ends_ahead(self.ego, ROAD_END_MARGIN_M)
+                {
                     if !self.sb.any_event_started() {
                         // Nothing happened yet, and nothing can: the test did not test what
                         // the file describes, and must not read as a pass.

@@ -4,7 +4,7 @@
 
 use paracosm_openscenario::model::{Dimension, Dynamics, Shape};
 
-use super::road::{wrap, Pose};
+use super::road::Pose;
 
 /// The fraction `[0, 1]` of a transition done at `tau` (`[0, 1]`, the fraction of its
 /// duration gone) for `shape`: linear `τ`, cubic `3τ² − 2τ³`, sinusoidal `(1 − cos πτ)/2`,
@@ -109,6 +109,9 @@ impl Transition {
     }
 }
 
+/// How close two times are to be one, s (far below any step).
+const TIME_EPS_S: f64 = 1e-9;
+
 /// A timed polyline: vertices with their times (s, from the simulation's start).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Timed {
@@ -117,44 +120,38 @@ pub struct Timed {
 }
 
 impl Timed {
-    /// The pose at `t` (s), linear between vertices, the heading of the leg (or of the
-    /// vertex where the leg has no length), and whether `t` is past the last vertex.
+    /// The pose at `t` (s): the position linear between vertices, the heading of the vertex
+    /// that starts the leg (not interpolated: esmini's polyline without interpolation; a
+    /// vertex whose file gives no heading faces along its leg: the storyboard fills it in),
+    /// and whether `t` is past the last vertex.
     pub fn at(&self, t: f64) -> (Pose, bool) {
         let n = self.vertices.len();
         let last = self.vertices[n - 1];
-        if t >= last.0 {
-            // Facing the way the last leg went (a vertex's own heading where it has none).
-            let mut end = last.1;
-            if n >= 2 {
-                let a = self.vertices[n - 2].1;
-                if (end.x - a.x).hypot(end.y - a.y) > 1e-9 {
-                    end.h = (end.y - a.y).atan2(end.x - a.x);
-                }
-            }
-            return (end, true);
+        if t >= last.0 - TIME_EPS_S {
+            return (last.1, t >= last.0);
         }
         let first = self.vertices[0];
         if t <= first.0 {
             return (first.1, false);
         }
-        let i = self.vertices.partition_point(|v| v.0 <= t).clamp(1, n - 1);
+        // A time within rounding of a vertex's is the vertex's (a step that adds `dt` to the
+        // time lands a few ulps short of the vertex it means, and would face as the vertex
+        // before).
+        let i = self
+            .vertices
+            .partition_point(|v| v.0 <= t + TIME_EPS_S)
+            .clamp(1, n - 1);
         let (a, b) = (self.vertices[i - 1], self.vertices[i]);
         let u = if b.0 > a.0 {
-            (t - a.0) / (b.0 - a.0)
+            ((t - a.0) / (b.0 - a.0)).max(0.0)
         } else {
             1.0
         };
-        let (dx, dy) = (b.1.x - a.1.x, b.1.y - a.1.y);
-        let h = if dx.hypot(dy) > 1e-9 {
-            dy.atan2(dx)
-        } else {
-            wrap(a.1.h + u * wrap(b.1.h - a.1.h))
-        };
         (
             Pose {
-                x: a.1.x + u * dx,
-                y: a.1.y + u * dy,
-                h,
+                x: a.1.x + u * (b.1.x - a.1.x),
+                y: a.1.y + u * (b.1.y - a.1.y),
+                h: a.1.h,
             },
             false,
         )
@@ -184,26 +181,14 @@ impl Untimed {
                     Pose {
                         x: a.x + u * (b.x - a.x),
                         y: a.y + u * (b.y - a.y),
-                        h: (b.y - a.y).atan2(b.x - a.x),
+                        h: a.h,
                     },
                     false,
                 );
             }
             left -= len;
         }
-        let n = self.vertices.len();
-        let end = self.vertices[n - 1];
-        let h = if n >= 2 {
-            let a = self.vertices[n - 2];
-            if (end.x - a.x).hypot(end.y - a.y) > 1e-9 {
-                (end.y - a.y).atan2(end.x - a.x)
-            } else {
-                end.h
-            }
-        } else {
-            end.h
-        };
-        (Pose { h, ..end }, true)
+        (self.vertices[self.vertices.len() - 1], true)
     }
 }
 
@@ -267,15 +252,26 @@ mod tests {
     }
 
     #[test]
-    fn a_timed_polyline_is_linear_between_its_vertices() {
-        let p = |x: f64, y: f64| Pose { x, y, h: 0.0 };
+    fn a_timed_polyline_is_linear_between_its_vertices_facing_as_each_leg_starts() {
+        let p = |x: f64, y: f64| Pose { x, y, h: 0.3 };
         let path = Timed {
-            vertices: vec![(1.0, p(0.0, 0.0)), (3.0, p(0.0, 4.0))],
+            vertices: vec![
+                (1.0, p(0.0, 0.0)),
+                (
+                    3.0,
+                    Pose {
+                        h: 0.7,
+                        ..p(0.0, 4.0)
+                    },
+                ),
+            ],
         };
         let (q, done) = path.at(2.0);
         assert!(!done && (q.y - 2.0).abs() < 1e-12);
-        assert!((q.h - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
-        assert!(path.at(3.5).1);
+        // The vertex's own heading, not the leg's direction (pi/2), nor interpolated.
+        assert_eq!(q.h, 0.3);
+        let (end, done) = path.at(3.5);
+        assert!(done && end.h == 0.7 && end.y == 4.0);
         let mut u = Untimed {
             vertices: vec![p(0.0, 0.0), p(3.0, 0.0), p(3.0, 4.0)],
             gone_m: 0.0,

@@ -266,19 +266,40 @@ impl Roads {
         let p = self.od_to_engine(x, y);
         let (k, i, _) = *self.index.lanes_at(p).first()?;
         let l = &self.map.lanes[k];
-        // The station: the point's projection on the nearest of the segment that holds it and
-        // its neighbours (a point past a segment's end is still held by its strip).
-        let mut best = (f64::INFINITY, l.s[i]);
-        for j in i.saturating_sub(1)..=(i + 1).min(l.centre.len() - 2) {
+        let last = l.centre.len().saturating_sub(2);
+        // The point's projection on segment `j`, as a share of it (unclamped), and the
+        // projected point.
+        let project = |j: usize| {
             let (a, b) = (l.centre[j], l.centre[j + 1]);
             let d = [b[0] - a[0], b[1] - a[1]];
             let len2 = d[0] * d[0] + d[1] * d[1];
-            let u = if len2 > 0.0 {
-                (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0)
+            if len2 > 0.0 {
+                ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / len2
             } else {
                 0.0
-            };
-            let q = [a[0] + u * d[0], a[1] + u * d[1]];
+            }
+        };
+        // The index names a station of the strip that holds the point, which may lie a few
+        // segments from it: walk to the segment the point projects into (never back).
+        let mut j = i.min(last);
+        let mut step = 0i8;
+        for _ in 0..l.centre.len() {
+            let u = project(j);
+            if u > 1.0 && j < last && step >= 0 {
+                (j, step) = (j + 1, 1);
+            } else if u < 0.0 && j > 0 && step <= 0 {
+                (j, step) = (j - 1, -1);
+            } else {
+                break;
+            }
+        }
+        // The station: the point's projection on the nearest of that segment and its
+        // neighbours (a point past a segment's end is still held by its strip).
+        let mut best = (f64::INFINITY, l.s[j]);
+        for j in j.saturating_sub(1)..=(j + 1).min(last) {
+            let (a, b) = (l.centre[j], l.centre[j + 1]);
+            let u = project(j).clamp(0.0, 1.0);
+            let q = [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])];
             let e = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
             if e < best.0 {
                 best = (e, l.s[j] + u * (l.s[j + 1] - l.s[j]));

@@ -1647,6 +1647,23 @@ impl Storyboard {
                 };
                 g.rule.holds(d, g.value)
             }
+            EntityTest::Distance {
+                position,
+                rule,
+                value,
+                freespace,
+                kind,
+            } => {
+                let at = paracosm_openscenario::Pos {
+                    file: String::new(),
+                    line: 0,
+                    col: 0,
+                };
+                self.resolve(position, &at).is_ok_and(|(p, _)| {
+                    let d = self.distance_to_point(e, [p.x, p.y], *freespace, kind);
+                    rule.holds(d, *value)
+                })
+            }
             EntityTest::ReachPosition {
                 position,
                 tolerance,
@@ -1718,6 +1735,26 @@ impl Storyboard {
             vb - a.state.speed
         };
         (long, lat, closing)
+    }
+
+    /// The distance from entity `e` to the point `p` (`[x, y]` m), as `kind` measures it in
+    /// `e`'s frame (`longitudinal`, `lateral`, else euclidean): from its reference point, or
+    /// with `freespace` from its bounding box (0 inside it). OpenSCENARIO `DistanceCondition`.
+    fn distance_to_point(&self, e: usize, p: [f64; 2], freespace: bool, kind: &str) -> f64 {
+        let a = &self.actors[e];
+        let pose = a.state.pose;
+        let (c, s) = (pose.h.cos(), pose.h.sin());
+        let (dx, dy) = (p[0] - pose.x, p[1] - pose.y);
+        let (mut long, mut lat) = (dx * c + dy * s, -dx * s + dy * c);
+        if freespace {
+            long = ((long - a.centre_m[0]).abs() - a.size_m[0] / 2.0).max(0.0);
+            lat = ((lat - a.centre_m[1]).abs() - a.size_m[1] / 2.0).max(0.0);
+        }
+        match kind {
+            "longitudinal" => long.abs(),
+            "lateral" => lat.abs(),
+            _ => long.hypot(lat),
+        }
     }
 
     /// Whether the bounding boxes of `a` and `b` touch (within 5 cm).

@@ -973,7 +973,10 @@ fn action_kinds(
             b.scene.car_name(c.index()).unwrap_or("a Car")
         };
         let (what, ok, wanted) = match *sink {
-            Action::Walk(_) | Action::PlaceCar(_) | Action::PlacePedestrian(_) => continue,
+            Action::Walk(_)
+            | Action::PlaceCar(_)
+            | Action::PlacePedestrian(_)
+            | Action::PlaceEgo => continue,
             Action::SetSpeed(c) => (
                 format!("setSpeed of {}", car(c)),
                 matches!(v, Value::Num(_)),
