@@ -636,3 +636,100 @@ serve(Recording())
     assert!(lines.len() > 100, "{} observations", lines.len());
     assert!(lines.iter().all(|l| l == "12.0"), "{:?}", &lines[..3]);
 }
+
+/// The ALKS crossing-pedestrian template, for `Import`.
+const CROSSING_TEMPLATE: &str =
+    "tests/data/xosc/alks/concrete_scenarios/alks_scenario_4_2_3_crossing_pedestrian_template.xosc";
+
+/// Runs `paracosm-fuzz` on `program` (written to `dir/prog.star`) with `args`.
+fn run_program(dir: &std::path::Path, program: &str, args: &[&str]) -> std::process::Output {
+    let path = dir.join("prog.star");
+    std::fs::write(&path, program).unwrap();
+    Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&path)
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
+
+/// A program imports an OpenSCENARIO scenario (`Import`), opens two of its parameters with
+/// its own `VarInterval`s and adds monitors over its entities and signals: every test's
+/// pedestrian walks at the speed the program's parameter gave the file (the storyboard moves
+/// it when the ego comes near), and the program's monitors judge the imported world.
+#[test]
+fn a_program_imports_a_scenario_opens_its_parameters_and_adds_monitors() {
+    let dir = tempfile::tempdir().unwrap();
+    let template = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(CROSSING_TEMPLATE);
+    let program = format!(
+        r#"w = World()
+s = Import("{}", params = {{
+    "Ego_InitSpeed_Ve0_kph": VarInterval(50, 60, name = "ego_kph"),
+    "TargetBlocking_Speed_kph": VarInterval(6, 12, name = "ped_kph"),
+}})
+CollisionMonitor(s.ego)
+walked = s.TargetBlocking.speed.max()
+Monitor(walked.map(lambda v: v - 1.0), over = "end", name = "ped_walked")
+Stl("G[0,60] (ego_lane_edge_m > 0.1)", name = "keeps_lane")
+test(horizon = 60)
+"#,
+        template.display()
+    );
+    let out = dir.path().join("c");
+    let o = run_program(
+        dir.path(),
+        &program,
+        &["--budget", "6", "--out", out.to_str().unwrap()],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    let text = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+    let records: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(records.len(), 6);
+    for r in &records {
+        assert!(r["error"].is_null(), "{r}");
+        let ped = r["params"]["ped_kph"].as_f64().unwrap();
+        assert!((6.0..12.0).contains(&ped), "{r}");
+        // The pedestrian's top speed is the one the program gave the file, m/s.
+        let walked = r["monitors"]["ped_walked"]["robustness"].as_f64().unwrap() + 1.0;
+        assert!(
+            (walked - ped / 3.6).abs() < 1e-6,
+            "walked at {walked} m/s, given {ped} km/h: {r}"
+        );
+        for m in ["collision", "keeps_lane", "offroad"] {
+            assert!(r["monitors"][m].is_object(), "{m}: {r}");
+        }
+        // The storyboard's stop trigger (the time the ego needs to reach the pedestrian, plus
+        // 10 s) ends the test before the program's 60 s horizon.
+        let t = r["metrics"]["simulated_s"].as_f64().unwrap();
+        assert!(t < 55.0, "{t}: {r}");
+    }
+    // A parameter the file does not declare, and an imported entity given to place(...).
+    for (bad, want) in [
+        (
+            program.replace("\"TargetBlocking_Speed_kph\"", "\"Pedestrian_Speed\""),
+            "Pedestrian_Speed",
+        ),
+        (
+            format!("{program}w.place(s.ego)\n"),
+            "leave it out of place",
+        ),
+    ] {
+        let o = run_program(
+            dir.path(),
+            &bad,
+            &[
+                "--budget",
+                "1",
+                "--out",
+                dir.path().join("bad").to_str().unwrap(),
+            ],
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains("prog.star:") && err.contains(want), "{err}");
+    }
+}

@@ -304,3 +304,69 @@ impl CallLimits {
         eval.set_max_callstack_size(super::MAX_CALL_DEPTH)
     }
 }
+
+/// A program's host with the storyboard of the scenario it imported (`Import(...)`): host
+/// functions from [`crate::xosc::IMPORT_HOST_BASE`] are the storyboard's, the others the
+/// program's lambdas. Without a storyboard (the check at load, on sample values), the
+/// storyboard's functions answer as they would before it moves anything: nothing performed,
+/// measures 0.
+pub(crate) struct WithStory<'s, H: Host> {
+    /// The program's host.
+    pub(crate) program: H,
+    /// The storyboard's host, `None` at load.
+    pub(crate) story: Option<&'s mut dyn Host>,
+    /// Both hosts' [`Host::reads`].
+    reads: Vec<StreamId>,
+}
+
+impl<'s, H: Host> WithStory<'s, H> {
+    /// `program` beside `story`.
+    pub(crate) fn new(program: H, story: Option<&'s mut dyn Host>) -> Self {
+        let mut reads = program.reads().to_vec();
+        if let Some(s) = &story {
+            reads.extend_from_slice(s.reads());
+        }
+        WithStory {
+            program,
+            story,
+            reads,
+        }
+    }
+}
+
+impl<H: Host> Host for WithStory<'_, H> {
+    fn call(&mut self, f: u32, args: &[Rx], streams: &Runtime) -> Result<Rx, HostError> {
+        if f < crate::xosc::IMPORT_HOST_BASE {
+            return self.program.call(f, args, streams);
+        }
+        match &mut self.story {
+            Some(s) => s.call(f, args, streams),
+            None if f == crate::xosc::IMPORT_HOST_BASE => Ok(Rx::Unit),
+            None => Ok(Rx::Num(0.0)),
+        }
+    }
+
+    fn performed(&mut self) -> Vec<(paracosm_engine::behaviour::Action, Rx)> {
+        let mut out = self.program.performed();
+        if let Some(s) = &mut self.story {
+            out.extend(s.performed());
+        }
+        out
+    }
+
+    fn log(&mut self) -> Vec<String> {
+        let mut out = self.program.log();
+        if let Some(s) = &mut self.story {
+            out.extend(s.log());
+        }
+        out
+    }
+
+    fn reads(&self) -> &[StreamId] {
+        &self.reads
+    }
+
+    fn ended(&self) -> bool {
+        self.program.ended() || self.story.as_ref().is_some_and(|s| s.ended())
+    }
+}

@@ -170,6 +170,15 @@ impl MapFiles {
         Ok(map)
     }
 
+    /// The file `path` (as the program writes it) is, relative to the program's folder;
+    /// `None` for a built-in scenario (it reads only [`BUILTIN_MAPS`]).
+    pub(crate) fn resolve(&self, path: &str) -> Option<PathBuf> {
+        match &self.base {
+            Base::Folder(dir) => Some(dir.join(path)),
+            Base::Builtin => None,
+        }
+    }
+
     /// Every file read so far, in order of path, with its SHA-256.
     pub(crate) fn inputs(&self) -> Vec<InputFile> {
         self.loaded

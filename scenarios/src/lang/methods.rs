@@ -898,6 +898,12 @@ pub(crate) fn world_methods(builder: &mut MethodsBuilder) {
         let mut actors = Vec::new();
         for o in objects.items {
             if let Some(a) = o.downcast_ref::<ActorVal>() {
+                if a.object == super::globals::import::IMPORTED {
+                    bail!(
+                        "{o} comes from Import(...), whose scenario places it: leave it out of \
+                         place(...)"
+                    );
+                }
                 actors.push(a.object);
             } else if let Some(x) = o.downcast_ref::<super::values::ObstacleVal>() {
                 actors.push(x.object);

@@ -228,6 +228,19 @@ pub struct SceneBuilder {
     pub loc_table: super::position::LocTable,
     /// Declared objects, in declaration order, until `place` places them.
     pub objects: Vec<ObjectDecl>,
+    /// The storyboard of the scenario `Import(...)` built into this world, which a test
+    /// runs beside the program's lambdas (its host functions from
+    /// [`crate::xosc::IMPORT_HOST_BASE`]).
+    pub(crate) story: Option<ImportedStory>,
+}
+
+/// The host that runs an imported OpenSCENARIO storyboard ([`SceneBuilder::story`]).
+pub(crate) struct ImportedStory(pub(crate) crate::xosc::StoryHost);
+
+impl std::fmt::Debug for ImportedStory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ImportedStory")
+    }
 }
 
 impl SceneBuilder {
@@ -245,6 +258,7 @@ impl SceneBuilder {
             locs: Vec::new(),
             loc_table: Default::default(),
             objects: Vec::new(),
+            story: None,
         }
     }
 

@@ -302,157 +302,201 @@ fn here(pos: &paracosm_openscenario::Pos, variable: &str) -> Site {
 }
 
 impl XoscWorlds {
-    /// The scene of `model` and the host that runs its storyboard.
+    /// The scene of `model` and the host that runs its storyboard: [`build_into`] a scene of
+    /// daylight without fog, with a collision monitor and a horizon of [`HORIZON_CAP_S`] (the
+    /// storyboard's stop trigger ends a test sooner).
     fn build(&self, model: &m::Scenario) -> Result<(Scene, StoryHost), ScenarioError> {
-        let ego = ego_of(model)?;
-        let Some(road) = &model.road_network else {
-            return Err(worlds_error(format!(
-                "{}: the scenario has no RoadNetwork LogicFile: paracosm needs its OpenDRIVE map",
-                model.file
-            )));
-        };
-        let map = self
-            .maps
-            .load(&road.item)
-            .map_err(|e| ScenarioError::Load(e.with_context(&format!("\n --> {}", road.pos))))?;
-        let roads = road::Roads::new(&map);
-        let driven = (!self.scripted_ego).then_some(ego);
-        let sb = Storyboard::new(model, roads, driven).map_err(|e| worlds_error(e.to_string()))?;
         let mut scene = Scene::new(None);
-        let site = here(&road.pos, "RoadNetwork");
+        let at = model
+            .road_network
+            .as_ref()
+            .map(|r| here(&r.pos, "RoadNetwork"))
+            .unwrap_or_else(|| Site::of(&model.file));
         let light = scene.push(Node::Const(Value::Num(1.0)));
         let fog = scene.push(Node::Const(Value::Num(0.0)));
         scene
-            .set_environment(light, fog, site.clone())
+            .set_environment(light, fog, at.clone())
             .map_err(|e| worlds_error(e.to_string()))?;
-        let friction = scene.push(Node::Const(Value::Num(0.8)));
-        let piece: PieceId = scene
-            .add_road(
-                |n| n.add_map("map", map.0.clone(), 0.8),
-                friction,
-                site.clone(),
-            )
-            .map_err(|e| worlds_error(e.to_string()))?;
-        let (mut sinks, probes, ego_actor) = place_entities(&mut scene, model, &sb, ego)?;
-        if self.scripted_ego {
-            sinks[ego] = Some(Sink::PlaceEgo);
-        }
-        let Some(ego_actor) = ego_actor else {
-            return Err(worlds_error("no ego".into()));
-        };
-        let ego_probes =
-            [Output::Pos, Output::Heading, Output::Speed].map(|o| scene.probe(ego_actor, o));
-        self.place_ego(&mut scene, &sb, ego, piece)?;
-        let tick = scene.push(Node::Tick);
-        scene.push(Node::Perform {
-            src: tick,
-            f: Func::Host(0),
-        });
-        for (k, signal) in [HEADWAY_SIGNAL, GAP_SIGNAL, LANE_EDGE_SIGNAL]
-            .into_iter()
-            .enumerate()
-        {
-            let id = scene.push(Node::Map {
-                src: tick,
-                f: Func::Host(k as u32 + 1),
-            });
-            scene.publish(signal.to_owned(), id, None);
-        }
-        scene.add_monitor(MonitorSpec::collision(), site.clone());
+        let built = build_into(&mut scene, model, &self.maps, self.scripted_ego, 0)?;
+        scene.add_monitor(MonitorSpec::collision(), at.clone());
         scene
             .set_settings(TestSettings {
-                site: Some(site),
+                site: Some(at),
                 horizon_s: Some(HORIZON_CAP_S),
                 map_axes: None,
                 offroad: None,
             })
             .map_err(|e| worlds_error(e.to_string()))?;
-        let mut reads: Vec<StreamId> = probes.clone();
-        reads.extend(ego_probes);
-        let host = StoryHost {
-            sb,
-            ego,
-            scripted_ego: self.scripted_ego,
-            sinks,
-            collided: probes,
-            ego_probes,
-            reads,
-            performed: Vec::new(),
-            measures: (f64::INFINITY, f64::INFINITY, f64::NAN),
-            road_end: None,
-            log: Vec::new(),
-        };
-        Ok((scene, host))
+        Ok((scene, built.host))
     }
+}
 
-    /// Places the ego where the storyboard's `Init` put it, at its initial speed, which the
-    /// system under test keeps as its set speed, with a route along its lanes.
-    fn place_ego(
-        &self,
-        scene: &mut Scene,
-        sb: &Storyboard,
-        ego: usize,
-        piece: PieceId,
-    ) -> Result<(), ScenarioError> {
-        let a = &sb.actors[ego];
-        let Some(lp) = a.state.lane else {
-            return Err(worlds_error(format!(
-                "{}: the ego {} does not start on a lane of the map",
-                self.template.display(),
-                a.name
-            )));
-        };
-        let (pos, heading) = sb.engine_pose(ego);
-        let (id, _) = sb.roads().ids(lp.lane);
-        let start = Location {
-            pos_m: pos,
-            heading_rad: heading,
-            piece,
-            lane: Lane::Driving(id),
-            at_m: lp.s,
-            through: None,
-            map_lane: Some(lp.lane),
-        };
-        // Along its lanes the way it faces (against a lane's travel too, as the storyboard
-        // moves entities), a point every 2 m.
-        let mut route = vec![[pos[0], pos[2]]];
-        let mut at = lp;
-        let prefer = |_: usize| false;
-        for _ in 0..(ROUTE_M / 2.0) as usize {
-            let more = sb.roads().advance(&mut at, 2.0, &prefer);
-            let (p, _) = sb.roads().to_engine(sb.roads().pose_of(&at));
-            route.push([p[0], p[2]]);
-            if !more {
-                break;
-            }
-        }
-        let speed = a.state.speed.max(0.0);
-        scene
-            .place_ego(
-                EgoSpec {
-                    start,
-                    initial_speed_mps: speed,
-                    vehicle: VehicleParams::default(),
-                    route,
-                    set_speed_mps: (!self.scripted_ego).then_some(speed),
-                    scripted: self.scripted_ego,
-                },
-                if self.scripted_ego {
-                    SutConfig::Scripted
-                } else {
-                    SutConfig::Aeb(AebConfig::default())
-                },
-            )
-            .map_err(|e| worlds_error(e.to_string()))
+/// Where an imported storyboard's host functions start in a program's graph
+/// (`Import(...)`): the program's own lambdas are numbered from 0.
+pub const IMPORT_HOST_BASE: u32 = 1 << 31;
+
+/// An OpenSCENARIO scenario's world built into a scene ([`build_into`]).
+pub(crate) struct Built {
+    /// The host that runs its storyboard (functions from the base given).
+    pub(crate) host: StoryHost,
+    /// Each entity's name and actor, in the file's order.
+    pub(crate) actors: Vec<(String, ActorRef)>,
+}
+
+/// Builds `model`'s world into `scene`: its OpenDRIVE map (read through `maps`) as a road
+/// piece, every entity where `Init` puts it (the ego as the ego vehicle, moved by the
+/// storyboard with `scripted_ego`, else driven by `aeb`), the storyboard run by host
+/// function `base` at every tick, and the ego's measures published as signals
+/// ([`HEADWAY_SIGNAL`], [`GAP_SIGNAL`], [`LANE_EDGE_SIGNAL`], host functions `base + 1..=3`).
+/// The scene's environment, monitors and settings are the caller's.
+///
+/// # Errors
+/// [`ScenarioError::Load`]: no map, a map that does not load, an ego not on a lane, an
+/// `Init` that cannot be performed, an actor the scene refuses.
+pub(crate) fn build_into(
+    scene: &mut Scene,
+    model: &m::Scenario,
+    maps: &MapFiles,
+    scripted_ego: bool,
+    base: u32,
+) -> Result<Built, ScenarioError> {
+    let ego = ego_of(model)?;
+    let Some(road) = &model.road_network else {
+        return Err(worlds_error(format!(
+            "{}: the scenario has no RoadNetwork LogicFile: paracosm needs its OpenDRIVE map",
+            model.file
+        )));
+    };
+    let map = maps
+        .load(&road.item)
+        .map_err(|e| ScenarioError::Load(e.with_context(&format!("\n --> {}", road.pos))))?;
+    let roads = road::Roads::new(&map);
+    let driven = (!scripted_ego).then_some(ego);
+    let sb = Storyboard::new(model, roads, driven).map_err(|e| worlds_error(e.to_string()))?;
+    let site = here(&road.pos, "RoadNetwork");
+    let friction = scene.push(Node::Const(Value::Num(0.8)));
+    let piece: PieceId = scene
+        .add_road(
+            |n| n.add_map("map", map.0.clone(), 0.8),
+            friction,
+            site.clone(),
+        )
+        .map_err(|e| worlds_error(e.to_string()))?;
+    let placed = place_entities(scene, model, &sb, ego)?;
+    let (mut sinks, probes, actors) = placed;
+    if scripted_ego {
+        sinks[ego] = Some(Sink::PlaceEgo);
     }
+    let ego_actor = actors[ego];
+    let ego_probes =
+        [Output::Pos, Output::Heading, Output::Speed].map(|o| scene.probe(ego_actor, o));
+    place_ego(scene, &sb, (ego, scripted_ego), piece, &model.file)?;
+    let tick = scene.push(Node::Tick);
+    scene.push(Node::Perform {
+        src: tick,
+        f: Func::Host(base),
+    });
+    for (k, signal) in [HEADWAY_SIGNAL, GAP_SIGNAL, LANE_EDGE_SIGNAL]
+        .into_iter()
+        .enumerate()
+    {
+        let id = scene.push(Node::Map {
+            src: tick,
+            f: Func::Host(base + k as u32 + 1),
+        });
+        scene.publish(signal.to_owned(), id, None);
+    }
+    let mut reads: Vec<StreamId> = probes.clone();
+    reads.extend(ego_probes);
+    let host = StoryHost {
+        sb,
+        ego,
+        base,
+        scripted_ego,
+        sinks,
+        collided: probes,
+        ego_probes,
+        reads,
+        performed: Vec::new(),
+        measures: (f64::INFINITY, f64::INFINITY, f64::NAN),
+        road_end: None,
+        log: Vec::new(),
+    };
+    let names = model.entities.iter().map(|e| e.name.clone());
+    Ok(Built {
+        host,
+        actors: names.zip(actors).collect(),
+    })
+}
+
+/// Places the ego where the storyboard's `Init` put it, at its initial speed, which the
+/// system under test keeps as its set speed, with a route along its lanes.
+fn place_ego(
+    scene: &mut Scene,
+    sb: &Storyboard,
+    (ego, scripted_ego): (usize, bool),
+    piece: PieceId,
+    file: &str,
+) -> Result<(), ScenarioError> {
+    let a = &sb.actors[ego];
+    let Some(lp) = a.state.lane else {
+        return Err(worlds_error(format!(
+            "{file}: the ego {} does not start on a lane of the map",
+            a.name
+        )));
+    };
+    let (pos, heading) = sb.engine_pose(ego);
+    let (id, _) = sb.roads().ids(lp.lane);
+    let start = Location {
+        pos_m: pos,
+        heading_rad: heading,
+        piece,
+        lane: Lane::Driving(id),
+        at_m: lp.s,
+        through: None,
+        map_lane: Some(lp.lane),
+    };
+    // Along its lanes the way it faces (against a lane's travel too, as the storyboard
+    // moves entities), a point every 2 m.
+    let mut route = vec![[pos[0], pos[2]]];
+    let mut at = lp;
+    let prefer = |_: usize| false;
+    for _ in 0..(ROUTE_M / 2.0) as usize {
+        let more = sb.roads().advance(&mut at, 2.0, &prefer);
+        let (p, _) = sb.roads().to_engine(sb.roads().pose_of(&at));
+        route.push([p[0], p[2]]);
+        if !more {
+            break;
+        }
+    }
+    let speed = a.state.speed.max(0.0);
+    scene
+        .place_ego(
+            EgoSpec {
+                start,
+                initial_speed_mps: speed,
+                vehicle: VehicleParams::default(),
+                route,
+                set_speed_mps: (!scripted_ego).then_some(speed),
+                scripted: scripted_ego,
+            },
+            if scripted_ego {
+                SutConfig::Scripted
+            } else {
+                SutConfig::Aeb(AebConfig::default())
+            },
+        )
+        .map_err(|e| worlds_error(e.to_string()))
 }
 
 /// Runs the storyboard: host function 0, on every step, reads the ego and every entity's
 /// contact, steps the storyboard and performs the place actions of the scripted entities;
 /// functions 1–3 give the ego's measures.
-struct StoryHost {
+pub(crate) struct StoryHost {
     sb: Storyboard,
     ego: usize,
+    /// Its first host function's number ([`IMPORT_HOST_BASE`] in an importing program).
+    base: u32,
     /// [`Source::scripted_ego`]: the storyboard moves the ego too, and nothing ends the test
     /// at the end of its road but the storyboard.
     scripted_ego: bool,
@@ -472,7 +516,7 @@ pub const ROAD_END_MARGIN_M: f64 = 2.0;
 
 impl Host for StoryHost {
     fn call(&mut self, f: u32, args: &[Value], streams: &Runtime) -> Result<Value, HostError> {
-        match f {
+        match f.wrapping_sub(self.base) {
             0 => {
                 let t = args.first().and_then(Value::as_num).unwrap_or(0.0);
                 let num = |id: StreamId| streams.current(id).and_then(Value::as_num);
@@ -550,8 +594,8 @@ impl Host for StoryHost {
 }
 
 /// The sinks that move each entity (none for the ego), each entity's `Collided` probe, and
-/// the ego's actor.
-type Placed = (Vec<Option<Sink>>, Vec<StreamId>, Option<ActorRef>);
+/// each entity's actor, in the file's order.
+type Placed = (Vec<Option<Sink>>, Vec<StreamId>, Vec<ActorRef>);
 
 /// Declares every entity of `model` into `scene` where the storyboard's `Init` put it: the
 /// ego as the ego vehicle (placed later), pedestrians as pedestrians, other entities as cars,
@@ -568,7 +612,7 @@ fn place_entities(
     let zero = scene.push(Node::Const(Value::Num(0.0)));
     let mut sinks = Vec::new();
     let mut probes = Vec::new();
-    let mut ego_actor = None;
+    let mut actors = Vec::new();
     for (i, ent) in model.entities.iter().enumerate() {
         let name = ent.name.clone();
         let at = here(&ent.pos, &name);
@@ -579,9 +623,7 @@ fn place_entities(
             height_m: ent.dimensions_m[2].max(0.1),
         };
         let actor = if i == ego {
-            let a = scene.declare_ego(name.clone(), at);
-            ego_actor = Some(a);
-            a
+            scene.declare_ego(name.clone(), at)
         } else if matches!(ent.kind, EntityKind::Pedestrian(_)) {
             let a = scene.declare_pedestrian(name.clone(), at);
             scene
@@ -623,6 +665,7 @@ fn place_entities(
             _ => None,
         });
         probes.push(scene.probe(actor, Output::Collided));
+        actors.push(actor);
     }
-    Ok((sinks, probes, ego_actor))
+    Ok((sinks, probes, actors))
 }

@@ -126,7 +126,7 @@ fn finished(b: &SceneBuilder, file: &str) -> Result<(), LoadError> {
 
 /// What [`finished`] finds wrong, and where, when one declaration is at fault.
 fn finished_message(b: &SceneBuilder) -> Result<(), (String, Option<&str>)> {
-    if !b.placed {
+    if !b.placed && (b.story.is_none() || !b.objects.is_empty()) {
         return Err((
             "the program never calls place(...): nothing to test".into(),
             None,
@@ -842,7 +842,8 @@ impl Program {
             limits
                 .install(&mut eval)
                 .map_err(|e| LoadError::new(LoadErrorKind::Evaluation, e.to_string()))?;
-            let mut host = StarHost::new(&mut eval, &functions, &limits, &self.file).at_load();
+            let host = StarHost::new(&mut eval, &functions, &limits, &self.file).at_load();
+            let mut host = super::host::WithStory::new(host, None);
             match sim.check_streams(&mut host) {
                 Ok(samples) => judged_kinds(b, &samples),
                 Err(e) => {
@@ -1065,7 +1066,7 @@ impl crate::Worlds for Program {
         run: &mut dyn FnMut(&crate::scene::Scene, &mut dyn Host),
     ) -> Result<(), ScenarioError> {
         let values = self.values(assignment)?;
-        self.evaluate(Some(values), |b, module| {
+        self.evaluate(Some(values), |mut b, module| {
             self.consistent(&b)?;
             let functions = lambda_values(&b, module)?;
             let test = super::values::TestState::default();
@@ -1077,7 +1078,10 @@ impl crate::Worlds for Program {
             limits
                 .install(&mut eval)
                 .map_err(|e| LoadError::new(LoadErrorKind::Evaluation, e.to_string()))?;
-            let mut host = StarHost::new(&mut eval, &functions, &limits, &self.file);
+            let host = StarHost::new(&mut eval, &functions, &limits, &self.file);
+            let mut story = b.story.take();
+            let story = story.as_mut().map(|s| &mut s.0 as &mut dyn Host);
+            let mut host = super::host::WithStory::new(host, story);
             run(&b.scene, &mut host);
             Ok(())
         })
