@@ -118,8 +118,8 @@ impl Param {
     /// `"name [unit]"`, or the bare name when unitless: an axis label.
     pub fn label(&self) -> String {
         match &self.unit {
-            Some(u) => format!("{} [{u}]", self.name),
-            None => self.name.clone(),
+            Some(u) if !u.is_empty() => format!("{} [{u}]", self.name),
+            _ => self.name.clone(),
         }
     }
 }

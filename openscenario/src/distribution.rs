@@ -114,7 +114,7 @@ pub enum Dist {
     Normal {
         /// `expectedValue`.
         mean: f64,
-        /// `variance` (the square of the standard deviation), at least 0.
+        /// `variance` (the square of the standard deviation), more than 0.
         variance: f64,
         /// `Range` `lowerLimit`.
         lo: Option<f64>,
@@ -130,7 +130,7 @@ pub enum Dist {
     LogNormal {
         /// `expectedValue`: the mean of `ln X`.
         mu: f64,
-        /// √`variance`: the standard deviation of `ln X`, at least 0.
+        /// √`variance`: the standard deviation of `ln X`, more than 0.
         sigma: f64,
         /// `Range` `lowerLimit`.
         lo: Option<f64>,
@@ -623,6 +623,21 @@ fn read_stochastic_dist(text: &Text, d: Node<'_, '_>) -> Result<Dist, XoscError>
         }
         Ok(x)
     };
+    // A variance of 0 is one value, not a distribution: a parameter to vary needs a spread.
+    let positive = |attr: &str| -> Result<f64, XoscError> {
+        let x = nonneg(attr)?;
+        if x == 0.0 {
+            return Err(XoscError::Invalid {
+                pos: text.attr_pos(d, attr),
+                reason: format!(
+                    "{attr} = 0: the distribution is one value, which paracosm cannot vary; \
+                     give a positive {attr}, or the value itself in the scenario's \
+                     ParameterDeclaration"
+                ),
+            });
+        }
+        Ok(x)
+    };
     Ok(match d.tag_name().name() {
         "ProbabilityDistributionSet" => read_probability_set(text, d)?,
         "Histogram" => read_histogram(text, d)?,
@@ -641,7 +656,7 @@ fn read_stochastic_dist(text: &Text, d: Node<'_, '_>) -> Result<Dist, XoscError>
         "NormalDistribution" => {
             check_attrs(text, d, &["expectedValue", "variance"])?;
             let mean = number(text, d, "expectedValue")?;
-            let variance = nonneg("variance")?;
+            let variance = positive("variance")?;
             let (lo, hi) = range_child(text, d)?;
             Dist::Normal {
                 mean,
@@ -653,7 +668,7 @@ fn read_stochastic_dist(text: &Text, d: Node<'_, '_>) -> Result<Dist, XoscError>
         "LogNormalDistribution" => {
             check_attrs(text, d, &["expectedValue", "variance"])?;
             let mu = number(text, d, "expectedValue")?;
-            let sigma = nonneg("variance")?.sqrt();
+            let sigma = positive("variance")?.sqrt();
             let (lo, hi) = range_child(text, d)?;
             Dist::LogNormal { mu, sigma, lo, hi }
         }
@@ -1116,6 +1131,18 @@ mod tests {
             r#"<NormalDistribution expectedValue="30" variance="-4"/>"#
         ))
         .contains("variance = -4: it must be at least 0"));
+        // One value is no distribution: refused at the attribute (it was an empty interval
+        // found by the campaign, without a line).
+        for tag in ["NormalDistribution", "LogNormalDistribution"] {
+            let e = error(&stochastic(&format!(
+                r#"<{tag} expectedValue="20" variance="0"/>"#
+            )));
+            assert!(
+                e.contains("variance = 0: the distribution is one value"),
+                "{e}"
+            );
+            assert!(e.contains("v.xosc:6:"), "{e}");
+        }
         assert!(
             error(&stochastic(r#"<NormalDistribution expectedValue="30"/>"#))
                 .contains("needs the attribute variance")

@@ -279,6 +279,10 @@ pub struct Scenario {
     /// The parameters of the failure map: none (a scenario without open parameters gets no
     /// map), one (a strip plot), or two (`[x axis, y axis]`). Continuous or discrete.
     pub map_axes: Vec<String>,
+    /// Whether a campaign's failure map is drawn over the two parameters its triage ranks
+    /// most relevant (when it ranks two) rather than [`Scenario::map_axes`], which are then
+    /// the fallback: an OpenSCENARIO campaign, whose file names no axes.
+    pub map_axes_by_relevance: bool,
     /// What the program loads with but checks or varies less than it seems to, whatever the
     /// system under test (see [`Scenario::warnings_for`] for the rest).
     pub warnings: Vec<Warning>,
@@ -443,6 +447,7 @@ impl Scenario {
             sut,
             monitors,
             map_axes,
+            map_axes_by_relevance: false,
             warnings: vec![],
             unused_params: vec![],
             camera_only: vec![],

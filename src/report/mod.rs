@@ -18,6 +18,7 @@ use crate::campaign::RESULTS_FILE;
 use crate::export::replay::replay_command;
 use crate::record::{RunRecord, Status};
 use crate::report::summary::{Counts, FailureEntry, FirstFailure, Summary};
+use crate::report::triage::Triage;
 
 pub use crate::report::summary::SUMMARY_FILE;
 
@@ -197,26 +198,46 @@ impl PlotData<'_> {
 
 /// The plots of a campaign, by file stem: the failure map and the failure-rate heat map over
 /// the scenario's map axes, and the pairs plot; none without open parameters.
-fn plan_plots(scenario: &Scenario) -> Vec<(&'static str, Plot)> {
-    if scenario.map_axes.is_empty() {
+fn plan_plots(scenario: &Scenario, triage: Option<&Triage>) -> Vec<(&'static str, Plot)> {
+    let axes = map_axes(scenario, triage);
+    if axes.is_empty() {
         return Vec::new();
     }
     vec![
         (
             "failure_map",
             Plot::Map {
-                axes: scenario.map_axes.clone(),
+                axes: axes.clone(),
                 color: crate::report::plot::Coloring::Outcome,
             },
         ),
-        (
-            "failure_rate",
-            Plot::Rate {
-                axes: scenario.map_axes.clone(),
-            },
-        ),
+        ("failure_rate", Plot::Rate { axes }),
         ("pairs", Plot::Pairs),
     ]
+}
+
+/// The failure map's axes: the two parameters `triage` ranks most relevant for a scenario
+/// that asks for them ([`Scenario::map_axes_by_relevance`]) when it ranks two, else the
+/// scenario's own.
+fn map_axes(scenario: &Scenario, triage: Option<&Triage>) -> Vec<String> {
+    match triage {
+        Some(t) if scenario.map_axes_by_relevance && t.ranking.len() >= 2 => {
+            t.ranking.iter().take(2).map(|r| r.param.clone()).collect()
+        }
+        _ => scenario.map_axes.clone(),
+    }
+}
+
+/// How a plot's title names a campaign's scenario: an OpenSCENARIO file by its file name,
+/// without the options its campaign name carries (`#open=...`); any other by its name.
+fn shown_name(name: &str) -> String {
+    if !crate::xosc::is_xosc(name) {
+        return name.to_owned();
+    }
+    let path = name.split(crate::xosc::OPTIONS_MARK).next().unwrap_or(name);
+    Path::new(path)
+        .file_name()
+        .map_or_else(|| path.to_owned(), |f| f.to_string_lossy().into_owned())
 }
 
 /// Writes `summary.json`, then the plots (`failure_map`, `failure_rate`, `pairs`: none without
@@ -229,7 +250,6 @@ fn plan_plots(scenario: &Scenario) -> Vec<(&'static str, Plot)> {
 /// [`crate::Error::Write`] when `summary.json` cannot be written.
 pub fn write_outputs(f: &Finished<'_>) -> Result<Written, crate::Error> {
     let scenario = f.scenario;
-    let planned = plan_plots(scenario);
     let plot_files = |stems: &[&str]| -> Vec<String> {
         stems
             .iter()
@@ -254,14 +274,17 @@ pub fn write_outputs(f: &Finished<'_>) -> Result<Written, crate::Error> {
         });
     }
     let base = outputs.clone();
-    let stems: Vec<&str> = planned.iter().map(|(s, _)| *s).collect();
+    // The same files whatever the axes (an empty space draws none).
+    let stems: Vec<&str> = plan_plots(scenario, None).iter().map(|(s, _)| *s).collect();
     outputs.extend(plot_files(&stems));
     outputs.push(crate::report::html::REPORT_FILE.to_owned());
     let mut summary = summarise(f, outputs);
     write_summary(f.out, &summary)?;
-
+    // Planned once the triage has ranked the parameters.
+    let planned = plan_plots(scenario, summary.triage.as_ref());
+    let shown = shown_name(&scenario.name);
     let data = PlotData {
-        scenario: &scenario.name,
+        scenario: &shown,
         strategy: &f.file.strategy,
         space: &scenario.space,
         records: f.records,
@@ -280,7 +303,7 @@ pub fn write_outputs(f: &Finished<'_>) -> Result<Written, crate::Error> {
         summary: &summary,
         space: &scenario.space,
         records: f.records,
-        map_axes: &scenario.map_axes,
+        map_axes: &map_axes(scenario, summary.triage.as_ref()),
     });
     if let Err(e) = &page {
         plot_warnings.push(format!(
@@ -643,8 +666,10 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
             dir.display()
         ));
     }
+    let shown = shown_name(&scenario.name);
+    let axes = map_axes(&scenario, summary.triage.as_ref());
     let data = PlotData {
-        scenario: &scenario.name,
+        scenario: &shown,
         strategy: &file.strategy,
         space: &scenario.space,
         records: &existing.records,
@@ -662,14 +687,14 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
     if redraw.html {
         crate::atomic::check_target(&dir.join(crate::report::html::REPORT_FILE))?;
     }
-    let mut drawn = redraw_plots(dir, &data, &scenario.map_axes, redraw)?;
+    let mut drawn = redraw_plots(dir, &data, &axes, redraw)?;
     if redraw.html {
         let page = crate::report::html::write(&crate::report::html::Page {
             out: dir,
             summary: &summary,
             space: &scenario.space,
             records: &existing.records,
-            map_axes: &scenario.map_axes,
+            map_axes: &axes,
         })?;
         drawn.push(page.display().to_string());
     }

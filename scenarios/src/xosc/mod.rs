@@ -254,6 +254,7 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
         },
         monitors: vec![MonitorSpec::collision(), MonitorSpec::implicit_off_road()],
         map_axes,
+        map_axes_by_relevance: true,
         warnings,
         unused_params: vec![],
         camera_only: vec![],

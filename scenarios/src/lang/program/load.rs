@@ -130,6 +130,7 @@ pub fn load(
         sut: program.sut.clone(),
         monitors,
         map_axes,
+        map_axes_by_relevance: false,
         warnings,
         unused_params,
         camera_only: found.camera_only,
