@@ -298,10 +298,10 @@ pub enum Action {
     },
     /// `TeleportAction`.
     Teleport(Position),
-    /// `FollowTrajectoryAction` with a polyline.
+    /// `FollowTrajectoryAction`.
     FollowTrajectory {
-        /// Vertices with their times, s (none without timing).
-        vertices: Vec<(Option<f64>, Position)>,
+        /// The trajectory's shape.
+        shape: TrajectoryShape,
         /// `Timing`: `(absolute, scale, offset_s)`; none: follow at the entity's speed.
         timing: Option<(bool, f64, f64)>,
     },
@@ -317,6 +317,40 @@ pub enum Action {
         lateral: Option<bool>,
         /// Longitudinal control, when said.
         longitudinal: Option<bool>,
+    },
+}
+
+/// The shape of a `FollowTrajectoryAction`'s trajectory.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TrajectoryShape {
+    /// `Polyline`: vertices with their times, s (none without timing), at least two.
+    Polyline(Vec<(Option<f64>, Position)>),
+    /// `Clothoid`: from `start` (the entity's pose when none), facing as it does, with
+    /// curvature `curvature` (1/m, positive to the left) changing by `curvature_prime`
+    /// (1/m², 1.0's `curvatureDot`) over `length` (m, > 0); `times`: at its start and its
+    /// end, s (`startTime`, `stopTime`), linear in the distance along it.
+    Clothoid {
+        /// Where it starts, and the heading it starts with.
+        start: Option<Position>,
+        /// 1/m.
+        curvature: f64,
+        /// 1/m².
+        curvature_prime: f64,
+        /// m.
+        length: f64,
+        /// `(startTime, stopTime)`, s.
+        times: Option<(f64, f64)>,
+    },
+    /// `Nurbs`: a rational B-spline of `order` (degree + 1, at least 2) over its control
+    /// points `(time s, weight > 0, position)` and `knots` (control points + order of them,
+    /// non-decreasing). Piegl and Tiller, *The NURBS Book* (1997), §4.2.
+    Nurbs {
+        /// Degree + 1.
+        order: usize,
+        /// `(time, weight, position)`.
+        points: Vec<(Option<f64>, f64, Position)>,
+        /// The knot vector.
+        knots: Vec<f64>,
     },
 }
 

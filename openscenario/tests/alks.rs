@@ -108,7 +108,10 @@ fn the_crossing_pedestrian_resolves_its_expressions() {
         .flat_map(|m| &m.events)
         .flat_map(|e| &e.actions)
         .find_map(|a| match &a.action {
-            Action::FollowTrajectory { vertices, .. } => Some(vertices.clone()),
+            Action::FollowTrajectory {
+                shape: paracosm_openscenario::model::TrajectoryShape::Polyline(vertices),
+                ..
+            } => Some(vertices.clone()),
             _ => None,
         })
         .expect("the pedestrian's trajectory");

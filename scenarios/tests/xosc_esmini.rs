@@ -162,7 +162,7 @@ fn check_all(files: &[PathBuf]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 12] = [
+const ESMINI_EXAMPLES: [&str; 13] = [
     "alks_cut-in",
     "alks_cut-out",
     "alks_decelerate",
@@ -170,6 +170,7 @@ const ESMINI_EXAMPLES: [&str; 12] = [
     "cut-in_simple",
     "drive_when_close",
     "highway_driver",
+    "lane-change_clothoid_based_trajectory",
     "override_bb",
     "slow-lead-vehicle",
     "straight_500m",

@@ -5,7 +5,7 @@ use std::fmt::Write;
 use paracosm_generators::{Domain, Value};
 use paracosm_openscenario::model::{
     Action, ConditionKind, EntityKind, EntityTest, LaneTarget, OffsetTarget, Position, Scenario,
-    SpeedTarget, Trigger,
+    SpeedTarget, TrajectoryShape, Trigger,
 };
 
 use super::Inspection;
@@ -238,13 +238,35 @@ fn action(s: &Scenario, a: &Action) -> String {
             _ => String::new(),
         },
         Action::Teleport(p) => format!("at {}", position(s, p)),
-        Action::FollowTrajectory { vertices, .. } => format!(
-            "follow a polyline of {} vertices to {}",
-            vertices.len(),
-            vertices
-                .last()
-                .map_or(String::new(), |(_, p)| position(s, p))
-        ),
+        Action::FollowTrajectory { shape, .. } => match shape {
+            TrajectoryShape::Polyline(vertices) => format!(
+                "follow a polyline of {} vertices to {}",
+                vertices.len(),
+                vertices
+                    .last()
+                    .map_or(String::new(), |(_, p)| position(s, p))
+            ),
+            TrajectoryShape::Clothoid {
+                start,
+                curvature,
+                curvature_prime,
+                length,
+                ..
+            } => format!(
+                "follow a clothoid of {length} m, curvature {curvature} 1/m changing by \
+                 {curvature_prime} 1/m2, from {}",
+                start
+                    .as_ref()
+                    .map_or("where it is".to_owned(), |p| position(s, p))
+            ),
+            TrajectoryShape::Nurbs { order, points, .. } => format!(
+                "follow a NURBS of order {order} over {} control points to {}",
+                points.len(),
+                points
+                    .last()
+                    .map_or(String::new(), |(_, _, p)| position(s, p))
+            ),
+        },
         Action::AssignRoute { waypoints } => format!(
             "route through {} waypoints to {}",
             waypoints.len(),

@@ -6,7 +6,9 @@ use roxmltree::Node;
 
 use super::{position, Reader};
 use crate::error::XoscError;
-use crate::model::{Action, Dimension, Dynamics, LaneTarget, OffsetTarget, Shape, SpeedTarget};
+use crate::model::{
+    Action, Dimension, Dynamics, LaneTarget, OffsetTarget, Shape, SpeedTarget, TrajectoryShape,
+};
 use crate::xml::{child, choice, elements, need, only};
 
 /// A `<PrivateAction>`.
@@ -305,22 +307,16 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
             "a trajectory's own parameter declarations are not supported",
         ));
     }
-    let (shape, _) = choice(r.text, need(r.text, traj, "Shape")?, &["Polyline"])?;
-    let mut vertices = Vec::new();
-    for v in elements(shape) {
-        if v.tag_name().name() != "Vertex" {
-            return Err(r
-                .text
-                .unsupported(v, "a polyline holds <Vertex> elements only"));
-        }
-        let time = r.scope.opt_num(r.text, v, "time")?;
-        vertices.push((time, position::read(r, need(r.text, v, "Position")?)?));
-    }
-    if vertices.len() < 2 {
-        return Err(r
-            .text
-            .invalid(shape, "a polyline needs at least two vertices"));
-    }
+    let (shape_node, kind) = choice(
+        r.text,
+        need(r.text, traj, "Shape")?,
+        &["Polyline", "Clothoid", "Nurbs"],
+    )?;
+    let shape = match kind {
+        "Polyline" => polyline(r, shape_node)?,
+        "Clothoid" => clothoid(r, shape_node)?,
+        _ => nurbs(r, shape_node)?,
+    };
     let time_ref = need(r.text, node, "TimeReference")?;
     let timing = match child(time_ref, "Timing") {
         None => None,
@@ -355,20 +351,7 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
                 format!("a timing's scale must be > 0, not {scale}"),
             ));
         }
-        let times: Option<Vec<f64>> = vertices.iter().map(|(t, _)| *t).collect();
-        match times {
-            None => {
-                return Err(r
-                    .text
-                    .invalid(shape, "with a <Timing>, every vertex needs a time"))
-            }
-            Some(t) if t.windows(2).any(|w| w[1] <= w[0]) => {
-                return Err(r
-                    .text
-                    .invalid(shape, "a polyline's vertex times must increase"))
-            }
-            Some(_) => {}
-        }
+        timed(r, shape_node, &shape)?;
     }
     if let Some(m) = child(node, "TrajectoryFollowingMode") {
         let mode = r.scope.string(r.text, m, "followingMode")?;
@@ -376,7 +359,160 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
             r.note(m, format!("followingMode {mode:?} is followed as \"position\": the entity is placed on the trajectory"));
         }
     }
-    Ok(Action::FollowTrajectory { vertices, timing })
+    Ok(Action::FollowTrajectory { shape, timing })
+}
+
+/// A `Polyline`: at least two `Vertex` elements, each with its position and time.
+fn polyline(r: &Reader<'_>, shape: Node<'_, '_>) -> Result<TrajectoryShape, XoscError> {
+    let mut vertices = Vec::new();
+    for v in elements(shape) {
+        if v.tag_name().name() != "Vertex" {
+            return Err(r
+                .text
+                .unsupported(v, "a polyline holds <Vertex> elements only"));
+        }
+        let time = r.scope.opt_num(r.text, v, "time")?;
+        vertices.push((time, position::read(r, need(r.text, v, "Position")?)?));
+    }
+    if vertices.len() < 2 {
+        return Err(r
+            .text
+            .invalid(shape, "a polyline needs at least two vertices"));
+    }
+    Ok(TrajectoryShape::Polyline(vertices))
+}
+
+/// A `Clothoid`: `curvature`, `curvaturePrime` (1.0's `curvatureDot`), `length`, optional
+/// `startTime` and `stopTime` (both or neither), and an optional start `Position`.
+fn clothoid(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, XoscError> {
+    let (sc, t) = (&r.scope, r.text);
+    let prime = match (
+        sc.opt_num(t, c, "curvaturePrime")?,
+        sc.opt_num(t, c, "curvatureDot")?,
+    ) {
+        (Some(p), _) | (None, Some(p)) => p,
+        (None, None) => return Err(t.invalid(c, "a clothoid needs curvaturePrime")),
+    };
+    let length = sc.num(t, c, "length")?;
+    if !(length.is_finite() && length > 0.0) {
+        return Err(XoscError::Invalid {
+            pos: t.attr_pos(c, "length"),
+            reason: format!("a clothoid's length must be > 0, not {length}"),
+        });
+    }
+    let times = match (
+        sc.opt_num(t, c, "startTime")?,
+        sc.opt_num(t, c, "stopTime")?,
+    ) {
+        (Some(a), Some(b)) if b > a => Some((a, b)),
+        (None, None) => None,
+        _ => {
+            return Err(t.invalid(
+                c,
+                "a clothoid's startTime and stopTime come together, stopTime after startTime",
+            ))
+        }
+    };
+    let start = match child(c, "Position") {
+        Some(p) => Some(position::read(r, p)?),
+        None => None,
+    };
+    Ok(TrajectoryShape::Clothoid {
+        start,
+        curvature: sc.num(t, c, "curvature")?,
+        curvature_prime: prime,
+        length,
+        times,
+    })
+}
+
+/// A `Nurbs`: `order` (at least 2), its `ControlPoint`s (at least `order`; `weight` > 0, 1
+/// when absent) and `Knot`s (control points + order of them, non-decreasing, the first below
+/// the last).
+fn nurbs(r: &Reader<'_>, n: Node<'_, '_>) -> Result<TrajectoryShape, XoscError> {
+    let (sc, t) = (&r.scope, r.text);
+    let order = sc.num(t, n, "order")?;
+    if !(order.fract() == 0.0 && (2.0..=16.0).contains(&order)) {
+        return Err(XoscError::Invalid {
+            pos: t.attr_pos(n, "order"),
+            reason: format!("a NURBS's order is a whole number from 2 to 16, not {order}"),
+        });
+    }
+    let order = order as usize;
+    let mut points = Vec::new();
+    let mut knots = Vec::new();
+    for e in elements(n) {
+        match e.tag_name().name() {
+            "ControlPoint" => {
+                let weight = sc.opt_num(t, e, "weight")?.unwrap_or(1.0);
+                if !(weight.is_finite() && weight > 0.0) {
+                    return Err(XoscError::Invalid {
+                        pos: t.attr_pos(e, "weight"),
+                        reason: format!("a control point's weight must be > 0, not {weight}"),
+                    });
+                }
+                let time = sc.opt_num(t, e, "time")?;
+                points.push((time, weight, position::read(r, need(t, e, "Position")?)?));
+            }
+            "Knot" => knots.push(sc.num(t, e, "value")?),
+            _ => {
+                return Err(
+                    t.unsupported(e, "a NURBS holds <ControlPoint> and <Knot> elements only")
+                )
+            }
+        }
+    }
+    if points.len() < order {
+        return Err(t.invalid(
+            n,
+            format!(
+                "a NURBS of order {order} needs at least {order} control points, not {}",
+                points.len()
+            ),
+        ));
+    }
+    if knots.len() != points.len() + order {
+        return Err(t.invalid(
+            n,
+            format!(
+                "a NURBS of order {order} with {} control points needs {} knots, not {}",
+                points.len(),
+                points.len() + order,
+                knots.len()
+            ),
+        ));
+    }
+    if knots.windows(2).any(|w| w[1] < w[0]) || knots[order - 1] >= knots[points.len()] {
+        return Err(t.invalid(
+            n,
+            "a NURBS's knots must not decrease, and must span its curve (the order-th knot below the one after the last control point's)",
+        ));
+    }
+    Ok(TrajectoryShape::Nurbs {
+        order,
+        points,
+        knots,
+    })
+}
+
+/// Checks, with a `<Timing>`, that `shape` gives its times: every vertex (increasing), the
+/// clothoid's start and stop, every control point.
+fn timed(r: &Reader<'_>, node: Node<'_, '_>, shape: &TrajectoryShape) -> Result<(), XoscError> {
+    let times: Option<Vec<f64>> = match shape {
+        TrajectoryShape::Polyline(v) => v.iter().map(|(t, _)| *t).collect(),
+        TrajectoryShape::Clothoid { times, .. } => times.map(|(a, b)| vec![a, b]),
+        TrajectoryShape::Nurbs { points, .. } => points.iter().map(|(t, _, _)| *t).collect(),
+    };
+    match times {
+        None => Err(r.text.invalid(
+            node,
+            "with a <Timing>, every vertex or control point needs a time (a clothoid its startTime and stopTime)",
+        )),
+        Some(t) if t.windows(2).any(|w| w[1] <= w[0]) => Err(r
+            .text
+            .invalid(node, "a trajectory's times must increase")),
+        Some(_) => Ok(()),
+    }
 }
 
 fn assign_route(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {

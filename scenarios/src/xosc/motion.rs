@@ -192,6 +192,164 @@ impl Untimed {
     }
 }
 
+/// A clothoid's points from `start` (OpenSCENARIO `x`, `y` m; its heading the curve's), of
+/// curvature `curvature` (1/m, positive to the left) changing by `prime` (1/m²) over `length`
+/// m: `(distance along it m, pose)`, one at least every
+/// [`paracosm_engine::network::POLYLINE_STEP_M`], facing along the curve. The engine's
+/// clothoid quadrature ([`paracosm_engine::network::RefLine`]).
+pub fn clothoid_poses(start: Pose, curvature: f64, prime: f64, length: f64) -> Vec<(f64, Pose)> {
+    use paracosm_engine::network::{RefLine, POLYLINE_STEP_M};
+    let line = RefLine {
+        length_m: length,
+        curv_start: curvature,
+        curv_end: curvature + prime * length,
+    };
+    let (c, s) = (start.h.cos(), start.h.sin());
+    line.polyline(POLYLINE_STEP_M)
+        .into_iter()
+        .map(|(d, [x, z])| {
+            // The engine's frame has +z to the right of travel; OpenSCENARIO's +y is left.
+            let (lx, ly) = (x, -z);
+            (
+                d,
+                Pose {
+                    x: start.x + c * lx - s * ly,
+                    y: start.y + s * lx + c * ly,
+                    h: super::road::wrap(start.h + line.heading(d)),
+                },
+            )
+        })
+        .collect()
+}
+
+/// The B-spline basis functions of `order` over `knots` at `u`, for the first `n` of them
+/// (Cox–de Boor recursion; Piegl and Tiller, *The NURBS Book*, 1997, eq. 2.5), with the
+/// curve's last parameter in its last non-empty span.
+fn basis(order: usize, knots: &[f64], n: usize, u: f64) -> Vec<f64> {
+    let end = knots[n];
+    let mut b: Vec<f64> = knots
+        .windows(2)
+        .map(|k| {
+            let inside = k[0] <= u && u < k[1];
+            let at_end = u >= end && k[0] < k[1] && k[1] == end;
+            if inside || at_end {
+                1.0
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    for d in 1..order {
+        for i in 0..knots.len() - 1 - d {
+            let left = if knots[i + d] > knots[i] {
+                (u - knots[i]) / (knots[i + d] - knots[i]) * b[i]
+            } else {
+                0.0
+            };
+            let right = if knots[i + d + 1] > knots[i + 1] {
+                (knots[i + d + 1] - u) / (knots[i + d + 1] - knots[i + 1]) * b[i + 1]
+            } else {
+                0.0
+            };
+            b[i] = left + right;
+        }
+    }
+    b.truncate(n);
+    b
+}
+
+/// Most points a NURBS trajectory is sampled into.
+const NURBS_SAMPLES: usize = 100_000;
+
+/// How far apart a NURBS trajectory's samples are along its control polygon, m (esmini's
+/// `NURBS_STEPLENGTH`).
+const NURBS_STEP_M: f64 = 1.0;
+
+/// One control point of a NURBS trajectory: its time (s), weight (> 0), `[x, y]` (m) and the
+/// heading its position gives (rad), if it gives one.
+pub type ControlPoint = (Option<f64>, f64, [f64; 2], Option<f64>);
+
+/// A NURBS curve of `order` over `points` and `knots` (Piegl and Tiller, *The NURBS Book*,
+/// 1997, eq. 4.2), sampled evenly in its parameter, one step per metre of its control
+/// polygon (at most [`NURBS_SAMPLES`] points): `(time, pose)`, as esmini samples it and reads
+/// the standard's optional times and headings (`roadmanager::NurbsShape`). Each control point's time belongs to the parameter
+/// where its basis function peaks, and times are linear in the parameter between those
+/// (when every control point has one). A point faces as the control points' headings blend
+/// by the same rational basis when every control point gives one, else along the curve (the
+/// next point; the last as the one before).
+pub fn nurbs_poses(
+    order: usize,
+    points: &[ControlPoint],
+    knots: &[f64],
+) -> Vec<(Option<f64>, Pose)> {
+    let n = points.len();
+    let (u0, u1) = (knots[order - 1], knots[n]);
+    let polygon: f64 = points
+        .windows(2)
+        .map(|w| (w[1].2[0] - w[0].2[0]).hypot(w[1].2[1] - w[0].2[1]))
+        .sum();
+    let samples = ((polygon / NURBS_STEP_M) as usize + 2).clamp(2, NURBS_SAMPLES);
+    let headed = points.iter().all(|p| p.3.is_some());
+    let mut peak = vec![(0.0f64, u0); n];
+    let mut out: Vec<(f64, Pose)> = (0..samples)
+        .map(|k| {
+            let u = u0 + (u1 - u0) * k as f64 / (samples - 1) as f64;
+            let b = basis(order, knots, n, u);
+            let w: f64 = b.iter().zip(points).map(|(bi, p)| bi * p.1).sum();
+            let w = if w > 0.0 { w } else { 1.0 };
+            let (mut x, mut y, mut h) = (0.0, 0.0, 0.0);
+            for (j, (bi, p)) in b.iter().zip(points).enumerate() {
+                let f = bi * p.1 / w;
+                x += f * p.2[0];
+                y += f * p.2[1];
+                if *bi > 1e-12 {
+                    h += f * super::road::wrap(p.3.unwrap_or(0.0) - h);
+                }
+                if *bi > peak[j].0 {
+                    peak[j] = (*bi, u);
+                }
+            }
+            (
+                u,
+                Pose {
+                    x,
+                    y,
+                    h: super::road::wrap(h),
+                },
+            )
+        })
+        .collect();
+    if !headed {
+        for k in 0..out.len() {
+            let (a, b) = if k + 1 < out.len() {
+                (out[k].1, out[k + 1].1)
+            } else {
+                (out[k - 1].1, out[k].1)
+            };
+            if (b.x - a.x).hypot(b.y - a.y) > 1e-12 {
+                out[k].1.h = (b.y - a.y).atan2(b.x - a.x);
+            } else if k > 0 {
+                out[k].1.h = out[k - 1].1.h;
+            }
+        }
+    }
+    let times: Option<Vec<f64>> = points.iter().map(|p| p.0).collect();
+    let Some(times) = times else {
+        return out.into_iter().map(|(_, p)| (None, p)).collect();
+    };
+    let mut cur = 0;
+    out.into_iter()
+        .map(|(u, p)| {
+            if u >= peak[cur + 1].1 {
+                cur = (cur + 1).min(n.max(2) - 2);
+            }
+            let (a, b) = (peak[cur].1, peak[cur + 1].1);
+            let w = if b > a { (u - a) / (b - a) } else { 0.0 };
+            (Some(times[cur] + w * (times[cur + 1] - times[cur])), p)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -279,5 +437,64 @@ mod tests {
         let (q, done) = u.advance(5.0);
         assert!(!done && (q.x - 3.0).abs() < 1e-12 && (q.y - 2.0).abs() < 1e-12);
         assert!(u.advance(3.0).1);
+    }
+
+    #[test]
+    fn a_rational_quadratic_nurbs_is_a_quarter_circle() {
+        // The NURBS Book, example 7.1: control points (R, 0), (R, R), (0, R), weights 1,
+        // √2/2, 1, knots 0 0 0 1 1 1.
+        let r = 7.0;
+        let w = std::f64::consts::FRAC_1_SQRT_2;
+        let points = [
+            (Some(0.0), 1.0, [r, 0.0], None),
+            (Some(1.0), w, [r, r], None),
+            (Some(2.0), 1.0, [0.0, r], None),
+        ];
+        let poses = nurbs_poses(3, &points, &[0.0, 0.0, 0.0, 1.0, 1.0, 1.0]);
+        // One step per metre of the control polygon (14 m).
+        assert_eq!(poses.len(), 16);
+        for (t, p) in &poses {
+            assert!((p.x.hypot(p.y) - r).abs() < 1e-9, "{p:?}");
+            assert!(t.is_some_and(|t| (0.0..=2.0).contains(&t)));
+        }
+        // Each control point's time where its basis function peaks (esmini's reading): the
+        // first at the start, the last at the end, the middle one halfway.
+        assert_eq!(poses[0].0, Some(0.0));
+        assert_eq!(poses[poses.len() - 1].0, Some(2.0));
+        assert!(poses.iter().any(|(t, _)| *t == Some(1.0)));
+        assert!(poses.windows(2).all(|w| w[1].0 >= w[0].0));
+        let mid = poses.len() / 2;
+        let (first, last) = (poses[0].1, poses[poses.len() - 1].1);
+        assert!((first.x - r).abs() < 1e-12 && first.y.abs() < 1e-12);
+        assert!(last.x.abs() < 1e-12 && (last.y - r).abs() < 1e-12);
+        // Facing along the circle, counter-clockwise: heading = angle + pi/2.
+        let mid = poses[mid].1;
+        let tangent = mid.y.atan2(mid.x) + std::f64::consts::FRAC_PI_2;
+        assert!((mid.h - tangent).abs() < 0.1, "{} vs {tangent}", mid.h);
+    }
+
+    #[test]
+    fn a_clothoid_without_curvature_change_is_an_arc_from_its_start() {
+        let start = Pose {
+            x: 10.0,
+            y: -3.0,
+            h: 0.4,
+        };
+        let (k, len) = (1.0 / 25.0, 30.0);
+        let poses = clothoid_poses(start, k, 0.0, len);
+        // The centre lies 25 m to the left of the start.
+        let centre = (
+            start.x - 25.0 * start.h.sin(),
+            start.y + 25.0 * start.h.cos(),
+        );
+        for (d, p) in &poses {
+            assert!(
+                ((p.x - centre.0).hypot(p.y - centre.1) - 25.0).abs() < 1e-6,
+                "{p:?}"
+            );
+            assert!((p.h - (start.h + k * d)).abs() < 1e-9);
+        }
+        let (d, _) = poses[poses.len() - 1];
+        assert!((d - len).abs() < 1e-9);
     }
 }

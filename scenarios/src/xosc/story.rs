@@ -10,10 +10,12 @@ use std::collections::VecDeque;
 
 use paracosm_openscenario::model::{
     self as m, Action, ConditionKind, Edge, EntityTest, Gap, LaneTarget, OffsetTarget, Position,
-    Priority, Rule, SpeedTarget,
+    Priority, Rule, SpeedTarget, TrajectoryShape,
 };
 
-use super::motion::{duration_s, offset_duration_s, Timed, Transition, Untimed};
+use super::motion::{
+    clothoid_poses, duration_s, nurbs_poses, offset_duration_s, Timed, Transition, Untimed,
+};
 use super::road::{wrap, LanePos, Pose, RoadError, Roads};
 
 /// The largest lateral acceleration of a `LaneOffsetAction` without `maxLateralAcc`, m/s².
@@ -955,8 +957,8 @@ impl Storyboard {
                 )
                 .map_err(|e| bad(e.to_string()))?;
             }
-            Action::FollowTrajectory { vertices, timing } => {
-                return self.start_trajectory(e, (vertices, timing), (a, &action.pos), t);
+            Action::FollowTrajectory { shape, timing } => {
+                return self.start_trajectory(e, (shape, timing), (a, &action.pos), t);
             }
             Action::AssignRoute { waypoints } => {
                 let mut roads = Vec::new();
@@ -1188,7 +1190,7 @@ impl Storyboard {
     fn start_trajectory(
         &mut self,
         e: usize,
-        (vertices, timing): (&[(Option<f64>, Position)], &Option<(bool, f64, f64)>),
+        (shape, timing): (&TrajectoryShape, &Option<(bool, f64, f64)>),
         (a, pos): (Option<usize>, &paracosm_openscenario::Pos),
         t: f64,
     ) -> Result<(), StoryError> {
@@ -1202,38 +1204,20 @@ impl Storyboard {
         if !scripted {
             return Ok(());
         }
-        let mut poses = Vec::new();
-        for (_, p) in vertices {
-            poses.push(self.resolve(p, pos)?.0);
-        }
-        // A world vertex without a heading faces along its leg (the next vertex; the last, from
-        // the one before), as esmini aligns what a file omits.
-        for k in 0..poses.len() {
-            if matches!(vertices[k].1, Position::World { h: None, .. }) {
-                let (a, b) = match (poses.get(k), poses.get(k + 1)) {
-                    (Some(a), Some(b)) => (*a, *b),
-                    _ if k > 0 => (poses[k - 1], poses[k]),
-                    _ => continue,
-                };
-                if (b.x - a.x).hypot(b.y - a.y) > 1e-9 {
-                    poses[k].h = (b.y - a.y).atan2(b.x - a.x);
-                }
-            }
-        }
-        let timed = vertices.iter().all(|(time, _)| time.is_some());
+        let points = self.trajectory_points(e, shape, pos)?;
+        let timed = points.iter().all(|(time, _)| time.is_some());
         let path = match timing {
             Some((absolute, scale, offset)) if timed => {
                 let base = if *absolute { 0.0 } else { t };
                 Path::Timed(Timed {
-                    vertices: vertices
+                    vertices: points
                         .iter()
-                        .zip(poses)
-                        .map(|((time, _), p)| (base + time.unwrap_or(0.0) * scale + offset, p))
+                        .map(|(time, p)| (base + time.unwrap_or(0.0) * scale + offset, *p))
                         .collect(),
                 })
             }
             _ => Path::Untimed(Untimed {
-                vertices: poses,
+                vertices: points.into_iter().map(|(_, p)| p).collect(),
                 gone_m: 0.0,
             }),
         };
@@ -1262,6 +1246,72 @@ impl Storyboard {
         self.drives[e].path = Some((path, a.unwrap_or(usize::MAX)));
 
         Ok(())
+    }
+
+    /// The points of trajectory `shape` for entity `e`, with their times in the file (none
+    /// untimed): a polyline's vertices (a world vertex without a heading facing along its leg,
+    /// the next vertex, or for the last the one before, as esmini aligns what a file omits); a
+    /// clothoid sampled from its start (`e`'s pose without a `Position`), its times linear in
+    /// the distance along it; a NURBS sampled along its parameter.
+    ///
+    /// # Errors
+    /// [`StoryError`] for a position that cannot be resolved (`pos`: the action's).
+    fn trajectory_points(
+        &self,
+        e: usize,
+        shape: &TrajectoryShape,
+        pos: &paracosm_openscenario::Pos,
+    ) -> Result<Vec<(Option<f64>, Pose)>, StoryError> {
+        Ok(match shape {
+            TrajectoryShape::Polyline(vertices) => {
+                let mut poses = Vec::new();
+                for (_, p) in vertices {
+                    poses.push(self.resolve(p, pos)?.0);
+                }
+                for k in 0..poses.len() {
+                    if matches!(vertices[k].1, Position::World { h: None, .. }) {
+                        let (a, b) = match (poses.get(k), poses.get(k + 1)) {
+                            (Some(a), Some(b)) => (*a, *b),
+                            _ if k > 0 => (poses[k - 1], poses[k]),
+                            _ => continue,
+                        };
+                        if (b.x - a.x).hypot(b.y - a.y) > 1e-9 {
+                            poses[k].h = (b.y - a.y).atan2(b.x - a.x);
+                        }
+                    }
+                }
+                vertices.iter().map(|(t, _)| *t).zip(poses).collect()
+            }
+            TrajectoryShape::Clothoid {
+                start,
+                curvature,
+                curvature_prime,
+                length,
+                times,
+            } => {
+                let from = match start {
+                    Some(p) => self.resolve(p, pos)?.0,
+                    None => self.actors[e].state.pose,
+                };
+                clothoid_poses(from, *curvature, *curvature_prime, *length)
+                    .into_iter()
+                    .map(|(d, p)| (times.map(|(a, b)| a + (b - a) * d / length), p))
+                    .collect()
+            }
+            TrajectoryShape::Nurbs {
+                order,
+                points,
+                knots,
+            } => {
+                let mut at = Vec::new();
+                for (time, weight, p) in points {
+                    let q = self.resolve(p, pos)?.0;
+                    let given = !matches!(p, Position::World { h: None, .. });
+                    at.push((*time, *weight, [q.x, q.y], given.then_some(q.h)));
+                }
+                nurbs_poses(*order, &at, knots)
+            }
+        })
     }
 
     /// `lp` (if any) facing `h`.
