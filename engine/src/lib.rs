@@ -32,6 +32,7 @@ pub mod rx;
 pub mod segmentation;
 pub mod sensor;
 mod sim;
+mod simd;
 mod spec;
 pub mod sut;
 pub mod ttc;
@@ -47,7 +48,8 @@ pub use obstacle::ObstacleState;
 pub use pedestrian::{PedestrianPhase, PedestrianState};
 pub use segmentation::{ObjectBox, SemanticClass};
 pub use sensor::camera::{
-    CameraFrame, CameraSpec, SavePngError, SENSOR_HEIGHT_MM, SENSOR_WIDTH_MM,
+    BackProjector, CameraFrame, CameraSpec, FrameUse, SavePngError, SENSOR_HEIGHT_MM,
+    SENSOR_WIDTH_MM,
 };
 pub use sensor::lidar::{LidarReturn, LidarSpec};
 pub use sensor::{SensorSpec, SettingError};

@@ -562,7 +562,22 @@ impl Simulation {
     /// [`EngineError::Sensor`] when the camera's values are out of range, no GPU adapter is
     /// found, or this build lacks the `render` feature.
     pub fn attach_camera(&mut self, camera: &CameraSpec, seed: u64) -> Result<(), EngineError> {
-        let sensor = crate::sensor::camera::sensor(&self.network, camera, seed, self.dt_s)?;
+        self.attach_camera_for(camera, crate::FrameUse::ALL, seed)
+    }
+
+    /// [`Simulation::attach_camera`] for a consumer that reads only what `usage` says (a
+    /// region of the image, some planes): the camera renders and reads back only that, and
+    /// its frames hold nothing else ([`crate::CameraFrame`]).
+    ///
+    /// # Errors
+    /// As [`Simulation::attach_camera`].
+    pub fn attach_camera_for(
+        &mut self,
+        camera: &CameraSpec,
+        usage: crate::FrameUse,
+        seed: u64,
+    ) -> Result<(), EngineError> {
+        let sensor = crate::sensor::camera::sensor(&self.network, camera, usage, seed, self.dt_s)?;
         self.mount(sensor)
     }
 

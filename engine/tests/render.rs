@@ -817,3 +817,81 @@ fn a_maps_world_is_uploaded_once_and_shared_by_every_test() {
     .unwrap();
     assert!(!r.scene(&own).shares_buffers_with(&r.scene(&own)));
 }
+
+/// A view that reads a region only ([`FrameUse`]) draws it through a scissor rectangle and
+/// reads back only it and only the planes asked for: inside the region its image, depth and
+/// labels are the whole frame's bit for bit (with pixel noise too: drawn for the whole frame
+/// in order); outside it the image is black, and planes not asked for are empty. Reused
+/// frame buffers ([`View::recycle`]) give the same frames as new ones.
+#[test]
+fn a_region_of_the_frame_is_the_whole_frames_pixels_bit_for_bit() {
+    use paracosm_engine::render::View;
+    use paracosm_engine::FrameUse;
+    let r = renderer();
+    let network = road();
+    let scene = r.scene(&network);
+    let objects = [car_at(30.0, 1.75, RED), car_at(45.0, 5.25, WHITE)];
+    for noise_sigma in [0.0, 3.0] {
+        let camera = CameraSpec {
+            noise_sigma,
+            ..CameraSpec::default()
+        };
+        let draw = |view: &mut View, x: f64| {
+            r.render_one(RenderJob {
+                scene: &scene,
+                view,
+                pose: CameraPose {
+                    chassis_m: [x, 0.5, 1.75],
+                    heading_rad: 0.02,
+                },
+                objects: &objects,
+                light: NOMINAL_LIGHT,
+                fog: 0.1,
+                t_s: 0.0,
+                noise_seed: 11,
+            })
+            .unwrap()
+        };
+        let region = [60, 96, 200, 104];
+        let mut whole = r.view(&camera).unwrap();
+        let mut image_only = r.view_for(&camera, FrameUse::image(Some(region))).unwrap();
+        let with_depth = FrameUse {
+            depth: true,
+            labels: false,
+            region: Some(region),
+        };
+        let mut depth_region = r.view_for(&camera, with_depth).unwrap();
+        for x in [10.0, 12.5] {
+            let full = draw(&mut whole, x);
+            let part = draw(&mut image_only, x);
+            let deep = draw(&mut depth_region, x);
+            assert_eq!(part.region, region);
+            assert!(part.depth_m.is_empty() && part.labels.is_empty());
+            assert!(deep.labels.is_empty() && deep.depth_m.len() == full.depth_m.len());
+            let (mut inside, mut car) = (0, 0);
+            for v in 0..camera.height {
+                for u in 0..camera.width {
+                    let i = (v * camera.width + u) as usize;
+                    let within = (60..260).contains(&u) && (96..200).contains(&v);
+                    if within {
+                        inside += 1;
+                        assert_eq!(part.rgb_at(u, v), full.rgb_at(u, v), "({u}, {v})");
+                        assert_eq!(deep.rgb_at(u, v), full.rgb_at(u, v), "({u}, {v})");
+                        assert_eq!(deep.depth_m[i].to_bits(), full.depth_m[i].to_bits());
+                        car +=
+                            usize::from(full.class_at(u, v) == paracosm_engine::SemanticClass::Car);
+                    } else {
+                        assert_eq!(part.rgb_at(u, v), [0, 0, 0], "({u}, {v}) outside");
+                        assert_eq!(deep.depth_m[i], f32::INFINITY);
+                    }
+                }
+            }
+            assert_eq!(inside, 200 * 104);
+            assert!(car > 50, "the region shows the red car: {car} pixels");
+            // The next frame reuses these buffers.
+            image_only.recycle(part);
+            depth_region.recycle(deep);
+            whole.recycle(full);
+        }
+    }
+}

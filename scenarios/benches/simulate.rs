@@ -11,6 +11,9 @@
 //! `t-loop` (200 s): with `safe_15s/star` they give the cost per simulated second that issue
 //! 23 compares (`experiments/bench/long_horizons.py` measures whole campaigns).
 //!
+//! `camera/*` runs one whole test of the pedestrian study with each system under test that
+//! sees through the camera (`vision`, `pilotnet`, an external process) and with `aeb`.
+//!
 //! `maps/*` runs one test on paracosm's own straight road (a 500 m `RoadSegment`, the
 //! baseline) and on three OpenDRIVE maps written by others (`tests/data/maps/`): esmini's
 //! straight 500 m road, CARLA's Town07 and esmini's `multi_intersections` (63 roads), for
@@ -102,6 +105,62 @@ fn bench(c: &mut Criterion) {
     }
     group.finish();
     maps(c);
+    camera(c);
+}
+
+/// One whole 15 s test of the pedestrian study (a point where the pedestrian stays clear)
+/// driven by each system under test that sees through the camera: `vision` (160 × 120 at
+/// 20 Hz, image and depth, pixel noise), `pilotnet` (320 × 240 at 10 Hz, its crop of the
+/// image only, tract) and an external process (`camera_sut.py`: 320 × 240 at 10 Hz, every
+/// frame sent through the protocol), beside `aeb` (lidar) for the ratio. The profile table
+/// in docs/performance.md ("The camera loop") splits these tests' time.
+fn camera(c: &mut Criterion) {
+    use paracosm_engine::sut::{ExternalConfig, SutConfig};
+    let base = builtin("pedestrian-crossing").unwrap();
+    let a = base
+        .space
+        .decode(&Point {
+            discrete: vec![],
+            continuous: vec![0.05, 0.9],
+        })
+        .unwrap();
+    let external = SutConfig::External(ExternalConfig::new(
+        vec!["python3".into(), "benches/camera_sut.py".into()],
+        30.0,
+        true,
+    ));
+    let mut group = c.benchmark_group("camera");
+    group.sample_size(10);
+    for (name, sut) in [
+        (
+            "aeb",
+            SutConfig::named("aeb", std::path::Path::new(".")).unwrap(),
+        ),
+        (
+            "vision",
+            SutConfig::named("vision", std::path::Path::new(".")).unwrap(),
+        ),
+        (
+            "pilotnet",
+            SutConfig::named("pilotnet", std::path::Path::new(".")).unwrap(),
+        ),
+        ("external", external),
+    ] {
+        let mut s = base.clone();
+        s.sut = sut;
+        let outcome = s.run(&a, 0).unwrap();
+        let simulated = outcome
+            .metrics
+            .iter()
+            .find(|(k, _)| *k == "simulated_s")
+            .map(|(_, v)| *v);
+        assert!(
+            simulated > Some(14.9),
+            "{name} ran its whole test: {simulated:?}"
+        );
+        group.bench_function(name, |b| b.iter(|| s.run(&a, 0).unwrap()));
+    }
+    group.finish();
 }
 
 /// One test on each of three maps, for two horizons (see the module's documentation).

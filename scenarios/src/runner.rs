@@ -316,9 +316,17 @@ impl Scenario {
             (Some(c), _) => (Some(c), true),
             (None, viewer) => (viewer, false),
         };
+        // The camera renders only what its system reads, unless a callback watches the
+        // frames (a person, a dataset): then every plane of the whole image.
+        let watched = options.on_frame.is_some() || options.on_sample.is_some();
+        let usage = if sut_sees && !watched {
+            sensors.frame_use
+        } else {
+            paracosm_engine::FrameUse::ALL
+        };
         let frame_every = match &camera {
             Some(c) => {
-                sim.attach_camera(c, seed)?;
+                sim.attach_camera_for(c, usage, seed)?;
                 period_ticks(Some(c.rate_hz), spec.dt_s)
             }
             None => 0,

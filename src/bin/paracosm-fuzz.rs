@@ -375,7 +375,19 @@ fn runtime_dir() {
     }
 }
 
+/// Mesa's CPU rasterisers (lavapipe, llvmpipe) render on the thread that submits unless
+/// `LP_NUM_THREADS` asks for helper threads. Each camera frame is small and every worker
+/// submits its own: helper threads only add hand-offs (about a tenth of a camera test's CPU
+/// time, docs/performance.md, "The camera loop"). A value the user set is kept; a GPU ignores
+/// it. Called first, before any thread starts.
+fn render_on_the_calling_thread() {
+    if std::env::var_os("LP_NUM_THREADS").is_none() {
+        std::env::set_var("LP_NUM_THREADS", "0");
+    }
+}
+
 fn main() -> ExitCode {
+    render_on_the_calling_thread();
     runtime_dir();
     paracosm_scenarios::memory::set_tool_name("paracosm-fuzz");
     stop_on_signals();

@@ -8,7 +8,7 @@ use super::mesh::{albedo, Mesh, Vertex};
 use super::post;
 use super::RenderError;
 use crate::network::Network;
-use crate::sensor::camera::{CameraFrame, CameraSpec};
+use crate::sensor::camera::{CameraFrame, CameraSpec, FrameUse};
 
 use crate::NOMINAL_LIGHT;
 
@@ -20,8 +20,6 @@ const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 const DEPTH_OUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 const LABEL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 const ZBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Planes of a view's readback buffer: colour, depth, labels.
-const PLANES: u64 = 3;
 /// Near clipping plane, in metres.
 const NEAR_M: f32 = 0.05;
 
@@ -109,6 +107,13 @@ impl SceneGeometry {
 /// many views render together through [`Renderer::render`].
 pub struct View {
     camera: CameraSpec,
+    usage: FrameUse,
+    /// The pixels drawn and read back: [`FrameUse::region_in`].
+    region: [u32; 4],
+    /// The camera's pixel noise, tabulated once.
+    noise: Option<Arc<post::Noise>>,
+    /// A frame whose buffers the next frame reuses ([`View::recycle`]).
+    spare: Option<CameraFrame>,
     color: wgpu::TextureView,
     color_texture: wgpu::Texture,
     depth_out: wgpu::TextureView,
@@ -128,6 +133,17 @@ impl View {
     /// The camera this view renders.
     pub fn camera(&self) -> &CameraSpec {
         &self.camera
+    }
+
+    /// What it renders and reads back of each frame.
+    pub fn usage(&self) -> FrameUse {
+        self.usage
+    }
+
+    /// Hands back a frame this view rendered and nobody reads any more: the next frame is
+    /// written into its buffers instead of new ones.
+    pub fn recycle(&mut self, frame: CameraFrame) {
+        self.spare = Some(frame);
     }
 }
 
@@ -158,6 +174,9 @@ pub struct Renderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
     pipeline: wgpu::RenderPipeline,
+    /// The same shader drawing the image only.
+    /// The same shader without the depth target, the label target or both.
+    partial_pipelines: [wgpu::RenderPipeline; 3],
     layout: wgpu::BindGroupLayout,
     cube: SceneGeometry,
     identity: wgpu::Buffer,
@@ -229,70 +248,7 @@ impl Renderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let vertex_attributes =
-            wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 8 => Uint32];
-        let instance_attributes = wgpu::vertex_attr_array![
-            3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4,
-            9 => Uint32
-        ];
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("paracosm camera"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[
-                    Some(wgpu::VertexBufferLayout {
-                        array_stride: std::mem::size_of::<Vertex>() as u64,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &vertex_attributes,
-                    }),
-                    Some(wgpu::VertexBufferLayout {
-                        array_stride: std::mem::size_of::<Instance>() as u64,
-                        step_mode: wgpu::VertexStepMode::Instance,
-                        attributes: &instance_attributes,
-                    }),
-                ],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: ZBUFFER_FORMAT,
-                depth_write_enabled: Some(true),
-                // Reversed Z: near is 1, infinitely far is 0.
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[
-                    Some(wgpu::ColorTargetState {
-                        format: COLOR_FORMAT,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    }),
-                    Some(wgpu::ColorTargetState {
-                        format: DEPTH_OUT_FORMAT,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    }),
-                    Some(wgpu::ColorTargetState {
-                        format: LABEL_FORMAT,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    }),
-                ],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let (pipeline, partial_pipelines) = pipelines(&device, &pipeline_layout, &shader);
         let cube = upload(&device, &Mesh::unit_cube());
         let identity = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("identity instance"),
@@ -303,6 +259,7 @@ impl Renderer {
             device,
             queue,
             pipeline,
+            partial_pipelines,
             layout,
             cube,
             identity,
@@ -342,12 +299,22 @@ impl Renderer {
         upload(&self.device, &Mesh::world(network))
     }
 
-    /// Creates the render targets of `camera`.
+    /// Creates the render targets of `camera`, for frames with every plane of the whole image.
     ///
     /// # Errors
     /// [`RenderError::Camera`] when the camera's values are out of range.
     pub fn view(&self, camera: &CameraSpec) -> Result<View, RenderError> {
+        self.view_for(camera, FrameUse::ALL)
+    }
+
+    /// Creates the render targets of `camera` for a consumer that reads what `usage` says:
+    /// only its region is drawn (a scissor rectangle) and only its planes are read back.
+    ///
+    /// # Errors
+    /// [`RenderError::Camera`] when the camera's values are out of range.
+    pub fn view_for(&self, camera: &CameraSpec, usage: FrameUse) -> Result<View, RenderError> {
         camera.validate().map_err(RenderError::Camera)?;
+        let region = usage.region_in(camera);
         let size = wgpu::Extent3d {
             width: camera.width,
             height: camera.height,
@@ -375,11 +342,12 @@ impl Renderer {
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         );
         // The three targets have 4 bytes per pixel; rows are padded to 256 bytes for the copy.
-        let padded_row = (4 * camera.width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+        let padded_row = (4 * region[2]).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let planes = 1 + u64::from(usage.depth) + u64::from(usage.labels);
         let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
-            size: PLANES * u64::from(padded_row) * u64::from(camera.height),
+            size: planes * u64::from(padded_row) * u64::from(region[3]),
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             mapped_at_creation: false,
         });
@@ -400,6 +368,10 @@ impl Renderer {
         let instance_capacity = 16;
         Ok(View {
             camera: camera.clone(),
+            usage,
+            region,
+            noise: post::Noise::shared(camera.noise_sigma),
+            spare: None,
             color: color_texture.create_view(&Default::default()),
             color_texture,
             depth_out: depth_texture.create_view(&Default::default()),
@@ -452,20 +424,27 @@ impl Renderer {
                     }
                 });
         }
-        self.device
-            .poll(wgpu::PollType::Wait {
-                submission_index: Some(index),
-                timeout: None,
-            })
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        let poll = self.device.poll(wgpu::PollType::Wait {
+            submission_index: Some(index),
+            timeout: None,
+        });
+        // Mesa's JIT code ran on this thread (LP_NUM_THREADS=0) with AVX registers.
+        crate::simd::clear_upper_vector_state();
+        poll.map_err(|e| RenderError::Readback(e.to_string()))?;
         if let Some(e) = failed.lock().unwrap_or_else(|p| p.into_inner()).take() {
             return Err(RenderError::Readback(e));
         }
         let mut frames = Vec::with_capacity(jobs.len());
-        for job in jobs.iter() {
-            let frame = read_frame(job)?;
+        for job in jobs.iter_mut() {
+            let mut frame = read_frame(job.view, job.t_s)?;
             job.view.readback.unmap();
-            frames.push(post::apply(frame, &job.view.camera, job.noise_seed));
+            post::apply(
+                &mut frame,
+                job.view.noise.as_deref(),
+                &job.view.camera,
+                job.noise_seed,
+            );
+            frames.push(frame);
         }
         Ok(frames)
     }
@@ -495,6 +474,7 @@ impl Renderer {
         }
         let view = &*job.view;
         let sky = sky_color(job.light);
+        let (depth, labels) = (view.usage.depth, view.usage.labels);
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("camera"),
@@ -513,7 +493,7 @@ impl Renderer {
                             store: wgpu::StoreOp::Store,
                         },
                     }),
-                    Some(wgpu::RenderPassColorAttachment {
+                    depth.then_some(wgpu::RenderPassColorAttachment {
                         view: &view.depth_out,
                         depth_slice: None,
                         resolve_target: None,
@@ -528,7 +508,7 @@ impl Renderer {
                             store: wgpu::StoreOp::Store,
                         },
                     }),
-                    Some(wgpu::RenderPassColorAttachment {
+                    labels.then_some(wgpu::RenderPassColorAttachment {
                         view: &view.labels,
                         depth_slice: None,
                         resolve_target: None,
@@ -551,7 +531,16 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.pipeline);
+            pass.set_pipeline(match (depth, labels) {
+                (true, true) => &self.pipeline,
+                (false, false) => &self.partial_pipelines[0],
+                (true, false) => &self.partial_pipelines[1],
+                (false, true) => &self.partial_pipelines[2],
+            });
+            let [x, y, w, h] = view.region;
+            if [x, y, w, h] != [0, 0, camera.width, camera.height] {
+                pass.set_scissor_rect(x, y, w, h);
+            }
             pass.set_bind_group(0, &view.bind_group, &[]);
             pass.set_vertex_buffer(0, job.scene.vertices.slice(..));
             pass.set_vertex_buffer(1, self.identity.slice(..));
@@ -564,36 +553,129 @@ impl Renderer {
                 pass.draw_indexed(0..self.cube.index_count, 0, 0..instances.len() as u32);
             }
         }
-        let size = wgpu::Extent3d {
-            width: camera.width,
-            height: camera.height,
-            depth_or_array_layers: 1,
-        };
-        let plane = u64::from(view.padded_row) * u64::from(camera.height);
-        for (texture, offset) in [
-            (&view.color_texture, 0),
-            (&view.depth_texture, plane),
-            (&view.label_texture, 2 * plane),
-        ] {
-            encoder.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &view.readback,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset,
-                        bytes_per_row: Some(view.padded_row),
-                        rows_per_image: Some(camera.height),
-                    },
-                },
-                size,
-            );
-        }
+        copy_planes(encoder, view);
     }
+}
+
+/// Copies the planes `view` reads, inside its region, into its readback buffer, one after
+/// the other (colour, then depth, then labels, each `padded_row × region height` bytes).
+fn copy_planes(encoder: &mut wgpu::CommandEncoder, view: &View) {
+    let [x, y, w, h] = view.region;
+    let size = wgpu::Extent3d {
+        width: w,
+        height: h,
+        depth_or_array_layers: 1,
+    };
+    let plane = u64::from(view.padded_row) * u64::from(h);
+    let planes = [
+        (&view.color_texture, true),
+        (&view.depth_texture, view.usage.depth),
+        (&view.label_texture, view.usage.labels),
+    ];
+    let read = planes.into_iter().filter(|(_, read)| *read);
+    for (k, (texture, _)) in read.enumerate() {
+        let offset = k as u64 * plane;
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x, y, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &view.readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset,
+                    bytes_per_row: Some(view.padded_row),
+                    rows_per_image: Some(h),
+                },
+            },
+            size,
+        );
+    }
+}
+
+/// The camera's render pipelines, one shader: every plane, then without depth and labels,
+/// without labels, without depth (the outputs of a missing target are dropped; the target is
+/// neither cleared nor written).
+fn pipelines(
+    device: &wgpu::Device,
+    pipeline_layout: &wgpu::PipelineLayout,
+    shader: &wgpu::ShaderModule,
+) -> (wgpu::RenderPipeline, [wgpu::RenderPipeline; 3]) {
+    let vertex_attributes =
+        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 8 => Uint32];
+    let instance_attributes = wgpu::vertex_attr_array![
+        3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4,
+        9 => Uint32
+    ];
+    let make_pipeline = |depth: bool, labels: bool| {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("paracosm camera"),
+            layout: Some(pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: shader,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[
+                    Some(wgpu::VertexBufferLayout {
+                        array_stride: std::mem::size_of::<Vertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &vertex_attributes,
+                    }),
+                    Some(wgpu::VertexBufferLayout {
+                        array_stride: std::mem::size_of::<Instance>() as u64,
+                        step_mode: wgpu::VertexStepMode::Instance,
+                        attributes: &instance_attributes,
+                    }),
+                ],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: ZBUFFER_FORMAT,
+                depth_write_enabled: Some(true),
+                // Reversed Z: near is 1, infinitely far is 0.
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: shader,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[
+                    Some(wgpu::ColorTargetState {
+                        format: COLOR_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    }),
+                    depth.then_some(wgpu::ColorTargetState {
+                        format: DEPTH_OUT_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    }),
+                    labels.then_some(wgpu::ColorTargetState {
+                        format: LABEL_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    }),
+                ],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    };
+    let all = make_pipeline(true, true);
+    let partial = [
+        make_pipeline(false, false),
+        make_pipeline(true, false),
+        make_pipeline(false, true),
+    ];
+    (all, partial)
 }
 
 fn upload(device: &wgpu::Device, mesh: &Mesh) -> SceneGeometry {
@@ -658,35 +740,75 @@ fn globals(camera: &CameraSpec, job: &RenderJob<'_>) -> Globals {
     }
 }
 
-fn read_frame(job: &RenderJob<'_>) -> Result<CameraFrame, RenderError> {
-    let view = &*job.view;
-    let (w, h) = (view.camera.width as usize, view.camera.height as usize);
+/// The frame in `view`'s mapped readback buffer, written into the buffers of its spare frame
+/// when it has one of the same shape.
+fn read_frame(view: &mut View, t_s: f64) -> Result<CameraFrame, RenderError> {
+    let (width, height) = (view.camera.width, view.camera.height);
+    let (full_w, full_h) = (width as usize, height as usize);
+    let [x0, y0, w, h] = view.region.map(|v| v as usize);
     let row = view.padded_row as usize;
+    let usage = view.usage;
+    let mut frame = match view.spare.take() {
+        Some(f)
+            if (f.width, f.height, f.region) == (width, height, view.region)
+                && f.rgb.len() == full_w * full_h * 3
+                && f.depth_m.len() == if usage.depth { full_w * full_h } else { 0 }
+                && f.labels.len() == if usage.labels { full_w * full_h } else { 0 } =>
+        {
+            f
+        }
+        _ => CameraFrame {
+            t_s,
+            width,
+            height,
+            region: view.region,
+            rgb: vec![0; full_w * full_h * 3],
+            depth_m: if usage.depth {
+                vec![f32::INFINITY; full_w * full_h]
+            } else {
+                Vec::new()
+            },
+            labels: if usage.labels {
+                vec![0; full_w * full_h]
+            } else {
+                Vec::new()
+            },
+        },
+    };
+    frame.t_s = t_s;
     let data = view
         .readback
         .slice(..)
         .get_mapped_range()
         .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let mut rgb = Vec::with_capacity(w * h * 3);
-    let mut depth_m = Vec::with_capacity(w * h);
-    let mut labels = Vec::with_capacity(w * h);
     let word = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+    let mut plane = 0;
     for y in 0..h {
         let line = &data[y * row..y * row + 4 * w];
-        for px in line.chunks_exact(4) {
-            rgb.extend_from_slice(&px[..3]);
+        let out = &mut frame.rgb[3 * ((y0 + y) * full_w + x0)..3 * ((y0 + y) * full_w + x0 + w)];
+        for (px, rgb) in line.chunks_exact(4).zip(out.chunks_exact_mut(3)) {
+            rgb.copy_from_slice(&px[..3]);
         }
-        let line = &data[(h + y) * row..(h + y) * row + 4 * w];
-        depth_m.extend(line.chunks_exact(4).map(|b| f32::from_bits(word(b))));
-        let line = &data[(2 * h + y) * row..(2 * h + y) * row + 4 * w];
-        labels.extend(line.chunks_exact(4).map(word));
     }
-    Ok(CameraFrame {
-        t_s: job.t_s,
-        width: view.camera.width,
-        height: view.camera.height,
-        rgb,
-        depth_m,
-        labels,
-    })
+    if usage.depth {
+        plane += h;
+        for y in 0..h {
+            let line = &data[(plane + y) * row..(plane + y) * row + 4 * w];
+            let out = &mut frame.depth_m[(y0 + y) * full_w + x0..(y0 + y) * full_w + x0 + w];
+            for (b, d) in line.chunks_exact(4).zip(out) {
+                *d = f32::from_bits(word(b));
+            }
+        }
+    }
+    if usage.labels {
+        plane += h;
+        for y in 0..h {
+            let line = &data[(plane + y) * row..(plane + y) * row + 4 * w];
+            let out = &mut frame.labels[(y0 + y) * full_w + x0..(y0 + y) * full_w + x0 + w];
+            for (b, l) in line.chunks_exact(4).zip(out) {
+                *l = word(b);
+            }
+        }
+    }
+    Ok(frame)
 }

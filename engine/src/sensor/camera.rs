@@ -138,7 +138,47 @@ impl CameraSpec {
     /// A camera-frame point `[right, up, forward]` in the vehicle frame `[forward, up,
     /// right]` relative to the chassis centre, metres: undoes the pitch and adds the mount.
     pub fn camera_to_vehicle(&self, p: [f64; 3]) -> [f64; 3] {
-        let (s, c) = self.pitch_rad.sin_cos();
+        self.back_projector().in_vehicle_frame(p)
+    }
+
+    /// [`CameraSpec::back_project`] then [`CameraSpec::camera_to_vehicle`] with the
+    /// intrinsics and the pitch's sine and cosine worked out once, for many pixels.
+    pub fn back_projector(&self) -> BackProjector {
+        let (sin, cos) = self.pitch_rad.sin_cos();
+        BackProjector {
+            focal_px: self.focal_px(),
+            centre: [f64::from(self.width) / 2.0, f64::from(self.height) / 2.0],
+            sin,
+            cos,
+            mount_m: self.mount_m,
+        }
+    }
+}
+
+/// A camera's back-projection with its constants worked out once
+/// ([`CameraSpec::back_projector`]): the same values as [`CameraSpec::back_project`] and
+/// [`CameraSpec::camera_to_vehicle`], bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BackProjector {
+    focal_px: f64,
+    centre: [f64; 2],
+    sin: f64,
+    cos: f64,
+    mount_m: [f64; 3],
+}
+
+impl BackProjector {
+    /// The point seen at pixel `(u, v)` (pixel centres at `+0.5`) with z-depth `depth_m`, in
+    /// the vehicle frame `[forward, up, right]` relative to the chassis centre, metres.
+    pub fn vehicle_point(&self, u: f64, v: f64, depth_m: f64) -> [f64; 3] {
+        let f = self.focal_px;
+        let [cx, cy] = self.centre;
+        self.in_vehicle_frame([(u - cx) / f * depth_m, (cy - v) / f * depth_m, depth_m])
+    }
+
+    /// A camera-frame point `[right, up, forward]` in the vehicle frame.
+    fn in_vehicle_frame(&self, p: [f64; 3]) -> [f64; 3] {
+        let (s, c) = (self.sin, self.cos);
         // The optical axis is (cos, -sin) in (forward, up); the camera's up is (sin, cos).
         let forward = c * p[2] + s * p[1];
         let up = -s * p[2] + c * p[1];
@@ -150,10 +190,88 @@ impl CameraSpec {
     }
 }
 
+/// What the consumer of a camera reads of each frame ([`crate::sut::Sensors::frame_use`]):
+/// the renderer draws and reads back only that. Default ([`FrameUse::ALL`]): every plane of
+/// the whole image.
+///
+/// A region is exact: its pixels are those of the whole frame bit for bit (the same
+/// projection, drawn through a scissor rectangle; pixel noise drawn for the whole frame in
+/// order). A camera with blur renders the whole image whatever the region asks (blur reads
+/// beyond a region's edge).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FrameUse {
+    /// Whether it reads the depth map ([`CameraFrame::depth_m`]).
+    pub depth: bool,
+    /// Whether it reads the labels ([`CameraFrame::labels`]).
+    pub labels: bool,
+    /// The part of the image it reads, `[column, row, width, height]` in pixels (clipped to
+    /// the image); `None`: all of it.
+    pub region: Option<[u32; 4]>,
+}
+
+impl FrameUse {
+    /// Every plane of the whole image: what a frame callback, a dataset or a person gets.
+    pub const ALL: FrameUse = FrameUse {
+        depth: true,
+        labels: true,
+        region: None,
+    };
+
+    /// The image only (no depth, no labels), `region` of it or all.
+    pub fn image(region: Option<[u32; 4]>) -> FrameUse {
+        FrameUse {
+            depth: false,
+            labels: false,
+            region,
+        }
+    }
+
+    /// What either `self` or `other` reads.
+    pub fn union(self, other: FrameUse) -> FrameUse {
+        let region = match (self.region, other.region) {
+            (Some([ax, ay, aw, ah]), Some([bx, by, bw, bh])) => {
+                let (x0, y0) = (ax.min(bx), ay.min(by));
+                let x1 = (ax + aw).max(bx + bw);
+                let y1 = (ay + ah).max(by + bh);
+                Some([x0, y0, x1 - x0, y1 - y0])
+            }
+            _ => None,
+        };
+        FrameUse {
+            depth: self.depth || other.depth,
+            labels: self.labels || other.labels,
+            region,
+        }
+    }
+
+    /// The region rendered for `camera`: `[column, row, width, height]`, the asked region
+    /// clipped to the image (at least 1 × 1), or the whole image when none is asked or the
+    /// camera blurs.
+    pub fn region_in(&self, camera: &CameraSpec) -> [u32; 4] {
+        let (w, h) = (camera.width, camera.height);
+        match self.region {
+            Some([x, y, rw, rh]) if camera.blur_sigma_px == 0.0 => {
+                let (x, y) = (x.min(w - 1), y.min(h - 1));
+                [x, y, rw.clamp(1, w - x), rh.clamp(1, h - y)]
+            }
+            _ => [0, 0, w, h],
+        }
+    }
+}
+
+impl Default for FrameUse {
+    fn default() -> Self {
+        FrameUse::ALL
+    }
+}
+
 /// One camera frame: an RGB image, the matching depth map and the ground-truth labels.
 ///
 /// Conventions: images are row-major, origin at the top-left pixel, rows top to bottom;
 /// pixel `(u, v)` (column, row) is at index `v · width + u`.
+///
+/// A camera whose consumer reads less ([`FrameUse`]) renders less: outside
+/// [`CameraFrame::region`] the image is black (0), and a plane it does not read is empty.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CameraFrame {
     /// Simulated time of the frame, seconds.
@@ -162,15 +280,23 @@ pub struct CameraFrame {
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// RGB8, `height × width × 3` bytes, row-major, top-left origin, sRGB-like 8-bit levels.
+    /// The pixels rendered, `[column, row, width, height]`: `[0, 0, width, height]` unless
+    /// the camera's consumer reads a region only ([`FrameUse::region`]).
+    pub region: [u32; 4],
+    /// RGB8, `height × width × 3` bytes, row-major, top-left origin, sRGB-like 8-bit levels;
+    /// 0 outside [`CameraFrame::region`].
     pub rgb: Vec<u8>,
     /// Depth in metres along the optical axis (z-depth, not range), `height × width`,
-    /// row-major; `+inf` where the ray meets only sky (nothing within `far_m`).
+    /// row-major; `+inf` where the ray meets only sky (nothing within `far_m`) and outside
+    /// [`CameraFrame::region`]. Empty when the camera's consumer does not read it
+    /// ([`FrameUse::depth`]).
     pub depth_m: Vec<f32>,
     /// Ground-truth labels, `height × width`, row-major: each pixel's
     /// [`crate::SemanticClass`] id in the low 8 bits and its actor (`1 +` index in its
     /// kind's set, 0 for the world and the sky) above ([`crate::segmentation`]). Drawn by the
-    /// renderer with the image; unaffected by fog, light, blur and noise.
+    /// renderer with the image; unaffected by fog, light, blur and noise; 0 outside
+    /// [`CameraFrame::region`]. Empty when the camera's consumer does not read them
+    /// ([`FrameUse::labels`]).
     pub labels: Vec<u32>,
 }
 
@@ -279,8 +405,8 @@ impl<'a> Observation<'a> {
 }
 
 /// The camera `spec` as a sensor of a world on `network` whose physics step is `dt_s`
-/// seconds, rendering through the process's shared [`crate::render::Renderer`]; `seed`
-/// drives its pixel noise.
+/// seconds, rendering through the process's shared [`crate::render::Renderer`] what `usage`
+/// says its consumer reads; `seed` drives its pixel noise.
 ///
 /// # Errors
 /// [`EngineError::Sensor`] when the camera's values are out of range, no GPU adapter is
@@ -288,6 +414,7 @@ impl<'a> Observation<'a> {
 pub(crate) fn sensor(
     network: &Network,
     spec: &CameraSpec,
+    usage: FrameUse,
     seed: u64,
     dt_s: f64,
 ) -> Result<Box<dyn Sensor>, EngineError> {
@@ -297,12 +424,12 @@ pub(crate) fn sensor(
     {
         let renderer =
             crate::render::Renderer::shared().map_err(|e| EngineError::Sensor(e.to_string()))?;
-        let rig = rig::CameraRig::new(renderer, network, spec, seed, dt_s)?;
+        let rig = rig::CameraRig::new(renderer, network, spec, usage, seed, dt_s)?;
         Ok(Box::new(rig))
     }
     #[cfg(not(feature = "render"))]
     {
-        let _ = (network, seed, dt_s);
+        let _ = (network, usage, seed, dt_s);
         Err(EngineError::Sensor(
             "this build has no camera: paracosm-engine was built without its `render` \
              feature"
@@ -316,7 +443,7 @@ pub(crate) fn sensor(
 mod rig {
     use std::sync::Arc;
 
-    use super::{CameraFrame, CameraSpec};
+    use super::{CameraFrame, CameraSpec, FrameUse};
     use crate::network::Network;
     use crate::render::{CameraPose, RenderJob, RenderObject, Renderer, SceneGeometry, View};
     use crate::EngineError;
@@ -356,6 +483,10 @@ mod rig {
                 chassis_m: scene.ego.pos_m,
                 heading_rad: scene.ego.heading_rad,
             };
+            // The last frame's buffers take the new one.
+            if let Some(old) = self.frame.take() {
+                self.view.recycle(old);
+            }
             let frame = self.render(pose, scene.boxes, (scene.light, scene.fog), scene.t_s)?;
             self.frame = Some(frame);
             Ok(())
@@ -371,11 +502,12 @@ mod rig {
             renderer: Arc<Renderer>,
             network: &Network,
             camera: &CameraSpec,
+            usage: FrameUse,
             seed: u64,
             dt_s: f64,
         ) -> Result<Self, EngineError> {
             let view = renderer
-                .view(camera)
+                .view_for(camera, usage)
                 .map_err(|e| EngineError::Sensor(e.to_string()))?;
             Ok(CameraRig {
                 scene: renderer.scene(network),
@@ -459,6 +591,18 @@ mod tests {
         let depth = ground * 0.1f64.cos() + 1.4 * 0.1f64.sin();
         let p = c.camera_to_vehicle(c.back_project(160.0, 120.0, depth));
         assert!(p[1].abs() < 1e-9, "{p:?}");
+        // The back-projector gives the same bits.
+        let b = c.back_projector();
+        for (u, v, d) in [
+            (160.0, 120.0, depth),
+            (3.5, 200.5, 7.25),
+            (319.5, 0.5, 80.0),
+        ] {
+            assert_eq!(
+                b.vehicle_point(u, v, d),
+                c.camera_to_vehicle(c.back_project(u, v, d))
+            );
+        }
         assert!((p[0] - ground).abs() < 1e-9, "{p:?}");
     }
 }

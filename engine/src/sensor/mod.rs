@@ -231,7 +231,9 @@ impl SensorSpec {
     fn build(&self, network: &Network, dt_s: f64) -> Result<Box<dyn Sensor>, EngineError> {
         match self {
             SensorSpec::Lidar(spec) => Ok(Box::new(lidar::Lidar::new(spec, dt_s))),
-            SensorSpec::Camera(spec) => camera::sensor(network, spec, 0, dt_s),
+            SensorSpec::Camera(spec) => {
+                camera::sensor(network, spec, camera::FrameUse::ALL, 0, dt_s)
+            }
         }
     }
 }

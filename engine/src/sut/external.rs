@@ -553,7 +553,16 @@ impl Process {
                 }
             },
         };
-        self.sensors = Sensors { camera, control_hz };
+        self.sensors = Sensors {
+            camera,
+            control_hz,
+            // The protocol sends the image, and the depth map when asked; never the labels.
+            frame_use: crate::FrameUse {
+                depth: self.wants_depth,
+                labels: false,
+                region: None,
+            },
+        };
         Ok(())
     }
 

@@ -12,6 +12,8 @@ mod cruise;
 mod external;
 #[cfg(feature = "onnx")]
 mod onnx;
+#[cfg(feature = "onnx")]
+mod resample;
 mod vision;
 
 pub use aeb::{Aeb, AebConfig};
@@ -49,6 +51,9 @@ pub struct Sensors {
     /// How often it decides, in Hz of simulated time; `None`: every physics step. Between
     /// decisions the last control is held.
     pub control_hz: Option<f64>,
+    /// What it reads of each camera frame (planes, a region): the camera renders and reads
+    /// back only that when nothing else watches the frames. Default: everything.
+    pub frame_use: crate::FrameUse,
 }
 
 /// A system under test.

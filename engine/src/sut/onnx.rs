@@ -291,39 +291,104 @@ impl Manifest {
 /// `image`'s triangle filter), channels reordered and normalised, as `channels × height ×
 /// width` (planar, row-major) whatever the layout. The same function prepares training data.
 pub fn preprocess(rgb: &image::RgbImage, input: &InputSpec) -> Vec<f32> {
-    let [top, bottom, left, right] = input.crop;
-    let (w, h) = (rgb.width(), rgb.height());
-    let cropped = image::imageops::crop_imm(
-        rgb,
-        left.min(w - 1),
-        top.min(h - 1),
-        w.saturating_sub(left + right).max(1),
-        h.saturating_sub(top + bottom).max(1),
-    )
-    .to_image();
-    let small = image::imageops::resize(
-        &cropped,
-        input.width,
-        input.height,
-        image::imageops::FilterType::Triangle,
-    );
-    let c = input.channels.count();
-    let n = (input.width * input.height) as usize;
-    let mut out = vec![0f32; c * n];
-    for (k, px) in small.pixels().enumerate() {
-        let [r, g, b] = px.0.map(|v| f32::from(v) / 255.0);
-        let values: [f32; 3] = match input.channels {
-            Channels::Rgb => [r, g, b],
-            Channels::Bgr => [b, g, r],
-            Channels::Gray => [(r + g + b) / 3.0, 0.0, 0.0],
-        };
-        for ch in 0..c {
-            let mean = input.mean.get(ch).copied().unwrap_or(0.0);
-            let std = input.std.get(ch).copied().unwrap_or(1.0);
-            out[ch * n + k] = (values[ch] - mean) / std;
+    let mut p = Preprocessor::new(rgb.width(), rgb.height(), input);
+    let mut out = Vec::new();
+    p.run(rgb.as_raw(), input, &mut out);
+    out
+}
+
+impl InputSpec {
+    /// The region of a `width × height` frame the model reads: `(column, row, width,
+    /// height)` of its crop in pixels, clipped to the frame (at least 1 × 1).
+    pub fn crop_region(&self, width: u32, height: u32) -> (u32, u32, u32, u32) {
+        let [top, bottom, left, right] = self.crop;
+        let (x0, y0) = (left.min(width - 1), top.min(height - 1));
+        // As `image::imageops::crop_imm` clips a crop that runs past the image.
+        let w = width.saturating_sub(left + right).max(1).min(width - x0);
+        let h = height.saturating_sub(top + bottom).max(1).min(height - y0);
+        (x0, y0, w, h)
+    }
+}
+
+/// [`preprocess`] for frames of one size: the crop's place, the resize weights and the
+/// resized image are worked out once and kept between frames ([`super::resample`]); the
+/// values are [`preprocess`]'s bit for bit.
+#[derive(Debug, Clone)]
+pub(crate) struct Preprocessor {
+    frame: (u32, u32),
+    origin: (u32, u32),
+    resampler: super::resample::Resampler,
+    small: Vec<u8>,
+    /// Per channel, the input value of each byte (RGB and BGR inputs).
+    table: Option<Vec<Vec<f32>>>,
+}
+
+impl Preprocessor {
+    /// For `width × height` frames and the model's `input`.
+    pub(crate) fn new(width: u32, height: u32, input: &InputSpec) -> Self {
+        let (x0, y0, w, h) = input.crop_region(width, height);
+        // For RGB and BGR each value depends on one byte: `(v / 255 − mean) / std`, as below.
+        let table = (input.channels != Channels::Gray).then(|| {
+            (0..input.channels.count())
+                .map(|ch| {
+                    let mean = input.mean.get(ch).copied().unwrap_or(0.0);
+                    let std = input.std.get(ch).copied().unwrap_or(1.0);
+                    (0..=255u8)
+                        .map(|v| (f32::from(v) / 255.0 - mean) / std)
+                        .collect()
+                })
+                .collect()
+        });
+        Preprocessor {
+            frame: (width, height),
+            origin: (x0, y0),
+            table,
+            resampler: super::resample::Resampler::new((w, h), (input.width, input.height)),
+            small: vec![0; (input.width * input.height * 3) as usize],
         }
     }
-    out
+
+    /// Whether it was made for `width × height` frames.
+    pub(crate) fn fits(&self, width: u32, height: u32) -> bool {
+        self.frame == (width, height)
+    }
+
+    /// Preprocesses `rgb` (RGB8, the frame size it was made for) into `out` (`channels ×
+    /// height × width`, replaced).
+    pub(crate) fn run(&mut self, rgb: &[u8], input: &InputSpec, out: &mut Vec<f32>) {
+        self.resampler
+            .resize(rgb, self.frame.0, self.origin, &mut self.small);
+        let c = input.channels.count();
+        let n = (input.width * input.height) as usize;
+        out.clear();
+        out.resize(c * n, 0.0);
+        if let Some(table) = &self.table {
+            // One look-up per value: the table holds the same arithmetic's results.
+            for (k, px) in self.small.chunks_exact(3).enumerate() {
+                for ch in 0..c {
+                    let source = match input.channels {
+                        Channels::Bgr => 2 - ch,
+                        _ => ch,
+                    };
+                    out[ch * n + k] = table[ch][usize::from(px[source])];
+                }
+            }
+            return;
+        }
+        for (k, px) in self.small.chunks_exact(3).enumerate() {
+            let [r, g, b] = [px[0], px[1], px[2]].map(|v| f32::from(v) / 255.0);
+            let values: [f32; 3] = match input.channels {
+                Channels::Rgb => [r, g, b],
+                Channels::Bgr => [b, g, r],
+                Channels::Gray => [(r + g + b) / 3.0, 0.0, 0.0],
+            };
+            for ch in 0..c {
+                let mean = input.mean.get(ch).copied().unwrap_or(0.0);
+                let std = input.std.get(ch).copied().unwrap_or(1.0);
+                out[ch * n + k] = (values[ch] - mean) / std;
+            }
+        }
+    }
 }
 
 type Plan = TypedRunnableModel;
@@ -483,10 +548,9 @@ impl OnnxConfig {
                 .map_err(|e| ModelError::Run(format!("{e:#}")))?;
             inputs.push(s.into());
         }
-        let out = self
-            .plan
-            .run(inputs)
-            .map_err(|e| ModelError::Run(format!("{e:#}")))?;
+        let out = self.plan.run(inputs);
+        crate::simd::clear_upper_vector_state();
+        let out = out.map_err(|e| ModelError::Run(format!("{e:#}")))?;
         let first = out
             .first()
             .ok_or_else(|| ModelError::Run("the model has no output".to_owned()))?;
@@ -555,6 +619,8 @@ pub(crate) fn cached(path: &Path) -> Result<OnnxConfig, ModelError> {
 /// The ONNX system under test: one model, its frame history and its last decision.
 pub struct OnnxSut {
     config: OnnxConfig,
+    /// The crop and resize for the frames' size, made at the first frame.
+    pre: Option<Preprocessor>,
     history: VecDeque<Vec<f32>>,
     last_frame_t: Option<f64>,
     decision: Control,
@@ -565,6 +631,7 @@ impl OnnxSut {
     pub fn new(config: OnnxConfig) -> Self {
         OnnxSut {
             config,
+            pre: None,
             history: VecDeque::new(),
             last_frame_t: None,
             decision: Control::default(),
@@ -573,18 +640,29 @@ impl OnnxSut {
 
     fn decide(&mut self, frame: &CameraFrame, speed_mps: f64) -> Result<Control, SutError> {
         let m = &self.config.manifest;
-        let x = preprocess(&frame.to_image(), &m.input);
+        let pre = match &mut self.pre {
+            Some(p) if p.fits(frame.width, frame.height) => p,
+            slot => slot.insert(Preprocessor::new(frame.width, frame.height, &m.input)),
+        };
         let depth = m.input.frames as usize;
-        if self.history.is_empty() {
-            self.history.extend(std::iter::repeat_n(x, depth));
+        // The oldest frame's buffer takes the new one (no allocation once the history is full).
+        let mut x = if self.history.len() == depth {
+            self.history.pop_front().unwrap_or_default()
         } else {
-            self.history.pop_front();
-            self.history.push_back(x);
+            Vec::new()
+        };
+        pre.run(&frame.rgb, &m.input, &mut x);
+        if self.history.is_empty() {
+            self.history
+                .extend(std::iter::repeat_n(x.clone(), depth - 1));
         }
-        let frames: Vec<Vec<f32>> = self.history.iter().cloned().collect();
+        self.history.push_back(x);
         let y = self
             .config
-            .run(&self.config.tensor(&frames), speed_mps as f32)
+            .run(
+                &self.config.tensor(self.history.make_contiguous()),
+                speed_mps as f32,
+            )
             .map_err(|e| SutError::Failed(format!("model `{}`: {e}", self.config.source)))?;
         // `bounded`: a control the model gives directly, in [-1, 1] (an external system
         // answering outside it gets `error` too; clamping it would hide a broken model).
@@ -678,9 +756,17 @@ fn declared_input_matches(
 
 impl Sut for OnnxSut {
     fn sensors(&self) -> Sensors {
+        let camera = &self.config.manifest.camera;
+        let (x, y, w, h) = self
+            .config
+            .manifest
+            .input
+            .crop_region(camera.width, camera.height);
         Sensors {
-            camera: Some(self.config.manifest.camera.clone()),
+            camera: Some(camera.clone()),
             control_hz: None,
+            // It reads its crop of the image: the rest is never drawn.
+            frame_use: crate::FrameUse::image(Some([x, y, w, h])),
         }
     }
 

@@ -120,7 +120,13 @@ impl Vision {
         // centre of the image.
         let mut sky = ([0.0; 3], 0usize);
         let mut road = ([0.0; 3], 0usize);
-        let mut points = Vec::with_capacity((w * h) as usize);
+        let project = cam.back_projector();
+        // One pass over the pixels: the sky, the road sample, the obstacle candidates (in
+        // the corridor, high enough), and the pixels where a marking may lie, whose brightness
+        // is judged once the road's level is known. (The points of a whole frame, kept for a
+        // second pass, took 0.8 MB allocated afresh every frame.)
+        let mut candidates = Vec::new();
+        let mut markings: Vec<(f64, f64, f64)> = Vec::new();
         for v in 0..h {
             for u in 0..w {
                 let d = frame.depth_at(u, v);
@@ -129,16 +135,22 @@ impl Vision {
                     accumulate(&mut sky, rgb);
                     continue;
                 }
-                let p = cam.camera_to_vehicle(cam.back_project(
-                    f64::from(u) + 0.5,
-                    f64::from(v) + 0.5,
-                    f64::from(d),
-                ));
+                let p = project.vehicle_point(f64::from(u) + 0.5, f64::from(v) + 0.5, f64::from(d));
                 let height = p[1] + chassis_height_m;
                 if height.abs() < 0.1 && p[2].abs() < 1.0 && (3.0..8.0).contains(&p[0]) {
                     accumulate(&mut road, rgb);
                 }
-                points.push((p, height, rgb));
+                if p[0] <= 0.0 {
+                    continue;
+                }
+                if height >= c.obstacle_height_m {
+                    if p[2].abs() <= c.cruise.corridor_half_width_m {
+                        candidates.push((p[0], rgb));
+                    }
+                } else if height.abs() < 0.1 && (4.0..16.0).contains(&p[0]) {
+                    let luma = rgb.iter().map(|&v| f64::from(v)).sum::<f64>() / 3.0;
+                    markings.push((p[0], p[2], luma));
+                }
             }
         }
         let mean = |(s, n): ([f64; 3], usize), fallback: [f64; 3]| {
@@ -152,25 +164,14 @@ impl Vision {
         let road = mean(road, [60.0; 3]);
         let road_luma = road.iter().sum::<f64>() / 3.0;
 
-        let mut candidates = Vec::new();
         let (mut left, mut right) = (Vec::new(), Vec::new());
-        for (p, height, rgb) in points {
-            if p[0] <= 0.0 {
-                continue;
-            }
-            if height >= c.obstacle_height_m {
-                if p[2].abs() <= c.cruise.corridor_half_width_m {
-                    candidates.push((p[0], rgb));
-                }
-            } else if height.abs() < 0.1 && (4.0..16.0).contains(&p[0]) {
-                let luma = rgb.iter().map(|&v| f64::from(v)).sum::<f64>() / 3.0;
-                if luma >= road_luma + c.contrast_threshold.max(0.5 * road_luma) {
-                    let y = p[2] + curvature * p[0] * p[0] / 2.0;
-                    if (-3.0..-0.3).contains(&y) {
-                        left.push(y);
-                    } else if (0.3..3.0).contains(&y) {
-                        right.push(y);
-                    }
+        for (x, lateral, luma) in markings {
+            if luma >= road_luma + c.contrast_threshold.max(0.5 * road_luma) {
+                let y = lateral + curvature * x * x / 2.0;
+                if (-3.0..-0.3).contains(&y) {
+                    left.push(y);
+                } else if (0.3..3.0).contains(&y) {
+                    right.push(y);
                 }
             }
         }
@@ -316,6 +317,12 @@ impl Sut for Vision {
         Sensors {
             camera: Some(self.config.camera.clone()),
             control_hz: None,
+            // The image and the depth map, all of them; never the labels.
+            frame_use: crate::FrameUse {
+                depth: true,
+                labels: false,
+                region: None,
+            },
         }
     }
 
