@@ -32,6 +32,7 @@ pub mod rx;
 pub mod segmentation;
 pub mod sensor;
 mod sim;
+#[cfg(feature = "render")]
 mod simd;
 mod spec;
 pub mod sut;

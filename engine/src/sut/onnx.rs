@@ -790,3 +790,92 @@ impl Sut for OnnxSut {
         Ok(self.decision)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// The preprocessing as it was written before `Preprocessor` (crop with `image`, resize
+    /// with `image`, normalise per pixel): the reference the shipped networks were trained on.
+    fn reference(rgb: &image::RgbImage, input: &InputSpec) -> Vec<f32> {
+        let [top, bottom, left, right] = input.crop;
+        let (w, h) = (rgb.width(), rgb.height());
+        let cropped = image::imageops::crop_imm(
+            rgb,
+            left.min(w - 1),
+            top.min(h - 1),
+            w.saturating_sub(left + right).max(1),
+            h.saturating_sub(top + bottom).max(1),
+        )
+        .to_image();
+        let small = image::imageops::resize(
+            &cropped,
+            input.width,
+            input.height,
+            image::imageops::FilterType::Triangle,
+        );
+        let c = input.channels.count();
+        let n = (input.width * input.height) as usize;
+        let mut out = vec![0f32; c * n];
+        for (k, px) in small.pixels().enumerate() {
+            let [r, g, b] = px.0.map(|v| f32::from(v) / 255.0);
+            let values: [f32; 3] = match input.channels {
+                Channels::Rgb => [r, g, b],
+                Channels::Bgr => [b, g, r],
+                Channels::Gray => [(r + g + b) / 3.0, 0.0, 0.0],
+            };
+            for ch in 0..c {
+                let mean = input.mean.get(ch).copied().unwrap_or(0.0);
+                let std = input.std.get(ch).copied().unwrap_or(1.0);
+                out[ch * n + k] = (values[ch] - mean) / std;
+            }
+        }
+        out
+    }
+
+    /// Crops inside, at and past the frame's edges (clipped as `crop_imm` clips), every
+    /// channel order, a crop the size of the input (copied, not resized): the same bits as
+    /// the reference, frame after frame with one `Preprocessor`.
+    #[test]
+    fn the_preprocessor_gives_the_references_bits() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let cases: [([u32; 4], (u32, u32), Channels); 6] = [
+            ([96, 40, 60, 60], (96, 48), Channels::Rgb),
+            ([0, 0, 0, 0], (64, 32), Channels::Bgr),
+            ([230, 0, 310, 0], (8, 8), Channels::Gray),
+            ([10, 300, 5, 400], (12, 6), Channels::Rgb),
+            ([20, 20, 40, 40], (240, 200), Channels::Rgb),
+            ([0, 40, 0, 0], (320, 200), Channels::Bgr),
+        ];
+        for (crop, (width, height), channels) in cases {
+            let input = InputSpec {
+                crop,
+                width,
+                height,
+                channels,
+                layout: Layout::Nchw,
+                mean: vec![0.5, 0.4, 0.3],
+                std: vec![0.25, 0.2, 0.3],
+                frames: 1,
+                speed: false,
+            };
+            let mut pre = Preprocessor::new(320, 240, &input);
+            let mut out = Vec::new();
+            for _ in 0..2 {
+                let frame =
+                    image::RgbImage::from_fn(320, 240, |_, _| image::Rgb(rng.random::<[u8; 3]>()));
+                pre.run(frame.as_raw(), &input, &mut out);
+                let want = reference(&frame, &input);
+                assert_eq!(out.len(), want.len(), "{crop:?}");
+                assert!(
+                    out.iter()
+                        .zip(&want)
+                        .all(|(a, b)| a.to_bits() == b.to_bits()),
+                    "{crop:?} → {width}×{height} {channels:?}"
+                );
+                assert_eq!(preprocess(&frame, &input), want);
+            }
+        }
+    }
+}
