@@ -740,6 +740,28 @@ fn globals(camera: &CameraSpec, job: &RenderJob<'_>) -> Globals {
     }
 }
 
+/// Where a plane's rows lie: the padded row in bytes, the frame's width and the region.
+struct Place {
+    row: usize,
+    full_w: usize,
+    x0: usize,
+    y0: usize,
+    w: usize,
+    h: usize,
+}
+
+/// Copies the plane of 32-bit words that starts at row `plane` of the readback `data` into
+/// the region of `out` (`height × width` values), each word through `convert`.
+fn copy_words<T>(data: &[u8], at: &Place, plane: usize, out: &mut [T], convert: fn(u32) -> T) {
+    for y in 0..at.h {
+        let line = &data[(plane + y) * at.row..(plane + y) * at.row + 4 * at.w];
+        let start = (at.y0 + y) * at.full_w + at.x0;
+        for (b, v) in line.chunks_exact(4).zip(&mut out[start..start + at.w]) {
+            *v = convert(u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        }
+    }
+}
+
 /// The frame in `view`'s mapped readback buffer, written into the buffers of its spare frame
 /// when it has one of the same shape.
 fn read_frame(view: &mut View, t_s: f64) -> Result<CameraFrame, RenderError> {
@@ -781,7 +803,6 @@ fn read_frame(view: &mut View, t_s: f64) -> Result<CameraFrame, RenderError> {
         .slice(..)
         .get_mapped_range()
         .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let word = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
     let mut plane = 0;
     for y in 0..h {
         let line = &data[y * row..y * row + 4 * w];
@@ -790,25 +811,21 @@ fn read_frame(view: &mut View, t_s: f64) -> Result<CameraFrame, RenderError> {
             rgb.copy_from_slice(&px[..3]);
         }
     }
+    let place = Place {
+        row,
+        full_w,
+        x0,
+        y0,
+        w,
+        h,
+    };
     if usage.depth {
         plane += h;
-        for y in 0..h {
-            let line = &data[(plane + y) * row..(plane + y) * row + 4 * w];
-            let out = &mut frame.depth_m[(y0 + y) * full_w + x0..(y0 + y) * full_w + x0 + w];
-            for (b, d) in line.chunks_exact(4).zip(out) {
-                *d = f32::from_bits(word(b));
-            }
-        }
+        copy_words(&data, &place, plane, &mut frame.depth_m, f32::from_bits);
     }
     if usage.labels {
         plane += h;
-        for y in 0..h {
-            let line = &data[(plane + y) * row..(plane + y) * row + 4 * w];
-            let out = &mut frame.labels[(y0 + y) * full_w + x0..(y0 + y) * full_w + x0 + w];
-            for (b, l) in line.chunks_exact(4).zip(out) {
-                *l = word(b);
-            }
-        }
+        copy_words(&data, &place, plane, &mut frame.labels, |w| w);
     }
     Ok(frame)
 }

@@ -226,24 +226,6 @@ impl FrameUse {
         }
     }
 
-    /// What either `self` or `other` reads.
-    pub fn union(self, other: FrameUse) -> FrameUse {
-        let region = match (self.region, other.region) {
-            (Some([ax, ay, aw, ah]), Some([bx, by, bw, bh])) => {
-                let (x0, y0) = (ax.min(bx), ay.min(by));
-                let x1 = (ax + aw).max(bx + bw);
-                let y1 = (ay + ah).max(by + bh);
-                Some([x0, y0, x1 - x0, y1 - y0])
-            }
-            _ => None,
-        };
-        FrameUse {
-            depth: self.depth || other.depth,
-            labels: self.labels || other.labels,
-            region,
-        }
-    }
-
     /// The region rendered for `camera`: `[column, row, width, height]`, the asked region
     /// clipped to the image (at least 1 × 1), or the whole image when none is asked or the
     /// camera blurs.

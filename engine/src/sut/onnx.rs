@@ -375,18 +375,12 @@ impl Preprocessor {
             }
             return;
         }
+        // Grey: one value from three bytes, `((r + g + b) / 3 − mean) / std`.
+        let mean = input.mean.first().copied().unwrap_or(0.0);
+        let std = input.std.first().copied().unwrap_or(1.0);
         for (k, px) in self.small.chunks_exact(3).enumerate() {
             let [r, g, b] = [px[0], px[1], px[2]].map(|v| f32::from(v) / 255.0);
-            let values: [f32; 3] = match input.channels {
-                Channels::Rgb => [r, g, b],
-                Channels::Bgr => [b, g, r],
-                Channels::Gray => [(r + g + b) / 3.0, 0.0, 0.0],
-            };
-            for ch in 0..c {
-                let mean = input.mean.get(ch).copied().unwrap_or(0.0);
-                let std = input.std.get(ch).copied().unwrap_or(1.0);
-                out[ch * n + k] = (values[ch] - mean) / std;
-            }
+            out[k] = ((r + g + b) / 3.0 - mean) / std;
         }
     }
 }
