@@ -542,6 +542,8 @@ fn ipog_suites_cover_every_pair_and_give_each_row_its_own_halton_block() {
 /// by path and by built-in name. The fixture was first written by the Rust version before the
 /// language existed; issue 14 added the default `offroad` monitor to both (every other field
 /// of every line stayed as it was), and this test checks the Rust definition against it too.
+/// `minD` then went from 60 to 95 m, past the crossing (a car that stops before the pedestrian
+/// must fail): only the `distance` monitor's fields changed.
 #[test]
 fn pedestrian_crossing_star_reproduces_the_rust_study_byte_for_byte() {
     let fixture = std::fs::read_to_string(

@@ -48,6 +48,7 @@ fn program(dir: &std::path::Path, fog: &str, extra: &str) -> std::path::PathBuf 
              v = AutonomousVehicle(loc = r.onLane(1, 10), speed = 5.0)\n\
              w.place(r, v)\n\
              CollisionMonitor(v)\n\
+             DistanceMonitor(v, minD = 5.0)\n\
              test(horizon = 2.0)\n"
         ),
     )

@@ -767,6 +767,7 @@ w = World()
 v = AutonomousVehicle(loc = s.onLane(1, 5.0), speed = 5.0)
 w.place(net, v)
 CollisionMonitor(v)
+DistanceMonitor(v, minD = 5.0)
 test(horizon = 3.0)
 "#
         )
@@ -790,6 +791,7 @@ v = AutonomousVehicle(loc = a.onLane(1, {starts}[k]), speed = 10.0)
 o = Obstacle(loc = ice.onLane(1, 50.0))
 w.place(net, v, o)
 CollisionMonitor(v)
+DistanceMonitor(v, minD = 5.0)
 test(horizon = 10.0)
 "#
         )
@@ -1078,4 +1080,45 @@ fn replay_names_a_monitor_cut_short_as_cut_short() {
         "{stdout}"
     );
     assert!(stdout.contains("lead_near failed (robustness"), "{stdout}");
+}
+
+/// A program whose monitors cannot fail a car that stops (collision and off-road only,
+/// wrapped or not) is warned about at its `place`; one with a `DistanceMonitor`, or a
+/// `Monitor` of its own, is not.
+#[test]
+fn monitors_that_a_stopped_car_passes_are_warned_about() {
+    let program = |monitors: &str| {
+        format!(
+            "w = World()\nr = RoadSegment(len = 200.0)\nv = AutonomousVehicle(loc = r.onLane(1, 10))\n\
+             p = Pedestrian(start = r.onLane(r.SideWalk, 100), target = r.onLane(-r.SideWalk, 100), \
+             dist = 20.0, car = v.pos, speed = VarInterval(1.0, 3.0))\nw.place(r, p, v)\n{monitors}\n"
+        )
+    };
+    let stopped = "a car that stops, and so never meets the danger, passes every test";
+    for monitors in [
+        "CollisionMonitor(v)",
+        "TimeToFailure(CollisionMonitor(v), minT = 10.0)",
+        "CollisionMonitor(v)\nOffRoadMonitor(v)",
+    ] {
+        let s = paracosm_scenarios::lang::load_source("t.star", &program(monitors), "t").unwrap();
+        let w: Vec<_> = s
+            .warnings
+            .iter()
+            .filter(|w| w.message.contains(stopped))
+            .collect();
+        assert_eq!(w.len(), 1, "{monitors}: {:?}", s.warnings);
+        assert_eq!(w[0].at, "t.star:5:1", "{monitors}");
+    }
+    for monitors in [
+        "CollisionMonitor(v)\nDistanceMonitor(v, minD = 95.0)",
+        "CollisionMonitor(v)\nMonitor(v.pos.map(lambda c: c.x - 105.0), over = \"eventually\")",
+        "Stl(\"G[0,15] (ego_separation_m > 0.5)\")",
+    ] {
+        let s = paracosm_scenarios::lang::load_source("t.star", &program(monitors), "t").unwrap();
+        assert!(
+            s.warnings.iter().all(|w| !w.message.contains(stopped)),
+            "{monitors}: {:?}",
+            s.warnings
+        );
+    }
 }

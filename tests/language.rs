@@ -791,7 +791,7 @@ fn objects_are_named_by_their_variable_or_where_they_were_made() {
 #[test]
 fn an_open_action_argument_is_named_and_used() {
     let sc = loads(&format!(
-        "{ROAD}lead = Car(loc = r.onLane(1, 60), speed = 8.0)\nw.place(r, v, lead)\ntick.filter(lambda t: t > 1).foreach(lead.brake(VarEnum([3, 7])))\nCollisionMonitor(v)\n"
+        "{ROAD}lead = Car(loc = r.onLane(1, 60), speed = 8.0)\nw.place(r, v, lead)\ntick.filter(lambda t: t > 1).foreach(lead.brake(VarEnum([3, 7])))\nCollisionMonitor(v)\nDistanceMonitor(v, minD = 20.0)\n"
     ));
     let names: Vec<&str> = sc.space.params().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["lead.brake"]);

@@ -47,7 +47,12 @@ fn the_shipped_map_scenarios_run_and_find_what_they_are_built_to_find() {
             r["metrics"]["min_road_edge_m"].as_f64().unwrap() > 1.7,
             "{r}"
         );
-        assert_eq!(r["monitors"]["distance"]["passed"], true, "{r}");
+        // Round the bend to the crossing, unless a collision there cut the run short.
+        let distance = &r["monitors"]["distance"];
+        assert!(
+            distance["passed"] == true || distance["cut_short"] == true,
+            "{r}"
+        );
     }
     // The left turn across oncoming traffic: collisions happen, and only where the oncoming
     // car reaches the junction while the ego turns (its arrival time at/speed in a band).

@@ -38,7 +38,7 @@ def test_the_space_of_a_builtin_scenario():
     assert s.space.bounds[2] == (5.0, 15.0) and s.space.units[2] == "m/s"
     assert s.space["decel"].unit == "m/s^2"
     assert len(s.space) == s.space.d == 6
-    assert s.monitors == ["collision", "distance", "offroad"]
+    assert s.monitors == ["collision", "distance", "closes_up", "offroad"]
     assert s.horizon_s == 20.0
     assert "pedestrian-crossing" in paracosm.BUILTIN_SCENARIOS
 

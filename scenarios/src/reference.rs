@@ -40,7 +40,7 @@ pub const EGO_START_M: f64 = 10.0;
 /// Where the pedestrian crosses along the road, m.
 pub const CROSSING_AT_M: f64 = 100.0;
 /// `minD` of the distance monitor, m.
-pub const MIN_DISTANCE_M: f64 = 60.0;
+pub const MIN_DISTANCE_M: f64 = 95.0;
 
 /// The scenario, ready to run: [`scene`]'s declarations read as a front end's load reads a
 /// program's ([`Scenario::from_scenes`]).

@@ -126,6 +126,21 @@ impl MonitorSpec {
         }
     }
 
+    /// Whether it can fail a car that stops and waits: a `DistanceMonitor`, or the program's
+    /// own `Monitor`, `Assert` or `Stl` (which may check progress; paracosm cannot tell). A
+    /// `CollisionMonitor` or an `OffRoadMonitor`, wrapped in `TimeToFailure` or not, cannot:
+    /// a car that never moves never collides and never leaves the road.
+    pub fn can_fail_a_stopped_car(&self) -> bool {
+        match self {
+            MonitorSpec::Collision { .. } | MonitorSpec::OffRoad { .. } => false,
+            MonitorSpec::TimeToFailure { inner, .. } => inner.can_fail_a_stopped_car(),
+            MonitorSpec::Distance { .. }
+            | MonitorSpec::Stl { .. }
+            | MonitorSpec::Stream { .. }
+            | MonitorSpec::Assert { .. } => true,
+        }
+    }
+
     /// Whether it reads the runner's signal `name` (an `Stl` formula naming it).
     pub fn reads_signal(&self, name: &str) -> bool {
         self.signals().iter().any(|s| s == name)

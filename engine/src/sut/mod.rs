@@ -14,6 +14,7 @@ mod external;
 mod onnx;
 #[cfg(feature = "onnx")]
 mod resample;
+mod stop;
 mod vision;
 
 pub use aeb::{Aeb, AebConfig};
@@ -28,6 +29,7 @@ pub use onnx::{
     manifest_path, preprocess, Channels, InputSpec, Layout, Manifest, ModelError, OnnxConfig,
     OnnxSut, OutputSpec,
 };
+pub use stop::StopAfter;
 pub use vision::{Perception, Vision, VisionConfig};
 
 use thiserror::Error;
@@ -95,6 +97,14 @@ pub enum SutConfig {
     /// An ONNX model run in process (`--sut-onnx`, `sut = "onnx:PATH"`).
     #[cfg(feature = "onnx")]
     Onnx(Box<OnnxConfig>),
+    /// `inner` until the ego has travelled `after_m` metres, then a full brake for good
+    /// ([`StopAfter`]): a vacuity check of a scenario's monitors (`--sut-stops-after`).
+    StopAfter {
+        /// The system that drives until then.
+        inner: Box<SutConfig>,
+        /// Distance after which it brakes, m, `>= 0`.
+        after_m: f64,
+    },
 }
 
 /// The name of the shipped network (`--sut pilotnet`), and its [`OnnxConfig`]'s `source`.
@@ -219,6 +229,7 @@ impl SutConfig {
         match self {
             #[cfg(feature = "onnx")]
             SutConfig::Onnx(c) => Some(&c.sha256),
+            SutConfig::StopAfter { inner, .. } => inner.model_sha256(),
             _ => None,
         }
     }
@@ -236,6 +247,9 @@ impl SutConfig {
             SutConfig::Onnx(c) if c.source == PILOTNET => PILOTNET.into(),
             #[cfg(feature = "onnx")]
             SutConfig::Onnx(c) => format!("onnx:{}", c.source),
+            SutConfig::StopAfter { inner, after_m } => {
+                format!("{} stopping after {after_m} m", inner.name())
+            }
         }
     }
 
@@ -249,6 +263,7 @@ impl SutConfig {
             #[cfg(feature = "onnx")]
             SutConfig::Onnx(_) => Some(true),
             SutConfig::External(_) => None,
+            SutConfig::StopAfter { inner, .. } => inner.has_camera(),
         }
     }
 
@@ -262,6 +277,9 @@ impl SutConfig {
             SutConfig::External(c) => Box::new(ExternalSut::new(c.clone())),
             #[cfg(feature = "onnx")]
             SutConfig::Onnx(c) => Box::new(OnnxSut::new((**c).clone())),
+            SutConfig::StopAfter { inner, after_m } => {
+                Box::new(StopAfter::new(inner.build(), *after_m))
+            }
         }
     }
 }

@@ -565,6 +565,15 @@ fn load_warnings(
                     .to_owned()
             },
         });
+    } else if !monitors.iter().any(MonitorSpec::can_fail_a_stopped_car) {
+        warnings.push(Warning {
+            at: first.placed_at.clone().unwrap_or_default(),
+            message: "no monitor checks that the ego vehicle gets anywhere: a car that stops, \
+                      and so never meets the danger, passes every test (add \
+                      DistanceMonitor(v, minD = ...) with minD past the point where the danger \
+                      is, or a Monitor or Stl of progress)"
+                .to_owned(),
+        });
     }
 }
 
