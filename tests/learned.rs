@@ -47,11 +47,14 @@ fn the_shipped_network_drives_and_its_records_do_not_depend_on_jobs() {
     );
     let campaign = std::fs::read_to_string(a.join("campaign.json")).unwrap();
     assert!(campaign.contains("\"pilotnet\""), "{campaign}");
-    // The network drives: every test covers ground (the distance monitor measures it).
+    // The network drives: past the crossing at 100 m (95 m from its start), in every test
+    // that does not end in a collision, and it keeps its lane.
     for l in &lines {
         let v: serde_json::Value = serde_json::from_str(&format!("{l}}}")).unwrap();
         let d = v["metrics"]["distance_travelled_m"].as_f64().unwrap();
-        assert!(d > 15.0, "{l}");
+        let collided = v["monitors"]["collision"]["passed"] == false;
+        assert!(collided || d > 95.0, "{l}");
+        assert_eq!(v["monitors"]["offroad"]["passed"], true, "{l}");
     }
 }
 

@@ -149,8 +149,11 @@ pub fn variables() -> Vec<(String, Vec<usize>)> {
 }
 
 /// Initial weights from ChaCha8 seeded with `seed`: He-uniform weights (bound
-/// `sqrt(6 / fan_in)`), zero biases. candle's own initialisation draws from an unseeded
-/// generator; these are reproducible.
+/// `sqrt(6 / fan_in)`), zero biases; the output layer's bound a tenth of that, so that the
+/// network starts near 0 on both outputs, in the linear part of its `tanh` (started at full
+/// scale, the first steps could drive both outputs into saturation, where the gradient
+/// vanishes and training stalls at "always brake, steer fully"). candle's own initialisation
+/// draws from an unseeded generator; these are reproducible.
 pub fn initial_weights(seed: u64) -> Vec<Weight> {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     variables()
@@ -161,7 +164,8 @@ pub fn initial_weights(seed: u64) -> Vec<Weight> {
                 vec![0.0; n]
             } else {
                 let fan_in: usize = shape[1..].iter().product();
-                let bound = (6.0 / fan_in as f64).sqrt() as f32;
+                let output = if name == "fc3.weight" { 0.1 } else { 1.0 };
+                let bound = (output * (6.0 / fan_in as f64).sqrt()) as f32;
                 (0..n)
                     .map(|_| rng.random_range(-bound..bound))
                     .collect::<Vec<f32>>()

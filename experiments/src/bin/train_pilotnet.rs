@@ -3,11 +3,17 @@
 //! its manifest and a model card.
 //!
 //! ```text
-//! paracosm-fuzz dataset experiments/scenarios/pilotnet_train.star --budget 96 --rate 10 \
-//!     --out experiments/out/pilotnet-data
+//! paracosm-fuzz dataset experiments/scenarios/pilotnet_train.star --budget 128 --rate 10 \
+//!     --steer-noise 0.08 --noise-hold 0.5 --out experiments/out/pilotnet-data
 //! cargo run --release -p paracosm-experiments --bin train_pilotnet -- \
-//!     --data experiments/out/pilotnet-data --out assets/models/pilotnet
+//!     --data experiments/out/pilotnet-data --out assets/models/pilotnet --epochs 8 --seed 0 \
+//!     --steering-weight 10 --closed-loop pedestrian-crossing
 //! ```
+//!
+//! AdamW with a linear warm-up and a half-cosine schedule, the gradient's norm clipped, and
+//! early stopping: after each epoch the validation frames are scored and, with
+//! `--closed-loop`, the network drives held-out tests of a scenario; the best epoch's weights
+//! are kept (docs/experiments.md, "The shipped network").
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -56,6 +62,88 @@ struct Args {
     /// of braking, a smooth function of what the camera sees, which a network can learn.
     #[arg(long, default_value_t = 0.0)]
     smooth_s: f64,
+    /// Gradient steps over which the learning rate rises linearly from 0 to `--lr`; after
+    /// them it falls along a half cosine to `--lr` × `--final-lr` at the last epoch's end.
+    #[arg(long, default_value_t = 200)]
+    warmup_steps: usize,
+    /// The learning rate at the end, as a share of `--lr`.
+    #[arg(long, default_value_t = 0.1)]
+    final_lr: f64,
+    /// Largest L2 norm of the gradient over all weights; a larger one is scaled down to it.
+    #[arg(long, default_value_t = 1.0)]
+    clip: f64,
+    /// Stop when this many epochs in a row have not improved the validation score (throttle
+    /// MSE + steering MSE + share of frames where the network and the teacher disagree about
+    /// braking); the weights kept are those of the best epoch.
+    #[arg(long, default_value_t = 3)]
+    patience: usize,
+    /// Judge each epoch in closed loop as well: the network, exported as it stands, drives
+    /// `--closed-loop-tests` tests of this scenario (a built-in name or a `.star` file) at
+    /// Halton points from index 4096 on (a data set's tests are the first points), and the
+    /// epoch with the fewest failed tests is kept (the validation score breaks ties).
+    #[arg(long, value_name = "SCENARIO")]
+    closed_loop: Option<String>,
+    /// How many closed-loop tests judge each epoch.
+    #[arg(long, default_value_t = 24)]
+    closed_loop_tests: usize,
+}
+
+/// The held-out closed-loop tests that judge an epoch ([`Args::closed_loop`]).
+struct ClosedLoop {
+    scenario: paracosm_scenarios::Scenario,
+    points: Vec<paracosm_generators::Assignment>,
+    manifest: Manifest,
+}
+
+/// Index of the first Halton point of the closed-loop tests.
+const CLOSED_LOOP_FROM: u64 = 4096;
+
+impl ClosedLoop {
+    fn new(name: &str, tests: usize, manifest: &Manifest) -> Result<Self> {
+        use paracosm_generators::{Generator, Halton};
+        let scenario = paracosm_scenarios::load(name).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let mut halton = Halton::new(&scenario.space);
+        halton.skip(CLOSED_LOOP_FROM)?;
+        let points = halton
+            .ask(tests)?
+            .iter()
+            .map(|p| scenario.space.decode(p))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(ClosedLoop {
+            scenario,
+            points,
+            manifest: manifest.clone(),
+        })
+    }
+
+    /// How many of the tests fail with the network of `weights` driving.
+    fn failures(&self, weights: &[pilotnet::Weight]) -> Result<usize> {
+        let onnx = pilotnet::to_onnx(weights, "an epoch under closed-loop validation");
+        let config =
+            paracosm_engine::sut::OnnxConfig::from_bytes("training", &onnx, self.manifest.clone())?;
+        let mut s = self.scenario.clone();
+        s.sut = paracosm_engine::sut::SutConfig::Onnx(Box::new(config));
+        let mut failed = 0;
+        for (i, a) in self.points.iter().enumerate() {
+            let o = s
+                .run(a, CLOSED_LOOP_FROM + i as u64)
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            failed += usize::from(!o.passed());
+        }
+        Ok(failed)
+    }
+}
+
+/// The weights of `varmap`, in [`pilotnet::variables`]' order.
+fn weights_of(varmap: &VarMap) -> Result<Vec<pilotnet::Weight>> {
+    let vars = varmap.data().lock().expect("no other user");
+    pilotnet::variables()
+        .into_iter()
+        .map(|(name, shape)| {
+            let v = vars[&name].as_tensor().flatten_all()?.to_vec1::<f32>()?;
+            Ok((name, shape, v))
+        })
+        .collect()
 }
 
 struct Frames {
@@ -219,24 +307,24 @@ fn main() -> Result<()> {
             ..Default::default()
         },
     )?;
-    let log = train_epochs(
+    let vars = varmap.all_vars();
+    let closed_loop = args
+        .closed_loop
+        .as_deref()
+        .map(|name| ClosedLoop::new(name, args.closed_loop_tests, &manifest))
+        .transpose()?;
+    let (log, best_epoch) = train_epochs(
         &args,
-        (&net, &mut opt),
+        (&net, &mut opt, &vars, &varmap),
+        closed_loop.as_ref(),
         &frames,
         (&train, &valid),
         &dev,
         started,
     )?;
     // The trained weights, in the order of `pilotnet::variables`.
-    let vars = varmap.data().lock().expect("training is over");
-    let weights: Vec<pilotnet::Weight> = pilotnet::variables()
-        .into_iter()
-        .map(|(name, shape)| {
-            let v = vars[&name].as_tensor().flatten_all()?.to_vec1::<f32>()?;
-            Ok((name, shape, v))
-        })
-        .collect::<Result<_>>()?;
     drop(vars);
+    let weights = weights_of(&varmap)?;
     let validation = evaluate(&net, &frames, &valid, &dev)?;
     let dataset: serde_json::Value = serde_json::from_slice(
         &std::fs::read(args.data.join("dataset.json")).context("reading dataset.json")?,
@@ -259,7 +347,7 @@ fn main() -> Result<()> {
         (train.len(), valid.len()),
         validation,
         onnx.len(),
-        &log,
+        (&log, best_epoch),
         started,
     );
     paracosm::atomic::write(&path("md"), card.as_bytes())?;
@@ -274,63 +362,148 @@ fn main() -> Result<()> {
     Ok(())
 }
 
-/// Trains `net` with `opt` for `args.epochs` passes over the `train` frames (shuffled by a
-/// ChaCha8 seeded with `args.seed`), evaluating on `valid` after each; prints and returns
-/// the log, a line per epoch.
+/// The learning rate at gradient step `step` of `total`: a linear warm-up over
+/// `args.warmup_steps`, then a half cosine from `args.lr` down to `args.lr * args.final_lr`.
+fn learning_rate(args: &Args, step: usize, total: usize) -> f64 {
+    if step < args.warmup_steps {
+        return args.lr * (step + 1) as f64 / args.warmup_steps as f64;
+    }
+    let span = total.saturating_sub(args.warmup_steps).max(1);
+    let done = ((step - args.warmup_steps) as f64 / span as f64).min(1.0);
+    let floor = args.lr * args.final_lr;
+    floor + (args.lr - floor) * 0.5 * (1.0 + (std::f64::consts::PI * done).cos())
+}
+
+/// `grads` scaled so that their L2 norm over `vars` is at most `clip`; returns the norm
+/// before scaling.
+fn clip_gradients(
+    grads: &mut candle_core::backprop::GradStore,
+    vars: &[Var],
+    clip: f64,
+) -> Result<f64> {
+    let mut sum = 0.0f64;
+    for v in vars {
+        if let Some(g) = grads.get(v) {
+            sum += f64::from(g.sqr()?.sum_all()?.to_scalar::<f32>()?);
+        }
+    }
+    let norm = sum.sqrt();
+    if norm > clip {
+        let k = clip / norm;
+        for v in vars {
+            if let Some(g) = grads.get(v) {
+                let scaled = (g * k)?;
+                grads.insert(v, scaled);
+            }
+        }
+    }
+    Ok(norm)
+}
+
+/// The validation score early stopping minimises: throttle MSE + steering MSE + the share of
+/// frames where the network and the teacher disagree about braking.
+fn score([t, st, agree]: [f64; 3]) -> f64 {
+    t + st + (1.0 - agree)
+}
+
+/// Trains `net` with `opt` for up to `args.epochs` passes over the `train` frames (shuffled
+/// by a ChaCha8 seeded with `args.seed`), evaluating on `valid` (and in `closed_loop`, when
+/// given) after each, and stops after `args.patience` epochs without a better one (fewer
+/// closed-loop failures, then a lower [`score`]); leaves the best epoch's weights in `vars`. Prints and returns the log, a line per epoch, and the best epoch (from 1).
 fn train_epochs(
     args: &Args,
-    (net, opt): (&PilotNet, &mut AdamW),
+    (net, opt, vars, varmap): (&PilotNet, &mut AdamW, &[Var], &VarMap),
+    closed_loop: Option<&ClosedLoop>,
     frames: &Frames,
     (train, valid): (&[usize], &[usize]),
     dev: &Device,
     started: Instant,
-) -> Result<Vec<String>> {
+) -> Result<(Vec<String>, usize)> {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
     let mut order = train.to_vec();
     let mut log = Vec::new();
     let weight = Tensor::new(&[1.0f32, args.steering_weight], dev)?.reshape((1, 2))?;
+    let total_steps = args.epochs * train.len().div_ceil(args.batch);
+    let mut step = 0;
+    let mut best: Option<((usize, f64), usize, Vec<Tensor>)> = None;
     for epoch in 0..args.epochs {
         order.shuffle(&mut rng);
-        let mut total = 0.0;
+        let (mut total, mut clipped) = (0.0, 0usize);
         for chunk in order.chunks(args.batch) {
             let (x, s, y) = batch(frames, chunk, dev)?;
-            let loss = if args.steering_weight == 1.0 {
-                candle_nn::loss::mse(&net.forward(&x, &s)?, &y)?
-            } else {
-                (net.forward(&x, &s)? - &y)?
-                    .sqr()?
-                    .broadcast_mul(&weight)?
-                    .mean_all()?
-            };
-            opt.backward_step(&loss)?;
+            let loss = (net.forward(&x, &s)? - &y)?
+                .sqr()?
+                .broadcast_mul(&weight)?
+                .mean_all()?;
+            opt.set_learning_rate(learning_rate(args, step, total_steps));
+            let mut grads = loss.backward()?;
+            clipped += usize::from(clip_gradients(&mut grads, vars, args.clip)? > args.clip);
+            opt.step(&grads)?;
+            step += 1;
             total += f64::from(loss.to_scalar::<f32>()?) * chunk.len() as f64;
         }
-        let [t, st, agree] = evaluate(net, frames, valid, dev)?;
+        let metrics = evaluate(net, frames, valid, dev)?;
+        let [t, st, agree] = metrics;
+        let failed = match closed_loop {
+            Some(c) => Some(c.failures(&weights_of(varmap)?)?),
+            None => None,
+        };
         let line = format!(
             "epoch {}: training MSE {:.4}; validation MSE throttle {t:.4}, steering {st:.5}, \
-             braking agreement {:.1} % ({:.0} s)",
+             braking agreement {:.1} %, score {:.4}{}; lr {:.2e}, {clipped} steps clipped \
+             ({:.0} s)",
             epoch + 1,
             total / train.len() as f64,
             100.0 * agree,
+            score(metrics),
+            match (failed, closed_loop) {
+                (Some(f), Some(c)) =>
+                    format!("; closed loop: {f} of {} tests failed", c.points.len()),
+                _ => String::new(),
+            },
+            opt.learning_rate(),
             started.elapsed().as_secs_f64()
         );
         eprintln!("{line}");
         log.push(line);
+        let this = (failed.unwrap_or(0), score(metrics));
+        if best.as_ref().is_none_or(|(b, _, _)| this < *b) {
+            let kept = vars
+                .iter()
+                .map(|v| v.as_tensor().copy())
+                .collect::<candle_core::Result<Vec<_>>>()?;
+            best = Some((this, epoch + 1, kept));
+        } else if best
+            .as_ref()
+            .is_some_and(|(_, e, _)| epoch + 1 - e >= args.patience)
+        {
+            log.push(format!(
+                "no better score for {} epochs: stopped",
+                args.patience
+            ));
+            eprintln!("{}", log.last().expect("just pushed"));
+            break;
+        }
     }
-    Ok(log)
+    let (_, best_epoch, kept) = best.context("no epoch ran (--epochs 0)")?;
+    for (v, t) in vars.iter().zip(kept) {
+        v.set(&t)?;
+    }
+    log.push(format!("kept the weights of epoch {best_epoch}"));
+    Ok((log, best_epoch))
 }
 
 /// The model card (Markdown): the network, the data set it was trained on (`dataset`, its
 /// `dataset.json`), the training and validation frame counts (`split`), the settings, the
 /// `[throttle MSE, steering MSE, braking agreement]` on the validation frames, the ONNX file's
-/// size in bytes and the training `log`.
+/// size in bytes, the training `log` and the epoch whose weights were kept.
 fn model_card(
     args: &Args,
     dataset: &serde_json::Value,
     (ntrain, nvalid): (usize, usize),
     [t, st, agree]: [f64; 3],
     bytes: usize,
-    log: &[String],
+    (log, best_epoch): (&[String], usize),
     started: Instant,
 ) -> String {
     let n = ntrain + nvalid;
@@ -350,9 +523,12 @@ fn model_card(
          | teacher | `{teacher}` (lidar time-to-collision braking, lane keeping) |\n\
          | tests | {tests} ({strategy} points, seed {dseed}) at {rate} frames/s{noise} |\n\
          | frames | {n} ({ntrain} training, {nvalid} validation: tests with id mod {h} = {hl}) |\n\
-         | training | candle-nn {cv}, AdamW lr {lr}, batch {batch}, {epochs} epochs, seed {seed}, \
-         MSE on (throttle, steering){sw} |\n\
+         | training | candle-nn {cv}, AdamW lr {lr} (linear warm-up over {warm} steps, then a \
+         half cosine to {flr} of it), gradient norm clipped at {clip}, batch {batch}, at most \
+         {epochs} epochs with early stopping after {patience} without a better validation score \
+         (weights of epoch {best} kept), seed {seed}, MSE on (throttle, steering){sw} |\n\
          | validation MSE | throttle {t:.4}, steering {st:.5} |\n\
+         | closed-loop validation | {closed} |\n\
          | braking agreement | {agree:.1} % of validation frames (throttle < -0.5 on both or \
          neither) |\n\
          | training time | {secs:.0} s on {threads} threads |\n\
@@ -374,7 +550,20 @@ fn model_card(
         lr = args.lr,
         batch = args.batch,
         epochs = args.epochs,
+        warm = args.warmup_steps,
+        flr = args.final_lr,
+        clip = args.clip,
+        patience = args.patience,
+        best = best_epoch,
         seed = args.seed,
+        closed = match &args.closed_loop {
+            Some(name) => format!(
+                "after each epoch the network drove {} tests of `{name}` (Halton points from \
+                 {CLOSED_LOOP_FROM} on); the epoch with the fewest failures was kept",
+                args.closed_loop_tests
+            ),
+            None => "none".to_owned(),
+        },
         agree = 100.0 * agree,
         secs = started.elapsed().as_secs_f64(),
         threads = rayon::current_num_threads(),
