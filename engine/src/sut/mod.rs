@@ -98,7 +98,7 @@ pub enum SutConfig {
     #[cfg(feature = "onnx")]
     Onnx(Box<OnnxConfig>),
     /// `inner` until the ego has travelled `after_m` metres, then a full brake for good
-    /// ([`StopAfter`]): a vacuity check of a scenario's monitors (`--sut-stops-after`).
+    /// ([`StopAfter`]): a vacuity check of a scenario's monitors (tests/liveness.rs).
     StopAfter {
         /// The system that drives until then.
         inner: Box<SutConfig>,
