@@ -417,6 +417,78 @@ fn cover_plan_prints_the_formulas_and_budgets() {
     );
 }
 
+/// `plan` prints what `generate --epsilon` writes, and both keep the dispersion promise: on a
+/// mixed space each strategy's row count × points per row equals the rows `generate` writes,
+/// and on a continuous space the plan's total is the covering suite's single row.
+#[test]
+fn cover_plan_and_generate_agree_on_the_tests_an_epsilon_needs() {
+    let dir = tempfile::tempdir().unwrap();
+    let mixed = dir.path().join("mixed.toml");
+    std::fs::write(
+        &mixed,
+        "[[param]]\nname = \"a\"\nlevels = [0, 1, 2]\n[[param]]\nname = \"b\"\nlevels = [0, 1]\n[[param]]\nname = \"x\"\ninterval = [0.0, 10.0]\n[[param]]\nname = \"y\"\ninterval = [-1.0, 1.0]\n",
+    )
+    .unwrap();
+    let continuous = dir.path().join("continuous.toml");
+    std::fs::write(
+        &continuous,
+        "[[param]]\nname = \"x\"\ninterval = [0.0, 10.0]\n[[param]]\nname = \"y\"\ninterval = [-1.0, 1.0]\n",
+    )
+    .unwrap();
+    let rows_written = |space: &std::path::Path, strategy: &str, epsilon: &str| -> u64 {
+        let o = cover(&[
+            "generate",
+            "--space",
+            space.to_str().unwrap(),
+            "--strategy",
+            strategy,
+            "--epsilon",
+            epsilon,
+        ]);
+        expect_code(&o, 0);
+        String::from_utf8(o.stdout).unwrap().lines().count() as u64 - 1
+    };
+    let epsilon = "0.004";
+    let p = success_json(&cover(&[
+        "plan",
+        "--space",
+        mixed.to_str().unwrap(),
+        "--epsilon",
+        epsilon,
+        "--json",
+    ]));
+    let suites = p["suites"].as_array().unwrap();
+    assert_eq!(suites.len(), 2, "{p}");
+    for s in suites {
+        let strategy = s["strategy"].as_str().unwrap();
+        assert!(s["worst_dispersion"].as_f64().unwrap() <= 0.004, "{s}");
+        assert!(
+            s["per_row"].as_u64().unwrap() >= p["halton_per_group"].as_u64().unwrap(),
+            "{s}"
+        );
+        assert_eq!(
+            s["total"].as_u64().unwrap(),
+            rows_written(&mixed, strategy, epsilon),
+            "{strategy}"
+        );
+    }
+    let p = success_json(&cover(&[
+        "plan",
+        "--space",
+        continuous.to_str().unwrap(),
+        "--epsilon",
+        epsilon,
+        "--json",
+    ]));
+    assert!(p["suites"].as_array().unwrap().is_empty(), "{p}");
+    assert!(p["halton_dispersion"].as_f64().unwrap() <= 0.004, "{p}");
+    assert_eq!(p["halton_dispersion_exact"], true);
+    assert_eq!(
+        p["total"].as_u64().unwrap(),
+        rows_written(&continuous, "ipog", epsilon)
+    );
+}
+
 #[test]
 fn cover_generate_model_writes_a_pairwise_array_that_respects_the_constraints() {
     let dir = tempfile::tempdir().unwrap();

@@ -37,7 +37,7 @@ enum Command {
     /// parameter names, then rows of values as written in the model).
     Generate(GenerateArgs),
     /// Print how many tests a (k, ε)-covering set needs: random k-wise rows by Proposition 3.2
-    /// and its union bound, Halton points per row from the measured n·dispersion constant.
+    /// and its union bound, Halton points per row measured to have dispersion at most ε.
     Plan(PlanArgs),
     /// Evaluate the robustness of a signal temporal logic formula on a trace (a CSV with a
     /// header, one column per signal, one row per sample), as the `Stl` monitor does.

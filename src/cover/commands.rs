@@ -106,8 +106,8 @@ pub struct GenerateArgs {
     )]
     pub budget: Option<u64>,
     /// With --strategy ipog or kwise instead of --budget: size each array row's Halton block
-    /// for this target dispersion, ceil(C / ε) points with C the measured n·dispersion
-    /// constant of `plan`.
+    /// so that its measured dispersion is at most this ε (the points per row that `plan`
+    /// prints, raised until every row's own block meets ε).
     #[arg(long, conflicts_with = "budget")]
     pub epsilon: Option<f64>,
     /// Seed of the random, scrambled Halton and Sobol strategies.
@@ -146,6 +146,10 @@ pub struct PlanArgs {
     /// Allowed failure probability of the random k-wise family, in (0, 1).
     #[arg(long, default_value_t = 0.01)]
     pub delta: f64,
+    /// Seed of the random k-wise array that `generate --strategy kwise --seed` would draw
+    /// (the plan prints what `generate --epsilon` writes with it).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -302,7 +306,8 @@ pub fn run_plan(a: &PlanArgs, out: &mut dyn Write) -> Result<(), Error> {
             nd.min(6)
         )));
     }
-    let p = plan(&space, strength, epsilon, delta).map_err(bad)?;
+    let mut p = plan(&space, strength, epsilon, delta).map_err(bad)?;
+    super::plan_suites(&mut p, &space, a.seed, MAX_GENERATE).map_err(bad)?;
     if a.json {
         let text = serde_json::to_string_pretty(&p).map_err(|e| Error::Internal(e.to_string()))?;
         writeln!(out, "{text}").map_err(output)

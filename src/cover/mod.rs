@@ -10,6 +10,9 @@ mod spec;
 
 pub use input::{parse_tests, read_tests, InputError, TestSet};
 pub use pict::{parse_pict, read_seeds, PictError, PictModel};
-pub use plan::{plan, suite_per_row, Plan, PlanError, MAX_PLANNED};
+pub use plan::{
+    halton_points_for, plan, plan_suites, suite_per_row, HaltonSize, Plan, PlanError, SuitePlan,
+    MAX_MEASURED, MAX_PLANNED,
+};
 pub use report::{estimate, Estimate, Metric};
 pub use spec::{load_space, parse_space, SpecError};
