@@ -38,7 +38,14 @@ fn run_seeded(out: &Path, strategy: &str, seed: &str, extra: &[&str]) -> std::pr
 #[test]
 fn every_falsifier_spends_the_budget_exactly_and_does_not_depend_on_jobs() {
     let dir = tempfile::tempdir().unwrap();
-    for strategy in ["falsify-nm", "falsify-pso", "falsify-sa", "falsify-ce"] {
+    for strategy in [
+        "falsify-nm",
+        "falsify-pso",
+        "falsify-sa",
+        "falsify-ce",
+        "falsify-bo",
+        "falsify-bo-lcb",
+    ] {
         let one = dir.path().join(format!("{strategy}-1"));
         let three = dir.path().join(format!("{strategy}-3"));
         let a = run(&one, strategy, &["--jobs", "1"]);
@@ -61,23 +68,25 @@ fn every_falsifier_spends_the_budget_exactly_and_does_not_depend_on_jobs() {
 
 #[test]
 fn a_resumed_adaptive_campaign_equals_an_uninterrupted_one() {
-    let dir = tempfile::tempdir().unwrap();
-    let whole = dir.path().join("whole");
-    run(&whole, "falsify-nm", &[]);
-    let expected = lines(&whole);
-    // Keep 13 complete records and half of the 14th: the search has to be replayed from
-    // the records (mid-batch) before it can go on.
-    let cut = dir.path().join("cut");
-    std::fs::create_dir_all(&cut).unwrap();
-    std::fs::copy(whole.join("campaign.json"), cut.join("campaign.json")).unwrap();
-    let text = std::fs::read_to_string(whole.join("results.jsonl")).unwrap();
-    let mut kept: String = text.split_inclusive('\n').take(13).collect();
-    let fourteenth = text.split_inclusive('\n').nth(13).unwrap();
-    kept.push_str(&fourteenth[..fourteenth.len() / 2]);
-    std::fs::write(cut.join("results.jsonl"), kept).unwrap();
-    let o = fuzz(&["--resume", "--out", cut.to_str().unwrap()]);
-    assert!(matches!(o.status.code(), Some(0 | 1)), "{o:?}");
-    assert_eq!(lines(&cut), expected);
+    for strategy in ["falsify-nm", "falsify-bo"] {
+        let dir = tempfile::tempdir().unwrap();
+        let whole = dir.path().join("whole");
+        run(&whole, strategy, &[]);
+        let expected = lines(&whole);
+        // Keep 13 complete records and half of the 14th: the search has to be replayed from
+        // the records (mid-batch; past falsify-bo's initial design of 8) before it can go on.
+        let cut = dir.path().join("cut");
+        std::fs::create_dir_all(&cut).unwrap();
+        std::fs::copy(whole.join("campaign.json"), cut.join("campaign.json")).unwrap();
+        let text = std::fs::read_to_string(whole.join("results.jsonl")).unwrap();
+        let mut kept: String = text.split_inclusive('\n').take(13).collect();
+        let fourteenth = text.split_inclusive('\n').nth(13).unwrap();
+        kept.push_str(&fourteenth[..fourteenth.len() / 2]);
+        std::fs::write(cut.join("results.jsonl"), kept).unwrap();
+        let o = fuzz(&["--resume", "--out", cut.to_str().unwrap()]);
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{strategy}: {o:?}");
+        assert_eq!(lines(&cut), expected, "{strategy}");
+    }
 }
 
 #[test]

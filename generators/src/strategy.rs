@@ -1,6 +1,6 @@
 use std::str::FromStr;
 
-use crate::falsify::{Falsifier, Method};
+use crate::falsify::{Acquisition, BayesOpt, BoTuning, Falsifier, Method};
 use crate::{
     FullFactorial, Generator, GeneratorError, GivenPoints, Halton, ParamSpace, Sobol, UniformRandom,
 };
@@ -29,6 +29,10 @@ pub enum Strategy {
     FalsifySa,
     /// [`Falsifier`] with the cross-entropy method.
     FalsifyCe,
+    /// [`BayesOpt`]: Gaussian-process Bayesian optimisation, expected improvement.
+    FalsifyBo,
+    /// [`BayesOpt`] with the lower confidence bound `μ − 2σ`.
+    FalsifyBoLcb,
     /// [`GivenPoints`]: points chosen outside paracosm (`paracosm-fuzz --points FILE`, an
     /// array from Python), in their order; built by [`Strategy::build_given`].
     Points,
@@ -42,18 +46,20 @@ impl Strategy {
     /// ([`Strategy::build_sized`]).
     pub const SUITES: [Strategy; 2] = [Strategy::Ipog, Strategy::KWise];
 
-    /// The adaptive falsifiers ([`Falsifier`]): their points depend on the robustness they
-    /// are told, so they run only inside a campaign.
-    pub const FALSIFIERS: [Strategy; 4] = [
+    /// The adaptive falsifiers ([`Falsifier`], [`BayesOpt`]): their points depend on the
+    /// robustness they are told, so they run only inside a campaign.
+    pub const FALSIFIERS: [Strategy; 6] = [
         Strategy::FalsifyNm,
         Strategy::FalsifyPso,
         Strategy::FalsifySa,
         Strategy::FalsifyCe,
+        Strategy::FalsifyBo,
+        Strategy::FalsifyBoLcb,
     ];
 
     /// Every strategy, in the order the command line lists them: the one list from which
     /// names, help, parsing and error messages are derived.
-    pub const LIST: [Strategy; 12] = [
+    pub const LIST: [Strategy; 14] = [
         Strategy::Random,
         Strategy::Halton,
         Strategy::ScrambledHalton,
@@ -64,6 +70,8 @@ impl Strategy {
         Strategy::FalsifyPso,
         Strategy::FalsifySa,
         Strategy::FalsifyCe,
+        Strategy::FalsifyBo,
+        Strategy::FalsifyBoLcb,
         Strategy::Points,
         Strategy::FullFactorial,
     ];
@@ -89,6 +97,8 @@ impl Strategy {
             Strategy::FalsifyPso => "falsify-pso",
             Strategy::FalsifySa => "falsify-sa",
             Strategy::FalsifyCe => "falsify-ce",
+            Strategy::FalsifyBo => "falsify-bo",
+            Strategy::FalsifyBoLcb => "falsify-bo-lcb",
             Strategy::Points => "points",
             Strategy::FullFactorial => "full-factorial",
         }
@@ -122,6 +132,13 @@ impl Strategy {
                 "Falsification: simulated annealing minimising robustness (argmin)"
             }
             Strategy::FalsifyCe => "Falsification: the cross-entropy method minimising robustness",
+            Strategy::FalsifyBo => {
+                "Falsification: Bayesian optimisation, a Gaussian process (Matérn 5/2) over \
+                 robustness and expected improvement maximised by L-BFGS (argmin, faer)"
+            }
+            Strategy::FalsifyBoLcb => {
+                "Falsification: as falsify-bo with the lower confidence bound μ − 2σ"
+            }
             Strategy::Points => {
                 "The points of a CSV file, in file order (chosen by --points FILE, which sets \
                  the budget to the file's row count)"
@@ -139,7 +156,14 @@ impl Strategy {
         Strategy::LIST.map(Strategy::name).join(", ")
     }
 
-    /// The search method of an adaptive strategy, `None` for the others.
+    /// Whether the strategy is adaptive ([`Strategy::FALSIFIERS`]): its points depend on the
+    /// robustness it is told.
+    pub fn is_adaptive(self) -> bool {
+        Strategy::FALSIFIERS.contains(&self)
+    }
+
+    /// The search method of a [`Falsifier`] strategy, `None` for the others (the Bayesian
+    /// ones included).
     pub fn method(self) -> Option<Method> {
         match self {
             Strategy::FalsifyNm => Some(Method::NelderMead),
@@ -163,6 +187,8 @@ impl Strategy {
             | Strategy::FalsifyPso
             | Strategy::FalsifySa
             | Strategy::FalsifyCe
+            | Strategy::FalsifyBo
+            | Strategy::FalsifyBoLcb
             | Strategy::Points
             | Strategy::FullFactorial => None,
         }
@@ -198,6 +224,15 @@ impl Strategy {
                 let method = self.method().expect("a falsifier has a method");
                 Box::new(Falsifier::new(space, method, seed)?)
             }
+            Strategy::FalsifyBo => Box::new(BayesOpt::new(space, seed)?),
+            Strategy::FalsifyBoLcb => Box::new(BayesOpt::with_tuning(
+                space,
+                seed,
+                BoTuning {
+                    acquisition: Acquisition::LowerConfidenceBound { beta: 2.0 },
+                    ..BoTuning::default()
+                },
+            )?),
         })
     }
 }
@@ -296,7 +331,7 @@ mod tests {
         );
         assert_eq!(
             "annealing".parse::<Strategy>().unwrap_err().to_string(),
-            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise, falsify-nm, falsify-pso, falsify-sa, falsify-ce, points, full-factorial)"
+            "unknown strategy `annealing` (expected one of: random, halton, halton-scrambled, sobol, ipog, kwise, falsify-nm, falsify-pso, falsify-sa, falsify-ce, falsify-bo, falsify-bo-lcb, points, full-factorial)"
         );
     }
 }

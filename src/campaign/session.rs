@@ -405,7 +405,7 @@ fn refusals(
             file.budget
         )));
     }
-    if file.shard.is_some() && strategy.method().is_some() {
+    if file.shard.is_some() && strategy.is_adaptive() {
         return Err(Error::BadInput(format!(
             "--shard cannot split a {strategy} campaign: each of its tests depends on all \
              earlier ones. Run it whole (it is parallel inside: --jobs)"

@@ -222,7 +222,7 @@ pub fn run_generate(a: &GenerateArgs, out: &mut dyn Write) -> Result<(), Error> 
     }
     let space = load_space(a.space.as_deref().unwrap_or_default()).map_err(bad)?;
     let strategy = crate::cli::strategy(a.strategy, a.scramble)?;
-    if strategy.method().is_some() {
+    if strategy.is_adaptive() {
         return Err(bad(format!(
             "{strategy} chooses each test from the robustness of earlier ones, so it \
              needs a simulator: run it with paracosm-fuzz --strategy {strategy}"

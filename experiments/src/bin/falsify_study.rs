@@ -1,5 +1,5 @@
 //! `falsify_study`: simulations until the first failure for random, Halton, Sobol and the
-//! falsifiers, on `pedestrian-crossing` and `follow-lead-car`, over 20 seeds.
+//! falsifiers (Bayesian optimisation included), on `pedestrian-crossing` and `follow-lead-car`, over 20 seeds.
 //!
 //! `cargo run --release -p paracosm-experiments --bin falsify_study`
 
@@ -40,6 +40,8 @@ fn main() -> Result<()> {
         Strategy::FalsifyPso,
         Strategy::FalsifySa,
         Strategy::FalsifyCe,
+        Strategy::FalsifyBo,
+        Strategy::FalsifyBoLcb,
     ];
     let study = falsification_study(
         &StudySettings {

@@ -33,7 +33,9 @@
 //! The budget is the campaign's: the generator never decides to stop, and the campaign asks
 //! exactly as many points as it has simulations.
 
+mod bayes;
 mod cross_entropy;
+pub mod gp;
 mod lane;
 
 use std::collections::VecDeque;
@@ -43,6 +45,7 @@ use std::thread::JoinHandle;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
+pub use bayes::{Acquisition, BayesOpt, BoTuning};
 pub use cross_entropy::CrossEntropy;
 
 use crate::{Generator, GeneratorError, Halton, ParamSpace, Point};
