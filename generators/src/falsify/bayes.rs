@@ -274,7 +274,10 @@ impl BayesOpt {
             starts.insert(0, h.clone());
         }
         let bounds = HyperBounds::default();
-        if self.batches.is_multiple_of(self.tuning.hyper_restart_every.max(1)) {
+        if self
+            .batches
+            .is_multiple_of(self.tuning.hyper_restart_every.max(1))
+        {
             for _ in 0..2 {
                 let draw = |rng: &mut ChaCha8Rng, (lo, hi): (f64, f64)| {
                     lo + (hi - lo) * rng.random::<f64>()
