@@ -7,12 +7,15 @@
 //!   quasi-random sampling against the adaptive falsifiers.
 //! - [`figure10`]: the paper's Figure 10 studies with learned drivers: light × fog, a 200 s
 //!   loop against fog, and other 3-D components (§4.2.2).
+//! - [`science`]: the coverage propositions of §3 measured (Proposition 3.2's bound, dispersion
+//!   and star discrepancy against n).
 #![warn(missing_docs)]
 
 pub mod falsification;
 pub mod figure10;
 pub mod onnx_export;
 pub mod pilotnet;
+pub mod science;
 
 use std::path::{Path, PathBuf};
 

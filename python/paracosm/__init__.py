@@ -1,6 +1,7 @@
 """paracosm from Python: samplers and coverage estimators of the unit cube (`paracosm.qmc`),
-covering arrays (`paracosm.covering`), and driving scenarios as a benchmark for samplers
-and falsifiers (`paracosm.Scenario`).
+covering arrays (`paracosm.covering`), paracosm's falsifiers on any objective
+(`paracosm.falsify`), and driving scenarios as a benchmark for samplers and falsifiers
+(`paracosm.Scenario`).
 
 The numbers are those of the Rust crates behind the command-line tools `paracosm-fuzz` and
 `paracosm-cover`: a scenario run from Python writes the same records as `paracosm-fuzz
@@ -22,7 +23,7 @@ if not _os.path.isdir(_os.environ.get("XDG_RUNTIME_DIR", "")):
     except OSError:
         pass
 
-from . import covering, qmc  # noqa: E402
+from . import covering, falsify, qmc  # noqa: E402
 from ._native import BUILTIN_SCENARIOS, RENDER, __version__  # noqa: E402
 from .scenario import Param, Scenario, Space, TestError  # noqa: E402
 
@@ -35,5 +36,6 @@ __all__ = [
     "TestError",
     "__version__",
     "covering",
+    "falsify",
     "qmc",
 ]

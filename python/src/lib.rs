@@ -13,6 +13,7 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
 mod covering;
+mod falsify;
 mod qmc;
 mod scenario;
 
@@ -33,6 +34,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RENDER", cfg!(feature = "render"))?;
     qmc::register(m)?;
     covering::register(m)?;
+    falsify::register(m)?;
     scenario::register(m)?;
     Ok(())
 }

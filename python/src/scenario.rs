@@ -215,11 +215,12 @@ impl ScenarioHandle {
 
 #[pymethods]
 impl ScenarioHandle {
-    /// Loads a built-in scenario by name or a `.star` program by path.
+    /// Loads a built-in scenario by name, a `.star` program or an OpenSCENARIO `.xosc` file
+    /// (with `paracosm-fuzz`'s options after it, [`paracosm::load_scenario`]) by path.
     #[new]
     fn new(py: Python<'_>, name_or_path: &str) -> PyResult<Self> {
         let scenario = py
-            .detach(|| paracosm_scenarios::load(name_or_path))
+            .detach(|| paracosm::load_scenario(name_or_path))
             .map_err(value_error)?;
         let warnings = paracosm::report::warnings_of(&scenario);
         Ok(ScenarioHandle { scenario, warnings })

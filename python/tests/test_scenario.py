@@ -408,3 +408,18 @@ def test_learned_systems_under_test_run_from_python(tmp_path):
     (tmp_path / "mine.toml").unlink()
     with pytest.raises(ValueError, match="mine.toml"):
         s.run(x, sut=f"onnx:{tmp_path / 'mine.onnx'}")
+
+
+def test_an_openscenario_file_loads_with_its_options_and_runs():
+    """An OpenSCENARIO logical scenario from the published ALKS suite, as `paracosm-fuzz FILE.xosc
+    --open ...` reads it: its space is the variation file's parameters then the opened ones, and
+    a test whose ego faces off the map ends in error (NaN with on_error="nan"), not a pass."""
+    path = Path(__file__).resolve().parents[2] / "tests/data/xosc/alks/alks_scenario_4_2_3_crossing_pedestrian_variation.xosc"
+    with pytest.warns(paracosm.scenario.ScenarioWarning):
+        s = paracosm.Scenario(f"{path}#open=TargetBlocking_Speed_kph=2..10")
+    assert s.space.names == ["Road", "Ego_InitSpeed_Ve0_kph", "Ego_InitPosition_LaneId",
+                             "TargetBlocking_Speed_kph"]
+    values = [s.robustness(np.random.default_rng(i).random(len(s.space)), on_error="nan") for i in range(4)]
+    assert any(np.isnan(values)) and any(np.isfinite(values)), values
+    with pytest.raises(ValueError, match="no_such.xosc"):
+        paracosm.Scenario(str(path.parent / "no_such.xosc"))
