@@ -23,6 +23,7 @@ per finished job in jobs/ (a rerun with the same settings reuses them; delete it
 import argparse
 import csv
 import glob
+import hashlib
 import json
 import os
 import statistics
@@ -62,7 +63,8 @@ def venv(family: str, wheel: str) -> Path:
     python = path / "bin" / "python"
     stamp = path / "installed.txt"
     requirements = HERE / FAMILIES[family][0]
-    want = requirements.read_text() + wheel
+    # The wheel's digest, not its name: a rebuilt wheel keeps its file name.
+    want = requirements.read_text() + wheel + hashlib.sha256(Path(wheel).read_bytes()).hexdigest()
     if not python.exists():
         subprocess.run([sys.executable, "-m", "venv", str(path)], check=True)
     if not stamp.exists() or stamp.read_text() != want:
