@@ -342,6 +342,8 @@ fn inputs_that_cannot_affect_the_ego_are_named() {
         "{}",
         stderr(&o)
     );
+    // Only a campaign that rendered names the adapter it rendered with.
+    assert!(!stderr(&o).contains("camera renderer"), "{}", stderr(&o));
     let o = campaign(
         &scenario("first_param_enum.star"),
         2,
@@ -349,6 +351,15 @@ fn inputs_that_cannot_affect_the_ego_are_named() {
         &["--sut", "vision"],
     );
     assert!(!stderr(&o).contains("lead_color"), "{}", stderr(&o));
+    let named = stderr(&o)
+        .lines()
+        .find_map(|l| l.strip_prefix("paracosm-fuzz: camera renderer: "))
+        .map(str::to_owned);
+    assert!(
+        named.is_some_and(|a| a.contains("Vulkan") || a.contains("Gl")),
+        "{}",
+        stderr(&o)
+    );
 }
 
 /// The texts an SVG shows.

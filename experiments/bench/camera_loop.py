@@ -21,6 +21,13 @@ machine), each system's ratio NEW / BASE; the load average before and after
 (/proc/loadavg), so a reader on a busy machine can compare. The binaries' results.jsonl must
 agree but for wall_ms: the script says which systems' verdicts differ and exits 1 when any do.
 
+Wall time is printed beside CPU time (tests per second of the whole campaign, and a test's
+marginal wall seconds), which is what a GPU changes. `--jobs N` runs the campaigns on N
+workers. `--save DIR` writes the first binary's full campaigns' results (`DIR/SUT.jsonl`,
+wall_ms left out); `--compare DIR` reads such a folder, written on another machine or with
+another renderer, and says per system how many records and verdicts differ (exit status 1
+when any verdict does).
+
     python3 experiments/bench/camera_loop.py --bin BASE --bin target/release/paracosm-fuzz
 """
 
@@ -50,14 +57,17 @@ def budget_of(sut, budget):
     return budget * 10 if sut == "aeb" else budget
 
 
-def run(binary, sut, budget, out):
-    """CPU seconds of one campaign, and its results as comparable lines."""
-    cmd = [binary, SCENARIO, "--strategy", "halton", "--budget", str(budget), "--jobs", "1",
-           "--out", out, "--force", *SUTS[sut]]
+def run(binary, sut, budget, out, jobs=1):
+    """CPU seconds, wall seconds and stderr of one campaign, and its results as comparable
+    lines."""
+    cmd = [binary, SCENARIO, "--strategy", "halton", "--budget", str(budget), "--jobs",
+           str(jobs), "--out", out, "--force", *SUTS[sut]]
+    start = time.perf_counter()
     proc = subprocess.Popen(cmd, cwd=REPO_ROOT, stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(proc.pid, 0)
     err = proc.stderr.read().decode(errors="replace")
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - start
     code = os.waitstatus_to_exitcode(status)
     if code not in (0, 1):
         sys.exit(f"{' '.join(cmd)} exited with {code}: {err[-2000:]}")
@@ -67,7 +77,17 @@ def run(binary, sut, budget, out):
             r = json.loads(line)
             r.pop("wall_ms", None)
             records.append(json.dumps(r, sort_keys=True))
-    return usage.ru_utime + usage.ru_stime, records
+    return usage.ru_utime + usage.ru_stime, wall, err, records
+
+
+def compare(records, folder, sut):
+    """(records that differ, verdicts that differ, tests) against `folder/SUT.jsonl`."""
+    theirs = Path(folder, f"{sut}.jsonl").read_text().splitlines()
+    if len(theirs) != len(records):
+        return len(records), len(records), len(records)
+    verdict = lambda line: json.loads(line)["status"]  # noqa: E731
+    return (sum(a != b for a, b in zip(records, theirs)),
+            sum(verdict(a) != verdict(b) for a, b in zip(records, theirs)), len(records))
 
 
 def loadavg():
@@ -85,6 +105,9 @@ def main():
     ap.add_argument("--runs", type=int, default=3, help="runs of each campaign (default 3)")
     ap.add_argument("--sut", action="append", choices=list(SUTS),
                     help="systems under test to measure (default: all four)")
+    ap.add_argument("--jobs", type=int, default=1, help="workers per campaign (default 1)")
+    ap.add_argument("--save", help="write the first binary's results to DIR/SUT.jsonl")
+    ap.add_argument("--compare", help="compare the first binary's results with DIR/SUT.jsonl")
     args = ap.parse_args()
     suts = args.sut or list(SUTS)
     if "aeb" not in suts:
@@ -93,6 +116,8 @@ def main():
     before = loadavg()
     started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     cpu = {}  # (bin, sut, budget) -> [seconds]
+    wall = {}  # likewise, wall seconds
+    renderer = set()
     records = {}  # (bin, sut) -> lines of the full campaign
     with tempfile.TemporaryDirectory() as tmp:
         for r in range(args.runs):
@@ -100,22 +125,28 @@ def main():
                 for b, binary in enumerate(bins):
                     for budget in (1, budget_of(sut, args.budget)):
                         out = os.path.join(tmp, f"{b}-{sut}-{budget}")
-                        seconds, lines = run(binary, sut, budget, out)
+                        seconds, w, err, lines = run(binary, sut, budget, out, args.jobs)
                         cpu.setdefault((b, sut, budget > 1), []).append(seconds)
+                        wall.setdefault((b, sut, budget > 1), []).append(w)
+                        renderer.update(line.split("camera renderer: ", 1)[1]
+                                        for line in err.splitlines()
+                                        if "camera renderer: " in line)
                         if budget > 1:
                             records[(b, sut)] = lines
             print(f"round {r + 1} of {args.runs} done", file=sys.stderr)
     after = loadavg()
     print(f"pedestrian study, {args.budget} Halton tests ({budget_of('aeb', args.budget)} "
-          f"for aeb), --jobs 1, medians of {args.runs} "
+          f"for aeb), --jobs {args.jobs}, medians of {args.runs} "
           f"runs; {started}; {platform.machine()}, {os.cpu_count()} cores; "
-          f"load average before {' '.join(before)}, after {' '.join(after)}")
+          f"load average before {' '.join(before)}, after {' '.join(after)}; camera renderer: "
+          f"{', '.join(sorted(renderer)) or 'none reported'}")
     marginal = {}
     for b, binary in enumerate(bins):
         print(f"\n{binary}")
         print("| system under test | CPU-s, 1 test | CPU-s, whole campaign | whole, per test "
-              "| marginal, per test | marginal against aeb |")
-        print("|---|---:|---:|---:|---:|---:|")
+              "| marginal, per test | marginal against aeb | wall s, whole campaign "
+              "| tests/s | marginal wall s per test |")
+        print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
         for sut in suts:
             n = budget_of(sut, args.budget)
             one = statistics.median(cpu[(b, sut, False)])
@@ -123,9 +154,24 @@ def main():
             m = (whole - one) / (n - 1)
             marginal[(b, sut)] = m
             ratio = m / marginal[(b, "aeb")] if marginal[(b, "aeb")] > 0 else float("nan")
+            w_one = statistics.median(wall[(b, sut, False)])
+            w_whole = statistics.median(wall[(b, sut, True)])
             print(f"| {sut} | {one:.2f} | {whole:.2f} ({n} tests) | {whole / n:.4f} | {m:.4f} "
-                  f"| {ratio:.1f}× |")
+                  f"| {ratio:.1f}× | {w_whole:.2f} | {n / w_whole:.1f} "
+                  f"| {(w_whole - w_one) / (n - 1):.4f} |")
     failed = False
+    if args.save:
+        os.makedirs(args.save, exist_ok=True)
+        for sut in suts:
+            Path(args.save, f"{sut}.jsonl").write_text("\n".join(records[(0, sut)]) + "\n")
+    if args.compare:
+        print(f"\nagainst {args.compare} (the first binary's full campaigns)")
+        print("| system under test | records that differ | verdicts that differ |")
+        print("|---|---:|---:|")
+        for sut in suts:
+            rec, ver, n = compare(records[(0, sut)], args.compare, sut)
+            failed |= ver > 0
+            print(f"| {sut} | {rec} of {n} | {ver} of {n} |")
     if len(bins) == 2:
         print(f"\nNEW / BASE (below 1 is faster): NEW {bins[1]}, BASE {bins[0]}")
         print("| system under test | whole campaign | marginal per test | verdicts |")

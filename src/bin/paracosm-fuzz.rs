@@ -580,6 +580,10 @@ fn run(cli: &Cli) -> Result<u8> {
         .notes()
         .iter()
         .for_each(|n| paracosm::cli::to_stderr(&format!("paracosm-fuzz: {n}")));
+    if let Some(r) = paracosm_engine::render::Renderer::in_use() {
+        // Which adapter drew the camera frames: a GPU, or lavapipe on the CPU.
+        paracosm::cli::to_stderr(&format!("paracosm-fuzz: camera renderer: {}", r.adapter()));
+    }
     if let Some(text) = outcome.human() {
         say(&text)?;
     }

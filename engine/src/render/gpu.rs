@@ -276,6 +276,12 @@ impl Renderer {
         SHARED.get_or_init(|| Renderer::new().map(Arc::new)).clone()
     }
 
+    /// The process-wide renderer if one was created and works, without creating one: `None`
+    /// when no camera has rendered yet in this process or no adapter was found.
+    pub fn in_use() -> Option<Arc<Renderer>> {
+        SHARED.get().and_then(|r| r.as_ref().ok().cloned())
+    }
+
     /// The adapter in use, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, llvmpipe)`.
     pub fn adapter(&self) -> &str {
         &self.adapter
