@@ -118,7 +118,7 @@ pub fn figure10a(budget: u64, jobs: usize, dir: &Path) -> Result<Figure10a> {
             ),
             x: "light intensity".into(),
             y: "fog density".into(),
-            value: "distance covered in 15 s, m".into(),
+            value: "distance covered, m (to the collision if one ended the test)".into(),
             marked: "collision".into(),
         },
         ((0.0, 1.0), (0.0, 1.0), (0.0, top)),

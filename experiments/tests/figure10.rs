@@ -11,6 +11,10 @@ fn the_training_programs_load_with_their_documented_parameters() {
             "follow_red_train.star",
             &["gap", "lead_speed", "brake_at"][..],
         ),
+        (
+            "follow_red_check.star",
+            &["gap", "lead_speed", "brake_at"][..],
+        ),
         ("loop_train.star", &["road", "at"][..]),
         ("fig10a_light_fog.star", &["light", "fog"][..]),
         ("fig10b_loop_fog.star", &["fog"][..]),
@@ -114,4 +118,34 @@ fn figure_10c_records_the_speed_of_the_four_cases_at_every_frame() {
     }
     let svg = std::fs::read_to_string(&f.plots[1]).unwrap();
     assert!(svg.contains("red lead (as trained)"));
+}
+
+#[test]
+fn the_shipped_follow_network_follows_the_red_car_for_the_whole_test_in_clear_weather() {
+    // Figure 10a's premise (the learned-drivers issue, requirement 2): at light 0.45–0.55
+    // around its training light 0.5 and without fog, `follow` drives behind the crawling red
+    // car for the full 15 s: no collision, at least 30 m covered, never off the road.
+    let s = paracosm_scenarios::load(&scenario_path("fig10a_light_fog.star").display().to_string())
+        .unwrap();
+    for (i, light) in [0.45, 0.475, 0.5, 0.525, 0.55].into_iter().enumerate() {
+        let a = s
+            .space
+            .decode(&paracosm_generators::Point {
+                discrete: vec![],
+                continuous: vec![light, 0.0],
+            })
+            .unwrap();
+        let o = s.run(&a, i as u64).unwrap();
+        let simulated = o
+            .metrics
+            .iter()
+            .find(|(n, _)| *n == "simulated_s")
+            .map(|(_, v)| *v)
+            .unwrap();
+        assert!(o.passed(), "light {light}: {:?}", o.monitors);
+        assert!(
+            (simulated - 15.0).abs() < 1e-6,
+            "light {light}: ended at {simulated} s"
+        );
+    }
 }

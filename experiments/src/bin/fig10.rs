@@ -17,7 +17,7 @@ struct Cli {
     #[arg(long, default_value = "abc")]
     parts: String,
     /// Halton tests of Figure 10a.
-    #[arg(long, default_value_t = 200, value_parser = paracosm::cli::positive)]
+    #[arg(long, default_value_t = 1000, value_parser = paracosm::cli::positive)]
     budget_a: u64,
     /// Halton tests of Figure 10b.
     #[arg(long, default_value_t = 40, value_parser = paracosm::cli::positive)]
@@ -33,6 +33,9 @@ struct Cli {
     #[arg(long)]
     docs: Option<PathBuf>,
 }
+
+/// Whether a Figure 10a test lies in a region of light × fog.
+type Region = fn(&figure10::LightFogTest) -> bool;
 
 /// `[lo, hi)` bands of width `step` over `[0, 1]`, the last one closed.
 fn band(x: f64, step: f64) -> usize {
@@ -75,6 +78,28 @@ fn main() -> Result<()> {
                 row.push_str(&format!(" {hits}/{}, {mean:.1} m |", cell.len()));
             }
             println!("{row}");
+        }
+        // The paper's finding ("the car performs best around the parameter values used
+        // during training"), with 95 % Wilson intervals over three regions.
+        let regions: [(&str, Region); 3] = [
+            ("light 0.4–0.6, fog < 0.25 (around training)", |t| {
+                (0.4..0.6).contains(&t.light) && t.fog < 0.25
+            }),
+            ("light < 0.4 or ≥ 0.6, fog < 0.25", |t| {
+                !(0.4..0.6).contains(&t.light) && t.fog < 0.25
+            }),
+            ("fog ≥ 0.25", |t| t.fog >= 0.25),
+        ];
+        for (name, inside) in regions {
+            let n = f.tests.iter().filter(|t| inside(t)).count() as u64;
+            let k = f.tests.iter().filter(|t| inside(t) && t.collision).count() as u64;
+            let (lo, hi) = paracosm_experiments::wilson95(k, n);
+            println!(
+                "  {name}: {k} of {n} collide ({:.1} %, 95 % interval {:.1}–{:.1} %)",
+                100.0 * k as f64 / n.max(1) as f64,
+                100.0 * lo,
+                100.0 * hi
+            );
         }
     }
     if cli.parts.contains('b') {

@@ -61,5 +61,23 @@ fn main() -> Result<()> {
         f.plots[0].display(),
         f.plots[1].display()
     );
+    println!(
+        "collisions by walking speed, both campaigns' {} tests (95 % Wilson intervals):",
+        2 * cli.budget
+    );
+    println!("| walking speed, m/s | tests | collisions | rate | 95 % interval |");
+    println!("|---|---:|---:|---:|---|");
+    for b in &f.by_speed {
+        println!(
+            "| {:.1}–{:.1} | {} | {} | {:.3} | [{:.3}, {:.3}] |",
+            b.lo,
+            b.hi,
+            b.tests,
+            b.collisions,
+            b.collisions as f64 / b.tests.max(1) as f64,
+            b.ci95.0,
+            b.ci95.1
+        );
+    }
     Ok(())
 }

@@ -48,10 +48,7 @@ enum What {
 
 /// The 95 % Wilson score interval of a proportion `p` observed over `n` trials.
 fn wilson(p: f64, n: f64) -> (f64, f64) {
-    let z = 1.959_964_f64;
-    let centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
-    let half = z * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt() / (1.0 + z * z / n);
-    ((centre - half).max(0.0), (centre + half).min(1.0))
+    paracosm_experiments::wilson95((p * n).round() as u64, n as u64)
 }
 
 fn main() -> Result<()> {
