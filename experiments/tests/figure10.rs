@@ -16,6 +16,7 @@ fn the_training_programs_load_with_their_documented_parameters() {
             &["gap", "lead_speed", "brake_at"][..],
         ),
         ("loop_train.star", &["road", "at"][..]),
+        ("loop_check.star", &["road", "at"][..]),
         ("fig10a_light_fog.star", &["light", "fog"][..]),
         ("fig10b_loop_fog.star", &["fog"][..]),
         ("fig10c_components.star", &["lead_color", "oncoming"][..]),
@@ -69,13 +70,21 @@ fn figure_10b_times_the_first_departure_from_the_road_with_a_200_s_time_out() {
             .unwrap(),
     )
     .unwrap();
-    // The metric agrees with the verdict: a time to failure exactly when the test failed,
-    // else a full 200 s simulated.
+    // The metrics agree with the verdict: a time to failure, or a full 200 s simulated
+    // that passes exactly when the car covered the distance asked (a car that stops on the
+    // road fails).
     let simulated = record["metrics"]["simulated_s"].as_f64().unwrap();
+    let travelled = record["metrics"]["distance_travelled_m"].as_f64().unwrap();
+    assert!((travelled - t.distance_m).abs() < 1e-6, "{travelled} {t:?}");
     match t.time_to_failure_s {
-        Some(_) => assert_eq!(record["status"], "fail"),
+        Some(s) => {
+            assert_eq!(record["status"], "fail");
+            let first = record["monitors"]["time_to_failure"]["first_violation_s"].as_f64();
+            assert_eq!(first, Some(s));
+        }
         None => {
-            assert_eq!(record["status"], "pass");
+            let drove = t.distance_m >= figure10::LOOP_MIN_DISTANCE_M;
+            assert_eq!(record["status"], if drove { "pass" } else { "fail" });
             assert!((simulated - LOOP_TIMEOUT_S).abs() < 1e-6, "{simulated}");
         }
     }

@@ -20,7 +20,7 @@ struct Cli {
     #[arg(long, default_value_t = 1000, value_parser = paracosm::cli::positive)]
     budget_a: u64,
     /// Halton tests of Figure 10b.
-    #[arg(long, default_value_t = 40, value_parser = paracosm::cli::positive)]
+    #[arg(long, default_value_t = 100, value_parser = paracosm::cli::positive)]
     budget_b: u64,
     /// Worker threads (default: all cores).
     #[arg(long)]
@@ -121,8 +121,14 @@ fn main() -> Result<()> {
         sorted.sort_by(|a, b| a.fog.total_cmp(&b.fog));
         for t in &sorted {
             match t.time_to_failure_s {
-                Some(s) => println!("  fog {:.3}: left the road at {s:.1} s", t.fog),
-                None => println!("  fog {:.3}: on the road at {LOOP_TIMEOUT_S} s", t.fog),
+                Some(s) => println!(
+                    "  fog {:.3}: left the road at {s:.1} s after {:.0} m",
+                    t.fog, t.distance_m
+                ),
+                None => println!(
+                    "  fog {:.3}: on the road at {LOOP_TIMEOUT_S} s after {:.0} m",
+                    t.fog, t.distance_m
+                ),
             }
         }
     }

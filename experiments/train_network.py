@@ -1,0 +1,100 @@
+#!/usr/bin/env python3
+"""Trains one of the shipped networks from its scenario with one command: the training data
+(`paracosm-fuzz dataset`), the training (`train_pilotnet`, which writes the ONNX file, its
+manifest and its model card), and a closed-loop evaluation on held-out tests
+(`paracosm-fuzz ... --sut-onnx`). Deterministic for a seed: with the seed a network was
+shipped with, the ONNX file it writes is the shipped one byte for byte, and the script says
+whether it is.
+
+    python3 experiments/train_network.py follow                # seed 0
+    python3 experiments/train_network.py pilotnet --seed 1 --out experiments/out/pilotnet-s1
+
+The recipes (scenario, budget, noise, training options, evaluation) are the ones
+docs/experiments.md gives for each network. Builds the release binaries first (the shared
+profile: a no-op when they are up to date).
+"""
+
+import argparse
+import hashlib
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+RECIPES = {
+    "pilotnet": {
+        "shipped": "assets/models/pilotnet.onnx",
+        "data": ["experiments/scenarios/pilotnet_train.star", "--budget", "128", "--rate", "10",
+                 "--steer-noise", "0.08", "--noise-hold", "0.5"],
+        "train": ["--epochs", "8", "--steering-weight", "10", "--closed-loop",
+                  "pedestrian-crossing"],
+        "evaluate": ["pedestrian-crossing", "--budget", "400"],
+    },
+    "follow": {
+        "shipped": "experiments/models/follow.onnx",
+        "data": ["experiments/scenarios/follow_red_train.star", "--budget", "64", "--rate", "10",
+                 "--steer-noise", "0.08", "--noise-hold", "0.5"],
+        "train": ["--epochs", "8", "--smooth-s", "1", "--steering-weight", "10",
+                  "--brake-weight", "6", "--closed-loop",
+                  "experiments/scenarios/follow_red_check.star"],
+        "evaluate": ["experiments/scenarios/follow_red_check.star", "--budget", "40"],
+    },
+    "loop": {
+        "shipped": "experiments/models/loop.onnx",
+        "data": ["experiments/scenarios/loop_train.star", "--budget", "48", "--rate", "10",
+                 "--steer-noise", "0.1", "--noise-hold", "0.5"],
+        "train": ["--steering-weight", "2"],
+        "evaluate": ["experiments/scenarios/fig10b_loop_fog.star", "--budget", "8"],
+    },
+}
+
+
+def run(cmd):
+    """Runs `cmd` in the repository, echoing it; exits with its status when it is not 0 (or
+    1 for a campaign, whose failed tests are what an evaluation reports)."""
+    print("$ " + " ".join(cmd), flush=True)
+    env = dict(os.environ)
+    env.setdefault("XDG_RUNTIME_DIR", "/tmp")
+    started = time.monotonic()
+    p = subprocess.run(cmd, cwd=ROOT, env=env)
+    if p.returncode not in (0, 1):
+        sys.exit(f"train_network: `{' '.join(cmd)}` exited with {p.returncode}")
+    return time.monotonic() - started
+
+
+def sha256(path):
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("network", choices=sorted(RECIPES))
+    ap.add_argument("--seed", type=int, default=0, help="training seed (default 0, as shipped)")
+    ap.add_argument("--out", help="output prefix (default experiments/out/NETWORK-sSEED)")
+    args = ap.parse_args()
+    recipe = RECIPES[args.network]
+    out = args.out or f"experiments/out/{args.network}-s{args.seed}"
+    data = f"{out}-data"
+    subprocess.run(["cargo", "build", "--release", "--locked", "-q", "-p", "paracosm", "--bin",
+                    "paracosm-fuzz", "-p", "paracosm-experiments", "--bin", "train_pilotnet"],
+                   cwd=ROOT, check=True)
+    fuzz = str(ROOT / "target/release/paracosm-fuzz")
+    t_data = run([fuzz, "dataset", *recipe["data"], "--out", data, "--force"])
+    t_train = run([str(ROOT / "target/release/train_pilotnet"), "--data", data, "--out", out,
+                   "--seed", str(args.seed), *recipe["train"]])
+    t_eval = run([fuzz, *recipe["evaluate"], "--sut-onnx", f"{out}.onnx", "--out",
+                  f"{out}-evaluation", "--force"])
+    shipped = ROOT / recipe["shipped"]
+    same = shipped.exists() and sha256(ROOT / f"{out}.onnx") == sha256(shipped)
+    print(f"\n{args.network}, seed {args.seed}: data {t_data:.0f} s, training {t_train:.0f} s, "
+          f"evaluation {t_eval:.0f} s (wall); wrote {out}.onnx, {out}.toml, {out}.md; "
+          f"evaluation in {out}-evaluation/")
+    print(f"{out}.onnx is {'identical to' if same else 'not'} the shipped {recipe['shipped']}"
+          + ("" if same else " (another seed, or the data or the code changed)"))
+
+
+if __name__ == "__main__":
+    main()
