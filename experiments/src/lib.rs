@@ -7,6 +7,8 @@
 //!   quasi-random sampling against the adaptive falsifiers.
 //! - [`figure10`]: the paper's Figure 10 studies with learned drivers: light × fog, a 200 s
 //!   loop against fog, and other 3-D components (§4.2.2).
+//! - [`perception`]: the road-segmentation and vehicle-detection networks of the paper's
+//!   §4.1 studies (Figures 5–8).
 //! - [`science`]: the coverage propositions of §3 measured (Proposition 3.2's bound, dispersion
 //!   and star discrepancy against n).
 #![warn(missing_docs)]
@@ -14,8 +16,10 @@
 pub mod falsification;
 pub mod figure10;
 pub mod onnx_export;
+pub mod perception;
 pub mod pilotnet;
 pub mod science;
+pub mod weights;
 
 use std::path::{Path, PathBuf};
 

@@ -145,6 +145,29 @@ impl Graph {
         )
     }
 
+    /// `Conv` with `dilation` between the kernel's taps on both axes (ONNX `dilations`),
+    /// otherwise as [`Graph::conv`].
+    pub fn conv_dilated(
+        &mut self,
+        x: &str,
+        weight: &str,
+        bias: &str,
+        stride: usize,
+        pad: usize,
+        dilation: usize,
+    ) -> String {
+        let (s, p, d) = (stride as i64, pad as i64, dilation as i64);
+        self.node(
+            "Conv",
+            &[x, weight, bias],
+            vec![
+                ints("strides", &[s, s]),
+                ints("pads", &[p, p, p, p]),
+                ints("dilations", &[d, d]),
+            ],
+        )
+    }
+
     /// `Relu`.
     pub fn relu(&mut self, x: &str) -> String {
         self.node("Relu", &[x], vec![])

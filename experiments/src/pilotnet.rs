@@ -62,8 +62,7 @@ throttle = 0
 steering = 1
 "#;
 
-/// One variable: its name (`conv1.weight`), its shape and its values, row-major.
-pub type Weight = (String, Vec<usize>, Vec<f32>);
+pub use crate::weights::{tensors, Weight};
 
 /// The network.
 pub struct PilotNet {
@@ -171,25 +170,6 @@ pub fn initial_weights(seed: u64) -> Vec<Weight> {
                     .collect::<Vec<f32>>()
             };
             (name, shape, data)
-        })
-        .collect()
-}
-
-/// Tensors by name, for [`VarBuilder::from_tensors`].
-///
-/// # Errors
-/// candle's, when a shape does not match its data.
-pub fn tensors(
-    weights: &[Weight],
-    device: &Device,
-) -> candle_core::Result<HashMap<String, Tensor>> {
-    weights
-        .iter()
-        .map(|(n, s, d)| {
-            Ok((
-                n.clone(),
-                Tensor::from_vec(d.clone(), s.as_slice(), device)?,
-            ))
         })
         .collect()
 }

@@ -12,6 +12,9 @@ use paracosm_experiments::onnx_export::Graph;
 use paracosm_experiments::pilotnet;
 use paracosm_generators::Strategy;
 
+mod common;
+use common::repo;
+
 /// A model that ignores its image: `controls = tanh(0 · image + bias)`, with `bias` the
 /// pre-tanh throttle and steering, on a `[1, 3, h, w]` input.
 fn constant_model(bias: [f32; 2], h: usize, w: usize) -> Vec<u8> {
@@ -241,10 +244,6 @@ test(horizon = 5.0)
     );
 }
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
 /// Requirement 3: tract's outputs for the shipped model equal candle's for the same weights
 /// (read back from the ONNX file) on 100 camera frames of the training scenario.
 #[test]
@@ -260,28 +259,20 @@ fn the_shipped_pilotnet_gives_tract_the_outputs_candle_computes() {
         "the shipped manifest is MANIFEST"
     );
     let dir = tempfile::tempdir().unwrap();
-    let summary = paracosm::export::dataset::export(
-        &paracosm::export::dataset::DatasetRequest {
-            scenario: repo()
-                .join("experiments/scenarios/pilotnet_train.star")
-                .display()
-                .to_string(),
-            strategy: Strategy::Halton,
-            seed: 0,
-            budget: 2,
-            strength: 2,
-            rate_hz: 4.0,
-            camera: manifest.camera.clone(),
-            sut: None,
-            out: dir.path().join("d"),
-            replace: false,
-            jobs: 2,
-            steer_noise: 0.0,
-            noise_hold_s: 1.0,
-        },
-        None,
-    )
-    .unwrap();
+    let draw = common::Draw {
+        strategy: Strategy::Halton,
+        seed: 0,
+        budget: 2,
+        rate_hz: 4.0,
+        steer_noise: 0.0,
+        noise_hold_s: 1.0,
+    };
+    let summary = common::dataset(
+        "experiments/scenarios/pilotnet_train.star",
+        &draw,
+        manifest.camera.clone(),
+        &dir.path().join("d"),
+    );
     assert!(summary.frames >= 100, "{} frames", summary.frames);
     let mut rows = csv::Reader::from_path(dir.path().join("d/frames.csv")).unwrap();
     let header = rows.headers().unwrap().clone();

@@ -3,42 +3,31 @@
 //! epochs, and the network it writes in the loop of the pedestrian study. About a minute of
 //! training on 2 cores; the full training is in docs/experiments.md.
 
-use std::path::PathBuf;
 use std::process::Command;
+
+mod common;
 
 use paracosm_engine::sut::SutConfig;
 use paracosm_generators::{Generator, Halton};
-
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 #[test]
 fn a_reduced_pilotnet_retrained_from_its_scenario_drives_past_the_crossing() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("data");
-    let summary = paracosm::export::dataset::export(
-        &paracosm::export::dataset::DatasetRequest {
-            scenario: repo()
-                .join("experiments/scenarios/pilotnet_train.star")
-                .display()
-                .to_string(),
-            strategy: paracosm_generators::Strategy::Halton,
-            seed: 0,
-            budget: 32,
-            strength: 2,
-            rate_hz: 10.0,
-            camera: paracosm_engine::CameraSpec::default(),
-            sut: None,
-            out: data.clone(),
-            replace: false,
-            jobs: 2,
-            steer_noise: 0.08,
-            noise_hold_s: 0.5,
-        },
-        None,
-    )
-    .unwrap();
+    let draw = common::Draw {
+        strategy: paracosm_generators::Strategy::Halton,
+        seed: 0,
+        budget: 32,
+        rate_hz: 10.0,
+        steer_noise: 0.08,
+        noise_hold_s: 0.5,
+    };
+    let summary = common::dataset(
+        "experiments/scenarios/pilotnet_train.star",
+        &draw,
+        paracosm_engine::CameraSpec::default(),
+        &data,
+    );
     assert_eq!(summary.errors, 0);
     assert!(summary.frames > 4_000, "{summary:?}");
 

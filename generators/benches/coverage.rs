@@ -1,7 +1,7 @@
 //! The coverage estimators at the sizes issue 3 names: exact dispersion for d = 2 (n = 100,000)
 //! and d = 3 (n = 1,000), the centered and wrap-around discrepancies (n = 4,000, d = 8), k-wise
 //! coverage of 10,000 rows × 50 binary parameters at t = 3, the star discrepancy (d = 2,
-//! n = 2,000), and the scrambled Halton sequence (2^16 points, d = 8).
+//! n = 2,000; d = 3, n = 1,000), and the scrambled Halton sequence (2^16 points, d = 8).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use paracosm_generators::coverage::{
@@ -54,6 +54,12 @@ fn bench(c: &mut Criterion) {
     let s2 = points(Strategy::Halton, 2000, 2);
     g.bench_function("star_d2_n2000", |b| {
         b.iter(|| star_discrepancy(&s2, 2, &StarOptions::default()).unwrap())
+    });
+    // d = 3 by the sweep (star3d.rs): 1,000 points; `cargo run --release -p
+    // paracosm-generators --example star3d -- N halton` times larger n.
+    let s3 = points(Strategy::Halton, 1000, 3);
+    g.bench_function("star_d3_n1000", |b| {
+        b.iter(|| star_discrepancy(&s3, 3, &StarOptions::default()).unwrap())
     });
     let space8 = unit(8);
     g.bench_function("halton_scrambled_65536x8", |b| {

@@ -22,6 +22,9 @@ struct Cli {
     /// Halton tests of Figure 10b.
     #[arg(long, default_value_t = 100, value_parser = paracosm::cli::positive)]
     budget_b: u64,
+    /// Halton tests of Figure 10c's sweep over lead speeds and gaps.
+    #[arg(long, default_value_t = 200, value_parser = paracosm::cli::positive)]
+    budget_c: u64,
     /// Worker threads (default: all cores).
     #[arg(long)]
     jobs: Option<usize>,
@@ -133,26 +136,57 @@ fn main() -> Result<()> {
         }
     }
     if cli.parts.contains('c') {
-        let f = figure10::figure10c(&cli.out.join("fig10c"))?;
-        copy(&f.plots[0], "fig10c_follow.png")?;
-        println!("Figure 10c: wrote {}", f.plots[0].display());
-        for c in &f.cases {
-            let at = |t: f64| {
-                c.speed
-                    .iter()
-                    .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
-                    .map_or(f64::NAN, |p| p.1)
-            };
-            let low = c.speed.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
-            println!(
-                "  {}: speed at 5/10/15/20 s {:.1}/{:.1}/{:.1}/{:.1} m/s, lowest {low:.1} m/s",
-                c.name,
-                at(5.0),
-                at(10.0),
-                at(15.0),
-                at(20.0)
-            );
-        }
+        figure_c(&cli, jobs, &copy)?;
+    }
+    Ok(())
+}
+
+/// Figure 10c: the four single runs with their speeds, then the sweep over lead speeds and
+/// gaps with rates and intervals.
+fn figure_c(cli: &Cli, jobs: usize, copy: &dyn Fn(&PathBuf, &str) -> Result<()>) -> Result<()> {
+    let f = figure10::figure10c(&cli.out.join("fig10c"))?;
+    copy(&f.plots[0], "fig10c_follow.png")?;
+    println!("Figure 10c: wrote {}", f.plots[0].display());
+    for c in &f.cases {
+        let at = |t: f64| {
+            c.speed
+                .iter()
+                .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+                .map_or(f64::NAN, |p| p.1)
+        };
+        let low = c.speed.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+        println!(
+            "  {}: speed at 5/10/15/20 s {:.1}/{:.1}/{:.1}/{:.1} m/s, lowest {low:.1} m/s",
+            c.name,
+            at(5.0),
+            at(10.0),
+            at(15.0),
+            at(20.0)
+        );
+    }
+    let (cases, errors) =
+        figure10::figure10c_sweep(cli.budget_c, jobs, &cli.out.join("fig10c-sweep"))?;
+    println!(
+        "Figure 10c over {} Halton tests (lead speed 3-8 m/s, gap 15-40 m; {errors} in error):",
+        cli.budget_c
+    );
+    for c in &cases {
+        let (cl, ch) = paracosm_experiments::wilson95(c.collisions, c.tests);
+        let (bl, bh) = paracosm_experiments::wilson95(c.fell_behind, c.tests);
+        println!(
+            "- {} lead{}: {} tests, {} collisions ({:.1}-{:.1} %), {} fell behind \
+             ({:.1}-{:.1} %), mean distance {:.1} m",
+            c.lead_color,
+            if c.oncoming { ", oncoming red car" } else { "" },
+            c.tests,
+            c.collisions,
+            100.0 * cl,
+            100.0 * ch,
+            c.fell_behind,
+            100.0 * bl,
+            100.0 * bh,
+            c.mean_distance_m
+        );
     }
     Ok(())
 }

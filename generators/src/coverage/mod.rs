@@ -12,6 +12,7 @@ mod error;
 mod kwise;
 mod ordered_sum;
 mod star;
+mod star3d;
 mod wrap_around;
 
 pub use covering::{k_epsilon_covering, KEpsilonCovering};

@@ -1,0 +1,38 @@
+//! Times the exact star discrepancy in d = 3 of the first N points of a sampler:
+//!
+//! ```text
+//! cargo run --release -p paracosm-generators --example star3d -- 10000 halton
+//! ```
+//!
+//! prints the value, whether it is exact, the seconds it took and the method.
+
+use paracosm_generators::coverage::{star_discrepancy, StarOptions};
+use paracosm_generators::{ParamSpace, Strategy};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let usage = "usage: star3d N SAMPLER (random, halton, sobol)";
+    let n: usize = args.next().ok_or(usage)?.parse()?;
+    let s: Strategy = args.next().ok_or(usage)?.parse()?;
+    let d = 3;
+    let pts: Vec<f64> = s
+        .build(&ParamSpace::unit_cube(d), 1)?
+        .ask(n)?
+        .into_iter()
+        .flat_map(|p| p.continuous)
+        .collect();
+    let t = std::time::Instant::now();
+    let options = StarOptions {
+        exact_max_points: [usize::MAX; 3],
+        ..StarOptions::default()
+    };
+    let r = star_discrepancy(&pts, d, &options)?;
+    println!(
+        "n {n} {s}: D* {:.6e} exact {} in {:.2} s ({})",
+        r.upper,
+        r.exact,
+        t.elapsed().as_secs_f64(),
+        r.method
+    );
+    Ok(())
+}
