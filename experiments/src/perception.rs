@@ -60,6 +60,8 @@ pub enum Task {
 pub const ROAD_CLASSES: [u8; 2] = [2, 3];
 /// The COCO category id of cars in `annotations.json`.
 pub const CAR_CATEGORY: u64 = 5;
+/// The COCO category id of obstacles (static boxes, such as the drive study's truck).
+pub const OBSTACLE_CATEGORY: u64 = 7;
 /// Boxes with fewer visible pixels than this are neither targets nor counted as visible
 /// (at 160 × 120, a car about 60 m ahead shows 20 pixels).
 pub const MIN_AREA: u64 = 12;
@@ -275,6 +277,11 @@ pub fn detections(logits: &[f32]) -> Vec<(f64, f64)> {
     out
 }
 
+/// Whether the pixel `(x, y)` lies in box `b` widened by `slack` pixels on each side.
+pub fn contains(b: &BoxPx, (x, y): (f64, f64), slack: f64) -> bool {
+    x >= b[0] - slack && x <= b[0] + b[2] + slack && y >= b[1] - slack && y <= b[1] + b[3] + slack
+}
+
 /// Detections against the visible boxes: `(whether each box is found, false positives)`. A box is found
 /// when a detection lies inside it (one block of slack each side, as a detection is a
 /// block's centre); each detection finds at most one box (the nearest centre), and a
@@ -287,13 +294,7 @@ pub fn match_detections(dets: &[(f64, f64)], boxes: &[BoxPx]) -> (Vec<bool>, usi
         let best = boxes
             .iter()
             .enumerate()
-            .filter(|(k, b)| {
-                !found[*k]
-                    && x >= b[0] - slack
-                    && x <= b[0] + b[2] + slack
-                    && y >= b[1] - slack
-                    && y <= b[1] + b[3] + slack
-            })
+            .filter(|(k, b)| !found[*k] && contains(b, (x, y), slack))
             .min_by(|(_, a), (_, b)| {
                 let d = |b: &&BoxPx| (b[0] + b[2] / 2.0 - x).hypot(b[1] + b[3] / 2.0 - y);
                 d(a).total_cmp(&d(b))
@@ -302,12 +303,7 @@ pub fn match_detections(dets: &[(f64, f64)], boxes: &[BoxPx]) -> (Vec<bool>, usi
             Some((k, _)) => found[k] = true,
             None => {
                 // Inside a box already found counts as a duplicate, not a false positive.
-                let inside = boxes.iter().any(|b| {
-                    x >= b[0] - slack
-                        && x <= b[0] + b[2] + slack
-                        && y >= b[1] - slack
-                        && y <= b[1] + b[3] + slack
-                });
+                let inside = boxes.iter().any(|b| contains(b, (x, y), slack));
                 false_positives += usize::from(!inside);
             }
         }

@@ -22,8 +22,9 @@ use candle_nn::{AdamW, Optimizer, ParamsAdamW, VarBuilder, VarMap};
 use clap::{Parser, Subcommand};
 use paracosm::report::plot::{xy_plot, Series, XyStyle};
 use paracosm_experiments::perception::{
-    self, centre_targets, detections, match_detections, road_counts, road_targets, BoxPx, Fcn,
-    OnnxMap, Task, CAR_CATEGORY, HEIGHT, MIN_AREA, OUT_H, OUT_W, WIDTH,
+    self, centre_targets, contains, detections, match_detections, road_counts, road_targets, BoxPx,
+    Fcn, OnnxMap, Task, BLOCK, CAR_CATEGORY, HEIGHT, MIN_AREA, OBSTACLE_CATEGORY, OUT_H, OUT_W,
+    WIDTH,
 };
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
@@ -738,21 +739,17 @@ fn drive_study(model: &Path, data: &Path, out: &Path) -> Result<()> {
         let trucks: Vec<BoxPx> = f
             .others
             .iter()
-            .filter(|(c, _)| *c == 7)
+            .filter(|(c, _)| *c == OBSTACLE_CATEGORY)
             .map(|(_, b)| *b)
             .collect();
-        let on = |&(x, y): &(f64, f64), b: &BoxPx| {
-            x >= b[0] && x <= b[0] + b[2] && y >= b[1] && y <= b[1] + b[3]
-        };
-        let in_car = |d: &(f64, f64)| f.cars.iter().any(|b| on(d, b));
-        let on_truck = dets
-            .iter()
-            .filter(|d| !in_car(d) && trucks.iter().any(|b| on(d, b)))
-            .count();
+        // A car is matched with the slack `match_detections` allows; the truck exactly.
+        let in_car = |&d: &(f64, f64)| f.cars.iter().any(|b| contains(b, d, BLOCK as f64));
+        let on_truck = |&d: &(f64, f64)| trucks.iter().any(|b| contains(b, d, 0.0));
+        let truck_hits = dets.iter().filter(|d| !in_car(d) && on_truck(d)).count();
         let kept: Vec<(f64, f64)> = dets
             .iter()
             .copied()
-            .filter(|d| in_car(d) || !trucks.iter().any(|b| on(d, b)))
+            .filter(|d| in_car(d) || !on_truck(d))
             .collect();
         let (hits, fp) = match_detections(&kept, &f.cars);
         let found = hits.iter().filter(|&&x| x).count();
@@ -765,7 +762,7 @@ fn drive_study(model: &Path, data: &Path, out: &Path) -> Result<()> {
             "t {:>4.1} s, {travelled:>5.1} m: {} cars visible, {found} found, {fp} false positives; truck {}",
             f.t_s,
             f.cars.len(),
-            if trucks.is_empty() { "not visible".to_owned() } else { format!("visible, {on_truck} detections on it") }
+            if trucks.is_empty() { "not visible".to_owned() } else { format!("visible, {truck_hits} detections on it") }
         );
         let at: Vec<String> = dets.iter().map(|(x, y)| format!("{x}:{y}")).collect();
         w.write_record([
@@ -775,7 +772,7 @@ fn drive_study(model: &Path, data: &Path, out: &Path) -> Result<()> {
             found.to_string(),
             fp.to_string(),
             (!trucks.is_empty()).to_string(),
-            on_truck.to_string(),
+            truck_hits.to_string(),
             at.join(" "),
         ])?;
         rows.push((travelled, f.cars.len(), found, fp));
