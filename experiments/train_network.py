@@ -27,11 +27,12 @@ ROOT = Path(__file__).resolve().parents[1]
 RECIPES = {
     "pilotnet": {
         "shipped": "assets/models/pilotnet.onnx",
-        "data": ["experiments/scenarios/pilotnet_train.star", "--budget", "128", "--rate", "10",
+        "data": ["experiments/scenarios/pilotnet_train.star", "--budget", "96", "--rate", "10",
                  "--steer-noise", "0.08", "--noise-hold", "0.5"],
         "train": ["--epochs", "8", "--steering-weight", "10", "--closed-loop",
                   "pedestrian-crossing"],
-        "evaluate": ["pedestrian-crossing", "--budget", "400"],
+        "evaluate": [["pedestrian-crossing", "--budget", "400"],
+                     ["experiments/scenarios/pilotnet_bends_check.star", "--budget", "40"]],
     },
     "follow": {
         "shipped": "experiments/models/follow.onnx",
@@ -40,14 +41,14 @@ RECIPES = {
         "train": ["--epochs", "8", "--smooth-s", "1", "--steering-weight", "10",
                   "--brake-weight", "6", "--closed-loop",
                   "experiments/scenarios/follow_red_check.star"],
-        "evaluate": ["experiments/scenarios/follow_red_check.star", "--budget", "40"],
+        "evaluate": [["experiments/scenarios/follow_red_check.star", "--budget", "40"]],
     },
     "loop": {
         "shipped": "experiments/models/loop.onnx",
         "data": ["experiments/scenarios/loop_train.star", "--budget", "48", "--rate", "10",
                  "--steer-noise", "0.1", "--noise-hold", "0.5"],
         "train": ["--steering-weight", "2"],
-        "evaluate": ["experiments/scenarios/fig10b_loop_fog.star", "--budget", "8"],
+        "evaluate": [["experiments/scenarios/fig10b_loop_fog.star", "--budget", "8"]],
     },
 }
 
@@ -85,13 +86,15 @@ def main():
     t_data = run([fuzz, "dataset", *recipe["data"], "--out", data, "--force"])
     t_train = run([str(ROOT / "target/release/train_pilotnet"), "--data", data, "--out", out,
                    "--seed", str(args.seed), *recipe["train"]])
-    t_eval = run([fuzz, *recipe["evaluate"], "--sut-onnx", f"{out}.onnx", "--out",
-                  f"{out}-evaluation", "--force"])
+    # Each evaluation (held-out tests in closed loop) in its own folder.
+    t_eval = sum(run([fuzz, *e, "--sut-onnx", f"{out}.onnx", "--out",
+                      f"{out}-evaluation" + (f"-{k}" if k else ""), "--force"])
+                 for k, e in enumerate(recipe["evaluate"]))
     shipped = ROOT / recipe["shipped"]
     same = shipped.exists() and sha256(ROOT / f"{out}.onnx") == sha256(shipped)
     print(f"\n{args.network}, seed {args.seed}: data {t_data:.0f} s, training {t_train:.0f} s, "
           f"evaluation {t_eval:.0f} s (wall); wrote {out}.onnx, {out}.toml, {out}.md; "
-          f"evaluation in {out}-evaluation/")
+          f"evaluations in {out}-evaluation*/")
     print(f"{out}.onnx is {'identical to' if same else 'not'} the shipped {recipe['shipped']}"
           + ("" if same else " (another seed, or the data or the code changed)"))
 

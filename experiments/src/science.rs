@@ -180,16 +180,62 @@ pub enum Sampler {
     Halton,
     /// Owen-scrambled Sobol points, seed 0.
     Sobol,
+    /// The continuous half of a (2, ε)-covering suite (PARACOSM §3.2, `--strategy ipog`) over
+    /// [`SUITE_LEVELS`] and `d` continuous parameters: one Halton block per row of the IPOG
+    /// array ([`suite_blocks`]); measured as the paper's condition 2 asks, by the worst row's
+    /// block.
+    Suite,
+}
+
+/// The discrete parameters of [`Sampler::Suite`]: four with three levels each (paracosm's
+/// strength-2 IPOG array has 11 rows for them; the smallest possible has 9).
+pub const SUITE_LEVELS: [u32; 4] = [3, 3, 3, 3];
+
+/// The continuous points of each row of a strength-2 IPOG (k, ε)-covering suite over
+/// [`SUITE_LEVELS`] and `d` unit intervals with `⌊n / rows⌋` points per row (at least 1), as
+/// `paracosm-fuzz --strategy ipog` makes them: one `m × d` row-major block per array row.
+///
+/// # Errors
+/// When the space or the array cannot be built (never for these levels).
+pub fn suite_blocks(n: usize, d: usize) -> Result<Vec<Vec<f64>>> {
+    use paracosm_generators::covering::{ArrayKind, CoveringSuite};
+    use paracosm_generators::{Param, Value};
+    let internal = |e: String| paracosm::Error::Internal(e);
+    let mut params: Vec<Param> = SUITE_LEVELS
+        .iter()
+        .enumerate()
+        .map(|(k, &l)| {
+            Param::levels(
+                &format!("level{k}"),
+                (0..i64::from(l)).map(Value::Int).collect(),
+            )
+        })
+        .collect();
+    params.extend((0..d).map(|k| Param::interval(&format!("x{k}"), 0.0, 1.0, "")));
+    let space = ParamSpace::new(params).map_err(|e| internal(e.to_string()))?;
+    let rows = CoveringSuite::new(&space, 2, ArrayKind::Ipog, 1, 0)
+        .map_err(|e| internal(e.to_string()))?
+        .rows();
+    let per_row = (n / rows).max(1) as u64;
+    let suite = CoveringSuite::new(&space, 2, ArrayKind::Ipog, per_row, 0)
+        .map_err(|e| internal(e.to_string()))?;
+    let mut blocks = vec![Vec::with_capacity(per_row as usize * d); rows];
+    for j in 0..suite.len() {
+        blocks[(j % rows as u64) as usize].extend(suite.point(j).continuous);
+    }
+    Ok(blocks)
 }
 
 impl Sampler {
-    /// The first `n` points in `d` dimensions, `n × d` row-major.
+    /// The first `n` points in `d` dimensions, `n × d` row-major (for [`Sampler::Suite`], its
+    /// rows' blocks one after the other).
     ///
     /// # Errors
     /// Sobol past its capacity.
     pub fn points(self, n: usize, d: usize) -> Result<Vec<f64>> {
         let space = ParamSpace::unit_cube(d);
         Ok(match self {
+            Sampler::Suite => suite_blocks(n, d)?.concat(),
             Sampler::Random(seed) => {
                 let mut rng = ChaCha8Rng::seed_from_u64(seed);
                 (0..n * d).map(|_| rng.random::<f64>()).collect()
@@ -201,12 +247,13 @@ impl Sampler {
         })
     }
 
-    /// `random`, `halton` or `sobol`.
+    /// `random`, `halton`, `sobol` or `suite`.
     pub fn name(self) -> &'static str {
         match self {
             Sampler::Random(_) => "random",
             Sampler::Halton => "halton",
             Sampler::Sobol => "sobol",
+            Sampler::Suite => "suite",
         }
     }
 }
@@ -214,11 +261,11 @@ impl Sampler {
 /// One measurement of the dispersion study.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measure {
-    /// `random`, `halton` or `sobol`.
+    /// `random`, `halton`, `sobol` or `suite`.
     pub sampler: &'static str,
     /// Dimension.
     pub d: usize,
-    /// Points.
+    /// Points (for [`Sampler::Suite`], rows × points per row: at most the `n` asked for).
     pub n: usize,
     /// Dispersion bracket `[lower, upper]` (equal when exact).
     pub dispersion: (f64, f64),
@@ -226,7 +273,8 @@ pub struct Measure {
     pub star: (f64, f64),
 }
 
-/// Dispersion and star discrepancy of `sampler`'s first `n` points in `d` dimensions, exact where
+/// Dispersion and star discrepancy of `sampler`'s first `n` points in `d` dimensions (of a
+/// suite's worst row block: brackets `[largest lower end, largest upper end]`), exact where
 /// `dispersion_exact` and `star_exact` allow (as [`DispersionOptions::exact_max_points`] and
 /// [`StarOptions::exact_max_points`]).
 ///
@@ -237,36 +285,48 @@ pub fn measure(
     d: usize,
     n: usize,
     dispersion_exact: &[usize],
-    star_exact: [usize; 3],
+    star_exact: [usize; 4],
 ) -> Result<Measure> {
-    let pts = sampler.points(n, d)?;
+    // A suite is measured by its worst row (PARACOSM §3.1's condition 2).
+    let sets = match sampler {
+        Sampler::Suite => suite_blocks(n, d)?,
+        s => vec![s.points(n, d)?],
+    };
     let internal =
         |e: paracosm_generators::coverage::CoverageError| paracosm::Error::Internal(e.to_string());
-    let disp = dispersion(
-        &pts,
-        d,
-        &DispersionOptions {
-            exact_max_points: dispersion_exact.to_vec(),
-            ..DispersionOptions::default()
-        },
-    )
-    .map_err(internal)?;
-    let star = star_discrepancy(
-        &pts,
-        d,
-        &StarOptions {
-            exact_max_points: star_exact,
-            ..StarOptions::default()
-        },
-    )
-    .map_err(internal)?;
-    Ok(Measure {
+    let mut worst = Measure {
         sampler: sampler.name(),
         d,
-        n,
-        dispersion: (disp.lower, disp.upper),
-        star: (star.lower, star.upper),
-    })
+        n: sets.iter().map(|s| s.len() / d).sum(),
+        dispersion: (0.0, 0.0),
+        star: (0.0, 0.0),
+    };
+    for pts in &sets {
+        let disp = dispersion(
+            pts,
+            d,
+            &DispersionOptions {
+                exact_max_points: dispersion_exact.to_vec(),
+                ..DispersionOptions::default()
+            },
+        )
+        .map_err(internal)?;
+        let star = star_discrepancy(
+            pts,
+            d,
+            &StarOptions {
+                exact_max_points: star_exact,
+                ..StarOptions::default()
+            },
+        )
+        .map_err(internal)?;
+        worst.dispersion = (
+            worst.dispersion.0.max(disp.lower),
+            worst.dispersion.1.max(disp.upper),
+        );
+        worst.star = (worst.star.0.max(star.lower), worst.star.1.max(star.upper));
+    }
+    Ok(worst)
 }
 
 /// The least-squares slope of `ln y` against `ln x`.

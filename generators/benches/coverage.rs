@@ -61,6 +61,12 @@ fn bench(c: &mut Criterion) {
     g.bench_function("star_d3_n1000", |b| {
         b.iter(|| star_discrepancy(&s3, 3, &StarOptions::default()).unwrap())
     });
+    // d = 4 by one scaled d = 3 sweep per prefix (star4d.rs): 256 points (`... --example star3d
+    // -- N halton 4` times larger n).
+    let s4 = points(Strategy::Halton, 256, 4);
+    g.bench_function("star_d4_n256", |b| {
+        b.iter(|| star_discrepancy(&s4, 4, &StarOptions::default()).unwrap())
+    });
     let space8 = unit(8);
     g.bench_function("halton_scrambled_65536x8", |b| {
         b.iter(|| Halton::scrambled(&space8, 0).unit_points(0, 65_536))

@@ -1,7 +1,9 @@
-//! Times the exact star discrepancy in d = 3 of the first N points of a sampler:
+//! Times the exact star discrepancy in d = 3 (or the D given, 1 to 4) of the first N points
+//! of a sampler:
 //!
 //! ```text
 //! cargo run --release -p paracosm-generators --example star3d -- 10000 halton
+//! cargo run --release -p paracosm-generators --example star3d -- 1024 halton 4
 //! ```
 //!
 //! prints the value, whether it is exact, the seconds it took and the method.
@@ -11,10 +13,10 @@ use paracosm_generators::{ParamSpace, Strategy};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let usage = "usage: star3d N SAMPLER (random, halton, sobol)";
+    let usage = "usage: star3d N SAMPLER (random, halton, sobol) [D]";
     let n: usize = args.next().ok_or(usage)?.parse()?;
     let s: Strategy = args.next().ok_or(usage)?.parse()?;
-    let d = 3;
+    let d: usize = args.next().map_or(Ok(3), |a| a.parse())?;
     let pts: Vec<f64> = s
         .build(&ParamSpace::unit_cube(d), 1)?
         .ask(n)?
@@ -23,7 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .collect();
     let t = std::time::Instant::now();
     let options = StarOptions {
-        exact_max_points: [usize::MAX; 3],
+        exact_max_points: [usize::MAX; 4],
         ..StarOptions::default()
     };
     let r = star_discrepancy(&pts, d, &options)?;

@@ -199,19 +199,22 @@ def star_discrepancy(sample, *, seed: int = 0) -> Bracket:
     """The L-infinity star discrepancy `sup_y |#(P in [0, y))/n - vol([0, y))|` of `sample`
     (`(n, d)`, values in [0, 1]).
 
-    Exact for d <= 3 (n <= 20,000 for d = 2, n <= 400 for d = 3) by enumerating the critical
-    grid (Bundschuh and Zhu, 1993); otherwise a bracket: the lower bound from a coordinate
+    Exact for d <= 4 (n <= 20,000 for d = 2, 4,096 for d = 3, 256 for d = 4): by enumerating
+    the critical grid (Bundschuh and Zhu, 1993) for d <= 2, by a sweep with blocked upper
+    envelopes (Dobkin, Eppstein and Mitchell, 1996) for d = 3, by one such sweep per prefix
+    along the first axis for d = 4. Otherwise a bracket: the lower bound from a coordinate
     ascent over the grid (from random starts drawn by `seed`), the upper one from Thiemard's
-    delta-cover (J. Complexity 17, 2001). Past d = 64 or n² · d = 5e7 (d = 8, n = 2,500)
-    the search and the cover are skipped: the bracket is the largest one-axis star
-    discrepancy below and 1 above, and a `RuntimeWarning` says so. Raises ValueError as
-    `discrepancy` does.
+    delta-cover (J. Complexity 17, 2001); `method` says how far the exact value can be from
+    the lower end (upper / lower). Past n² · d = 5e7 (d = 8, n = 2,500) the search is skipped
+    and the lower end is the largest one-axis star discrepancy; past d = 64 the upper end is 1.
+    A `RuntimeWarning` says when the bracket is loose (upper at least twice lower). Raises
+    ValueError as `discrepancy` does.
     """
     a = unit_matrix(sample, "sample")
     lower, upper, exact, corner, method = _native.star_discrepancy(
         a, positive_int(seed, "seed", minimum=0, maximum=2**64 - 1)
     )
-    if not exact and upper >= 1.0:
+    if not exact and (upper >= 1.0 or upper > 2.0 * lower):
         warnings.warn(f"star_discrepancy gives a loose bracket: {method}", RuntimeWarning, stacklevel=2)
     corner = np.asarray(corner, dtype=np.float64)
     return Bracket(lower, upper, exact, np.stack([np.zeros_like(corner), corner]), method)
@@ -221,10 +224,11 @@ def dispersion(sample, *, seed: int = 0) -> Bracket:
     """The dispersion of `sample` (`(n, d)`, values in [0, 1]): the largest volume of an open
     axis-parallel box inside [0, 1]^d holding no point (PARACOSM, section 3.1).
 
-    Exact for d <= 2, and for d >= 3 up to n = 2,500 (d = 3), 300 (d = 4), 120 (d = 5) and
-    60 (d = 6); for d >= 7, and past those sizes, a certified bracket (greedy boxes from starts drawn by `seed`
-    below, a branch and bound above). No other library computes it exactly. Raises
-    ValueError as `discrepancy` does.
+    Exact for d <= 2, and for d >= 3 up to n = 10,000 (d = 3), 1,000 (d = 4), 120 (d = 5) and
+    60 (d = 6); for d >= 7, and past those sizes, a certified bracket (greedy boxes from starts
+    drawn by `seed` below, a branch and bound above) whose `method` says how far the exact
+    value can be from the lower end. No other library computes it exactly. Raises ValueError
+    as `discrepancy` does.
     """
     a = unit_matrix(sample, "sample")
     lower, upper, exact, lo, hi, method = _native.dispersion(

@@ -3,7 +3,8 @@
 //! - `science prop32 [--seeds 4000]`: Proposition 3.2's bound against the empirical cover time of
 //!   random k-wise families, 12 models × δ ∈ {0.1, 0.05, 0.01};
 //! - `science dispersion [--dims 2,3,4]`: dispersion and star discrepancy against n for
-//!   random (3 seeds), Halton and Sobol points, n = 64 … 16,384, with fitted log–log slopes.
+//!   random (3 seeds), Halton and Sobol points and the continuous half of an IPOG (2, ε)-covering
+//!   suite (its worst row), n = 64 … 16,384, with fitted log–log slopes.
 //!
 //! `cargo run --release -p paracosm-experiments --bin science -- prop32`
 
@@ -41,7 +42,7 @@ enum What {
         #[arg(long, default_value = "2,3,4", value_delimiter = ',')]
         dims: Vec<usize>,
         /// Largest n per dimension d = 2, 3, 4 (powers of 4 from 64 up to it).
-        #[arg(long, default_value = "16384,16384,1024", value_delimiter = ',')]
+        #[arg(long, default_value = "16384,16384,16384", value_delimiter = ',')]
         max_n: Vec<usize>,
     },
 }
@@ -97,7 +98,7 @@ fn dispersion_study(out: &Path, dims: &[usize], max_n: &[usize]) -> Result<()> {
         "| d | sampler | n | dispersion | n · dispersion | star discrepancy |\n|---:|---|---:|---:|---:|---:|\n",
     );
     let mut slopes = String::from(
-        "| d | sampler | dispersion slope (exact points) | its reference: ln n / n (random), 1/n (QMC, Prop. 3.3) | star discrepancy slope (exact points) | its reference: n^(-1/2) (random), (ln n)^d / n (QMC) |\n|---:|---|---:|---:|---:|---:|\n",
+        "| d | sampler | dispersion slope (exact points) | its reference: ln n / n (random), 1/n (QMC and suite, Prop. 3.3) | star discrepancy slope (exact points) | its reference: n^(-1/2) (random), (ln n)^d / n (QMC and suite) |\n|---:|---|---:|---:|---:|---:|\n",
     );
     let mut plots = Vec::new();
     for &d in dims {
@@ -108,7 +109,12 @@ fn dispersion_study(out: &Path, dims: &[usize], max_n: &[usize]) -> Result<()> {
             .map(|k| 64usize << (2 * k))
             .take_while(|&n| n <= top)
             .collect();
-        for sampler in [Sampler::Random(0), Sampler::Halton, Sampler::Sobol] {
+        for sampler in [
+            Sampler::Random(0),
+            Sampler::Halton,
+            Sampler::Sobol,
+            Sampler::Suite,
+        ] {
             let seeds: Vec<Sampler> = match sampler {
                 Sampler::Random(_) => (0..3).map(Sampler::Random).collect(),
                 s => vec![s],
@@ -199,10 +205,11 @@ fn measure_sizes(
     table: &mut String,
 ) -> Result<(Pairs, Pairs)> {
     // Exact dispersion as far as it runs in a minute or so; star discrepancy exact in
-    // d <= 2 (O(n²)) and d = 3 to n = 10,000 (the sweep, O(n^{5/2}): 4,096 points in about
-    // 7 s), bracketed beyond.
-    let dispersion_exact = [16_384, 1_024, 120, 60];
-    let star_exact = [usize::MAX, 20_000, 10_000];
+    // d <= 2 (O(n²)), d = 3 to n = 16,384 (the sweep, O(n^{5/2}): 16,384 points in about
+    // 2.5 minutes and 5 GB) and d = 4 to 1,024 (the prefix sweeps, O(n^{7/2}): about 3
+    // minutes), bracketed beyond.
+    let dispersion_exact = [16_384, 4_096, 120, 60];
+    let star_exact = [usize::MAX, 20_000, 16_384, 1_024];
     let mut disp_pts = Vec::new();
     let mut star_pts = Vec::new();
     for &n in ns {
@@ -223,19 +230,27 @@ fn measure_sizes(
                 m.sampler, m.dispersion.0, m.dispersion.1, m.star.0, m.star.1
             )?;
         }
+        // A bracket with how far it can be from the exact value.
         let show = |l: f64, u: f64| {
             if l == u {
                 format!("{l:.3e}")
             } else {
-                format!("[{l:.2e}, {u:.2e}]")
+                format!("[{l:.2e}, {u:.2e}] (×{:.1})", u / l)
             }
+        };
+        // A suite uses rows × points per row, at most n.
+        let n = ms[0].n;
+        // n · dispersion of a bracket: at most n times its upper end.
+        let scaled = if dl == du {
+            format!("{:.2}", n as f64 * du)
+        } else {
+            format!("≤ {:.2}", n as f64 * du)
         };
         writeln!(
             table,
-            "| {d} | {} | {n} | {} | {:.2} | {} |",
+            "| {d} | {} | {n} | {} | {scaled} | {} |",
             sampler.name(),
             show(dl, du),
-            n as f64 * du,
             show(sl, su)
         )?;
         if dl == du {

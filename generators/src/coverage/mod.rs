@@ -13,6 +13,7 @@ mod kwise;
 mod ordered_sum;
 mod star;
 mod star3d;
+mod star4d;
 mod wrap_around;
 
 pub use covering::{k_epsilon_covering, KEpsilonCovering};

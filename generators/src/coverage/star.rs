@@ -21,22 +21,26 @@ pub struct StarDiscrepancy {
 }
 
 /// Most dimensions in which [`star_discrepancy`] searches and covers; past it only the
-/// one-axis lower bound is computed, and the upper bound is 1.
+/// one-axis lower bound is computed, and the upper bound is 1. A bracket's
+/// [`StarDiscrepancy::method`] says how far it can be from the exact value (`upper / lower`).
 pub const MAX_SEARCH_DIMS: usize = 64;
 
 /// The largest `n² · d` for which [`star_discrepancy`] searches and covers past its exact
 /// limits (measured on this project's 2-core machine: `d = 8, n = 2,000`, 3.2·10^7, takes 4 s;
-/// `d = 4, n = 10,000`, 4·10^8, took 38 s); past it, as past [`MAX_SEARCH_DIMS`].
+/// `d = 4, n = 10,000`, 4·10^8, took 38 s); past it the lower bound is the one-axis one, and
+/// the upper bound still the grid cover (which costs `O(n·d)` plus its cells).
 pub const MAX_SEARCH_WORK: f64 = 5e7;
 
 /// Limits of [`star_discrepancy`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct StarOptions {
-    /// Largest `n` solved exactly for `d = 1, 2, 3`. Default `[usize::MAX, 20_000, 4_096]`:
-    /// in d = 3 the sweep takes about 7 s and 330 MB at 4,096 points and 44 s and 2 GB at
-    /// 10,000 on this project's 2-core machine (the campaign summary computes it after every
-    /// campaign; raise it for research sizes).
-    pub exact_max_points: [usize; 3],
+    /// Largest `n` solved exactly for `d = 1, 2, 3, 4`. Default
+    /// `[usize::MAX, 20_000, 4_096, 256]`: in d = 3 the sweep takes about 7 s and 330 MB at
+    /// 4,096 points and 44 s and 2 GB at 10,000, in d = 4 the prefix sweeps take 1.1 s at 256
+    /// Halton points and 198 s at 1,024, on this project's 2-core machine with another job
+    /// beside them (`cargo run --release -p paracosm-generators --example star3d -- 1024 halton
+    /// 4`). The campaign summary computes it after every campaign; raise it for research sizes.
+    pub exact_max_points: [usize; 4],
     /// Cells of the grid δ-cover of the upper bound, at most. Default 2,000,000.
     pub cover_cells: usize,
     /// Random starts of the lower-bound search. Default 8.
@@ -48,7 +52,7 @@ pub struct StarOptions {
 impl Default for StarOptions {
     fn default() -> Self {
         StarOptions {
-            exact_max_points: [usize::MAX, 20_000, 4_096],
+            exact_max_points: [usize::MAX, 20_000, 4_096, 256],
             cover_cells: 2_000_000,
             search_starts: 8,
             seed: 0,
@@ -66,13 +70,14 @@ impl Default for StarOptions {
 /// with k points and calculating the star discrepancy are NP-hard problems", J. Complexity 25,
 /// 2009, §1).
 ///
-/// - Exact for `d <= 3` within [`StarOptions::exact_max_points`], by enumerating `Γ` with
+/// - Exact for `d <= 4` within [`StarOptions::exact_max_points`], by enumerating `Γ` with
 ///   running counts, as in Bundschuh and Zhu ("A method for exact calculation of the
 ///   discrepancy of low-dimensional finite point sets I", Abh. Math. Sem. Univ. Hamburg 63,
 ///   1993): `O(n log n)` for `d = 1`, `O(n²)` for `d = 2`; for `d = 3` a sweep over the first
 ///   axis with blocked upper envelopes, `O(n^{5/2})` (Dobkin, Eppstein and Mitchell,
 ///   "Computing the discrepancy with applications to supersampling patterns", ACM TOG 15(4),
-///   1996; `star3d.rs`).
+///   1996; `star3d.rs`); for `d = 4` one such sweep, volumes scaled, per prefix of the points
+///   sorted along the first axis, `O(n^{7/2})` (`star4d.rs`).
 /// - Otherwise a certified bracket. Lower: the best grid point found by coordinate ascent
 ///   from random starts. Upper: the δ-cover bound of Thiémard ("An algorithm to compute
 ///   bounds for the star discrepancy", J. Complexity 17, 2001) on the uniform grid with `m`
@@ -93,11 +98,12 @@ pub fn star_discrepancy(
     if n == 0 {
         return Err(CoverageError::Shape("the point set is empty".into()));
     }
-    if d <= 3 && n <= options.exact_max_points[d - 1] {
+    if d <= 4 && n <= options.exact_max_points[d - 1] {
         let (value, witness) = match d {
             1 => exact_1d(points),
             2 => plane_terms(points, points, 1.0, n),
-            _ => super::star3d::exact_3d_sweep(points),
+            3 => super::star3d::exact_3d_sweep(points),
+            _ => super::star4d::exact_4d_prefixes(points),
         };
         return Ok(StarDiscrepancy {
             lower: value,
@@ -108,16 +114,23 @@ pub fn star_discrepancy(
                 "exact: sweep of the critical grid with blocked envelopes (d = 3; Dobkin, \
                  Eppstein, Mitchell 1996)"
                     .to_owned()
+            } else if d == 4 {
+                "exact: one scaled d = 3 sweep per prefix along the first axis (d = 4; Dobkin, \
+                 Eppstein, Mitchell 1996)"
+                    .to_owned()
             } else {
                 format!("exact: enumeration of the critical grid (d = {d})")
             },
         });
     }
     let work = (n as f64) * (n as f64) * d as f64;
-    if d > MAX_SEARCH_DIMS || work > MAX_SEARCH_WORK {
-        // The search and the grid cover cost grows with d; past this, the cheap lower bound
-        // of the boxes `[0, 1)^(d-1) × [0, y)` along one axis (each axis's 1-D star
-        // discrepancy), O(n d log n), and the trivial upper bound 1.
+    let searched = d <= MAX_SEARCH_DIMS && work <= MAX_SEARCH_WORK;
+    let (lower, witness) = if searched {
+        search(points, d, options)
+    } else {
+        // The search costs O(n²·d) per round; past its limit, the cheap lower bound of the
+        // boxes `[0, 1)^(d-1) × [0, y)` along one axis (each axis's 1-D star discrepancy),
+        // O(n d log n).
         let mut best = (0.0, vec![1.0; d]);
         for axis in 0..d {
             let column: Vec<f64> = points.chunks_exact(d).map(|p| p[axis]).collect();
@@ -128,32 +141,53 @@ pub fn star_discrepancy(
                 best = (value, witness);
             }
         }
-        return Ok(StarDiscrepancy {
-            lower: best.0,
-            upper: 1.0,
-            exact: false,
-            witness: best.1,
-            method: format!(
-                "bracket (d = {d}, n = {n}: past the search limits of {MAX_SEARCH_DIMS} \
-                 dimensions or n² · d = {MAX_SEARCH_WORK:.0e}): lower = the largest 1-D star \
-                 discrepancy of one coordinate, upper = 1; the search and the grid cover were \
-                 skipped"
-            ),
-        });
-    }
-    let (lower, witness) = search(points, d, options);
-    let (upper, m) = cover_bound(points, d, options.cover_cells);
+        best
+    };
+    // The grid cover costs O(n·d + cells·d) whatever n is: past the search's limit it still
+    // gives an upper bound (all but useless past a few dimensions, where it has 1 or 2 cells
+    // per axis).
+    let (upper, m) = if d <= MAX_SEARCH_DIMS {
+        let (u, m) = cover_bound(points, d, options.cover_cells);
+        (u.max(lower), Some(m))
+    } else {
+        (1.0, None)
+    };
+    let lower_how = if searched {
+        format!(
+            "coordinate ascent over the critical grid ({} starts)",
+            options.search_starts
+        )
+    } else {
+        format!(
+            "the largest 1-D star discrepancy of one coordinate (n = {n}, d = {d}: past the \
+             search limits of {MAX_SEARCH_DIMS} dimensions or n² · d = {MAX_SEARCH_WORK:.0e})"
+        )
+    };
+    let upper_how = match m {
+        Some(m) => format!("δ-cover bound on a uniform grid of {m}^{d} cells (Thiémard 2001)"),
+        None => "1 (no grid cover past 64 dimensions)".to_owned(),
+    };
     Ok(StarDiscrepancy {
         lower,
-        upper: upper.max(lower),
+        upper,
         exact: false,
         witness,
         method: format!(
-            "bracket: lower = coordinate ascent over the critical grid ({} starts), upper = \
-             δ-cover bound on a uniform grid of {m}^{d} cells (Thiémard 2001)",
-            options.search_starts
+            "bracket: lower = {lower_how}, upper = {upper_how}; the exact value is at most {} \
+             the lower end",
+            bracket_factor(lower, upper)
         ),
     })
+}
+
+/// How far a bracket `[lower, upper]` can be from the exact value, as words: "1.7 times",
+/// or "unbounded times" when `lower` is 0.
+pub(super) fn bracket_factor(lower: f64, upper: f64) -> String {
+    if lower > 0.0 {
+        format!("{:.3} times", upper / lower)
+    } else {
+        "unbounded times".to_owned()
+    }
 }
 
 /// Local discrepancy at `y`: `max(vol − open count / n, closed count / n − vol)`.
@@ -227,6 +261,37 @@ fn exact_3d(points: &[f64]) -> (f64, Vec<f64>) {
         let (v, w) = plane_terms(&open, &closed, y0, n);
         if v > best.0 {
             best = (v, std::iter::once(y0).chain(w).collect());
+        }
+    }
+    best
+}
+
+/// The enumeration in `d = 4`: every pair of the first two grid coordinates, the plane of the
+/// last two by [`plane_terms`]; `O(n⁴ log n)`, the reference of [`super::star4d`].
+#[cfg(test)]
+fn exact_4d(points: &[f64]) -> f64 {
+    let n = points.len() / 4;
+    let grid = |k: usize| {
+        let mut g: Vec<f64> = points.chunks_exact(4).map(|p| p[k]).collect();
+        g.push(1.0);
+        g.sort_by(f64::total_cmp);
+        g.dedup();
+        g
+    };
+    let (g0, g1) = (grid(0), grid(1));
+    let mut best: f64 = -1.0;
+    for &y0 in &g0 {
+        for &y1 in &g1 {
+            let subset = |inside: &dyn Fn(f64, f64) -> bool| -> Vec<f64> {
+                points
+                    .chunks_exact(4)
+                    .filter(|p| inside(p[0], y0) && inside(p[1], y1))
+                    .flat_map(|p| [p[2], p[3]])
+                    .collect()
+            };
+            let open = subset(&|x, y| x < y);
+            let closed = subset(&|x, y| x <= y);
+            best = best.max(plane_terms(&open, &closed, y0 * y1, n).0);
         }
     }
     best
@@ -412,6 +477,27 @@ mod tests {
         assert!((r.lower - 0.9).abs() < 1e-12, "{r:?}");
         assert_eq!(r.upper, 1.0);
         assert!(r.method.contains("search limits"), "{}", r.method);
+        assert!(r.method.contains("at most 1.111 times"), "{}", r.method);
+    }
+
+    #[test]
+    fn past_the_search_work_the_cover_still_bounds_and_the_bracket_says_how_far() {
+        // 5,000 random points in d = 3 with no exact solve: n² · d = 7.5e7 is past the search,
+        // but the grid cover (125³ cells) bounds it well below 1.
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let pts: Vec<f64> = (0..15_000)
+            .map(|_| rand::Rng::random::<f64>(&mut rng))
+            .collect();
+        let options = StarOptions {
+            exact_max_points: [0; 4],
+            ..StarOptions::default()
+        };
+        let r = star_discrepancy(&pts, 3, &options).unwrap();
+        assert!(!r.exact);
+        assert!(r.upper < 0.1 && r.lower > 0.0, "{r:?}");
+        let factor = format!("at most {:.3} times the lower end", r.upper / r.lower);
+        assert!(r.method.contains(&factor), "{}", r.method);
+        assert!(r.method.contains("125^3 cells"), "{}", r.method);
     }
 
     /// Brute force over the critical grid.
@@ -501,7 +587,7 @@ mod tests {
 
         #[test]
         fn exact_matches_brute_force(
-            d in 1usize..4,
+            d in 1usize..5,
             raw in prop::collection::vec(0u8..9, 3..30),
         ) {
             // Coordinates on a coarse grid (ties and boundary values included).
@@ -534,6 +620,25 @@ mod tests {
         }
 
         #[test]
+        fn the_prefix_sweeps_equal_the_enumeration_in_d4(
+            raw in prop::collection::vec(0u16..=1000, 4..160),
+            coarse in any::<bool>(),
+        ) {
+            // Up to 40 points: planes of several blocks in the larger prefixes; on a coarse
+            // grid, ties along every axis and the values 0 and 1.
+            let n = raw.len() / 4;
+            let pts: Vec<f64> = raw[..n * 4]
+                .iter()
+                .map(|&v| if coarse { f64::from(v % 7) / 6.0 } else { f64::from(v) / 1000.0 })
+                .collect();
+            let s = star_discrepancy(&pts, 4, &StarOptions::default()).unwrap();
+            let b = exact_4d(&pts);
+            prop_assert!(s.exact);
+            prop_assert!((s.upper - b).abs() < 1e-12, "prefix sweeps {} vs enumeration {}", s.upper, b);
+            prop_assert!((local(&pts, 4, &s.witness) - s.upper).abs() < 1e-12);
+        }
+
+        #[test]
         fn bracket_contains_the_exact_value(
             raw in prop::collection::vec(0u8..=255, 6..60),
         ) {
@@ -541,7 +646,7 @@ mod tests {
             let n = raw.len() / d;
             let pts: Vec<f64> = raw[..n * d].iter().map(|&v| v as f64 / 255.0).collect();
             let exact = star_discrepancy(&pts, d, &StarOptions::default()).unwrap();
-            let opts = StarOptions { exact_max_points: [0, 0, 0], cover_cells: 20_000, ..StarOptions::default() };
+            let opts = StarOptions { exact_max_points: [0; 4], cover_cells: 20_000, ..StarOptions::default() };
             let b = star_discrepancy(&pts, d, &opts).unwrap();
             prop_assert!(!b.exact);
             prop_assert!(b.lower <= exact.upper + 1e-12 && exact.upper <= b.upper + 1e-12,

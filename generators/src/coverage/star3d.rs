@@ -19,10 +19,12 @@
 
 use rayon::prelude::*;
 
-/// Side of a block of cells. On this project's 2-core machine, the exact star discrepancy of
-/// 10,000 Halton points in d = 3 took 45.3 s with 16, 44.0 s with 20, 46.5 s with 24 and
-/// 53.0 s with 32 (`cargo run --release -p paracosm-generators --example star3d -- 10000
-/// halton`).
+/// Largest side of a block of cells (a plane of `m × m` cells takes `m^(1/3)`, at most this).
+/// On this project's 2-core machine, the exact star discrepancy of 10,000 Halton points in
+/// d = 3 took 45.3 s with 16, 44.0 s with 20, 46.5 s with 24 and 53.0 s with 32 (`cargo run
+/// --release -p paracosm-generators --example star3d -- 10000 halton`); 384 points in d = 4
+/// (385 planes of up to 385² cells) took 8.8 s with 20 everywhere, 4.1 s with `m^(1/3)`, 4.2 s
+/// with `0.7·m^(1/3)` and 4.9 s with `1.4·m^(1/3)` (`... -- 384 halton 4`, beside another job).
 const BLOCK: usize = 20;
 
 /// One block of the plane: its cells sorted by `u_i·v_j`, both terms' counts in that order,
@@ -46,13 +48,19 @@ struct Block {
     hull: [Vec<u16>; 2],
     /// Per term, the envelope's entry that was largest at the last `z` asked.
     at: [usize; 2],
+    /// Per term, the factor of the volume (1 in d = 3; the first coordinate's level when the
+    /// plane serves a prefix of a d = 4 set, `star4d.rs`).
+    scale: [f64; 2],
 }
 
 impl Block {
     /// The term's line at position `k`, as (slope, intercept) in units of `1/n`: open
-    /// `n·s·z − c`, closed `c − n·s·z`.
+    /// `n·σ₀·s·z − c`, closed `c − n·σ₁·s·z` (`σ` the term's [`Block::scale`]).
     fn line(&self, term: usize, k: usize) -> (f64, f64) {
-        let (a, c) = (self.slope[k], f64::from(self.counts[term][k]));
+        let (a, c) = (
+            self.slope[k] * self.scale[term],
+            f64::from(self.counts[term][k]),
+        );
         if term == 0 {
             (a, -c)
         } else {
@@ -113,6 +121,8 @@ impl Block {
 
 /// The plane of cells `(i, j)`, both terms, in blocks.
 struct Plane {
+    /// Side of a block of cells, at most [`BLOCK`].
+    side: usize,
     /// Blocks per row of blocks, and rows of blocks.
     nbj: usize,
     nbi: usize,
@@ -127,15 +137,21 @@ struct Plane {
 }
 
 impl Plane {
-    fn new(u: &[f64], v: &[f64], n: usize) -> Self {
+    /// The plane over the grid `u × v`, `n` the divisor of the counts (the size of the whole
+    /// set) and `scale` each term's factor of the volume.
+    fn new(u: &[f64], v: &[f64], n: f64, scale: [f64; 2]) -> Self {
         let (m1, m2) = (u.len(), v.len());
-        let (nbi, nbj) = (m1.div_ceil(BLOCK), m2.div_ceil(BLOCK));
+        // An insertion rebuilds O(m / B) blocks of B² cells and a query reads (m / B)² blocks:
+        // the two balance at B ≈ m^(1/3), which is BLOCK (tuned at 10,000 points) for the
+        // largest planes.
+        let side = ((m1.max(m2) as f64).cbrt().round() as usize).clamp(4, BLOCK);
+        let (nbi, nbj) = (m1.div_ceil(side), m2.div_ceil(side));
         let blocks = (0..nbi * nbj)
             .into_par_iter()
             .map(|b| {
-                let (i0, j0) = ((b / nbj) * BLOCK, (b % nbj) * BLOCK);
-                let (h, w) = (BLOCK.min(m1 - i0), BLOCK.min(m2 - j0));
-                let s = |c: usize| n as f64 * (u[i0 + c / w] * v[j0 + c % w]);
+                let (i0, j0) = ((b / nbj) * side, (b % nbj) * side);
+                let (h, w) = (side.min(m1 - i0), side.min(m2 - j0));
+                let s = |c: usize| n * (u[i0 + c / w] * v[j0 + c % w]);
                 let mut cell: Vec<u16> = (0..(h * w) as u16).collect();
                 cell.sort_by(|&a, &b| s(a as usize).total_cmp(&s(b as usize)));
                 let mut position = vec![0u16; h * w];
@@ -152,10 +168,12 @@ impl Plane {
                     counts: [vec![0; h * w], vec![0; h * w]],
                     hull: [Vec::new(), Vec::new()],
                     at: [0, 0],
+                    scale,
                 }
             })
             .collect();
         Plane {
+            side,
             nbj,
             nbi,
             blocks,
@@ -168,10 +186,11 @@ impl Plane {
     /// Adds 1 to the term's count of every cell `(i, j)` with `i >= i0` and `j >= j0`.
     fn add_quadrant(&mut self, term: usize, i0: usize, j0: usize) {
         let (nbi, nbj) = (self.nbi, self.nbj);
-        let (bi, bj) = (i0 / BLOCK, j0 / BLOCK);
+        let side = self.side;
+        let (bi, bj) = (i0 / side, j0 / side);
         // Blocks whose first row and column are inside take the lazy count; the rest of the
         // quadrant lies in the row of blocks `bi` and the column of blocks `bj`.
-        let (fi, fj) = (i0.div_ceil(BLOCK), j0.div_ceil(BLOCK));
+        let (fi, fj) = (i0.div_ceil(side), j0.div_ceil(side));
         for r in fi..nbi {
             for l in &mut self.lazy[term][r * nbj + fj..(r + 1) * nbj] {
                 *l += 1;
@@ -250,6 +269,17 @@ impl Plane {
 /// (about 1.6 GB at n = 10,000).
 pub(super) fn exact_3d_sweep(points: &[f64]) -> (f64, Vec<f64>) {
     let n = points.len() / 3;
+    let (value, witness, _) = scaled_3d_sweep(points, [1.0, 1.0], n as f64);
+    (value, witness)
+}
+
+/// The largest of `σ₀·vol − open count/n` and `closed count/n − σ₁·vol` over the critical grid
+/// of `points` (`m × 3`, row-major, in `[0, 1]`; `m` may be 0), with `σ = scale` and `n`
+/// (any positive divisor, usually the size of a larger set that `points` is part of): its
+/// value, the grid corner where it is reached and the term (0 open, 1 closed). With `σ = 1`
+/// and `n = m`, the star discrepancy of `points`.
+pub(super) fn scaled_3d_sweep(points: &[f64], scale: [f64; 2], n: f64) -> (f64, Vec<f64>, usize) {
+    let m = points.len() / 3;
     let grid = |k: usize| {
         let mut g: Vec<f64> = points.chunks_exact(3).map(|p| p[k]).collect();
         g.push(1.0);
@@ -265,25 +295,25 @@ pub(super) fn exact_3d_sweep(points: &[f64]) -> (f64, Vec<f64>) {
         .map(|p| (p[0], rank(&u, p[1]), rank(&v, p[2])))
         .collect();
     pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut plane = Plane::new(&u, &v, n);
-    let mut best = (f64::NEG_INFINITY, vec![1.0; 3]);
+    let mut plane = Plane::new(&u, &v, n, scale);
+    let mut best = (f64::NEG_INFINITY, vec![1.0; 3], 0);
     let mut next = 0;
     for &z in &w {
         // Open boxes at z: the points with a first coordinate below z are in.
-        let (val, i, j) = plane.max_at(0, z, n as f64);
+        let (val, i, j) = plane.max_at(0, z, n);
         if val > best.0 {
-            best = (val, vec![z, u[i], v[j]]);
+            best = (val, vec![z, u[i], v[j]], 0);
         }
-        while next < n && pts[next].0 <= z {
+        while next < m && pts[next].0 <= z {
             let (_, r1, r2) = pts[next];
             // Open: cell (i, j) counts a point with r1 < i and r2 < j; closed: r1 <= i, r2 <= j.
             plane.add_quadrant(0, r1 + 1, r2 + 1);
             plane.add_quadrant(1, r1, r2);
             next += 1;
         }
-        let (val, i, j) = plane.max_at(1, z, n as f64);
+        let (val, i, j) = plane.max_at(1, z, n);
         if val > best.0 {
-            best = (val, vec![z, u[i], v[j]]);
+            best = (val, vec![z, u[i], v[j]], 1);
         }
     }
     best

@@ -180,7 +180,9 @@ pub fn dispersion(
             method: format!(
                 "bracket (d = {d}, n = {n}: past the search limits of {MAX_SEARCH_DIMS} \
                  dimensions or n × d² = {MAX_BRACKET_WORK}): lower = the widest empty slab, \
-                 upper = 1; the sweep and the branch and bound were skipped"
+                 upper = 1; the sweep and the branch and bound were skipped; the exact value is \
+                 at most {} the lower end",
+                super::star::bracket_factor(width, 1.0)
             ),
         });
     }
@@ -196,14 +198,15 @@ pub fn dispersion(
         ),
         _ => {
             let b = bracket::bracket(&inner, d, options);
+            let exact = b.upper <= b.witness.volume();
+            let lower = b.witness.volume();
             let method = format!(
                 "bracket (d = {d}, n = {n} is past the exact limit {limit}): lower = largest \
                  empty box found (capped sweep, greedy maximal boxes), upper = branch and bound \
-                 over box corners after {} regions",
-                b.regions
+                 over box corners after {} regions; the exact value is at most {} the lower end",
+                b.regions,
+                super::star::bracket_factor(lower, b.upper.max(lower))
             );
-            let exact = b.upper <= b.witness.volume();
-            let lower = b.witness.volume();
             return Ok(Dispersion {
                 lower,
                 upper: b.upper.max(lower),
