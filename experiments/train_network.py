@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Trains one of the shipped networks from its scenario with one command: the training data
 (`paracosm-fuzz dataset`), the training (`train_pilotnet`, which writes the ONNX file, its
-manifest and its model card), and a closed-loop evaluation on held-out tests
-(`paracosm-fuzz ... --sut-onnx`). Deterministic for a seed: with the seed a network was
+manifest and its model card), DAgger rounds where the recipe has them (the network drives,
+the teacher labels its states: `dataset --learner-onnx`, and a fresh network trains on all the
+data), and a closed-loop evaluation on held-out tests (`paracosm-fuzz ... --sut-onnx`). Deterministic for a seed: with the seed a network was
 shipped with, the ONNX file it writes is the shipped one byte for byte, and the script says
 whether it is.
 
@@ -17,6 +18,7 @@ profile: a no-op when they are up to date).
 import argparse
 import hashlib
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -47,8 +49,13 @@ RECIPES = {
         "shipped": "experiments/models/loop.onnx",
         "data": ["experiments/scenarios/loop_train.star", "--budget", "48", "--rate", "10",
                  "--steer-noise", "0.1", "--noise-hold", "0.5"],
-        "train": ["--steering-weight", "2"],
-        "evaluate": [["experiments/scenarios/fig10b_loop_fog.star", "--budget", "8"]],
+        "train": ["--epochs", "8", "--steering-weight", "10", "--closed-loop",
+                  "experiments/scenarios/loop_check.star"],
+        # One DAgger round: the network of the round before drives the same tests while the
+        # teacher labels its states; the next network trains on all the data so far.
+        "dagger": [["experiments/scenarios/loop_train.star", "--budget", "48", "--rate", "10"]],
+        "evaluate": [["experiments/scenarios/loop_check.star", "--strategy", "random",
+                      "--seed", "1", "--budget", "100"]],
     },
 }
 
@@ -75,6 +82,9 @@ def main():
     ap.add_argument("network", choices=sorted(RECIPES))
     ap.add_argument("--seed", type=int, default=0, help="training seed (default 0, as shipped)")
     ap.add_argument("--out", help="output prefix (default experiments/out/NETWORK-sSEED)")
+    ap.add_argument("--delete-data", action="store_true",
+                    help="delete the data sets once the last network is trained (several GB "
+                         "each; the same command writes them again, bit for bit)")
     args = ap.parse_args()
     recipe = RECIPES[args.network]
     out = args.out or f"experiments/out/{args.network}-s{args.seed}"
@@ -83,9 +93,24 @@ def main():
                     "paracosm-fuzz", "-p", "paracosm-experiments", "--bin", "train_pilotnet"],
                    cwd=ROOT, check=True)
     fuzz = str(ROOT / "target/release/paracosm-fuzz")
+    trainer = str(ROOT / "target/release/train_pilotnet")
+    rounds = recipe.get("dagger", [])
+    # Round 0 trains on the teacher's drives; each DAgger round adds the drives of the
+    # network before it, labelled by the teacher (`dataset --learner-onnx`), and trains a
+    # fresh network on everything. The last round's network is OUT.onnx.
+    outs = [f"{out}-round{k}" for k in range(len(rounds))] + [out]
+    datas = [data] + [f"{out}-data{k + 1}" for k in range(len(rounds))]
     t_data = run([fuzz, "dataset", *recipe["data"], "--out", data, "--force"])
-    t_train = run([str(ROOT / "target/release/train_pilotnet"), "--data", data, "--out", out,
+    t_train = run([trainer, *[a for d in datas[:1] for a in ("--data", d)], "--out", outs[0],
                    "--seed", str(args.seed), *recipe["train"]])
+    for k, more in enumerate(rounds, start=1):
+        t_data += run([fuzz, "dataset", *more, "--learner-onnx", f"{outs[k - 1]}.onnx",
+                       "--out", datas[k], "--force"])
+        t_train += run([trainer, *[a for d in datas[:k + 1] for a in ("--data", d)],
+                        "--out", outs[k], "--seed", str(args.seed), *recipe["train"]])
+    if args.delete_data:
+        for d in datas:
+            shutil.rmtree(ROOT / d, ignore_errors=True)
     # Each evaluation (held-out tests in closed loop) in its own folder.
     t_eval = sum(run([fuzz, *e, "--sut-onnx", f"{out}.onnx", "--out",
                       f"{out}-evaluation" + (f"-{k}" if k else ""), "--force"])

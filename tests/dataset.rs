@@ -221,6 +221,23 @@ fn bad_dataset_settings_exit_2_with_the_reason() {
             &["--noise-hold", "0"][..],
             "--noise-hold 0 must be a positive",
         ),
+        (
+            &[
+                "--learner-onnx",
+                "assets/models/pilotnet.onnx",
+                "--teacher-share",
+                "1.5",
+            ][..],
+            "--teacher-share 1.5 must be in [0, 1]",
+        ),
+        (
+            &["--teacher-share", "0.5"][..],
+            "the following required arguments were not provided",
+        ),
+        (
+            &["--learner-onnx", "no/such/model.onnx"][..],
+            "--learner-onnx:",
+        ),
     ] {
         let r = o(extra);
         expect_code(&r, 2);
@@ -306,4 +323,71 @@ fn steering_noise_moves_the_car_and_the_teacher_steers_back() {
         against > along,
         "teacher steered against the noise on {against} frames, with it on {along}"
     );
+}
+
+/// The named columns of `dir/frames.csv`, one row per frame.
+fn columns(dir: &Path, names: &[&str]) -> Vec<Vec<f64>> {
+    let mut rows = csv::Reader::from_path(dir.join("frames.csv")).unwrap();
+    let header: Vec<String> = rows.headers().unwrap().iter().map(String::from).collect();
+    let at: Vec<usize> = names
+        .iter()
+        .map(|n| header.iter().position(|h| h == n).unwrap())
+        .collect();
+    rows.records()
+        .map(|r| {
+            let r = r.unwrap();
+            at.iter().map(|&i| r[i].parse().unwrap()).collect()
+        })
+        .collect()
+}
+
+/// DAgger (`--learner-onnx`): the network drives, so the car moves exactly as when the network
+/// is the system under test on its own, while the labels are the teacher's answers at the
+/// network's states; with the teacher's share 1 the teacher's answers are what the car applies.
+#[test]
+fn a_learner_drives_and_the_teacher_labels() {
+    let dir = tempfile::tempdir().unwrap();
+    let (alone, dagger, teacher) = (
+        dir.path().join("alone"),
+        dir.path().join("dagger"),
+        dir.path().join("teacher"),
+    );
+    export(&alone, "2", &["--sut", "pilotnet"]);
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/pilotnet.onnx");
+    let model = model.to_str().unwrap();
+    export(&dagger, "2", &["--learner-onnx", model]);
+    export(
+        &teacher,
+        "1",
+        &["--learner-onnx", model, "--teacher-share", "1"],
+    );
+    let motion = [
+        "test",
+        "t_s",
+        "ego_x_m",
+        "ego_z_m",
+        "ego_heading_rad",
+        "ego_speed_mps",
+    ];
+    let (a, d) = (columns(&alone, &motion), columns(&dagger, &motion));
+    assert!(a.len() > 20, "{} frames", a.len());
+    assert_eq!(a, d, "the learner's drive, frame by frame");
+    // What the car applied is the network's answer; the labels are another system's.
+    let (sa, sd) = (steering(&alone), steering(&dagger));
+    assert!(sa.iter().zip(&sd).all(|(a, d)| a.0 == d.1));
+    let relabelled = sa.iter().zip(&sd).filter(|(a, d)| a.0 != d.0).count();
+    assert!(
+        relabelled * 2 > sd.len(),
+        "{relabelled} of {} labels differ from the network's answers",
+        sd.len()
+    );
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dagger.join("dataset.json")).unwrap()).unwrap();
+    assert_eq!(meta["teacher"], "aeb");
+    assert_eq!(meta["learner"]["teacher_share"], 0.0);
+    assert_eq!(meta["learner"]["sha256"].as_str().unwrap().len(), 64);
+    // Share 1: the teacher drives at the network's rate, and applies what it labels.
+    let st = steering(&teacher);
+    assert!(st.iter().all(|(s, a)| s == a));
+    assert_ne!(columns(&teacher, &motion), d, "another drive");
 }

@@ -173,11 +173,18 @@ pub const LOOP_TIMEOUT_S: f64 = 200.0;
 /// Figure 10b: `budget` Halton tests of `fig10b_loop_fog.star` (the `loop` network around a
 /// loop of roads and T-intersections for up to 200 s, fog open), the campaign in
 /// `dir/campaign/`, time to failure against fog density in `dir/figure10b.{png,svg}`.
+/// `model`: another ONNX network (with its manifest beside it) in place of the shipped
+/// `loop.onnx`, e.g. one of another training seed.
 ///
 /// # Errors
-/// When the scenario does not load, or a campaign or the plot cannot be written.
-pub fn figure10b(budget: u64, jobs: usize, dir: &Path) -> Result<Figure10b> {
-    let scenario = load("fig10b_loop_fog.star")?;
+/// When the scenario does not load, the model cannot be used ([`Error::BadInput`]), or a
+/// campaign or the plot cannot be written.
+pub fn figure10b(budget: u64, jobs: usize, dir: &Path, model: Option<&Path>) -> Result<Figure10b> {
+    let mut scenario = load("fig10b_loop_fog.star")?;
+    if let Some(m) = model {
+        scenario.sut = paracosm_engine::sut::SutConfig::onnx(m)
+            .map_err(|e| Error::BadInput(format!("--loop-onnx: {e}")))?;
+    }
     let report = campaign(&scenario, budget, jobs).run(&dir.join("campaign"), |_| {})?;
     let mut tests = Vec::new();
     let mut errors = 0;
@@ -226,7 +233,7 @@ pub fn figure10b(budget: u64, jobs: usize, dir: &Path) -> Result<Figure10b> {
         ),
         (
             format!(
-                "on the road at 200 s, under {LOOP_MIN_DISTANCE_M:.0} m: stopped ({})",
+                "on the road at 200 s, under {LOOP_MIN_DISTANCE_M:.0} m: stopped or crawled ({})",
                 stopped.len()
             ),
             stopped.iter().map(|t| (t.fog, LOOP_TIMEOUT_S)).collect(),

@@ -227,7 +227,8 @@ pub struct Sample<'a> {
     /// The ego vehicle's state at the frame.
     pub ego: EgoState,
     /// The control the system under test answered for this step (or the answer it holds
-    /// between decisions): the label of a training sample.
+    /// between decisions), or its [`Sut::label`](paracosm_engine::sut::Sut::label) when it
+    /// has one (a teacher's answer while a learner drives): the label of a training sample.
     pub control: Control,
     /// The control the vehicle applies from this step on: [`Sample::control`], or what
     /// [`RunOptions::perturb`] made of it.
@@ -360,11 +361,12 @@ impl Scenario {
                     // A viewing camera's frames are for people, not for the system.
                     obs.readings.retain(|(name, _)| *name != "camera");
                 }
-                control = sut.act(&obs)?;
+                let answer = sut.act(&obs)?;
                 applied = match options.perturb.as_mut() {
-                    Some(p) => p(tick as f64 * spec.dt_s, control),
-                    None => control,
+                    Some(p) => p(tick as f64 * spec.dt_s, answer),
+                    None => answer,
                 };
+                control = sut.label().unwrap_or(answer);
             }
             if frame_every > 0 && tick % frame_every == 0 {
                 if let (Some(f), Some(frame), Some(camera)) = (

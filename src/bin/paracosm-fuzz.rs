@@ -246,6 +246,20 @@ struct DatasetArgs {
     /// Seconds each noise value is held.
     #[arg(long, value_name = "S", default_value_t = 1.0)]
     noise_hold: f64,
+    /// An ONNX network that drives while the teacher labels (DAgger: Ross, Gordon and Bagnell
+    /// 2011): the frames show the network's own states, the labels are the teacher's answers
+    /// for them (docs/experiments.md)
+    #[arg(long, value_name = "MODEL.onnx")]
+    learner_onnx: Option<PathBuf>,
+    /// With --learner-onnx: the probability in [0, 1] that a decision applies the teacher's
+    /// answer instead of the network's (DAgger's beta)
+    #[arg(
+        long,
+        value_name = "P",
+        default_value_t = 0.0,
+        requires = "learner_onnx"
+    )]
+    teacher_share: f64,
     /// The teacher, instead of the scenario's system under test.
     #[command(flatten)]
     sut: SutArgs,
@@ -313,6 +327,15 @@ impl DatasetArgs {
             jobs: self.jobs.map_or_else(num_cpus, |j| j as usize),
             steer_noise: self.steer_noise,
             noise_hold_s: self.noise_hold,
+            learner: self
+                .learner_onnx
+                .as_deref()
+                .map(|m| {
+                    paracosm_engine::sut::SutConfig::onnx(m)
+                        .map_err(|e| Error::BadInput(format!("--learner-onnx: {e}")))
+                })
+                .transpose()?,
+            teacher_share: self.teacher_share,
         })
     }
 }

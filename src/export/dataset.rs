@@ -73,6 +73,13 @@ pub struct DatasetRequest {
     pub steer_noise: f64,
     /// How long each noise value is held, s, `> 0`.
     pub noise_hold_s: f64,
+    /// A learner that drives while the teacher labels (DAgger, [`paracosm_engine::sut::Dagger`]):
+    /// the frames are the learner's states, `throttle` and `steering` the teacher's answers.
+    /// `None`: the teacher drives.
+    pub learner: Option<SutConfig>,
+    /// With a learner: the probability in `[0, 1]` that a decision applies the teacher's
+    /// answer instead of the learner's (DAgger's β); 0: the learner always drives.
+    pub teacher_share: f64,
 }
 
 /// Noise injected into the teacher's steering while it drives (DART: Laskey et al. 2017,
@@ -289,6 +296,12 @@ pub fn export(req: &DatasetRequest, stop: Option<&AtomicBool>) -> Result<Dataset
         )));
     }
     SteerNoise::new(req.steer_noise, req.noise_hold_s, 0)?;
+    if !(0.0..=1.0).contains(&req.teacher_share) {
+        return Err(Error::BadInput(format!(
+            "--teacher-share {} must be in [0, 1] (a probability)",
+            req.teacher_share
+        )));
+    }
     let camera = CameraSpec {
         rate_hz: req.rate_hz,
         ..req.camera.clone()
@@ -299,6 +312,13 @@ pub fn export(req: &DatasetRequest, stop: Option<&AtomicBool>) -> Result<Dataset
     let mut scenario = crate::load_scenario(&req.scenario)?;
     if let Some(sut) = &req.sut {
         scenario.sut = sut.clone();
+    }
+    if let Some(learner) = &req.learner {
+        scenario.sut = SutConfig::Dagger {
+            learner: Box::new(learner.clone()),
+            teacher: Box::new(scenario.sut.clone()),
+            beta: req.teacher_share,
+        };
     }
     let campaign = Campaign {
         scenario: &scenario,
@@ -651,7 +671,16 @@ fn manifest(
         "rate_hz": req.rate_hz,
         "steer_noise": req.steer_noise,
         "noise_hold_s": req.noise_hold_s,
-        "teacher": scenario.sut.name(),
+        "teacher": match &scenario.sut {
+            SutConfig::Dagger { teacher, .. } => teacher.name(),
+            other => other.name(),
+        },
+        // DAgger: the learner that drove while the teacher labelled (null: the teacher drove).
+        "learner": req.learner.as_ref().map(|l| serde_json::json!({
+            "name": l.name(),
+            "sha256": l.model_sha256(),
+            "teacher_share": req.teacher_share,
+        })),
         // The camera that took the frames: the teacher's own when it has one (a 64 × 48
         // teacher camera was written up as the 320 × 240 default), else --camera's.
         "camera": done.iter().find_map(|t| t.camera.as_ref()).unwrap_or(camera),
@@ -668,6 +697,6 @@ fn manifest(
         "depth": "z-depth along the optical axis in metres, float32 .npy, height x width; inf where only sky",
         "mask": "8-bit PNG, each pixel a class id",
         "classes": SemanticClass::ALL.iter().map(|c| (c.name(), c.id())).collect::<std::collections::BTreeMap<_, _>>(),
-        "control": "throttle in [-1, 1] (negative: brake), steering in [-1, 1] (positive: left), as the teacher answered for the frame's step; applied_steering: what the vehicle applied (the answer plus the injected steer_noise)",
+        "control": "throttle in [-1, 1] (negative: brake), steering in [-1, 1] (positive: left), as the teacher answered for the frame's step; applied_steering: what the vehicle applied (the answer, or the learner's when one drove, plus the injected steer_noise)",
     })
 }

@@ -9,6 +9,7 @@
 mod aeb;
 mod constant;
 mod cruise;
+mod dagger;
 mod external;
 #[cfg(feature = "onnx")]
 mod onnx;
@@ -20,6 +21,7 @@ mod vision;
 pub use aeb::{Aeb, AebConfig};
 pub use constant::ConstantControl;
 pub use cruise::Cruise;
+pub use dagger::Dagger;
 pub use external::{
     check_command, reap_orphans, track_orphans, CommandError, ExternalConfig, ExternalSut,
     ProcessPool, PROTOCOL_VERSION,
@@ -77,6 +79,13 @@ pub trait Sut: Send {
     /// # Errors
     /// [`SutError::Failed`] if the system cannot answer.
     fn act(&mut self, obs: &Observation<'_>) -> Result<Control, SutError>;
+
+    /// The label of the last decision when it is not the answer: a teacher's answer while a
+    /// learner drives ([`Dagger`]), what `paracosm-fuzz dataset` records. `None` (the
+    /// default): the answer is its own label.
+    fn label(&self) -> Option<Control> {
+        None
+    }
 }
 
 /// A system under test by configuration: what a scenario names and a campaign builds per test.
@@ -104,6 +113,16 @@ pub enum SutConfig {
         inner: Box<SutConfig>,
         /// Distance after which it brakes, m, `>= 0`.
         after_m: f64,
+    },
+    /// `learner` drives and `teacher` labels ([`Dagger`]): training data on the learner's
+    /// own states (`paracosm-fuzz dataset --learner-onnx`).
+    Dagger {
+        /// The system that drives.
+        learner: Box<SutConfig>,
+        /// The system whose answers are the labels.
+        teacher: Box<SutConfig>,
+        /// Probability in `[0, 1]` that a decision applies the teacher's answer instead.
+        beta: f64,
     },
 }
 
@@ -230,6 +249,7 @@ impl SutConfig {
             #[cfg(feature = "onnx")]
             SutConfig::Onnx(c) => Some(&c.sha256),
             SutConfig::StopAfter { inner, .. } => inner.model_sha256(),
+            SutConfig::Dagger { learner, .. } => learner.model_sha256(),
             _ => None,
         }
     }
@@ -250,6 +270,15 @@ impl SutConfig {
             SutConfig::StopAfter { inner, after_m } => {
                 format!("{} stopping after {after_m} m", inner.name())
             }
+            SutConfig::Dagger {
+                learner,
+                teacher,
+                beta,
+            } => format!(
+                "{} driving, {} labelling (teacher's share {beta})",
+                learner.name(),
+                teacher.name()
+            ),
         }
     }
 
@@ -264,6 +293,7 @@ impl SutConfig {
             SutConfig::Onnx(_) => Some(true),
             SutConfig::External(_) => None,
             SutConfig::StopAfter { inner, .. } => inner.has_camera(),
+            SutConfig::Dagger { learner, .. } => learner.has_camera(),
         }
     }
 
@@ -280,6 +310,11 @@ impl SutConfig {
             SutConfig::StopAfter { inner, after_m } => {
                 Box::new(StopAfter::new(inner.build(), *after_m))
             }
+            SutConfig::Dagger {
+                learner,
+                teacher,
+                beta,
+            } => Box::new(Dagger::new(learner.build(), teacher.build(), *beta)),
         }
     }
 }

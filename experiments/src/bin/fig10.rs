@@ -20,11 +20,15 @@ struct Cli {
     #[arg(long, default_value_t = 1000, value_parser = paracosm::cli::positive)]
     budget_a: u64,
     /// Halton tests of Figure 10b.
-    #[arg(long, default_value_t = 100, value_parser = paracosm::cli::positive)]
+    #[arg(long, default_value_t = 400, value_parser = paracosm::cli::positive)]
     budget_b: u64,
     /// Halton tests of Figure 10c's sweep over lead speeds and gaps.
     #[arg(long, default_value_t = 200, value_parser = paracosm::cli::positive)]
     budget_c: u64,
+    /// Figure 10b with this ONNX network (its manifest beside it) instead of the shipped
+    /// experiments/models/loop.onnx, e.g. one of another training seed.
+    #[arg(long, value_name = "MODEL.onnx")]
+    loop_onnx: Option<PathBuf>,
     /// Worker threads (default: all cores).
     #[arg(long)]
     jobs: Option<usize>,
@@ -43,6 +47,46 @@ type Region = fn(&figure10::LightFogTest) -> bool;
 /// `[lo, hi)` bands of width `step` over `[0, 1]`, the last one closed.
 fn band(x: f64, step: f64) -> usize {
     ((x / step) as usize).min((1.0 / step).round() as usize - 1)
+}
+
+/// Figure 10b by fog band: how many tests left the road, how many stayed on it short of 1,000 m (stopped or crawled), how many
+/// drove the whole 200 s (with a 95 % Wilson interval), and the median time to failure of
+/// those that left the road.
+fn loop_bands(tests: &[figure10::LoopTest]) {
+    let edges = [0.0, 0.025, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5, 1.0];
+    println!("| fog | tests | drove 200 s (95 % interval) | left the road | median time to leaving | on the road, short of 1,000 m |");
+    println!("|---|---|---|---|---|---|");
+    for w in edges.windows(2) {
+        let last = w[1] >= 1.0;
+        let band: Vec<_> = tests
+            .iter()
+            .filter(|t| t.fog >= w[0] && (t.fog < w[1] || (last && t.fog <= w[1])))
+            .collect();
+        let mut left: Vec<f64> = band.iter().filter_map(|t| t.time_to_failure_s).collect();
+        left.sort_by(f64::total_cmp);
+        let drove = band
+            .iter()
+            .filter(|t| {
+                t.time_to_failure_s.is_none() && t.distance_m >= figure10::LOOP_MIN_DISTANCE_M
+            })
+            .count();
+        let stopped = band.len() - drove - left.len();
+        let (lo, hi) = paracosm_experiments::wilson95(drove as u64, band.len() as u64);
+        let median = match left.len() {
+            0 => "–".to_owned(),
+            n if n % 2 == 1 => format!("{:.1} s", left[n / 2]),
+            n => format!("{:.1} s", 0.5 * (left[n / 2 - 1] + left[n / 2])),
+        };
+        println!(
+            "| {}–{} | {} | {drove} ({:.0}–{:.0} %) | {} | {median} | {stopped} |",
+            w[0],
+            w[1],
+            band.len(),
+            100.0 * lo,
+            100.0 * hi,
+            left.len()
+        );
+    }
 }
 
 fn main() -> Result<()> {
@@ -106,7 +150,12 @@ fn main() -> Result<()> {
         }
     }
     if cli.parts.contains('b') {
-        let f = figure10::figure10b(cli.budget_b, jobs, &cli.out.join("fig10b"))?;
+        let f = figure10::figure10b(
+            cli.budget_b,
+            jobs,
+            &cli.out.join("fig10b"),
+            cli.loop_onnx.as_deref(),
+        )?;
         copy(&f.plots[0], "fig10b_loop.png")?;
         let failed = f
             .tests
@@ -120,6 +169,7 @@ fn main() -> Result<()> {
             f.errors,
             f.plots[0].display()
         );
+        loop_bands(&f.tests);
         let mut sorted = f.tests.clone();
         sorted.sort_by(|a, b| a.fog.total_cmp(&b.fog));
         for t in &sorted {

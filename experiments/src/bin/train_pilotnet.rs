@@ -30,9 +30,11 @@ use rayon::prelude::*;
 
 #[derive(Debug, Parser)]
 struct Args {
-    /// A folder written by `paracosm-fuzz dataset`.
-    #[arg(long)]
-    data: PathBuf,
+    /// A folder written by `paracosm-fuzz dataset`. Repeat it to pool several (a teacher's
+    /// drives and DAgger rounds, `dataset --learner-onnx`); a test's id is then taken within
+    /// its folder (validation: the tests with id mod `--holdout-every` its last value, in each).
+    #[arg(long, required = true)]
+    data: Vec<PathBuf>,
     /// Output prefix: writes PREFIX.onnx, PREFIX.toml and PREFIX.md.
     #[arg(long, default_value = "experiments/out/pilotnet")]
     out: PathBuf,
@@ -88,6 +90,10 @@ struct Args {
     /// epoch with the fewest failed tests is kept (the validation score breaks ties).
     #[arg(long, value_name = "SCENARIO")]
     closed_loop: Option<String>,
+    /// Also write each epoch's network as PREFIX-epochN.onnx (with its manifest), to drive
+    /// and compare them after training.
+    #[arg(long)]
+    save_epochs: bool,
     /// How many closed-loop tests judge each epoch.
     #[arg(long, default_value_t = 24)]
     closed_loop_tests: usize,
@@ -121,21 +127,30 @@ impl ClosedLoop {
         })
     }
 
-    /// How many of the tests fail with the network of `weights` driving.
-    fn failures(&self, weights: &[pilotnet::Weight]) -> Result<usize> {
+    /// How many of the tests fail with the network of `weights` driving, and how many times
+    /// each monitor failed (a test can fail several), by name.
+    fn failures(
+        &self,
+        weights: &[pilotnet::Weight],
+    ) -> Result<(usize, std::collections::BTreeMap<String, usize>)> {
         let onnx = pilotnet::to_onnx(weights, "an epoch under closed-loop validation");
         let config =
             paracosm_engine::sut::OnnxConfig::from_bytes("training", &onnx, self.manifest.clone())?;
         let mut s = self.scenario.clone();
         s.sut = paracosm_engine::sut::SutConfig::Onnx(Box::new(config));
-        let mut failed = 0;
+        let (mut failed, mut by_monitor) = (0, std::collections::BTreeMap::new());
         for (i, a) in self.points.iter().enumerate() {
             let o = s
                 .run(a, CLOSED_LOOP_FROM + i as u64)
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
             failed += usize::from(!o.passed());
+            for (name, v) in &o.monitors {
+                if !v.passed {
+                    *by_monitor.entry(name.clone()).or_insert(0) += 1;
+                }
+            }
         }
-        Ok(failed)
+        Ok((failed, by_monitor))
     }
 }
 
@@ -274,13 +289,24 @@ fn main() -> Result<()> {
     let started = Instant::now();
     let manifest = Manifest::parse(pilotnet::MANIFEST, std::path::Path::new("pilotnet.toml"))
         .map_err(anyhow::Error::msg)?;
-    let mut frames = load(&args.data, &manifest)?;
+    let mut frames = load(&args.data[0], &manifest)?;
+    for (k, more) in args.data.iter().enumerate().skip(1) {
+        let f = load(more, &manifest)?;
+        frames.images.extend(f.images);
+        frames.speeds.extend(f.speeds);
+        frames.targets.extend(f.targets);
+        frames
+            .tests
+            .extend(f.tests.iter().map(|t| ((k as u64) << 32) | t));
+        frames.times.extend(f.times);
+    }
     if args.smooth_s > 0.0 {
         smooth_throttle(&mut frames, args.smooth_s);
     }
     let n = frames.speeds.len();
-    let (train, valid): (Vec<usize>, Vec<usize>) =
-        (0..n).partition(|&i| frames.tests[i] % args.holdout_every != args.holdout_every - 1);
+    let (train, valid): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| {
+        (frames.tests[i] & u64::from(u32::MAX)) % args.holdout_every != args.holdout_every - 1
+    });
     let braking = |idx: &[usize]| {
         idx.iter()
             .filter(|&&i| frames.targets[2 * i] < -0.5)
@@ -331,9 +357,17 @@ fn main() -> Result<()> {
     drop(vars);
     let weights = weights_of(&varmap)?;
     let validation = evaluate(&net, &frames, &valid, &dev)?;
-    let dataset: serde_json::Value = serde_json::from_slice(
-        &std::fs::read(args.data.join("dataset.json")).context("reading dataset.json")?,
-    )?;
+    let datasets = args
+        .data
+        .iter()
+        .map(|d| {
+            let path = d.join("dataset.json");
+            let text =
+                std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
+            Ok(serde_json::from_slice::<serde_json::Value>(&text)?)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let dataset = &datasets[0];
     let doc = format!(
         "PilotNet-style driver trained by paracosm-experiments train_pilotnet on {}",
         dataset["scenario"]
@@ -348,7 +382,7 @@ fn main() -> Result<()> {
     paracosm::atomic::write(&path("toml"), pilotnet::MANIFEST.as_bytes())?;
     let card = model_card(
         &args,
-        &dataset,
+        &datasets,
         (train.len(), valid.len()),
         validation,
         onnx.len(),
@@ -465,9 +499,22 @@ fn train_epochs(
             total / train.len() as f64,
             100.0 * agree,
             score(metrics),
-            match (failed, closed_loop) {
-                (Some(f), Some(c)) =>
-                    format!("; closed loop: {f} of {} tests failed", c.points.len()),
+            match (&failed, closed_loop) {
+                (Some((f, by)), Some(c)) => format!(
+                    "; closed loop: {f} of {} tests failed{}",
+                    c.points.len(),
+                    if by.is_empty() {
+                        String::new()
+                    } else {
+                        format!(
+                            " ({})",
+                            by.iter()
+                                .map(|(m, k)| format!("{m} {k}"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )
+                    }
+                ),
                 _ => String::new(),
             },
             opt.learning_rate(),
@@ -475,7 +522,22 @@ fn train_epochs(
         );
         eprintln!("{line}");
         log.push(line);
-        let this = (failed.unwrap_or(0), score(metrics));
+        if args.save_epochs {
+            let onnx = pilotnet::to_onnx(&weights_of(varmap)?, "an epoch kept by --save-epochs");
+            let stem = args
+                .out
+                .file_name()
+                .map_or_else(Default::default, |n| n.to_os_string());
+            let mut name = stem;
+            name.push(format!("-epoch{}", epoch + 1));
+            let path = args.out.with_file_name(name).with_extension("onnx");
+            if let Some(dir) = path.parent() {
+                std::fs::create_dir_all(dir)?;
+            }
+            paracosm::atomic::write(&path, &onnx)?;
+            paracosm::atomic::write(&path.with_extension("toml"), pilotnet::MANIFEST.as_bytes())?;
+        }
+        let this = (failed.as_ref().map_or(0, |f| f.0), score(metrics));
         if best.as_ref().is_none_or(|(b, _, _)| this < *b) {
             let kept = vars
                 .iter()
@@ -502,13 +564,13 @@ fn train_epochs(
     Ok((log, best_epoch))
 }
 
-/// The model card (Markdown): the network, the data set it was trained on (`dataset`, its
-/// `dataset.json`), the training and validation frame counts (`split`), the settings, the
+/// The model card (Markdown): the network, the data sets it was trained on (`datasets`, their
+/// `dataset.json`; the first describes the table's rows, the others a row of their own), the training and validation frame counts (`split`), the settings, the
 /// `[throttle MSE, steering MSE, braking agreement]` on the validation frames, the ONNX file's
 /// size in bytes, the training `log` and the epoch whose weights were kept.
 fn model_card(
     args: &Args,
-    dataset: &serde_json::Value,
+    datasets: &[serde_json::Value],
     (ntrain, nvalid): (usize, usize),
     [t, st, agree]: [f64; 3],
     bytes: usize,
@@ -516,6 +578,33 @@ fn model_card(
     started: Instant,
 ) -> String {
     let n = ntrain + nvalid;
+    let dataset = &datasets[0];
+    let more = datasets
+        .iter()
+        .skip(1)
+        .map(|d| {
+            let driver =
+                match d["learner"]["name"].as_str() {
+                    Some(l) => format!(
+                    "`{l}` drove (SHA-256 {}…, teacher's share {}) while `{}` labelled (DAgger)",
+                    d["learner"]["sha256"].as_str().unwrap_or("?").get(..8).unwrap_or("?"),
+                    d["learner"]["teacher_share"],
+                    d["teacher"].as_str().unwrap_or("?")
+                ),
+                    None => format!("`{}` drove", d["teacher"].as_str().unwrap_or("?")),
+                };
+            format!(
+                "| more data | `{}`: {} tests ({} points, seed {}), {} frames; {driver}; steering \
+                 noise ±{} |\n",
+                d["scenario"].as_str().unwrap_or("?"),
+                d["tests"],
+                d["strategy"].as_str().unwrap_or("?"),
+                d["seed"],
+                d["frames"],
+                d["steer_noise"]
+            )
+        })
+        .collect::<String>();
     let stem = args
         .out
         .file_name()
@@ -531,6 +620,7 @@ fn model_card(
          | training scenario | `{scenario}` |\n\
          | teacher | `{teacher}` (lidar time-to-collision braking, lane keeping) |\n\
          | tests | {tests} ({strategy} points, seed {dseed}) at {rate} frames/s{noise} |\n\
+         {more}\
          | frames | {n} ({ntrain} training, {nvalid} validation: tests with id mod {h} = {hl}) |\n\
          | training | candle-nn {cv}, AdamW lr {lr} (linear warm-up over {warm} steps, then a \
          half cosine to {flr} of it), gradient norm clipped at {clip}, batch {batch}, at most \

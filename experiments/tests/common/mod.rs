@@ -42,6 +42,8 @@ pub fn dataset(scenario: &str, draw: &Draw, camera: CameraSpec, out: &Path) -> D
             jobs: 2,
             steer_noise: draw.steer_noise,
             noise_hold_s: draw.noise_hold_s,
+            learner: None,
+            teacher_share: 0.0,
         },
         None,
     )
