@@ -487,8 +487,14 @@ fn train_epochs(
         }
         let metrics = evaluate(net, frames, valid, dev)?;
         let [t, st, agree] = metrics;
+        // The epoch's weights, read once for the closed loop and --save-epochs.
+        let weights = if closed_loop.is_some() || args.save_epochs {
+            weights_of(varmap)?
+        } else {
+            Vec::new()
+        };
         let failed = match closed_loop {
-            Some(c) => Some(c.failures(&weights_of(varmap)?)?),
+            Some(c) => Some(c.failures(&weights)?),
             None => None,
         };
         let line = format!(
@@ -523,7 +529,7 @@ fn train_epochs(
         eprintln!("{line}");
         log.push(line);
         if args.save_epochs {
-            let onnx = pilotnet::to_onnx(&weights_of(varmap)?, "an epoch kept by --save-epochs");
+            let onnx = pilotnet::to_onnx(&weights, "an epoch kept by --save-epochs");
             let stem = args
                 .out
                 .file_name()
@@ -565,9 +571,10 @@ fn train_epochs(
 }
 
 /// The model card (Markdown): the network, the data sets it was trained on (`datasets`, their
-/// `dataset.json`; the first describes the table's rows, the others a row of their own), the training and validation frame counts (`split`), the settings, the
-/// `[throttle MSE, steering MSE, braking agreement]` on the validation frames, the ONNX file's
-/// size in bytes, the training `log` and the epoch whose weights were kept.
+/// `dataset.json`; the first describes the table's rows, the others a row each), the training
+/// and validation frame counts (`split`), the settings, the `[throttle MSE, steering MSE,
+/// braking agreement]` on the validation frames, the ONNX file's size in bytes, the training
+/// `log` and the epoch whose weights were kept.
 fn model_card(
     args: &Args,
     datasets: &[serde_json::Value],
