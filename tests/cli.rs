@@ -669,6 +669,7 @@ fn pedestrian_crossing_star_reproduces_the_rust_study_byte_for_byte() {
         jobs: 2,
         stop_at_first_failure: false,
         points: None,
+        trace: None,
     };
     let out = dir.path().join("rust");
     campaign.run(&out, |_| {}).unwrap();

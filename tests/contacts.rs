@@ -166,6 +166,40 @@ test(horizon = 10.0, offroad = False)
     assert!(ped);
 }
 
+/// A car that rear-ends a slower one stays stopped where it hit it (it does not drive on and
+/// ram it again), and the car it hit brakes to a stop: a crash ends both drives (LANGUAGE.md,
+/// `Car`; a pedestrian met only stops a car until the pedestrian has walked on, as
+/// `a_car_running_into_a_stopped_car_stops_and_a_pedestrian_walking_into_one_collides` and the
+/// `t-loop` built-in have it).
+#[test]
+fn a_car_that_collides_stays_stopped() {
+    let program = format!(
+        "{ROAD}a = Car(loc = r.onLane(1, 20), speed = 15.0)
+b = Car(loc = r.onLane(1, 40), speed = 3.0)
+w.place(r, v, a, b)
+test(horizon = 10.0, offroad = False)
+"
+    );
+    let out = trace(&program, 9.0, |s| {
+        (
+            x_of(s, car(s, 0)),
+            x_of(s, car(s, 1)),
+            flag(s, car(s, 0), Output::Collided),
+        )
+    });
+    let hit = out.iter().position(|o| o.2).expect("a runs into b");
+    // 15.5 m between bumpers closing at 12 m/s: about 1.3 s.
+    assert!((70..90).contains(&hit), "hit at step {hit}");
+    let (a_then, _, _) = out[hit + 60];
+    let (a_end, b_end, _) = *out.last().unwrap();
+    assert_eq!(a_then, a_end, "a stays where it stopped");
+    // b, run into at 3 m/s, brakes to a stop within a second at μ·g; it stays short of the
+    // 9 s it would have driven on.
+    let (_, b_then, _) = out[hit + 60];
+    assert_eq!(b_then, b_end, "b has stopped: {b_then} {b_end}");
+    assert!(b_end < 40.0 + 3.0 * 3.0, "{b_end}");
+}
+
 #[test]
 fn a_lane_changing_car_moves_over_the_ground_at_its_speed_on_a_bend() {
     // Before: its speed was its progress along the start lane's path, so after changing

@@ -113,6 +113,7 @@ fn a_panic_in_a_simulation_is_an_internal_error_record_not_a_failure_of_the_syst
         jobs: 2,
         stop_at_first_failure: false,
         points: None,
+        trace: None,
     };
     let dir = tempfile::tempdir().unwrap();
     let report = campaign.run(dir.path(), |_| {}).unwrap();

@@ -430,7 +430,7 @@ fn a_turn_a_map_fork_lacks_is_refused() {
     assert!(
         stderr.contains("Car c: the route's turn 1 (\"left\") is not possible at the fork")
             && stderr.contains(
-                "roundabout.xodr ends: it offers \"straight\" (road:21, +45°) and \"right\" (road:41, -66°) there"
+                "roundabout.xodr ends: it offers \"straight\" (road:21, +45°) and \"right\" (road:41, -67°) there"
             )
             && stderr.contains("left.star:5:1"),
         "{stderr}"

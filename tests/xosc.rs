@@ -166,6 +166,20 @@ fn a_scenario_in_the_older_forms_reads() {
 "#,
     )
     .unwrap();
+    // `xosc` loads the map as a campaign would: without it the file is refused, naming its
+    // LogicFile.
+    let (code, _, err) = xosc(&[file.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("road.xodr") && err.contains("old.xosc:7:"),
+        "{err}"
+    );
+    std::fs::copy(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/xosc/alks/concrete_scenarios/road_networks/alks_road_straight.xodr"),
+        dir.path().join("road.xodr"),
+    )
+    .unwrap();
     let (code, out, err) = xosc(&[file.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     for want in [

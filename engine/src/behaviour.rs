@@ -87,9 +87,11 @@ pub enum Action {
     /// The car changes to the lane the value names (a lane number of its start segment, or a
     /// `(lane, duration_s)` tuple; 3 s by default).
     ChangeLane(Handle<CarSpec>),
-    /// The car is put at the value, `(Vec3 [x, y, z] m, heading rad)`, for this step, off its
-    /// path: a scripted car (an OpenSCENARIO storyboard's) whose motion its script computes.
-    /// Its reported velocity is the move it makes over the step. It stops for nothing, but
+    /// The car is put at the value, `(Vec3 [x, y, z] m, heading rad)` or `(Vec3, heading,
+    /// speed m/s)`, for this step, off its path: a scripted car (an OpenSCENARIO
+    /// storyboard's) whose motion its script computes. Its reported velocity is the speed
+    /// given, along its heading, else the move it makes over the step (so a teleport with a
+    /// speed given reports that speed, not the jump over one step). It stops for nothing, but
     /// what it touches at the new pose is recorded as a collision of both.
     PlaceCar(Handle<CarSpec>),
     /// The pedestrian is put at the value, `(Vec3 [x, y, z] m of its feet, heading rad)`, for
@@ -100,6 +102,10 @@ pub enum Action {
     /// [`crate::EgoSpec::scripted`] is set (a storyboard replays it; no system under test
     /// drives it).
     PlaceEgo,
+    /// The system under test is asked to keep the value, m/s (a finite number `>= 0`), from
+    /// now on: the set speed its observation carries ([`crate::Observation::set_speed_mps`]),
+    /// as an OpenSCENARIO storyboard's `SpeedAction` on the ego it drives asks.
+    SetEgoSpeed,
 }
 
 impl Action {
@@ -111,7 +117,7 @@ impl Action {
             | Action::Brake(c)
             | Action::ChangeLane(c)
             | Action::PlaceCar(c) => ActorRef::Car(c),
-            Action::PlaceEgo => ActorRef::Ego,
+            Action::PlaceEgo | Action::SetEgoSpeed => ActorRef::Ego,
         }
     }
 }

@@ -26,6 +26,10 @@ pub struct CarState {
     pub enabled: bool,
 }
 
+/// Where a script puts a car for a step: its ground point `[x, z]` (m) and heading (rad),
+/// and the speed the script gives it (m/s), if it gives one ([`Car::place`]).
+pub(crate) type ScriptedPose = (([f64; 2], f64), Option<f64>);
+
 /// When a lane change starts.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub enum LaneChangeStart {
@@ -158,6 +162,10 @@ pub(crate) struct Car {
     /// Whether it has touched anything since the test began (the ego, a car, a pedestrian,
     /// an obstacle).
     pub(crate) collided: bool,
+    /// Whether it has crashed: run into a car or an obstacle, or been run into by a car. A
+    /// crashed car stops for the rest of the test ([`Car::advance`]); a pedestrian it meets
+    /// only stops it until the pedestrian has walked out of its path.
+    pub(crate) wrecked: bool,
     /// The gap it keeps to whatever is ahead on its path, m (`Car(keep_distance=)`): it
     /// brakes, no harder than its tyres allow, to stop that far from it. `None`: it does not
     /// brake for anything (it still stops against what it meets).
@@ -173,7 +181,7 @@ pub(crate) struct Car {
     pub(crate) speed_override: Option<f64>,
     /// The pose a place action gave it for this step (`[x, z]` m, heading rad): it goes
     /// there instead of along its path ([`Car::place`]).
-    pub(crate) script: Option<([f64; 2], f64)>,
+    pub(crate) script: Option<ScriptedPose>,
 }
 
 impl Car {
@@ -217,6 +225,7 @@ impl Car {
             speed_stream,
             touching: false,
             collided: false,
+            wrecked: false,
             keep_distance_m: None,
             lane_change: None,
             change_started_s: None,
@@ -529,7 +538,13 @@ impl Car {
                 room = room.min(stopping_speed(gap - keep, braking, dt_s));
             }
         }
-        let wanted = speed_mps.max(0.0).min(room);
+        // A crashed car (it ran into a car or an obstacle, or a car ran into it) stops there
+        // for the rest of the test: at once against what it ran into, else braking at `μ·g`.
+        let wanted = if self.wrecked {
+            0.0
+        } else {
+            speed_mps.max(0.0).min(room)
+        };
         let rolling = match self.rolling {
             // It enters the test at its command; one too fast to stop before the end brakes
             // at `μ·g` from the first step and stops at the end.
@@ -556,9 +571,10 @@ impl Car {
             s_new = (self.s + k * step).min(end);
         }
         let hit = self.first_contact(solids, me, (self.s, s_new), next_t);
-        if let Some((free_s, _)) = hit {
+        if let Some((free_s, o)) = hit {
             s_new = free_s;
             self.collided = true;
+            self.wrecked |= !matches!(o, ActorRef::Pedestrian(_));
         }
         self.s = s_new;
         // At the end of its path, or against what it ran into, the car has stopped.
@@ -573,12 +589,14 @@ impl Car {
     }
 
     /// Puts the car at `pose` (`[x, z]` m, heading rad) for this step, off its path (a
-    /// scripted car): its velocity is the move over the step. It stops for nothing; returns
-    /// the first object of `solids` its box touches there, which it records as collided.
+    /// scripted car): its velocity is the move over the step, or, when its script gives its
+    /// speed (m/s), that speed along its heading (a teleport's step then has the car's speed,
+    /// not the jump over the step, as esmini reports it). It stops for nothing; returns the
+    /// first object of `solids` its box touches there, which it records as collided.
     pub(crate) fn place(
         &mut self,
         physics: &mut PhysicsWorld,
-        pose: ([f64; 2], f64),
+        (pose, speed): (([f64; 2], f64), Option<f64>),
         dt_s: f64,
         zone: AwakeZone,
         solids: &Solids,
@@ -588,6 +606,10 @@ impl Car {
         self.here = pose;
         self.rolling = Some(0.0);
         self.moved_from(physics, start, dt_s, zone);
+        if let Some(v) = speed {
+            self.speed = v;
+            self.velocity = [v * pose.1.cos(), -v * pose.1.sin()];
+        }
         self.body?;
         let [x, z] = pose.0;
         let centre = [x, CLEARANCE_M + self.size.height_m / 2.0, z];

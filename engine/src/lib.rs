@@ -59,7 +59,7 @@ pub use spec::{
     CarSpec, EgoSpec, EnvironmentSpec, ObstacleSpec, PedestrianSpec, TriggeredPedestrian,
     WorldSpec, DEFAULT_DT_S,
 };
-pub use vehicle::VehicleParams;
+pub use vehicle::{VehicleParams, EGO_SIZE_RANGE_M, GROUND_CLEARANCE_M};
 
 /// The physics steps of `dt_s` seconds between two events of a rate of `hz` per simulated
 /// second (`name` in messages), which must be a whole number `k >= 1`: `hz = 1 / (k · dt_s)`

@@ -125,12 +125,22 @@ impl Pedestrian {
     /// Puts the pedestrian at `pose` (`[x, y, z]` m of its feet, heading rad) for this step
     /// (a scripted pedestrian): its velocity is the move over the step and it faces `pose`'s
     /// heading. A pedestrian placed does not also walk in the same step.
-    pub(crate) fn place(&mut self, physics: &mut PhysicsWorld, pose: ([f64; 3], f64), dt_s: f64) {
+    pub(crate) fn place(
+        &mut self,
+        physics: &mut PhysicsWorld,
+        pose: ([f64; 3], f64),
+        speed: Option<f64>,
+        dt_s: f64,
+    ) {
         self.walked = true;
         let before = self.step_start;
         self.pos = pose.0;
         self.heading_rad = pose.1;
-        self.velocity = [0, 1, 2].map(|i| (self.pos[i] - before[i]) / dt_s);
+        self.velocity = match speed {
+            // Its script's speed along its heading (a teleport's step too).
+            Some(v) => [v * pose.1.cos(), 0.0, -v * pose.1.sin()],
+            None => [0, 1, 2].map(|i| (self.pos[i] - before[i]) / dt_s),
+        };
         physics.bodies[self.body].set_next_kinematic_translation(centre(self.pos));
     }
 

@@ -170,6 +170,7 @@ fn check_ego_and_step(spec: &WorldSpec) -> Result<(), EngineError> {
             "the ego vehicle must start on a driving lane".into(),
         ));
     }
+    crate::VehicleParams::check_size(&spec.ego.vehicle.size)?;
     if !(spec.ego.initial_speed_mps.is_finite() && spec.ego.initial_speed_mps >= 0.0) {
         return Err(invalid(format!(
             "ego initial speed {} m/s is negative or not finite",
@@ -352,11 +353,17 @@ fn build_obstacles(
 /// is not `expected`.
 /// The pose a place action's value gives: `(Vec3 [x, y, z] m, heading rad)`, every number
 /// finite; `None` for anything else.
-fn placed_pose(value: &Value) -> Option<([f64; 3], f64)> {
+/// A placed actor's pose, `(Vec3 [x, y, z] m, heading rad)`, and the speed its script gives
+/// it when the tuple has a third number (m/s, finite and `>= 0`): see [`Action::PlaceCar`].
+fn placed_pose(value: &Value) -> Option<([f64; 3], f64, Option<f64>)> {
+    let pose = |p: &[f64; 3], h: f64| p.iter().all(|x| x.is_finite()) && h.is_finite();
     match value {
         Value::Tuple(t) => match t.as_slice() {
-            [Value::Vec3(p), Value::Num(h)] if p.iter().all(|x| x.is_finite()) && h.is_finite() => {
-                Some((*p, *h))
+            [Value::Vec3(p), Value::Num(h)] if pose(p, *h) => Some((*p, *h, None)),
+            [Value::Vec3(p), Value::Num(h), Value::Num(v)]
+                if pose(p, *h) && v.is_finite() && *v >= 0.0 =>
+            {
+                Some((*p, *h, Some(*v)))
             }
             _ => None,
         },
@@ -792,12 +799,19 @@ impl Simulation {
         let Some(car) = self.cars.get_mut(h) else {
             return Ok(None);
         };
-        if let Some(pose) = car.script.take() {
+        if let Some((pose, speed)) = car.script.take() {
             let zone = AwakeZone {
                 ego_m,
                 radius_m: reach_m + ego_radius_m + car.radius_m() + SLEEP_MARGIN_M,
             };
-            let hit = car.place(&mut self.physics, pose, dt, zone, solids, ActorRef::Car(h));
+            let hit = car.place(
+                &mut self.physics,
+                (pose, speed),
+                dt,
+                zone,
+                solids,
+                ActorRef::Car(h),
+            );
             if car.body.is_some() {
                 solids.move_to(ActorRef::Car(h), car.pose());
             }
@@ -842,6 +856,8 @@ impl Simulation {
             Some(ActorRef::Car(j)) => {
                 if let Some(c) = self.cars.get_mut(j) {
                     c.collided = true;
+                    // Run into by a car: a crash, which ends its drive too.
+                    c.wrecked = true;
                 }
             }
             Some(ActorRef::Pedestrian(j)) => {
@@ -1067,11 +1083,11 @@ impl Simulation {
                         bad(
                             format!("the pose given to {}", self.names.car(h.index())),
                             value,
-                            "a (Vec3 [x, y, z] m, heading rad) pair of finite numbers",
+                            "a (Vec3 [x, y, z] m, heading rad[, speed m/s >= 0]) tuple of finite numbers",
                         )
                     })?;
                     if let Some(car) = self.cars.get_mut(h) {
-                        car.script = Some(([pose.0[0], pose.0[2]], pose.1));
+                        car.script = Some((([pose.0[0], pose.0[2]], pose.1), pose.2));
                     }
                 }
                 Action::PlacePedestrian(h) => {
@@ -1079,11 +1095,11 @@ impl Simulation {
                         bad(
                             format!("the pose given to {}", self.names.pedestrian(h.index())),
                             value,
-                            "a (Vec3 [x, y, z] m, heading rad) pair of finite numbers",
+                            "a (Vec3 [x, y, z] m, heading rad[, speed m/s >= 0]) tuple of finite numbers",
                         )
                     })?;
                     if let Some(p) = self.pedestrians.get_mut(h) {
-                        p.place(&mut self.physics, pose, dt);
+                        p.place(&mut self.physics, (pose.0, pose.1), pose.2, dt);
                     }
                 }
                 Action::PlaceEgo => {
@@ -1091,7 +1107,7 @@ impl Simulation {
                         bad(
                             "the pose given to the ego".into(),
                             value,
-                            "a (Vec3 [x, y, z] m, heading rad) pair of finite numbers",
+                            "a (Vec3 [x, y, z] m, heading rad[, speed m/s >= 0]) tuple of finite numbers",
                         )
                     })?;
                     if !self.ego.scripted {
@@ -1105,6 +1121,16 @@ impl Simulation {
                     }
                     self.ego.place(&mut self.physics, pose.0, pose.1);
                 }
+                Action::SetEgoSpeed => match value {
+                    Value::Num(v) if v.is_finite() && *v >= 0.0 => self.set_speed_mps = Some(*v),
+                    _ => {
+                        return Err(bad(
+                            "the set speed given to the ego's system under test".into(),
+                            value,
+                            "a finite number >= 0 (m/s)",
+                        ))
+                    }
+                },
             }
         }
         self.sinks = sinks;

@@ -26,6 +26,41 @@ pub struct VehicleParams {
     pub max_steer_rad: f64,
 }
 
+/// The body sizes the ego vehicle model is made for, m, each `[least, most]`: length
+/// (its wheels sit 0.8 m inside each end, so a shorter body has no wheelbase), width (the
+/// wheels 0.1 m inside each side) and height (a body taller than the chassis rides high is
+/// raised so that it clears the road by [`GROUND_CLEARANCE_M`]). From a small city car to an
+/// articulated truck's length; beyond them the ray-cast vehicle is no model of the vehicle.
+pub const EGO_SIZE_RANGE_M: [[f64; 2]; 3] = [[2.5, 25.0], [1.0, 3.5], [0.5, 5.0]];
+
+/// The least distance between the ego vehicle's body and the road at rest, m.
+pub const GROUND_CLEARANCE_M: f64 = 0.1;
+
+impl VehicleParams {
+    /// Whether `size` is in [`EGO_SIZE_RANGE_M`].
+    ///
+    /// # Errors
+    /// [`crate::EngineError::InvalidWorld`] naming the side out of range and the range, for
+    /// example "the ego vehicle's length 30 m is outside the vehicle model's range
+    /// [2.5, 25] m".
+    pub fn check_size(size: &crate::Size) -> Result<(), crate::EngineError> {
+        let sides = [
+            ("length", size.length_m),
+            ("width", size.width_m),
+            ("height", size.height_m),
+        ];
+        for ((side, v), [lo, hi]) in sides.into_iter().zip(EGO_SIZE_RANGE_M) {
+            if !(v >= lo && v <= hi) {
+                return Err(crate::EngineError::InvalidWorld(format!(
+                    "the ego vehicle's {side} {v} m is outside the vehicle model's range \
+                     [{lo}, {hi}] m"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
 impl Default for VehicleParams {
     fn default() -> Self {
         VehicleParams {
@@ -103,7 +138,15 @@ impl EgoVehicle {
             .linvel(forward * speed_mps as f32)
             .linear_damping(0.02)
             .can_sleep(false);
-        let collider = ColliderBuilder::cuboid(len / 2.0, hei / 2.0, wid / 2.0)
+        // A body taller than the chassis rides high is raised to clear the road; the default
+        // body (1 m) sits 0.4 m above it, centred on the chassis.
+        let lift = (hei / 2.0 - (ride_m - GROUND_CLEARANCE_M as f32)).max(0.0);
+        let mut collider = ColliderBuilder::cuboid(len / 2.0, hei / 2.0, wid / 2.0);
+        if lift > 0.0 {
+            // (Only then: a body that needs none is built as it always was, bit for bit.)
+            collider = collider.translation(Vector::new(0.0, lift, 0.0));
+        }
+        let collider = collider
             .mass(params.mass_kg as f32)
             .active_events(ActiveEvents::COLLISION_EVENTS)
             .active_collision_types(

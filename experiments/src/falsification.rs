@@ -211,6 +211,7 @@ fn campaign_trials(settings: &StudySettings<'_>, dir: &Path) -> Result<Vec<Trial
                     jobs: settings.jobs,
                     stop_at_first_failure: true,
                     points: None,
+                    trace: None,
                 };
                 let run_dir = dir
                     .join("runs")

@@ -36,6 +36,7 @@ fn campaign(scenario: &Scenario, budget: u64, jobs: usize) -> Campaign<'_> {
         jobs,
         stop_at_first_failure: false,
         points: None,
+        trace: None,
     }
 }
 

@@ -158,6 +158,7 @@ pub fn figure9_with(
             jobs,
             stop_at_first_failure: false,
             points: None,
+            trace: None,
         };
         let report = campaign.run(&dir.join(strategy.name()), |_| {})?;
         let flat: Vec<f64> = report

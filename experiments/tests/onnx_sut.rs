@@ -72,6 +72,7 @@ fn campaign_records(sut: SutConfig, budget: u64, jobs: usize) -> Vec<paracosm::R
         jobs,
         stop_at_first_failure: false,
         points: None,
+        trace: None,
     };
     let points = campaign.points().unwrap();
     points

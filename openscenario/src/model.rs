@@ -77,6 +77,9 @@ pub struct Entity {
     /// Bounding box centre in the entity's frame `[x, y, z]`, m (x forward from the rear
     /// axle, the standard's reference point for vehicles).
     pub centre_m: [f64; 3],
+    /// Where its bounding box's `Dimensions` are written (in a catalog file for a catalog
+    /// entry).
+    pub box_pos: Pos,
     /// The name of the controller its `ObjectController` assigns, if any.
     pub controller: Option<String>,
     /// Where it is declared.
@@ -318,6 +321,22 @@ pub enum Action {
         /// Longitudinal control, when said.
         longitudinal: Option<bool>,
     },
+}
+
+impl Action {
+    /// The element's name in the standard: `SpeedAction`, `LaneChangeAction`, ...
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Action::Speed { .. } => "SpeedAction",
+            Action::LaneChange { .. } => "LaneChangeAction",
+            Action::LaneOffset { .. } => "LaneOffsetAction",
+            Action::LongitudinalDistance { .. } => "LongitudinalDistanceAction",
+            Action::Teleport(_) => "TeleportAction",
+            Action::FollowTrajectory { .. } => "FollowTrajectoryAction",
+            Action::AssignRoute { .. } => "AssignRouteAction",
+            Action::ActivateController { .. } => "ActivateControllerAction",
+        }
+    }
 }
 
 /// The shape of a `FollowTrajectoryAction`'s trajectory.

@@ -163,6 +163,7 @@ impl ScenarioHandle {
                         jobs,
                         stop_at_first_failure: false,
                         points: Some(&points),
+                        trace: None,
                     };
                     let mut lines = Vec::with_capacity(points.len());
                     let mut collect = OnRecord(|r: &RunRecord| {

@@ -306,6 +306,10 @@ pub struct Scenario {
     pub unused_params: Vec<String>,
     /// The open parameters that only a camera sees.
     pub camera_only: Vec<CameraOnly>,
+    /// The vehicle the system under test drives, as the summary names it, when the
+    /// scenario's file chose it among its entities (OpenSCENARIO: `Ego, 5 × 2 × 1.8 m`);
+    /// `None` for a program's `AutonomousVehicle`.
+    pub ego: Option<String>,
     /// The program text it was loaded from (empty for scenarios written in Rust): part of a
     /// campaign's fingerprint, so a resumed campaign runs the same program.
     pub source: Arc<str>,
@@ -466,6 +470,7 @@ impl Scenario {
             warnings: vec![],
             unused_params: vec![],
             camera_only: vec![],
+            ego: None,
             source: Arc::from(""),
             input_files: Vec::new(),
             worlds: Arc::new(RustWorlds(build)),

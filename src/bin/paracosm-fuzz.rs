@@ -57,6 +57,24 @@ struct Cli {
     /// replays a test that `export` wrote. Not with --sut, --sut-cmd or --sut-onnx.
     #[arg(long)]
     scripted_ego: bool,
+    /// With an OpenSCENARIO scenario (.xosc): the vehicle the system under test drives, for
+    /// a file with several vehicles, none named Ego or hero, whose storyboard activates no
+    /// controller (such a file is refused without it). The summary names the ego.
+    #[arg(long, value_name = "NAME")]
+    ego: Option<String>,
+    /// With an OpenSCENARIO scenario (.xosc): end each test at this simulated time, s, at
+    /// the latest (the storyboard's stop trigger may end it sooner). Needed by a storyboard
+    /// without a stop trigger, which is refused without it.
+    #[arg(long, value_name = "SECONDS")]
+    horizon: Option<f64>,
+    /// Write each test's trace to OUT/trace/test_N.csv: every entity's pose, speed and
+    /// acceleration in the map's frame, laid out as esmini's CSV log (docs/cli.md, "Traces").
+    #[arg(long)]
+    trace: bool,
+    /// With --trace: the time between two lines of a trace, s [default: 0.1] (implies
+    /// --trace).
+    #[arg(long, value_name = "SECONDS")]
+    trace_every: Option<f64>,
     /// How test points are chosen [default: halton].
     #[arg(long, value_parser = paracosm::cli::strategy_parser())]
     strategy: Option<Strategy>,
@@ -301,6 +319,13 @@ struct ReplayArgs {
     /// mounted when the system under test has none).
     #[arg(long, value_name = "DIR")]
     frames: Option<PathBuf>,
+    /// Folder for the test's trace, DIR/test_ID.csv: every entity's pose, speed and
+    /// acceleration, laid out as esmini's CSV log (as a campaign's --trace writes).
+    #[arg(long, value_name = "DIR")]
+    trace: Option<PathBuf>,
+    /// With --trace: the time between two lines, s [default: 0.1].
+    #[arg(long, value_name = "SECONDS", requires = "trace")]
+    trace_every: Option<f64>,
     /// A system under test to replay with instead of the recorded one.
     #[command(flatten)]
     sut: SutArgs,
@@ -434,7 +459,21 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Some(Sub::Replay(a)) => {
             let sut = a.sut.config();
-            sut.and_then(|s| paracosm::export::replay::replay(&a.results, a.id, a.frames.as_deref(), s))
+            let trace = a.trace.clone().map(|path| paracosm::export::trace::TraceSpec {
+                path,
+                every_s: a
+                    .trace_every
+                    .unwrap_or(paracosm::export::trace::DEFAULT_EVERY_S),
+            });
+            sut.and_then(|s| {
+                paracosm::export::replay::replay_traced(
+                    &a.results,
+                    a.id,
+                    a.frames.as_deref(),
+                    s,
+                    trace,
+                )
+            })
                 .map_err(anyhow::Error::new)
                 .and_then(|r| say(&r.text(a.id, a.frames.as_deref())).map(|()| r))
                 .map(|r| if r.matches { 0 } else { 3 })
@@ -491,7 +530,7 @@ fn main() -> ExitCode {
                 say(&text).map(|()| if e.matches { 0 } else { 3 })
             }),
         Some(Sub::Map(a)) => map(a),
-        Some(Sub::Xosc(a)) => paracosm::xosc::inspect(&a.file, &a.open, a.continuous)
+        Some(Sub::Xosc(a)) => paracosm::xosc::inspect_with_map(&a.file, &a.open, a.continuous)
             .map_err(anyhow::Error::from)
             .and_then(|i| say(&i.text()).map(|()| 0)),
         None => run(&cli),
@@ -626,12 +665,20 @@ impl Cli {
                     open: self.open.clone(),
                     continuous: self.continuous,
                     scripted_ego: self.scripted_ego,
+                    ego: self.ego.clone(),
+                    horizon_s: self.horizon,
                 },
             )),
-            Some(_) if !self.open.is_empty() || self.continuous || self.scripted_ego => {
+            Some(_)
+                if !self.open.is_empty()
+                    || self.continuous
+                    || self.scripted_ego
+                    || self.ego.is_some()
+                    || self.horizon.is_some() =>
+            {
                 return Err(Error::BadInput(
-                    "--open, --continuous and --scripted-ego are for an OpenSCENARIO scenario \
-                     (.xosc)"
+                    "--open, --continuous, --scripted-ego, --ego and --horizon are for an \
+                     OpenSCENARIO scenario (.xosc)"
                         .into(),
                 ))
             }
@@ -653,6 +700,10 @@ impl Cli {
             deny_warnings: self.deny_warnings,
             junit: self.junit.clone(),
             points: self.points.clone(),
+            trace_every_s: (self.trace || self.trace_every.is_some()).then_some(
+                self.trace_every
+                    .unwrap_or(paracosm::export::trace::DEFAULT_EVERY_S),
+            ),
         })
     }
 }

@@ -163,6 +163,7 @@ fn shard_records(
         jobs: 1,
         stop_at_first_failure: false,
         points: None,
+        trace: None,
     };
     campaign.check_origin(
         &existing.records,

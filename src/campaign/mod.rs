@@ -53,6 +53,9 @@ pub struct Campaign<'a> {
     /// The points of [`Strategy::Points`], in test order (`budget` of them at least); `None`
     /// for every other strategy, which makes its own.
     pub points: Option<&'a [Point]>,
+    /// Write each test's trace (`--trace`): every entity's pose, speed and acceleration, to
+    /// `path/test_N.csv` ([`crate::export::trace`]); `None`: no trace.
+    pub trace: Option<crate::export::trace::TraceSpec>,
 }
 
 /// What a finished campaign reports.
@@ -202,6 +205,58 @@ impl Campaign<'_> {
     /// As [`Campaign::run_one`], with a viewing camera and a frame callback: what a replay
     /// does.
     pub fn run_one_with(&self, id: u64, point: &Point, options: &mut RunOptions<'_>) -> RunRecord {
+        match &self.trace {
+            Some(trace) if options.on_world.is_none() && options.on_step.is_none() => {
+                let mut world = None;
+                let mut states = Vec::new();
+                let mut on_world = |w: &paracosm_engine::WorldSpec| world = Some(w.clone());
+                let mut on_step = |s: &paracosm_engine::Snapshot| states.push(s.clone());
+                let mut traced = RunOptions {
+                    camera: options.camera.clone(),
+                    on_frame: options
+                        .on_frame
+                        .as_deref_mut()
+                        .map(|f| f as &mut dyn FnMut(&paracosm_engine::CameraFrame)),
+                    on_sample: options
+                        .on_sample
+                        .as_deref_mut()
+                        .map(|f| f as &mut dyn FnMut(&paracosm_scenarios::Sample<'_>)),
+                    perturb: options.perturb.as_deref_mut().map(|f| {
+                        f as &mut dyn FnMut(
+                            f64,
+                            paracosm_engine::Control,
+                        ) -> paracosm_engine::Control
+                    }),
+                    on_world: Some(&mut on_world),
+                    on_step: Some(&mut on_step),
+                };
+                let mut record = self.run_one_untraced(id, point, &mut traced);
+                if let Some(world) = world {
+                    let path = trace.path.join(format!("test_{id}.csv"));
+                    let written = crate::export::trace::write(
+                        &path,
+                        &world,
+                        &states,
+                        (trace.every_s, world.dt_s),
+                        (
+                            &self.scenario.name,
+                            &crate::export::trace::ego_name(self.scenario),
+                        ),
+                    );
+                    if let Err(e) = written {
+                        // A test whose trace was asked for and is missing is no result.
+                        record.status = Status::Error;
+                        record.error = Some(format!("its trace was not written: {e}"));
+                    }
+                }
+                record
+            }
+            _ => self.run_one_untraced(id, point, options),
+        }
+    }
+
+    /// [`Campaign::run_one_with`] without writing a trace.
+    fn run_one_untraced(&self, id: u64, point: &Point, options: &mut RunOptions<'_>) -> RunRecord {
         let started = Instant::now();
         let seed = test_seed(self.seed, id);
         let scenario = self.scenario;
@@ -743,6 +798,7 @@ mod tests {
             jobs,
             stop_at_first_failure: false,
             points: None,
+            trace: None,
         }
     }
 

@@ -117,6 +117,7 @@ mod tests {
             jobs: 1,
             stop_at_first_failure: false,
             points: None,
+            trace: None,
         };
         c.run(dir.path(), |_| {}).unwrap();
         let path = dir.path().join(RESULTS_FILE);

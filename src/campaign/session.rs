@@ -17,6 +17,9 @@ use crate::report::summary::Summary;
 use crate::report::{warnings_of, write_outputs, Finished};
 use crate::Error;
 
+/// The folder of a campaign's traces (`--trace`), inside its output folder.
+pub const TRACE_FOLDER: &str = "trace";
+
 /// What to run: `paracosm-fuzz`'s arguments as data. `None` fields take the defaults (or,
 /// with `resume`, the stored campaign's values).
 #[derive(Debug, Clone)]
@@ -54,6 +57,9 @@ pub struct Request {
     /// values in their units (levels as written), one test per row in file order, or the
     /// `results.jsonl` of another campaign. Strategy `points`; the budget is the row count.
     pub points: Option<PathBuf>,
+    /// Write each test's trace into `out/trace/test_N.csv`, a line every this many seconds
+    /// (`--trace`, `--trace-every`; [`crate::export::trace`]).
+    pub trace_every_s: Option<f64>,
 }
 
 impl Request {
@@ -75,6 +81,7 @@ impl Request {
             deny_warnings: false,
             junit: None,
             points: None,
+            trace_every_s: None,
         }
     }
 }
@@ -243,6 +250,19 @@ pub fn run(
         jobs,
         stop_at_first_failure,
         points: points.as_deref(),
+        trace: match request.trace_every_s {
+            Some(every_s) => {
+                if !(every_s.is_finite() && every_s > 0.0) {
+                    return Err(Error::BadInput(format!(
+                        "--trace-every {every_s} s must be a finite number of seconds > 0"
+                    )));
+                }
+                let path = out.join(TRACE_FOLDER);
+                crate::atomic::make_output_folder(&path)?;
+                Some(crate::export::trace::TraceSpec { path, every_s })
+            }
+            None => None,
+        },
     };
     campaign.check_origin(
         &existing.records,

@@ -329,6 +329,7 @@ pub fn export(req: &DatasetRequest, stop: Option<&AtomicBool>) -> Result<Dataset
         jobs: req.jobs,
         stop_at_first_failure: false,
         points: None,
+        trace: None,
     };
     let points = campaign.points()?;
     prepare(&req.out, req.replace)?;

@@ -7,6 +7,7 @@
 
 pub mod dataset;
 pub mod replay;
+pub mod trace;
 pub mod xml;
 pub mod xodr;
 pub mod xosc;
@@ -119,7 +120,7 @@ pub fn export(
     let replayed = crate::export::replay::replay_with(
         results,
         id,
-        None,
+        (None, None),
         None,
         Some(&mut on_world),
         Some(&mut on_step),

@@ -105,7 +105,31 @@ pub fn replay(
     frames: Option<&Path>,
     sut: Option<SutConfig>,
 ) -> Result<Replay, Error> {
-    replay_with(results, id, frames, sut, None, None)
+    replay_with(results, id, (frames, None), sut, None, None)
+}
+
+/// [`replay`], writing the test's trace (`replay --trace DIR`: `DIR/test_ID.csv`,
+/// [`crate::export::trace`]) as a campaign's `--trace` does.
+///
+/// # Errors
+/// As [`replay`]; [`Error::BadInput`] or [`Error::Write`] when the folder cannot be made.
+pub fn replay_traced(
+    results: &Path,
+    id: u64,
+    frames: Option<&Path>,
+    sut: Option<SutConfig>,
+    trace: Option<crate::export::trace::TraceSpec>,
+) -> Result<Replay, Error> {
+    if let Some(t) = &trace {
+        if !(t.every_s.is_finite() && t.every_s > 0.0) {
+            return Err(Error::BadInput(format!(
+                "--trace-every {} s must be a finite number of seconds > 0",
+                t.every_s
+            )));
+        }
+        crate::atomic::make_output_folder(&t.path)?;
+    }
+    replay_with(results, id, (frames, trace), sut, None, None)
 }
 
 /// [`replay`], also calling `on_world` with the test's world as built and `on_step` with its
@@ -116,7 +140,7 @@ pub fn replay(
 pub fn replay_with(
     results: &Path,
     id: u64,
-    frames: Option<&Path>,
+    (frames, trace): (Option<&Path>, Option<crate::export::trace::TraceSpec>),
     sut: Option<SutConfig>,
     on_world: Option<&mut dyn FnMut(&paracosm_engine::WorldSpec)>,
     on_step: Option<&mut dyn FnMut(&paracosm_engine::Snapshot)>,
@@ -149,6 +173,7 @@ pub fn replay_with(
         jobs: 1,
         stop_at_first_failure: false,
         points: None,
+        trace,
     };
     if let Some(dir) = frames {
         std::fs::create_dir_all(dir)

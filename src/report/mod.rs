@@ -418,6 +418,7 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
             &scenario.sut,
             &f.file.sut,
         )),
+        ego: scenario.ego.clone(),
         strategy: f.file.strategy.clone(),
         seed: f.file.seed,
         budget: f.file.budget,
@@ -482,6 +483,9 @@ pub fn human(
     )];
     if let Some(sut) = &summary.sut {
         lines.push(format!("system under test: {}", sut.text()));
+    }
+    if let Some(ego) = &summary.ego {
+        lines.push(format!("ego vehicle: {ego}"));
     }
     if let Some(f) = &summary.first_failure {
         lines.push(first_failure_line(f, scenario));

@@ -176,6 +176,10 @@ pub struct Summary {
     /// The system under test that ran; `null` in summaries written before it was recorded.
     #[serde(default)]
     pub sut: Option<SutSummary>,
+    /// The vehicle the system under test drives, when the scenario's file chose it among
+    /// its entities (an OpenSCENARIO file: its name and bounding box, `Ego, 5 × 2 × 1.8 m`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ego: Option<String>,
     /// Strategy name.
     pub strategy: String,
     /// Campaign seed.

@@ -126,13 +126,30 @@ pub fn inspect(path: &Path, opens: &[String], continuous: bool) -> Result<Inspec
     })
 }
 
+/// [`inspect`], and the scenario's OpenDRIVE map loaded as a campaign over it would load it
+/// (`paracosm-fuzz xosc`: a file whose campaign would refuse its map is refused when listed).
+///
+/// # Errors
+/// As [`inspect`]; [`Error::Scenario`] when the map does not load (naming the `LogicFile`'s
+/// line and column).
+pub fn inspect_with_map(
+    path: &Path,
+    opens: &[String],
+    continuous: bool,
+) -> Result<Inspection, Error> {
+    let found = inspect(path, opens, continuous)?;
+    paracosm_scenarios::xosc::load_map(&found.scenario)?;
+    Ok(found)
+}
+
 /// The separator between an OpenSCENARIO file and its options in a campaign's scenario name:
-/// `file.xosc#open=Name=lo..hi;open=Name=a,b;continuous;scripted-ego` (what `campaign.json`
+/// `file.xosc#open=Name=lo..hi;open=Name=a,b;continuous;scripted-ego;ego=Name;horizon=30`
+/// (what `campaign.json`
 /// keeps, so that resume, report, replay and export build the same space and world).
 pub const OPTIONS_MARK: char = '#';
 
 /// How a campaign reads an OpenSCENARIO file (`paracosm-fuzz FILE.xosc` options).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct XoscOptions {
     /// `--open`: declared parameters opened, `Name=lo..hi` or `Name=a,b,c`.
     pub open: Vec<String>,
@@ -141,6 +158,11 @@ pub struct XoscOptions {
     /// `--scripted-ego`: the storyboard moves the ego as every other entity (no system under
     /// test), to replay an exported test ([`paracosm_scenarios::xosc::Source::scripted_ego`]).
     pub scripted_ego: bool,
+    /// `--ego NAME`: the vehicle the system under test drives, for a file that does not say
+    /// plainly ([`paracosm_scenarios::xosc::ego_of`]).
+    pub ego: Option<String>,
+    /// `--horizon`: the longest test, s; a storyboard without a stop trigger needs it.
+    pub horizon_s: Option<f64>,
 }
 
 /// The campaign scenario name of `path` with `options`: the path alone without options.
@@ -152,6 +174,12 @@ pub fn campaign_name(path: &str, options: &XoscOptions) -> String {
     }
     if options.scripted_ego {
         options_text.push("scripted-ego".into());
+    }
+    if let Some(ego) = &options.ego {
+        options_text.push(format!("ego={ego}"));
+    }
+    if let Some(h) = options.horizon_s {
+        options_text.push(format!("horizon={h}"));
     }
     let options = options_text;
     if options.is_empty() {
@@ -182,14 +210,22 @@ pub fn campaign_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Err
     let mut opens = Vec::new();
     let mut continuous = false;
     let mut scripted_ego = false;
+    let mut ego = None;
+    let mut horizon_s = None;
     for o in options.split(';').filter(|o| !o.is_empty()) {
         match o.split_once('=') {
             Some(("open", spec)) => opens.push(spec.to_owned()),
+            Some(("ego", e)) => ego = Some(e.to_owned()),
+            Some(("horizon", h)) => {
+                horizon_s = Some(h.parse::<f64>().map_err(|_| {
+                    Error::BadInput(format!("{name}: horizon={h} is not a number of seconds"))
+                })?)
+            }
             None if o == "continuous" => continuous = true,
             None if o == "scripted-ego" => scripted_ego = true,
             _ => {
                 return Err(Error::BadInput(format!(
-                "{name}: unknown option {o:?} after {OPTIONS_MARK} (open=Name=lo..hi, continuous, scripted-ego)"
+                "{name}: unknown option {o:?} after {OPTIONS_MARK} (open=Name=lo..hi, continuous, scripted-ego, ego=NAME, horizon=S)"
             )))
             }
         }
@@ -231,6 +267,8 @@ pub fn campaign_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Err
         space,
         overrides,
         scripted_ego,
+        ego,
+        horizon_s,
     })?;
     scenario
         .warnings

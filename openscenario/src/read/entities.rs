@@ -83,7 +83,7 @@ pub(super) fn read(
                 "more than one <ObjectController> per entity is not supported",
             ));
         }
-        let (kind, dimensions_m, centre_m, notes) = if tag == "CatalogReference" {
+        let (kind, dimensions_m, centre_m, box_pos, notes) = if tag == "CatalogReference" {
             catalogs.with_entry(r, body, &["Vehicle", "Pedestrian", "MiscObject"], object)?
         } else {
             let scope = r.scope.clone();
@@ -101,6 +101,7 @@ pub(super) fn read(
             kind,
             dimensions_m,
             centre_m,
+            box_pos,
             controller,
             pos: r.text.pos(obj),
         });
@@ -109,7 +110,9 @@ pub(super) fn read(
     Ok(out)
 }
 
-type Object = (EntityKind, [f64; 3], [f64; 3], Vec<String>);
+/// An object's kind, bounding box (dimensions, centre, where its dimensions are written) and
+/// notes.
+type Object = (EntityKind, [f64; 3], [f64; 3], crate::Pos, Vec<String>);
 
 /// A `Vehicle`, `Pedestrian` or `MiscObject` element: its kind, bounding box and notes.
 fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscError> {
@@ -154,7 +157,13 @@ fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscErr
             scope.opt_string(text, e, "name")?.unwrap_or_default()
         ));
     }
-    Ok((kind(category), dimensions_m, centre_m, notes))
+    Ok((
+        kind(category),
+        dimensions_m,
+        centre_m,
+        text.pos(dims),
+        notes,
+    ))
 }
 
 /// An `ObjectController`: the controller's name.

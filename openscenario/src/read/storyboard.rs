@@ -182,6 +182,18 @@ fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
                     ),
                 ));
             };
+            // The schema's Action is a choice of one GlobalAction, UserDefinedAction or
+            // PrivateAction: a second child would be silently dropped.
+            if let Some(extra) = elements(a).nth(1) {
+                return Err(r.text.invalid(
+                    extra,
+                    format!(
+                        "an <Action> holds one action (the schema's choice), not a second \
+                         <{}>: give each its own <Action>",
+                        extra.tag_name().name()
+                    ),
+                ));
+            }
             actions.push(NamedAction {
                 name: name(r, a)?,
                 pos: r.text.pos(a),

@@ -7,8 +7,8 @@ use std::collections::HashMap;
 
 use starlark::syntax::AstModule;
 use starlark_syntax::syntax::ast::{
-    ArgumentP, AssignTargetP, AstArgument, AstExpr, AstNoPayload, AstStmt, BinOp, CallArgsP, ExprP,
-    StmtP,
+    ArgumentP, AssignTargetP, AstArgument, AstExpr, AstLiteral, AstNoPayload, AstStmt, BinOp,
+    CallArgsP, ExprP, StmtP,
 };
 use starlark_syntax::syntax::uniplate::Visit;
 
@@ -391,6 +391,16 @@ impl Walker<'_> {
         self.expr(f, None, in_code);
     }
 
+    /// The items of a dict argument: an open value is named by its key (`Import("s.xosc",
+    /// params = {"Ego_Speed": VarInterval(...)})` opens the file's parameter `Ego_Speed`).
+    fn dict_items(&mut self, items: &[(AstExpr, AstExpr)]) {
+        for (k, v) in items {
+            if let (ExprP::Literal(AstLiteral::String(key)), true) = (&k.node, is_declarer(v)) {
+                self.site(v, Some(key.node.clone()), None, None);
+            }
+        }
+    }
+
     /// Argument number `position` of the call `c`.
     fn argument(&mut self, c: &Call<'_>, position: usize, a: &AstArgument) {
         let value = a.node.expr();
@@ -452,6 +462,9 @@ impl Walker<'_> {
                     self.site(x, n, None, argument_of);
                 }
             }
+        }
+        if let (ArgumentP::Named(..), ExprP::Dict(items)) = (&a.node, &value.node) {
+            self.dict_items(items);
         }
         // A positional argument of a method: `lead.brake(VarEnum(...))` is
         // `lead.brake`; with several, `r.onLane(VarEnum(...), VarInterval(...))`
@@ -666,6 +679,19 @@ mod tests {
         assert_eq!(s.passed_to("c"), [("Car", "color")]);
         assert!(s.read_in_code("k"), "inside a lambda");
         assert!(s.read_in_code("d"), "in a condition");
+    }
+
+    /// An open parameter written inline in `Import`'s `params` is named by the file's
+    /// parameter it opens (it was `param0`).
+    #[test]
+    fn an_inline_import_parameter_is_named_by_its_key() {
+        let src = "s = Import(\"x.xosc\", params = {\"Ego_Speed\": VarInterval(1, 2)})\n";
+        let col = src.find("VarInterval").unwrap() + 1;
+        let s = syntax(src);
+        assert_eq!(
+            s.site(&format!("t.star:1:{col}")).unwrap().name.as_deref(),
+            Some("Ego_Speed")
+        );
     }
 
     #[test]

@@ -131,6 +131,10 @@ pub struct Scene {
     signals: Vec<Signal>,
     sensors: Vec<SensorSpec>,
     settings: TestSettings,
+    /// Top-level variables that hold an actor declared under another name (`lead = s.Lead`
+    /// of an imported scenario): each publishes the actor's outputs as its own
+    /// (`lead.speed`), as a variable a declaration is assigned to does.
+    aliases: Vec<(String, ActorRef)>,
 }
 
 impl Scene {
@@ -163,6 +167,7 @@ impl Scene {
             signals: Vec::new(),
             sensors: SensorSpec::defaults(),
             settings: TestSettings::default(),
+            aliases: Vec::new(),
         }
     }
 
@@ -315,6 +320,30 @@ impl Scene {
         let actor = ActorRef::Car(self.car_handles.add());
         self.actors.push(DeclaredActor { actor, name, site });
         actor
+    }
+
+    /// Names `actor` by the top-level `variable` that holds it (`lead = s.Lead`), so that
+    /// its outputs are published as `variable.speed`, ... as a declaration's own variable's
+    /// are.
+    pub fn alias_actor(&mut self, variable: String, actor: ActorRef) {
+        if !self.aliases.iter().any(|(v, _)| *v == variable) {
+            self.aliases.push((variable, actor));
+        }
+    }
+
+    /// The actor a top-level variable names: the declaration assigned to it, else an alias
+    /// ([`Scene::alias_actor`]).
+    pub fn actor_of_variable(&self, variable: &str) -> Option<ActorRef> {
+        self.actors
+            .iter()
+            .find(|o| o.site.variable.as_deref() == Some(variable))
+            .map(|o| o.actor)
+            .or_else(|| {
+                self.aliases
+                    .iter()
+                    .find(|(v, _)| v == variable)
+                    .map(|(_, a)| *a)
+            })
     }
 
     /// The actors declared so far, in declaration order.

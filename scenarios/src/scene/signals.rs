@@ -244,11 +244,7 @@ impl Scene {
                     continue;
                 }
                 let found = s.split_once('.').and_then(|(var, rest)| {
-                    let actor = self
-                        .actors()
-                        .iter()
-                        .find(|o| o.site.variable.as_deref() == Some(var))?
-                        .actor;
+                    let actor = self.actor_of_variable(var)?;
                     let field = rest.split('.').next()?;
                     let (_, output) = ACTOR_SIGNALS.iter().find(|(n, _)| *n == field)?;
                     Some((format!("{var}.{field}"), actor, *output))

@@ -39,8 +39,10 @@ pub const GAP_SIGNAL: &str = "ego_gap_m";
 pub const LANE_EDGE_SIGNAL: &str = "ego_lane_edge_m";
 /// The longest test, s: a storyboard ends at its stop trigger, or here.
 pub const HORIZON_CAP_S: f64 = 3600.0;
-/// How far ahead the ego's route is planned, m.
-const ROUTE_M: f64 = 3000.0;
+/// How far ahead the ego's route is planned, m (at most: it ends where its lanes end). The
+/// ALKS free-driving road is a little over 5 km, which a route of 3 km left the ego to leave
+/// halfway, failing the test off-road.
+const ROUTE_M: f64 = 20_000.0;
 
 /// The parameter values of one test as OpenSCENARIO overrides (`name`, value text), from the
 /// test's assignment (a value set's index expands to its parameters, for example).
@@ -67,6 +69,12 @@ pub struct Source {
     /// trajectories and actions; no system under test drives it): to replay a test exported
     /// by `paracosm-fuzz export`, or to run a file as esmini does with its controllers off.
     pub scripted_ego: bool,
+    /// `--ego NAME`: the vehicle the system under test drives, when the file does not say
+    /// plainly ([`ego_of`]).
+    pub ego: Option<String>,
+    /// `--horizon`: the longest test, s (finite, `> 0`); without it a test ends at the
+    /// storyboard's stop trigger, and a storyboard without one is refused.
+    pub horizon_s: Option<f64>,
 }
 
 /// An OpenSCENARIO error as a load error.
@@ -78,12 +86,43 @@ fn worlds_error(message: String) -> ScenarioError {
     ScenarioError::Load(LoadError::new(LoadErrorKind::Worlds, message))
 }
 
-/// The entity the system under test drives: the one whose controller the storyboard
-/// activates, else one named `Ego` or `hero` (any case), else the first vehicle.
+/// The entity the system under test drives: the vehicle `named` (`--ego NAME`), else the one
+/// whose controller the storyboard activates, else the one named `Ego` or `hero` (any
+/// case), else the scenario's only vehicle. With `any_vehicle` (the storyboard moves every
+/// entity, so nothing is tested of the ego) the first vehicle stands in when none is plainly
+/// the ego.
 ///
 /// # Errors
-/// [`ScenarioError::Load`] for a scenario without vehicles.
-pub fn ego_of(s: &m::Scenario) -> Result<usize, ScenarioError> {
+/// [`ScenarioError::Load`]: `named` is no vehicle of the scenario; the scenario has no
+/// vehicle; or several vehicles and none plainly the ego (the message lists them and asks
+/// for `--ego NAME`).
+pub fn ego_of(
+    s: &m::Scenario,
+    named: Option<&str>,
+    any_vehicle: bool,
+) -> Result<usize, ScenarioError> {
+    let vehicle = |i: &usize| matches!(s.entities[*i].kind, EntityKind::Vehicle(_));
+    let vehicles: Vec<usize> = (0..s.entities.len()).filter(vehicle).collect();
+    let list = || {
+        vehicles
+            .iter()
+            .map(|&i| s.entities[i].name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if let Some(name) = named {
+        return vehicles
+            .iter()
+            .copied()
+            .find(|&i| s.entities[i].name == name)
+            .ok_or_else(|| {
+                worlds_error(format!(
+                    "{}: --ego {name:?} is not a vehicle of the scenario (its vehicles: {})",
+                    s.file,
+                    list()
+                ))
+            });
+    }
     let activated = s
         .stories
         .iter()
@@ -97,21 +136,34 @@ pub fn ego_of(s: &m::Scenario) -> Result<usize, ScenarioError> {
             });
             activates.then(|| g.actors.first().copied()).flatten()
         });
-    let vehicle = |i: &usize| matches!(s.entities[*i].kind, EntityKind::Vehicle(_));
+    let by_name = || {
+        vehicles
+            .iter()
+            .copied()
+            .find(|&i| ["ego", "hero"].contains(&s.entities[i].name.to_ascii_lowercase().as_str()))
+    };
+    let only = || (vehicles.len() == 1).then(|| vehicles[0]);
+    let first = || any_vehicle.then(|| vehicles.first().copied()).flatten();
     activated
         .filter(vehicle)
-        .or_else(|| {
-            (0..s.entities.len()).find(|&i| {
-                vehicle(&i)
-                    && ["ego", "hero"].contains(&s.entities[i].name.to_ascii_lowercase().as_str())
-            })
-        })
-        .or_else(|| (0..s.entities.len()).find(vehicle))
+        .or_else(by_name)
+        .or_else(only)
+        .or_else(first)
         .ok_or_else(|| {
-            worlds_error(format!(
-                "{}: the scenario has no vehicle for the system under test to drive",
-                s.file
-            ))
+            worlds_error(if vehicles.is_empty() {
+                format!(
+                    "{}: the scenario has no vehicle for the system under test to drive",
+                    s.file
+                )
+            } else {
+                format!(
+                    "{}: which vehicle is the ego? None is named Ego or hero and the storyboard \
+                     activates no controller: name it with --ego NAME (in a program, \
+                     Import(..., ego = \"NAME\")) (the scenario's vehicles: {})",
+                    s.file,
+                    list()
+                )
+            })
         })
 }
 
@@ -150,12 +202,23 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
                      ActivateControllerAction does nothing",
                     name(e)
                 )),
-                Action::Teleport(_) | Action::Speed { .. } if init && Some(e) == ego => None,
-                _ if Some(e) == ego => Some(format!(
-                    "the system under test drives {}: this action of the storyboard is not \
-                     performed",
-                    name(e)
-                )),
+                // Its place, its initial speed and its route (the lanes it plans through).
+                Action::Teleport(_) | Action::AssignRoute { .. } if init && Some(e) == ego => None,
+                // Its initial speed in Init; later, the set speed of the system under test.
+                Action::Speed { .. } if Some(e) == ego => None,
+                _ if Some(e) == ego => {
+                    return Err(worlds_error(format!(
+                        "{}: the system under test drives {}, and paracosm cannot hand it this \
+                         {}: its storyboard asks it of the ego only as a SpeedAction (the \
+                         system's set speed), an ActivateControllerAction, or in Init a \
+                         TeleportAction or an AssignRouteAction. Run the file with \
+                         --scripted-ego to have the storyboard move the ego, or name another \
+                         vehicle with --ego",
+                        na.pos,
+                        name(e),
+                        na.action.kind_name()
+                    )))
+                }
                 _ => None,
             };
             if let Some(message) = ignored {
@@ -193,14 +256,6 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
             each(&g.actors, na, false)?;
         }
     }
-    if s.stop.is_none() {
-        warnings.push(Warning {
-            at: s.file.clone(),
-            message: format!(
-                "the storyboard has no stop trigger: each test runs {HORIZON_CAP_S} s"
-            ),
-        });
-    }
     Ok(warnings)
 }
 
@@ -214,8 +269,9 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
 /// paracosm does not perform ([`check`]).
 pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
     let model = read_scenario(&source.template, &[]).map_err(xosc_error)?;
-    let ego = ego_of(&model)?;
+    let ego = ego_of(&model, source.ego.as_deref(), source.scripted_ego)?;
     let mut warnings = check(&model, (!source.scripted_ego).then_some(ego))?;
+    let horizon_s = horizon(&model, source.horizon_s)?;
     // The model's LogicFile path is already joined with the scenario's folder.
     let dir = PathBuf::new();
     let worlds = XoscWorlds {
@@ -223,6 +279,8 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
         overrides: source.overrides,
         maps: MapFiles::new(Base::Folder(dir)),
         scripted_ego: source.scripted_ego,
+        ego: source.ego.clone(),
+        horizon_s,
     };
     // The scene of the declared values: the map loads, the Init places every entity.
     let (scene, _) = worlds.build(&model)?;
@@ -246,7 +304,7 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
             model.version.0, model.version.1, model.file
         ),
         space: source.space,
-        horizon_s: HORIZON_CAP_S,
+        horizon_s,
         sut: if source.scripted_ego {
             SutConfig::Scripted
         } else {
@@ -258,6 +316,11 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
         warnings,
         unused_params: vec![],
         camera_only: vec![],
+        ego: Some({
+            let e = &model.entities[ego];
+            let [l, w, h] = e.dimensions_m;
+            format!("{}, {l} × {w} × {h} m", e.name)
+        }),
         source: Arc::from(
             crate::text_file::read_text(
                 &source.template,
@@ -277,6 +340,33 @@ struct XoscWorlds {
     maps: MapFiles,
     /// [`Source::scripted_ego`].
     scripted_ego: bool,
+    /// [`Source::ego`].
+    ego: Option<String>,
+    /// The longest test, s ([`horizon`]).
+    horizon_s: f64,
+}
+
+/// The longest test of `model`, s: `given` (`--horizon`), else [`HORIZON_CAP_S`] when the
+/// storyboard has a stop trigger that ends it sooner.
+///
+/// # Errors
+/// [`ScenarioError::Load`]: `given` is not a finite number `> 0`, or the storyboard has no
+/// stop trigger (or an empty one) and no horizon is given: its tests would never end (they
+/// ran to the cap before, and read as passes).
+pub fn horizon(model: &m::Scenario, given: Option<f64>) -> Result<f64, ScenarioError> {
+    match given {
+        Some(h) if h.is_finite() && h > 0.0 => Ok(h),
+        Some(h) => Err(worlds_error(format!(
+            "{}: --horizon {h} s must be a finite number of seconds > 0",
+            model.file
+        ))),
+        None if model.stop.as_ref().is_none_or(|t| t.0.is_empty()) => Err(worlds_error(format!(
+            "{}: the storyboard has no stop trigger, so nothing ends a test: give \
+                 --horizon SECONDS (in a program, test(horizon = ...))",
+            model.file
+        ))),
+        None => Ok(HORIZON_CAP_S),
+    }
 }
 
 impl Worlds for XoscWorlds {
@@ -318,18 +408,38 @@ impl XoscWorlds {
         scene
             .set_environment(light, fog, at.clone())
             .map_err(|e| worlds_error(e.to_string()))?;
-        let built = build_into(&mut scene, model, &self.maps, self.scripted_ego, 0)?;
+        let ego = ego_of(model, self.ego.as_deref(), self.scripted_ego)?;
+        let built = build_into(&mut scene, model, &self.maps, (ego, self.scripted_ego), 0)?;
         scene.add_monitor(MonitorSpec::collision(), at.clone());
         scene
             .set_settings(TestSettings {
                 site: Some(at),
-                horizon_s: Some(HORIZON_CAP_S),
+                horizon_s: Some(self.horizon_s),
                 map_axes: None,
                 offroad: None,
             })
             .map_err(|e| worlds_error(e.to_string()))?;
         Ok((scene, built.host))
     }
+}
+
+/// Loads `model`'s OpenDRIVE map as a campaign over it would (`paracosm-fuzz xosc` checks it,
+/// so that a file whose campaign would refuse its map is refused when listed too).
+///
+/// # Errors
+/// [`ScenarioError::Load`] naming the `LogicFile`'s line and column: the scenario has no
+/// `RoadNetwork` map, or the map does not load.
+pub fn load_map(model: &m::Scenario) -> Result<(), ScenarioError> {
+    let Some(road) = &model.road_network else {
+        return Err(worlds_error(format!(
+            "{}: the scenario has no RoadNetwork LogicFile: paracosm needs its OpenDRIVE map",
+            model.file
+        )));
+    };
+    MapFiles::new(Base::Folder(PathBuf::new()))
+        .load(&road.item)
+        .map(drop)
+        .map_err(|e| ScenarioError::Load(e.with_context(&format!("\n --> {}", road.pos))))
 }
 
 /// Where an imported storyboard's host functions start in a program's graph
@@ -358,10 +468,9 @@ pub(crate) fn build_into(
     scene: &mut Scene,
     model: &m::Scenario,
     maps: &MapFiles,
-    scripted_ego: bool,
+    (ego, scripted_ego): (usize, bool),
     base: u32,
 ) -> Result<Built, ScenarioError> {
-    let ego = ego_of(model)?;
     let Some(road) = &model.road_network else {
         return Err(worlds_error(format!(
             "{}: the scenario has no RoadNetwork LogicFile: paracosm needs its OpenDRIVE map",
@@ -391,12 +500,22 @@ pub(crate) fn build_into(
     let ego_actor = actors[ego];
     let ego_probes =
         [Output::Pos, Output::Heading, Output::Speed].map(|o| scene.probe(ego_actor, o));
-    place_ego(scene, &sb, (ego, scripted_ego), piece, &model.file)?;
+    place_ego(
+        scene,
+        &sb,
+        (ego, &model.entities[ego], scripted_ego),
+        piece,
+        &model.file,
+    )?;
     let tick = scene.push(Node::Tick);
-    scene.push(Node::Perform {
-        src: tick,
-        f: Func::Host(base),
-    });
+    // Its errors name the storyboard, not the graph's node.
+    scene.graph_mut().push_at(
+        Node::Perform {
+            src: tick,
+            f: Func::Host(base),
+        },
+        format!("the storyboard of {}", model.file),
+    );
     for (k, signal) in [HEADWAY_SIGNAL, GAP_SIGNAL, LANE_EDGE_SIGNAL]
         .into_iter()
         .enumerate()
@@ -407,6 +526,7 @@ pub(crate) fn build_into(
         });
         scene.publish(signal.to_owned(), id, None);
     }
+    let sb_init_speed = sb.actors[ego].state.speed.max(0.0);
     let mut reads: Vec<StreamId> = probes.clone();
     reads.extend(ego_probes);
     let host = StoryHost {
@@ -420,6 +540,8 @@ pub(crate) fn build_into(
         reads,
         performed: Vec::new(),
         measures: (f64::INFINITY, f64::INFINITY, f64::NAN),
+        asked: None,
+        most_asked_mps: sb_init_speed,
         road_end: None,
         log: Vec::new(),
     };
@@ -430,12 +552,44 @@ pub(crate) fn build_into(
     })
 }
 
+/// The ego vehicle of `entity`: paracosm's vehicle model with the body of the entity's
+/// `BoundingBox` (length × width × height, m; its centre is where the storyboard puts the
+/// chassis' centre), the model's mass and actuators otherwise.
+///
+/// # Errors
+/// [`ScenarioError::Load`] naming the box's file, line and column when a side is outside
+/// the vehicle model's range ([`paracosm_engine::EGO_SIZE_RANGE_M`]).
+fn ego_vehicle(entity: &m::Entity) -> Result<VehicleParams, ScenarioError> {
+    let [length_m, width_m, height_m] = entity.dimensions_m;
+    let size = Size {
+        length_m,
+        width_m,
+        height_m,
+    };
+    VehicleParams::check_size(&size).map_err(|e| {
+        let e = match e {
+            paracosm_engine::EngineError::InvalidWorld(why) => why,
+            other => other.to_string(),
+        };
+        worlds_error(format!(
+            "{}: the bounding box of {} ({length_m} × {width_m} × {height_m} m) cannot be \
+             the ego: {e}",
+            entity.box_pos, entity.name
+        ))
+    })?;
+    Ok(VehicleParams {
+        size,
+        ..VehicleParams::default()
+    })
+}
+
 /// Places the ego where the storyboard's `Init` put it, at its initial speed, which the
-/// system under test keeps as its set speed, with a route along its lanes.
+/// system under test keeps as its set speed, with a route along its lanes, with the body
+/// of its `BoundingBox` ([`ego_vehicle`]).
 fn place_ego(
     scene: &mut Scene,
     sb: &Storyboard,
-    (ego, scripted_ego): (usize, bool),
+    (ego, entity, scripted_ego): (usize, &m::Entity, bool),
     piece: PieceId,
     file: &str,
 ) -> Result<(), ScenarioError> {
@@ -461,7 +615,8 @@ fn place_ego(
     // moves entities), a point every 2 m.
     let mut route = vec![[pos[0], pos[2]]];
     let mut at = lp;
-    let prefer = |_: usize| false;
+    // Through junctions as its Init's AssignRouteAction asks, else the storyboard's way.
+    let prefer = |lane: usize| sb.route_takes(ego, lane);
     for _ in 0..(ROUTE_M / 2.0) as usize {
         let more = sb.roads().advance(&mut at, 2.0, &prefer);
         let (p, _) = sb.roads().to_engine(sb.roads().pose_of(&at));
@@ -471,12 +626,13 @@ fn place_ego(
         }
     }
     let speed = a.state.speed.max(0.0);
+    let vehicle = ego_vehicle(entity)?;
     scene
         .place_ego(
             EgoSpec {
                 start,
                 initial_speed_mps: speed,
-                vehicle: VehicleParams::default(),
+                vehicle,
                 route,
                 set_speed_mps: (!scripted_ego).then_some(speed),
                 scripted: scripted_ego,
@@ -507,9 +663,42 @@ pub(crate) struct StoryHost {
     reads: Vec<StreamId>,
     performed: Vec<(Sink, Value)>,
     measures: (f64, f64, f64),
+    /// The set speed last handed to the system under test ([`Storyboard::set_speed`]), m/s.
+    asked: Option<f64>,
+    /// The highest speed the file asked of the driven ego so far (its `Init` speed, its
+    /// `SpeedAction`s), m/s.
+    most_asked_mps: f64,
     /// When the ego's road ended before the storyboard did, s.
     road_end: Option<f64>,
     log: Vec<String>,
+}
+
+/// How far the driven ego must have travelled, m, by the end of a storyboard that asked it to
+/// drive (an `Init` speed or a `SpeedAction` target above [`STILL_MPS`]) for the test to
+/// count: one whose ego stood still tested nothing the file describes.
+pub const MOVED_M: f64 = 0.5;
+/// Speeds up to this, m/s, ask the ego to stand still ([`MOVED_M`]).
+pub const STILL_MPS: f64 = 0.1;
+
+impl StoryHost {
+    /// At the end of the storyboard (`t`, s): an error when the file asked the driven ego to
+    /// drive and it travelled less than [`MOVED_M`]: the test tested nothing the file
+    /// describes and must not read as a pass.
+    ///
+    /// # Errors
+    /// A [`HostError`] that says so, with the speed asked and the distance travelled.
+    fn check_the_ego_moved(&self, t: f64) -> Result<(), HostError> {
+        let travelled = self.sb.actors[self.ego].state.travelled_m;
+        if self.most_asked_mps > STILL_MPS && travelled < MOVED_M {
+            return Err(HostError(format!(
+                "t = {t:.2} s: the storyboard ended, and the ego {} travelled {travelled:.2} m \
+                 though the file asked it to drive at up to {:.2} m/s: the system under test \
+                 never drove it, so the test tested nothing the file describes",
+                self.sb.actors[self.ego].name, self.most_asked_mps
+            )));
+        }
+        Ok(())
+    }
 }
 
 /// How close to the end of its lanes the ego's front may come before a test ends there, m.
@@ -561,11 +750,32 @@ impl Host for StoryHost {
                 self.sb
                     .step(t, DEFAULT_DT_S)
                     .map_err(|e| HostError(e.to_string()))?;
+                // The storyboard's timeline, for the test's record.
+                for (kind, name, what) in self.sb.transitions() {
+                    self.log
+                        .push(format!("t = {t:.3} s: {kind} {name:?} {what}"));
+                }
+                // A SpeedAction on the driven ego: the system under test's set speed.
+                let asked = self.sb.set_speed().filter(|_| !self.scripted_ego);
+                if asked.is_some() && asked != self.asked {
+                    self.asked = asked;
+                    self.performed
+                        .push((Sink::SetEgoSpeed, Value::Num(asked.unwrap_or(0.0))));
+                }
+                self.most_asked_mps = self.most_asked_mps.max(asked.unwrap_or(0.0));
+                if self.sb.ended && !self.scripted_ego {
+                    self.check_the_ego_moved(t)?;
+                }
                 for (e, sink) in self.sinks.iter().enumerate() {
                     if let Some(sink) = sink {
+                        // Where the storyboard puts it, and its speed there (a teleport's
+                        // step keeps the entity's speed, as esmini reports it).
                         let (p, h) = self.sb.engine_pose(e);
-                        self.performed
-                            .push((*sink, Value::Tuple(vec![Value::Vec3(p), Value::Num(h)])));
+                        let v = self.sb.actors[e].state.speed.max(0.0);
+                        self.performed.push((
+                            *sink,
+                            Value::Tuple(vec![Value::Vec3(p), Value::Num(h), Value::Num(v)]),
+                        ));
                     }
                 }
                 Ok(Value::Unit)
@@ -642,12 +852,20 @@ fn place_entities(
         } else {
             let a = scene.declare_car(name.clone(), at);
             let ahead = [pos[0] + 0.5 * heading.cos(), pos[2] - 0.5 * heading.sin()];
+            // Its speed stream is read only before the first step, where a car enters the
+            // test at its speed: the Init's (the storyboard places it at every step).
+            let init_speed = sb.actors[i].state.speed.max(0.0);
+            let speed = if init_speed == 0.0 {
+                zero
+            } else {
+                scene.push(Node::Const(Value::Num(init_speed)))
+            };
             scene
                 .place_car(
                     a,
                     CarSpec {
                         path: vec![[pos[0], pos[2]], ahead],
-                        speed: zero,
+                        speed,
                         color: "white".to_owned(),
                         size,
                         enabled: true,

@@ -164,7 +164,11 @@ enum Owner {
 #[derive(Debug, Clone)]
 struct Cond {
     cond: m::Condition,
-    prev: bool,
+    /// Its value at its last evaluation; `None` before its first (its first evaluation, at
+    /// the start of the simulation or when its element first waits, is no edge: a rising
+    /// edge needs the condition seen false before it is seen true, as in esmini's
+    /// `OSCCondition::CheckEdge`).
+    prev: Option<bool>,
     history: VecDeque<(f64, bool)>,
 }
 
@@ -233,7 +237,19 @@ pub struct Storyboard {
     /// Whether the storyboard's stop trigger has fired.
     pub ended: bool,
     started: bool,
+    /// The speed the storyboard asks of the ego the system under test drives now, m/s: its
+    /// `SpeedAction`s' transitions, which the host hands the system as its set speed
+    /// ([`Storyboard::set_speed`]); `None` until one starts.
+    set_speed: Option<f64>,
 }
+
+/// How close the driven ego's speed must come to a `SpeedAction`'s target, once the action's
+/// transition is over, for the action to end: this many m/s plus [`SET_SPEED_REACHED_SHARE`]
+/// of the target (a cruise controller settles under its set speed: `aeb`'s proportional
+/// gain keeps 11.84 m/s of 12 and 19.14 of 20, `tests/xosc_ego.rs`).
+pub const SET_SPEED_REACHED_MPS: f64 = 0.5;
+/// See [`SET_SPEED_REACHED_MPS`].
+pub const SET_SPEED_REACHED_SHARE: f64 = 0.05;
 
 fn site(pos: &paracosm_openscenario::Pos) -> String {
     pos.to_string()
@@ -289,6 +305,7 @@ impl Storyboard {
                 .collect(),
             ended: false,
             started: false,
+            set_speed: None,
         };
         sb.stop = scenario
             .stop
@@ -334,6 +351,7 @@ impl Storyboard {
                                     )
                                 });
                             for na in &ev.actions {
+                                sb.check_references(na)?;
                                 let ai = sb.push(Kind::Action, &na.name, 1);
                                 sb.elems[ei].children.push(ai);
                                 sb.elems[ai].action = Some((na.clone(), g.actors.clone()));
@@ -355,6 +373,55 @@ impl Storyboard {
         }
         // Init's transitions run from the start.
         Ok(sb)
+    }
+
+    /// Checks the roads and lanes that `na` names where they do not depend on where an
+    /// entity is when it starts: a teleport or a route's waypoint to a lane or road position
+    /// (the road, the lane at that station), and a lane change to an absolute lane id (some
+    /// road of the map has it). So a reference that cannot be met is refused when the file
+    /// loads, at the action's line and column, rather than failing every test.
+    ///
+    /// # Errors
+    /// [`StoryError`] at the action, naming the action and the map's refusal.
+    fn check_references(&self, na: &m::NamedAction) -> Result<(), StoryError> {
+        let refused = |message: String| StoryError {
+            at: site(&na.pos),
+            message: format!("{} {:?}: {message}", na.action.kind_name(), na.name),
+        };
+        let position = |p: &Position| -> Result<(), StoryError> {
+            match p {
+                Position::Lane { road, lane, s, .. } => self
+                    .roads
+                    .lane_pos(road, *lane, *s, 0.0)
+                    .map(drop)
+                    .map_err(|e| refused(e.to_string())),
+                Position::Road { road, s, t, .. } => self
+                    .roads
+                    .road_pos(road, *s, *t)
+                    .map(drop)
+                    .map_err(|e| refused(e.to_string())),
+                _ => Ok(()),
+            }
+        };
+        match &na.action {
+            Action::Teleport(p) => position(p),
+            Action::AssignRoute { waypoints } => {
+                waypoints.iter().try_for_each(|(p, _)| position(p))
+            }
+            Action::LaneChange {
+                target: LaneTarget::Absolute(id),
+                ..
+            } => {
+                if self.roads.map().lanes.iter().any(|l| l.od_id == *id) {
+                    Ok(())
+                } else {
+                    Err(refused(format!(
+                        "no road of the map has a lane {id}, so no entity can change to it"
+                    )))
+                }
+            }
+            _ => Ok(()),
+        }
     }
 
     fn push(&mut self, kind: Kind, name: &str, max_runs: u32) -> usize {
@@ -384,7 +451,7 @@ impl Storyboard {
                     g.iter()
                         .map(|c| Cond {
                             cond: c.clone(),
-                            prev: false,
+                            prev: None,
                             history: VecDeque::new(),
                         })
                         .collect()
@@ -489,10 +556,11 @@ impl Storyboard {
             if self.waits(k) {
                 self.trigger_now[k] = self.evaluate(k, t);
             } else {
-                // Not waiting: its conditions start afresh (edges, delays) when it waits again.
+                // Not waiting: its delays start afresh when it waits again; an edge is taken
+                // against the last value seen (esmini's `OSCCondition::Reset` clears only the
+                // delay history).
                 self.trigger_now[k] = false;
                 for c in self.triggers[k].iter_mut().flatten() {
-                    c.prev = false;
                     c.history.clear();
                 }
             }
@@ -508,6 +576,8 @@ impl Storyboard {
         for e in 0..self.actors.len() {
             if self.actors[e].scripted {
                 self.drive(e, t, dt)?;
+            } else {
+                self.ask_speed(e, t + dt);
             }
         }
         // An event whose actions ended in this step's motion ends in this step.
@@ -722,7 +792,18 @@ impl Storyboard {
             return Ok(());
         };
         for e in actors {
-            self.start_task(e, &action, Some(a), t)?;
+            // An action that cannot be performed names itself and its entity.
+            self.start_task(e, &action, Some(a), t)
+                .map_err(|err| StoryError {
+                    at: err.at,
+                    message: format!(
+                        "{} {:?} of {}: {}",
+                        action.action.kind_name(),
+                        action.name,
+                        self.actors[e].name,
+                        err.message
+                    ),
+                })?;
         }
         if self.elems[a].pending == 0 {
             self.end_elem(a);
@@ -1003,11 +1084,9 @@ impl Storyboard {
                 (v, continuous.then_some((*entity, *value, *factor)))
             }
         };
-        if !scripted {
+        if !scripted && a.is_none() {
             // The ego's initial speed; later, the system under test drives it.
-            if a.is_none() {
-                self.actors[e].state.speed = to.max(0.0);
-            }
+            self.actors[e].state.speed = to.max(0.0);
             return Ok(());
         }
         let tr = Transition {
@@ -1406,6 +1485,70 @@ impl Storyboard {
         Ok(())
     }
 
+    /// The transitions the acts, events and actions made in the last [`Storyboard::step`]:
+    /// `(kind, name, transition)`, kind `act`, `event` or `action`, transition `start`,
+    /// `end`, `stop` or `skip` (the standard's names: startTransition, endTransition,
+    /// stopTransition, skipTransition), in the storyboard's order.
+    pub fn transitions(&self) -> Vec<(&'static str, &str, &'static str)> {
+        let mut out = Vec::new();
+        for e in &self.elems {
+            if !matches!(e.kind, Kind::Act | Kind::Event | Kind::Action) {
+                continue;
+            }
+            for (made, what) in [
+                (e.moves.start, "start"),
+                (e.moves.end, "end"),
+                (e.moves.stop, "stop"),
+                (e.moves.skip, "skip"),
+            ] {
+                if made {
+                    out.push((e.kind.name(), e.name.as_str(), what));
+                }
+            }
+        }
+        out
+    }
+
+    /// The speed the storyboard asks of the ego the system under test drives, m/s, at the
+    /// end of the last step: the value its `SpeedAction`s' transitions have then (a target
+    /// that follows another entity, that entity's speed then); `None` before the first
+    /// `SpeedAction` of the storyboard on it (its set speed is its `Init` speed).
+    pub fn set_speed(&self) -> Option<f64> {
+        self.set_speed
+    }
+
+    /// Whether entity `e`'s route (its `AssignRouteAction`) takes lane `lane`: a lane of a
+    /// road it names, or a junction's connecting lane that leads to one (false without a
+    /// route).
+    pub fn route_takes(&self, e: usize, lane: usize) -> bool {
+        let roads = &self.drives[e].prefer_roads;
+        roads.contains(&self.roads.ids(lane).1) || roads.contains(&self.roads.exit_road(lane))
+    }
+
+    /// The speed asked at `t1` of entity `e`, which the system under test drives
+    /// ([`Storyboard::set_speed`]); its `SpeedAction` ends once the transition is over and
+    /// its speed has come within [`SET_SPEED_REACHED_MPS`] and [`SET_SPEED_REACHED_SHARE`]
+    /// of the target.
+    fn ask_speed(&mut self, e: usize, t1: f64) {
+        let Some((tr, track, a)) = self.drives[e].speed else {
+            return;
+        };
+        let (mut v, over) = tr.at(t1);
+        if over {
+            if let Some((r, value, factor)) = track {
+                let rv = self.actors[r].state.speed;
+                v = if factor { rv * value } else { rv + value };
+            } else {
+                let reached = SET_SPEED_REACHED_MPS + SET_SPEED_REACHED_SHARE * tr.to.abs();
+                if (self.actors[e].state.speed - tr.to).abs() <= reached {
+                    self.drives[e].speed = None;
+                    self.task_done(Some(a));
+                }
+            }
+        }
+        self.set_speed = Some(v.max(0.0));
+    }
+
     /// Moves scripted entity `e` from `t` to `t + dt`.
     fn drive(&mut self, e: usize, t: f64, dt: f64) -> Result<(), StoryError> {
         let t1 = t + dt;
@@ -1596,11 +1739,11 @@ impl Storyboard {
                 let cond = &mut self.triggers[k][g][c];
                 let edged = match cond.cond.edge {
                     Edge::None => raw,
-                    Edge::Rising => raw && !cond.prev,
-                    Edge::Falling => !raw && cond.prev,
-                    Edge::RisingOrFalling => raw != cond.prev,
+                    Edge::Rising => raw && cond.prev == Some(false),
+                    Edge::Falling => !raw && cond.prev == Some(true),
+                    Edge::RisingOrFalling => cond.prev.is_some_and(|p| p != raw),
                 };
-                cond.prev = raw;
+                cond.prev = Some(raw);
                 // With a delay, the condition's value `delay` seconds ago.
                 let value = if cond.cond.delay_s > 0.0 {
                     cond.history.push_back((t, edged));

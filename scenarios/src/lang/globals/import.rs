@@ -35,6 +35,12 @@ pub(crate) const SPECS: &[Builtin] = &[Builtin {
              open parameter constant over time)",
         )
         .or("{}"),
+        named(
+            "ego",
+            "string: the vehicle the system under test drives, when the file does not say \
+             plainly (none named Ego or hero, no controller activated, several vehicles)",
+        )
+        .or("None"),
     ],
     declares: Declares::Actor,
     takes_whole: true,
@@ -60,6 +66,7 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
     fn Import<'v>(
         #[starlark(require = pos)] path: &str,
         #[starlark(require = named)] params: Option<Value<'v>>,
+        #[starlark(require = named)] ego: Option<&str>,
         eval: &mut Evaluator<'v, '_, '_>,
     ) -> anyhow::Result<Value<'v>> {
         let st = state(eval)?;
@@ -79,14 +86,14 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         let overrides = overrides(params, &b)?;
         let model =
             paracosm_openscenario::read_scenario(&file, &overrides).map_err(|e| anyhow!("{e}"))?;
-        let ego = crate::xosc::ego_of(&model).map_err(|e| anyhow!("{e}"))?;
+        let ego = crate::xosc::ego_of(&model, ego, false).map_err(|e| anyhow!("{e}"))?;
         let warnings = crate::xosc::check(&model, Some(ego)).map_err(|e| anyhow!("{e}"))?;
         b.warnings.extend(warnings);
         let built = crate::xosc::build_into(
             &mut b.scene,
             &model,
             &st.maps,
-            false,
+            (ego, false),
             crate::xosc::IMPORT_HOST_BASE,
         )
         .map_err(|e| anyhow!("{e}"))?;

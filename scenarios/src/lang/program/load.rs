@@ -134,6 +134,7 @@ pub fn load(
         warnings,
         unused_params,
         camera_only: found.camera_only,
+        ego: None,
         source: Arc::from(source),
         input_files: program.maps.inputs(),
         worlds: Arc::new(program),

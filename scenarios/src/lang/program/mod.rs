@@ -318,6 +318,18 @@ impl Program {
             }
             let printed = std::mem::take(&mut *state.log.borrow_mut());
             let mut b = state.scene.into_inner();
+            // An imported entity held by a top-level variable (`lead = s.Lead`) publishes
+            // its outputs under that variable's name, as a declaration's variable does.
+            for name in module.names() {
+                let imported = module.get(name.as_str()).and_then(|v| {
+                    starlark::values::ValueLike::downcast_ref::<crate::lang::values::ActorVal>(v)
+                        .filter(|a| a.object == crate::lang::globals::import::IMPORTED)
+                        .map(|a| a.kind)
+                });
+                if let Some(actor) = imported {
+                    b.scene.alias_actor(name.as_str().to_owned(), actor);
+                }
+            }
             if !b.scene.has_values()
                 && !self
                     .load_output_shown
@@ -977,7 +989,8 @@ fn action_kinds(
             Action::Walk(_)
             | Action::PlaceCar(_)
             | Action::PlacePedestrian(_)
-            | Action::PlaceEgo => continue,
+            | Action::PlaceEgo
+            | Action::SetEgoSpeed => continue,
             Action::SetSpeed(c) => (
                 format!("setSpeed of {}", car(c)),
                 matches!(v, Value::Num(_)),

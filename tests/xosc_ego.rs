@@ -1,0 +1,646 @@
+//! The ego of an OpenSCENARIO file is the file's vehicle (issue "An imported scenario tests
+//! the ego it names"): its `BoundingBox` is its body, the storyboard's `SpeedAction`s on it
+//! become its system's set speed, what paracosm cannot hand the system is refused at load,
+//! a file that does not say which vehicle is the ego needs `--ego`, and a rising edge needs
+//! the condition false first. Every scenario here is written for the test, on the ALKS
+//! straight road (`tests/data/xosc/alks/`), with outcomes computed by hand.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// One step of the simulation, s.
+const STEP_S: f64 = 1.0 / 60.0;
+
+fn road() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/xosc/alks/concrete_scenarios/road_networks/alks_road_straight.xodr")
+}
+
+/// A vehicle `name` with a bounding box `[length, width, height]` whose centre is `cx` m ahead
+/// of its reference point.
+fn vehicle(name: &str, [l, w, h]: [f64; 3], cx: f64) -> String {
+    format!(
+        r#"<ScenarioObject name="{name}">
+  <Vehicle name="{name}_v" vehicleCategory="car">
+    <BoundingBox><Center x="{cx}" y="0" z="{hz}"/><Dimensions width="{w}" length="{l}" height="{h}"/></BoundingBox>
+    <Axles>
+      <FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/>
+      <RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/>
+    </Axles>
+    <Properties/>
+  </Vehicle>
+</ScenarioObject>"#,
+        hz = h / 2.0
+    )
+}
+
+/// A parked box `name`, `length` m long, centred at `s` m of lane −4.
+fn parked_box(name: &str, length: f64) -> String {
+    format!(
+        r#"<ScenarioObject name="{name}">
+  <MiscObject name="box" miscObjectCategory="obstacle" mass="500">
+    <BoundingBox><Center x="0" y="0" z="0.75"/><Dimensions width="1.8" length="{length}" height="1.5"/></BoundingBox>
+    <Properties/>
+  </MiscObject>
+</ScenarioObject>"#
+    )
+}
+
+fn teleport(entity: &str, s: f64, speed: f64) -> String {
+    format!(
+        r#"<Private entityRef="{entity}">
+      <PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="{s}" offset="0"/></Position></TeleportAction></PrivateAction>
+      <PrivateAction><LongitudinalAction><SpeedAction>
+        <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
+        <SpeedActionTarget><AbsoluteTargetSpeed value="{speed}"/></SpeedActionTarget>
+      </SpeedAction></LongitudinalAction></PrivateAction>
+    </Private>"#
+    )
+}
+
+/// A whole scenario: `entities`, `init`, then `story` (a `<Story>` or nothing) and a stop
+/// trigger at `stop_s`.
+fn scenario(entities: &str, init: &str, story: &str, stop: &str) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<OpenSCENARIO>
+  <FileHeader revMajor="1" revMinor="2" date="2026-11-28T00:00:00" description="ego" author="paracosm"/>
+  <RoadNetwork><LogicFile filepath="{road}"/></RoadNetwork>
+  <Entities>
+{entities}
+  </Entities>
+  <Storyboard>
+<Init><Actions>
+{init}
+</Actions></Init>
+{story}
+<StopTrigger><ConditionGroup>
+{stop}
+</ConditionGroup></StopTrigger>
+  </Storyboard>
+</OpenSCENARIO>
+"#,
+        road = road().display()
+    )
+}
+
+fn at_time(name: &str, t: f64, edge: &str) -> String {
+    format!(
+        r#"<Condition name="{name}" delay="0" conditionEdge="{edge}">
+  <ByValueCondition><SimulationTimeCondition value="{t}" rule="greaterThan"/></ByValueCondition>
+</Condition>"#
+    )
+}
+
+fn run(dir: &Path, file: &str, text: &str, args: &[&str]) -> (i32, String, Vec<serde_json::Value>) {
+    let path = dir.join(file);
+    std::fs::write(&path, text).unwrap();
+    let out = dir.join(format!("{file}.out"));
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&path)
+        .args(args)
+        .args(if args.contains(&"--budget") {
+            &[][..]
+        } else {
+            &["--budget", "1"][..]
+        })
+        .args(["--force", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    let records = std::fs::read_to_string(out.join("results.jsonl"))
+        .unwrap_or_default()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    (o.status.code().unwrap_or(-1), err, records)
+}
+
+/// A scripted ego at 10 m/s from s = 50 m into a box parked with its rear at s = 109 m: its
+/// front starts `cx + length / 2` ahead of its reference point, so it touches the box after
+/// `(109 − 50 − cx − length / 2) / 10` s. A 10 m truck (centre 4 m ahead) touches at 5.00 s,
+/// a 5 × 2 m car (centre 1.4 m ahead) at 5.51 s; paracosm's own 4.5 m car would have
+/// touched the box at 5.275 s and 5.535 s. The first step whose poses overlap is within one
+/// step after the hand value, and the contact is reported one step later (rapier finds a
+/// step's contacts before it moves the bodies: docs/openscenario.md).
+
+#[test]
+fn the_egos_body_is_its_bounding_box() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, size, cx) in [
+        ("truck", [10.0, 2.5, 3.2], 4.0),
+        ("car", [5.0, 2.0, 1.5], 1.4),
+    ] {
+        let text = scenario(
+            &format!("{}\n{}", vehicle("Ego", size, cx), parked_box("Box", 2.0)),
+            &format!(
+                "{}\n{}",
+                teleport("Ego", 50.0, 10.0),
+                teleport("Box", 110.0, 0.0)
+            ),
+            "",
+            &at_time("End", 20.0, "rising"),
+        );
+        let (code, err, records) = run(
+            dir.path(),
+            &format!("{name}.xosc"),
+            &text,
+            &["--scripted-ego"],
+        );
+        assert_eq!(code, 1, "the ego hits the box: {err}");
+        let r = &records[0];
+        let hit = r["monitors"]["collision"]["first_violation_s"]
+            .as_f64()
+            .unwrap();
+        let hand = (109.0 - 50.0 - cx - size[0] / 2.0) / 10.0;
+        let overlap = (hand / STEP_S - 1e-6).ceil() * STEP_S;
+        assert!(
+            (hit - (overlap + STEP_S)).abs() < 1e-6,
+            "{name}: touched at {hit} s, by hand {hand} s"
+        );
+    }
+}
+
+/// A bounding box outside the vehicle model's range is refused at load with its line and
+/// column and the range; a 30 m ego is no car paracosm can drive.
+#[test]
+fn an_ego_outside_the_vehicle_models_range_is_refused_at_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = scenario(
+        &vehicle("Ego", [30.0, 2.5, 3.0], 4.0),
+        &teleport("Ego", 50.0, 10.0),
+        "",
+        &at_time("End", 5.0, "rising"),
+    );
+    let (code, err, _) = run(dir.path(), "long.xosc", &text, &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("long.xosc:8:") && err.contains("length 30 m") && err.contains("[2.5, 25]"),
+        "{err}"
+    );
+}
+
+/// The ego starts parked (as Euro NCAP's files and ASAM's SequentialEvents start it) and the
+/// storyboard brings it to test speed: a `SpeedAction` to 20 m/s at 2 m/s² from t = 1 s, then,
+/// when that event ends, one to 10 m/s at 2 m/s²; the stop trigger waits for the second to
+/// end. Under `aeb` the ego follows them as its set speed: it comes within the action's
+/// tolerance of 20 m/s (0.5 m/s + 5 %: 18.5 m/s; its proportional cruise control would
+/// settle at 19.14 m/s), never much over it, and ends near 10 m/s. By hand the first
+/// action's ramp ends at 11 s; the second ramps from the speed the ego has then (about
+/// 18.5 m/s) at 2 m/s², about 4.3 s, so the test ends between 14.5 and 22 s (the cruise
+/// controller lags a little behind each ramp). The ego the storyboard used to
+/// leave parked never moves and fails the monitors below.
+#[test]
+fn the_storyboards_speed_actions_are_the_systems_set_speed() {
+    let dir = tempfile::tempdir().unwrap();
+    let speed = |event: &str, to: f64, start: &str| {
+        format!(
+            r#"<Event name="{event}" priority="override">
+  <Action name="{event}Action"><PrivateAction><LongitudinalAction><SpeedAction>
+    <SpeedActionDynamics dynamicsShape="linear" value="2" dynamicsDimension="rate"/>
+    <SpeedActionTarget><AbsoluteTargetSpeed value="{to}"/></SpeedActionTarget>
+  </SpeedAction></LongitudinalAction></PrivateAction></Action>
+  <StartTrigger><ConditionGroup>{start}</ConditionGroup></StartTrigger>
+</Event>"#
+        )
+    };
+    let ended = |name: &str, event: &str| {
+        format!(
+            r#"<Condition name="{name}" delay="0" conditionEdge="rising">
+  <ByValueCondition><StoryboardElementStateCondition storyboardElementType="event" storyboardElementRef="{event}" state="endTransition"/></ByValueCondition>
+</Condition>"#
+        )
+    };
+    let story = format!(
+        r#"<Story name="S"><Act name="A">
+  <ManeuverGroup maximumExecutionCount="1" name="G">
+    <Actors selectTriggeringEntities="false"><EntityRef entityRef="Ego"/></Actors>
+    <Maneuver name="M">
+{}
+{}
+    </Maneuver>
+  </ManeuverGroup>
+</Act></Story>"#,
+        speed("Accelerate", 20.0, &at_time("Go", 1.0, "rising")),
+        speed("Slow", 10.0, &ended("Fast", "Accelerate"))
+    );
+    let text = scenario(
+        &vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+        &teleport("Ego", 50.0, 0.0),
+        &story,
+        &format!(
+            "{}\n</ConditionGroup><ConditionGroup>{}",
+            ended("Done", "Slow"),
+            at_time("Cap", 60.0, "rising")
+        ),
+    );
+    std::fs::write(dir.path().join("ncap.xosc"), &text).unwrap();
+    let program = r#"w = World()
+s = Import("ncap.xosc")
+top = s.ego.speed.max()
+Monitor(top.map(lambda v: v - 18.49), over = "end", name = "reaches_20")
+Monitor(top.map(lambda v: 21.0 - v), over = "end", name = "not_over_21")
+Monitor(s.ego.speed.map(lambda v: 1.5 - max(v - 10.0, 10.0 - v)), over = "end", name = "ends_near_10")
+test(horizon = 100)
+"#;
+    let (code, err, records) = run(dir.path(), "prog.star", program, &[]);
+    assert_eq!(code, 0, "{err}\n{records:?}");
+    let r = &records[0];
+    for m in ["reaches_20", "not_over_21", "ends_near_10", "offroad"] {
+        assert_eq!(r["monitors"][m]["passed"], true, "{m}: {r}");
+    }
+    let end = r["metrics"]["simulated_s"].as_f64().unwrap();
+    assert!(
+        end > 14.5 && end < 22.0,
+        "the second action's end stops the test: {end} s"
+    );
+}
+
+/// What paracosm cannot hand the system under test (here a lane change of the driven ego) is
+/// refused at load with the action's line and column, not dropped with a warning; the same
+/// file runs with `--scripted-ego`.
+#[test]
+fn an_ego_action_the_system_cannot_take_is_refused_at_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let story = format!(
+        r#"<Story name="S"><Act name="A">
+  <ManeuverGroup maximumExecutionCount="1" name="G">
+    <Actors selectTriggeringEntities="false"><EntityRef entityRef="Ego"/></Actors>
+    <Maneuver name="M">
+<Event name="Change" priority="override">
+  <Action name="ChangeAction"><PrivateAction><LateralAction><LaneChangeAction>
+    <LaneChangeActionDynamics dynamicsShape="sinusoidal" value="3" dynamicsDimension="time"/>
+    <LaneChangeTarget><RelativeTargetLane entityRef="Ego" value="1"/></LaneChangeTarget>
+  </LaneChangeAction></LateralAction></PrivateAction></Action>
+  <StartTrigger><ConditionGroup>{}</ConditionGroup></StartTrigger>
+</Event>
+    </Maneuver>
+  </ManeuverGroup>
+</Act></Story>"#,
+        at_time("Go", 1.0, "rising")
+    );
+    let text = scenario(
+        &vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+        &teleport("Ego", 50.0, 10.0),
+        &story,
+        &at_time("End", 6.0, "rising"),
+    );
+    let (code, err, _) = run(dir.path(), "change.xosc", &text, &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("change.xosc:")
+            && err.contains("LaneChangeAction")
+            && err.contains("--scripted-ego"),
+        "{err}"
+    );
+    let (code, err, records) = run(dir.path(), "change.xosc", &text, &["--scripted-ego"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(records[0]["status"], "pass");
+}
+
+/// A file with two vehicles, neither named Ego or hero, and no controller activated: which
+/// one is the ego is not plain, so the load asks for `--ego NAME`; with it the summary names
+/// the ego and its box.
+#[test]
+fn a_file_without_a_plain_ego_needs_ego_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = scenario(
+        &format!(
+            "{}\n{}",
+            vehicle("Car1", [4.0, 1.8, 1.5], 1.3),
+            vehicle("Car2", [5.0, 2.0, 1.5], 1.4)
+        ),
+        &format!(
+            "{}\n{}",
+            teleport("Car1", 50.0, 10.0),
+            teleport("Car2", 120.0, 10.0)
+        ),
+        "",
+        &at_time("End", 3.0, "rising"),
+    );
+    let (code, err, _) = run(dir.path(), "two.xosc", &text, &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--ego NAME") && err.contains("Car1, Car2"),
+        "{err}"
+    );
+    let (code, err, _) = run(dir.path(), "two.xosc", &text, &["--ego", "Nobody"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("\"Nobody\""), "{err}");
+    let path = dir.path().join("two.xosc");
+    let out = dir.path().join("named");
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&path)
+        .args(["--ego", "Car2", "--budget", "1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        stdout.contains("ego vehicle: Car2, 5 × 2 × 1.5 m"),
+        "{stdout}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["ego"], "Car2, 5 × 2 × 1.5 m");
+}
+
+/// A rising edge needs the condition false before it is true: a stop trigger whose condition
+/// holds from the start (`SimulationTime > −1`, rising) never fires, and the test runs to the
+/// second group's time (8 s); with `none` it ends at once.
+#[test]
+fn the_start_of_the_simulation_is_no_rising_edge() {
+    let dir = tempfile::tempdir().unwrap();
+    for (edge, lo, hi) in [("rising", 8.0, 8.1), ("none", 0.0, 0.1)] {
+        let text = scenario(
+            &vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+            &teleport("Ego", 50.0, 10.0),
+            "",
+            &format!(
+                "{}\n</ConditionGroup><ConditionGroup>{}",
+                at_time("Always", -1.0, edge),
+                at_time("Late", 8.0, "rising")
+            ),
+        );
+        let (code, err, records) = run(dir.path(), "edge.xosc", &text, &["--scripted-ego"]);
+        assert_eq!(code, 0, "{err}");
+        let end = records[0]["metrics"]["simulated_s"].as_f64().unwrap();
+        assert!(end >= lo && end <= hi, "{edge}: ended at {end} s");
+    }
+}
+
+/// An `<Action>` holds one action (the schema's choice): a second `<PrivateAction>` in it is
+/// refused at its line and column, not silently dropped.
+#[test]
+fn an_action_with_two_actions_is_refused_at_the_second() {
+    let dir = tempfile::tempdir().unwrap();
+    let two = r#"<Story name="S"><Act name="A">
+  <ManeuverGroup maximumExecutionCount="1" name="G">
+    <Actors selectTriggeringEntities="false"><EntityRef entityRef="Box"/></Actors>
+    <Maneuver name="M">
+<Event name="E" priority="override">
+  <Action name="Two">
+    <PrivateAction><LongitudinalAction><SpeedAction>
+      <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
+      <SpeedActionTarget><AbsoluteTargetSpeed value="3"/></SpeedActionTarget>
+    </SpeedAction></LongitudinalAction></PrivateAction>
+    <PrivateAction><LongitudinalAction><SpeedAction>
+      <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
+      <SpeedActionTarget><AbsoluteTargetSpeed value="5"/></SpeedActionTarget>
+    </SpeedAction></LongitudinalAction></PrivateAction>
+  </Action>
+</Event>
+    </Maneuver>
+  </ManeuverGroup>
+</Act></Story>"#;
+    let text = scenario(
+        &format!(
+            "{}\n{}",
+            vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+            parked_box("Box", 2.0)
+        ),
+        &format!(
+            "{}\n{}",
+            teleport("Ego", 50.0, 10.0),
+            teleport("Box", 200.0, 0.0)
+        ),
+        two,
+        &at_time("End", 3.0, "rising"),
+    );
+    let (code, err, _) = run(dir.path(), "two_actions.xosc", &text, &[]);
+    assert_eq!(code, 2, "{err}");
+    let line = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| l.contains("<PrivateAction><LongitudinalAction><SpeedAction>"))
+        .nth(3)
+        .map(|(i, _)| i + 1)
+        .unwrap();
+    assert!(
+        err.contains(&format!("two_actions.xosc:{line}:")) && err.contains("one action"),
+        "line {line}: {err}"
+    );
+}
+
+/// A storyboard without a stop trigger has nothing to end its tests: it is refused at load,
+/// asking for `--horizon`, rather than run to a cap; with `--horizon 5` each test ends at
+/// 5 s.
+#[test]
+fn a_storyboard_without_a_stop_trigger_needs_a_horizon() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = scenario(
+        &vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+        &teleport("Ego", 50.0, 10.0),
+        "",
+        "",
+    )
+    .replace(
+        "<StopTrigger><ConditionGroup>\n\n</ConditionGroup></StopTrigger>",
+        "",
+    );
+    assert!(!text.contains("StopTrigger"), "{text}");
+    let (code, err, _) = run(dir.path(), "endless.xosc", &text, &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("no stop trigger") && err.contains("--horizon"),
+        "{err}"
+    );
+    let (code, err, records) = run(dir.path(), "endless.xosc", &text, &["--horizon", "5"]);
+    assert_eq!(code, 0, "{err}");
+    let end = records[0]["metrics"]["simulated_s"].as_f64().unwrap();
+    assert!((end - 5.0).abs() < 0.02, "ended at {end} s");
+}
+
+/// `--trace` writes each test's trace laid out as esmini's CSV log: every entity's speed,
+/// position and heading. At t = 0 the scripted box has its `Init` speed (5 m/s), a teleport
+/// of it at 2 s keeps its speed (no jump over one step), and the ego's box centre moves 10 m
+/// a second from 50 + 4 m (its reference point plus the box centre's offset).
+#[test]
+fn a_trace_records_every_entity_as_esminis_log_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let story = format!(
+        r#"<Story name="S"><Act name="A">
+  <ManeuverGroup maximumExecutionCount="1" name="G">
+    <Actors selectTriggeringEntities="false"><EntityRef entityRef="Box"/></Actors>
+    <Maneuver name="M">
+<Event name="Jump" priority="override">
+  <Action name="JumpAction"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="400" offset="0"/></Position></TeleportAction></PrivateAction></Action>
+  <StartTrigger><ConditionGroup>{}</ConditionGroup></StartTrigger>
+</Event>
+    </Maneuver>
+  </ManeuverGroup>
+</Act></Story>"#,
+        at_time("Go", 2.0, "rising")
+    );
+    let text = scenario(
+        &format!(
+            "{}\n{}",
+            vehicle("Ego", [10.0, 2.5, 3.2], 4.0),
+            parked_box("Box", 2.0)
+        ),
+        &format!(
+            "{}\n{}",
+            teleport("Ego", 50.0, 10.0),
+            teleport("Box", 200.0, 5.0)
+        ),
+        &story,
+        &at_time("End", 4.0, "rising"),
+    );
+    let (code, err, records) = run(
+        dir.path(),
+        "traced.xosc",
+        &text,
+        &["--scripted-ego", "--trace-every", "0.01"],
+    );
+    assert_eq!(code, 0, "{err}");
+    let log = records[0]["log"].to_string();
+    assert!(
+        log.contains("event \\\"Jump\\\" start"),
+        "the timeline: {log}"
+    );
+    let csv = std::fs::read_to_string(dir.path().join("traced.xosc.out/trace/test_0.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert!(lines.next().unwrap().starts_with("paracosm VERSION"));
+    lines.next();
+    assert!(lines.next().unwrap().starts_with("Number of Vehicles: 2"));
+    let header = lines.next().unwrap();
+    assert!(
+        header.starts_with("Index [-], TimeStamp [s], #1 Entity_Name [-], #1 Entity_ID [-], #1 Current_Speed [m/s]"),
+        "{header}"
+    );
+    let rows: Vec<Vec<String>> = lines
+        .map(|l| l.split(',').map(|c| c.trim().to_owned()).collect())
+        .collect();
+    // Every step of the 4 s test (and the start).
+    assert!(rows.len() >= 240, "{} rows", rows.len());
+    let num = |r: &[String], k: usize| r[k].parse::<f64>().unwrap();
+    // Entity k's column c is at 2 + 31 k + c.
+    let (ego, boxed) = (2, 2 + 31);
+    assert_eq!(rows[0][ego], "Ego");
+    assert_eq!(rows[0][boxed], "Box");
+    assert!(
+        (num(&rows[0], ego + 2) - 10.0).abs() < 1e-9,
+        "{:?}",
+        rows[0]
+    );
+    for r in &rows {
+        let t = num(r, 1);
+        let v = num(r, boxed + 2);
+        assert!((v - 5.0).abs() < 1e-6, "the box's speed at {t} s: {v} m/s");
+        let x = num(r, ego + 11);
+        assert!(
+            (x - (54.0 + 10.0 * t)).abs() < 0.02,
+            "the ego's x at {t} s: {x} m"
+        );
+    }
+    let box_x_late = num(rows.last().unwrap(), boxed + 11);
+    assert!(
+        box_x_late > 400.0,
+        "the teleport moved the box: {box_x_late}"
+    );
+}
+
+/// Lane and road references that do not depend on where an entity is are checked when the
+/// file loads: a lane change to a lane no road has, and a teleport to a road the map lacks,
+/// are refused at the action's line and column, naming the action (and `xosc FILE`, which
+/// loads the map too, refuses a map that does not load).
+#[test]
+fn lane_and_road_references_are_checked_at_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let event = |action: &str| {
+        format!(
+            r#"<Story name="S"><Act name="A">
+  <ManeuverGroup maximumExecutionCount="1" name="G">
+    <Actors selectTriggeringEntities="false"><EntityRef entityRef="Box"/></Actors>
+    <Maneuver name="M">
+<Event name="E" priority="override">
+  <Action name="Bad"><PrivateAction>{action}</PrivateAction></Action>
+  <StartTrigger><ConditionGroup>{}</ConditionGroup></StartTrigger>
+</Event>
+    </Maneuver>
+  </ManeuverGroup>
+</Act></Story>"#,
+            at_time("Go", 1.0, "rising")
+        )
+    };
+    for (file, action, want) in [
+        (
+            "lane.xosc",
+            r#"<LateralAction><LaneChangeAction>
+    <LaneChangeActionDynamics dynamicsShape="sinusoidal" value="3" dynamicsDimension="time"/>
+    <LaneChangeTarget><AbsoluteTargetLane value="-9"/></LaneChangeTarget>
+  </LaneChangeAction></LateralAction>"#,
+            "lane -9",
+        ),
+        (
+            "road.xosc",
+            r#"<TeleportAction><Position><LanePosition roadId="77" laneId="-4" s="10" offset="0"/></Position></TeleportAction>"#,
+            "77",
+        ),
+    ] {
+        let text = scenario(
+            &format!(
+                "{}\n{}",
+                vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+                parked_box("Box", 2.0)
+            ),
+            &format!(
+                "{}\n{}",
+                teleport("Ego", 50.0, 10.0),
+                teleport("Box", 200.0, 5.0)
+            ),
+            &event(action),
+            &at_time("End", 3.0, "rising"),
+        );
+        let line = text
+            .lines()
+            .position(|l| l.contains("<Action name=\"Bad\">"))
+            .unwrap()
+            + 1;
+        let (code, err, _) = run(dir.path(), file, &text, &[]);
+        assert_eq!(code, 2, "{file}: {err}");
+        assert!(
+            err.contains(&format!("{file}:{line}:"))
+                && err.contains("\"Bad\"")
+                && err.contains(want),
+            "{file}: line {line}: {err}"
+        );
+        assert!(!err.contains("stream "), "{err}");
+    }
+}
+
+/// In a program: an open parameter written inline in `Import(params = {...})` is named by the
+/// file's parameter it opens (it was `param0`), and an imported entity bound to a variable
+/// (`ped = s.TargetBlocking`) publishes its outputs under that name (`ped.speed`), as any
+/// actor assigned to a variable does (it was refused: "nothing publishes").
+#[test]
+fn an_imported_entity_and_an_inline_parameter_take_the_programs_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let template = Path::new(env!("CARGO_MANIFEST_DIR")).join(
+        "tests/data/xosc/alks/concrete_scenarios/alks_scenario_4_2_3_crossing_pedestrian_template.xosc",
+    );
+    let program = format!(
+        r#"w = World()
+s = Import("{}", params = {{"TargetBlocking_Speed_kph": VarInterval(6, 12)}})
+ped = s.TargetBlocking
+Stl("G[0,60] (ped.speed < 4)", name = "ped_walks")
+test(horizon = 60)
+"#,
+        template.display()
+    );
+    let (code, err, records) = run(dir.path(), "prog.star", &program, &["--budget", "2"]);
+    assert!(matches!(code, 0 | 1), "{err}");
+    assert_eq!(records.len(), 2, "{err}");
+    for r in &records {
+        let kph = r["params"]["TargetBlocking_Speed_kph"].as_f64().unwrap();
+        assert!((6.0..12.0).contains(&kph), "{r}");
+        assert_eq!(r["monitors"]["ped_walks"]["passed"], true, "{r}");
+    }
+}
