@@ -119,7 +119,8 @@ pub fn ego_of(
             .find(|&i| s.entities[i].name == name)
             .ok_or_else(|| {
                 worlds_error(format!(
-                    "{}: --ego {name:?} is not a vehicle of the scenario (its vehicles: {})",
+                    "{}: the ego named {name:?} (--ego, or Import's ego=) is not a vehicle of the \
+                     scenario (its vehicles: {})",
                     s.file,
                     list()
                 ))
