@@ -269,10 +269,10 @@ fn an_ego_action_the_system_cannot_take_is_refused_at_load() {
     <Actors selectTriggeringEntities="false"><EntityRef entityRef="Ego"/></Actors>
     <Maneuver name="M">
 <Event name="Change" priority="override">
-  <Action name="ChangeAction"><PrivateAction><LateralAction><LaneChangeAction>
-    <LaneChangeActionDynamics dynamicsShape="sinusoidal" value="3" dynamicsDimension="time"/>
-    <LaneChangeTarget><RelativeTargetLane entityRef="Ego" value="1"/></LaneChangeTarget>
-  </LaneChangeAction></LateralAction></PrivateAction></Action>
+  <Action name="ChangeAction"><PrivateAction><LateralAction><LaneOffsetAction continuous="false">
+    <LaneOffsetActionDynamics maxLateralAcc="0.5" dynamicsShape="sinusoidal"/>
+    <LaneOffsetTarget><AbsoluteTargetLaneOffset value="0.5"/></LaneOffsetTarget>
+  </LaneOffsetAction></LateralAction></PrivateAction></Action>
   <StartTrigger><ConditionGroup>{}</ConditionGroup></StartTrigger>
 </Event>
     </Maneuver>
@@ -290,7 +290,7 @@ fn an_ego_action_the_system_cannot_take_is_refused_at_load() {
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("change.xosc:")
-            && err.contains("LaneChangeAction")
+            && err.contains("LaneOffsetAction")
             && err.contains("--scripted-ego"),
         "{err}"
     );
@@ -643,4 +643,270 @@ test(horizon = 60)
         assert!((6.0..12.0).contains(&kph), "{r}");
         assert_eq!(r["monitors"]["ped_walks"]["passed"], true, "{r}");
     }
+}
+
+/// A story whose one maneuver, on `actor`, holds `events`.
+fn story_of(actor: &str, events: &[String]) -> String {
+    format!(
+        r#"<Story name="S"><Act name="A">
+  <ManeuverGroup maximumExecutionCount="1" name="G">
+    <Actors selectTriggeringEntities="false"><EntityRef entityRef="{actor}"/></Actors>
+    <Maneuver name="M">
+{}
+    </Maneuver>
+  </ManeuverGroup>
+</Act></Story>"#,
+        events.join("\n")
+    )
+}
+
+/// An event `name` of one private action `action` (the XML inside `<PrivateAction>`),
+/// started by the conditions `start`.
+fn event(name: &str, action: &str, start: &str) -> String {
+    format!(
+        r#"<Event name="{name}" priority="override">
+  <Action name="{name}Action"><PrivateAction>{action}</PrivateAction></Action>
+  <StartTrigger><ConditionGroup>{start}</ConditionGroup></StartTrigger>
+</Event>"#
+    )
+}
+
+fn activate(lateral: bool, longitudinal: bool) -> String {
+    format!(r#"<ActivateControllerAction lateral="{lateral}" longitudinal="{longitudinal}"/>"#)
+}
+
+fn speed_step(to: f64) -> String {
+    format!(
+        r#"<LongitudinalAction><SpeedAction>
+    <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
+    <SpeedActionTarget><AbsoluteTargetSpeed value="{to}"/></SpeedActionTarget>
+  </SpeedAction></LongitudinalAction>"#
+    )
+}
+
+/// The rows of trace `file` as (time s, the first entity's speed m/s, its centre's x and y
+/// m, OpenDRIVE frame).
+fn trace_rows(file: &Path) -> Vec<(f64, f64, f64, f64)> {
+    let csv = std::fs::read_to_string(file).unwrap();
+    csv.lines()
+        .skip(4)
+        .map(|l| {
+            let c: Vec<f64> = l
+                .split(',')
+                .map(|c| c.trim().parse::<f64>().unwrap_or(f64::NAN))
+                .collect();
+            (c[1], c[4], c[13], c[14])
+        })
+        .collect()
+}
+
+/// Where the storyboard activates the ego's controller, it moves the ego until then (its
+/// SpeedAction to 15 m/s is the ego's speed at once, as esmini's default controller performs
+/// it) and the system under test drives it after: by hand the ego's centre is at
+/// 50 + 1.4 + 10 · 0.5 + 15 · 1.5 = 78.9 m at the hand-over (2 s), at exactly 15 m/s, and `aeb`
+/// then cruises on near its set speed of 15 m/s (its proportional cruise settles a little
+/// under it). Driven from the start, `aeb` would have reached about 11 m/s by 1 s.
+#[test]
+fn the_storyboard_drives_the_ego_until_it_activates_its_controller() {
+    let dir = tempfile::tempdir().unwrap();
+    let story = story_of(
+        "Ego",
+        &[
+            event("Faster", &speed_step(15.0), &at_time("Go", 0.5, "rising")),
+            event(
+                "Activate",
+                &format!(
+                    "<ControllerAction>{}</ControllerAction>",
+                    activate(true, true)
+                ),
+                &at_time("Hand", 2.0, "rising"),
+            ),
+        ],
+    );
+    let text = scenario(
+        &vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+        &teleport("Ego", 50.0, 10.0),
+        &story,
+        &at_time("End", 8.0, "rising"),
+    );
+    let (code, err, records) = run(
+        dir.path(),
+        "handover.xosc",
+        &text,
+        &["--trace-every", "0.1"],
+    );
+    assert_eq!(code, 0, "{err}\n{records:?}");
+    let r = &records[0];
+    assert_eq!(r["status"], "pass", "{r}");
+    let log = r["log"].to_string();
+    assert!(
+        log.contains("the system under test takes over the ego Ego at 15.00 m/s"),
+        "{log}"
+    );
+    let rows = trace_rows(&dir.path().join("handover.xosc.out/trace/test_0.csv"));
+    let at = |t: f64| {
+        *rows
+            .iter()
+            .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+            .unwrap()
+    };
+    let (_, v1, _, _) = at(1.0);
+    assert!(
+        (v1 - 15.0).abs() < 0.01,
+        "scripted until 2 s: {v1} m/s at 1 s"
+    );
+    let (t2, _, x2, _) = at(2.0);
+    let hand = 50.0 + 1.4 + 10.0 * 0.5 + 15.0 * 1.5;
+    assert!(
+        (x2 - hand).abs() < 0.3,
+        "at {t2} s the ego's centre is at {x2} m, by hand {hand} m"
+    );
+    let (_, v8, x8, _) = *rows.last().unwrap();
+    assert!(
+        (13.5..=15.5).contains(&v8),
+        "aeb cruises near its set speed 15: {v8} m/s"
+    );
+    assert!(
+        x8 > x2 + 5.5 * 13.5,
+        "driven on after the hand-over: {x8} m"
+    );
+}
+
+/// A deactivation of the driven ego's controller is refused at load; a storyboard that ends
+/// before its activation is an error (the system under test never drove).
+#[test]
+fn an_ego_never_handed_over_is_an_error_and_a_deactivation_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = |lateral: bool, longitudinal: bool, at: f64| {
+        scenario(
+            &vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+            &teleport("Ego", 50.0, 10.0),
+            &story_of(
+                "Ego",
+                &[event(
+                    "Activate",
+                    &format!(
+                        "<ControllerAction>{}</ControllerAction>",
+                        activate(lateral, longitudinal)
+                    ),
+                    &at_time("Hand", at, "rising"),
+                )],
+            ),
+            &at_time("End", 3.0, "rising"),
+        )
+    };
+    let (code, err, _) = run(dir.path(), "off.xosc", &file(false, false, 1.0), &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("off.xosc:") && err.contains("deactivates"),
+        "{err}"
+    );
+    let (code, err, records) = run(dir.path(), "late.xosc", &file(true, true, 5.0), &[]);
+    assert_eq!(code, 3, "{err}");
+    assert_eq!(records[0]["status"], "error", "{:?}", records[0]);
+    assert!(
+        records[0]["error"]
+            .to_string()
+            .contains("before its ActivateControllerAction handed the ego Ego"),
+        "{:?}",
+        records[0]
+    );
+    // Longitudinal only: the whole ego is handed over, and the load says so.
+    let (code, err, _) = run(dir.path(), "half.xosc", &file(false, true, 1.0), &[]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("activates only the longitudinal control of Ego"),
+        "{err}"
+    );
+}
+
+/// `aeb` stops the ego behind a parked box (rear at s = 149 m) while the stop trigger waits
+/// for the ego to travel 250 m, past the box: nothing can move again, so after 10 s of
+/// stillness (`STUCK_S`) the test ends as an error naming the condition, not at the 3,600 s
+/// cap and not as a pass.
+#[test]
+fn a_storyboard_that_waits_on_what_cannot_happen_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = scenario(
+        &format!(
+            "{}\n{}",
+            vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+            parked_box("Box", 2.0)
+        ),
+        &format!(
+            "{}\n{}",
+            teleport("Ego", 50.0, 10.0),
+            teleport("Box", 150.0, 0.0)
+        ),
+        "",
+        r#"<Condition name="PastTheBox" delay="0" conditionEdge="none">
+  <ByEntityCondition><TriggeringEntities triggeringEntitiesRule="any"><EntityRef entityRef="Ego"/></TriggeringEntities>
+  <EntityCondition><TraveledDistanceCondition value="250"/></EntityCondition></ByEntityCondition>
+</Condition>"#,
+    );
+    let (code, err, records) = run(dir.path(), "stuck.xosc", &text, &[]);
+    assert_eq!(code, 3, "{err}");
+    let r = &records[0];
+    assert_eq!(r["status"], "error", "{r}");
+    let why = r["error"].as_str().unwrap();
+    assert!(
+        why.contains("waits on \"PastTheBox\" (")
+            && why.contains("stuck.xosc:42:1)")
+            && why.contains("can no longer"),
+        "{why}"
+    );
+    // "at t = 25.317 s, the storyboard of ...": stopped by the 10 s of stillness, not the cap.
+    let end: f64 = why
+        .strip_prefix("at t = ")
+        .and_then(|w| w.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or(f64::NAN);
+    assert!(end < 40.0, "ended {end} s in, not at the cap: {why}");
+}
+
+/// A lane change of the driven ego is the system's new route: `aeb`, on lane −4 at 10 m/s,
+/// follows a route into lane −3 (3.5 m to its left) that joins it 3 s × 10 m/s = 30 m ahead;
+/// the action ends once the ego is within 0.3 m of the lane's centre (`LANE_REACHED_M`), and
+/// its end stops the test; the ego then drives on in the new lane, 3.5 m left of where it
+/// started.
+#[test]
+fn a_lane_change_of_the_driven_ego_is_its_systems_route() {
+    let dir = tempfile::tempdir().unwrap();
+    let change = r#"<LateralAction><LaneChangeAction>
+    <LaneChangeActionDynamics dynamicsShape="sinusoidal" value="3" dynamicsDimension="time"/>
+    <LaneChangeTarget><RelativeTargetLane entityRef="Ego" value="1"/></LaneChangeTarget>
+  </LaneChangeAction></LateralAction>"#;
+    let story = story_of(
+        "Ego",
+        &[event("Change", change, &at_time("Go", 1.0, "rising"))],
+    );
+    let ended = r#"<Condition name="Changed" delay="0" conditionEdge="rising">
+  <ByValueCondition><StoryboardElementStateCondition storyboardElementType="event" storyboardElementRef="Change" state="endTransition"/></ByValueCondition>
+</Condition>
+</ConditionGroup><ConditionGroup>"#
+        .to_owned()
+        + &at_time("Cap", 30.0, "rising");
+    let text = scenario(
+        &vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+        &teleport("Ego", 50.0, 10.0),
+        &story,
+        &ended,
+    );
+    let (code, err, records) = run(dir.path(), "lane.xosc", &text, &["--trace-every", "0.1"]);
+    assert_eq!(code, 0, "{err}\n{records:?}");
+    let r = &records[0];
+    assert_eq!(r["status"], "pass", "{r}");
+    let log = r["log"].to_string();
+    assert!(log.contains("is given a new route"), "{log}");
+    let end = r["metrics"]["simulated_s"].as_f64().unwrap();
+    assert!(
+        end > 2.5 && end < 10.0,
+        "the lane change's end stops the test: {end} s"
+    );
+    let rows = trace_rows(&dir.path().join("lane.xosc.out/trace/test_0.csv"));
+    let (y0, y1) = (rows[0].3, rows.last().unwrap().3);
+    assert!(
+        ((y1 - y0) - 3.5).abs() < 0.35,
+        "one lane (3.5 m) to the left: from y = {y0} to {y1} m"
+    );
 }

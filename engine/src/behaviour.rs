@@ -106,6 +106,18 @@ pub enum Action {
     /// now on: the set speed its observation carries ([`crate::Observation::set_speed_mps`]),
     /// as an OpenSCENARIO storyboard's `SpeedAction` on the ego it drives asks.
     SetEgoSpeed,
+    /// The system under test takes over the ego that a script placed until now (the value is
+    /// ignored): its chassis becomes a dynamic body moving at the velocity of its last placed
+    /// step, and the system's control drives it from this step on (an OpenSCENARIO
+    /// storyboard's `ActivateControllerAction` on the ego, after which esmini hands the ego
+    /// to its controller). Only for an ego whose [`crate::EgoSpec::scripted`] is set; a
+    /// second release does nothing.
+    ReleaseEgo,
+    /// The system under test is given a new route to follow from now on: the value is a
+    /// tuple of two or more `Vec3 [x, y, z]` points (m, world frame; `y` is not read), the
+    /// route its observation carries ([`crate::Observation::route`]), as an OpenSCENARIO
+    /// storyboard's `LaneChangeAction` or `AssignRouteAction` on the ego it drives asks.
+    SetEgoRoute,
 }
 
 impl Action {
@@ -117,7 +129,9 @@ impl Action {
             | Action::Brake(c)
             | Action::ChangeLane(c)
             | Action::PlaceCar(c) => ActorRef::Car(c),
-            Action::PlaceEgo | Action::SetEgoSpeed => ActorRef::Ego,
+            Action::PlaceEgo | Action::SetEgoSpeed | Action::ReleaseEgo | Action::SetEgoRoute => {
+                ActorRef::Ego
+            }
         }
     }
 }

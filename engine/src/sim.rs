@@ -1102,38 +1102,83 @@ impl Simulation {
                         p.place(&mut self.physics, (pose.0, pose.1), pose.2, dt);
                     }
                 }
-                Action::PlaceEgo => {
-                    let pose = placed_pose(value).ok_or_else(|| {
-                        bad(
-                            "the pose given to the ego".into(),
-                            value,
-                            "a (Vec3 [x, y, z] m, heading rad[, speed m/s >= 0]) tuple of finite numbers",
-                        )
-                    })?;
-                    if !self.ego.scripted {
-                        return Err(bad(
-                            "a pose given to the ego, which the system under test drives \
-                             (EgoSpec::scripted is not set)"
-                                .into(),
-                            value,
-                            "no pose",
-                        ));
-                    }
-                    self.ego.place(&mut self.physics, pose.0, pose.1);
-                }
-                Action::SetEgoSpeed => match value {
-                    Value::Num(v) if v.is_finite() && *v >= 0.0 => self.set_speed_mps = Some(*v),
-                    _ => {
-                        return Err(bad(
-                            "the set speed given to the ego's system under test".into(),
-                            value,
-                            "a finite number >= 0 (m/s)",
-                        ))
-                    }
-                },
+                Action::PlaceEgo
+                | Action::SetEgoRoute
+                | Action::ReleaseEgo
+                | Action::SetEgoSpeed => self.act_on_ego(*sink, value, t)?,
             }
         }
         self.sinks = sinks;
+        Ok(())
+    }
+
+    /// Performs a storyboard's action on the ego at time `t` (s): a pose for a scripted ego,
+    /// a route or a set speed for its system under test, the hand-over to that system.
+    ///
+    /// # Errors
+    /// [`crate::rx::RxError::Input`] for a value the action cannot take (a pose or route that
+    /// is not a tuple of finite numbers, a negative set speed), or a pose for an ego the system
+    /// under test drives.
+    fn act_on_ego(&mut self, action: Action, value: &Value, t: f64) -> Result<(), EngineError> {
+        let bad = |name: String, v: &Value, expected: &str| bad_input(t, name, v, expected);
+        match action {
+            Action::PlaceEgo => {
+                let pose = placed_pose(value).ok_or_else(|| {
+                    bad(
+                    "the pose given to the ego".into(),
+                    value,
+                    "a (Vec3 [x, y, z] m, heading rad[, speed m/s >= 0]) tuple of finite numbers",
+                )
+                })?;
+                if !self.ego.scripted {
+                    return Err(bad(
+                        "a pose given to the ego, which the system under test drives \
+                     (EgoSpec::scripted is not set)"
+                            .into(),
+                        value,
+                        "no pose",
+                    ));
+                }
+                self.ego.place(&mut self.physics, pose.0, pose.1);
+            }
+            Action::SetEgoRoute => {
+                let points: Option<Vec<[f64; 2]>> = match value {
+                    Value::Tuple(items) if items.len() >= 2 => items
+                        .iter()
+                        .map(|v| match v {
+                            Value::Vec3(p) if p[0].is_finite() && p[2].is_finite() => {
+                                Some([p[0], p[2]])
+                            }
+                            _ => None,
+                        })
+                        .collect(),
+                    _ => None,
+                };
+                let Some(points) = points else {
+                    return Err(bad(
+                        "the route given to the ego's system under test".into(),
+                        value,
+                        "a tuple of two or more Vec3 [x, y, z] points of finite numbers (m)",
+                    ));
+                };
+                self.route = points;
+            }
+            Action::ReleaseEgo => {
+                let v = self.ego_velocity;
+                self.ego.release(&mut self.physics, [v[0], 0.0, v[2]]);
+            }
+            Action::SetEgoSpeed => match value {
+                Value::Num(v) if v.is_finite() && *v >= 0.0 => self.set_speed_mps = Some(*v),
+                _ => {
+                    return Err(bad(
+                        "the set speed given to the ego's system under test".into(),
+                        value,
+                        "a finite number >= 0 (m/s)",
+                    ))
+                }
+            },
+            _ => {}
+        }
         Ok(())
     }
 

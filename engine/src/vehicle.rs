@@ -203,6 +203,26 @@ impl EgoVehicle {
         physics.bodies[self.body].set_next_kinematic_position(pose);
     }
 
+    /// Hands a scripted vehicle to its controls ([`crate::Action::ReleaseEgo`]): its chassis
+    /// becomes a dynamic body moving at `velocity_mps` (m/s, world frame), which the vehicle
+    /// model drives from the next step on. A vehicle no script places is left as it is.
+    pub(crate) fn release(&mut self, physics: &mut PhysicsWorld, velocity_mps: [f64; 3]) {
+        if !self.scripted {
+            return;
+        }
+        let body = &mut physics.bodies[self.body];
+        body.set_body_type(RigidBodyType::Dynamic, true);
+        body.set_linvel(
+            Vector::new(
+                velocity_mps[0] as f32,
+                velocity_mps[1] as f32,
+                velocity_mps[2] as f32,
+            ),
+            true,
+        );
+        self.scripted = false;
+    }
+
     /// Sets engine, brake and steering from `control` (clamped), as documented on [`Control`].
     /// rapier's `brake` is an impulse per step, hence the factor `dt`.
     pub(crate) fn apply(&mut self, control: Control, dt_s: f64) {

@@ -237,6 +237,8 @@ impl Aeb {
             self.curves.clear();
             self.boxes.clear();
             self.curves_of = route.as_ptr() as usize;
+            // A new route (a storyboard's lane change): followed from its start.
+            self.progress = 0;
         }
         if self.progress < route.len() {
             extend_boxes(&mut self.boxes, route, self.progress + WINDOW);

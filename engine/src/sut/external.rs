@@ -678,6 +678,9 @@ pub struct ExternalSut {
     /// The number of the next observation in this test, from 0: sent as `step`, and the
     /// answer must carry it back (SUT_PROTOCOL.md).
     step: u64,
+    /// The route last sent (its address and length in the observation), so that a route is
+    /// sent in the first observation that has one and again only when it changes.
+    route_sent: (usize, usize),
 }
 
 impl ExternalSut {
@@ -688,6 +691,7 @@ impl ExternalSut {
             process: None,
             healthy: false,
             step: 0,
+            route_sent: (0, 0),
         }
     }
 
@@ -726,6 +730,7 @@ impl Sut for ExternalSut {
         // The physics step is not known here; the hello carries the default step.
         let dt_s = crate::DEFAULT_DT_S;
         self.step = 0;
+        self.route_sent = (0, 0);
         if self.process.is_none() {
             let pooled = if self.config.reuse {
                 self.config
@@ -779,6 +784,13 @@ impl Sut for ExternalSut {
         // asks one.
         if let Some(v) = obs.set_speed_mps {
             header["ego"]["set_speed_mps"] = json!(v);
+        }
+        // The route to follow, in the first observation that has one and when it changes (a
+        // storyboard's lane change or route of the ego).
+        let route = (obs.route.as_ptr() as usize, obs.route.len());
+        if !obs.route.is_empty() && route != self.route_sent {
+            header["route_m"] = json!(obs.route);
+            self.route_sent = route;
         }
         // Every reading the program declared, as named arrays (SUT_PROTOCOL.md), in the
         // order of their names.

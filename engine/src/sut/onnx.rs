@@ -632,7 +632,15 @@ impl OnnxSut {
         }
     }
 
-    fn decide(&mut self, frame: &CameraFrame, speed_mps: f64) -> Result<Control, SutError> {
+    /// The model's control for `frame` at `speed_mps` (m/s); `set_speed_mps` (the scenario's
+    /// set speed, [`Observation::set_speed_mps`]) replaces the manifest's `cruise_mps` for a
+    /// model without a `throttle` output, and is not seen by one with it.
+    fn decide(
+        &mut self,
+        frame: &CameraFrame,
+        speed_mps: f64,
+        set_speed_mps: Option<f64>,
+    ) -> Result<Control, SutError> {
         let m = &self.config.manifest;
         let pre = match &mut self.pre {
             Some(p) if p.fits(frame.width, frame.height) => p,
@@ -682,7 +690,9 @@ impl OnnxSut {
         let steering = read(o.steering, "steering", true)?.unwrap_or(0.0);
         let throttle = match (read(o.throttle, "throttle", true)?, o.cruise_mps) {
             (Some(t), _) => t,
-            (None, Some(target)) => super::Cruise::default().throttle(speed_mps, target, None),
+            (None, Some(target)) => {
+                super::Cruise::default().throttle(speed_mps, set_speed_mps.unwrap_or(target), None)
+            }
             (None, None) => 0.0,
         };
         let braking = read(o.brake, "brake", false)?.is_some_and(|b| b > o.brake_threshold);
@@ -779,7 +789,7 @@ impl Sut for OnnxSut {
         })?;
         if self.last_frame_t != Some(frame.t_s) {
             self.last_frame_t = Some(frame.t_s);
-            self.decision = self.decide(frame, obs.ego.speed_mps)?;
+            self.decision = self.decide(frame, obs.ego.speed_mps, obs.set_speed_mps)?;
         }
         Ok(self.decision)
     }

@@ -185,46 +185,9 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
             message: n.text.clone(),
         })
         .collect();
-    let name = |i: usize| s.entities[i].name.clone();
     let mut each = |who: &[usize], na: &m::NamedAction, init: bool| -> Result<(), ScenarioError> {
-        if let Action::LongitudinalDistance {
-            continuous: true, ..
-        } = na.action
-        {
-            return Err(worlds_error(format!(
-                "{}: a continuous LongitudinalDistanceAction is not supported (paracosm places \
-                 the entity at the distance once: continuous=\"false\")",
-                na.pos
-            )));
-        }
         for &e in who {
-            let ignored = match &na.action {
-                Action::ActivateController { .. } if Some(e) == ego => None,
-                Action::ActivateController { .. } => Some(format!(
-                    "{} has no controller in paracosm: the storyboard moves it, and its \
-                     ActivateControllerAction does nothing",
-                    name(e)
-                )),
-                // Its place, its initial speed and its route (the lanes it plans through).
-                Action::Teleport(_) | Action::AssignRoute { .. } if init && Some(e) == ego => None,
-                // Its initial speed in Init; later, the set speed of the system under test.
-                Action::Speed { .. } if Some(e) == ego => None,
-                _ if Some(e) == ego => {
-                    return Err(worlds_error(format!(
-                        "{}: the system under test drives {}, and paracosm cannot hand it this \
-                         {}: its storyboard asks it of the ego only as a SpeedAction (the \
-                         system's set speed), an ActivateControllerAction, or in Init a \
-                         TeleportAction or an AssignRouteAction. Run the file with \
-                         --scripted-ego to have the storyboard move the ego, or name another \
-                         vehicle with --ego",
-                        na.pos,
-                        name(e),
-                        na.action.kind_name()
-                    )))
-                }
-                _ => None,
-            };
-            if let Some(message) = ignored {
+            if let Some(message) = performed_otherwise(s, na, (e, ego), init)? {
                 warnings.push(Warning {
                     at: na.pos.to_string(),
                     message,
@@ -260,6 +223,87 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
         }
     }
     Ok(warnings)
+}
+
+/// How paracosm performs action `na` on entity `e` (`ego`: the entity the system under test
+/// drives; `init`: in `Init`): `None` as written, `Some(note)` otherwise (a warning at load).
+///
+/// # Errors
+/// [`ScenarioError::Load`] naming the action's line and column: a continuous
+/// `LongitudinalDistanceAction`, a deactivation of the driven ego's controller, or an action
+/// on the driven ego that paracosm cannot hand its system (all but a `SpeedAction`, a
+/// `LaneChangeAction` or `AssignRouteAction` after `Init`, an `ActivateControllerAction`, and
+/// in `Init` a `TeleportAction` or `AssignRouteAction`).
+fn performed_otherwise(
+    s: &m::Scenario,
+    na: &m::NamedAction,
+    (e, ego): (usize, Option<usize>),
+    init: bool,
+) -> Result<Option<String>, ScenarioError> {
+    let name = &s.entities[e].name;
+    let driven = Some(e) == ego;
+    if let Action::LongitudinalDistance {
+        continuous: true, ..
+    } = na.action
+    {
+        return Err(worlds_error(format!(
+            "{}: a continuous LongitudinalDistanceAction is not supported (paracosm places the \
+             entity at the distance once: continuous=\"false\")",
+            na.pos
+        )));
+    }
+    Ok(match &na.action {
+        Action::ActivateController {
+            lateral,
+            longitudinal,
+        } if driven => match (lateral, longitudinal) {
+            (Some(false), Some(false)) => {
+                return Err(worlds_error(format!(
+                    "{}: this ActivateControllerAction deactivates the controller of {name}, \
+                     handing it back to the storyboard, which paracosm cannot do: the system \
+                     under test drives the ego from its activation to the end. Run the file \
+                     with --scripted-ego to have the storyboard move the ego",
+                    na.pos
+                )));
+            }
+            (Some(false), _) | (_, Some(false)) => {
+                let (only, too) = if *lateral == Some(false) {
+                    ("longitudinal", "steering")
+                } else {
+                    ("lateral", "speed")
+                };
+                Some(format!(
+                    "this ActivateControllerAction activates only the {only} control of {name}: \
+                     paracosm hands the system under test the whole ego, its {too} too"
+                ))
+            }
+            _ => None,
+        },
+        Action::ActivateController { .. } => Some(format!(
+            "{name} has no controller in paracosm: the storyboard moves it, and its \
+             ActivateControllerAction does nothing"
+        )),
+        // Its place, its initial speed and its route (the lanes it plans through).
+        Action::Teleport(_) | Action::AssignRoute { .. } if init && driven => None,
+        // Its initial speed in Init; later, the set speed of the system under test.
+        Action::Speed { .. } if driven => None,
+        // Later, the route of the system under test: into the lane, or along the route's
+        // roads.
+        Action::LaneChange { .. } | Action::AssignRoute { .. } if !init && driven => None,
+        _ if driven => {
+            return Err(worlds_error(format!(
+                "{}: the system under test drives {name}, and paracosm cannot hand it this {}: \
+                 its storyboard asks it of the ego only as a SpeedAction (the system's set \
+                 speed), a LaneChangeAction or an AssignRouteAction (the system's route), an \
+                 ActivateControllerAction, or in Init a TeleportAction or an \
+                 AssignRouteAction. Run the file with --scripted-ego to have the storyboard \
+                 move the ego, or name another vehicle with --ego",
+                na.pos,
+                na.action.kind_name()
+            )))
+        }
+        _ => None,
+    })
 }
 
 /// The scenario of `source`: its space, the `aeb` system under test (which keeps the ego's
@@ -484,8 +528,12 @@ pub(crate) fn build_into(
         .load(&road.item)
         .map_err(|e| ScenarioError::Load(e.with_context(&format!("\n --> {}", road.pos))))?;
     let roads = road::Roads::new(&map);
-    let driven = (!scripted_ego).then_some(ego);
-    let sb = Storyboard::new(model, roads, driven).map_err(|e| worlds_error(e.to_string()))?;
+    let hand_over = !scripted_ego && activates_controller_of(model, ego);
+    let driven = (!scripted_ego && !hand_over).then_some(ego);
+    let mut sb = Storyboard::new(model, roads, driven).map_err(|e| worlds_error(e.to_string()))?;
+    if hand_over {
+        sb.hand_over_on_activation(ego);
+    }
     let site = here(&road.pos, "RoadNetwork");
     let friction = scene.push(Node::Const(Value::Num(0.8)));
     let piece: PieceId = scene
@@ -497,7 +545,7 @@ pub(crate) fn build_into(
         .map_err(|e| worlds_error(e.to_string()))?;
     let placed = place_entities(scene, model, &sb, ego)?;
     let (mut sinks, probes, actors) = placed;
-    if scripted_ego {
+    if scripted_ego || hand_over {
         sinks[ego] = Some(Sink::PlaceEgo);
     }
     let ego_actor = actors[ego];
@@ -507,6 +555,7 @@ pub(crate) fn build_into(
         scene,
         &sb,
         (ego, &model.entities[ego], scripted_ego),
+        hand_over,
         piece,
         &model.file,
     )?;
@@ -537,6 +586,7 @@ pub(crate) fn build_into(
         ego,
         base,
         scripted_ego,
+        hand_over: hand_over.then_some(None),
         sinks,
         collided: probes,
         ego_probes,
@@ -546,6 +596,7 @@ pub(crate) fn build_into(
         asked: None,
         most_asked_mps: sb_init_speed,
         road_end: None,
+        stuck_since: None,
         log: Vec::new(),
     };
     let names = model.entities.iter().map(|e| e.name.clone());
@@ -586,13 +637,65 @@ fn ego_vehicle(entity: &m::Entity) -> Result<VehicleParams, ScenarioError> {
     })
 }
 
+/// Whether `model`'s storyboard activates a controller of entity `e`: then the storyboard
+/// moves it until the activation and the system under test drives it after
+/// ([`Storyboard::hand_over_on_activation`]).
+fn activates_controller_of(model: &m::Scenario, e: usize) -> bool {
+    model
+        .stories
+        .iter()
+        .flat_map(|st| &st.acts)
+        .flat_map(|a| &a.groups)
+        .filter(|g| g.actors.contains(&e))
+        .flat_map(|g| &g.maneuvers)
+        .flat_map(|mv| &mv.events)
+        .flat_map(|ev| &ev.actions)
+        .any(|na| matches!(na.action, Action::ActivateController { .. }))
+}
+
+/// The route of the ego `ego` from `from` (engine world `[x, z]`, m): it joins its lanes at
+/// `at` advanced `ahead_m` metres, then follows them the way it faces (against a lane's
+/// travel too, as the storyboard moves entities), through junctions as its
+/// `AssignRouteAction` asks (else the storyboard's way), a point every 2 m for [`ROUTE_M`].
+fn lane_route(
+    sb: &Storyboard,
+    ego: usize,
+    from: [f64; 2],
+    mut at: road::LanePos,
+    ahead_m: f64,
+) -> Vec<[f64; 2]> {
+    let mut route = vec![from];
+    let prefer = |lane: usize| sb.route_takes(ego, lane);
+    let point = |at: &road::LanePos| {
+        let (p, _) = sb.roads().to_engine(sb.roads().pose_of(at));
+        [p[0], p[2]]
+    };
+    if ahead_m > 0.0 {
+        if !sb.roads().advance(&mut at, ahead_m, &prefer) {
+            route.push(point(&at));
+            return route;
+        }
+        route.push(point(&at));
+    }
+    for _ in 0..(ROUTE_M / 2.0) as usize {
+        let more = sb.roads().advance(&mut at, 2.0, &prefer);
+        route.push(point(&at));
+        if !more {
+            break;
+        }
+    }
+    route
+}
+
 /// Places the ego where the storyboard's `Init` put it, at its initial speed, which the
 /// system under test keeps as its set speed, with a route along its lanes, with the body
-/// of its `BoundingBox` ([`ego_vehicle`]).
+/// of its `BoundingBox` ([`ego_vehicle`]). With `hand_over` its chassis is placed by the
+/// storyboard until the system under test takes it over.
 fn place_ego(
     scene: &mut Scene,
     sb: &Storyboard,
     (ego, entity, scripted_ego): (usize, &m::Entity, bool),
+    hand_over: bool,
     piece: PieceId,
     file: &str,
 ) -> Result<(), ScenarioError> {
@@ -614,20 +717,7 @@ fn place_ego(
         through: None,
         map_lane: Some(lp.lane),
     };
-    // Along its lanes the way it faces (against a lane's travel too, as the storyboard
-    // moves entities), a point every 2 m.
-    let mut route = vec![[pos[0], pos[2]]];
-    let mut at = lp;
-    // Through junctions as its Init's AssignRouteAction asks, else the storyboard's way.
-    let prefer = |lane: usize| sb.route_takes(ego, lane);
-    for _ in 0..(ROUTE_M / 2.0) as usize {
-        let more = sb.roads().advance(&mut at, 2.0, &prefer);
-        let (p, _) = sb.roads().to_engine(sb.roads().pose_of(&at));
-        route.push([p[0], p[2]]);
-        if !more {
-            break;
-        }
-    }
+    let route = lane_route(sb, ego, [pos[0], pos[2]], lp, 0.0);
     let speed = a.state.speed.max(0.0);
     let vehicle = ego_vehicle(entity)?;
     scene
@@ -638,7 +728,7 @@ fn place_ego(
                 vehicle,
                 route,
                 set_speed_mps: (!scripted_ego).then_some(speed),
-                scripted: scripted_ego,
+                scripted: scripted_ego || hand_over,
             },
             if scripted_ego {
                 SutConfig::Scripted
@@ -660,6 +750,11 @@ pub(crate) struct StoryHost {
     /// [`Source::scripted_ego`]: the storyboard moves the ego too, and nothing ends the test
     /// at the end of its road but the storyboard.
     scripted_ego: bool,
+    /// When the storyboard moves the ego until it activates the ego's controller: `Some(None)`
+    /// before the hand-over, `Some(Some((t, travelled)))` after it (its time, s, and the
+    /// distance the ego had travelled then, m); `None` when the system drives from the start
+    /// or the storyboard throughout.
+    hand_over: Option<Option<(f64, f64)>>,
     sinks: Vec<Option<Sink>>,
     collided: Vec<StreamId>,
     ego_probes: [StreamId; 3],
@@ -673,6 +768,10 @@ pub(crate) struct StoryHost {
     most_asked_mps: f64,
     /// When the ego's road ended before the storyboard did, s.
     road_end: Option<f64>,
+    /// Since when the world the system under test drives in stands still while the
+    /// storyboard waits on conditions that only motion could change, s
+    /// ([`Storyboard::stuck`], [`STUCK_S`]).
+    stuck_since: Option<f64>,
     log: Vec<String>,
 }
 
@@ -691,13 +790,89 @@ impl StoryHost {
     /// # Errors
     /// A [`HostError`] that says so, with the speed asked and the distance travelled.
     fn check_the_ego_moved(&self, t: f64) -> Result<(), HostError> {
-        let travelled = self.sb.actors[self.ego].state.travelled_m;
+        let mut travelled = self.sb.actors[self.ego].state.travelled_m;
+        match self.hand_over {
+            Some(None) => {
+                return Err(HostError(format!(
+                    "t = {t:.2} s: the storyboard ended before its ActivateControllerAction \
+                     handed the ego {} to the system under test: the storyboard moved it \
+                     throughout, so the test tested nothing of the system",
+                    self.sb.actors[self.ego].name
+                )))
+            }
+            Some(Some((_, then))) => travelled -= then,
+            None => {}
+        }
         if self.most_asked_mps > STILL_MPS && travelled < MOVED_M {
             return Err(HostError(format!(
                 "t = {t:.2} s: the storyboard ended, and the ego {} travelled {travelled:.2} m \
                  though the file asked it to drive at up to {:.2} m/s: the system under test \
                  never drove it, so the test tested nothing the file describes",
                 self.sb.actors[self.ego].name, self.most_asked_mps
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl StoryHost {
+    /// Hands the ego to the system under test in the step (at `t`, s) whose
+    /// `ActivateControllerAction` activated its controller: the storyboard stops placing it,
+    /// the engine releases its chassis ([`Sink::ReleaseEgo`]) at the speed it had, which
+    /// becomes the system's set speed unless a `SpeedAction` is running, and the timeline
+    /// records it.
+    fn hand_over_if_activated(&mut self, t: f64) {
+        if self.hand_over != Some(None) || self.sb.actors[self.ego].scripted {
+            return;
+        }
+        let a = &self.sb.actors[self.ego];
+        let speed = a.state.speed.max(0.0);
+        self.hand_over = Some(Some((t, a.state.travelled_m)));
+        self.log.push(format!(
+            "t = {t:.3} s: the system under test takes over the ego {} at {speed:.2} m/s",
+            a.name
+        ));
+        self.sinks[self.ego] = None;
+        self.performed.push((Sink::ReleaseEgo, Value::Unit));
+        // What the file asks of it from now on: at least to keep the speed it has.
+        self.most_asked_mps = speed;
+        if self.sb.set_speed().is_none() {
+            self.asked = Some(speed);
+            self.performed.push((Sink::SetEgoSpeed, Value::Num(speed)));
+        }
+    }
+}
+
+/// How long, s, the world may stand still while the storyboard waits on conditions that only
+/// motion could change before the test ends as an error ([`Storyboard::stuck`]): the system
+/// under test holds the ego still (behind a stopped target, say) and the storyboard waits on
+/// what can no longer happen.
+pub const STUCK_S: f64 = 10.0;
+
+impl StoryHost {
+    /// An error once the world has stood still for [`STUCK_S`] while the storyboard waits on
+    /// conditions that only motion could change (at `t`, s); only while the system under
+    /// test drives the ego.
+    ///
+    /// # Errors
+    /// A [`HostError`] naming the conditions waited on and since when all stands still.
+    fn check_the_storyboard_can_go_on(&mut self, t: f64) -> Result<(), HostError> {
+        let waited = (!self.sb.actors[self.ego].scripted)
+            .then(|| self.sb.stuck(STILL_MPS))
+            .flatten();
+        let Some(waited) = waited else {
+            self.stuck_since = None;
+            return Ok(());
+        };
+        let since = *self.stuck_since.get_or_insert(t);
+        if t - since >= STUCK_S {
+            return Err(HostError(format!(
+                "t = {t:.2} s: the storyboard waits on {}, which can no longer become true: \
+                 every entity has stood still since t = {since:.2} s (the system under test \
+                 holds the ego {} still), no scripted motion is in progress and no condition \
+                 waited on reads time, so the test cannot play out as the file describes",
+                waited.join(", "),
+                self.sb.actors[self.ego].name
             )));
         }
         Ok(())
@@ -719,10 +894,12 @@ impl Host for StoryHost {
                 };
                 let heading = num(self.ego_probes[1]).unwrap_or(0.0);
                 let speed = num(self.ego_probes[2]).unwrap_or(0.0);
-                if !self.scripted_ego {
+                // The system under test drives the ego now.
+                let driven = !self.sb.actors[self.ego].scripted;
+                if driven {
                     self.sb.observe(self.ego, pos, heading, speed, DEFAULT_DT_S);
                 }
-                if !self.scripted_ego
+                if driven
                     && self.road_end.is_none()
                     && self.sb.road_ends_ahead(self.ego, ROAD_END_MARGIN_M)
                 {
@@ -758,8 +935,29 @@ impl Host for StoryHost {
                     self.log
                         .push(format!("t = {t:.3} s: {kind} {name:?} {what}"));
                 }
+                self.hand_over_if_activated(t);
+                // A lane change or a route of the driven ego: the system's new route.
+                if let Some(ask) = self.sb.take_route() {
+                    let route =
+                        lane_route(&self.sb, self.ego, [pos[0], pos[2]], ask.join, ask.ahead_m);
+                    let points = route
+                        .iter()
+                        .map(|p| Value::Vec3([p[0], 0.0, p[1]]))
+                        .collect();
+                    self.performed
+                        .push((Sink::SetEgoRoute, Value::Tuple(points)));
+                    self.log.push(format!(
+                        "t = {t:.3} s: the system under test is given a new route ({} points, \
+                         joining its lane {:.1} m ahead)",
+                        route.len(),
+                        ask.ahead_m
+                    ));
+                }
                 // A SpeedAction on the driven ego: the system under test's set speed.
-                let asked = self.sb.set_speed().filter(|_| !self.scripted_ego);
+                let asked = self
+                    .sb
+                    .set_speed()
+                    .filter(|_| !self.sb.actors[self.ego].scripted);
                 if asked.is_some() && asked != self.asked {
                     self.asked = asked;
                     self.performed
@@ -768,6 +966,9 @@ impl Host for StoryHost {
                 self.most_asked_mps = self.most_asked_mps.max(asked.unwrap_or(0.0));
                 if self.sb.ended && !self.scripted_ego {
                     self.check_the_ego_moved(t)?;
+                }
+                if !self.scripted_ego {
+                    self.check_the_storyboard_can_go_on(t)?;
                 }
                 for (e, sink) in self.sinks.iter().enumerate() {
                     if let Some(sink) = sink {
@@ -845,7 +1046,9 @@ fn place_entities(
                     a,
                     PedestrianSpec {
                         start: pos,
-                        target: pos,
+                        // Never walked to (the storyboard places it): it faces its Init
+                        // heading from t = 0.
+                        target: [pos[0] + heading.cos(), pos[1], pos[2] - heading.sin()],
                         speed: zero,
                         name: format!("Pedestrian {name} ({})", ent.pos),
                     },

@@ -41,7 +41,9 @@ pub struct Actor {
     /// The bounding box's centre relative to the entity's reference point, m (x forward, y
     /// left, z up).
     pub centre_m: [f64; 3],
-    /// Whether the storyboard moves it (every entity but the ego).
+    /// Whether the storyboard moves it now: every entity but the ego the system under test
+    /// drives, and that ego too until its controller is activated
+    /// ([`Storyboard::hand_over_on_activation`]).
     pub scripted: bool,
     /// Its state now.
     pub state: State,
@@ -186,6 +188,9 @@ struct Drive {
     /// The lateral move in progress.
     lateral: Option<Lateral>,
     path: Option<(Path, usize)>,
+    /// A driven ego's lane change in progress: the lane it changes to, the offset from its
+    /// centre there (m), the action; it ends once the ego is there ([`LANE_REACHED_M`]).
+    lane_goal: Option<(usize, f64, usize)>,
     prefer_roads: Vec<usize>,
     /// Its heading relative to its lane's travel, rad, kept as it moves along the lane
     /// (esmini's relative heading): set where it is placed or where its trajectory ends,
@@ -241,7 +246,30 @@ pub struct Storyboard {
     /// `SpeedAction`s' transitions, which the host hands the system as its set speed
     /// ([`Storyboard::set_speed`]); `None` until one starts.
     set_speed: Option<f64>,
+    /// The ego that the storyboard moves until an `ActivateControllerAction` on it hands it
+    /// to the system under test ([`Storyboard::hand_over_on_activation`]).
+    hand_over: Option<usize>,
+    /// A new route asked of the driven ego since the host last took one
+    /// ([`Storyboard::take_route`]).
+    route: Option<RouteAsk>,
 }
+
+/// A route the storyboard asks of the ego the system under test drives (a `LaneChangeAction`
+/// or an `AssignRouteAction` on it): from where the ego is, join `join` (a place on the lane
+/// to drive in, abeam the ego, at the offset asked) `ahead_m` metres further along, then
+/// follow the lanes from there, through junctions as the ego's route prefers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RouteAsk {
+    /// The lane position abeam the ego (its station) on the lane to drive in.
+    pub join: LanePos,
+    /// How far ahead the route joins that lane, m: the lane change's length (its distance, or
+    /// its duration at the ego's speed); 0 for a route on the lane the ego is in.
+    pub ahead_m: f64,
+}
+
+/// How close to the target lane's centre (plus the offset asked) a driven ego must come for
+/// its `LaneChangeAction` to end, m.
+pub const LANE_REACHED_M: f64 = 0.3;
 
 /// How close the driven ego's speed must come to a `SpeedAction`'s target, once the action's
 /// transition is over, for the action to end: this many m/s plus [`SET_SPEED_REACHED_SHARE`]
@@ -306,6 +334,8 @@ impl Storyboard {
             ended: false,
             started: false,
             set_speed: None,
+            hand_over: None,
+            route: None,
         };
         sb.stop = scenario
             .stop
@@ -530,6 +560,45 @@ impl Storyboard {
             .any(|e| e.kind == Kind::Event && (e.runs > 0 || e.phase != Phase::Standby))
     }
 
+    /// What the storyboard waits on when it can wait no more: `None` while anything can still
+    /// change a condition it waits on; else the conditions of the triggers it waits on
+    /// (their names and kinds). Nothing can change when every entity stands still (at most
+    /// `still_mps`, m/s), no scripted entity has a motion in progress, and no trigger it waits
+    /// on reads time: a `SimulationTimeCondition`, a `StandStillCondition` or
+    /// `EndOfRoadCondition` (they hold after a duration), or a `delay`. A still world keeps
+    /// every other condition's value, and so every edge away.
+    pub fn stuck(&self, still_mps: f64) -> Option<Vec<String>> {
+        if self.ended || !self.started {
+            return None;
+        }
+        let moving = self.actors.iter().zip(&self.drives).any(|(a, d)| {
+            a.state.speed.abs() > still_mps
+                || (a.scripted && (d.speed.is_some() || d.lateral.is_some() || d.path.is_some()))
+        });
+        if moving {
+            return None;
+        }
+        let mut waited = Vec::new();
+        for k in (0..self.triggers.len()).filter(|&k| self.waits(k)) {
+            for c in self.triggers[k].iter().flatten() {
+                let timed = c.cond.delay_s > 0.0
+                    || matches!(
+                        c.cond.kind,
+                        m::ConditionKind::SimulationTime { .. }
+                            | m::ConditionKind::Entity {
+                                test: m::EntityTest::Standstill(_) | m::EntityTest::EndOfRoad(_),
+                                ..
+                            }
+                    );
+                if timed {
+                    return None;
+                }
+                waited.push(format!("{:?} ({})", c.cond.name, c.cond.pos));
+            }
+        }
+        (!waited.is_empty()).then_some(waited)
+    }
+
     /// Records whether entity `e` has touched anything solid.
     pub fn set_collided(&mut self, e: usize, collided: bool) {
         self.actors[e].state.collided = collided;
@@ -578,6 +647,7 @@ impl Storyboard {
                 self.drive(e, t, dt)?;
             } else {
                 self.ask_speed(e, t + dt);
+                self.ask_lane(e);
             }
         }
         // An event whose actions ended in this step's motion ends in this step.
@@ -1049,8 +1119,36 @@ impl Storyboard {
                     }
                 }
                 self.drives[e].prefer_roads = roads;
+                if !scripted {
+                    // The driven ego's route, planned again from where it is.
+                    if let Some(lp) = self.actors[e].state.lane {
+                        self.route = Some(RouteAsk {
+                            join: lp,
+                            ahead_m: 0.0,
+                        });
+                    }
+                }
             }
-            Action::ActivateController { .. } => {}
+            Action::ActivateController {
+                lateral,
+                longitudinal,
+            } => {
+                // Any domain activated hands the whole ego over (the load says so); a
+                // deactivation is refused at load (`check`).
+                let on = lateral.unwrap_or(true) || longitudinal.unwrap_or(true);
+                if on && Some(e) == self.hand_over && self.actors[e].scripted {
+                    self.actors[e].scripted = false;
+                    // Its lateral move and path end with the script (and their actions); a
+                    // running SpeedAction goes on as the system's set speed.
+                    let old = [
+                        self.drives[e].lateral.take().map(|l| l.action),
+                        self.drives[e].path.take().map(|p| p.1),
+                    ];
+                    for o in old {
+                        self.override_task(o);
+                    }
+                }
+            }
         }
         Ok(())
     }
@@ -1120,9 +1218,6 @@ impl Storyboard {
             message,
         };
         let scripted = self.actors[e].scripted;
-        if !scripted {
-            return Ok(());
-        }
         let st = self.actors[e].state;
         let Some(lp) = st.lane else {
             return Err(bad(format!(
@@ -1169,6 +1264,31 @@ impl Storyboard {
         } else {
             duration_s(dynamics, target_d - lp.d, st.speed.abs())
         };
+        if !scripted {
+            // The system under test drives it: a route into the lane, over the change's
+            // length (at least one second of driving), which it follows.
+            let ahead_m = if by_distance {
+                duration
+            } else {
+                duration * st.speed.abs()
+            }
+            .max(st.speed.abs())
+            .max(1.0);
+            let join = LanePos {
+                lane: to_lane,
+                s: lp.s,
+                d: *offset_m,
+                rev: lp.rev,
+            };
+            self.route = Some(RouteAsk { join, ahead_m });
+            let old = self.drives[e].lane_goal.take().map(|g| g.2);
+            self.override_task(old);
+            if let Some(a) = a {
+                self.elems[a].pending += 1;
+            }
+            self.drives[e].lane_goal = Some((to_lane, *offset_m, a.unwrap_or(usize::MAX)));
+            return Ok(());
+        }
         let tr = Transition {
             from: lp.d,
             to: target_d,
@@ -1523,6 +1643,38 @@ impl Storyboard {
     pub fn route_takes(&self, e: usize, lane: usize) -> bool {
         let roads = &self.drives[e].prefer_roads;
         roads.contains(&self.roads.ids(lane).1) || roads.contains(&self.roads.exit_road(lane))
+    }
+
+    /// Has the storyboard move `ego` (scripted, as in [`Storyboard::new`] with `None`) until
+    /// an `ActivateControllerAction` on it activates a domain: from then on the system
+    /// under test drives it (its [`Actor::scripted`] turns false, the host hands it over and
+    /// feeds its motion back through [`Storyboard::observe`]), as esmini's default
+    /// controller hands the ego to the controller the file activates.
+    pub fn hand_over_on_activation(&mut self, ego: usize) {
+        self.hand_over = Some(ego);
+        self.actors[ego].scripted = true;
+    }
+
+    /// The route asked of the driven ego since the last call, if any (a `LaneChangeAction`
+    /// or an `AssignRouteAction` on it): the host hands it to the system under test.
+    pub fn take_route(&mut self) -> Option<RouteAsk> {
+        self.route.take()
+    }
+
+    /// Ends the driven ego `e`'s `LaneChangeAction` once it is in the lane it changes to,
+    /// within [`LANE_REACHED_M`] of the offset asked.
+    fn ask_lane(&mut self, e: usize) {
+        let Some((lane, offset, a)) = self.drives[e].lane_goal else {
+            return;
+        };
+        let there = self.actors[e]
+            .state
+            .lane
+            .is_some_and(|lp| lp.lane == lane && (lp.d - offset).abs() <= LANE_REACHED_M);
+        if there {
+            self.drives[e].lane_goal = None;
+            self.task_done(Some(a));
+        }
     }
 
     /// The speed asked at `t1` of entity `e`, which the system under test drives

@@ -990,7 +990,9 @@ fn action_kinds(
             | Action::PlaceCar(_)
             | Action::PlacePedestrian(_)
             | Action::PlaceEgo
-            | Action::SetEgoSpeed => continue,
+            | Action::SetEgoSpeed
+            | Action::ReleaseEgo
+            | Action::SetEgoRoute => continue,
             Action::SetSpeed(c) => (
                 format!("setSpeed of {}", car(c)),
                 matches!(v, Value::Num(_)),
