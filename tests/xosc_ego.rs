@@ -762,6 +762,7 @@ fn the_storyboard_drives_the_ego_until_it_activates_its_controller() {
         "at {t2} s the ego's centre is at {x2} m, by hand {hand} m"
     );
     let (_, v8, x8, _) = *rows.last().unwrap();
+    eprintln!("speed at 1 s {v1:.3} m/s; centre at {t2:.2} s {x2:.2} m (hand {hand:.2}); at the end {v8:.2} m/s, {x8:.1} m");
     assert!(
         (13.5..=15.5).contains(&v8),
         "aeb cruises near its set speed 15: {v8} m/s"
@@ -861,6 +862,7 @@ fn a_storyboard_that_waits_on_what_cannot_happen_is_an_error() {
         .and_then(|w| w.split(' ').next())
         .and_then(|t| t.parse().ok())
         .unwrap_or(f64::NAN);
+    eprintln!("stuck: {why}");
     assert!(end < 40.0, "ended {end} s in, not at the cap: {why}");
 }
 
@@ -905,6 +907,7 @@ fn a_lane_change_of_the_driven_ego_is_its_systems_route() {
     );
     let rows = trace_rows(&dir.path().join("lane.xosc.out/trace/test_0.csv"));
     let (y0, y1) = (rows[0].3, rows.last().unwrap().3);
+    eprintln!("lane change: y {y0:.3} -> {y1:.3} m, ended at {end:.2} s");
     assert!(
         ((y1 - y0) - 3.5).abs() < 0.35,
         "one lane (3.5 m) to the left: from y = {y0} to {y1} m"

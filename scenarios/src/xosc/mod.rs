@@ -879,6 +879,45 @@ impl StoryHost {
     }
 }
 
+impl StoryHost {
+    /// At `t` (s), with the system under test driving the ego (`driven`) or the storyboard
+    /// driving it until the hand-over: what happens when the ego's front comes within
+    /// [`ROAD_END_MARGIN_M`] of the end of its lanes. Before any event started, or before the
+    /// hand-over, the scenario cannot play out: an error. After, the test ends there (its log
+    /// says so), since the ego could only leave the map, which would read as its failure.
+    ///
+    /// # Errors
+    /// A [`HostError`] that says why the scenario cannot play out.
+    fn check_the_road_goes_on(&mut self, t: f64, driven: bool) -> Result<(), HostError> {
+        let before_hand_over = self.hand_over == Some(None);
+        if !(driven || before_hand_over)
+            || self.road_end.is_some()
+            || !self.sb.road_ends_ahead(self.ego, ROAD_END_MARGIN_M)
+        {
+            return Ok(());
+        }
+        let before = if before_hand_over {
+            "the storyboard handed the ego to the system under test"
+        } else if !self.sb.any_event_started() {
+            "any event of the storyboard started"
+        } else {
+            self.road_end = Some(t);
+            self.log.push(format!(
+                "t = {t:.2} s: the ego reached the end of its road before the storyboard's \
+                 stop trigger; the test ends here"
+            ));
+            return Ok(());
+        };
+        // Nothing of the system was tested, and nothing can be: the test must not read as a
+        // pass, nor as the system's failure.
+        Err(HostError(format!(
+            "t = {t:.2} s: the ego reached the end of its road before {before}, so the \
+             scenario cannot play out (does the ego start facing the way its lane leads off \
+             the map?)"
+        )))
+    }
+}
+
 /// How close to the end of its lanes the ego's front may come before a test ends there, m.
 pub const ROAD_END_MARGIN_M: f64 = 2.0;
 
@@ -899,31 +938,17 @@ impl Host for StoryHost {
                 if driven {
                     self.sb.observe(self.ego, pos, heading, speed, DEFAULT_DT_S);
                 }
-                if driven
-                    && self.road_end.is_none()
-                    && self.sb.road_ends_ahead(self.ego, ROAD_END_MARGIN_M)
-                {
-                    if !self.sb.any_event_started() {
-                        // Nothing happened yet, and nothing can: the test did not test what
-                        // the file describes, and must not read as a pass.
-                        return Err(HostError(format!(
-                            "t = {t:.2} s: the ego reached the end of its road before any \
-                             event of the storyboard started, so the scenario cannot play \
-                             out (does the ego start facing the way its lane leads off the \
-                             map?)"
-                        )));
-                    }
-                    // Past here the ego could only leave the map, which would read as its
-                    // failure: the test ends, and says why.
-                    self.road_end = Some(t);
-                    self.log.push(format!(
-                        "t = {t:.2} s: the ego reached the end of its road before the \
-                         storyboard's stop trigger; the test ends here"
-                    ));
-                }
+                self.check_the_road_goes_on(t, driven)?;
                 for (e, id) in self.collided.iter().enumerate() {
                     let hit = matches!(streams.current(*id), Some(Value::Bool(true)));
                     self.sb.set_collided(e, hit);
+                    if hit && e == self.ego && self.hand_over == Some(None) {
+                        return Err(HostError(format!(
+                            "t = {t:.2} s: the ego collided while the storyboard drove it, \
+                             before its ActivateControllerAction handed it to the system under \
+                             test: the test says nothing of the system"
+                        )));
+                    }
                 }
                 // The measures of the world at `t`, before the storyboard moves it on.
                 self.measures = self.sb.measures(self.ego);
