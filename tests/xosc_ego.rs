@@ -84,6 +84,26 @@ fn scenario(entities: &str, init: &str, story: &str, stop: &str) -> String {
     )
 }
 
+/// [`scenario`] of two entities, each `(its ScenarioObject, its name, its s on lane −4 in m,
+/// its Init speed in m/s)`.
+fn two_entities(
+    first: (String, &str, f64, f64),
+    second: (String, &str, f64, f64),
+    story: &str,
+    stop: &str,
+) -> String {
+    scenario(
+        &format!("{}\n{}", first.0, second.0),
+        &format!(
+            "{}\n{}",
+            teleport(first.1, first.2, first.3),
+            teleport(second.1, second.2, second.3)
+        ),
+        story,
+        stop,
+    )
+}
+
 fn at_time(name: &str, t: f64, edge: &str) -> String {
     format!(
         r#"<Condition name="{name}" delay="0" conditionEdge="{edge}">
@@ -132,13 +152,9 @@ fn the_egos_body_is_its_bounding_box() {
         ("truck", [10.0, 2.5, 3.2], 4.0),
         ("car", [5.0, 2.0, 1.5], 1.4),
     ] {
-        let text = scenario(
-            &format!("{}\n{}", vehicle("Ego", size, cx), parked_box("Box", 2.0)),
-            &format!(
-                "{}\n{}",
-                teleport("Ego", 50.0, 10.0),
-                teleport("Box", 110.0, 0.0)
-            ),
+        let text = two_entities(
+            (vehicle("Ego", size, cx), "Ego", 50.0, 10.0),
+            (parked_box("Box", 2.0), "Box", 110.0, 0.0),
             "",
             &at_time("End", 20.0, "rising"),
         );
@@ -687,6 +703,12 @@ fn speed_step(to: f64) -> String {
 /// The rows of trace `file` as (time s, the first entity's speed m/s, its centre's x and y
 /// m, OpenDRIVE frame).
 fn trace_rows(file: &Path) -> Vec<(f64, f64, f64, f64)> {
+    trace_rows_of(file, 0)
+}
+
+/// [`trace_rows`] of the trace's entity `k` (its columns start at 2 + 31 k).
+fn trace_rows_of(file: &Path, k: usize) -> Vec<(f64, f64, f64, f64)> {
+    let o = 31 * k;
     let csv = std::fs::read_to_string(file).unwrap();
     csv.lines()
         .skip(4)
@@ -695,7 +717,7 @@ fn trace_rows(file: &Path) -> Vec<(f64, f64, f64, f64)> {
                 .split(',')
                 .map(|c| c.trim().parse::<f64>().unwrap_or(f64::NAN))
                 .collect();
-            (c[1], c[4], c[13], c[14])
+            (c[1], c[o + 4], c[o + 13], c[o + 14])
         })
         .collect()
 }
@@ -828,17 +850,9 @@ fn an_ego_never_handed_over_is_an_error_and_a_deactivation_is_refused() {
 #[test]
 fn a_storyboard_that_waits_on_what_cannot_happen_is_an_error() {
     let dir = tempfile::tempdir().unwrap();
-    let text = scenario(
-        &format!(
-            "{}\n{}",
-            vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
-            parked_box("Box", 2.0)
-        ),
-        &format!(
-            "{}\n{}",
-            teleport("Ego", 50.0, 10.0),
-            teleport("Box", 150.0, 0.0)
-        ),
+    let text = two_entities(
+        (vehicle("Ego", [5.0, 2.0, 1.5], 1.4), "Ego", 50.0, 10.0),
+        (parked_box("Box", 2.0), "Box", 150.0, 0.0),
         "",
         r#"<Condition name="PastTheBox" delay="0" conditionEdge="none">
   <ByEntityCondition><TriggeringEntities triggeringEntitiesRule="any"><EntityRef entityRef="Ego"/></TriggeringEntities>
@@ -911,5 +925,45 @@ fn a_lane_change_of_the_driven_ego_is_its_systems_route() {
     assert!(
         ((y1 - y0) - 3.5).abs() < 0.35,
         "one lane (3.5 m) to the left: from y = {y0} to {y1} m"
+    );
+}
+
+/// A pedestrian enters the test at its `Init` speed and heading: the trace's first row (t = 0)
+/// has the walker's 1.5 m/s (before: 0 until its first step), and its x grows by 1.5 m/s.
+#[test]
+fn a_pedestrians_init_speed_is_its_speed_at_t_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let walker = r#"<ScenarioObject name="Walker">
+  <Pedestrian model3d="Adult" mass="70" name="walker" pedestrianCategory="pedestrian">
+    <BoundingBox><Center x="0" y="0" z="0.9"/><Dimensions width="0.5" length="0.5" height="1.8"/></BoundingBox>
+    <Properties/>
+  </Pedestrian>
+</ScenarioObject>"#;
+    let text = two_entities(
+        (walker.to_owned(), "Walker", 100.0, 1.5),
+        (vehicle("Ego", [5.0, 2.0, 1.5], 1.4), "Ego", 50.0, 10.0),
+        "",
+        &at_time("End", 1.0, "rising"),
+    );
+    let (code, err, _) = run(
+        dir.path(),
+        "walker.xosc",
+        &text,
+        &["--scripted-ego", "--trace-every", "0.1"],
+    );
+    assert_eq!(code, 0, "{err}");
+    // The ego comes first in the trace, the walker second.
+    let rows = trace_rows_of(&dir.path().join("walker.xosc.out/trace/test_0.csv"), 1);
+    let (t0, v0, x0, _) = rows[0];
+    let (t1, v1, x1, _) = *rows.last().unwrap();
+    eprintln!("walker: {v0} m/s at {t0} s, {v1} m/s at {t1} s, x {x0} -> {x1} m");
+    assert!(
+        t0 == 0.0 && (v0 - 1.5).abs() < 1e-9,
+        "at t = {t0} s: {v0} m/s"
+    );
+    assert!((v1 - 1.5).abs() < 1e-6, "at t = {t1} s: {v1} m/s");
+    assert!(
+        ((x1 - x0) - 1.5 * (t1 - t0)).abs() < 0.02,
+        "x {x0} -> {x1} m over {t0}..{t1} s"
     );
 }

@@ -27,6 +27,11 @@ pub struct PedestrianState {
     pub phase: PedestrianPhase,
     /// Time the walk started, in seconds since the run began, `None` before the trigger.
     pub triggered_at_s: Option<f64>,
+    /// Velocity `[x, y, z]`, m/s: its move over the last step (a placed pedestrian: its
+    /// script's speed along its heading; before the first step, its initial speed).
+    pub velocity_mps: [f64; 3],
+    /// The way it faces, rad (counter-clockwise from `+x` seen from above).
+    pub heading_rad: f64,
 }
 
 /// A kinematic pedestrian: a sensor capsule moved by position, not by forces. It never pushes
@@ -57,11 +62,13 @@ pub(crate) struct Pedestrian {
 }
 
 impl Pedestrian {
+    /// Builds a pedestrian standing at `start`, facing `target`, moving at
+    /// `initial_speed_mps` (m/s) the way it faces until its first step.
     pub(crate) fn build(
         physics: &mut PhysicsWorld,
-        start: [f64; 3],
-        target: [f64; 3],
+        (start, target): ([f64; 3], [f64; 3]),
         speed_stream: crate::sim::Input,
+        initial_speed_mps: f64,
     ) -> Self {
         let body = RigidBodyBuilder::kinematic_position_based().translation(centre(start));
         let collider = ColliderBuilder::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M)
@@ -84,7 +91,11 @@ impl Pedestrian {
             step_start: start,
             walked: false,
             heading_rad,
-            velocity: [0.0; 3],
+            velocity: [
+                initial_speed_mps * heading_rad.cos(),
+                0.0,
+                -initial_speed_mps * heading_rad.sin(),
+            ],
             phase: PedestrianPhase::Waiting,
             triggered_at_s: None,
         }
@@ -200,6 +211,8 @@ impl Pedestrian {
             pos_m: self.pos,
             phase: self.phase,
             triggered_at_s: self.triggered_at_s,
+            velocity_mps: self.velocity,
+            heading_rad: self.heading_rad,
         }
     }
 }
@@ -222,9 +235,9 @@ mod tests {
         let mut physics = PhysicsWorld::new();
         let mut p = Pedestrian::build(
             &mut physics,
-            [100.0, 0.0, 4.0],
-            [100.0, 0.0, -4.0],
+            ([100.0, 0.0, 4.0], [100.0, 0.0, -4.0]),
             crate::sim::Input::Stream(crate::rx::StreamId(0)),
+            0.0,
         );
         let dt = 0.1;
         assert_eq!(p.state().phase, PedestrianPhase::Waiting);

@@ -177,6 +177,14 @@ fn check_ego_and_step(spec: &WorldSpec) -> Result<(), EngineError> {
             spec.ego.initial_speed_mps
         )));
     }
+    for (i, p) in spec.pedestrians.iter().enumerate() {
+        if !(p.initial_speed_mps.is_finite() && p.initial_speed_mps >= 0.0) {
+            return Err(invalid(format!(
+                "pedestrian {i}'s initial speed {} m/s is negative or not finite",
+                p.initial_speed_mps
+            )));
+        }
+    }
     Ok(())
 }
 
@@ -466,7 +474,12 @@ impl Simulation {
         let mut pedestrians = Set::default();
         for p in &spec.pedestrians {
             let speed = Input::of(&spec.streams, p.speed);
-            let ped = Pedestrian::build(&mut physics, p.start, p.target, speed);
+            let ped = Pedestrian::build(
+                &mut physics,
+                (p.start, p.target),
+                speed,
+                p.initial_speed_mps,
+            );
             let collider = ped.collider;
             owners.insert(collider, Owner::Pedestrian(pedestrians.insert(ped)));
         }

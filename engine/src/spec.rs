@@ -41,6 +41,11 @@ pub struct PedestrianSpec {
     pub target: [f64; 3],
     /// Walking speed stream, m/s; read at each walking step, values `<= 0` stand still.
     pub speed: StreamId,
+    /// Its speed at t = 0, m/s (`>= 0`), the way it faces (from `start` toward `target`):
+    /// what it reports before its first step. 0 for a pedestrian that waits to walk (the
+    /// language's); a scripted pedestrian (an OpenSCENARIO storyboard's) enters the test at
+    /// its `Init` speed.
+    pub initial_speed_mps: f64,
     /// How run-time messages name it, e.g. `Pedestrian p (f.star:9:5)`; empty: `pedestrian
     /// N`, by its index.
     pub name: String,
@@ -186,6 +191,7 @@ impl WorldSpec {
                 start: s,
                 target: t,
                 speed,
+                initial_speed_mps: 0.0,
                 name: String::new(),
             });
         }

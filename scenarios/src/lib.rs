@@ -23,7 +23,8 @@ use std::path::Path;
 
 pub use error::ScenarioError;
 pub use runner::{signal, RunOptions, Sample, TestOutcome};
-pub use scenario::{CameraOnly, InputFile, MonitorSpec, RustWorlds, Scenario, Warning, Worlds};
+pub use scenario::{CameraOnly, InputFile, RustWorlds, Scenario, Warning, Worlds};
+pub use scene::MonitorSpec;
 
 /// The shipped scenario programs: `(file name, source)`.
 pub const BUILTIN_SOURCES: [(&str, &str); 11] = [

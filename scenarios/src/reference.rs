@@ -169,6 +169,7 @@ pub fn scene(mut scene: Scene) -> Result<Scene, ScenarioError> {
                 start: from,
                 target: to,
                 speed,
+                initial_speed_mps: 0.0,
                 name: "Pedestrian p".to_owned(),
             },
         )

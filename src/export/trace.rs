@@ -77,7 +77,8 @@ struct Pose {
 }
 
 /// The entities of `state`, the ego first, then the NPC cars, then the pedestrians (in the
-/// world's order). A pedestrian's speed is its move over the last step (`previous`).
+/// world's order). A pedestrian's speed is its move over the last step (`previous`); in the
+/// first row, its initial speed and heading.
 fn poses(state: &Snapshot, previous: Option<&Snapshot>, dt: f64, ego_ride_m: f64) -> Vec<Pose> {
     let mut out = vec![Pose {
         pos: [
@@ -100,7 +101,8 @@ fn poses(state: &Snapshot, previous: Option<&Snapshot>, dt: f64, ego_ride_m: f64
                 let (dx, dz) = (p.pos_m[0] - b.pos_m[0], p.pos_m[2] - b.pos_m[2]);
                 (dx.hypot(dz) / dt, (-dz).atan2(dx))
             }
-            _ => (0.0, 0.0),
+            // The first row: its initial speed and the way it faces.
+            _ => (p.velocity_mps[0].hypot(p.velocity_mps[2]), p.heading_rad),
         };
         out.push(Pose {
             pos: p.pos_m,

@@ -546,6 +546,7 @@ impl SceneBuilder {
                     start: s,
                     target: t,
                     speed,
+                    initial_speed_mps: 0.0,
                     name: pedestrian_name,
                 },
             )

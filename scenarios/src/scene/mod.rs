@@ -13,13 +13,16 @@
 //! ([`Scene::new`]), since an open parameter may shape the world itself (a road's length,
 //! how many lanes, whether a car is present).
 
+pub mod builtin_signals;
 mod error;
+mod monitor;
 mod params;
 mod signals;
 mod stream_types;
 mod world;
 
 pub use error::{refused, LoadError, LoadErrorKind, Site};
+pub use monitor::MonitorSpec;
 pub use params::{coordinate_names, level_value, representative, OverTime, ParamDecl, ParamValue};
 pub use stream_types::{stream_types, SType};
 
@@ -31,8 +34,6 @@ use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{CarSpec, EgoSpec, ObstacleSpec, PedestrianSpec, SensorSpec};
 
 use paracosm_generators::Assignment;
-
-use crate::MonitorSpec;
 
 /// The `tick` stream: the first node of every scene's graph.
 pub const TICK: StreamId = StreamId(0);

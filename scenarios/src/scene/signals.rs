@@ -28,7 +28,7 @@ fn known_signal(
     vector: &[Option<bool>],
     s: &str,
 ) -> Result<bool, LoadError> {
-    if crate::runner::signal::ALL.contains(&s) {
+    if super::builtin_signals::ALL.contains(&s) {
         return Ok(true);
     }
     for ((n, _), v) in out.iter().zip(vector) {
@@ -282,7 +282,7 @@ impl Scene {
                              variable at the top level publishes <variable>.pos.x/.y/.z, .vel.x/.y/.z, \
                              .speed, .heading and .collision (actors: {})\n --> {at}",
                             m.name(),
-                            crate::runner::signal::ALL.join(", "),
+                            super::builtin_signals::ALL.join(", "),
                             if mine.is_empty() {
                                 "none".to_owned()
                             } else {

@@ -93,3 +93,40 @@ fn a_scene_without_an_ego_builds_no_world_and_says_so() {
     assert_eq!(e.kind, LoadErrorKind::Worlds);
     assert!(e.message.contains("AutonomousVehicle"), "{}", e.message);
 }
+
+/// The scene model sits at the bottom (issue "One front-end contract"): no file of `scene/`
+/// refers to the runner, the scenario built around a scene, or a front end (the language,
+/// OpenSCENARIO, the Rust reference study) outside comments and tests.
+#[test]
+fn the_scene_model_imports_no_runner_and_no_front_end() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/scene");
+    let above = [
+        "crate::runner",
+        "crate::scenario",
+        "crate::lang",
+        "crate::xosc",
+        "crate::reference",
+        "crate::Scenario",
+    ];
+    let mut files = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.file_name().is_some_and(|n| n == "tests.rs") {
+            continue;
+        }
+        files += 1;
+        let text = std::fs::read_to_string(&path).unwrap();
+        for (i, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            for a in above {
+                assert!(
+                    !code.contains(a),
+                    "{}:{}: the scene model refers to `{a}`: {line}",
+                    path.display(),
+                    i + 1
+                );
+            }
+        }
+    }
+    assert!(files >= 7, "{files} files read");
+}

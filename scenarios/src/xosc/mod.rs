@@ -1075,6 +1075,7 @@ fn place_entities(
                         // heading from t = 0.
                         target: [pos[0] + heading.cos(), pos[1], pos[2] - heading.sin()],
                         speed: zero,
+                        initial_speed_mps: sb.actors[i].state.speed.max(0.0),
                         name: format!("Pedestrian {name} ({})", ent.pos),
                     },
                 )
