@@ -17,23 +17,21 @@ pub mod fuzz;
 pub mod map;
 pub mod record;
 pub mod report;
+pub mod scenario_ref;
 pub mod xosc;
 
 pub use campaign::{Campaign, CampaignReport, Observer, OnRecord, ResultsFile};
 pub use error::Error;
 pub use record::{RunRecord, Status};
+pub use scenario_ref::ScenarioRef;
 
-/// The scenario a campaign names: a built-in scenario, a `.star` program, or an OpenSCENARIO
-/// file with its options ([`xosc::campaign_name`]).
+/// The scenario `name` names: a built-in scenario, a `.star` program, or an OpenSCENARIO
+/// file read as it is ([`ScenarioRef::named`]; with options, build a [`ScenarioRef`]).
 ///
 /// # Errors
-/// What [`paracosm_scenarios::load`] or [`xosc::campaign_scenario`] returns.
+/// What [`ScenarioRef::load`] returns.
 pub fn load_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Error> {
-    if xosc::is_xosc(name) {
-        xosc::campaign_scenario(name)
-    } else {
-        Ok(paracosm_scenarios::load(name)?)
-    }
+    ScenarioRef::named(name).load()
 }
 
 /// Refuses a system under test for a scenario whose ego a script places (`--scripted-ego`):

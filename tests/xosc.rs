@@ -263,14 +263,12 @@ fn value_sets_become_one_parameter_of_their_sets() {
 fn the_crossing_pedestrian_runs_on_the_storyboard_and_meets_an_ego_that_does_not_brake() {
     use paracosm_engine::sut::{AebConfig, SutConfig};
     use paracosm_generators::{Point, Value};
-    let name = paracosm::xosc::campaign_name(
-        &format!("{}/{CROSSING}", env!("CARGO_MANIFEST_DIR")),
-        &paracosm::xosc::XoscOptions {
-            open: vec!["TargetBlocking_InitPosition_LongitudinalOffset_m=80..120".to_owned()],
-            ..Default::default()
-        },
-    );
-    let mut scenario = paracosm::load_scenario(&name).expect("the campaign's scenario builds");
+    let name = paracosm::ScenarioRef::OpenScenario(paracosm::scenario_ref::XoscRef {
+        xosc: format!("{}/{CROSSING}", env!("CARGO_MANIFEST_DIR")),
+        open: vec!["TargetBlocking_InitPosition_LongitudinalOffset_m=80..120".to_owned()],
+        ..Default::default()
+    });
+    let mut scenario = name.load().expect("the campaign's scenario builds");
     let names: Vec<&str> = scenario
         .space
         .params()
@@ -746,4 +744,92 @@ test(horizon = 60)
         assert_eq!(o.status.code(), Some(2), "{err}");
         assert!(err.contains("prog.star:") && err.contains(want), "{err}");
     }
+}
+
+/// Copies the folder `from` into `to`, recursively.
+fn copy_folder(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_folder(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+/// A campaign is one fixed scenario: its load reads the variation file, the scenario and the
+/// catalogs it names once, its fingerprint covers each of them, and every test reads those
+/// texts. A copy of the crossing pedestrian's files is loaded, then its OpenSCENARIO files are
+/// deleted: the campaign's tests still run (each test read them from disk again before).
+#[test]
+fn an_openscenario_campaign_reads_its_files_once_at_load() {
+    use paracosm_generators::Point;
+    let dir = tempfile::tempdir().unwrap();
+    let alks = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xosc/alks");
+    copy_folder(&alks, dir.path());
+    let variation = dir
+        .path()
+        .join("alks_scenario_4_2_3_crossing_pedestrian_variation.xosc");
+    let scenario = paracosm::load_scenario(variation.to_str().unwrap()).expect("it loads");
+    let read: Vec<&str> = scenario
+        .input_files
+        .iter()
+        .map(|f| f.path.as_str())
+        .collect();
+    println!("the campaign's input files: {read:#?}");
+    let has = |tail: &str| read.iter().any(|p| p.ends_with(tail));
+    assert!(
+        has("alks_scenario_4_2_3_crossing_pedestrian_variation.xosc"),
+        "{read:?}"
+    );
+    assert!(
+        has("concrete_scenarios/alks_scenario_4_2_3_crossing_pedestrian_template.xosc"),
+        "{read:?}"
+    );
+    assert!(has(".xodr"), "the map: {read:?}");
+    assert!(
+        read.iter().any(|p| p.contains("catalogs/vehicles/")),
+        "a vehicle catalog: {read:?}"
+    );
+    assert!(
+        read.iter().any(|p| p.contains("catalogs/pedestrians/")),
+        "a pedestrian catalog: {read:?}"
+    );
+    assert!(scenario.input_files.iter().all(|f| f.sha256.len() == 64));
+    let a = scenario
+        .space
+        .decode(&Point {
+            discrete: vec![0, 6, 1],
+            continuous: vec![],
+        })
+        .expect("decodes");
+    let before = scenario.run(&a, 1).expect("the test runs");
+    std::fs::remove_file(&variation).unwrap();
+    let scenarios = dir.path().join("concrete_scenarios");
+    std::fs::remove_dir_all(scenarios.join("catalogs")).unwrap();
+    for entry in std::fs::read_dir(&scenarios).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|x| x == "xosc") {
+            std::fs::remove_file(path).unwrap();
+        }
+    }
+    let after = scenario
+        .run(&a, 1)
+        .expect("the test runs on the files read at load");
+    println!(
+        "with its OpenSCENARIO files deleted, the test gives {:?}, as before",
+        after.metrics
+    );
+    assert!(
+        before
+            .metrics
+            .iter()
+            .any(|(n, v)| *n == "simulated_s" && *v > 10.0),
+        "{:?}",
+        before.metrics
+    );
+    assert_eq!(format!("{before:?}"), format!("{after:?}"));
 }

@@ -8,7 +8,10 @@
 //! - [`figure10`]: the paper's Figure 10 studies with learned drivers: light × fog, a 200 s
 //!   loop against fog, and other 3-D components (§4.2.2).
 //! - [`perception`]: the road-segmentation and vehicle-detection networks of the paper's
-//!   §4.1 studies (Figures 5–8).
+//!   §4.1 studies (Figures 5–8), their training ([`perception::train`]) and the studies
+//!   ([`perception::studies`]).
+//! - [`pilotnet_training`]: training the PilotNet-style driver ([`pilotnet`]) on recorded
+//!   drives, with early stopping in closed loop.
 //! - [`science`]: the coverage propositions of §3 measured (Proposition 3.2's bound, dispersion
 //!   and star discrepancy against n).
 #![warn(missing_docs)]
@@ -18,8 +21,12 @@ pub mod figure10;
 pub mod onnx_export;
 pub mod perception;
 pub mod pilotnet;
+pub mod pilotnet_training;
 pub mod science;
+pub mod training_error;
 pub mod weights;
+
+pub use training_error::TrainingError;
 
 use std::path::{Path, PathBuf};
 

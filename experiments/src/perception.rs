@@ -16,6 +16,9 @@
 //!
 //! Input `image` `[1, 3, 120, 160]`, RGB, each channel `(level / 255 - 0.5) / 0.25`; output
 //! `logits` `[1, 1, 30, 40]`, row-major.
+//!
+//! [`train`] trains either network on a data set and writes it with its model card;
+//! [`studies`] runs the studies of Figures 5–8 with a trained one.
 
 use std::collections::HashMap;
 
@@ -24,6 +27,10 @@ use candle_nn::{Conv2d, Conv2dConfig, VarBuilder};
 use rand::{Rng, SeedableRng};
 
 use crate::onnx_export::Graph;
+
+mod data;
+pub mod studies;
+pub mod train;
 
 /// Height of the network's image, pixels.
 pub const HEIGHT: usize = 120;

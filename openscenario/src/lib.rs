@@ -12,6 +12,7 @@
 pub mod distribution;
 pub mod error;
 pub mod expr;
+pub mod files;
 pub mod model;
 pub mod params;
 pub mod read;
@@ -19,7 +20,8 @@ pub mod text;
 mod xml;
 
 pub use error::{Pos, XoscError};
-pub use read::{read_scenario, read_scenario_text};
+pub use files::FileSet;
+pub use read::{read_scenario, read_scenario_in, read_scenario_text};
 pub use text::Text;
 
 /// A parameter's or expression's value (OpenSCENARIO 1.3, "Parameters": `double`, `int`,

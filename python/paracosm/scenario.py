@@ -286,15 +286,20 @@ def _uniform(rows: list[dict], records: list[dict], space: Space) -> list[dict]:
 
 class Scenario:
     """A scenario program: a built-in name (`paracosm.BUILTIN_SCENARIOS`) or the path of a
-    `.star` file.
+    `.star` file; or an OpenSCENARIO file (`.xosc`, a variation file or a scenario) read with
+    `paracosm-fuzz`'s options: `open` (a list of `"Name=lo..hi"` or `"Name=a,b,c"`),
+    `continuous`, `scripted_ego`, `ego` (the vehicle's name) and `horizon` (s).
 
     Warnings of the program (LANGUAGE.md, "Warnings") are issued as `ScenarioWarning`.
     Raises ValueError naming the file, line and column when the program does not load.
     Instances are thread-safe: two threads may run tests of one scenario at once.
     """
 
-    def __init__(self, name_or_path, *, sut=None):
-        self._native = _native.ScenarioHandle(os.fspath(name_or_path))
+    def __init__(self, name_or_path, *, sut=None, open=(), continuous=False, scripted_ego=False,
+                 ego=None, horizon=None):
+        self._native = _native.ScenarioHandle(
+            os.fspath(name_or_path), open=list(open), continuous=continuous,
+            scripted_ego=scripted_ego, ego=ego, horizon=horizon)
         self._sut = _sut_args(sut)
         # Checked now, as a run would check it: a bad name fails here, not at the first run.
         self._sut_name = self._native.sut_name(**self._sut)

@@ -216,13 +216,49 @@ impl ScenarioHandle {
 
 #[pymethods]
 impl ScenarioHandle {
-    /// Loads a built-in scenario by name, a `.star` program or an OpenSCENARIO `.xosc` file
-    /// (with `paracosm-fuzz`'s options after it, [`paracosm::load_scenario`]) by path.
+    /// Loads a built-in scenario by name, a `.star` program or an OpenSCENARIO `.xosc` file by
+    /// path, the file read with `paracosm-fuzz`'s options (`open`: `Name=lo..hi` or
+    /// `Name=a,b,c` each; `continuous`, `scripted_ego`, `ego`, `horizon` in s), which only an
+    /// OpenSCENARIO file takes ([`paracosm::ScenarioRef`]).
     #[new]
-    fn new(py: Python<'_>, name_or_path: &str) -> PyResult<Self> {
-        let scenario = py
-            .detach(|| paracosm::load_scenario(name_or_path))
-            .map_err(value_error)?;
+    #[pyo3(signature = (name_or_path, *, open = Vec::new(), continuous = false, scripted_ego = false, ego = None, horizon = None))]
+    fn new(
+        py: Python<'_>,
+        name_or_path: &str,
+        open: Vec<String>,
+        continuous: bool,
+        scripted_ego: bool,
+        ego: Option<String>,
+        horizon: Option<f64>,
+    ) -> PyResult<Self> {
+        let reference = match paracosm::ScenarioRef::named(name_or_path) {
+            paracosm::ScenarioRef::OpenScenario(x) => {
+                paracosm::ScenarioRef::OpenScenario(paracosm::scenario_ref::XoscRef {
+                    open,
+                    continuous,
+                    scripted_ego,
+                    ego,
+                    horizon_s: horizon,
+                    ..x
+                })
+            }
+            program
+                if open.is_empty()
+                    && !continuous
+                    && !scripted_ego
+                    && ego.is_none()
+                    && horizon.is_none() =>
+            {
+                program
+            }
+            _ => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "{name_or_path}: open, continuous, scripted_ego, ego and horizon are for an \
+                     OpenSCENARIO scenario (.xosc)"
+                )))
+            }
+        };
+        let scenario = py.detach(|| reference.load()).map_err(value_error)?;
         let warnings = paracosm::report::warnings_of(&scenario);
         Ok(ScenarioHandle { scenario, warnings })
     }

@@ -416,10 +416,12 @@ def test_an_openscenario_file_loads_with_its_options_and_runs():
     a test whose ego faces off the map ends in error (NaN with on_error="nan"), not a pass."""
     path = Path(__file__).resolve().parents[2] / "tests/data/xosc/alks/alks_scenario_4_2_3_crossing_pedestrian_variation.xosc"
     with pytest.warns(paracosm.scenario.ScenarioWarning):
-        s = paracosm.Scenario(f"{path}#open=TargetBlocking_Speed_kph=2..10")
+        s = paracosm.Scenario(path, open=["TargetBlocking_Speed_kph=2..10"])
     assert s.space.names == ["Road", "Ego_InitSpeed_Ve0_kph", "Ego_InitPosition_LaneId",
                              "TargetBlocking_Speed_kph"]
     values = [s.robustness(np.random.default_rng(i).random(len(s.space)), on_error="nan") for i in range(4)]
     assert any(np.isnan(values)) and any(np.isfinite(values)), values
     with pytest.raises(ValueError, match="no_such.xosc"):
         paracosm.Scenario(str(path.parent / "no_such.xosc"))
+    with pytest.raises(ValueError, match="are for an OpenSCENARIO scenario"):
+        paracosm.Scenario("pedestrian-crossing", open=["walking_speed=1..2"])

@@ -8,6 +8,11 @@
 //! - `load/params_10000_refused`: 10,000 parameters, refused with the limit named (the issue
 //!   asks for under 5 s or a refusal).
 //!
+//! - `xosc_test_read/from_disk` and `xosc_test_read/from_file_set`: what each test of an
+//!   OpenSCENARIO campaign pays to read its scenario with its values (the ALKS crossing
+//!   pedestrian's template, its three catalogs): read from disk and parsed, as every test did
+//!   before the campaign kept its file set, against parsed from the texts its load read.
+//!
 //! Run with `cargo bench -p paracosm-scenarios --bench load`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -56,5 +61,22 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+fn xosc_test_read(c: &mut Criterion) {
+    let template = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(
+        "../tests/data/xosc/alks/concrete_scenarios/alks_scenario_4_2_3_crossing_pedestrian_template.xosc",
+    );
+    let values = [("Ego_InitSpeed_Ve0_kph".to_owned(), "40".to_owned())];
+    let mut group = c.benchmark_group("xosc_test_read");
+    group.bench_function("from_disk", |b| {
+        b.iter(|| paracosm_openscenario::read_scenario(&template, &values).unwrap())
+    });
+    let files = paracosm_openscenario::FileSet::new();
+    paracosm_openscenario::read_scenario_in(&files, &template, &[]).unwrap();
+    group.bench_function("from_file_set", |b| {
+        b.iter(|| paracosm_openscenario::read_scenario_in(&files, &template, &values).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, xosc_test_read);
 criterion_main!(benches);

@@ -76,22 +76,6 @@ fn here(line: u32, variable: &str) -> Site {
 /// [`ScenarioError::Load`] if a location is off the road or a declaration is repeated
 /// (neither happens for the study's ranges).
 pub fn scene(mut scene: Scene) -> Result<Scene, ScenarioError> {
-    let worlds = |e: String| ScenarioError::Load(LoadError::new(LoadErrorKind::Worlds, e));
-    let number = |scene: &mut Scene, name: &str, (lo, hi): (f64, f64), unit: &str, line| {
-        let decl = ParamDecl {
-            name: Some(name.to_owned()),
-            domain: Domain::Interval { lo, hi },
-            unit: Some(unit.to_owned()),
-            over_time: OverTime::Constant,
-            site: here(line, name),
-        };
-        match scene.declare_param(decl).0 {
-            ParamValue::Level(Level::Real(x)) => Ok(x),
-            other => Err(worlds(format!(
-                "{name}: a number was expected, got {other:?}"
-            ))),
-        }
-    };
     let walking_speed = number(
         &mut scene,
         WALKING_SPEED,
@@ -106,13 +90,69 @@ pub fn scene(mut scene: Scene) -> Result<Scene, ScenarioError> {
         "m",
         line!(),
     )?;
+    let road = build_road(&mut scene)?;
+    place_actors(&mut scene, road, walking_speed, trigger)?;
+    scene.add_monitor(MonitorSpec::collision(), here(line!(), "collision"));
+    scene.add_monitor(
+        MonitorSpec::distance(MIN_DISTANCE_M),
+        here(line!(), "distance"),
+    );
+    scene
+        .set_settings(TestSettings {
+            site: Some(here(line!(), "test")),
+            horizon_s: Some(HORIZON_S),
+            map_axes: Some(vec![WALKING_SPEED.to_owned(), TRIGGER_DISTANCE.to_owned()]),
+            offroad: None,
+        })
+        .map_err(|e| worlds(e.to_string()))?;
+    Ok(scene)
+}
+
+/// A load error of kind [`LoadErrorKind::Worlds`] saying `e`.
+fn worlds(e: String) -> ScenarioError {
+    ScenarioError::Load(LoadError::new(LoadErrorKind::Worlds, e))
+}
+
+/// Declares into `scene` the open parameter `name`, an interval `[lo, hi)` in `unit`,
+/// declared at line `line`, and returns its value in this scene.
+///
+/// # Errors
+/// [`ScenarioError::Load`] when the scene gives it a value that is not a number.
+fn number(
+    scene: &mut Scene,
+    name: &str,
+    (lo, hi): (f64, f64),
+    unit: &str,
+    line: u32,
+) -> Result<f64, ScenarioError> {
+    let decl = ParamDecl {
+        name: Some(name.to_owned()),
+        domain: Domain::Interval { lo, hi },
+        unit: Some(unit.to_owned()),
+        over_time: OverTime::Constant,
+        site: here(line, name),
+    };
+    match scene.declare_param(decl).0 {
+        ParamValue::Level(Level::Real(x)) => Ok(x),
+        other => Err(worlds(format!(
+            "{name}: a number was expected, got {other:?}"
+        ))),
+    }
+}
+
+/// Sets `scene`'s environment (light 0.5, no fog) and adds the road: one straight piece
+/// `r`, 200 m long with two lanes, of friction 0.8.
+///
+/// # Errors
+/// [`ScenarioError::Load`] if the environment or the road is declared twice.
+fn build_road(scene: &mut Scene) -> Result<PieceId, ScenarioError> {
     let light = scene.push(Node::Const(Value::Num(0.5)));
     let fog = scene.push(Node::Const(Value::Num(0.0)));
     scene
         .set_environment(light, fog, here(line!(), "w"))
         .map_err(|e| worlds(e.to_string()))?;
     let friction = scene.push(Node::Const(Value::Num(0.8)));
-    let road: PieceId = scene
+    scene
         .add_road(
             |n| {
                 n.add(
@@ -127,19 +167,34 @@ pub fn scene(mut scene: Scene) -> Result<Scene, ScenarioError> {
             friction,
             here(line!(), "r"),
         )
-        .map_err(|e| worlds(e.to_string()))?;
+        .map_err(|e| worlds(e.to_string()))
+}
+
+/// Declares and places the actors on `road`: the ego under `aeb` on lane 1,
+/// [`EGO_START_M`] along, at the system's cruise speed; the pedestrian at [`CROSSING_AT_M`]
+/// from the right sidewalk to the left one, walking at `walking_speed` (m/s) once the ego
+/// comes within `trigger` (m).
+///
+/// # Errors
+/// [`ScenarioError::Load`] if a location is off the road or an actor is placed twice.
+fn place_actors(
+    scene: &mut Scene,
+    road: PieceId,
+    walking_speed: f64,
+    trigger: f64,
+) -> Result<(), ScenarioError> {
     let on = |scene: &Scene, lane, at_m| {
         scene
             .roads()
             .on_lane(road, lane, at_m)
             .map_err(|e| worlds(e.to_string()))
     };
-    let start = on(&scene, Lane::Driving(1), EGO_START_M)?;
+    let start = on(scene, Lane::Driving(1), EGO_START_M)?;
     let ego = scene.declare_ego("v".to_owned(), here(line!(), "v"));
     let ego_pos = scene.probe(ego, Output::Pos);
     let pedestrian = scene.declare_pedestrian("p".to_owned(), here(line!(), "p"));
-    let from = on(&scene, Lane::SideWalk, CROSSING_AT_M)?.pos_m;
-    let to = on(&scene, Lane::OppositeSideWalk, CROSSING_AT_M)?.pos_m;
+    let from = on(scene, Lane::SideWalk, CROSSING_AT_M)?.pos_m;
+    let to = on(scene, Lane::OppositeSideWalk, CROSSING_AT_M)?.pos_m;
     let dist = scene.push(Node::Const(Value::Num(trigger)));
     let speed = scene.push(Node::Const(Value::Num(walking_speed)));
     let ActorRef::Pedestrian(handle) = pedestrian else {
@@ -174,18 +229,5 @@ pub fn scene(mut scene: Scene) -> Result<Scene, ScenarioError> {
             },
         )
         .map_err(|e| worlds(e.to_string()))?;
-    scene.add_monitor(MonitorSpec::collision(), here(line!(), "collision"));
-    scene.add_monitor(
-        MonitorSpec::distance(MIN_DISTANCE_M),
-        here(line!(), "distance"),
-    );
-    scene
-        .set_settings(TestSettings {
-            site: Some(here(line!(), "test")),
-            horizon_s: Some(HORIZON_S),
-            map_axes: Some(vec![WALKING_SPEED.to_owned(), TRIGGER_DISTANCE.to_owned()]),
-            offroad: None,
-        })
-        .map_err(|e| worlds(e.to_string()))?;
-    Ok(scene)
+    Ok(())
 }

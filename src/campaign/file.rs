@@ -12,6 +12,8 @@ use paracosm_generators::Param;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use crate::ScenarioRef;
+
 /// File name of the campaign's settings in the output folder.
 pub const CAMPAIGN_FILE: &str = "campaign.json";
 
@@ -216,8 +218,9 @@ pub struct CampaignFile {
     /// and name, parameter space, system under test, strategy, seed, budget and strength.
     /// Shards of one campaign share it.
     pub fingerprint: String,
-    /// The scenario as given: a built-in name, or the absolute path of a `.star` file.
-    pub scenario: String,
+    /// The scenario: a built-in name or the absolute path of a `.star` file (a string), or an
+    /// OpenSCENARIO file's absolute path with its options (an object, [`ScenarioRef`]).
+    pub scenario: ScenarioRef,
     /// [`Settings::sut`].
     pub sut: SutChoice,
     /// [`Settings::strategy`].
@@ -307,7 +310,7 @@ impl CampaignFile {
     /// The campaign of `scenario` (loaded from `scenario_arg`) with `settings`, and its
     /// fingerprint.
     pub fn new(
-        scenario_arg: &str,
+        scenario_arg: &ScenarioRef,
         scenario: &paracosm_scenarios::Scenario,
         settings: Settings,
     ) -> CampaignFile {
@@ -339,14 +342,10 @@ impl CampaignFile {
             };
             sha256_hex(&serde_json::to_vec(&f).expect("settings serialise"))
         };
-        let path = Path::new(scenario_arg);
         CampaignFile {
             tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
             fingerprint,
-            scenario: match std::fs::canonicalize(path) {
-                Ok(p) if path.is_file() => p.display().to_string(),
-                _ => scenario_arg.to_owned(),
-            },
+            scenario: scenario_arg.absolute(),
             sut,
             strategy: strategy.to_owned(),
             seed,
@@ -425,7 +424,11 @@ impl CampaignFile {
                 out.push(format!("{name}: {a} vs {b}"));
             }
         };
-        cmp("scenario", self.scenario.clone(), other.scenario.clone());
+        cmp(
+            "scenario",
+            self.scenario.to_string(),
+            other.scenario.to_string(),
+        );
         cmp("strategy", self.strategy.clone(), other.strategy.clone());
         cmp("seed", self.seed.to_string(), other.seed.to_string());
         cmp("budget", self.budget.to_string(), other.budget.to_string());
@@ -522,8 +525,13 @@ mod tests {
             strength: 2,
             shard,
         };
-        let make =
-            |seed, shard| CampaignFile::new("pedestrian-crossing", &s, settings(seed, shard));
+        let make = |seed, shard| {
+            CampaignFile::new(
+                &ScenarioRef::named("pedestrian-crossing"),
+                &s,
+                settings(seed, shard),
+            )
+        };
         let a = make(0, None);
         assert_eq!(a.fingerprint, make(0, None).fingerprint);
         assert_ne!(a.fingerprint, make(1, None).fingerprint);
@@ -532,7 +540,11 @@ mod tests {
         assert_eq!(a.differences(&make(1, None)), ["seed: 0 vs 1"]);
         let mut edited = s.clone();
         edited.source = "# edited\n".into();
-        let b = CampaignFile::new("pedestrian-crossing", &edited, settings(0, None));
+        let b = CampaignFile::new(
+            &ScenarioRef::named("pedestrian-crossing"),
+            &edited,
+            settings(0, None),
+        );
         assert_eq!(a.differences(&b), ["the scenario program's text differs"]);
     }
 }

@@ -31,7 +31,7 @@ pub struct Merged {
 /// cannot be read; [`Error::Write`] when the merged folder cannot be written.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
     let (template, shards) = read_shards(dirs)?;
-    let mut scenario = crate::load_scenario(&template.scenario)?;
+    let mut scenario = template.scenario.load()?;
     if let Some(sut) = template.sut.config()? {
         scenario.sut = sut;
     }

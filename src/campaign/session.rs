@@ -15,7 +15,7 @@ use crate::campaign::{Campaign, CampaignReport, Observer, ResultsFile, RESULTS_F
 use crate::record::RunRecord;
 use crate::report::summary::Summary;
 use crate::report::{warnings_of, write_outputs, Finished};
-use crate::Error;
+use crate::{Error, ScenarioRef};
 
 /// The folder of a campaign's traces (`--trace`), inside its output folder.
 pub const TRACE_FOLDER: &str = "trace";
@@ -24,9 +24,9 @@ pub const TRACE_FOLDER: &str = "trace";
 /// with `resume`, the stored campaign's values).
 #[derive(Debug, Clone)]
 pub struct Request {
-    /// A built-in scenario's name or a `.star` path; `None` only with `resume` (taken from
-    /// the folder's `campaign.json`).
-    pub scenario: Option<String>,
+    /// A built-in scenario's name, a `.star` path or an OpenSCENARIO file with its options;
+    /// `None` only with `resume` (taken from the folder's `campaign.json`).
+    pub scenario: Option<ScenarioRef>,
     /// The strategy [default: halton].
     pub strategy: Option<Strategy>,
     /// Campaign seed [default: 0].
@@ -66,7 +66,7 @@ impl Request {
     /// A request for `scenario` into `out`, everything else by default.
     pub fn new(scenario: &str, out: &Path) -> Self {
         Request {
-            scenario: Some(scenario.to_owned()),
+            scenario: Some(ScenarioRef::named(scenario)),
             strategy: None,
             seed: None,
             budget: None,
@@ -150,6 +150,33 @@ pub struct Outcome {
 }
 
 impl Outcome {
+    /// The outcome of the campaign of `file` and `scenario` in `out`: `done` records of the
+    /// `expected` in the folder, what the loop reported, and the outputs `written` at the end
+    /// (`None` when interrupted).
+    fn new(
+        file: CampaignFile,
+        scenario: Scenario,
+        out: &Path,
+        report: CampaignReport,
+        done: u64,
+        expected: u64,
+        written: Option<crate::report::Written>,
+    ) -> Outcome {
+        Outcome {
+            done,
+            expected,
+            plot_warnings: written
+                .as_ref()
+                .map(|w: &crate::report::Written| w.plot_warnings.clone())
+                .unwrap_or_default(),
+            summary: written.map(|w| w.summary),
+            report,
+            file,
+            scenario,
+            out: out.to_path_buf(),
+        }
+    }
+
     /// What a front end tells the user besides the summary: an interruption and how to
     /// resume, a stop at the first failure, plots that could not be drawn.
     pub fn notes(&self) -> Vec<String> {
@@ -216,54 +243,21 @@ pub fn run(
     observers: &mut [&mut dyn Observer],
 ) -> Result<Outcome, Error> {
     let out = &request.out;
-    let stored = stored_campaign(request)?;
-    let (mut file, scenario, points) = settings(request, stored.as_ref())?;
-    // A campaign that stops at its first failure does so when resumed too.
-    let stop_at_first_failure = match &stored {
-        Some(s) => s.stop_at_first_failure || request.stop_at_first_failure,
-        None => request.stop_at_first_failure,
-    };
-    file.stop_at_first_failure = stop_at_first_failure;
-    let warnings = warnings_of(&scenario);
-    let strategy = refusals(request, &file, &warnings)?;
-    check_strength(request, &scenario, strategy)?;
-    let jobs = request.jobs.unwrap_or_else(|| {
-        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-    });
+    let Checked {
+        stored,
+        file,
+        scenario,
+        points,
+        warnings,
+        strategy,
+        jobs,
+    } = check_request(request)?;
     // One writer per folder, from here to the end of the run (crate::campaign::lock).
     let _lock = claim_folder(request, &file, stored.is_some())?;
     let ids = file.ids();
-    let existing = match stored {
-        Some(_) => crate::campaign::results::load(out, &scenario, ids.clone(), true)?,
-        None => crate::campaign::results::Existing {
-            records: Vec::new(),
-            repaired_bytes: 0,
-        },
-    };
+    let existing = existing_records(out, &scenario, ids.clone(), stored.is_some())?;
     let start = ids.start + existing.records.len() as u64;
-    let campaign = Campaign {
-        scenario: &scenario,
-        strategy,
-        seed: file.seed,
-        budget: file.budget,
-        strength: file.strength,
-        jobs,
-        stop_at_first_failure,
-        points: points.as_deref(),
-        trace: match request.trace_every_s {
-            Some(every_s) => {
-                if !(every_s.is_finite() && every_s > 0.0) {
-                    return Err(Error::BadInput(format!(
-                        "--trace-every {every_s} s must be a finite number of seconds > 0"
-                    )));
-                }
-                let path = out.join(TRACE_FOLDER);
-                crate::atomic::make_output_folder(&path)?;
-                Some(crate::export::trace::TraceSpec { path, every_s })
-            }
-            None => None,
-        },
-    };
+    let campaign = new_campaign(request, &scenario, &file, strategy, jobs, points.as_deref())?;
     campaign.check_origin(
         &existing.records,
         ids.start,
@@ -306,19 +300,124 @@ pub fn run(
     let report = campaign.run_ids(start..ids.end, prior, stop, &mut [&mut chain])?;
     let done = chain.outputs.records.len() as u64;
     drop(chain);
-    Ok(Outcome {
-        done,
-        expected: ids.end - ids.start,
-        plot_warnings: written
-            .as_ref()
-            .map(|w: &crate::report::Written| w.plot_warnings.clone())
-            .unwrap_or_default(),
-        summary: written.map(|w| w.summary),
-        report,
+    Ok(Outcome::new(
         file,
         scenario,
-        out: out.clone(),
+        out,
+        report,
+        done,
+        ids.end - ids.start,
+        written,
+    ))
+}
+
+/// A request's settings, checked before anything is written ([`check_request`]).
+struct Checked {
+    /// The campaign in the folder that the request resumes, if any.
+    stored: Option<CampaignFile>,
+    /// The campaign's settings, as stored in `campaign.json`.
+    file: CampaignFile,
+    /// The scenario under test.
+    scenario: Scenario,
+    /// The points of a `--points` campaign, in test order.
+    points: Option<Vec<Point>>,
+    /// The scenario's warnings for this system under test.
+    warnings: Vec<String>,
+    /// The campaign's strategy.
+    strategy: Strategy,
+    /// Worker threads.
+    jobs: usize,
+}
+
+/// The settings of `request` (with the campaign it resumes, if any), checked and refused
+/// before anything is written ([`run`]'s errors but [`Error::Write`]).
+fn check_request(request: &Request) -> Result<Checked, Error> {
+    let stored = stored_campaign(request)?;
+    let (mut file, scenario, points) = settings(request, stored.as_ref())?;
+    // A campaign that stops at its first failure does so when resumed too.
+    let stop_at_first_failure = match &stored {
+        Some(s) => s.stop_at_first_failure || request.stop_at_first_failure,
+        None => request.stop_at_first_failure,
+    };
+    file.stop_at_first_failure = stop_at_first_failure;
+    let warnings = warnings_of(&scenario);
+    let strategy = refusals(request, &file, &warnings)?;
+    check_strength(request, &scenario, strategy)?;
+    let jobs = request.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    });
+    Ok(Checked {
+        stored,
+        file,
+        scenario,
+        points,
+        warnings,
+        strategy,
+        jobs,
     })
+}
+
+/// The records already in `out` for the campaign of `scenario` over `ids` when `resumed`
+/// (a half-written last line cut off), none otherwise.
+fn existing_records(
+    out: &Path,
+    scenario: &Scenario,
+    ids: std::ops::Range<u64>,
+    resumed: bool,
+) -> Result<crate::campaign::results::Existing, Error> {
+    Ok(if resumed {
+        crate::campaign::results::load(out, scenario, ids, true)?
+    } else {
+        crate::campaign::results::Existing {
+            records: Vec::new(),
+            repaired_bytes: 0,
+        }
+    })
+}
+
+/// The campaign of `file` over `scenario` with `strategy` on `jobs` threads (with its
+/// `points`), writing traces when `request` asks for them ([`trace_spec`]).
+fn new_campaign<'a>(
+    request: &Request,
+    scenario: &'a Scenario,
+    file: &CampaignFile,
+    strategy: Strategy,
+    jobs: usize,
+    points: Option<&'a [Point]>,
+) -> Result<Campaign<'a>, Error> {
+    Ok(Campaign {
+        scenario,
+        strategy,
+        seed: file.seed,
+        budget: file.budget,
+        strength: file.strength,
+        jobs,
+        stop_at_first_failure: file.stop_at_first_failure,
+        points,
+        trace: trace_spec(request)?,
+    })
+}
+
+/// Where and how often to write each test's trace (`--trace-every`, s), creating the folder
+/// `out/trace`; `None` without `--trace`.
+///
+/// # Errors
+/// [`Error::BadInput`] for a time that is not finite and `> 0`; the folder's error when it
+/// cannot be made.
+fn trace_spec(request: &Request) -> Result<Option<crate::export::trace::TraceSpec>, Error> {
+    match request.trace_every_s {
+        Some(every_s) => {
+            if !(every_s.is_finite() && every_s > 0.0) {
+                return Err(Error::BadInput(format!(
+                    "--trace-every {every_s} s must be a finite number of seconds > 0"
+                )));
+            }
+            let path = request.out.join(TRACE_FOLDER);
+            crate::atomic::make_output_folder(&path)?;
+            Ok(Some(crate::export::trace::TraceSpec { path, every_s }))
+        }
+        None => Ok(None),
+    }
 }
 
 /// Prepares the campaign folder (`replace`, `resume`), takes its lock, and writes `file` into
@@ -541,8 +640,8 @@ fn refuse(out: &Path, diffs: Vec<String>) -> Error {
 }
 
 /// Scenario `name`, under the system under test of `choice` when it names one.
-fn load_scenario(name: &str, choice: &SutChoice) -> Result<Scenario, Error> {
-    let mut scenario = crate::load_scenario(name)?;
+fn load_scenario(name: &ScenarioRef, choice: &SutChoice) -> Result<Scenario, Error> {
+    let mut scenario = name.load()?;
     if let Some(s) = choice.config()? {
         crate::refuse_sut_for_scripted_ego(&scenario)?;
         scenario.sut = s;
@@ -555,7 +654,7 @@ fn load_scenario(name: &str, choice: &SutChoice) -> Result<Scenario, Error> {
 fn requested_settings(
     request: &Request,
     stored: Option<&CampaignFile>,
-    name: &str,
+    name: &ScenarioRef,
 ) -> Result<(CampaignFile, Scenario, Option<Vec<Point>>), Error> {
     let choice = SutChoice::of(request.sut.as_ref());
     let scenario = load_scenario(name, &choice)?;

@@ -50,7 +50,7 @@ fn input(e: impl std::fmt::Display) -> Error {
 fn network_document(
     world: &WorldSpec,
     scenario: &paracosm_scenarios::Scenario,
-    program: &str,
+    program: &crate::ScenarioRef,
     maps: &[&PieceKind],
 ) -> Result<String, Error> {
     if maps.is_empty() {
@@ -65,7 +65,7 @@ fn network_document(
             })
             .or(scenario.input_files.first())
             .ok_or_else(|| input("the program's map is not among the files it read"))?;
-        if crate::xosc::is_xosc(program) {
+        if program.xosc().is_some() {
             // An OpenSCENARIO scenario's map path is already joined with its folder.
             paracosm_scenarios::text_file::read_text(
                 Path::new(&read.path),
@@ -73,7 +73,8 @@ fn network_document(
             )
             .map_err(|e| input(format!("cannot read {}: {e}", read.path)))
         } else {
-            paracosm_scenarios::lang::map_files::read_input_file(program, &read.path).map_err(input)
+            paracosm_scenarios::lang::map_files::read_input_file(program.path(), &read.path)
+                .map_err(input)
         }
     } else {
         Err(input(
@@ -95,42 +96,11 @@ pub fn export(
     out: &Path,
     ego: xosc::EgoMotion,
 ) -> Result<Exported, Error> {
-    // A file where the folder should be is the user's mistake, refused before the replay.
-    if out.exists() && !out.is_dir() {
-        return Err(Error::BadInput(format!(
-            "--out `{}` is a file, not a folder: give a folder for the exported files",
-            out.display()
-        )));
-    }
-    // The folder and the two files are checked before the replay (exit 2, before any work).
-    crate::atomic::make_output_folder(out)?;
-    crate::atomic::check_targets(
-        out,
-        [format!("test_{id}.xosc"), format!("test_{id}.xodr")]
-            .iter()
-            .map(String::as_str),
-    )?;
+    check_out_folder(out, id)?;
     let dir = results.parent().unwrap_or(Path::new("."));
     let campaign = CampaignFile::read(dir).map_err(input)?;
-    let scenario = crate::load_scenario(&campaign.scenario)?;
-    let mut world: Option<WorldSpec> = None;
-    let mut states: Vec<Snapshot> = Vec::new();
-    let mut on_world = |w: &WorldSpec| world = Some(w.clone());
-    let mut on_step = |s: &Snapshot| states.push(s.clone());
-    let replayed = crate::export::replay::replay_with(
-        results,
-        id,
-        (None, None),
-        None,
-        Some(&mut on_world),
-        Some(&mut on_step),
-    )?;
-    let world = world.ok_or_else(|| {
-        input(format!(
-            "test {id} built no world: {}",
-            replayed.replayed.error.clone().unwrap_or_default()
-        ))
-    })?;
+    let scenario = campaign.scenario.load()?;
+    let (world, states, replayed) = replay_recording(results, id)?;
     let stem = format!("test_{id}");
     let xodr_name = format!("{stem}.xodr");
     // The network: the program's map as it is, or the pieces written out.
@@ -142,13 +112,7 @@ pub fn export(
         .filter(|k| matches!(k, PieceKind::Map { .. }))
         .collect();
     let network = network_document(&world, &scenario, &campaign.scenario, &maps)?;
-    let origin_m = maps
-        .first()
-        .and_then(|k| match k {
-            PieceKind::Map { map, .. } => Some(map.0.origin_m),
-            _ => None,
-        })
-        .unwrap_or([0.0, 0.0]);
+    let origin_m = map_origin_m(&maps);
     let params: Vec<(String, serde_json::Value)> = replayed.recorded["params"]
         .as_object()
         .map(|m| m.iter().map(|(k, v)| (k.clone(), v.clone())).collect())
@@ -175,7 +139,84 @@ pub fn export(
     for (path, text) in [(&xodr_path, &network), (&xosc_path, &document)] {
         crate::atomic::write(path, text.as_bytes())?;
     }
-    let not_in_file = scenario
+    let not_in_file = monitors_not_in_file(&scenario);
+    Ok(Exported {
+        xosc: xosc_path,
+        xodr: xodr_path,
+        matches: replayed.matches,
+        not_in_file,
+    })
+}
+
+/// Refuses an `out` that is a file, then makes the folder and checks that test `id`'s two
+/// files can be written there: all before the replay (exit 2, before any work).
+///
+/// # Errors
+/// [`Error::BadInput`] for a file where the folder should be; the folder's or the targets'
+/// errors.
+fn check_out_folder(out: &Path, id: u64) -> Result<(), Error> {
+    // A file where the folder should be is the user's mistake, refused before the replay.
+    if out.exists() && !out.is_dir() {
+        return Err(Error::BadInput(format!(
+            "--out `{}` is a file, not a folder: give a folder for the exported files",
+            out.display()
+        )));
+    }
+    // The folder and the two files are checked before the replay (exit 2, before any work).
+    crate::atomic::make_output_folder(out)?;
+    crate::atomic::check_targets(
+        out,
+        [format!("test_{id}.xosc"), format!("test_{id}.xodr")]
+            .iter()
+            .map(String::as_str),
+    )?;
+    Ok(())
+}
+
+/// Replays test `id` of the campaign whose results are `results`, keeping its world as built
+/// and its state at the start and after every step.
+///
+/// # Errors
+/// As [`replay::replay_with`]; [`Error::BadInput`] when the test built no world.
+fn replay_recording(
+    results: &Path,
+    id: u64,
+) -> Result<(WorldSpec, Vec<Snapshot>, replay::Replay), Error> {
+    let mut world: Option<WorldSpec> = None;
+    let mut states: Vec<Snapshot> = Vec::new();
+    let mut on_world = |w: &WorldSpec| world = Some(w.clone());
+    let mut on_step = |s: &Snapshot| states.push(s.clone());
+    let replayed = crate::export::replay::replay_with(
+        results,
+        id,
+        (None, None),
+        None,
+        Some(&mut on_world),
+        Some(&mut on_step),
+    )?;
+    let world = world.ok_or_else(|| {
+        input(format!(
+            "test {id} built no world: {}",
+            replayed.replayed.error.clone().unwrap_or_default()
+        ))
+    })?;
+    Ok((world, states, replayed))
+}
+
+/// The origin `[x, z]` (m) of the first of `maps`, `[0, 0]` without a map.
+fn map_origin_m(maps: &[&PieceKind]) -> [f64; 2] {
+    maps.first()
+        .and_then(|k| match k {
+            PieceKind::Map { map, .. } => Some(map.0.origin_m),
+            _ => None,
+        })
+        .unwrap_or([0.0, 0.0])
+}
+
+/// The names of `scenario`'s monitors that an OpenSCENARIO file cannot carry (all but
+/// collision and leaving the road), in the scenario's order.
+fn monitors_not_in_file(scenario: &paracosm_scenarios::Scenario) -> Vec<String> {
+    scenario
         .monitors
         .iter()
         .filter(|m| {
@@ -186,11 +227,5 @@ pub fn export(
             )
         })
         .map(|m| m.name().to_owned())
-        .collect();
-    Ok(Exported {
-        xosc: xosc_path,
-        xodr: xodr_path,
-        matches: replayed.matches,
-        not_in_file,
-    })
+        .collect()
 }

@@ -148,7 +148,7 @@ pub fn replay_with(
     let dir = results.parent().unwrap_or(Path::new("."));
     let (line_no, line) = find_record(results, id)?;
     let campaign_file = CampaignFile::read(dir).map_err(input)?;
-    let mut scenario = crate::load_scenario(&campaign_file.scenario)?;
+    let mut scenario = campaign_file.scenario.load()?;
     let changed = changed_since(&campaign_file, &scenario);
     let record = RunRecord::from_line(&line, &scenario.space).map_err(|e| {
         input(format!(
@@ -175,6 +175,47 @@ pub fn replay_with(
         points: None,
         trace,
     };
+    let (replayed, written, thumbnails) =
+        run_writing_frames(&campaign, id, &point, frames, on_world, on_step)?;
+    if record.seed != replayed.seed {
+        return Err(input(format!(
+            "{}:{line_no}: test {id} was recorded with seed {} but campaign.json gives {}: the \
+             results and campaign.json are from different campaigns",
+            results.display(),
+            record.seed,
+            replayed.seed
+        )));
+    }
+    let contact_sheet = write_contact_sheet(frames, &thumbnails, id)?;
+    let matches = verdicts_match(&recorded, &replayed);
+    Ok(Replay {
+        recorded,
+        replayed,
+        matches,
+        frames: written,
+        contact_sheet,
+        changed,
+    })
+}
+
+/// Thumbnails of the frames written, with their times (s), in time order.
+type Thumbnails = Vec<(f64, image::RgbImage)>;
+
+/// Runs test `id` at `point` with `campaign`, calling `on_world` and `on_step`. With
+/// `frames`, makes that folder and writes every camera frame (a default camera) as
+/// `frame_NNNNN.png` there. Returns the run's record, the frames written in time order, and
+/// their thumbnails with their times (s).
+///
+/// # Errors
+/// [`Error::BadInput`] when the folder cannot be made or a frame cannot be written.
+fn run_writing_frames(
+    campaign: &Campaign<'_>,
+    id: u64,
+    point: &Point,
+    frames: Option<&Path>,
+    on_world: Option<&mut dyn FnMut(&paracosm_engine::WorldSpec)>,
+    on_step: Option<&mut dyn FnMut(&paracosm_engine::Snapshot)>,
+) -> Result<(RunRecord, Vec<PathBuf>, Thumbnails), Error> {
     if let Some(dir) = frames {
         std::fs::create_dir_all(dir)
             .map_err(|e| input(format!("cannot create `{}`: {e}", dir.display())))?;
@@ -197,7 +238,7 @@ pub fn replay_with(
     };
     let replayed = campaign.run_one_with(
         id,
-        &point,
+        point,
         &mut RunOptions {
             camera: frames.map(|_| CameraSpec::default()),
             on_frame: Some(&mut on_frame),
@@ -210,33 +251,25 @@ pub fn replay_with(
     if let Some(e) = write_error {
         return Err(input(e));
     }
-    if record.seed != replayed.seed {
-        return Err(input(format!(
-            "{}:{line_no}: test {id} was recorded with seed {} but campaign.json gives {}: the \
-             results and campaign.json are from different campaigns",
-            results.display(),
-            record.seed,
-            replayed.seed
-        )));
-    }
-    let contact_sheet = match frames {
+    Ok((replayed, written, thumbnails))
+}
+
+/// Writes `contact_sheet.png` of test `id` into `frames` from the `thumbnails` (time s,
+/// image); `None` without a folder or frames.
+fn write_contact_sheet(
+    frames: Option<&Path>,
+    thumbnails: &[(f64, image::RgbImage)],
+    id: u64,
+) -> Result<Option<PathBuf>, Error> {
+    Ok(match frames {
         Some(dir) if !thumbnails.is_empty() => {
             let path = dir.join("contact_sheet.png");
             crate::atomic::with_temp(&path, |tmp| {
-                crate::report::plot::contact_sheet(tmp, &thumbnails, &format!("test {id}"))
+                crate::report::plot::contact_sheet(tmp, thumbnails, &format!("test {id}"))
             })?;
             Some(path)
         }
         _ => None,
-    };
-    let matches = verdicts_match(&recorded, &replayed);
-    Ok(Replay {
-        recorded,
-        replayed,
-        matches,
-        frames: written,
-        contact_sheet,
-        changed,
     })
 }
 

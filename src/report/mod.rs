@@ -229,12 +229,12 @@ fn map_axes(scenario: &Scenario, triage: Option<&Triage>) -> Vec<String> {
 }
 
 /// How a plot's title names a campaign's scenario: an OpenSCENARIO file by its file name,
-/// without the options its campaign name carries (`#open=...`); any other by its name.
+/// without the options its campaign name carries (` --open ...`); any other by its name.
 fn shown_name(name: &str) -> String {
-    if !crate::xosc::is_xosc(name) {
+    let path = name.split(" --").next().unwrap_or(name);
+    if !crate::scenario_ref::is_xosc(path) {
         return name.to_owned();
     }
-    let path = name.split(crate::xosc::OPTIONS_MARK).next().unwrap_or(name);
     Path::new(path)
         .file_name()
         .map_or_else(|| path.to_owned(), |f| f.to_string_lossy().into_owned())
@@ -620,7 +620,7 @@ fn triage_lines(t: &crate::report::triage::Triage) -> Vec<String> {
 /// or two; [`crate::Error::Plot`] when a plot cannot be written.
 pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts), crate::Error> {
     let file = CampaignFile::read(dir)?;
-    let mut scenario = crate::load_scenario(&file.scenario)?;
+    let mut scenario = file.scenario.load()?;
     if let Some(s) = file.sut.config()? {
         scenario.sut = s;
     }

@@ -23,6 +23,22 @@ impl Inspection {
         if let Some(r) = &s.road_network {
             let _ = writeln!(out, "road network: {}", r.item);
         }
+        self.write_parameters(&mut out);
+        write_entities(s, &mut out);
+        write_storyboard(s, &mut out);
+        for n in &s.notes {
+            let _ = writeln!(out, "note: {}: {}", n.pos, n.text);
+        }
+        for l in &self.limits {
+            let _ = writeln!(out, "note: {l}");
+        }
+        out
+    }
+
+    /// Writes the parameters (declared, with the domains of the open ones, and those of the
+    /// value-set distributions) and the file's own grid or stochastic distribution.
+    fn write_parameters(&self, out: &mut String) {
+        let s = &self.scenario;
         let _ = writeln!(out, "parameters ({} declared):", s.params.len());
         for (d, v) in &s.params {
             let open = self.space.iter().find(|p| p.name == d.name);
@@ -55,71 +71,73 @@ impl Inspection {
             }
             None => {}
         }
-        let _ = writeln!(out, "entities:");
-        for e in &s.entities {
-            let kind = match &e.kind {
-                EntityKind::Vehicle(c) => format!("vehicle ({c})"),
-                EntityKind::Pedestrian(c) => format!("pedestrian ({c})"),
-                EntityKind::MiscObject(c) => format!("object ({c})"),
-            };
-            let [l, w, h] = e.dimensions_m;
-            let _ = writeln!(
-                out,
-                "  {}: {kind}, {l} x {w} x {h} m{}",
-                e.name,
-                e.controller
-                    .as_ref()
-                    .map_or(String::new(), |c| format!(", controller {c}"))
-            );
-        }
-        let _ = writeln!(out, "init:");
-        for (e, a) in &s.init {
-            let _ = writeln!(out, "  {}: {}", s.entities[*e].name, action(s, &a.action));
-        }
-        for story in &s.stories {
-            let _ = writeln!(out, "story {}:", story.name);
-            for act in &story.acts {
-                let start = act
-                    .start
-                    .as_ref()
-                    .map_or("at once".to_string(), |t| trigger(s, t));
-                let _ = writeln!(out, "  act {} starts {start}", act.name);
-                for g in &act.groups {
-                    let actors: Vec<&str> = g
-                        .actors
-                        .iter()
-                        .map(|&a| s.entities[a].name.as_str())
-                        .collect();
-                    for m in &g.maneuvers {
-                        for e in &m.events {
-                            let when = e
-                                .start
-                                .as_ref()
-                                .map_or("with its act".to_string(), |t| trigger(s, t));
-                            let _ = writeln!(
-                                out,
-                                "    event {} ({}) starts {when}:",
-                                e.name,
-                                actors.join(", ")
-                            );
-                            for a in &e.actions {
-                                let _ = writeln!(out, "      {}: {}", a.name, action(s, &a.action));
-                            }
+    }
+}
+
+/// Writes the entities (kind, size in m, controller) and their `Init` actions.
+fn write_entities(s: &Scenario, out: &mut String) {
+    let _ = writeln!(out, "entities:");
+    for e in &s.entities {
+        let kind = match &e.kind {
+            EntityKind::Vehicle(c) => format!("vehicle ({c})"),
+            EntityKind::Pedestrian(c) => format!("pedestrian ({c})"),
+            EntityKind::MiscObject(c) => format!("object ({c})"),
+        };
+        let [l, w, h] = e.dimensions_m;
+        let _ = writeln!(
+            out,
+            "  {}: {kind}, {l} x {w} x {h} m{}",
+            e.name,
+            e.controller
+                .as_ref()
+                .map_or(String::new(), |c| format!(", controller {c}"))
+        );
+    }
+    let _ = writeln!(out, "init:");
+    for (e, a) in &s.init {
+        let _ = writeln!(out, "  {}: {}", s.entities[*e].name, action(s, &a.action));
+    }
+}
+
+/// Writes the storyboard: each story's acts and events with their start triggers and
+/// actions, then the stop trigger.
+fn write_storyboard(s: &Scenario, out: &mut String) {
+    for story in &s.stories {
+        let _ = writeln!(out, "story {}:", story.name);
+        for act in &story.acts {
+            let start = act
+                .start
+                .as_ref()
+                .map_or("at once".to_string(), |t| trigger(s, t));
+            let _ = writeln!(out, "  act {} starts {start}", act.name);
+            for g in &act.groups {
+                let actors: Vec<&str> = g
+                    .actors
+                    .iter()
+                    .map(|&a| s.entities[a].name.as_str())
+                    .collect();
+                for m in &g.maneuvers {
+                    for e in &m.events {
+                        let when = e
+                            .start
+                            .as_ref()
+                            .map_or("with its act".to_string(), |t| trigger(s, t));
+                        let _ = writeln!(
+                            out,
+                            "    event {} ({}) starts {when}:",
+                            e.name,
+                            actors.join(", ")
+                        );
+                        for a in &e.actions {
+                            let _ = writeln!(out, "      {}: {}", a.name, action(s, &a.action));
                         }
                     }
                 }
             }
         }
-        if let Some(t) = &s.stop {
-            let _ = writeln!(out, "stops {}", trigger(s, t));
-        }
-        for n in &s.notes {
-            let _ = writeln!(out, "note: {}: {}", n.pos, n.text);
-        }
-        for l in &self.limits {
-            let _ = writeln!(out, "note: {l}");
-        }
-        out
+    }
+    if let Some(t) = &s.stop {
+        let _ = writeln!(out, "stops {}", trigger(s, t));
     }
 }
 

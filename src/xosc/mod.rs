@@ -12,7 +12,9 @@ use std::path::{Path, PathBuf};
 use paracosm_generators::Param;
 use paracosm_openscenario::distribution::{read_variation, VariationFile};
 use paracosm_openscenario::model::Scenario;
-use paracosm_openscenario::{read_scenario, Text, XoscError};
+use paracosm_openscenario::{read_scenario_in, FileSet, XoscError};
+
+use crate::scenario_ref::{ScenarioRef, XoscRef};
 
 use crate::Error;
 
@@ -45,11 +47,24 @@ pub struct Inspection {
 /// variation whose scenario does not read, an `--open` of a parameter that is not declared,
 /// is varied already, or whose range breaks its constraint groups.
 pub fn inspect(path: &Path, opens: &[String], continuous: bool) -> Result<Inspection, Error> {
+    inspect_in(&FileSet::new(), path, opens, continuous)
+}
+
+/// [`inspect`], reading every file through `files` (a campaign keeps them for its tests).
+///
+/// # Errors
+/// As [`inspect`].
+pub fn inspect_in(
+    files: &FileSet,
+    path: &Path,
+    opens: &[String],
+    continuous: bool,
+) -> Result<Inspection, Error> {
     let input = |e: XoscError| Error::Input {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    let text = Text::read(path).map_err(input)?;
+    let text = files.text(path).map_err(input)?;
     let doc = text.parse().map_err(input)?;
     let is_variation = paracosm_openscenario::distribution::is_variation(&doc);
     drop(doc);
@@ -75,7 +90,7 @@ pub fn inspect(path: &Path, opens: &[String], continuous: bool) -> Result<Inspec
     } else {
         (None, path.to_path_buf())
     };
-    let scenario = read_scenario(&scenario_path, &[]).map_err(input)?;
+    let scenario = read_scenario_in(files, &scenario_path, &[]).map_err(input)?;
     let mut space = Vec::new();
     let mut limits = Vec::new();
     let mut grid_runs = Some(1u64);
@@ -142,95 +157,18 @@ pub fn inspect_with_map(
     Ok(found)
 }
 
-/// The separator between an OpenSCENARIO file and its options in a campaign's scenario name:
-/// `file.xosc#open=Name=lo..hi;open=Name=a,b;continuous;scripted-ego;ego=Name;horizon=30`
-/// (what `campaign.json`
-/// keeps, so that resume, report, replay and export build the same space and world).
-pub const OPTIONS_MARK: char = '#';
-
-/// How a campaign reads an OpenSCENARIO file (`paracosm-fuzz FILE.xosc` options).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct XoscOptions {
-    /// `--open`: declared parameters opened, `Name=lo..hi` or `Name=a,b,c`.
-    pub open: Vec<String>,
-    /// `--continuous`: a `DistributionRange` becomes an interval over its range.
-    pub continuous: bool,
-    /// `--scripted-ego`: the storyboard moves the ego as every other entity (no system under
-    /// test), to replay an exported test ([`paracosm_scenarios::xosc::Source::scripted_ego`]).
-    pub scripted_ego: bool,
-    /// `--ego NAME`: the vehicle the system under test drives, for a file that does not say
-    /// plainly ([`paracosm_scenarios::xosc::ego_of`]).
-    pub ego: Option<String>,
-    /// `--horizon`: the longest test, s; a storyboard without a stop trigger needs it.
-    pub horizon_s: Option<f64>,
-}
-
-/// The campaign scenario name of `path` with `options`: the path alone without options.
-pub fn campaign_name(path: &str, options: &XoscOptions) -> String {
-    let (opens, continuous) = (&options.open, options.continuous);
-    let mut options_text: Vec<String> = opens.iter().map(|o| format!("open={o}")).collect();
-    if continuous {
-        options_text.push("continuous".into());
-    }
-    if options.scripted_ego {
-        options_text.push("scripted-ego".into());
-    }
-    if let Some(ego) = &options.ego {
-        options_text.push(format!("ego={ego}"));
-    }
-    if let Some(h) = options.horizon_s {
-        options_text.push(format!("horizon={h}"));
-    }
-    let options = options_text;
-    if options.is_empty() {
-        path.to_owned()
-    } else {
-        format!("{path}{OPTIONS_MARK}{}", options.join(";"))
-    }
-}
-
-/// Whether a campaign's scenario name is an OpenSCENARIO file (with or without options).
-pub fn is_xosc(name: &str) -> bool {
-    let path = name.split(OPTIONS_MARK).next().unwrap_or(name);
-    path.to_ascii_lowercase().ends_with(".xosc")
-}
-
-/// The scenario a campaign over an OpenSCENARIO file runs (name as [`campaign_name`] writes
-/// it): its space is the variation file's varied parameters then the `--open`ed ones, each
-/// test re-reads the scenario with its values (a value set expands to its parameters).
+/// The scenario a campaign over the OpenSCENARIO file `x` runs: its space is the variation
+/// file's varied parameters then the `--open`ed ones; the files are read once, here, and each
+/// test reads the scenario's text with its values (a value set expands to its parameters).
 ///
 /// # Errors
 /// [`Error::Input`] or [`Error::BadInput`] as [`inspect`]; a scenario that does not build
 /// (`paracosm_scenarios::xosc::scenario`).
-pub fn campaign_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Error> {
-    let (path, options) = match name.split_once(OPTIONS_MARK) {
-        Some((p, o)) => (p, o),
-        None => (name, ""),
-    };
-    let mut opens = Vec::new();
-    let mut continuous = false;
-    let mut scripted_ego = false;
-    let mut ego = None;
-    let mut horizon_s = None;
-    for o in options.split(';').filter(|o| !o.is_empty()) {
-        match o.split_once('=') {
-            Some(("open", spec)) => opens.push(spec.to_owned()),
-            Some(("ego", e)) => ego = Some(e.to_owned()),
-            Some(("horizon", h)) => {
-                horizon_s = Some(h.parse::<f64>().map_err(|_| {
-                    Error::BadInput(format!("{name}: horizon={h} is not a number of seconds"))
-                })?)
-            }
-            None if o == "continuous" => continuous = true,
-            None if o == "scripted-ego" => scripted_ego = true,
-            _ => {
-                return Err(Error::BadInput(format!(
-                "{name}: unknown option {o:?} after {OPTIONS_MARK} (open=Name=lo..hi, continuous, scripted-ego, ego=NAME, horizon=S)"
-            )))
-            }
-        }
-    }
-    let found = inspect(Path::new(path), &opens, continuous)?;
+pub fn campaign_scenario(x: &XoscRef) -> Result<paracosm_scenarios::Scenario, Error> {
+    let path = x.xosc.as_str();
+    let (opens, continuous) = (&x.open, x.continuous);
+    let files = std::sync::Arc::new(FileSet::new());
+    let found = inspect_in(&files, Path::new(path), opens, continuous)?;
     let space = paracosm_generators::ParamSpace::new(found.space.clone())
         .map_err(|e| Error::BadInput(format!("{path}: {e}")))?;
     let sets: Vec<String> = (0..found.variation.as_ref().map_or(0, |v| v.multi.len()))
@@ -263,12 +201,13 @@ pub fn campaign_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Err
     let template = PathBuf::from(&found.scenario.file);
     let mut scenario = paracosm_scenarios::xosc::scenario(paracosm_scenarios::xosc::Source {
         template,
-        name: name.to_owned(),
+        files,
+        name: ScenarioRef::OpenScenario(x.clone()).to_string(),
         space,
         overrides,
-        scripted_ego,
-        ego,
-        horizon_s,
+        scripted_ego: x.scripted_ego,
+        ego: x.ego.clone(),
+        horizon_s: x.horizon_s,
     })?;
     scenario
         .warnings

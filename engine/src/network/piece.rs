@@ -234,83 +234,106 @@ impl PieceKind {
                 radius_m,
                 angle_rad,
                 ..
-            } => {
-                let min = MIN_CURVE_RADIUS_M.max(self.half_width_m() + 1.0);
-                if !(radius_m.is_finite() && radius_m >= min) {
-                    bad(format!(
-                        "Arc radius {radius_m} m is too tight for {lanes} lanes (at least {min} m)"
-                    ))
-                } else if radius_m > MAX_EXTENT_M {
-                    bad(format!(
-                        "Arc radius {} m is over {MAX_EXTENT_M} m (use a RoadSegment)",
-                        readable(radius_m)
-                    ))
-                } else if !(angle_rad.is_finite()
-                    && angle_rad != 0.0
-                    && angle_rad.abs() <= MAX_TURN_RAD + 1e-12)
-                {
-                    bad(format!(
-                        "Arc angle {angle_rad} rad must be non-zero and within ±3π/2 (±{MAX_TURN_RAD:.4})"
-                    ))
-                } else {
-                    Ok(())
-                }
-            }
+            } => self.validate_arc(radius_m, angle_rad),
             PieceKind::Clothoid {
                 length_m,
                 curv_start,
                 curv_end,
                 ..
-            } => {
-                let max_k = 1.0 / MIN_CURVE_RADIUS_M.max(self.half_width_m() + 1.0);
-                if !(length_m.is_finite() && length_m > 0.0 && length_m <= 10_000.0) {
-                    bad(format!(
-                        "Clothoid length {length_m} m is outside (0, 10000]"
-                    ))
-                } else if !(curv_start.is_finite() && curv_end.is_finite())
-                    || curv_start.abs().max(curv_end.abs()) > max_k
-                {
-                    bad(format!(
-                        "Clothoid curvature from {curv_start} to {curv_end} 1/m is too tight for \
-                         {lanes} lanes (|curvature| at most {max_k:.4} 1/m, a radius of {:.1} m)",
-                        1.0 / max_k
-                    ))
-                } else {
-                    let turn = self.ref_line().expect("curved").heading(length_m);
-                    if turn.abs() > MAX_TURN_RAD + 1e-12 {
-                        bad(format!(
-                            "Clothoid turns {turn:.4} rad; at most ±3π/2 (±{MAX_TURN_RAD:.4})"
-                        ))
-                    } else {
-                        Ok(())
-                    }
-                }
-            }
-            PieceKind::Roundabout { radius_m, .. } => {
-                let min = self.half_width_m() + 3.0;
-                if !(radius_m.is_finite() && radius_m >= min) {
-                    bad(format!(
-                        "Roundabout radius {radius_m} m is too small for {lanes} lanes (at least {} m)",
-                        super::lanes::min_roundabout_radius_m(lanes)
-                    ))
-                } else if radius_m > 1_000.0 {
-                    bad(format!(
-                        "Roundabout radius {} m is over 1000 m",
-                        readable(radius_m)
-                    ))
-                } else if !super::lanes::roundabout_fits(lanes, radius_m) {
-                    bad(format!(
-                        "Roundabout radius {radius_m} m is too small for {lanes} lanes: the way \
-                         from an outer lane onto the ring and off it would turn tighter than \
-                         {} m or leave no ring between entry and exit (at least {} m)",
-                        super::lanes::MIN_PATH_RADIUS_M,
-                        super::lanes::min_roundabout_radius_m(lanes)
-                    ))
-                } else {
-                    Ok(())
-                }
-            }
+            } => self.validate_clothoid(length_m, curv_start, curv_end),
+            PieceKind::Roundabout { radius_m, .. } => self.validate_roundabout(radius_m),
             _ => Ok(()),
+        }
+    }
+
+    /// Checks an `Arc`'s radius (m) against its lanes and [`MAX_EXTENT_M`], and its angle
+    /// (rad) against [`MAX_TURN_RAD`].
+    fn validate_arc(&self, radius_m: f64, angle_rad: f64) -> Result<(), EngineError> {
+        let bad = |m: String| Err(EngineError::InvalidWorld(m));
+        let lanes = self.lanes();
+        let min = MIN_CURVE_RADIUS_M.max(self.half_width_m() + 1.0);
+        if !(radius_m.is_finite() && radius_m >= min) {
+            bad(format!(
+                "Arc radius {radius_m} m is too tight for {lanes} lanes (at least {min} m)"
+            ))
+        } else if radius_m > MAX_EXTENT_M {
+            bad(format!(
+                "Arc radius {} m is over {MAX_EXTENT_M} m (use a RoadSegment)",
+                readable(radius_m)
+            ))
+        } else if !(angle_rad.is_finite()
+            && angle_rad != 0.0
+            && angle_rad.abs() <= MAX_TURN_RAD + 1e-12)
+        {
+            bad(format!(
+                "Arc angle {angle_rad} rad must be non-zero and within ±3π/2 (±{MAX_TURN_RAD:.4})"
+            ))
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Checks a `Clothoid`'s length (m), its curvatures (1/m) against its lanes, and its turn
+    /// (rad) against [`MAX_TURN_RAD`].
+    fn validate_clothoid(
+        &self,
+        length_m: f64,
+        curv_start: f64,
+        curv_end: f64,
+    ) -> Result<(), EngineError> {
+        let bad = |m: String| Err(EngineError::InvalidWorld(m));
+        let lanes = self.lanes();
+        let max_k = 1.0 / MIN_CURVE_RADIUS_M.max(self.half_width_m() + 1.0);
+        if !(length_m.is_finite() && length_m > 0.0 && length_m <= 10_000.0) {
+            bad(format!(
+                "Clothoid length {length_m} m is outside (0, 10000]"
+            ))
+        } else if !(curv_start.is_finite() && curv_end.is_finite())
+            || curv_start.abs().max(curv_end.abs()) > max_k
+        {
+            bad(format!(
+                "Clothoid curvature from {curv_start} to {curv_end} 1/m is too tight for \
+                 {lanes} lanes (|curvature| at most {max_k:.4} 1/m, a radius of {:.1} m)",
+                1.0 / max_k
+            ))
+        } else {
+            let turn = self.ref_line().expect("curved").heading(length_m);
+            if turn.abs() > MAX_TURN_RAD + 1e-12 {
+                bad(format!(
+                    "Clothoid turns {turn:.4} rad; at most ±3π/2 (±{MAX_TURN_RAD:.4})"
+                ))
+            } else {
+                Ok(())
+            }
+        }
+    }
+
+    /// Checks a `Roundabout`'s radius (m): large enough for its lanes and their paths onto
+    /// and off the ring, at most 1000 m.
+    fn validate_roundabout(&self, radius_m: f64) -> Result<(), EngineError> {
+        let bad = |m: String| Err(EngineError::InvalidWorld(m));
+        let lanes = self.lanes();
+        let min = self.half_width_m() + 3.0;
+        if !(radius_m.is_finite() && radius_m >= min) {
+            bad(format!(
+                "Roundabout radius {radius_m} m is too small for {lanes} lanes (at least {} m)",
+                super::lanes::min_roundabout_radius_m(lanes)
+            ))
+        } else if radius_m > 1_000.0 {
+            bad(format!(
+                "Roundabout radius {} m is over 1000 m",
+                readable(radius_m)
+            ))
+        } else if !super::lanes::roundabout_fits(lanes, radius_m) {
+            bad(format!(
+                "Roundabout radius {radius_m} m is too small for {lanes} lanes: the way \
+                 from an outer lane onto the ring and off it would turn tighter than \
+                 {} m or leave no ring between entry and exit (at least {} m)",
+                super::lanes::MIN_PATH_RADIUS_M,
+                super::lanes::min_roundabout_radius_m(lanes)
+            ))
+        } else {
+            Ok(())
         }
     }
 

@@ -770,100 +770,119 @@ impl Sut for ExternalSut {
         };
         let step = self.step;
         self.step += 1;
-        let mut header = json!({
-            "type": "observation",
-            "step": step,
-            "t_s": obs.t_s,
-            "ego": {
-                "pos_m": obs.ego.pos_m,
-                "heading_rad": obs.ego.heading_rad,
-                "speed_mps": obs.ego.speed_mps,
-            },
-        });
-        // The speed the scenario asks the ego to keep (an OpenSCENARIO `Init` speed), when it
-        // asks one.
-        if let Some(v) = obs.set_speed_mps {
-            header["ego"]["set_speed_mps"] = json!(v);
-        }
-        // The route to follow, in the first observation that has one and when it changes (a
-        // storyboard's lane change or route of the ego).
-        let route = (obs.route.as_ptr() as usize, obs.route.len());
-        if !obs.route.is_empty() && route != self.route_sent {
-            header["route_m"] = json!(obs.route);
-            self.route_sent = route;
-        }
+        let mut header = observation_header(obs, step, &mut self.route_sent);
         // Every reading the program declared, as named arrays (SUT_PROTOCOL.md), in the
         // order of their names.
         let sent = match p.declared_readings(obs) {
             Ok(sent) => sent,
             Err(e) => return Err(self.fail(e)),
         };
-        let descriptors: Vec<Json> = sent
-            .iter()
-            .map(|b| {
-                let mut d = json!({"name": b.name, "dtype": b.dtype, "shape": b.shape,
-                    "nbytes": b.bytes.len()});
-                if let Some(t) = b.t_s {
-                    d["t_s"] = json!(t);
-                }
-                d
-            })
-            .collect();
+        let descriptors = buffer_descriptors(&sent);
         let payloads: Vec<&[u8]> = sent.iter().map(|b| b.bytes.as_slice()).collect();
         header["buffers"] = Json::Array(descriptors);
         let reply = match p.request(&header, &payloads, timeout) {
             Ok(m) => m,
             Err(e) => return Err(self.fail(e)),
         };
-        let value = |k: &str| -> Result<f64, Broke> {
-            let v = reply
-                .header
-                .get(k)
-                .ok_or_else(|| Broke::Answer(format!("answered {} without `{k}`", reply.header)))?;
-            // JSON has no NaN: clients that write `NaN` send a string or a bare token the
-            // parser rejects; both end here or in the frame reader.
-            let x = v.as_f64().ok_or_else(|| {
-                Broke::Answer(format!("answered {k} = {v}; controls must be numbers"))
-            })?;
-            if !x.is_finite() || !(-1.0..=1.0).contains(&x) {
-                return Err(Broke::Answer(format!(
-                    "answered {k} = {x}, outside [-1, 1]"
-                )));
-            }
-            Ok(x)
-        };
         // An answer that runs behind (a second answer to an earlier observation) or ahead is
         // an error of this test, never a control applied at the wrong step.
-        match reply.header.get("step").map(Json::as_u64) {
-            Some(Some(s)) if s == step => {}
-            Some(Some(s)) => {
-                return Err(self.fail(format!(
-                    "answered step {s} to the observation of step {step}: {} (each \
-                     observation gets exactly one answer, which carries its `step`)",
-                    if s < step {
-                        "an extra or late answer"
-                    } else {
-                        "an answer ahead of its observation"
-                    }
-                )))
-            }
-            Some(None) => {
-                return Err(self.fail(format!(
-                    "answered `step` = {}; it must be the observation's step, a whole number",
-                    reply.header["step"]
-                )))
-            }
-            None => {
-                return Err(self.fail(format!(
-                    "answered {} without `step` (protocol {PROTOCOL_VERSION}: the answer \
-                     carries the observation's step)",
-                    reply.header
-                )))
-            }
+        if let Some(message) = wrong_step(&reply.header, step) {
+            return Err(self.fail(message));
         }
-        match (value("throttle"), value("steering")) {
+        match (
+            control_value(&reply.header, "throttle"),
+            control_value(&reply.header, "steering"),
+        ) {
             (Ok(throttle), Ok(steering)) => Ok(Control { throttle, steering }),
             (Err(e), _) | (_, Err(e)) => Err(self.fail(e)),
         }
     }
+}
+
+/// The header of observation number `step`, without its `buffers`: time (s), the ego's
+/// position (m), heading (rad), speed (m/s) and set speed (m/s) when the scenario asks one,
+/// and the route (m) when it is the first one or differs from `route_sent` (its address and
+/// length), which it then records.
+fn observation_header(obs: &Observation<'_>, step: u64, route_sent: &mut (usize, usize)) -> Json {
+    let mut header = json!({
+        "type": "observation",
+        "step": step,
+        "t_s": obs.t_s,
+        "ego": {
+            "pos_m": obs.ego.pos_m,
+            "heading_rad": obs.ego.heading_rad,
+            "speed_mps": obs.ego.speed_mps,
+        },
+    });
+    // The speed the scenario asks the ego to keep (an OpenSCENARIO `Init` speed), when it
+    // asks one.
+    if let Some(v) = obs.set_speed_mps {
+        header["ego"]["set_speed_mps"] = json!(v);
+    }
+    // The route to follow, in the first observation that has one and when it changes (a
+    // storyboard's lane change or route of the ego).
+    let route = (obs.route.as_ptr() as usize, obs.route.len());
+    if !obs.route.is_empty() && route != *route_sent {
+        header["route_m"] = json!(obs.route);
+        *route_sent = route;
+    }
+    header
+}
+
+/// The `buffers` descriptors of the arrays `sent` (SUT_PROTOCOL.md): name, dtype, shape,
+/// byte count and, where the reading has one, its time (s).
+fn buffer_descriptors(sent: &[Payload]) -> Vec<Json> {
+    sent.iter()
+        .map(|b| {
+            let mut d = json!({"name": b.name, "dtype": b.dtype, "shape": b.shape,
+                "nbytes": b.bytes.len()});
+            if let Some(t) = b.t_s {
+                d["t_s"] = json!(t);
+            }
+            d
+        })
+        .collect()
+}
+
+/// What is wrong with an answer that does not carry the `step` of the observation it
+/// answers (the failure's message); `None` when it carries it.
+fn wrong_step(header: &Json, step: u64) -> Option<String> {
+    match header.get("step").map(Json::as_u64) {
+        Some(Some(s)) if s == step => None,
+        Some(Some(s)) => Some(format!(
+            "answered step {s} to the observation of step {step}: {} (each \
+             observation gets exactly one answer, which carries its `step`)",
+            if s < step {
+                "an extra or late answer"
+            } else {
+                "an answer ahead of its observation"
+            }
+        )),
+        Some(None) => Some(format!(
+            "answered `step` = {}; it must be the observation's step, a whole number",
+            header["step"]
+        )),
+        None => Some(format!(
+            "answered {header} without `step` (protocol {PROTOCOL_VERSION}: the answer \
+             carries the observation's step)"
+        )),
+    }
+}
+
+/// The control `k` of an answer: a finite number in `[-1, 1]`.
+fn control_value(header: &Json, k: &str) -> Result<f64, Broke> {
+    let v = header
+        .get(k)
+        .ok_or_else(|| Broke::Answer(format!("answered {header} without `{k}`")))?;
+    // JSON has no NaN: clients that write `NaN` send a string or a bare token the
+    // parser rejects; both end here or in the frame reader.
+    let x = v
+        .as_f64()
+        .ok_or_else(|| Broke::Answer(format!("answered {k} = {v}; controls must be numbers")))?;
+    if !x.is_finite() || !(-1.0..=1.0).contains(&x) {
+        return Err(Broke::Answer(format!(
+            "answered {k} = {x}, outside [-1, 1]"
+        )));
+    }
+    Ok(x)
 }

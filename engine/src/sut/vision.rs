@@ -113,18 +113,57 @@ impl Vision {
         curvature: f64,
     ) -> Perception {
         let c = &self.config;
+        let diff = |a: [f64; 3], b: [f64; 3]| -> f64 { (0..3).map(|i| (a[i] - b[i]).abs()).sum() };
+        let scan = self.scan_frame(frame, chassis_height_m);
+        let mean = |(s, n): ([f64; 3], usize), fallback: [f64; 3]| {
+            if n == 0 {
+                fallback
+            } else {
+                s.map(|v| v / n as f64)
+            }
+        };
+        let sky = mean(scan.sky, [255.0; 3]);
+        let road = mean(scan.road, [60.0; 3]);
+        let road_luma = road.iter().sum::<f64>() / 3.0;
+
+        let (mut left, mut right) =
+            paint_by_side(scan.markings, road_luma, c.contrast_threshold, curvature);
+        let obstacle_m =
+            nearest_visible_object(scan.candidates, c.min_obstacle_pixels.max(1), |mean| {
+                diff(mean, sky) >= c.contrast_threshold && diff(mean, road) >= c.contrast_threshold
+            });
+        let half_lane = crate::network::LANE_WIDTH_M / 2.0;
+        let lane_centre_m = match (
+            nearest_line(&mut left, false),
+            nearest_line(&mut right, true),
+        ) {
+            (Some(l), Some(r)) => Some((l + r) / 2.0),
+            (Some(l), None) => Some(l + half_lane),
+            (None, Some(r)) => Some(r - half_lane),
+            (None, None) => None,
+        };
+        Perception {
+            obstacle_m,
+            lane_centre_m,
+        }
+    }
+
+    /// One pass over the pixels of `frame`, back-projected with the chassis centre
+    /// `chassis_height_m` (m) above the road: the sky (pixels with no depth), the road sample
+    /// near the bottom centre of the image, the obstacle candidates (in the corridor, high
+    /// enough), and the pixels where a marking may lie, whose brightness is judged once the
+    /// road's level is known.
+    fn scan_frame(&self, frame: &CameraFrame, chassis_height_m: f64) -> FrameScan {
+        let c = &self.config;
         let cam = &c.camera;
         let (w, h) = (frame.width, frame.height);
-        let diff = |a: [f64; 3], b: [f64; 3]| -> f64 { (0..3).map(|i| (a[i] - b[i]).abs()).sum() };
         // Sky: the mean of pixels with no depth; road: the mean of road pixels near the bottom
         // centre of the image.
         let mut sky = ([0.0; 3], 0usize);
         let mut road = ([0.0; 3], 0usize);
         let project = cam.back_projector();
-        // One pass over the pixels: the sky, the road sample, the obstacle candidates (in
-        // the corridor, high enough), and the pixels where a marking may lie, whose brightness
-        // is judged once the road's level is known. (The points of a whole frame, kept for a
-        // second pass, took 0.8 MB allocated afresh every frame.)
+        // (The points of a whole frame, kept for a second pass, took 0.8 MB allocated afresh
+        // every frame.)
         let mut candidates = Vec::new();
         let mut markings: Vec<(f64, f64, f64)> = Vec::new();
         for v in 0..h {
@@ -153,59 +192,11 @@ impl Vision {
                 }
             }
         }
-        let mean = |(s, n): ([f64; 3], usize), fallback: [f64; 3]| {
-            if n == 0 {
-                fallback
-            } else {
-                s.map(|v| v / n as f64)
-            }
-        };
-        let sky = mean(sky, [255.0; 3]);
-        let road = mean(road, [60.0; 3]);
-        let road_luma = road.iter().sum::<f64>() / 3.0;
-
-        let (mut left, mut right) = (Vec::new(), Vec::new());
-        for (x, lateral, luma) in markings {
-            if luma >= road_luma + c.contrast_threshold.max(0.5 * road_luma) {
-                let y = lateral + curvature * x * x / 2.0;
-                if (-3.0..-0.3).contains(&y) {
-                    left.push(y);
-                } else if (0.3..3.0).contains(&y) {
-                    right.push(y);
-                }
-            }
-        }
-        let obstacle_m = nearest_visible_object(candidates, c.min_obstacle_pixels.max(1), |mean| {
-            diff(mean, sky) >= c.contrast_threshold && diff(mean, road) >= c.contrast_threshold
-        });
-        // The nearest line on each side: the median of the markings within 0.6 m of the
-        // innermost one.
-        let nearest = |xs: &mut Vec<f64>, inner_first: bool| -> Option<f64> {
-            if xs.len() < MIN_MARKING_PIXELS {
-                return None;
-            }
-            xs.sort_by(f64::total_cmp);
-            if !inner_first {
-                xs.reverse();
-            }
-            let edge = *xs.first()?;
-            let band: Vec<f64> = xs
-                .iter()
-                .copied()
-                .filter(|x| (x - edge).abs() < 0.6)
-                .collect();
-            Some(band[band.len() / 2])
-        };
-        let half_lane = crate::network::LANE_WIDTH_M / 2.0;
-        let lane_centre_m = match (nearest(&mut left, false), nearest(&mut right, true)) {
-            (Some(l), Some(r)) => Some((l + r) / 2.0),
-            (Some(l), None) => Some(l + half_lane),
-            (None, Some(r)) => Some(r - half_lane),
-            (None, None) => None,
-        };
-        Perception {
-            obstacle_m,
-            lane_centre_m,
+        FrameScan {
+            sky,
+            road,
+            candidates,
+            markings,
         }
     }
 
@@ -258,6 +249,63 @@ fn route_curvature(obs: &Observation<'_>, ahead_m: f64) -> f64 {
     let turn =
         (h1 - h0 + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
     turn / walked
+}
+
+/// What one pass over a frame's pixels gathers ([`Vision::scan_frame`]).
+struct FrameScan {
+    /// Running `(sum, count)` of the sky's colours (pixels with no depth).
+    sky: ([f64; 3], usize),
+    /// Running `(sum, count)` of the colours of the road 3 to 8 m ahead, within 1 m of the
+    /// axis.
+    road: ([f64; 3], usize),
+    /// `(forward distance m, rgb)` of the pixels standing above the road in the corridor.
+    candidates: Vec<(f64, [u8; 3])>,
+    /// `(forward m, lateral m, luma)` of the road pixels 4 to 16 m ahead.
+    markings: Vec<(f64, f64, f64)>,
+}
+
+/// The lateral positions (m, right positive) of the paint among `markings` (`(forward m,
+/// lateral m, luma)`): pixels brighter than the road's luma `road_luma` by `threshold` and
+/// by half the road's level, each read as `y + κx²/2` on a road of curvature `curvature`
+/// (1/m), split into the left (`-3..-0.3` m) and the right (`0.3..3` m) side.
+fn paint_by_side(
+    markings: Vec<(f64, f64, f64)>,
+    road_luma: f64,
+    threshold: f64,
+    curvature: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    for (x, lateral, luma) in markings {
+        if luma >= road_luma + threshold.max(0.5 * road_luma) {
+            let y = lateral + curvature * x * x / 2.0;
+            if (-3.0..-0.3).contains(&y) {
+                left.push(y);
+            } else if (0.3..3.0).contains(&y) {
+                right.push(y);
+            }
+        }
+    }
+    (left, right)
+}
+
+/// The nearest line on one side (m): the median of the markings `xs` within 0.6 m of the
+/// innermost one (the largest when not `inner_first`, the smallest when it is); `None` below
+/// [`MIN_MARKING_PIXELS`]. Sorts `xs`.
+fn nearest_line(xs: &mut [f64], inner_first: bool) -> Option<f64> {
+    if xs.len() < MIN_MARKING_PIXELS {
+        return None;
+    }
+    xs.sort_by(f64::total_cmp);
+    if !inner_first {
+        xs.reverse();
+    }
+    let edge = *xs.first()?;
+    let band: Vec<f64> = xs
+        .iter()
+        .copied()
+        .filter(|x| (x - edge).abs() < 0.6)
+        .collect();
+    Some(band[band.len() / 2])
 }
 
 /// Adds a pixel to a running `(sum, count)` of colours.

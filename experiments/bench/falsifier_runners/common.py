@@ -29,8 +29,7 @@ OBJECTIVES = SCENARIOS + ANALYTIC
 ALKS = "alks-crossing-pedestrian"
 ALKS_FILE = os.path.join(os.path.dirname(__file__), "..", "..", "..", "tests", "data", "xosc", "alks",
                          "alks_scenario_4_2_3_crossing_pedestrian_variation.xosc")
-ALKS_OPTIONS = ("#open=TargetBlocking_InitPosition_LateralOffset_m=-8..-2"
-                ";open=TargetBlocking_Speed_kph=2..10")
+ALKS_OPEN = ["TargetBlocking_InitPosition_LateralOffset_m=-8..-2", "TargetBlocking_Speed_kph=2..10"]
 
 
 def objective(name: str, seed: int):
@@ -40,7 +39,8 @@ def objective(name: str, seed: int):
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            s = paracosm.Scenario(os.path.normpath(ALKS_FILE) + ALKS_OPTIONS if name == ALKS else name)
+            s = (paracosm.Scenario(os.path.normpath(ALKS_FILE), open=ALKS_OPEN) if name == ALKS
+                 else paracosm.Scenario(name))
         return (lambda x: s.robustness(x, on_error="nan")), len(s.space)
     if name == "disc":
         c = np.random.default_rng(1000 + seed).uniform(0.1, 0.9, 2)

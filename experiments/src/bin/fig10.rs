@@ -99,94 +99,106 @@ fn main() -> Result<()> {
         Ok(())
     };
     if cli.parts.contains('a') {
-        let f = figure10::figure10a(cli.budget_a, jobs, &cli.out.join("fig10a"))?;
-        copy(&f.plots[0], "fig10a_follow.png")?;
-        println!(
-            "Figure 10a: {} tests ({} in error), {} collisions; wrote {}",
-            f.tests.len(),
-            f.errors,
-            f.tests.iter().filter(|t| t.collision).count(),
-            f.plots[0].display()
-        );
-        println!("collisions / tests and mean distance covered (m), light (columns) × fog (rows):");
-        println!("| fog \\ light | 0–0.2 | 0.2–0.4 | 0.4–0.6 | 0.6–0.8 | 0.8–1 |");
-        println!("|---|---|---|---|---|---|");
-        for fb in 0..4 {
-            let mut row = format!("| {:.2}–{:.2} |", fb as f64 * 0.25, fb as f64 * 0.25 + 0.25);
-            for lb in 0..5 {
-                let cell: Vec<_> = f
-                    .tests
-                    .iter()
-                    .filter(|t| band(t.fog, 0.25) == fb && band(t.light, 0.2) == lb)
-                    .collect();
-                let hits = cell.iter().filter(|t| t.collision).count();
-                let mean =
-                    cell.iter().map(|t| t.distance_m).sum::<f64>() / cell.len().max(1) as f64;
-                row.push_str(&format!(" {hits}/{}, {mean:.1} m |", cell.len()));
-            }
-            println!("{row}");
-        }
-        // The paper's finding ("the car performs best around the parameter values used
-        // during training"), with 95 % Wilson intervals over three regions.
-        let regions: [(&str, Region); 3] = [
-            ("light 0.4–0.6, fog < 0.25 (around training)", |t| {
-                (0.4..0.6).contains(&t.light) && t.fog < 0.25
-            }),
-            ("light < 0.4 or ≥ 0.6, fog < 0.25", |t| {
-                !(0.4..0.6).contains(&t.light) && t.fog < 0.25
-            }),
-            ("fog ≥ 0.25", |t| t.fog >= 0.25),
-        ];
-        for (name, inside) in regions {
-            let n = f.tests.iter().filter(|t| inside(t)).count() as u64;
-            let k = f.tests.iter().filter(|t| inside(t) && t.collision).count() as u64;
-            let (lo, hi) = paracosm_experiments::wilson95(k, n);
-            println!(
-                "  {name}: {k} of {n} collide ({:.1} %, 95 % interval {:.1}–{:.1} %)",
-                100.0 * k as f64 / n.max(1) as f64,
-                100.0 * lo,
-                100.0 * hi
-            );
-        }
+        figure_a(&cli, jobs, &copy)?;
     }
     if cli.parts.contains('b') {
-        let f = figure10::figure10b(
-            cli.budget_b,
-            jobs,
-            &cli.out.join("fig10b"),
-            cli.loop_onnx.as_deref(),
-        )?;
-        copy(&f.plots[0], "fig10b_loop.png")?;
-        let failed = f
-            .tests
-            .iter()
-            .filter(|t| t.time_to_failure_s.is_some())
-            .count();
-        println!(
-            "Figure 10b: {} tests ({} in error), {failed} left the road within {LOOP_TIMEOUT_S} s; \
-             wrote {}",
-            f.tests.len(),
-            f.errors,
-            f.plots[0].display()
-        );
-        loop_bands(&f.tests);
-        let mut sorted = f.tests.clone();
-        sorted.sort_by(|a, b| a.fog.total_cmp(&b.fog));
-        for t in &sorted {
-            match t.time_to_failure_s {
-                Some(s) => println!(
-                    "  fog {:.3}: left the road at {s:.1} s after {:.0} m",
-                    t.fog, t.distance_m
-                ),
-                None => println!(
-                    "  fog {:.3}: on the road at {LOOP_TIMEOUT_S} s after {:.0} m",
-                    t.fog, t.distance_m
-                ),
-            }
-        }
+        figure_b(&cli, jobs, &copy)?;
     }
     if cli.parts.contains('c') {
         figure_c(&cli, jobs, &copy)?;
+    }
+    Ok(())
+}
+
+/// Figure 10a: collisions and distance covered by light × fog band, then the collision
+/// rates with intervals in three regions.
+fn figure_a(cli: &Cli, jobs: usize, copy: &dyn Fn(&PathBuf, &str) -> Result<()>) -> Result<()> {
+    let f = figure10::figure10a(cli.budget_a, jobs, &cli.out.join("fig10a"))?;
+    copy(&f.plots[0], "fig10a_follow.png")?;
+    println!(
+        "Figure 10a: {} tests ({} in error), {} collisions; wrote {}",
+        f.tests.len(),
+        f.errors,
+        f.tests.iter().filter(|t| t.collision).count(),
+        f.plots[0].display()
+    );
+    println!("collisions / tests and mean distance covered (m), light (columns) × fog (rows):");
+    println!("| fog \\ light | 0–0.2 | 0.2–0.4 | 0.4–0.6 | 0.6–0.8 | 0.8–1 |");
+    println!("|---|---|---|---|---|---|");
+    for fb in 0..4 {
+        let mut row = format!("| {:.2}–{:.2} |", fb as f64 * 0.25, fb as f64 * 0.25 + 0.25);
+        for lb in 0..5 {
+            let cell: Vec<_> = f
+                .tests
+                .iter()
+                .filter(|t| band(t.fog, 0.25) == fb && band(t.light, 0.2) == lb)
+                .collect();
+            let hits = cell.iter().filter(|t| t.collision).count();
+            let mean = cell.iter().map(|t| t.distance_m).sum::<f64>() / cell.len().max(1) as f64;
+            row.push_str(&format!(" {hits}/{}, {mean:.1} m |", cell.len()));
+        }
+        println!("{row}");
+    }
+    // The paper's finding ("the car performs best around the parameter values used
+    // during training"), with 95 % Wilson intervals over three regions.
+    let regions: [(&str, Region); 3] = [
+        ("light 0.4–0.6, fog < 0.25 (around training)", |t| {
+            (0.4..0.6).contains(&t.light) && t.fog < 0.25
+        }),
+        ("light < 0.4 or ≥ 0.6, fog < 0.25", |t| {
+            !(0.4..0.6).contains(&t.light) && t.fog < 0.25
+        }),
+        ("fog ≥ 0.25", |t| t.fog >= 0.25),
+    ];
+    for (name, inside) in regions {
+        let n = f.tests.iter().filter(|t| inside(t)).count() as u64;
+        let k = f.tests.iter().filter(|t| inside(t) && t.collision).count() as u64;
+        let (lo, hi) = paracosm_experiments::wilson95(k, n);
+        println!(
+            "  {name}: {k} of {n} collide ({:.1} %, 95 % interval {:.1}–{:.1} %)",
+            100.0 * k as f64 / n.max(1) as f64,
+            100.0 * lo,
+            100.0 * hi
+        );
+    }
+    Ok(())
+}
+
+/// Figure 10b: the tests by fog band, then each test's fate in order of fog.
+fn figure_b(cli: &Cli, jobs: usize, copy: &dyn Fn(&PathBuf, &str) -> Result<()>) -> Result<()> {
+    let f = figure10::figure10b(
+        cli.budget_b,
+        jobs,
+        &cli.out.join("fig10b"),
+        cli.loop_onnx.as_deref(),
+    )?;
+    copy(&f.plots[0], "fig10b_loop.png")?;
+    let failed = f
+        .tests
+        .iter()
+        .filter(|t| t.time_to_failure_s.is_some())
+        .count();
+    println!(
+        "Figure 10b: {} tests ({} in error), {failed} left the road within {LOOP_TIMEOUT_S} s; \
+         wrote {}",
+        f.tests.len(),
+        f.errors,
+        f.plots[0].display()
+    );
+    loop_bands(&f.tests);
+    let mut sorted = f.tests.clone();
+    sorted.sort_by(|a, b| a.fog.total_cmp(&b.fog));
+    for t in &sorted {
+        match t.time_to_failure_s {
+            Some(s) => println!(
+                "  fog {:.3}: left the road at {s:.1} s after {:.0} m",
+                t.fog, t.distance_m
+            ),
+            None => println!(
+                "  fog {:.3}: on the road at {LOOP_TIMEOUT_S} s after {:.0} m",
+                t.fog, t.distance_m
+            ),
+        }
     }
     Ok(())
 }

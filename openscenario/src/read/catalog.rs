@@ -3,7 +3,8 @@
 //! `.xosc` files) and an entry in it, with `ParameterAssignments` for the entry's own
 //! `ParameterDeclarations`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use roxmltree::Node;
 
@@ -68,8 +69,8 @@ impl Catalogs {
             .iter()
             .filter(|(k, _)| kinds.contains(&k.as_str()))
         {
-            for file in catalog_files(r, reference, dir)? {
-                let text = Text::read(&file)?;
+            for file in catalog_files(r, reference, dir)?.iter() {
+                let text = r.files.text(file)?;
                 let doc = text.parse()?;
                 let Some(cat) = elements(doc.root_element()).find(|c| {
                     c.tag_name().name() == "Catalog"
@@ -120,26 +121,18 @@ fn assignments(
     Ok(out)
 }
 
-/// The `.xosc` files of a catalog folder, sorted.
+/// The `.xosc` files of a catalog folder, sorted (listed once per scenario's file set).
 fn catalog_files(
     r: &Reader<'_>,
     reference: Node<'_, '_>,
-    dir: &PathBuf,
-) -> Result<Vec<PathBuf>, XoscError> {
-    let entries = std::fs::read_dir(dir).map_err(|e| {
+    dir: &Path,
+) -> Result<Arc<[PathBuf]>, XoscError> {
+    let files = r.files.xosc_files(dir).map_err(|e| {
         r.text.invalid(
             reference,
             format!("the catalog folder {} cannot be read: {e}", dir.display()),
         )
     })?;
-    let mut files: Vec<PathBuf> = entries
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| {
-            p.extension()
-                .is_some_and(|x| x.eq_ignore_ascii_case("xosc"))
-        })
-        .collect();
     if files.len() > MAX_CATALOG_FILES {
         return Err(r.text.invalid(
             reference,
@@ -149,6 +142,5 @@ fn catalog_files(
             ),
         ));
     }
-    files.sort();
     Ok(files)
 }

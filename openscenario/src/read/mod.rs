@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use roxmltree::Node;
 
 use crate::error::XoscError;
+use crate::files::FileSet;
 use crate::model::{Note, Scenario};
 use crate::params::{read_declarations, Scope};
 use crate::text::Text;
@@ -23,6 +24,8 @@ pub use catalog::Catalogs;
 /// The state of reading one scenario file: its text, its parameters, its entities' names.
 pub(crate) struct Reader<'t> {
     pub(crate) text: &'t Text,
+    /// The scenario's files: its catalogs are read through it.
+    pub(crate) files: &'t FileSet,
     pub(crate) scope: Scope,
     pub(crate) names: Vec<String>,
     pub(crate) notes: std::rc::Rc<std::cell::RefCell<Vec<Note>>>,
@@ -58,6 +61,7 @@ impl Reader<'_> {
         };
         Ok(Reader {
             text: self.text,
+            files: self.files,
             scope,
             names: self.names.clone(),
             notes: self.notes.clone(),
@@ -82,9 +86,23 @@ impl Reader<'_> {
 /// well-formed, is not a scenario, declares or uses parameters wrongly, references missing
 /// catalogs or entities, or holds an element paracosm does not support.
 pub fn read_scenario(path: &Path, overrides: &[(String, String)]) -> Result<Scenario, XoscError> {
-    let text = Text::read(path)?;
+    read_scenario_in(&FileSet::new(), path, overrides)
+}
+
+/// As [`read_scenario`], reading the file and its catalogs through `files`: each is read from
+/// disk the first time and from `files` after, so the tests of a campaign read the texts its
+/// load read.
+///
+/// # Errors
+/// As [`read_scenario`].
+pub fn read_scenario_in(
+    files: &FileSet,
+    path: &Path,
+    overrides: &[(String, String)],
+) -> Result<Scenario, XoscError> {
+    let text = files.text(path)?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    read_scenario_text(&text, &dir, overrides)
+    read_with(files, &text, &dir, overrides)
 }
 
 /// `base` joined with `rel`, without `.` components (paths in messages read as written).
@@ -101,6 +119,16 @@ pub(crate) fn join(base: &Path, rel: &str) -> PathBuf {
 /// # Errors
 /// As [`read_scenario`].
 pub fn read_scenario_text(
+    text: &Text,
+    dir: &Path,
+    overrides: &[(String, String)],
+) -> Result<Scenario, XoscError> {
+    read_with(&FileSet::new(), text, dir, overrides)
+}
+
+/// [`read_scenario_text`] with the catalogs read through `files`.
+fn read_with(
+    files: &FileSet,
     text: &Text,
     dir: &Path,
     overrides: &[(String, String)],
@@ -143,6 +171,7 @@ pub fn read_scenario_text(
         .collect();
     let mut r = Reader {
         text,
+        files,
         scope,
         names: Vec::new(),
         notes: Default::default(),

@@ -23,63 +23,9 @@ const POSITIONS: &[&str] = &[
 pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscError> {
     let (p, tag) = choice(r.text, node, POSITIONS)?;
     let (s, t) = (&r.scope, r.text);
-    let lane_id = |attr: &str| -> Result<i32, XoscError> {
-        let v = s.num(t, p, attr)?;
-        if v.fract() != 0.0 || v.abs() > 1000.0 {
-            return Err(XoscError::Invalid {
-                pos: t.attr_pos(p, attr),
-                reason: format!("a lane id is a whole number, not {v}"),
-            });
-        }
-        Ok(v as i32)
-    };
     Ok(match tag {
-        "WorldPosition" => {
-            for a in ["z", "p", "r"] {
-                if s.opt_num(t, p, a)?.is_some_and(|v| v != 0.0) {
-                    r.note(
-                        p,
-                        format!(
-                            "a world position's {a} is not honoured: paracosm's roads are flat"
-                        ),
-                    );
-                }
-            }
-            Position::World {
-                x: s.num(t, p, "x")?,
-                y: s.num(t, p, "y")?,
-                h: s.opt_num(t, p, "h")?,
-            }
-        }
-        "RelativeWorldPosition" | "RelativeObjectPosition" => {
-            if s.opt_num(t, p, "dz")?.is_some_and(|v| v != 0.0) {
-                r.note(
-                    p,
-                    "a relative position's dz is not honoured: paracosm's roads are flat",
-                );
-            }
-            let (entity, dx, dy) = (
-                r.entity(p, "entityRef")?,
-                s.num(t, p, "dx")?,
-                s.num(t, p, "dy")?,
-            );
-            let orientation = orientation(r, p)?;
-            if tag == "RelativeWorldPosition" {
-                Position::RelativeWorld {
-                    entity,
-                    dx,
-                    dy,
-                    orientation,
-                }
-            } else {
-                Position::RelativeObject {
-                    entity,
-                    dx,
-                    dy,
-                    orientation,
-                }
-            }
-        }
+        "WorldPosition" => world(r, p)?,
+        "RelativeWorldPosition" | "RelativeObjectPosition" => relative(r, p, tag)?,
         "RoadPosition" => Position::Road {
             road: s.string(t, p, "roadId")?,
             s: s.num(t, p, "s")?,
@@ -94,32 +40,103 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscE
         },
         "LanePosition" => Position::Lane {
             road: s.string(t, p, "roadId")?,
-            lane: lane_id("laneId")?,
+            lane: lane_id(r, p, "laneId")?,
             s: s.num(t, p, "s")?,
             offset: s.opt_num(t, p, "offset")?.unwrap_or(0.0),
             orientation: orientation(r, p)?,
         },
-        _ => {
-            if child(p, "Orientation").is_some() {
-                return Err(r.text.unsupported(
-                    p,
-                    "an orientation on a relative lane position is not supported",
-                ));
-            }
-            let ds = s.opt_num(t, p, "ds")?;
-            if ds.is_none() || p.attribute("dsLane").is_some() {
-                return Err(r.text.unsupported(
-                    p,
-                    "a relative lane position needs ds (dsLane is not supported)",
-                ));
-            }
-            Position::RelativeLane {
-                entity: r.entity(p, "entityRef")?,
-                d_lane: lane_id("dLane")?,
-                ds: ds.unwrap_or(0.0),
-                offset: s.opt_num(t, p, "offset")?.unwrap_or(0.0),
-            }
+        _ => relative_lane(r, p)?,
+    })
+}
+
+/// Attribute `attr` of `p` read as a lane id: a whole number of at most 1000 in size.
+fn lane_id(r: &Reader<'_>, p: Node<'_, '_>, attr: &str) -> Result<i32, XoscError> {
+    let (s, t) = (&r.scope, r.text);
+    let v = s.num(t, p, attr)?;
+    if v.fract() != 0.0 || v.abs() > 1000.0 {
+        return Err(XoscError::Invalid {
+            pos: t.attr_pos(p, attr),
+            reason: format!("a lane id is a whole number, not {v}"),
+        });
+    }
+    Ok(v as i32)
+}
+
+/// A `<WorldPosition>`: `x`, `y` (m) and heading `h` (rad); a `z`, pitch or roll other than
+/// 0 is noted as not honoured.
+fn world(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
+    let (s, t) = (&r.scope, r.text);
+    for a in ["z", "p", "r"] {
+        if s.opt_num(t, p, a)?.is_some_and(|v| v != 0.0) {
+            r.note(
+                p,
+                format!("a world position's {a} is not honoured: paracosm's roads are flat"),
+            );
         }
+    }
+    Ok(Position::World {
+        x: s.num(t, p, "x")?,
+        y: s.num(t, p, "y")?,
+        h: s.opt_num(t, p, "h")?,
+    })
+}
+
+/// A `<RelativeWorldPosition>` or `<RelativeObjectPosition>` (as `tag` says): the entity and
+/// the offsets `dx`, `dy` (m) from it, with its orientation; a `dz` other than 0 is noted as
+/// not honoured.
+fn relative(r: &Reader<'_>, p: Node<'_, '_>, tag: &str) -> Result<Position, XoscError> {
+    let (s, t) = (&r.scope, r.text);
+    if s.opt_num(t, p, "dz")?.is_some_and(|v| v != 0.0) {
+        r.note(
+            p,
+            "a relative position's dz is not honoured: paracosm's roads are flat",
+        );
+    }
+    let (entity, dx, dy) = (
+        r.entity(p, "entityRef")?,
+        s.num(t, p, "dx")?,
+        s.num(t, p, "dy")?,
+    );
+    let orientation = orientation(r, p)?;
+    Ok(if tag == "RelativeWorldPosition" {
+        Position::RelativeWorld {
+            entity,
+            dx,
+            dy,
+            orientation,
+        }
+    } else {
+        Position::RelativeObject {
+            entity,
+            dx,
+            dy,
+            orientation,
+        }
+    })
+}
+
+/// A `<RelativeLanePosition>`: the entity, the lanes `dLane` across, `ds` along (m) and the
+/// lateral `offset` (m); an orientation or a `dsLane` is refused.
+fn relative_lane(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
+    let (s, t) = (&r.scope, r.text);
+    if child(p, "Orientation").is_some() {
+        return Err(r.text.unsupported(
+            p,
+            "an orientation on a relative lane position is not supported",
+        ));
+    }
+    let ds = s.opt_num(t, p, "ds")?;
+    if ds.is_none() || p.attribute("dsLane").is_some() {
+        return Err(r.text.unsupported(
+            p,
+            "a relative lane position needs ds (dsLane is not supported)",
+        ));
+    }
+    Ok(Position::RelativeLane {
+        entity: r.entity(p, "entityRef")?,
+        d_lane: lane_id(r, p, "dLane")?,
+        ds: ds.unwrap_or(0.0),
+        offset: s.opt_num(t, p, "offset")?.unwrap_or(0.0),
     })
 }
 

@@ -94,11 +94,14 @@ struct Loaded {
     sha256: String,
 }
 
-/// The maps a program has read, by the path it wrote.
+/// The maps a program has read, by the path it wrote, and the OpenSCENARIO files it or its
+/// scenario has read (`Import`, an OpenSCENARIO campaign): each read once, for every test.
 #[derive(Debug)]
 pub(crate) struct MapFiles {
     base: Base,
     loaded: Mutex<BTreeMap<String, Loaded>>,
+    /// The OpenSCENARIO files read: a scenario, its catalogs, a variation file.
+    pub(crate) xosc: std::sync::Arc<paracosm_openscenario::FileSet>,
 }
 
 fn sha256_hex(bytes: &[u8]) -> String {
@@ -110,9 +113,19 @@ fn sha256_hex(bytes: &[u8]) -> String {
 
 impl MapFiles {
     pub(crate) fn new(base: Base) -> MapFiles {
+        Self::sharing(base, Default::default())
+    }
+
+    /// As [`MapFiles::new`], with the OpenSCENARIO files `xosc` already read (an OpenSCENARIO
+    /// campaign's load reads its variation file and scenario before its maps).
+    pub(crate) fn sharing(
+        base: Base,
+        xosc: std::sync::Arc<paracosm_openscenario::FileSet>,
+    ) -> MapFiles {
         MapFiles {
             base,
             loaded: Mutex::new(BTreeMap::new()),
+            xosc,
         }
     }
 
@@ -179,9 +192,12 @@ impl MapFiles {
         }
     }
 
-    /// Every file read so far, in order of path, with its SHA-256.
+    /// Every file read so far with its SHA-256: the maps in order of path, then the
+    /// OpenSCENARIO files in order of path (hashed as read: UTF-8 text without a byte-order
+    /// mark).
     pub(crate) fn inputs(&self) -> Vec<InputFile> {
-        self.loaded
+        let mut out: Vec<InputFile> = self
+            .loaded
             .lock()
             .map(|l| {
                 l.iter()
@@ -191,7 +207,12 @@ impl MapFiles {
                     })
                     .collect()
             })
-            .unwrap_or_default()
+            .unwrap_or_default();
+        out.extend(self.xosc.texts().into_iter().map(|(path, text)| InputFile {
+            path: path.display().to_string(),
+            sha256: sha256_hex(text.text.as_bytes()),
+        }));
+        out
     }
 
     /// What the maps read so far do not use: `(file, message)`.

@@ -404,6 +404,45 @@ impl Walker<'_> {
     /// Argument number `position` of the call `c`.
     fn argument(&mut self, c: &Call<'_>, position: usize, a: &AstArgument) {
         let value = a.node.expr();
+        self.named_argument(c, a);
+        // An item of a tuple or list argument: `o = Obstacle(size = (VarInterval(
+        // ...), 1, 1))` is `o.size[0]`, `route = [VarEnum(...)]` of `v` is
+        // `v.route[0]`.
+        if let (ArgumentP::Named(kw, _), ExprP::Tuple(items) | ExprP::List(items)) =
+            (&a.node, &value.node)
+        {
+            self.item_arguments(c, &kw.node, items);
+        }
+        if let (ArgumentP::Named(..), ExprP::Dict(items)) = (&a.node, &value.node) {
+            self.dict_items(items);
+        }
+        // A positional argument of a method: `lead.brake(VarEnum(...))` is
+        // `lead.brake`; with several, `r.onLane(VarEnum(...), VarInterval(...))`
+        // gives `r.onLane[0]` and `r.onLane[1]`.
+        if let (ArgumentP::Positional(_), true, ExprP::Dot(obj, method)) =
+            (&a.node, is_declarer(value), &c.f.node)
+        {
+            if let ExprP::Identifier(o) = &obj.node {
+                let n = if c.open_positional + c.open_named > 1 {
+                    format!("{}.{}[{position}]", o.node.ident, method.node)
+                } else {
+                    format!("{}.{}", o.node.ident, method.node)
+                };
+                // The input it feeds, for its unit: `onLane(lane, at)`'s `at`.
+                let argument_of = positional_keyword(&method.node, position)
+                    .map(|k| (method.node.to_string(), k.to_owned()));
+                self.site(value, Some(n), None, argument_of);
+            }
+        }
+        self.argument_value(c, position, a);
+    }
+
+    /// A keyword argument `a` of the call `c` that is an open parameter: named after the
+    /// object and method (`r.onLane(at = VarInterval(...))` is `r.onLane`, or
+    /// `r.onLane[i]` among several), else after the variable assigned the call or the
+    /// callee, and the keyword (`w.fog`, `World.fog`).
+    fn named_argument(&mut self, c: &Call<'_>, a: &AstArgument) {
+        let value = a.node.expr();
         let signature_position = match (&a.node, &c.method_of) {
             (ArgumentP::Named(kw, _), Some((_, m))) => method_position(m, &kw.node, &c.keywords),
             _ => None,
@@ -435,55 +474,37 @@ impl Walker<'_> {
                 .map(|b| (b, kw.node.clone()));
             self.site(value, n, None, argument_of);
         }
-        // An item of a tuple or list argument: `o = Obstacle(size = (VarInterval(
-        // ...), 1, 1))` is `o.size[0]`, `route = [VarEnum(...)]` of `v` is
-        // `v.route[0]`.
-        if let (ArgumentP::Named(kw, _), ExprP::Tuple(items) | ExprP::List(items)) =
-            (&a.node, &value.node)
-        {
-            let owner = c.target.map(str::to_owned).or_else(|| c.name.clone());
-            for (i, x) in items.iter().enumerate() {
-                // A variable as an item (`size = (sz, 1, 1)`): passed whole to
-                // that item's input, for its unit.
-                if let (ExprP::Identifier(id), true, Some(b)) = (&x.node, c.builtin, &c.name) {
-                    self.out.passed.push((
-                        b.clone(),
-                        format!("{}[{i}]", kw.node),
-                        id.node.ident.clone(),
-                    ));
-                }
-                if is_declarer(x) {
-                    let n = owner.as_ref().map(|o| format!("{o}.{}[{i}]", kw.node));
-                    let argument_of = c
-                        .name
-                        .clone()
-                        .filter(|_| c.builtin)
-                        .map(|b| (b, format!("{}[{i}]", kw.node)));
-                    self.site(x, n, None, argument_of);
-                }
+    }
+
+    /// The items of a tuple or list given to keyword `kw` of the call `c`: a variable passed
+    /// whole to a builtin's item, and an open parameter named `<owner>.<kw>[i]`.
+    fn item_arguments(&mut self, c: &Call<'_>, kw: &str, items: &[AstExpr]) {
+        let owner = c.target.map(str::to_owned).or_else(|| c.name.clone());
+        for (i, x) in items.iter().enumerate() {
+            // A variable as an item (`size = (sz, 1, 1)`): passed whole to
+            // that item's input, for its unit.
+            if let (ExprP::Identifier(id), true, Some(b)) = (&x.node, c.builtin, &c.name) {
+                self.out
+                    .passed
+                    .push((b.clone(), format!("{kw}[{i}]"), id.node.ident.clone()));
+            }
+            if is_declarer(x) {
+                let n = owner.as_ref().map(|o| format!("{o}.{kw}[{i}]"));
+                let argument_of = c
+                    .name
+                    .clone()
+                    .filter(|_| c.builtin)
+                    .map(|b| (b, format!("{kw}[{i}]")));
+                self.site(x, n, None, argument_of);
             }
         }
-        if let (ArgumentP::Named(..), ExprP::Dict(items)) = (&a.node, &value.node) {
-            self.dict_items(items);
-        }
-        // A positional argument of a method: `lead.brake(VarEnum(...))` is
-        // `lead.brake`; with several, `r.onLane(VarEnum(...), VarInterval(...))`
-        // gives `r.onLane[0]` and `r.onLane[1]`.
-        if let (ArgumentP::Positional(_), true, ExprP::Dot(obj, method)) =
-            (&a.node, is_declarer(value), &c.f.node)
-        {
-            if let ExprP::Identifier(o) = &obj.node {
-                let n = if c.open_positional + c.open_named > 1 {
-                    format!("{}.{}[{position}]", o.node.ident, method.node)
-                } else {
-                    format!("{}.{}", o.node.ident, method.node)
-                };
-                // The input it feeds, for its unit: `onLane(lane, at)`'s `at`.
-                let argument_of = positional_keyword(&method.node, position)
-                    .map(|k| (method.node.to_string(), k.to_owned()));
-                self.site(value, Some(n), None, argument_of);
-            }
-        }
+    }
+
+    /// What argument number `position` of the call `c` passes: a variable passed whole to a
+    /// builtin (under the keyword of the input it feeds), the variables a sum adds whole, and
+    /// the walk of any other expression.
+    fn argument_value(&mut self, c: &Call<'_>, position: usize, a: &AstArgument) {
+        let value = a.node.expr();
         // The keyword of the input the argument feeds: its own, or a method's
         // by position (`r.onLane(1, x)`'s `at`).
         let keyword = match (&a.node, &c.method_of) {

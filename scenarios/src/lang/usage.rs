@@ -165,24 +165,7 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
             out.push(Change::Other);
         }
     };
-    // Road pieces: a friction, or geometry.
-    let (pa, pb) = (a.network.pieces(), b.network.pieces());
-    if pa.len() != pb.len() || differ(&a.network.links(), &b.network.links()) {
-        out.push(Change::Other);
-    } else {
-        for (i, (x, y)) in pa.iter().zip(pb).enumerate() {
-            if x == y {
-                continue;
-            }
-            let mut y2 = y.clone();
-            y2.kind = y.kind.with_friction(x.kind.friction());
-            if *x == y2 {
-                friction(PieceId(i), &mut out);
-            } else {
-                out.push(Change::Other);
-            }
-        }
-    }
+    piece_changes(a, b, &mut friction, &mut out);
     other(differ(&a.ego, &b.ego), &mut out);
     other(differ(&a.pedestrians, &b.pedestrians), &mut out);
     recoloured(
@@ -198,6 +181,43 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
     );
     other(differ(&a.sensors, &b.sensors), &mut out);
     other(differ(&a.frictions, &b.frictions), &mut out);
+    car_changes(a, b, &mut out);
+    stream_changes(a, b, &mut friction, &mut out);
+    out
+}
+
+/// What differs between the road pieces of `a` and `b`, pushed on `out`: a piece's friction
+/// alone goes to `friction`; any other difference (geometry, links, another count) is
+/// [`Change::Other`].
+fn piece_changes(
+    a: &WorldSpec,
+    b: &WorldSpec,
+    friction: &mut impl FnMut(PieceId, &mut Vec<Change>),
+    out: &mut Vec<Change>,
+) {
+    // Road pieces: a friction, or geometry.
+    let (pa, pb) = (a.network.pieces(), b.network.pieces());
+    if pa.len() != pb.len() || differ(&a.network.links(), &b.network.links()) {
+        out.push(Change::Other);
+    } else {
+        for (i, (x, y)) in pa.iter().zip(pb).enumerate() {
+            if x == y {
+                continue;
+            }
+            let mut y2 = y.clone();
+            y2.kind = y.kind.with_friction(x.kind.friction());
+            if *x == y2 {
+                friction(PieceId(i), out);
+            } else {
+                out.push(Change::Other);
+            }
+        }
+    }
+}
+
+/// What differs between the cars of `a` and `b`, pushed on `out`: a car's colour, or
+/// [`Change::Other`]; a car disabled in both worlds counts as unchanged.
+fn car_changes(a: &WorldSpec, b: &WorldSpec, out: &mut Vec<Change>) {
     // A car disabled in both worlds is not in either test (nothing collides with it or sees
     // it): what else differs about it changes nothing.
     if a.cars.len() == b.cars.len() && a.cars.iter().any(|c| !c.enabled) {
@@ -207,10 +227,20 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
                 *y = x.clone();
             }
         }
-        recoloured(&a.cars, &cars_b, |c| &mut c.color, Change::Colour, &mut out);
+        recoloured(&a.cars, &cars_b, |c| &mut c.color, Change::Colour, out);
     } else {
-        recoloured(&a.cars, &b.cars, |c| &mut c.color, Change::Colour, &mut out);
+        recoloured(&a.cars, &b.cars, |c| &mut c.color, Change::Colour, out);
     }
+}
+
+/// What differs between the streams of `a` and `b`, pushed on `out`: the light, a piece's
+/// friction (to `friction`), or [`Change::Other`] for a stream something reads.
+fn stream_changes(
+    a: &WorldSpec,
+    b: &WorldSpec,
+    friction: &mut impl FnMut(PieceId, &mut Vec<Change>),
+    out: &mut Vec<Change>,
+) {
     // Streams: the light, a piece's friction, or anything else.
     let (na, nb) = (a.streams.nodes(), b.streams.nodes());
     if na.len() != nb.len() {
@@ -240,13 +270,12 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
             } else if i == a.environment.light.0 {
                 out.push(Change::Light);
             } else if let Some(p) = piece {
-                friction(p, &mut out);
+                friction(p, out);
             }
             // Any other stream is read by nothing: a constant friction, which the network
             // carries and the comparison of the pieces has seen.
         }
     }
-    out
 }
 
 /// What [`analyse`] needs.

@@ -1,8 +1,9 @@
 //! OpenSCENARIO front end: a scenario file read by `paracosm-openscenario` becomes a
-//! [`Scenario`] whose tests each re-read the file with the test's parameter values and build
-//! a [`Scene`]: the map of its `RoadNetwork`, the ego vehicle (driven by the system under
-//! test) and every other entity as a scripted car or pedestrian, whose motion the storyboard
-//! runtime ([`story`]) computes step by step and hands to the engine as place actions.
+//! [`Scenario`] whose tests each read the file's text (kept from the load) with the test's
+//! parameter values and build a [`Scene`]: the map of its `RoadNetwork`, the ego vehicle
+//! (driven by the system under test) and every other entity as a scripted car or pedestrian,
+//! whose motion the storyboard runtime ([`story`]) computes step by step and hands to the
+//! engine as place actions.
 //!
 //! Published signals (for `Stl` and `Monitor`): [`HEADWAY_SIGNAL`], [`GAP_SIGNAL`] and
 //! [`LANE_EDGE_SIGNAL`], the R157-style measures of the ego.
@@ -21,7 +22,7 @@ use paracosm_engine::sut::{AebConfig, SutConfig};
 use paracosm_engine::{CarSpec, EgoSpec, PedestrianSpec, Size, VehicleParams, DEFAULT_DT_S};
 use paracosm_generators::{Assignment, ParamSpace};
 use paracosm_openscenario::model::{self as m, Action, EntityKind};
-use paracosm_openscenario::read_scenario;
+use paracosm_openscenario::read_scenario_in;
 
 use crate::lang::map_files::{Base, MapFiles};
 use crate::scenario::{Warning, Worlds};
@@ -59,8 +60,13 @@ pub struct OverrideError(pub String);
 
 /// What a campaign over an OpenSCENARIO scenario needs.
 pub struct Source {
-    /// The scenario file (`Storyboard`), read again for every test.
+    /// The scenario file (`Storyboard`), read again for every test with its values, through
+    /// [`Source::files`].
     pub template: PathBuf,
+    /// The OpenSCENARIO files the campaign's load has read (the variation file, the
+    /// scenario): the scenario's catalogs join them at load, and every test reads these
+    /// texts, not the disk.
+    pub files: Arc<paracosm_openscenario::FileSet>,
     /// The campaign's name for it (the file given on the command line).
     pub name: String,
     /// The space of the test's parameters.
@@ -315,7 +321,7 @@ fn performed_otherwise(
 /// declared values, its map does not load, the scene cannot be built, or it holds an action
 /// paracosm does not perform ([`check`]).
 pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
-    let model = read_scenario(&source.template, &[]).map_err(xosc_error)?;
+    let model = read_scenario_in(&source.files, &source.template, &[]).map_err(xosc_error)?;
     let ego = ego_of(&model, source.ego.as_deref(), source.scripted_ego)?;
     let mut warnings = check(&model, (!source.scripted_ego).then_some(ego))?;
     let horizon_s = horizon(&model, source.horizon_s)?;
@@ -324,7 +330,7 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
     let worlds = XoscWorlds {
         template: source.template.clone(),
         overrides: source.overrides,
-        maps: MapFiles::new(Base::Folder(dir)),
+        maps: MapFiles::sharing(Base::Folder(dir), source.files.clone()),
         scripted_ego: source.scripted_ego,
         ego: source.ego.clone(),
         horizon_s,
@@ -369,11 +375,12 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
             format!("{}, {l} × {w} × {h} m", e.name)
         }),
         source: Arc::from(
-            crate::text_file::read_text(
-                &source.template,
-                paracosm_openscenario::text::MAX_FILE_BYTES,
-            )
-            .unwrap_or_default(),
+            source
+                .files
+                .text(&source.template)
+                .map_err(xosc_error)?
+                .text
+                .as_str(),
         ),
         input_files,
         worlds: Arc::new(worlds),
@@ -423,7 +430,8 @@ impl Worlds for XoscWorlds {
         run: &mut dyn FnMut(&Scene, &mut dyn Host),
     ) -> Result<(), ScenarioError> {
         let overrides = (self.overrides)(assignment).map_err(|e| worlds_error(e.0))?;
-        let model = read_scenario(&self.template, &overrides).map_err(xosc_error)?;
+        let model =
+            read_scenario_in(&self.maps.xosc, &self.template, &overrides).map_err(xosc_error)?;
         let (scene, mut host) = self.build(&model)?;
         run(&scene, &mut host);
         Ok(())

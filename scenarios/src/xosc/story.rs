@@ -297,6 +297,29 @@ impl Storyboard {
         roads: Roads,
         ego: Option<usize>,
     ) -> Result<Self, StoryError> {
+        let mut sb = Storyboard::unbuilt(scenario, roads, ego);
+        sb.stop = scenario
+            .stop
+            .as_ref()
+            .filter(|t| !t.0.is_empty())
+            .map(|t| sb.add_trigger(t, Owner::Storyboard));
+        for story in &scenario.stories {
+            let s = sb.push(Kind::Story, &story.name, 1);
+            sb.roots.push(s);
+            for act in &story.acts {
+                sb.add_act(s, act)?;
+            }
+        }
+        sb.trigger_now = vec![false; sb.triggers.len()];
+        sb.perform_init(scenario)?;
+        // Init's transitions run from the start.
+        Ok(sb)
+    }
+
+    /// The storyboard of `scenario` on `roads` before its stories are read and its `Init`
+    /// performed: every entity at the origin (0 m, 0 m, heading 0 rad), standing, on no
+    /// lane; every entity scripted but `ego`.
+    fn unbuilt(scenario: &m::Scenario, roads: Roads, ego: Option<usize>) -> Self {
         let actors = scenario
             .entities
             .iter()
@@ -316,7 +339,7 @@ impl Storyboard {
                 ),
             })
             .collect();
-        let mut sb = Storyboard {
+        Storyboard {
             roads,
             drives: vec![Drive::default(); scenario.entities.len()],
             actors,
@@ -336,73 +359,86 @@ impl Storyboard {
             set_speed: None,
             hand_over: None,
             route: None,
-        };
-        sb.stop = scenario
+        }
+    }
+
+    /// Adds `act` under story element `s`: the act, its triggers, and its maneuver groups
+    /// with their maneuvers, events and actions.
+    ///
+    /// # Errors
+    /// [`StoryError`] for an action naming a road or lane the map lacks
+    /// ([`Storyboard::check_references`]).
+    fn add_act(&mut self, s: usize, act: &m::Act) -> Result<(), StoryError> {
+        let a = self.push(Kind::Act, &act.name, 1);
+        self.elems[s].children.push(a);
+        // An empty trigger (`<StartTrigger/>`) is no trigger: the act starts with
+        // its story (esmini's reading); an empty stop trigger never fires.
+        self.elems[a].start = act
+            .start
+            .as_ref()
+            .filter(|t| !t.0.is_empty())
+            .map(|t| self.add_trigger(t, Owner::ActStart(a)));
+        self.elems[a].stop = act
             .stop
             .as_ref()
             .filter(|t| !t.0.is_empty())
-            .map(|t| sb.add_trigger(t, Owner::Storyboard));
-        for story in &scenario.stories {
-            let s = sb.push(Kind::Story, &story.name, 1);
-            sb.roots.push(s);
-            for act in &story.acts {
-                let a = sb.push(Kind::Act, &act.name, 1);
-                sb.elems[s].children.push(a);
-                // An empty trigger (`<StartTrigger/>`) is no trigger: the act starts with
-                // its story (esmini's reading); an empty stop trigger never fires.
-                sb.elems[a].start = act
-                    .start
-                    .as_ref()
-                    .filter(|t| !t.0.is_empty())
-                    .map(|t| sb.add_trigger(t, Owner::ActStart(a)));
-                sb.elems[a].stop = act
-                    .stop
-                    .as_ref()
-                    .filter(|t| !t.0.is_empty())
-                    .map(|t| sb.add_trigger(t, Owner::ActStop(a)));
-                for g in &act.groups {
-                    let gi = sb.push(Kind::Group, &g.name, g.max_count);
-                    sb.elems[a].children.push(gi);
-                    for man in &g.maneuvers {
-                        let mi = sb.push(Kind::Maneuver, &man.name, 1);
-                        sb.elems[gi].children.push(mi);
-                        for ev in &man.events {
-                            let ei = sb.push(Kind::Event, &ev.name, ev.max_count);
-                            sb.elems[mi].children.push(ei);
-                            sb.elems[ei].priority = ev.priority;
-                            sb.elems[ei].start =
-                                ev.start.as_ref().filter(|t| !t.0.is_empty()).map(|t| {
-                                    sb.add_trigger(
-                                        t,
-                                        Owner::EventStart {
-                                            event: ei,
-                                            maneuver: mi,
-                                        },
-                                    )
-                                });
-                            for na in &ev.actions {
-                                sb.check_references(na)?;
-                                let ai = sb.push(Kind::Action, &na.name, 1);
-                                sb.elems[ei].children.push(ai);
-                                sb.elems[ai].action = Some((na.clone(), g.actors.clone()));
-                            }
-                        }
-                    }
+            .map(|t| self.add_trigger(t, Owner::ActStop(a)));
+        for g in &act.groups {
+            let gi = self.push(Kind::Group, &g.name, g.max_count);
+            self.elems[a].children.push(gi);
+            for man in &g.maneuvers {
+                let mi = self.push(Kind::Maneuver, &man.name, 1);
+                self.elems[gi].children.push(mi);
+                for ev in &man.events {
+                    self.add_event(mi, ev, &g.actors)?;
                 }
             }
         }
-        sb.trigger_now = vec![false; sb.triggers.len()];
-        // Init: positions first, in the file's order, then the rest (a relative position may
-        // name an entity placed later in the file).
+        Ok(())
+    }
+
+    /// Adds event `ev` under maneuver element `mi`: the event, its start trigger, and its
+    /// actions, each acting on `actors` (its maneuver group's).
+    ///
+    /// # Errors
+    /// [`StoryError`] for an action naming a road or lane the map lacks
+    /// ([`Storyboard::check_references`]).
+    fn add_event(&mut self, mi: usize, ev: &m::Event, actors: &[usize]) -> Result<(), StoryError> {
+        let ei = self.push(Kind::Event, &ev.name, ev.max_count);
+        self.elems[mi].children.push(ei);
+        self.elems[ei].priority = ev.priority;
+        self.elems[ei].start = ev.start.as_ref().filter(|t| !t.0.is_empty()).map(|t| {
+            self.add_trigger(
+                t,
+                Owner::EventStart {
+                    event: ei,
+                    maneuver: mi,
+                },
+            )
+        });
+        for na in &ev.actions {
+            self.check_references(na)?;
+            let ai = self.push(Kind::Action, &na.name, 1);
+            self.elems[ei].children.push(ai);
+            self.elems[ai].action = Some((na.clone(), actors.to_vec()));
+        }
+        Ok(())
+    }
+
+    /// Performs `scenario`'s `Init`: positions first, in the file's order, then the rest (a
+    /// relative position may name an entity placed later in the file).
+    ///
+    /// # Errors
+    /// [`StoryError`] for an `Init` action that cannot be performed.
+    fn perform_init(&mut self, scenario: &m::Scenario) -> Result<(), StoryError> {
         let (places, rest): (Vec<_>, Vec<_>) = scenario
             .init
             .iter()
             .partition(|(_, a)| matches!(a.action, Action::Teleport(_)));
         for (e, a) in places.into_iter().chain(rest) {
-            sb.start_task(*e, a, None, 0.0)?;
+            self.start_task(*e, a, None, 0.0)?;
         }
-        // Init's transitions run from the start.
-        Ok(sb)
+        Ok(())
     }
 
     /// Checks the roads and lanes that `na` names where they do not depend on where an
@@ -947,32 +983,13 @@ impl Storyboard {
                 dx,
                 dy,
                 orientation,
-            } => {
-                let r = self.actors[*entity].state.pose;
-                let (x, y) = (r.x + dx, r.y + dy);
-                let pose = Pose {
-                    x,
-                    y,
-                    h: orient(orientation, r.h),
-                };
-                (pose, self.facing(self.roads.anchor(x, y), pose.h))
-            }
+            } => self.world_offset(*entity, *dx, *dy, orientation),
             Position::RelativeObject {
                 entity,
                 dx,
                 dy,
                 orientation,
-            } => {
-                let r = self.actors[*entity].state.pose;
-                let (c, s) = (r.h.cos(), r.h.sin());
-                let (x, y) = (r.x + c * dx - s * dy, r.y + s * dx + c * dy);
-                let pose = Pose {
-                    x,
-                    y,
-                    h: orient(orientation, r.h),
-                };
-                (pose, self.facing(self.roads.anchor(x, y), pose.h))
-            }
+            } => self.object_offset(*entity, *dx, *dy, orientation),
             Position::Road {
                 road,
                 s,
@@ -992,32 +1009,13 @@ impl Storyboard {
                 s,
                 offset,
                 orientation,
-            } => {
-                let lp = self
-                    .roads
-                    .lane_pos(road, *lane, *s, *offset)
-                    .map_err(|e| bad(e.to_string()))?;
-                // Without an orientation, or relative to it, the lane's driving direction
-                // (esmini's reading: a left lane of right-hand traffic faces against `s`).
-                let travel = self.roads.travel_heading(&LanePos { rev: false, ..lp });
-                let h = orient(orientation, travel);
-                self.placed(lp, h)
-            }
+            } => self.lane_position(road, (*lane, *s, *offset), orientation, at)?,
             Position::RelativeRoad {
                 entity,
                 ds,
                 dt,
                 orientation,
-            } => {
-                let lp = self.lane_of(*entity, "RelativeRoadPosition", at)?;
-                let (road, t) = self.roads.road_t(&lp).map_err(|e| bad(e.to_string()))?;
-                let lp = self
-                    .roads
-                    .road_pos(&road, lp.s + ds, t + dt)
-                    .map_err(|e| bad(e.to_string()))?;
-                let h = orient(orientation, self.roads.along_heading(&lp));
-                self.placed(lp, h)
-            }
+            } => self.road_offset(*entity, (*ds, *dt), orientation, at)?,
             Position::RelativeLane {
                 entity,
                 d_lane,
@@ -1032,6 +1030,101 @@ impl Storyboard {
                 (self.roads.pose_of(&lp), Some(lp))
             }
         })
+    }
+
+    /// A `RelativeWorldPosition`: `dx`, `dy` (m, along the world's axes) from entity
+    /// `entity`, heading `orientation` against the entity's (rad); its pose and its place on
+    /// the lanes.
+    fn world_offset(
+        &self,
+        entity: usize,
+        dx: f64,
+        dy: f64,
+        orientation: &Option<m::Orientation>,
+    ) -> (Pose, Option<LanePos>) {
+        let r = self.actors[entity].state.pose;
+        let (x, y) = (r.x + dx, r.y + dy);
+        let pose = Pose {
+            x,
+            y,
+            h: orient(orientation, r.h),
+        };
+        (pose, self.facing(self.roads.anchor(x, y), pose.h))
+    }
+
+    /// A `RelativeObjectPosition`: `dx` forward and `dy` left (m, in entity `entity`'s
+    /// frame) of the entity, heading `orientation` against the entity's (rad); its pose and
+    /// its place on the lanes.
+    fn object_offset(
+        &self,
+        entity: usize,
+        dx: f64,
+        dy: f64,
+        orientation: &Option<m::Orientation>,
+    ) -> (Pose, Option<LanePos>) {
+        let r = self.actors[entity].state.pose;
+        let (c, s) = (r.h.cos(), r.h.sin());
+        let (x, y) = (r.x + c * dx - s * dy, r.y + s * dx + c * dy);
+        let pose = Pose {
+            x,
+            y,
+            h: orient(orientation, r.h),
+        };
+        (pose, self.facing(self.roads.anchor(x, y), pose.h))
+    }
+
+    /// A `LanePosition`: lane id `lane` of road `road`, `s` along the road (m), `offset` from
+    /// the lane's centre (m), heading `orientation` against the lane's driving direction
+    /// (rad); its pose and its place on the lanes.
+    ///
+    /// # Errors
+    /// [`StoryError`] at `at` for a road or lane the map lacks.
+    fn lane_position(
+        &self,
+        road: &str,
+        (lane, s, offset): (i32, f64, f64),
+        orientation: &Option<m::Orientation>,
+        at: &paracosm_openscenario::Pos,
+    ) -> Result<(Pose, Option<LanePos>), StoryError> {
+        let lp = self
+            .roads
+            .lane_pos(road, lane, s, offset)
+            .map_err(|e| StoryError {
+                at: site(at),
+                message: e.to_string(),
+            })?;
+        // Without an orientation, or relative to it, the lane's driving direction
+        // (esmini's reading: a left lane of right-hand traffic faces against `s`).
+        let travel = self.roads.travel_heading(&LanePos { rev: false, ..lp });
+        let h = orient(orientation, travel);
+        Ok(self.placed(lp, h))
+    }
+
+    /// A `RelativeRoadPosition`: `ds` along and `dt` across (m) entity `entity`'s road from
+    /// its road coordinates, heading `orientation` against the road's reference line (rad);
+    /// its pose and its place on the lanes.
+    ///
+    /// # Errors
+    /// [`StoryError`] at `at` when the entity is on no lane or the place is off its road.
+    fn road_offset(
+        &self,
+        entity: usize,
+        (ds, dt): (f64, f64),
+        orientation: &Option<m::Orientation>,
+        at: &paracosm_openscenario::Pos,
+    ) -> Result<(Pose, Option<LanePos>), StoryError> {
+        let bad = |message: String| StoryError {
+            at: site(at),
+            message,
+        };
+        let lp = self.lane_of(entity, "RelativeRoadPosition", at)?;
+        let (road, t) = self.roads.road_t(&lp).map_err(|e| bad(e.to_string()))?;
+        let lp = self
+            .roads
+            .road_pos(&road, lp.s + ds, t + dt)
+            .map_err(|e| bad(e.to_string()))?;
+        let h = orient(orientation, self.roads.along_heading(&lp));
+        Ok(self.placed(lp, h))
     }
 
     /// Starts action `action` on entity `e` at `t` (s), for action element `a` (`None` in
@@ -1051,20 +1144,7 @@ impl Storyboard {
         match &action.action {
             Action::Teleport(p) => {
                 if scripted || a.is_none() {
-                    let (pose, lane) = self.resolve(p, &action.pos)?;
-                    let st = &mut self.actors[e].state;
-                    st.pose = pose;
-                    st.lane = lane;
-                    self.drives[e].rel_h = self.relative_heading(pose.h, lane);
-                    let d = &mut self.drives[e];
-                    // The motion it was making ends (and its action with it).
-                    let old = [
-                        d.path.take().map(|p| p.1),
-                        d.lateral.take().map(|l| l.action),
-                    ];
-                    for o in old {
-                        self.override_task(o);
-                    }
+                    self.teleport(e, p, &action.pos)?;
                 }
             }
             Action::Speed { target, dynamics } => {
@@ -1112,45 +1192,96 @@ impl Storyboard {
                 return self.start_trajectory(e, (shape, timing), (a, &action.pos), t);
             }
             Action::AssignRoute { waypoints } => {
-                let mut roads = Vec::new();
-                for (p, _) in waypoints {
-                    if let (_, Some(lp)) = self.resolve(p, &action.pos)? {
-                        roads.push(self.roads.ids(lp.lane).1);
-                    }
-                }
-                self.drives[e].prefer_roads = roads;
-                if !scripted {
-                    // The driven ego's route, planned again from where it is.
-                    if let Some(lp) = self.actors[e].state.lane {
-                        self.route = Some(RouteAsk {
-                            join: lp,
-                            ahead_m: 0.0,
-                        });
-                    }
-                }
+                self.assign_route(e, waypoints, &action.pos, scripted)?;
             }
             Action::ActivateController {
                 lateral,
                 longitudinal,
-            } => {
-                // Any domain activated hands the whole ego over (the load says so); a
-                // deactivation is refused at load (`check`).
-                let on = lateral.unwrap_or(true) || longitudinal.unwrap_or(true);
-                if on && Some(e) == self.hand_over && self.actors[e].scripted {
-                    self.actors[e].scripted = false;
-                    // Its lateral move and path end with the script (and their actions); a
-                    // running SpeedAction goes on as the system's set speed.
-                    let old = [
-                        self.drives[e].lateral.take().map(|l| l.action),
-                        self.drives[e].path.take().map(|p| p.1),
-                    ];
-                    for o in old {
-                        self.override_task(o);
-                    }
-                }
+            } => self.activate_controller(e, *lateral, *longitudinal),
+        }
+        Ok(())
+    }
+
+    /// Performs a `TeleportAction` of entity `e` to `p` (written at `at`): places it there,
+    /// notes its heading relative to its lane's travel (rad), and ends the path or lateral
+    /// move it was making (and their actions).
+    ///
+    /// # Errors
+    /// [`StoryError`] for a position off the map.
+    fn teleport(
+        &mut self,
+        e: usize,
+        p: &Position,
+        at: &paracosm_openscenario::Pos,
+    ) -> Result<(), StoryError> {
+        let (pose, lane) = self.resolve(p, at)?;
+        let st = &mut self.actors[e].state;
+        st.pose = pose;
+        st.lane = lane;
+        self.drives[e].rel_h = self.relative_heading(pose.h, lane);
+        let d = &mut self.drives[e];
+        // The motion it was making ends (and its action with it).
+        let old = [
+            d.path.take().map(|p| p.1),
+            d.lateral.take().map(|l| l.action),
+        ];
+        for o in old {
+            self.override_task(o);
+        }
+        Ok(())
+    }
+
+    /// Performs an `AssignRouteAction` (written at `at`) on entity `e`: the roads of its
+    /// `waypoints` become the roads it prefers at junctions; for the driven ego (not
+    /// `scripted`), a route planned again from where it is.
+    ///
+    /// # Errors
+    /// [`StoryError`] for a waypoint off the map.
+    fn assign_route(
+        &mut self,
+        e: usize,
+        waypoints: &[(Position, String)],
+        at: &paracosm_openscenario::Pos,
+        scripted: bool,
+    ) -> Result<(), StoryError> {
+        let mut roads = Vec::new();
+        for (p, _) in waypoints {
+            if let (_, Some(lp)) = self.resolve(p, at)? {
+                roads.push(self.roads.ids(lp.lane).1);
+            }
+        }
+        self.drives[e].prefer_roads = roads;
+        if !scripted {
+            // The driven ego's route, planned again from where it is.
+            if let Some(lp) = self.actors[e].state.lane {
+                self.route = Some(RouteAsk {
+                    join: lp,
+                    ahead_m: 0.0,
+                });
             }
         }
         Ok(())
+    }
+
+    /// Performs an `ActivateControllerAction` on entity `e` with its `lateral` and
+    /// `longitudinal` domains: the ego handed over on activation is then driven by the
+    /// system under test, its lateral move and path ended.
+    fn activate_controller(&mut self, e: usize, lateral: Option<bool>, longitudinal: Option<bool>) {
+        // Any domain activated hands the whole ego over (the load says so); a
+        // deactivation is refused at load (`check`).
+        let on = lateral.unwrap_or(true) || longitudinal.unwrap_or(true);
+        if on && Some(e) == self.hand_over && self.actors[e].scripted {
+            self.actors[e].scripted = false;
+            // Its lateral move and path end with the script (and their actions); a
+            // running SpeedAction goes on as the system's set speed.
+            let old = [
+                self.drives[e].lateral.take().map(|l| l.action),
+                self.drives[e].path.take().map(|p| p.1),
+            ];
+            for o in old {
+                self.override_task(o);
+            }
+        }
     }
 
     /// Starts a `SpeedAction` on `e` (see [`Storyboard::start_task`]).
@@ -1225,31 +1356,7 @@ impl Storyboard {
                 self.actors[e].name
             )));
         };
-        let id = match target {
-            LaneTarget::Absolute(id) => *id,
-            LaneTarget::Relative { entity, lanes } => {
-                let Some(rl) = self.actors[*entity].state.lane else {
-                    return Err(bad(format!(
-                        "a lane change relative to {}, which is not on a lane",
-                        self.actors[*entity].name
-                    )));
-                };
-                // Counted to the reference's left as it drives: +t along s.
-                let step = if rl.along_s(&self.roads) {
-                    lanes.signum()
-                } else {
-                    -lanes.signum()
-                };
-                let mut id = self.roads.ids(rl.lane).0;
-                for _ in 0..lanes.unsigned_abs() {
-                    id += step;
-                    if id == 0 {
-                        id += step;
-                    }
-                }
-                id
-            }
-        };
+        let id = self.lane_change_target_id(target, pos)?;
         let to_lane = self.roads.lane_with_id(lp.lane, id, lp.s).ok_or_else(|| {
             bad(format!(
                 "{}'s road has no lane {id} at s = {:.1} m",
@@ -1265,28 +1372,7 @@ impl Storyboard {
             duration_s(dynamics, target_d - lp.d, st.speed.abs())
         };
         if !scripted {
-            // The system under test drives it: a route into the lane, over the change's
-            // length (at least one second of driving), which it follows.
-            let ahead_m = if by_distance {
-                duration
-            } else {
-                duration * st.speed.abs()
-            }
-            .max(st.speed.abs())
-            .max(1.0);
-            let join = LanePos {
-                lane: to_lane,
-                s: lp.s,
-                d: *offset_m,
-                rev: lp.rev,
-            };
-            self.route = Some(RouteAsk { join, ahead_m });
-            let old = self.drives[e].lane_goal.take().map(|g| g.2);
-            self.override_task(old);
-            if let Some(a) = a {
-                self.elems[a].pending += 1;
-            }
-            self.drives[e].lane_goal = Some((to_lane, *offset_m, a.unwrap_or(usize::MAX)));
+            self.ask_lane_change_route(e, (lp, to_lane, *offset_m), (by_distance, duration), a);
             return Ok(());
         }
         let tr = Transition {
@@ -1314,6 +1400,84 @@ impl Storyboard {
             a,
         );
         Ok(())
+    }
+
+    /// The lane id a `LaneChangeAction` (written at `pos`) changes to: an absolute one as
+    /// written; a relative one counted from the reference entity's lane, to its left as it
+    /// drives, skipping id 0.
+    ///
+    /// # Errors
+    /// [`StoryError`] at `pos` when the reference entity is on no lane.
+    fn lane_change_target_id(
+        &self,
+        target: &LaneTarget,
+        pos: &paracosm_openscenario::Pos,
+    ) -> Result<i32, StoryError> {
+        Ok(match target {
+            LaneTarget::Absolute(id) => *id,
+            LaneTarget::Relative { entity, lanes } => {
+                let Some(rl) = self.actors[*entity].state.lane else {
+                    return Err(StoryError {
+                        at: site(pos),
+                        message: format!(
+                            "a lane change relative to {}, which is not on a lane",
+                            self.actors[*entity].name
+                        ),
+                    });
+                };
+                // Counted to the reference's left as it drives: +t along s.
+                let step = if rl.along_s(&self.roads) {
+                    lanes.signum()
+                } else {
+                    -lanes.signum()
+                };
+                let mut id = self.roads.ids(rl.lane).0;
+                for _ in 0..lanes.unsigned_abs() {
+                    id += step;
+                    if id == 0 {
+                        id += step;
+                    }
+                }
+                id
+            }
+        })
+    }
+
+    /// A lane change of the driven ego `e` (which the system under test drives), from `lp`
+    /// into lane `to_lane` at `offset_m` (m) from its centre, for action `a`: asks for a
+    /// route into the lane over the change's length (`duration` is m when `by_distance`,
+    /// else s at the ego's speed; at least one second of driving and 1 m), which it follows,
+    /// and notes the lane goal that ends the action, ending the one it replaces.
+    fn ask_lane_change_route(
+        &mut self,
+        e: usize,
+        (lp, to_lane, offset_m): (LanePos, usize, f64),
+        (by_distance, duration): (bool, f64),
+        a: Option<usize>,
+    ) {
+        let st = self.actors[e].state;
+        // The system under test drives it: a route into the lane, over the change's
+        // length (at least one second of driving), which it follows.
+        let ahead_m = if by_distance {
+            duration
+        } else {
+            duration * st.speed.abs()
+        }
+        .max(st.speed.abs())
+        .max(1.0);
+        let join = LanePos {
+            lane: to_lane,
+            s: lp.s,
+            d: offset_m,
+            rev: lp.rev,
+        };
+        self.route = Some(RouteAsk { join, ahead_m });
+        let old = self.drives[e].lane_goal.take().map(|g| g.2);
+        self.override_task(old);
+        if let Some(a) = a {
+            self.elems[a].pending += 1;
+        }
+        self.drives[e].lane_goal = Some((to_lane, offset_m, a.unwrap_or(usize::MAX)));
     }
 
     /// Starts lateral move `l` of `e` for action `a`, ending the one it replaces.

@@ -84,8 +84,8 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             )
         })?;
         let overrides = overrides(params, &b)?;
-        let model =
-            paracosm_openscenario::read_scenario(&file, &overrides).map_err(|e| anyhow!("{e}"))?;
+        let model = paracosm_openscenario::read_scenario_in(&st.maps.xosc, &file, &overrides)
+            .map_err(|e| anyhow!("{e}"))?;
         let ego = crate::xosc::ego_of(&model, ego, false).map_err(|e| anyhow!("{e}"))?;
         let warnings = crate::xosc::check(&model, Some(ego)).map_err(|e| anyhow!("{e}"))?;
         b.warnings.extend(warnings);

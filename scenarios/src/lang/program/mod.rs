@@ -233,6 +233,21 @@ fn one_walker_each(b: &SceneBuilder) -> Result<(), LoadError> {
     Ok(())
 }
 
+/// Lets an imported entity held by a top-level variable of `module` (`lead = s.Lead`)
+/// publish its outputs in `b` under that variable's name, as a declaration's variable does.
+fn alias_imported(module: &Module<'_>, b: &mut SceneBuilder) {
+    for name in module.names() {
+        let imported = module.get(name.as_str()).and_then(|v| {
+            starlark::values::ValueLike::downcast_ref::<crate::lang::values::ActorVal>(v)
+                .filter(|a| a.object == crate::lang::globals::import::IMPORTED)
+                .map(|a| a.kind)
+        });
+        if let Some(actor) = imported {
+            b.scene.alias_actor(name.as_str().to_owned(), actor);
+        }
+    }
+}
+
 impl Program {
     /// Evaluates the program with `values` (by declaration index; `None`: representative
     /// values) within the loading limits, checks that it finished, and calls `then` with what
@@ -276,76 +291,81 @@ impl Program {
                     // A parameter that only these values declare explains the failure first.
                     self.same_params_so_far(&state.scene.borrow())?;
                 }
-                result.map_err(|e| {
-                    let message = super::suggest_keyword(&format!("{e}"));
-                    // Limit errors (steps, heap) carry no span: say which program hit them,
-                    // and the statement it was running then.
-                    let message = if message.contains(&self.file) {
-                        message
-                    } else {
-                        match self.where_stopped(again) {
-                            Some(at) => format!("{message}\n{at}"),
-                            None => format!("{message}\n --> {}", self.file),
-                        }
-                    };
-                    // The first evaluation: say which values it ran with.
-                    let b = state.scene.borrow();
-                    let message = if !b.scene.has_values() && !b.scene.params().is_empty() {
-                        let values: Vec<String> = b
-                            .scene
-                            .params()
-                            .iter()
-                            .enumerate()
-                            .map(|(k, d)| {
-                                let name =
-                                    self.param_name(d).unwrap_or_else(|| format!("param{k}"));
-                                match &d.domain {
-                                    Domain::Interval { lo, .. } => format!("{name} = {lo}"),
-                                    Domain::Levels(l) => format!("{name} = {}", l[0]),
-                                }
-                            })
-                            .collect();
-                        format!(
-                            "{message}\n(evaluated with the first values: {})",
-                            values.join(", ")
-                        )
-                    } else {
-                        message
-                    };
-                    LoadError::new(LoadErrorKind::Evaluation, message)
-                })?;
+                result.map_err(|e| self.evaluation_error(e, again, &state.scene))?;
                 steps = eval.get_total_tick_count();
             }
             let printed = std::mem::take(&mut *state.log.borrow_mut());
             let mut b = state.scene.into_inner();
-            // An imported entity held by a top-level variable (`lead = s.Lead`) publishes
-            // its outputs under that variable's name, as a declaration's variable does.
-            for name in module.names() {
-                let imported = module.get(name.as_str()).and_then(|v| {
-                    starlark::values::ValueLike::downcast_ref::<crate::lang::values::ActorVal>(v)
-                        .filter(|a| a.object == crate::lang::globals::import::IMPORTED)
-                        .map(|a| a.kind)
-                });
-                if let Some(actor) = imported {
-                    b.scene.alias_actor(name.as_str().to_owned(), actor);
-                }
-            }
-            if !b.scene.has_values()
-                && !self
-                    .load_output_shown
-                    .swap(true, std::sync::atomic::Ordering::Relaxed)
-            {
-                // The evaluation at load: what the program prints is shown once, on stderr.
-                // A stderr that cannot be written (`2>&1 | head -1`) drops the lines.
-                let mut err = std::io::stderr().lock();
-                for line in &printed {
-                    let _ = writeln!(err, "{}: print: {line}", self.file);
-                }
-            }
+            alias_imported(&module, &mut b);
+            self.show_load_output(&b, &printed);
             b.log = printed;
             finished(&b, &self.file)?;
             Ok((then(b, &module)?, steps))
         })
+    }
+
+    /// The load error of an evaluation with `values` (by declaration index; `None`:
+    /// representative values) that failed with `e`, having declared `scene` so far:
+    /// starlark's message with a keyword suggested, where it stopped when the message names
+    /// no place in the program, and, for the first evaluation, the values it ran with.
+    fn evaluation_error(
+        &self,
+        e: starlark::Error,
+        values: Option<Vec<ParamValue>>,
+        scene: &std::cell::RefCell<SceneBuilder>,
+    ) -> LoadError {
+        let message = super::suggest_keyword(&format!("{e}"));
+        // Limit errors (steps, heap) carry no span: say which program hit them,
+        // and the statement it was running then.
+        let message = if message.contains(&self.file) {
+            message
+        } else {
+            match self.where_stopped(values) {
+                Some(at) => format!("{message}\n{at}"),
+                None => format!("{message}\n --> {}", self.file),
+            }
+        };
+        // The first evaluation: say which values it ran with.
+        let b = scene.borrow();
+        let message = if !b.scene.has_values() && !b.scene.params().is_empty() {
+            let values: Vec<String> = b
+                .scene
+                .params()
+                .iter()
+                .enumerate()
+                .map(|(k, d)| {
+                    let name = self.param_name(d).unwrap_or_else(|| format!("param{k}"));
+                    match &d.domain {
+                        Domain::Interval { lo, .. } => format!("{name} = {lo}"),
+                        Domain::Levels(l) => format!("{name} = {}", l[0]),
+                    }
+                })
+                .collect();
+            format!(
+                "{message}\n(evaluated with the first values: {})",
+                values.join(", ")
+            )
+        } else {
+            message
+        };
+        LoadError::new(LoadErrorKind::Evaluation, message)
+    }
+
+    /// Shows what an evaluation printed (`printed`), once per program, when it is the
+    /// evaluation at load (`b` was given no values).
+    fn show_load_output(&self, b: &SceneBuilder, printed: &[String]) {
+        if !b.scene.has_values()
+            && !self
+                .load_output_shown
+                .swap(true, std::sync::atomic::Ordering::Relaxed)
+        {
+            // The evaluation at load: what the program prints is shown once, on stderr.
+            // A stderr that cannot be written (`2>&1 | head -1`) drops the lines.
+            let mut err = std::io::stderr().lock();
+            for line in printed {
+                let _ = writeln!(err, "{}: print: {line}", self.file);
+            }
+        }
     }
 
     /// Sets the limits of an evaluation at load on `eval` (steps, heap, call depth, and the

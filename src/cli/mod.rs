@@ -1,5 +1,8 @@
 //! Helpers shared by the command-line tools.
 
+pub mod fuzz;
+pub mod process;
+
 use std::process::ExitCode;
 
 use clap::Parser;

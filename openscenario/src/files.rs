@@ -1,0 +1,115 @@
+//! The files one OpenSCENARIO scenario reads (its variation file, its scenario, its catalogs
+//! and the catalog folders' listings), each read from disk once and kept: a campaign is one
+//! fixed scenario, so every test reads the texts its load read, even if a file changes on disk
+//! while the campaign runs, and a test costs no file system calls.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, PoisonError};
+
+use crate::error::XoscError;
+use crate::text::Text;
+
+/// The files a scenario has read, by path as named (`dir/file.xosc`, with `.` components
+/// removed), and the `.xosc` files of each catalog folder it listed. Shared between threads:
+/// the tests of a campaign read through one set.
+#[derive(Debug, Default)]
+pub struct FileSet {
+    texts: Mutex<BTreeMap<PathBuf, Arc<Text>>>,
+    folders: Mutex<BTreeMap<PathBuf, Arc<[PathBuf]>>>,
+}
+
+impl FileSet {
+    /// An empty set: the first read of each file goes to disk.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The text of `path`: read from disk ([`Text::read`]) the first time, from the set after.
+    ///
+    /// # Errors
+    /// [`XoscError::Io`] when the file is missing, unreadable, not UTF-8 or larger than
+    /// [`crate::text::MAX_FILE_BYTES`] (an error is not kept: a later call reads again).
+    pub fn text(&self, path: &Path) -> Result<Arc<Text>, XoscError> {
+        if let Some(t) = lock(&self.texts).get(path) {
+            return Ok(t.clone());
+        }
+        let text = Arc::new(Text::read(path)?);
+        // Two threads may read the same file at once; the first one kept wins, so every
+        // reader sees one text.
+        Ok(lock(&self.texts)
+            .entry(path.to_path_buf())
+            .or_insert(text)
+            .clone())
+    }
+
+    /// The `.xosc` files of the folder `dir` (extension compared without case), sorted, and
+    /// how many there are: listed the first time, from the set after.
+    ///
+    /// # Errors
+    /// The [`std::io::Error`] of a folder that cannot be listed.
+    pub fn xosc_files(&self, dir: &Path) -> Result<Arc<[PathBuf]>, std::io::Error> {
+        if let Some(files) = lock(&self.folders).get(dir) {
+            return Ok(files.clone());
+        }
+        let mut files: Vec<PathBuf> = std::fs::read_dir(dir)?
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .filter(|p| {
+                p.extension()
+                    .is_some_and(|x| x.eq_ignore_ascii_case("xosc"))
+            })
+            .collect();
+        files.sort();
+        let files: Arc<[PathBuf]> = files.into();
+        Ok(lock(&self.folders)
+            .entry(dir.to_path_buf())
+            .or_insert(files)
+            .clone())
+    }
+
+    /// Every file read so far, by path, with its text: what a campaign's fingerprint covers.
+    pub fn texts(&self) -> Vec<(PathBuf, Arc<Text>)> {
+        lock(&self.texts)
+            .iter()
+            .map(|(p, t)| (p.clone(), t.clone()))
+            .collect()
+    }
+}
+
+/// The map behind `m`; a thread that panicked while holding it left it whole (each insert is
+/// one call), so its contents are still good.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_is_read_once_and_kept_though_it_changes_on_disk() {
+        let dir = std::env::temp_dir().join(format!("paracosm-fileset-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("a.xosc");
+        std::fs::write(&path, "<OpenSCENARIO/>").unwrap();
+        let files = FileSet::new();
+        let first = files.text(&path).unwrap();
+        std::fs::write(&path, "<Changed/>").unwrap();
+        let second = files.text(&path).unwrap();
+        assert!(Arc::ptr_eq(&first, &second));
+        assert_eq!(second.text, "<OpenSCENARIO/>");
+        std::fs::write(dir.join("b.XOSC"), "").unwrap();
+        std::fs::write(dir.join("c.txt"), "").unwrap();
+        let listed = files.xosc_files(&dir).unwrap();
+        assert_eq!(listed.len(), 2, "{listed:?}");
+        std::fs::write(dir.join("d.xosc"), "").unwrap();
+        assert_eq!(
+            files.xosc_files(&dir).unwrap().len(),
+            2,
+            "the listing is kept"
+        );
+        assert_eq!(files.texts().len(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
