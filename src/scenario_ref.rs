@@ -48,13 +48,21 @@ pub struct XoscRef {
 }
 
 impl<'de> Deserialize<'de> for ScenarioRef {
-    /// A string is a program; an object an OpenSCENARIO file with its options (read through
+    /// A string is a program, or an OpenSCENARIO file read as it is ([`ScenarioRef::named`]);
+    /// an object an OpenSCENARIO file with its options (read through
     /// a `serde_json::Value`: serde's untagged enums cannot read the numbers of a workspace
     /// whose `serde_json` keeps them as text).
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         use serde::de::Error as _;
         match serde_json::Value::deserialize(d)? {
-            serde_json::Value::String(s) => Ok(ScenarioRef::Program(s)),
+            serde_json::Value::String(s) if s.to_ascii_lowercase().contains(".xosc#") => {
+                Err(D::Error::custom(format!(
+                    "{s}: an OpenSCENARIO campaign written by a paracosm before 2026-11-28 \
+                     (its options after `#`); its folder cannot be resumed, reported or merged \
+                     by this one: rerun the campaign"
+                )))
+            }
+            serde_json::Value::String(s) => Ok(ScenarioRef::named(&s)),
             v @ serde_json::Value::Object(_) => serde_json::from_value(v)
                 .map(ScenarioRef::OpenScenario)
                 .map_err(D::Error::custom),
@@ -190,6 +198,10 @@ mod tests {
             ScenarioRef::named("b.XOSC"),
             ScenarioRef::OpenScenario(_)
         ));
+        let plain: ScenarioRef = serde_json::from_str(r#""/data/b.xosc""#).unwrap();
+        assert!(matches!(plain, ScenarioRef::OpenScenario(_)), "{plain:?}");
+        let old = serde_json::from_str::<ScenarioRef>(r#""a.xosc#open=A=1..2""#).unwrap_err();
+        assert!(old.to_string().contains("rerun the campaign"), "{old}");
         let unknown = serde_json::from_str::<ScenarioRef>(r#"{"xosc":"a.xosc","opne":[]}"#);
         assert!(
             unknown.is_err(),

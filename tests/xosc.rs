@@ -833,3 +833,53 @@ fn an_openscenario_campaign_reads_its_files_once_at_load() {
     );
     assert_eq!(format!("{before:?}"), format!("{after:?}"));
 }
+
+/// A campaign over an OpenSCENARIO file given by a relative path, with options, resumes bare
+/// (`--resume --out DIR`, the command printed after Ctrl-C) from another folder:
+/// `campaign.json` keeps the file's absolute path and its options, and the fingerprint names
+/// the files relative to the file's folder. Then `report` reads the folder back.
+#[test]
+fn an_openscenario_campaign_resumes_bare_from_another_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let alks = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xosc/alks");
+    let run = |cwd: &std::path::Path, args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+            .args(args)
+            .current_dir(cwd)
+            .output()
+            .unwrap();
+        (
+            o.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (code, err) = run(
+        &alks,
+        &[
+            "alks_scenario_4_2_3_crossing_pedestrian_variation.xosc",
+            "--open",
+            "TargetBlocking_Speed_kph=2..10",
+            "--budget",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!([0, 1, 3].contains(&code), "exit {code}: {err}");
+    let campaign = std::fs::read_to_string(out.join("campaign.json")).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&campaign).unwrap();
+    println!("campaign.json's scenario: {}", json["scenario"]);
+    assert_eq!(
+        json["scenario"]["open"][0],
+        "TargetBlocking_Speed_kph=2..10"
+    );
+    assert!(json["scenario"]["xosc"]
+        .as_str()
+        .is_some_and(|p| std::path::Path::new(p).is_absolute()));
+    let (code, err) = run(dir.path(), &["--resume", "--out", out.to_str().unwrap()]);
+    assert!([0, 1, 3].contains(&code), "exit {code}: {err}");
+    assert!(!err.contains("refusing"), "{err}");
+    let (code, err) = run(dir.path(), &["report", out.to_str().unwrap()]);
+    assert!([0, 1, 3].contains(&code), "exit {code}: {err}");
+}

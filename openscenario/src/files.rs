@@ -10,9 +10,10 @@ use std::sync::{Arc, Mutex, PoisonError};
 use crate::error::XoscError;
 use crate::text::Text;
 
-/// The files a scenario has read, by path as named (`dir/file.xosc`, with `.` components
-/// removed), and the `.xosc` files of each catalog folder it listed. Shared between threads:
-/// the tests of a campaign read through one set.
+/// The files a scenario has read, by path as named with `.` components removed and `dir/..`
+/// folded (so `a/./b/../c.xosc` and `a/c.xosc` are one file; a path is not made absolute),
+/// and the `.xosc` files of each catalog folder it listed. Shared between threads: the tests
+/// of a campaign read through one set.
 #[derive(Debug, Default)]
 pub struct FileSet {
     texts: Mutex<BTreeMap<PathBuf, Arc<Text>>>,
@@ -31,25 +32,27 @@ impl FileSet {
     /// [`XoscError::Io`] when the file is missing, unreadable, not UTF-8 or larger than
     /// [`crate::text::MAX_FILE_BYTES`] (an error is not kept: a later call reads again).
     pub fn text(&self, path: &Path) -> Result<Arc<Text>, XoscError> {
-        if let Some(t) = lock(&self.texts).get(path) {
+        let key = folded(path);
+        if let Some(t) = lock(&self.texts).get(&key) {
             return Ok(t.clone());
         }
         let text = Arc::new(Text::read(path)?);
         // Two threads may read the same file at once; the first one kept wins, so every
         // reader sees one text.
-        Ok(lock(&self.texts)
-            .entry(path.to_path_buf())
-            .or_insert(text)
-            .clone())
+        Ok(lock(&self.texts).entry(key).or_insert(text).clone())
     }
 
-    /// The `.xosc` files of the folder `dir` (extension compared without case), sorted, and
-    /// how many there are: listed the first time, from the set after.
+    /// The `.xosc` files of the folder `dir` (extension compared without case), sorted:
+    /// listed the first time, from the set after. The first listing also reads each of them
+    /// ([`FileSet::text`]; one that cannot be read is left to the read that needs it, which
+    /// reports it), so that a test whose values choose another catalog entry reads the text
+    /// the campaign's load read, and the campaign's fingerprint covers it.
     ///
     /// # Errors
     /// The [`std::io::Error`] of a folder that cannot be listed.
     pub fn xosc_files(&self, dir: &Path) -> Result<Arc<[PathBuf]>, std::io::Error> {
-        if let Some(files) = lock(&self.folders).get(dir) {
+        let key = folded(dir);
+        if let Some(files) = lock(&self.folders).get(&key) {
             return Ok(files.clone());
         }
         let mut files: Vec<PathBuf> = std::fs::read_dir(dir)?
@@ -61,11 +64,11 @@ impl FileSet {
             })
             .collect();
         files.sort();
+        for f in &files {
+            let _ = self.text(f);
+        }
         let files: Arc<[PathBuf]> = files.into();
-        Ok(lock(&self.folders)
-            .entry(dir.to_path_buf())
-            .or_insert(files)
-            .clone())
+        Ok(lock(&self.folders).entry(key).or_insert(files).clone())
     }
 
     /// Every file read so far, by path, with its text: what a campaign's fingerprint covers.
@@ -75,6 +78,23 @@ impl FileSet {
             .map(|(p, t)| (p.clone(), t.clone()))
             .collect()
     }
+}
+
+/// `path` with its `.` components removed and each `name/..` folded (lexically: a link is
+/// not followed), the key of a file in the set.
+fn folded(path: &Path) -> PathBuf {
+    use std::path::Component;
+    let mut out: Vec<Component<'_>> = Vec::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out.iter().collect()
 }
 
 /// The map behind `m`; a thread that panicked while holding it left it whole (each insert is
@@ -88,8 +108,16 @@ mod tests {
     use super::*;
 
     #[test]
+    fn one_file_spelled_two_ways_is_one_key() {
+        assert_eq!(folded(Path::new("a/./b/../c.xosc")), Path::new("a/c.xosc"));
+        assert_eq!(folded(Path::new("../x/./y.xosc")), Path::new("../x/y.xosc"));
+        assert_eq!(folded(Path::new("/r/a/../../b")), Path::new("/b"));
+    }
+
+    #[test]
     fn a_file_is_read_once_and_kept_though_it_changes_on_disk() {
         let dir = std::env::temp_dir().join(format!("paracosm-fileset-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("a.xosc");
         std::fs::write(&path, "<OpenSCENARIO/>").unwrap();
@@ -109,7 +137,11 @@ mod tests {
             2,
             "the listing is kept"
         );
-        assert_eq!(files.texts().len(), 1);
+        assert_eq!(
+            files.texts().len(),
+            2,
+            "a listed folder's files are read with it"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -297,6 +297,8 @@ class Scenario:
 
     def __init__(self, name_or_path, *, sut=None, open=(), continuous=False, scripted_ego=False,
                  ego=None, horizon=None):
+        if isinstance(open, str):
+            raise TypeError("open is a list of 'Name=lo..hi' or 'Name=a,b,c' strings, not one string")
         self._native = _native.ScenarioHandle(
             os.fspath(name_or_path), open=list(open), continuous=continuous,
             scripted_ego=scripted_ego, ego=ego, horizon=horizon)

@@ -24,12 +24,14 @@ impl std::fmt::Display for Warning {
     }
 }
 
-/// A file a program read, as it names it, and the SHA-256 of its bytes (64 hex digits).
+/// A file a scenario read, as it names it, and the SHA-256 of its bytes (64 hex digits; an
+/// OpenSCENARIO file's as read: UTF-8 text without a byte-order mark).
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct InputFile {
-    /// The path as the program writes it (relative to the program's folder).
+    /// The path as the program writes it (relative to the program's folder); for an
+    /// OpenSCENARIO campaign relative to the folder of the file it names.
     pub path: String,
-    /// SHA-256 of the file's bytes, lowercase hex.
+    /// SHA-256 of the file's bytes (or text, above), lowercase hex.
     pub sha256: String,
 }
 
@@ -83,8 +85,9 @@ pub struct Scenario {
     /// The program text it was loaded from (empty for scenarios written in Rust): part of a
     /// campaign's fingerprint, so a resumed campaign runs the same program.
     pub source: Arc<str>,
-    /// The files the program read (its OpenDRIVE maps), with their SHA-256: part of a
-    /// campaign's fingerprint, so `--resume` refuses a campaign whose map has changed.
+    /// The files the scenario read (its OpenDRIVE maps; an OpenSCENARIO scenario's variation
+    /// file, scenario and catalogs), with their SHA-256: part of a campaign's fingerprint, so
+    /// `--resume` refuses a campaign whose map or catalog has changed.
     pub input_files: Vec<InputFile>,
     /// Builds each test's world.
     pub(crate) worlds: Arc<dyn Worlds>,

@@ -248,9 +248,9 @@ pub struct CampaignFile {
     /// campaign.json. Absent in files written before it existed.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub checks: BTreeMap<String, String>,
-    /// The files the program read (its OpenDRIVE maps) with their SHA-256, also folded into
-    /// the fingerprint: kept apart so that `--resume` can name a changed map. Left out of the
-    /// file when the program reads none.
+    /// The files the scenario read (its OpenDRIVE maps; an OpenSCENARIO scenario's files)
+    /// with their SHA-256, also folded into the fingerprint: kept apart so that `--resume`
+    /// can name a changed file. Left out of the file when the program reads none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub input_files: Vec<paracosm_scenarios::InputFile>,
     /// Whether the campaign stops at its first failure (`--stop-at-first-failure`), kept so
@@ -292,7 +292,7 @@ struct Fingerprinted<'a> {
     /// Only when the scenario's own system under test is an ONNX model.
     #[serde(skip_serializing_if = "Option::is_none")]
     scenario_model_sha256: Option<&'a str>,
-    /// The files the program read (OpenDRIVE maps) and their SHA-256; only when it read any,
+    /// The files the scenario read and their SHA-256; only when it read any,
     /// so the fingerprints of the others stay as they were.
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     input_files: &'a [paracosm_scenarios::InputFile],

@@ -66,9 +66,10 @@ fn network_document(
             .or(scenario.input_files.first())
             .ok_or_else(|| input("the program's map is not among the files it read"))?;
         if program.xosc().is_some() {
-            // An OpenSCENARIO scenario's map path is already joined with its folder.
+            // An OpenSCENARIO campaign names its files relative to the folder of its file.
+            let folder = Path::new(program.path()).parent().unwrap_or(Path::new(""));
             paracosm_scenarios::text_file::read_text(
-                Path::new(&read.path),
+                &folder.join(&read.path),
                 paracosm_scenarios::lang::map_files::MAX_MAP_BYTES,
             )
             .map_err(|e| input(format!("cannot read {}: {e}", read.path)))

@@ -202,13 +202,23 @@ pub fn campaign_scenario(x: &XoscRef) -> Result<paracosm_scenarios::Scenario, Er
     let mut scenario = paracosm_scenarios::xosc::scenario(paracosm_scenarios::xosc::Source {
         template,
         files,
-        name: ScenarioRef::OpenScenario(x.clone()).to_string(),
+        // The file's name and options, not its folder: the fingerprint of a campaign is the
+        // same from any folder and on any machine (shards on other mount points merge).
+        name: ScenarioRef::OpenScenario(XoscRef {
+            xosc: file_name(path),
+            ..x.clone()
+        })
+        .to_string(),
         space,
         overrides,
         scripted_ego: x.scripted_ego,
         ego: x.ego.clone(),
         horizon_s: x.horizon_s,
     })?;
+    let base = Path::new(path).parent().unwrap_or(Path::new(""));
+    for f in &mut scenario.input_files {
+        f.path = relative_to(base, &f.path);
+    }
     scenario
         .warnings
         .extend(found.limits.iter().map(|l| paracosm_scenarios::Warning {
@@ -216,4 +226,30 @@ pub fn campaign_scenario(x: &XoscRef) -> Result<paracosm_scenarios::Scenario, Er
             message: l.clone(),
         }));
     Ok(scenario)
+}
+
+/// The last component of `path` (the path itself when it has none).
+fn file_name(path: &str) -> String {
+    Path::new(path)
+        .file_name()
+        .map_or_else(|| path.to_owned(), |f| f.to_string_lossy().into_owned())
+}
+
+/// `path` relative to the folder `base` when it lies inside it (both resolved by the file
+/// system), else `path` as it is: a campaign's input files are named the same from any
+/// folder, so its fingerprint is too.
+pub(crate) fn relative_to(base: &Path, path: &str) -> String {
+    let canon = |p: &Path| {
+        std::fs::canonicalize(if p.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            p
+        })
+    };
+    match (canon(base), canon(Path::new(path))) {
+        (Ok(b), Ok(p)) => p
+            .strip_prefix(&b)
+            .map_or_else(|_| path.to_owned(), |r| r.display().to_string()),
+        _ => path.to_owned(),
+    }
 }

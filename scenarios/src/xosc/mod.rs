@@ -60,14 +60,14 @@ pub struct OverrideError(pub String);
 
 /// What a campaign over an OpenSCENARIO scenario needs.
 pub struct Source {
-    /// The scenario file (`Storyboard`), read again for every test with its values, through
-    /// [`Source::files`].
+    /// The scenario file (`Storyboard`), parsed again for every test with its values, from
+    /// its text kept in [`Source::files`].
     pub template: PathBuf,
     /// The OpenSCENARIO files the campaign's load has read (the variation file, the
     /// scenario): the scenario's catalogs join them at load, and every test reads these
     /// texts, not the disk.
     pub files: Arc<paracosm_openscenario::FileSet>,
-    /// The campaign's name for it (the file given on the command line).
+    /// The campaign's name for it: the file's name with its options (`a.xosc --open ...`).
     pub name: String,
     /// The space of the test's parameters.
     pub space: ParamSpace,
