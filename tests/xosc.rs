@@ -883,3 +883,48 @@ fn an_openscenario_campaign_resumes_bare_from_another_folder() {
     let (code, err) = run(dir.path(), &["report", out.to_str().unwrap()]);
     assert!([0, 1, 3].contains(&code), "exit {code}: {err}");
 }
+
+/// A FIFO given as the scenario, or lying in a catalog folder, is refused at once (exit 2,
+/// "not a regular file") instead of blocking the read forever.
+#[test]
+fn a_fifo_in_place_of_an_openscenario_file_is_refused_not_waited_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let alks = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xosc/alks");
+    copy_folder(&alks, dir.path());
+    let fifo = dir.path().join("fifo.xosc");
+    let catalog_fifo = dir
+        .path()
+        .join("concrete_scenarios/catalogs/vehicles/a_fifo.xosc");
+    for f in [&fifo, &catalog_fifo] {
+        let made = Command::new("mkfifo").arg(f).status().unwrap();
+        assert!(made.success());
+    }
+    let crossing = dir
+        .path()
+        .join("alks_scenario_4_2_3_crossing_pedestrian_variation.xosc");
+    for (file, why) in [(&fifo, "the scenario"), (&crossing, "a catalog")] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+            .arg("xosc")
+            .arg(file)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let started = std::time::Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break s;
+            }
+            if started.elapsed().as_secs() > 30 {
+                child.kill().unwrap();
+                panic!("a FIFO as {why}: still waiting after 30 s");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        };
+        let mut err = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+        println!("a FIFO as {why}: exit {:?}: {err}", status.code());
+        assert_eq!(status.code(), Some(2), "{err}");
+        assert!(err.contains("not a regular file"), "{err}");
+    }
+}

@@ -37,25 +37,46 @@ impl Text {
         }
     }
 
-    /// Reads `path` (at most [`MAX_FILE_BYTES`]).
+    /// Reads `path` (at most [`MAX_FILE_BYTES`]). Only a regular file (or a link to one) is
+    /// opened: a FIFO would block the read, a device (`/dev/zero`) would never end it.
     ///
     /// # Errors
-    /// [`XoscError::Io`] when the file is missing, unreadable, not UTF-8 or too large.
+    /// [`XoscError::Io`] when the file is missing, not a regular file, unreadable, not UTF-8
+    /// or too large.
     pub fn read(path: &std::path::Path) -> Result<Self, XoscError> {
+        use std::io::Read;
         let file = path.display().to_string();
         let io = |reason: String| XoscError::Io {
             file: file.clone(),
             reason,
         };
-        let len = std::fs::metadata(path)
-            .map_err(|e| io(e.to_string()))?
-            .len();
+        let meta = std::fs::metadata(path).map_err(|e| io(e.to_string()))?;
+        if !meta.is_file() {
+            return Err(io(
+                "not a regular file (a folder, a FIFO or a device): an OpenSCENARIO file is \
+                 read from a regular file"
+                    .into(),
+            ));
+        }
+        let len = meta.len();
         if len > MAX_FILE_BYTES {
             return Err(io(format!(
                 "{len} bytes, more than the {MAX_FILE_BYTES} an OpenSCENARIO file may have"
             )));
         }
-        let text = std::fs::read_to_string(path).map_err(|e| io(e.to_string()))?;
+        // The file may grow between the size check and the read: read at most one byte more
+        // than the limit, and refuse it if it is there.
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)
+            .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(|e| io(e.to_string()))?;
+        if bytes.len() as u64 > MAX_FILE_BYTES {
+            return Err(io(format!(
+                "more than the {MAX_FILE_BYTES} bytes an OpenSCENARIO file may have"
+            )));
+        }
+        let text = String::from_utf8(bytes)
+            .map_err(|e| io(format!("not UTF-8 text ({})", e.utf8_error())))?;
         Ok(Text::new(file, text))
     }
 
