@@ -12,7 +12,7 @@ fn text(data: &[u8]) -> Option<&str> {
 
 fn study_space() -> &'static ParamSpace {
     static SPACE: OnceLock<ParamSpace> = OnceLock::new();
-    SPACE.get_or_init(|| paracosm_scenarios::reference::scenario().space)
+    SPACE.get_or_init(|| paracosm_scenarios::reference::scenario().space().clone())
 }
 
 /// A space file (TOML), a CSV test set (with and without a space), and an STL formula (as

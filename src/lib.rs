@@ -18,7 +18,6 @@ pub mod map;
 pub mod record;
 pub mod report;
 pub mod scenario_ref;
-pub mod xosc;
 
 pub use campaign::{Campaign, CampaignReport, Observer, OnRecord, ResultsFile};
 pub use error::Error;
@@ -41,11 +40,11 @@ pub fn load_scenario(name: &str) -> Result<paracosm_scenarios::Scenario, Error> 
 /// [`Error::BadInput`] when `scenario`'s system under test is
 /// [`paracosm_engine::sut::SutConfig::Scripted`].
 pub fn refuse_sut_for_scripted_ego(scenario: &paracosm_scenarios::Scenario) -> Result<(), Error> {
-    if matches!(scenario.sut, paracosm_engine::sut::SutConfig::Scripted) {
+    if matches!(scenario.sut(), paracosm_engine::sut::SutConfig::Scripted) {
         return Err(Error::BadInput(format!(
             "{}: the storyboard moves the ego (--scripted-ego), so no system under test drives \
              it: leave out --sut, --sut-cmd and --sut-onnx, or --scripted-ego",
-            scenario.name
+            scenario.name()
         )));
     }
     Ok(())

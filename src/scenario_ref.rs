@@ -8,6 +8,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
+pub use paracosm_scenarios::xosc::XoscRef;
 
 /// The scenario of a campaign. In `campaign.json`, a program is its name or path (a string),
 /// an OpenSCENARIO file an object with its options (`{"xosc": "/abs/file.xosc", "open":
@@ -19,32 +20,6 @@ pub enum ScenarioRef {
     Program(String),
     /// An OpenSCENARIO file and how the campaign reads it.
     OpenScenario(XoscRef),
-}
-
-/// An OpenSCENARIO scenario or variation file and the options of `paracosm-fuzz FILE.xosc`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct XoscRef {
-    /// The file (a variation file, or a scenario alone), as given or made absolute.
-    pub xosc: String,
-    /// `--open`: declared parameters opened, `Name=lo..hi` or `Name=a,b,c`.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub open: Vec<String>,
-    /// `--continuous`: a `DistributionRange` becomes an interval over its range.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub continuous: bool,
-    /// `--scripted-ego`: the storyboard moves the ego as every other entity (no system under
-    /// test), to replay an exported test.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub scripted_ego: bool,
-    /// `--ego NAME`: the vehicle the system under test drives, for a file that does not say
-    /// plainly.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ego: Option<String>,
-    /// `--horizon`: the longest test, s (finite, `> 0`); a storyboard without a stop trigger
-    /// needs it.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub horizon_s: Option<f64>,
 }
 
 impl<'de> Deserialize<'de> for ScenarioRef {
@@ -121,14 +96,14 @@ impl ScenarioRef {
     }
 
     /// Loads the scenario: [`paracosm_scenarios::load`] for a program,
-    /// [`crate::xosc::campaign_scenario`] for an OpenSCENARIO file.
+    /// [`paracosm_scenarios::xosc::campaign_scenario`] for an OpenSCENARIO file.
     ///
     /// # Errors
     /// What those return.
     pub fn load(&self) -> Result<paracosm_scenarios::Scenario, Error> {
         match self {
             ScenarioRef::Program(name) => Ok(paracosm_scenarios::load(name)?),
-            ScenarioRef::OpenScenario(x) => crate::xosc::campaign_scenario(x),
+            ScenarioRef::OpenScenario(x) => Ok(paracosm_scenarios::xosc::campaign_scenario(x)?),
         }
     }
 }
@@ -139,25 +114,7 @@ impl std::fmt::Display for ScenarioRef {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             ScenarioRef::Program(p) => f.write_str(p),
-            ScenarioRef::OpenScenario(x) => {
-                f.write_str(&x.xosc)?;
-                for o in &x.open {
-                    write!(f, " --open {o}")?;
-                }
-                if x.continuous {
-                    f.write_str(" --continuous")?;
-                }
-                if x.scripted_ego {
-                    f.write_str(" --scripted-ego")?;
-                }
-                if let Some(e) = &x.ego {
-                    write!(f, " --ego {e}")?;
-                }
-                if let Some(h) = x.horizon_s {
-                    write!(f, " --horizon {h}")?;
-                }
-                Ok(())
-            }
+            ScenarioRef::OpenScenario(x) => x.fmt(f),
         }
     }
 }

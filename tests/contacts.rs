@@ -25,12 +25,12 @@ fn load(source: &str) -> Result<Scenario, String> {
 fn trace<T>(source: &str, seconds: f64, mut f: impl FnMut(&Simulation) -> T) -> Vec<T> {
     let scenario = load(source).unwrap();
     let point = Strategy::Halton
-        .build(&scenario.space, 0)
+        .build(scenario.space(), 0)
         .unwrap()
         .ask(1)
         .unwrap()
         .remove(0);
-    let assignment = scenario.space.decode(&point).unwrap();
+    let assignment = scenario.space().decode(&point).unwrap();
     let mut out = Vec::new();
     scenario
         .with_world(&assignment, &mut |spec, host| {
@@ -94,7 +94,7 @@ test(horizon = 10.0, offroad = False)
     assert!(xs.iter().all(|(x, _, _)| x + 2.25 <= 59.25 + 1e-3));
     // The monitor named by its variable fails, with robustness 0 (it touched).
     let scenario = load(&program).unwrap();
-    assert!(scenario.monitors.iter().any(|m| m.name() == "hit"));
+    assert!(scenario.monitors().iter().any(|m| m.name() == "hit"));
     let a = common::no_params(&scenario);
     let outcome = scenario.run(&a, 0).unwrap();
     let (_, hit) = outcome.monitors.iter().find(|(n, _)| n == "hit").unwrap();
@@ -284,7 +284,7 @@ test(horizon = 10.0)
 "
     );
     let s = load(&program).unwrap();
-    let names: Vec<&str> = s.monitors.iter().map(|m| m.name()).collect();
+    let names: Vec<&str> = s.monitors().iter().map(|m| m.name()).collect();
     assert_eq!(
         names,
         [

@@ -262,7 +262,7 @@ fn a_network_of_pieces_round_trips_through_the_opendrive_importer() {
     // The same network, built by the program.
     let scenario = paracosm_scenarios::load(file.to_str().unwrap()).unwrap();
     let mut network = None;
-    let a = scenario.space.decode(&paracosm_generators::Point {
+    let a = scenario.space().decode(&paracosm_generators::Point {
         discrete: vec![],
         continuous: vec![],
     });

@@ -220,7 +220,7 @@ fn a_monitor_of_a_constant_loads_with_a_warning() {
     let src = format!("{ROAD}w.place(r, v, lead)\nMonitor(5.0, name = \"c\")\nAssert(True, name = \"a\")\nCollisionMonitor(v)\n");
     let s = paracosm_scenarios::lang::load_source("t.star", &src, "t").unwrap();
     let w: Vec<String> = s
-        .warnings
+        .warnings()
         .iter()
         .map(|w| format!("{}: {}", w.at, w.message))
         .collect();
@@ -349,7 +349,7 @@ w.place(r, s, v, lead, c, e)
 CollisionMonitor(v)
 "#;
     let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
-    let mut names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+    let mut names: Vec<&str> = s.space().params().iter().map(|p| p.name.as_str()).collect();
     names.sort();
     assert_eq!(
         names,
@@ -399,7 +399,7 @@ w.place(r, v, c, o, o2)
 CollisionMonitor(v)
 "#;
     let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
-    let w: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
+    let w: Vec<&str> = s.warnings().iter().map(|w| w.message.as_str()).collect();
     for expected in [
         "`r.onLane_1` is declared in s but feeds onLane(at=), which is in m",
         "`r.onLane_2` is declared in km but feeds onLane(at=), which is in m",
@@ -429,12 +429,12 @@ CollisionMonitor(v)
 "#;
     let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
     assert!(
-        s.warnings.iter().any(|w| w.at == "t.star:5:5"
+        s.warnings().iter().any(|w| w.at == "t.star:5:5"
             && w.message.contains(
                 "ChangeLane(to = -1) moves it from lane 2 into a lane of the other direction"
             )),
         "{:?}",
-        s.warnings
+        s.warnings()
     );
     let e = load_err(
         r#"
@@ -774,9 +774,13 @@ test(horizon = 3.0)
     };
     for levels in [r#"["straight", "bend"]"#, r#"["bend", "straight"]"#] {
         let s = paracosm_scenarios::lang::load_source("t.star", &bend(levels), "t").unwrap();
-        assert_eq!(s.unused_params, vec!["idle".to_owned()], "{levels}");
-        assert_eq!(s.warnings.len(), 1, "{levels}: {:?}", s.warnings);
-        assert!(s.warnings[0].message.contains("`idle`"), "{:?}", s.warnings);
+        assert_eq!(s.unused_params(), vec!["idle".to_owned()], "{levels}");
+        assert_eq!(s.warnings().len(), 1, "{levels}: {:?}", s.warnings());
+        assert!(
+            s.warnings()[0].message.contains("`idle`"),
+            "{:?}",
+            s.warnings()
+        );
     }
     let start = |starts: &str| {
         format!(
@@ -797,15 +801,15 @@ test(horizon = 10.0)
         )
     };
     let s = paracosm_scenarios::lang::load_source("t.star", &start("[5.0, 580.0]"), "t").unwrap();
-    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert!(s.warnings().is_empty(), "{:?}", s.warnings());
     let s = paracosm_scenarios::lang::load_source("t.star", &start("[5.0, 6.0]"), "t").unwrap();
     assert!(
-        s.warnings.len() == 1
-            && s.warnings[0]
+        s.warnings().len() == 1
+            && s.warnings()[0]
                 .message
                 .contains("`far_mu` sets the friction of"),
         "{:?}",
-        s.warnings
+        s.warnings()
     );
 }
 
@@ -879,8 +883,8 @@ fn silent_misreadings_found_by_new_programs_are_refused_or_read_right() {
         "t",
     )
     .unwrap();
-    assert!(s.unused_params.is_empty(), "{:?}", s.unused_params);
-    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert!(s.unused_params().is_empty(), "{:?}", s.unused_params());
+    assert!(s.warnings().is_empty(), "{:?}", s.warnings());
     // The returned unbound action sets the lead's speed to the event's value, 7 m/s.
     let (r, _) = run_one(
         &format!(
@@ -909,13 +913,13 @@ fn a_monitor_of_an_open_value_is_not_a_constant_one() {
         "t",
     )
     .unwrap();
-    let w: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
+    let w: Vec<&str> = s.warnings().iter().map(|w| w.message.as_str()).collect();
     assert_eq!(w.len(), 1, "{w:#?}");
     assert!(
         w[0].contains("monitor `c` judges a constant stream"),
         "{w:#?}"
     );
-    assert!(s.unused_params.is_empty(), "{:?}", s.unused_params);
+    assert!(s.unused_params().is_empty(), "{:?}", s.unused_params());
 }
 
 /// A horizon between two steps is rounded up to whole steps of 1/60 s: 0.005 s runs one step
@@ -1102,11 +1106,11 @@ fn monitors_that_a_stopped_car_passes_are_warned_about() {
     ] {
         let s = paracosm_scenarios::lang::load_source("t.star", &program(monitors), "t").unwrap();
         let w: Vec<_> = s
-            .warnings
+            .warnings()
             .iter()
             .filter(|w| w.message.contains(stopped))
             .collect();
-        assert_eq!(w.len(), 1, "{monitors}: {:?}", s.warnings);
+        assert_eq!(w.len(), 1, "{monitors}: {:?}", s.warnings());
         assert_eq!(w[0].at, "t.star:5:1", "{monitors}");
     }
     for monitors in [
@@ -1116,9 +1120,9 @@ fn monitors_that_a_stopped_car_passes_are_warned_about() {
     ] {
         let s = paracosm_scenarios::lang::load_source("t.star", &program(monitors), "t").unwrap();
         assert!(
-            s.warnings.iter().all(|w| !w.message.contains(stopped)),
+            s.warnings().iter().all(|w| !w.message.contains(stopped)),
             "{monitors}: {:?}",
-            s.warnings
+            s.warnings()
         );
     }
 }

@@ -224,9 +224,9 @@ test(horizon = 10.0)
     assert!(gaps.iter().any(|g| (g - gaps[0]).abs() > 0.5), "{gaps:?}");
     // Library check of the same world: the lambda's speed is the parameter's value.
     let s = loads(&program("tick.map(lambda t: lim)"));
-    let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = s.space().params().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["lim[0]", "lim[1]"]);
-    let _ = assign(&s.space, &[("lim[0]", Value::Real(3.0))]);
+    let _ = assign(s.space(), &[("lim[0]", Value::Real(3.0))]);
 }
 
 /// An actor's output read inside a lambda without a top-level variable stays a stream: the
@@ -687,7 +687,7 @@ test(horizon = 3.0, offroad = False)
 "#
     );
     let sc = loads(&src);
-    let out = sc.run(&assign(&sc.space, &[]), 0).unwrap();
+    let out = sc.run(&assign(sc.space(), &[]), 0).unwrap();
     let v = |n: &str| {
         out.monitors
             .iter()
@@ -706,7 +706,7 @@ test(horizon = 3.0, offroad = False)
         "Stl(\"G[2.9,2.9] (c_shift > 3.49 & c_shift < 3.51 & p_moved < 0.000001 & q_moved > 0.8 & q_moved < 1.0)\", name = \"moved\")\nStl(\"G[2.5,2.5] (a_speed",
     );
     let sc = loads(&src2);
-    let out = sc.run(&assign(&sc.space, &[]), 0).unwrap();
+    let out = sc.run(&assign(sc.space(), &[]), 0).unwrap();
     let moved = out.monitors.iter().find(|(m, _)| m == "moved").unwrap();
     assert!(moved.1.passed, "{:?}", moved.1);
     // A lane the car's segment lacks is refused at load.
@@ -793,10 +793,15 @@ fn an_open_action_argument_is_named_and_used() {
     let sc = loads(&format!(
         "{ROAD}lead = Car(loc = r.onLane(1, 60), speed = 8.0)\nw.place(r, v, lead)\ntick.filter(lambda t: t > 1).foreach(lead.brake(VarEnum([3, 7])))\nCollisionMonitor(v)\nDistanceMonitor(v, minD = 20.0)\n"
     ));
-    let names: Vec<&str> = sc.space.params().iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = sc
+        .space()
+        .params()
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect();
     assert_eq!(names, ["lead.brake"]);
-    assert!(sc.unused_params.is_empty(), "{:?}", sc.unused_params);
-    assert!(sc.warnings.is_empty(), "{:?}", sc.warnings);
+    assert!(sc.unused_params().is_empty(), "{:?}", sc.unused_params());
+    assert!(sc.warnings().is_empty(), "{:?}", sc.warnings());
 }
 
 /// A passing `Stl` formula reports the whole trace's robustness: `F[0,15] where.x > 60` over
@@ -865,7 +870,7 @@ fn levels_keep_their_type_a_text_true_is_not_a_bool() {
 fn on_lane_takes_keywords_and_its_open_arguments_have_names_of_their_own() {
     let names = |src: &str| -> Vec<String> {
         loads(src)
-            .space
+            .space()
             .params()
             .iter()
             .map(|p| p.name.clone())

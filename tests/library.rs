@@ -8,7 +8,8 @@ use std::sync::Arc;
 use paracosm::campaign::session::{Plan, Request};
 use paracosm::{CampaignReport, Error, Observer, RunRecord, Status};
 use paracosm_generators::Assignment;
-use paracosm_scenarios::{ScenarioError, Worlds};
+use paracosm_scenarios::front_end::{Findings, Source};
+use paracosm_scenarios::{FrontEnd, ScenarioError};
 
 /// An observer that checks the order of the calls and counts what it saw.
 #[derive(Default)]
@@ -80,30 +81,42 @@ fn a_campaign_runs_from_the_library_with_a_custom_observer() {
     );
 }
 
-/// The pedestrian study's worlds, with a defect: a world with a walking speed above 1.5 m/s
-/// panics while it is built.
-struct Defective;
+/// The pedestrian study's front end, with a defect: a world with a walking speed above
+/// 1.5 m/s panics while it is built.
+struct Defective(Arc<dyn FrontEnd>);
 
-impl Worlds for Defective {
+impl FrontEnd for Defective {
+    fn space(&self) -> &paracosm_generators::ParamSpace {
+        self.0.space()
+    }
+
     fn with_scene(
         &self,
-        assignment: &Assignment,
+        assignment: Option<&Assignment>,
         run: &mut dyn FnMut(&paracosm_scenarios::scene::Scene, &mut dyn paracosm_engine::rx::Host),
     ) -> Result<(), ScenarioError> {
-        if assignment.real("walking_speed").unwrap() > 1.5 {
-            panic!(
-                "a defect at walking speed {:?}",
-                assignment.real("walking_speed")
-            );
+        if let Some(speed) = assignment.and_then(|a| a.real("walking_speed")) {
+            if speed > 1.5 {
+                panic!("a defect at walking speed {speed:?}");
+            }
         }
-        paracosm_scenarios::RustWorlds(paracosm_scenarios::reference::scene)
-            .with_scene(assignment, run)
+        self.0.with_scene(assignment, run)
+    }
+
+    fn source(&self) -> Source {
+        self.0.source()
+    }
+
+    fn findings(&self) -> Findings {
+        self.0.findings()
     }
 }
 
 #[test]
 fn a_panic_in_a_simulation_is_an_internal_error_record_not_a_failure_of_the_system() {
-    let scenario = paracosm_scenarios::reference::scenario().with_worlds(Arc::new(Defective));
+    let study = paracosm_scenarios::reference::scenario();
+    let scenario =
+        paracosm_scenarios::Scenario::new(Arc::new(Defective(study.front_end().clone()))).unwrap();
     let campaign = paracosm::Campaign {
         scenario: &scenario,
         strategy: paracosm_generators::Strategy::Halton,

@@ -42,12 +42,12 @@ const LIVENESS: [&str; 2] = ["distance", "closes_up"];
 
 /// `n` tests of `s` at the first Halton points of its space, with seeds 0, 1, ...
 fn run_tests(s: &Scenario, n: usize) -> Vec<(String, TestOutcome)> {
-    let points = Halton::new(&s.space).ask(n).unwrap();
+    let points = Halton::new(s.space()).ask(n).unwrap();
     points
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let a = s.space.decode(p).unwrap();
+            let a = s.space().decode(p).unwrap();
             let o = s.run(&a, i as u64).unwrap();
             (format!("{a:?}"), o)
         })
@@ -87,16 +87,16 @@ fn a_car_that_stops_before_the_point_of_interest_fails_every_shipped_scenario() 
     for &(name, poi_m, brake_at_m) in POINTS_OF_INTEREST {
         let own = paracosm_scenarios::builtin(name).unwrap();
         assert!(
-            own.monitors.iter().any(|m| LIVENESS.contains(&m.name())),
+            own.monitors().iter().any(|m| LIVENESS.contains(&m.name())),
             "{name} declares no liveness check"
         );
         let mut by_liveness = 0;
         for after_m in [0.0, brake_at_m] {
             let mut stops = own.clone();
-            stops.sut = SutConfig::StopAfter {
-                inner: Box::new(own.sut.clone()),
+            stops.set_sut(SutConfig::StopAfter {
+                inner: Box::new(own.sut().clone()),
                 after_m,
-            };
+            });
             let runs = run_tests(&stops, 6);
             // On ice it may slide on into the danger; judged are the tests where it came to
             // rest short of the point, and those must be most of them.
@@ -153,7 +153,7 @@ fn the_liveness_checks_do_not_fail_the_scenarios_own_systems() {
             assert!(
                 failed.is_empty() || !others_passed,
                 "{name}: {} failed only {failed:?} ({values}): {:?}",
-                own.sut.name(),
+                own.sut().name(),
                 o.monitors
             );
         }

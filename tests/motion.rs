@@ -92,7 +92,7 @@ fn check_program(path: &Path, tests: usize) -> Worst {
     let scenario = paracosm_scenarios::load(path.to_str().unwrap())
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let points = Strategy::Halton
-        .build(&scenario.space, 0)
+        .build(scenario.space(), 0)
         .unwrap()
         .ask(tests)
         .unwrap();
@@ -103,7 +103,7 @@ fn check_program(path: &Path, tests: usize) -> Worst {
         .display()
         .to_string();
     for (k, point) in points.iter().enumerate() {
-        let assignment = scenario.space.decode(point).unwrap();
+        let assignment = scenario.space().decode(point).unwrap();
         scenario
             .with_world(&assignment, &mut |spec, host| {
                 let mut sim = Simulation::new(spec).unwrap();
@@ -115,7 +115,7 @@ fn check_program(path: &Path, tests: usize) -> Worst {
                     .chain(sim.cars().map(ActorRef::Car))
                     .collect();
                 let mut last: Vec<Option<Reading>> = vec![None; actors.len()];
-                let steps = ((CHECK_S.min(scenario.horizon_s)) / dt).round() as usize;
+                let steps = ((CHECK_S.min(scenario.horizon_s())) / dt).round() as usize;
                 for step in 0..=steps {
                     if sim.evaluate(host).is_err() {
                         break;

@@ -627,7 +627,7 @@ fn left_hand_traffic_drives_each_lane_the_other_way() {
         .unwrap();
         let s = paracosm_scenarios::load(p.to_str().unwrap()).unwrap();
         let a = s
-            .space
+            .space()
             .decode(&paracosm_generators::Point::default())
             .unwrap();
         let w = s.instantiate(&a).unwrap();
@@ -747,7 +747,7 @@ fn a_link_to_a_road_the_map_lacks_is_a_warning_and_the_road_ends_there() {
     );
     let s = paracosm_scenarios::load(p.to_str().unwrap()).unwrap();
     let a = s
-        .space
+        .space()
         .decode(&paracosm_generators::Point::default())
         .unwrap();
     let route = s.instantiate(&a).unwrap().ego.route;

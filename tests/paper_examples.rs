@@ -43,7 +43,7 @@ fn scenario(file: &Path) -> paracosm_scenarios::Scenario {
 #[test]
 fn the_simple_world_has_no_open_stream_and_every_test_is_the_same() {
     let file = example("simple_world.star");
-    assert!(scenario(&file).space.params().is_empty());
+    assert!(scenario(&file).space().params().is_empty());
     let (records, stderr) = run(&file, 3, 0);
     assert!(!stderr.contains("warning"), "{stderr}");
     for r in &records[1..] {
@@ -56,12 +56,12 @@ fn the_simple_world_has_no_open_stream_and_every_test_is_the_same() {
 #[test]
 fn the_family_of_worlds_has_the_papers_six_ranges() {
     let s = scenario(&example("family_of_worlds.star"));
-    let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = s.space().params().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(
         names,
         ["light", "fog", "friction", "nlanes", "dist", "speed"]
     );
-    let nlanes = s.space.param("nlanes").unwrap();
+    let nlanes = s.space().param("nlanes").unwrap();
     assert_eq!(
         format!("{:?}", nlanes.domain),
         format!(
@@ -146,7 +146,7 @@ fn the_grid_is_built_by_iteration_for_every_size() {
 #[test]
 fn the_fog_polynomial_is_four_coefficients() {
     let s = scenario(&example("fog_polynomial.star"));
-    let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = s.space().params().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["fog.c0", "fog.c1", "fog.c2", "fog.c3"]);
     let (records, _) = run(&example("fog_polynomial.star"), 3, 0);
     for r in &records {

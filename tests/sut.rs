@@ -258,11 +258,11 @@ fn replay_writes_frames_and_a_contact_sheet_and_confirms_the_verdict() {
 #[test]
 fn vision_fails_in_fog_dark_and_glare_but_not_in_clear_nominal_light() {
     let mut s = paracosm_scenarios::builtin("fog-light").unwrap();
-    s.sut = paracosm_engine::sut::SutConfig::builtin("vision").unwrap();
+    s.set_sut(paracosm_engine::sut::SutConfig::builtin("vision").unwrap());
     let run = |light: f64, fog: f64| {
         // Both parameters span [0, 1], light first: the unit point is the value.
         let a = s
-            .space
+            .space()
             .decode(&paracosm_generators::Point {
                 discrete: vec![],
                 continuous: vec![light, fog],

@@ -94,7 +94,7 @@ fn a_formula_decided_at_once_changes_no_collision_verdict() {
 fn robustness_of(file: &str, name: &str) -> f64 {
     let s = paracosm_scenarios::load(scenario(file).to_str().unwrap()).unwrap();
     let a = s
-        .space
+        .space()
         .decode(&Point {
             discrete: vec![],
             continuous: vec![],

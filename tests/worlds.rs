@@ -35,7 +35,7 @@ fn worlds_with_2_4_and_6_lanes_really_differ() {
     for n in [2, 4, 6] {
         // The cone ~37 m ahead: within the lidar's ±30° even across six lanes.
         let a = assign(
-            &s.space,
+            s.space(),
             &[("nlanes", Value::Int(n)), ("gap", Value::Real(39.5))],
         );
         let world = s.instantiate(&a).unwrap();
@@ -92,7 +92,7 @@ fn worlds_with_2_4_and_6_lanes_really_differ() {
 fn an_open_place_on_a_lane_moves_the_car_to_the_sampled_gap() {
     let s = load("scenarios", "cut_in.star");
     for gap in [2.0, 11.5, 29.0] {
-        let a = assign(&s.space, &[("gap", Value::Real(gap))]);
+        let a = assign(s.space(), &[("gap", Value::Real(gap))]);
         let sim = Simulation::new(&s.instantiate(&a).unwrap()).unwrap();
         let snap = sim.snapshot();
         let ego_x = snap.ego.pos_m[0];
@@ -108,7 +108,7 @@ fn an_open_place_on_a_lane_moves_the_car_to_the_sampled_gap() {
 /// Full brake from 25 m/s for the whole test; where the ego stops, m from its start.
 fn braking_distance(s: &Scenario, first: f64, second: f64) -> f64 {
     let a = assign(
-        &s.space,
+        s.space(),
         &[
             ("friction[0]", Value::Real(first)),
             ("friction[1]", Value::Real(second)),
@@ -120,7 +120,7 @@ fn braking_distance(s: &Scenario, first: f64, second: f64) -> f64 {
         throttle: -1.0,
         steering: 0.0,
     });
-    while sim.t_s() < s.horizon_s {
+    while sim.t_s() < s.horizon_s() {
         let c = brake.act(&sim.observation()).unwrap();
         sim.step(c, &mut NoHost).unwrap();
     }
@@ -130,7 +130,7 @@ fn braking_distance(s: &Scenario, first: f64, second: f64) -> f64 {
 #[test]
 fn a_friction_that_drops_halfway_lengthens_the_braking_distance() {
     let s = load("tests/scenarios", "friction_drops.star");
-    let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = s.space().params().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["friction[0]", "friction[1]"]);
     let dry = braking_distance(&s, 0.85, 0.85);
     let drops = braking_distance(&s, 0.85, 0.1);
@@ -279,7 +279,7 @@ CollisionMonitor(v)
     let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
     for (lanes, pieces) in [(2, 2), (4, 3)] {
         let a = assign(
-            &s.space,
+            s.space(),
             &[
                 ("lanes", Value::Int(lanes)),
                 ("start_speed", Value::Real(7.5)),
@@ -321,16 +321,16 @@ w.place(r, v, wall)
 CollisionMonitor(v)
 "#;
     let s = paracosm_scenarios::lang::load_source("t.star", src, "t").unwrap();
-    let a = assign(&s.space, &[]);
+    let a = assign(s.space(), &[]);
     // aeb sees it with its lidar and stops.
     let o = s.run(&a, 0).unwrap();
     assert!(o.passed(), "{o:?}");
     // Full throttle into it: a collision.
     let mut hits = s.clone();
-    hits.sut = paracosm_engine::sut::SutConfig::Constant(Control {
+    hits.set_sut(paracosm_engine::sut::SutConfig::Constant(Control {
         throttle: 0.5,
         steering: 0.0,
-    });
+    }));
     let o = hits.run(&a, 0).unwrap();
     let (_, collision) = o.monitors.iter().find(|(n, _)| n == "collision").unwrap();
     assert!(!collision.passed, "{o:?}");
@@ -362,7 +362,7 @@ CollisionMonitor(v, name = "collision_" + names)
     let fixed = src.replace("name = \"collision_\" + names", "name = \"collision\"");
     let s = paracosm_scenarios::lang::load_source("t.star", &fixed, "t").unwrap();
     let a = assign(
-        &s.space,
+        s.space(),
         &[("n", Value::Int(4)), ("gap", Value::Real(12.0))],
     );
     let world = s.instantiate(&a).unwrap();
@@ -413,7 +413,7 @@ fn every_shipped_scenario_gives_the_same_results_for_any_thread_count() {
 #[test]
 fn checking_a_slow_program_stops_at_the_load_budget_and_says_so() {
     let s = load("tests/scenarios", "slow_to_evaluate.star");
-    let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    let w: Vec<String> = s.warnings().iter().map(|w| w.to_string()).collect();
     let budget = paracosm_scenarios::lang::MAX_CHECK_STEPS;
     let found = w
         .iter()
@@ -751,7 +751,7 @@ fn line_of(key: &str) -> usize {
 fn every_input_takes_a_constant_const_an_open_value_and_what_the_reference_says() {
     let load = |src: &str| paracosm_scenarios::lang::load_source("every.star", src, "every");
     let base = load(&every_input(&[])).unwrap_or_else(|e| panic!("{e}"));
-    let empty = base.space.decode(&Point {
+    let empty = base.space().decode(&Point {
         discrete: vec![],
         continuous: vec![],
     });
@@ -774,8 +774,8 @@ fn every_input_takes_a_constant_const_an_open_value_and_what_the_reference_says(
         // Open per test: the two ends give different worlds, and both run.
         let open = load(&every_input(&[(s.key, s.open)]))
             .unwrap_or_else(|e| panic!("{}: open: {e}", s.key));
-        assert_eq!(open.space.params().len(), 1, "{}", s.key);
-        let (a, b) = (x_at(&open.space, false), x_at(&open.space, true));
+        assert_eq!(open.space().params().len(), 1, "{}", s.key);
+        let (a, b) = (x_at(open.space(), false), x_at(open.space(), true));
         let (wa, wb) = (open.instantiate(&a).unwrap(), open.instantiate(&b).unwrap());
         assert_ne!(
             format!("{wa:?}"),
@@ -814,7 +814,7 @@ fn every_input_takes_a_constant_const_an_open_value_and_what_the_reference_says(
             let got = load(&every_input(&[(s.key, &form)]));
             match (got, ok) {
                 (Ok(sc), true) => {
-                    let a = x_at(&sc.space, true);
+                    let a = x_at(sc.space(), true);
                     sc.run(&a, 0)
                         .unwrap_or_else(|e| panic!("{} {what}: {e}", s.key));
                 }
@@ -851,7 +851,7 @@ fn every_input_takes_a_constant_const_an_open_value_and_what_the_reference_says(
 }
 
 fn empty_assignment(s: &Scenario) -> Assignment {
-    s.space
+    s.space()
         .decode(&Point {
             discrete: vec![],
             continuous: vec![],
@@ -883,7 +883,7 @@ test(horizon = 6.0)
             .unwrap();
     let mut seen = Vec::new();
     for x in [2.5, 6.0, 9.5] {
-        let a = assign(&direct.space, &[("cruise", Value::Real(x))]);
+        let a = assign(direct.space(), &[("cruise", Value::Real(x))]);
         let (d, l) = (direct.run(&a, 0).unwrap(), lambda.run(&a, 0).unwrap());
         assert_eq!(format!("{d:?}"), format!("{l:?}"), "cruise = {x}");
         let (_, collision) = d.monitors.iter().find(|(n, _)| n == "collision").unwrap();
@@ -900,7 +900,7 @@ fn the_reference_example_places_a_truck_only_on_six_lanes() {
     let s = load("tests/scenarios", "truck_on_six_lanes.star");
     for (n, trucks) in [(2, 0), (4, 0), (6, 1)] {
         let a = assign(
-            &s.space,
+            s.space(),
             &[("nlanes", Value::Int(n)), ("gap", Value::Real(30.0))],
         );
         let world = s.instantiate(&a).unwrap();
@@ -946,5 +946,5 @@ test(horizon = HORIZON)
     );
     assert!(e.contains("t.star:5:5"), "{e}");
     let s = paracosm_scenarios::lang::load_source("t.star", &with("\"aeb\"", "10.0"), "t").unwrap();
-    assert_eq!(s.horizon_s, 10.0);
+    assert_eq!(s.horizon_s(), 10.0);
 }

@@ -199,15 +199,13 @@ fn a_scenario_in_the_older_forms_reads() {
     }
 }
 
-/// A variation file with a `ValueSetDistribution` (parameters assigned together) beside a
-/// single-parameter one: the sets become one discrete parameter and the grid multiplies.
-#[test]
-fn value_sets_become_one_parameter_of_their_sets() {
-    let dir = tempfile::tempdir().unwrap();
+/// A variation file in `dir` over ALKS 4.2.3 (the crossing pedestrian) whose `Deterministic`
+/// element holds `distributions`.
+fn crossing_variation(dir: &std::path::Path, distributions: &str) -> std::path::PathBuf {
     let alks = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xosc/alks");
     let template =
         alks.join("concrete_scenarios/alks_scenario_4_2_3_crossing_pedestrian_template.xosc");
-    let variation = dir.path().join("sets.xosc");
+    let variation = dir.join("sets.xosc");
     std::fs::write(
         &variation,
         format!(
@@ -217,7 +215,26 @@ fn value_sets_become_one_parameter_of_their_sets() {
   <ParameterValueDistribution>
     <ScenarioFile filepath="{}"/>
     <Deterministic>
-      <DeterministicSingleParameterDistribution parameterName="Ego_InitSpeed_Ve0_kph">
+{distributions}
+    </Deterministic>
+  </ParameterValueDistribution>
+</OpenSCENARIO>
+"#,
+            template.display()
+        ),
+    )
+    .unwrap();
+    variation
+}
+
+/// A variation file with a `ValueSetDistribution` (parameters assigned together) beside a
+/// single-parameter one: the sets become one discrete parameter and the grid multiplies.
+#[test]
+fn value_sets_become_one_parameter_of_their_sets() {
+    let dir = tempfile::tempdir().unwrap();
+    let variation = crossing_variation(
+        dir.path(),
+        r#"      <DeterministicSingleParameterDistribution parameterName="Ego_InitSpeed_Ve0_kph">
         <DistributionSet><Element value="30"/><Element value="50"/></DistributionSet>
       </DeterministicSingleParameterDistribution>
       <DeterministicMultiParameterDistribution>
@@ -235,15 +252,8 @@ fn value_sets_become_one_parameter_of_their_sets() {
             <ParameterAssignment parameterRef="TargetBlocking_InitPosition_LateralOffset_m" value="-2"/>
           </ParameterValueSet>
         </ValueSetDistribution>
-      </DeterministicMultiParameterDistribution>
-    </Deterministic>
-  </ParameterValueDistribution>
-</OpenSCENARIO>
-"#,
-            template.display()
-        ),
-    )
-    .unwrap();
+      </DeterministicMultiParameterDistribution>"#,
+    );
     let (code, out, err) = xosc(&[variation.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     for want in [
@@ -270,7 +280,7 @@ fn the_crossing_pedestrian_runs_on_the_storyboard_and_meets_an_ego_that_does_not
     });
     let mut scenario = name.load().expect("the campaign's scenario builds");
     let names: Vec<&str> = scenario
-        .space
+        .space()
         .params()
         .iter()
         .map(|p| p.name.as_str())
@@ -288,7 +298,7 @@ fn the_crossing_pedestrian_runs_on_the_storyboard_and_meets_an_ego_that_does_not
         discrete: vec![0, 6, 1],
         continuous: vec![0.5],
     };
-    let a = scenario.space.decode(&point).expect("decodes");
+    let a = scenario.space().decode(&point).expect("decodes");
     assert_eq!(a.get("Ego_InitSpeed_Ve0_kph"), Some(&Value::Int(35)));
     assert_eq!(a.get("Ego_InitPosition_LaneId"), Some(&Value::Int(-4)));
     let braking = scenario.run(&a, 1).expect("the test runs");
@@ -309,7 +319,7 @@ fn the_crossing_pedestrian_runs_on_the_storyboard_and_meets_an_ego_that_does_not
     );
     let mut blind = AebConfig::default();
     blind.cruise.ttc_brake_s = 0.0;
-    scenario.sut = SutConfig::Aeb(blind);
+    scenario.set_sut(SutConfig::Aeb(blind));
     let hit = scenario.run(&a, 1).expect("the test runs");
     let collision = hit
         .monitors
@@ -775,7 +785,7 @@ fn an_openscenario_campaign_reads_its_files_once_at_load() {
         .join("alks_scenario_4_2_3_crossing_pedestrian_variation.xosc");
     let scenario = paracosm::load_scenario(variation.to_str().unwrap()).expect("it loads");
     let read: Vec<&str> = scenario
-        .input_files
+        .input_files()
         .iter()
         .map(|f| f.path.as_str())
         .collect();
@@ -798,9 +808,9 @@ fn an_openscenario_campaign_reads_its_files_once_at_load() {
         read.iter().any(|p| p.contains("catalogs/pedestrians/")),
         "a pedestrian catalog: {read:?}"
     );
-    assert!(scenario.input_files.iter().all(|f| f.sha256.len() == 64));
+    assert!(scenario.input_files().iter().all(|f| f.sha256.len() == 64));
     let a = scenario
-        .space
+        .space()
         .decode(&Point {
             discrete: vec![0, 6, 1],
             continuous: vec![],
@@ -927,4 +937,49 @@ fn a_fifo_in_place_of_an_openscenario_file_is_refused_not_waited_on() {
         assert_eq!(status.code(), Some(2), "{err}");
         assert!(err.contains("not a regular file"), "{err}");
     }
+}
+
+/// A value set binds its parameters as the variation file parsed them: a value whose text
+/// holds `, Name=value` is that one parameter's value (here not a number, so the test is an
+/// error naming it), never a second assignment.
+#[test]
+fn a_value_sets_value_is_one_value_not_more_assignments() {
+    use paracosm_generators::Point;
+    let dir = tempfile::tempdir().unwrap();
+    let hostile = "4, TargetBlocking_InitPosition_LateralOffset_m=-1";
+    let variation = crossing_variation(
+        dir.path(),
+        &format!(
+            r#"      <DeterministicMultiParameterDistribution>
+        <ValueSetDistribution>
+          <ParameterValueSet>
+            <ParameterAssignment parameterRef="TargetBlocking_Speed_kph" value="4"/>
+            <ParameterAssignment parameterRef="TargetBlocking_InitPosition_LateralOffset_m" value="-6"/>
+          </ParameterValueSet>
+          <ParameterValueSet>
+            <ParameterAssignment parameterRef="TargetBlocking_Speed_kph" value="{hostile}"/>
+            <ParameterAssignment parameterRef="TargetBlocking_InitPosition_LateralOffset_m" value="-6"/>
+          </ParameterValueSet>
+        </ValueSetDistribution>
+      </DeterministicMultiParameterDistribution>"#
+        ),
+    );
+    let scenario = paracosm::ScenarioRef::named(variation.to_str().unwrap())
+        .load()
+        .expect("the campaign's scenario builds");
+    let test = |set: u32| {
+        let a = (scenario.space())
+            .decode(&Point {
+                discrete: vec![set],
+                continuous: vec![],
+            })
+            .unwrap();
+        scenario.run(&a, 0)
+    };
+    assert!(test(0).is_ok(), "{:?}", test(0));
+    let e = test(1)
+        .expect_err("a value that is not a number")
+        .to_string();
+    println!("{e}");
+    assert!(e.contains(hostile), "{e}");
 }

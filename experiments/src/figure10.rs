@@ -183,8 +183,10 @@ pub const LOOP_TIMEOUT_S: f64 = 200.0;
 pub fn figure10b(budget: u64, jobs: usize, dir: &Path, model: Option<&Path>) -> Result<Figure10b> {
     let mut scenario = load("fig10b_loop_fog.star")?;
     if let Some(m) = model {
-        scenario.sut = paracosm_engine::sut::SutConfig::onnx(m)
-            .map_err(|e| Error::BadInput(format!("--loop-onnx: {e}")))?;
+        scenario.set_sut(
+            paracosm_engine::sut::SutConfig::onnx(m)
+                .map_err(|e| Error::BadInput(format!("--loop-onnx: {e}")))?,
+        );
     }
     let report = campaign(&scenario, budget, jobs).run(&dir.join("campaign"), |_| {})?;
     let mut tests = Vec::new();
@@ -295,7 +297,7 @@ pub fn figure10c(dir: &Path) -> Result<Figure10c> {
     let scenario = load("fig10c_components.star")?;
     std::fs::create_dir_all(dir).map_err(|e| Error::write(dir, e))?;
     let run = campaign(&scenario, 1, 1);
-    let space = &scenario.space;
+    let space = scenario.space();
     let level = |param: &str, want: &Value| -> Result<u32> {
         let p = space
             .param(param)

@@ -151,7 +151,7 @@ pub fn figure9_with(
 ) -> Result<Figure9> {
     let mut scenario = paracosm_scenarios::builtin("pedestrian-crossing")?;
     if let Some(sut) = sut {
-        scenario.sut = sut;
+        scenario.set_sut(sut);
     }
     let mut runs: Vec<(String, Vec<RunRecord>, u64)> = Vec::new();
     let mut dispersion = [0.0; 2];
@@ -201,8 +201,8 @@ pub fn figure9_with(
         .collect();
     let plots = paracosm::report::plot::failure_map(
         &dir.join("figure9"),
-        &scenario.space,
-        &scenario.map_axes,
+        scenario.space(),
+        scenario.map_axes(),
         &panels,
         paracosm::report::plot::Coloring::Outcome,
     )?;

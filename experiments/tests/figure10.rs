@@ -23,7 +23,7 @@ fn the_training_programs_load_with_their_documented_parameters() {
     ] {
         let s = paracosm_scenarios::load(&scenario_path(file).display().to_string())
             .unwrap_or_else(|e| panic!("{file}: {e}"));
-        let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+        let names: Vec<&str> = s.space().params().iter().map(|p| p.name.as_str()).collect();
         assert_eq!(names, params, "{file}");
     }
 }
@@ -139,7 +139,7 @@ fn the_shipped_follow_network_follows_the_red_car_for_the_whole_test_in_clear_we
         .unwrap();
     for (i, light) in [0.45, 0.475, 0.5, 0.525, 0.55].into_iter().enumerate() {
         let a = s
-            .space
+            .space()
             .decode(&paracosm_generators::Point {
                 discrete: vec![],
                 continuous: vec![light, 0.0],
@@ -169,11 +169,11 @@ fn the_loop_network_drives_round_the_loop_from_unseen_starts() {
     let mut s =
         paracosm_scenarios::load(&scenario_path("loop_check.star").display().to_string()).unwrap();
     let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/loop.onnx");
-    s.sut = paracosm_engine::sut::SutConfig::onnx(&model).unwrap();
-    let mut halton = Halton::new(&s.space);
+    s.set_sut(paracosm_engine::sut::SutConfig::onnx(&model).unwrap());
+    let mut halton = Halton::new(s.space());
     halton.skip(100).unwrap();
     for (i, p) in halton.ask(8).unwrap().iter().enumerate() {
-        let a = s.space.decode(p).unwrap();
+        let a = s.space().decode(p).unwrap();
         let o = s.run(&a, i as u64).unwrap();
         assert!(o.passed(), "{a:?}: {:?} {:?}", o.monitors, o.metrics);
     }

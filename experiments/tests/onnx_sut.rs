@@ -62,7 +62,7 @@ fn write_model(dir: &Path, name: &str, bytes: &[u8], manifest: Option<&str>) -> 
 
 fn campaign_records(sut: SutConfig, budget: u64, jobs: usize) -> Vec<paracosm::RunRecord> {
     let mut scenario = paracosm_scenarios::load("pedestrian-crossing").unwrap();
-    scenario.sut = sut;
+    scenario.set_sut(sut);
     let campaign = Campaign {
         scenario: &scenario,
         strategy: Strategy::Halton,
@@ -229,9 +229,13 @@ test(horizon = 5.0)
     let star = dir.path().join("learned.star");
     std::fs::write(&star, program).unwrap();
     let s = paracosm_scenarios::load(star.to_str().unwrap()).unwrap();
-    assert!(s.sut.name().ends_with("models/go.onnx"), "{}", s.sut.name());
+    assert!(
+        s.sut().name().ends_with("models/go.onnx"),
+        "{}",
+        s.sut().name()
+    );
     let o = s
-        .run(&s.space.decode(&Default::default()).unwrap(), 0)
+        .run(&s.space().decode(&Default::default()).unwrap(), 0)
         .unwrap();
     assert!(o.passed(), "{o:?}");
     // A missing model is an error at load, at the call.

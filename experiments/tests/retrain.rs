@@ -65,12 +65,12 @@ fn a_reduced_pilotnet_retrained_from_its_scenario_drives_past_the_crossing() {
     // scenario's liveness check, 95 m), and it leaves the road in at most 2 of 16 (the full
     // network, trained on three times the data with a bend for up to 8 epochs, in none of 400).
     let mut s = paracosm_scenarios::builtin("pedestrian-crossing").unwrap();
-    s.sut = SutConfig::onnx(&onnx).unwrap();
-    let mut halton = Halton::new(&s.space);
+    s.set_sut(SutConfig::onnx(&onnx).unwrap());
+    let mut halton = Halton::new(s.space());
     halton.skip(4096 + 64).unwrap();
     let (mut passed, mut offroad) = (0, 0);
     for (i, p) in halton.ask(16).unwrap().iter().enumerate() {
-        let a = s.space.decode(p).unwrap();
+        let a = s.space().decode(p).unwrap();
         let o = s.run(&a, i as u64).unwrap();
         let failed: Vec<&str> = o
             .monitors

@@ -72,7 +72,7 @@ impl ScenarioHandle {
         match sut {
             Some(s) => {
                 let mut scenario = self.scenario.clone();
-                scenario.sut = s;
+                scenario.set_sut(s);
                 std::borrow::Cow::Owned(scenario)
             }
             None => std::borrow::Cow::Borrowed(&self.scenario),
@@ -83,7 +83,7 @@ impl ScenarioHandle {
     /// coordinate `u` in `[0, 1]` (1 is taken as the largest value below it, the interval's
     /// upper end), a discrete one as level `min(floor(u · L), L − 1)`.
     fn unit_points(&self, values: &[f64], rows: usize, d: usize) -> PyResult<Vec<Point>> {
-        let params = self.scenario.space.params();
+        let params = self.scenario.space().params();
         if d != params.len() {
             return Err(value_error(format!(
                 "points has {d} columns, the scenario has {} parameters ({})",
@@ -266,26 +266,26 @@ impl ScenarioHandle {
     /// The scenario's name.
     #[getter]
     fn name(&self) -> String {
-        self.scenario.name.clone()
+        self.scenario.name().to_owned()
     }
 
     /// Its one-line description.
     #[getter]
     fn description(&self) -> String {
-        self.scenario.description.clone()
+        self.scenario.description().to_owned()
     }
 
     /// Length of one test, s.
     #[getter]
     fn horizon_s(&self) -> f64 {
-        self.scenario.horizon_s
+        self.scenario.horizon_s()
     }
 
     /// The monitors' names, in order.
     #[getter]
     fn monitors(&self) -> Vec<String> {
         self.scenario
-            .monitors
+            .monitors()
             .iter()
             .map(|m| m.name().to_owned())
             .collect()
@@ -300,7 +300,7 @@ impl ScenarioHandle {
     /// The system under test it runs by default.
     #[getter]
     fn sut(&self) -> String {
-        self.scenario.sut.name()
+        self.scenario.sut().name()
     }
 
     /// The name of the system under test that these arguments choose (the scenario's own
@@ -315,7 +315,7 @@ impl ScenarioHandle {
         sut_fresh: bool,
     ) -> PyResult<String> {
         Ok(sut_config(sut, sut_cmd, sut_timeout, sut_fresh)?
-            .map_or_else(|| self.scenario.sut.name(), |s| s.name()))
+            .map_or_else(|| self.scenario.sut().name(), |s| s.name()))
     }
 
     /// What the program loads with but checks or varies less than it seems to.
@@ -326,7 +326,7 @@ impl ScenarioHandle {
 
     /// The parameters as JSON (`[{"name", "domain", "unit"}]`, as in `campaign.json`).
     fn space_json(&self) -> String {
-        serde_json::to_string(self.scenario.space.params()).expect("a space serialises")
+        serde_json::to_string(self.scenario.space().params()).expect("a space serialises")
     }
 
     /// Runs unit-cube rows (`(n, d)` float64, every parameter in declaration order).
@@ -368,7 +368,7 @@ impl ScenarioHandle {
         sut_timeout: f64,
         sut_fresh: bool,
     ) -> PyResult<Vec<String>> {
-        let set = paracosm::cover::parse_tests(file, text, false, Some(&self.scenario.space))
+        let set = paracosm::cover::parse_tests(file, text, false, Some(self.scenario.space()))
             .map_err(value_error)?;
         let sut = sut_config(sut, sut_cmd, sut_timeout, sut_fresh)?;
         self.run_points(py, set.points, sut, jobs, seed)

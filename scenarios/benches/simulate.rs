@@ -46,7 +46,7 @@ fn bench(c: &mut Criterion) {
     for (case, u) in [("safe_15s", [0.05, 0.9]), ("collision", [0.26, 0.09])] {
         for (name, s) in &versions {
             let a = s
-                .space
+                .space()
                 .decode(&Point {
                     discrete: vec![],
                     continuous: u.to_vec(),
@@ -84,7 +84,7 @@ fn bench(c: &mut Criterion) {
     ] {
         let s = builtin(&name.replace('_', "-")).unwrap();
         let a = s
-            .space
+            .space()
             .decode(&Point {
                 discrete: vec![],
                 continuous: u.to_vec(),
@@ -98,7 +98,7 @@ fn bench(c: &mut Criterion) {
             .find(|(k, _)| *k == "simulated_s")
             .map(|(_, v)| *v)
             .unwrap();
-        assert_eq!(simulated, s.horizon_s, "{name} runs to its horizon");
+        assert_eq!(simulated, s.horizon_s(), "{name} runs to its horizon");
         group.bench_function(format!("{name}_{simulated}s"), |b| {
             b.iter(|| s.run(&a, 0).unwrap())
         });
@@ -118,7 +118,7 @@ fn camera(c: &mut Criterion) {
     use paracosm_engine::sut::{ExternalConfig, SutConfig};
     let base = builtin("pedestrian-crossing").unwrap();
     let a = base
-        .space
+        .space()
         .decode(&Point {
             discrete: vec![],
             continuous: vec![0.05, 0.9],
@@ -147,7 +147,7 @@ fn camera(c: &mut Criterion) {
         ("external", external),
     ] {
         let mut s = base.clone();
-        s.sut = sut;
+        s.set_sut(sut);
         let outcome = s.run(&a, 0).unwrap();
         let simulated = outcome
             .metrics
@@ -203,7 +203,7 @@ fn maps(c: &mut Criterion) {
             );
             let s = lang::load_source(&format!("{name}.star"), &text, name).unwrap();
             let a = s
-                .space
+                .space()
                 .decode(&Point {
                     discrete: vec![],
                     continuous: vec![0.5],

@@ -39,6 +39,15 @@ pub enum ScenarioError {
         /// The system's message.
         message: String,
     },
+    /// An OpenSCENARIO file, or an option given with it, that a campaign cannot read: the
+    /// message names the file (with the line and column) or the option.
+    #[error("{message}")]
+    Input {
+        /// The file given.
+        path: std::path::PathBuf,
+        /// What is wrong, naming the file or the option.
+        message: String,
+    },
     /// The system under test failed.
     #[error(transparent)]
     Sut(#[from] SutError),

@@ -10,7 +10,9 @@
 #![warn(missing_docs)]
 
 mod error;
+pub mod front_end;
 pub mod lang;
+pub mod map_files;
 pub use paracosm_engine::memory;
 pub mod reference;
 mod runner;
@@ -22,8 +24,12 @@ pub mod xosc;
 use std::path::Path;
 
 pub use error::ScenarioError;
+pub use front_end::{FrontEnd, RustScenes, SceneFn};
 pub use runner::{signal, RunOptions, Sample, TestOutcome};
-pub use scenario::{CameraOnly, InputFile, RustWorlds, Scenario, Warning, Worlds};
+pub use scenario::{
+    map_axes_of, monitors_of, scene_contract, CameraOnly, InputFile, Scenario, SceneContract,
+    Warning,
+};
 pub use scene::MonitorSpec;
 
 /// The shipped scenario programs: `(file name, source)`.

@@ -125,6 +125,13 @@ fn publish_streams(
     Ok(())
 }
 
+/// What judges one test: its scene's monitors ([`crate::scenario::monitors_of`]) and its
+/// horizon, s.
+struct Judged {
+    monitors: Vec<MonitorSpec>,
+    horizon_s: f64,
+}
+
 /// The monitors of one test and which of them have settled their verdict.
 struct Watch {
     monitors: Vec<Box<dyn Monitor>>,
@@ -247,11 +254,18 @@ impl Scenario {
         options: &mut RunOptions<'_>,
     ) -> Result<TestOutcome, ScenarioError> {
         let mut out = None;
-        self.worlds.with_scene(assignment, &mut |scene, host| {
-            out = Some(
+        self.with_scene(assignment, &mut |scene, host| {
+            // Each test is judged by its own scene's monitors, over its own horizon.
+            let judged = crate::scenario::monitors_of(scene, self.name())
+                .map_err(ScenarioError::Load)
+                .map(|monitors| Judged {
+                    monitors,
+                    horizon_s: scene.horizon_s(),
+                });
+            out = Some(judged.and_then(|judged| {
                 crate::scenario::world_of(scene)
-                    .and_then(|spec| self.run_world(&spec, seed, host, options)),
-            );
+                    .and_then(|spec| self.run_world(&spec, &judged, seed, host, options))
+            }));
         })?;
         out.ok_or_else(|| ScenarioError::Language("no world was built".into()))?
     }
@@ -259,6 +273,7 @@ impl Scenario {
     fn run_world(
         &self,
         spec: &WorldSpec,
+        judged: &Judged,
         seed: u64,
         host: &mut dyn Host,
         options: &mut RunOptions<'_>,
@@ -267,7 +282,7 @@ impl Scenario {
             f(spec);
         }
         let mut sim = Simulation::new(spec)?;
-        let mut sut = self.sut.build();
+        let mut sut = self.sut().build();
         sut.reset(seed)?;
         let sensors = sut.sensors();
         // The system's own camera, or else the viewing camera, whose frames it never sees.
@@ -291,15 +306,15 @@ impl Scenario {
             None => 0,
         };
         let control_every = period_ticks(sensors.control_hz, spec.dt_s);
-        let monitors: Vec<Box<dyn Monitor>> = self
+        let monitors: Vec<Box<dyn Monitor>> = judged
             .monitors
             .iter()
-            .map(|m| m.build(self.horizon_s))
+            .map(|m| m.build(judged.horizon_s))
             .collect();
-        let mut watch = self.watch(spec, monitors);
+        let mut watch = watch(spec, &judged.monitors, monitors);
         // Whole steps covering the horizon: a horizon between two steps is rounded up (a
         // horizon of 0.005 s is one step, not none), within 1e-9 of a step it is that step.
-        let ticks = ((self.horizon_s / spec.dt_s - 1e-9).ceil() as u64).max(1);
+        let ticks = ((judged.horizon_s / spec.dt_s - 1e-9).ceil() as u64).max(1);
         // Streams are evaluated for the state a snapshot shows, so a published stream's value
         // and the runner's own signals describe the same moment.
         sim.evaluate(host)?;
@@ -354,40 +369,37 @@ impl Scenario {
 
         Ok(outcome(watch, tick < ticks, sim.t_s(), host.log()))
     }
+}
 
-    /// The monitors of one test and what they read: the published streams, and the runner's
-    /// signals that only some monitors need.
-    fn watch(&self, spec: &WorldSpec, monitors: Vec<Box<dyn Monitor>>) -> Watch {
-        Watch {
-            settled: vec![false; monitors.len()],
-            monitors,
-            signals: Signals::new(),
-            published: spec
-                .published
+/// The monitors of one test and what they read: the published streams, and the runner's
+/// signals that only some monitors need.
+fn watch(spec: &WorldSpec, specs: &[MonitorSpec], monitors: Vec<Box<dyn Monitor>>) -> Watch {
+    Watch {
+        settled: vec![false; monitors.len()],
+        monitors,
+        signals: Signals::new(),
+        published: spec
+            .published
+            .iter()
+            .map(|(name, id)| Published {
+                components: [".x", ".y", ".z"].map(|c| format!("{name}{c}")),
+                name: name.clone(),
+                id: *id,
+                judged: specs
+                    .iter()
+                    .filter_map(MonitorSpec::judged_stream)
+                    .find(|(_, signal, _)| *signal == name)
+                    .map(|(_, _, bools)| bools),
+            })
+            .collect(),
+        parts: SnapshotParts {
+            ttc: specs
                 .iter()
-                .map(|(name, id)| Published {
-                    components: [".x", ".y", ".z"].map(|c| format!("{name}{c}")),
-                    name: name.clone(),
-                    id: *id,
-                    judged: self
-                        .monitors
-                        .iter()
-                        .filter_map(MonitorSpec::judged_stream)
-                        .find(|(_, signal, _)| *signal == name)
-                        .map(|(_, _, bools)| bools),
-                })
-                .collect(),
-            parts: SnapshotParts {
-                ttc: self
-                    .monitors
-                    .iter()
-                    .any(|m| m.reads_runner_signal(signal::EGO_TTC_S)),
-                lane_offset: self
-                    .monitors
-                    .iter()
-                    .any(|m| m.reads_runner_signal(signal::EGO_LANE_OFFSET_M)),
-            },
-        }
+                .any(|m| m.reads_runner_signal(signal::EGO_TTC_S)),
+            lane_offset: specs
+                .iter()
+                .any(|m| m.reads_runner_signal(signal::EGO_LANE_OFFSET_M)),
+        },
     }
 }
 
@@ -459,7 +471,7 @@ mod tests {
         let s = pedestrian_crossing::scenario();
         let u = |v: f64, (lo, hi): (f64, f64)| (v - lo) / (hi - lo);
         let a = s
-            .space
+            .space()
             .decode(&Point {
                 discrete: vec![],
                 continuous: vec![
@@ -518,7 +530,7 @@ mod tests {
     fn instantiate_uses_the_assignment() {
         let s = pedestrian_crossing::scenario();
         let a = s
-            .space
+            .space()
             .decode(&Point {
                 discrete: vec![],
                 continuous: vec![0.0, 0.5],

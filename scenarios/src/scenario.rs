@@ -1,7 +1,8 @@
 use paracosm_engine::sut::SutConfig;
 use std::sync::Arc;
 
-use crate::scene::{LoadError, MonitorSpec, Scene};
+use crate::front_end::{FrontEnd, RustScenes, SceneFn};
+use crate::scene::{LoadError, LoadErrorKind, MonitorSpec, Scene};
 use crate::ScenarioError;
 use paracosm_engine::rx::Host;
 use paracosm_engine::WorldSpec;
@@ -48,58 +49,194 @@ pub struct CameraOnly {
 }
 
 /// A parameterised family of tests (paper §3.1, "test configuration"): open parameters, a
-/// world template, a system under test, monitors, and a horizon.
+/// world template, a system under test, monitors, and a horizon. Built by one constructor,
+/// [`Scenario::new`], from a [`FrontEnd`]; read through its accessors.
 #[derive(Clone)]
 pub struct Scenario {
-    /// Name, e.g. `pedestrian-crossing`.
-    pub name: String,
-    /// One-line description.
-    pub description: String,
-    /// The open parameters.
-    pub space: ParamSpace,
-    /// Length of one test, in seconds of simulated time.
-    pub horizon_s: f64,
-    /// The system under test the scenario runs by default.
-    pub sut: SutConfig,
-    /// The monitors, evaluated on every test.
-    pub monitors: Vec<MonitorSpec>,
-    /// The parameters of the failure map: none (a scenario without open parameters gets no
-    /// map), one (a strip plot), or two (`[x axis, y axis]`). Continuous or discrete.
-    pub map_axes: Vec<String>,
-    /// Whether a campaign's failure map is drawn over the two parameters its triage ranks
-    /// most relevant (when it ranks two) rather than [`Scenario::map_axes`], which are then
-    /// the fallback: an OpenSCENARIO campaign, whose file names no axes.
-    pub map_axes_by_relevance: bool,
-    /// What the program loads with but checks or varies less than it seems to, whatever the
-    /// system under test (see [`Scenario::warnings_for`] for the rest).
-    pub warnings: Vec<Warning>,
-    /// The coordinates of the space that no object reads (by name, as in
-    /// [`ParamSpace::params`]): sampled and recorded, but left out of coverage.
-    pub unused_params: Vec<String>,
-    /// The open parameters that only a camera sees.
-    pub camera_only: Vec<CameraOnly>,
-    /// The vehicle the system under test drives, as the summary names it, when the
-    /// scenario's file chose it among its entities (OpenSCENARIO: `Ego, 5 × 2 × 1.8 m`);
-    /// `None` for a program's `AutonomousVehicle`.
-    pub ego: Option<String>,
-    /// The program text it was loaded from (empty for scenarios written in Rust): part of a
-    /// campaign's fingerprint, so a resumed campaign runs the same program.
-    pub source: Arc<str>,
-    /// The files the scenario read (its OpenDRIVE maps; an OpenSCENARIO scenario's variation
-    /// file, scenario and catalogs), with their SHA-256: part of a campaign's fingerprint, so
-    /// `--resume` refuses a campaign whose map or catalog has changed.
-    pub input_files: Vec<InputFile>,
-    /// Builds each test's world.
-    pub(crate) worlds: Arc<dyn Worlds>,
+    name: String,
+    description: String,
+    space: ParamSpace,
+    horizon_s: f64,
+    sut: SutConfig,
+    monitors: Vec<MonitorSpec>,
+    map_axes: Vec<String>,
+    map_axes_by_relevance: bool,
+    warnings: Vec<Warning>,
+    unused_params: Vec<String>,
+    camera_only: Vec<CameraOnly>,
+    ego: Option<String>,
+    source: Arc<str>,
+    input_files: Vec<InputFile>,
+    front_end: Arc<dyn FrontEnd>,
 }
 
 impl Scenario {
+    /// The scenario of `front_end`: its space, source and findings as the front end gives
+    /// them, and its monitors, system under test, horizon and failure-map axes read from the
+    /// scene of the declared values ([`FrontEnd::with_scene`] with `None`) by
+    /// [`scene_contract`], as every test's are ([`Scenario::run`] judges a test with its own
+    /// scene's monitors).
+    ///
+    /// # Errors
+    /// What the front end's scene returns; [`ScenarioError::Load`] (kind
+    /// [`LoadErrorKind::Settings`]) for failure-map axes that are not parameters, or a monitor
+    /// named as the default `OffRoadMonitor`; [`ScenarioError::Language`] for a scene without
+    /// an ego vehicle.
+    pub fn new(front_end: Arc<dyn FrontEnd>) -> Result<Self, ScenarioError> {
+        let source = front_end.source();
+        let space = front_end.space().clone();
+        let mut contract = None;
+        front_end.with_scene(None, &mut |scene, _| {
+            contract = Some(scene_contract(scene, &space, &source.name));
+        })?;
+        let contract = contract
+            .ok_or_else(|| ScenarioError::Language("the front end built no scene".into()))??;
+        let findings = front_end.findings();
+        Ok(Scenario {
+            name: source.name,
+            description: source.description,
+            space,
+            horizon_s: contract.horizon_s,
+            sut: contract.sut,
+            monitors: contract.monitors,
+            map_axes: contract.map_axes,
+            map_axes_by_relevance: source.map_axes_by_relevance,
+            warnings: findings.warnings,
+            unused_params: findings.unused_params,
+            camera_only: findings.camera_only,
+            ego: source.ego,
+            source: source.text,
+            input_files: source.files,
+            front_end,
+        })
+    }
+
+    /// The scenario whose tests `build` declares, in plain Rust ([`RustScenes`]): its space,
+    /// monitors, horizon, system under test and failure map are read from the scene `build`
+    /// declares with representative values, as for any front end ([`Scenario::new`]).
+    ///
+    /// # Errors
+    /// As [`RustScenes::new`] and [`Scenario::new`].
+    pub fn from_scenes(
+        name: &str,
+        description: &str,
+        build: SceneFn,
+    ) -> Result<Self, ScenarioError> {
+        Scenario::new(Arc::new(RustScenes::new(name, description, build)?))
+    }
+
+    /// Name, e.g. `pedestrian-crossing`.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// One-line description.
+    pub fn description(&self) -> &str {
+        &self.description
+    }
+
+    /// The open parameters.
+    pub fn space(&self) -> &ParamSpace {
+        &self.space
+    }
+
+    /// Length of one test, in seconds of simulated time, in `(0, ∞)`.
+    pub fn horizon_s(&self) -> f64 {
+        self.horizon_s
+    }
+
+    /// The system under test the scenario runs: the one its scenes place, unless
+    /// [`Scenario::set_sut`] chose another.
+    pub fn sut(&self) -> &SutConfig {
+        &self.sut
+    }
+
+    /// Runs the scenario's tests with `sut` instead of the system its scenes place (the
+    /// command line's `--sut`, a learned model).
+    pub fn set_sut(&mut self, sut: SutConfig) {
+        self.sut = sut;
+    }
+
+    /// The monitors of the declared values' scene ([`scene_contract`]), the default
+    /// `OffRoadMonitor` included; each test is judged by its own scene's.
+    pub fn monitors(&self) -> &[MonitorSpec] {
+        &self.monitors
+    }
+
+    /// The parameters of the failure map: none (a scenario without open parameters gets no
+    /// map), one (a strip plot), or two (`[x axis, y axis]`). Continuous or discrete.
+    pub fn map_axes(&self) -> &[String] {
+        &self.map_axes
+    }
+
+    /// Whether a campaign's failure map is drawn over the two parameters its triage ranks
+    /// most relevant (when it ranks two) rather than [`Scenario::map_axes`], which are then
+    /// the fallback: an OpenSCENARIO campaign, whose file names no axes.
+    pub fn map_axes_by_relevance(&self) -> bool {
+        self.map_axes_by_relevance
+    }
+
+    /// What the scenario loads with but checks or varies less than it seems to, whatever
+    /// the system under test (see [`Scenario::warnings_for`] for the rest).
+    pub fn warnings(&self) -> &[Warning] {
+        &self.warnings
+    }
+
+    /// The coordinates of the space that no object reads (by name, as in
+    /// [`ParamSpace::params`]): sampled and recorded, but left out of coverage.
+    pub fn unused_params(&self) -> &[String] {
+        &self.unused_params
+    }
+
+    /// The open parameters that only a camera sees.
+    pub fn camera_only(&self) -> &[CameraOnly] {
+        &self.camera_only
+    }
+
+    /// The vehicle the system under test drives, as the summary names it, when the
+    /// scenario's file chose it among its entities (OpenSCENARIO: `Ego, 5 × 2 × 1.8 m`);
+    /// `None` for a program's `AutonomousVehicle`.
+    pub fn ego(&self) -> Option<&str> {
+        self.ego.as_deref()
+    }
+
+    /// The program text it was loaded from (empty for scenarios written in Rust): part of a
+    /// campaign's fingerprint, so a resumed campaign runs the same program.
+    pub fn source(&self) -> &Arc<str> {
+        &self.source
+    }
+
+    /// The files the scenario read (its OpenDRIVE maps; an OpenSCENARIO scenario's variation
+    /// file, scenario and catalogs), with their SHA-256: part of a campaign's fingerprint, so
+    /// `--resume` refuses a campaign whose map or catalog has changed.
+    pub fn input_files(&self) -> &[InputFile] {
+        &self.input_files
+    }
+
+    /// The front end that builds each test's scene.
+    pub fn front_end(&self) -> &Arc<dyn FrontEnd> {
+        &self.front_end
+    }
+
+    /// Builds the scene of the test `assignment` and calls `run` with it and the host that
+    /// runs its lambdas ([`FrontEnd::with_scene`]).
+    ///
+    /// # Errors
+    /// As [`FrontEnd::with_scene`].
+    pub fn with_scene(
+        &self,
+        assignment: &Assignment,
+        run: &mut dyn FnMut(&Scene, &mut dyn Host),
+    ) -> Result<(), ScenarioError> {
+        self.front_end.with_scene(Some(assignment), run)
+    }
+
     /// Builds the world of the test `assignment` and calls `run` with it and the host that
     /// runs its lambdas, for a caller that steps the test's [`paracosm_engine::Simulation`]
     /// itself (to read every actor's outputs each step, as `tests/motion.rs` does).
     ///
     /// # Errors
-    /// As [`Worlds::with_scene`], and [`ScenarioError::Load`] when the test's scene builds
+    /// As [`FrontEnd::with_scene`], and [`ScenarioError::Load`] when the test's scene builds
     /// no world ([`Scene::world`]).
     pub fn with_world(
         &self,
@@ -107,17 +244,10 @@ impl Scenario {
         run: &mut dyn FnMut(&WorldSpec, &mut dyn Host),
     ) -> Result<(), ScenarioError> {
         let mut built = Ok(());
-        self.worlds.with_scene(assignment, &mut |scene, host| {
+        self.with_scene(assignment, &mut |scene, host| {
             built = world_of(scene).map(|spec| run(&spec, host));
         })?;
         built
-    }
-
-    /// The scenario with its scenes built by `worlds` instead: for a library user's own
-    /// scene builder (or a test's), keeping the space, monitors and system under test.
-    pub fn with_worlds(mut self, worlds: Arc<dyn Worlds>) -> Self {
-        self.worlds = worlds;
-        self
     }
 }
 
@@ -134,121 +264,130 @@ pub(crate) fn world_of(scene: &Scene) -> Result<WorldSpec, ScenarioError> {
     })
 }
 
-/// Builds the scene of each test (paper §3.1: a test case closes every open stream).
-pub trait Worlds: Send + Sync {
-    /// Builds the scene for `assignment` and calls `run` with it and a host for its lambdas
-    /// (a Starlark program's: each test gets its own evaluation of the program, heap and
-    /// evaluator), for the duration of the test.
-    ///
-    /// # Errors
-    /// [`ScenarioError::MissingParam`] for an assignment that lacks a parameter;
-    /// [`ScenarioError::Load`] or [`ScenarioError::Engine`] when these values give an
-    /// impossible scene.
-    fn with_scene(
-        &self,
-        assignment: &Assignment,
-        run: &mut dyn FnMut(&Scene, &mut dyn Host),
-    ) -> Result<(), ScenarioError>;
+/// What a scene says of how its test is judged: read by [`Scenario::new`] from the declared
+/// values' scene and by the runner from each test's.
+#[derive(Debug, Clone)]
+pub struct SceneContract {
+    /// The scene's monitors, then the default `OffRoadMonitor` unless the scene judges
+    /// leaving the road or opts out (`test(offroad = False)`).
+    pub monitors: Vec<MonitorSpec>,
+    /// The failure map's axes: the scene's settings', else the space's first two
+    /// parameters.
+    pub map_axes: Vec<String>,
+    /// The test's length, s.
+    pub horizon_s: f64,
+    /// The system under test the scene places.
+    pub sut: SutConfig,
 }
 
-/// Scenes declared by a Rust function, whose streams call no lambda: it receives an empty
-/// scene whose open parameters take the test's values by name ([`Scene::for_assignment`])
-/// and declares the test into it.
-pub struct RustWorlds(pub SceneFn);
-
-/// A Rust function that declares a scenario's scene into the empty scene it receives.
-pub type SceneFn = fn(Scene) -> Result<Scene, ScenarioError>;
-
-impl Worlds for RustWorlds {
-    fn with_scene(
-        &self,
-        assignment: &Assignment,
-        run: &mut dyn FnMut(&Scene, &mut dyn Host),
-    ) -> Result<(), ScenarioError> {
-        let scene = (self.0)(Scene::for_assignment(assignment))?;
-        run(&scene, &mut paracosm_engine::rx::NoHost);
-        Ok(())
+/// The monitors that judge a test of `scene`: its own, then the default `OffRoadMonitor`
+/// ([`MonitorSpec::implicit_off_road`]) unless one judges leaving the road or the settings
+/// opt out.
+///
+/// # Errors
+/// [`LoadError`] of kind [`LoadErrorKind::Settings`] naming the monitor's place: a monitor
+/// named as the default one, which would then be added beside it. `file` names the place
+/// when the scene has no site for it.
+pub fn monitors_of(scene: &Scene, file: &str) -> Result<Vec<MonitorSpec>, LoadError> {
+    let mut monitors = scene.monitor_specs();
+    let has_off_road = monitors.iter().any(MonitorSpec::judges_off_road);
+    if scene.settings().offroad.unwrap_or(true) && !has_off_road {
+        let implicit = MonitorSpec::implicit_off_road();
+        if let Some(k) = monitors.iter().position(|m| m.name() == implicit.name()) {
+            let at = scene
+                .monitors()
+                .nth(k)
+                .map_or(file.to_owned(), |(_, s)| s.to_string());
+            return Err(LoadError::new(
+                LoadErrorKind::Settings,
+                format!(
+                    "error: a monitor is named `{}`, the name of the default OffRoadMonitor: \
+                     rename it, declare OffRoadMonitor(v) yourself, or opt out with \
+                     test(offroad = False)\n --> {at}",
+                    implicit.name()
+                ),
+            ));
+        }
+        monitors.push(implicit);
     }
+    Ok(monitors)
 }
 
-impl Scenario {
-    /// The scenario whose tests `build` declares, in plain Rust: its space, monitors, horizon,
-    /// system under test and failure map are read from the scene `build` declares with
-    /// representative values, as a front end's load does (the default `OffRoadMonitor` is
-    /// added unless the scene judges leaving the road or opts out).
-    ///
-    /// # Errors
-    /// What `build` returns; [`ScenarioError::Language`] for an open parameter without a
-    /// name, one that varies over time (a Rust scene declares constant parameters), or a
-    /// scene without an ego vehicle; [`ScenarioError::Space`] for an invalid space.
-    pub fn from_scenes(
-        name: &str,
-        description: &str,
-        build: SceneFn,
-    ) -> Result<Self, ScenarioError> {
-        let probe = build(Scene::new(None))?;
-        let mut params = Vec::new();
-        for d in probe.params() {
-            let bad = |why: &str| {
-                ScenarioError::Language(format!("the parameter declared at {}: {why}", d.site))
-            };
-            let name = d.name.as_deref().ok_or_else(|| bad("it has no name"))?;
-            if d.over_time != crate::scene::OverTime::Constant {
-                return Err(bad(
-                    "it varies over time, which a Rust scene does not declare",
-                ));
-            }
-            params.push(match &d.domain {
-                paracosm_generators::Domain::Interval { lo, hi } => {
-                    paracosm_generators::Param::interval(
-                        name,
-                        *lo,
-                        *hi,
-                        d.unit.as_deref().unwrap_or(""),
-                    )
-                }
-                paracosm_generators::Domain::Levels(levels) => {
-                    paracosm_generators::Param::levels(name, levels.clone())
-                }
-            });
+/// How `scene` is judged ([`SceneContract`]), its failure-map axes checked against `space`.
+///
+/// # Errors
+/// As [`monitors_of`]; [`LoadErrorKind::Settings`] for axes that name one parameter twice
+/// or a name that is not a parameter of `space`; [`ScenarioError::Language`] for a scene
+/// without an ego vehicle.
+pub fn scene_contract(
+    scene: &Scene,
+    space: &ParamSpace,
+    file: &str,
+) -> Result<SceneContract, ScenarioError> {
+    let monitors = monitors_of(scene, file)?;
+    let map_axes = map_axes_of(scene, space, file)?;
+    let sut = scene
+        .ego()
+        .map(|(_, sut)| sut.clone())
+        .ok_or_else(|| ScenarioError::Language("the scene places no ego vehicle".into()))?;
+    Ok(SceneContract {
+        monitors,
+        map_axes,
+        horizon_s: scene.horizon_s(),
+        sut,
+    })
+}
+
+/// The failure map's axes of `scene`: its settings' (`test(map = ...)`), checked against
+/// `space`, else the space's first two parameters.
+///
+/// # Errors
+/// [`LoadErrorKind::Settings`] for axes that name one parameter twice or a name that is not
+/// a parameter of `space`, at the settings' site (else `file`).
+pub fn map_axes_of(
+    scene: &Scene,
+    space: &ParamSpace,
+    file: &str,
+) -> Result<Vec<String>, LoadError> {
+    let settings = |message: String| LoadError::new(LoadErrorKind::Settings, message);
+    // Where `test(map=)` was given, else the scenario's file.
+    let test_at = || {
+        let site = scene.settings().site.as_ref();
+        site.map_or(file.to_owned(), ToString::to_string)
+    };
+    let Some(axes) = &scene.settings().map_axes else {
+        return Ok(space
+            .params()
+            .iter()
+            .take(2)
+            .map(|p| p.name.clone())
+            .collect());
+    };
+    if let [a, b] = &axes[..] {
+        if a == b {
+            return Err(settings(format!(
+                "error: test(map=...) names `{a}` twice: a failure map needs two different \
+                 parameters\n --> {}",
+                test_at(),
+            )));
         }
-        let space = ParamSpace::new(params)?;
-        let mut monitors = probe.monitor_specs();
-        if probe.settings().offroad.unwrap_or(true)
-            && !monitors.iter().any(MonitorSpec::judges_off_road)
-        {
-            monitors.push(MonitorSpec::implicit_off_road());
-        }
-        let sut = probe
-            .ego()
-            .map(|(_, sut)| sut.clone())
-            .ok_or_else(|| ScenarioError::Language("the scene places no ego vehicle".into()))?;
-        let map_axes = probe.settings().map_axes.clone().unwrap_or_else(|| {
-            space
-                .params()
-                .iter()
-                .take(2)
-                .map(|p| p.name.clone())
-                .collect()
-        });
-        Ok(Scenario {
-            name: name.to_owned(),
-            description: description.to_owned(),
-            space,
-            horizon_s: probe.horizon_s(),
-            sut,
-            monitors,
-            map_axes,
-            map_axes_by_relevance: false,
-            warnings: vec![],
-            unused_params: vec![],
-            camera_only: vec![],
-            ego: None,
-            source: Arc::from(""),
-            input_files: Vec::new(),
-            worlds: Arc::new(RustWorlds(build)),
-        })
     }
+    for a in axes {
+        if space.param(a).is_none() {
+            let known: Vec<&str> = space.params().iter().map(|p| p.name.as_str()).collect();
+            return Err(settings(format!(
+                "error: test(map=...) names `{a}`, which is not a parameter (the parameters: \
+                 {})\n --> {}",
+                if known.is_empty() {
+                    "none".to_owned()
+                } else {
+                    known.join(", ")
+                },
+                test_at(),
+            )));
+        }
+    }
+    Ok(axes.clone())
 }
 
 impl Scenario {
@@ -294,8 +433,7 @@ impl Scenario {
     /// [`ScenarioError::Engine`] when the values give an impossible world.
     pub fn instantiate(&self, assignment: &Assignment) -> Result<WorldSpec, ScenarioError> {
         let mut out = None;
-        self.worlds
-            .with_scene(assignment, &mut |scene, _| out = Some(world_of(scene)))?;
+        self.with_scene(assignment, &mut |scene, _| out = Some(world_of(scene)))?;
         out.ok_or_else(|| ScenarioError::Language("no world was built".into()))?
     }
 }

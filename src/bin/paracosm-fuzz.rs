@@ -58,9 +58,11 @@ fn main() -> ExitCode {
             .and_then(|s| say(&s.text()).map(|()| s.exit_code())),
         Some(Sub::Export(a)) => export(a),
         Some(Sub::Map(a)) => map(a),
-        Some(Sub::Xosc(a)) => paracosm::xosc::inspect_with_map(&a.file, &a.open, a.continuous)
-            .map_err(anyhow::Error::from)
-            .and_then(|i| say(&i.text()).map(|()| 0)),
+        Some(Sub::Xosc(a)) => {
+            paracosm_scenarios::xosc::inspect_with_map(&a.file, &a.open, a.continuous)
+                .map_err(|e| anyhow::Error::new(Error::from(e)))
+                .and_then(|i| say(&i.text()).map(|()| 0))
+        }
         None => run(&cli),
     };
     let code = match result {
@@ -120,10 +122,10 @@ fn run(cli: &Cli) -> Result<u8> {
         for name in paracosm_scenarios::builtin_names() {
             let s =
                 paracosm_scenarios::builtin(&name).context("a built-in scenario fails to load")?;
-            let params: Vec<String> = s.space.params().iter().map(|p| p.label()).collect();
+            let params: Vec<String> = s.space().params().iter().map(|p| p.label()).collect();
             say(&format!(
                 "{name}\n    {}\n    parameters: {}",
-                s.description,
+                s.description(),
                 params.join(", ")
             ))?;
         }

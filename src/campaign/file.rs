@@ -324,11 +324,11 @@ impl CampaignFile {
             points,
         } = settings;
         let strategy = strategy.as_str();
-        let space = scenario.space.params().to_vec();
-        let source_sha256 = sha256_hex(scenario.source.as_bytes());
+        let space = scenario.space().params().to_vec();
+        let source_sha256 = sha256_hex(scenario.source().as_bytes());
         let fingerprint = {
             let f = Fingerprinted {
-                scenario_name: &scenario.name,
+                scenario_name: scenario.name(),
                 scenario_source_sha256: source_sha256.clone(),
                 space: &space,
                 sut: &sut,
@@ -337,8 +337,8 @@ impl CampaignFile {
                 budget,
                 strength,
                 points_sha256: points.as_ref().map(|p| p.sha256.as_str()),
-                scenario_model_sha256: scenario.sut.model_sha256(),
-                input_files: &scenario.input_files,
+                scenario_model_sha256: scenario.sut().model_sha256(),
+                input_files: scenario.input_files(),
             };
             sha256_hex(&serde_json::to_vec(&f).expect("settings serialise"))
         };
@@ -356,7 +356,7 @@ impl CampaignFile {
             points,
             scenario_sha256: Some(source_sha256),
             checks: BTreeMap::new(),
-            input_files: scenario.input_files.clone(),
+            input_files: scenario.input_files().to_vec(),
             stop_at_first_failure: false,
         }
         .checked()
@@ -538,8 +538,13 @@ mod tests {
         let sharded = make(0, Some(Shard { index: 1, count: 2 }));
         assert_eq!(a.fingerprint, sharded.fingerprint, "shards share it");
         assert_eq!(a.differences(&make(1, None)), ["seed: 0 vs 1"]);
-        let mut edited = s.clone();
-        edited.source = "# edited\n".into();
+        // The same program with one more comment line.
+        let edited = paracosm_scenarios::lang::load_source(
+            "pedestrian_crossing.star",
+            &format!("{}# edited\n", s.source()),
+            "pedestrian-crossing",
+        )
+        .unwrap();
         let b = CampaignFile::new(
             &ScenarioRef::named("pedestrian-crossing"),
             &edited,

@@ -33,7 +33,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
     let (template, shards) = read_shards(dirs)?;
     let mut scenario = template.scenario.load()?;
     if let Some(sut) = template.sut.config()? {
-        scenario.sut = sut;
+        scenario.set_sut(sut);
     }
     let mut records = Vec::with_capacity(template.budget as usize);
     for (dir, file) in shards.values() {
@@ -223,7 +223,7 @@ pub fn merge_folders(
         warnings: crate::report::warnings_of(&m.scenario),
     })?;
     if let Some(path) = junit {
-        crate::report::junit::write(path, &m.scenario.name, &m.records, out)?;
+        crate::report::junit::write(path, m.scenario.name(), &m.records, out)?;
     }
     let text = format!(
         "merged {} shards into {}\n{}",

@@ -185,12 +185,12 @@ impl Campaign<'_> {
                 .points
                 .ok_or(paracosm_generators::GeneratorError::NeedsPoints)?;
             return Ok(Strategy::build_given(
-                &self.scenario.space,
+                self.scenario.space(),
                 points.to_vec(),
             )?);
         }
         Ok(self.strategy.build_sized(
-            &self.scenario.space,
+            self.scenario.space(),
             self.seed,
             self.budget,
             self.strength,
@@ -239,7 +239,7 @@ impl Campaign<'_> {
                         &states,
                         (trace.every_s, world.dt_s),
                         (
-                            &self.scenario.name,
+                            self.scenario.name(),
                             &crate::export::trace::ego_name(self.scenario),
                         ),
                     );
@@ -260,7 +260,7 @@ impl Campaign<'_> {
         let started = Instant::now();
         let seed = test_seed(self.seed, id);
         let scenario = self.scenario;
-        let decoded = scenario.space.decode(point);
+        let decoded = scenario.space().decode(point);
         let outcome = match &decoded {
             Ok(assignment) => catch_unwind(AssertUnwindSafe(|| {
                 scenario.run_with(assignment, seed, options)

@@ -32,7 +32,7 @@ pub fn load(
     ids: Range<u64>,
     repair: bool,
 ) -> Result<Existing, Error> {
-    let space = &scenario.space;
+    let space = scenario.space();
     let passive = scenario.passive_monitors();
     let path = dir.join(RESULTS_FILE);
     paracosm_engine::files::regular_file(&path).map_err(|e| Error::input(&path, e))?;

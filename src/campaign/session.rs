@@ -294,7 +294,7 @@ pub fn run(
                 Ok(())
             },
         )),
-        junit: junit_path.map(|path| junit_at_end(path, scenario.name.clone(), out)),
+        junit: junit_path.map(|path| junit_at_end(path, scenario.name().to_owned(), out)),
     };
     let prior = stored.is_some().then_some(existing.records.as_slice());
     let report = campaign.run_ids(start..ids.end, prior, stop, &mut [&mut chain])?;
@@ -484,12 +484,12 @@ fn stored_campaign(request: &Request) -> Result<Option<CampaignFile>, Error> {
 /// there are no t-tuples (and a space with none has no covering array at all).
 fn check_strength(request: &Request, scenario: &Scenario, strategy: Strategy) -> Result<(), Error> {
     if let (Some(t), true) = (request.strength, Strategy::SUITES.contains(&strategy)) {
-        let nd = scenario.space.level_counts().len();
+        let nd = scenario.space().level_counts().len();
         if t > nd {
             return Err(Error::BadInput(format!(
                 "--strength {t}: a covering array of strength {t} needs {t} discrete parameters, \
                  and {} has {nd}{}",
-                scenario.name,
+                scenario.name(),
                 if nd == 0 {
                     " (its suite is Halton points alone: leave --strength out)"
                 } else {
@@ -644,7 +644,7 @@ fn load_scenario(name: &ScenarioRef, choice: &SutChoice) -> Result<Scenario, Err
     let mut scenario = name.load()?;
     if let Some(s) = choice.config()? {
         crate::refuse_sut_for_scripted_ego(&scenario)?;
-        scenario.sut = s;
+        scenario.set_sut(s);
     }
     Ok(scenario)
 }
@@ -688,7 +688,7 @@ fn requested_settings(
                 let suite = request
                     .strategy
                     .is_some_and(|s| Strategy::SUITES.contains(&s));
-                match scenario.space.level_counts().len() {
+                match scenario.space().level_counts().len() {
                     1 if suite => 1,
                     _ => 2,
                 }
@@ -870,7 +870,7 @@ fn read_points(
         &path.display().to_string(),
         &text,
         is_jsonl,
-        Some(&scenario.space),
+        Some(scenario.space()),
     )
     .map_err(|e| Error::malformed(path, e.to_string()))?;
     if let Some(b) = request.budget.filter(|&b| b != set.points.len() as u64) {

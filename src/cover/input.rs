@@ -400,7 +400,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let space = paracosm_scenarios::builtin("pedestrian-crossing")
             .unwrap()
-            .space;
+            .space()
+            .clone();
         let f = write(
             &dir,
             "a.csv",
@@ -446,7 +447,8 @@ mod tests {
         }
         let space = paracosm_scenarios::builtin("pedestrian-crossing")
             .unwrap()
-            .space;
+            .space()
+            .clone();
         let f = write(&dir, "far.csv", "walking_speed,trigger_distance\n11,30\n");
         let e = read_tests(&f, Some(&space)).unwrap_err().to_string();
         assert!(

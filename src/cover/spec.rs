@@ -68,12 +68,12 @@ struct SpecParam {
 /// error ([`SpecError::Program`]).
 pub fn load_space(spec: &str) -> Result<ParamSpace, SpecError> {
     if let Ok(s) = paracosm_scenarios::builtin(spec) {
-        return Ok(s.space);
+        return Ok(s.space().clone());
     }
     let path = Path::new(spec);
     if spec.ends_with(".star") {
         return paracosm_scenarios::load(spec)
-            .map(|s| s.space)
+            .map(|s| s.space().clone())
             .map_err(|e| SpecError::Program(e.to_string()));
     }
     if !path.exists() {

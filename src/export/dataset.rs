@@ -311,14 +311,14 @@ pub fn export(req: &DatasetRequest, stop: Option<&AtomicBool>) -> Result<Dataset
         .map_err(|e| Error::BadInput(format!("dataset camera: {e}")))?;
     let mut scenario = crate::load_scenario(&req.scenario)?;
     if let Some(sut) = &req.sut {
-        scenario.sut = sut.clone();
+        scenario.set_sut(sut.clone());
     }
     if let Some(learner) = &req.learner {
-        scenario.sut = SutConfig::Dagger {
+        scenario.set_sut(SutConfig::Dagger {
             learner: Box::new(learner.clone()),
-            teacher: Box::new(scenario.sut.clone()),
+            teacher: Box::new(scenario.sut().clone()),
             beta: req.teacher_share,
-        };
+        });
     }
     let campaign = Campaign {
         scenario: &scenario,
@@ -496,7 +496,7 @@ fn write_index(
 ) -> Result<DatasetSummary, Error> {
     let out = &req.out;
     let names: Vec<String> = scenario
-        .space
+        .space()
         .params()
         .iter()
         .map(|p| p.name.clone())
@@ -672,7 +672,7 @@ fn manifest(
         "rate_hz": req.rate_hz,
         "steer_noise": req.steer_noise,
         "noise_hold_s": req.noise_hold_s,
-        "teacher": match &scenario.sut {
+        "teacher": match scenario.sut() {
             SutConfig::Dagger { teacher, .. } => teacher.name(),
             other => other.name(),
         },

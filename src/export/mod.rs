@@ -54,27 +54,27 @@ fn network_document(
     maps: &[&PieceKind],
 ) -> Result<String, Error> {
     if maps.is_empty() {
-        xodr::write(&world.network, &scenario.name).map_err(input)
+        xodr::write(&world.network, scenario.name()).map_err(input)
     } else if maps.len() == 1 && world.network.pieces().len() == 1 {
         let read = scenario
-            .input_files
+            .input_files()
             .iter()
             .find(|f| {
                 matches!(maps[0], PieceKind::Map { map, .. }
                     if map.0.source.ends_with(f.path.trim_start_matches("./")))
             })
-            .or(scenario.input_files.first())
+            .or(scenario.input_files().first())
             .ok_or_else(|| input("the program's map is not among the files it read"))?;
         if program.xosc().is_some() {
             // An OpenSCENARIO campaign names its files relative to the folder of its file.
             let folder = Path::new(program.path()).parent().unwrap_or(Path::new(""));
             paracosm_scenarios::text_file::read_text(
                 &folder.join(&read.path),
-                paracosm_scenarios::lang::map_files::MAX_MAP_BYTES,
+                paracosm_scenarios::map_files::MAX_MAP_BYTES,
             )
             .map_err(|e| input(format!("cannot read {}: {e}", read.path)))
         } else {
-            paracosm_scenarios::lang::map_files::read_input_file(program.path(), &read.path)
+            paracosm_scenarios::map_files::read_input_file(program.path(), &read.path)
                 .map_err(input)
         }
     } else {
@@ -120,7 +120,7 @@ pub fn export(
         .unwrap_or_default();
     let description = format!(
         "paracosm test {id} of {} (campaign {}, seed {}): {}",
-        scenario.name,
+        scenario.name(),
         &campaign.fingerprint[..16.min(campaign.fingerprint.len())],
         campaign.seed,
         replayed.recorded["status"].as_str().unwrap_or("?")
@@ -132,7 +132,7 @@ pub fn export(
         network_file: xodr_name.clone(),
         world: &world,
         states: &states,
-        horizon_s: scenario.horizon_s,
+        horizon_s: scenario.horizon_s(),
         origin_m,
     });
     let xosc_path = out.join(format!("{stem}.xosc"));
@@ -218,7 +218,7 @@ fn map_origin_m(maps: &[&PieceKind]) -> [f64; 2] {
 /// collision and leaving the road), in the scenario's order.
 fn monitors_not_in_file(scenario: &paracosm_scenarios::Scenario) -> Vec<String> {
     scenario
-        .monitors
+        .monitors()
         .iter()
         .filter(|m| {
             !matches!(

@@ -150,7 +150,7 @@ pub fn replay_with(
     let campaign_file = CampaignFile::read(dir).map_err(input)?;
     let mut scenario = campaign_file.scenario.load()?;
     let changed = changed_since(&campaign_file, &scenario);
-    let record = RunRecord::from_line(&line, &scenario.space).map_err(|e| {
+    let record = RunRecord::from_line(&line, scenario.space()).map_err(|e| {
         input(format!(
             "{}: not a results record of this campaign: {e}",
             crate::error::located(results, line_no, e.column())
@@ -161,7 +161,7 @@ pub fn replay_with(
     let point: Point = record.point;
     if let Some(s) = sut.or(campaign_file.sut.config().map_err(input)?) {
         crate::refuse_sut_for_scripted_ego(&scenario)?;
-        scenario.sut = s;
+        scenario.set_sut(s);
     }
     let strategy: Strategy = campaign_file.strategy.parse().map_err(input)?;
     let campaign = Campaign {
@@ -279,7 +279,7 @@ pub fn changed_since(
     file: &CampaignFile,
     scenario: &paracosm_scenarios::Scenario,
 ) -> Option<String> {
-    let now = crate::campaign::file::sha256_hex(scenario.source.as_bytes());
+    let now = crate::campaign::file::sha256_hex(scenario.source().as_bytes());
     if file
         .scenario_sha256
         .as_ref()
@@ -293,7 +293,7 @@ pub fn changed_since(
     }
     file.input_files
         .iter()
-        .find(|f| !scenario.input_files.contains(f))
+        .find(|f| !scenario.input_files().contains(f))
         .map(|f| {
             format!(
                 "the file `{}` the program reads changed since the campaign ran",

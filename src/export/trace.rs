@@ -266,8 +266,7 @@ pub fn write(
 /// (`Scenario::ego`, `Ego, 5 × 2 × 1.8 m`), else `ego`.
 pub fn ego_name(scenario: &paracosm_scenarios::Scenario) -> String {
     scenario
-        .ego
-        .as_deref()
+        .ego()
         .and_then(|e| e.split(", ").next())
         .unwrap_or("ego")
         .to_owned()

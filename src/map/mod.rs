@@ -22,7 +22,7 @@ use crate::Error;
 pub use junctions::{Connection, Junction};
 
 /// Largest map file read, bytes: the limit a program's `Map(...)` has.
-pub const MAX_MAP_BYTES: u64 = paracosm_scenarios::lang::map_files::MAX_MAP_BYTES;
+pub const MAX_MAP_BYTES: u64 = paracosm_scenarios::map_files::MAX_MAP_BYTES;
 
 /// A map read for listing and drawing ([`read`]).
 #[derive(Debug, Clone)]

@@ -221,10 +221,10 @@ fn plan_plots(scenario: &Scenario, triage: Option<&Triage>) -> Vec<(&'static str
 /// scenario's own.
 fn map_axes(scenario: &Scenario, triage: Option<&Triage>) -> Vec<String> {
     match triage {
-        Some(t) if scenario.map_axes_by_relevance && t.ranking.len() >= 2 => {
+        Some(t) if scenario.map_axes_by_relevance() && t.ranking.len() >= 2 => {
             t.ranking.iter().take(2).map(|r| r.param.clone()).collect()
         }
-        _ => scenario.map_axes.clone(),
+        _ => scenario.map_axes().to_vec(),
     }
 }
 
@@ -282,11 +282,11 @@ pub fn write_outputs(f: &Finished<'_>) -> Result<Written, crate::Error> {
     write_summary(f.out, &summary)?;
     // Planned once the triage has ranked the parameters.
     let planned = plan_plots(scenario, summary.triage.as_ref());
-    let shown = shown_name(&scenario.name);
+    let shown = shown_name(scenario.name());
     let data = PlotData {
         scenario: &shown,
         strategy: &f.file.strategy,
-        space: &scenario.space,
+        space: scenario.space(),
         records: f.records,
         triage: summary.triage.as_ref(),
     };
@@ -301,7 +301,7 @@ pub fn write_outputs(f: &Finished<'_>) -> Result<Written, crate::Error> {
     let page = crate::report::html::write(&crate::report::html::Page {
         out: f.out,
         summary: &summary,
-        space: &scenario.space,
+        space: scenario.space(),
         records: f.records,
         map_axes: &map_axes(scenario, summary.triage.as_ref()),
     });
@@ -382,7 +382,7 @@ fn used_only(space: &ParamSpace, points: &[Point], unused: &[String]) -> (ParamS
 /// The scenario's warnings for its system under test, as text.
 pub fn warnings_of(scenario: &Scenario) -> Vec<String> {
     scenario
-        .warnings_for(&scenario.sut)
+        .warnings_for(scenario.sut())
         .iter()
         .map(ToString::to_string)
         .collect()
@@ -394,7 +394,7 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
     let scenario = f.scenario;
     let coverage = {
         let points: Vec<Point> = f.records.iter().map(|r| r.point.clone()).collect();
-        let (space, points) = used_only(&scenario.space, &points, &scenario.unused_params);
+        let (space, points) = used_only(scenario.space(), &points, scenario.unused_params());
         let set = crate::cover::TestSet { space, points };
         let metrics: Vec<crate::cover::Metric> = ["dispersion", "cd", "wd", "md", "l2star", "star"]
             .iter()
@@ -413,24 +413,24 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
     Summary {
         failures: failures(f.records, f.out),
         tool: format!("paracosm {}", env!("CARGO_PKG_VERSION")),
-        scenario: scenario.name.clone(),
+        scenario: scenario.name().to_owned(),
         sut: Some(crate::report::summary::SutSummary::of(
-            &scenario.sut,
+            scenario.sut(),
             &f.file.sut,
         )),
-        ego: scenario.ego.clone(),
+        ego: scenario.ego().map(str::to_owned),
         strategy: f.file.strategy.clone(),
         seed: f.file.seed,
         budget: f.file.budget,
         shard: f.file.shard,
         tests_run: f.records.len() as u64,
         jobs: f.jobs,
-        space: scenario.space.params().to_vec(),
-        unused_params: scenario.unused_params.clone(),
+        space: scenario.space().params().to_vec(),
+        unused_params: scenario.unused_params().to_vec(),
         counts: Counts::of(f.records),
         first_failure: FirstFailure::of(f.records),
         coverage,
-        triage: crate::report::triage::triage(&scenario.space, f.records),
+        triage: crate::report::triage::triage(scenario.space(), f.records),
         warnings: f.warnings.clone(),
         wall_s: f.wall_s,
         outputs,
@@ -469,7 +469,7 @@ pub fn human(
         "{} of {} tests of {} ({}, seed {}{}): {} passed, {} failed, {} errors{}{speed}",
         summary.tests_run,
         expected,
-        scenario.name,
+        scenario.name(),
         summary.strategy,
         summary.seed,
         summary
@@ -517,7 +517,7 @@ fn first_failure_line(f: &FirstFailure, scenario: &Scenario) -> String {
         .iter()
         .map(|(n, v)| {
             let unit = scenario
-                .space
+                .space()
                 .param(n)
                 .and_then(|p| p.unit.as_ref())
                 .map(|u| format!(" {u}"))
@@ -622,7 +622,7 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
     let file = CampaignFile::read(dir)?;
     let mut scenario = file.scenario.load()?;
     if let Some(s) = file.sut.config()? {
-        scenario.sut = s;
+        scenario.set_sut(s);
     }
     let ids = file.ids();
     let existing = crate::campaign::results::load(dir, &scenario, ids.clone(), false)?;
@@ -670,12 +670,12 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
             dir.display()
         ));
     }
-    let shown = shown_name(&scenario.name);
+    let shown = shown_name(scenario.name());
     let axes = map_axes(&scenario, summary.triage.as_ref());
     let data = PlotData {
         scenario: &shown,
         strategy: &file.strategy,
-        space: &scenario.space,
+        space: scenario.space(),
         records: &existing.records,
         triage: summary.triage.as_ref(),
     };
@@ -696,7 +696,7 @@ pub fn reread(dir: &Path, redraw: &crate::cli::Redraw) -> Result<(String, Counts
         let page = crate::report::html::write(&crate::report::html::Page {
             out: dir,
             summary: &summary,
-            space: &scenario.space,
+            space: scenario.space(),
             records: &existing.records,
             map_axes: &axes,
         })?;

@@ -66,7 +66,7 @@ pub fn draw(
     let (actor, spread) = moving_actor(&tests).ok_or_else(|| {
         Error::BadInput(format!(
             "--on-map: no actor's start moves by {MOVES_M} m or more between the tests: no parameter of {} places an actor on the road, so there is nothing to draw on the map (use --map for a failure map over the parameters)",
-            scenario.name
+            scenario.name()
         ))
     })?;
     let marks: Vec<MapMark> = tests
@@ -81,7 +81,11 @@ pub fn draw(
         .collect();
     let map = road_map(&world, scenario)?;
     let label = format!("where {actor} starts in each test (it moves over {spread:.1} m)");
-    let title = format!("{}: {} tests over the road map", scenario.name, marks.len());
+    let title = format!(
+        "{}: {} tests over the road map",
+        scenario.name(),
+        marks.len()
+    );
     let drawing = RoadMapDrawing {
         map: &map,
         title: &title,
@@ -161,9 +165,9 @@ fn road_map(world: &WorldSpec, scenario: &Scenario) -> Result<Arc<RoadMap>, Erro
     match (maps.len(), pieces.len()) {
         (1, 1) => Ok(maps[0].clone()),
         (0, _) => {
-            let text = crate::export::xodr::write(&world.network, &scenario.name)
+            let text = crate::export::xodr::write(&world.network, scenario.name())
                 .map_err(|e| Error::BadInput(format!("--on-map: {e}")))?;
-            let name = format!("the roads of {}", scenario.name);
+            let name = format!("the roads of {}", scenario.name());
             opendrive::import(&name, &text)
                 .map(|i| i.map)
                 .map_err(|e| {

@@ -108,7 +108,7 @@ pub fn assign(space: &ParamSpace, values: &[(&str, Value)]) -> Assignment {
 
 /// The one test of a scenario without open parameters.
 pub fn no_params(s: &paracosm_scenarios::Scenario) -> Assignment {
-    s.space
+    s.space()
         .decode(&Point {
             discrete: vec![],
             continuous: vec![],

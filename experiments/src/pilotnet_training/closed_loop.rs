@@ -35,12 +35,12 @@ impl ClosedLoop {
         use paracosm_generators::{Generator, Halton};
         let scenario =
             paracosm_scenarios::load(name).map_err(|e| TrainingError::Scenario(e.to_string()))?;
-        let mut halton = Halton::new(&scenario.space);
+        let mut halton = Halton::new(scenario.space());
         halton.skip(CLOSED_LOOP_FROM)?;
         let points = halton
             .ask(tests)?
             .iter()
-            .map(|p| scenario.space.decode(p))
+            .map(|p| scenario.space().decode(p))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(ClosedLoop {
             scenario,
@@ -56,7 +56,7 @@ impl ClosedLoop {
         let config =
             paracosm_engine::sut::OnnxConfig::from_bytes("training", &onnx, self.manifest.clone())?;
         let mut s = self.scenario.clone();
-        s.sut = paracosm_engine::sut::SutConfig::Onnx(Box::new(config));
+        s.set_sut(paracosm_engine::sut::SutConfig::Onnx(Box::new(config)));
         let (mut failed, mut by_monitor) = (0, BTreeMap::new());
         for (i, a) in self.points.iter().enumerate() {
             let o = s

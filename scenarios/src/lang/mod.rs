@@ -11,7 +11,6 @@
 mod builtins;
 mod globals;
 mod host;
-pub mod map_files;
 mod methods;
 mod names;
 mod position;
@@ -216,7 +215,7 @@ fn check_nesting(source: &str) -> Result<(), (usize, usize)> {
 /// [`ScenarioError::Load`] as for [`load_file`]; an error that only some values cause
 /// names them.
 pub fn load_source(file: &str, source: &str, name: &str) -> Result<Scenario, ScenarioError> {
-    load_with_base(file, source, name, map_files::Base::of(file, false))
+    load_with_base(file, source, name, crate::map_files::Base::of(file, false))
 }
 
 /// [`load_source`] for a built-in scenario, whose maps are built in too.
@@ -225,14 +224,14 @@ pub(crate) fn load_builtin(
     source: &str,
     name: &str,
 ) -> Result<Scenario, ScenarioError> {
-    load_with_base(file, source, name, map_files::Base::Builtin)
+    load_with_base(file, source, name, crate::map_files::Base::Builtin)
 }
 
 fn load_with_base(
     file: &str,
     source: &str,
     name: &str,
-    base: map_files::Base,
+    base: crate::map_files::Base,
 ) -> Result<Scenario, ScenarioError> {
     let lang = |m: String| ScenarioError::Load(LoadError::new(LoadErrorKind::Syntax, m));
     let dialect = Dialect {

@@ -240,14 +240,14 @@ fn parameters_take_their_global_names_and_over_time_adds_coordinates() {
         "w = World(light = 1.0, fog = fog)\nr = RoadSegment(len = 200.0)\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, v)\nCollisionMonitor(v)\n"
     );
     let s = load_source("ok.star", &src, "ok").unwrap();
-    let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = s.space().params().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["fog.c0", "fog.c1", "fog.c2", "levels"]);
     // Items of a tuple or list argument are named by their index.
     let src = format!(
         "{HEADER}o = Obstacle(loc = r.onLane(-1, 80), size = (VarInterval(0.5, 2), 1.0, VarInterval(1, 2)))\nc = Car(loc = r.onLane(1, 40), route = [VarEnum([\"left\", \"right\"])])\nw.place(r, v, o, c)\nCollisionMonitor(v)\n"
     );
     let s = load_source("ok.star", &src, "ok").unwrap();
-    let names: Vec<&str> = s.space.params().iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = s.space().params().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["o.size[0]", "o.size[2]", "c.route[0]"]);
 }
 
@@ -281,7 +281,7 @@ fn stl_monitors_judge_tests_and_settle_early() {
     let s = load_source("stl.star", &program, "stl").unwrap();
     let run = |speed: f64, trigger: f64| {
         let a = s
-            .space
+            .space()
             .decode(&paracosm_generators::Point {
                 discrete: vec![],
                 continuous: vec![(speed - 0.5) / 9.5, (trigger - 5.0) / 55.0],
@@ -312,7 +312,7 @@ fn stl_monitors_judge_tests_and_settle_early() {
         + "Stl(\"G[0,15] (p.pos.x - ego_x_m > 0.5 * ego_speed_mps - 1)\", name = \"ahead\")\n";
     let s2 = load_source("stl.star", &both, "stl").unwrap();
     let a = s2
-        .space
+        .space()
         .decode(&paracosm_generators::Point {
             discrete: vec![],
             continuous: vec![(1.0 - 0.5) / 9.5, (55.0 - 5.0) / 55.0],
@@ -456,7 +456,7 @@ fn inputs_of_the_right_kind_load_whatever_their_form() {
     // `numLane=`, the paper's spelling, on every piece, open or not.
     let src = "w = World()\nn = VarEnum([2, 4])\nr = RoadSegment(len = 100.0, numLane = n)\na = Arc(radius = 40.0, numLane = n)\nk = Clothoid(numLane = n)\nx = CrossIntersection(numLane = n)\nro = Roundabout(numLane = n)\nr.connect((r.TWO, a, a.ONE), (a.TWO, k, k.ONE), (k.TWO, x, x.ONE), (x.THREE, ro, ro.ONE))\nv = AutonomousVehicle(loc = r.onLane(1, 10))\nw.place(r, a, k, x, ro, v)\nCollisionMonitor(v)\n";
     let s = load_source("ok.star", src, "ok").unwrap();
-    assert_eq!(s.space.params()[0].name, "n");
+    assert_eq!(s.space().params()[0].name, "n");
     let src = format!("{HEADER}r2 = RoadSegment(len = 50.0, friction = VarEnum([0.3, 0.9]))\nnet = r.connect((r.TWO, r2, r2.ONE))\np = Pedestrian(start = r.onLane(r.SideWalk, 100), target = r.onLane(-r.SideWalk, 100), speed = 1.0, dist = 10.0, car = v.pos.map(lambda p: p))\nw.place(r, r2, v, p)\nCollisionMonitor(v)\n");
     load_source("ok.star", &src, "ok").unwrap();
 }
@@ -465,7 +465,7 @@ fn inputs_of_the_right_kind_load_whatever_their_form() {
 fn run_once(src: &str) -> Result<crate::TestOutcome, crate::ScenarioError> {
     let s = load_source("run.star", src, "run").unwrap();
     let a = s
-        .space
+        .space()
         .decode(&paracosm_generators::Point {
             discrete: vec![],
             continuous: vec![],
@@ -525,7 +525,7 @@ fn a_parameter_in_another_unit_than_its_input_is_a_warning() {
         "kmh = VarInterval(10, 50, unit = \"km/h\")\nw = World",
     );
     let s = load_source("unit.star", &src, "unit").unwrap();
-    let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    let w: Vec<String> = s.warnings().iter().map(|w| w.to_string()).collect();
     assert!(
         w.iter().any(
             |w| w.contains("declared in km/h but feeds Car(speed=), which is in m/s")
@@ -541,7 +541,7 @@ fn a_parameter_in_another_unit_than_its_input_is_a_warning() {
     );
     assert!(inline.contains("fog = VarInterval"), "{inline}");
     let s = load_source("inline.star", &inline, "inline").unwrap();
-    let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    let w: Vec<String> = s.warnings().iter().map(|w| w.to_string()).collect();
     assert!(
         w.iter()
             .any(|w| w
@@ -561,11 +561,11 @@ fn a_parameter_in_another_unit_than_its_input_is_a_warning() {
     );
     let s = load_source("fine.star", &fine, "fine").unwrap();
     assert!(
-        !s.warnings
+        !s.warnings()
             .iter()
             .any(|w| w.to_string().contains("is declared in")),
         "{:?}",
-        s.warnings
+        s.warnings()
     );
     // Spellings of m/s² a user types (the shipped follow-lead-car writes `m/s^2`), and a
     // wrong one that still warns.
@@ -584,10 +584,10 @@ fn a_parameter_in_another_unit_than_its_input_is_a_warning() {
         );
         let s = load_source("decel.star", &src, "decel").unwrap();
         let warned = s
-            .warnings
+            .warnings()
             .iter()
             .any(|w| w.to_string().contains("is declared in"));
-        assert_eq!(warned, warns, "{unit}: {:?}", s.warnings);
+        assert_eq!(warned, warns, "{unit}: {:?}", s.warnings());
     }
     // Added to other numbers, a parameter keeps its unit: `r.onLane(1, 10.0 + gap)` with a
     // gap in s, and a speed in km/h less a constant, warn; a product may convert a unit
@@ -621,7 +621,7 @@ fn a_parameter_in_another_unit_than_its_input_is_a_warning() {
         };
         let s = load_source("sum.star", &src, "sum").unwrap();
         let w: Vec<String> = s
-            .warnings
+            .warnings()
             .iter()
             .map(|w| w.to_string())
             .filter(|w| w.contains("is declared in"))
@@ -637,7 +637,7 @@ fn a_parameter_in_another_unit_than_its_input_is_a_warning() {
 #[test]
 fn a_stream_nothing_reads_is_named_in_a_warning() {
     let unread = |s: &crate::Scenario| -> Vec<String> {
-        s.warnings
+        s.warnings()
             .iter()
             .map(|w| w.to_string())
             .filter(|w| w.contains("nothing uses this stream's values"))
@@ -651,7 +651,7 @@ fn a_stream_nothing_reads_is_named_in_a_warning() {
     );
     let s = load_source("unread.star", &src, "unread").unwrap();
     let w = unread(&s);
-    assert_eq!(w.len(), 1, "{:?}", s.warnings);
+    assert_eq!(w.len(), 1, "{:?}", s.warnings());
     // The last stream of the chain (the filter), not each one.
     assert!(w[0].contains("unread.star:6:"), "{w:?}");
     // Read by a car, a Signal, a foreach or a monitor: no warning.
@@ -663,7 +663,7 @@ fn a_stream_nothing_reads_is_named_in_a_warning() {
     ] {
         let src = with_car(car, used);
         let s = load_source("used.star", &src, "used").unwrap();
-        assert!(unread(&s).is_empty(), "{used}: {:?}", s.warnings);
+        assert!(unread(&s).is_empty(), "{used}: {:?}", s.warnings());
     }
     // Read by its name in a lambda (LANGUAGE.md, "Streams"), which makes no edge in the
     // graph: `limit` was named, and `k`, which changes the car's speed, called inert.
@@ -672,7 +672,7 @@ fn a_stream_nothing_reads_is_named_in_a_warning() {
         "k = VarInterval(5.0, 15.0)\nlimit = tick.map(lambda t: k - t)\nc = Car",
     );
     let s = load_source("named.star", &src, "named").unwrap();
-    assert!(unread(&s).is_empty(), "{:?}", s.warnings);
+    assert!(unread(&s).is_empty(), "{:?}", s.warnings());
     // Read in some worlds of the family only: not unread. The first world (`mode = "b"`)
     // leaves the stream unread; it is held in a list, so no variable names it.
     let src = with_car(", speed = fast[0] if mode == \"a\" else 5.0", "").replace(
@@ -680,7 +680,7 @@ fn a_stream_nothing_reads_is_named_in_a_warning() {
         "mode = VarEnum([\"b\", \"a\"])\nfast = [tick.map(lambda t: 5.0 + t)]\nc = Car",
     );
     let s = load_source("some.star", &src, "some").unwrap();
-    assert!(unread(&s).is_empty(), "{:?}", s.warnings);
+    assert!(unread(&s).is_empty(), "{:?}", s.warnings());
 }
 
 #[test]
@@ -711,7 +711,7 @@ fn monitors_have_unique_names_and_the_default_offroad_monitor_yields_to_a_declar
 
     let names = |src: &str| -> Vec<String> {
         let s = load_source("m.star", src, "m").unwrap();
-        s.monitors.iter().map(|m| m.name().to_owned()).collect()
+        s.monitors().iter().map(|m| m.name().to_owned()).collect()
     };
     let base = format!("{HEADER}w.place(r, v)\nCollisionMonitor(v)\n");
     assert_eq!(names(&base), ["collision", "offroad"]);
@@ -740,7 +740,7 @@ fn the_map_names_one_or_two_parameters_of_any_kind() {
     );
     let axes = |map: &str| -> Result<Vec<String>, String> {
         load_source("map.star", &format!("{base}test(map = {map})\n"), "map")
-            .map(|s| s.map_axes)
+            .map(|s| s.map_axes().to_vec())
             .map_err(|e| e.to_string())
     };
     assert_eq!(axes("\"c\"").unwrap(), ["c"]);
@@ -757,16 +757,16 @@ fn the_map_names_one_or_two_parameters_of_any_kind() {
     assert!(e.contains("names `c` twice"), "{e}");
     // Without test(map=), the first two parameters, whatever their kind.
     let s = load_source("map.star", &base, "map").unwrap();
-    assert_eq!(s.map_axes, ["c", "f"]);
+    assert_eq!(s.map_axes(), ["c", "f"]);
 }
 
 #[test]
 fn a_test_without_monitors_runs_to_its_horizon() {
     let src = format!("{HEADER}w.place(r, v)\ntest(horizon = 3.0, offroad = False)\n");
     let s = load_source("none.star", &src, "none").unwrap();
-    assert!(s.monitors.is_empty());
+    assert!(s.monitors().is_empty());
     assert!(s
-        .warnings
+        .warnings()
         .iter()
         .any(|w| w.message.contains("every test passes")));
     let o = run_once(&src).unwrap();
@@ -975,11 +975,11 @@ fn a_dropped_action_is_refused_and_a_changelane_across_warns() {
     }
     let s = load_source("ok.star", &format!("{HEADER}{car}tick.take(1).foreach(c.changeLane(1))\ndef f(t):\n    c.brake(3)\ntick.filter(lambda t: t > 1).foreach(f)\n"), "ok").unwrap();
     assert!(
-        s.warnings.iter().any(|w| w.message.contains(
+        s.warnings().iter().any(|w| w.message.contains(
             "Car c.changeLane(1) moves it from lane -1 into a lane of the other direction"
         ) && w.at == "ok.star:7:1"),
         "{:?}",
-        s.warnings
+        s.warnings()
     );
 }
 
@@ -992,11 +992,11 @@ fn a_parameter_of_a_car_disabled_in_every_test_changes_nothing() {
         "s = VarInterval(1.0, 9.0)\npaint = VarEnum([\"red\", \"blue\"])\nc = Car",
     );
     let s = load_source("off.star", &src, "off").unwrap();
-    assert_eq!(s.unused_params, ["s", "paint"], "{:?}", s.warnings);
+    assert_eq!(s.unused_params(), ["s", "paint"], "{:?}", s.warnings());
     // Enabled in some tests: both matter.
     let src = src.replace("enabled = False", "enabled = VarEnum([False, True])");
     let s = load_source("some.star", &src, "some").unwrap();
-    assert!(s.unused_params.is_empty(), "{:?}", s.unused_params);
+    assert!(s.unused_params().is_empty(), "{:?}", s.unused_params());
 }
 
 /// Hostile input, second round, requirement 4: the most parameters a program may declare
@@ -1014,8 +1014,8 @@ fn the_most_parameters_a_program_may_declare_load_and_one_more_is_refused() {
     };
     let most = super::MAX_PARAMS;
     let s = load_source("most.star", &program(most), "most").unwrap();
-    assert_eq!(s.space.params().len(), most);
-    assert_eq!(s.unused_params.len(), most, "none of them is used");
+    assert_eq!(s.space().params().len(), most);
+    assert_eq!(s.unused_params().len(), most, "none of them is used");
     let m = err(&program(most + 1));
     assert!(
         m.contains(&format!(

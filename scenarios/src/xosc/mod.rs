@@ -8,9 +8,15 @@
 //! Published signals (for `Stl` and `Monitor`): [`HEADWAY_SIGNAL`], [`GAP_SIGNAL`] and
 //! [`LANE_EDGE_SIGNAL`], the R157-style measures of the ego.
 
+mod campaign;
+mod describe;
 pub mod motion;
 pub mod road;
+mod space;
 pub mod story;
+
+pub use campaign::{campaign_scenario, inspect, inspect_in, inspect_with_map, Inspection, XoscRef};
+pub use space::{open_param, value_sets_param, varied_param};
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -24,8 +30,9 @@ use paracosm_generators::{Assignment, ParamSpace};
 use paracosm_openscenario::model::{self as m, Action, EntityKind};
 use paracosm_openscenario::read_scenario_in;
 
-use crate::lang::map_files::{Base, MapFiles};
-use crate::scenario::{Warning, Worlds};
+use crate::front_end::FrontEnd;
+use crate::map_files::{Base, MapFiles};
+use crate::scenario::Warning;
 use crate::scene::{LoadError, LoadErrorKind, Scene, Site, TestSettings};
 use crate::{MonitorSpec, Scenario, ScenarioError};
 
@@ -69,6 +76,12 @@ pub struct Source {
     pub files: Arc<paracosm_openscenario::FileSet>,
     /// The campaign's name for it: the file's name with its options (`a.xosc --open ...`).
     pub name: String,
+    /// The folder its input files are named relative to ([`relative_to`]): the campaign
+    /// file's, so its fingerprint is the same from any folder.
+    pub files_base: PathBuf,
+    /// What the campaign's reading of the file found before the scenario loads (a variation
+    /// file's limits): the scenario's own warnings follow them.
+    pub warnings: Vec<Warning>,
     /// The space of the test's parameters.
     pub space: ParamSpace,
     /// The overrides of one test.
@@ -325,24 +338,6 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
     let ego = ego_of(&model, source.ego.as_deref(), source.scripted_ego)?;
     let mut warnings = check(&model, (!source.scripted_ego).then_some(ego))?;
     let horizon_s = horizon(&model, source.horizon_s)?;
-    // The model's LogicFile path is already joined with the scenario's folder.
-    let dir = PathBuf::new();
-    let worlds = XoscWorlds {
-        template: source.template.clone(),
-        overrides: source.overrides,
-        maps: MapFiles::sharing(Base::Folder(dir), source.files.clone()),
-        scripted_ego: source.scripted_ego,
-        ego: source.ego.clone(),
-        horizon_s,
-    };
-    // The scene of the declared values: the map loads, the Init places every entity.
-    let (scene, _) = worlds.build(&model)?;
-    drop(scene);
-    warnings.extend(worlds.maps.warnings().into_iter().map(|w| Warning {
-        at: model.file.clone(),
-        message: w,
-    }));
-    let input_files = worlds.maps.inputs();
     // The failure map's axes: the intervals first, then the parameters with most levels.
     let mut axes: Vec<&paracosm_generators::Param> = source.space.params().iter().collect();
     axes.sort_by_key(|p| match &p.domain {
@@ -350,31 +345,36 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
         paracosm_generators::Domain::Levels(l) => usize::MAX - l.len(),
     });
     let map_axes = axes.iter().take(2).map(|p| p.name.clone()).collect();
-    Ok(Scenario {
+    // The model's LogicFile path is already joined with the scenario's folder.
+    let dir = PathBuf::new();
+    let mut front_end = XoscFrontEnd {
+        template: source.template.clone(),
+        overrides: source.overrides,
+        maps: MapFiles::sharing(Base::Folder(dir), source.files.clone()),
+        scripted_ego: source.scripted_ego,
+        ego: source.ego.clone(),
+        horizon_s,
+        map_axes,
+        space: source.space,
+        source: crate::front_end::Source::default(),
+        warnings: Vec::new(),
+    };
+    // The scene of the declared values: the map loads, the Init places every entity.
+    let (scene, _) = front_end.build(&model)?;
+    drop(scene);
+    warnings.extend(front_end.maps.warnings().into_iter().map(|w| Warning {
+        at: model.file.clone(),
+        message: w,
+    }));
+    warnings.extend(source.warnings);
+    front_end.warnings = warnings;
+    front_end.source = crate::front_end::Source {
         name: source.name,
         description: format!(
             "OpenSCENARIO {}.{} scenario {}",
             model.version.0, model.version.1, model.file
         ),
-        space: source.space,
-        horizon_s,
-        sut: if source.scripted_ego {
-            SutConfig::Scripted
-        } else {
-            SutConfig::Aeb(AebConfig::default())
-        },
-        monitors: vec![MonitorSpec::collision(), MonitorSpec::implicit_off_road()],
-        map_axes,
-        map_axes_by_relevance: true,
-        warnings,
-        unused_params: vec![],
-        camera_only: vec![],
-        ego: Some({
-            let e = &model.entities[ego];
-            let [l, w, h] = e.dimensions_m;
-            format!("{}, {l} × {w} × {h} m", e.name)
-        }),
-        source: Arc::from(
+        text: Arc::from(
             source
                 .files
                 .text(&source.template)
@@ -382,13 +382,43 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
                 .text
                 .as_str(),
         ),
-        input_files,
-        worlds: Arc::new(worlds),
-    })
+        files: (front_end.maps.inputs().into_iter())
+            .map(|f| crate::InputFile {
+                path: relative_to(&source.files_base, &f.path),
+                ..f
+            })
+            .collect(),
+        ego: Some({
+            let e = &model.entities[ego];
+            let [l, w, h] = e.dimensions_m;
+            format!("{}, {l} × {w} × {h} m", e.name)
+        }),
+        map_axes_by_relevance: true,
+    };
+    Scenario::new(Arc::new(front_end))
 }
 
-/// The worlds of an OpenSCENARIO scenario: the file read with each test's values.
-struct XoscWorlds {
+/// `path` relative to the folder `base` when it lies inside it (both resolved by the file
+/// system), else `path` as it is: a campaign's input files are named the same from any
+/// folder, so its fingerprint is too.
+pub fn relative_to(base: &std::path::Path, path: &str) -> String {
+    let canon = |p: &std::path::Path| {
+        std::fs::canonicalize(if p.as_os_str().is_empty() {
+            std::path::Path::new(".")
+        } else {
+            p
+        })
+    };
+    match (canon(base), canon(std::path::Path::new(path))) {
+        (Ok(b), Ok(p)) => p
+            .strip_prefix(&b)
+            .map_or_else(|_| path.to_owned(), |r| r.display().to_string()),
+        _ => path.to_owned(),
+    }
+}
+
+/// The front end of an OpenSCENARIO scenario: the file read with each test's values.
+struct XoscFrontEnd {
     template: PathBuf,
     overrides: Overrides,
     maps: MapFiles,
@@ -398,6 +428,14 @@ struct XoscWorlds {
     ego: Option<String>,
     /// The longest test, s ([`horizon`]).
     horizon_s: f64,
+    /// The failure map's axes (the intervals first, then the parameters with most levels).
+    map_axes: Vec<String>,
+    /// [`Source::space`].
+    space: ParamSpace,
+    /// What the load read.
+    source: crate::front_end::Source,
+    /// What the load found.
+    warnings: Vec<Warning>,
 }
 
 /// The longest test of `model`, s: `given` (`--horizon`), else [`HORIZON_CAP_S`] when the
@@ -423,18 +461,36 @@ pub fn horizon(model: &m::Scenario, given: Option<f64>) -> Result<f64, ScenarioE
     }
 }
 
-impl Worlds for XoscWorlds {
+impl FrontEnd for XoscFrontEnd {
+    fn space(&self) -> &ParamSpace {
+        &self.space
+    }
+
     fn with_scene(
         &self,
-        assignment: &Assignment,
+        assignment: Option<&Assignment>,
         run: &mut dyn FnMut(&Scene, &mut dyn Host),
     ) -> Result<(), ScenarioError> {
-        let overrides = (self.overrides)(assignment).map_err(|e| worlds_error(e.0))?;
+        let overrides = match assignment {
+            Some(a) => (self.overrides)(a).map_err(|e| worlds_error(e.0))?,
+            None => Vec::new(),
+        };
         let model =
             read_scenario_in(&self.maps.xosc, &self.template, &overrides).map_err(xosc_error)?;
         let (scene, mut host) = self.build(&model)?;
         run(&scene, &mut host);
         Ok(())
+    }
+
+    fn source(&self) -> crate::front_end::Source {
+        self.source.clone()
+    }
+
+    fn findings(&self) -> crate::front_end::Findings {
+        crate::front_end::Findings {
+            warnings: self.warnings.clone(),
+            ..Default::default()
+        }
     }
 }
 
@@ -447,7 +503,7 @@ fn here(pos: &paracosm_openscenario::Pos, variable: &str) -> Site {
     }
 }
 
-impl XoscWorlds {
+impl XoscFrontEnd {
     /// The scene of `model` and the host that runs its storyboard: [`build_into`] a scene of
     /// daylight without fog, with a collision monitor and a horizon of [`HORIZON_CAP_S`] (the
     /// storyboard's stop trigger ends a test sooner).
@@ -470,7 +526,7 @@ impl XoscWorlds {
             .set_settings(TestSettings {
                 site: Some(at),
                 horizon_s: Some(self.horizon_s),
-                map_axes: None,
+                map_axes: Some(self.map_axes.clone()),
                 offroad: None,
             })
             .map_err(|e| worlds_error(e.to_string()))?;

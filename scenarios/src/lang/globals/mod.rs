@@ -33,7 +33,7 @@ pub struct LoadState {
     /// What the program printed while evaluating.
     pub log: RefCell<Vec<String>>,
     /// The maps the program reads, shared by its evaluations.
-    pub(crate) maps: std::sync::Arc<crate::lang::map_files::MapFiles>,
+    pub(crate) maps: std::sync::Arc<crate::map_files::MapFiles>,
 }
 
 impl starlark::PrintHandler for LoadState {
@@ -49,7 +49,7 @@ impl LoadState {
     pub fn new(
         values: Option<Vec<super::scene::ParamValue>>,
         objects: std::sync::Arc<std::collections::HashMap<String, String>>,
-        maps: std::sync::Arc<crate::lang::map_files::MapFiles>,
+        maps: std::sync::Arc<crate::map_files::MapFiles>,
     ) -> Self {
         LoadState {
             scene: RefCell::new(SceneBuilder::new(values)),

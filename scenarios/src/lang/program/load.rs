@@ -61,7 +61,7 @@ pub fn load(
     name: &str,
     ast: AstModule,
     globals: Globals,
-    base: crate::lang::map_files::Base,
+    base: crate::map_files::Base,
 ) -> Result<Scenario, ScenarioError> {
     let syntax = Syntax::of(&ast, &crate::lang::builtins::taking_whole());
     refuse_dropped_actions(&syntax, file)?;
@@ -76,7 +76,7 @@ pub fn load(
         horizon_s: crate::lang::DEFAULT_HORIZON_S,
         sut: SutConfig::builtin("aeb")
             .map_err(|e| LoadError::new(LoadErrorKind::Declarations, e.to_string()))?,
-        maps: Arc::new(crate::lang::map_files::MapFiles::new(base)),
+        maps: Arc::new(crate::map_files::MapFiles::new(base)),
         load_output_shown: false.into(),
         combinations: std::sync::OnceLock::new(),
         load_steps: 0.into(),
@@ -88,7 +88,7 @@ pub fn load(
     let space = parameter_space(&program)?;
     let combinations = check_combinations(&program)?;
     let mut effects = probe_effects(&program, &first, &combinations.unread)?;
-    let (monitors, map_axes) = monitors_and_map(&first.world, &space, file)?;
+    let (monitors, _map_axes) = monitors_and_map(&first.world, &space, file)?;
     let mut warnings = first.world.warnings.clone();
     load_warnings(
         &first.world,
@@ -122,23 +122,56 @@ pub fn load(
         .iter()
         .flat_map(|&k| coordinate_names(&program.params[k].0, program.params[k].1.over_time))
         .collect();
-    Ok(Scenario {
+    let source = crate::front_end::Source {
         name: name.to_owned(),
         description: crate::lang::header(source),
-        space,
-        horizon_s: program.horizon_s,
-        sut: program.sut.clone(),
-        monitors,
-        map_axes,
+        text: Arc::from(source),
+        files: program.maps.inputs(),
+        ego: None,
         map_axes_by_relevance: false,
+    };
+    let findings = crate::front_end::Findings {
         warnings,
         unused_params,
         camera_only: found.camera_only,
-        ego: None,
-        source: Arc::from(source),
-        input_files: program.maps.inputs(),
-        worlds: Arc::new(program),
-    })
+    };
+    let loaded = Loaded {
+        program,
+        space,
+        source,
+        findings,
+    };
+    Scenario::new(Arc::new(loaded))
+}
+
+/// A loaded program as a front end: its space, what it read and what its load found.
+struct Loaded {
+    program: Program,
+    space: ParamSpace,
+    source: crate::front_end::Source,
+    findings: crate::front_end::Findings,
+}
+
+impl crate::FrontEnd for Loaded {
+    fn space(&self) -> &ParamSpace {
+        &self.space
+    }
+
+    fn with_scene(
+        &self,
+        assignment: Option<&Assignment>,
+        run: &mut dyn FnMut(&crate::scene::Scene, &mut dyn Host),
+    ) -> Result<(), ScenarioError> {
+        self.program.with_scene(assignment, run)
+    }
+
+    fn source(&self) -> crate::front_end::Source {
+        self.source.clone()
+    }
+
+    fn findings(&self) -> crate::front_end::Findings {
+        self.findings.clone()
+    }
 }
 
 /// Phase 1: an action on a line of its own (`car.brake(6)`) does nothing.
@@ -452,72 +485,15 @@ fn probe_parameter(
 }
 
 /// Phase 7: the monitors, with the default `OffRoadMonitor` unless the program opts out or
-/// declares one, and the failure map's axes (`test(map=)`, else the first two parameters).
+/// declares one, and the failure map's axes (`test(map=)`, else the first two parameters),
+/// as [`crate::Scenario::new`] reads them from any front end's scene.
 fn monitors_and_map(
     first: &SceneBuilder,
     space: &ParamSpace,
     file: &str,
 ) -> Result<(Vec<MonitorSpec>, Vec<String>), LoadError> {
-    let settings = |message: String| LoadError::new(LoadErrorKind::Settings, message);
-    let mut monitors = first.scene.monitor_specs();
-    let has_off_road = monitors.iter().any(MonitorSpec::judges_off_road);
-    if first.scene.settings().offroad.unwrap_or(true) && !has_off_road {
-        let implicit = MonitorSpec::implicit_off_road();
-        if let Some(k) = monitors.iter().position(|m| m.name() == implicit.name()) {
-            let at = first
-                .scene
-                .monitors()
-                .nth(k)
-                .map_or(file.to_owned(), |(_, s)| s.to_string());
-            return Err(settings(format!(
-                "error: a monitor is named `{}`, the name of the default OffRoadMonitor: rename \
-                 it, declare OffRoadMonitor(v) yourself, or opt out with test(offroad = False)\n \
-                 --> {at}",
-                implicit.name()
-            )));
-        }
-        monitors.push(implicit);
-    }
-    // Where `test(map=)` was given, else the program's file.
-    let test_at = || {
-        let site = first.scene.settings().site.as_ref();
-        site.map_or(file.to_owned(), ToString::to_string)
-    };
-    let map_axes = match &first.scene.settings().map_axes {
-        Some(axes) => {
-            if let [a, b] = &axes[..] {
-                if a == b {
-                    return Err(settings(format!(
-                        "error: test(map=...) names `{a}` twice: a failure map needs two \
-                         different parameters\n --> {}",
-                        test_at(),
-                    )));
-                }
-            }
-            for a in axes {
-                if space.param(a).is_none() {
-                    let known: Vec<&str> = space.params().iter().map(|p| p.name.as_str()).collect();
-                    return Err(settings(format!(
-                        "error: test(map=...) names `{a}`, which is not a parameter (the \
-                         parameters: {})\n --> {}",
-                        if known.is_empty() {
-                            "none".to_owned()
-                        } else {
-                            known.join(", ")
-                        },
-                        test_at(),
-                    )));
-                }
-            }
-            axes.clone()
-        }
-        None => space
-            .params()
-            .iter()
-            .take(2)
-            .map(|p| p.name.clone())
-            .collect(),
-    };
+    let monitors = crate::scenario::monitors_of(&first.scene, file)?;
+    let map_axes = crate::scenario::map_axes_of(&first.scene, space, file)?;
     Ok((monitors, map_axes))
 }
 

@@ -88,7 +88,7 @@ pub struct Program {
     /// [`Syntax::objects`], shared with every evaluation.
     objects: Arc<std::collections::HashMap<String, String>>,
     /// The maps it reads, read once and shared with every evaluation.
-    maps: Arc<super::map_files::MapFiles>,
+    maps: Arc<crate::map_files::MapFiles>,
     /// Whether what the program prints at load has been shown (the load evaluates it more
     /// than once with the representative values; its output is shown once).
     load_output_shown: std::sync::atomic::AtomicBool,
@@ -1094,14 +1094,21 @@ fn formula_kinds(
     Ok(())
 }
 
-impl crate::Worlds for Program {
-    fn with_scene(
+impl Program {
+    /// The scene of one test ([`crate::FrontEnd::with_scene`]): the program evaluated with
+    /// `assignment`'s values (`None`: each parameter's representative value), its lambdas
+    /// run by a fresh evaluator.
+    ///
+    /// # Errors
+    /// [`ScenarioError::MissingParam`] for an assignment that lacks a parameter;
+    /// [`ScenarioError::Load`] when the program fails for these values.
+    pub(crate) fn with_scene(
         &self,
-        assignment: &Assignment,
+        assignment: Option<&Assignment>,
         run: &mut dyn FnMut(&crate::scene::Scene, &mut dyn Host),
     ) -> Result<(), ScenarioError> {
-        let values = self.values(assignment)?;
-        self.evaluate(Some(values), |mut b, module| {
+        let values = assignment.map(|a| self.values(a)).transpose()?;
+        self.evaluate(values, |mut b, module| {
             self.consistent(&b)?;
             let functions = lambda_values(&b, module)?;
             let test = super::values::TestState::default();

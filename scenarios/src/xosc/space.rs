@@ -5,7 +5,7 @@ use paracosm_openscenario::distribution::{Dist, ValueSets, Varied};
 use paracosm_openscenario::model::Scenario;
 use paracosm_openscenario::params::ValueError;
 
-use crate::Error;
+use crate::ScenarioError;
 
 /// Levels as paracosm values: whole numbers as `Int` (lane ids), other numbers as `Real`,
 /// anything else as `Text` (road files), all of one kind.
@@ -129,12 +129,18 @@ fn bounds(v: &Varied, wide: (f64, f64)) -> (f64, f64, Option<String>) {
 /// groups (both ends of an interval, every level).
 ///
 /// # Errors
-/// [`Error::BadInput`] naming the option: the text is not `Name=lo..hi` or `Name=a,b,...`,
+/// [`ScenarioError::Input`] naming the option: the text is not `Name=lo..hi` or `Name=a,b,...`,
 /// the name is not declared or is varied already, or a value breaks the declaration's
 /// constraint groups.
-pub fn open_param(text: &str, scenario: &Scenario, space: &[Param]) -> Result<Param, Error> {
-    open_levels(text, scenario, space)
-        .map_err(|why| Error::BadInput(format!("--open {text}: {why}")))
+pub fn open_param(
+    text: &str,
+    scenario: &Scenario,
+    space: &[Param],
+) -> Result<Param, ScenarioError> {
+    open_levels(text, scenario, space).map_err(|why| ScenarioError::Input {
+        path: std::path::PathBuf::from(&scenario.file),
+        message: format!("--open {text}: {why}"),
+    })
 }
 
 fn open_levels(text: &str, scenario: &Scenario, space: &[Param]) -> Result<Param, ValueError> {
@@ -197,19 +203,19 @@ fn open_levels(text: &str, scenario: &Scenario, space: &[Param]) -> Result<Param
 /// set makes together), with the number of sets the file's grid has for it.
 ///
 /// # Errors
-/// [`Error::Input`] naming the variation file's position when a set assigns a parameter the
+/// [`ScenarioError::Input`] naming the variation file's position when a set assigns a parameter the
 /// scenario does not declare.
 pub fn value_sets_param(
     file: &std::path::Path,
     k: usize,
     sets: &ValueSets,
     scenario: &Scenario,
-) -> Result<(Param, u64), Error> {
+) -> Result<(Param, u64), ScenarioError> {
     let mut levels = Vec::new();
     for set in &sets.sets {
         for a in set {
             if !scenario.params.iter().any(|(d, _)| d.name == a.name) {
-                return Err(Error::Input {
+                return Err(ScenarioError::Input {
                     path: file.to_path_buf(),
                     message: format!(
                         "{}: parameter {:?} is assigned but the scenario does not declare it",

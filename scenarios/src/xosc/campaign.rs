@@ -1,11 +1,9 @@
-//! `paracosm-fuzz xosc`: an OpenSCENARIO logical scenario as paracosm reads it (issue "The
-//! industry's logical scenarios as campaigns"). Given a parameter value distribution file
-//! (or a scenario file), it reads the scenario it names with `paracosm-openscenario`, turns
-//! each varied parameter into a parameter of paracosm's space, and lists the scenario's
-//! entities, `Init` and storyboard, and everything read but not honoured as written.
-
-mod describe;
-mod space;
+//! An OpenSCENARIO logical scenario as a campaign reads it: the typed reference a campaign
+//! keeps ([`XoscRef`]: the file and the command line's options), the reading that
+//! `paracosm-fuzz xosc` lists ([`inspect`]: given a parameter value distribution file or a
+//! scenario file, the scenario it names read with `paracosm-openscenario`, each varied or
+//! `--open`ed parameter a parameter of paracosm's space), and the campaign's
+//! [`crate::Scenario`] over it ([`campaign_scenario`], its files read once into a [`FileSet`]).
 
 use std::path::{Path, PathBuf};
 
@@ -14,11 +12,59 @@ use paracosm_openscenario::distribution::{read_variation, VariationFile};
 use paracosm_openscenario::model::Scenario;
 use paracosm_openscenario::{read_scenario_in, FileSet, XoscError};
 
-use crate::scenario_ref::{ScenarioRef, XoscRef};
+use crate::ScenarioError;
 
-use crate::Error;
+use super::space::{open_param, value_sets_param, varied_param};
 
-pub use space::{open_param, value_sets_param, varied_param};
+/// An OpenSCENARIO scenario or variation file and the options of `paracosm-fuzz FILE.xosc`.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct XoscRef {
+    /// The file (a variation file, or a scenario alone), as given or made absolute.
+    pub xosc: String,
+    /// `--open`: declared parameters opened, `Name=lo..hi` or `Name=a,b,c`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub open: Vec<String>,
+    /// `--continuous`: a `DistributionRange` becomes an interval over its range.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub continuous: bool,
+    /// `--scripted-ego`: the storyboard moves the ego as every other entity (no system under
+    /// test), to replay an exported test.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub scripted_ego: bool,
+    /// `--ego NAME`: the vehicle the system under test drives, for a file that does not say
+    /// plainly.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ego: Option<String>,
+    /// `--horizon`: the longest test, s (finite, `> 0`); a storyboard without a stop trigger
+    /// needs it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub horizon_s: Option<f64>,
+}
+
+impl std::fmt::Display for XoscRef {
+    /// The file with its options as `paracosm-fuzz` takes them (`file.xosc --open A=1..2
+    /// --continuous`): a campaign's name for it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.xosc)?;
+        for o in &self.open {
+            write!(f, " --open {o}")?;
+        }
+        if self.continuous {
+            f.write_str(" --continuous")?;
+        }
+        if self.scripted_ego {
+            f.write_str(" --scripted-ego")?;
+        }
+        if let Some(e) = &self.ego {
+            write!(f, " --ego {e}")?;
+        }
+        if let Some(h) = self.horizon_s {
+            write!(f, " --horizon {h}")?;
+        }
+        Ok(())
+    }
+}
 
 /// A logical scenario read for listing ([`inspect`]).
 #[derive(Debug, Clone)]
@@ -43,10 +89,14 @@ pub struct Inspection {
 /// `DistributionRange` becomes an interval over its range instead of its levels.
 ///
 /// # Errors
-/// [`Error::Input`] naming the file, line and column: a file that is not OpenSCENARIO, a
+/// [`ScenarioError::Input`] naming the file, line and column: a file that is not OpenSCENARIO, a
 /// variation whose scenario does not read, an `--open` of a parameter that is not declared,
 /// is varied already, or whose range breaks its constraint groups.
-pub fn inspect(path: &Path, opens: &[String], continuous: bool) -> Result<Inspection, Error> {
+pub fn inspect(
+    path: &Path,
+    opens: &[String],
+    continuous: bool,
+) -> Result<Inspection, ScenarioError> {
     inspect_in(&FileSet::new(), path, opens, continuous)
 }
 
@@ -59,8 +109,8 @@ pub fn inspect_in(
     path: &Path,
     opens: &[String],
     continuous: bool,
-) -> Result<Inspection, Error> {
-    let input = |e: XoscError| Error::Input {
+) -> Result<Inspection, ScenarioError> {
+    let input = |e: XoscError| ScenarioError::Input {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
@@ -77,7 +127,7 @@ pub fn inspect_in(
             .filter(|c| !matches!(c, std::path::Component::CurDir))
             .collect();
         if !p.is_file() {
-            return Err(Error::Input {
+            return Err(ScenarioError::Input {
                 path: path.to_path_buf(),
                 message: format!(
                     "{}: the scenario file {} is not there",
@@ -104,7 +154,7 @@ pub fn inspect_in(
         for p in &v.params {
             let declared = scenario.params.iter().any(|(d, _)| d.name == p.name);
             if !declared {
-                return Err(Error::Input {
+                return Err(ScenarioError::Input {
                     path: path.to_path_buf(),
                     message: format!(
                         "{}: parameter {:?} is varied but {} does not declare it",
@@ -145,15 +195,15 @@ pub fn inspect_in(
 /// (`paracosm-fuzz xosc`: a file whose campaign would refuse its map is refused when listed).
 ///
 /// # Errors
-/// As [`inspect`]; [`Error::Scenario`] when the map does not load (naming the `LogicFile`'s
+/// As [`inspect`]; [`ScenarioError::Load`] when the map does not load (naming the `LogicFile`'s
 /// line and column).
 pub fn inspect_with_map(
     path: &Path,
     opens: &[String],
     continuous: bool,
-) -> Result<Inspection, Error> {
+) -> Result<Inspection, ScenarioError> {
     let found = inspect(path, opens, continuous)?;
-    paracosm_scenarios::xosc::load_map(&found.scenario)?;
+    super::load_map(&found.scenario)?;
     Ok(found)
 }
 
@@ -162,94 +212,104 @@ pub fn inspect_with_map(
 /// test reads the scenario's text with its values (a value set expands to its parameters).
 ///
 /// # Errors
-/// [`Error::Input`] or [`Error::BadInput`] as [`inspect`]; a scenario that does not build
+/// [`ScenarioError::Input`] as [`inspect`]; a scenario that does not build
 /// (`paracosm_scenarios::xosc::scenario`).
-pub fn campaign_scenario(x: &XoscRef) -> Result<paracosm_scenarios::Scenario, Error> {
+pub fn campaign_scenario(x: &XoscRef) -> Result<crate::Scenario, ScenarioError> {
     let path = x.xosc.as_str();
     let (opens, continuous) = (&x.open, x.continuous);
     let files = std::sync::Arc::new(FileSet::new());
     let found = inspect_in(&files, Path::new(path), opens, continuous)?;
-    let space = paracosm_generators::ParamSpace::new(found.space.clone())
-        .map_err(|e| Error::BadInput(format!("{path}: {e}")))?;
-    let sets: Vec<String> = (0..found.variation.as_ref().map_or(0, |v| v.multi.len()))
-        .map(|k| format!("value_set_{k}"))
+    let space = paracosm_generators::ParamSpace::new(found.space.clone()).map_err(|e| {
+        ScenarioError::Input {
+            path: PathBuf::from(path),
+            message: format!("{path}: {e}"),
+        }
+    })?;
+    // Each value set's parameter, its levels (the sets as written, `Name=value, ...`) and
+    // the assignments each level makes, as the variation file parsed them: a test binds the
+    // set by its level, never by splitting the level's text (a value may hold `, ` or `=`).
+    let sets: Vec<ValueSetLevels> = found
+        .variation
+        .iter()
+        .flat_map(|v| v.multi.iter().enumerate())
+        .map(|(k, multi)| {
+            let name = format!("value_set_{k}");
+            let levels = match space.param(&name).map(|p| &p.domain) {
+                Some(paracosm_generators::Domain::Levels(l)) => l.clone(),
+                _ => Vec::new(),
+            };
+            let pairs = multi
+                .sets
+                .iter()
+                .map(|set| {
+                    set.iter()
+                        .map(|a| (a.name.clone(), a.value.clone()))
+                        .collect()
+                })
+                .collect();
+            (name, levels, pairs)
+        })
         .collect();
-    let overrides: paracosm_scenarios::xosc::Overrides = std::sync::Arc::new(move |a| {
+    let overrides: super::Overrides = std::sync::Arc::new(move |a| {
         let mut out = Vec::new();
         for (name, value) in a.iter() {
+            if let Some((_, levels, pairs)) = sets.iter().find(|(n, _, _)| n == name) {
+                let k = levels.iter().position(|l| l == value).ok_or_else(|| {
+                    super::OverrideError(format!("{name}: {value:?} is not one of its value sets"))
+                })?;
+                out.extend(pairs[k].iter().cloned());
+                continue;
+            }
             let text = match value {
                 paracosm_generators::Value::Int(i) => i.to_string(),
                 paracosm_generators::Value::Real(x) => format!("{x}"),
                 paracosm_generators::Value::Bool(b) => b.to_string(),
                 paracosm_generators::Value::Text(t) => t.clone(),
             };
-            if sets.iter().any(|s| s == name) {
-                for pair in text.split(", ") {
-                    let (n, v) = pair.split_once('=').ok_or_else(|| {
-                        paracosm_scenarios::xosc::OverrideError(format!(
-                            "{name}: the value set {text:?} is not Name=value"
-                        ))
-                    })?;
-                    out.push((n.to_owned(), v.to_owned()));
-                }
-            } else {
-                out.push((name.to_owned(), text));
-            }
+            out.push((name.to_owned(), text));
         }
         Ok(out)
     });
     let template = PathBuf::from(&found.scenario.file);
-    let mut scenario = paracosm_scenarios::xosc::scenario(paracosm_scenarios::xosc::Source {
+    let scenario = super::scenario(super::Source {
         template,
         files,
         // The file's name and options, not its folder: the fingerprint of a campaign is the
         // same from any folder and on any machine (shards on other mount points merge).
-        name: ScenarioRef::OpenScenario(XoscRef {
+        name: XoscRef {
             xosc: file_name(path),
             ..x.clone()
-        })
+        }
         .to_string(),
+        files_base: Path::new(path).parent().unwrap_or(Path::new("")).to_owned(),
         space,
         overrides,
         scripted_ego: x.scripted_ego,
         ego: x.ego.clone(),
         horizon_s: x.horizon_s,
+        warnings: found
+            .limits
+            .iter()
+            .map(|l| crate::Warning {
+                at: path.to_owned(),
+                message: l.clone(),
+            })
+            .collect(),
     })?;
-    let base = Path::new(path).parent().unwrap_or(Path::new(""));
-    for f in &mut scenario.input_files {
-        f.path = relative_to(base, &f.path);
-    }
-    scenario
-        .warnings
-        .extend(found.limits.iter().map(|l| paracosm_scenarios::Warning {
-            at: path.to_owned(),
-            message: l.clone(),
-        }));
     Ok(scenario)
 }
+
+/// A value set's parameter (`value_set_K`), its levels, and the assignments (name, value as
+/// written) each level makes.
+type ValueSetLevels = (
+    String,
+    Vec<paracosm_generators::Value>,
+    Vec<Vec<(String, String)>>,
+);
 
 /// The last component of `path` (the path itself when it has none).
 fn file_name(path: &str) -> String {
     Path::new(path)
         .file_name()
         .map_or_else(|| path.to_owned(), |f| f.to_string_lossy().into_owned())
-}
-
-/// `path` relative to the folder `base` when it lies inside it (both resolved by the file
-/// system), else `path` as it is: a campaign's input files are named the same from any
-/// folder, so its fingerprint is too.
-pub(crate) fn relative_to(base: &Path, path: &str) -> String {
-    let canon = |p: &Path| {
-        std::fs::canonicalize(if p.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            p
-        })
-    };
-    match (canon(base), canon(Path::new(path))) {
-        (Ok(b), Ok(p)) => p
-            .strip_prefix(&b)
-            .map_or_else(|_| path.to_owned(), |r| r.display().to_string()),
-        _ => path.to_owned(),
-    }
 }

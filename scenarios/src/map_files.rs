@@ -1,5 +1,7 @@
-//! The files a program reads: OpenDRIVE maps (`OpenDrive("map.xodr")`), the one file access
-//! a program has.
+//! The files a scenario reads, for every front end: a program's OpenDRIVE maps
+//! (`OpenDrive("map.xodr")`, the one file access a program has) and the OpenSCENARIO files of
+//! an `Import` or of an OpenSCENARIO campaign (its map, variation file, scenario and catalogs,
+//! through [`paracosm_openscenario::FileSet`]).
 //!
 //! A path is resolved against the folder of the program's file (for a built-in scenario,
 //! against the maps built into the binary; for a program given as text, against the current
@@ -8,7 +10,7 @@
 //! SHA-256 enters the campaign's fingerprint ([`crate::Scenario::input_files`]), so
 //! `--resume` refuses a campaign whose map has changed since.
 
-use super::load_error::{refused, LoadError, LoadErrorKind};
+use crate::lang::load_error::{refused, LoadError, LoadErrorKind};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -24,14 +26,11 @@ pub const MAX_MAP_BYTES: u64 = 16 << 20;
 
 /// The maps shipped with the built-in scenarios: `(path as the programs write it, text)`.
 pub const BUILTIN_MAPS: [(&str, &str); 3] = [
-    ("maps/bend.xodr", include_str!("../../maps/bend.xodr")),
-    (
-        "maps/junction.xodr",
-        include_str!("../../maps/junction.xodr"),
-    ),
+    ("maps/bend.xodr", include_str!("../maps/bend.xodr")),
+    ("maps/junction.xodr", include_str!("../maps/junction.xodr")),
     (
         "maps/roundabout.xodr",
-        include_str!("../../maps/roundabout.xodr"),
+        include_str!("../maps/roundabout.xodr"),
     ),
 ];
 
