@@ -205,6 +205,16 @@ fn crossing_variation(dir: &std::path::Path, distributions: &str) -> std::path::
     let alks = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xosc/alks");
     let template =
         alks.join("concrete_scenarios/alks_scenario_4_2_3_crossing_pedestrian_template.xosc");
+    variation_over(dir, &template, distributions)
+}
+
+/// A variation file `sets.xosc` in `dir` over the scenario file `template` whose
+/// `Deterministic` element holds `distributions` (they start on line 6).
+fn variation_over(
+    dir: &std::path::Path,
+    template: &std::path::Path,
+    distributions: &str,
+) -> std::path::PathBuf {
     let variation = dir.join("sets.xosc");
     std::fs::write(
         &variation,
@@ -982,4 +992,67 @@ fn a_value_sets_value_is_one_value_not_more_assignments() {
         .to_string();
     println!("{e}");
     assert!(e.contains(hostile), "{e}");
+}
+
+/// A variation file that varies a parameter nothing in the scenario reads gets the warning a
+/// program's unread parameter gets, naming the variation file's line, and the parameter is
+/// left out of coverage (`unused_params`); a parameter only the storyboard reads (the
+/// pedestrian's speed, a `SpeedAction`'s target) is used, though no entity's `Init` changes.
+#[test]
+fn a_varied_parameter_nothing_reads_is_named_unused_as_in_a_program() {
+    let dir = tempfile::tempdir().unwrap();
+    let concrete = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/xosc/alks/concrete_scenarios");
+    let template = std::fs::read_to_string(
+        concrete.join("alks_scenario_4_2_3_crossing_pedestrian_template.xosc"),
+    )
+    .unwrap()
+    .replace("\"./", &format!("\"{}/", concrete.display()))
+    .replacen(
+        "<ParameterDeclarations>",
+        "<ParameterDeclarations>\n    <ParameterDeclaration name=\"Unread\" \
+         parameterType=\"double\" value=\"1.0\"/>",
+        1,
+    );
+    let scenario_file = dir.path().join("crossing_with_unread.xosc");
+    std::fs::write(&scenario_file, template).unwrap();
+    let variation = variation_over(
+        dir.path(),
+        &scenario_file,
+        r#"      <DeterministicSingleParameterDistribution parameterName="TargetBlocking_Speed_kph">
+        <DistributionSet><Element value="3"/><Element value="6"/></DistributionSet>
+      </DeterministicSingleParameterDistribution>
+      <DeterministicSingleParameterDistribution parameterName="Unread">
+        <DistributionSet><Element value="1"/><Element value="2"/><Element value="3"/></DistributionSet>
+      </DeterministicSingleParameterDistribution>"#,
+    );
+    let scenario = paracosm::ScenarioRef::OpenScenario(paracosm::scenario_ref::XoscRef {
+        xosc: variation.display().to_string(),
+        ..Default::default()
+    })
+    .load()
+    .expect("the variation loads");
+    assert_eq!(scenario.unused_params(), ["Unread"]);
+    let warning = scenario
+        .warnings()
+        .iter()
+        .find(|w| w.message.contains("`Unread`"))
+        .expect("a warning names the unread parameter");
+    assert_eq!(
+        warning.at,
+        format!("{}:10:7", variation.display()),
+        "{warning}"
+    );
+    assert!(
+        warning.message.contains("no object uses it"),
+        "the program's wording: {warning}"
+    );
+    assert!(
+        !scenario
+            .warnings()
+            .iter()
+            .any(|w| w.message.contains("TargetBlocking_Speed_kph")),
+        "the storyboard reads the speed: {:?}",
+        scenario.warnings()
+    );
 }

@@ -599,7 +599,28 @@ impl Scope {
         decls: &[ParamDecl],
         overrides: &[(String, String)],
     ) -> Result<Scope, XoscError> {
-        let scope = Scope::build(None, text, decls, overrides)?;
+        let scope = Scope::build(None, text, decls, &texts(overrides))?;
+        scope.check_all_constraints(decls)?;
+        Ok(scope)
+    }
+
+    /// The scope of `decls` (read from `text`) with `values` (name, typed value: a run's,
+    /// from a campaign's test or a program's `Import(params=)`) replacing declared values; a
+    /// later value of the same name replaces an earlier one. A value is coerced to the
+    /// declared type as the declaration's own text would be (`Str("5")` is the number 5 for a
+    /// `double`) but never evaluated: a text holding `$name` is that text.
+    ///
+    /// # Errors
+    /// As [`Scope::new`].
+    pub fn with_values(
+        text: &Text,
+        decls: &[ParamDecl],
+        values: &[(String, Value)],
+    ) -> Result<Scope, XoscError> {
+        let given: Vec<(&str, Given<'_>)> = (values.iter())
+            .map(|(n, v)| (n.as_str(), Given::Value(v)))
+            .collect();
+        let scope = Scope::build(None, text, decls, &given)?;
         scope.check_all_constraints(decls)?;
         Ok(scope)
     }
@@ -615,7 +636,7 @@ impl Scope {
         decls: &[ParamDecl],
         overrides: &[(String, String)],
     ) -> Result<Scope, XoscError> {
-        Scope::build(None, text, decls, overrides)
+        Scope::build(None, text, decls, &texts(overrides))
     }
 
     /// Checks every declaration of `decls` (this scope's own) against its constraint groups
@@ -662,7 +683,7 @@ impl Scope {
         decls: &[ParamDecl],
         overrides: &[(String, String)],
     ) -> Result<Scope, XoscError> {
-        let scope = Scope::build(Some(self), text, decls, overrides)?;
+        let scope = Scope::build(Some(self), text, decls, &texts(overrides))?;
         scope.check_all_constraints(decls)?;
         Ok(scope)
     }
@@ -671,7 +692,7 @@ impl Scope {
         parent: Option<&Scope>,
         text: &Text,
         decls: &[ParamDecl],
-        overrides: &[(String, String)],
+        overrides: &[(&str, Given<'_>)],
     ) -> Result<Scope, XoscError> {
         let mut index: HashMap<&str, usize> = HashMap::new();
         for (i, d) in decls.iter().enumerate() {
@@ -682,23 +703,24 @@ impl Scope {
                 });
             }
         }
-        let mut given: Vec<Option<&str>> = vec![None; decls.len()];
-        for (name, value) in overrides {
-            match index.get(name.as_str()) {
-                Some(&i) => given[i] = Some(value.as_str()),
+        let mut given: Vec<Option<Given<'_>>> = vec![None; decls.len()];
+        for &(name, value) in overrides {
+            match index.get(name) {
+                Some(&i) => given[i] = Some(value),
                 None => return Err(undeclared_override(text, decls, name)),
             }
         }
-        let effective: Vec<&str> = decls
+        // What each declaration's value reads: a typed value reads nothing.
+        let deps: Vec<Vec<usize>> = decls
             .iter()
             .zip(&given)
-            .map(|(d, g)| g.unwrap_or(d.raw.as_str()))
-            .collect();
-        let deps: Vec<Vec<usize>> = effective
-            .iter()
-            .map(|t| {
-                refs_of(t)
-                    .iter()
+            .map(|(d, g)| match g {
+                Some(Given::Value(_)) => Vec::new(),
+                Some(Given::Text(t)) => refs_of(t),
+                None => refs_of(&d.raw),
+            })
+            .map(|refs| {
+                refs.iter()
                     .filter_map(|n| index.get(n.as_str()).copied())
                     .collect()
             })
@@ -977,6 +999,23 @@ impl Scope {
     }
 }
 
+/// A value replacing a declared one.
+#[derive(Debug, Clone, Copy)]
+enum Given<'a> {
+    /// A text the file writes (a `CatalogReference`'s `ParameterAssignment`), evaluated as
+    /// the declaration's own text would be.
+    Text(&'a str),
+    /// A run's typed value, coerced to the declared type and never evaluated.
+    Value(&'a Value),
+}
+
+/// `overrides` as texts to evaluate.
+fn texts(overrides: &[(String, String)]) -> Vec<(&str, Given<'_>)> {
+    (overrides.iter())
+        .map(|(n, t)| (n.as_str(), Given::Text(t.as_str())))
+        .collect()
+}
+
 fn undeclared_override(text: &Text, decls: &[ParamDecl], name: &str) -> XoscError {
     let declared: Vec<&str> = decls.iter().map(|d| d.name.as_str()).collect();
     let listing = if declared.is_empty() {
@@ -998,9 +1037,24 @@ fn undeclared_override(text: &Text, decls: &[ParamDecl], name: &str) -> XoscErro
 fn evaluate_decl(
     text: &Text,
     d: &ParamDecl,
-    given: Option<&str>,
+    given: Option<Given<'_>>,
     lookup: &dyn Fn(&str) -> Option<Value>,
 ) -> Result<Value, XoscError> {
+    let given = match given {
+        Some(Given::Value(v)) => {
+            return d.ty.coerce(v.clone()).map_err(|reason| XoscError::Invalid {
+                pos: d.pos.clone(),
+                reason: format!(
+                    "parameter {} = {} (given for the run) ({}): {reason}",
+                    d.name,
+                    quoted(v),
+                    d.ty.xsd_name()
+                ),
+            });
+        }
+        Some(Given::Text(t)) => Some(t),
+        None => None,
+    };
     let written = given.unwrap_or(&d.raw);
     let (pos_of, label) = match given {
         Some(g) => (
@@ -1226,6 +1280,34 @@ mod tests {
         assert!(scope(&p("t", "dateTime", "yesterday"), &[]).is_err());
         let e = reason(scope(&p("n", "int", "1"), &[("n", "1.5")]).unwrap_err());
         assert!(e.contains("(given for the run)"), "{e}");
+        assert!(e.contains("1.5 is not an int"), "{e}");
+    }
+
+    /// A run's value is bound by name as the value it is: coerced to the declared type, never
+    /// evaluated (a text holding `$b` is that text), and what reads it sees it.
+    #[test]
+    fn a_runs_value_is_typed_and_never_evaluated() {
+        let text = doc(&[
+            p("s", "string", "x"),
+            p("d", "double", "1"),
+            p("n", "int", "1"),
+            p("twice", "double", "${$d * 2}"),
+        ]
+        .join("\n"));
+        let ds = decls_of(&text).unwrap();
+        let values = [
+            ("s".to_owned(), Value::Str("$d".to_owned())),
+            ("d".to_owned(), Value::Str("5".to_owned())),
+            ("n".to_owned(), Value::Num(3.0)),
+        ];
+        let s = Scope::with_values(&text, &ds, &values).unwrap();
+        assert_eq!(s.get("s"), Some(&Value::Str("$d".to_owned())));
+        assert_eq!(s.get("d"), Some(&Value::Num(5.0)));
+        assert_eq!(s.get("n"), Some(&Value::Num(3.0)));
+        assert_eq!(s.get("twice"), Some(&Value::Num(10.0)));
+        let e = Scope::with_values(&text, &ds, &[("n".to_owned(), Value::Num(1.5))]).unwrap_err();
+        let e = reason(e);
+        assert!(e.contains("n = 1.5 (given for the run) (int)"), "{e}");
         assert!(e.contains("1.5 is not an int"), "{e}");
     }
 

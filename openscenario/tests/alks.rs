@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use paracosm_openscenario::distribution::{read_variation, Dist, Kind};
 use paracosm_openscenario::model::{Action, ConditionKind, EntityKind};
-use paracosm_openscenario::{read_scenario, Text};
+use paracosm_openscenario::{read_scenario, Text, Value};
 
 fn alks() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/xosc/alks")
@@ -126,13 +126,14 @@ fn the_crossing_pedestrian_resolves_its_expressions() {
         other => panic!("{other:?}"),
     }
     // An override changes what the expressions give.
-    let s = read_scenario(&path, &[("Ego_InitSpeed_Ve0_kph".into(), "36".into())]).unwrap();
+    let s = read_scenario(&path, &[("Ego_InitSpeed_Ve0_kph".into(), Value::Num(36.0))]).unwrap();
     assert!(s.init.iter().any(|(_, a)| matches!(
         a.action,
         Action::Speed { target: paracosm_openscenario::model::SpeedTarget::Absolute(v), .. } if (v - 10.0).abs() < 1e-12
     )));
     // One outside the declaration's constraint groups is refused, naming it.
-    let e = read_scenario(&path, &[("Ego_InitSpeed_Ve0_kph".into(), "90".into())]).unwrap_err();
+    let e =
+        read_scenario(&path, &[("Ego_InitSpeed_Ve0_kph".into(), Value::Num(90.0))]).unwrap_err();
     assert!(e.to_string().contains("Ego_InitSpeed_Ve0_kph"), "{e}");
 }
 
@@ -163,7 +164,9 @@ fn every_alks_variation_reads_and_names_a_template_that_declares_what_it_varies(
             // Every level of the file's grid reads as an override of the template, but for
             // the levels the template's own constraint groups refuse (below).
             for level in p.dist.levels().unwrap() {
-                if let Err(e) = read_scenario(&template, &[(p.name.clone(), level.clone())]) {
+                if let Err(e) =
+                    read_scenario(&template, &[(p.name.clone(), Value::Str(level.clone()))])
+                {
                     let file = v.file_name().unwrap().to_string_lossy().into_owned();
                     refused.push(format!("{file}: {} = {level}", p.name));
                     assert!(e.to_string().contains(&p.name), "{e}");

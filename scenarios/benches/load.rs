@@ -65,7 +65,10 @@ fn xosc_test_read(c: &mut Criterion) {
     let template = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(
         "../tests/data/xosc/alks/concrete_scenarios/alks_scenario_4_2_3_crossing_pedestrian_template.xosc",
     );
-    let values = [("Ego_InitSpeed_Ve0_kph".to_owned(), "40".to_owned())];
+    let values = [(
+        "Ego_InitSpeed_Ve0_kph".to_owned(),
+        paracosm_openscenario::Value::Num(40.0),
+    )];
     let mut group = c.benchmark_group("xosc_test_read");
     group.bench_function("from_disk", |b| {
         b.iter(|| paracosm_openscenario::read_scenario(&template, &values).unwrap())

@@ -85,6 +85,7 @@ pub struct RustScenes {
     space: ParamSpace,
     name: String,
     description: String,
+    findings: Findings,
 }
 
 /// A Rust function that declares a scenario's scene into the empty scene it receives.
@@ -100,6 +101,7 @@ impl RustScenes {
     pub fn new(name: &str, description: &str, build: SceneFn) -> Result<Self, ScenarioError> {
         let probe = build(Scene::new(None))?;
         let mut params = Vec::new();
+        let mut sites = Vec::new();
         for d in probe.params() {
             let bad = |why: &str| {
                 ScenarioError::Language(format!("the parameter declared at {}: {why}", d.site))
@@ -110,6 +112,7 @@ impl RustScenes {
                     "it varies over time, which a Rust scene does not declare",
                 ));
             }
+            sites.push((name.to_owned(), d.site.to_string()));
             params.push(match &d.domain {
                 paracosm_generators::Domain::Interval { lo, hi } => {
                     paracosm_generators::Param::interval(
@@ -124,12 +127,17 @@ impl RustScenes {
                 }
             });
         }
-        Ok(RustScenes {
+        let mut scenes = RustScenes {
             build,
             space: ParamSpace::new(params)?,
             name: name.to_owned(),
             description: description.to_owned(),
-        })
+            findings: Findings::default(),
+        };
+        // What each parameter changes, as a program's load finds it.
+        let horizon_s = (probe.settings().horizon_s).unwrap_or(crate::scene::DEFAULT_HORIZON_S);
+        scenes.findings = crate::analysis::findings_of(&scenes, &sites, horizon_s);
+        Ok(scenes)
     }
 }
 
@@ -161,7 +169,7 @@ impl FrontEnd for RustScenes {
     }
 
     fn findings(&self) -> Findings {
-        Findings::default()
+        self.findings.clone()
     }
 }
 

@@ -9,6 +9,7 @@
 //! [`builtin_names`] and loaded by [`builtin`]; [`load`] takes a path or a built-in name.
 #![warn(missing_docs)]
 
+pub mod analysis;
 mod error;
 pub mod front_end;
 pub mod lang;

@@ -27,9 +27,14 @@ fn alks(name: &str) -> PathBuf {
 /// The storyboard of template `name` with `overrides`, every entity scripted, and the index
 /// of each entity by name.
 fn storyboard(name: &str, overrides: &[(&str, &str)]) -> (Storyboard, Vec<String>) {
-    let overrides: Vec<(String, String)> = overrides
+    let overrides: Vec<(String, paracosm_openscenario::Value)> = overrides
         .iter()
-        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .map(|(a, b)| {
+            (
+                a.to_string(),
+                paracosm_openscenario::Value::Str(b.to_string()),
+            )
+        })
         .collect();
     let model = read_scenario(&alks(name), &overrides).expect("the template reads");
     let road = model.road_network.as_ref().expect("a road network");

@@ -78,14 +78,15 @@ impl Reader<'_> {
     }
 }
 
-/// Reads the scenario file at `path` with `overrides` (parameter name → value text, from a
-/// variation file or the command line) for its declared parameters.
+/// Reads the scenario file at `path` with `overrides` (parameter name → typed value, from a
+/// variation file, a campaign's test or a program's `Import`) for its declared parameters
+/// ([`Scope::with_values`]: coerced to the declared type, never evaluated as text).
 ///
 /// # Errors
 /// [`XoscError`] naming the file, line and column: the file cannot be read, is not
 /// well-formed, is not a scenario, declares or uses parameters wrongly, references missing
 /// catalogs or entities, or holds an element paracosm does not support.
-pub fn read_scenario(path: &Path, overrides: &[(String, String)]) -> Result<Scenario, XoscError> {
+pub fn read_scenario(path: &Path, overrides: &[(String, Value)]) -> Result<Scenario, XoscError> {
     read_scenario_in(&FileSet::new(), path, overrides)
 }
 
@@ -98,7 +99,7 @@ pub fn read_scenario(path: &Path, overrides: &[(String, String)]) -> Result<Scen
 pub fn read_scenario_in(
     files: &FileSet,
     path: &Path,
-    overrides: &[(String, String)],
+    overrides: &[(String, Value)],
 ) -> Result<Scenario, XoscError> {
     let text = files.text(path)?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
@@ -121,7 +122,7 @@ pub(crate) fn join(base: &Path, rel: &str) -> PathBuf {
 pub fn read_scenario_text(
     text: &Text,
     dir: &Path,
-    overrides: &[(String, String)],
+    overrides: &[(String, Value)],
 ) -> Result<Scenario, XoscError> {
     read_with(&FileSet::new(), text, dir, overrides)
 }
@@ -131,7 +132,7 @@ fn read_with(
     files: &FileSet,
     text: &Text,
     dir: &Path,
-    overrides: &[(String, String)],
+    overrides: &[(String, Value)],
 ) -> Result<Scenario, XoscError> {
     let doc = text.parse()?;
     let root = text.open_root(&doc)?;
@@ -156,7 +157,7 @@ fn read_with(
     let version = read_version(text, root)?;
     let storyboard = need(text, root, "Storyboard")?;
     let decls = read_declarations(text, child(root, "ParameterDeclarations"))?;
-    let scope = Scope::new(text, &decls, overrides)?;
+    let scope = Scope::with_values(text, &decls, overrides)?;
     let params = decls
         .iter()
         .map(|d| {

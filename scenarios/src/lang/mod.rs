@@ -17,7 +17,7 @@ mod position;
 mod program;
 mod scene;
 mod types;
-mod usage;
+mod units;
 mod values;
 
 use std::path::Path;

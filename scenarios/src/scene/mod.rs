@@ -136,6 +136,20 @@ pub struct Scene {
     /// of an imported scenario): each publishes the actor's outputs as its own
     /// (`lead.speed`), as a variable a declaration is assigned to does.
     aliases: Vec<(String, ActorRef)>,
+    /// What the front end's host reads in this test ([`HostInputs`]).
+    host_inputs: Option<std::sync::Arc<dyn HostInputs>>,
+}
+
+/// What a front end's host (an OpenSCENARIO storyboard, which moves its entities outside the
+/// scene's stream graph) reads in one test, kept with the test's scene so that the load's
+/// analyses can tell two tests apart by it as by their worlds ([`crate::analysis`]).
+pub trait HostInputs: std::fmt::Debug + Send + Sync {
+    /// Whether `other` is the same front end's and reads the same (its values compared, not
+    /// where they were written).
+    fn same_as(&self, other: &dyn HostInputs) -> bool;
+
+    /// The inputs as [`std::any::Any`], for [`HostInputs::same_as`] to downcast `other`.
+    fn as_any(&self) -> &dyn std::any::Any;
 }
 
 impl Scene {
@@ -169,6 +183,7 @@ impl Scene {
             sensors: SensorSpec::defaults(),
             settings: TestSettings::default(),
             aliases: Vec::new(),
+            host_inputs: None,
         }
     }
 
@@ -180,6 +195,18 @@ impl Scene {
         let mut scene = Scene::new(Some(Vec::new()));
         scene.by_name = Some(assignment.clone());
         scene
+    }
+
+    /// Keeps what the front end's host reads in this test ([`HostInputs`]), replacing any
+    /// kept before.
+    pub fn set_host_inputs(&mut self, inputs: std::sync::Arc<dyn HostInputs>) {
+        self.host_inputs = Some(inputs);
+    }
+
+    /// What the front end's host reads in this test; `None` for a scene with no host or one
+    /// whose front end keeps nothing (a program's lambdas are analysed from its code).
+    pub fn host_inputs(&self) -> Option<&dyn HostInputs> {
+        self.host_inputs.as_deref()
     }
 
     // ---- the stream graph ----

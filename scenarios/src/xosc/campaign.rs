@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use paracosm_generators::Param;
 use paracosm_openscenario::distribution::{read_variation, VariationFile};
 use paracosm_openscenario::model::Scenario;
-use paracosm_openscenario::{read_scenario_in, FileSet, XoscError};
+use paracosm_openscenario::{read_scenario_in, FileSet, Value, XoscError};
 
 use crate::ScenarioError;
 
@@ -77,6 +77,9 @@ pub struct Inspection {
     pub scenario: Scenario,
     /// paracosm's space: one parameter per varied parameter, then one per `--open`.
     pub space: Vec<Param>,
+    /// Where each parameter of the space is set, in its order: the variation file's
+    /// distribution (`file:line:col`), or `--open Name=...`.
+    pub sites: Vec<String>,
     /// How many runs the variation file's own deterministic grid has (the product of its
     /// parameters' level counts), when it is deterministic.
     pub grid_runs: Option<u64>,
@@ -142,6 +145,7 @@ pub fn inspect_in(
     };
     let scenario = read_scenario_in(files, &scenario_path, &[]).map_err(input)?;
     let mut space = Vec::new();
+    let mut sites = Vec::new();
     let mut limits = Vec::new();
     let mut grid_runs = Some(1u64);
     if let Some(v) = &variation {
@@ -168,11 +172,13 @@ pub fn inspect_in(
             grid_runs = grid_runs.and_then(|g| levels.and_then(|n| g.checked_mul(n)));
             limits.extend(limit);
             space.push(param);
+            sites.push(p.pos.to_string());
         }
         for (k, sets) in v.multi.iter().enumerate() {
             let (param, runs) = value_sets_param(path, k, sets, &scenario)?;
             grid_runs = grid_runs.and_then(|g| g.checked_mul(runs));
             space.push(param);
+            sites.push(sets.pos.to_string());
         }
     } else {
         grid_runs = None;
@@ -180,12 +186,14 @@ pub fn inspect_in(
     for o in opens {
         let param = open_param(o, &scenario, &space)?;
         space.push(param);
+        sites.push(format!("--open {o}"));
     }
     Ok(Inspection {
         file: path.to_path_buf(),
         variation,
         scenario,
         space,
+        sites,
         grid_runs,
         limits,
     })
@@ -243,7 +251,7 @@ pub fn campaign_scenario(x: &XoscRef) -> Result<crate::Scenario, ScenarioError> 
                 .iter()
                 .map(|set| {
                     set.iter()
-                        .map(|a| (a.name.clone(), a.value.clone()))
+                        .map(|a| (a.name.clone(), Value::Str(a.value.clone())))
                         .collect()
                 })
                 .collect();
@@ -260,13 +268,7 @@ pub fn campaign_scenario(x: &XoscRef) -> Result<crate::Scenario, ScenarioError> 
                 out.extend(pairs[k].iter().cloned());
                 continue;
             }
-            let text = match value {
-                paracosm_generators::Value::Int(i) => i.to_string(),
-                paracosm_generators::Value::Real(x) => format!("{x}"),
-                paracosm_generators::Value::Bool(b) => b.to_string(),
-                paracosm_generators::Value::Text(t) => t.clone(),
-            };
-            out.push((name.to_owned(), text));
+            out.push((name.to_owned(), typed(value)));
         }
         Ok(out)
     });
@@ -283,6 +285,7 @@ pub fn campaign_scenario(x: &XoscRef) -> Result<crate::Scenario, ScenarioError> 
         .to_string(),
         files_base: Path::new(path).parent().unwrap_or(Path::new("")).to_owned(),
         space,
+        param_sites: found.sites.clone(),
         overrides,
         scripted_ego: x.scripted_ego,
         ego: x.ego.clone(),
@@ -300,12 +303,23 @@ pub fn campaign_scenario(x: &XoscRef) -> Result<crate::Scenario, ScenarioError> 
 }
 
 /// A value set's parameter (`value_set_K`), its levels, and the assignments (name, value as
-/// written) each level makes.
+/// written, coerced to the declared type when the scenario is read) each level makes.
 type ValueSetLevels = (
     String,
     Vec<paracosm_generators::Value>,
-    Vec<Vec<(String, String)>>,
+    Vec<Vec<(String, Value)>>,
 );
+
+/// A test's value of a parameter as the OpenSCENARIO value it overrides with: whole and real
+/// numbers as numbers, texts as texts (a road file; coerced to the declared type when read).
+fn typed(value: &paracosm_generators::Value) -> Value {
+    match value {
+        paracosm_generators::Value::Int(i) => Value::Num(*i as f64),
+        paracosm_generators::Value::Real(x) => Value::Num(*x),
+        paracosm_generators::Value::Bool(b) => Value::Bool(*b),
+        paracosm_generators::Value::Text(t) => Value::Str(t.clone()),
+    }
+}
 
 /// The last component of `path` (the path itself when it has none).
 fn file_name(path: &str) -> String {

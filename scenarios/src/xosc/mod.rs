@@ -10,6 +10,7 @@
 
 mod campaign;
 mod describe;
+mod host_inputs;
 pub mod motion;
 pub mod road;
 mod space;
@@ -54,10 +55,13 @@ pub const HORIZON_CAP_S: f64 = 3600.0;
 /// slower on its 10 km roads).
 const ROUTE_M: f64 = 6000.0;
 
-/// The parameter values of one test as OpenSCENARIO overrides (`name`, value text), from the
-/// test's assignment (a value set's index expands to its parameters, for example).
-pub type Overrides =
-    Arc<dyn Fn(&Assignment) -> Result<Vec<(String, String)>, OverrideError> + Send + Sync>;
+/// The parameter values of one test as OpenSCENARIO overrides (`name`, typed value), from the
+/// test's assignment (a value set's level expands to its parameters, for example).
+pub type Overrides = Arc<
+    dyn Fn(&Assignment) -> Result<Vec<(String, paracosm_openscenario::Value)>, OverrideError>
+        + Send
+        + Sync,
+>;
 
 /// Why a test's values cannot be written as overrides (a value set that is not
 /// `Name=value, ...`).
@@ -84,6 +88,9 @@ pub struct Source {
     pub warnings: Vec<Warning>,
     /// The space of the test's parameters.
     pub space: ParamSpace,
+    /// Where each parameter of the space is set, in its order (`file:line:col` of its
+    /// distribution, `--open Name=...`): the load's warnings about it name it.
+    pub param_sites: Vec<String>,
     /// The overrides of one test.
     pub overrides: Overrides,
     /// Whether the storyboard moves the ego as it moves every other entity (its `Init`, its
@@ -357,17 +364,27 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
         map_axes,
         space: source.space,
         source: crate::front_end::Source::default(),
-        warnings: Vec::new(),
+        findings: crate::front_end::Findings::default(),
     };
     // The scene of the declared values: the map loads, the Init places every entity.
-    let (scene, _) = front_end.build(&model)?;
+    let model = Arc::new(model);
+    let (scene, _) = front_end.build(model.clone())?;
     drop(scene);
+    // What each parameter changes, as a program's load finds it: one the storyboard and the
+    // scene never read is left out of coverage, with the warning a program gets.
+    let names: Vec<(String, String)> = (front_end.space.params().iter())
+        .zip(&source.param_sites)
+        .map(|(p, site)| (p.name.clone(), site.clone()))
+        .collect();
+    let mut findings = crate::analysis::findings_of(&front_end, &names, horizon_s);
+    warnings.append(&mut findings.warnings);
     warnings.extend(front_end.maps.warnings().into_iter().map(|w| Warning {
         at: model.file.clone(),
         message: w,
     }));
     warnings.extend(source.warnings);
-    front_end.warnings = warnings;
+    findings.warnings = warnings;
+    front_end.findings = findings;
     front_end.source = crate::front_end::Source {
         name: source.name,
         description: format!(
@@ -435,7 +452,7 @@ struct XoscFrontEnd {
     /// What the load read.
     source: crate::front_end::Source,
     /// What the load found.
-    warnings: Vec<Warning>,
+    findings: crate::front_end::Findings,
 }
 
 /// The longest test of `model`, s: `given` (`--horizon`), else [`HORIZON_CAP_S`] when the
@@ -477,7 +494,7 @@ impl FrontEnd for XoscFrontEnd {
         };
         let model =
             read_scenario_in(&self.maps.xosc, &self.template, &overrides).map_err(xosc_error)?;
-        let (scene, mut host) = self.build(&model)?;
+        let (scene, mut host) = self.build(Arc::new(model))?;
         run(&scene, &mut host);
         Ok(())
     }
@@ -487,10 +504,7 @@ impl FrontEnd for XoscFrontEnd {
     }
 
     fn findings(&self) -> crate::front_end::Findings {
-        crate::front_end::Findings {
-            warnings: self.warnings.clone(),
-            ..Default::default()
-        }
+        self.findings.clone()
     }
 }
 
@@ -507,8 +521,10 @@ impl XoscFrontEnd {
     /// The scene of `model` and the host that runs its storyboard: [`build_into`] a scene of
     /// daylight without fog, with a collision monitor and a horizon of [`HORIZON_CAP_S`] (the
     /// storyboard's stop trigger ends a test sooner).
-    fn build(&self, model: &m::Scenario) -> Result<(Scene, StoryHost), ScenarioError> {
+    fn build(&self, model: Arc<m::Scenario>) -> Result<(Scene, StoryHost), ScenarioError> {
         let mut scene = Scene::new(None);
+        scene.set_host_inputs(Arc::new(host_inputs::StoryInputs(model.clone())));
+        let model = &*model;
         let at = model
             .road_network
             .as_ref()

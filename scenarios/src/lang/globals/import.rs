@@ -160,14 +160,17 @@ fn returned<'v>(
     heap.alloc(AllocStruct(fields))
 }
 
-/// `params` as OpenSCENARIO overrides `(name, text)`: numbers in Rust's shortest form,
-/// strings as they are, bools as `true`/`false`; an open parameter constant over time is its
-/// value in this evaluation.
+/// `params` as OpenSCENARIO overrides `(name, typed value)`: numbers, strings (taken as they
+/// are, never evaluated: `"$x"` is that text) and bools; an open parameter constant over time
+/// is its value in this evaluation. The file coerces each to its declared type.
 ///
 /// # Errors
 /// A value that is not a dict of strings to numbers, strings or bools (a stream, which has no
 /// one value for the file, included).
-fn overrides(params: Option<Value>, b: &SceneBuilder) -> anyhow::Result<Vec<(String, String)>> {
+fn overrides(
+    params: Option<Value>,
+    b: &SceneBuilder,
+) -> anyhow::Result<Vec<(String, paracosm_openscenario::Value)>> {
     let Some(params) = params.filter(|p| !p.is_none()) else {
         return Ok(Vec::new());
     };
@@ -182,10 +185,10 @@ fn overrides(params: Option<Value>, b: &SceneBuilder) -> anyhow::Result<Vec<(Str
         let Some(name) = k.unpack_str() else {
             bail!("Import(params=): a parameter's name is a string, got {k}");
         };
-        let text = if let Some(t) = text_value(v, b) {
-            t
+        let value = if let Some(t) = text_value(v, b) {
+            paracosm_openscenario::Value::Str(t)
         } else if let Some(x) = v.unpack_bool() {
-            x.to_string()
+            paracosm_openscenario::Value::Bool(x)
         } else {
             let x = load_time_number(v, b, &format!("Import(params=) {name:?}")).map_err(|_| {
                 anyhow!(
@@ -195,9 +198,9 @@ fn overrides(params: Option<Value>, b: &SceneBuilder) -> anyhow::Result<Vec<(Str
                     crate::lang::a_type(v.get_type())
                 )
             })?;
-            format!("{x}")
+            paracosm_openscenario::Value::Num(x)
         };
-        out.push((name.to_owned(), text));
+        out.push((name.to_owned(), value));
     }
     Ok(out)
 }

@@ -100,15 +100,21 @@ pub fn load(
     );
     monitor_warnings(&program, &first.world, &mut warnings);
     let read_in_code = second_looks(&program, &monitors, &mut effects, file, &mut warnings);
+    let sites: Vec<(String, String)> = (program.params.iter())
+        .map(|(name, decl)| (name.clone(), decl.site.to_string()))
+        .collect();
     let found = usage::analyse(usage::Inputs {
-        params: &program.params,
+        params: &sites,
         changes: &effects.changes,
         read_in_code: &read_in_code,
         stl_reads_light: reads_light(&monitors),
-        world: &first.world,
+        scene: &first.world.scene,
     });
     warnings.extend(found.warnings);
-    warnings.extend(usage::unit_warnings(&program.params, &program.syntax));
+    warnings.extend(crate::lang::units::unit_warnings(
+        &program.params,
+        &program.syntax,
+    ));
     for message in program.maps.warnings() {
         // "file:line: what": the map's own place.
         let (at, what) = match message.split_once(": ") {
@@ -476,7 +482,7 @@ fn probe_parameter(
         let other = program
             .world_for(values)
             .map_err(|e| for_values(&label, e))?;
-        seen.extend(usage::changes(base, &other, program.horizon_s));
+        seen.extend(usage::world_changes(base, &other, program.horizon_s));
         if !program.load_budget_left() {
             break;
         }

@@ -24,8 +24,8 @@ use super::globals::LoadState;
 use super::host::{CallLimits, StarHost};
 use super::names::{final_names, Syntax};
 use super::scene::{self, coordinate_names, ParamDecl, ParamValue, SceneBuilder};
-use super::usage;
 use super::values::OverTime;
+use crate::analysis as usage;
 use crate::scenario::Warning;
 use crate::{MonitorSpec, Scenario, ScenarioError};
 
@@ -801,7 +801,7 @@ impl Program {
                     continue;
                 };
                 steps += s;
-                let found = usage::changes(&from, &to, self.horizon_s);
+                let found = usage::world_changes(&from, &to, self.horizon_s);
                 let decisive = found.iter().any(|c| !usage::inert(c, false));
                 out.extend(found);
                 if decisive {

@@ -1,19 +1,15 @@
-//! Which inputs each open parameter changes, found when the program loads by building the
-//! world with each of the parameter's other values and comparing it with the first: a
-//! parameter that changes nothing and that no code reads is left out of coverage, and one that
-//! cannot affect the ego is named in a warning (LANGUAGE.md, "Warnings").
+//! What differs between two tests of one scenario: their scenes' worlds compared part by part
+//! (a colour, the light, a piece's friction, or anything else), and what their front end's
+//! host reads ([`crate::scene::HostInputs`]: an OpenSCENARIO storyboard).
 
 use std::collections::{BTreeSet, HashSet};
 
 use paracosm_engine::network::{PieceId, Surface};
 use paracosm_engine::WorldSpec;
 
-use super::names::Syntax;
-use super::scene::{ParamDecl, SceneBuilder};
-use super::types;
-use crate::scenario::{CameraOnly, Warning};
+use crate::scene::{LoadError, Scene};
 
-/// What changed between two worlds of one program.
+/// What changed between two tests of one scenario.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Change {
     /// The light (a stream no other stream reads).
@@ -144,8 +140,53 @@ fn recoloured<T: Clone + PartialEq + std::fmt::Debug>(
     }
 }
 
-/// What differs between `a` and `b`, two worlds of one program whose tests last `horizon_s`.
-pub fn changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
+/// What differs between the tests of the scenes `a` and `b` of one scenario, whose tests last
+/// `horizon_s`: their worlds ([`world_changes`]), and [`Change::Other`] when they judge with
+/// other monitors or settings, run another system under test, or their hosts read different
+/// inputs ([`Scene::host_inputs`]: a storyboard with other speeds, routes, triggers).
+///
+/// # Errors
+/// What [`Scene::world`] returns for either scene.
+pub fn scene_changes(a: &Scene, b: &Scene, horizon_s: f64) -> Result<Vec<Change>, LoadError> {
+    let mut out = world_changes(&a.world()?, &b.world()?, horizon_s);
+    let same_host = match (a.host_inputs(), b.host_inputs()) {
+        (None, None) => true,
+        (Some(x), Some(y)) => x.same_as(y),
+        _ => false,
+    };
+    let judged = |s: &Scene| {
+        let monitors: Vec<_> = s.monitors().map(|(m, _)| m.clone()).collect();
+        let settings = s.settings();
+        (
+            monitors,
+            settings.horizon_s,
+            settings.offroad,
+            s.ego().map(|(_, sut)| sut.clone()),
+        )
+    };
+    if !same_host || differ(&judged(a), &judged(b)) {
+        out.push(Change::Other);
+    }
+    Ok(out)
+}
+
+/// What differs between `a` and `b`, two worlds of one scenario whose tests last `horizon_s`.
+/// Every field of [`WorldSpec`] is named here, so that a field added to it fails to compile
+/// until its comparison is written.
+pub fn world_changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
+    let WorldSpec {
+        dt_s,
+        network: _, // piece_changes
+        frictions,  // and stream_changes
+        ego,
+        pedestrians,
+        cars: _, // car_changes
+        obstacles,
+        environment,
+        streams: _,   // stream_changes
+        published: _, // the streams monitors judge: stream_changes
+        sensors,
+    } = a;
     let mut out = Vec::new();
     // The pieces a vehicle can be on, in either world, worked out once a friction differs.
     let mut reached: Option<HashSet<PieceId>> = None;
@@ -166,21 +207,21 @@ pub fn changes(a: &WorldSpec, b: &WorldSpec, horizon_s: f64) -> Vec<Change> {
         }
     };
     piece_changes(a, b, &mut friction, &mut out);
-    other(differ(&a.ego, &b.ego), &mut out);
-    other(differ(&a.pedestrians, &b.pedestrians), &mut out);
+    other(differ(ego, &b.ego), &mut out);
+    other(differ(pedestrians, &b.pedestrians), &mut out);
     recoloured(
-        &a.obstacles,
+        obstacles,
         &b.obstacles,
         |o| &mut o.color,
         Change::ObstacleColour,
         &mut out,
     );
     other(
-        differ(&a.environment, &b.environment) || a.dt_s != b.dt_s,
+        differ(environment, &b.environment) || *dt_s != b.dt_s,
         &mut out,
     );
-    other(differ(&a.sensors, &b.sensors), &mut out);
-    other(differ(&a.frictions, &b.frictions), &mut out);
+    other(differ(sensors, &b.sensors), &mut out);
+    other(differ(frictions, &b.frictions), &mut out);
     car_changes(a, b, &mut out);
     stream_changes(a, b, &mut friction, &mut out);
     out
@@ -278,32 +319,6 @@ fn stream_changes(
     }
 }
 
-/// What [`analyse`] needs.
-pub struct Inputs<'a> {
-    /// Each parameter's final name and declaration.
-    pub params: &'a [(String, ParamDecl)],
-    /// What each parameter's other values changed, by parameter.
-    pub changes: &'a [Vec<Change>],
-    /// Whether code of the program (a lambda, a `def`, an expression) reads the parameter's
-    /// variable, by parameter.
-    pub read_in_code: &'a [bool],
-    /// Whether an `Stl` formula reads the `light` signal.
-    pub stl_reads_light: bool,
-    /// The program's first evaluation (for the cars' and obstacles' names).
-    pub world: &'a SceneBuilder,
-}
-
-/// The findings: warnings, the parameters no object reads (by index), and those only a camera
-/// sees.
-pub struct Usage {
-    /// Warnings, in parameter order.
-    pub warnings: Vec<Warning>,
-    /// Indices of the parameters that change nothing.
-    pub unused: Vec<usize>,
-    /// Parameters only a camera sees.
-    pub camera_only: Vec<CameraOnly>,
-}
-
 /// Pieces a vehicle can be on during a test of world `w`: every piece the ego can reach
 /// within the horizon (on or off the road, at full throttle all the way: the engine bounds any
 /// system's acceleration), and every piece an NPC car in the test drives over on its route.
@@ -324,149 +339,4 @@ fn driven(w: &WorldSpec, horizon_s: f64) -> HashSet<PieceId> {
         driven.extend(c.path.iter().filter_map(|&p| surface.piece_under(p)));
     }
     driven
-}
-
-/// Whether a change cannot affect the ego: a friction where no vehicle can be, or what only a
-/// camera sees (a colour; the light, unless an `Stl` formula reads it).
-pub fn inert(c: &Change, stl_reads_light: bool) -> bool {
-    match c {
-        Change::Friction { driven, .. } => !driven,
-        Change::Colour(_) | Change::ObstacleColour(_) => true,
-        Change::Light => !stl_reads_light,
-        Change::Other => false,
-    }
-}
-
-/// Classifies every parameter by what it changes.
-pub fn analyse(i: Inputs<'_>) -> Usage {
-    let mut usage = Usage {
-        warnings: Vec::new(),
-        unused: Vec::new(),
-        camera_only: Vec::new(),
-    };
-    for (k, (name, decl)) in i.params.iter().enumerate() {
-        let changes = &i.changes[k];
-        if i.read_in_code[k] {
-            continue;
-        }
-        if changes.is_empty() {
-            usage.unused.push(k);
-            usage.warnings.push(Warning {
-                at: decl.site.to_string(),
-                message: format!(
-                    "`{name}` is sampled but no object uses it: every value builds the same \
-                     world, so coverage leaves it out (summary.json lists it under unused_params)"
-                ),
-            });
-            continue;
-        }
-        let undriven = |c: &Change| matches!(c, Change::Friction { driven: false, .. });
-        if changes.iter().all(undriven) {
-            let pieces: BTreeSet<String> = changes
-                .iter()
-                .filter_map(|c| match c {
-                    Change::Friction { piece, .. } => Some(piece.clone()),
-                    _ => None,
-                })
-                .collect();
-            usage.warnings.push(Warning {
-                at: decl.site.to_string(),
-                message: format!(
-                    "`{name}` sets the friction of {}, where no vehicle can be during a test (the \
-                     ego cannot get there within the horizon even at full throttle, and no car's \
-                     route crosses it): it cannot affect the ego",
-                    pieces.into_iter().collect::<Vec<_>>().join(", ")
-                ),
-            });
-            continue;
-        }
-        if changes.iter().all(|c| inert(c, i.stl_reads_light)) {
-            let mut sets: Vec<String> = Vec::new();
-            for c in changes {
-                let s = match c {
-                    Change::Light => "the light".to_owned(),
-                    Change::Colour(car) => format!(
-                        "the colour of {}",
-                        i.world.scene.car_name(*car).unwrap_or("a car")
-                    ),
-                    Change::ObstacleColour(k) => format!(
-                        "the colour of {}",
-                        i.world.scene.obstacle_name(*k).unwrap_or("an obstacle")
-                    ),
-                    _ => continue,
-                };
-                if !sets.contains(&s) {
-                    sets.push(s);
-                }
-            }
-            usage.camera_only.push(CameraOnly {
-                param: name.clone(),
-                at: decl.site.to_string(),
-                sets: sets.join(" and "),
-            });
-        }
-    }
-    usage
-}
-
-/// A warning for each parameter declared with a `unit=` that is passed whole to an input in
-/// another unit (`unit = "km/h"` feeding `Car(speed=)`, in m/s).
-pub fn unit_warnings(params: &[(String, ParamDecl)], syntax: &Syntax) -> Vec<Warning> {
-    // Spellings of one unit compare equal: spaces dropped, `m/s^2` and `m/s**2` are `m/s²`.
-    let norm = |u: &str| {
-        u.split_whitespace()
-            .collect::<String>()
-            .replace("**", "^")
-            .replace("^2", "²")
-            .replace("^3", "³")
-    };
-    let mut out = Vec::new();
-    for (name, decl) in params {
-        let (Some(unit), Some(site)) = (&decl.unit, syntax.site(&decl.site.to_string())) else {
-            continue;
-        };
-        // Where it is passed whole: through its variable, or written inline in the call; or
-        // added to other numbers through its variable (`onLane(1, 10.0 + gap)`).
-        let mut inputs: Vec<(&str, &str)> = site
-            .variable
-            .as_deref()
-            .map(|v| {
-                let mut all = syntax.passed_to(v);
-                all.extend(syntax.summed_in(v));
-                all
-            })
-            .unwrap_or_default();
-        if let Some((builtin, keyword)) = &site.argument_of {
-            inputs.push((builtin, keyword));
-        }
-        for (builtin, keyword) in inputs {
-            if let Some(input) = super::builtins::input_of(builtin, keyword) {
-                if let types::Kind::Number { unit: theirs, .. } = input.kind {
-                    // A dimensionless input: any unit but "1" or "-" says the program expects
-                    // another scale (`unit = "%"` for a fog in [0, 1]).
-                    let plain = theirs.is_empty();
-                    let mismatch = if plain {
-                        !matches!(norm(unit).as_str(), "" | "1" | "-")
-                    } else {
-                        norm(theirs) != norm(unit)
-                    };
-                    if mismatch {
-                        let theirs = if plain {
-                            "a plain number (no unit)".to_owned()
-                        } else {
-                            format!("in {theirs}")
-                        };
-                        out.push(Warning {
-                            at: decl.site.to_string(),
-                            message: format!(
-                                "`{name}` is declared in {unit} but feeds {builtin}({keyword}=), \
-                                 which is {theirs}"
-                            ),
-                        });
-                    }
-                }
-            }
-        }
-    }
-    out
 }
