@@ -1,0 +1,298 @@
+//! The storyboard's conditions (OpenSCENARIO 1.3 User Guide, "Conditions and triggers"):
+//! each trigger's condition groups evaluated with edges and delays, the entity and value
+//! conditions, and the ego's measures (headway, gap, distance to its lane's edge).
+
+use super::*;
+
+#[derive(Debug, Clone)]
+pub(in crate::xosc::story) struct Cond {
+    pub(in crate::xosc::story) cond: m::Condition,
+    /// Its value at its last evaluation; `None` before its first (its first evaluation, at
+    /// the start of the simulation or when its element first waits, is no edge: a rising
+    /// edge needs the condition seen false before it is seen true, as in esmini's
+    /// `OSCCondition::CheckEdge`).
+    pub(in crate::xosc::story) prev: Option<bool>,
+    pub(in crate::xosc::story) history: VecDeque<(f64, bool)>,
+}
+
+impl Storyboard {
+    pub(in crate::xosc::story) fn evaluate(&mut self, k: usize, t: f64) -> bool {
+        let mut any = false;
+        for g in 0..self.triggers[k].len() {
+            let mut all = true;
+            for c in 0..self.triggers[k][g].len() {
+                let raw = self.condition(&self.triggers[k][g][c].cond.kind, t);
+                let cond = &mut self.triggers[k][g][c];
+                let edged = match cond.cond.edge {
+                    Edge::None => raw,
+                    Edge::Rising => raw && cond.prev == Some(false),
+                    Edge::Falling => !raw && cond.prev == Some(true),
+                    Edge::RisingOrFalling => cond.prev.is_some_and(|p| p != raw),
+                };
+                cond.prev = Some(raw);
+                // With a delay, the condition's value `delay` seconds ago.
+                let value = if cond.cond.delay_s > 0.0 {
+                    cond.history.push_back((t, edged));
+                    let cut = t - cond.cond.delay_s + 1e-9;
+                    let mut v = false;
+                    while let Some(&(ts, e)) = cond.history.front() {
+                        if ts <= cut {
+                            v |= e;
+                            cond.history.pop_front();
+                        } else {
+                            break;
+                        }
+                    }
+                    v
+                } else {
+                    edged
+                };
+                all &= value;
+            }
+            any |= all;
+        }
+        any
+    }
+
+    pub(in crate::xosc::story) fn condition(&self, kind: &ConditionKind, t: f64) -> bool {
+        match kind {
+            ConditionKind::SimulationTime { rule, value } => rule.holds(t, *value),
+            ConditionKind::ElementState {
+                element_type,
+                element,
+                state,
+            } => self.elems.iter().any(|e| {
+                e.kind.name().eq_ignore_ascii_case(element_type)
+                    && e.name == *element
+                    && match state.as_str() {
+                        "startTransition" => e.last.start,
+                        "endTransition" => e.last.end,
+                        "stopTransition" => e.last.stop,
+                        "skipTransition" => e.last.skip,
+                        "completeState" => e.phase == Phase::Complete,
+                        "runningState" => e.phase == Phase::Running,
+                        "standbyState" => e.phase == Phase::Standby,
+                        _ => false,
+                    }
+            }),
+            ConditionKind::Parameter { name, rule, value } => {
+                let Some((_, v)) = self.params.iter().find(|(n, _)| n == name) else {
+                    return false;
+                };
+                match (v.trim().parse::<f64>(), value.trim().parse::<f64>()) {
+                    (Ok(a), Ok(b)) => rule.holds(a, b),
+                    _ => match rule {
+                        Rule::Eq => v == value,
+                        Rule::Ne => v != value,
+                        _ => false,
+                    },
+                }
+            }
+            ConditionKind::Entity {
+                entities,
+                all,
+                test,
+            } => {
+                let mut hits = entities.iter().map(|&e| self.entity_test(e, test));
+                if *all {
+                    hits.all(|h| h)
+                } else {
+                    hits.any(|h| h)
+                }
+            }
+        }
+    }
+
+    pub(in crate::xosc::story) fn entity_test(&self, e: usize, test: &EntityTest) -> bool {
+        let st = &self.actors[e].state;
+        match test {
+            // Undefined (the reference behind, or the entity standing; not closing in) is
+            // false whatever the rule, as esmini has it: an "infinite" headway must not
+            // satisfy `greaterThan`.
+            EntityTest::TimeHeadway(g) => {
+                let (long, _, _) = self.gap(e, g);
+                long >= 0.0 && st.speed > 1e-9 && g.rule.holds(long / st.speed, g.value)
+            }
+            EntityTest::TimeToCollision(g) => {
+                let (long, _, closing) = self.gap(e, g);
+                long >= 0.0 && closing > 1e-9 && g.rule.holds(long / closing, g.value)
+            }
+            EntityTest::RelativeDistance(g) => {
+                let (long, lat, _) = self.gap(e, g);
+                let d = match g.kind.as_str() {
+                    "longitudinal" => long.abs(),
+                    "lateral" => lat.abs(),
+                    _ => long.hypot(lat),
+                };
+                g.rule.holds(d, g.value)
+            }
+            EntityTest::Distance {
+                position,
+                rule,
+                value,
+                freespace,
+                kind,
+            } => {
+                let at = paracosm_openscenario::Pos {
+                    file: String::new(),
+                    line: 0,
+                    col: 0,
+                };
+                self.resolve(position, &at).is_ok_and(|(p, _)| {
+                    let d = self.distance_to_point(e, [p.x, p.y], *freespace, kind);
+                    rule.holds(d, *value)
+                })
+            }
+            EntityTest::ReachPosition {
+                position,
+                tolerance,
+            } => {
+                let at = paracosm_openscenario::Pos {
+                    file: String::new(),
+                    line: 0,
+                    col: 0,
+                };
+                self.resolve(position, &at)
+                    .is_ok_and(|(p, _)| (p.x - st.pose.x).hypot(p.y - st.pose.y) <= *tolerance)
+            }
+            EntityTest::Speed { rule, value } => rule.holds(st.speed, *value),
+            EntityTest::RelativeSpeed {
+                entity,
+                rule,
+                value,
+            } => rule.holds(st.speed - self.actors[*entity].state.speed, *value),
+            EntityTest::Acceleration { rule, value } => rule.holds(st.accel, *value),
+            EntityTest::Standstill(d) => st.still_s >= *d - 1e-9,
+            EntityTest::TraveledDistance(d) => st.travelled_m >= *d,
+            EntityTest::EndOfRoad(d) => st.at_end_s > 0.0 && st.at_end_s >= *d - 1e-9,
+            EntityTest::Collision(other) => match other {
+                Some(o) => st.collided && self.touching(e, *o),
+                None => st.collided,
+            },
+        }
+    }
+
+    /// The longitudinal and lateral distances from entity `e` to `g`'s entity in `e`'s frame
+    /// (m; between bounding boxes with `freespace`, between reference points otherwise) and
+    /// the speed at which `e` closes in on it along its heading (m/s).
+    pub(in crate::xosc::story) fn gap(&self, e: usize, g: &Gap) -> (f64, f64, f64) {
+        let (a, b) = (&self.actors[e], &self.actors[g.entity]);
+        let h = a.state.pose.h;
+        let (c, s) = (h.cos(), h.sin());
+        let centre = |x: &Actor| {
+            let p = x.state.pose;
+            let (cc, ss) = (p.h.cos(), p.h.sin());
+            (
+                p.x + cc * x.centre_m[0] - ss * x.centre_m[1],
+                p.y + ss * x.centre_m[0] + cc * x.centre_m[1],
+            )
+        };
+        let (pa, pb) = if g.freespace {
+            (centre(a), centre(b))
+        } else {
+            (
+                (a.state.pose.x, a.state.pose.y),
+                (b.state.pose.x, b.state.pose.y),
+            )
+        };
+        let (dx, dy) = (pb.0 - pa.0, pb.1 - pa.1);
+        let mut long = dx * c + dy * s;
+        let mut lat = -dx * s + dy * c;
+        if g.freespace {
+            // Half the extent of each box along and across `e`'s heading.
+            let rel = b.state.pose.h - h;
+            let half_long_b = 0.5 * (b.size_m[0] * rel.cos().abs() + b.size_m[1] * rel.sin().abs());
+            let half_lat_b = 0.5 * (b.size_m[0] * rel.sin().abs() + b.size_m[1] * rel.cos().abs());
+            let shrink = |d: f64, half: f64| d.signum() * (d.abs() - half).max(0.0);
+            long = shrink(long, a.size_m[0] / 2.0 + half_long_b);
+            lat = shrink(lat, a.size_m[1] / 2.0 + half_lat_b);
+        }
+        let vb = b.state.speed * (b.state.pose.h - h).cos();
+        let closing = if long >= 0.0 {
+            a.state.speed - vb
+        } else {
+            vb - a.state.speed
+        };
+        (long, lat, closing)
+    }
+
+    /// The distance from entity `e` to the point `p` (`[x, y]` m), as `kind` measures it in
+    /// `e`'s frame (`longitudinal`, `lateral`, else euclidean): from its reference point, or
+    /// with `freespace` from its bounding box (0 inside it). OpenSCENARIO `DistanceCondition`.
+    pub(in crate::xosc::story) fn distance_to_point(
+        &self,
+        e: usize,
+        p: [f64; 2],
+        freespace: bool,
+        kind: &str,
+    ) -> f64 {
+        let a = &self.actors[e];
+        let pose = a.state.pose;
+        let (c, s) = (pose.h.cos(), pose.h.sin());
+        let (dx, dy) = (p[0] - pose.x, p[1] - pose.y);
+        let (mut long, mut lat) = (dx * c + dy * s, -dx * s + dy * c);
+        if freespace {
+            long = ((long - a.centre_m[0]).abs() - a.size_m[0] / 2.0).max(0.0);
+            lat = ((lat - a.centre_m[1]).abs() - a.size_m[1] / 2.0).max(0.0);
+        }
+        match kind {
+            "longitudinal" => long.abs(),
+            "lateral" => lat.abs(),
+            _ => long.hypot(lat),
+        }
+    }
+
+    /// Whether the bounding boxes of `a` and `b` touch (within 5 cm).
+    pub(in crate::xosc::story) fn touching(&self, a: usize, b: usize) -> bool {
+        let g = Gap {
+            entity: b,
+            rule: Rule::Lt,
+            value: 0.0,
+            freespace: true,
+            frame: "entity".into(),
+            kind: "euclidianDistance".into(),
+        };
+        let (long, lat, _) = self.gap(a, &g);
+        long.abs() <= 0.05 && lat.abs() <= 0.05
+    }
+
+    /// The R157-style measures of entity `e`: its time headway (s) and following distance (m,
+    /// between bounding boxes) to the nearest entity ahead of it in its lane (within the two
+    /// half-widths sideways), `inf` with none; and the distance from its box's side to its
+    /// lane's nearer edge (m, negative once over it; `nan` off every lane).
+    pub fn measures(&self, e: usize) -> (f64, f64, f64) {
+        let a = &self.actors[e];
+        let mut gap_m = f64::INFINITY;
+        for (j, b) in self.actors.iter().enumerate() {
+            if j == e {
+                continue;
+            }
+            let g = Gap {
+                entity: j,
+                rule: Rule::Lt,
+                value: 0.0,
+                freespace: true,
+                frame: "entity".into(),
+                kind: "longitudinal".into(),
+            };
+            let (long, lat, _) = self.gap(e, &g);
+            let _ = b;
+            if long >= 0.0 && lat == 0.0 {
+                gap_m = gap_m.min(long);
+            }
+        }
+        let headway_s = if a.state.speed > 1e-9 {
+            gap_m / a.state.speed
+        } else {
+            f64::INFINITY
+        };
+        let edge_m = match a.state.lane {
+            Some(lp) => {
+                let w = self.roads.lane_width(lp.lane, lp.s);
+                w / 2.0 - lp.d.abs() - a.size_m[1] / 2.0
+            }
+            None => f64::NAN,
+        };
+        (headway_s, gap_m, edge_m)
+    }
+}

@@ -1,0 +1,216 @@
+//! Scripted entities driven each step by their tasks in progress: speed, lateral move and
+//! trajectory, along the map's lanes.
+
+use super::*;
+
+/// A speed target that follows another entity: its index, the value, whether a factor.
+pub(in crate::xosc::story) type Track = Option<(usize, f64, bool)>;
+
+/// A lane change's target: the lane and the offset from its centre there, m.
+pub(in crate::xosc::story) type ToLane = Option<(usize, f64)>;
+
+/// A scripted entity's motion in progress, each with the action it belongs to.
+#[derive(Debug, Clone, Default)]
+pub(in crate::xosc::story) struct Drive {
+    /// The speed transition, a target that follows another entity, the action.
+    pub(in crate::xosc::story) speed: Option<(Transition, Track, usize)>,
+    /// The lateral move in progress.
+    pub(in crate::xosc::story) lateral: Option<Lateral>,
+    pub(in crate::xosc::story) path: Option<(Path, usize)>,
+    /// A driven ego's lane change in progress: the lane it changes to, the offset from its
+    /// centre there (m), the action; it ends once the ego is there ([`LANE_REACHED_M`]).
+    pub(in crate::xosc::story) lane_goal: Option<(usize, f64, usize)>,
+    pub(in crate::xosc::story) prefer_roads: Vec<usize>,
+    /// Its heading relative to its lane's travel, rad, kept as it moves along the lane
+    /// (esmini's relative heading): set where it is placed or where its trajectory ends,
+    /// 0 after a lateral move.
+    pub(in crate::xosc::story) rel_h: f64,
+}
+
+impl Storyboard {
+    /// Moves scripted entity `e` from `t` to `t + dt`.
+    pub(in crate::xosc::story) fn drive(
+        &mut self,
+        e: usize,
+        t: f64,
+        dt: f64,
+    ) -> Result<(), StoryError> {
+        let t1 = t + dt;
+        let st = self.actors[e].state;
+        // Speed.
+        let mut v1 = st.speed;
+        let mut done = Vec::new();
+        if let Some((tr, track, a)) = self.drives[e].speed {
+            let (v, over) = tr.at(t1);
+            v1 = v;
+            if over {
+                match track {
+                    Some((r, value, factor)) => {
+                        let rv = self.actors[r].state.speed;
+                        v1 = if factor { rv * value } else { rv + value };
+                    }
+                    None => {
+                        self.drives[e].speed = None;
+                        done.push(a);
+                    }
+                }
+            }
+        }
+        v1 = v1.max(0.0);
+        // At the new speed over the step (esmini's integration: the speed first, then the
+        // move).
+        let dist = v1 * dt;
+        let mut pose = st.pose;
+        let mut lane = st.lane;
+        let mut at_end = false;
+        let mut speed_now = v1;
+        if let Some((path, a)) = &mut self.drives[e].path {
+            let (p, over) = match path {
+                Path::Timed(p) => p.at(t1),
+                Path::Untimed(u) => u.advance(dist),
+            };
+            let timed = matches!(path, Path::Timed(_));
+            let a = *a;
+            if timed {
+                let moved = (p.x - pose.x).hypot(p.y - pose.y);
+                if moved > 1e-9 || !over {
+                    speed_now = moved / dt;
+                }
+            }
+            pose = p;
+            lane = self.facing(self.roads.anchor(p.x, p.y), p.h);
+            if over {
+                // It goes on at the speed it had, along its lane facing the way the last leg
+                // went (esmini's reading).
+                self.drives[e].rel_h = self.relative_heading(p.h, lane);
+                self.drives[e].path = None;
+                done.push(a);
+            }
+        } else if let Some(lp) = lane {
+            let (p, l, end, ended) = self.drive_on_lane(e, lp, (dist, dt, pose.h));
+            pose = p;
+            lane = Some(l);
+            at_end = end;
+            done.extend(ended);
+        } else {
+            pose.x += dist * pose.h.cos();
+            pose.y += dist * pose.h.sin();
+        }
+        let moved = (pose.x - st.pose.x).hypot(pose.y - st.pose.y);
+        let s = &mut self.actors[e].state;
+        s.accel = (speed_now - s.speed) / dt;
+        s.speed = speed_now;
+        s.pose = pose;
+        s.lane = lane;
+        s.travelled_m += moved;
+        s.still_s = if speed_now.abs() < 1e-3 {
+            s.still_s + dt
+        } else {
+            0.0
+        };
+        s.at_end_s = if at_end { s.at_end_s + dt } else { 0.0 };
+        for a in done {
+            self.override_task(Some(a));
+        }
+        Ok(())
+    }
+
+    /// Moves scripted entity `e`, on lane position `lp` facing `h0`, a step of `dt` s in which
+    /// it travels `dist` m, along its lanes with its lateral move: its pose, lane position,
+    /// whether its lanes ended, and the action whose lateral move ended (if any).
+    ///
+    /// A lateral move is esmini's (`LatLaneChangeAction`, `LatLaneOffsetAction`): a lane
+    /// change takes its lateral step out of the step's travel (by time, `√(dist² − lat²)` along
+    /// the lane; by distance, `dist / √(1 + r²)` with `r` the offset's slope per metre) and
+    /// faces the way it moves; a lane offset lags one step and faces `atan(rate / speed)`.
+    pub(in crate::xosc::story) fn drive_on_lane(
+        &mut self,
+        e: usize,
+        mut lp: LanePos,
+        (dist, dt, h0): (f64, f64, f64),
+    ) -> (Pose, LanePos, bool, Option<usize>) {
+        let mut ended = None;
+        let mut along = dist;
+        // The heading relative to the lane's travel, as a slope against the travel.
+        let mut slip = 0.0;
+        if let Some(mut l) = self.drives[e].lateral {
+            let moving = dist > 1e-12;
+            let (d, over) = if l.offset {
+                let (d, over) = l.tr.at(l.param);
+                slip = (l.tr.slope(l.param) * dt).atan2(dist);
+                l.param += dt;
+                (d, over)
+            } else if !moving {
+                // Standing, a lane change waits (esmini steps it only while moving).
+                (lp.d, false)
+            } else if l.tr.duration_s <= 0.0 {
+                (l.tr.to, true)
+            } else if l.by_distance {
+                let r = l.tr.slope(l.param);
+                along = dist / (1.0 + r * r).sqrt();
+                l.param += along;
+                slip = r.atan();
+                l.tr.at(l.param)
+            } else {
+                let lat = (l.tr.slope(l.param) * dt).abs().min(dist);
+                along = (dist * dist - lat * lat).sqrt();
+                slip = (l.tr.slope(l.param) * dt).signum() * lat.atan2(along);
+                l.param += dt;
+                l.tr.at(l.param)
+            };
+            lp.d = d;
+            self.drives[e].lateral = Some(l);
+            if over {
+                slip = 0.0;
+                if let Some((k, offset)) = l.to_lane {
+                    let up = lp.along_s(&self.roads);
+                    let beside = (self.roads.ids(k).1 == self.roads.ids(lp.lane).1)
+                        .then(|| self.roads.lane_with_id(lp.lane, self.roads.ids(k).0, lp.s))
+                        .flatten();
+                    if let Some(k2) = beside {
+                        // Re-anchored on the target lane beside it here.
+                        lp.lane = k2;
+                        lp.rev = self.roads.forward(k2) != up;
+                        lp.d = offset;
+                    }
+                }
+                if !l.continuous {
+                    self.drives[e].lateral = None;
+                    ended = Some(l.action);
+                }
+            }
+        }
+        let prefer_roads = self.drives[e].prefer_roads.clone();
+        // A route names the roads it takes; a junction's connecting road is preferred by
+        // the road it leads to.
+        let prefer = |n: usize| {
+            prefer_roads.contains(&self.roads.ids(n).1)
+                || prefer_roads.contains(&self.roads.exit_road(n))
+        };
+        let up_before = lp.along_s(&self.roads);
+        let at_end = !self.roads.advance(&mut lp, along, &prefer);
+        if lp.along_s(&self.roads) != up_before {
+            // Its lane runs on in a road of the other direction: a lateral move in
+            // progress keeps its side of the motion.
+            if let Some(l) = &mut self.drives[e].lateral {
+                l.tr.from = -l.tr.from;
+                l.tr.to = -l.tr.to;
+                if let Some((_, offset)) = &mut l.to_lane {
+                    *offset = -*offset;
+                }
+            }
+        }
+        let travel = self.roads.travel_heading(&lp);
+        // `d` is left of increasing `s`: against `s`, the same move turns the other way.
+        let side = if lp.along_s(&self.roads) { 1.0 } else { -1.0 };
+        let h = if dist > 1e-12 {
+            wrap(travel + side * slip + self.drives[e].rel_h)
+        } else {
+            h0
+        };
+        let mut pose = self.roads.pose_of(&lp);
+        // Standing still, it keeps the way it faces.
+        pose.h = h;
+        (pose, lp, at_end, ended)
+    }
+}

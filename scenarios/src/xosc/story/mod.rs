@@ -1,0 +1,455 @@
+//! The storyboard runtime: an OpenSCENARIO storyboard (OpenSCENARIO 1.3 User Guide,
+//! "Storyboard and entities", "Conditions and triggers") run step by step over the test's
+//! world. Stories, acts, maneuver groups, maneuvers, events and actions move through the
+//! standard's states (standby, running, complete) on their triggers: condition groups (an OR
+//! of ANDs), each condition with its edge and delay; event priorities (override, skip,
+//! parallel) and execution counts. Scripted entities (every entity but the ego, which the
+//! system under test drives) move as their actions say, on the map's lanes.
+
+mod conditions;
+mod drive;
+mod elements;
+mod positions;
+mod tasks;
+
+use conditions::Cond;
+use drive::{Drive, ToLane};
+use elements::{Elem, Kind, Owner, Phase};
+pub use tasks::DEFAULT_LATERAL_ACC_MPS2;
+use tasks::{Lateral, Path};
+
+use std::collections::VecDeque;
+
+use paracosm_openscenario::model::{
+    self as m, Action, ConditionKind, Edge, EntityTest, Gap, LaneTarget, Position, Priority, Rule,
+    SpeedTarget, TrajectoryShape,
+};
+
+use super::motion::{
+    clothoid_poses, duration_s, nurbs_poses, offset_duration_s, Timed, Transition, Untimed,
+};
+use super::road::{wrap, LanePos, Pose, RoadError, Roads};
+
+/// Orientation `o` against `base` (rad): a relative one added to it, an absolute one as
+/// written, `base` without one.
+fn orient(o: &Option<m::Orientation>, base: f64) -> f64 {
+    match o {
+        Some(o) if o.relative => wrap(base + o.h),
+        Some(o) => wrap(o.h),
+        None => base,
+    }
+}
+
+/// One entity as the storyboard sees it.
+#[derive(Debug, Clone)]
+pub struct Actor {
+    /// Its name in the file.
+    pub name: String,
+    /// Length, width, height of its bounding box, m.
+    pub size_m: [f64; 3],
+    /// The bounding box's centre relative to the entity's reference point, m (x forward, y
+    /// left, z up).
+    pub centre_m: [f64; 3],
+    /// Whether the storyboard moves it now: every entity but the ego the system under test
+    /// drives, and that ego too until its controller is activated
+    /// ([`Storyboard::hand_over_on_activation`]).
+    pub scripted: bool,
+    /// Its state now.
+    pub state: State,
+}
+
+/// Where an entity is and how it moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct State {
+    /// Its reference point's pose (the rear axle's centre for a vehicle).
+    pub pose: Pose,
+    /// Speed along its heading, m/s.
+    pub speed: f64,
+    /// Acceleration over the last step, m/s².
+    pub accel: f64,
+    /// Where it is on the map's lanes, when it follows them.
+    pub lane: Option<LanePos>,
+    /// Distance travelled since the start, m.
+    pub travelled_m: f64,
+    /// How long it has stood still, s.
+    pub still_s: f64,
+    /// How long it has stood at the end of its lanes, s.
+    pub at_end_s: f64,
+    /// Whether it has touched anything solid.
+    pub collided: bool,
+}
+
+impl State {
+    fn at(pose: Pose, lane: Option<LanePos>) -> Self {
+        State {
+            pose,
+            speed: 0.0,
+            accel: 0.0,
+            lane,
+            travelled_m: 0.0,
+            still_s: 0.0,
+            at_end_s: 0.0,
+            collided: false,
+        }
+    }
+}
+
+/// Why the storyboard cannot go on (an action that cannot be performed where it stands).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{at}: {message}")]
+pub struct StoryError {
+    /// Where the action or condition is written, `file:line:col`.
+    pub at: String,
+    /// What went wrong.
+    pub message: String,
+}
+
+/// The storyboard of one test and the entities it moves.
+#[derive(Debug, Clone)]
+pub struct Storyboard {
+    roads: Roads,
+    /// The entities, in the file's order.
+    pub actors: Vec<Actor>,
+    drives: Vec<Drive>,
+    elems: Vec<Elem>,
+    roots: Vec<usize>,
+    triggers: Vec<Vec<Vec<Cond>>>,
+    owners: Vec<Owner>,
+    trigger_now: Vec<bool>,
+    stop: Option<usize>,
+    params: Vec<(String, String)>,
+    /// Whether the storyboard's stop trigger has fired.
+    pub ended: bool,
+    started: bool,
+    /// The speed the storyboard asks of the ego the system under test drives now, m/s: its
+    /// `SpeedAction`s' transitions, which the host hands the system as its set speed
+    /// ([`Storyboard::set_speed`]); `None` until one starts.
+    set_speed: Option<f64>,
+    /// The ego that the storyboard moves until an `ActivateControllerAction` on it hands it
+    /// to the system under test ([`Storyboard::hand_over_on_activation`]).
+    hand_over: Option<usize>,
+    /// A new route asked of the driven ego since the host last took one
+    /// ([`Storyboard::take_route`]).
+    route: Option<RouteAsk>,
+}
+
+/// A route the storyboard asks of the ego the system under test drives (a `LaneChangeAction`
+/// or an `AssignRouteAction` on it): from where the ego is, join `join` (a place on the lane
+/// to drive in, abeam the ego, at the offset asked) `ahead_m` metres further along, then
+/// follow the lanes from there, through junctions as the ego's route prefers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RouteAsk {
+    /// The lane position abeam the ego (its station) on the lane to drive in.
+    pub join: LanePos,
+    /// How far ahead the route joins that lane, m: the lane change's length (its distance, or
+    /// its duration at the ego's speed); 0 for a route on the lane the ego is in.
+    pub ahead_m: f64,
+}
+
+/// How close to the target lane's centre (plus the offset asked) a driven ego must come for
+/// its `LaneChangeAction` to end, m.
+pub const LANE_REACHED_M: f64 = 0.3;
+
+/// How close the driven ego's speed must come to a `SpeedAction`'s target, once the action's
+/// transition is over, for the action to end: this many m/s plus [`SET_SPEED_REACHED_SHARE`]
+/// of the target (a cruise controller settles under its set speed: `aeb`'s proportional
+/// gain keeps 11.84 m/s of 12 and 19.14 of 20, `tests/xosc_ego.rs`).
+pub const SET_SPEED_REACHED_MPS: f64 = 0.5;
+/// See [`SET_SPEED_REACHED_MPS`].
+pub const SET_SPEED_REACHED_SHARE: f64 = 0.05;
+
+fn site(pos: &paracosm_openscenario::Pos) -> String {
+    pos.to_string()
+}
+
+impl Storyboard {
+    /// The storyboard of `scenario` on `roads`, its `Init` performed: every entity placed and
+    /// given its initial speed. `ego` is the entity the system under test drives (not
+    /// scripted); with `None`, the storyboard moves every entity (the ego too, at the speed
+    /// its `Init` gives it).
+    ///
+    /// # Errors
+    /// [`StoryError`] for an `Init` action that cannot be performed (a position off the map,
+    /// a relative position to an entity not yet placed).
+    pub fn new(
+        scenario: &m::Scenario,
+        roads: Roads,
+        ego: Option<usize>,
+    ) -> Result<Self, StoryError> {
+        let mut sb = Storyboard::unbuilt(scenario, roads, ego);
+        sb.stop = scenario
+            .stop
+            .as_ref()
+            .filter(|t| !t.0.is_empty())
+            .map(|t| sb.add_trigger(t, Owner::Storyboard));
+        for story in &scenario.stories {
+            let s = sb.push(Kind::Story, &story.name, 1);
+            sb.roots.push(s);
+            for act in &story.acts {
+                sb.add_act(s, act)?;
+            }
+        }
+        sb.trigger_now = vec![false; sb.triggers.len()];
+        sb.perform_init(scenario)?;
+        // Init's transitions run from the start.
+        Ok(sb)
+    }
+
+    /// The storyboard of `scenario` on `roads` before its stories are read and its `Init`
+    /// performed: every entity at the origin (0 m, 0 m, heading 0 rad), standing, on no
+    /// lane; every entity scripted but `ego`.
+    fn unbuilt(scenario: &m::Scenario, roads: Roads, ego: Option<usize>) -> Self {
+        let actors = scenario
+            .entities
+            .iter()
+            .enumerate()
+            .map(|(i, e)| Actor {
+                name: e.name.clone(),
+                size_m: e.dimensions_m,
+                centre_m: e.centre_m,
+                scripted: Some(i) != ego,
+                state: State::at(
+                    Pose {
+                        x: 0.0,
+                        y: 0.0,
+                        h: 0.0,
+                    },
+                    None,
+                ),
+            })
+            .collect();
+        Storyboard {
+            roads,
+            drives: vec![Drive::default(); scenario.entities.len()],
+            actors,
+            elems: Vec::new(),
+            roots: Vec::new(),
+            triggers: Vec::new(),
+            owners: Vec::new(),
+            trigger_now: Vec::new(),
+            stop: None,
+            params: scenario
+                .params
+                .iter()
+                .map(|(d, v)| (d.name.clone(), v.to_text()))
+                .collect(),
+            ended: false,
+            started: false,
+            set_speed: None,
+            hand_over: None,
+            route: None,
+        }
+    }
+
+    /// The map the storyboard moves its entities on.
+    pub fn roads(&self) -> &Roads {
+        &self.roads
+    }
+
+    /// Entity `e`'s reference point and the centre of its bounding box, engine world
+    /// coordinates: `([x, y, z] m of the box's base centre, heading rad)`.
+    pub fn engine_pose(&self, e: usize) -> ([f64; 3], f64) {
+        let a = &self.actors[e];
+        let p = a.state.pose;
+        let (c, s) = (p.h.cos(), p.h.sin());
+        let centre = Pose {
+            x: p.x + c * a.centre_m[0] - s * a.centre_m[1],
+            y: p.y + s * a.centre_m[0] + c * a.centre_m[1],
+            h: p.h,
+        };
+        self.roads.to_engine(centre)
+    }
+
+    /// Sets the state of an entity the storyboard does not move (the ego) from what the
+    /// simulation shows: its box centre `[x, y, z]` (engine world, m), heading (rad), speed
+    /// along its heading (m/s); `dt` is the step (s).
+    pub fn observe(&mut self, e: usize, centre: [f64; 3], heading: f64, speed: f64, dt: f64) {
+        let a = &mut self.actors[e];
+        let o = self.roads.map().origin_m;
+        let (x, y) = (centre[0] + o[0], -centre[2] + o[1]);
+        let (c, s) = (heading.cos(), heading.sin());
+        let pose = Pose {
+            x: x - c * a.centre_m[0] + s * a.centre_m[1],
+            y: y - s * a.centre_m[0] - c * a.centre_m[1],
+            h: heading,
+        };
+        let st = &mut a.state;
+        let moved = (pose.x - st.pose.x).hypot(pose.y - st.pose.y);
+        if self.started {
+            st.accel = (speed - st.speed) / dt;
+            st.travelled_m += moved;
+        }
+        st.speed = speed;
+        st.pose = pose;
+        st.lane = self
+            .roads
+            .anchor(pose.x, pose.y)
+            .map(|lp| self.roads.facing(lp, heading));
+        st.still_s = if speed.abs() < 1e-3 {
+            st.still_s + dt
+        } else {
+            0.0
+        };
+    }
+
+    /// Whether the lanes entity `e` follows end within `margin_m` (m) of its bounding box's
+    /// front: there is no lane for it to drive on beyond. `false` off every lane.
+    pub fn road_ends_ahead(&self, e: usize, margin_m: f64) -> bool {
+        let a = &self.actors[e];
+        let Some(mut lp) = a.state.lane else {
+            return false;
+        };
+        let reach = (a.centre_m[0] + a.size_m[0] / 2.0).max(0.0) + margin_m;
+        !self.roads.advance(&mut lp, reach, &|_| false)
+    }
+
+    /// Whether any event of the storyboard has started (run at least once, or runs now).
+    pub fn any_event_started(&self) -> bool {
+        self.elems
+            .iter()
+            .any(|e| e.kind == Kind::Event && (e.runs > 0 || e.phase != Phase::Standby))
+    }
+
+    /// What the storyboard waits on when it can wait no more: `None` while anything can still
+    /// change a condition it waits on; else the conditions of the triggers it waits on
+    /// (their names and kinds). Nothing can change when every entity stands still (at most
+    /// `still_mps`, m/s), no scripted entity has a motion in progress, and no trigger it waits
+    /// on reads time: a `SimulationTimeCondition`, a `StandStillCondition` or
+    /// `EndOfRoadCondition` (they hold after a duration), or a `delay`. A still world keeps
+    /// every other condition's value, and so every edge away.
+    pub fn stuck(&self, still_mps: f64) -> Option<Vec<String>> {
+        if self.ended || !self.started {
+            return None;
+        }
+        let moving = self.actors.iter().zip(&self.drives).any(|(a, d)| {
+            a.state.speed.abs() > still_mps
+                || (a.scripted && (d.speed.is_some() || d.lateral.is_some() || d.path.is_some()))
+        });
+        if moving {
+            return None;
+        }
+        let mut waited = Vec::new();
+        for k in (0..self.triggers.len()).filter(|&k| self.waits(k)) {
+            for c in self.triggers[k].iter().flatten() {
+                let timed = c.cond.delay_s > 0.0
+                    || matches!(
+                        c.cond.kind,
+                        m::ConditionKind::SimulationTime { .. }
+                            | m::ConditionKind::Entity {
+                                test: m::EntityTest::Standstill(_) | m::EntityTest::EndOfRoad(_),
+                                ..
+                            }
+                    );
+                if timed {
+                    return None;
+                }
+                waited.push(format!("{:?} ({})", c.cond.name, c.cond.pos));
+            }
+        }
+        (!waited.is_empty()).then_some(waited)
+    }
+
+    /// Records whether entity `e` has touched anything solid.
+    pub fn set_collided(&mut self, e: usize, collided: bool) {
+        self.actors[e].state.collided = collided;
+    }
+
+    /// One step at time `t` (s) of length `dt` (s): the triggers read the world as it is at
+    /// `t`, the elements move through their states, and every scripted entity moves to where
+    /// it is at `t + dt`.
+    ///
+    /// # Errors
+    /// [`StoryError`] for an action that cannot be performed where its entity stands.
+    pub fn step(&mut self, t: f64, dt: f64) -> Result<(), StoryError> {
+        // The transitions of the last step, for this step's conditions.
+        for e in &mut self.elems {
+            e.last = std::mem::take(&mut e.moves);
+        }
+        if !self.started {
+            self.started = true;
+            for r in self.roots.clone() {
+                self.start_elem(r, t)?;
+            }
+        }
+        for k in 0..self.triggers.len() {
+            if self.waits(k) {
+                self.trigger_now[k] = self.evaluate(k, t);
+            } else {
+                // Not waiting: its delays start afresh when it waits again; an edge is taken
+                // against the last value seen (esmini's `OSCCondition::Reset` clears only the
+                // delay history).
+                self.trigger_now[k] = false;
+                for c in self.triggers[k].iter_mut().flatten() {
+                    c.history.clear();
+                }
+            }
+        }
+        if let Some(k) = self.stop {
+            if self.trigger_now[k] {
+                self.ended = true;
+            }
+        }
+        for r in self.roots.clone() {
+            self.run_story(r, t)?;
+        }
+        for e in 0..self.actors.len() {
+            if self.actors[e].scripted {
+                self.drive(e, t, dt)?;
+            } else {
+                self.ask_speed(e, t + dt);
+                self.ask_lane(e);
+            }
+        }
+        // An event whose actions ended in this step's motion ends in this step.
+        for ev in 0..self.elems.len() {
+            let e = &self.elems[ev];
+            if e.kind == Kind::Event
+                && e.phase == Phase::Running
+                && e.children
+                    .iter()
+                    .all(|&a| self.elems[a].phase == Phase::Complete)
+            {
+                self.end_elem(ev);
+                if self.elems[ev].runs < self.elems[ev].max_runs {
+                    self.elems[ev].phase = Phase::Standby;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The transitions the acts, events and actions made in the last [`Storyboard::step`]:
+    /// `(kind, name, transition)`, kind `act`, `event` or `action`, transition `start`,
+    /// `end`, `stop` or `skip` (the standard's names: startTransition, endTransition,
+    /// stopTransition, skipTransition), in the storyboard's order.
+    pub fn transitions(&self) -> Vec<(&'static str, &str, &'static str)> {
+        let mut out = Vec::new();
+        for e in &self.elems {
+            if !matches!(e.kind, Kind::Act | Kind::Event | Kind::Action) {
+                continue;
+            }
+            for (made, what) in [
+                (e.moves.start, "start"),
+                (e.moves.end, "end"),
+                (e.moves.stop, "stop"),
+                (e.moves.skip, "skip"),
+            ] {
+                if made {
+                    out.push((e.kind.name(), e.name.as_str(), what));
+                }
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_are_named_as_the_standard_names_them() {
+        assert_eq!(Kind::Group.name(), "maneuverGroup");
+        assert!(Kind::Action.name().eq_ignore_ascii_case("ACTION"));
+    }
+}

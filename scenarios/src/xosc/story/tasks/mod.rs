@@ -1,0 +1,165 @@
+//! The storyboard's actions: `Init` performed, references checked, and each running action's
+//! task started by its kind, one file per kind (speed, lateral, trajectory, teleport, route,
+//! controller, distance).
+
+mod controller;
+mod distance;
+mod lateral;
+mod route;
+mod speed;
+mod teleport;
+mod trajectory;
+
+pub(in crate::xosc::story) use lateral::Lateral;
+pub use lateral::DEFAULT_LATERAL_ACC_MPS2;
+pub(in crate::xosc::story) use trajectory::Path;
+
+use super::*;
+
+impl Storyboard {
+    /// Performs `scenario`'s `Init`: positions first, in the file's order, then the rest (a
+    /// relative position may name an entity placed later in the file).
+    ///
+    /// # Errors
+    /// [`StoryError`] for an `Init` action that cannot be performed.
+    pub(in crate::xosc::story) fn perform_init(
+        &mut self,
+        scenario: &m::Scenario,
+    ) -> Result<(), StoryError> {
+        let (places, rest): (Vec<_>, Vec<_>) = scenario
+            .init
+            .iter()
+            .partition(|(_, a)| matches!(a.action, Action::Teleport(_)));
+        for (e, a) in places.into_iter().chain(rest) {
+            self.start_task(*e, a, None, 0.0)?;
+        }
+        Ok(())
+    }
+
+    /// Checks the roads and lanes that `na` names where they do not depend on where an
+    /// entity is when it starts: a teleport or a route's waypoint to a lane or road position
+    /// (the road, the lane at that station), and a lane change to an absolute lane id (some
+    /// road of the map has it). So a reference that cannot be met is refused when the file
+    /// loads, at the action's line and column, rather than failing every test.
+    ///
+    /// # Errors
+    /// [`StoryError`] at the action, naming the action and the map's refusal.
+    pub(in crate::xosc::story) fn check_references(
+        &self,
+        na: &m::NamedAction,
+    ) -> Result<(), StoryError> {
+        let refused = |message: String| StoryError {
+            at: site(&na.pos),
+            message: format!("{} {:?}: {message}", na.action.kind_name(), na.name),
+        };
+        let position = |p: &Position| -> Result<(), StoryError> {
+            match p {
+                Position::Lane { road, lane, s, .. } => self
+                    .roads
+                    .lane_pos(road, *lane, *s, 0.0)
+                    .map(drop)
+                    .map_err(|e| refused(e.to_string())),
+                Position::Road { road, s, t, .. } => self
+                    .roads
+                    .road_pos(road, *s, *t)
+                    .map(drop)
+                    .map_err(|e| refused(e.to_string())),
+                _ => Ok(()),
+            }
+        };
+        match &na.action {
+            Action::Teleport(p) => position(p),
+            Action::AssignRoute { waypoints } => {
+                waypoints.iter().try_for_each(|(p, _)| position(p))
+            }
+            Action::LaneChange {
+                target: LaneTarget::Absolute(id),
+                ..
+            } => {
+                if self.roads.map().lanes.iter().any(|l| l.od_id == *id) {
+                    Ok(())
+                } else {
+                    Err(refused(format!(
+                        "no road of the map has a lane {id}, so no entity can change to it"
+                    )))
+                }
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Starts action `action` on entity `e` at `t` (s), for action element `a` (`None` in
+    /// `Init`).
+    pub(in crate::xosc::story) fn start_task(
+        &mut self,
+        e: usize,
+        action: &m::NamedAction,
+        a: Option<usize>,
+        t: f64,
+    ) -> Result<(), StoryError> {
+        let bad = |message: String| StoryError {
+            at: site(&action.pos),
+            message,
+        };
+        let scripted = self.actors[e].scripted;
+        match &action.action {
+            Action::Teleport(p) => {
+                if scripted || a.is_none() {
+                    self.teleport(e, p, &action.pos)?;
+                }
+            }
+            Action::Speed { target, dynamics } => {
+                return self.start_speed(e, (target, dynamics), a, t);
+            }
+            Action::LaneChange {
+                target,
+                dynamics,
+                offset_m,
+            } => {
+                return self.start_lane_change(e, (target, dynamics, offset_m), (a, &action.pos));
+            }
+            Action::LaneOffset {
+                target,
+                shape,
+                max_lateral_acc,
+                continuous,
+            } => {
+                return self.start_lane_offset(
+                    e,
+                    (target, shape, max_lateral_acc, continuous),
+                    (a, &action.pos),
+                );
+            }
+            Action::LongitudinalDistance {
+                entity,
+                distance_m,
+                time_gap_s,
+                freespace,
+                displacement,
+                ..
+            } => {
+                if !scripted {
+                    return Ok(());
+                }
+                self.place_at_distance(
+                    e,
+                    *entity,
+                    (*distance_m, *time_gap_s, *freespace),
+                    displacement,
+                )
+                .map_err(|e| bad(e.to_string()))?;
+            }
+            Action::FollowTrajectory { shape, timing } => {
+                return self.start_trajectory(e, (shape, timing), (a, &action.pos), t);
+            }
+            Action::AssignRoute { waypoints } => {
+                self.assign_route(e, waypoints, &action.pos, scripted)?;
+            }
+            Action::ActivateController {
+                lateral,
+                longitudinal,
+            } => self.activate_controller(e, *lateral, *longitudinal),
+        }
+        Ok(())
+    }
+}

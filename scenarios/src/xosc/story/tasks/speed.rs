@@ -1,0 +1,91 @@
+//! `SpeedAction`: a speed transition on a scripted entity, or the set speed asked of the ego
+//! the system under test drives.
+
+use super::super::*;
+
+impl Storyboard {
+    /// Starts a `SpeedAction` on `e` (see [`Storyboard::start_task`]).
+    pub(in crate::xosc::story) fn start_speed(
+        &mut self,
+        e: usize,
+        (target, dynamics): (&SpeedTarget, &m::Dynamics),
+        a: Option<usize>,
+        t: f64,
+    ) -> Result<(), StoryError> {
+        let scripted = self.actors[e].scripted;
+        let begin = |sb: &mut Storyboard| {
+            if let Some(a) = a {
+                sb.elems[a].pending += 1;
+            }
+        };
+
+        let v0 = self.actors[e].state.speed;
+        let (to, track) = match target {
+            SpeedTarget::Absolute(v) => (*v, None),
+            SpeedTarget::Relative {
+                entity,
+                value,
+                factor,
+                continuous,
+            } => {
+                let r = self.actors[*entity].state.speed;
+                let v = if *factor { r * value } else { r + value };
+                (v, continuous.then_some((*entity, *value, *factor)))
+            }
+        };
+        if !scripted && a.is_none() {
+            // The ego's initial speed; later, the system under test drives it.
+            self.actors[e].state.speed = to.max(0.0);
+            return Ok(());
+        }
+        let tr = Transition {
+            from: v0,
+            to: to.max(0.0),
+            start_s: t,
+            duration_s: duration_s(dynamics, to - v0, 0.5 * (v0 + to).abs()),
+            shape: dynamics.shape,
+        };
+        if a.is_none() && tr.duration_s == 0.0 {
+            self.actors[e].state.speed = tr.to;
+            return Ok(());
+        }
+        let old = self.drives[e].speed.take().map(|s| s.2);
+        self.override_task(old);
+        begin(self);
+        self.drives[e].speed = Some((tr, track, a.unwrap_or(usize::MAX)));
+
+        Ok(())
+    }
+
+    /// The speed the storyboard asks of the ego the system under test drives, m/s, at the
+    /// end of the last step: the value its `SpeedAction`s' transitions have then (a target
+    /// that follows another entity, that entity's speed then); `None` before the first
+    /// `SpeedAction` of the storyboard on it (its set speed is its `Init` speed).
+    pub fn set_speed(&self) -> Option<f64> {
+        self.set_speed
+    }
+
+    /// The speed asked at `t1` of entity `e`, which the system under test drives
+    /// ([`Storyboard::set_speed`]); its `SpeedAction` ends once the transition is over and
+    /// its speed has come within [`SET_SPEED_REACHED_MPS`] and [`SET_SPEED_REACHED_SHARE`]
+    /// of the target.
+    pub(in crate::xosc::story) fn ask_speed(&mut self, e: usize, t1: f64) {
+        let Some((tr, track, a)) = self.drives[e].speed else {
+            return;
+        };
+        let (mut v, over) = tr.at(t1);
+        if over {
+            if let Some((r, value, factor)) = track {
+                let rv = self.actors[r].state.speed;
+                v = if factor { rv * value } else { rv + value };
+            } else {
+                let reached = SET_SPEED_REACHED_MPS + SET_SPEED_REACHED_SHARE * tr.to.abs();
+                if (self.actors[e].state.speed - tr.to).abs() <= reached {
+                    self.drives[e].speed = None;
+                    self.task_done(Some(a));
+                }
+            }
+        }
+        self.set_speed = Some(v.max(0.0));
+    }
+}
