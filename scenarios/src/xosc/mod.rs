@@ -618,7 +618,17 @@ pub(crate) fn build_into(
     let friction = scene.push(Node::Const(Value::Num(0.8)));
     let piece: PieceId = scene
         .add_road(
-            |n| n.add_map("map", map.0.clone(), 0.8),
+            // The handle the map files keep: every test shares its query index and
+            // collision mesh, built by the first.
+            |n| {
+                n.add(
+                    "map",
+                    paracosm_engine::network::PieceKind::Map {
+                        map: map.clone(),
+                        friction: 0.8,
+                    },
+                )
+            },
             friction,
             site.clone(),
         )
