@@ -614,25 +614,7 @@ pub(crate) fn build_into(
     if hand_over {
         sb.hand_over_on_activation(ego);
     }
-    let site = here(&road.pos, "RoadNetwork");
-    let friction = scene.push(Node::Const(Value::Num(0.8)));
-    let piece: PieceId = scene
-        .add_road(
-            // The handle the map files keep: every test shares its query index and
-            // collision mesh, built by the first.
-            |n| {
-                n.add(
-                    "map",
-                    paracosm_engine::network::PieceKind::Map {
-                        map: map.clone(),
-                        friction: 0.8,
-                    },
-                )
-            },
-            friction,
-            site.clone(),
-        )
-        .map_err(|e| worlds_error(e.to_string()))?;
+    let piece = add_map(scene, &map, here(&road.pos, "RoadNetwork"))?;
     let placed = place_entities(scene, model, &sb, ego)?;
     let (mut sinks, probes, actors) = placed;
     if scripted_ego || hand_over {
@@ -694,6 +676,27 @@ pub(crate) fn build_into(
         host,
         actors: names.zip(actors).collect(),
     })
+}
+
+/// Adds `map` to `scene` as one road piece, with friction 0.8, declared at `site`: through
+/// the handle the map files keep, so that every test shares the query index and collision
+/// mesh the first test built.
+///
+/// # Errors
+/// [`ScenarioError::Load`] when the scene refuses the piece.
+fn add_map(
+    scene: &mut Scene,
+    map: &paracosm_engine::network::MapRef,
+    site: Site,
+) -> Result<PieceId, ScenarioError> {
+    let friction = scene.push(Node::Const(Value::Num(0.8)));
+    let piece = paracosm_engine::network::PieceKind::Map {
+        map: map.clone(),
+        friction: 0.8,
+    };
+    scene
+        .add_road(|n| n.add("map", piece), friction, site)
+        .map_err(|e| worlds_error(e.to_string()))
 }
 
 /// The ego vehicle of `entity`: paracosm's vehicle model with the body of the entity's
