@@ -685,6 +685,25 @@ fn run_program(dir: &std::path::Path, program: &str, args: &[&str]) -> std::proc
         .unwrap()
 }
 
+/// Runs a campaign of `budget` tests of `program` (written to `dir/prog.star`) into `dir/c`,
+/// which it must finish (exit 0 or 1): the campaign's folder and what it wrote to stderr.
+fn run_campaign(
+    dir: &std::path::Path,
+    program: &str,
+    budget: usize,
+) -> (std::path::PathBuf, String) {
+    let out = dir.join("c");
+    let budget = budget.to_string();
+    let o = run_program(
+        dir,
+        program,
+        &["--budget", &budget, "--out", out.to_str().unwrap()],
+    );
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    (out, err)
+}
+
 /// A program imports an OpenSCENARIO scenario (`Import`), opens two of its parameters with
 /// its own `VarInterval`s and adds monitors over its entities and signals: every test's
 /// pedestrian walks at the speed the program's parameter gave the file (the storyboard moves
@@ -707,14 +726,7 @@ test(horizon = 60)
 "#,
         template.display()
     );
-    let out = dir.path().join("c");
-    let o = run_program(
-        dir.path(),
-        &program,
-        &["--budget", "6", "--out", out.to_str().unwrap()],
-    );
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    let (out, _) = run_campaign(dir.path(), &program, 6);
     let text = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
     let records: Vec<serde_json::Value> = text
         .lines()
@@ -764,6 +776,40 @@ test(horizon = 60)
         assert_eq!(o.status.code(), Some(2), "{err}");
         assert!(err.contains("prog.star:") && err.contains(want), "{err}");
     }
+}
+
+/// A parameter a program gives `Import(params=)` is read by the imported storyboard alone (the
+/// pedestrian's speed): the load sees it change the test and keeps it in coverage, while a
+/// parameter nothing reads is named unused.
+#[test]
+fn an_imported_storyboards_parameter_is_used_and_an_unread_one_is_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let template = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(CROSSING_TEMPLATE);
+    let program = format!(
+        r#"w = World()
+spare = VarInterval(0.0, 1.0, name = "spare")
+s = Import("{}", params = {{
+    "Ego_InitSpeed_Ve0_kph": "40",
+    "TargetBlocking_Speed_kph": VarEnum([3.0, 6.5], name = "ped_kph"),
+}})
+CollisionMonitor(s.ego)
+DistanceMonitor(s.ego, minD = 5.0, name = "moved")
+"#,
+        template.display()
+    );
+    let (out, err) = run_campaign(dir.path(), &program, 2);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(
+        summary["unused_params"],
+        serde_json::json!(["spare"]),
+        "{err}"
+    );
+    assert!(
+        err.contains("`spare` is sampled but no object uses it"),
+        "{err}"
+    );
+    assert!(!err.contains("`ped_kph`"), "{err}");
 }
 
 /// Copies the folder `from` into `to`, recursively.

@@ -156,7 +156,7 @@ pub(crate) struct Car {
     /// How the camera draws it.
     pub(crate) albedo: [f32; 3],
     /// Its speed stream, m/s.
-    pub(crate) speed_stream: crate::sim::Input,
+    pub(crate) speed_stream: crate::rx::Input,
     /// Whether it touches the ego vehicle now.
     pub(crate) touching: bool,
     /// Whether it has touched anything since the test began (the ego, a car, a pedestrian,
@@ -193,7 +193,7 @@ impl Car {
         size: Size,
         enabled: bool,
         albedo: [f32; 3],
-        speed_stream: crate::sim::Input,
+        speed_stream: crate::rx::Input,
     ) -> Self {
         let mut cumulative = vec![0.0];
         for w in path.windows(2) {
@@ -854,7 +854,7 @@ mod tests {
             size,
             false,
             [0.5; 3],
-            crate::sim::Input::Stream(StreamId(0)),
+            crate::rx::Input::Stream(StreamId(0)),
         )
     }
 

@@ -44,7 +44,7 @@ pub(crate) struct Pedestrian {
     pub(crate) body: RigidBodyHandle,
     pub(crate) collider: ColliderHandle,
     /// Its walking speed stream, m/s.
-    pub(crate) speed_stream: crate::sim::Input,
+    pub(crate) speed_stream: crate::rx::Input,
     /// Whether it touches the ego vehicle now.
     pub(crate) touching: bool,
     /// Whether it has touched anything since the test began (the ego, a car, an obstacle).
@@ -67,7 +67,7 @@ impl Pedestrian {
     pub(crate) fn build(
         physics: &mut PhysicsWorld,
         (start, target): ([f64; 3], [f64; 3]),
-        speed_stream: crate::sim::Input,
+        speed_stream: crate::rx::Input,
         initial_speed_mps: f64,
     ) -> Self {
         let body = RigidBodyBuilder::kinematic_position_based().translation(centre(start));
@@ -236,7 +236,7 @@ mod tests {
         let mut p = Pedestrian::build(
             &mut physics,
             ([100.0, 0.0, 4.0], [100.0, 0.0, -4.0]),
-            crate::sim::Input::Stream(crate::rx::StreamId(0)),
+            crate::rx::Input::Stream(crate::rx::StreamId(0)),
             0.0,
         );
         let dt = 0.1;

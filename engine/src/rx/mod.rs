@@ -30,6 +30,7 @@
 
 mod expect;
 mod graph;
+mod input;
 mod open;
 mod runtime;
 #[cfg(test)]
@@ -38,6 +39,7 @@ mod value;
 
 pub use expect::{describe, Expect};
 pub use graph::{Func, Graph, NativeError, NativeFn, Node, StreamId};
+pub(crate) use input::{constant, number, Input};
 pub use open::OpenStream;
 pub use runtime::{Host, HostError, Inputs, NoHost, Runtime};
 pub use value::Value;

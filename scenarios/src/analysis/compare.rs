@@ -149,11 +149,7 @@ fn recoloured<T: Clone + PartialEq + std::fmt::Debug>(
 /// What [`Scene::world`] returns for either scene.
 pub fn scene_changes(a: &Scene, b: &Scene, horizon_s: f64) -> Result<Vec<Change>, LoadError> {
     let mut out = world_changes(&a.world()?, &b.world()?, horizon_s);
-    let same_host = match (a.host_inputs(), b.host_inputs()) {
-        (None, None) => true,
-        (Some(x), Some(y)) => x.same_as(y),
-        _ => false,
-    };
+    let same_host = same_host_inputs(a.host_inputs(), b.host_inputs());
     let judged = |s: &Scene| {
         let monitors: Vec<_> = s.monitors().map(|(m, _)| m.clone()).collect();
         let settings = s.settings();
@@ -168,6 +164,19 @@ pub fn scene_changes(a: &Scene, b: &Scene, horizon_s: f64) -> Result<Vec<Change>
         out.push(Change::Other);
     }
     Ok(out)
+}
+
+/// Whether two tests' hosts read the same inputs ([`Scene::host_inputs`]): both have none,
+/// or both have some that are [`crate::scene::HostInputs::same_as`] each other.
+pub fn same_host_inputs(
+    a: Option<&dyn crate::scene::HostInputs>,
+    b: Option<&dyn crate::scene::HostInputs>,
+) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some(x), Some(y)) => x.same_as(y),
+        _ => false,
+    }
 }
 
 /// What differs between `a` and `b`, two worlds of one scenario whose tests last `horizon_s`.

@@ -11,7 +11,7 @@ mod probe;
 
 use std::collections::BTreeSet;
 
-pub use compare::{scene_changes, unread_streams, world_changes, Change};
+pub use compare::{same_host_inputs, scene_changes, unread_streams, world_changes, Change};
 pub use probe::{probe, Probed};
 
 use crate::scenario::{CameraOnly, Warning};

@@ -244,9 +244,9 @@ impl std::fmt::Debug for ImportedStory {
 }
 
 impl SceneBuilder {
-    /// A builder of a scene for an evaluation that gives the parameters `values` (by
-    /// declaration index; `None`: representative values).
-    pub fn new(values: Option<Vec<ParamValue>>) -> Self {
+    /// A builder of a scene for an evaluation that gives the parameters `values` (by name;
+    /// `None`: representative values).
+    pub fn new(values: Option<crate::scene::GivenValues>) -> Self {
         SceneBuilder {
             scene: Scene::new(values),
             route_m: MAX_ROUTE_M,

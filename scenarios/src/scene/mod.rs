@@ -23,7 +23,9 @@ mod world;
 
 pub use error::{refused, LoadError, LoadErrorKind, Site};
 pub use monitor::MonitorSpec;
-pub use params::{coordinate_names, level_value, representative, OverTime, ParamDecl, ParamValue};
+pub use params::{
+    coordinate_names, level_value, representative, GivenValues, OverTime, ParamDecl, ParamValue,
+};
 pub use stream_types::{stream_types, SType};
 
 use paracosm_engine::actor::{Roster, Set};
@@ -114,8 +116,9 @@ pub enum SceneError {
 pub struct Scene {
     graph: GraphBuilder,
     params: Vec<ParamDecl>,
-    values: Option<Vec<ParamValue>>,
-    by_name: Option<Assignment>,
+    given: Option<GivenValues>,
+    /// The value each declared parameter took, by declaration index (with `given`).
+    bound: Vec<ParamValue>,
     roads: Network,
     road_sites: Vec<Site>,
     frictions: Vec<(PieceId, StreamId)>,
@@ -154,18 +157,18 @@ pub trait HostInputs: std::fmt::Debug + Send + Sync {
 
 impl Scene {
     /// An empty scene whose graph holds the `tick` stream as [`TICK`], for a test that gives
-    /// the open parameters `values` (by declaration order; `None`: each parameter's
-    /// [`representative`] value, as a front end uses to learn a scenario's parameters). The
-    /// sensors are [`SensorSpec::defaults`].
-    pub fn new(values: Option<Vec<ParamValue>>) -> Self {
+    /// the open parameters `values` (bound by name as each is declared, [`GivenValues`];
+    /// `None`: each parameter's [`representative`] value, as a front end uses to learn a
+    /// scenario's parameters). The sensors are [`SensorSpec::defaults`].
+    pub fn new(values: Option<GivenValues>) -> Self {
         let mut graph = GraphBuilder::new();
         let tick = graph.push(Node::Tick);
         debug_assert_eq!(tick, TICK);
         Scene {
             graph,
             params: Vec::new(),
-            values,
-            by_name: None,
+            given: values,
+            bound: Vec::new(),
             roads: Network::new(),
             road_sites: Vec::new(),
             frictions: Vec::new(),
@@ -188,13 +191,9 @@ impl Scene {
     }
 
     /// An empty scene (as [`Scene::new`]) whose open parameters take their values from
-    /// `assignment` by name as they are declared: for a front end whose parameters are
-    /// named when declared (a Rust caller, a scenario file). A parameter without a name, or
-    /// one the assignment lacks, takes its [`representative`] value.
+    /// `assignment` by name as they are declared ([`GivenValues::of_assignment`]).
     pub fn for_assignment(assignment: &Assignment) -> Self {
-        let mut scene = Scene::new(Some(Vec::new()));
-        scene.by_name = Some(assignment.clone());
-        scene
+        Scene::new(Some(GivenValues::of_assignment(assignment)))
     }
 
     /// Keeps what the front end's host reads in this test ([`HostInputs`]), replacing any
@@ -207,6 +206,12 @@ impl Scene {
     /// whose front end keeps nothing (a program's lambdas are analysed from its code).
     pub fn host_inputs(&self) -> Option<&dyn HostInputs> {
         self.host_inputs.as_deref()
+    }
+
+    /// [`Scene::host_inputs`], shared, to keep beside the scene's world after the scene is
+    /// dropped.
+    pub fn shared_host_inputs(&self) -> Option<std::sync::Arc<dyn HostInputs>> {
+        self.host_inputs.clone()
     }
 
     // ---- the stream graph ----
@@ -244,21 +249,17 @@ impl Scene {
 
     // ---- open parameters ----
 
-    /// Declares an open parameter; returns its value in this test (a parameter beyond the
-    /// values given gets its [`representative`] value, so that a front end goes on and
-    /// reports the mismatch, naming it) and its index in declaration order.
+    /// Declares an open parameter; returns its value in this test, bound by name
+    /// ([`GivenValues::value_of`]; a parameter the values do not name gets its
+    /// [`representative`] value, so that a front end goes on and reports the mismatch, naming
+    /// it) and its index in declaration order.
     pub fn declare_param(&mut self, decl: ParamDecl) -> (ParamValue, usize) {
         let k = self.params.len();
-        let horizon_s = self.horizon_s();
-        let named = self.by_name.as_ref().and_then(|a| {
-            let level = a.get(decl.name.as_deref()?)?;
-            (decl.over_time == OverTime::Constant).then(|| ParamValue::Level(level.clone()))
-        });
-        let value = named
-            .or_else(|| self.values.as_ref().and_then(|v| v.get(k).cloned()))
-            .unwrap_or_else(|| representative(&decl, horizon_s));
-        if let (Some(_), Some(values)) = (&self.by_name, self.values.as_mut()) {
-            values.push(value.clone());
+        let value = (self.given.as_ref())
+            .and_then(|g| g.value_of(&decl, k).cloned())
+            .unwrap_or_else(|| representative(&decl, self.horizon_s()));
+        if self.given.is_some() {
+            self.bound.push(value.clone());
         }
         self.params.push(decl);
         (value, k)
@@ -272,14 +273,14 @@ impl Scene {
     /// Whether this scene was made with values for its parameters (`false`: representative
     /// values, as when a front end learns a scenario's parameters).
     pub fn has_values(&self) -> bool {
-        self.values.is_some()
+        self.given.is_some()
     }
 
     /// The value of the parameter declared `k`-th in this test.
     pub fn param_value(&self, k: usize) -> Option<ParamValue> {
         let decl = self.params.get(k)?;
-        Some(match &self.values {
-            Some(values) => values.get(k)?.clone(),
+        Some(match &self.given {
+            Some(_) => self.bound.get(k)?.clone(),
             None => representative(decl, self.horizon_s()),
         })
     }

@@ -89,3 +89,62 @@ pub fn coordinate_names(name: &str, over_time: OverTime) -> Vec<String> {
         OverTime::Polynomial(d) => (0..=d).map(|i| format!("{name}.c{i}")).collect(),
     }
 }
+
+/// The values one test gives a scenario's open parameters, bound by name as each parameter is
+/// declared ([`super::Scene::declare_param`]): one way for every front end.
+///
+/// A parameter is named by its declaration (`name=`, a scenario file's parameter) or, for one
+/// that takes its name from where it stands (a program's `x = VarInterval(...)`, or the
+/// `param3` of one assigned to nothing), by the names the front end learnt from its first
+/// evaluation ([`GivenValues::standing`]). A parameter without a name, or one whose name
+/// the values lack, takes its [`representative`] value, so that the front end goes on and
+/// reports the mismatch, naming the parameter.
+#[derive(Debug, Clone, Default)]
+pub struct GivenValues {
+    values: std::collections::BTreeMap<String, ParamValue>,
+    standing: Option<std::sync::Arc<[(Site, String)]>>,
+}
+
+impl GivenValues {
+    /// Values by name; a name given twice keeps its last value.
+    pub fn new(values: impl IntoIterator<Item = (String, ParamValue)>) -> Self {
+        GivenValues {
+            values: values.into_iter().collect(),
+            standing: None,
+        }
+    }
+
+    /// The values of a generator's assignment, each a constant level
+    /// ([`ParamValue::Level`]); a parameter that varies over time finds none here and takes
+    /// its representative value.
+    pub fn of_assignment(assignment: &paracosm_generators::Assignment) -> Self {
+        Self::new(
+            assignment
+                .iter()
+                .map(|(n, v)| (n.to_owned(), ParamValue::Level(v.clone()))),
+        )
+    }
+
+    /// These values, for parameters whose declarations give no name: the parameter declared
+    /// `k`-th is named `standing[k].1` when it is declared at `standing[k].0`.
+    pub fn standing(mut self, standing: std::sync::Arc<[(Site, String)]>) -> Self {
+        self.standing = Some(standing);
+        self
+    }
+
+    /// The name of `decl`, declared `k`-th: its own, else the one it stands under.
+    pub fn name_of<'a>(&'a self, decl: &'a ParamDecl, k: usize) -> Option<&'a str> {
+        decl.name.as_deref().or_else(|| {
+            let (site, name) = self.standing.as_deref()?.get(k)?;
+            (*site == decl.site).then_some(name.as_str())
+        })
+    }
+
+    /// The value `decl`, declared `k`-th, takes: the one given under its name when it is of
+    /// the declaration's kind (a level for a constant, a stream for one over time).
+    pub fn value_of(&self, decl: &ParamDecl, k: usize) -> Option<&ParamValue> {
+        let v = self.values.get(self.name_of(decl, k)?)?;
+        let constant = decl.over_time == OverTime::Constant;
+        (matches!(v, ParamValue::Level(_)) == constant).then_some(v)
+    }
+}

@@ -130,3 +130,60 @@ fn the_scene_model_imports_no_runner_and_no_front_end() {
     }
     assert!(files >= 7, "{files} files read");
 }
+
+/// A declaration for the binding tests: `name`, a `[0, 1)` interval, declared at line `line`.
+fn decl(name: Option<&str>, line: u32, over_time: OverTime) -> ParamDecl {
+    ParamDecl {
+        name: name.map(str::to_owned),
+        domain: paracosm_generators::Domain::Interval { lo: 0.0, hi: 1.0 },
+        unit: None,
+        over_time,
+        site: Site {
+            file: "p.star".into(),
+            line,
+            col: 5,
+            variable: None,
+        },
+    }
+}
+
+/// Every front end binds by name: a parameter takes the value given under its own name, or
+/// under the name it stands under (a program's `x = VarInterval(...)`) when it is declared
+/// where the front end first saw it; another place, an unknown name or a value of the other
+/// kind (a level for a parameter that varies over time) gives the representative value.
+#[test]
+fn a_scene_binds_values_by_name_whatever_the_declaration_order() {
+    let level = |x: f64| ParamValue::Level(paracosm_generators::Value::Real(x));
+    let given = GivenValues::new([
+        ("speed".to_owned(), level(0.25)),
+        ("gap".to_owned(), level(0.75)),
+        ("fog".to_owned(), level(0.5)),
+    ])
+    .standing(std::sync::Arc::from(vec![
+        (decl(None, 1, OverTime::Constant).site, "gap".to_owned()),
+        (decl(None, 2, OverTime::Constant).site, "fog".to_owned()),
+    ]));
+    let mut scene = Scene::new(Some(given));
+    // Declared in another order than given: each finds its own.
+    let (gap, k) = scene.declare_param(decl(None, 1, OverTime::Constant));
+    assert_eq!((gap, k), (level(0.75), 0));
+    let (speed, _) = scene.declare_param(decl(Some("speed"), 9, OverTime::Constant));
+    assert_eq!(speed, level(0.25));
+    // Declared second but somewhere else than the front end saw: not `fog`'s value.
+    let (moved, _) = scene.declare_param(decl(None, 7, OverTime::Constant));
+    assert_eq!(
+        moved,
+        level(0.0),
+        "the representative of [0, 1) is its low end"
+    );
+    let (unknown, _) = scene.declare_param(decl(Some("rain"), 3, OverTime::Constant));
+    assert_eq!(
+        unknown,
+        representative(&decl(Some("rain"), 3, OverTime::Constant), 15.0)
+    );
+    let over = decl(Some("gap"), 4, OverTime::Piecewise(3));
+    let (stream, _) = scene.declare_param(over.clone());
+    assert_eq!(stream, representative(&over, scene.horizon_s()));
+    assert_eq!(scene.param_value(1), Some(level(0.25)));
+    assert!(scene.has_values());
+}

@@ -10,7 +10,7 @@ use crate::scene::HostInputs;
 
 /// The scenario resolved with one test's values.
 #[derive(Debug)]
-pub(super) struct StoryInputs(pub(super) Arc<m::Scenario>);
+pub(crate) struct StoryInputs(pub(crate) Arc<m::Scenario>);
 
 impl HostInputs for StoryInputs {
     /// The same when everything the storyboard and the scene's build read is equal: the map,

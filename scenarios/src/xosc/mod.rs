@@ -11,6 +11,7 @@
 mod campaign;
 mod describe;
 mod host_inputs;
+pub(crate) use host_inputs::StoryInputs;
 pub mod motion;
 pub mod road;
 mod space;

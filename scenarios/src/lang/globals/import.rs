@@ -5,9 +5,10 @@
 //! ego), so that a companion program adds monitors, signals and open parameters to a
 //! scenario the industry wrote (issue "The industry's logical scenarios as campaigns").
 
+use std::sync::Arc;
+
 use anyhow::{anyhow, bail};
 use paracosm_engine::behaviour::Output;
-use paracosm_engine::rx::{Node, Value as Rx};
 use starlark::environment::GlobalsBuilder;
 use starlark::eval::Evaluator;
 use starlark::starlark_module;
@@ -97,14 +98,11 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
             crate::xosc::IMPORT_HOST_BASE,
         )
         .map_err(|e| anyhow!("{e}"))?;
-        // The values the storyboard reads are in no other input of the world: as a constant
-        // of its graph, a parameter given to Import is seen to change the world.
-        let values: Vec<String> = model
-            .params
-            .iter()
-            .map(|(d, v)| format!("{}={}", d.name, v.to_text()))
-            .collect();
-        b.scene.push(Node::Const(Rx::Text(values.join(", "))));
+        // The values the storyboard reads are in no other input of the world: the scene
+        // keeps the scenario as resolved with them, which the load compares between tests.
+        let model = Arc::new(model);
+        b.scene
+            .set_host_inputs(Arc::new(crate::xosc::StoryInputs(model.clone())));
         let actors: Vec<(String, ActorVal)> = built
             .actors
             .iter()

@@ -44,10 +44,10 @@ impl starlark::PrintHandler for LoadState {
 }
 
 impl LoadState {
-    /// The state of an evaluation that gives the open parameters `values` (by declaration
-    /// index; `None`: their representative values).
+    /// The state of an evaluation that gives the open parameters `values` (by name; `None`:
+    /// their representative values).
     pub fn new(
-        values: Option<Vec<super::scene::ParamValue>>,
+        values: Option<crate::scene::GivenValues>,
         objects: std::sync::Arc<std::collections::HashMap<String, String>>,
         maps: std::sync::Arc<crate::map_files::MapFiles>,
     ) -> Self {

@@ -394,7 +394,7 @@ fn check_combinations(program: &Program) -> Result<Combinations, LoadError> {
             let (w, s) = program
                 .world_counted(values.clone())
                 .map_err(|e| for_values(label, e))?;
-            unread.push(usage::unread_streams(&w, &[]));
+            unread.push(usage::unread_streams(&w.world, &[]));
             steps += s;
         }
     }
@@ -409,14 +409,14 @@ fn probe_effects(
     unread: &[BTreeSet<String>],
 ) -> Result<Effects, LoadError> {
     let syntax = &program.syntax;
-    let base = first.world.scene.world()?;
+    let base = Evaluated::of(&first.world.scene)?;
     let read_by_name: Vec<usize> = first
         .stream_variables
         .iter()
         .filter(|(name, _)| syntax.read_in_code(name))
         .map(|&(_, id)| id)
         .collect();
-    let mut unread_everywhere = usage::unread_streams(&base, &read_by_name);
+    let mut unread_everywhere = usage::unread_streams(&base.world, &read_by_name);
     for other in unread {
         unread_everywhere.retain(|site| other.contains(site));
     }
@@ -447,7 +447,7 @@ fn probe_effects(
 fn probe_parameter(
     program: &Program,
     k: usize,
-    base: &WorldSpec,
+    base: &Evaluated,
     base_values: &[ParamValue],
 ) -> Result<Vec<usage::Change>, LoadError> {
     let mut seen = Vec::new();
@@ -482,7 +482,7 @@ fn probe_parameter(
         let other = program
             .world_for(values)
             .map_err(|e| for_values(&label, e))?;
-        seen.extend(usage::world_changes(base, &other, program.horizon_s));
+        seen.extend(base.changes(&other, program.horizon_s));
         if !program.load_budget_left() {
             break;
         }
@@ -610,7 +610,9 @@ fn monitor_warnings(program: &Program, first: &SceneBuilder, warnings: &mut Vec<
                 continue;
             };
             for (signal, c, varies) in constants.iter_mut() {
-                if c.is_some() && constant_of(&w.published, w.streams.nodes(), signal) != *c {
+                if c.is_some()
+                    && constant_of(&w.world.published, w.world.streams.nodes(), signal) != *c
+                {
                     *varies = true;
                 }
             }

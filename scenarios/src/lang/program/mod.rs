@@ -27,6 +27,7 @@ use super::scene::{self, coordinate_names, ParamDecl, ParamValue, SceneBuilder};
 use super::values::OverTime;
 use crate::analysis as usage;
 use crate::scenario::Warning;
+use crate::scene::GivenValues;
 use crate::{MonitorSpec, Scenario, ScenarioError};
 
 /// Most combinations of parameter values checked when a program loads; beyond it, the rows
@@ -99,7 +100,7 @@ pub struct Program {
     /// The worlds of the combinations that [`Program::changes_elsewhere`] varies parameters
     /// from, by index in [`Program::combinations`], with their step counts.
     #[allow(clippy::type_complexity)]
-    base_worlds: std::sync::Mutex<std::collections::BTreeMap<usize, Option<(Arc<WorldSpec>, u64)>>>,
+    base_worlds: std::sync::Mutex<std::collections::BTreeMap<usize, Option<(Arc<Evaluated>, u64)>>>,
 }
 
 fn lambda_values<'v>(b: &SceneBuilder, module: &Module<'v>) -> Result<Vec<Value<'v>>, LoadError> {
@@ -249,12 +250,12 @@ fn alias_imported(module: &Module<'_>, b: &mut SceneBuilder) {
 }
 
 impl Program {
-    /// Evaluates the program with `values` (by declaration index; `None`: representative
-    /// values) within the loading limits, checks that it finished, and calls `then` with what
+    /// Evaluates the program with `values` (bound by name, [`Program::given`]; `None`:
+    /// representative values) within the loading limits, checks that it finished, and calls `then` with what
     /// it declared and its module (whose lambdas the test calls).
     fn evaluate<R>(
         &self,
-        values: Option<Vec<ParamValue>>,
+        values: Option<GivenValues>,
         then: impl FnOnce(SceneBuilder, &Module) -> Result<R, LoadError>,
     ) -> Result<R, LoadError> {
         self.evaluate_counted(values, then).map(|(r, _)| r)
@@ -263,7 +264,7 @@ impl Program {
     /// [`Program::evaluate`], also returning the evaluation's step count.
     fn evaluate_counted<R>(
         &self,
-        values: Option<Vec<ParamValue>>,
+        values: Option<GivenValues>,
         then: impl FnOnce(SceneBuilder, &Module) -> Result<R, LoadError>,
     ) -> Result<(R, u64), LoadError> {
         let again = values.clone();
@@ -304,14 +305,13 @@ impl Program {
         })
     }
 
-    /// The load error of an evaluation with `values` (by declaration index; `None`:
-    /// representative values) that failed with `e`, having declared `scene` so far:
+    /// The load error of an evaluation with `values` (`None`: representative values) that failed with `e`, having declared `scene` so far:
     /// starlark's message with a keyword suggested, where it stopped when the message names
     /// no place in the program, and, for the first evaluation, the values it ran with.
     fn evaluation_error(
         &self,
         e: starlark::Error,
-        values: Option<Vec<ParamValue>>,
+        values: Option<GivenValues>,
         scene: &std::cell::RefCell<SceneBuilder>,
     ) -> LoadError {
         let message = super::suggest_keyword(&format!("{e}"));
@@ -414,7 +414,7 @@ impl Program {
     /// by evaluating again, with the same values and limits, with a hook before every
     /// statement that notes it: only on this error path, since the hook slows every
     /// statement. `None` when the second evaluation ran no statement.
-    fn where_stopped(&self, values: Option<Vec<ParamValue>>) -> Option<String> {
+    fn where_stopped(&self, values: Option<GivenValues>) -> Option<String> {
         let last: std::cell::Cell<Option<starlark::codemap::Span>> = std::cell::Cell::new(None);
         let note = |at: starlark::codemap::FileSpanRef, _: bool, _: &mut Evaluator<'_, '_, '_>| {
             last.set(Some(at.span));
@@ -582,11 +582,28 @@ impl Program {
         Ok(())
     }
 
-    /// The values of an assignment, by declaration index.
+    /// The values of an assignment, by name ([`Program::given`]).
     ///
     /// # Errors
     /// [`ScenarioError::MissingParam`] for a parameter (or coordinate) it lacks.
-    fn values(&self, a: &Assignment) -> Result<Vec<ParamValue>, ScenarioError> {
+    fn values(&self, a: &Assignment) -> Result<GivenValues, ScenarioError> {
+        self.values_by_index(a).map(|v| self.given(v))
+    }
+
+    /// The values of `values`, one per parameter in declaration order, by the parameters'
+    /// names (and the names they stand under, for a declaration that gives none).
+    fn given(&self, values: Vec<ParamValue>) -> GivenValues {
+        let standing: Arc<[(crate::scene::Site, String)]> = (self.params.iter())
+            .map(|(name, d)| (d.site.clone(), name.clone()))
+            .collect();
+        GivenValues::new(self.params.iter().map(|(n, _)| n.clone()).zip(values)).standing(standing)
+    }
+
+    /// The values of an assignment, one per parameter in declaration order.
+    ///
+    /// # Errors
+    /// [`ScenarioError::MissingParam`] for a parameter (or coordinate) it lacks.
+    fn values_by_index(&self, a: &Assignment) -> Result<Vec<ParamValue>, ScenarioError> {
         self.params
             .iter()
             .map(|(name, p)| {
@@ -801,7 +818,7 @@ impl Program {
                     continue;
                 };
                 steps += s;
-                let found = usage::world_changes(&from, &to, self.horizon_s);
+                let found = from.changes(&to, self.horizon_s);
                 let decisive = found.iter().any(|c| !usage::inert(c, false));
                 out.extend(found);
                 if decisive {
@@ -816,19 +833,52 @@ impl Program {
     }
 
     /// The world of one evaluation with `values`, checked for consistency.
-    fn world_for(&self, values: Vec<ParamValue>) -> Result<WorldSpec, LoadError> {
+    fn world_for(&self, values: Vec<ParamValue>) -> Result<Evaluated, LoadError> {
         self.world_counted(values).map(|(w, _)| w)
     }
 
     /// [`Program::world_for`], also returning the evaluation's step count.
-    fn world_counted(&self, values: Vec<ParamValue>) -> Result<(WorldSpec, u64), LoadError> {
-        let out = self.evaluate_counted(Some(values), |b, _| {
+    fn world_counted(&self, values: Vec<ParamValue>) -> Result<(Evaluated, u64), LoadError> {
+        let out = self.evaluate_counted(Some(self.given(values)), |b, _| {
             self.consistent(&b)?;
-            b.scene.world()
+            Evaluated::of(&b.scene)
         });
         if let Ok((_, steps)) = &out {
             self.load_steps
                 .fetch_add(*steps, std::sync::atomic::Ordering::Relaxed);
+        }
+        out
+    }
+}
+
+/// The world one evaluation built, with what the storyboard it imported reads
+/// ([`crate::scene::Scene::host_inputs`]): two evaluations differ in either.
+struct Evaluated {
+    /// The world.
+    world: WorldSpec,
+    /// What an `Import`ed storyboard reads in this world; `None` without one.
+    host: Option<Arc<dyn crate::scene::HostInputs>>,
+}
+
+impl Evaluated {
+    /// The world of `scene` and its host's inputs.
+    ///
+    /// # Errors
+    /// What [`crate::scene::Scene::world`] returns.
+    fn of(scene: &crate::scene::Scene) -> Result<Evaluated, LoadError> {
+        Ok(Evaluated {
+            world: scene.world()?,
+            host: scene.shared_host_inputs(),
+        })
+    }
+
+    /// What differs from `self` in `to`, whose tests last `horizon_s` (s): the worlds'
+    /// [`usage::world_changes`], and [`usage::Change::Other`] when the storyboards read
+    /// different inputs (an `Import(params=)` speed, trigger or route).
+    fn changes(&self, to: &Evaluated, horizon_s: f64) -> Vec<usage::Change> {
+        let mut out = usage::world_changes(&self.world, &to.world, horizon_s);
+        if !usage::same_host_inputs(self.host.as_deref(), to.host.as_deref()) {
+            out.push(usage::Change::Other);
         }
         out
     }

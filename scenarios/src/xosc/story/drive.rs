@@ -12,10 +12,11 @@ pub(in crate::xosc::story) type ToLane = Option<(usize, f64)>;
 /// A scripted entity's motion in progress, each with the action it belongs to.
 #[derive(Debug, Clone, Default)]
 pub(in crate::xosc::story) struct Drive {
-    /// The speed transition, a target that follows another entity, the action.
-    pub(in crate::xosc::story) speed: Option<(Transition, Track, usize)>,
+    /// The `SpeedAction` in progress.
+    pub(in crate::xosc::story) speed: Option<SpeedTask>,
     /// The lateral move in progress.
     pub(in crate::xosc::story) lateral: Option<Lateral>,
+    /// The trajectory in progress and its action.
     pub(in crate::xosc::story) path: Option<(Path, usize)>,
     /// A driven ego's lane change in progress: the lane it changes to, the offset from its
     /// centre there (m), the action; it ends once the ego is there ([`LANE_REACHED_M`]).
@@ -40,20 +41,12 @@ impl Storyboard {
         // Speed.
         let mut v1 = st.speed;
         let mut done = Vec::new();
-        if let Some((tr, track, a)) = self.drives[e].speed {
-            let (v, over) = tr.at(t1);
+        if let Some(task) = self.drives[e].speed {
+            let (v, over) = task.step(t1, |r| self.actors[r].state.speed);
             v1 = v;
-            if over {
-                match track {
-                    Some((r, value, factor)) => {
-                        let rv = self.actors[r].state.speed;
-                        v1 = if factor { rv * value } else { rv + value };
-                    }
-                    None => {
-                        self.drives[e].speed = None;
-                        done.push(a);
-                    }
-                }
+            if over && task.ends() {
+                self.drives[e].speed = None;
+                done.push(task.action);
             }
         }
         v1 = v1.max(0.0);
@@ -65,10 +58,7 @@ impl Storyboard {
         let mut at_end = false;
         let mut speed_now = v1;
         if let Some((path, a)) = &mut self.drives[e].path {
-            let (p, over) = match path {
-                Path::Timed(p) => p.at(t1),
-                Path::Untimed(u) => u.advance(dist),
-            };
+            let (p, over) = path.step(t1, dist);
             let timed = matches!(path, Path::Timed(_));
             let a = *a;
             if timed {
@@ -119,10 +109,8 @@ impl Storyboard {
     /// it travels `dist` m, along its lanes with its lateral move: its pose, lane position,
     /// whether its lanes ended, and the action whose lateral move ended (if any).
     ///
-    /// A lateral move is esmini's (`LatLaneChangeAction`, `LatLaneOffsetAction`): a lane
-    /// change takes its lateral step out of the step's travel (by time, `√(dist² − lat²)` along
-    /// the lane; by distance, `dist / √(1 + r²)` with `r` the offset's slope per metre) and
-    /// faces the way it moves; a lane offset lags one step and faces `atan(rate / speed)`.
+    /// A lateral move steps itself ([`Lateral::step`], esmini's `LatLaneChangeAction` and
+    /// `LatLaneOffsetAction`).
     pub(in crate::xosc::story) fn drive_on_lane(
         &mut self,
         e: usize,
@@ -134,30 +122,8 @@ impl Storyboard {
         // The heading relative to the lane's travel, as a slope against the travel.
         let mut slip = 0.0;
         if let Some(mut l) = self.drives[e].lateral {
-            let moving = dist > 1e-12;
-            let (d, over) = if l.offset {
-                let (d, over) = l.tr.at(l.param);
-                slip = (l.tr.slope(l.param) * dt).atan2(dist);
-                l.param += dt;
-                (d, over)
-            } else if !moving {
-                // Standing, a lane change waits (esmini steps it only while moving).
-                (lp.d, false)
-            } else if l.tr.duration_s <= 0.0 {
-                (l.tr.to, true)
-            } else if l.by_distance {
-                let r = l.tr.slope(l.param);
-                along = dist / (1.0 + r * r).sqrt();
-                l.param += along;
-                slip = r.atan();
-                l.tr.at(l.param)
-            } else {
-                let lat = (l.tr.slope(l.param) * dt).abs().min(dist);
-                along = (dist * dist - lat * lat).sqrt();
-                slip = (l.tr.slope(l.param) * dt).signum() * lat.atan2(along);
-                l.param += dt;
-                l.tr.at(l.param)
-            };
+            let (d, over, a, s) = l.step(lp.d, dist, dt);
+            (along, slip) = (a, s);
             lp.d = d;
             self.drives[e].lateral = Some(l);
             if over {

@@ -366,7 +366,7 @@ impl Storyboard {
         }
         if self.elems[i].kind == Kind::Action {
             for d in &mut self.drives {
-                if d.speed.as_ref().is_some_and(|s| s.2 == i) {
+                if d.speed.as_ref().is_some_and(|s| s.action == i) {
                     d.speed = None;
                 }
                 if d.lateral.as_ref().is_some_and(|l| l.action == i) {

@@ -13,10 +13,10 @@ mod positions;
 mod tasks;
 
 use conditions::Cond;
-use drive::{Drive, ToLane};
+use drive::{Drive, ToLane, Track};
 use elements::{Elem, Kind, Owner, Phase};
 pub use tasks::DEFAULT_LATERAL_ACC_MPS2;
-use tasks::{Lateral, Path};
+use tasks::{Lateral, Path, SpeedTask};
 
 use std::collections::VecDeque;
 

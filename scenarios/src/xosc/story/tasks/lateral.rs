@@ -28,6 +28,51 @@ pub(in crate::xosc::story) struct Lateral {
     pub(in crate::xosc::story) continuous: bool,
 }
 
+impl Lateral {
+    /// One step of `dt` (s) in which the entity, `d_now` (m) from its lane's centre, travels
+    /// `dist` (m): the offset it reaches (m), whether the transition is over, how far it
+    /// travels along the lane (m) and its heading against that travel (rad).
+    ///
+    /// As esmini steps it: a lane change takes its lateral step out of the step's travel (by
+    /// time, `√(dist² − lat²)` along the lane; by distance, `dist / √(1 + r²)` with `r` the
+    /// offset's slope per metre) and faces the way it moves, and waits while the entity
+    /// stands; a lane offset lags one step and faces `atan(rate / speed)`.
+    pub(in crate::xosc::story) fn step(
+        &mut self,
+        d_now: f64,
+        dist: f64,
+        dt: f64,
+    ) -> (f64, bool, f64, f64) {
+        let moving = dist > 1e-12;
+        let mut along = dist;
+        let mut slip = 0.0;
+        let (d, over) = if self.offset {
+            let (d, over) = self.tr.at(self.param);
+            slip = (self.tr.slope(self.param) * dt).atan2(dist);
+            self.param += dt;
+            (d, over)
+        } else if !moving {
+            // Standing, a lane change waits (esmini steps it only while moving).
+            (d_now, false)
+        } else if self.tr.duration_s <= 0.0 {
+            (self.tr.to, true)
+        } else if self.by_distance {
+            let r = self.tr.slope(self.param);
+            along = dist / (1.0 + r * r).sqrt();
+            self.param += along;
+            slip = r.atan();
+            self.tr.at(self.param)
+        } else {
+            let lat = (self.tr.slope(self.param) * dt).abs().min(dist);
+            along = (dist * dist - lat * lat).sqrt();
+            slip = (self.tr.slope(self.param) * dt).signum() * lat.atan2(along);
+            self.param += dt;
+            self.tr.at(self.param)
+        };
+        (d, over, along, slip)
+    }
+}
+
 impl Storyboard {
     /// Starts a `LaneChangeAction` on `e`.
     pub(in crate::xosc::story) fn start_lane_change(

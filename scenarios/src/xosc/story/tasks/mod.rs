@@ -12,6 +12,7 @@ mod trajectory;
 
 pub(in crate::xosc::story) use lateral::Lateral;
 pub use lateral::DEFAULT_LATERAL_ACC_MPS2;
+pub(in crate::xosc::story) use speed::SpeedTask;
 pub(in crate::xosc::story) use trajectory::Path;
 
 use super::*;

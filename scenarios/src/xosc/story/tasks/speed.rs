@@ -3,6 +3,44 @@
 
 use super::super::*;
 
+/// A `SpeedAction` in progress on one entity.
+#[derive(Debug, Clone, Copy)]
+pub(in crate::xosc::story) struct SpeedTask {
+    /// The speed over time, m/s.
+    pub(in crate::xosc::story) tr: Transition,
+    /// A target that follows another entity (`continuous`): its index, the value, whether a
+    /// factor.
+    pub(in crate::xosc::story) track: Track,
+    /// Its action.
+    pub(in crate::xosc::story) action: usize,
+}
+
+impl SpeedTask {
+    /// The speed the task asks at `t1` (s), m/s, given each entity's speed now (`speed_of`),
+    /// and whether its transition is over: past it, a target that follows another entity
+    /// is that entity's speed times, or plus, the value.
+    pub(in crate::xosc::story) fn step(
+        &self,
+        t1: f64,
+        speed_of: impl Fn(usize) -> f64,
+    ) -> (f64, bool) {
+        let (v, over) = self.tr.at(t1);
+        match (over, self.track) {
+            (true, Some((r, value, factor))) => {
+                let rv = speed_of(r);
+                (if factor { rv * value } else { rv + value }, true)
+            }
+            _ => (v, over),
+        }
+    }
+
+    /// Whether the task ends with its transition (a target that follows another entity
+    /// goes on).
+    pub(in crate::xosc::story) fn ends(&self) -> bool {
+        self.track.is_none()
+    }
+}
+
 impl Storyboard {
     /// Starts a `SpeedAction` on `e` (see [`Storyboard::start_task`]).
     pub(in crate::xosc::story) fn start_speed(
@@ -49,10 +87,14 @@ impl Storyboard {
             self.actors[e].state.speed = tr.to;
             return Ok(());
         }
-        let old = self.drives[e].speed.take().map(|s| s.2);
+        let old = self.drives[e].speed.take().map(|s| s.action);
         self.override_task(old);
         begin(self);
-        self.drives[e].speed = Some((tr, track, a.unwrap_or(usize::MAX)));
+        self.drives[e].speed = Some(SpeedTask {
+            tr,
+            track,
+            action: a.unwrap_or(usize::MAX),
+        });
 
         Ok(())
     }
@@ -70,20 +112,15 @@ impl Storyboard {
     /// its speed has come within [`SET_SPEED_REACHED_MPS`] and [`SET_SPEED_REACHED_SHARE`]
     /// of the target.
     pub(in crate::xosc::story) fn ask_speed(&mut self, e: usize, t1: f64) {
-        let Some((tr, track, a)) = self.drives[e].speed else {
+        let Some(task) = self.drives[e].speed else {
             return;
         };
-        let (mut v, over) = tr.at(t1);
-        if over {
-            if let Some((r, value, factor)) = track {
-                let rv = self.actors[r].state.speed;
-                v = if factor { rv * value } else { rv + value };
-            } else {
-                let reached = SET_SPEED_REACHED_MPS + SET_SPEED_REACHED_SHARE * tr.to.abs();
-                if (self.actors[e].state.speed - tr.to).abs() <= reached {
-                    self.drives[e].speed = None;
-                    self.task_done(Some(a));
-                }
+        let (v, over) = task.step(t1, |r| self.actors[r].state.speed);
+        if over && task.ends() {
+            let reached = SET_SPEED_REACHED_MPS + SET_SPEED_REACHED_SHARE * task.tr.to.abs();
+            if (self.actors[e].state.speed - task.tr.to).abs() <= reached {
+                self.drives[e].speed = None;
+                self.task_done(Some(task.action));
             }
         }
         self.set_speed = Some(v.max(0.0));

@@ -3,10 +3,25 @@
 
 use super::super::*;
 
+/// A `FollowTrajectoryAction` in progress: its vertices' times kept (`timing` given and every
+/// vertex timed), or followed at the entity's speed.
 #[derive(Debug, Clone)]
 pub(in crate::xosc::story) enum Path {
+    /// Where the entity is at each time.
     Timed(Timed),
+    /// The path the entity follows at its own speed.
     Untimed(Untimed),
+}
+
+impl Path {
+    /// Where the entity is after a step ending at `t1` (s) in which it travels `dist` (m) at
+    /// its speed, and whether the trajectory is over.
+    pub(in crate::xosc::story) fn step(&mut self, t1: f64, dist: f64) -> (Pose, bool) {
+        match self {
+            Path::Timed(p) => p.at(t1),
+            Path::Untimed(u) => u.advance(dist),
+        }
+    }
 }
 
 impl Storyboard {
