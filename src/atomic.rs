@@ -215,6 +215,41 @@ pub fn check_target(path: &Path) -> Result<(), Error> {
     }
 }
 
+/// Checks, before any work, an output `option` names for a command that reads `inputs`: it
+/// may be replaced ([`check_target`]), its folder exists, and it is none of the inputs (the
+/// same file by device and inode, however it is spelt or linked: `map M.xodr --png M.xodr`
+/// would replace the map it draws).
+///
+/// # Errors
+/// [`Error::BadInput`] naming `option`, the path and what is wrong.
+pub fn check_output(path: &Path, option: &str, inputs: &[&Path]) -> Result<(), Error> {
+    use std::os::unix::fs::MetadataExt;
+    check_target(path)?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(Error::BadInput(format!(
+                "{option} `{}`: the folder `{}` does not exist; create it first",
+                path.display(),
+                dir.display()
+            )));
+        }
+    }
+    let Ok(out) = std::fs::metadata(path) else {
+        return Ok(());
+    };
+    for input in inputs {
+        if std::fs::metadata(input).is_ok_and(|m| m.dev() == out.dev() && m.ino() == out.ino()) {
+            return Err(Error::BadInput(format!(
+                "{option} `{}` is the input `{}`: writing it would replace what is read; give \
+                 another path",
+                path.display(),
+                input.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// The files of a campaign folder that the campaign itself writes and reads back.
 pub const CAMPAIGN_OWNED: [&str; 3] = ["results.jsonl", "campaign.json", "summary.json"];
 

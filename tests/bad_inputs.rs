@@ -33,6 +33,13 @@ fn assert_refused(what: &str, o: &Output, phrases: &[&str]) {
         o.status
     );
     assert!(!stderr.contains("panicked"), "{what}: {stderr}");
+    // The one first line (docs/limits.md): the error leads, before any warning.
+    let first = stderr.lines().next().unwrap_or_default();
+    assert!(
+        (first.starts_with("paracosm-fuzz: error: ")
+            || first.starts_with("paracosm-cover: error: ")),
+        "{what}: the first line is not the error:\n{stderr}"
+    );
     for p in phrases {
         assert!(stderr.contains(p), "{what}: `{p}` not in\n{stderr}");
     }

@@ -333,3 +333,34 @@ fn a_network_of_pieces_round_trips_through_the_opendrive_importer() {
         );
     }
 }
+
+/// An OpenSCENARIO campaign whose variation chooses the road network among five maps (ALKS
+/// 4.3.1's `Road`) exports a test on a curve with that curve's map, byte for byte, not the
+/// template's straight road.
+#[test]
+fn an_openscenario_test_exports_the_map_it_ran_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c");
+    let alks = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xosc/alks");
+    let variation = alks.join("alks_scenario_4_3_1_follow_lead_vehicle_comfortable_variation.xosc");
+    let o = campaign(&variation, "4", &out);
+    assert!(matches!(o.status.code(), Some(0 | 1 | 3)), "{o:?}");
+    let on_curve = records(&out)
+        .into_iter()
+        .find(|r| {
+            r["status"] != "error"
+                && r["params"]["Road"]
+                    .as_str()
+                    .is_some_and(|m| !m.contains("straight"))
+        })
+        .expect("a test on a curve among the first four");
+    let road = on_curve["params"]["Road"].as_str().unwrap();
+    let id = on_curve["id"].as_u64().unwrap();
+    let (_, xodr) = export(&out.join("results.jsonl"), id, &dir.path().join("x"));
+    let map = std::fs::read_to_string(alks.join("concrete_scenarios").join(road)).unwrap();
+    println!("test {id} ran on {road}");
+    assert!(
+        xodr == map,
+        "test {id} ran on {road}; the export wrote another map"
+    );
+}

@@ -198,6 +198,38 @@ fn a_map_that_does_not_load_exits_2_naming_the_file_line_and_column() {
         expect_code(&o, 2);
         assert!(!String::from_utf8_lossy(&o.stderr).contains("panicked"));
     }
+    // A drawing into a missing folder, or over the map it draws (spelt another way, or
+    // through a link): refused before the map is read, the error first, the map unchanged.
+    let copy = dir.path().join("m.xodr");
+    std::fs::copy(&map, &copy).unwrap();
+    let link = dir.path().join("link.png");
+    std::os::unix::fs::symlink(&copy, &link).unwrap();
+    let before = std::fs::read(&copy).unwrap();
+    let spelt = dir.path().join(".").join("m.xodr");
+    for (option, out, says) in [
+        (
+            "--png",
+            dir.path().join("missing/sub/m.png"),
+            "does not exist",
+        ),
+        ("--svg", spelt.clone(), "is the input"),
+        ("--png", spelt, "is the input"),
+        ("--png", link, "a symbolic link"),
+    ] {
+        let o = fuzz(&["map", copy.to_str().unwrap(), option, out.to_str().unwrap()]);
+        expect_code(&o, 2);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            stderr.starts_with("paracosm-fuzz: error: ") && stderr.contains(says),
+            "{option} {}: {stderr}",
+            out.display()
+        );
+        assert_eq!(
+            std::fs::read(&copy).unwrap(),
+            before,
+            "the map is unchanged"
+        );
+    }
 }
 
 /// The `sut` object of `dir/summary.json`, and the text of `dir/report.html`.

@@ -69,6 +69,35 @@ fn an_open_outside_the_constraint_groups_or_of_an_undeclared_parameter_is_refuse
     let (code, _, err) = xosc(&[CROSSING, "--open", "Nope=1..2"]);
     assert_eq!(code, 2);
     assert!(err.contains("is not declared"), "{err}");
+    // A whole-number parameter opened as an interval, or given a fractional level, is refused
+    // at load (exit 2, naming its declaration), not handed 0.5 in every test.
+    let side = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(
+        "tests/data/xosc/alks/concrete_scenarios/alks_scenario_4_1_3_side_vehicle_template.xosc",
+    );
+    let side = side.to_str().unwrap();
+    for (open, says) in [
+        (
+            "SideVehicle_InitPosition_RelativeLaneId=-1..1",
+            "is declared int",
+        ),
+        (
+            "SideVehicle_InitPosition_RelativeLaneId=-1,0.5",
+            "0.5 is not an int",
+        ),
+    ] {
+        let (code, _, err) = xosc(&[side, "--open", open]);
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.starts_with("paracosm-fuzz: error: --open") && err.contains(says),
+            "{err}"
+        );
+    }
+    let (code, _, err) = xosc(&[
+        side,
+        "--open",
+        "SideVehicle_InitPosition_RelativeLaneId=-1,1",
+    ]);
+    assert_eq!(code, 0, "{err}");
 }
 
 /// OpenSCENARIO 1.0's forms: an inline vehicle and pedestrian, `ActivateControllerAction`
@@ -352,20 +381,8 @@ fn a_scenario_written_here_runs_as_a_campaign_and_a_continuous_distance_is_refus
     let dir = tempfile::tempdir().unwrap();
     let file = brake_file(dir.path());
     let out = dir.path().join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
-        .arg(&file)
-        .args(["--open", "LeadBrake=2..9", "--budget", "4", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
-    let results = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
-    let records: Vec<serde_json::Value> = results
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    assert_eq!(records.len(), 4);
+    let (code, err, records) = brake_campaign(&file, "LeadBrake=2..9", 4, &out);
+    assert!(matches!(code, Some(0 | 1)), "{err}");
     for r in &records {
         assert_ne!(r["status"], "error", "{r}");
         assert!(r["monitors"]["collision"].is_object(), "{r}");
@@ -397,6 +414,62 @@ fn a_scenario_written_here_runs_as_a_campaign_and_a_continuous_distance_is_refus
         err.contains("brake.xosc:38:") && err.contains("continuous LongitudinalDistanceAction"),
         "{err}"
     );
+}
+
+/// A number out of its documented range that comes from a test's value (a braking rate of
+/// up to 1e6 m/s², opened on the command line) ends that test in an error naming the file,
+/// line and column of the action, its element and the range; the test whose value is in range
+/// runs (the fixed numbers of a file are refused at load: `tests/bad_inputs/xosc/`).
+#[test]
+fn a_tests_value_out_of_range_ends_that_test_in_an_error_naming_the_action() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = brake_file(dir.path());
+    let out = dir.path().join("out");
+    let (code, err, records) = brake_campaign(&file, "LeadBrake=2..1e6", 3, &out);
+    // 3: a test ended in error and none failed; 1 if the one in range failed.
+    assert!(matches!(code, Some(1 | 3)), "{err}");
+    for r in &records {
+        let rate = r["params"]["LeadBrake"].as_f64().unwrap();
+        if rate <= 100.0 {
+            assert_ne!(r["status"], "error", "{r}");
+        } else {
+            assert_eq!(r["status"], "error", "{r}");
+            let why = r["error"].as_str().unwrap();
+            assert!(
+                why.contains("brake.xosc:")
+                    && why.contains("<SpeedActionDynamics> attribute value")
+                    && why.contains("out of range for an acceleration (m/s²)"),
+                "{why}"
+            );
+        }
+    }
+    assert!(records.iter().any(|r| r["status"] == "error"));
+    assert!(records.iter().any(|r| r["status"] != "error"));
+}
+
+/// Runs a campaign of `budget` tests over `file` with `--open open` into `out`: its exit code,
+/// stderr and records (`budget` of them).
+fn brake_campaign(
+    file: &std::path::Path,
+    open: &str,
+    budget: usize,
+    out: &std::path::Path,
+) -> (Option<i32>, String, Vec<serde_json::Value>) {
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(file)
+        .args(["--open", open, "--budget", &budget.to_string(), "--out"])
+        .arg(out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    let results =
+        std::fs::read_to_string(out.join("results.jsonl")).unwrap_or_else(|e| panic!("{e}: {err}"));
+    let records: Vec<serde_json::Value> = results
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(records.len(), budget, "{err}");
+    (o.status.code(), err, records)
 }
 
 /// `dir/brake.xosc`: [`brake_scenario`] placed once, not continuously, 20 m along the road.
@@ -826,6 +899,23 @@ fn copy_folder(from: &std::path::Path, to: &std::path::Path) {
     }
 }
 
+/// A copy of the ALKS suite in a new temporary folder, the path of its file `name` there, and
+/// the scenario that file loads.
+fn copied_alks(
+    name: &str,
+) -> (
+    tempfile::TempDir,
+    std::path::PathBuf,
+    paracosm_scenarios::Scenario,
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let alks = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xosc/alks");
+    copy_folder(&alks, dir.path());
+    let file = dir.path().join(name);
+    let scenario = paracosm::load_scenario(file.to_str().unwrap()).expect("it loads");
+    (dir, file, scenario)
+}
+
 /// A campaign is one fixed scenario: its load reads the variation file, the scenario and the
 /// catalogs it names once, its fingerprint covers each of them, and every test reads those
 /// texts. A copy of the crossing pedestrian's files is loaded, then its OpenSCENARIO files are
@@ -833,13 +923,8 @@ fn copy_folder(from: &std::path::Path, to: &std::path::Path) {
 #[test]
 fn an_openscenario_campaign_reads_its_files_once_at_load() {
     use paracosm_generators::Point;
-    let dir = tempfile::tempdir().unwrap();
-    let alks = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xosc/alks");
-    copy_folder(&alks, dir.path());
-    let variation = dir
-        .path()
-        .join("alks_scenario_4_2_3_crossing_pedestrian_variation.xosc");
-    let scenario = paracosm::load_scenario(variation.to_str().unwrap()).expect("it loads");
+    let (dir, variation, scenario) =
+        copied_alks("alks_scenario_4_2_3_crossing_pedestrian_variation.xosc");
     let read: Vec<&str> = scenario
         .input_files()
         .iter()
@@ -950,8 +1035,51 @@ fn an_openscenario_campaign_resumes_bare_from_another_folder() {
     assert!([0, 1, 3].contains(&code), "exit {code}: {err}");
 }
 
-/// A FIFO given as the scenario, or lying in a catalog folder, is refused at once (exit 2,
-/// "not a regular file") instead of blocking the read forever.
+/// A variation that chooses the road network among five maps (ALKS 4.3.1's `Road`) has every
+/// one read, checked and fingerprinted at load: with the maps deleted afterwards, a test on
+/// each level still runs, on the map the load read.
+#[test]
+fn every_map_a_level_chooses_is_read_at_load() {
+    use paracosm_generators::Point;
+    let (dir, _, scenario) =
+        copied_alks("alks_scenario_4_3_1_follow_lead_vehicle_comfortable_variation.xosc");
+    let maps: Vec<&str> = (scenario.input_files().iter())
+        .map(|f| f.path.as_str())
+        .filter(|p| p.ends_with(".xodr"))
+        .collect();
+    println!("the maps read at load: {maps:#?}");
+    for m in [
+        "alks_road_straight.xodr",
+        "alks_road_left_radius_250m.xodr",
+        "alks_road_right_radius_250m.xodr",
+        "alks_road_left_radius_1000m.xodr",
+        "alks_road_right_radius_1000m.xodr",
+    ] {
+        assert!(maps.iter().any(|p| p.ends_with(m)), "{m} in {maps:?}");
+    }
+    std::fs::remove_dir_all(dir.path().join("concrete_scenarios/road_networks")).unwrap();
+    let space = scenario.space();
+    assert_eq!(space.params()[0].name, "Road");
+    let layout = space.layout();
+    for level in 0..5 {
+        // The other parameters at their middle level: the file's first lateral offset
+        // (-1.75 m) breaks its own constraint (greater than -1.75 m).
+        let mut discrete: Vec<u32> = layout.iter().flatten().map(|n| n / 2).collect();
+        discrete[0] = level;
+        let continuous = vec![0.5; layout.iter().filter(|l| l.is_none()).count()];
+        let a = space.decode(&Point {
+            discrete,
+            continuous,
+        });
+        let record = scenario.run(&a.unwrap(), 1);
+        assert!(record.is_ok(), "level {level}: {record:?}");
+    }
+}
+
+/// A FIFO given as the scenario, named as a variation file's scenario, or lying in a catalog
+/// folder (sorted after the entry the scenario needs, so no search would reach it) is refused
+/// at once (exit 2, "is a FIFO, not a regular file") instead of blocking the read forever or
+/// being passed over.
 #[test]
 fn a_fifo_in_place_of_an_openscenario_file_is_refused_not_waited_on() {
     let dir = tempfile::tempdir().unwrap();
@@ -960,7 +1088,7 @@ fn a_fifo_in_place_of_an_openscenario_file_is_refused_not_waited_on() {
     let fifo = dir.path().join("fifo.xosc");
     let catalog_fifo = dir
         .path()
-        .join("concrete_scenarios/catalogs/vehicles/a_fifo.xosc");
+        .join("concrete_scenarios/catalogs/vehicles/zz_fifo.xosc");
     for f in [&fifo, &catalog_fifo] {
         let made = Command::new("mkfifo").arg(f).status().unwrap();
         assert!(made.success());
@@ -968,7 +1096,20 @@ fn a_fifo_in_place_of_an_openscenario_file_is_refused_not_waited_on() {
     let crossing = dir
         .path()
         .join("alks_scenario_4_2_3_crossing_pedestrian_variation.xosc");
-    for (file, why) in [(&fifo, "the scenario"), (&crossing, "a catalog")] {
+    let variation = dir.path().join("v.xosc");
+    std::fs::write(
+        &variation,
+        r#"<OpenSCENARIO><FileHeader revMajor="1" revMinor="3" date="2026-11-29T00:00:00" description="v" author="x"/>
+<ParameterValueDistribution><ScenarioFile filepath="fifo.xosc"/>
+<Deterministic><DeterministicSingleParameterDistribution parameterName="P"><DistributionSet><Element value="1"/></DistributionSet></DeterministicSingleParameterDistribution></Deterministic>
+</ParameterValueDistribution></OpenSCENARIO>"#,
+    )
+    .unwrap();
+    for (file, why) in [
+        (&fifo, "the scenario"),
+        (&crossing, "a catalog"),
+        (&variation, "a variation's scenario"),
+    ] {
         let mut child = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
             .arg("xosc")
             .arg(file)
@@ -991,13 +1132,17 @@ fn a_fifo_in_place_of_an_openscenario_file_is_refused_not_waited_on() {
         std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
         println!("a FIFO as {why}: exit {:?}: {err}", status.code());
         assert_eq!(status.code(), Some(2), "{err}");
-        assert!(err.contains("not a regular file"), "{err}");
+        assert!(
+            err.starts_with("paracosm-fuzz: error: ")
+                && err.contains("is a FIFO, not a regular file"),
+            "{err}"
+        );
     }
 }
 
 /// A value set binds its parameters as the variation file parsed them: a value whose text
-/// holds `, Name=value` is that one parameter's value (here not a number, so the test is an
-/// error naming it), never a second assignment.
+/// holds `, Name=value` is that one parameter's value (here not a number, so the load refuses
+/// it, naming that parameter and its declared type), never a second assignment.
 #[test]
 fn a_value_sets_value_is_one_value_not_more_assignments() {
     use paracosm_generators::Point;
@@ -1020,24 +1165,45 @@ fn a_value_sets_value_is_one_value_not_more_assignments() {
       </DeterministicMultiParameterDistribution>"#
         ),
     );
+    let e = paracosm::ScenarioRef::named(variation.to_str().unwrap())
+        .load()
+        .map(|_| ())
+        .expect_err("a value that is not a number is refused at load")
+        .to_string();
+    println!("{e}");
+    assert!(
+        e.contains(&format!("parameter TargetBlocking_Speed_kph = {hostile:?}"))
+            && e.contains("not a number")
+            && e.contains("declared double"),
+        "{e}"
+    );
+    // The same sets with a number in its place build, and each set is one test.
+    let variation = crossing_variation(
+        dir.path(),
+        r#"      <DeterministicMultiParameterDistribution>
+        <ValueSetDistribution>
+          <ParameterValueSet>
+            <ParameterAssignment parameterRef="TargetBlocking_Speed_kph" value="4"/>
+            <ParameterAssignment parameterRef="TargetBlocking_InitPosition_LateralOffset_m" value="-6"/>
+          </ParameterValueSet>
+          <ParameterValueSet>
+            <ParameterAssignment parameterRef="TargetBlocking_Speed_kph" value="5"/>
+          </ParameterValueSet>
+        </ValueSetDistribution>
+      </DeterministicMultiParameterDistribution>"#,
+    );
     let scenario = paracosm::ScenarioRef::named(variation.to_str().unwrap())
         .load()
         .expect("the campaign's scenario builds");
-    let test = |set: u32| {
+    for set in 0..2 {
         let a = (scenario.space())
             .decode(&Point {
                 discrete: vec![set],
                 continuous: vec![],
             })
             .unwrap();
-        scenario.run(&a, 0)
-    };
-    assert!(test(0).is_ok(), "{:?}", test(0));
-    let e = test(1)
-        .expect_err("a value that is not a number")
-        .to_string();
-    println!("{e}");
-    assert!(e.contains(hostile), "{e}");
+        assert!(scenario.run(&a, 0).is_ok(), "set {set}");
+    }
 }
 
 /// A variation file that varies a parameter nothing in the scenario reads gets the warning a

@@ -74,12 +74,16 @@ fn campaign_records(sut: SutConfig, budget: u64, jobs: usize) -> Vec<paracosm::R
         points: None,
         trace: None,
     };
-    let points = campaign.points().unwrap();
-    points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| campaign.run_one(i as u64, p))
-        .collect()
+    let mut records = Vec::new();
+    campaign
+        .points_in_chunks(|first, points| {
+            for (k, p) in points.iter().enumerate() {
+                records.push(campaign.run_one(first + k as u64, p));
+            }
+            Ok(true)
+        })
+        .unwrap();
+    records
 }
 
 #[test]

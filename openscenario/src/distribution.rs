@@ -693,6 +693,28 @@ fn weight(text: &Text, node: Node<'_, '_>) -> Result<f64, XoscError> {
     Ok(w)
 }
 
+/// Refuses weights whose sum is not a finite number: each weight is finite, but two of
+/// 1e308 sum to infinity, and every level's share of the draw would then be 0 or NaN (the
+/// last level drawn every time).
+fn weights_sum(
+    text: &Text,
+    d: Node<'_, '_>,
+    weights: impl Iterator<Item = f64>,
+) -> Result<(), XoscError> {
+    let total: f64 = weights.sum();
+    if total.is_finite() {
+        return Ok(());
+    }
+    Err(text.invalid(
+        d,
+        format!(
+            "<{}>'s weights sum to {total}, past the largest number: scale them down (only \
+             their ratios count)",
+            d.tag_name().name()
+        ),
+    ))
+}
+
 fn read_probability_set(text: &Text, d: Node<'_, '_>) -> Result<Dist, XoscError> {
     check_attrs(text, d, &[])?;
     let mut out = Vec::new();
@@ -709,6 +731,7 @@ fn read_probability_set(text: &Text, d: Node<'_, '_>) -> Result<Dist, XoscError>
         check_attrs(text, e, &["value", "weight"])?;
         out.push((required(text, e, "value")?.to_string(), weight(text, e)?));
     }
+    weights_sum(text, d, out.iter().map(|(_, w)| *w))?;
     if out.iter().all(|(_, w)| *w == 0.0) {
         return Err(text.invalid(
             d,
@@ -750,6 +773,7 @@ fn read_histogram(text: &Text, d: Node<'_, '_>) -> Result<Dist, XoscError> {
         }
         bins.push((lo, hi, w));
     }
+    weights_sum(text, d, bins.iter().map(|&(_, _, w)| w))?;
     if bins.iter().all(|&(_, _, w)| w == 0.0) {
         return Err(text.invalid(
             d,
@@ -1167,6 +1191,11 @@ mod tests {
         assert!(error(&stochastic(r#"<ProbabilityDistributionSet><Element value="a" weight="-1"/></ProbabilityDistributionSet>"#)).contains("at least 0"));
         assert!(error(&stochastic(r#"<ProbabilityDistributionSet><Element value="a" weight="0"/></ProbabilityDistributionSet>"#)).contains("positive weight"));
         assert!(error(&stochastic(r#"<ProbabilityDistributionSet/>"#)).contains("positive weight"));
+        assert!(error(&stochastic(r#"<ProbabilityDistributionSet><Element value="a" weight="1e308"/><Element value="b" weight="1e308"/></ProbabilityDistributionSet>"#)).contains("scale them down"));
+        assert!(error(&stochastic(
+            r#"<Histogram><Bin weight="1e308"><Range lowerLimit="0" upperLimit="1"/></Bin><Bin weight="1e308"><Range lowerLimit="1" upperLimit="2"/></Bin></Histogram>"#
+        ))
+        .contains("scale them down"));
         let e = read(&stochastic(
             r#"<UserDefinedDistribution type="mine">x</UserDefinedDistribution>"#,
         ))

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use crate::error::XoscError;
-use crate::text::Text;
+use crate::text::{not_regular, Text};
 
 /// The files a scenario has read, by path as named with `.` components removed and `dir/..`
 /// folded (so `a/./b/../c.xosc` and `a/c.xosc` are one file; a path is not made absolute),
@@ -49,7 +49,9 @@ impl FileSet {
     /// the campaign's load read, and the campaign's fingerprint covers it.
     ///
     /// # Errors
-    /// The [`std::io::Error`] of a folder that cannot be listed.
+    /// The [`std::io::Error`] of a folder that cannot be listed, or one naming a `.xosc` entry
+    /// that is not a regular file (a FIFO, a device, a folder: its entries could not be
+    /// searched, and reading it would block or never end).
     pub fn xosc_files(&self, dir: &Path) -> Result<Arc<[PathBuf]>, std::io::Error> {
         let key = folded(dir);
         if let Some(files) = lock(&self.folders).get(&key) {
@@ -65,6 +67,16 @@ impl FileSet {
             .collect();
         files.sort();
         for f in &files {
+            if let Some(kind) = std::fs::metadata(f).ok().as_ref().and_then(not_regular) {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    format!(
+                        "its entry {} is {kind}, not a regular file: every .xosc file of a \
+                         catalog folder is read for the entries it holds",
+                        f.display()
+                    ),
+                ));
+            }
             let _ = self.text(f);
         }
         let files: Arc<[PathBuf]> = files.into();

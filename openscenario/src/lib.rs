@@ -15,12 +15,14 @@ pub mod expr;
 pub mod files;
 pub mod model;
 pub mod params;
+pub mod quantity;
 pub mod read;
 pub mod text;
 mod xml;
 
 pub use error::{Pos, XoscError};
 pub use files::FileSet;
+pub use quantity::Quantity;
 pub use read::{read_scenario, read_scenario_in, read_scenario_text};
 pub use text::Text;
 

@@ -20,6 +20,7 @@ use roxmltree::Node;
 
 use crate::error::{Pos, XoscError};
 use crate::expr::{self, is_param_name, parse_number};
+use crate::quantity::Quantity;
 use crate::text::Text;
 use crate::Value;
 
@@ -332,6 +333,8 @@ pub fn read_declarations(
         return Ok(Vec::new());
     };
     let mut out: Vec<ParamDecl> = Vec::new();
+    // Each name's index in `out`: a linear scan per declaration was quadratic in their count.
+    let mut seen: HashMap<String, usize> = HashMap::new();
     for child in node.children().filter(Node::is_element) {
         if child.tag_name().name() != "ParameterDeclaration" {
             return Err(text.unsupported(
@@ -343,7 +346,7 @@ pub fn read_declarations(
             ));
         }
         let d = read_declaration(text, child)?;
-        if let Some(first) = out.iter().find(|p| p.name == d.name) {
+        if let Some(first) = seen.get(&d.name).map(|&i| &out[i]) {
             return Err(XoscError::Invalid {
                 pos: text.attr_pos(child, "name"),
                 reason: format!(
@@ -352,6 +355,7 @@ pub fn read_declarations(
                 ),
             });
         }
+        seen.insert(d.name.clone(), out.len());
         out.push(d);
     }
     Ok(out)
@@ -951,6 +955,48 @@ impl Scope {
         attr: &str,
     ) -> Result<Option<f64>, XoscError> {
         self.converted(text, node, attr, as_number)
+    }
+
+    /// `node`'s attribute `attr` resolved as a number ([`Scope::num`]) of quantity `q`,
+    /// refused outside `q`'s range ([`Quantity::range`]).
+    ///
+    /// # Errors
+    /// As [`Scope::num`]; Invalid at the attribute, naming the element, when the value is
+    /// out of range.
+    pub fn num_in(
+        &self,
+        text: &Text,
+        node: Node<'_, '_>,
+        attr: &str,
+        q: Quantity,
+    ) -> Result<f64, XoscError> {
+        let v = self.opt_num_in(text, node, attr, q)?;
+        Scope::need(text, node, attr, v)
+    }
+
+    /// As [`Scope::num_in`], `None` when the attribute is absent.
+    ///
+    /// # Errors
+    /// As [`Scope::num_in`], except for a missing attribute.
+    pub fn opt_num_in(
+        &self,
+        text: &Text,
+        node: Node<'_, '_>,
+        attr: &str,
+        q: Quantity,
+    ) -> Result<Option<f64>, XoscError> {
+        let v = self.opt_num(text, node, attr)?;
+        match v.and_then(|v| q.refusal(v)) {
+            None => Ok(v),
+            Some(why) => Err(XoscError::Invalid {
+                pos: text.attr_pos(node, attr),
+                reason: format!(
+                    "<{}> attribute {attr} = {:?}: {why}",
+                    node.tag_name().name(),
+                    node.attribute(attr).unwrap_or_default()
+                ),
+            }),
+        }
     }
 
     /// `node`'s attribute `attr` resolved as a text (numbers and booleans as written by

@@ -18,7 +18,97 @@ pub struct Text {
     pub text: String,
     /// Byte offset of each line's start.
     line_starts: Vec<usize>,
+    /// `(byte offset, characters before it)` every [`MARK_BYTES`] bytes or so (each on a
+    /// character boundary), from 0: a column is counted from the nearest mark, not from the
+    /// line's start, so a file written on one line costs no more than a pretty-printed one.
+    char_marks: Vec<(usize, usize)>,
 }
+
+/// What a file with metadata `meta` (links followed) is when it is not a regular file: `"a
+/// directory"`, `"a FIFO"`, `"a character device"`, `"a block device"`, `"a socket"`; `None`
+/// for a regular file.
+pub fn not_regular(meta: &std::fs::Metadata) -> Option<&'static str> {
+    use std::os::unix::fs::FileTypeExt;
+    let t = meta.file_type();
+    let kinds = [
+        (t.is_dir(), "a directory"),
+        (t.is_fifo(), "a FIFO"),
+        (t.is_char_device(), "a character device"),
+        (t.is_block_device(), "a block device"),
+        (t.is_socket(), "a socket"),
+    ];
+    (!t.is_file()).then(|| {
+        kinds
+            .iter()
+            .find(|(is, _)| *is)
+            .map_or("an unknown kind of file", |&(_, kind)| kind)
+    })
+}
+
+/// The most attributes one element may have in an XML file paracosm reads (OpenSCENARIO or
+/// OpenDRIVE): their elements have at most a few dozen. `roxmltree` compares each attribute
+/// with every earlier one of its element, so 500,000 attributes on one element took minutes;
+/// past this limit the file is refused before it is parsed.
+pub const MAX_ATTRIBUTES: usize = 1000;
+
+/// An element with more than [`MAX_ATTRIBUTES`] attributes, found by [`check_breadth`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "an element with more than {max} attributes: paracosm reads at most {max} on one element",
+    max = MAX_ATTRIBUTES
+)]
+pub struct TooManyAttributes {
+    /// The byte offset of the element's `<`.
+    pub offset: usize,
+}
+
+/// Refuses an XML text with an element of more than [`MAX_ATTRIBUTES`] attributes, in one
+/// pass over its bytes and before any parser sees it. An attribute is counted at each `=`
+/// outside quotes inside a start tag; comments, CDATA sections, processing instructions and
+/// the text between elements are skipped, so an `=` in them counts for nothing.
+///
+/// # Errors
+/// [`TooManyAttributes`] with the element's byte offset.
+pub fn check_breadth(text: &str) -> Result<(), TooManyAttributes> {
+    let b = text.as_bytes();
+    let skip_to = |from: usize, end: &[u8]| -> usize {
+        b[from..]
+            .windows(end.len())
+            .position(|w| w == end)
+            .map_or(b.len(), |i| from + i + end.len())
+    };
+    let mut i = 0;
+    while let Some(lt) = b[i..].iter().position(|&c| c == b'<').map(|p| i + p) {
+        let rest = &b[lt..];
+        if rest.starts_with(b"<!--") {
+            i = skip_to(lt + 4, b"-->");
+        } else if rest.starts_with(b"<![CDATA[") {
+            i = skip_to(lt + 9, b"]]>");
+        } else if rest.starts_with(b"<?") {
+            i = skip_to(lt + 2, b"?>");
+        } else {
+            let (mut quote, mut count, mut j) = (None, 0, lt + 1);
+            while j < b.len() {
+                match (quote, b[j]) {
+                    (None, b'>') => break,
+                    (None, q @ (b'"' | b'\'')) => quote = Some(q),
+                    (None, b'=') => count += 1,
+                    (Some(q), c) if c == q => quote = None,
+                    _ => {}
+                }
+                j += 1;
+            }
+            if count > MAX_ATTRIBUTES {
+                return Err(TooManyAttributes { offset: lt });
+            }
+            i = j;
+        }
+    }
+    Ok(())
+}
+
+/// The spacing of [`Text`]'s character marks, bytes.
+const MARK_BYTES: usize = 1024;
 
 impl Text {
     /// `text`, named `file`.
@@ -30,10 +120,22 @@ impl Text {
         }
         let mut line_starts = vec![0];
         line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
+        let mut char_marks = vec![(0, 0)];
+        let (mut at, mut chars) = (0, 0);
+        while at + MARK_BYTES < text.len() {
+            let mut next = at + MARK_BYTES;
+            while !text.is_char_boundary(next) {
+                next += 1;
+            }
+            chars += text[at..next].chars().count();
+            char_marks.push((next, chars));
+            at = next;
+        }
         Text {
             file: file.into(),
             text,
             line_starts,
+            char_marks,
         }
     }
 
@@ -51,12 +153,11 @@ impl Text {
             reason,
         };
         let meta = std::fs::metadata(path).map_err(|e| io(e.to_string()))?;
-        if !meta.is_file() {
-            return Err(io(
-                "not a regular file (a folder, a FIFO or a device): an OpenSCENARIO file is \
-                 read from a regular file"
-                    .into(),
-            ));
+        if let Some(kind) = not_regular(&meta) {
+            return Err(io(format!(
+                "is {kind}, not a regular file: an OpenSCENARIO file is read from a regular \
+                 file (a FIFO would block, a device never ends)"
+            )));
         }
         let len = meta.len();
         if len > MAX_FILE_BYTES {
@@ -80,14 +181,29 @@ impl Text {
         Ok(Text::new(file, text))
     }
 
-    /// The position of byte `offset`.
+    /// The number of characters before byte `offset` (a character boundary), counted from
+    /// the nearest mark below it.
+    fn chars_before(&self, offset: usize) -> usize {
+        let i = self
+            .char_marks
+            .partition_point(|&(b, _)| b <= offset)
+            .max(1)
+            - 1;
+        let (b, chars) = self.char_marks[i];
+        chars + self.text.get(b..offset).map_or(0, |s| s.chars().count())
+    }
+
+    /// The position of byte `offset`: its line found by bisection, its column from the
+    /// nearest character mark (both cost at most `log n + MARK_BYTES`).
     pub fn pos_at(&self, offset: usize) -> Pos {
+        let offset = offset.min(self.text.len());
         let line = self.line_starts.partition_point(|&s| s <= offset).max(1);
         let start = self.line_starts[line - 1];
-        let col = self
-            .text
-            .get(start..offset.min(self.text.len()))
-            .map_or(1, |s| s.chars().count() + 1);
+        let col = if self.text.is_char_boundary(offset) {
+            self.chars_before(offset) - self.chars_before(start) + 1
+        } else {
+            1
+        };
         Pos {
             file: self.file.clone(),
             line: line as u32,
@@ -112,6 +228,10 @@ impl Text {
     /// # Errors
     /// [`XoscError::Xml`] with the parser's position when the text is not well-formed.
     pub fn parse(&self) -> Result<Document<'_>, XoscError> {
+        check_breadth(&self.text).map_err(|e| XoscError::Invalid {
+            pos: self.pos_at(e.offset),
+            reason: e.to_string(),
+        })?;
         let opts = roxmltree::ParsingOptions {
             allow_dtd: false,
             ..Default::default()
@@ -161,5 +281,60 @@ impl Text {
             pos: self.pos(node),
             reason: reason.into(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Columns counted from the character marks equal a count from the line's start, on a
+    /// long line of multi-byte characters and across line breaks.
+    #[test]
+    fn columns_from_the_marks_equal_a_count_from_the_line_start() {
+        let mut s = String::new();
+        for i in 0..3000 {
+            s.push_str(if i % 7 == 0 { "é€ " } else { "ab " });
+            if i % 1000 == 999 {
+                s.push('\n');
+            }
+        }
+        let t = Text::new("f.xosc", s.clone());
+        for (offset, _) in s.char_indices().step_by(37) {
+            let line_start = s[..offset].rfind('\n').map_or(0, |i| i + 1);
+            let col = s[line_start..offset].chars().count() + 1;
+            let line = s[..offset].matches('\n').count() + 1;
+            let p = t.pos_at(offset);
+            assert_eq!(
+                (p.line, p.col),
+                (line as u32, col as u32),
+                "at byte {offset}"
+            );
+        }
+        assert_eq!(t.pos_at(s.len()).line, 4);
+    }
+
+    /// An element's attributes are counted at each `=` outside quotes of its start tag;
+    /// comments, CDATA, processing instructions, text and quoted values do not count.
+    #[test]
+    fn an_element_with_too_many_attributes_is_found_in_one_pass() {
+        let attrs = |n: usize| -> String { (0..n).map(|i| format!(" a{i}=\"1\"")).collect() };
+        let fine = format!(
+            "<?xml version=\"1.0\"?><!-- {} --><r{}><![CDATA[{}]]>{}<e v=\"{}\"/></r>",
+            "=".repeat(5000),
+            attrs(MAX_ATTRIBUTES),
+            "=".repeat(5000),
+            "=".repeat(5000),
+            "=".repeat(5000)
+        );
+        assert_eq!(check_breadth(&fine), Ok(()));
+        let wide = format!("<r><x/><e{}/></r>", attrs(MAX_ATTRIBUTES + 1));
+        assert_eq!(check_breadth(&wide), Err(TooManyAttributes { offset: 7 }));
+        let t = Text::new("w.xosc", wide);
+        let e = t.parse().unwrap_err().to_string();
+        assert!(
+            e.starts_with("w.xosc:1:8: an element with more than 1000"),
+            "{e}"
+        );
     }
 }

@@ -85,6 +85,28 @@ pub fn read_input_file(scenario: &str, path: &str) -> Result<String, LoadError> 
     }
 }
 
+/// Imports the OpenDRIVE text of `file` ([`opendrive::import`]), first refusing an element
+/// with more attributes than paracosm's XML readers take
+/// ([`paracosm_openscenario::text::check_breadth`]: the parsers' cost grows with their
+/// square). Every map a user names is read through here.
+///
+/// # Errors
+/// [`opendrive::MapError`] at the element's line and column for too many attributes; the
+/// importer's errors otherwise.
+pub fn import_map(file: &str, text: &str) -> Result<opendrive::Imported, opendrive::MapError> {
+    if let Err(e) = paracosm_openscenario::text::check_breadth(text) {
+        let before = &text[..e.offset];
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        return Err(opendrive::MapError {
+            file: file.to_owned(),
+            line: Some(before.matches('\n').count() as u32 + 1),
+            column: Some(before[line_start..].chars().count() as u32 + 1),
+            message: e.to_string(),
+        });
+    }
+    opendrive::import(file, text)
+}
+
 #[derive(Debug, Clone)]
 struct Loaded {
     /// The map with what is derived from it once for every test ([`MapRef`]'s cache).
@@ -168,8 +190,8 @@ impl MapFiles {
                 (shown, text)
             }
         };
-        let imported = opendrive::import(&shown, &text)
-            .map_err(|e| files(format!("the OpenDRIVE map {e}")))?;
+        let imported =
+            import_map(&shown, &text).map_err(|e| files(format!("the OpenDRIVE map {e}")))?;
         let map = MapRef::new(imported.map);
         loaded.insert(
             path.to_owned(),

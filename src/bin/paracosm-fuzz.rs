@@ -99,6 +99,11 @@ fn say(text: &str) -> Result<()> {
 /// `paracosm-fuzz map`: the listing on stdout, the importer's warnings on stderr, then the
 /// drawings.
 fn map(a: &MapArgs) -> Result<u8> {
+    for (p, option) in [(&a.png, "--png"), (&a.svg, "--svg")] {
+        if let Some(p) = p {
+            paracosm::atomic::check_output(p, option, &[&a.file])?;
+        }
+    }
     let listing = paracosm::map::read(&a.file)?;
     for w in &listing.warnings {
         paracosm::cli::to_stderr(&format!("paracosm-fuzz: warning: {w}"));
@@ -134,17 +139,30 @@ fn run(cli: &Cli) -> Result<u8> {
     let mut progress = Progress::new(cli.verbose);
     let bar = progress.clone();
     let mut plan = |p: &Plan<'_>| {
-        p.notes()
-            .iter()
-            .for_each(|n| paracosm::cli::to_stderr(&format!("paracosm-fuzz: {n}")));
+        bar.hold(
+            p.notes()
+                .iter()
+                .map(|n| format!("paracosm-fuzz: {n}"))
+                .collect(),
+        );
         bar.start(p.to_run);
     };
+    let held = progress.clone();
     let outcome = paracosm::campaign::session::run(
         &cli.request()?,
         Some(&STOP),
         &mut plan,
         &mut [&mut progress],
-    )?;
+    );
+    let outcome = match outcome {
+        Ok(o) => o,
+        Err(e) => {
+            // The error first (main prints it), then the warnings the load found.
+            paracosm::cli::to_stderr(&paracosm::cli::error_text("paracosm-fuzz", &e.to_string()));
+            held.release();
+            return Ok(e.exit_code());
+        }
+    };
     progress.finish();
     outcome
         .notes()

@@ -76,12 +76,19 @@ pub struct CampaignReport {
 }
 
 impl Campaign<'_> {
-    /// The campaign's points, in test order: `budget` points from the strategy's generator.
+    /// The campaign's points, in test order, in chunks of at most 4,096:
+    /// `budget` points from the strategy's generator, each chunk asked for when `each` has
+    /// taken the one before, so memory does not grow with the budget. `each` gets the id of
+    /// the chunk's first point and the chunk, and returns whether to go on.
     ///
     /// # Errors
     /// [`Error::Generator`] when the strategy cannot produce them; [`Error::BadInput`] for an
-    /// adaptive strategy, whose points exist only as the campaign runs.
-    pub fn points(&self) -> Result<Vec<Point>, Error> {
+    /// adaptive strategy, whose points exist only as the campaign runs; the first error of
+    /// `each`.
+    pub fn points_in_chunks(
+        &self,
+        mut each: impl FnMut(u64, Vec<Point>) -> Result<bool, Error>,
+    ) -> Result<(), Error> {
         let mut generator = self.generator()?;
         if generator.batch().is_some() {
             return Err(Error::BadInput(format!(
@@ -90,7 +97,17 @@ impl Campaign<'_> {
                 self.strategy
             )));
         }
-        Ok(generator.ask(self.budget as usize)?)
+        self.check_capacity(generator.as_ref(), self.budget)?;
+        let mut next = 0;
+        while next < self.budget {
+            let n = POINT_CHUNK.min(self.budget - next);
+            let chunk = generator.ask(n as usize)?;
+            if !each(next, chunk)? {
+                break;
+            }
+            next += n;
+        }
+        Ok(())
     }
 
     /// Checks that `records` (the tests `first_id..` in order, as read from `file`, whose line
@@ -437,19 +454,7 @@ impl Campaign<'_> {
     ) -> Result<Option<Vec<Point>>, Error> {
         match generator.batch() {
             None => {
-                let capacity = match self.strategy {
-                    Strategy::Points => self.points.map(|p| p.len() as u64),
-                    s => s.capacity(),
-                };
-                if let Some(limit) = capacity.filter(|&c| ids.end > c) {
-                    return Err(paracosm_generators::GeneratorError::CapacityExceeded {
-                        generator: generator.name(),
-                        what: "points",
-                        limit,
-                        requested: ids.end,
-                    }
-                    .into());
-                }
+                self.check_capacity(&*generator, ids.end)?;
                 generator.skip(ids.start)?;
                 let n = POINT_CHUNK.min(ids.end - ids.start) as usize;
                 Ok(Some(generator.ask(n)?))
@@ -462,6 +467,34 @@ impl Campaign<'_> {
                 )))
             }
             Some(_) => Ok(None),
+        }
+    }
+}
+
+impl Campaign<'_> {
+    /// Refuses `end` points from `generator` when its strategy has fewer (a covering array's
+    /// rows, the points given), before any test runs.
+    ///
+    /// # Errors
+    /// [`Error::Generator`] with the strategy's limit.
+    fn check_capacity(
+        &self,
+        generator: &dyn paracosm_generators::Generator,
+        end: u64,
+    ) -> Result<(), Error> {
+        let capacity = match self.strategy {
+            Strategy::Points => self.points.map(|p| p.len() as u64),
+            s => s.capacity(),
+        };
+        match capacity.filter(|&c| end > c) {
+            Some(limit) => Err(paracosm_generators::GeneratorError::CapacityExceeded {
+                generator: generator.name(),
+                what: "points",
+                limit,
+                requested: end,
+            }
+            .into()),
+            None => Ok(()),
         }
     }
 }
@@ -837,13 +870,53 @@ mod tests {
         let c = campaign(&s, 2);
         let dir = tempfile::tempdir().unwrap();
         let report = c.run(dir.path(), |_| {}).unwrap();
-        let points = c.points().unwrap();
+        let mut points = Vec::new();
+        c.points_in_chunks(|first, chunk| {
+            assert_eq!(first, points.len() as u64);
+            points.extend(chunk);
+            Ok(true)
+        })
+        .unwrap();
+        assert_eq!(points.len(), 12);
         for id in [0u64, 7, 11] {
             let replay = c.run_one(id, &points[id as usize]);
             assert_eq!(
                 strip_wall(replay),
                 strip_wall(report.records[id as usize].clone())
             );
+        }
+    }
+
+    /// Points asked for in chunks of 4,096 are the points asked for at once, in order, for a
+    /// sequence and for seeded random draws; `each` returning false stops the asking.
+    #[test]
+    fn points_in_chunks_are_the_points_asked_for_at_once() {
+        let s = paracosm_scenarios::reference::scenario();
+        for strategy in [Strategy::Halton, Strategy::Random] {
+            let c = Campaign {
+                strategy,
+                budget: 5000,
+                ..campaign(&s, 1)
+            };
+            let whole = c.generator().unwrap().ask(5000).unwrap();
+            let mut chunks = Vec::new();
+            c.points_in_chunks(|first, chunk| {
+                chunks.push((first, chunk.len()));
+                assert_eq!(
+                    chunk[..],
+                    whole[first as usize..first as usize + chunk.len()]
+                );
+                Ok(true)
+            })
+            .unwrap();
+            assert_eq!(chunks, [(0, 4096), (4096, 904)], "{strategy}");
+            let mut asked = 0;
+            c.points_in_chunks(|_, _| {
+                asked += 1;
+                Ok(false)
+            })
+            .unwrap();
+            assert_eq!(asked, 1);
         }
     }
 

@@ -16,6 +16,8 @@ pub struct Progress {
     bar: ProgressBar,
     failures: u64,
     verbose: bool,
+    /// Lines held until the first test starts ([`Progress::hold`]), shared by the clones.
+    held: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
 }
 
 impl Progress {
@@ -25,6 +27,31 @@ impl Progress {
             bar: ProgressBar::hidden(),
             failures: 0,
             verbose,
+            held: std::sync::Arc::default(),
+        }
+    }
+
+    /// Holds `lines` (the load's warnings) until the campaign starts its tests, when
+    /// [`Observer::started`] prints them: a refusal found after the load but before any test
+    /// (a covering array too large to build) is then the first line on stderr, and the
+    /// caller prints the held lines after it ([`Progress::release`]).
+    pub fn hold(&self, lines: Vec<String>) {
+        self.held
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .extend(lines);
+    }
+
+    /// Prints the lines still held ([`Progress::hold`]) on stderr.
+    pub fn release(&self) {
+        let lines = std::mem::take(
+            &mut *self
+                .held
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner),
+        );
+        for line in lines {
+            self.note(&line);
         }
     }
 
@@ -53,6 +80,11 @@ impl Progress {
 }
 
 impl Observer for Progress {
+    fn started(&mut self, _prior: &[RunRecord]) -> Result<(), Error> {
+        self.release();
+        Ok(())
+    }
+
     fn record(&mut self, r: &RunRecord) -> Result<(), Error> {
         self.failures += u64::from(r.status == Status::Fail);
         if self.verbose {

@@ -63,12 +63,12 @@ pub fn to_stderr(line: &str) {
 }
 
 /// Parses the command line of `tool`. On `--help`/`--version` prints and returns
-/// `Err(ExitCode::SUCCESS)`; on bad usage prints `tool: <one-line reason> (see --help)` to
+/// `Err(ExitCode::SUCCESS)`; on bad usage prints `tool: error: <one-line reason> (see --help)` to
 /// stderr and returns `Err(2)`.
 pub fn parse_args<T: Parser>(tool: &str) -> Result<T, ExitCode> {
     T::try_parse().map_err(|e| {
         if e.use_stderr() {
-            to_stderr(&format!("{tool}: {} (see --help)", one_line(&e)));
+            to_stderr(&format!("{tool}: error: {} (see --help)", one_line(&e)));
             ExitCode::from(2)
         } else {
             let _ = e.print();

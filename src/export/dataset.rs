@@ -331,33 +331,37 @@ pub fn export(req: &DatasetRequest, stop: Option<&AtomicBool>) -> Result<Dataset
         points: None,
         trace: None,
     };
-    let points = campaign.points()?;
     prepare(&req.out, req.replace)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(req.jobs.max(1))
         .build()
         .map_err(|e| Error::Internal(format!("cannot start the worker pool: {e}")))?;
     let out = req.out.as_path();
-    let tests: Vec<Result<Option<TestData>, Error>> = pool.install(|| {
-        points
-            .par_iter()
-            .enumerate()
-            .map(|(id, point)| {
-                if stop.is_some_and(|s| s.load(Ordering::SeqCst)) {
-                    return Ok(None);
-                }
-                record_test(&campaign, id as u64, point, &camera, req, out).map(Some)
-            })
-            .collect()
-    });
     let mut done = Vec::new();
     let mut interrupted = false;
-    for t in tests {
-        match t? {
-            Some(t) => done.push(t),
-            None => interrupted = true,
+    // The points come in chunks as the tests run (`--budget 1e12` starts at once).
+    campaign.points_in_chunks(|first, points| {
+        let tests: Vec<Result<Option<TestData>, Error>> = pool.install(|| {
+            points
+                .par_iter()
+                .enumerate()
+                .map(|(k, point)| {
+                    if stop.is_some_and(|s| s.load(Ordering::SeqCst)) {
+                        return Ok(None);
+                    }
+                    let id = first + k as u64;
+                    record_test(&campaign, id, point, &camera, req, out).map(Some)
+                })
+                .collect()
+        });
+        for t in tests {
+            match t? {
+                Some(t) => done.push(t),
+                None => interrupted = true,
+            }
         }
-    }
+        Ok(!interrupted)
+    })?;
     let summary = write_index(req, &scenario, &camera, &done, interrupted, started)?;
     Ok(summary)
 }

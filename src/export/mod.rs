@@ -56,15 +56,36 @@ fn network_document(
     if maps.is_empty() {
         xodr::write(&world.network, scenario.name()).map_err(input)
     } else if maps.len() == 1 && world.network.pieces().len() == 1 {
-        let read = scenario
-            .input_files()
+        // The map the test ran on (a variation may choose among several): its source path
+        // ends with the input file's path, both without `.` components.
+        let plain = |p: &str| -> std::path::PathBuf {
+            Path::new(p)
+                .components()
+                .filter(|c| !matches!(c, std::path::Component::CurDir))
+                .collect()
+        };
+        let source = match maps[0] {
+            PieceKind::Map { map, .. } => plain(&map.0.source),
+            _ => std::path::PathBuf::new(),
+        };
+        let inputs = scenario.input_files();
+        let xodr: Vec<_> = inputs
             .iter()
-            .find(|f| {
-                matches!(maps[0], PieceKind::Map { map, .. }
-                    if map.0.source.ends_with(f.path.trim_start_matches("./")))
+            .filter(|f| f.path.to_ascii_lowercase().ends_with(".xodr"))
+            .collect();
+        let read = inputs
+            .iter()
+            .find(|f| source.ends_with(plain(&f.path)))
+            .or(match xodr[..] {
+                [one] => Some(one),
+                _ => None,
             })
-            .or(scenario.input_files().first())
-            .ok_or_else(|| input("the program's map is not among the files it read"))?;
+            .ok_or_else(|| {
+                input(format!(
+                    "the test's map {} is not among the files the campaign read",
+                    source.display()
+                ))
+            })?;
         if program.xosc().is_some() {
             // An OpenSCENARIO campaign names its files relative to the folder of its file.
             let folder = Path::new(program.path()).parent().unwrap_or(Path::new(""));

@@ -14,7 +14,6 @@ mod junctions;
 use std::path::Path;
 use std::sync::Arc;
 
-use paracosm_engine::network::opendrive;
 use paracosm_engine::network::RoadMap;
 
 use crate::Error;
@@ -90,8 +89,8 @@ pub fn read(path: &Path) -> Result<MapListing, Error> {
     let shown = path.display().to_string();
     let text = paracosm_scenarios::text_file::read_text(path, MAX_MAP_BYTES)
         .map_err(|e| Error::input(path, e))?;
-    let imported =
-        opendrive::import(&shown, &text).map_err(|e| Error::malformed(path, e.to_string()))?;
+    let imported = paracosm_scenarios::map_files::import_map(&shown, &text)
+        .map_err(|e| Error::malformed(path, e.to_string()))?;
     let doc = roxmltree::Document::parse(&text)
         .map_err(|e| Error::malformed(path, format!("{shown}: malformed XML: {e}")))?;
     let map = imported.map;

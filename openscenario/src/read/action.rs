@@ -9,6 +9,7 @@ use crate::error::XoscError;
 use crate::model::{
     Action, Dimension, Dynamics, LaneTarget, OffsetTarget, Shape, SpeedTarget, TrajectoryShape,
 };
+use crate::quantity::Quantity;
 use crate::xml::{child, choice, elements, need, only};
 
 /// A `<PrivateAction>`.
@@ -103,7 +104,12 @@ fn dynamics(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Dynamics, XoscError> {
             r.note(node, format!("followingMode {mode:?} is followed as \"position\": the value follows the shape exactly"));
         }
     }
-    let mut value = r.scope.num(r.text, node, "value")?;
+    let q = match dimension {
+        Dimension::Rate => Quantity::Acceleration,
+        Dimension::Time => Quantity::Duration,
+        Dimension::Distance => Quantity::Distance,
+    };
+    let mut value = r.scope.num_in(r.text, node, "value", q)?;
     if dimension == Dimension::Rate && value < 0.0 {
         // The standard's value is >= 0; files (the ALKS cut-in) write a deceleration as a
         // negative rate. The target gives the direction, so the rate is its magnitude.
@@ -152,7 +158,7 @@ fn speed(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
         &["AbsoluteTargetSpeed", "RelativeTargetSpeed"],
     )?;
     let target = if tag == "AbsoluteTargetSpeed" {
-        SpeedTarget::Absolute(r.scope.num(r.text, t, "value")?)
+        SpeedTarget::Absolute(r.scope.num_in(r.text, t, "value", Quantity::Speed)?)
     } else {
         let factor = match r.scope.string(r.text, t, "speedTargetValueType")?.as_str() {
             "delta" => false,
@@ -166,7 +172,16 @@ fn speed(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
         };
         SpeedTarget::Relative {
             entity: r.entity(t, "entityRef")?,
-            value: r.scope.num(r.text, t, "value")?,
+            value: r.scope.num_in(
+                r.text,
+                t,
+                "value",
+                if factor {
+                    Quantity::Factor
+                } else {
+                    Quantity::Speed
+                },
+            )?,
             factor,
             continuous: r.scope.bool(r.text, t, "continuous")?,
         }
@@ -175,8 +190,12 @@ fn speed(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
 }
 
 fn distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
-    let distance_m = r.scope.opt_num(r.text, node, "distance")?;
-    let time_gap_s = r.scope.opt_num(r.text, node, "timeGap")?;
+    let distance_m = r
+        .scope
+        .opt_num_in(r.text, node, "distance", Quantity::Distance)?;
+    let time_gap_s = r
+        .scope
+        .opt_num_in(r.text, node, "timeGap", Quantity::Duration)?;
     if distance_m.is_some() == time_gap_s.is_some() {
         return Err(r.text.invalid(
             node,
@@ -254,7 +273,7 @@ fn lane_change(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> 
         dynamics,
         offset_m: r
             .scope
-            .opt_num(r.text, node, "targetLaneOffset")?
+            .opt_num_in(r.text, node, "targetLaneOffset", Quantity::Lateral)?
             .unwrap_or(0.0),
     })
 }
@@ -267,17 +286,19 @@ fn lane_offset(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> 
         &["AbsoluteTargetLaneOffset", "RelativeTargetLaneOffset"],
     )?;
     let target = if tag == "AbsoluteTargetLaneOffset" {
-        OffsetTarget::Absolute(r.scope.num(r.text, t, "value")?)
+        OffsetTarget::Absolute(r.scope.num_in(r.text, t, "value", Quantity::Lateral)?)
     } else {
         OffsetTarget::Relative {
             entity: r.entity(t, "entityRef")?,
-            value: r.scope.num(r.text, t, "value")?,
+            value: r.scope.num_in(r.text, t, "value", Quantity::Lateral)?,
         }
     };
     Ok(Action::LaneOffset {
         target,
         shape: shape(r, d)?,
-        max_lateral_acc: r.scope.opt_num(r.text, d, "maxLateralAcc")?,
+        max_lateral_acc: r
+            .scope
+            .opt_num_in(r.text, d, "maxLateralAcc", Quantity::Acceleration)?,
         continuous: r.scope.bool(r.text, node, "continuous")?,
     })
 }
@@ -288,7 +309,7 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
         r.text.unsupported(node, "a trajectory is read from <TrajectoryRef><Trajectory> or <Trajectory> (trajectory catalogs are not supported)")
     })?;
     if r.scope
-        .opt_num(r.text, node, "initialDistanceOffset")?
+        .opt_num_in(r.text, node, "initialDistanceOffset", Quantity::Distance)?
         .is_some_and(|d| d != 0.0)
     {
         return Err(XoscError::Unsupported {
@@ -339,8 +360,8 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
             };
             Some((
                 absolute,
-                r.scope.num(r.text, t, "scale")?,
-                r.scope.num(r.text, t, "offset")?,
+                r.scope.num_in(r.text, t, "scale", Quantity::Factor)?,
+                r.scope.num_in(r.text, t, "offset", Quantity::Time)?,
             ))
         }
     };
@@ -371,7 +392,7 @@ fn polyline(r: &Reader<'_>, shape: Node<'_, '_>) -> Result<TrajectoryShape, Xosc
                 .text
                 .unsupported(v, "a polyline holds <Vertex> elements only"));
         }
-        let time = r.scope.opt_num(r.text, v, "time")?;
+        let time = r.scope.opt_num_in(r.text, v, "time", Quantity::Time)?;
         vertices.push((time, position::read(r, need(r.text, v, "Position")?)?));
     }
     if vertices.len() < 2 {
@@ -393,7 +414,7 @@ fn clothoid(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, XoscErro
         (Some(p), _) | (None, Some(p)) => p,
         (None, None) => return Err(t.invalid(c, "a clothoid needs curvaturePrime")),
     };
-    let length = sc.num(t, c, "length")?;
+    let length = sc.num_in(t, c, "length", Quantity::Distance)?;
     if !(length.is_finite() && length > 0.0) {
         return Err(XoscError::Invalid {
             pos: t.attr_pos(c, "length"),
@@ -401,8 +422,8 @@ fn clothoid(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, XoscErro
         });
     }
     let times = match (
-        sc.opt_num(t, c, "startTime")?,
-        sc.opt_num(t, c, "stopTime")?,
+        sc.opt_num_in(t, c, "startTime", Quantity::Time)?,
+        sc.opt_num_in(t, c, "stopTime", Quantity::Time)?,
     ) {
         (Some(a), Some(b)) if b > a => Some((a, b)),
         (None, None) => None,
@@ -419,7 +440,7 @@ fn clothoid(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, XoscErro
     };
     Ok(TrajectoryShape::Clothoid {
         start,
-        curvature: sc.num(t, c, "curvature")?,
+        curvature: sc.num_in(t, c, "curvature", Quantity::Curvature)?,
         curvature_prime: prime,
         length,
         times,
@@ -451,7 +472,7 @@ fn nurbs(r: &Reader<'_>, n: Node<'_, '_>) -> Result<TrajectoryShape, XoscError> 
                         reason: format!("a control point's weight must be > 0, not {weight}"),
                     });
                 }
-                let time = sc.opt_num(t, e, "time")?;
+                let time = sc.opt_num_in(t, e, "time", Quantity::Time)?;
                 points.push((time, weight, position::read(r, need(t, e, "Position")?)?));
             }
             "Knot" => knots.push(sc.num(t, e, "value")?),

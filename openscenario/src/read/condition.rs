@@ -5,6 +5,7 @@ use roxmltree::Node;
 use super::{position, Reader};
 use crate::error::XoscError;
 use crate::model::{Condition, ConditionKind, Edge, EntityTest, Gap, Rule, Trigger};
+use crate::quantity::Quantity;
 use crate::xml::{choice, elements, need};
 
 /// A `StartTrigger` or `StopTrigger`: its condition groups.
@@ -36,7 +37,7 @@ pub(super) fn trigger(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Trigger, Xos
 }
 
 fn condition(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Condition, XoscError> {
-    let delay_s = r.scope.num(r.text, c, "delay")?;
+    let delay_s = r.scope.num_in(r.text, c, "delay", Quantity::Duration)?;
     if delay_s.is_nan() || delay_s < 0.0 {
         return Err(XoscError::Invalid {
             pos: r.text.attr_pos(c, "delay"),
@@ -105,7 +106,7 @@ fn by_value(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError
     Ok(match tag {
         "SimulationTimeCondition" => ConditionKind::SimulationTime {
             rule: rule(r, v)?,
-            value: r.scope.num(r.text, v, "value")?,
+            value: r.scope.num_in(r.text, v, "value", Quantity::Time)?,
         },
         "StoryboardElementStateCondition" => {
             let one_of = |attr: &str, allowed: &[&str]| -> Result<String, XoscError> {
@@ -279,13 +280,19 @@ fn no_direction(r: &Reader<'_>, c: Node<'_, '_>) -> Result<(), XoscError> {
     }
 }
 
-/// The [`Gap`] of condition `c`, whose other entity `target` names.
-fn gap(r: &Reader<'_>, c: Node<'_, '_>, target: Node<'_, '_>) -> Result<Gap, XoscError> {
+/// The [`Gap`] of condition `c`, whose other entity `target` names, its value a quantity
+/// `q` (a time gap or a distance).
+fn gap(
+    r: &Reader<'_>,
+    c: Node<'_, '_>,
+    target: Node<'_, '_>,
+    q: Quantity,
+) -> Result<Gap, XoscError> {
     let (frame, kind) = measure(r, c)?;
     Ok(Gap {
         entity: r.entity(target, "entityRef")?,
         rule: rule(r, c)?,
-        value: r.scope.num(r.text, c, "value")?,
+        value: r.scope.num_in(r.text, c, "value", q)?,
         freespace: r.scope.bool(r.text, c, "freespace")?,
         frame,
         kind,
@@ -301,14 +308,14 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
         no_direction(r, c)?;
     }
     Ok(match tag {
-        "TimeHeadwayCondition" => EntityTest::TimeHeadway(gap(r, c, c)?),
+        "TimeHeadwayCondition" => EntityTest::TimeHeadway(gap(r, c, c, Quantity::Duration)?),
         "TimeToCollisionCondition" => {
             let (target, _) = choice(
                 t,
                 need(t, c, "TimeToCollisionConditionTarget")?,
                 &["EntityRef"],
             )?;
-            EntityTest::TimeToCollision(gap(r, c, target)?)
+            EntityTest::TimeToCollision(gap(r, c, target, Quantity::Duration)?)
         }
         "RelativeDistanceCondition" => {
             if c.attribute("relativeDistanceType").is_none() {
@@ -317,7 +324,7 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
                     "a relative distance condition needs relativeDistanceType",
                 ));
             }
-            EntityTest::RelativeDistance(gap(r, c, c)?)
+            EntityTest::RelativeDistance(gap(r, c, c, Quantity::Distance)?)
         }
         "DistanceCondition" => {
             let (frame, kind) = measure(r, c)?;
@@ -334,31 +341,37 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
             EntityTest::Distance {
                 position: position::read(r, need(t, c, "Position")?)?,
                 rule: rule(r, c)?,
-                value: s.num(t, c, "value")?,
+                value: s.num_in(t, c, "value", Quantity::Distance)?,
                 freespace: s.bool(t, c, "freespace")?,
                 kind,
             }
         }
         "ReachPositionCondition" => EntityTest::ReachPosition {
             position: position::read(r, need(t, c, "Position")?)?,
-            tolerance: s.num(t, c, "tolerance")?,
+            tolerance: s.num_in(t, c, "tolerance", Quantity::Size)?,
         },
         "SpeedCondition" => EntityTest::Speed {
             rule: rule(r, c)?,
-            value: s.num(t, c, "value")?,
+            value: s.num_in(t, c, "value", Quantity::Speed)?,
         },
         "RelativeSpeedCondition" => EntityTest::RelativeSpeed {
             entity: r.entity(c, "entityRef")?,
             rule: rule(r, c)?,
-            value: s.num(t, c, "value")?,
+            value: s.num_in(t, c, "value", Quantity::Speed)?,
         },
         "AccelerationCondition" => EntityTest::Acceleration {
             rule: rule(r, c)?,
-            value: s.num(t, c, "value")?,
+            value: s.num_in(t, c, "value", Quantity::Acceleration)?,
         },
-        "StandStillCondition" => EntityTest::Standstill(s.num(t, c, "duration")?),
-        "TraveledDistanceCondition" => EntityTest::TraveledDistance(s.num(t, c, "value")?),
-        "EndOfRoadCondition" => EntityTest::EndOfRoad(s.num(t, c, "duration")?),
+        "StandStillCondition" => {
+            EntityTest::Standstill(s.num_in(t, c, "duration", Quantity::Duration)?)
+        }
+        "TraveledDistanceCondition" => {
+            EntityTest::TraveledDistance(s.num_in(t, c, "value", Quantity::Distance)?)
+        }
+        "EndOfRoadCondition" => {
+            EntityTest::EndOfRoad(s.num_in(t, c, "duration", Quantity::Duration)?)
+        }
         _ => {
             let (target, _) = choice(t, c, &["EntityRef"])?;
             EntityTest::Collision(Some(r.entity(target, "entityRef")?))

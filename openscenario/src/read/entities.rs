@@ -6,6 +6,7 @@ use super::{Catalogs, Reader};
 use crate::error::XoscError;
 use crate::model::{Entity, EntityKind, Located};
 use crate::params::Scope;
+use crate::quantity::Quantity;
 use crate::text::Text;
 use crate::xml::{child, choice, elements, need, only};
 
@@ -135,9 +136,9 @@ fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscErr
     let dims = need(text, bb, "Dimensions")?;
     let centre = need(text, bb, "Center")?;
     let dimensions_m = [
-        scope.num(text, dims, "length")?,
-        scope.num(text, dims, "width")?,
-        scope.num(text, dims, "height")?,
+        scope.num_in(text, dims, "length", Quantity::Size)?,
+        scope.num_in(text, dims, "width", Quantity::Size)?,
+        scope.num_in(text, dims, "height", Quantity::Size)?,
     ];
     if dimensions_m.iter().any(|&d| !(d > 0.0 && d <= 100.0)) {
         return Err(text.invalid(
@@ -146,9 +147,9 @@ fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscErr
         ));
     }
     let centre_m = [
-        scope.num(text, centre, "x")?,
-        scope.num(text, centre, "y")?,
-        scope.num(text, centre, "z")?,
+        scope.num_in(text, centre, "x", Quantity::Offset)?,
+        scope.num_in(text, centre, "y", Quantity::Offset)?,
+        scope.num_in(text, centre, "z", Quantity::Offset)?,
     ];
     let mut notes = Vec::new();
     if child(e, "Performance").is_some() {

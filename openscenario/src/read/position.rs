@@ -6,6 +6,7 @@ use roxmltree::Node;
 use super::Reader;
 use crate::error::XoscError;
 use crate::model::{Orientation, Position};
+use crate::quantity::Quantity;
 use crate::xml::{child, choice};
 
 /// The positions paracosm reads.
@@ -28,21 +29,23 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscE
         "RelativeWorldPosition" | "RelativeObjectPosition" => relative(r, p, tag)?,
         "RoadPosition" => Position::Road {
             road: s.string(t, p, "roadId")?,
-            s: s.num(t, p, "s")?,
-            t: s.num(t, p, "t")?,
+            s: s.num_in(t, p, "s", Quantity::Distance)?,
+            t: s.num_in(t, p, "t", Quantity::Lateral)?,
             orientation: orientation(r, p)?,
         },
         "RelativeRoadPosition" => Position::RelativeRoad {
             entity: r.entity(p, "entityRef")?,
-            ds: s.num(t, p, "ds")?,
-            dt: s.num(t, p, "dt")?,
+            ds: s.num_in(t, p, "ds", Quantity::Distance)?,
+            dt: s.num_in(t, p, "dt", Quantity::Lateral)?,
             orientation: orientation(r, p)?,
         },
         "LanePosition" => Position::Lane {
             road: s.string(t, p, "roadId")?,
             lane: lane_id(r, p, "laneId")?,
-            s: s.num(t, p, "s")?,
-            offset: s.opt_num(t, p, "offset")?.unwrap_or(0.0),
+            s: s.num_in(t, p, "s", Quantity::Distance)?,
+            offset: s
+                .opt_num_in(t, p, "offset", Quantity::Lateral)?
+                .unwrap_or(0.0),
             orientation: orientation(r, p)?,
         },
         _ => relative_lane(r, p)?,
@@ -75,9 +78,9 @@ fn world(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
         }
     }
     Ok(Position::World {
-        x: s.num(t, p, "x")?,
-        y: s.num(t, p, "y")?,
-        h: s.opt_num(t, p, "h")?,
+        x: s.num_in(t, p, "x", Quantity::Coordinate)?,
+        y: s.num_in(t, p, "y", Quantity::Coordinate)?,
+        h: s.opt_num_in(t, p, "h", Quantity::Angle)?,
     })
 }
 
@@ -94,8 +97,8 @@ fn relative(r: &Reader<'_>, p: Node<'_, '_>, tag: &str) -> Result<Position, Xosc
     }
     let (entity, dx, dy) = (
         r.entity(p, "entityRef")?,
-        s.num(t, p, "dx")?,
-        s.num(t, p, "dy")?,
+        s.num_in(t, p, "dx", Quantity::Distance)?,
+        s.num_in(t, p, "dy", Quantity::Distance)?,
     );
     let orientation = orientation(r, p)?;
     Ok(if tag == "RelativeWorldPosition" {
@@ -125,7 +128,7 @@ fn relative_lane(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError>
             "an orientation on a relative lane position is not supported",
         ));
     }
-    let ds = s.opt_num(t, p, "ds")?;
+    let ds = s.opt_num_in(t, p, "ds", Quantity::Distance)?;
     if ds.is_none() || p.attribute("dsLane").is_some() {
         return Err(r.text.unsupported(
             p,
@@ -136,7 +139,9 @@ fn relative_lane(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError>
         entity: r.entity(p, "entityRef")?,
         d_lane: lane_id(r, p, "dLane")?,
         ds: ds.unwrap_or(0.0),
-        offset: s.opt_num(t, p, "offset")?.unwrap_or(0.0),
+        offset: s
+            .opt_num_in(t, p, "offset", Quantity::Lateral)?
+            .unwrap_or(0.0),
     })
 }
 
@@ -162,7 +167,9 @@ fn orientation(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Option<Orientation>, X
         }
     }
     Ok(Some(Orientation {
-        h: r.scope.opt_num(r.text, o, "h")?.unwrap_or(0.0),
+        h: r.scope
+            .opt_num_in(r.text, o, "h", Quantity::Angle)?
+            .unwrap_or(0.0),
         relative,
     }))
 }

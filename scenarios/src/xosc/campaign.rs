@@ -103,6 +103,37 @@ pub fn inspect(
     inspect_in(&FileSet::new(), path, opens, continuous)
 }
 
+/// The scenario file that the variation file `path` (read as `v`) names, relative to its
+/// folder with `.` components removed.
+///
+/// # Errors
+/// [`ScenarioError::Input`] at the `ScenarioFile` element when it is absent or not a regular
+/// file (naming what it is: a FIFO would block the read, a device never end it).
+fn scenario_of(path: &Path, v: &VariationFile) -> Result<PathBuf, ScenarioError> {
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let p: PathBuf = dir
+        .join(&v.scenario_file)
+        .components()
+        .filter(|c| !matches!(c, std::path::Component::CurDir))
+        .collect();
+    let what = match std::fs::metadata(&p) {
+        Err(_) => Some("is not there".to_owned()),
+        Ok(m) => paracosm_openscenario::text::not_regular(&m)
+            .map(|kind| format!("is {kind}, not a regular file")),
+    };
+    if let Some(what) = what {
+        return Err(ScenarioError::Input {
+            path: path.to_path_buf(),
+            message: format!(
+                "{}: the scenario file {} {what}",
+                v.scenario_pos,
+                p.display()
+            ),
+        });
+    }
+    Ok(p)
+}
+
 /// [`inspect`], reading every file through `files` (a campaign keeps them for its tests).
 ///
 /// # Errors
@@ -123,22 +154,7 @@ pub fn inspect_in(
     drop(doc);
     let (variation, scenario_path) = if is_variation {
         let v = read_variation(&text).map_err(input)?;
-        let dir = path.parent().unwrap_or(Path::new(""));
-        let p: PathBuf = dir
-            .join(&v.scenario_file)
-            .components()
-            .filter(|c| !matches!(c, std::path::Component::CurDir))
-            .collect();
-        if !p.is_file() {
-            return Err(ScenarioError::Input {
-                path: path.to_path_buf(),
-                message: format!(
-                    "{}: the scenario file {} is not there",
-                    v.scenario_pos,
-                    p.display()
-                ),
-            });
-        }
+        let p = scenario_of(path, &v)?;
         (Some(v), p)
     } else {
         (None, path.to_path_buf())

@@ -371,6 +371,9 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
     let model = Arc::new(model);
     let (scene, _) = front_end.build(model.clone())?;
     drop(scene);
+    // Every map a level can choose is read now, fingerprinted with the rest of the file set,
+    // and shared by the tests: a campaign is one fixed scenario.
+    front_end.read_every_map()?;
     // What each parameter changes, as a program's load finds it: one the storyboard and the
     // scene never read is left out of coverage, with the warning a program gets.
     let names: Vec<(String, String)> = (front_end.space.params().iter())
@@ -518,7 +521,76 @@ fn here(pos: &paracosm_openscenario::Pos, variable: &str) -> Site {
     }
 }
 
+/// How many readings of the scenario [`XoscFrontEnd::read_every_map`] makes at most to find
+/// the maps its levels choose (one per level of each parameter with levels).
+pub const MAX_MAP_LEVEL_READS: usize = 256;
+
+/// The most levels a parameter may have for [`XoscFrontEnd::read_every_map`] to read each
+/// level's map at load (a road network is chosen among a few maps, not thousands).
+pub const MAX_MAP_LEVELS: u32 = 64;
+
 impl XoscFrontEnd {
+    /// Reads the OpenDRIVE map of every level of every parameter with levels (each moved
+    /// alone from a point of the space that reads), through the campaign's [`MapFiles`]: a variation
+    /// that chooses the road network (the ALKS files' `Road`) has all its maps read, checked
+    /// and fingerprinted at load, and a map edited while the campaign runs or before it
+    /// resumes is not used. A level whose scenario does not read is left to its test, which
+    /// ends in that error; a parameter of more than [`MAX_MAP_LEVELS`] levels, and the levels
+    /// past [`MAX_MAP_LEVEL_READS`] readings, have their maps read by the first test that uses
+    /// them.
+    ///
+    /// # Errors
+    /// [`ScenarioError::Load`] for a map a level names that does not load, naming the
+    /// `LogicFile`'s line and column.
+    fn read_every_map(&self) -> Result<(), ScenarioError> {
+        let layout = self.space.layout();
+        let counts: Vec<u32> = layout.iter().flatten().copied().collect();
+        // The other parameters at their middle level, first level or last level, and every
+        // interval at its middle: a file's own levels may break its constraint groups (ALKS
+        // 4.3.1's lateral offset of -1.75 m must be greater than -1.75 m), so a level is read
+        // with the first of these that reads.
+        let picks: [fn(u32) -> u32; 3] = [|n| n / 2, |_| 0, |n| n - 1];
+        let bases: Vec<paracosm_generators::Point> = picks
+            .iter()
+            .map(|pick| paracosm_generators::Point {
+                discrete: counts.iter().map(|&n| pick(n.max(1))).collect(),
+                continuous: vec![0.5; layout.iter().filter(|l| l.is_none()).count()],
+            })
+            .collect();
+        let mut reads = 0;
+        for (d, &levels) in counts.iter().enumerate() {
+            if levels > MAX_MAP_LEVELS {
+                continue;
+            }
+            for level in 0..levels {
+                for base in &bases {
+                    if reads == MAX_MAP_LEVEL_READS {
+                        return Ok(());
+                    }
+                    reads += 1;
+                    let mut point = base.clone();
+                    point.discrete[d] = level;
+                    if let Some(road) = self.road_network_at(&point) {
+                        self.maps.load(&road.item).map_err(|e| {
+                            ScenarioError::Load(e.with_context(&format!("\n --> {}", road.pos)))
+                        })?;
+                        break;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The `LogicFile` the scenario reads with the values of `point`; `None` when they do not
+    /// decode or the scenario does not read with them.
+    fn road_network_at(&self, point: &paracosm_generators::Point) -> Option<m::Located<String>> {
+        let a = self.space.decode(point).ok()?;
+        let overrides = (self.overrides)(&a).ok()?;
+        let model = read_scenario_in(&self.maps.xosc, &self.template, &overrides).ok()?;
+        model.road_network
+    }
+
     /// The scene of `model` and the host that runs its storyboard: [`build_into`] a scene of
     /// daylight without fog, with a collision monitor and a horizon of [`HORIZON_CAP_S`] (the
     /// storyboard's stop trigger ends a test sooner).

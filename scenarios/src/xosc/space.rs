@@ -3,7 +3,7 @@
 use paracosm_generators::{Density, Param, Value};
 use paracosm_openscenario::distribution::{Dist, ValueSets, Varied};
 use paracosm_openscenario::model::Scenario;
-use paracosm_openscenario::params::ValueError;
+use paracosm_openscenario::params::{ParamType, ValueError};
 
 use crate::ScenarioError;
 
@@ -180,6 +180,17 @@ fn open_levels(text: &str, scenario: &Scenario, space: &[Param]) -> Result<Param
         if lo >= hi {
             return Err(format!("the interval needs lo < hi, not {lo}..{hi}").into());
         }
+        if decl.ty != ParamType::Double {
+            // An interval's values are real numbers: a whole-number, boolean or text
+            // parameter would be handed 0.5 and every such test would end in error.
+            return Err(format!(
+                "{name} is declared {} (at {}): an interval gives it real numbers; open it \
+                 as levels, Name=a,b,c",
+                decl.ty.xsd_name(),
+                decl.pos
+            )
+            .into());
+        }
         check(paracosm_openscenario::Value::Num(lo))?;
         check(paracosm_openscenario::Value::Num(hi))?;
         return Ok(Param::interval(name, lo, hi, ""));
@@ -193,6 +204,13 @@ fn open_levels(text: &str, scenario: &Scenario, space: &[Param]) -> Result<Param
             Ok(n) if n.is_finite() => paracosm_openscenario::Value::Num(n),
             _ => paracosm_openscenario::Value::Str(t.clone()),
         };
+        let v = decl.ty.coerce(v).map_err(|why| {
+            ValueError(format!(
+                "level {t:?}: {why} (the parameter is declared {} at {})",
+                decl.ty.xsd_name(),
+                decl.pos
+            ))
+        })?;
         check(v)?;
     }
     Ok(Param::levels(name, levels_of(&texts)))
@@ -214,12 +232,34 @@ pub fn value_sets_param(
     let mut levels = Vec::new();
     for set in &sets.sets {
         for a in set {
-            if !scenario.params.iter().any(|(d, _)| d.name == a.name) {
+            let Some((decl, _)) = scenario.params.iter().find(|(d, _)| d.name == a.name) else {
                 return Err(ScenarioError::Input {
                     path: file.to_path_buf(),
                     message: format!(
                         "{}: parameter {:?} is assigned but the scenario does not declare it",
                         a.pos, a.name
+                    ),
+                });
+            };
+            // The value is checked here, at load, as the declaration types and constrains
+            // it: a value no test could use ends the load, not every test of its set.
+            let v = paracosm_openscenario::Value::Str(a.value.clone());
+            let checked = decl.ty.coerce(v).and_then(|v| {
+                scenario
+                    .scope
+                    .check_constraints(decl, &v)
+                    .map_err(|why| ValueError(why.to_string()))
+            });
+            if let Err(why) = checked {
+                return Err(ScenarioError::Input {
+                    path: file.to_path_buf(),
+                    message: format!(
+                        "{}: parameter {} = {:?}: {why} (declared {} at {})",
+                        a.pos,
+                        a.name,
+                        a.value,
+                        decl.ty.xsd_name(),
+                        decl.pos
                     ),
                 });
             }
