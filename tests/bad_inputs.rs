@@ -371,5 +371,9 @@ fn bad_openscenario_files() {
     f.set_len(paracosm_openscenario::text::MAX_FILE_BYTES + 1)
         .unwrap();
     let o = run("fuzz", &["xosc".into(), huge.display().to_string()]);
-    assert_refused("huge.xosc", &o, &["huge.xosc", "bytes, more than"]);
+    assert_refused(
+        "huge.xosc",
+        &o,
+        &["huge.xosc", "larger than the limit of 64 MiB"],
+    );
 }

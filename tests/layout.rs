@@ -1,5 +1,7 @@
 //! The workspace's dependency rules (DESIGN.md): `generators` and `oracles` depend on neither
-//! rapier, wgpu, nor each other (nor any other crate of the workspace), even transitively.
+//! rapier, wgpu, nor each other (nor any other crate of the workspace), even transitively; the
+//! engine depends on no crate of the workspace but `paracosm-files`, the one door for input
+//! files, which depends on none.
 
 use std::process::Command;
 
@@ -45,5 +47,14 @@ fn generators_and_oracles_stay_free_of_physics_rendering_and_each_other() {
 fn the_engine_does_not_depend_on_generators_or_scenarios() {
     let deps = normal_dependencies("paracosm-engine");
     assert!(deps.iter().any(|d| d == "rapier3d"));
-    assert!(deps.iter().all(|d| !d.starts_with("paracosm")), "{deps:?}");
+    assert!(
+        deps.iter()
+            .all(|d| !d.starts_with("paracosm") || d == "paracosm-files"),
+        "{deps:?}"
+    );
+    let files = normal_dependencies("paracosm-files");
+    assert!(
+        files.iter().all(|d| !d.starts_with("paracosm")),
+        "{files:?}"
+    );
 }

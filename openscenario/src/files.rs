@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use crate::error::XoscError;
-use crate::text::{not_regular, Text};
+use crate::text::Text;
 
 /// The files a scenario has read, by path as named with `.` components removed and `dir/..`
 /// folded (so `a/./b/../c.xosc` and `a/c.xosc` are one file; a path is not made absolute),
@@ -67,7 +67,7 @@ impl FileSet {
             .collect();
         files.sort();
         for f in &files {
-            if let Some(kind) = std::fs::metadata(f).ok().as_ref().and_then(not_regular) {
+            if let Some(kind) = paracosm_files::not_regular(f) {
                 return Err(std::io::Error::new(
                     std::io::ErrorKind::InvalidInput,
                     format!(

@@ -24,27 +24,6 @@ pub struct Text {
     char_marks: Vec<(usize, usize)>,
 }
 
-/// What a file with metadata `meta` (links followed) is when it is not a regular file: `"a
-/// directory"`, `"a FIFO"`, `"a character device"`, `"a block device"`, `"a socket"`; `None`
-/// for a regular file.
-pub fn not_regular(meta: &std::fs::Metadata) -> Option<&'static str> {
-    use std::os::unix::fs::FileTypeExt;
-    let t = meta.file_type();
-    let kinds = [
-        (t.is_dir(), "a directory"),
-        (t.is_fifo(), "a FIFO"),
-        (t.is_char_device(), "a character device"),
-        (t.is_block_device(), "a block device"),
-        (t.is_socket(), "a socket"),
-    ];
-    (!t.is_file()).then(|| {
-        kinds
-            .iter()
-            .find(|(is, _)| *is)
-            .map_or("an unknown kind of file", |&(_, kind)| kind)
-    })
-}
-
 /// The most attributes one element may have in an XML file paracosm reads (OpenSCENARIO or
 /// OpenDRIVE): their elements have at most a few dozen. `roxmltree` compares each attribute
 /// with every earlier one of its element, so 500,000 attributes on one element took minutes;
@@ -139,45 +118,20 @@ impl Text {
         }
     }
 
-    /// Reads `path` (at most [`MAX_FILE_BYTES`]). Only a regular file (or a link to one) is
-    /// opened: a FIFO would block the read, a device (`/dev/zero`) would never end it.
+    /// Reads `path` (at most [`MAX_FILE_BYTES`]) through the project's one door for inputs
+    /// ([`paracosm_files::read_text`]): only a regular file (or a link to one) is opened, as a
+    /// FIFO would block the read and a device (`/dev/zero`) would never end it, and no more
+    /// than the limit is read.
     ///
     /// # Errors
-    /// [`XoscError::Io`] when the file is missing, not a regular file, unreadable, not UTF-8
-    /// or too large.
+    /// [`XoscError::Io`] when the file is missing, not a regular file (naming what it is),
+    /// unreadable, not UTF-8 (naming the line and column of the first bad byte) or too large.
     pub fn read(path: &std::path::Path) -> Result<Self, XoscError> {
-        use std::io::Read;
         let file = path.display().to_string();
-        let io = |reason: String| XoscError::Io {
+        let text = paracosm_files::read_text(path, MAX_FILE_BYTES).map_err(|e| XoscError::Io {
             file: file.clone(),
-            reason,
-        };
-        let meta = std::fs::metadata(path).map_err(|e| io(e.to_string()))?;
-        if let Some(kind) = not_regular(&meta) {
-            return Err(io(format!(
-                "is {kind}, not a regular file: an OpenSCENARIO file is read from a regular \
-                 file (a FIFO would block, a device never ends)"
-            )));
-        }
-        let len = meta.len();
-        if len > MAX_FILE_BYTES {
-            return Err(io(format!(
-                "{len} bytes, more than the {MAX_FILE_BYTES} an OpenSCENARIO file may have"
-            )));
-        }
-        // The file may grow between the size check and the read: read at most one byte more
-        // than the limit, and refuse it if it is there.
-        let mut bytes = Vec::new();
-        std::fs::File::open(path)
-            .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
-            .map_err(|e| io(e.to_string()))?;
-        if bytes.len() as u64 > MAX_FILE_BYTES {
-            return Err(io(format!(
-                "more than the {MAX_FILE_BYTES} bytes an OpenSCENARIO file may have"
-            )));
-        }
-        let text = String::from_utf8(bytes)
-            .map_err(|e| io(format!("not UTF-8 text ({})", e.utf8_error())))?;
+            reason: e.to_string(),
+        })?;
         Ok(Text::new(file, text))
     }
 

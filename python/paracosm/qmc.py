@@ -171,7 +171,8 @@ def discrepancy(sample, *, method: str = "CD") -> float:
 
     O(d n^2) time, in parallel with the GIL released; the same value on any thread count.
     Raises ValueError for an unknown method, a sample that is not a non-empty 2-D array of
-    real numbers, NaN, or a value outside [0, 1].
+    real numbers, NaN, or a value outside [0, 1]; MemoryError when the sums' working memory
+    (about (2d + 130) x 8 bytes a point) cannot be allocated.
     """
     if method not in _METHODS:
         raise ValueError(f"method {method!r} is not one of {', '.join(map(repr, _METHODS))}")
@@ -208,7 +209,8 @@ def star_discrepancy(sample, *, seed: int = 0) -> Bracket:
     the lower end (upper / lower). Past n² · d = 5e7 (d = 8, n = 2,500) the search is skipped
     and the lower end is the largest one-axis star discrepancy; past d = 64 the upper end is 1.
     A `RuntimeWarning` says when the bracket is loose (upper at least twice lower). Raises
-    ValueError as `discrepancy` does.
+    ValueError as `discrepancy` does; MemoryError when its working memory (about 32d + 64
+    bytes a point) cannot be allocated.
     """
     a = unit_matrix(sample, "sample")
     lower, upper, exact, corner, method = _native.star_discrepancy(
@@ -228,7 +230,8 @@ def dispersion(sample, *, seed: int = 0) -> Bracket:
     60 (d = 6); for d >= 7, and past those sizes, a certified bracket (greedy boxes from starts
     drawn by `seed` below, a branch and bound above) whose `method` says how far the exact
     value can be from the lower end. No other library computes it exactly. Raises ValueError
-    as `discrepancy` does.
+    as `discrepancy` does; MemoryError when its working memory (about 32d + 64 bytes a point)
+    cannot be allocated.
     """
     a = unit_matrix(sample, "sample")
     lower, upper, exact, lo, hi, method = _native.dispersion(

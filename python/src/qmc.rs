@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 
 use paracosm_generators::coverage::{
     discrepancy as discrepancy_of, dispersion as dispersion_of, star_discrepancy as star_of,
-    Discrepancy, DispersionOptions, StarOptions,
+    CoverageError, Discrepancy, DispersionOptions, StarOptions,
 };
 use paracosm_generators::{Halton, ParamSpace, Sobol, SOBOL_MAX_DIMENSIONS};
 
@@ -170,6 +170,17 @@ impl SobolEngine {
     }
 }
 
+/// An estimator's error as Python's: MemoryError when its working memory cannot be allocated
+/// (the process never aborts), ValueError for the rest.
+fn estimator_error(e: CoverageError) -> PyErr {
+    match e {
+        CoverageError::OutOfMemory { .. } => {
+            pyo3::exceptions::PyMemoryError::new_err(e.to_string())
+        }
+        e => value_error(e),
+    }
+}
+
 /// A C-contiguous `(n, d)` float64 array's values and `d`.
 fn rows<'a>(sample: &'a PyReadonlyArray2<'_, f64>) -> PyResult<(&'a [f64], usize)> {
     let d = sample.shape()[1];
@@ -196,7 +207,7 @@ fn discrepancy(py: Python<'_>, sample: PyReadonlyArray2<'_, f64>, method: &str) 
     };
     let (values, d) = rows(&sample)?;
     py.detach(|| discrepancy_of(values, d, kind))
-        .map_err(value_error)
+        .map_err(estimator_error)
 }
 
 /// The L∞ star discrepancy: `(lower, upper, exact, corner, method)`, the box being
@@ -215,7 +226,7 @@ fn star_discrepancy(
     };
     let s = py
         .detach(|| star_of(values, d, &options))
-        .map_err(value_error)?;
+        .map_err(estimator_error)?;
     Ok((s.lower, s.upper, s.exact, s.witness, s.method))
 }
 
@@ -235,7 +246,7 @@ fn dispersion(
     };
     let s = py
         .detach(|| dispersion_of(values, d, &options))
-        .map_err(value_error)?;
+        .map_err(estimator_error)?;
     Ok((
         s.lower,
         s.upper,

@@ -142,6 +142,19 @@ def test_bad_arguments_are_value_errors():
         qmc.Halton(2, rng="x")
 
 
+def test_a_point_set_too_large_for_the_estimators_memory_raises_memory_error():
+    # A broadcast array of 2e8 points (no memory of its own) aborted the interpreter inside
+    # the extension: the discrepancy's pair sums need about 1 KiB a point in d = 1. The set
+    # is made large enough that its working memory is four times this machine's.
+    import os
+
+    memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    n = max(2 * 10**8, 4 * memory // 1056 + 1)
+    sample = np.broadcast_to(np.float64(0.5), (n, 1))
+    with pytest.raises(MemoryError, match="working memory"):
+        qmc.discrepancy(sample, method="CD")
+
+
 def test_sizes_past_what_the_sequences_hold_are_errors_not_crashes():
     # Each of these aborted the interpreter (a failed allocation), raised a PanicException
     # (a BaseException) or an OverflowError, or returned inf and values past 1.

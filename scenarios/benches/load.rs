@@ -13,6 +13,17 @@
 //!   pedestrian's template, its three catalogs): read from disk and parsed, as every test did
 //!   before the campaign kept its file set, against parsed from the texts its load read.
 //!
+//! - `xosc_read/alks_suite`: the ALKS suite's 15 variation files (with 4.3.2's reference)
+//!   inspected as `paracosm-fuzz
+//!   xosc` lists them (each variation file, its template and catalogs read from disk and
+//!   parsed; Hostile input, third round, requirement 4);
+//! - `xosc_read/events_100000`: a scenario of 100,000 events, each started when the one before
+//!   ends (a chain of element-state conditions), read from its text;
+//! - `xosc_chain/events_10000_test_2s`: one whole 2 s test (`--scripted-ego`) of a chain of
+//!   10,000 events on esmini's straight road: every step evaluates every waiting event's
+//!   condition, each reading the element it names (found once when the storyboard is built,
+//!   where each evaluation searched the storyboard's elements).
+//!
 //! Run with `cargo bench -p paracosm-scenarios --bench load`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -81,5 +92,116 @@ fn xosc_test_read(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, xosc_test_read);
+/// A scenario on esmini's straight road (relative to `tests/data/xosc/written/`) of `n`
+/// events in one maneuver: event 0 starts at 0.1 s, event `i` when event `i − 1` ends; each
+/// sets the speed of the one entity.
+pub fn event_chain(n: usize) -> String {
+    let mut s = String::from(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<OpenSCENARIO>
+  <FileHeader revMajor="1" revMinor="1" date="2026-11-29T00:00:00" description="a chain of events" author="paracosm"/>
+  <RoadNetwork><LogicFile filepath="../esmini/xodr/straight_500m.xodr"/></RoadNetwork>
+  <Entities>
+    <ScenarioObject name="hero"><Vehicle name="v" vehicleCategory="car"><BoundingBox><Center x="1.4" y="0" z="0.8"/><Dimensions width="1.9" length="4.6" height="1.5"/></BoundingBox><Performance maxSpeed="50" maxAcceleration="5" maxDeceleration="9"/><Axles><FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/><RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/></Axles><Properties/></Vehicle></ScenarioObject>
+  </Entities>
+  <Storyboard>
+    <Init><Actions><Private entityRef="hero">
+      <PrivateAction><TeleportAction><Position><RoadPosition roadId="1" s="20" t="-1.5"/></Position></TeleportAction></PrivateAction>
+      <PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/><SpeedActionTarget><AbsoluteTargetSpeed value="10"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction>
+    </Private></Actions></Init>
+    <Story name="s"><Act name="a"><ManeuverGroup maximumExecutionCount="1" name="g"><Actors selectTriggeringEntities="false"><EntityRef entityRef="hero"/></Actors><Maneuver name="m">
+"#,
+    );
+    for i in 0..n {
+        let start = if i == 0 {
+            r#"<ByValueCondition><SimulationTimeCondition value="0.1" rule="greaterThan"/></ByValueCondition>"#.to_owned()
+        } else {
+            format!(
+                r#"<ByValueCondition><StoryboardElementStateCondition storyboardElementType="event" storyboardElementRef="e{}" state="endTransition"/></ByValueCondition>"#,
+                i - 1
+            )
+        };
+        s.push_str(&format!(
+            r#"<Event name="e{i}" priority="parallel"><Action name="a{i}"><PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/><SpeedActionTarget><AbsoluteTargetSpeed value="{}"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction></Action><StartTrigger><ConditionGroup><Condition name="c{i}" delay="0" conditionEdge="none">{start}</Condition></ConditionGroup></StartTrigger></Event>
+"#,
+            10 + i % 2
+        ));
+    }
+    s.push_str(
+        r#"</Maneuver></ManeuverGroup><StartTrigger><ConditionGroup><Condition name="go" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition></Condition></ConditionGroup></StartTrigger></Act></Story>
+    <StopTrigger><ConditionGroup><Condition name="end" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="2" rule="greaterThan"/></ByValueCondition></Condition></ConditionGroup></StopTrigger>
+  </Storyboard>
+</OpenSCENARIO>
+"#,
+    );
+    s
+}
+
+fn xosc_read(c: &mut Criterion) {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/xosc");
+    let mut suite: Vec<_> = std::fs::read_dir(data.join("alks"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let name = p.to_string_lossy();
+            name.contains("_variation") && name.ends_with(".xosc")
+        })
+        .collect();
+    suite.sort();
+    assert_eq!(suite.len(), 15);
+    let mut group = c.benchmark_group("xosc_read");
+    group.sample_size(10);
+    group.bench_function("alks_suite", |b| {
+        b.iter(|| {
+            for f in &suite {
+                paracosm_scenarios::xosc::inspect(f, &[], false).unwrap();
+            }
+        })
+    });
+    let chain = event_chain(100_000);
+    let text = paracosm_openscenario::Text::new("chain.xosc", chain);
+    let dir = data.join("written");
+    group.bench_function("events_100000", |b| {
+        b.iter(|| {
+            let s = paracosm_openscenario::read_scenario_text(&text, &dir, &[]).unwrap();
+            assert_eq!(
+                s.stories[0].acts[0].groups[0].maneuvers[0].events.len(),
+                100_000
+            );
+        })
+    });
+    group.finish();
+}
+
+fn xosc_chain(c: &mut Criterion) {
+    // Beside a link to the shipped folders, so that the map's relative path reads.
+    let dir = std::env::temp_dir().join(format!("paracosm-bench-chain-{}", std::process::id()));
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/xosc");
+    std::fs::create_dir_all(dir.join("written")).unwrap();
+    let _ = std::fs::remove_file(dir.join("esmini"));
+    std::os::unix::fs::symlink(data.join("esmini"), dir.join("esmini")).unwrap();
+    let file = dir.join("written/chain.xosc");
+    std::fs::write(&file, event_chain(10_000)).unwrap();
+    let x = paracosm_scenarios::xosc::XoscRef {
+        xosc: file.display().to_string(),
+        open: Vec::new(),
+        continuous: false,
+        scripted_ego: true,
+        ego: None,
+        horizon_s: None,
+    };
+    let s = paracosm_scenarios::xosc::campaign_scenario(&x).unwrap();
+    let a = s
+        .space()
+        .decode(&paracosm_generators::Point::default())
+        .unwrap();
+    let mut group = c.benchmark_group("xosc_chain");
+    group.sample_size(10);
+    group.bench_function("events_10000_test_2s", |b| {
+        b.iter(|| assert!(s.run(&a, 0).unwrap().passed()))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, xosc_test_read, xosc_read, xosc_chain);
 criterion_main!(benches);

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use paracosm_engine::network::{opendrive, MapRef};
 use paracosm_openscenario::read_scenario;
 use paracosm_scenarios::xosc::road::Roads;
-use paracosm_scenarios::xosc::story::Storyboard;
+use paracosm_scenarios::xosc::story::{StoryError, Storyboard};
 
 const DT: f64 = 1.0 / 60.0;
 
@@ -220,37 +220,82 @@ fn every_alks_template_runs_to_its_stop_trigger() {
 /// (`SimulationTime > 5`, `delay` 3 s) holds from the start, in an act that starts at 10 s,
 /// starts at 13 s, not at 10 s; and an element-state condition sees the transition of the
 /// step before (a second event starts on the first's `endTransition`).
-#[test]
-fn a_delay_counts_from_when_the_element_waits_and_transitions_are_seen_next_step() {
-    let road = alks("road_networks/alks_road_straight.xodr");
-    let file = std::env::temp_dir().join(format!("paracosm-delay-{}.xosc", std::process::id()));
-    let speed = |v: f64| {
-        format!(
-            r#"<PrivateAction><LongitudinalAction><SpeedAction>
+/// The ALKS suite's straight road, for the scenarios written here.
+fn straight_road() -> PathBuf {
+    alks("road_networks/alks_road_straight.xodr")
+}
+
+/// A box-shaped obstacle named `name` (4 × 1.8 × 1.5 m), as a `ScenarioObject`.
+fn box_object(name: &str) -> String {
+    format!(
+        r#"<ScenarioObject name="{name}"><MiscObject name="box" miscObjectCategory="obstacle" mass="500">
+        <BoundingBox><Center x="0" y="0" z="0.75"/><Dimensions width="1.8" length="4" height="1.5"/></BoundingBox>
+        <Properties/></MiscObject></ScenarioObject>"#
+    )
+}
+
+/// A `SpeedAction` to `v` m/s at once, as a `PrivateAction`.
+fn step_to(v: f64) -> String {
+    format!(
+        r#"<PrivateAction><LongitudinalAction><SpeedAction>
               <SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/>
               <SpeedActionTarget><AbsoluteTargetSpeed value="{v}"/></SpeedActionTarget>
             </SpeedAction></LongitudinalAction></PrivateAction>"#
-        )
-    };
-    let vehicle = |name: &str| {
-        format!(
-            r#"<ScenarioObject name="{name}"><MiscObject name="box" miscObjectCategory="obstacle" mass="500">
-        <BoundingBox><Center x="0" y="0" z="0.75"/><Dimensions width="1.8" length="4" height="1.5"/></BoundingBox>
-        <Properties/></MiscObject></ScenarioObject>"#
-        )
-    };
-    let text = format!(
+    )
+}
+
+/// A scenario on the ALKS suite's straight road: its `entities`, its `Init` actions, its
+/// `stories` (whole `<Story>` elements) and a stop trigger at `stop_s` seconds.
+fn on_straight_road(
+    description: &str,
+    entities: &str,
+    init: &str,
+    stories: &str,
+    stop_s: f64,
+) -> String {
+    format!(
         r#"<?xml version="1.0" encoding="UTF-8"?>
 <OpenSCENARIO>
-  <FileHeader revMajor="1" revMinor="2" date="2026-11-26T00:00:00" description="delay" author="paracosm"/>
+  <FileHeader revMajor="1" revMinor="2" date="2026-11-29T00:00:00" description="{description}" author="paracosm"/>
   <RoadNetwork><LogicFile filepath="{road}"/></RoadNetwork>
-  <Entities>{a}{b}</Entities>
+  <Entities>{entities}</Entities>
   <Storyboard>
-    <Init><Actions>
-      <Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>
-      <Private entityRef="B"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-3" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>
-    </Actions></Init>
-    <Story name="S">
+    <Init><Actions>{init}</Actions></Init>
+    {stories}
+    <StopTrigger><ConditionGroup>
+      <Condition name="End" delay="0" conditionEdge="none">
+        <ByValueCondition><SimulationTimeCondition value="{stop_s}" rule="greaterOrEqual"/></ByValueCondition>
+      </Condition>
+    </ConditionGroup></StopTrigger>
+  </Storyboard>
+</OpenSCENARIO>
+"#,
+        road = straight_road().display(),
+    )
+}
+
+/// The storyboard of the scenario `text` (written to a file named by `tag` and read from it),
+/// every entity scripted, or why its `Init` cannot be performed.
+fn storyboard_of(tag: &str, text: &str) -> Result<Storyboard, StoryError> {
+    let file = std::env::temp_dir().join(format!("paracosm-{tag}-{}.xosc", std::process::id()));
+    std::fs::write(&file, text).unwrap();
+    let model = read_scenario(&file, &[]).expect("reads");
+    std::fs::remove_file(&file).ok();
+    let road = model.road_network.as_ref().expect("a road network");
+    let map = MapRef::new(
+        opendrive::import(&road.item, &std::fs::read_to_string(&road.item).unwrap())
+            .unwrap()
+            .map,
+    );
+    Storyboard::new(&model, Roads::new(&map), None)
+}
+
+#[test]
+fn a_delay_counts_from_when_the_element_waits_and_transitions_are_seen_next_step() {
+    let init = r#"<Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>
+      <Private entityRef="B"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-3" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>"#;
+    let story = format!(
+        r#"<Story name="S">
       <Act name="Late">
         <ManeuverGroup maximumExecutionCount="1" name="G">
           <Actors selectTriggeringEntities="false"><EntityRef entityRef="A"/><EntityRef entityRef="B"/></Actors>
@@ -279,31 +324,13 @@ fn a_delay_counts_from_when_the_element_waits_and_transitions_are_seen_next_step
           </Condition>
         </ConditionGroup></StartTrigger>
       </Act>
-    </Story>
-    <StopTrigger><ConditionGroup>
-      <Condition name="End" delay="0" conditionEdge="none">
-        <ByValueCondition><SimulationTimeCondition value="20" rule="greaterOrEqual"/></ByValueCondition>
-      </Condition>
-    </ConditionGroup></StopTrigger>
-  </Storyboard>
-</OpenSCENARIO>
-"#,
-        road = road.display(),
-        a = vehicle("A"),
-        b = vehicle("B"),
-        go = speed(5.0),
-        faster = speed(10.0),
+    </Story>"#,
+        go = step_to(5.0),
+        faster = step_to(10.0),
     );
-    std::fs::write(&file, text).unwrap();
-    let model = read_scenario(&file, &[]).expect("reads");
-    std::fs::remove_file(&file).ok();
-    let road = model.road_network.as_ref().expect("a road network");
-    let map = MapRef::new(
-        opendrive::import(&road.item, &std::fs::read_to_string(&road.item).unwrap())
-            .unwrap()
-            .map,
-    );
-    let mut sb = Storyboard::new(&model, Roads::new(&map), None).expect("Init performs");
+    let entities = box_object("A") + &box_object("B");
+    let text = on_straight_road("delay", &entities, init, &story, 20.0);
+    let mut sb = storyboard_of("delay", &text).expect("Init performs");
     let (mut went, mut faster) = (None, None);
     run(&mut sb, 30.0, |t, sb| {
         let v = sb.actors[0].state.speed;
@@ -326,6 +353,76 @@ fn a_delay_counts_from_when_the_element_waits_and_transitions_are_seen_next_step
         faster > went && faster - went < 4.0 * DT,
         "the second event started {} s after the first",
         faster - went
+    );
+}
+
+/// A chain of events, each started when the one before ends, named plainly or qualified
+/// with its maneuver (`M::e3`, OpenSCENARIO 1.1+): every event fires, in order. Each
+/// condition reads the element it names, found once when the storyboard is built (a
+/// qualified name passed the load's check but matched nothing when run, so the chain stopped
+/// at its first qualified link).
+#[test]
+fn a_chain_of_events_fires_in_order_each_when_the_one_before_ends() {
+    let n = 40;
+    let mut events = String::new();
+    for i in 0..n {
+        let start = if i == 0 {
+            r#"<SimulationTimeCondition value="0.5" rule="greaterThan"/>"#.to_owned()
+        } else {
+            let name = if i % 2 == 0 {
+                format!("e{}", i - 1)
+            } else {
+                format!("M::e{}", i - 1)
+            };
+            format!(
+                r#"<StoryboardElementStateCondition storyboardElementType="event" storyboardElementRef="{name}" state="endTransition"/>"#
+            )
+        };
+        events.push_str(&format!(
+            r#"<Event name="e{i}" priority="parallel"><Action name="a{i}">{go}</Action>
+            <StartTrigger><ConditionGroup><Condition name="c{i}" delay="0" conditionEdge="none"><ByValueCondition>{start}</ByValueCondition></Condition></ConditionGroup></StartTrigger></Event>
+"#,
+            go = step_to(0.25 * f64::from(i + 1))
+        ));
+    }
+    let init = r#"<Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>"#;
+    let story = format!(
+        r#"<Story name="S"><Act name="Act">
+      <ManeuverGroup maximumExecutionCount="1" name="G">
+        <Actors selectTriggeringEntities="false"><EntityRef entityRef="A"/></Actors>
+        <Maneuver name="M">{events}</Maneuver>
+      </ManeuverGroup>
+      <StartTrigger><ConditionGroup><Condition name="T" delay="0" conditionEdge="none">
+        <ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition>
+      </Condition></ConditionGroup></StartTrigger>
+    </Act></Story>"#
+    );
+    let text = on_straight_road("chain", &box_object("A"), init, &story, 5.0);
+    let mut sb = storyboard_of("chain", &text).expect("Init performs");
+    let mut speeds = Vec::new();
+    run(&mut sb, 10.0, |_, sb| speeds.push(sb.actors[0].state.speed));
+    assert!(
+        speeds.windows(2).all(|w| w[1] >= w[0]),
+        "the events fired out of order: {speeds:?}"
+    );
+    let last = speeds.last().copied().unwrap_or_default();
+    assert_eq!(last, 0.25 * f64::from(n), "the chain stopped at {last} m/s");
+}
+
+/// A position relative to an entity that is on no lane names where that entity stands, so
+/// that the reader finds the placement at fault (the ego's teleport far off the map), not
+/// only the relative position that could not be resolved.
+#[test]
+fn a_position_relative_to_an_entity_off_the_map_says_where_that_entity_stands() {
+    let init = r#"<Private entityRef="A"><PrivateAction><TeleportAction><Position><WorldPosition x="5000000" y="0"/></Position></TeleportAction></PrivateAction></Private>
+      <Private entityRef="B"><PrivateAction><TeleportAction><Position><RelativeRoadPosition entityRef="A" ds="30" dt="0"/></Position></TeleportAction></PrivateAction></Private>"#;
+    let entities = box_object("A") + &box_object("B");
+    let text = on_straight_road("far", &entities, init, "", 5.0);
+    let e = storyboard_of("far", &text).unwrap_err();
+    let message = e.to_string();
+    assert!(
+        message.contains("to A, which is not on a lane: it stands at x = 5000000.0 m, y = 0.0 m"),
+        "{message}"
     );
 }
 

@@ -157,7 +157,8 @@ fn run(cli: &Cli) -> Result<u8> {
     let outcome = match outcome {
         Ok(o) => o,
         Err(e) => {
-            // The error first (main prints it), then the warnings the load found.
+            // The bar cleared, the error first, then the warnings the load found.
+            held.finish();
             paracosm::cli::to_stderr(&paracosm::cli::error_text("paracosm-fuzz", &e.to_string()));
             held.release();
             return Ok(e.exit_code());

@@ -1,6 +1,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::error::reserve_working;
 use super::ordered_sum::ordered_sum;
 use super::wrap_around::wrap_around_pair_sum;
 use super::{check_unit_points, CoverageError};
@@ -59,12 +60,17 @@ impl Discrepancy {
 ///
 /// # Errors
 /// [`CoverageError::Shape`] for `d = 0`, a ragged length or `n = 0`;
-/// [`CoverageError::OutsideUnitCube`] for NaN or a value outside `[0, 1]`.
+/// [`CoverageError::OutsideUnitCube`] for NaN or a value outside `[0, 1]`;
+/// [`CoverageError::OutOfMemory`] when the pair sums' buffers (about `(2d + 130) × 8` bytes a
+/// point) cannot be allocated.
 pub fn discrepancy(points: &[f64], d: usize, kind: Discrepancy) -> Result<f64, CoverageError> {
     let n = check_unit_points(points, d)?;
     if n == 0 {
         return Err(CoverageError::Shape("the point set is empty".into()));
     }
+    // The pair sums' columns (two of n per dimension) and two blocks of 64 rows of n.
+    let per_point = (2 * d).saturating_add(130).saturating_mul(8);
+    reserve_working("the discrepancy", n, d, per_point)?;
     let nf = n as f64;
     let df = d as f64;
     Ok(match kind {

@@ -44,4 +44,46 @@ pub enum CoverageError {
         /// The strength.
         t: usize,
     },
+    /// The estimator's working memory for this many points cannot be allocated (asked of
+    /// the system before any of it is used: a point set too large is refused, never a crash).
+    #[error(
+        "{what} of {n} points in {d} dimensions needs {gib:.1} GiB of working memory, \
+         which cannot be allocated"
+    )]
+    OutOfMemory {
+        /// The estimator.
+        what: &'static str,
+        /// Number of points.
+        n: usize,
+        /// Dimension.
+        d: usize,
+        /// The working memory asked for, GiB.
+        gib: f64,
+    },
+}
+
+/// Asks the system for `bytes_per_point × n` bytes at once and gives them back unused: the
+/// estimator `what` on `n` points in `d` dimensions then needs about that much, in buffers it
+/// allocates as it goes, and a set too large for the machine is refused here with
+/// [`CoverageError::OutOfMemory`] instead of aborting the process (a Rust allocation that
+/// fails aborts; the Python package raises `MemoryError`).
+///
+/// # Errors
+/// [`CoverageError::OutOfMemory`] when the product overflows or cannot be reserved.
+pub(crate) fn reserve_working(
+    what: &'static str,
+    n: usize,
+    d: usize,
+    bytes_per_point: usize,
+) -> Result<(), CoverageError> {
+    let bytes = n.checked_mul(bytes_per_point);
+    let refused = || CoverageError::OutOfMemory {
+        what,
+        n,
+        d,
+        gib: n as f64 * bytes_per_point as f64 / f64::from(1u32 << 30),
+    };
+    let bytes = bytes.ok_or_else(refused)?;
+    let mut probe: Vec<u8> = Vec::new();
+    probe.try_reserve_exact(bytes).map_err(|_| refused())
 }

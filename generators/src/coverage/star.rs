@@ -88,7 +88,9 @@ impl Default for StarOptions {
 ///
 /// # Errors
 /// [`CoverageError::Shape`] for `d = 0`, a ragged length or `n = 0`;
-/// [`CoverageError::OutsideUnitCube`] for NaN or a value outside `[0, 1]`.
+/// [`CoverageError::OutsideUnitCube`] for NaN or a value outside `[0, 1]`;
+/// [`CoverageError::OutOfMemory`] when its buffers (about `32d + 64` bytes a point) cannot be
+/// allocated.
 pub fn star_discrepancy(
     points: &[f64],
     d: usize,
@@ -98,6 +100,9 @@ pub fn star_discrepancy(
     if n == 0 {
         return Err(CoverageError::Shape("the point set is empty".into()));
     }
+    // Copies of the points and their columns, sorted.
+    let per_point = d.saturating_mul(32).saturating_add(64);
+    super::error::reserve_working("the star discrepancy", n, d, per_point)?;
     if d <= 4 && n <= options.exact_max_points[d - 1] {
         let (value, witness) = match d {
             1 => exact_1d(points),

@@ -106,7 +106,7 @@ pub(super) fn read(
             controller,
             pos: r.text.pos(obj),
         });
-        r.names.push(name);
+        std::rc::Rc::make_mut(&mut r.names).push(name);
     }
     Ok(out)
 }

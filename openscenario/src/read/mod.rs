@@ -27,7 +27,8 @@ pub(crate) struct Reader<'t> {
     /// The scenario's files: its catalogs are read through it.
     pub(crate) files: &'t FileSet,
     pub(crate) scope: Scope,
-    pub(crate) names: Vec<String>,
+    /// The entities' names, shared by the readers of nested scopes.
+    pub(crate) names: std::rc::Rc<Vec<String>>,
     pub(crate) notes: std::rc::Rc<std::cell::RefCell<Vec<Note>>>,
     pub(crate) dir: PathBuf,
 }
@@ -63,7 +64,7 @@ impl Reader<'_> {
             text: self.text,
             files: self.files,
             scope,
-            names: self.names.clone(),
+            names: std::rc::Rc::clone(&self.names),
             notes: self.notes.clone(),
             dir: self.dir.clone(),
         })
@@ -174,7 +175,7 @@ fn read_with(
         text,
         files,
         scope,
-        names: Vec::new(),
+        names: std::rc::Rc::default(),
         notes: Default::default(),
         dir: dir.to_path_buf(),
     };

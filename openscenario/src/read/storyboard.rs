@@ -1,6 +1,8 @@
 //! The storyboard (OpenSCENARIO 1.3 User Guide, "Storyboard"): `Init`, stories, acts,
 //! maneuver groups, maneuvers, events and their triggers.
 
+use std::collections::HashSet;
+
 use roxmltree::Node;
 
 use super::{action, condition, Reader};
@@ -227,17 +229,17 @@ fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
 /// Every `StoryboardElementStateCondition` names an element of the storyboard of the type it
 /// says.
 fn check_references(stories: &[Story], stop: Option<&Trigger>) -> Result<(), XoscError> {
-    let mut names: Vec<(&str, &str)> = Vec::new();
+    let mut names: HashSet<(&str, &str)> = HashSet::new();
     for s in stories {
-        names.push(("story", &s.name));
+        names.insert(("story", &s.name));
         for a in &s.acts {
-            names.push(("act", &a.name));
+            names.insert(("act", &a.name));
             for g in &a.groups {
-                names.push(("maneuverGroup", &g.name));
+                names.insert(("maneuverGroup", &g.name));
                 for m in &g.maneuvers {
-                    names.push(("maneuver", &m.name));
+                    names.insert(("maneuver", &m.name));
                     for e in &m.events {
-                        names.push(("event", &e.name));
+                        names.insert(("event", &e.name));
                         names.extend(e.actions.iter().map(|a| ("action", a.name.as_str())));
                     }
                 }
@@ -266,9 +268,8 @@ fn check_references(stories: &[Story], stop: Option<&Trigger>) -> Result<(), Xos
             {
                 // 1.1+ may qualify a name with its parents (`Event::Action`).
                 let last = element.rsplit("::").next().unwrap_or(element);
-                let found = names
-                    .iter()
-                    .any(|&(t, n)| t == element_type && (n == element || n == last));
+                let found = names.contains(&(element_type.as_str(), element.as_str()))
+                    || names.contains(&(element_type.as_str(), last));
                 if !found {
                     return Err(XoscError::Invalid {
                         pos: c.pos.clone(),

@@ -118,7 +118,7 @@ fn scenario_of(path: &Path, v: &VariationFile) -> Result<PathBuf, ScenarioError>
         .collect();
     let what = match std::fs::metadata(&p) {
         Err(_) => Some("is not there".to_owned()),
-        Ok(m) => paracosm_openscenario::text::not_regular(&m)
+        Ok(m) => paracosm_files::kind_of(&m.file_type())
             .map(|kind| format!("is {kind}, not a regular file")),
     };
     if let Some(what) = what {

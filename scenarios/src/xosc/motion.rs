@@ -192,11 +192,17 @@ impl Untimed {
     }
 }
 
+/// Most steps a clothoid trajectory is sampled into (25 km at the engine's 0.25 m step; a
+/// clothoid may be as long as [`paracosm_openscenario::Quantity::Distance`] allows, 1,000 km).
+pub const CLOTHOID_SAMPLES: usize = 100_000;
+
 /// A clothoid's points from `start` (OpenSCENARIO `x`, `y` m; its heading the curve's), of
 /// curvature `curvature` (1/m, positive to the left) changing by `prime` (1/m²) over `length`
 /// m: `(distance along it m, pose)`, one at least every
-/// [`paracosm_engine::network::POLYLINE_STEP_M`], facing along the curve. The engine's
-/// clothoid quadrature ([`paracosm_engine::network::RefLine`]).
+/// [`paracosm_engine::network::POLYLINE_STEP_M`] (for a clothoid longer than
+/// [`CLOTHOID_SAMPLES`] such steps, its length over [`CLOTHOID_SAMPLES`]: at most that many
+/// points, whatever the length), facing along the curve. The engine's clothoid quadrature
+/// ([`paracosm_engine::network::RefLine`]).
 pub fn clothoid_poses(start: Pose, curvature: f64, prime: f64, length: f64) -> Vec<(f64, Pose)> {
     use paracosm_engine::network::{RefLine, POLYLINE_STEP_M};
     let line = RefLine {
@@ -205,7 +211,7 @@ pub fn clothoid_poses(start: Pose, curvature: f64, prime: f64, length: f64) -> V
         curv_end: curvature + prime * length,
     };
     let (c, s) = (start.h.cos(), start.h.sin());
-    line.polyline(POLYLINE_STEP_M)
+    line.polyline(POLYLINE_STEP_M.max(length / CLOTHOID_SAMPLES as f64))
         .into_iter()
         .map(|(d, [x, z])| {
             // The engine's frame has +z to the right of travel; OpenSCENARIO's +y is left.
@@ -222,40 +228,60 @@ pub fn clothoid_poses(start: Pose, curvature: f64, prime: f64, length: f64) -> V
         .collect()
 }
 
-/// The B-spline basis functions of `order` over `knots` at `u`, for the first `n` of them
-/// (Cox–de Boor recursion; Piegl and Tiller, *The NURBS Book*, 1997, eq. 2.5), with the
-/// curve's last parameter in its last non-empty span.
-fn basis(order: usize, knots: &[f64], n: usize, u: f64) -> Vec<f64> {
+/// The B-spline basis functions of `order` over `knots` at `u` that can be non-zero there,
+/// among the first `n`: `(first, values)`, `values[i]` being function `first + i` (Cox–de
+/// Boor recursion; Piegl and Tiller, *The NURBS Book*, 1997, eq. 2.5), with the curve's last
+/// parameter in its last non-empty span. Only the spans that hold `u` and the triangle of
+/// functions above them are computed, `O(order²)` whatever the number of knots (every other
+/// function is zero at `u`); the arithmetic is the full recursion's, so the values are its
+/// bits.
+fn basis(order: usize, knots: &[f64], n: usize, u: f64) -> (usize, Vec<f64>) {
     let end = knots[n];
-    let mut b: Vec<f64> = knots
-        .windows(2)
-        .map(|k| {
-            let inside = k[0] <= u && u < k[1];
-            let at_end = u >= end && k[0] < k[1] && k[1] == end;
-            if inside || at_end {
-                1.0
-            } else {
-                0.0
-            }
-        })
+    // The degree-0 functions that are 1: the non-empty span holding `u` (knots do not
+    // decrease, so at most one) and, at the end, the last non-empty span ending there.
+    let holds = knots.partition_point(|&k| k <= u);
+    let mut ones: Vec<usize> = Vec::with_capacity(2);
+    if holds > 0 && holds < knots.len() {
+        ones.push(holds - 1);
+    }
+    if u >= end {
+        let last = knots.partition_point(|&k| k < end);
+        if last > 0 && last < knots.len() && knots[last] == end && knots[last - 1] < end {
+            ones.push(last - 1);
+        }
+    }
+    let spans = knots.len() - 1;
+    let (Some(&lo), Some(&hi)) = (ones.iter().min(), ones.iter().max()) else {
+        return (0, Vec::new());
+    };
+    let first = lo.saturating_sub(order - 1);
+    let mut b: Vec<f64> = (first..=hi)
+        .map(|i| if ones.contains(&i) { 1.0 } else { 0.0 })
         .collect();
+    let at = |b: &[f64], i: usize| {
+        if i >= first && i <= hi {
+            b[i - first]
+        } else {
+            0.0
+        }
+    };
     for d in 1..order {
-        for i in 0..knots.len() - 1 - d {
+        for i in first..=hi.min(spans.saturating_sub(d + 1)) {
             let left = if knots[i + d] > knots[i] {
-                (u - knots[i]) / (knots[i + d] - knots[i]) * b[i]
+                (u - knots[i]) / (knots[i + d] - knots[i]) * at(&b, i)
             } else {
                 0.0
             };
             let right = if knots[i + d + 1] > knots[i + 1] {
-                (knots[i + d + 1] - u) / (knots[i + d + 1] - knots[i + 1]) * b[i + 1]
+                (knots[i + d + 1] - u) / (knots[i + d + 1] - knots[i + 1]) * at(&b, i + 1)
             } else {
                 0.0
             };
-            b[i] = left + right;
+            b[i - first] = left + right;
         }
     }
-    b.truncate(n);
-    b
+    b.truncate(n.saturating_sub(first));
+    (first, b)
 }
 
 /// Most points a NURBS trajectory is sampled into.
@@ -294,11 +320,13 @@ pub fn nurbs_poses(
     let mut out: Vec<(f64, Pose)> = (0..samples)
         .map(|k| {
             let u = u0 + (u1 - u0) * k as f64 / (samples - 1) as f64;
-            let b = basis(order, knots, n, u);
-            let w: f64 = b.iter().zip(points).map(|(bi, p)| bi * p.1).sum();
+            let (first, b) = basis(order, knots, n, u);
+            let near = points.get(first..).unwrap_or(&[]);
+            let w: f64 = b.iter().zip(near).map(|(bi, p)| bi * p.1).sum();
             let w = if w > 0.0 { w } else { 1.0 };
             let (mut x, mut y, mut h) = (0.0, 0.0, 0.0);
-            for (j, (bi, p)) in b.iter().zip(points).enumerate() {
+            for (j, (bi, p)) in b.iter().zip(near).enumerate() {
+                let j = first + j;
                 let f = bi * p.1 / w;
                 x += f * p.2[0];
                 y += f * p.2[1];
@@ -471,6 +499,89 @@ mod tests {
         let mid = poses[mid].1;
         let tangent = mid.y.atan2(mid.x) + std::f64::consts::FRAC_PI_2;
         assert!((mid.h - tangent).abs() < 0.1, "{} vs {tangent}", mid.h);
+    }
+
+    /// The full Cox–de Boor recursion over every knot span, as the basis was computed before
+    /// it kept to the spans that hold `u`.
+    fn full_basis(order: usize, knots: &[f64], n: usize, u: f64) -> Vec<f64> {
+        let end = knots[n];
+        let mut b: Vec<f64> = knots
+            .windows(2)
+            .map(|k| {
+                let at_end = u >= end && k[0] < k[1] && k[1] == end;
+                f64::from(u8::from((k[0] <= u && u < k[1]) || at_end))
+            })
+            .collect();
+        for d in 1..order {
+            for i in 0..knots.len() - 1 - d {
+                let left = if knots[i + d] > knots[i] {
+                    (u - knots[i]) / (knots[i + d] - knots[i]) * b[i]
+                } else {
+                    0.0
+                };
+                let right = if knots[i + d + 1] > knots[i + 1] {
+                    (knots[i + d + 1] - u) / (knots[i + d + 1] - knots[i + 1]) * b[i + 1]
+                } else {
+                    0.0
+                };
+                b[i] = left + right;
+            }
+        }
+        b.truncate(n);
+        b
+    }
+
+    #[test]
+    fn the_basis_near_u_has_the_full_recursions_bits_and_zeros_elsewhere() {
+        // Clamped, uniform, repeated inner knots, and an unclamped end with knots past it.
+        let cases: [(usize, Vec<f64>); 4] = [
+            (3, vec![0.0, 0.0, 0.0, 0.3, 0.7, 1.0, 1.0, 1.0]),
+            (4, (0..12).map(f64::from).collect()),
+            (3, vec![0.0, 0.0, 0.0, 0.5, 0.5, 0.8, 1.0, 1.0, 1.0]),
+            (2, vec![0.0, 1.0, 2.0, 3.0, 3.0, 4.0]),
+        ];
+        for (order, knots) in cases {
+            let n = knots.len() - order;
+            let (u0, u1) = (knots[order - 1], knots[n]);
+            for k in 0..=200 {
+                let u = u0 + (u1 - u0) * f64::from(k) / 200.0;
+                let full = full_basis(order, &knots, n, u);
+                let (first, near) = basis(order, &knots, n, u);
+                for (i, f) in full.iter().enumerate() {
+                    let got = i.checked_sub(first).and_then(|j| near.get(j)).copied();
+                    match got {
+                        Some(g) => assert!(g == *f, "order {order} u {u} i {i}: {g} vs {f}"),
+                        None => assert!(*f == 0.0, "order {order} u {u} i {i}: {f} left out"),
+                    }
+                }
+                // `order` functions, and at the curve's end of an unclamped knot vector
+                // those of the last non-empty span too.
+                assert!(near.len() <= 2 * order, "{} functions at u {u}", near.len());
+            }
+        }
+    }
+
+    #[test]
+    fn a_nurbs_of_100000_control_points_is_sampled_in_linear_time() {
+        // A straight line of 100,000 control points 1 m apart, order 16: the full recursion
+        // took order · knots per sample (1.6e11 in all); the near basis order² per sample.
+        let n = 100_000;
+        let points: Vec<ControlPoint> =
+            (0..n).map(|i| (None, 1.0, [i as f64, 0.0], None)).collect();
+        let order = 16;
+        let knots: Vec<f64> = (0..n + order)
+            .map(|i| (i.clamp(order - 1, n) - (order - 1)) as f64)
+            .collect();
+        let poses = nurbs_poses(order, &points, &knots);
+        assert_eq!(poses.len(), NURBS_SAMPLES);
+        assert!(poses
+            .iter()
+            .all(|(_, p)| p.y.abs() < 1e-9 && p.h.abs() < 1e-9));
+        let (a, b) = (poses[0].1, poses[poses.len() - 1].1);
+        assert!(
+            a.x.abs() < 1e-9 && (b.x - (n - 1) as f64).abs() < 1e-6,
+            "{a:?} {b:?}"
+        );
     }
 
     #[test]

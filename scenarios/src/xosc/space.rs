@@ -264,12 +264,58 @@ pub fn value_sets_param(
                 });
             }
         }
-        let text: Vec<String> = set
-            .iter()
-            .map(|a| format!("{}={}", a.name, a.value))
-            .collect();
-        levels.push(Value::Text(text.join(", ")));
+        levels.push(Value::Text(set_text(
+            set.iter().map(|a| (a.name.as_str(), a.value.as_str())),
+        )));
     }
     let n = levels.len() as u64;
     Ok((Param::levels(&format!("value_set_{k}"), levels), n))
+}
+
+/// A value set's level as listed and recorded: `Name=value, Name=value` in the set's order,
+/// a name or value quoted as a Rust string literal (`"40, LeadSpeed=0.5"`) when it is empty,
+/// holds `,`, `=`, `"`, `\\` or a control character, or starts or ends with a space, so that
+/// two different sets never read alike.
+pub fn set_text<'a>(assignments: impl Iterator<Item = (&'a str, &'a str)>) -> String {
+    fn shown(s: &str) -> String {
+        let plain = !s.is_empty()
+            && s.trim() == s
+            && !s
+                .chars()
+                .any(|c| matches!(c, ',' | '=' | '"' | '\\') || c.is_control());
+        if plain {
+            s.to_owned()
+        } else {
+            format!("{s:?}")
+        }
+    }
+    let parts: Vec<String> = assignments
+        .map(|(name, value)| format!("{}={}", shown(name), shown(value)))
+        .collect();
+    parts.join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn value_sets_that_differ_are_listed_differently() {
+        let one = set_text([("A", "40, LeadSpeed=0.5")].into_iter());
+        let two = set_text([("A", "40"), ("LeadSpeed", "0.5")].into_iter());
+        assert_eq!(one, r#"A="40, LeadSpeed=0.5""#);
+        assert_eq!(two, "A=40, LeadSpeed=0.5");
+        assert_ne!(one, two);
+        assert_eq!(set_text([("A", "")].into_iter()), r#"A="""#);
+        assert_eq!(set_text([("A", " x")].into_iter()), r#"A=" x""#);
+        assert_eq!(
+            set_text([("A", r#"say "hi""#)].into_iter()),
+            r#"A="say \"hi\"""#
+        );
+        // Plain values are listed as written (the ALKS suite's levels are unchanged).
+        assert_eq!(
+            set_text([("Ego_Speed", "16.67"), ("Road", "r.xodr")].into_iter()),
+            "Ego_Speed=16.67, Road=r.xodr"
+        );
+    }
 }

@@ -1,11 +1,18 @@
 //! The axes of the failure plots. A continuous parameter spans its interval; a discrete one
-//! has a column per level, in declaration order, with points jittered within it; a strip
-//! plot's other axis is the outcome (pass, fail, error).
+//! has a column per level, in declaration order, with points jittered within it, up to
+//! [`MAX_CATEGORIES`] levels (past that a plot would draw a label and a heat-map cell per
+//! level: two parameters of 10^6 levels asked for 10^12 cells); a parameter of more levels
+//! is drawn as numbers, its values when they are all numbers, else its level indices, binned
+//! like an interval; a strip plot's other axis is the outcome (pass, fail, error).
 
 use paracosm_generators::{Domain, ParamSpace, Value};
 
 use super::PlotError;
 use crate::record::{RunRecord, Status};
+
+/// Most levels a discrete parameter's axis draws one band each for (see the module's
+/// documentation).
+pub(crate) const MAX_CATEGORIES: usize = 60;
 
 /// Half the width of the band a category's points are jittered over (a category spans 1).
 const JITTER: f64 = 0.35;
@@ -24,6 +31,15 @@ pub(crate) enum Axis {
     Levels {
         name: String,
         levels: Vec<Value>,
+        label: String,
+    },
+    /// A discrete parameter of more than [`MAX_CATEGORIES`] levels, not all numbers: a
+    /// test's coordinate is its level's index (found by the level's text), in
+    /// `[0, levels − 1]`, binned like an interval.
+    Index {
+        name: String,
+        index: std::collections::HashMap<String, usize>,
+        levels: usize,
         label: String,
     },
     /// The test's outcome: pass, fail, error as bands 0, 1, 2.
@@ -68,11 +84,12 @@ impl Axis {
                 hi: *hi,
                 label: p.label(),
             },
-            Domain::Levels(levels) => Axis::Levels {
+            Domain::Levels(levels) if levels.len() <= MAX_CATEGORIES => Axis::Levels {
                 name: name.to_owned(),
                 levels: levels.clone(),
                 label: p.label(),
             },
+            Domain::Levels(levels) => many_levels(name, levels, p.label()),
         })
     }
 
@@ -81,6 +98,7 @@ impl Axis {
         match self {
             Axis::Interval { lo, hi, .. } => (*lo, *hi),
             Axis::Levels { levels, .. } => (-0.5, levels.len() as f64 - 0.5),
+            Axis::Index { levels, .. } => (0.0, levels.saturating_sub(1).max(1) as f64),
             Axis::Outcome => (-0.5, OUTCOMES.len() as f64 - 0.5),
             Axis::All => (-0.5, 0.5),
         }
@@ -90,6 +108,7 @@ impl Axis {
     pub(crate) fn label(&self) -> String {
         match self {
             Axis::Interval { label, .. } | Axis::Levels { label, .. } => label.clone(),
+            Axis::Index { label, .. } => format!("{label} (level index)"),
             Axis::Outcome => "outcome".into(),
             Axis::All => String::new(),
         }
@@ -98,7 +117,7 @@ impl Axis {
     /// The names of its bands, when it is categorical.
     pub(crate) fn categories(&self) -> Option<Vec<String>> {
         match self {
-            Axis::Interval { .. } => None,
+            Axis::Interval { .. } | Axis::Index { .. } => None,
             Axis::Levels { levels, .. } => Some(levels.iter().map(|l| l.to_string()).collect()),
             Axis::Outcome => Some(OUTCOMES.map(str::to_owned).to_vec()),
             Axis::All => Some(vec!["all tests".into()]),
@@ -108,7 +127,7 @@ impl Axis {
     /// The band index of `r` on a categorical axis.
     fn category(&self, r: &RunRecord) -> Option<usize> {
         match self {
-            Axis::Interval { .. } => None,
+            Axis::Interval { .. } | Axis::Index { .. } => None,
             Axis::Levels { name, levels, .. } => {
                 let v = r.params.as_ref()?.get(name)?;
                 levels.iter().position(|l| l == v)
@@ -127,6 +146,7 @@ impl Axis {
     pub(crate) fn coord(&self, r: &RunRecord, salt: u64) -> Option<f64> {
         match self {
             Axis::Interval { name, .. } => r.params.as_ref()?.real(name),
+            Axis::Index { .. } => self.index_of(r),
             _ => self
                 .category(r)
                 .map(|i| i as f64 + 2.0 * JITTER * unit_hash(r.id, salt)),
@@ -141,11 +161,28 @@ impl Axis {
         }
     }
 
+    /// The level index of `r` on an [`Axis::Index`], as a coordinate.
+    fn index_of(&self, r: &RunRecord) -> Option<f64> {
+        match self {
+            Axis::Index { name, index, .. } => {
+                let v = r.params.as_ref()?.get(name)?;
+                index.get(&v.to_string()).map(|&i| i as f64)
+            }
+            _ => None,
+        }
+    }
+
     /// The heat-map cell of `r` along the axis (of [`Axis::bins`]`(bins)`).
     pub(crate) fn bin(&self, r: &RunRecord, bins: usize) -> Option<usize> {
         match self {
             Axis::Interval { lo, hi, name, .. } => {
                 let v = r.params.as_ref()?.real(name)?;
+                let n = bins.max(1);
+                Some((((v - lo) / (hi - lo) * n as f64).floor().max(0.0) as usize).min(n - 1))
+            }
+            Axis::Index { .. } => {
+                let (lo, hi) = self.range();
+                let v = self.index_of(r)?;
                 let n = bins.max(1);
                 Some((((v - lo) / (hi - lo) * n as f64).floor().max(0.0) as usize).min(n - 1))
             }
@@ -156,12 +193,45 @@ impl Axis {
     /// The coordinates `(from, to)` of cell `k` of `n` along the axis.
     pub(crate) fn bin_span(&self, k: usize, n: usize) -> (f64, f64) {
         match self {
-            Axis::Interval { lo, hi, .. } => {
+            Axis::Interval { .. } | Axis::Index { .. } => {
+                let (lo, hi) = self.range();
                 let d = (hi - lo) / n as f64;
                 (lo + k as f64 * d, lo + (k + 1) as f64 * d)
             }
             _ => (k as f64 - 0.5, k as f64 + 0.5),
         }
+    }
+}
+
+/// The axis of a discrete parameter `name` of more than [`MAX_CATEGORIES`] `levels`: an
+/// interval over its values when they are all finite numbers spanning more than one value,
+/// else its level indices.
+fn many_levels(name: &str, levels: &[Value], label: String) -> Axis {
+    let numbers: Option<Vec<f64>> = levels
+        .iter()
+        .map(|l| l.as_f64().filter(|x| x.is_finite()))
+        .collect();
+    if let Some(xs) = numbers {
+        let lo = xs.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if hi > lo && (hi - lo).is_finite() {
+            return Axis::Interval {
+                name: name.to_owned(),
+                lo,
+                hi,
+                label,
+            };
+        }
+    }
+    let mut index = std::collections::HashMap::with_capacity(levels.len());
+    for (i, l) in levels.iter().enumerate() {
+        index.entry(l.to_string()).or_insert(i);
+    }
+    Axis::Index {
+        name: name.to_owned(),
+        index,
+        levels: levels.len(),
+        label,
     }
 }
 

@@ -317,7 +317,11 @@ pub fn adaptive_bins(tests: usize, space: &ParamSpace, axes: &[String]) -> usize
     let (mut c, mut levels) = (0i32, 1.0f64);
     for a in axes {
         match space.param(a).map(|p| &p.domain) {
-            Some(paracosm_generators::Domain::Levels(l)) => levels *= l.len().max(1) as f64,
+            Some(paracosm_generators::Domain::Levels(l))
+                if l.len() <= super::axis::MAX_CATEGORIES =>
+            {
+                levels *= l.len().max(1) as f64
+            }
             _ => c += 1,
         }
     }
@@ -632,6 +636,67 @@ mod tests {
         assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
         let svg = std::fs::read_to_string(svg).unwrap();
         assert!(svg.contains("1/2") && svg.contains("dist [m]"));
+    }
+
+    #[test]
+    fn parameters_of_a_million_levels_give_bounded_plots() {
+        // Two parameters of 10^6 levels asked for 10^12 heat-map cells and drew a label per
+        // level (a 495 MB SVG for 4 tests): numbers are drawn as an interval over their
+        // values, texts by their level index, each binned.
+        let s = ParamSpace::new(vec![
+            Param::levels("lane", (0..1_000_000).map(Value::Int).collect()),
+            Param::levels(
+                "name",
+                (0..1_000_000)
+                    .map(|i| Value::Text(format!("n{i}")))
+                    .collect(),
+            ),
+        ])
+        .unwrap();
+        let records: Vec<RunRecord> = (0..4u32)
+            .map(|i| {
+                let point = Point {
+                    discrete: vec![i * 250_000, 999_999 - i * 250_000],
+                    continuous: vec![],
+                };
+                RunRecord {
+                    params: s.decode(&point).ok(),
+                    point,
+                    status: if i % 2 == 0 {
+                        Status::Pass
+                    } else {
+                        Status::Fail
+                    },
+                    ..record(u64::from(i), &space(), 0, [0.5, 0.5], Status::Pass)
+                }
+            })
+            .collect();
+        let axes = names(&["lane", "name"]);
+        let bins = adaptive_bins(records.len(), &s, &axes);
+        let g = failure_rates(&records, &s, &axes, bins).unwrap();
+        assert_eq!((g.columns, g.rows), (bins, bins));
+        assert_eq!(g.cells.iter().map(|c| c.1).sum::<u32>(), 4);
+        let dir = tempfile::tempdir().unwrap();
+        let [_, rate] =
+            failure_rate_map(&dir.path().join("rate"), &s, &axes, "t", &records, bins).unwrap();
+        let [_, map] = failure_map(
+            &dir.path().join("m"),
+            &s,
+            &axes,
+            &[("t", &records)],
+            Coloring::Outcome,
+        )
+        .unwrap();
+        for svg in [rate, map] {
+            let text = std::fs::read_to_string(&svg).unwrap();
+            assert!(
+                text.len() < 1 << 20,
+                "{}: {} bytes",
+                svg.display(),
+                text.len()
+            );
+            assert!(text.contains("name (level index)"), "{}", svg.display());
+        }
     }
 
     #[test]

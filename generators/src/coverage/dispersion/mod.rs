@@ -124,13 +124,18 @@ impl Default for DispersionOptions {
 ///
 /// # Errors
 /// [`CoverageError::Shape`] for `d = 0` or a length not a multiple of `d`;
-/// [`CoverageError::OutsideUnitCube`] for a value that is NaN or outside `[0, 1]`.
+/// [`CoverageError::OutsideUnitCube`] for a value that is NaN or outside `[0, 1]`;
+/// [`CoverageError::OutOfMemory`] when its buffers (about `32d + 64` bytes a point) cannot be
+/// allocated.
 pub fn dispersion(
     points: &[f64],
     d: usize,
     options: &DispersionOptions,
 ) -> Result<Dispersion, CoverageError> {
     let n = check_unit_points(points, d)?;
+    // Copies of the points and their columns, sorted.
+    let per_point = d.saturating_mul(32).saturating_add(64);
+    super::error::reserve_working("the dispersion", n, d, per_point)?;
     // Points with a coordinate on the boundary are inside no open box.
     let inner: Vec<f64> = points
         .chunks_exact(d)
@@ -149,42 +154,8 @@ pub fn dispersion(
     let past_exact = d >= 3 && m > limit;
     if d > MAX_SEARCH_DIMS || (past_exact && m.saturating_mul(d * d) > MAX_BRACKET_WORK) {
         // The sweep's and the bracket's work grows with d (boxes of d sides, greedy starts
-        // per dimension): past this, only the cheap lower bound of the widest empty slab (a
-        // box spanning every other axis whole), O(n d log n).
-        let mut best = (
-            0.0,
-            0,
-            EmptyBox {
-                lo: vec![],
-                hi: vec![],
-            },
-        );
-        for axis in 0..d {
-            let column: Vec<f64> = inner.chunks_exact(d).map(|p| p[axis]).collect();
-            let gap = max_gap(&column);
-            let width = gap.hi[0] - gap.lo[0];
-            if width > best.0 {
-                best = (width, axis, gap);
-            }
-        }
-        let (width, axis, gap) = best;
-        let mut lo = vec![0.0; d];
-        let mut hi = vec![1.0; d];
-        lo[axis] = gap.lo[0];
-        hi[axis] = gap.hi[0];
-        return Ok(Dispersion {
-            lower: width,
-            upper: 1.0,
-            exact: width >= 1.0,
-            witness: EmptyBox { lo, hi },
-            method: format!(
-                "bracket (d = {d}, n = {n}: past the search limits of {MAX_SEARCH_DIMS} \
-                 dimensions or n × d² = {MAX_BRACKET_WORK}): lower = the widest empty slab, \
-                 upper = 1; the sweep and the branch and bound were skipped; the exact value is \
-                 at most {} the lower end",
-                super::star::bracket_factor(width, 1.0)
-            ),
-        });
+        // per dimension): past this, only the cheap lower bound of the widest empty slab.
+        return Ok(widest_slab(&inner, d, n));
     }
     let (witness, method) = match d {
         1 => (max_gap(&inner), "exact: largest gap (d = 1)".to_owned()),
@@ -224,6 +195,46 @@ pub fn dispersion(
         witness,
         method,
     })
+}
+
+/// The dispersion's bracket past the search limits: the widest empty slab (a box spanning
+/// every axis but one whole) of the `inner` points (`m × d`, row-major, none on the
+/// boundary; `n` points in all), O(n d log n), as the lower end and 1 as the upper.
+fn widest_slab(inner: &[f64], d: usize, n: usize) -> Dispersion {
+    let mut best = (
+        0.0,
+        0,
+        EmptyBox {
+            lo: vec![],
+            hi: vec![],
+        },
+    );
+    for axis in 0..d {
+        let column: Vec<f64> = inner.chunks_exact(d).map(|p| p[axis]).collect();
+        let gap = max_gap(&column);
+        let width = gap.hi[0] - gap.lo[0];
+        if width > best.0 {
+            best = (width, axis, gap);
+        }
+    }
+    let (width, axis, gap) = best;
+    let mut lo = vec![0.0; d];
+    let mut hi = vec![1.0; d];
+    lo[axis] = gap.lo[0];
+    hi[axis] = gap.hi[0];
+    Dispersion {
+        lower: width,
+        upper: 1.0,
+        exact: width >= 1.0,
+        witness: EmptyBox { lo, hi },
+        method: format!(
+            "bracket (d = {d}, n = {n}: past the search limits of {MAX_SEARCH_DIMS} \
+             dimensions or n × d² = {MAX_BRACKET_WORK}): lower = the widest empty slab, \
+             upper = 1; the sweep and the branch and bound were skipped; the exact value is \
+             at most {} the lower end",
+            super::star::bracket_factor(width, 1.0)
+        ),
+    }
 }
 
 /// Most dimensions in which [`dispersion`] searches for empty boxes (the exact sweep or the

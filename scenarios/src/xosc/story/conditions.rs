@@ -2,6 +2,8 @@
 //! each trigger's condition groups evaluated with edges and delays, the entity and value
 //! conditions, and the ego's measures (headway, gap, distance to its lane's edge).
 
+use std::collections::HashMap;
+
 use super::*;
 
 #[derive(Debug, Clone)]
@@ -12,7 +14,74 @@ pub(in crate::xosc::story) struct Cond {
     /// edge needs the condition seen false before it is seen true, as in esmini's
     /// `OSCCondition::CheckEdge`).
     pub(in crate::xosc::story) prev: Option<bool>,
-    pub(in crate::xosc::story) history: VecDeque<(f64, bool)>,
+    /// With a delay, its values over the last `delay` seconds as runs of one value (a
+    /// condition that keeps its value for a minute holds one run, not 3,600 steps' values).
+    pub(in crate::xosc::story) history: VecDeque<Run>,
+    /// The time up to which its delayed values have been taken (s; −∞ while none has).
+    pub(in crate::xosc::story) taken: f64,
+    /// What it reads, found once when the storyboard is built
+    /// ([`Storyboard::resolve_references`]): the elements an element-state condition names,
+    /// the parameter a parameter condition reads (none when nothing is declared by its name);
+    /// empty for the other kinds.
+    pub(in crate::xosc::story) refs: Vec<usize>,
+}
+
+/// A run of evaluations of a delayed condition that gave one value: the first and last
+/// evaluation's times (s) and the value.
+#[derive(Debug, Clone, Copy)]
+pub(in crate::xosc::story) struct Run {
+    first: f64,
+    last: f64,
+    value: bool,
+}
+
+impl Cond {
+    /// A condition `cond` not yet evaluated.
+    pub(in crate::xosc::story) fn new(cond: m::Condition) -> Cond {
+        Cond {
+            cond,
+            prev: None,
+            history: VecDeque::new(),
+            taken: f64::NEG_INFINITY,
+            refs: Vec::new(),
+        }
+    }
+
+    /// Records `value`, this step's (at `t`, s), and gives the delayed value: whether any
+    /// value recorded between the last step's cut and this step's (`t − delay`) was true,
+    /// taking each recorded step once.
+    fn delayed(&mut self, t: f64, value: bool) -> bool {
+        match self.history.back_mut() {
+            Some(run) if run.value == value => run.last = t,
+            _ => self.history.push_back(Run {
+                first: t,
+                last: t,
+                value,
+            }),
+        }
+        let cut = t - self.cond.delay_s + 1e-9;
+        let mut out = false;
+        while let Some(&run) = self.history.front() {
+            if run.first > cut {
+                break;
+            }
+            // The run's steps after the last cut and up to this one.
+            out |= run.value && run.last > self.taken;
+            if run.last > cut {
+                break;
+            }
+            self.history.pop_front();
+        }
+        self.taken = cut;
+        out
+    }
+
+    /// Forgets its delayed values: its element no longer waits, and its delay starts afresh
+    /// when it waits again.
+    pub(in crate::xosc::story) fn forget_delay(&mut self) {
+        self.history.clear();
+        self.taken = f64::NEG_INFINITY;
+    }
 }
 
 impl Storyboard {
@@ -21,7 +90,7 @@ impl Storyboard {
         for g in 0..self.triggers[k].len() {
             let mut all = true;
             for c in 0..self.triggers[k][g].len() {
-                let raw = self.condition(&self.triggers[k][g][c].cond.kind, t);
+                let raw = self.condition(&self.triggers[k][g][c], t);
                 let cond = &mut self.triggers[k][g][c];
                 let edged = match cond.cond.edge {
                     Edge::None => raw,
@@ -32,18 +101,7 @@ impl Storyboard {
                 cond.prev = Some(raw);
                 // With a delay, the condition's value `delay` seconds ago.
                 let value = if cond.cond.delay_s > 0.0 {
-                    cond.history.push_back((t, edged));
-                    let cut = t - cond.cond.delay_s + 1e-9;
-                    let mut v = false;
-                    while let Some(&(ts, e)) = cond.history.front() {
-                        if ts <= cut {
-                            v |= e;
-                            cond.history.pop_front();
-                        } else {
-                            break;
-                        }
-                    }
-                    v
+                    cond.delayed(t, edged)
                 } else {
                     edged
                 };
@@ -54,29 +112,67 @@ impl Storyboard {
         any
     }
 
-    pub(in crate::xosc::story) fn condition(&self, kind: &ConditionKind, t: f64) -> bool {
-        match kind {
-            ConditionKind::SimulationTime { rule, value } => rule.holds(t, *value),
-            ConditionKind::ElementState {
-                element_type,
-                element,
-                state,
-            } => self.elems.iter().any(|e| {
-                e.kind.name().eq_ignore_ascii_case(element_type)
-                    && e.name == *element
-                    && match state.as_str() {
-                        "startTransition" => e.last.start,
-                        "endTransition" => e.last.end,
-                        "stopTransition" => e.last.stop,
-                        "skipTransition" => e.last.skip,
-                        "completeState" => e.phase == Phase::Complete,
-                        "runningState" => e.phase == Phase::Running,
-                        "standbyState" => e.phase == Phase::Standby,
-                        _ => false,
+    /// Finds, once, what each condition reads by name ([`Cond::refs`]), so that a step's
+    /// evaluation costs each condition what it names, not a search of the storyboard: a
+    /// chain of 10,000 events each started by the one before is linear per step, not
+    /// quadratic. An element is named as the storyboard check reads it (OpenSCENARIO 1.1+
+    /// may qualify a name with its parents, `Event::Action`: the last part names it).
+    pub(in crate::xosc::story) fn resolve_references(&mut self) {
+        let mut elems: HashMap<(String, &str), Vec<usize>> = HashMap::new();
+        for (i, e) in self.elems.iter().enumerate() {
+            let key = (e.kind.name().to_ascii_lowercase(), e.name.as_str());
+            elems.entry(key).or_default().push(i);
+        }
+        let mut params: HashMap<&str, usize> = HashMap::new();
+        for (i, (n, _)) in self.params.iter().enumerate() {
+            params.entry(n.as_str()).or_insert(i);
+        }
+        let mut found: Vec<Vec<usize>> = Vec::new();
+        for cond in self.triggers.iter().flatten().flatten() {
+            found.push(match &cond.cond.kind {
+                ConditionKind::ElementState {
+                    element_type,
+                    element,
+                    ..
+                } => {
+                    let kind = element_type.to_ascii_lowercase();
+                    let last = element.rsplit("::").next().unwrap_or(element);
+                    let mut refs =
+                        (elems.get(&(kind.clone(), element.as_str())).cloned()).unwrap_or_default();
+                    if last != element {
+                        refs.extend(elems.get(&(kind, last)).into_iter().flatten());
                     }
+                    refs
+                }
+                ConditionKind::Parameter { name, .. } => {
+                    params.get(name.as_str()).copied().into_iter().collect()
+                }
+                _ => Vec::new(),
+            });
+        }
+        for (cond, refs) in self.triggers.iter_mut().flatten().flatten().zip(found) {
+            cond.refs = refs;
+        }
+    }
+
+    pub(in crate::xosc::story) fn condition(&self, cond: &Cond, t: f64) -> bool {
+        match &cond.cond.kind {
+            ConditionKind::SimulationTime { rule, value } => rule.holds(t, *value),
+            ConditionKind::ElementState { state, .. } => cond.refs.iter().any(|&i| {
+                let e = &self.elems[i];
+                match state.as_str() {
+                    "startTransition" => e.last.start,
+                    "endTransition" => e.last.end,
+                    "stopTransition" => e.last.stop,
+                    "skipTransition" => e.last.skip,
+                    "completeState" => e.phase == Phase::Complete,
+                    "runningState" => e.phase == Phase::Running,
+                    "standbyState" => e.phase == Phase::Standby,
+                    _ => false,
+                }
             }),
-            ConditionKind::Parameter { name, rule, value } => {
-                let Some((_, v)) = self.params.iter().find(|(n, _)| n == name) else {
+            ConditionKind::Parameter { rule, value, .. } => {
+                let Some((_, v)) = cond.refs.first().map(|&i| &self.params[i]) else {
                     return false;
                 };
                 match (v.trim().parse::<f64>(), value.trim().parse::<f64>()) {

@@ -169,15 +169,7 @@ impl Storyboard {
         self.owners.push(owner);
         self.triggers.push(
             t.0.iter()
-                .map(|g| {
-                    g.iter()
-                        .map(|c| Cond {
-                            cond: c.clone(),
-                            prev: None,
-                            history: VecDeque::new(),
-                        })
-                        .collect()
-                })
+                .map(|g| g.iter().map(|c| Cond::new(c.clone())).collect())
                 .collect(),
         );
         self.triggers.len() - 1

@@ -190,6 +190,7 @@ impl Storyboard {
             }
         }
         sb.trigger_now = vec![false; sb.triggers.len()];
+        sb.resolve_references();
         sb.perform_init(scenario)?;
         // Init's transitions run from the start.
         Ok(sb)
@@ -380,7 +381,7 @@ impl Storyboard {
                 // delay history).
                 self.trigger_now[k] = false;
                 for c in self.triggers[k].iter_mut().flatten() {
-                    c.history.clear();
+                    c.forget_delay();
                 }
             }
         }

@@ -26,9 +26,14 @@ impl Storyboard {
         at: &paracosm_openscenario::Pos,
     ) -> Result<LanePos, StoryError> {
         let r = &self.actors[e];
+        let (x, y) = (r.state.pose.x, r.state.pose.y);
         r.state.lane.ok_or_else(|| StoryError {
             at: site(at),
-            message: format!("a {what} to {}, which is not on a lane", r.name),
+            message: format!(
+                "a {what} to {}, which is not on a lane: it stands at x = {x:.1} m, y = {y:.1} m \
+                 (where its last position put it, or the origin before its Init places it)",
+                r.name
+            ),
         })
     }
 
