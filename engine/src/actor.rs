@@ -1,13 +1,105 @@
 //! Actors as sets with typed handles, the way rapier keeps bodies and colliders: each kind of
 //! actor (NPC cars, pedestrians, static obstacles) lives in its own [`Set`], and each actor
-//! carries its own [`Size`], look, speed source and contact state.
+//! carries its own [`Size`], look, speed source and contact state. [`ActorKind`] is what the
+//! step loop asks of every kind alike.
 
 use std::fmt;
 use std::marker::PhantomData;
 
+use rapier3d::prelude::{PhysicsWorld, Pose, Shape, SharedShape};
 use serde::{Deserialize, Serialize};
 
 use crate::segmentation::SemanticClass;
+
+/// An actor's contact state, kept by the actor itself.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct Contact {
+    /// Whether it touches the ego vehicle now (collision events).
+    pub(crate) touching: bool,
+    /// Whether it has touched anything since the test began (the ego, a car, a pedestrian,
+    /// an obstacle).
+    pub(crate) collided: bool,
+}
+
+/// An actor's motion as a program reads it (`pos`, `vel`, `heading`, `speed`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Motion {
+    /// Its reference point `[x, y, z]`, m.
+    pub(crate) pos_m: [f64; 3],
+    /// Its velocity `[x, y, z]`, m/s.
+    pub(crate) vel_mps: [f64; 3],
+    /// The way it faces, rad, counter-clockwise from `+x` seen from above.
+    pub(crate) heading_rad: f64,
+    /// Its speed, m/s, `>= 0`.
+    pub(crate) speed_mps: f64,
+}
+
+/// What the step loop ([`crate::Simulation`]) asks of every kind of actor, so that the loop
+/// names no kind: its contact state, its motion, its solid shape, how the time-to-collision
+/// test and the camera see it, and what a step does to it. Each kind implements it in its
+/// own file; `actors.rs` keeps the sets and registers each kind once.
+pub(crate) trait ActorKind {
+    /// Its contact state.
+    fn contact(&self) -> Contact;
+
+    /// Its contact state, to record a contact.
+    fn contact_mut(&mut self) -> &mut Contact;
+
+    /// Its motion now, `None` when it is not in this test (a disabled car: its outputs have
+    /// no events).
+    fn motion(&self) -> Option<Motion>;
+
+    /// Its solid shape where it is now, for contacts between kinematic actors and for its
+    /// `separation` output; `None` when it is not in this test.
+    fn solid(&self, physics: &PhysicsWorld) -> Option<(Pose, SharedShape)>;
+
+    /// Its collider where the physics world has it (an asleep car: where it would be), for
+    /// the snapshot's minimum separation; `None` when it is not in this test.
+    fn collider_now<'a>(&self, physics: &'a PhysicsWorld) -> Option<(Pose, &'a dyn Shape)>;
+
+    /// It as the time-to-collision test sees it, `None` when it is not in this test.
+    fn mover(&self) -> Option<crate::ttc::Mover>;
+
+    /// The box the camera draws for actor `index` of its kind, `None` when it is not seen.
+    fn visible(&self, index: usize) -> Option<VisibleBox>;
+
+    /// Records that a car ran into it.
+    fn run_into_by_car(&mut self) {
+        self.contact_mut().collided = true;
+    }
+
+    /// Starts a step, before the step's actions.
+    fn start_step(&mut self) {}
+
+    /// Ends a step, after the physics step has taken its moves.
+    fn end_step(&mut self) {}
+}
+
+/// What a step's actions and moves of the actors read and write: the physics world, the
+/// stream graph's values this step, the road surface, the time at the step's start and the
+/// step's length (s).
+pub(crate) struct StepWorld<'a> {
+    /// The physics world the actors' bodies are in.
+    pub(crate) physics: &'a mut PhysicsWorld,
+    /// The stream graph, evaluated for this step.
+    pub(crate) streams: &'a crate::rx::Runtime,
+    /// The road surface (its frictions now).
+    pub(crate) surface: &'a crate::network::Surface,
+    /// The time at the step's start, s.
+    pub(crate) t_s: f64,
+    /// The step's length, s.
+    pub(crate) dt_s: f64,
+}
+
+/// A heading from `atan2`, in `[-π, π]`, as one in `(-π, π]` (a location's and the ego's
+/// range): `-π` becomes `π`, every other value keeps its bits.
+pub(crate) fn half_open(heading_rad: f64) -> f64 {
+    if heading_rad <= -std::f64::consts::PI {
+        heading_rad + std::f64::consts::TAU
+    } else {
+        heading_rad
+    }
+}
 
 /// The size of a box-shaped body, metres: one struct and one axis order everywhere (the
 /// collider, the camera's drawing, the placement check, time to collision).

@@ -19,6 +19,24 @@ pub enum ActorRef {
     Obstacle(Handle<ObstacleSpec>),
 }
 
+impl ActorRef {
+    /// Whether a car that runs into this actor crashes, and stops for the rest of the test:
+    /// every actor but a pedestrian, which only stops it until it has walked out of its path.
+    pub(crate) fn wrecks_a_car(self) -> bool {
+        !matches!(self, ActorRef::Pedestrian(_))
+    }
+
+    /// Its handle's index in its kind's order (0 for the ego).
+    pub(crate) fn index(self) -> usize {
+        match self {
+            ActorRef::Ego => 0,
+            ActorRef::Pedestrian(h) => h.index(),
+            ActorRef::Car(h) => h.index(),
+            ActorRef::Obstacle(h) => h.index(),
+        }
+    }
+}
+
 /// What a probe reads from its actor, each step (paper §2: `rxout pos, vel, ...`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Output {
@@ -134,6 +152,46 @@ impl Action {
             }
         }
     }
+}
+
+/// What a place action's value must be ([`Action::PlaceCar`]), as its error says.
+pub(crate) const POSE_EXPECTED: &str =
+    "a (Vec3 [x, y, z] m, heading rad[, speed m/s >= 0]) tuple of finite numbers";
+
+/// A placed actor's pose, `(Vec3 [x, y, z] m, heading rad)`, and the speed its script gives
+/// it when the tuple has a third number (m/s, finite and `>= 0`): see [`Action::PlaceCar`].
+/// `None` for anything else.
+pub(crate) fn placed_pose(value: &Value) -> Option<([f64; 3], f64, Option<f64>)> {
+    let pose = |p: &[f64; 3], h: f64| p.iter().all(|x| x.is_finite()) && h.is_finite();
+    match value {
+        Value::Tuple(t) => match t.as_slice() {
+            [Value::Vec3(p), Value::Num(h)] if pose(p, *h) => Some((*p, *h, None)),
+            [Value::Vec3(p), Value::Num(h), Value::Num(v)]
+                if pose(p, *h) && v.is_finite() && *v >= 0.0 =>
+            {
+                Some((*p, *h, Some(*v)))
+            }
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// The error for `value`, given at time `t_s` (s) to `name` (an action's argument), which
+/// is not `expected`.
+pub(crate) fn bad_input(
+    t_s: f64,
+    name: String,
+    value: &Value,
+    expected: &str,
+) -> crate::EngineError {
+    crate::rx::RxError::Input {
+        name,
+        t_s,
+        value: crate::rx::describe(value),
+        expected: expected.into(),
+    }
+    .into()
 }
 
 /// Collects nodes; each push returns the new stream's id.

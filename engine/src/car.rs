@@ -1,10 +1,11 @@
 use rapier3d::prelude::*;
 use serde::Serialize;
 
-use crate::actor::{Size, VisibleBox};
-use crate::behaviour::ActorRef;
+use crate::actor::{half_open, ActorKind, Contact, Motion, Size, StepWorld, VisibleBox};
+use crate::behaviour::{bad_input, placed_pose, Action, ActorRef, POSE_EXPECTED};
 use crate::contact::Solids;
-use crate::rx::StreamId;
+use crate::rx::{constant, number, Graph, Input, StreamId, Value};
+use crate::{CarSpec, EngineError};
 
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
@@ -54,12 +55,15 @@ pub struct LaneChangeSpec {
 }
 
 impl LaneChangeSpec {
-    /// The share of the offset done at `tau` in `[0, 1]`, and its rate `d/dτ`.
+    /// The share of the offset done at `tau` in `[0, 1]`, and its rate `d/dτ`: the
+    /// minimum-jerk [`crate::transition::Shape`], stepped by the same code as every
+    /// OpenSCENARIO transition.
     fn profile(tau: f64) -> (f64, f64) {
-        let t = tau.clamp(0.0, 1.0);
-        let p = t * t * t * (10.0 - 15.0 * t + 6.0 * t * t);
-        let dp = 30.0 * t * t * (1.0 - t) * (1.0 - t);
-        (p, dp)
+        use crate::transition::{progress, progress_slope, Shape};
+        (
+            progress(Shape::MinimumJerk, tau),
+            progress_slope(Shape::MinimumJerk, tau),
+        )
     }
 }
 
@@ -102,6 +106,40 @@ fn stopping_speed(d_m: f64, a_mps2: f64, dt_s: f64) -> f64 {
 
 /// Gravitational acceleration in m/s², for the tyres' friction limit `μ·g`.
 pub(crate) const GRAVITY_MPS2: f64 = 9.81;
+
+/// Slack added to the distance within which an NPC car stays in the physics step, m: more
+/// than the car and the ego can close in one step at any speed the engine models.
+const SLEEP_MARGIN_M: f64 = 10.0;
+
+/// Checks car `i` of a graph of `n` streams: its route, size and lane change.
+///
+/// # Errors
+/// [`EngineError::InvalidWorld`] naming the car and the first value out of range.
+fn check_spec(i: usize, c: &CarSpec, n: usize) -> Result<(), EngineError> {
+    let invalid = |m: String| EngineError::InvalidWorld(m);
+    if c.path.len() < 2 || c.path.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(invalid(format!(
+            "car {i} has no route of two or more points"
+        )));
+    }
+    if !c.size.is_valid() {
+        return Err(invalid(format!("car {i} has the size {:?}", c.size)));
+    }
+    if let Some(change) = c.lane_change {
+        let starts_ok = match change.start {
+            LaneChangeStart::At(t0) => t0.is_finite() && t0 >= 0.0,
+            LaneChangeStart::When(s) => s.0 < n,
+        };
+        if !(change.offset_m.is_finite()
+            && change.duration_s.is_finite()
+            && change.duration_s > 0.0
+            && starts_ok)
+        {
+            return Err(invalid(format!("car {i} has the lane change {change:?}")));
+        }
+    }
+    Ok(())
+}
 
 /// A kinematic NPC car following a polyline at a commanded speed. Solid: the ego vehicle
 /// collides with it physically, and the lidar sees it.
@@ -157,11 +195,14 @@ pub(crate) struct Car {
     pub(crate) albedo: [f32; 3],
     /// Its speed stream, m/s.
     pub(crate) speed_stream: crate::rx::Input,
-    /// Whether it touches the ego vehicle now.
-    pub(crate) touching: bool,
-    /// Whether it has touched anything since the test began (the ego, a car, a pedestrian,
-    /// an obstacle).
-    pub(crate) collided: bool,
+    /// Whether it touches the ego vehicle now, and whether it has touched anything since the
+    /// test began (the ego, a car, a pedestrian, an obstacle).
+    contact: Contact,
+    /// How messages name it ([`CarSpec::name`], else `car i`).
+    name: String,
+    /// The lanes of the segment it starts on, for `changeLane`: each lane's number and its
+    /// offset from the start lane, m ([`CarSpec::lane_offsets_m`]).
+    lanes: Vec<(i32, f64)>,
     /// Whether it has crashed: run into a car or an obstacle, or been run into by a car. A
     /// crashed car stops for the rest of the test ([`Car::advance`]); a pedestrian it meets
     /// only stops it until the pedestrian has walked out of its path.
@@ -185,6 +226,186 @@ pub(crate) struct Car {
 }
 
 impl Car {
+    /// Car `i` of a world whose stream graph is `graph`, built into `physics` from its spec.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] naming the car and the first value out of range: a route
+    /// of fewer than two finite points, a size, a lane change or a kept distance.
+    pub(crate) fn from_spec(
+        i: usize,
+        c: &CarSpec,
+        graph: &Graph,
+        physics: &mut PhysicsWorld,
+    ) -> Result<Self, EngineError> {
+        check_spec(i, c, graph.nodes().len())?;
+        let mut car = Car::build(
+            physics,
+            c.path.clone(),
+            c.size,
+            c.enabled,
+            crate::colour::albedo(&c.color).unwrap_or([0.45, 0.45, 0.45]),
+            Input::of(graph, c.speed),
+        );
+        car.lane_change = c.lane_change;
+        if let Some(keep) = c.keep_distance_m {
+            if !(keep.is_finite() && keep >= 0.0) {
+                return Err(EngineError::InvalidWorld(format!(
+                    "car {i} keeps the distance {keep} m (finite and >= 0)"
+                )));
+            }
+        }
+        car.keep_distance_m = c.keep_distance_m;
+        // A car enters the test at its speed stream's first value, so at t = 0 (before a
+        // step has measured it) its speed is that value where it is known without running
+        // the program's code: a constant or an open parameter, also one varying over time.
+        if let Some(v) = constant(graph, c.speed).filter(|v| v.is_finite()) {
+            car.enter_at(v);
+        }
+        car.name = if c.name.is_empty() {
+            format!("car {i}")
+        } else {
+            c.name.clone()
+        };
+        car.lanes = c.lane_offsets_m.clone();
+        Ok(car)
+    }
+
+    /// Performs one of this step's actions on the car ([`Action::SetSpeed`],
+    /// [`Action::Brake`], [`Action::ChangeLane`], [`Action::PlaceCar`]) with its event's
+    /// `value`.
+    ///
+    /// # Errors
+    /// [`crate::rx::RxError::Input`] for a value the action cannot take, naming the car.
+    pub(crate) fn act(
+        &mut self,
+        action: Action,
+        value: &Value,
+        world: &StepWorld,
+    ) -> Result<(), EngineError> {
+        let (t, dt) = (world.t_s, world.dt_s);
+        let bad = |name: String, expected: &str| bad_input(t, name, value, expected);
+        match action {
+            Action::SetSpeed(_) => match value.as_num() {
+                Some(v) if v.is_finite() && v >= 0.0 && !matches!(value, Value::Bool(_)) => {
+                    self.speed_override = Some(v)
+                }
+                _ => {
+                    return Err(bad(
+                        format!("the speed given to {}'s setSpeed", self.name),
+                        "a finite number >= 0 (m/s)",
+                    ))
+                }
+            },
+            Action::Brake(_) => match value {
+                Value::Num(d) if d.is_finite() && *d > 0.0 => {
+                    self.speed_override = Some((self.speed_mps() - d * dt).max(0.0))
+                }
+                _ => {
+                    return Err(bad(
+                        format!("the deceleration given to {}'s brake", self.name),
+                        "a finite number > 0 (m/s²)",
+                    ))
+                }
+            },
+            Action::ChangeLane(_) => self.change_lane(value, t)?,
+            Action::PlaceCar(_) => {
+                let pose = placed_pose(value).ok_or_else(|| {
+                    bad(format!("the pose given to {}", self.name), POSE_EXPECTED)
+                })?;
+                self.script = Some((([pose.0[0], pose.0[2]], pose.1), pose.2));
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// Performs a `changeLane` event at time `t` (s): `value` is the lane, or `(lane,
+    /// duration in s)` (3 s when only the lane is given).
+    ///
+    /// # Errors
+    /// [`crate::rx::RxError::Input`] for a lane the car's segment lacks or a duration that is
+    /// not positive, naming the lanes it has.
+    fn change_lane(&mut self, value: &Value, t: f64) -> Result<(), EngineError> {
+        let (lane, duration) = match value {
+            Value::Num(l) => (*l, 3.0),
+            Value::Tuple(v) if v.len() == 2 => match (&v[0], &v[1]) {
+                (Value::Num(l), Value::Num(d)) => (*l, *d),
+                _ => (f64::NAN, f64::NAN),
+            },
+            _ => (f64::NAN, f64::NAN),
+        };
+        let offset = self
+            .lanes
+            .iter()
+            .find(|(l, _)| f64::from(*l) == lane)
+            .map(|(_, o)| *o);
+        let Some(offset) = offset.filter(|_| duration.is_finite() && duration > 0.0) else {
+            let known: Vec<String> = self.lanes.iter().map(|(l, _)| l.to_string()).collect();
+            return Err(bad_input(
+                t,
+                format!("the lane given to {}'s changeLane", self.name),
+                value,
+                &if known.is_empty() {
+                    "a lane of the segment the car starts on; it starts inside a junction, where there is none".to_owned()
+                } else {
+                    format!(
+                        "a lane of the segment the car starts on ({}), or (lane, duration > 0 s)",
+                        known.join(", ")
+                    )
+                },
+            ));
+        };
+        self.change_lane_to(offset, duration, t);
+        Ok(())
+    }
+
+    /// Moves the car over the step: to the pose its script gave it this step, else along its
+    /// path at its commanded speed (an action's, else its speed stream's), starting its lane
+    /// change when due; and moves it in `solids`. `me` is its handle; `reach` is the ego's
+    /// planar position `[x, z]` (m) and the distance from it within which the car stays in
+    /// the physics step before the car's own radius and a margin are added (the farthest
+    /// reach of the sensors that read the physics world plus the ego's bounding radius, m).
+    /// Returns what it ran into, if anything.
+    ///
+    /// # Errors
+    /// [`EngineError::Stream`] for a speed stream without a number now.
+    pub(crate) fn step(
+        &mut self,
+        me: ActorRef,
+        world: &mut StepWorld,
+        reach: ([f64; 2], f64),
+        solids: &mut Solids,
+    ) -> Result<Option<ActorRef>, EngineError> {
+        let (t, dt) = (world.t_s, world.dt_s);
+        let zone = AwakeZone {
+            ego_m: reach.0,
+            radius_m: reach.1 + self.radius_m() + SLEEP_MARGIN_M,
+        };
+        let hit = if let Some((pose, speed)) = self.script.take() {
+            self.place(world.physics, (pose, speed), dt, zone, solids, me)
+        } else {
+            let v = match self.speed_override {
+                Some(v) => v,
+                None => {
+                    let what = || format!("the speed of {}", self.name);
+                    number(world.streams, self.speed_stream, t, what)?
+                }
+            };
+            match self.lane_change.map(|c| c.start) {
+                Some(LaneChangeStart::At(t0)) if t >= t0 => self.start_lane_change(t0),
+                Some(LaneChangeStart::When(s)) if world.streams.fired(s) => {
+                    self.start_lane_change(t)
+                }
+                _ => {}
+            }
+            let friction = world.surface.friction_at(self.ground_m());
+            self.advance(world.physics, v, friction, (t, dt), zone, solids, me)
+        };
+        if self.body.is_some() {
+            solids.move_to(me, self.pose());
+        }
+        Ok(hit)
+    }
     /// A car on `path` (world `[x, z]` metres, two points or more), in the physics world when
     /// `enabled`, driven by `speed_stream`.
     pub(crate) fn build(
@@ -223,8 +444,9 @@ impl Car {
             ),
             albedo,
             speed_stream,
-            touching: false,
-            collided: false,
+            contact: Contact::default(),
+            name: String::new(),
+            lanes: Vec::new(),
             wrecked: false,
             keep_distance_m: None,
             lane_change: None,
@@ -573,8 +795,8 @@ impl Car {
         let hit = self.first_contact(solids, me, (self.s, s_new), next_t);
         if let Some((free_s, o)) = hit {
             s_new = free_s;
-            self.collided = true;
-            self.wrecked |= !matches!(o, ActorRef::Pedestrian(_));
+            self.contact.collided = true;
+            self.wrecked |= o.wrecks_a_car();
         }
         self.s = s_new;
         // At the end of its path, or against what it ran into, the car has stopped.
@@ -617,7 +839,7 @@ impl Car {
             return None;
         }
         let hit = solids.first_hit(me, self.shape().as_ref(), &self.pose_at(pose), false);
-        self.collided |= hit.is_some();
+        self.contact.collided |= hit.is_some();
         hit
     }
 
@@ -747,42 +969,6 @@ impl Car {
         None
     }
 
-    /// Its velocity over the ground in the last step, `[x, z]` m/s (before the first step,
-    /// its entry speed along its heading).
-    pub(crate) fn velocity_mps(&self) -> [f64; 2] {
-        self.velocity
-    }
-
-    /// The car as the time-to-collision test sees it, `None` when it is not in this test.
-    pub(crate) fn mover(&self) -> Option<crate::ttc::Mover> {
-        self.body?;
-        let ([x, z], heading_rad) = self.here;
-        Some(crate::ttc::Mover {
-            pos_m: [x, z],
-            velocity_mps: self.velocity,
-            heading_rad,
-            half_size_m: [self.size.length_m / 2.0, self.size.width_m / 2.0],
-        })
-    }
-
-    /// The box the camera draws: from the road to its roof, so it covers the wheels under
-    /// the collider's clearance.
-    pub(crate) fn visible(&self, index: usize) -> Option<VisibleBox> {
-        self.body?;
-        let ([x, z], heading_rad) = self.here;
-        Some(VisibleBox {
-            base_m: [x, 0.0, z],
-            size: Size {
-                height_m: self.size.height_m + CLEARANCE_M,
-                ..self.size
-            },
-            heading_rad,
-            albedo: self.albedo,
-            class: crate::segmentation::SemanticClass::Car,
-            actor: index,
-        })
-    }
-
     /// The centre of its body `[x, y, z]`, metres: its `pos` output (an actor's reference
     /// point, as the ego's chassis centre is the ego's).
     pub(crate) fn centre_m(&self) -> [f64; 3] {
@@ -798,6 +984,81 @@ impl Car {
             speed_mps: self.speed,
             enabled: self.body.is_some(),
         }
+    }
+}
+
+impl ActorKind for Car {
+    fn contact(&self) -> Contact {
+        self.contact
+    }
+
+    fn contact_mut(&mut self) -> &mut Contact {
+        &mut self.contact
+    }
+
+    fn motion(&self) -> Option<Motion> {
+        self.body?;
+        let [vx, vz] = self.velocity;
+        Some(Motion {
+            pos_m: self.centre_m(),
+            vel_mps: [vx, 0.0, vz],
+            heading_rad: half_open(self.here.1),
+            speed_mps: vx.hypot(vz),
+        })
+    }
+
+    fn solid(&self, _: &PhysicsWorld) -> Option<(Pose, SharedShape)> {
+        self.body?;
+        Some((self.pose(), self.shape()))
+    }
+
+    fn collider_now<'a>(&self, physics: &'a PhysicsWorld) -> Option<(Pose, &'a dyn Shape)> {
+        // A sleeping car's collider stays where it fell asleep: it gives the pose it keeps
+        // itself (equal to the collider's when awake).
+        let (body, h) = self.body?;
+        let co = &physics.colliders[h];
+        let awake = physics.bodies[body].is_enabled();
+        Some((if awake { *co.position() } else { self.pose() }, co.shape()))
+    }
+
+    /// The car as the time-to-collision test sees it, `None` when it is not in this test.
+    fn mover(&self) -> Option<crate::ttc::Mover> {
+        self.body?;
+        let ([x, z], heading_rad) = self.here;
+        Some(crate::ttc::Mover {
+            pos_m: [x, z],
+            velocity_mps: self.velocity,
+            heading_rad,
+            half_size_m: [self.size.length_m / 2.0, self.size.width_m / 2.0],
+        })
+    }
+
+    /// The box the camera draws: from the road to its roof, so it covers the wheels under
+    /// the collider's clearance.
+    fn visible(&self, index: usize) -> Option<VisibleBox> {
+        self.body?;
+        let ([x, z], heading_rad) = self.here;
+        Some(VisibleBox {
+            base_m: [x, 0.0, z],
+            size: Size {
+                height_m: self.size.height_m + CLEARANCE_M,
+                ..self.size
+            },
+            heading_rad,
+            albedo: self.albedo,
+            class: crate::segmentation::SemanticClass::Car,
+            actor: index,
+        })
+    }
+
+    /// Run into by a car: a crash, which ends its drive too.
+    fn run_into_by_car(&mut self) {
+        self.contact.collided = true;
+        self.wrecked = true;
+    }
+
+    fn end_step(&mut self) {
+        self.settle();
     }
 }
 

@@ -13,11 +13,13 @@
 #![warn(missing_docs)]
 
 pub mod actor;
+mod actors;
 pub mod behaviour;
 mod car;
 pub mod colour;
 mod contact;
 mod control;
+mod ego;
 mod environment;
 mod error;
 pub mod files;
@@ -36,12 +38,14 @@ mod sim;
 mod simd;
 mod spec;
 pub mod sut;
+pub mod transition;
 pub mod ttc;
 mod vehicle;
 
 pub use actor::{Handle, Set, Size, VisibleBox};
 pub use car::{CarState, LaneChangeSpec, LaneChangeStart};
 pub use control::Control;
+pub use ego::EgoState;
 pub use environment::{visibility_m, FOG_EXTINCTION_PER_M, NOMINAL_LIGHT};
 pub use error::{EngineError, RateError};
 pub use network::{Lane, Location, Network, PieceId, PieceKind};
@@ -54,7 +58,7 @@ pub use sensor::camera::{
 };
 pub use sensor::lidar::{LidarReturn, LidarSpec};
 pub use sensor::{SensorSpec, SettingError};
-pub use sim::{EgoState, Observation, Simulation, Snapshot, SnapshotParts};
+pub use sim::{Observation, Simulation, Snapshot, SnapshotParts};
 pub use spec::{
     CarSpec, EgoSpec, EnvironmentSpec, ObstacleSpec, PedestrianSpec, TriggeredPedestrian,
     WorldSpec, DEFAULT_DT_S,

@@ -1,7 +1,8 @@
 use rapier3d::prelude::*;
 use serde::Serialize;
 
-use crate::actor::{Size, VisibleBox};
+use crate::actor::{ActorKind, Contact, Motion, Size, VisibleBox};
+use crate::{EngineError, ObstacleSpec};
 
 /// A static obstacle's state, for snapshots.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -21,14 +22,36 @@ pub(crate) struct Obstacle {
     pub(crate) collider: ColliderHandle,
     state: ObstacleState,
     pub(crate) albedo: [f32; 3],
-    /// Whether it touches the ego vehicle now.
-    pub(crate) touching: bool,
-    /// Whether anything solid (the ego, a car, a pedestrian) has touched it since the test
-    /// began.
-    pub(crate) collided: bool,
+    /// Whether it touches the ego vehicle now, and whether anything solid (the ego, a car, a
+    /// pedestrian) has touched it since the test began.
+    contact: Contact,
 }
 
 impl Obstacle {
+    /// Obstacle `i` of a world, built into `physics` from its spec.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] for an invalid size or a base that is not finite.
+    pub(crate) fn from_spec(
+        i: usize,
+        o: &ObstacleSpec,
+        physics: &mut PhysicsWorld,
+    ) -> Result<Self, EngineError> {
+        if !o.size.is_valid() || o.base_m.iter().any(|v| !v.is_finite()) {
+            return Err(EngineError::InvalidWorld(format!(
+                "obstacle {i} has the size {:?} at {:?}",
+                o.size, o.base_m
+            )));
+        }
+        Ok(Obstacle::build(
+            physics,
+            o.base_m,
+            o.heading_rad,
+            o.size,
+            crate::colour::albedo(&o.color).unwrap_or([0.45, 0.45, 0.45]),
+        ))
+    }
+
     /// An obstacle standing on `base_m` (its base's centre, metres), turned `heading_rad`.
     pub(crate) fn build(
         physics: &mut PhysicsWorld,
@@ -60,29 +83,57 @@ impl Obstacle {
                 size,
             },
             albedo,
-            touching: false,
-            collided: false,
+            contact: Contact::default(),
         }
     }
 
     pub(crate) fn state(&self) -> ObstacleState {
         self.state
     }
+}
 
-    pub(crate) fn visible(&self, index: usize) -> VisibleBox {
-        VisibleBox {
+impl ActorKind for Obstacle {
+    fn contact(&self) -> Contact {
+        self.contact
+    }
+
+    fn contact_mut(&mut self) -> &mut Contact {
+        &mut self.contact
+    }
+
+    fn motion(&self) -> Option<Motion> {
+        Some(Motion {
+            pos_m: self.state.base_m,
+            vel_mps: [0.0; 3],
+            heading_rad: self.state.heading_rad,
+            speed_mps: 0.0,
+        })
+    }
+
+    fn solid(&self, physics: &PhysicsWorld) -> Option<(Pose, SharedShape)> {
+        let c = &physics.colliders[self.collider];
+        Some((*c.position(), c.shared_shape().clone()))
+    }
+
+    fn collider_now<'a>(&self, physics: &'a PhysicsWorld) -> Option<(Pose, &'a dyn Shape)> {
+        let c = &physics.colliders[self.collider];
+        Some((*c.position(), c.shape()))
+    }
+
+    fn visible(&self, index: usize) -> Option<VisibleBox> {
+        Some(VisibleBox {
             base_m: self.state.base_m,
             size: self.state.size,
             heading_rad: self.state.heading_rad,
             albedo: self.albedo,
             class: crate::segmentation::SemanticClass::Obstacle,
             actor: index,
-        }
+        })
     }
 
     /// It as the time-to-collision test sees it: standing still.
-    pub(crate) fn mover(&self) -> crate::ttc::Mover {
-        crate::ttc::Mover {
+    fn mover(&self) -> Option<crate::ttc::Mover> {
+        Some(crate::ttc::Mover {
             pos_m: [self.state.base_m[0], self.state.base_m[2]],
             velocity_mps: [0.0, 0.0],
             heading_rad: self.state.heading_rad,
@@ -90,6 +141,6 @@ impl Obstacle {
                 self.state.size.length_m / 2.0,
                 self.state.size.width_m / 2.0,
             ],
-        }
+        })
     }
 }

@@ -1,6 +1,12 @@
 use rapier3d::prelude::*;
 use serde::Serialize;
 
+use crate::actor::{half_open, ActorKind, Contact, Motion, StepWorld, VisibleBox};
+use crate::behaviour::{bad_input, placed_pose, Action, ActorRef, POSE_EXPECTED};
+use crate::contact::Solids;
+use crate::rx::{number, Graph, Input, Value};
+use crate::{EngineError, PedestrianSpec};
+
 /// Capsule radius of a pedestrian, in metres.
 pub(crate) const PED_RADIUS_M: f32 = 0.3;
 /// Half-height of the capsule's cylinder, in metres (total height 1.8 m).
@@ -45,10 +51,11 @@ pub(crate) struct Pedestrian {
     pub(crate) collider: ColliderHandle,
     /// Its walking speed stream, m/s.
     pub(crate) speed_stream: crate::rx::Input,
-    /// Whether it touches the ego vehicle now.
-    pub(crate) touching: bool,
-    /// Whether it has touched anything since the test began (the ego, a car, an obstacle).
-    pub(crate) collided: bool,
+    /// Whether it touches the ego vehicle now, and whether it has touched anything since the
+    /// test began (the ego, a car, an obstacle).
+    contact: Contact,
+    /// How messages name it ([`PedestrianSpec::name`], else `pedestrian i`).
+    name: String,
     target: [f64; 3],
     pos: [f64; 3],
     /// Where it was at the start of this step ([`Pedestrian::rest`]).
@@ -62,6 +69,78 @@ pub(crate) struct Pedestrian {
 }
 
 impl Pedestrian {
+    /// Checks pedestrian `i` before anything is built: its initial speed.
+    ///
+    /// # Errors
+    /// [`EngineError::InvalidWorld`] for an initial speed that is negative or not finite.
+    pub(crate) fn check_spec(i: usize, p: &PedestrianSpec) -> Result<(), EngineError> {
+        if !(p.initial_speed_mps.is_finite() && p.initial_speed_mps >= 0.0) {
+            return Err(EngineError::InvalidWorld(format!(
+                "pedestrian {i}'s initial speed {} m/s is negative or not finite",
+                p.initial_speed_mps
+            )));
+        }
+        Ok(())
+    }
+
+    /// Pedestrian `i` of a world whose stream graph is `graph`, built into `physics` from
+    /// its spec (checked by [`Pedestrian::check_spec`]).
+    pub(crate) fn from_spec(
+        i: usize,
+        p: &PedestrianSpec,
+        graph: &Graph,
+        physics: &mut PhysicsWorld,
+    ) -> Self {
+        let speed = Input::of(graph, p.speed);
+        let mut ped = Pedestrian::build(physics, (p.start, p.target), speed, p.initial_speed_mps);
+        ped.name = if p.name.is_empty() {
+            format!("pedestrian {i}")
+        } else {
+            p.name.clone()
+        };
+        ped
+    }
+
+    /// Performs one of this step's actions on the pedestrian ([`Action::Walk`] at its speed
+    /// stream's value now, [`Action::PlacePedestrian`]) with its event's `value`.
+    ///
+    /// # Errors
+    /// [`EngineError::Stream`] for a speed stream without a number now;
+    /// [`crate::rx::RxError::Input`] for a pose that is not one, naming the pedestrian.
+    pub(crate) fn act(
+        &mut self,
+        action: Action,
+        value: &Value,
+        world: &mut StepWorld,
+    ) -> Result<(), EngineError> {
+        let (t, dt) = (world.t_s, world.dt_s);
+        match action {
+            Action::Walk(_) => {
+                let what = || format!("the speed of {}", self.name);
+                let v = number(world.streams, self.speed_stream, t, what)?;
+                self.walk(world.physics, t, dt, v);
+            }
+            Action::PlacePedestrian(_) => {
+                let pose = placed_pose(value).ok_or_else(|| {
+                    let name = format!("the pose given to {}", self.name);
+                    bad_input(t, name, value, POSE_EXPECTED)
+                })?;
+                self.place(world.physics, (pose.0, pose.1), pose.2, dt);
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// What it walked into this step among `solids`, as `me` (rapier reports no contact
+    /// between two kinematic bodies); it records the collision.
+    pub(crate) fn walked_into(&mut self, me: ActorRef, solids: &Solids) -> Option<ActorRef> {
+        let capsule = Capsule::new_y(PED_HALF_HEIGHT_M, PED_RADIUS_M);
+        let hit = solids.first_hit(me, &capsule, &self.collider_pose(), false);
+        self.contact.collided |= hit.is_some();
+        hit
+    }
+
     /// Builds a pedestrian standing at `start`, facing `target`, moving at
     /// `initial_speed_mps` (m/s) the way it faces until its first step.
     pub(crate) fn build(
@@ -84,8 +163,8 @@ impl Pedestrian {
             body,
             collider,
             speed_stream,
-            touching: false,
-            collided: false,
+            contact: Contact::default(),
+            name: String::new(),
             target,
             pos: start,
             step_start: start,
@@ -162,48 +241,9 @@ impl Pedestrian {
         self.walked = false;
     }
 
-    /// The way it faces, rad: toward its target, all the test long (a placed pedestrian: the
-    /// heading it was placed with).
-    pub(crate) fn heading_rad(&self) -> f64 {
-        self.heading_rad
-    }
-
     /// Its capsule's pose now (its feet at [`Pedestrian::pos`]).
     pub(crate) fn collider_pose(&self) -> Pose {
         Pose::from_translation(centre(self.pos))
-    }
-
-    /// Feet position `[x, y, z]` in metres.
-    pub(crate) fn pos(&self) -> [f64; 3] {
-        self.pos
-    }
-
-    /// Velocity `[x, y, z]` in m/s over the last step.
-    pub(crate) fn velocity(&self) -> [f64; 3] {
-        self.velocity
-    }
-
-    /// The pedestrian as the time-to-collision test sees it.
-    pub(crate) fn mover(&self) -> crate::ttc::Mover {
-        let r = f64::from(PED_RADIUS_M);
-        crate::ttc::Mover {
-            pos_m: [self.pos[0], self.pos[2]],
-            velocity_mps: [self.velocity[0], self.velocity[2]],
-            heading_rad: 0.0,
-            half_size_m: [r, r],
-        }
-    }
-
-    /// The box the camera draws: the capsule's bounding box, [`crate::Size::PEDESTRIAN`].
-    pub(crate) fn visible(&self, index: usize) -> crate::actor::VisibleBox {
-        crate::actor::VisibleBox {
-            base_m: self.pos,
-            size: crate::Size::PEDESTRIAN,
-            heading_rad: 0.0,
-            albedo: [0.75, 0.22, 0.18],
-            class: crate::segmentation::SemanticClass::Pedestrian,
-            actor: index,
-        }
     }
 
     pub(crate) fn state(&self) -> PedestrianState {
@@ -214,6 +254,65 @@ impl Pedestrian {
             velocity_mps: self.velocity,
             heading_rad: self.heading_rad,
         }
+    }
+}
+
+impl ActorKind for Pedestrian {
+    fn contact(&self) -> Contact {
+        self.contact
+    }
+
+    fn contact_mut(&mut self) -> &mut Contact {
+        &mut self.contact
+    }
+
+    fn motion(&self) -> Option<Motion> {
+        let v = self.velocity;
+        Some(Motion {
+            pos_m: self.pos,
+            vel_mps: v,
+            heading_rad: half_open(self.heading_rad),
+            speed_mps: v[0].hypot(v[1]).hypot(v[2]),
+        })
+    }
+
+    fn solid(&self, _: &PhysicsWorld) -> Option<(Pose, SharedShape)> {
+        Some((
+            self.collider_pose(),
+            SharedShape::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M),
+        ))
+    }
+
+    fn collider_now<'a>(&self, physics: &'a PhysicsWorld) -> Option<(Pose, &'a dyn Shape)> {
+        let c = &physics.colliders[self.collider];
+        Some((*c.position(), c.shape()))
+    }
+
+    /// The pedestrian as the time-to-collision test sees it.
+    fn mover(&self) -> Option<crate::ttc::Mover> {
+        let r = f64::from(PED_RADIUS_M);
+        Some(crate::ttc::Mover {
+            pos_m: [self.pos[0], self.pos[2]],
+            velocity_mps: [self.velocity[0], self.velocity[2]],
+            heading_rad: 0.0,
+            half_size_m: [r, r],
+        })
+    }
+
+    /// The box the camera draws: the capsule's bounding box, [`crate::Size::PEDESTRIAN`].
+    fn visible(&self, index: usize) -> Option<VisibleBox> {
+        Some(VisibleBox {
+            base_m: self.pos,
+            size: crate::Size::PEDESTRIAN,
+            heading_rad: 0.0,
+            albedo: [0.75, 0.22, 0.18],
+            class: crate::segmentation::SemanticClass::Pedestrian,
+            actor: index,
+        })
+    }
+
+    fn start_step(&mut self) {
+        self.rest();
     }
 }
 
@@ -247,13 +346,13 @@ mod tests {
         assert_eq!(s.phase, PedestrianPhase::Walking);
         assert_eq!(s.triggered_at_s, Some(0.1));
         assert!((s.pos_m[2] - 3.8).abs() < 1e-12);
-        assert!((p.velocity()[2] + 2.0).abs() < 1e-9);
+        assert!((p.state().velocity_mps[2] + 2.0).abs() < 1e-9);
         // A second walk event in the same step takes no second step.
         p.walk(&mut physics, 0.1, dt, 2.0);
         assert!((p.state().pos_m[2] - 3.8).abs() < 1e-12);
-        assert!((p.velocity()[2] + 2.0).abs() < 1e-9);
+        assert!((p.state().velocity_mps[2] + 2.0).abs() < 1e-9);
         // It faces its target (-z: heading pi/2) from the start.
-        assert!((p.heading_rad() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert!((p.state().heading_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
         // 8 m at 0.2 m per step: arrives after 40 steps in all, and stays.
         for i in 0..45 {
             p.rest();

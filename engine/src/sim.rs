@@ -1,16 +1,16 @@
-use std::collections::HashMap;
 use std::sync::mpsc::{channel, Receiver};
 
 use rapier3d::prelude::*;
 use serde::Serialize;
 
-use crate::actor::{Handle, Set, Size, VisibleBox};
+use crate::actor::{Contact, Handle, Size, StepWorld, VisibleBox};
+use crate::actors::Actors;
 use crate::behaviour::{Action, ActorRef, Output, Probe};
-use crate::car::{AwakeZone, Car, CarState, LaneChangeStart};
+use crate::car::{CarState, LaneChangeStart};
 use crate::contact::Solids;
+use crate::ego::{Ego, EgoState};
 use crate::network::{Lane, Network, PieceId, Surface};
-use crate::obstacle::{Obstacle, ObstacleState};
-use crate::pedestrian::{Pedestrian, PED_HALF_HEIGHT_M, PED_RADIUS_M};
+use crate::obstacle::ObstacleState;
 use crate::rx::{constant, number, Host, Input, Inputs, Runtime, StreamId, Value};
 use crate::sensor::{Reading, Scene, Sensor, Sensors};
 use crate::vehicle::EgoVehicle;
@@ -18,17 +18,6 @@ use crate::{
     CameraFrame, CameraSpec, CarSpec, Control, EngineError, ObstacleSpec, PedestrianSpec,
     PedestrianState, WorldSpec, NOMINAL_LIGHT,
 };
-
-/// The ego vehicle's state.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct EgoState {
-    /// Chassis centre `[x, y, z]` in metres.
-    pub pos_m: [f64; 3],
-    /// Heading in rad, counter-clockwise seen from above, `0` along `+x`, in `(-π, π]`.
-    pub heading_rad: f64,
-    /// Signed speed along the heading in m/s (negative when reversing).
-    pub speed_mps: f64,
-}
 
 /// What a system under test sees at one instant.
 #[derive(Debug, Clone)]
@@ -118,37 +107,6 @@ impl SnapshotParts {
     };
 }
 
-/// How messages name the actors: [`crate::CarSpec::name`], [`crate::PedestrianSpec::name`].
-#[derive(Debug, Clone, Default)]
-struct ActorNames {
-    cars: Vec<String>,
-    pedestrians: Vec<String>,
-}
-
-impl ActorNames {
-    fn car(&self, i: usize) -> String {
-        match self.cars.get(i) {
-            Some(n) if !n.is_empty() => n.clone(),
-            _ => format!("car {i}"),
-        }
-    }
-
-    fn pedestrian(&self, i: usize) -> String {
-        match self.pedestrians.get(i) {
-            Some(n) if !n.is_empty() => n.clone(),
-            _ => format!("pedestrian {i}"),
-        }
-    }
-}
-
-/// Which actor a collider belongs to.
-#[derive(Debug, Clone, Copy)]
-enum Owner {
-    Pedestrian(Handle<PedestrianSpec>),
-    Car(Handle<CarSpec>),
-    Obstacle(Handle<ObstacleSpec>),
-}
-
 /// Checks what [`Simulation::new`] checks before it builds anything: the step, the sensors'
 /// settings, and the ego vehicle's start lane and speed.
 ///
@@ -177,24 +135,13 @@ fn check_ego_and_step(spec: &WorldSpec) -> Result<(), EngineError> {
             spec.ego.initial_speed_mps
         )));
     }
-    for (i, p) in spec.pedestrians.iter().enumerate() {
-        if !(p.initial_speed_mps.is_finite() && p.initial_speed_mps >= 0.0) {
-            return Err(invalid(format!(
-                "pedestrian {i}'s initial speed {} m/s is negative or not finite",
-                p.initial_speed_mps
-            )));
-        }
-    }
-    Ok(())
+    Actors::check(spec)
 }
 
-/// The streams the world itself reads every step: each pedestrian's and car's speed, the
-/// varying frictions, the published streams, light and fog.
+/// The streams the world itself reads every step: the actors' ([`Actors::read_streams`]),
+/// the varying frictions, the published streams, light and fog.
 fn read_streams(spec: &WorldSpec) -> impl Iterator<Item = StreamId> + Clone + '_ {
-    spec.pedestrians
-        .iter()
-        .map(|p| p.speed)
-        .chain(spec.cars.iter().map(|c| c.speed))
+    Actors::read_streams(spec)
         .chain(spec.frictions.iter().map(|f| f.1))
         .chain(spec.published.iter().map(|p| p.1))
         .chain([spec.environment.light, spec.environment.fog])
@@ -222,159 +169,15 @@ fn world_runtime(spec: &WorldSpec, reads: impl Iterator<Item = StreamId>) -> Run
     rt
 }
 
-/// Checks car `i` of a graph of `n` streams: its route, size, lane change and kept distance.
-///
-/// # Errors
-/// [`EngineError::InvalidWorld`] naming the car and the first value out of range.
-fn check_car(i: usize, c: &CarSpec, n: usize) -> Result<(), EngineError> {
-    let invalid = |m: String| EngineError::InvalidWorld(m);
-    if c.path.len() < 2 || c.path.iter().flatten().any(|v| !v.is_finite()) {
-        return Err(invalid(format!(
-            "car {i} has no route of two or more points"
-        )));
-    }
-    if !c.size.is_valid() {
-        return Err(invalid(format!("car {i} has the size {:?}", c.size)));
-    }
-    if let Some(change) = c.lane_change {
-        let starts_ok = match change.start {
-            LaneChangeStart::At(t0) => t0.is_finite() && t0 >= 0.0,
-            LaneChangeStart::When(s) => s.0 < n,
-        };
-        if !(change.offset_m.is_finite()
-            && change.duration_s.is_finite()
-            && change.duration_s > 0.0
-            && starts_ok)
-        {
-            return Err(invalid(format!("car {i} has the lane change {change:?}")));
-        }
-    }
-    Ok(())
-}
-
-/// Builds `spec`'s NPC cars into `physics`, each car's collider recorded in `owners`.
-///
-/// # Errors
-/// [`EngineError::InvalidWorld`] for a car with an invalid route, size, lane change or kept
-/// distance ([`check_car`]).
-fn build_cars(
-    spec: &WorldSpec,
-    physics: &mut PhysicsWorld,
-    owners: &mut HashMap<ColliderHandle, Owner>,
-) -> Result<Set<Car, CarSpec>, EngineError> {
-    let n = spec.streams.nodes().len();
-    let mut cars = Set::default();
-    for (i, c) in spec.cars.iter().enumerate() {
-        check_car(i, c, n)?;
-        let mut car = Car::build(
-            physics,
-            c.path.clone(),
-            c.size,
-            c.enabled,
-            crate::colour::albedo(&c.color).unwrap_or([0.45, 0.45, 0.45]),
-            Input::of(&spec.streams, c.speed),
-        );
-        car.lane_change = c.lane_change;
-        if let Some(keep) = c.keep_distance_m {
-            if !(keep.is_finite() && keep >= 0.0) {
-                return Err(EngineError::InvalidWorld(format!(
-                    "car {i} keeps the distance {keep} m (finite and >= 0)"
-                )));
-            }
-        }
-        car.keep_distance_m = c.keep_distance_m;
-        // A car enters the test at its speed stream's first value, so at t = 0 (before a
-        // step has measured it) its speed is that value where it is known without running
-        // the program's code: a constant or an open parameter, also one varying over time.
-        if let Some(v) = constant(&spec.streams, c.speed).filter(|v| v.is_finite()) {
-            car.enter_at(v);
-        }
-        let collider = car.body.map(|(_, c)| c);
-        let h = cars.insert(car);
-        if let Some(collider) = collider {
-            owners.insert(collider, Owner::Car(h));
-        }
-    }
-    Ok(cars)
-}
-
-/// Builds `spec`'s static obstacles into `physics`, each collider recorded in `owners`.
-///
-/// # Errors
-/// [`EngineError::InvalidWorld`] for an obstacle with an invalid size or base.
-fn build_obstacles(
-    spec: &WorldSpec,
-    physics: &mut PhysicsWorld,
-    owners: &mut HashMap<ColliderHandle, Owner>,
-) -> Result<Set<Obstacle, ObstacleSpec>, EngineError> {
-    let mut obstacles = Set::default();
-    for (i, o) in spec.obstacles.iter().enumerate() {
-        if !o.size.is_valid() || o.base_m.iter().any(|v| !v.is_finite()) {
-            return Err(EngineError::InvalidWorld(format!(
-                "obstacle {i} has the size {:?} at {:?}",
-                o.size, o.base_m
-            )));
-        }
-        let obstacle = Obstacle::build(
-            physics,
-            o.base_m,
-            o.heading_rad,
-            o.size,
-            crate::colour::albedo(&o.color).unwrap_or([0.45, 0.45, 0.45]),
-        );
-        let collider = obstacle.collider;
-        owners.insert(collider, Owner::Obstacle(obstacles.insert(obstacle)));
-    }
-    Ok(obstacles)
-}
-
-/// The error for `value`, given at time `t_s` (s) to `name` (an action's argument), which
-/// is not `expected`.
-/// The pose a place action's value gives: `(Vec3 [x, y, z] m, heading rad)`, every number
-/// finite; `None` for anything else.
-/// A placed actor's pose, `(Vec3 [x, y, z] m, heading rad)`, and the speed its script gives
-/// it when the tuple has a third number (m/s, finite and `>= 0`): see [`Action::PlaceCar`].
-fn placed_pose(value: &Value) -> Option<([f64; 3], f64, Option<f64>)> {
-    let pose = |p: &[f64; 3], h: f64| p.iter().all(|x| x.is_finite()) && h.is_finite();
-    match value {
-        Value::Tuple(t) => match t.as_slice() {
-            [Value::Vec3(p), Value::Num(h)] if pose(p, *h) => Some((*p, *h, None)),
-            [Value::Vec3(p), Value::Num(h), Value::Num(v)]
-                if pose(p, *h) && v.is_finite() && *v >= 0.0 =>
-            {
-                Some((*p, *h, Some(*v)))
-            }
-            _ => None,
-        },
-        _ => None,
-    }
-}
-
-fn bad_input(t_s: f64, name: String, value: &Value, expected: &str) -> EngineError {
-    crate::rx::RxError::Input {
-        name,
-        t_s,
-        value: crate::rx::describe(value),
-        expected: expected.into(),
-    }
-    .into()
-}
-
 /// A running world: the physics, the actors in their sets, the stream graph that drives
 /// them, and the ego vehicle's sensors, advanced in fixed steps by [`Simulation::step`].
 pub struct Simulation {
     physics: PhysicsWorld,
     network: Network,
     surface: Surface,
-    ego: EgoVehicle,
-    route: Vec<[f64; 2]>,
-    /// [`EgoSpec::set_speed_mps`].
-    set_speed_mps: Option<f64>,
-    pedestrians: Set<Pedestrian, PedestrianSpec>,
-    cars: Set<Car, CarSpec>,
-    obstacles: Set<Obstacle, ObstacleSpec>,
-    /// The actor each actor collider belongs to.
-    owners: HashMap<ColliderHandle, Owner>,
+    ego: Ego,
+    /// The NPC cars, pedestrians and obstacles, each kind in its set.
+    actors: Actors,
     /// The light and the fog density, each `[0, 1]`.
     light_fog_inputs: (Input, Input),
     light_fog: (f64, f64),
@@ -384,22 +187,11 @@ pub struct Simulation {
     /// The step whose streams [`Simulation::evaluate`] has computed, if it has.
     evaluated: Option<u64>,
     sinks: Vec<(Action, Value)>,
-    /// Each car's lanes for `changeLane` ([`crate::CarSpec::lane_offsets_m`]).
-    car_lanes: Vec<Vec<(i32, f64)>>,
-    /// How messages name each car and each pedestrian ([`crate::CarSpec::name`]).
-    names: ActorNames,
     sensors: Sensors,
     events: Receiver<CollisionEvent>,
     collector: ChannelEventCollector,
     dt_s: f64,
     tick: u64,
-    /// Whether the ego vehicle has touched anything since the test began.
-    ego_collided: bool,
-    /// The ego vehicle's velocity over the last step, m/s: its chassis centre's move over
-    /// the step's length (rapier integrates the position over substeps, so the body's final
-    /// `linvel` differs from the move by up to 0.06 m/s while the suspension settles); before
-    /// the first step, its body's velocity.
-    ego_velocity: [f64; 3],
 }
 
 impl Simulation {
@@ -423,12 +215,18 @@ impl Simulation {
         let surface = Surface::new(&spec.network);
         // Each step sets every wheel's friction from the piece under it (EgoVehicle::grip).
         let friction = surface.friction_at([start.pos_m[0], start.pos_m[2]]);
-        let ego = EgoVehicle::build(
+        let vehicle = EgoVehicle::build(
             &mut physics,
             &spec.ego.vehicle,
             (start.pos_m, start.heading_rad, spec.ego.initial_speed_mps),
             friction,
             spec.ego.scripted,
+        );
+        let ego = Ego::new(
+            vehicle,
+            &physics,
+            spec.ego.route.clone(),
+            spec.ego.set_speed_mps,
         );
 
         let ids = read_streams(spec);
@@ -441,21 +239,7 @@ impl Simulation {
                 )));
             }
         }
-        let mut owners = HashMap::new();
-        let mut pedestrians = Set::default();
-        for p in &spec.pedestrians {
-            let speed = Input::of(&spec.streams, p.speed);
-            let ped = Pedestrian::build(
-                &mut physics,
-                (p.start, p.target),
-                speed,
-                p.initial_speed_mps,
-            );
-            let collider = ped.collider;
-            owners.insert(collider, Owner::Pedestrian(pedestrians.insert(ped)));
-        }
-        let cars = build_cars(spec, &mut physics, &mut owners)?;
-        let obstacles = build_obstacles(spec, &mut physics, &mut owners)?;
+        let actors = Actors::build(spec, &mut physics)?;
 
         let (collision_tx, events) = channel();
         let (force_tx, _) = channel();
@@ -465,13 +249,8 @@ impl Simulation {
             physics,
             network: spec.network.clone(),
             surface,
-            route: spec.ego.route.clone(),
-            set_speed_mps: spec.ego.set_speed_mps,
             ego,
-            pedestrians,
-            cars,
-            obstacles,
-            owners,
+            actors,
             light_fog_inputs: (
                 Input::of(&spec.streams, spec.environment.light),
                 Input::of(&spec.streams, spec.environment.fog),
@@ -486,21 +265,12 @@ impl Simulation {
             streams: world_runtime(spec, ids),
             evaluated: None,
             sinks: Vec::new(),
-            car_lanes: spec.cars.iter().map(|c| c.lane_offsets_m.clone()).collect(),
-            names: ActorNames {
-                cars: spec.cars.iter().map(|c| c.name.clone()).collect(),
-                pedestrians: spec.pedestrians.iter().map(|p| p.name.clone()).collect(),
-            },
             sensors,
             events,
             collector: ChannelEventCollector::new(collision_tx, force_tx, tear_tx),
             dt_s: spec.dt_s,
             tick: 0,
-            ego_collided: false,
-            ego_velocity: [0.0; 3],
         };
-        let v = sim.physics.bodies[sim.ego.body].linvel();
-        sim.ego_velocity = [v.x, v.y, v.z].map(f64::from);
         // Contacts and ray casts need the broad phase filled before the first step.
         sim.physics.detect_collisions(&(), &());
         sim.capture_all(|_| true)?;
@@ -524,7 +294,7 @@ impl Simulation {
 
     /// The ego vehicle's state now.
     pub fn ego_state(&self) -> EgoState {
-        ego_state(&self.physics, &self.ego)
+        self.ego.state(&self.physics)
     }
 
     /// What the system under test sees now: odometry, its route, and every sensor's latest
@@ -539,8 +309,8 @@ impl Simulation {
             t_s: self.t_s(),
             dt_s: self.dt_s,
             ego: self.ego_state(),
-            route: &self.route,
-            set_speed_mps: self.set_speed_mps,
+            route: &self.ego.route,
+            set_speed_mps: self.ego.set_speed_mps,
             readings,
         }
     }
@@ -594,12 +364,7 @@ impl Simulation {
     /// The boxes the camera draws: every enabled NPC car (its colour, from the ground to its
     /// roof), every pedestrian and every obstacle.
     pub fn visible_boxes(&self) -> Vec<VisibleBox> {
-        self.cars
-            .iter()
-            .filter_map(|(h, c)| c.visible(h.index()))
-            .chain(self.pedestrians.iter().map(|(h, p)| p.visible(h.index())))
-            .chain(self.obstacles.iter().map(|(h, o)| o.visible(h.index())))
-            .collect()
+        self.actors.visible_boxes()
     }
 
     /// Captures every sensor that `due` selects.
@@ -616,17 +381,12 @@ impl Simulation {
         } else {
             Vec::new()
         };
-        let asleep: Vec<(ColliderHandle, Pose)> = self
-            .cars
-            .values()
-            .filter(|c| c.is_asleep(&self.physics))
-            .filter_map(|c| Some((c.body?.1, c.collider_pose())))
-            .collect();
+        let asleep = self.actors.asleep(&self.physics);
         let scene = Scene {
             asleep: &asleep,
             physics: &self.physics,
-            ego_body: self.ego.body,
-            ego: ego_state(&self.physics, &self.ego),
+            ego_body: self.ego.vehicle.body,
+            ego: self.ego.state(&self.physics),
             light: self.light_fog.0,
             fog: self.light_fog.1,
             t_s: self.t_s(),
@@ -654,16 +414,11 @@ impl Simulation {
         let dt = self.dt_s;
         let t = self.t_s();
         self.evaluate(host)?;
-        let before = self.physics.bodies[self.ego.body].translation();
+        let before = self.ego.position(&self.physics);
         self.set_frictions(t)?;
-        if !self.ego.scripted {
-            self.ego.apply(control, dt);
-            self.ego.grip(&self.physics, &self.surface);
-            self.ego.update(&mut self.physics, dt);
-        }
-        for p in self.pedestrians.values_mut() {
-            p.rest();
-        }
+        self.ego
+            .drive(control, &mut self.physics, &self.surface, dt);
+        self.actors.start_step();
         self.act(t)?;
         self.move_kinematic_actors(t)?;
         if self.tick == 0 {
@@ -671,17 +426,10 @@ impl Simulation {
             self.capture_again_before_first_step()?;
         }
         self.physics.step_with_events(&(), &self.collector);
-        for car in self.cars.values_mut() {
-            car.settle();
-        }
+        self.actors.end_step();
         self.record_ego_contacts();
-        self.ego_collided |= self.ego_contact();
-        let after = self.physics.bodies[self.ego.body].translation();
-        self.ego_velocity = [
-            (f64::from(after.x) - f64::from(before.x)) / dt,
-            (f64::from(after.y) - f64::from(before.y)) / dt,
-            (f64::from(after.z) - f64::from(before.z)) / dt,
-        ];
+        self.ego.collided |= self.ego_contact();
+        self.ego.measure(before, &self.physics, dt);
         self.tick += 1;
         self.capture_due()
     }
@@ -703,159 +451,42 @@ impl Simulation {
 
     /// Moves the kinematic actors for the step at time `t` (s): each NPC car along its path
     /// (stopping short of, or against, what it meets; asleep when out of every sensor's
-    /// reach), then records the pedestrians that walked into a car or an obstacle.
+    /// reach), then records the pedestrians that walked into a car or an obstacle
+    /// ([`Actors::move_kinematic`]).
     ///
     /// # Errors
     /// [`EngineError::Stream`] for a car speed stream without a number now.
     fn move_kinematic_actors(&mut self, t: f64) -> Result<(), EngineError> {
         // NPC cars beyond the reach of every sensor that reads the physics world, and of the
-        // ego's body, sleep out of rapier's step (Car::advance).
+        // ego's body, sleep out of rapier's step (Car::step).
         let reach_m = self
             .sensors
             .values()
             .map(|s| s.physics_reach_m())
             .fold(0.0, f64::max);
-        let chassis = self.physics.bodies[self.ego.body].position().translation;
-        let ego_m = [f64::from(chassis.x), f64::from(chassis.z)];
+        let chassis = self.ego.position(&self.physics);
+        let ego_m = [chassis[0], chassis[2]];
         let ego_radius_m = {
-            let s = self.ego.size();
+            let s = self.ego.vehicle.size();
             0.5 * (s.length_m.powi(2) + s.width_m.powi(2) + s.height_m.powi(2)).sqrt()
         };
         // What a car may run into: obstacles, pedestrians (where this step's walk took
         // them), the other cars (each where it is when this one moves), and the ego for a
         // car that keeps its distance.
-        // (A world without NPC cars has nothing kinematic to stop: the pedestrians only, then,
-        // against obstacles.)
-        let kinematic_contacts =
-            !self.cars.is_empty() || !(self.pedestrians.is_empty() || self.obstacles.is_empty());
-        let mut solids = if kinematic_contacts {
+        let mut solids = if self.actors.kinematic_contacts() {
             self.solids()
         } else {
             Solids::new()
         };
-        let handles: Vec<Handle<CarSpec>> = self.cars.iter().map(|(h, _)| h).collect();
-        for h in handles {
-            let hit = self.advance_car(h, t, &mut solids, (ego_m, reach_m, ego_radius_m))?;
-            self.mark_hit(hit);
-        }
-        // A pedestrian that walks into a car or an obstacle (rapier reports no contact
-        // between two kinematic bodies): both record the collision.
-        let capsule = Capsule::new_y(PED_HALF_HEIGHT_M, PED_RADIUS_M);
-        for (h, p) in self.pedestrians.iter_mut().filter(|_| kinematic_contacts) {
-            let me = ActorRef::Pedestrian(h);
-            if let Some(o) = solids.first_hit(me, &capsule, &p.collider_pose(), false) {
-                p.collided = true;
-                match o {
-                    ActorRef::Car(j) => {
-                        if let Some(c) = self.cars.get_mut(j) {
-                            c.collided = true;
-                        }
-                    }
-                    ActorRef::Obstacle(j) => {
-                        if let Some(o) = self.obstacles.get_mut(j) {
-                            o.collided = true;
-                        }
-                    }
-                    _ => {}
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// Advances car `h` over the step at time `t` (s) and moves it in `solids`; `awake` is the
-    /// ego's planar position `[x, z]` (m), the farthest reach of the sensors that read the
-    /// physics world (m) and the ego's bounding radius (m), from which the car's
-    /// [`AwakeZone`] is computed. Returns what it ran into, if anything.
-    ///
-    /// # Errors
-    /// [`EngineError::Stream`] for a speed stream without a number now.
-    fn advance_car(
-        &mut self,
-        h: Handle<CarSpec>,
-        t: f64,
-        solids: &mut Solids,
-        awake: ([f64; 2], f64, f64),
-    ) -> Result<Option<ActorRef>, EngineError> {
-        let dt = self.dt_s;
-        let (ego_m, reach_m, ego_radius_m) = awake;
-        let i = h.index();
-        let Some(car) = self.cars.get_mut(h) else {
-            return Ok(None);
+        let mut world = StepWorld {
+            physics: &mut self.physics,
+            streams: &self.streams,
+            surface: &self.surface,
+            t_s: t,
+            dt_s: self.dt_s,
         };
-        if let Some((pose, speed)) = car.script.take() {
-            let zone = AwakeZone {
-                ego_m,
-                radius_m: reach_m + ego_radius_m + car.radius_m() + SLEEP_MARGIN_M,
-            };
-            let hit = car.place(
-                &mut self.physics,
-                (pose, speed),
-                dt,
-                zone,
-                solids,
-                ActorRef::Car(h),
-            );
-            if car.body.is_some() {
-                solids.move_to(ActorRef::Car(h), car.pose());
-            }
-            return Ok(hit);
-        }
-        let v = match car.speed_override {
-            Some(v) => v,
-            None => {
-                let names = &self.names;
-                let what = || format!("the speed of {}", names.car(i));
-                number(&self.streams, car.speed_stream, t, what)?
-            }
-        };
-        match car.lane_change.map(|c| c.start) {
-            Some(LaneChangeStart::At(t0)) if t >= t0 => car.start_lane_change(t0),
-            Some(LaneChangeStart::When(s)) if self.streams.fired(s) => car.start_lane_change(t),
-            _ => {}
-        }
-        let friction = self.surface.friction_at(car.ground_m());
-        let zone = AwakeZone {
-            ego_m,
-            radius_m: reach_m + ego_radius_m + car.radius_m() + SLEEP_MARGIN_M,
-        };
-        let hit = car.advance(
-            &mut self.physics,
-            v,
-            friction,
-            (t, dt),
-            zone,
-            solids,
-            ActorRef::Car(h),
-        );
-        if car.body.is_some() {
-            solids.move_to(ActorRef::Car(h), car.pose());
-        }
-        Ok(hit)
-    }
-
-    /// Records that `hit` (a car, a pedestrian or an obstacle that a car ran into) collided.
-    fn mark_hit(&mut self, hit: Option<ActorRef>) {
-        match hit {
-            Some(ActorRef::Car(j)) => {
-                if let Some(c) = self.cars.get_mut(j) {
-                    c.collided = true;
-                    // Run into by a car: a crash, which ends its drive too.
-                    c.wrecked = true;
-                }
-            }
-            Some(ActorRef::Pedestrian(j)) => {
-                if let Some(p) = self.pedestrians.get_mut(j) {
-                    p.collided = true;
-                }
-            }
-            Some(ActorRef::Obstacle(j)) => {
-                if let Some(o) = self.obstacles.get_mut(j) {
-                    o.collided = true;
-                }
-            }
-            _ => {}
-        }
+        self.actors
+            .move_kinematic(&mut world, &mut solids, (ego_m, reach_m + ego_radius_m))
     }
 
     /// Reads this step's collision events between the ego vehicle and the actors: each actor
@@ -866,34 +497,14 @@ impl Simulation {
                 CollisionEvent::Started(a, b, _) => (a, b, true),
                 CollisionEvent::Stopped(a, b, _) => (a, b, false),
             };
-            let other = if a == self.ego.collider {
+            let other = if a == self.ego.vehicle.collider {
                 b
-            } else if b == self.ego.collider {
+            } else if b == self.ego.vehicle.collider {
                 a
             } else {
                 continue;
             };
-            match self.owners.get(&other) {
-                Some(Owner::Pedestrian(h)) => {
-                    if let Some(p) = self.pedestrians.get_mut(*h) {
-                        p.touching = started;
-                        p.collided |= started;
-                    }
-                }
-                Some(Owner::Car(h)) => {
-                    if let Some(c) = self.cars.get_mut(*h) {
-                        c.touching = started;
-                        c.collided |= started;
-                    }
-                }
-                Some(Owner::Obstacle(h)) => {
-                    if let Some(o) = self.obstacles.get_mut(*h) {
-                        o.touching = started;
-                        o.collided |= started;
-                    }
-                }
-                None => {}
-            }
+            self.actors.record_ego_contact(other, started);
         }
     }
 
@@ -937,11 +548,7 @@ impl Simulation {
             physics: &self.physics,
             ego: &self.ego,
             ego_touching: self.ego_contact(),
-            ego_collided: self.ego_collided,
-            ego_velocity: self.ego_velocity,
-            pedestrians: &self.pedestrians,
-            cars: &self.cars,
-            obstacles: &self.obstacles,
+            actors: &self.actors,
         };
         self.streams.step(t, &inputs, host, &mut self.sinks)?;
         self.evaluated = Some(self.tick);
@@ -966,17 +573,17 @@ impl Simulation {
     /// The handles of the world's NPC cars, in [`WorldSpec::cars`]' order (a disabled car
     /// included).
     pub fn cars(&self) -> impl Iterator<Item = Handle<CarSpec>> + '_ {
-        self.cars.iter().map(|(h, _)| h)
+        self.actors.cars.iter().map(|(h, _)| h)
     }
 
     /// The handles of the world's pedestrians, in [`WorldSpec::pedestrians`]' order.
     pub fn pedestrians(&self) -> impl Iterator<Item = Handle<PedestrianSpec>> + '_ {
-        self.pedestrians.iter().map(|(h, _)| h)
+        self.actors.pedestrians.iter().map(|(h, _)| h)
     }
 
     /// The handles of the world's obstacles, in [`WorldSpec::obstacles`]' order.
     pub fn obstacles(&self) -> impl Iterator<Item = Handle<ObstacleSpec>> + '_ {
-        self.obstacles.iter().map(|(h, _)| h)
+        self.actors.obstacles.iter().map(|(h, _)| h)
     }
 
     /// The latest value of stream `id` (after [`Simulation::evaluate`] for this step), `None`
@@ -1000,218 +607,26 @@ impl Simulation {
             .collect())
     }
 
-    /// Performs this step's `foreach` events, in order: walking steps, car speeds, brakes and
-    /// lane changes.
+    /// Performs this step's `foreach` events, in order: each actor's ([`Actors::act`]:
+    /// walking steps, car speeds, brakes, lane changes, placements) and the ego's.
     ///
     /// # Errors
     /// [`crate::rx::RxError::Input`] for an argument the action cannot take (a speed that is
     /// not a number, a lane the car's segment lacks).
     fn act(&mut self, t: f64) -> Result<(), EngineError> {
-        let dt = self.dt_s;
-        let sinks = std::mem::take(&mut self.sinks);
-        let bad = |name: String, v: &Value, expected: &str| bad_input(t, name, v, expected);
-        for (sink, value) in &sinks {
-            match *sink {
-                Action::Walk(h) => {
-                    if let Some(p) = self.pedestrians.get_mut(h) {
-                        let what = || format!("the speed of {}", self.names.pedestrian(h.index()));
-                        let v = number(&self.streams, p.speed_stream, t, what)?;
-                        p.walk(&mut self.physics, t, dt, v);
-                    }
-                }
-                Action::SetSpeed(h) => {
-                    let Some(car) = self.cars.get_mut(h) else {
-                        continue;
-                    };
-                    match value.as_num() {
-                        Some(v)
-                            if v.is_finite() && v >= 0.0 && !matches!(value, Value::Bool(_)) =>
-                        {
-                            car.speed_override = Some(v)
-                        }
-                        _ => {
-                            return Err(bad(
-                                format!(
-                                    "the speed given to {}'s setSpeed",
-                                    self.names.car(h.index())
-                                ),
-                                value,
-                                "a finite number >= 0 (m/s)",
-                            ))
-                        }
-                    }
-                }
-                Action::Brake(h) => {
-                    let Some(car) = self.cars.get_mut(h) else {
-                        continue;
-                    };
-                    match value {
-                        Value::Num(d) if d.is_finite() && *d > 0.0 => {
-                            car.speed_override = Some((car.speed_mps() - d * dt).max(0.0))
-                        }
-                        _ => {
-                            return Err(bad(
-                                format!(
-                                    "the deceleration given to {}'s brake",
-                                    self.names.car(h.index())
-                                ),
-                                value,
-                                "a finite number > 0 (m/s²)",
-                            ))
-                        }
-                    }
-                }
-                Action::ChangeLane(h) => self.change_lane(h, value, t)?,
-                Action::PlaceCar(h) => {
-                    let pose = placed_pose(value).ok_or_else(|| {
-                        bad(
-                            format!("the pose given to {}", self.names.car(h.index())),
-                            value,
-                            "a (Vec3 [x, y, z] m, heading rad[, speed m/s >= 0]) tuple of finite numbers",
-                        )
-                    })?;
-                    if let Some(car) = self.cars.get_mut(h) {
-                        car.script = Some((([pose.0[0], pose.0[2]], pose.1), pose.2));
-                    }
-                }
-                Action::PlacePedestrian(h) => {
-                    let pose = placed_pose(value).ok_or_else(|| {
-                        bad(
-                            format!("the pose given to {}", self.names.pedestrian(h.index())),
-                            value,
-                            "a (Vec3 [x, y, z] m, heading rad[, speed m/s >= 0]) tuple of finite numbers",
-                        )
-                    })?;
-                    if let Some(p) = self.pedestrians.get_mut(h) {
-                        p.place(&mut self.physics, (pose.0, pose.1), pose.2, dt);
-                    }
-                }
-                Action::PlaceEgo
-                | Action::SetEgoRoute
-                | Action::ReleaseEgo
-                | Action::SetEgoSpeed => self.act_on_ego(*sink, value, t)?,
-            }
-        }
-        self.sinks = sinks;
-        Ok(())
-    }
-
-    /// Performs a storyboard's action on the ego at time `t` (s): a pose for a scripted ego,
-    /// a route or a set speed for its system under test, the hand-over to that system.
-    ///
-    /// # Errors
-    /// [`crate::rx::RxError::Input`] for a value the action cannot take (a pose or route that
-    /// is not a tuple of finite numbers, a negative set speed), or a pose for an ego the system
-    /// under test drives.
-    fn act_on_ego(&mut self, action: Action, value: &Value, t: f64) -> Result<(), EngineError> {
-        let bad = |name: String, v: &Value, expected: &str| bad_input(t, name, v, expected);
-        match action {
-            Action::PlaceEgo => {
-                let pose = placed_pose(value).ok_or_else(|| {
-                    bad(
-                    "the pose given to the ego".into(),
-                    value,
-                    "a (Vec3 [x, y, z] m, heading rad[, speed m/s >= 0]) tuple of finite numbers",
-                )
-                })?;
-                if !self.ego.scripted {
-                    return Err(bad(
-                        "a pose given to the ego, which the system under test drives \
-                     (EgoSpec::scripted is not set)"
-                            .into(),
-                        value,
-                        "no pose",
-                    ));
-                }
-                self.ego.place(&mut self.physics, pose.0, pose.1);
-            }
-            Action::SetEgoRoute => {
-                let points: Option<Vec<[f64; 2]>> = match value {
-                    Value::Tuple(items) if items.len() >= 2 => items
-                        .iter()
-                        .map(|v| match v {
-                            Value::Vec3(p) if p[0].is_finite() && p[2].is_finite() => {
-                                Some([p[0], p[2]])
-                            }
-                            _ => None,
-                        })
-                        .collect(),
-                    _ => None,
-                };
-                let Some(points) = points else {
-                    return Err(bad(
-                        "the route given to the ego's system under test".into(),
-                        value,
-                        "a tuple of two or more Vec3 [x, y, z] points of finite numbers (m)",
-                    ));
-                };
-                self.route = points;
-            }
-            Action::ReleaseEgo => {
-                let v = self.ego_velocity;
-                self.ego.release(&mut self.physics, [v[0], 0.0, v[2]]);
-            }
-            Action::SetEgoSpeed => match value {
-                Value::Num(v) if v.is_finite() && *v >= 0.0 => self.set_speed_mps = Some(*v),
-                _ => {
-                    return Err(bad(
-                        "the set speed given to the ego's system under test".into(),
-                        value,
-                        "a finite number >= 0 (m/s)",
-                    ))
-                }
-            },
-            _ => {}
-        }
-        Ok(())
-    }
-
-    /// Performs a `changeLane` event of car `h` at time `t` (s): `value` is the lane, or
-    /// `(lane, duration in s)` (3 s when only the lane is given).
-    ///
-    /// # Errors
-    /// [`crate::rx::RxError::Input`] for a lane the car's segment lacks or a duration that is
-    /// not positive, naming the lanes it has.
-    fn change_lane(
-        &mut self,
-        h: Handle<CarSpec>,
-        value: &Value,
-        t: f64,
-    ) -> Result<(), EngineError> {
-        let (lane, duration) = match value {
-            Value::Num(l) => (*l, 3.0),
-            Value::Tuple(v) if v.len() == 2 => match (&v[0], &v[1]) {
-                (Value::Num(l), Value::Num(d)) => (*l, *d),
-                _ => (f64::NAN, f64::NAN),
-            },
-            _ => (f64::NAN, f64::NAN),
+        let mut world = StepWorld {
+            physics: &mut self.physics,
+            streams: &self.streams,
+            surface: &self.surface,
+            t_s: t,
+            dt_s: self.dt_s,
         };
-        let lanes = self.car_lanes.get(h.index()).cloned().unwrap_or_default();
-        let offset = lanes
-            .iter()
-            .find(|(l, _)| f64::from(*l) == lane)
-            .map(|(_, o)| *o);
-        let Some(offset) = offset.filter(|_| duration.is_finite() && duration > 0.0) else {
-            let known: Vec<String> = lanes.iter().map(|(l, _)| l.to_string()).collect();
-            return Err(bad_input(
-                t,
-                format!(
-                    "the lane given to {}'s changeLane",
-                    self.names.car(h.index())
-                ),
-                value,
-                &if known.is_empty() {
-                    "a lane of the segment the car starts on; it starts inside a junction, where there is none".to_owned()
-                } else {
-                    format!(
-                        "a lane of the segment the car starts on ({}), or (lane, duration > 0 s)",
-                        known.join(", ")
-                    )
-                },
-            ));
-        };
-        if let Some(car) = self.cars.get_mut(h) {
-            car.change_lane_to(offset, duration, t);
+        for (sink, value) in &self.sinks {
+            if sink.actor() == ActorRef::Ego {
+                self.ego.act(*sink, value, world.physics, t)?;
+            } else {
+                self.actors.act(*sink, value, &mut world)?;
+            }
         }
         Ok(())
     }
@@ -1239,19 +654,13 @@ impl Simulation {
             physics: &self.physics,
             ego: &self.ego,
             ego_touching: self.ego_contact(),
-            ego_collided: self.ego_collided,
-            ego_velocity: self.ego_velocity,
-            pedestrians: &self.pedestrians,
-            cars: &self.cars,
-            obstacles: &self.obstacles,
+            actors: &self.actors,
         }
     }
 
     /// Whether the ego vehicle touches any actor now.
     fn ego_contact(&self) -> bool {
-        self.pedestrians.values().any(|p| p.touching)
-            || self.cars.values().any(|c| c.touching)
-            || self.obstacles.values().any(|o| o.touching)
+        self.actors.touching_ego()
     }
 
     /// The state monitors are computed from, every field of it.
@@ -1264,25 +673,9 @@ impl Simulation {
     /// NaN, for a runner whose monitors do not read it. Every other field is as
     /// [`Simulation::snapshot`] gives it, bit for bit.
     pub fn snapshot_of(&self, parts: SnapshotParts) -> Snapshot {
-        let chassis = &self.physics.colliders[self.ego.collider];
-        let collider = |h: ColliderHandle| {
-            let c = &self.physics.colliders[h];
-            (*c.position(), c.shape())
-        };
-        // Each actor's shape where it is now: a sleeping car's collider stays where it fell
-        // asleep, so cars give the pose they keep themselves (equal to the collider's when
-        // awake).
-        let actors = self
-            .pedestrians
-            .values()
-            .map(|p| collider(p.collider))
-            .chain(self.cars.values().filter_map(|c| {
-                let (body, h) = c.body?;
-                let co = &self.physics.colliders[h];
-                let awake = self.physics.bodies[body].is_enabled();
-                Some((if awake { *co.position() } else { c.pose() }, co.shape()))
-            }))
-            .chain(self.obstacles.values().map(|o| collider(o.collider)));
+        let chassis = &self.physics.colliders[self.ego.vehicle.collider];
+        // Each actor's shape where it is now ([`ActorKind::collider_now`]).
+        let actors = (self.actors.all()).filter_map(|(_, a)| a.collider_now(&self.physics));
         // The exact distance (GJK) to the nearest actor. The distance between bounding boxes
         // is a lower bound, so an actor whose bound is no smaller than the best distance found
         // cannot change the minimum, and is skipped; nearest bounds are tried first.
@@ -1315,7 +708,7 @@ impl Simulation {
         let ego = self.ego_state();
         let centre = [ego.pos_m[0], ego.pos_m[2]];
         let edge = self.surface.edge_distance_m(centre);
-        let size = self.ego.size();
+        let size = self.ego.vehicle.size();
         let ego_mover = crate::ttc::Mover {
             pos_m: [ego.pos_m[0], ego.pos_m[2]],
             velocity_mps: [
@@ -1326,13 +719,8 @@ impl Simulation {
             half_size_m: [size.length_m / 2.0, size.width_m / 2.0],
         };
         let ttc_s = if parts.ttc {
-            let movers: Vec<crate::ttc::Mover> = self
-                .pedestrians
-                .values()
-                .map(Pedestrian::mover)
-                .chain(self.cars.values().filter_map(Car::mover))
-                .chain(self.obstacles.values().map(Obstacle::mover))
-                .collect();
+            let movers: Vec<crate::ttc::Mover> =
+                self.actors.all().filter_map(|(_, a)| a.mover()).collect();
             crate::ttc::time_to_collision_s(&ego_mover, &movers)
         } else {
             f64::NAN
@@ -1341,9 +729,14 @@ impl Simulation {
             t_s: self.t_s(),
             ego,
             ttc_s,
-            pedestrians: self.pedestrians.values().map(Pedestrian::state).collect(),
-            cars: self.cars.values().map(Car::state).collect(),
-            obstacles: self.obstacles.values().map(Obstacle::state).collect(),
+            pedestrians: self
+                .actors
+                .pedestrians
+                .values()
+                .map(|p| p.state())
+                .collect(),
+            cars: self.actors.cars.values().map(|c| c.state()).collect(),
+            obstacles: self.actors.obstacles.values().map(|o| o.state()).collect(),
             ego_contact: self.ego_contact(),
             min_separation_m: min_sep,
             light: self.light_fog.0,
@@ -1367,19 +760,19 @@ impl Simulation {
     /// step (set from the piece under the wheel at the start of the step), in the order front
     /// right, front left, rear right, rear left; before the first step, the start piece's.
     pub fn ego_wheel_frictions(&self) -> Vec<f64> {
-        self.ego.wheel_frictions()
+        self.ego.vehicle.wheel_frictions()
     }
 
     /// The size of the ego vehicle's body.
     pub fn ego_size(&self) -> Size {
-        self.ego.size()
+        self.ego.vehicle.size()
     }
 
     /// The half extents of a car's collider along its length, height and width, metres, or
     /// `None` for a car not in this test (for checking that the drawing and the collider
     /// agree).
     pub fn car_collider_half_extents_m(&self, car: usize) -> Option<[f64; 3]> {
-        let (_, c) = self.cars.iter().nth(car)?;
+        let (_, c) = self.actors.cars.iter().nth(car)?;
         let (_, collider) = c.body?;
         let cuboid = self.physics.colliders[collider].shape().as_cuboid()?;
         let h = cuboid.half_extents;
@@ -1387,72 +780,22 @@ impl Simulation {
     }
 }
 
-/// Slack added to the distance within which an NPC car stays in the physics step, m: more
-/// than the car and the ego can close in one step at any speed the engine models.
-const SLEEP_MARGIN_M: f64 = 10.0;
-
-fn ego_state(physics: &PhysicsWorld, ego: &EgoVehicle) -> EgoState {
-    let body = &physics.bodies[ego.body];
-    let p = body.translation();
-    let forward = *body.rotation() * Vector::X;
-    EgoState {
-        pos_m: [p.x, p.y, p.z].map(f64::from),
-        heading_rad: half_open(f64::from(-forward.z).atan2(f64::from(forward.x))),
-        speed_mps: f64::from(body.linvel().dot(forward)),
-    }
-}
-
 /// The physics outputs the stream graph reads.
 struct WorldInputs<'a> {
     physics: &'a PhysicsWorld,
-    ego: &'a EgoVehicle,
+    ego: &'a Ego,
     /// Whether the ego vehicle touches any actor.
     ego_touching: bool,
-    /// Whether the ego vehicle has touched anything since the test began.
-    ego_collided: bool,
-    /// Its velocity over the last step, m/s ([`Simulation::ego_velocity`]).
-    ego_velocity: [f64; 3],
-    pedestrians: &'a Set<Pedestrian, PedestrianSpec>,
-    cars: &'a Set<Car, CarSpec>,
-    obstacles: &'a Set<Obstacle, ObstacleSpec>,
-}
-
-/// A heading from `atan2`, in `[-π, π]`, as one in `(-π, π]` (a location's and the ego's
-/// range): `-π` becomes `π`, every other value keeps its bits.
-fn half_open(heading_rad: f64) -> f64 {
-    if heading_rad <= -std::f64::consts::PI {
-        heading_rad + std::f64::consts::TAU
-    } else {
-        heading_rad
-    }
+    actors: &'a Actors,
 }
 
 impl WorldInputs<'_> {
     /// Every solid object's collider where it is now ([`Simulation::solids`]).
     fn solids(&self) -> Solids {
         let mut solids = Solids::new();
-        let ego = &self.physics.colliders[self.ego.collider];
+        let ego = &self.physics.colliders[self.ego.vehicle.collider];
         solids.put(ActorRef::Ego, *ego.position(), ego.shared_shape().clone());
-        for (h, car) in self.cars.iter() {
-            if car.body.is_some() {
-                solids.put(ActorRef::Car(h), car.pose(), car.shape());
-            }
-        }
-        for (h, p) in self.pedestrians.iter() {
-            solids.put(
-                ActorRef::Pedestrian(h),
-                p.collider_pose(),
-                SharedShape::capsule_y(PED_HALF_HEIGHT_M, PED_RADIUS_M),
-            );
-        }
-        for (h, o) in self.obstacles.iter() {
-            let c = &self.physics.colliders[o.collider];
-            solids.put(
-                ActorRef::Obstacle(h),
-                *c.position(),
-                c.shared_shape().clone(),
-            );
-        }
+        self.actors.put_solids(self.physics, &mut solids);
         solids
     }
 
@@ -1468,90 +811,39 @@ impl WorldInputs<'_> {
 
 impl Inputs for WorldInputs<'_> {
     fn probe(&self, probe: Probe) -> Value {
-        let output = probe.output;
-        match probe.actor {
+        let me = probe.actor;
+        // A disabled car is not in the test: its outputs have no events (it still moves
+        // along its path unseen, which nothing reads).
+        let (motion, contact, solid) = match me {
             ActorRef::Ego => {
-                let s = ego_state(self.physics, self.ego);
-                let vel = self.ego_velocity;
-                match output {
-                    Output::Pos => Value::Vec3(s.pos_m),
-                    Output::Vel => Value::Vec3(vel),
-                    Output::Heading => Value::Num(s.heading_rad),
-                    // The size of its velocity, negative when it moves backwards.
-                    Output::Speed => {
-                        let norm = vel[0].hypot(vel[1]).hypot(vel[2]);
-                        Value::Num(if s.speed_mps < 0.0 { -norm } else { norm })
-                    }
-                    Output::Collision => Value::Bool(self.ego_touching),
-                    Output::Collided => Value::Bool(self.ego_collided),
-                    Output::Separation => {
-                        let c = &self.physics.colliders[self.ego.collider];
-                        self.separation(ActorRef::Ego, c.shape(), c.position(), self.ego_touching)
-                    }
-                }
+                let c = &self.physics.colliders[self.ego.vehicle.collider];
+                let contact = Contact {
+                    touching: self.ego_touching,
+                    collided: self.ego.collided,
+                };
+                let solid = Some((*c.position(), c.shared_shape().clone()));
+                (self.ego.motion(self.physics), contact, solid)
             }
-            ActorRef::Pedestrian(h) => match self.pedestrians.get(h) {
+            other => {
+                let Some(a) = self.actors.get(other) else {
+                    return Value::Unit;
+                };
+                let Some(m) = a.motion() else {
+                    return Value::Unit;
+                };
+                (m, a.contact(), a.solid(self.physics))
+            }
+        };
+        match probe.output {
+            Output::Pos => Value::Vec3(motion.pos_m),
+            Output::Vel => Value::Vec3(motion.vel_mps),
+            Output::Heading => Value::Num(motion.heading_rad),
+            Output::Speed => Value::Num(motion.speed_mps),
+            Output::Collision => Value::Bool(contact.touching),
+            Output::Collided => Value::Bool(contact.collided),
+            Output::Separation => match solid {
+                Some((pose, shape)) => self.separation(me, shape.as_ref(), &pose, contact.touching),
                 None => Value::Unit,
-                Some(p) => {
-                    let v = p.velocity();
-                    match output {
-                        Output::Pos => Value::Vec3(p.pos()),
-                        Output::Vel => Value::Vec3(v),
-                        Output::Heading => Value::Num(half_open(p.heading_rad())),
-                        Output::Speed => Value::Num(v[0].hypot(v[1]).hypot(v[2])),
-                        Output::Collision => Value::Bool(p.touching),
-                        Output::Collided => Value::Bool(p.collided),
-                        Output::Separation => self.separation(
-                            ActorRef::Pedestrian(h),
-                            &Capsule::new_y(PED_HALF_HEIGHT_M, PED_RADIUS_M),
-                            &p.collider_pose(),
-                            p.touching,
-                        ),
-                    }
-                }
-            },
-            ActorRef::Car(h) => match self.cars.get(h) {
-                // A disabled car is not in the test: its outputs have no events (it still
-                // moves along its path unseen, which nothing reads).
-                None => Value::Unit,
-                Some(c) if c.body.is_none() => Value::Unit,
-                Some(c) => {
-                    let s = c.state();
-                    let [vx, vz] = c.velocity_mps();
-                    match output {
-                        Output::Pos => Value::Vec3(c.centre_m()),
-                        Output::Vel => Value::Vec3([vx, 0.0, vz]),
-                        Output::Heading => Value::Num(half_open(s.heading_rad)),
-                        Output::Speed => Value::Num(vx.hypot(vz)),
-                        Output::Collision => Value::Bool(c.touching),
-                        Output::Collided => Value::Bool(c.collided),
-                        Output::Separation => self.separation(
-                            ActorRef::Car(h),
-                            c.shape().as_ref(),
-                            &c.pose(),
-                            c.touching,
-                        ),
-                    }
-                }
-            },
-            ActorRef::Obstacle(h) => match self.obstacles.get(h) {
-                None => Value::Unit,
-                Some(o) => {
-                    let s = o.state();
-                    match output {
-                        Output::Pos => Value::Vec3(s.base_m),
-                        Output::Vel => Value::Vec3([0.0; 3]),
-                        Output::Heading => Value::Num(s.heading_rad),
-                        Output::Speed => Value::Num(0.0),
-                        Output::Collision => Value::Bool(o.touching),
-                        Output::Collided => Value::Bool(o.collided),
-                        Output::Separation => {
-                            let c = &self.physics.colliders[o.collider];
-                            let me = ActorRef::Obstacle(h);
-                            self.separation(me, c.shape(), c.position(), o.touching)
-                        }
-                    }
-                }
             },
         }
     }
@@ -1772,9 +1064,9 @@ mod tests {
                 .any(|r| r.point_m[2] < -2.5);
             seen_oncoming |= oncoming_seen;
             // The lidar sees an asleep car where it would be awake.
-            let oncoming = sleepy.cars.values().nth(1).unwrap();
+            let oncoming = sleepy.actors.cars.values().nth(1).unwrap();
             seen_asleep += usize::from(oncoming_seen && oncoming.is_asleep(&sleepy.physics));
-            for (i, car) in sleepy.cars.values().enumerate() {
+            for (i, car) in sleepy.actors.cars.values().enumerate() {
                 let asleep = car.is_asleep(&sleepy.physics);
                 asleep_steps += usize::from(asleep);
                 woke += usize::from(was_asleep[i] && !asleep);
@@ -1785,7 +1077,11 @@ mod tests {
                     assert_eq!(*sleepy.physics.colliders[collider].position(), car.pose());
                 }
             }
-            assert!(awake.cars.values().all(|c| !c.is_asleep(&awake.physics)));
+            assert!(awake
+                .actors
+                .cars
+                .values()
+                .all(|c| !c.is_asleep(&awake.physics)));
         }
         assert!(asleep_steps > 1000, "{asleep_steps}");
         assert!(woke >= 2, "{woke}");
@@ -1913,7 +1209,7 @@ mod tests {
             sim.light_fog_inputs,
             (Input::Const(_), Input::Const(_))
         ));
-        let walker = sim.pedestrians.values().next().unwrap();
+        let walker = sim.actors.pedestrians.values().next().unwrap();
         assert_eq!(walker.speed_stream, Input::Const(1.0));
         // A light that varies over the test stays a stream, read each step.
         let mut nodes = s.streams.nodes().to_vec();

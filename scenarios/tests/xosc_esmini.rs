@@ -8,9 +8,9 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+use paracosm_engine::network::roads::{wrap, Roads};
 use paracosm_engine::network::{opendrive, MapRef};
 use paracosm_openscenario::read_scenario;
-use paracosm_scenarios::xosc::road::{wrap, Roads};
 use paracosm_scenarios::xosc::story::Storyboard;
 
 /// esmini's step in the fixtures, s.

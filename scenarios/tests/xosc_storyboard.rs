@@ -5,9 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
+use paracosm_engine::network::roads::Roads;
 use paracosm_engine::network::{opendrive, MapRef};
 use paracosm_openscenario::read_scenario;
-use paracosm_scenarios::xosc::road::Roads;
 use paracosm_scenarios::xosc::story::{StoryError, Storyboard};
 
 const DT: f64 = 1.0 / 60.0;
@@ -457,7 +457,7 @@ fn a_point_on_a_lane_anchors_at_its_own_station() {
             let (s0, s1) = (lane.s[0], lane.s[lane.s.len() - 1]);
             let mut s = s0 + 0.5;
             while s < s1 - 0.5 {
-                let lp = paracosm_scenarios::xosc::road::LanePos {
+                let lp = paracosm_engine::network::roads::LanePos {
                     lane: k,
                     s,
                     d: 0.3,

@@ -16,6 +16,7 @@ mod lanes;
 mod map;
 pub mod opendrive;
 mod piece;
+pub mod roads;
 mod surface;
 
 pub use curve::{Frame, RefLine, SampledLine, POLYLINE_STEP_M};

@@ -77,8 +77,8 @@ impl Sut for Dagger {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::EgoState;
     use crate::sut::ConstantControl;
+    use crate::EgoState;
 
     fn obs() -> Observation<'static> {
         Observation {

@@ -62,8 +62,8 @@ impl Sut for StopAfter {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::EgoState;
     use crate::sut::ConstantControl;
+    use crate::EgoState;
 
     fn obs(x: f64) -> Observation<'static> {
         Observation {

@@ -13,7 +13,7 @@ mod describe;
 mod host_inputs;
 pub(crate) use host_inputs::StoryInputs;
 pub mod motion;
-pub mod road;
+
 mod space;
 pub mod story;
 
@@ -680,7 +680,7 @@ pub(crate) fn build_into(
     let map = maps
         .load(&road.item)
         .map_err(|e| ScenarioError::Load(e.with_context(&format!("\n --> {}", road.pos))))?;
-    let roads = road::Roads::new(&map);
+    let roads = paracosm_engine::network::roads::Roads::new(&map);
     let hand_over = !scripted_ego && activates_controller_of(model, ego);
     let driven = (!scripted_ego && !hand_over).then_some(ego);
     let mut sb = Storyboard::new(model, roads, driven).map_err(|e| worlds_error(e.to_string()))?;
@@ -827,12 +827,12 @@ fn lane_route(
     sb: &Storyboard,
     ego: usize,
     from: [f64; 2],
-    mut at: road::LanePos,
+    mut at: paracosm_engine::network::roads::LanePos,
     ahead_m: f64,
 ) -> Vec<[f64; 2]> {
     let mut route = vec![from];
     let prefer = |lane: usize| sb.route_takes(ego, lane);
-    let point = |at: &road::LanePos| {
+    let point = |at: &paracosm_engine::network::roads::LanePos| {
         let (p, _) = sb.roads().to_engine(sb.roads().pose_of(at));
         [p[0], p[2]]
     };

@@ -4,23 +4,26 @@
 
 use paracosm_openscenario::model::{Dimension, Dynamics, Shape};
 
-use super::road::Pose;
+use paracosm_engine::network::roads::{wrap, Pose};
 
-/// The fraction `[0, 1]` of a transition done at `tau` (`[0, 1]`, the fraction of its
-/// duration gone) for `shape`: linear `τ`, cubic `3τ² − 2τ³`, sinusoidal `(1 − cos πτ)/2`,
-/// step 1.
-pub fn progress(shape: Shape, tau: f64) -> f64 {
-    let tau = tau.clamp(0.0, 1.0);
+pub use paracosm_engine::transition::Transition;
+
+/// The engine's transition shape ([`paracosm_engine::transition::Shape`]) of an OpenSCENARIO
+/// `dynamicsShape`: every transition of the storyboard runs on the engine's one
+/// implementation, as the language's lane changes do.
+pub fn shape_of(shape: Shape) -> paracosm_engine::transition::Shape {
+    use paracosm_engine::transition::Shape as S;
     match shape {
-        Shape::Step => 1.0,
-        Shape::Linear => tau,
-        Shape::Cubic => tau * tau * (3.0 - 2.0 * tau),
-        Shape::Sinusoidal => 0.5 * (1.0 - (std::f64::consts::PI * tau).cos()),
+        Shape::Step => S::Step,
+        Shape::Linear => S::Linear,
+        Shape::Cubic => S::Cubic,
+        Shape::Sinusoidal => S::Sinusoidal,
     }
 }
 
 /// The peak rate of a transition of `shape` over `delta` in a unit time, per unit of
-/// `delta`: linear 1, cubic 1.5, sinusoidal π/2 (the largest slope of [`progress`]).
+/// `delta`: linear 1, cubic 1.5, sinusoidal π/2 (the largest slope of the shape's progress,
+/// [`paracosm_engine::transition::progress_slope`]).
 fn peak_slope(shape: Shape) -> f64 {
     match shape {
         Shape::Step | Shape::Linear => 1.0,
@@ -55,57 +58,6 @@ pub fn offset_duration_s(shape: Shape, delta: f64, max_acc: f64) -> f64 {
         Shape::Step => 0.0,
         Shape::Sinusoidal => std::f64::consts::PI * (d / (2.0 * a)).sqrt(),
         Shape::Linear | Shape::Cubic => (6.0 * d / a).sqrt(),
-    }
-}
-
-/// The slope of [`progress`] at `tau` (`[0, 1]`): linear 1, cubic `6τ(1 − τ)`, sinusoidal
-/// `(π/2)·sin πτ`, step 0.
-pub fn progress_slope(shape: Shape, tau: f64) -> f64 {
-    let tau = tau.clamp(0.0, 1.0);
-    match shape {
-        Shape::Step => 0.0,
-        Shape::Linear => 1.0,
-        Shape::Cubic => 6.0 * tau * (1.0 - tau),
-        Shape::Sinusoidal => std::f64::consts::FRAC_PI_2 * (std::f64::consts::PI * tau).sin(),
-    }
-}
-
-/// A value moving from `from` to `to` between `start_s` and `start_s + duration_s`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Transition {
-    /// Value at the start.
-    pub from: f64,
-    /// Value at the end.
-    pub to: f64,
-    /// Start time, s.
-    pub start_s: f64,
-    /// Length, s (0: a step).
-    pub duration_s: f64,
-    /// Its shape.
-    pub shape: Shape,
-}
-
-impl Transition {
-    /// The value at `t` (s) and whether the transition is over.
-    pub fn at(&self, t: f64) -> (f64, bool) {
-        if self.duration_s <= 0.0 || t >= self.start_s + self.duration_s - 1e-9 {
-            return (self.to, true);
-        }
-        let tau = (t - self.start_s) / self.duration_s;
-        (
-            self.from + (self.to - self.from) * progress(self.shape, tau),
-            false,
-        )
-    }
-
-    /// The value's rate of change at `t` (per s, or per unit of whatever `start_s` and
-    /// `duration_s` count); 0 for a step and outside the transition.
-    pub fn slope(&self, t: f64) -> f64 {
-        if self.duration_s <= 0.0 || t >= self.start_s + self.duration_s || t < self.start_s {
-            return 0.0;
-        }
-        let tau = (t - self.start_s) / self.duration_s;
-        (self.to - self.from) / self.duration_s * progress_slope(self.shape, tau)
     }
 }
 
@@ -221,7 +173,7 @@ pub fn clothoid_poses(start: Pose, curvature: f64, prime: f64, length: f64) -> V
                 Pose {
                     x: start.x + c * lx - s * ly,
                     y: start.y + s * lx + c * ly,
-                    h: super::road::wrap(start.h + line.heading(d)),
+                    h: wrap(start.h + line.heading(d)),
                 },
             )
         })
@@ -331,20 +283,13 @@ pub fn nurbs_poses(
                 x += f * p.2[0];
                 y += f * p.2[1];
                 if *bi > 1e-12 {
-                    h += f * super::road::wrap(p.3.unwrap_or(0.0) - h);
+                    h += f * wrap(p.3.unwrap_or(0.0) - h);
                 }
                 if *bi > peak[j].0 {
                     peak[j] = (*bi, u);
                 }
             }
-            (
-                u,
-                Pose {
-                    x,
-                    y,
-                    h: super::road::wrap(h),
-                },
-            )
+            (u, Pose { x, y, h: wrap(h) })
         })
         .collect();
     if !headed {
@@ -384,12 +329,16 @@ mod tests {
 
     #[test]
     fn shapes_start_at_zero_end_at_one_and_are_symmetric() {
+        use paracosm_engine::transition::progress;
         for shape in [Shape::Linear, Shape::Cubic, Shape::Sinusoidal] {
-            assert_eq!(progress(shape, 0.0), 0.0);
-            assert!((progress(shape, 1.0) - 1.0).abs() < 1e-12);
-            assert!((progress(shape, 0.5) - 0.5).abs() < 1e-12, "{shape:?}");
+            assert_eq!(progress(shape_of(shape), 0.0), 0.0);
+            assert!((progress(shape_of(shape), 1.0) - 1.0).abs() < 1e-12);
+            assert!(
+                (progress(shape_of(shape), 0.5) - 0.5).abs() < 1e-12,
+                "{shape:?}"
+            );
         }
-        assert_eq!(progress(Shape::Step, 0.0), 1.0);
+        assert_eq!(progress(shape_of(Shape::Step), 0.0), 1.0);
     }
 
     #[test]
@@ -407,7 +356,7 @@ mod tests {
             to: 3.5,
             start_s: 0.0,
             duration_s: t,
-            shape: Shape::Sinusoidal,
+            shape: shape_of(Shape::Sinusoidal),
         };
         let h = 1e-6;
         let slope = (tr.at(t / 2.0 + h).0 - tr.at(t / 2.0 - h).0) / (2.0 * h);
@@ -430,7 +379,7 @@ mod tests {
             to: delta,
             start_s: 0.0,
             duration_s: t,
-            shape: Shape::Sinusoidal,
+            shape: shape_of(Shape::Sinusoidal),
         };
         let h = 1e-4;
         let acc = (tr.at(2.0 * h).0 - 2.0 * tr.at(h).0 + tr.at(0.0).0) / (h * h);

@@ -109,7 +109,8 @@ impl Storyboard {
     /// it travels `dist` m, along its lanes with its lateral move: its pose, lane position,
     /// whether its lanes ended, and the action whose lateral move ended (if any).
     ///
-    /// A lateral move steps itself ([`Lateral::step`], esmini's `LatLaneChangeAction` and
+    /// A lateral move is stepped by the engine's one transition implementation
+    /// ([`paracosm_engine::transition::LateralMove::step`], esmini's `LatLaneChangeAction` and
     /// `LatLaneOffsetAction`).
     pub(in crate::xosc::story) fn drive_on_lane(
         &mut self,
@@ -122,7 +123,7 @@ impl Storyboard {
         // The heading relative to the lane's travel, as a slope against the travel.
         let mut slip = 0.0;
         if let Some(mut l) = self.drives[e].lateral {
-            let (d, over, a, s) = l.step(lp.d, dist, dt);
+            let (d, over, a, s) = l.mv.step(lp.d, dist, dt);
             (along, slip) = (a, s);
             lp.d = d;
             self.drives[e].lateral = Some(l);
@@ -159,8 +160,8 @@ impl Storyboard {
             // Its lane runs on in a road of the other direction: a lateral move in
             // progress keeps its side of the motion.
             if let Some(l) = &mut self.drives[e].lateral {
-                l.tr.from = -l.tr.from;
-                l.tr.to = -l.tr.to;
+                l.mv.tr.from = -l.mv.tr.from;
+                l.mv.tr.to = -l.mv.tr.to;
                 if let Some((_, offset)) = &mut l.to_lane {
                     *offset = -*offset;
                 }

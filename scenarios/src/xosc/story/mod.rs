@@ -26,9 +26,10 @@ use paracosm_openscenario::model::{
 };
 
 use super::motion::{
-    clothoid_poses, duration_s, nurbs_poses, offset_duration_s, Timed, Transition, Untimed,
+    clothoid_poses, duration_s, nurbs_poses, offset_duration_s, shape_of, Timed, Transition,
+    Untimed,
 };
-use super::road::{wrap, LanePos, Pose, RoadError, Roads};
+use paracosm_engine::network::roads::{wrap, LanePos, Pose, RoadError, Roads};
 
 /// Orientation `o` against `base` (rad): a relative one added to it, an absolute one as
 /// written, `base` without one.

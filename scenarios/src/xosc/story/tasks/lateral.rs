@@ -2,75 +2,25 @@
 //! route asked of the driven ego.
 
 use super::super::*;
+use paracosm_engine::transition::{LateralMove, LateralRule};
 use paracosm_openscenario::model::OffsetTarget;
 
 /// The largest lateral acceleration of a `LaneOffsetAction` without `maxLateralAcc`, m/s².
 pub const DEFAULT_LATERAL_ACC_MPS2: f64 = 0.5;
 
-/// A lateral move (`LaneChangeAction`, `LaneOffsetAction`) as esmini performs it: the offset
-/// `d` (m, left of increasing `s`) over a parameter that counts time (s) or, for a lane change
-/// by distance, the path along the lane (m), from 0; stepped only while the entity moves.
+/// A lateral move (`LaneChangeAction`, `LaneOffsetAction`) as esmini performs it: the
+/// engine's [`LateralMove`] (the offset `d`, m, left of increasing `s`, over time or the path
+/// along the lane, stepped by its [`LateralRule`]), with the lane it changes to and its action.
 #[derive(Debug, Clone, Copy)]
 pub(in crate::xosc::story) struct Lateral {
-    /// The offset over the parameter (`start_s` 0).
-    pub(in crate::xosc::story) tr: Transition,
-    /// The parameter so far.
-    pub(in crate::xosc::story) param: f64,
-    /// Whether the parameter is the path along the lane (a lane change by distance).
-    pub(in crate::xosc::story) by_distance: bool,
-    /// A `LaneOffsetAction`: the offset lags one step and the lane motion is not slowed.
-    pub(in crate::xosc::story) offset: bool,
+    /// The move, stepped by the engine.
+    pub(in crate::xosc::story) mv: LateralMove,
     /// The lane it changes to.
     pub(in crate::xosc::story) to_lane: ToLane,
     /// Its action.
     pub(in crate::xosc::story) action: usize,
     /// Whether it goes on after its transition (`continuous`).
     pub(in crate::xosc::story) continuous: bool,
-}
-
-impl Lateral {
-    /// One step of `dt` (s) in which the entity, `d_now` (m) from its lane's centre, travels
-    /// `dist` (m): the offset it reaches (m), whether the transition is over, how far it
-    /// travels along the lane (m) and its heading against that travel (rad).
-    ///
-    /// As esmini steps it: a lane change takes its lateral step out of the step's travel (by
-    /// time, `√(dist² − lat²)` along the lane; by distance, `dist / √(1 + r²)` with `r` the
-    /// offset's slope per metre) and faces the way it moves, and waits while the entity
-    /// stands; a lane offset lags one step and faces `atan(rate / speed)`.
-    pub(in crate::xosc::story) fn step(
-        &mut self,
-        d_now: f64,
-        dist: f64,
-        dt: f64,
-    ) -> (f64, bool, f64, f64) {
-        let moving = dist > 1e-12;
-        let mut along = dist;
-        let mut slip = 0.0;
-        let (d, over) = if self.offset {
-            let (d, over) = self.tr.at(self.param);
-            slip = (self.tr.slope(self.param) * dt).atan2(dist);
-            self.param += dt;
-            (d, over)
-        } else if !moving {
-            // Standing, a lane change waits (esmini steps it only while moving).
-            (d_now, false)
-        } else if self.tr.duration_s <= 0.0 {
-            (self.tr.to, true)
-        } else if self.by_distance {
-            let r = self.tr.slope(self.param);
-            along = dist / (1.0 + r * r).sqrt();
-            self.param += along;
-            slip = r.atan();
-            self.tr.at(self.param)
-        } else {
-            let lat = (self.tr.slope(self.param) * dt).abs().min(dist);
-            along = (dist * dist - lat * lat).sqrt();
-            slip = (self.tr.slope(self.param) * dt).signum() * lat.atan2(along);
-            self.param += dt;
-            self.tr.at(self.param)
-        };
-        (d, over, along, slip)
-    }
 }
 
 impl Storyboard {
@@ -121,15 +71,21 @@ impl Storyboard {
             } else {
                 duration
             },
-            shape: dynamics.shape,
+            shape: shape_of(dynamics.shape),
+        };
+        let rule = if by_distance {
+            LateralRule::TravelByDistance
+        } else {
+            LateralRule::TravelByTime
         };
         self.begin_lateral(
             e,
             Lateral {
-                tr,
-                param: 0.0,
-                by_distance,
-                offset: false,
+                mv: LateralMove {
+                    tr,
+                    param: 0.0,
+                    rule,
+                },
                 to_lane: Some((to_lane, *offset_m)),
                 action: a.unwrap_or(usize::MAX),
                 continuous: false,
@@ -267,15 +223,16 @@ impl Storyboard {
             to,
             start_s: 0.0,
             duration_s: offset_duration_s(*shape, to - lp.d, acc),
-            shape: *shape,
+            shape: shape_of(*shape),
         };
         self.begin_lateral(
             e,
             Lateral {
-                tr,
-                param: 0.0,
-                by_distance: false,
-                offset: true,
+                mv: LateralMove {
+                    tr,
+                    param: 0.0,
+                    rule: LateralRule::Offset,
+                },
                 to_lane: None,
                 action: a.unwrap_or(usize::MAX),
                 continuous: *continuous,

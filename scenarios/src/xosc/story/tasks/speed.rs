@@ -81,7 +81,7 @@ impl Storyboard {
             to: to.max(0.0),
             start_s: t,
             duration_s: duration_s(dynamics, to - v0, 0.5 * (v0 + to).abs()),
-            shape: dynamics.shape,
+            shape: shape_of(dynamics.shape),
         };
         if a.is_none() && tr.duration_s == 0.0 {
             self.actors[e].state.speed = tr.to;

@@ -1,5 +1,8 @@
-//! Where OpenSCENARIO positions lie on an OpenDRIVE map, and how an entity moves along its
-//! lanes. Poses here are in the OpenSCENARIO (OpenDRIVE) frame: x east, y north (m), heading
+//! Lane coordinates on an OpenDRIVE map, the engine's lane API for scripted entities: where
+//! OpenSCENARIO positions lie (road and lane positions, `anchor`), and how an entity moves
+//! along its lanes (`advance`, across links and junctions, a route's roads preferred). An
+//! OpenSCENARIO storyboard's tasks drive its entities through it, the engine's transitions
+//! ([`crate::transition`]) and its placement (`Action::PlaceCar`). Poses here are in the OpenSCENARIO (OpenDRIVE) frame: x east, y north (m), heading
 //! counter-clockwise from x (rad); [`Roads::to_engine`] turns one into the engine's world
 //! (`[x, y, z]`, z = −(y − origin)).
 
@@ -7,7 +10,7 @@ use std::f64::consts::PI;
 
 use std::sync::Arc;
 
-use paracosm_engine::network::{MapIndex, MapRef, RoadMap};
+use super::{MapIndex, MapRef, RoadMap};
 
 /// A pose in the OpenSCENARIO frame: `x`, `y` in m, heading `h` in rad.
 #[derive(Debug, Clone, Copy, PartialEq)]
