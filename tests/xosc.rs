@@ -1268,3 +1268,43 @@ fn a_varied_parameter_nothing_reads_is_named_unused_as_in_a_program() {
         scenario.warnings()
     );
 }
+
+/// With `--scripted-ego` no system under test drives, so nothing reads the sensors and none
+/// is mounted: each test's outcome is the one it has with the sensors mounted (a constant
+/// control that the scripted ego never reads, so the lidar captures every step).
+#[test]
+fn a_scripted_ego_test_without_sensors_is_judged_as_with_them() {
+    let mut scenario = paracosm::ScenarioRef::OpenScenario(paracosm::scenario_ref::XoscRef {
+        xosc: format!("{}/{CROSSING}", env!("CARGO_MANIFEST_DIR")),
+        scripted_ego: true,
+        ..Default::default()
+    })
+    .load()
+    .expect("the variation loads");
+    assert_eq!(scenario.sut().name(), "scripted");
+    let space = scenario.space().clone();
+    let points: Vec<paracosm_generators::Point> = (0..3)
+        .map(|i| paracosm_generators::Point {
+            discrete: space.level_counts().iter().map(|c| (i * 7) % c).collect(),
+            continuous: vec![0.25 + 0.25 * f64::from(i); space.continuous_dims()],
+        })
+        .collect();
+    let outcomes = |s: &paracosm_scenarios::Scenario| -> Vec<_> {
+        points
+            .iter()
+            .map(|p| s.run(&space.decode(p).unwrap(), 0).unwrap())
+            .collect()
+    };
+    let unsensed = outcomes(&scenario);
+    scenario.set_sut(paracosm_engine::sut::SutConfig::Constant(
+        paracosm_engine::Control::default(),
+    ));
+    assert_eq!(unsensed, outcomes(&scenario));
+    let simulated = |o: &paracosm_scenarios::TestOutcome| {
+        o.metrics
+            .iter()
+            .find(|(k, _)| *k == "simulated_s")
+            .map_or(0.0, |(_, v)| *v)
+    };
+    assert!(unsensed.iter().any(|o| simulated(o) > 30.0), "{unsensed:?}");
+}

@@ -29,6 +29,9 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use paracosm_scenarios::lang;
 
+mod common;
+use common::event_chain;
+
 const HEAD: &str = "w = World()\nr = RoadSegment(len = 200.0)\n\
 v = AutonomousVehicle(loc = r.onLane(1, 10.0))\nw.place(r, v)\nCollisionMonitor(v)\n\
 test(horizon = 2.0)\n";
@@ -90,51 +93,6 @@ fn xosc_test_read(c: &mut Criterion) {
         b.iter(|| paracosm_openscenario::read_scenario_in(&files, &template, &values).unwrap())
     });
     group.finish();
-}
-
-/// A scenario on esmini's straight road (relative to `tests/data/xosc/written/`) of `n`
-/// events in one maneuver: event 0 starts at 0.1 s, event `i` when event `i − 1` ends; each
-/// sets the speed of the one entity.
-pub fn event_chain(n: usize) -> String {
-    let mut s = String::from(
-        r#"<?xml version="1.0" encoding="UTF-8"?>
-<OpenSCENARIO>
-  <FileHeader revMajor="1" revMinor="1" date="2026-11-29T00:00:00" description="a chain of events" author="paracosm"/>
-  <RoadNetwork><LogicFile filepath="../esmini/xodr/straight_500m.xodr"/></RoadNetwork>
-  <Entities>
-    <ScenarioObject name="hero"><Vehicle name="v" vehicleCategory="car"><BoundingBox><Center x="1.4" y="0" z="0.8"/><Dimensions width="1.9" length="4.6" height="1.5"/></BoundingBox><Performance maxSpeed="50" maxAcceleration="5" maxDeceleration="9"/><Axles><FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/><RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/></Axles><Properties/></Vehicle></ScenarioObject>
-  </Entities>
-  <Storyboard>
-    <Init><Actions><Private entityRef="hero">
-      <PrivateAction><TeleportAction><Position><RoadPosition roadId="1" s="20" t="-1.5"/></Position></TeleportAction></PrivateAction>
-      <PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/><SpeedActionTarget><AbsoluteTargetSpeed value="10"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction>
-    </Private></Actions></Init>
-    <Story name="s"><Act name="a"><ManeuverGroup maximumExecutionCount="1" name="g"><Actors selectTriggeringEntities="false"><EntityRef entityRef="hero"/></Actors><Maneuver name="m">
-"#,
-    );
-    for i in 0..n {
-        let start = if i == 0 {
-            r#"<ByValueCondition><SimulationTimeCondition value="0.1" rule="greaterThan"/></ByValueCondition>"#.to_owned()
-        } else {
-            format!(
-                r#"<ByValueCondition><StoryboardElementStateCondition storyboardElementType="event" storyboardElementRef="e{}" state="endTransition"/></ByValueCondition>"#,
-                i - 1
-            )
-        };
-        s.push_str(&format!(
-            r#"<Event name="e{i}" priority="parallel"><Action name="a{i}"><PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/><SpeedActionTarget><AbsoluteTargetSpeed value="{}"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction></Action><StartTrigger><ConditionGroup><Condition name="c{i}" delay="0" conditionEdge="none">{start}</Condition></ConditionGroup></StartTrigger></Event>
-"#,
-            10 + i % 2
-        ));
-    }
-    s.push_str(
-        r#"</Maneuver></ManeuverGroup><StartTrigger><ConditionGroup><Condition name="go" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition></Condition></ConditionGroup></StartTrigger></Act></Story>
-    <StopTrigger><ConditionGroup><Condition name="end" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="2" rule="greaterThan"/></ByValueCondition></Condition></ConditionGroup></StopTrigger>
-  </Storyboard>
-</OpenSCENARIO>
-"#,
-    );
-    s
 }
 
 fn xosc_read(c: &mut Criterion) {

@@ -1,6 +1,7 @@
 use std::ops::ControlFlow;
 
 use paracosm_engine::rx::Host;
+use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{
     CameraFrame, CameraSpec, Control, EgoState, Simulation, Snapshot, SnapshotParts, WorldSpec,
 };
@@ -270,6 +271,23 @@ impl Scenario {
         out.ok_or_else(|| ScenarioError::Language("no world was built".into()))?
     }
 
+    /// The test's simulation of `spec`: with its sensors mounted, or with none when no system
+    /// under test drives (a script places the ego at every step, `--scripted-ego`), since
+    /// nothing would read them.
+    ///
+    /// # Errors
+    /// [`ScenarioError::Engine`] when the world cannot be built.
+    fn simulation(&self, spec: &WorldSpec) -> Result<Simulation, ScenarioError> {
+        if matches!(self.sut(), SutConfig::Scripted) && !spec.sensors.is_empty() {
+            let unsensed = WorldSpec {
+                sensors: Vec::new(),
+                ..spec.clone()
+            };
+            return Ok(Simulation::new(&unsensed)?);
+        }
+        Ok(Simulation::new(spec)?)
+    }
+
     fn run_world(
         &self,
         spec: &WorldSpec,
@@ -281,7 +299,7 @@ impl Scenario {
         if let Some(f) = options.on_world.as_mut() {
             f(spec);
         }
-        let mut sim = Simulation::new(spec)?;
+        let mut sim = self.simulation(spec)?;
         let mut sut = self.sut().build();
         sut.reset(seed)?;
         let sensors = sut.sensors();

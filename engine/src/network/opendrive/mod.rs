@@ -693,6 +693,23 @@ fn bake(
     })
 }
 
+/// The width of `lane` wherever it is read (m), when it has one width all along: no width
+/// profile, or a profile of one nonzero finite value, whose interpolation gives that value's
+/// bits at any distance (`w + (w − w)·t`); `None` for a width that varies.
+fn one_width(lane: &xodr::Lane) -> Option<f64> {
+    match lane.widths.first() {
+        None => Some(f64::from(lane.width_at(0.0))),
+        Some(&w)
+            if w != 0.0
+                && w.is_finite()
+                && lane.widths.iter().all(|v| v.to_bits() == w.to_bits()) =>
+        {
+            Some(f64::from(lane.width_at(0.0)))
+        }
+        Some(_) => None,
+    }
+}
+
 /// A lane's stations: each one's `s` (m), the lane's centre there (world `[x, z]`, m) and its
 /// width (m).
 type Stations = (Vec<f64>, Vec<[f64; 2]>, Vec<f64>);
@@ -712,6 +729,7 @@ fn sample_lane(
     n: usize,
 ) -> Result<Stations, MapError> {
     let (mut ss, mut centre, mut width) = (Vec::new(), Vec::new(), Vec::new());
+    let one_width = one_width(lane);
     for i in 0..=n {
         let s = if i == n {
             s1
@@ -726,10 +744,19 @@ fn sample_lane(
             s: if i == n { s1 - SECTION_END_M } else { s },
             offset: 0.0,
         };
-        let (Some(c), Some(cs)) = (net.lane_point(at), net.centerline_s(at)) else {
+        let Some(c) = net.lane_point(at) else {
             continue;
         };
-        let w = f64::from(lane.width_at(cs));
+        // The distance along the lane is read only for a width that varies: the crate sums
+        // the lane from its start for each (`centerline_s`), so every station would cost the
+        // lane's length. Where `lane_point` has a point, `centerline_s` has a distance.
+        let w = match one_width {
+            Some(w) => w,
+            None => match net.centerline_s(at) {
+                Some(cs) => f64::from(lane.width_at(cs)),
+                None => continue,
+            },
+        };
         if !(c.x.is_finite() && c.y.is_finite() && w.is_finite()) {
             return Err(r.error(
                 r.road_node(&p.road_id),
@@ -744,4 +771,63 @@ fn sample_lane(
         width.push(w.max(0.0));
     }
     Ok((ss, centre, width))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Where a lane has one width ([`one_width`]), the crate's width at the distance along
+    /// the lane gives the same bits at every station, so reading that distance (a sum over
+    /// the lane from its start) can be left out without changing the map.
+    #[test]
+    fn a_lane_of_one_width_has_its_bits_at_every_distance_along_it() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let (mut one, mut varying) = (0, 0);
+        for file in [
+            "tests/data/xosc/alks/concrete_scenarios/road_networks/alks_road_straight.xodr",
+            "tests/data/maps/esmini/lane_width_and_offset.xodr",
+            "tests/data/maps/esmini/multi_intersections.xodr",
+            "tests/data/maps/carla/Town07.xodr",
+        ] {
+            let text = std::fs::read_to_string(root.join(file)).unwrap();
+            let (net, provenance) = xodr::load_str_with_provenance(&text).unwrap();
+            for p in &provenance.lanes {
+                let Some(lane) = net.lane(p.lane) else {
+                    continue;
+                };
+                let Some(w) = one_width(lane) else {
+                    varying += 1;
+                    continue;
+                };
+                let length = net
+                    .road_by_od_id(&p.road_id)
+                    .map_or(0.0, xodr::Road::length);
+                for k in 0..=40 {
+                    let at = xodr::LanePosition {
+                        lane: p.lane,
+                        s: length * f64::from(k) / 40.0,
+                        offset: 0.0,
+                    };
+                    if let Some(cs) = net.centerline_s(at) {
+                        assert_eq!(
+                            f64::from(lane.width_at(cs)).to_bits(),
+                            w.to_bits(),
+                            "{file}: road {} lane {} at s = {}",
+                            p.road_id,
+                            p.od_id,
+                            at.s
+                        );
+                        one += 1;
+                    }
+                }
+            }
+        }
+        // Both kinds were met: lanes of one width checked, lanes whose width varies left to
+        // the distance along them.
+        assert!(
+            one > 1000 && varying > 0,
+            "{one} stations, {varying} varying lanes"
+        );
+    }
 }
