@@ -100,7 +100,7 @@ pub fn openscenario(data: &[u8]) {
     let text = paracosm_openscenario::Text::new("fuzz.xosc", s);
     let (is_variation, catalog) = match text.parse() {
         Ok(doc) => (
-            paracosm_openscenario::distribution::is_variation(&doc),
+            paracosm_openscenario::distribution::is_variation(doc),
             doc.root_element()
                 .children()
                 .find(|c| c.has_tag_name("Catalog"))

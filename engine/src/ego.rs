@@ -9,6 +9,7 @@ use crate::actor::{half_open, Motion};
 use crate::behaviour::{bad_input, placed_pose, Action, POSE_EXPECTED};
 use crate::control::Control;
 use crate::network::Surface;
+use crate::physics_step::KinematicVelocity;
 use crate::rx::Value;
 use crate::vehicle::EgoVehicle;
 use crate::EngineError;
@@ -40,6 +41,10 @@ pub(crate) struct Ego {
     /// from the move by up to 0.06 m/s while the suspension settles); before the first step,
     /// its body's velocity.
     pub(crate) velocity: [f64; 3],
+    /// Its body's velocity when the last step moved it without rapier's solver (a scripted
+    /// ego in a world of kinematic bodies, [`crate::physics_step::Moved`]); `None` when its
+    /// body carries its own.
+    pub(crate) kinematic: Option<KinematicVelocity>,
 }
 
 impl Ego {
@@ -58,6 +63,7 @@ impl Ego {
             set_speed_mps,
             collided: false,
             velocity: [v.x, v.y, v.z].map(f64::from),
+            kinematic: None,
         }
     }
 
@@ -69,7 +75,11 @@ impl Ego {
         EgoState {
             pos_m: [p.x, p.y, p.z].map(f64::from),
             heading_rad: half_open(f64::from(-forward.z).atan2(f64::from(forward.x))),
-            speed_mps: f64::from(body.linvel().dot(forward)),
+            speed_mps: f64::from(
+                self.kinematic
+                    .map_or(body.linvel(), |k| k.linvel)
+                    .dot(forward),
+            ),
         }
     }
 
@@ -168,7 +178,8 @@ impl Ego {
             }
             Action::ReleaseEgo => {
                 let v = self.velocity;
-                self.vehicle.release(physics, [v[0], 0.0, v[2]]);
+                let angvel = self.kinematic.map(|k| k.angvel);
+                self.vehicle.release(physics, [v[0], 0.0, v[2]], angvel);
             }
             Action::SetEgoSpeed => match value {
                 Value::Num(v) if v.is_finite() && *v >= 0.0 => self.set_speed_mps = Some(*v),

@@ -27,6 +27,7 @@ pub mod memory;
 pub mod network;
 mod obstacle;
 mod pedestrian;
+mod physics_step;
 pub mod placement;
 #[cfg(feature = "render")]
 pub mod render;

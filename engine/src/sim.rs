@@ -425,7 +425,8 @@ impl Simulation {
             // The sensors' first readings were taken before light and fog were known.
             self.capture_again_before_first_step()?;
         }
-        self.physics.step_with_events(&(), &self.collector);
+        let moved = crate::physics_step::step(&mut self.physics, &self.collector);
+        self.ego.kinematic = moved.of(self.ego.vehicle.body);
         self.actors.end_step();
         self.record_ego_contacts();
         self.ego.collided |= self.ego_contact();

@@ -205,13 +205,23 @@ impl EgoVehicle {
 
     /// Hands a scripted vehicle to its controls ([`crate::Action::ReleaseEgo`]): its chassis
     /// becomes a dynamic body moving at `velocity_mps` (m/s, world frame), which the vehicle
-    /// model drives from the next step on. A vehicle no script places is left as it is.
-    pub(crate) fn release(&mut self, physics: &mut PhysicsWorld, velocity_mps: [f64; 3]) {
+    /// model drives from the next step on, turning at `angvel` (rad/s) when the last step
+    /// moved it without rapier's solver (else at the rate rapier's step gave its body). A
+    /// vehicle no script places is left as it is.
+    pub(crate) fn release(
+        &mut self,
+        physics: &mut PhysicsWorld,
+        velocity_mps: [f64; 3],
+        angvel: Option<AngVector>,
+    ) {
         if !self.scripted {
             return;
         }
         let body = &mut physics.bodies[self.body];
         body.set_body_type(RigidBodyType::Dynamic, true);
+        if let Some(w) = angvel {
+            body.set_angvel(w, true);
+        }
         body.set_linvel(
             Vector::new(
                 velocity_mps[0] as f32,

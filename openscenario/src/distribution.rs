@@ -279,7 +279,7 @@ fn elements<'a, 'i>(node: Node<'a, 'i>) -> impl Iterator<Item = Node<'a, 'i>> {
 /// `UserDefinedDistribution`, unknown elements and attributes.
 pub fn read_variation(text: &Text) -> Result<VariationFile, XoscError> {
     let doc = text.parse()?;
-    let root = text.open_root(&doc)?;
+    let root = text.open_root(doc)?;
     if elements(root).any(|c| c.has_tag_name("Storyboard")) {
         return Err(text.invalid(
             root,
@@ -1261,7 +1261,7 @@ mod tests {
         assert!(e
             .to_string()
             .contains("this is a scenario, not a parameter value distribution"));
-        assert!(!is_variation(&scenario.parse().unwrap()));
+        assert!(!is_variation(scenario.parse().unwrap()));
         let catalog = Text::new(
             "c.xosc",
             "<OpenSCENARIO><FileHeader/><Catalog name=\"x\"/></OpenSCENARIO>",
@@ -1286,7 +1286,7 @@ mod tests {
             Err(XoscError::Xml { .. })
         ));
         let t = file("<Deterministic/>");
-        assert!(is_variation(&t.parse().unwrap()));
+        assert!(is_variation(t.parse().unwrap()));
         let no_file = Text::new("x.xosc", "<OpenSCENARIO><ParameterValueDistribution><Deterministic/></ParameterValueDistribution></OpenSCENARIO>");
         assert!(read_variation(&no_file)
             .unwrap_err()

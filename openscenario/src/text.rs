@@ -1,5 +1,9 @@
 //! One parsed XML file with fast positions: `roxmltree`'s `text_pos_at` walks the text from
-//! its start at every call, so a file's line starts are found once and searched.
+//! its start at every call, so a file's line starts are found once and searched. The file is
+//! parsed once and the document kept ([`Text::parse`]): the tests of a campaign read one
+//! [`Text`] through the campaign's [`crate::FileSet`], and share its parse.
+
+use std::sync::OnceLock;
 
 use roxmltree::{Document, Node};
 
@@ -9,7 +13,18 @@ use crate::error::{Pos, XoscError};
 /// few MiB; past this the file is refused rather than parsed.
 pub const MAX_FILE_BYTES: u64 = 64 << 20;
 
-/// A file's name and text with its line starts.
+self_cell::self_cell!(
+    /// A parsed document and the copy of the text it borrows (the same bytes as
+    /// [`Text::text`], so node offsets are offsets into it).
+    struct Parsed {
+        owner: Box<str>,
+        #[covariant]
+        dependent: Document,
+    }
+    impl {Debug}
+);
+
+/// A file's name and text with its line starts, and its parse once made.
 #[derive(Debug)]
 pub struct Text {
     /// The file as named.
@@ -22,6 +37,8 @@ pub struct Text {
     /// character boundary), from 0: a column is counted from the nearest mark, not from the
     /// line's start, so a file written on one line costs no more than a pretty-printed one.
     char_marks: Vec<(usize, usize)>,
+    /// The document of the first [`Text::parse`], or its error.
+    parsed: OnceLock<Result<Parsed, XoscError>>,
 }
 
 /// The most attributes one element may have in an XML file paracosm reads (OpenSCENARIO or
@@ -115,6 +132,7 @@ impl Text {
             text,
             line_starts,
             char_marks,
+            parsed: OnceLock::new(),
         }
     }
 
@@ -177,12 +195,29 @@ impl Text {
             .map_or_else(|| self.pos(node), |a| self.pos_at(a.range_value().start))
     }
 
-    /// Parses the text (DTDs refused, as the standard has none).
+    /// The text's document (DTDs refused, as the standard has none): parsed at the first call
+    /// and kept, so every later call (each test of a campaign that reads this file) costs
+    /// nothing. The text is not to be changed after the first call.
     ///
     /// # Errors
-    /// [`XoscError::Xml`] with the parser's position when the text is not well-formed.
-    pub fn parse(&self) -> Result<Document<'_>, XoscError> {
-        check_breadth(&self.text).map_err(|e| XoscError::Invalid {
+    /// [`XoscError::Xml`] with the parser's position when the text is not well-formed;
+    /// [`XoscError::Invalid`] for an element of more than [`MAX_ATTRIBUTES`] attributes (the
+    /// same error at every call).
+    pub fn parse(&self) -> Result<&Document<'_>, XoscError> {
+        let parsed = self.parsed.get_or_init(|| {
+            Parsed::try_new(self.text.clone().into_boxed_str(), |text| {
+                self.parse_text(text)
+            })
+        });
+        match parsed {
+            Ok(p) => Ok(p.borrow_dependent()),
+            Err(e) => Err(e.clone()),
+        }
+    }
+
+    /// Parses `text` (this file's text) as [`Text::parse`] does.
+    fn parse_text<'t>(&self, text: &'t str) -> Result<Document<'t>, XoscError> {
+        check_breadth(text).map_err(|e| XoscError::Invalid {
             pos: self.pos_at(e.offset),
             reason: e.to_string(),
         })?;
@@ -190,7 +225,7 @@ impl Text {
             allow_dtd: false,
             ..Default::default()
         };
-        Document::parse_with_options(&self.text, opts).map_err(|e| {
+        Document::parse_with_options(text, opts).map_err(|e| {
             let p = e.pos();
             XoscError::Xml {
                 pos: Pos {
@@ -241,6 +276,35 @@ impl Text {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A text is parsed once: every call returns the one document, whose node offsets are
+    /// offsets into the text (positions read as before); a text that is not well-formed gives
+    /// the same error at every call.
+    #[test]
+    fn a_text_is_parsed_once_and_its_document_shared() {
+        let text = Text::new("a.xosc", "\u{feff}<A>\n  <B x=\"1\"/>\n</A>\n");
+        let first = text.parse().unwrap();
+        let second = text.parse().unwrap();
+        assert!(std::ptr::eq(first, second));
+        let b = first.root_element().first_element_child().unwrap();
+        let pos = text.attr_pos(b, "x");
+        assert_eq!((pos.line, pos.col), (2, 9));
+        let shared = std::sync::Arc::new(Text::new("b.xosc", "<A><B></A>"));
+        let errors: Vec<XoscError> = (0..2)
+            .map(|_| {
+                let t = shared.clone();
+                std::thread::spawn(move || t.parse().map(drop).unwrap_err())
+                    .join()
+                    .unwrap()
+            })
+            .collect();
+        assert_eq!(errors[0], errors[1]);
+        assert!(
+            matches!(errors[0], XoscError::Xml { .. }),
+            "{:?}",
+            errors[0]
+        );
+    }
 
     /// Columns counted from the character marks equal a count from the line's start, on a
     /// long line of multi-byte characters and across line breaks.

@@ -136,7 +136,7 @@ fn read_with(
     overrides: &[(String, Value)],
 ) -> Result<Scenario, XoscError> {
     let doc = text.parse()?;
-    let root = text.open_root(&doc)?;
+    let root = text.open_root(doc)?;
     if child(root, "ParameterValueDistribution").is_some() {
         return Err(text.invalid(
             root,

@@ -150,8 +150,7 @@ pub fn inspect_in(
     };
     let text = files.text(path).map_err(input)?;
     let doc = text.parse().map_err(input)?;
-    let is_variation = paracosm_openscenario::distribution::is_variation(&doc);
-    drop(doc);
+    let is_variation = paracosm_openscenario::distribution::is_variation(doc);
     let (variation, scenario_path) = if is_variation {
         let v = read_variation(&text).map_err(input)?;
         let p = scenario_of(path, &v)?;
