@@ -104,21 +104,51 @@ fn asams_sequential_events_scripted_end_at_the_hand_value() {
     }
 }
 
-/// ASAM's `DoubleLaneChanger` cannot run yet: its map (`SampleDatabase.xodr`) has lanes
-/// without a `<width>`, which paracosm's OpenDRIVE reader refuses. It is refused at load,
-/// naming the map's line and the scenario's `LogicFile`, never run on a map read otherwise
-/// than written. (Its stop trigger, already true at the start, is the case of
-/// `the_start_of_the_simulation_is_no_rising_edge` in `tests/xosc_ego.rs`.)
+/// ASAM's `DoubleLaneChanger` runs: its map (`SampleDatabase.xodr`) has two lanes with neither
+/// `<width>` nor `<border>`, read as 0 m wide (as esmini and libOpenDRIVE read them) with a
+/// warning naming the map's line. With the storyboard moving every entity, A1 changes into the
+/// ego's lane when it is 5 m past it (hand: 1.641 s, the first step after it 1.650 s) and back
+/// when that lane change completes (3.641 s), and the stop trigger ends the test when A1 is 50 m
+/// past A2 (11.991 s), each within two steps of 1/60 s. (Its stop trigger, already true at the
+/// start, is the case of `the_start_of_the_simulation_is_no_rising_edge` in `tests/xosc_ego.rs`.)
 #[test]
-fn asams_double_lane_changer_is_refused_for_its_map_at_load() {
+fn asams_double_lane_changer_runs_at_the_hand_values() {
     let file = data("asam_examples/DoubleLaneChanger.xosc");
-    let (code, err, _) = run_one(&[file.to_str().unwrap(), "--scripted-ego"]);
-    assert_eq!(code, 2, "{err}");
+    let (code, err, r) = run_one(&[file.to_str().unwrap(), "--scripted-ego"]);
+    assert_eq!(code, 0, "{err}\n{r}");
     assert!(
-        err.contains("SampleDatabase.xodr:")
-            && err.contains("<width>")
-            && err.contains("DoubleLaneChanger.xosc:13:5"),
+        err.contains("SampleDatabase.xodr:1807: 2 lanes with neither <width> nor <border>"),
         "{err}"
+    );
+    let at = |line: &str| -> f64 {
+        let log = r["log"].as_array().unwrap();
+        let found = log
+            .iter()
+            .filter_map(|l| l.as_str())
+            .find(|l| l.ends_with(line))
+            .unwrap_or_else(|| panic!("no `{line}` in {log:?}"));
+        found
+            .trim_start_matches("t = ")
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    for (line, hand) in [
+        ("event \"MyLaneChangeRightEvent\" start", 1.641),
+        ("event \"MyLaneChangeLeftEvent\" start", 3.641),
+    ] {
+        let t = at(line);
+        assert!(
+            t >= hand && t - hand <= 2.0 * STEP_S,
+            "{line} at {t} s, by hand {hand} s"
+        );
+    }
+    let end = r["metrics"]["simulated_s"].as_f64().unwrap();
+    assert!(
+        end >= 11.991 && end - 11.991 <= 2.0 * STEP_S,
+        "the stop trigger ends the test at {end} s, by hand 11.991 s"
     );
 }
 
@@ -132,6 +162,12 @@ fn euro_ncap_ccr_files_scripted_meet_the_target_at_the_hand_value() {
         ("scenariogeneration/CCRs_scenarios/xosc/CCRs42.xosc", 12.108),
         ("scenariogeneration/CCRs_scenarios/xosc/CCRs44.xosc", 12.108),
         ("scenariogeneration/CCRm_scenarios/xosc/CCRm22.xosc", 12.846),
+        // CCRb: the target held 12 m or 40 m ahead of the ego (a continuous
+        // `LongitudinalDistanceAction`) until it brakes at 2 or 6 m/s².
+        ("scenariogeneration/CCRb_scenarios/xosc/CCRb0.xosc", 8.559),
+        ("scenariogeneration/CCRb_scenarios/xosc/CCRb1.xosc", 7.478),
+        ("scenariogeneration/CCRb_scenarios/xosc/CCRb2.xosc", 11.878),
+        ("scenariogeneration/CCRb_scenarios/xosc/CCRb3.xosc", 9.645),
     ] {
         let (code, err, r) = run_one(&[data(file).to_str().unwrap(), "--scripted-ego"]);
         assert_eq!(

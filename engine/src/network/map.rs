@@ -845,8 +845,6 @@ fn beyond_ends(l: &MapLane, p: [f64; 2]) -> (bool, bool) {
     (before_start, past_end)
 }
 
-type Segment = GeomWithData<Line<[f64; 2]>, (usize, usize)>;
-
 /// Point queries on a map: R-trees of the lanes' centre-line segments and of the driving
 /// surface's edges, built once per map ([`MapRef::index`]) and shared.
 #[derive(Debug)]
@@ -915,11 +913,57 @@ fn no_recent_hits() -> [std::sync::atomic::AtomicU64; RECENT_HITS] {
     std::array::from_fn(|_| std::sync::atomic::AtomicU64::new(u64::MAX))
 }
 
+/// The drivable lanes of a map in a tree of their own, for [`MapTrees::new`]'s probes of the
+/// edges of the driving surface: only drivable lanes answer, and the reach is half the widest
+/// drivable lane, not the widest lane of any kind (a 6 m verge would triple the search).
+struct DrivableLanes<'a> {
+    lanes: &'a [MapLane],
+    tree: super::centre_tree::CentreTree,
+    reach_2: f64,
+}
+
+impl<'a> DrivableLanes<'a> {
+    fn new(lanes: &'a [MapLane]) -> Self {
+        let widest = lanes
+            .iter()
+            .filter(|l| l.drivable && l.s.len() > 1)
+            .flat_map(|l| l.width.iter())
+            .fold(0.0f64, |w, &x| w.max(x));
+        let r = widest / 2.0 + 1e-9;
+        DrivableLanes {
+            lanes,
+            tree: super::centre_tree::CentreTree::new(lanes, |k| lanes[k].drivable),
+            reach_2: r * r,
+        }
+    }
+
+    /// Whether a drivable lane other than `except` holds `p` (its strip, [`strip_offset`]):
+    /// the segment `last` and its two neighbours first, then the tree, whose hit becomes
+    /// `last`. The same answer as a search of every lane's segments.
+    fn hold(&self, p: [f64; 2], except: usize, last: &mut Option<(usize, usize)>) -> bool {
+        if let Some((k, i)) = *last {
+            let lane = &self.lanes[k];
+            let near = i.saturating_sub(1)..(i + 2).min(lane.centre.len() - 1);
+            if near.into_iter().any(|j| strip_offset(lane, j, p).is_some()) {
+                return true;
+            }
+        }
+        let hit = self
+            .tree
+            .within(self.lanes, p, self.reach_2)
+            .find(|&(k, i)| k != except && strip_offset(&self.lanes[k], i, p).is_some());
+        if hit.is_some() {
+            *last = hit;
+        }
+        hit.is_some()
+    }
+}
+
 /// The R-trees of a [`MapIndex`], derived from its map alone and shared by every index of
 /// that map ([`MapRef::index`]).
 #[derive(Debug)]
 pub struct MapTrees {
-    centres: RTree<Segment>,
+    centres: super::centre_tree::CentreTree,
     edges: RTree<GeomWithData<Line<[f64; 2]>, ()>>,
     widest_m: f64,
 }
@@ -940,27 +984,13 @@ impl MapTrees {
     /// with no drivable lane beyond them (probed 0.2 m outside), and the ends of drivable
     /// lanes that nothing continues.
     fn new(map: &Arc<RoadMap>) -> MapTrees {
-        let mut segments = Vec::new();
-        let mut widest = 0.0f64;
-        for (k, l) in map.lanes.iter().enumerate() {
-            for i in 0..l.s.len() - 1 {
-                segments.push(Segment::new(
-                    Line::new(l.centre[i], l.centre[i + 1]),
-                    (k, i),
-                ));
-                widest = widest.max(l.width[i]).max(l.width[i + 1]);
-            }
-        }
-        // The centre lines first: finding the edges asks which points are on a lane.
-        let index = MapIndex {
-            map: map.clone(),
-            recent: no_recent_hits(),
-            trees: Arc::new(MapTrees {
-                centres: RTree::bulk_load(segments),
-                edges: RTree::new(),
-                widest_m: widest,
-            }),
-        };
+        let widest = map
+            .lanes
+            .iter()
+            .filter(|l| l.s.len() > 1)
+            .flat_map(|l| l.width.iter())
+            .fold(0.0f64, |w, &x| w.max(x));
+        let drivable = DrivableLanes::new(&map.lanes);
         let mut has_predecessor = vec![false; map.lanes.len()];
         for l in &map.lanes {
             for &n in &l.successors {
@@ -983,8 +1013,11 @@ impl MapTrees {
                     let t = side * (l.width[i] / 2.0 + extra);
                     [l.centre[i][0] + t * r[0], l.centre[i][1] + t * r[1]]
                 };
+                // The segment that last held a probe is tried first, with its neighbours:
+                // along a border the next probe is almost always on the same neighbour lane.
+                let mut last: Option<(usize, usize)> = None;
                 let closed: Vec<bool> = (0..n)
-                    .map(|i| !index.drivable_at(border(i, 0.2), Some(k)))
+                    .map(|i| !drivable.hold(border(i, 0.2), k, &mut last))
                     .collect();
                 for i in 0..n - 1 {
                     if closed[i] || closed[i + 1] {
@@ -1015,10 +1048,11 @@ impl MapTrees {
                 }
             }
         }
-        let MapIndex { trees, .. } = index;
-        let mut trees = Arc::try_unwrap(trees).expect("the trees are not shared yet");
-        trees.edges = RTree::bulk_load(edges);
-        trees
+        MapTrees {
+            centres: super::centre_tree::CentreTree::new(&map.lanes, |_| true),
+            edges: RTree::bulk_load(edges),
+            widest_m: widest,
+        }
     }
 }
 
@@ -1035,15 +1069,16 @@ impl MapIndex {
 
     /// The lanes whose strips hold `p`, with `p`'s lateral offset from their centre line
     /// (m, positive to the right of increasing `s`).
-    fn strips_at(&self, p: [f64; 2]) -> impl Iterator<Item = (usize, f64)> + '_ {
+    fn strips_at(&self, p: [f64; 2]) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
+        self.segments_near(p)
+            .filter_map(move |(k, i)| strip_offset(&self.map.lanes[k], i, p).map(|t| (k, i, t)))
+    }
+
+    /// The centre-line segments `(lane, i)` (stations `i`, `i + 1`) within half the widest
+    /// lane's width of `p`: every segment whose strip may hold it, in no particular order.
+    fn segments_near(&self, p: [f64; 2]) -> impl Iterator<Item = (usize, usize)> + '_ {
         let r = self.trees.widest_m / 2.0 + 1e-9;
-        self.trees
-            .centres
-            .locate_within_distance(p, r * r)
-            .filter_map(move |seg| {
-                let (k, i) = seg.data;
-                strip_offset(&self.map.lanes[k], i, p).map(|t| (k, t))
-            })
+        self.trees.centres.within(&self.map.lanes, p, r * r)
     }
 
     /// The lanes (indices into [`RoadMap::lanes`]) whose strips hold the world point `[x, z]`
@@ -1051,16 +1086,7 @@ impl MapIndex {
     /// the point's lateral offset from the centre line (m, positive to the right of
     /// increasing `s`), nearest centre first, one segment a lane.
     pub fn lanes_at(&self, p: [f64; 2]) -> Vec<(usize, usize, f64)> {
-        let r = self.trees.widest_m / 2.0 + 1e-9;
-        let mut out: Vec<(usize, usize, f64)> = self
-            .trees
-            .centres
-            .locate_within_distance(p, r * r)
-            .filter_map(|seg| {
-                let (k, i) = seg.data;
-                strip_offset(&self.map.lanes[k], i, p).map(|t| (k, i, t))
-            })
-            .collect();
+        let mut out: Vec<(usize, usize, f64)> = self.strips_at(p).collect();
         out.sort_by(|a, b| {
             a.2.abs()
                 .total_cmp(&b.2.abs())
@@ -1070,11 +1096,6 @@ impl MapIndex {
         let mut seen = std::collections::BTreeSet::new();
         out.retain(|x| seen.insert(x.0));
         out
-    }
-
-    fn drivable_at(&self, p: [f64; 2], except: Option<usize>) -> bool {
-        self.strips_at(p)
-            .any(|(k, _)| Some(k) != except && self.map.lanes[k].drivable)
     }
 
     /// Whether the world point `[x, z]` lies on any lane of the map (driving or not).
@@ -1094,14 +1115,8 @@ impl MapIndex {
         if recent.filter(|&r| r != u64::MAX).any(|r| holds(unpack(r))) {
             return true;
         }
-        let r = self.trees.widest_m / 2.0 + 1e-9;
-        let hit = self
-            .trees
-            .centres
-            .locate_within_distance(p, r * r)
-            .find(|seg| holds(seg.data));
-        if let Some(seg) = hit {
-            let (k, i) = seg.data;
+        let hit = self.segments_near(p).find(|&seg| holds(seg));
+        if let Some((k, i)) = hit {
             // The oldest slot goes: slots shift by one, the newest hit first.
             for j in (1..RECENT_HITS).rev() {
                 self.recent[j].store(self.recent[j - 1].load(Relaxed), Relaxed);
@@ -1137,6 +1152,26 @@ impl MapIndex {
             .filter(|l| l.drivable)
             .map(MapLane::travel_points)
             .collect()
+    }
+}
+
+#[cfg(test)]
+impl MapLane {
+    /// A forward driving lane of road 0 with the stations `s` (m), the centre line `centre`
+    /// (world `[x, z]`, m, one point a station) and one width (m) all along, for tests.
+    pub(crate) fn driving_for_tests(s: Vec<f64>, centre: Vec<[f64; 2]>, width_m: f64) -> MapLane {
+        MapLane {
+            road: 0,
+            section: 0,
+            od_id: -1,
+            kind: "driving".into(),
+            drivable: true,
+            forward: true,
+            width: vec![width_m; s.len()],
+            s,
+            centre,
+            successors: Vec::new(),
+        }
     }
 }
 
@@ -1229,18 +1264,7 @@ mod end_tangent_tests {
             .iter()
             .map(|&x| [r * (x / r).sin(), -(r - r * (x / r).cos())])
             .collect();
-        MapLane {
-            road: 0,
-            section: 0,
-            od_id: -1,
-            kind: "driving".into(),
-            drivable: true,
-            forward: true,
-            width: vec![3.5; s.len()],
-            s,
-            centre,
-            successors: vec![],
-        }
+        MapLane::driving_for_tests(s, centre, 3.5)
     }
 
     /// The heading at a bend's ends is its true tangent within 0.01°, where the one-sided
@@ -1259,5 +1283,68 @@ mod end_tangent_tests {
             let lagged = l.pose(l.s_range().1).1.to_degrees();
             assert!((lagged - deg).abs() > 0.1, "r {r}: {lagged}");
         }
+    }
+}
+
+#[cfg(test)]
+mod edge_probe_tests {
+    use super::*;
+
+    /// [`DrivableLanes::hold`], with its hint carried along each border as
+    /// [`MapTrees::new`] carries it, answers as a search of every lane's segments within half
+    /// the widest lane of any kind does (the search before drivable lanes had a tree of their
+    /// own), at every probe of the edges of four maps (a motorway on a curve, a town with
+    /// junctions, lanes whose widths and offsets vary, and junctions next to each other).
+    #[test]
+    fn the_edge_probes_answer_as_a_search_of_every_lane() {
+        let mut probes = 0;
+        let mut open = 0;
+        for file in [
+            "tests/data/xosc/alks/concrete_scenarios/road_networks/alks_road_left_radius_250m.xodr",
+            "tests/data/maps/carla/Town07.xodr",
+            "tests/data/maps/esmini/lane_width_and_offset.xodr",
+            "tests/data/maps/esmini/multi_intersections.xodr",
+        ] {
+            let path = format!("{}/../{file}", env!("CARGO_MANIFEST_DIR"));
+            let text = std::fs::read_to_string(&path).unwrap();
+            let map = super::super::opendrive::import(&path, &text).unwrap().map;
+            let drivable = DrivableLanes::new(&map.lanes);
+            let every = super::super::centre_tree::CentreTree::new(&map.lanes, |_| true);
+            let widest = map
+                .lanes
+                .iter()
+                .flat_map(|l| l.width.iter())
+                .fold(0.0f64, |w, &x| w.max(x));
+            let r = widest / 2.0 + 1e-9;
+            let reference = |p: [f64; 2], except: usize| {
+                every.within(&map.lanes, p, r * r).any(|(k, i)| {
+                    k != except
+                        && map.lanes[k].drivable
+                        && strip_offset(&map.lanes[k], i, p).is_some()
+                })
+            };
+            for (k, l) in map.lanes.iter().enumerate().filter(|(_, l)| l.drivable) {
+                let n = l.s.len();
+                for side in [1.0, -1.0] {
+                    let mut last = None;
+                    for i in 0..n - 1 {
+                        let (a, b) = (l.centre[i], l.centre[i + 1]);
+                        let d = [b[0] - a[0], b[1] - a[1]];
+                        let len = d[0].hypot(d[1]).max(1e-12);
+                        let t = side * (l.width[i] / 2.0 + 0.2);
+                        let p = [a[0] - t * d[1] / len, a[1] + t * d[0] / len];
+                        let fast = drivable.hold(p, k, &mut last);
+                        assert_eq!(fast, reference(p, k), "{file}: lane {k} station {i}");
+                        probes += 1;
+                        open += usize::from(fast);
+                    }
+                }
+            }
+        }
+        // Both answers were met many times.
+        assert!(
+            open > 1000 && probes - open > 1000,
+            "{open} open of {probes} probes"
+        );
     }
 }

@@ -8,6 +8,7 @@
 //! already coincide.
 
 mod build;
+mod centre_tree;
 #[cfg(test)]
 pub(crate) use build::SEPARATE_ROAD;
 mod curve;

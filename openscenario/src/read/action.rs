@@ -202,7 +202,16 @@ fn distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
             "a longitudinal distance action gives either distance or timeGap",
         ));
     }
+    let continuous = r.scope.bool(r.text, node, "continuous")?;
     if let Some(c) = child(node, "DynamicConstraints") {
+        if continuous {
+            return Err(r.text.unsupported(
+                c,
+                "a continuous longitudinal distance action with <DynamicConstraints> is not \
+                 supported (esmini approaches the gap by a damped spring within them): paracosm \
+                 holds a continuous gap kinematically, without constraints",
+            ));
+        }
         r.note(c, "a longitudinal distance action's dynamic constraints are not applied: the gap is held kinematically");
     }
     Ok(Action::LongitudinalDistance {
@@ -210,7 +219,7 @@ fn distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
         distance_m,
         time_gap_s,
         freespace: r.scope.bool(r.text, node, "freespace")?,
-        continuous: r.scope.bool(r.text, node, "continuous")?,
+        continuous,
         displacement: one_of(
             r,
             node,

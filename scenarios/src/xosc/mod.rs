@@ -256,8 +256,7 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
 /// drives; `init`: in `Init`): `None` as written, `Some(note)` otherwise (a warning at load).
 ///
 /// # Errors
-/// [`ScenarioError::Load`] naming the action's line and column: a continuous
-/// `LongitudinalDistanceAction`, a deactivation of the driven ego's controller, or an action
+/// [`ScenarioError::Load`] naming the action's line and column: a deactivation of the driven ego's controller, or an action
 /// on the driven ego that paracosm cannot hand its system (all but a `SpeedAction`, a
 /// `LaneChangeAction` or `AssignRouteAction` after `Init`, an `ActivateControllerAction`, and
 /// in `Init` a `TeleportAction` or `AssignRouteAction`).
@@ -269,16 +268,6 @@ fn performed_otherwise(
 ) -> Result<Option<String>, ScenarioError> {
     let name = &s.entities[e].name;
     let driven = Some(e) == ego;
-    if let Action::LongitudinalDistance {
-        continuous: true, ..
-    } = na.action
-    {
-        return Err(worlds_error(format!(
-            "{}: a continuous LongitudinalDistanceAction is not supported (paracosm places the \
-             entity at the distance once: continuous=\"false\")",
-            na.pos
-        )));
-    }
     Ok(match &na.action {
         Action::ActivateController {
             lateral,

@@ -275,6 +275,7 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
     let mut warnings = check_elements(&r, root)?;
     numbers::check(&r, root)?;
     warnings.extend(numbers::lane_type_warnings(&r, root));
+    warnings.extend(numbers::widthless_lane_warnings(&r, root));
     warnings.extend(check_references(&r)?);
     check_widths(&r)?;
     // A map far from the origin is moved to it, in its text, before anything evaluates it.
@@ -301,14 +302,61 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
         None => (doc, text),
     };
     let r = Reader::new(file, &doc);
-    let (net, provenance) = xodr::load_str_with_provenance(text).map_err(|e| MapError {
-        file: file.to_owned(),
-        line: None,
-        column: None,
-        message: format!(
-            "the xodr crate could not bake the map ({e}): every road was skipped, for a reason paracosm's own checks do not name"
-        ),
-    })?;
+    let (net, provenance) = crate_bake(&r, text)?;
+    warnings.extend(crate_warnings(&r, &provenance)?);
+    check_self_links(&r, &net)?;
+    check_gaps(&r, &net)?;
+    let mut map = bake(&r, &net, &provenance)?;
+    map.origin_m = shift.unwrap_or([0.0, 0.0]);
+    warnings.extend(links::link_and_check(&r, &mut map)?);
+    warnings.extend(overlaps::check(&r, &map)?);
+    Ok(Imported {
+        map: Arc::new(map),
+        warnings,
+    })
+}
+
+/// The `xodr` crate's reading of `text`, the map `r` reads.
+///
+/// # Errors
+/// A map the crate bakes no road of: at the first lane with neither width nor border where
+/// that is why, else naming the crate's reason.
+fn crate_bake(r: &Reader, text: &str) -> Result<(xodr::RoadNetwork, xodr::Provenance), MapError> {
+    let (file, doc) = (r.file, r.doc);
+    xodr::load_str_with_provenance(text).map_err(|e| {
+        // A map whose every lane has neither width nor border has no lane to bake.
+        match numbers::first_widthless_lane(doc.root_element()) {
+            Some(lane) => r.error(
+                Some(lane),
+                format!(
+                    "lane {} of road \"{}\" has neither <width> nor <border>: it is 0 m wide, and no lane of the map has a width, so there is no road surface (the xodr crate: {e})",
+                    lane.attribute("id").unwrap_or("?"),
+                    lane.ancestors()
+                        .find(|a| a.has_tag_name("road"))
+                        .and_then(|a| a.attribute("id"))
+                        .unwrap_or("?")
+                ),
+            ),
+            None => MapError {
+                file: file.to_owned(),
+                line: None,
+                column: None,
+                message: format!(
+                    "the xodr crate could not bake the map ({e}): every road was skipped, for a reason paracosm's own checks do not name"
+                ),
+            },
+        }
+    })
+}
+
+/// The crate's warnings about the map `r` reads, as paracosm words them: its faults are
+/// errors; what it reads otherwise than written, warnings; what paracosm reads itself (link
+/// gaps) or reads as the crate does (lanes without width), nothing.
+///
+/// # Errors
+/// The first fault, at its road.
+fn crate_warnings(r: &Reader, provenance: &xodr::Provenance) -> Result<Vec<String>, MapError> {
+    let mut warnings = Vec::new();
     for w in &provenance.warnings {
         let debug = format!("{w:?}");
         let variant = debug.split([' ', '{', '(']).next().unwrap_or("");
@@ -317,6 +365,19 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
             .nth(1)
             .and_then(|t| t.split('"').next());
         let node = road.and_then(|id| r.road_node(id));
+        // A lane with neither `<width>` nor `<border>` is 0 m wide, and the crate, which drops
+        // it and stacks the lanes outside it on the lane inside, bakes the same surface: a
+        // warning names it (`numbers::widthless_lane_warnings`).
+        if let xodr::Warning::LaneDropped {
+            road_id,
+            section,
+            lane,
+        } = w
+        {
+            if widthless(r, road_id, *section, *lane) {
+                continue;
+            }
+        }
         if FAULTS.contains(&variant) {
             return Err(r.error(
                 node,
@@ -339,16 +400,30 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
             warnings.push(format!("{w}{done}"));
         }
     }
-    check_self_links(&r, &net)?;
-    check_gaps(&r, &net)?;
-    let mut map = bake(&r, &net, &provenance)?;
-    map.origin_m = shift.unwrap_or([0.0, 0.0]);
-    warnings.extend(links::link_and_check(&r, &mut map)?);
-    warnings.extend(overlaps::check(&r, &map)?);
-    Ok(Imported {
-        map: Arc::new(map),
-        warnings,
-    })
+    Ok(warnings)
+}
+
+/// Whether lane `lane` of lane section `section` (zero-based, in the document's order) of road
+/// `road_id` has neither `<width>` nor `<border>`.
+fn widthless(r: &Reader, road_id: &str, section: usize, lane: i32) -> bool {
+    let Some(road) = r.road_node(road_id) else {
+        return false;
+    };
+    road.descendants()
+        .filter(|n| n.has_tag_name("laneSection"))
+        .nth(section)
+        .and_then(|sec| {
+            sec.descendants().find(|n| {
+                n.has_tag_name("lane")
+                    && n.attribute("id")
+                        .and_then(|id| id.trim().parse::<i32>().ok())
+                        == Some(lane)
+            })
+        })
+        .is_some_and(|n| {
+            !n.children()
+                .any(|c| c.has_tag_name("width") || c.has_tag_name("border"))
+        })
 }
 
 /// Walks the tree: unknown elements are errors; unused ones and non-flat profiles, warnings.

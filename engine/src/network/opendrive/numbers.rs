@@ -181,8 +181,8 @@ pub(super) fn check(r: &Reader, root: Node) -> Result<(), MapError> {
     Ok(())
 }
 
-/// Checks element `n`'s own attributes: those OpenDRIVE requires are there, a lane has a
-/// width, and each numeric attribute is in its range ([`judge`]).
+/// Checks element `n`'s own attributes: those OpenDRIVE requires are there, and each numeric
+/// attribute is in its range ([`judge`]).
 ///
 /// # Errors
 /// The first missing or out-of-range attribute, naming the element and its line and column.
@@ -198,21 +198,6 @@ fn check_values(r: &Reader, n: Node) -> Result<(), MapError> {
         return Err(r.error(
             Some(n),
             format!("<{name}>{road} has no `{missing}`, which OpenDRIVE requires"),
-        ));
-    }
-    if name == "lane"
-        && n.attribute("id").is_some_and(|id| id.trim() != "0")
-        && !n
-            .children()
-            .any(|c| c.has_tag_name("width") || c.has_tag_name("border"))
-    {
-        return Err(r.error(
-            Some(n),
-            format!(
-                "lane {} of road \"{}\" has no <width> (nor <border>): it has no extent",
-                n.attribute("id").unwrap_or("?"),
-                road_id(n)
-            ),
         ));
     }
     for &(attr, rule) in rules(n) {
@@ -412,6 +397,42 @@ pub(super) fn lane_type_warnings(r: &Reader, root: Node) -> Vec<String> {
             )
         })
         .collect()
+}
+
+/// One warning for the lanes (other than a centre lane) with neither `<width>` nor
+/// `<border>`: the schema lets a lane leave both out (ASAM's own `SampleDatabase.xodr` does),
+/// and such a lane is 0 m wide, as the `xodr` crate, esmini and libOpenDRIVE read it: it
+/// takes no room, and no entity can stand on it (a position on it is refused where it is
+/// read).
+pub(super) fn widthless_lane_warnings(r: &Reader, root: Node) -> Vec<String> {
+    let widthless: Vec<Node> = root.descendants().filter(|n| widthless(*n)).collect();
+    let Some(first) = widthless.first() else {
+        return Vec::new();
+    };
+    let count = widthless.len();
+    vec![format!(
+        "{}:{}: {count} lane{} with neither <width> nor <border> (first: lane {} of road \"{}\"): taken as 0 m wide, as esmini and libOpenDRIVE read {}",
+        r.file,
+        r.line(*first),
+        if count == 1 { "" } else { "s" },
+        first.attribute("id").unwrap_or("?"),
+        road_id(*first),
+        if count == 1 { "it" } else { "them" },
+    )]
+}
+
+/// The first lane (other than a centre lane) with neither `<width>` nor `<border>`.
+pub(super) fn first_widthless_lane<'a, 'i>(root: Node<'a, 'i>) -> Option<Node<'a, 'i>> {
+    root.descendants().find(|n| widthless(*n))
+}
+
+/// Whether `n` is a lane (other than a centre lane) with neither `<width>` nor `<border>`.
+fn widthless(n: Node) -> bool {
+    n.has_tag_name("lane")
+        && n.attribute("id").is_some_and(|id| id.trim() != "0")
+        && !n
+            .children()
+            .any(|c| c.has_tag_name("width") || c.has_tag_name("border"))
 }
 
 /// Geometry records and lane sections start within their road's length.

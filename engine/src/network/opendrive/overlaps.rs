@@ -12,9 +12,10 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use rstar::primitives::{GeomWithData, Line};
-use rstar::{PointDistance, RTree};
+use rstar::primitives::Line;
+use rstar::PointDistance;
 
+use super::super::centre_tree::CentreTree;
 use super::{MapError, Reader, RoadMap};
 
 /// How far inside another lane's strip a point must be to count as on it, m.
@@ -34,19 +35,15 @@ const NAMED: usize = 5;
 /// (world `[x, z]`, m) and how many stations did.
 type Crossings = BTreeMap<(usize, usize), ([f64; 2], usize)>;
 
-/// A lane's segment: `(lane, station index)`.
-type Segment = GeomWithData<Line<[f64; 2]>, (usize, usize)>;
-
 /// Checks `map` (see the module documentation).
 ///
 /// # Errors
 /// A flat road whose lanes lie on themselves, naming the road, its line and the point.
 pub(super) fn check(r: &Reader, map: &RoadMap) -> Result<Vec<String>, MapError> {
-    let (segments, widest) = segments(map);
-    if segments.is_empty() {
+    let Some(widest) = widest(map) else {
         return Ok(Vec::new());
-    }
-    let tree = RTree::bulk_load(segments);
+    };
+    let tree = CentreTree::new(&map.lanes, |l| judged(map, l));
     let links = linked(map);
     let reach = widest / 2.0;
     let (crossings, folds) = overlaps(map, &tree, &links, reach);
@@ -111,24 +108,19 @@ fn judged(map: &RoadMap, l: usize) -> bool {
     lane.drivable && map.roads[lane.road].junction.is_none()
 }
 
-/// The segments of every checked lane's centre line ([`judged`]), and the widest such lane's
-/// width, m.
-fn segments(map: &RoadMap) -> (Vec<Segment>, f64) {
-    let mut segments = Vec::new();
-    let mut widest: f64 = 0.0;
+/// The widest checked lane's width ([`judged`]) at the start of any of its segments, m;
+/// `None` where no checked lane has a segment.
+fn widest(map: &RoadMap) -> Option<f64> {
+    let mut widest = None;
     for (l, lane) in map.lanes.iter().enumerate() {
         if !judged(map, l) {
             continue;
         }
-        for i in 0..lane.centre.len() - 1 {
-            segments.push(Segment::new(
-                Line::new(lane.centre[i], lane.centre[i + 1]),
-                (l, i),
-            ));
-            widest = widest.max(lane.width[i]);
+        for i in 0..lane.centre.len().saturating_sub(1) {
+            widest = Some(widest.unwrap_or(0.0f64).max(lane.width[i]));
         }
     }
-    (segments, widest)
+    widest
 }
 
 /// Where the checked lanes lie on each other, from each lane's stations (one a metre, away
@@ -138,7 +130,7 @@ fn segments(map: &RoadMap) -> (Vec<Segment>, f64) {
 /// (their lanes lie on each other more than [`SELF_GAP_M`] apart along the road).
 fn overlaps(
     map: &RoadMap,
-    tree: &RTree<Segment>,
+    tree: &CentreTree,
     links: &BTreeSet<(usize, usize)>,
     reach: f64,
 ) -> (Crossings, BTreeSet<usize>) {
@@ -157,8 +149,7 @@ fn overlaps(
                 continue;
             }
             next_s = s + 1.0;
-            for seg in tree.locate_within_distance(*p, reach * reach) {
-                let (m, j) = seg.data;
+            for (m, j) in tree.within(&map.lanes, *p, reach * reach) {
                 let other = &map.lanes[m];
                 let (o_first, o_last) = other.s_range();
                 let t = other.s[j];
@@ -166,7 +157,11 @@ fn overlaps(
                     continue;
                 }
                 let half = other.width[j].min(other.width[j + 1]) / 2.0;
-                if seg.geom().distance_2(p).sqrt() > half - INSIDE_MARGIN_M {
+                if Line::new(other.centre[j], other.centre[j + 1])
+                    .distance_2(p)
+                    .sqrt()
+                    > half - INSIDE_MARGIN_M
+                {
                     continue;
                 }
                 let (a, b) = (lane.road, other.road);

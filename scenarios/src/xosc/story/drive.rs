@@ -16,6 +16,8 @@ pub(in crate::xosc::story) struct Drive {
     pub(in crate::xosc::story) speed: Option<SpeedTask>,
     /// The lateral move in progress.
     pub(in crate::xosc::story) lateral: Option<Lateral>,
+    /// The continuous `LongitudinalDistanceAction` in progress.
+    pub(in crate::xosc::story) keep: Option<Keep>,
     /// The trajectory in progress and its action.
     pub(in crate::xosc::story) path: Option<(Path, usize)>,
     /// A driven ego's lane change in progress: the lane it changes to, the offset from its

@@ -199,6 +199,8 @@ impl Storyboard {
                         self.start_elem(a, t)?;
                         for g in self.elems[a].children.clone() {
                             self.start_group(g, t)?;
+                            let maneuvers = self.elems[g].children.iter().copied();
+                            self.new_maneuvers.extend(maneuvers);
                         }
                     }
                 }
@@ -366,6 +368,9 @@ impl Storyboard {
                 }
                 if d.path.as_ref().is_some_and(|s| s.1 == i) {
                     d.path = None;
+                }
+                if d.keep.as_ref().is_some_and(|k| k.action == i) {
+                    d.keep = None;
                 }
             }
             self.elems[i].pending = 0;

@@ -16,7 +16,7 @@ use conditions::Cond;
 use drive::{Drive, ToLane, Track};
 use elements::{Elem, Kind, Owner, Phase};
 pub use tasks::DEFAULT_LATERAL_ACC_MPS2;
-use tasks::{Lateral, Path, SpeedTask};
+use tasks::{Keep, Lateral, Path, SpeedTask};
 
 use std::collections::VecDeque;
 
@@ -132,6 +132,9 @@ pub struct Storyboard {
     /// A new route asked of the driven ego since the host last took one
     /// ([`Storyboard::take_route`]).
     route: Option<RouteAsk>,
+    /// The maneuvers that acts started in the current step's run of the stories, whose
+    /// events the step judges after it ([`Storyboard::judge_new_events`]).
+    new_maneuvers: Vec<usize>,
 }
 
 /// A route the storyboard asks of the ego the system under test drives (a `LaneChangeAction`
@@ -240,6 +243,7 @@ impl Storyboard {
             set_speed: None,
             hand_over: None,
             route: None,
+            new_maneuvers: Vec::new(),
         }
     }
 
@@ -391,9 +395,12 @@ impl Storyboard {
                 self.ended = true;
             }
         }
+        self.new_maneuvers.clear();
         for r in self.roots.clone() {
             self.run_story(r, t)?;
         }
+        self.judge_new_events(t)?;
+        self.keep_distances(t + dt)?;
         for e in 0..self.actors.len() {
             if self.actors[e].scripted {
                 self.drive(e, t, dt)?;
@@ -417,6 +424,34 @@ impl Storyboard {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// The events of each maneuver that its act started in this step's run of the stories
+    /// ([`Storyboard::new_maneuvers`]), judged in this step at time `t` (s): esmini's
+    /// traversal of the storyboard evaluates an element's children in the frame that starts
+    /// it (`StoryBoardElement::EvalTriggers`, `tests/data/xosc/third_party/ESMINI_NOTES.md`),
+    /// so such an event's start trigger is first evaluated now (it did not wait when this
+    /// step's triggers were evaluated: its maneuver did not run), and an event that fires (or
+    /// has no start trigger) starts now, its actions moving its actors over this step.
+    fn judge_new_events(&mut self, t: f64) -> Result<(), StoryError> {
+        if self.new_maneuvers.is_empty() {
+            return Ok(());
+        }
+        let started = std::mem::take(&mut self.new_maneuvers);
+        for &m in &started {
+            for ev in self.elems[m].children.clone() {
+                if let Some(k) = self.elems[ev].start {
+                    if self.waits(k) {
+                        self.trigger_now[k] = self.evaluate(k, t);
+                    }
+                }
+            }
+        }
+        for &m in &started {
+            self.run_maneuver(m, t)?;
+        }
+        self.new_maneuvers = started;
         Ok(())
     }
 

@@ -10,6 +10,7 @@ mod speed;
 mod teleport;
 mod trajectory;
 
+pub(in crate::xosc::story) use distance::Keep;
 pub(in crate::xosc::story) use lateral::Lateral;
 pub use lateral::DEFAULT_LATERAL_ACC_MPS2;
 pub(in crate::xosc::story) use speed::SpeedTask;
@@ -137,18 +138,21 @@ impl Storyboard {
                 time_gap_s,
                 freespace,
                 displacement,
+                continuous,
                 ..
             } => {
                 if !scripted {
                     return Ok(());
                 }
-                self.place_at_distance(
-                    e,
-                    *entity,
-                    (*distance_m, *time_gap_s, *freespace),
-                    displacement,
-                )
-                .map_err(|e| bad(e.to_string()))?;
+                let keep = distance::Keep {
+                    reference: *entity,
+                    gap: (*distance_m, *time_gap_s, *freespace),
+                    displacement: displacement.clone(),
+                    action: a.unwrap_or(usize::MAX),
+                    at: site(&action.pos),
+                };
+                self.start_distance(e, keep, *continuous)
+                    .map_err(|e| bad(e.to_string()))?;
             }
             Action::FollowTrajectory { shape, timing } => {
                 return self.start_trajectory(e, (shape, timing), (a, &action.pos), t);

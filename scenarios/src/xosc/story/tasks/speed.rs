@@ -83,6 +83,9 @@ impl Storyboard {
             duration_s: duration_s(dynamics, to - v0, 0.5 * (v0 + to).abs()),
             shape: shape_of(dynamics.shape),
         };
+        // A gap kept to another entity is the same longitudinal domain: it ends.
+        let old = self.drives[e].keep.take().map(|k| k.action);
+        self.override_task(old);
         if a.is_none() && tr.duration_s == 0.0 {
             self.actors[e].state.speed = tr.to;
             return Ok(());
