@@ -55,28 +55,33 @@ impl Storyboard {
     /// What [`Storyboard::place_at_distance`] returns, at the action.
     pub(in crate::xosc::story) fn keep_distances(&mut self, t1: f64) -> Result<(), StoryError> {
         for e in 0..self.actors.len() {
-            let Some(k) = self.drives[e].keep.clone() else {
-                continue;
-            };
             if !self.actors[e].scripted {
                 continue;
             }
-            self.place_at_distance(e, k.reference, k.gap, &k.displacement)
-                .map(|()| {
-                    // With the speed its reference's `SpeedAction` gives it over this step,
-                    // which esmini has stepped by then (an action before this one).
-                    if let Some(task) = self.drives[k.reference].speed {
-                        let (v, _) = task.step(t1, |r| self.actors[r].state.speed);
-                        self.actors[e].state.speed = v.max(0.0);
-                    }
-                })
-                .map_err(|err| StoryError {
-                    at: k.at.clone(),
-                    message: format!(
-                        "LongitudinalDistanceAction of {}: {err}",
-                        self.actors[e].name
-                    ),
-                })?;
+            // Taken out for the step and put back: no copy of its texts each step.
+            let Some(k) = self.drives[e].keep.take() else {
+                continue;
+            };
+            let placed = self.place_at_distance(e, k.reference, k.gap, &k.displacement);
+            // With the speed a scripted reference's `SpeedAction` gives it over this step,
+            // which esmini has stepped by then (an action before this one). A reference the
+            // system under test drives has the speed it drives at: its `SpeedAction` is
+            // only the speed asked of that system.
+            if placed.is_ok() && self.actors[k.reference].scripted {
+                if let Some(task) = self.drives[k.reference].speed {
+                    let (v, _) = task.step(t1, |r| self.actors[r].state.speed);
+                    self.actors[e].state.speed = v.max(0.0);
+                }
+            }
+            let result = placed.map_err(|err| StoryError {
+                at: k.at.clone(),
+                message: format!(
+                    "LongitudinalDistanceAction of {}: {err}",
+                    self.actors[e].name
+                ),
+            });
+            self.drives[e].keep = Some(k);
+            result?;
         }
         Ok(())
     }
