@@ -1309,3 +1309,115 @@ fn a_scripted_ego_test_without_sensors_is_judged_as_with_them() {
     };
     assert!(unsensed.iter().any(|o| simulated(o) > 30.0), "{unsensed:?}");
 }
+
+/// [`brake_scenario`] with an `EnvironmentAction` in `Init` that gives the world `weather`
+/// (the inside of `<Weather>`), written to `dir/name`.
+fn weather_file(dir: &std::path::Path, name: &str, weather: &str) -> std::path::PathBuf {
+    let file = dir.join(name);
+    let text = brake_scenario("false", 20.0, "leadingReferencedEntity").replacen(
+        "<Init>\n  <Actions>",
+        &format!(
+            "<Init>\n  <Actions>\n    <GlobalAction><EnvironmentAction><Environment name=\"w\">\
+             <Weather>{weather}</Weather></Environment></EnvironmentAction></GlobalAction>"
+        ),
+        1,
+    );
+    assert!(text.contains("EnvironmentAction"));
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
+/// An `EnvironmentAction`'s fog is the world's: the system under test's sensors see as far
+/// as its visual range. `aeb` stops behind the braking lead in clear air (100 km) and runs
+/// into it in a fog of 8 m (fog density 0.98: its lidar's range capped at 8 m).
+#[test]
+fn an_environment_actions_fog_is_the_fog_the_system_under_test_senses() {
+    let dir = tempfile::tempdir().unwrap();
+    let clear = weather_file(dir.path(), "clear.xosc", r#"<Fog visualRange="100000"/>"#);
+    let fog = weather_file(dir.path(), "fog.xosc", r#"<Fog visualRange="8"/>"#);
+    let (code, err, clear) = brake_campaign(&clear, "LeadBrake=8..9", 2, &dir.path().join("c"));
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err, fog) = brake_campaign(&fog, "LeadBrake=8..9", 2, &dir.path().join("f"));
+    assert_eq!(code, Some(1), "{err}");
+    for (c, f) in clear.iter().zip(&fog) {
+        assert_eq!(c["status"], "pass", "{c}");
+        assert_eq!(f["status"], "fail", "{f}");
+        assert!(
+            c["metrics"]["min_distance_m"].as_f64().unwrap() > 1.0,
+            "{c}"
+        );
+        assert_eq!(f["metrics"]["min_distance_m"].as_f64().unwrap(), 0.0, "{f}");
+    }
+}
+
+/// Rain is refused at load while a system under test drives (its camera and lidar would
+/// sense a dry world), naming the action's line and column; with `--scripted-ego` it runs,
+/// with a warning.
+#[test]
+fn rain_is_refused_when_a_system_under_test_would_sense_a_dry_world() {
+    let dir = tempfile::tempdir().unwrap();
+    let rain = weather_file(
+        dir.path(),
+        "rain.xosc",
+        r#"<Precipitation precipitationType="rain" precipitationIntensity="4"/>"#,
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&rain)
+        .args(["--budget", "1", "--out"])
+        .arg(dir.path().join("a"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("rain.xosc:30:5:"), "{err}");
+    assert!(err.contains("brings rain (4 mm/h)"), "{err}");
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&rain)
+        .args(["--scripted-ego", "--budget", "1", "--out"])
+        .arg(dir.path().join("b"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    assert!(err.contains("rain (4 mm/h) is not modelled"), "{err}");
+}
+
+/// `Init` places an entity relative to one the file places later (other readers accept it):
+/// the lead, written first, is put 30 m ahead of the ego once the ego is placed.
+#[test]
+fn an_init_position_relative_to_an_entity_placed_later_waits_for_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = brake_scenario("false", 20.0, "leadingReferencedEntity");
+    let lead = text.find("    <Private entityRef=\"Lead\">").unwrap();
+    let end = text[lead..].find("    </Private>\n").unwrap() + lead + "    </Private>\n".len();
+    let lead_block = text[lead..end].replace(
+        r#"<LongitudinalDistanceAction entityRef="Ego" distance="30" freespace="true" continuous="false" displacement="leadingReferencedEntity"/>"#,
+        "",
+    );
+    let lead_block = lead_block.replace(
+        "<PrivateAction><LongitudinalAction>\n        \n      </LongitudinalAction></PrivateAction>",
+        r#"<PrivateAction><TeleportAction><Position><RelativeLanePosition entityRef="Ego" dLane="0" ds="30"/></Position></TeleportAction></PrivateAction>"#,
+    );
+    assert!(lead_block.contains("RelativeLanePosition"), "{lead_block}");
+    let ego = text.find("    <Private entityRef=\"Ego\">").unwrap();
+    // The lead's block first, then the ego's.
+    let reordered = format!(
+        "{}{}{}{}",
+        &text[..ego],
+        lead_block,
+        &text[ego..lead],
+        &text[end..]
+    );
+    let file = dir.path().join("later.xosc");
+    std::fs::write(&file, reordered).unwrap();
+    let (code, err, records) = brake_campaign(&file, "LeadBrake=2..9", 2, &dir.path().join("o"));
+    assert!(matches!(code, Some(0 | 1)), "{err}");
+    for r in &records {
+        assert_ne!(r["status"], "error", "{r}");
+        let gap = r["metrics"]["min_distance_m"].as_f64().unwrap();
+        assert!(
+            gap < 30.0,
+            "the lead stands ahead of the ego and brakes: {gap} m"
+        );
+    }
+}

@@ -46,6 +46,12 @@ pub struct Scenario {
     pub entities: Vec<Entity>,
     /// `Init`'s private actions: (entity, action).
     pub init: Vec<(usize, NamedAction)>,
+    /// `Init`'s global actions (environment, parameter and variable actions), in order.
+    pub init_global: Vec<NamedAction>,
+    /// `VariableDeclarations` (OpenSCENARIO 1.2): each variable's name, type and initial
+    /// value, in order. Unlike a parameter, a variable's value changes while a test runs
+    /// (`VariableSetAction`, `VariableModifyAction`) and `VariableCondition` reads it.
+    pub variables: Vec<(String, crate::params::ParamType, Value)>,
     /// The stories.
     pub stories: Vec<Story>,
     /// The storyboard's stop trigger.
@@ -307,7 +313,13 @@ pub enum Action {
         shape: TrajectoryShape,
         /// `Timing`: `(absolute, scale, offset_s)`; none: follow at the entity's speed.
         timing: Option<(bool, f64, f64)>,
+        /// `TrajectoryFollowingMode` is `position` (esmini turns a polyline's heading at its
+        /// corners only); else `follow`, also when the element is missing, as esmini reads
+        /// it (the heading turns along each whole leg).
+        position_mode: bool,
     },
+    /// `AcquirePositionAction`: a route from where the entity is to this position.
+    AcquirePosition(Position),
     /// `AssignRouteAction`: a route through waypoints (the first is where the entity is
     /// routed from), each with its `routeStrategy`.
     AssignRoute {
@@ -321,6 +333,63 @@ pub enum Action {
         /// Longitudinal control, when said.
         longitudinal: Option<bool>,
     },
+    /// `AppearanceAction`: a vehicle's lights (`LightStateAction`) or an animation
+    /// (`AnimationAction`), named here; paracosm draws neither, and nothing it models reads
+    /// them.
+    Appearance(String),
+    /// `VisibilityAction`: whether the entity is drawn (`graphics`), seen by the other
+    /// traffic (`traffic`) and by sensors (`sensors`).
+    Visibility {
+        /// Drawn by the image generator (the camera).
+        graphics: bool,
+        /// Seen by other traffic participants.
+        traffic: bool,
+        /// Seen by sensors (the system under test's).
+        sensors: bool,
+    },
+    /// `EnvironmentAction` (a global action): the parts of the world's environment it
+    /// gives, the others kept.
+    Environment(Environment),
+    /// `ParameterSetAction` or `VariableSetAction` (global): the parameter or variable
+    /// `name` takes `value` (of its declared type).
+    SetValue {
+        /// The parameter's or variable's name.
+        name: String,
+        /// A variable (`VariableAction`), else a parameter (`ParameterAction`).
+        variable: bool,
+        /// The new value, of the declared type.
+        value: Value,
+    },
+    /// `ParameterModifyAction` or `VariableModifyAction` (global): the numeric parameter or
+    /// variable `name` becomes `value + by` (`AddValue`) or `value · by` (`MultiplyByValue`).
+    ModifyValue {
+        /// The parameter's or variable's name.
+        name: String,
+        /// A variable, else a parameter.
+        variable: bool,
+        /// `MultiplyByValue`, else `AddValue`.
+        multiply: bool,
+        /// The operand.
+        by: f64,
+    },
+}
+
+/// An `Environment` (inline or from an environment catalog): what an `EnvironmentAction`
+/// sets. Each part is `None` where the element does not give it (the world keeps it).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Environment {
+    /// `TimeOfDay`: the time of day its `dateTime` gives, s after midnight (`[0, 86400)`),
+    /// and whether it runs on with the simulated time (`animation`).
+    pub time_of_day: Option<(f64, bool)>,
+    /// `Weather/Sun`: illuminance, lux (1.2's `illuminance`, 1.0's `intensity`), and
+    /// elevation above the horizon, rad.
+    pub sun: Option<(f64, f64)>,
+    /// `Weather/Fog`'s `visualRange`, m (> 0).
+    pub fog_visual_range_m: Option<f64>,
+    /// `Weather/Precipitation`: its type (`dry`, `rain`, `snow`) and intensity, mm/h.
+    pub precipitation: Option<(String, f64)>,
+    /// `RoadCondition`'s `frictionScaleFactor` (>= 0): the factor on the road's friction.
+    pub friction_scale: Option<f64>,
 }
 
 impl Action {
@@ -334,8 +403,29 @@ impl Action {
             Action::Teleport(_) => "TeleportAction",
             Action::FollowTrajectory { .. } => "FollowTrajectoryAction",
             Action::AssignRoute { .. } => "AssignRouteAction",
+            Action::AcquirePosition(_) => "AcquirePositionAction",
             Action::ActivateController { .. } => "ActivateControllerAction",
+            Action::Appearance(_) => "AppearanceAction",
+            Action::Visibility { .. } => "VisibilityAction",
+            Action::Environment(_) => "EnvironmentAction",
+            Action::SetValue {
+                variable: false, ..
+            } => "ParameterSetAction",
+            Action::SetValue { variable: true, .. } => "VariableSetAction",
+            Action::ModifyValue {
+                variable: false, ..
+            } => "ParameterModifyAction",
+            Action::ModifyValue { variable: true, .. } => "VariableModifyAction",
         }
+    }
+
+    /// Whether it is a global action (it acts on the world, not on the maneuver group's
+    /// actors).
+    pub fn is_global(&self) -> bool {
+        matches!(
+            self,
+            Action::Environment(_) | Action::SetValue { .. } | Action::ModifyValue { .. }
+        )
     }
 }
 
@@ -464,6 +554,43 @@ pub enum Position {
         ds: f64,
         /// m from the target lane's centre along +t.
         offset: f64,
+        /// Orientation: relative to the lane's heading there (as the position faces without
+        /// one), or absolute.
+        orientation: Option<Orientation>,
+    },
+    /// `RoutePosition`: a place on a route (written in place or from a route catalog).
+    Route {
+        /// The route's waypoints (each a position and its `routeStrategy`), at least two.
+        waypoints: Vec<(Position, String)>,
+        /// Where on it (`InRoutePosition`).
+        at: InRoute,
+        /// Orientation: relative to the route's direction there, or absolute.
+        orientation: Option<Orientation>,
+    },
+}
+
+/// Where on a route a `RoutePosition` is (`InRoutePosition`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum InRoute {
+    /// `FromCurrentEntity`: where the entity is.
+    Entity(usize),
+    /// `FromLaneCoordinates`: `path_s` m along the route from its first waypoint (in the
+    /// roads' stations), on the lane of `<lane id>` `lane` of the road there, `offset` m
+    /// from its centre along +t.
+    Lane {
+        /// m along the route.
+        path_s: f64,
+        /// `<lane id>`.
+        lane: i32,
+        /// m from the lane's centre.
+        offset: f64,
+    },
+    /// `FromRoadCoordinates`: `path_s` m along the route, `t` m across the road there.
+    Road {
+        /// m along the route.
+        path_s: f64,
+        /// m left of the reference line.
+        t: f64,
     },
 }
 
@@ -560,6 +687,16 @@ pub enum ConditionKind {
         /// The value as written.
         value: String,
     },
+    /// `VariableCondition` (OpenSCENARIO 1.2): as [`ConditionKind::Parameter`], on a
+    /// declared variable's current value.
+    Variable {
+        /// The variable.
+        name: String,
+        /// Comparison.
+        rule: Rule,
+        /// The value as written.
+        value: String,
+    },
     /// A `ByEntityCondition`: the triggering entities and what each is tested for.
     Entity {
         /// The triggering entities.
@@ -613,6 +750,8 @@ pub enum EntityTest {
         freespace: bool,
         /// `relativeDistanceType`: `longitudinal`, `lateral` or `euclidianDistance`.
         kind: String,
+        /// `coordinateSystem`: `entity` or `road` (`lane` longitudinally).
+        frame: String,
     },
     /// `ReachPositionCondition`.
     ReachPosition {
@@ -650,6 +789,9 @@ pub enum EntityTest {
     TraveledDistance(f64),
     /// `EndOfRoadCondition`: off the road's end for this long, s.
     EndOfRoad(f64),
+    /// `OffroadCondition`: off every lane of the map (its reference point outside the
+    /// road's width, as esmini's `Position::IsOffRoad`) for longer than this, s.
+    Offroad(f64),
     /// `CollisionCondition` with this entity (`ByType` is refused; `None` is kept for a
     /// collision with anything).
     Collision(Option<usize>),

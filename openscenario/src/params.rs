@@ -325,7 +325,9 @@ pub(crate) fn required<'a>(
 /// Unsupported for an element other than `ParameterDeclaration` / `ConstraintGroup` /
 /// `ValueConstraint` where those belong, for an unknown attribute and for a `parameterType`
 /// given as a parameter; Invalid for a missing attribute, a name that cannot be referenced, an
-/// unknown type or rule, an empty constraint group and a name declared twice.
+/// unknown type or rule, an empty constraint group and a name declared twice with a different
+/// type, value or constraints (the same declaration twice, as esmini's own files write, is
+/// read as one).
 pub fn read_declarations(
     text: &Text,
     node: Option<Node<'_, '_>>,
@@ -348,10 +350,23 @@ pub fn read_declarations(
         }
         let d = read_declaration(text, child)?;
         if let Some(first) = seen.get(&d.name).map(|&i| &out[i]) {
+            // esmini lets the later of two declarations shadow the earlier; a file written
+            // for it (esmini's `follow_reference`, its vehicle catalog) repeats one with the
+            // same type and value, which means one parameter. Two that differ are refused:
+            // which one the author meant is not written.
+            if first.ty == d.ty
+                && first.raw == d.raw
+                && first.constraint_groups.is_empty()
+                && d.constraint_groups.is_empty()
+            {
+                continue;
+            }
             return Err(XoscError::Invalid {
                 pos: text.attr_pos(child, "name"),
                 reason: format!(
-                    "parameter {} is declared twice in one <ParameterDeclarations> (first at line {})",
+                    "parameter {} is declared twice in one <ParameterDeclarations> (first at \
+                     line {}) with a different type, value or constraints: the schema allows \
+                     one declaration per name (the same type and value twice is read as one)",
                     d.name, first.pos.line
                 ),
             });
@@ -1180,6 +1195,27 @@ mod tests {
 
     fn p(name: &str, ty: &str, value: &str) -> String {
         format!(r#"<ParameterDeclaration name="{name}" parameterType="{ty}" value="{value}"/>"#)
+    }
+
+    /// esmini's own files repeat a declaration word for word: read as one. Two that differ
+    /// are refused, naming the line of the first.
+    #[test]
+    fn a_declaration_repeated_word_for_word_is_one_and_a_different_one_is_refused() {
+        let same = format!(
+            "{}\n{}\n{}",
+            p("a", "double", "2"),
+            p("b", "int", "1"),
+            p("a", "double", "2")
+        );
+        let ds = decls_of(&doc(&same)).unwrap();
+        assert_eq!(
+            ds.iter().map(|d| d.name.as_str()).collect::<Vec<_>>(),
+            ["a", "b"]
+        );
+        let other = format!("{}\n{}", p("a", "double", "2"), p("a", "double", "3"));
+        let e = reason(decls_of(&doc(&other)).unwrap_err());
+        assert!(e.contains("parameter a is declared twice"), "{e}");
+        assert!(e.contains("first at line 3"), "{e}");
     }
 
     fn reason(e: XoscError) -> String {

@@ -162,18 +162,24 @@ fn check_all(files: &[PathBuf]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 15] = [
+const ESMINI_EXAMPLES: [&str; 21] = [
     "alks_cut-in",
     "alks_cut-out",
     "alks_decelerate",
+    "alks_pedestrian",
     "alks_r157_cut_in_quick_brake",
+    "cut-in",
+    "cut-in_environment",
     "cut-in_simple",
     "drive_when_close",
+    "follow_reference",
     "highway_driver",
     "lane-change_clothoid_based_trajectory",
+    "lane-change_trajectory_wp",
     "left-hand-traffic_by_heading",
     "left-hand-traffic_using_road_rule",
     "override_bb",
+    "pedestrian",
     "slow-lead-vehicle",
     "straight_500m",
     "straight_500m_pedestrian",
@@ -205,9 +211,15 @@ fn scenarios_written_here_move_as_in_esmini() {
 #[test]
 fn the_fields_files_move_as_in_esmini() {
     let files: Vec<PathBuf> = [
+        "asam_examples/CutIn.xosc",
         "asam_examples/DoubleLaneChanger.xosc",
+        "asam_examples/EndOfTrafficJam.xosc",
+        "asam_examples/FastOvertakeWithReInitialization.xosc",
         "asam_examples/SequentialEvents_0-100-0kph_Explicit.xosc",
         "asam_examples/SequentialEvents_0-100-0kph_Implicit.xosc",
+        "asam_examples/SimpleOvertake.xosc",
+        "asam_examples/SlowPrecedingVehicle.xosc",
+        "asam_examples/TrafficJam.xosc",
         "scenariogeneration/CCRb_scenarios/xosc/CCRb0.xosc",
         "scenariogeneration/CCRb_scenarios/xosc/CCRb1.xosc",
         "scenariogeneration/CCRb_scenarios/xosc/CCRb2.xosc",

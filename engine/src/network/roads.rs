@@ -367,6 +367,140 @@ impl Roads {
         (l.od_id, l.road)
     }
 
+    /// The roads of the shortest way (by lane length, Dijkstra) from `from` to the road of
+    /// `to`, in order, junctions' connecting roads included: along lanes into their
+    /// successors, and across to a lane of the same road section that travels the same way
+    /// (a lane change, free). The way starts in `from`'s direction of travel and ends on a
+    /// lane of `to`'s road that travels as `to`'s does. `None` when no way leads there.
+    pub fn route_roads(&self, from: &LanePos, to: &LanePos) -> Option<Vec<usize>> {
+        self.route_between(from, to).map(|(roads, _)| roads)
+    }
+
+    /// As [`Roads::route_roads`], with the way's length in the roads' stations (m): from
+    /// `from`'s station to `to`'s, over the lanes between.
+    pub fn route_between(&self, from: &LanePos, to: &LanePos) -> Option<(Vec<usize>, f64)> {
+        use std::cmp::Reverse;
+        use std::collections::BinaryHeap;
+        let lanes = &self.map.lanes;
+        let n = lanes.len();
+        let goal_road = lanes[to.lane].road;
+        let goal_way = lanes[to.lane].forward != to.rev;
+        let way = |k: usize| lanes[k].forward;
+        let length = |k: usize| {
+            let (a, b) = lanes[k].s_range();
+            (b - a).max(0.0)
+        };
+        // The lanes of each road section, for the free lane changes.
+        let mut sections: std::collections::HashMap<(usize, usize), Vec<usize>> =
+            std::collections::HashMap::new();
+        for (k, l) in lanes.iter().enumerate() {
+            if l.drivable {
+                sections.entry((l.road, l.section)).or_default().push(k);
+            }
+        }
+        let mut dist = vec![f64::INFINITY; n];
+        let mut back = vec![usize::MAX; n];
+        let mut heap = BinaryHeap::new();
+        let start = from.lane;
+        // Along `from`'s lane from where it stands to the lane's end.
+        let (a, b) = lanes[start].s_range();
+        let up = lanes[start].forward != from.rev;
+        dist[start] = if up { b - from.s } else { from.s - a }.max(0.0);
+        heap.push(Reverse((ordered(dist[start]), start)));
+        while let Some(Reverse((d, k))) = heap.pop() {
+            let d = d.0;
+            if d > dist[k] {
+                continue;
+            }
+            if lanes[k].road == goal_road && way(k) == goal_way {
+                // `d` runs to the end of lane `k`: back to `to`'s station on it.
+                let (ka, kb) = lanes[k].s_range();
+                let past = if way(k) {
+                    kb - to.s.clamp(ka, kb)
+                } else {
+                    to.s.clamp(ka, kb) - ka
+                };
+                let length = d - past;
+                let mut roads = Vec::new();
+                let mut at = k;
+                loop {
+                    let r = lanes[at].road;
+                    if roads.last() != Some(&r) {
+                        roads.push(r);
+                    }
+                    if back[at] == usize::MAX {
+                        break;
+                    }
+                    at = back[at];
+                }
+                roads.reverse();
+                return Some((roads, length));
+            }
+            let siblings = sections
+                .get(&(lanes[k].road, lanes[k].section))
+                .into_iter()
+                .flatten()
+                .copied()
+                .filter(|&j| j != k && way(j) == way(k));
+            let next = lanes[k]
+                .successors
+                .iter()
+                .map(|&j| (j, length(j)))
+                .chain(siblings.map(|j| (j, 0.0)));
+            for (j, cost) in next {
+                let nd = d + cost;
+                if nd < dist[j] {
+                    dist[j] = nd;
+                    back[j] = k;
+                    heap.push(Reverse((ordered(nd), j)));
+                }
+            }
+        }
+        None
+    }
+
+    /// Moves `lp` `ds` metres of station (≥ 0, the roads' `s`, as OpenSCENARIO's route
+    /// positions count `pathS`) in its lane's direction of travel, into a successor lane
+    /// where the lane ends: the first that `prefer` accepts, else the first. Returns `false`
+    /// when the lanes end before: `lp` then stands at the end.
+    pub fn advance_stations(
+        &self,
+        lp: &mut LanePos,
+        mut ds: f64,
+        prefer: &dyn Fn(usize) -> bool,
+    ) -> bool {
+        for _ in 0..self.map.lanes.len().max(1) {
+            let l = &self.map.lanes[lp.lane];
+            let (a, b) = l.s_range();
+            let up = l.forward != lp.rev;
+            let left = if up { b - lp.s } else { lp.s - a };
+            if ds <= left {
+                lp.s += if up { ds } else { -ds };
+                return true;
+            }
+            ds -= left.max(0.0);
+            let Some(next) = l
+                .successors
+                .iter()
+                .copied()
+                .find(|&n| prefer(n))
+                .or_else(|| l.successors.first().copied())
+            else {
+                lp.s = if up { b } else { a };
+                return false;
+            };
+            let n = &self.map.lanes[next];
+            let (na, nb) = n.s_range();
+            *lp = LanePos {
+                lane: next,
+                s: if n.forward { na } else { nb },
+                d: lp.d,
+                rev: false,
+            };
+        }
+        false
+    }
+
     /// Moves `lp` `dist` metres (≥ 0, along the path at its offset from its lane's centre
     /// line) in the lane's direction of travel, into a successor lane where the lane ends:
     /// the first that `prefer` accepts, else the first. Returns `false` when the lanes end before: `lp` then stands at the
@@ -445,5 +579,29 @@ mod tests {
         assert!((wrap(3.0 * PI) - PI).abs() < 1e-12);
         assert!((wrap(-PI) - PI).abs() < 1e-12);
         assert!((wrap(0.5) - 0.5).abs() < 1e-12);
+    }
+}
+
+/// A distance as a totally ordered key for the route search's heap (distances are finite
+/// and ≥ 0, so their bits order as the numbers do).
+fn ordered(d: f64) -> Ordered {
+    Ordered(d)
+}
+
+/// See [`ordered`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Ordered(f64);
+
+impl Eq for Ordered {}
+
+impl PartialOrd for Ordered {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Ordered {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
     }
 }

@@ -7,7 +7,8 @@ use roxmltree::Node;
 use super::{position, Reader};
 use crate::error::XoscError;
 use crate::model::{
-    Action, Dimension, Dynamics, LaneTarget, OffsetTarget, Shape, SpeedTarget, TrajectoryShape,
+    Action, Dimension, Dynamics, LaneTarget, OffsetTarget, Position, Shape, SpeedTarget,
+    TrajectoryShape,
 };
 use crate::quantity::Quantity;
 use crate::xml::{child, choice, elements, need, only};
@@ -24,9 +25,37 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
             "RoutingAction",
             "ControllerAction",
             "ActivateControllerAction",
+            "AppearanceAction",
+            "VisibilityAction",
         ],
     )?;
     match tag {
+        "AppearanceAction" => {
+            let (kind, tag) = choice(r.text, a, &["LightStateAction", "AnimationAction"])?;
+            let what = if tag == "LightStateAction" {
+                "a vehicle's lights"
+            } else {
+                "an animation"
+            };
+            r.note(
+                kind,
+                format!("<{tag}> is read but not modelled: paracosm draws no {}, and its sensors and monitors read none", if tag == "LightStateAction" { "vehicle lights" } else { "animations" }),
+            );
+            Ok(Action::Appearance(what.to_string()))
+        }
+        "VisibilityAction" => {
+            if child(a, "SensorReferenceSet").is_some() {
+                return Err(r.text.unsupported(
+                    a,
+                    "a visibility for some sensors only (<SensorReferenceSet>) is not supported: paracosm hides an entity from every sensor or none",
+                ));
+            }
+            Ok(Action::Visibility {
+                graphics: r.scope.bool(r.text, a, "graphics")?,
+                traffic: r.scope.bool(r.text, a, "traffic")?,
+                sensors: r.scope.bool(r.text, a, "sensors")?,
+            })
+        }
         // OpenSCENARIO 1.0 puts it directly under <PrivateAction>.
         "ActivateControllerAction" => activate(r, a),
         "LongitudinalAction" => {
@@ -50,11 +79,22 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
             need(r.text, a, "Position")?,
         )?)),
         "RoutingAction" => {
-            let (f, tag) = choice(r.text, a, &["FollowTrajectoryAction", "AssignRouteAction"])?;
-            if tag == "AssignRouteAction" {
-                assign_route(r, f)
-            } else {
-                follow_trajectory(r, f)
+            let (f, tag) = choice(
+                r.text,
+                a,
+                &[
+                    "FollowTrajectoryAction",
+                    "AssignRouteAction",
+                    "AcquirePositionAction",
+                ],
+            )?;
+            match tag {
+                "AssignRouteAction" => assign_route(r, f),
+                "AcquirePositionAction" => Ok(Action::AcquirePosition(position::read(
+                    r,
+                    need(r.text, f, "Position")?,
+                )?)),
+                _ => follow_trajectory(r, f),
             }
         }
         _ => {
@@ -312,11 +352,10 @@ fn lane_offset(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> 
     })
 }
 
+/// A `FollowTrajectoryAction`: its trajectory inline (`<TrajectoryRef><Trajectory>`, or 1.0's
+/// `<Trajectory>`) or from a trajectory catalog (`<CatalogReference>` in either place), with
+/// its timing.
 fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
-    let holder = child(node, "TrajectoryRef").unwrap_or(node);
-    let traj = child(holder, "Trajectory").ok_or_else(|| {
-        r.text.unsupported(node, "a trajectory is read from <TrajectoryRef><Trajectory> or <Trajectory> (trajectory catalogs are not supported)")
-    })?;
     if r.scope
         .opt_num_in(r.text, node, "initialDistanceOffset", Quantity::Distance)?
         .is_some_and(|d| d != 0.0)
@@ -326,27 +365,6 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
             reason: "a trajectory's initialDistanceOffset is not supported".into(),
         });
     }
-    if r.scope.bool(r.text, traj, "closed")? {
-        return Err(r
-            .text
-            .unsupported(traj, "a closed trajectory is not supported"));
-    }
-    if child(traj, "ParameterDeclarations").is_some_and(|p| elements(p).next().is_some()) {
-        return Err(r.text.unsupported(
-            traj,
-            "a trajectory's own parameter declarations are not supported",
-        ));
-    }
-    let (shape_node, kind) = choice(
-        r.text,
-        need(r.text, traj, "Shape")?,
-        &["Polyline", "Clothoid", "Nurbs"],
-    )?;
-    let shape = match kind {
-        "Polyline" => polyline(r, shape_node)?,
-        "Clothoid" => clothoid(r, shape_node)?,
-        _ => nurbs(r, shape_node)?,
-    };
     let time_ref = need(r.text, node, "TimeReference")?;
     let timing = match child(time_ref, "Timing") {
         None => None,
@@ -381,15 +399,72 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
                 format!("a timing's scale must be > 0, not {scale}"),
             ));
         }
-        timed(r, shape_node, &shape)?;
     }
+    let holder = child(node, "TrajectoryRef").unwrap_or(node);
+    let read = |r: &Reader<'_>, traj: Node<'_, '_>| trajectory(r, traj, timing.is_some());
+    let shape = match (
+        child(holder, "Trajectory"),
+        child(holder, "CatalogReference"),
+    ) {
+        (Some(traj), None) => read(&r.scoped(traj)?, traj)?,
+        (None, Some(c)) => r.catalogs.read_entry(r, c, &["Trajectory"], read)?,
+        _ => {
+            return Err(r.text.invalid(
+                holder,
+                "a trajectory is read from one <Trajectory> or one <CatalogReference> here",
+            ))
+        }
+    };
+    let mut position_mode = false;
     if let Some(m) = child(node, "TrajectoryFollowingMode") {
         let mode = r.scope.string(r.text, m, "followingMode")?;
-        if mode != "position" {
-            r.note(m, format!("followingMode {mode:?} is followed as \"position\": the entity is placed on the trajectory"));
+        position_mode = mode == "position";
+        if !position_mode {
+            r.note(m, format!("followingMode {mode:?} places the entity on the trajectory as \"position\" does (its heading turns along each leg of a polyline, as esmini's does in this mode)"));
         }
     }
-    Ok(Action::FollowTrajectory { shape, timing })
+    Ok(Action::FollowTrajectory {
+        shape,
+        timing,
+        position_mode,
+    })
+}
+
+/// A `<Trajectory>`'s shape, read with `r`'s scope (the trajectory's own parameters in it);
+/// with `timed`, each of its points must have a time.
+fn trajectory(
+    r: &Reader<'_>,
+    traj: Node<'_, '_>,
+    timed_: bool,
+) -> Result<TrajectoryShape, XoscError> {
+    if traj.tag_name().name() != "Trajectory" {
+        return Err(r.text.invalid(
+            traj,
+            format!(
+                "a trajectory catalog entry is a <Trajectory>, not <{}>",
+                traj.tag_name().name()
+            ),
+        ));
+    }
+    if r.scope.bool(r.text, traj, "closed")? {
+        return Err(r
+            .text
+            .unsupported(traj, "a closed trajectory is not supported"));
+    }
+    let (shape_node, kind) = choice(
+        r.text,
+        need(r.text, traj, "Shape")?,
+        &["Polyline", "Clothoid", "Nurbs"],
+    )?;
+    let shape = match kind {
+        "Polyline" => polyline(r, shape_node)?,
+        "Clothoid" => clothoid(r, shape_node)?,
+        _ => nurbs(r, shape_node)?,
+    };
+    if timed_ {
+        timed(r, shape_node, &shape)?;
+    }
+    Ok(shape)
 }
 
 /// A `Polyline`: at least two `Vertex` elements, each with its position and time.
@@ -545,17 +620,30 @@ fn timed(r: &Reader<'_>, node: Node<'_, '_>, shape: &TrajectoryShape) -> Result<
     }
 }
 
+/// An `AssignRouteAction`: its `<Route>`, inline (with its own parameter declarations) or
+/// from a route catalog (`<CatalogReference>`, with the reference's parameter assignments).
 fn assign_route(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
-    let route = child(node, "Route").ok_or_else(|| {
-        r.text.unsupported(
-            node,
-            "a route is read from <Route> (catalog references are not supported)",
-        )
-    })?;
-    if child(route, "ParameterDeclarations").is_some_and(|p| elements(p).next().is_some()) {
-        return Err(r.text.unsupported(
+    let (holder, tag) = choice(r.text, node, &["Route", "CatalogReference"])?;
+    let waypoints = if tag == "Route" {
+        route(&r.scoped(holder)?, holder)?
+    } else {
+        r.catalogs.read_entry(r, holder, &["Route"], route)?
+    };
+    Ok(Action::AssignRoute { waypoints })
+}
+
+/// A `<Route>`'s waypoints, read with `r`'s scope (the route's own parameters in it).
+pub(super) fn route(
+    r: &Reader<'_>,
+    route: Node<'_, '_>,
+) -> Result<Vec<(Position, String)>, XoscError> {
+    if route.tag_name().name() != "Route" {
+        return Err(r.text.invalid(
             route,
-            "a route's own parameter declarations are not supported",
+            format!(
+                "a route catalog entry is a <Route>, not <{}>",
+                route.tag_name().name()
+            ),
         ));
     }
     if r.scope.bool(r.text, route, "closed")? {
@@ -590,5 +678,5 @@ fn assign_route(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError>
             .text
             .invalid(route, "a route needs at least two waypoints"));
     }
-    Ok(Action::AssignRoute { waypoints })
+    Ok(waypoints)
 }

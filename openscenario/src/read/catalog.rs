@@ -64,20 +64,40 @@ impl Catalogs {
         let entry = r.scope.string(r.text, reference, "entryName")?;
         let assignments = assignments(r, reference)?;
         let mut missing = Vec::new();
-        for (kind, dir) in self
+        let dirs: Vec<&(String, PathBuf)> = self
             .dirs
             .iter()
             .filter(|(k, _)| kinds.contains(&k.as_str()))
-        {
+            .collect();
+        // The standard names a catalog by its <Catalog name>; esmini finds it by its file's
+        // name (`catalogName.xosc`), and files written for esmini rely on that: a catalog
+        // no <Catalog name> matches is looked for so, with a note.
+        let none_named = dirs.iter().all(|(_, d)| !has_catalog_named(r, d, &catalog));
+        let named = |file: &Path, cat: &str| {
+            none_named && file.file_stem().and_then(|f| f.to_str()) == Some(cat)
+        };
+        for (kind, dir) in dirs.iter().map(|(k, d)| (k, d)) {
             for file in catalog_files(r, reference, dir)?.iter() {
                 let text = r.files.text(file)?;
                 let doc = text.parse()?;
+                let by_file = named(file, &catalog);
                 let Some(cat) = elements(doc.root_element()).find(|c| {
                     c.tag_name().name() == "Catalog"
-                        && c.attribute("name") == Some(catalog.as_str())
+                        && (by_file || c.attribute("name") == Some(catalog.as_str()))
                 }) else {
                     continue;
                 };
+                if by_file {
+                    r.note(
+                        reference,
+                        format!(
+                            "no catalog is named {catalog:?}: the one in {} (named {:?}) is \
+                             read, found by its file's name as esmini finds it",
+                            file.display(),
+                            cat.attribute("name").unwrap_or_default()
+                        ),
+                    );
+                }
                 if let Some(e) = elements(cat).find(|e| e.attribute("name") == Some(entry.as_str()))
                 {
                     let decls = read_declarations(&text, child(e, "ParameterDeclarations"))?;
@@ -104,6 +124,43 @@ impl Catalogs {
     }
 }
 
+impl Catalogs {
+    /// As [`Catalogs::with_entry`], calling `read` with a reader of the entry
+    /// ([`Reader::in_catalog`]: the catalog file's text, the entry's scope, the scenario's
+    /// entities, notes and catalogs), for entries that hold storyboard elements (maneuvers,
+    /// routes, trajectories, environments).
+    ///
+    /// # Errors
+    /// As [`Catalogs::with_entry`].
+    pub(crate) fn read_entry<R>(
+        &self,
+        r: &Reader<'_>,
+        reference: Node<'_, '_>,
+        kinds: &[&str],
+        read: impl FnOnce(&Reader<'_>, Node<'_, '_>) -> Result<R, XoscError>,
+    ) -> Result<R, XoscError> {
+        self.with_entry(r, reference, kinds, |text, entry, scope| {
+            read(&r.in_catalog(text, scope), entry)
+        })
+    }
+}
+
+/// Whether a file of catalog folder `dir` holds a `<Catalog name="cat">` (a folder that
+/// cannot be read holds none: its error is the lookup's).
+fn has_catalog_named(r: &Reader<'_>, dir: &Path, cat: &str) -> bool {
+    let Ok(files) = r.files.xosc_files(dir) else {
+        return false;
+    };
+    files.iter().any(|f| {
+        r.files.text(f).is_ok_and(|text| {
+            text.parse().is_ok_and(|doc| {
+                elements(doc.root_element())
+                    .any(|c| c.tag_name().name() == "Catalog" && c.attribute("name") == Some(cat))
+            })
+        })
+    })
+}
+
 /// The reference's `ParameterAssignments`, each value resolved in the scenario's scope.
 fn assignments(
     r: &Reader<'_>,
@@ -114,9 +171,14 @@ fn assignments(
         .into_iter()
         .flat_map(elements)
     {
-        let name = r.scope.string(r.text, a, "parameterRef")?;
+        // `parameterRef` names the entry's parameter; esmini and files written for it put a
+        // `$` before the name, which is not a reference to the scenario's parameter.
+        let name = match a.attribute("parameterRef") {
+            Some(n) => n.trim().trim_start_matches('$').to_string(),
+            None => r.scope.string(r.text, a, "parameterRef")?,
+        };
         let value = r.scope.string(r.text, a, "value")?;
-        out.push((name.trim_start_matches('$').to_string(), value));
+        out.push((name, value));
     }
     Ok(out)
 }

@@ -64,8 +64,26 @@ fn condition(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Condition, XoscError> {
     } else {
         by_entity(r, by)?
     };
+    // A condition's name is a label nothing in the standard refers to; esmini's expressions
+    // also concatenate texts (`${Brake + _ + $Gap}`), which paracosm's do not: a name that
+    // does not evaluate is kept as written, with a note.
+    let name = match r.scope.string(r.text, c, "name") {
+        Ok(name) => name,
+        Err(_)
+            if c.attribute("name")
+                .is_some_and(|n| n.trim_start().starts_with("${")) =>
+        {
+            let raw = c.attribute("name").unwrap_or_default().to_string();
+            r.note(
+                c,
+                format!("this condition's name {raw:?} is not an expression paracosm evaluates (esmini's concatenate texts); it is a label nothing refers to, kept as written"),
+            );
+            raw
+        }
+        Err(e) => return Err(e),
+    };
     Ok(Condition {
-        name: r.scope.string(r.text, c, "name")?,
+        name,
         delay_s,
         edge,
         kind,
@@ -101,6 +119,7 @@ fn by_value(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError
             "SimulationTimeCondition",
             "StoryboardElementStateCondition",
             "ParameterCondition",
+            "VariableCondition",
         ],
     )?;
     Ok(match tag {
@@ -148,18 +167,38 @@ fn by_value(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError
             }
         }
         _ => {
-            let name = r.scope.string(r.text, v, "parameterRef")?;
-            let name = name.trim_start_matches('$').to_string();
-            if r.scope.get(&name).is_none() {
+            let variable = tag == "VariableCondition";
+            let attr = if variable {
+                "variableRef"
+            } else {
+                "parameterRef"
+            };
+            // The name of a parameter or variable, not a reference to its value: esmini's
+            // files may put a `$` before it.
+            let name = crate::params::required(r.text, v, attr)?
+                .trim()
+                .trim_start_matches('$')
+                .to_string();
+            let declared = if variable { &r.variables } else { &r.globals };
+            if !declared.iter().any(|(n, _)| *n == name) {
                 return Err(XoscError::Invalid {
-                    pos: r.text.attr_pos(v, "parameterRef"),
-                    reason: format!("parameter {name:?} is not declared"),
+                    pos: r.text.attr_pos(v, attr),
+                    reason: if variable {
+                        format!("variable {name:?} is not declared in the scenario's <VariableDeclarations>")
+                    } else {
+                        format!(
+                            "parameter {name:?} is not declared in the scenario's own \
+                             <ParameterDeclarations> (a condition reads the scenario's \
+                             parameters while a test runs)"
+                        )
+                    },
                 });
             }
-            ConditionKind::Parameter {
-                name,
-                rule: rule(r, v)?,
-                value: r.scope.string(r.text, v, "value")?,
+            let (rule, value) = (rule(r, v)?, r.scope.string(r.text, v, "value")?);
+            if variable {
+                ConditionKind::Variable { name, rule, value }
+            } else {
+                ConditionKind::Parameter { name, rule, value }
             }
         }
     })
@@ -179,6 +218,7 @@ const ENTITY_CONDITIONS: &[&str] = &[
     "TraveledDistanceCondition",
     "EndOfRoadCondition",
     "CollisionCondition",
+    "OffroadCondition",
 ];
 
 fn by_entity(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError> {
@@ -268,14 +308,16 @@ fn measure(r: &Reader<'_>, c: Node<'_, '_>) -> Result<(String, String), XoscErro
     Ok((frame, kind))
 }
 
-/// Refuses 1.2's `direction` on speed and acceleration conditions: paracosm compares the
-/// whole speed or acceleration.
+/// Reads 1.2's `direction` on speed and acceleration conditions: `longitudinal` is the speed
+/// or acceleration along the entity's heading, which is what paracosm compares (its entities
+/// face the way they move, so the longitudinal part is the whole); `lateral` and `vertical`
+/// are refused.
 fn no_direction(r: &Reader<'_>, c: Node<'_, '_>) -> Result<(), XoscError> {
-    match c.attribute("direction") {
-        None => Ok(()),
-        Some(_) => Err(XoscError::Unsupported {
+    match r.scope.opt_string(r.text, c, "direction")?.as_deref() {
+        None | Some("longitudinal") => Ok(()),
+        Some(other) => Err(XoscError::Unsupported {
             pos: r.text.attr_pos(c, "direction"),
-            reason: "a speed or acceleration condition's direction is not supported: paracosm compares the whole speed or acceleration".into(),
+            reason: format!("a speed or acceleration condition's direction {other:?} is not supported: paracosm compares the speed or acceleration along the entity's heading (direction=\"longitudinal\")"),
         }),
     }
 }
@@ -289,6 +331,17 @@ fn gap(
     q: Quantity,
 ) -> Result<Gap, XoscError> {
     let (frame, kind) = measure(r, c)?;
+    // Along the road or its lanes, and across the road; not along a trajectory, and not
+    // across in lanes (counted in lanes, not metres).
+    if frame == "trajectory" || (frame == "lane" && kind != "longitudinal") {
+        return Err(XoscError::Unsupported {
+            pos: r.text.attr_pos(c, "coordinateSystem"),
+            reason: format!(
+                "a {kind} distance in the {frame:?} coordinate system is not supported: \
+                 paracosm measures in the entity's, the road's, and longitudinally along lanes"
+            ),
+        });
+    }
     Ok(Gap {
         entity: r.entity(target, "entityRef")?,
         rule: rule(r, c)?,
@@ -328,13 +381,13 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
         }
         "DistanceCondition" => {
             let (frame, kind) = measure(r, c)?;
-            if frame != "entity" {
+            if frame == "trajectory" || (frame == "lane" && kind != "longitudinal") {
                 return Err(XoscError::Unsupported {
                     pos: t.attr_pos(c, "coordinateSystem"),
                     reason: format!(
-                        "a distance condition in the {frame:?} coordinate system is not \
-                         supported: paracosm measures it in the entity's (coordinateSystem \
-                         \"entity\")"
+                        "a {kind} distance condition in the {frame:?} coordinate system is not \
+                         supported: paracosm measures in the entity's, the road's, and \
+                         longitudinally along lanes"
                     ),
                 });
             }
@@ -344,6 +397,7 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
                 value: s.num_in(t, c, "value", Quantity::Distance)?,
                 freespace: s.bool(t, c, "freespace")?,
                 kind,
+                frame,
             }
         }
         "ReachPositionCondition" => EntityTest::ReachPosition {
@@ -371,6 +425,9 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
         }
         "EndOfRoadCondition" => {
             EntityTest::EndOfRoad(s.num_in(t, c, "duration", Quantity::Duration)?)
+        }
+        "OffroadCondition" => {
+            EntityTest::Offroad(s.num_in(t, c, "duration", Quantity::Duration)?)
         }
         _ => {
             let (target, _) = choice(t, c, &["EntityRef"])?;

@@ -132,6 +132,39 @@ fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscErr
     let category = scope
         .opt_string(text, e, category_attr)?
         .unwrap_or_else(|| tag.to_lowercase());
+    // What the schema lets an object hold; a trailer hitched to a vehicle is refused (the
+    // storyboard would leave it standing while its tractor drives off).
+    let vehicle = tag == "Vehicle";
+    crate::xml::only(
+        text,
+        e,
+        if vehicle {
+            &[
+                "ParameterDeclarations",
+                "BoundingBox",
+                "Performance",
+                "Axles",
+                "Properties",
+                "TrailerHitch",
+                "TrailerCoupler",
+                "Trailer",
+            ]
+        } else {
+            &["ParameterDeclarations", "BoundingBox", "Properties"]
+        },
+    )?;
+    if let Some(trailer) = child(e, "Trailer") {
+        let towed = match child(trailer, "TrailerRef") {
+            Some(r) => !scope.string(text, r, "entityRef")?.trim().is_empty(),
+            None => crate::xml::elements(trailer).next().is_some(),
+        };
+        if towed {
+            return Err(text.unsupported(
+                trailer,
+                "a vehicle towing a trailer is not supported: paracosm moves each entity on its own, so the trailer would be left standing",
+            ));
+        }
+    }
     let bb = need(text, e, "BoundingBox")?;
     let dims = need(text, bb, "Dimensions")?;
     let centre = need(text, bb, "Center")?;

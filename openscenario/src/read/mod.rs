@@ -4,6 +4,7 @@ mod action;
 mod catalog;
 mod condition;
 mod entities;
+mod global;
 mod position;
 mod storyboard;
 
@@ -31,9 +32,17 @@ pub(crate) struct Reader<'t> {
     pub(crate) names: std::rc::Rc<Vec<String>>,
     pub(crate) notes: std::rc::Rc<std::cell::RefCell<Vec<Note>>>,
     pub(crate) dir: PathBuf,
+    /// The scenario's catalog folders (read once its `CatalogLocations` are), shared by the
+    /// readers of nested scopes and of catalog entries.
+    pub(crate) catalogs: std::rc::Rc<Catalogs>,
+    /// The scenario's own parameters (its root `ParameterDeclarations`) and their types: the
+    /// ones a `ParameterCondition` reads and a `ParameterAction` sets while a test runs.
+    pub(crate) globals: std::rc::Rc<Vec<(String, crate::params::ParamType)>>,
+    /// The scenario's variables (`VariableDeclarations`) and their types.
+    pub(crate) variables: std::rc::Rc<Vec<(String, crate::params::ParamType)>>,
 }
 
-impl Reader<'_> {
+impl<'t> Reader<'t> {
     /// The entity named by `node`'s attribute `attr`.
     pub(crate) fn entity(&self, node: Node<'_, '_>, attr: &str) -> Result<usize, XoscError> {
         let name = self.scope.string(self.text, node, attr)?;
@@ -67,7 +76,33 @@ impl Reader<'_> {
             names: std::rc::Rc::clone(&self.names),
             notes: self.notes.clone(),
             dir: self.dir.clone(),
+            catalogs: std::rc::Rc::clone(&self.catalogs),
+            globals: std::rc::Rc::clone(&self.globals),
+            variables: std::rc::Rc::clone(&self.variables),
         })
+    }
+
+    /// A reader of a catalog entry: `text` is the catalog file's, `scope` the entry's own
+    /// (its declarations with the reference's assignments), the entities, notes and catalogs
+    /// this one's; relative paths are taken from the catalog file's folder.
+    pub(crate) fn in_catalog<'c>(&self, text: &'c Text, scope: &Scope) -> Reader<'c>
+    where
+        't: 'c,
+    {
+        Reader {
+            text,
+            files: self.files,
+            scope: scope.clone(),
+            names: std::rc::Rc::clone(&self.names),
+            notes: self.notes.clone(),
+            dir: Path::new(&text.file)
+                .parent()
+                .map(Path::to_path_buf)
+                .unwrap_or_default(),
+            catalogs: std::rc::Rc::clone(&self.catalogs),
+            globals: std::rc::Rc::clone(&self.globals),
+            variables: std::rc::Rc::clone(&self.variables),
+        }
     }
 
     /// Notes that `node` is read but not honoured as written.
@@ -153,6 +188,7 @@ fn read_with(
             "RoadNetwork",
             "Entities",
             "Storyboard",
+            "VariableDeclarations",
         ],
     )?;
     let version = read_version(text, root)?;
@@ -178,11 +214,17 @@ fn read_with(
         names: std::rc::Rc::default(),
         notes: Default::default(),
         dir: dir.to_path_buf(),
+        catalogs: std::rc::Rc::default(),
+        globals: std::rc::Rc::new(decls.iter().map(|d| (d.name.clone(), d.ty)).collect()),
+        variables: std::rc::Rc::default(),
     };
-    let catalogs = Catalogs::read(&r, child(root, "CatalogLocations"))?;
+    let variables = read_variables(&r, child(root, "VariableDeclarations"))?;
+    r.variables = std::rc::Rc::new(variables.iter().map(|(n, t, _)| (n.clone(), *t)).collect());
+    r.catalogs = std::rc::Rc::new(Catalogs::read(&r, child(root, "CatalogLocations"))?);
     let road_network = entities::road_network(&r, child(root, "RoadNetwork"))?;
+    let catalogs = std::rc::Rc::clone(&r.catalogs);
     let entities = entities::read(&mut r, &catalogs, child(root, "Entities"))?;
-    let (init, stories, stop) = storyboard::read(&r, storyboard)?;
+    let (init, init_global, stories, stop) = storyboard::read(&r, storyboard)?;
     Ok(Scenario {
         file: text.file.clone(),
         version,
@@ -191,10 +233,56 @@ fn read_with(
         road_network,
         entities,
         init,
+        init_global,
+        variables,
         stories,
         stop,
         notes: r.notes.take(),
     })
+}
+
+/// `VariableDeclarations` (OpenSCENARIO 1.2): each `VariableDeclaration`'s name, type
+/// (`variableType`) and initial value, in order.
+///
+/// # Errors
+/// Invalid for a name declared twice, an unknown type, a value not of its type (or not
+/// resolved: a variable's value may be `$parameter` or `${expr}`).
+fn read_variables(
+    r: &Reader<'_>,
+    node: Option<Node<'_, '_>>,
+) -> Result<Vec<(String, crate::params::ParamType, Value)>, XoscError> {
+    let mut out: Vec<(String, crate::params::ParamType, Value)> = Vec::new();
+    for v in node.into_iter().flat_map(crate::xml::elements) {
+        if v.tag_name().name() != "VariableDeclaration" {
+            return Err(r.text.unsupported(
+                v,
+                format!(
+                    "<{}> in <VariableDeclarations>: only <VariableDeclaration> belongs there",
+                    v.tag_name().name()
+                ),
+            ));
+        }
+        let name = crate::params::required(r.text, v, "name")?.to_string();
+        if out.iter().any(|(n, _, _)| *n == name) {
+            return Err(r
+                .text
+                .invalid(v, format!("variable {name} is declared twice")));
+        }
+        let ty_name = crate::params::required(r.text, v, "variableType")?;
+        let ty = crate::params::ParamType::from_xsd(ty_name).ok_or_else(|| XoscError::Invalid {
+            pos: r.text.attr_pos(v, "variableType"),
+            reason: format!("unknown variableType {ty_name:?}"),
+        })?;
+        let text = r.scope.string(r.text, v, "value")?;
+        let value = ty
+            .coerce(Value::Str(text))
+            .map_err(|e| XoscError::Invalid {
+                pos: r.text.attr_pos(v, "value"),
+                reason: format!("variable {name} is of type {}: {}", ty.xsd_name(), e.0),
+            })?;
+        out.push((name, ty, value));
+    }
+    Ok(out)
 }
 
 /// `FileHeader`'s revision, 1.0 to 1.3.

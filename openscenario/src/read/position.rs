@@ -18,6 +18,7 @@ const POSITIONS: &[&str] = &[
     "RelativeRoadPosition",
     "LanePosition",
     "RelativeLanePosition",
+    "RoutePosition",
 ];
 
 /// A `<Position>` element.
@@ -48,7 +49,54 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscE
                 .unwrap_or(0.0),
             orientation: orientation(r, p)?,
         },
+        "RoutePosition" => route(r, p)?,
         _ => relative_lane(r, p)?,
+    })
+}
+
+/// A `<RoutePosition>`: its route (`RouteRef`: a `<Route>` or a route catalog's
+/// `<CatalogReference>`), where on it (`InRoutePosition`) and its orientation.
+fn route(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
+    use crate::model::InRoute;
+    let (s, t) = (&r.scope, r.text);
+    let (holder, tag) = choice(
+        t,
+        crate::xml::need(t, p, "RouteRef")?,
+        &["Route", "CatalogReference"],
+    )?;
+    let waypoints = if tag == "Route" {
+        super::action::route(&r.scoped(holder)?, holder)?
+    } else {
+        r.catalogs
+            .read_entry(r, holder, &["Route"], super::action::route)?
+    };
+    let (w, tag) = choice(
+        t,
+        crate::xml::need(t, p, "InRoutePosition")?,
+        &[
+            "FromCurrentEntity",
+            "FromLaneCoordinates",
+            "FromRoadCoordinates",
+        ],
+    )?;
+    let at = match tag {
+        "FromCurrentEntity" => InRoute::Entity(r.entity(w, "entityRef")?),
+        "FromLaneCoordinates" => InRoute::Lane {
+            path_s: s.num_in(t, w, "pathS", Quantity::Distance)?,
+            lane: lane_id(r, w, "laneId")?,
+            offset: s
+                .opt_num_in(t, w, "laneOffset", Quantity::Lateral)?
+                .unwrap_or(0.0),
+        },
+        _ => InRoute::Road {
+            path_s: s.num_in(t, w, "pathS", Quantity::Distance)?,
+            t: s.num_in(t, w, "t", Quantity::Lateral)?,
+        },
+    };
+    Ok(Position::Route {
+        waypoints,
+        at,
+        orientation: orientation(r, p)?,
     })
 }
 
@@ -119,15 +167,10 @@ fn relative(r: &Reader<'_>, p: Node<'_, '_>, tag: &str) -> Result<Position, Xosc
 }
 
 /// A `<RelativeLanePosition>`: the entity, the lanes `dLane` across, `ds` along (m) and the
-/// lateral `offset` (m); an orientation or a `dsLane` is refused.
+/// lateral `offset` (m), with its orientation (the schema allows one; ASAM's own examples
+/// and esmini's give it); a `dsLane` is refused.
 fn relative_lane(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
     let (s, t) = (&r.scope, r.text);
-    if child(p, "Orientation").is_some() {
-        return Err(r.text.unsupported(
-            p,
-            "an orientation on a relative lane position is not supported",
-        ));
-    }
     let ds = s.opt_num_in(t, p, "ds", Quantity::Distance)?;
     if ds.is_none() || p.attribute("dsLane").is_some() {
         return Err(r.text.unsupported(
@@ -142,6 +185,7 @@ fn relative_lane(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError>
         offset: s
             .opt_num_in(t, p, "offset", Quantity::Lateral)?
             .unwrap_or(0.0),
+        orientation: orientation(r, p)?,
     })
 }
 

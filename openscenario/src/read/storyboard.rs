@@ -5,26 +5,42 @@ use std::collections::HashSet;
 
 use roxmltree::Node;
 
-use super::{action, condition, Reader};
+use super::{action, condition, global, Reader};
 use crate::error::XoscError;
 use crate::model::{
     Act, ConditionKind, Event, Maneuver, ManeuverGroup, NamedAction, Priority, Story, Trigger,
 };
 use crate::xml::{child, elements, need, only};
 
-type Storyboard = (Vec<(usize, NamedAction)>, Vec<Story>, Option<Trigger>);
+/// `Init`'s private actions (entity, action), its global actions, the stories and the stop
+/// trigger.
+type Storyboard = (
+    Vec<(usize, NamedAction)>,
+    Vec<NamedAction>,
+    Vec<Story>,
+    Option<Trigger>,
+);
 
 /// The `Storyboard` element: `Init`'s private actions, the stories and the stop trigger.
 pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Storyboard, XoscError> {
     only(r.text, node, &["Init", "Story", "StopTrigger"])?;
     let mut init = Vec::new();
+    let mut init_global = Vec::new();
     let actions = need(r.text, need(r.text, node, "Init")?, "Actions")?;
     for a in elements(actions) {
+        if a.tag_name().name() == "GlobalAction" {
+            init_global.push(NamedAction {
+                name: String::new(),
+                pos: r.text.pos(a),
+                action: global::global(r, a)?,
+            });
+            continue;
+        }
         if a.tag_name().name() != "Private" {
             return Err(r.text.unsupported(
                 a,
                 format!(
-                    "<{}> in <Init> is not supported; paracosm reads <Private> actions",
+                    "<{}> in <Init> is not supported; paracosm reads <Private> and <GlobalAction> actions",
                     a.tag_name().name()
                 ),
             ));
@@ -67,7 +83,7 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Storyboard, Xos
         None => None,
     };
     check_references(&stories, stop.as_ref())?;
-    Ok((init, stories, stop))
+    Ok((init, init_global, stories, stop))
 }
 
 fn name(r: &Reader<'_>, node: Node<'_, '_>) -> Result<String, XoscError> {
@@ -111,11 +127,17 @@ fn act(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Act, XoscError> {
         for m in elements(g) {
             match m.tag_name().name() {
                 "Actors" => {}
-                "Maneuver" => maneuvers.push(maneuver(r, m)?),
+                "Maneuver" => maneuvers.push(maneuver(&r.scoped(m)?, m)?),
+                "CatalogReference" => maneuvers.push(r.catalogs.read_entry(
+                    r,
+                    m,
+                    &["Maneuver"],
+                    maneuver,
+                )?),
                 other => {
                     return Err(r.text.unsupported(
                         m,
-                        format!("<{other}> in <ManeuverGroup> is not supported (maneuver catalogs are not read); paracosm reads <Maneuver>"),
+                        format!("<{other}> in <ManeuverGroup> is not supported; paracosm reads <Maneuver> or a maneuver catalog's <CatalogReference>"),
                     ))
                 }
             }
@@ -154,8 +176,18 @@ fn act(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Act, XoscError> {
     })
 }
 
+/// A `<Maneuver>`, read with `r`'s scope (the maneuver's own parameters in it: a catalog
+/// entry's with the reference's assignments).
 fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
-    let r = &r.scoped(m)?;
+    if m.tag_name().name() != "Maneuver" {
+        return Err(r.text.invalid(
+            m,
+            format!(
+                "a maneuver catalog entry is a <Maneuver>, not <{}>",
+                m.tag_name().name()
+            ),
+        ));
+    }
     only(r.text, m, &["ParameterDeclarations", "Event"])?;
     let mut events = Vec::new();
     for e in elements(m).filter(|e| e.tag_name().name() == "Event") {
@@ -173,15 +205,10 @@ fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
         };
         let mut actions = Vec::new();
         for a in elements(e).filter(|a| a.tag_name().name() == "Action") {
-            let Some(p) = child(a, "PrivateAction") else {
-                let what = elements(a).next().map_or("nothing".to_string(), |c| {
-                    format!("<{}>", c.tag_name().name())
-                });
-                return Err(r.text.unsupported(
+            let Some(p) = elements(a).next() else {
+                return Err(r.text.invalid(
                     a,
-                    format!(
-                        "an action holding {what} is not supported; paracosm reads <PrivateAction>"
-                    ),
+                    "an <Action> holds one <PrivateAction> or <GlobalAction>, not nothing",
                 ));
             };
             // The schema's Action is a choice of one GlobalAction, UserDefinedAction or
@@ -199,7 +226,19 @@ fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
             actions.push(NamedAction {
                 name: name(r, a)?,
                 pos: r.text.pos(a),
-                action: action::private(r, p)?,
+                action: match p.tag_name().name() {
+                    "PrivateAction" => action::private(r, p)?,
+                    "GlobalAction" => global::global(r, p)?,
+                    other => {
+                        return Err(r.text.unsupported(
+                            p,
+                            format!(
+                                "<{other}> in <Action> is not supported; paracosm reads \
+                                 <PrivateAction> or <GlobalAction>"
+                            ),
+                        ))
+                    }
+                },
             });
         }
         if actions.is_empty() {

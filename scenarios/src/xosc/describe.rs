@@ -166,6 +166,20 @@ fn name(s: &Scenario, e: usize) -> &str {
 /// One line for a position.
 fn position(s: &Scenario, p: &Position) -> String {
     match p {
+        Position::Route { waypoints, at, .. } => {
+            let on = match at {
+                paracosm_openscenario::model::InRoute::Entity(e) => {
+                    format!("where {} is", name(s, *e))
+                }
+                paracosm_openscenario::model::InRoute::Lane { path_s, lane, .. } => {
+                    format!("{path_s} m along, lane {lane}")
+                }
+                paracosm_openscenario::model::InRoute::Road { path_s, t } => {
+                    format!("{path_s} m along, {t} m across")
+                }
+            };
+            format!("on a route of {} waypoints, {on}", waypoints.len())
+        }
         Position::World { x, y, h } => format!(
             "world ({x}, {y}){}",
             h.map_or(String::new(), |h| format!(" heading {h} rad"))
@@ -195,6 +209,7 @@ fn position(s: &Scenario, p: &Position) -> String {
             d_lane,
             ds,
             offset,
+            ..
         } => {
             format!(
                 "{ds} m along, {d_lane} lanes left of {} (offset {offset})",
@@ -256,6 +271,7 @@ fn action(s: &Scenario, a: &Action) -> String {
             _ => String::new(),
         },
         Action::Teleport(p) => format!("at {}", position(s, p)),
+        Action::AcquirePosition(p) => format!("route to {}", position(s, p)),
         Action::FollowTrajectory { shape, .. } => match shape {
             TrajectoryShape::Polyline(vertices) => format!(
                 "follow a polyline of {} vertices to {}",
@@ -293,7 +309,57 @@ fn action(s: &Scenario, a: &Action) -> String {
                 .map_or(String::new(), |(p, _)| position(s, p))
         ),
         Action::ActivateController { .. } => "the system under test takes over".into(),
+        Action::Environment(_)
+        | Action::Appearance(_)
+        | Action::Visibility { .. }
+        | Action::SetValue { .. }
+        | Action::ModifyValue { .. } => not_motion(a),
     }
+}
+
+/// One line for an action that moves no entity (the environment, an entity's appearance or
+/// visibility, a parameter or variable).
+fn not_motion(a: &Action) -> String {
+    match a {
+        Action::Environment(e) => environment(e),
+        Action::Appearance(what) => format!("{what} (not modelled)"),
+        Action::Visibility {
+            graphics,
+            traffic,
+            sensors,
+        } => format!("visible: graphics {graphics}, traffic {traffic}, sensors {sensors}"),
+        Action::SetValue { name, value, .. } => format!("{name} = {}", value.to_text()),
+        Action::ModifyValue {
+            name, multiply, by, ..
+        } => format!("{name} {} {by}", if *multiply { "*=" } else { "+=" }),
+        _ => String::new(),
+    }
+}
+
+/// One line for an `EnvironmentAction`'s environment: the parts it gives.
+fn environment(e: &paracosm_openscenario::model::Environment) -> String {
+    let mut parts = Vec::new();
+    if let Some((secs, animation)) = e.time_of_day {
+        let running = if animation { ", running" } else { "" };
+        parts.push(format!(
+            "time of day {:02}:{:02}{running}",
+            (secs / 3600.0) as u32,
+            ((secs % 3600.0) / 60.0) as u32
+        ));
+    }
+    if let Some((lux, elevation)) = e.sun {
+        parts.push(format!("sun {lux} lx at {elevation} rad"));
+    }
+    if let Some(v) = e.fog_visual_range_m {
+        parts.push(format!("fog, visual range {v} m"));
+    }
+    if let Some((kind, mm)) = &e.precipitation {
+        parts.push(format!("{kind} {mm} mm/h"));
+    }
+    if let Some(f) = e.friction_scale {
+        parts.push(format!("road friction x {f}"));
+    }
+    format!("environment: {}", parts.join(", "))
 }
 
 /// One line for a trigger: `when A and B, or C`.
@@ -326,6 +392,9 @@ fn condition(s: &Scenario, c: &ConditionKind) -> String {
             state,
         } => format!("{element_type} {element} {state}"),
         ConditionKind::Parameter { name, rule, value } => format!("${name} {rule:?} {value}"),
+        ConditionKind::Variable { name, rule, value } => {
+            format!("variable {name} {rule:?} {value}")
+        }
         ConditionKind::Entity { entities, test, .. } => {
             let who: Vec<&str> = entities.iter().map(|&e| name(s, e)).collect();
             let what = match test {
@@ -360,8 +429,9 @@ fn condition(s: &Scenario, c: &ConditionKind) -> String {
                     value,
                     freespace,
                     kind,
+                    frame,
                 } => format!(
-                    "{kind} distance{} to {} {rule:?} {value} m",
+                    "{kind} distance{} to {} in {frame} coordinates {rule:?} {value} m",
                     if *freespace { " from its box" } else { "" },
                     position(s, p)
                 ),
@@ -380,6 +450,7 @@ fn condition(s: &Scenario, c: &ConditionKind) -> String {
                 EntityTest::Standstill(d) => format!("still for {d} s"),
                 EntityTest::TraveledDistance(d) => format!("travelled {d} m"),
                 EntityTest::EndOfRoad(d) => format!("past the road's end for {d} s"),
+                EntityTest::Offroad(d) => format!("off the road for more than {d} s"),
                 EntityTest::Collision(Some(e)) => format!("touches {}", name(s, *e)),
                 EntityTest::Collision(None) => "touches anything".into(),
             };

@@ -30,15 +30,27 @@ impl HostInputs for StoryInputs {
             road_network,
             entities,
             init,
+            init_global,
+            variables,
             stories,
             stop,
             notes,
         } = &*self.0;
+        // A parameter that a condition reads while the test runs is read by the storyboard.
+        let read_by_conditions = |a: &m::Scenario, b: &m::Scenario| {
+            a.params
+                .iter()
+                .zip(&b.params)
+                .all(|((d, va), (_, vb))| va == vb || !condition_reads(a, &d.name))
+        };
         *file == b.file
             && *version == b.version
             && *road_network == b.road_network
             && *entities == b.entities
             && *init == b.init
+            && *init_global == b.init_global
+            && *variables == b.variables
+            && read_by_conditions(&self.0, b)
             && *stories == b.stories
             && *stop == b.stop
             && *notes == b.notes
@@ -47,4 +59,25 @@ impl HostInputs for StoryInputs {
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }
+}
+
+/// Whether a `ParameterCondition` of `s` (in its stories or its stop trigger) reads the
+/// parameter `name`.
+fn condition_reads(s: &m::Scenario, name: &str) -> bool {
+    let reads = |t: &m::Trigger| {
+        t.0.iter()
+            .flatten()
+            .any(|c| matches!(&c.kind, m::ConditionKind::Parameter { name: n, .. } if n == name))
+    };
+    s.stop.as_ref().is_some_and(reads)
+        || s.stories.iter().flat_map(|st| &st.acts).any(|act| {
+            act.start.as_ref().is_some_and(reads)
+                || act.stop.as_ref().is_some_and(reads)
+                || act
+                    .groups
+                    .iter()
+                    .flat_map(|g| &g.maneuvers)
+                    .flat_map(|m| &m.events)
+                    .any(|e| e.start.as_ref().is_some_and(reads))
+        })
 }

@@ -213,6 +213,11 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
         })
         .collect();
     let mut each = |who: &[usize], na: &m::NamedAction, init: bool| -> Result<(), ScenarioError> {
+        if na.action.is_global() {
+            // On the world, not on the actors.
+            warnings.extend(global_otherwise(na, ego)?);
+            return Ok(());
+        }
         for &e in who {
             if let Some(message) = performed_otherwise(s, na, (e, ego), init)? {
                 warnings.push(Warning {
@@ -225,6 +230,9 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
     };
     for (e, na) in &s.init {
         each(&[*e], na, true)?;
+    }
+    for na in &s.init_global {
+        each(&[], na, true)?;
     }
     for g in s
         .stories
@@ -250,6 +258,43 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
         }
     }
     Ok(warnings)
+}
+
+/// How paracosm performs global action `na` (`ego`: the entity a system under test drives,
+/// if one does): as written, or with a warning for what its world does not model.
+///
+/// # Errors
+/// [`ScenarioError::Load`] at the action: rain or snow while a system under test drives
+/// (paracosm's camera and range sensor do not model precipitation, so the system would sense a dry
+/// world).
+fn global_otherwise(
+    na: &m::NamedAction,
+    ego: Option<usize>,
+) -> Result<Option<Warning>, ScenarioError> {
+    let Action::Environment(env) = &na.action else {
+        return Ok(None);
+    };
+    let Some((kind, mm)) = env
+        .precipitation
+        .as_ref()
+        .filter(|(k, mm)| k != "dry" && *mm > 0.0)
+    else {
+        return Ok(None);
+    };
+    if ego.is_some() {
+        return Err(worlds_error(format!(
+            "{}: this EnvironmentAction brings {kind} ({mm} mm/h), which paracosm's camera and \
+             range sensor do not model: the system under test would sense a dry world. Run the file \
+             with --scripted-ego (no system senses it), or give the test its fog and light",
+            na.pos
+        )));
+    }
+    Ok(Some(Warning {
+        at: na.pos.to_string(),
+        message: format!(
+            "{kind} ({mm} mm/h) is not modelled: no system under test senses the world here"
+        ),
+    }))
 }
 
 /// How paracosm performs action `na` on entity `e` (`ego`: the entity the system under test
@@ -299,13 +344,39 @@ fn performed_otherwise(
             "{name} has no controller in paracosm: the storyboard moves it, and its \
              ActivateControllerAction does nothing"
         )),
+        // The lights of a vehicle: noted where read.
+        Action::Appearance(_) => None,
+        // Hidden from the system under test's camera or sensors: paracosm cannot hide an
+        // entity from them, so a test under a system would test a world it does not sense.
+        Action::Visibility {
+            graphics, sensors, ..
+        } if ego.is_some() && !driven && !(*graphics && *sensors) => {
+            return Err(worlds_error(format!(
+                "{}: this VisibilityAction hides {name} from the {} of the system under test, \
+                 which paracosm cannot do: its camera and range sensor see every entity. Run the \
+                 file with --scripted-ego (no system senses the world)",
+                na.pos,
+                if *sensors { "camera" } else { "sensors" }
+            )));
+        }
+        Action::Visibility {
+            graphics, sensors, ..
+        } if !(driven || *graphics && *sensors) => Some(format!(
+            "{name} is hidden here, which paracosm does not model: no system under test senses \
+             the world (--scripted-ego)"
+        )),
+        Action::Visibility { .. } if !driven => None,
         // Its place, its initial speed and its route (the lanes it plans through).
         Action::Teleport(_) | Action::AssignRoute { .. } if init && driven => None,
         // Its initial speed in Init; later, the set speed of the system under test.
         Action::Speed { .. } if driven => None,
         // Later, the route of the system under test: into the lane, or along the route's
         // roads.
-        Action::LaneChange { .. } | Action::AssignRoute { .. } if !init && driven => None,
+        Action::LaneChange { .. } | Action::AssignRoute { .. } | Action::AcquirePosition(_)
+            if !init && driven =>
+        {
+            None
+        }
         _ if driven => {
             return Err(worlds_error(format!(
                 "{}: the system under test drives {name}, and paracosm cannot hand it this {}: \
@@ -592,13 +663,25 @@ impl XoscFrontEnd {
             .as_ref()
             .map(|r| here(&r.pos, "RoadNetwork"))
             .unwrap_or_else(|| Site::of(&model.file));
-        let light = scene.push(Node::Const(Value::Num(1.0)));
-        let fog = scene.push(Node::Const(Value::Num(0.0)));
+        // Daylight without fog, or what the storyboard's EnvironmentActions set, read from
+        // the storyboard each step (its host functions LIGHT_FN and FOG_FN).
+        let sets = environment_sets(model);
+        let light = (!sets.light).then(|| scene.push(Node::Const(Value::Num(DEFAULT_LIGHT))));
+        let fog = (!sets.fog).then(|| scene.push(Node::Const(Value::Num(0.0))));
+        let ego = ego_of(model, self.ego.as_deref(), self.scripted_ego)?;
+        let built = build_into(&mut scene, model, &self.maps, (ego, self.scripted_ego), 0)?;
+        let mut from_storyboard = |f: u32| {
+            let tick = scene.push(Node::Tick);
+            scene.push(Node::Map {
+                src: tick,
+                f: Func::Host(f),
+            })
+        };
+        let light = light.unwrap_or_else(|| from_storyboard(LIGHT_FN));
+        let fog = fog.unwrap_or_else(|| from_storyboard(FOG_FN));
         scene
             .set_environment(light, fog, at.clone())
             .map_err(|e| worlds_error(e.to_string()))?;
-        let ego = ego_of(model, self.ego.as_deref(), self.scripted_ego)?;
-        let built = build_into(&mut scene, model, &self.maps, (ego, self.scripted_ego), 0)?;
         scene.add_monitor(MonitorSpec::collision(), at.clone());
         scene
             .set_settings(TestSettings {
@@ -676,7 +759,16 @@ pub(crate) fn build_into(
     if hand_over {
         sb.hand_over_on_activation(ego);
     }
-    let piece = add_map(scene, &map, here(&road.pos, "RoadNetwork"))?;
+    let friction = if environment_sets(model).friction {
+        let tick = scene.push(Node::Tick);
+        scene.push(Node::Map {
+            src: tick,
+            f: Func::Host(base + FRICTION_FN),
+        })
+    } else {
+        scene.push(Node::Const(Value::Num(story::MAP_FRICTION)))
+    };
+    let piece = add_map(scene, &map, friction, here(&road.pos, "RoadNetwork"))?;
     let placed = place_entities(scene, model, &sb, ego)?;
     let (mut sinks, probes, actors) = placed;
     if scripted_ego || hand_over {
@@ -740,21 +832,22 @@ pub(crate) fn build_into(
     })
 }
 
-/// Adds `map` to `scene` as one road piece, with friction 0.8, declared at `site`: through
-/// the handle the map files keep, so that every test shares the query index and collision
-/// mesh the first test built.
+/// Adds `map` to `scene` as one road piece, with friction [`story::MAP_FRICTION`] (or the
+/// stream `friction`, when a `RoadCondition` changes it), declared at `site`: through the
+/// handle the map files keep, so that every test shares the query index and collision mesh
+/// the first test built.
 ///
 /// # Errors
 /// [`ScenarioError::Load`] when the scene refuses the piece.
 fn add_map(
     scene: &mut Scene,
     map: &paracosm_engine::network::MapRef,
+    friction: StreamId,
     site: Site,
 ) -> Result<PieceId, ScenarioError> {
-    let friction = scene.push(Node::Const(Value::Num(0.8)));
     let piece = paracosm_engine::network::PieceKind::Map {
         map: map.clone(),
-        friction: 0.8,
+        friction: story::MAP_FRICTION,
     };
     scene
         .add_road(|n| n.add("map", piece), friction, site)
@@ -1073,8 +1166,72 @@ impl StoryHost {
     }
 }
 
+/// The light of an OpenSCENARIO test that no `EnvironmentAction` sets (`[0, 1]`, 0.5
+/// nominal daylight).
+pub const DEFAULT_LIGHT: f64 = 1.0;
+
+/// The storyboard's host functions (from its base) that give the light, the fog density and
+/// the map's friction coefficient its `EnvironmentAction`s set.
+const LIGHT_FN: u32 = 4;
+/// See [`LIGHT_FN`].
+const FOG_FN: u32 = 5;
+/// See [`LIGHT_FN`].
+const FRICTION_FN: u32 = 6;
+
+/// Which of the world's light, fog and road friction an `EnvironmentAction` of the scenario
+/// (in `Init` or a story) sets.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct EnvironmentSets {
+    /// The light (a time of day or a sun).
+    pub(crate) light: bool,
+    /// The fog.
+    pub(crate) fog: bool,
+    /// The road's friction.
+    pub(crate) friction: bool,
+}
+
+/// What the `EnvironmentAction`s of `model` set.
+pub(crate) fn environment_sets(model: &m::Scenario) -> EnvironmentSets {
+    let actions = model.init_global.iter().chain(
+        model
+            .stories
+            .iter()
+            .flat_map(|st| &st.acts)
+            .flat_map(|a| &a.groups)
+            .flat_map(|g| &g.maneuvers)
+            .flat_map(|mv| &mv.events)
+            .flat_map(|e| &e.actions),
+    );
+    let mut sets = EnvironmentSets::default();
+    for na in actions {
+        if let Action::Environment(e) = &na.action {
+            sets.light |= e.time_of_day.is_some() || e.sun.is_some();
+            sets.fog |= e.fog_visual_range_m.is_some();
+            sets.friction |= e.friction_scale.is_some();
+        }
+    }
+    sets
+}
+
 /// How close to the end of its lanes the ego's front may come before a test ends there, m.
 pub const ROAD_END_MARGIN_M: f64 = 2.0;
+
+impl StoryHost {
+    /// What host function `k` ([`LIGHT_FN`], [`FOG_FN`], [`FRICTION_FN`]) gives at the tick
+    /// `args[0]` (s): the light, fog density or road friction the storyboard's
+    /// `EnvironmentAction`s have set, else the world's default.
+    fn environment(&self, k: u32, args: &[Value]) -> f64 {
+        let env = self.sb.environment();
+        match k {
+            LIGHT_FN => {
+                let t = args.first().and_then(Value::as_num).unwrap_or(0.0);
+                env.light(t).unwrap_or(DEFAULT_LIGHT)
+            }
+            FOG_FN => env.fog().unwrap_or(0.0),
+            _ => env.friction().unwrap_or(story::MAP_FRICTION),
+        }
+    }
+}
 
 impl Host for StoryHost {
     fn call(&mut self, f: u32, args: &[Value], streams: &Runtime) -> Result<Value, HostError> {
@@ -1167,6 +1324,7 @@ impl Host for StoryHost {
             1 => Ok(Value::Num(self.measures.0)),
             2 => Ok(Value::Num(self.measures.1)),
             3 => Ok(Value::Num(self.measures.2)),
+            k @ (LIGHT_FN | FOG_FN | FRICTION_FN) => Ok(Value::Num(self.environment(k, args))),
             _ => Err(HostError(format!("no host function {f}"))),
         }
     }

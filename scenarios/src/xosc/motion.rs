@@ -64,18 +64,69 @@ pub fn offset_duration_s(shape: Shape, delta: f64, max_acc: f64) -> f64 {
 /// How close two times are to be one, s (far below any step).
 const TIME_EPS_S: f64 = 1e-9;
 
+/// How the heading turns between a polyline's vertices (esmini's
+/// `PolyLineBase::InterpolationMode`, chosen by the trajectory's following mode).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Turn {
+    /// The heading of the vertex that starts the leg (sampled curves: clothoids, NURBS).
+    None,
+    /// From one vertex's heading to the next's along the whole leg (`follow`).
+    Segment,
+    /// The leg's vertex heading, turned to the next within 2 m (at most half a leg) of each
+    /// corner, and to the last vertex's within the last 2 m (`position`).
+    Corner,
+}
+
+impl Turn {
+    /// The heading on leg `i` (from vertex `i` to `i + 1` of headings `h`, rad) at `local`
+    /// m of its `len` m, as esmini's `PolyLineBase::EvaluateSegmentByLocalS` turns it.
+    pub fn heading(self, h: &[f64], i: usize, local: f64, len: f64) -> f64 {
+        let n = h.len();
+        if i + 1 >= n || len <= 0.0 {
+            return h[i.min(n - 1)];
+        }
+        let diff = |a: f64, b: f64| wrap(a - b);
+        let local = local.clamp(0.0, len);
+        match self {
+            Turn::None => h[i],
+            Turn::Segment => wrap(h[i] + local / len * diff(h[i + 1], h[i])),
+            Turn::Corner => {
+                let r = (len / 2.0).min(2.0);
+                if local < r {
+                    if i > 0 {
+                        let a = (r + local) / (2.0 * r);
+                        wrap(h[i - 1] + a * diff(h[i], h[i - 1]))
+                    } else {
+                        h[i]
+                    }
+                } else if local > len - r {
+                    let a = if i + 2 < n {
+                        (r + (len - local)) / (2.0 * r)
+                    } else {
+                        (len - local) / r
+                    };
+                    wrap(h[i] + (1.0 - a) * diff(h[i + 1], h[i]))
+                } else {
+                    h[i]
+                }
+            }
+        }
+    }
+}
+
 /// A timed polyline: vertices with their times (s, from the simulation's start).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Timed {
     /// `(t, pose)` in increasing `t`.
     pub vertices: Vec<(f64, Pose)>,
+    /// How the heading turns between vertices.
+    pub turn: Turn,
 }
 
 impl Timed {
-    /// The pose at `t` (s): the position linear between vertices, the heading of the vertex
-    /// that starts the leg (not interpolated: esmini's polyline without interpolation; a
-    /// vertex whose file gives no heading faces along its leg: the storyboard fills it in),
-    /// and whether `t` is past the last vertex.
+    /// The pose at `t` (s): the position linear between vertices, the heading turned as
+    /// [`Turn`] says (a vertex whose file gives no heading faces along its leg: the
+    /// storyboard fills it in), and whether `t` is past the last vertex.
     pub fn at(&self, t: f64) -> (Pose, bool) {
         let n = self.vertices.len();
         let last = self.vertices[n - 1];
@@ -99,11 +150,19 @@ impl Timed {
         } else {
             1.0
         };
+        let h = match self.turn {
+            Turn::None => a.1.h,
+            turn => {
+                let hs: Vec<f64> = self.vertices.iter().map(|v| v.1.h).collect();
+                let len = (b.1.x - a.1.x).hypot(b.1.y - a.1.y);
+                turn.heading(&hs, i - 1, u * len, len)
+            }
+        };
         (
             Pose {
                 x: a.1.x + u * (b.1.x - a.1.x),
                 y: a.1.y + u * (b.1.y - a.1.y),
-                h: a.1.h,
+                h,
             },
             false,
         )
@@ -117,6 +176,8 @@ pub struct Untimed {
     pub vertices: Vec<Pose>,
     /// Distance gone along it, m.
     pub gone_m: f64,
+    /// How the heading turns between vertices.
+    pub turn: Turn,
 }
 
 impl Untimed {
@@ -124,16 +185,23 @@ impl Untimed {
     pub fn advance(&mut self, dist: f64) -> (Pose, bool) {
         self.gone_m += dist.max(0.0);
         let mut left = self.gone_m;
-        for w in self.vertices.windows(2) {
+        for (i, w) in self.vertices.windows(2).enumerate() {
             let (a, b) = (w[0], w[1]);
             let len = (b.x - a.x).hypot(b.y - a.y);
             if left <= len && len > 0.0 {
                 let u = left / len;
+                let h = match self.turn {
+                    Turn::None => a.h,
+                    turn => {
+                        let hs: Vec<f64> = self.vertices.iter().map(|v| v.h).collect();
+                        turn.heading(&hs, i, left, len)
+                    }
+                };
                 return (
                     Pose {
                         x: a.x + u * (b.x - a.x),
                         y: a.y + u * (b.y - a.y),
-                        h: a.h,
+                        h,
                     },
                     false,
                 );
@@ -390,6 +458,7 @@ mod tests {
     fn a_timed_polyline_is_linear_between_its_vertices_facing_as_each_leg_starts() {
         let p = |x: f64, y: f64| Pose { x, y, h: 0.3 };
         let path = Timed {
+            turn: Turn::None,
             vertices: vec![
                 (1.0, p(0.0, 0.0)),
                 (
@@ -408,6 +477,7 @@ mod tests {
         let (end, done) = path.at(3.5);
         assert!(done && end.h == 0.7 && end.y == 4.0);
         let mut u = Untimed {
+            turn: Turn::None,
             vertices: vec![p(0.0, 0.0), p(3.0, 0.0), p(3.0, 4.0)],
             gone_m: 0.0,
         };

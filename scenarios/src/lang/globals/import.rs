@@ -87,6 +87,15 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         let overrides = overrides(params, &b)?;
         let model = paracosm_openscenario::read_scenario_in(&st.maps.xosc, &file, &overrides)
             .map_err(|e| anyhow!("{e}"))?;
+        let sets = crate::xosc::environment_sets(&model);
+        if sets.light || sets.fog {
+            bail!(
+                "{}: an EnvironmentAction of this scenario sets the world's light or fog, \
+                 which the program's World(...) gives: run the file itself (paracosm-fuzz \
+                 FILE), or leave the light and fog to the program",
+                model.file
+            );
+        }
         let ego = crate::xosc::ego_of(&model, ego, false).map_err(|e| anyhow!("{e}"))?;
         let warnings = crate::xosc::check(&model, Some(ego)).map_err(|e| anyhow!("{e}"))?;
         b.warnings.extend(warnings);

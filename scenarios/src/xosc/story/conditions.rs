@@ -24,6 +24,9 @@ pub(in crate::xosc::story) struct Cond {
     /// the parameter a parameter condition reads (none when nothing is declared by its name);
     /// empty for the other kinds.
     pub(in crate::xosc::story) refs: Vec<usize>,
+    /// The storyboard's count of transitions when it was last evaluated: an element-state
+    /// condition reads the transitions its elements made since ([`elements::Change`]).
+    pub(in crate::xosc::story) seen: u64,
 }
 
 /// A run of evaluations of a delayed condition that gave one value: the first and last
@@ -44,6 +47,7 @@ impl Cond {
             history: VecDeque::new(),
             taken: f64::NEG_INFINITY,
             refs: Vec::new(),
+            seen: 0,
         }
     }
 
@@ -91,7 +95,9 @@ impl Storyboard {
             let mut all = true;
             for c in 0..self.triggers[k][g].len() {
                 let raw = self.condition(&self.triggers[k][g][c], t);
+                let seq = self.seq;
                 let cond = &mut self.triggers[k][g][c];
+                cond.seen = seq;
                 let edged = match cond.cond.edge {
                     Edge::None => raw,
                     Edge::Rising => raw && cond.prev == Some(false),
@@ -124,8 +130,12 @@ impl Storyboard {
             elems.entry(key).or_default().push(i);
         }
         let mut params: HashMap<&str, usize> = HashMap::new();
-        for (i, (n, _)) in self.params.iter().enumerate() {
-            params.entry(n.as_str()).or_insert(i);
+        for (i, p) in self.params.iter().enumerate() {
+            params.entry(p.name.as_str()).or_insert(i);
+        }
+        let mut variables: HashMap<&str, usize> = HashMap::new();
+        for (i, v) in self.variables.iter().enumerate() {
+            variables.entry(v.name.as_str()).or_insert(i);
         }
         let mut found: Vec<Vec<usize>> = Vec::new();
         for cond in self.triggers.iter().flatten().flatten() {
@@ -147,6 +157,9 @@ impl Storyboard {
                 ConditionKind::Parameter { name, .. } => {
                     params.get(name.as_str()).copied().into_iter().collect()
                 }
+                ConditionKind::Variable { name, .. } => {
+                    variables.get(name.as_str()).copied().into_iter().collect()
+                }
                 _ => Vec::new(),
             });
         }
@@ -160,19 +173,29 @@ impl Storyboard {
             ConditionKind::SimulationTime { rule, value } => rule.holds(t, *value),
             ConditionKind::ElementState { state, .. } => cond.refs.iter().any(|&i| {
                 let e = &self.elems[i];
+                // The transitions it made since this condition last read them, newest first.
+                let since = e.changes.iter().rev().take_while(|c| c.seq >= cond.seen);
+                let made = |what| since.clone().any(|c| c.what == what);
+                let was = |phase| e.phase == phase || since.clone().any(|c| c.phase == phase);
                 match state.as_str() {
-                    "startTransition" => e.last.start,
-                    "endTransition" => e.last.end,
-                    "stopTransition" => e.last.stop,
-                    "skipTransition" => e.last.skip,
-                    "completeState" => e.phase == Phase::Complete,
-                    "runningState" => e.phase == Phase::Running,
-                    "standbyState" => e.phase == Phase::Standby,
+                    "startTransition" => made(elements::Transition::Start),
+                    "endTransition" => made(elements::Transition::End),
+                    "stopTransition" => made(elements::Transition::Stop),
+                    "skipTransition" => made(elements::Transition::Skip),
+                    "completeState" => was(Phase::Complete),
+                    "runningState" => was(Phase::Running),
+                    "standbyState" => was(Phase::Standby),
                     _ => false,
                 }
             }),
-            ConditionKind::Parameter { rule, value, .. } => {
-                let Some((_, v)) = cond.refs.first().map(|&i| &self.params[i]) else {
+            ConditionKind::Parameter { rule, value, .. }
+            | ConditionKind::Variable { rule, value, .. } => {
+                let store = if matches!(cond.cond.kind, ConditionKind::Variable { .. }) {
+                    &self.variables
+                } else {
+                    &self.params
+                };
+                let Some(v) = cond.refs.first().map(|&i| &store[i].text) else {
                     return false;
                 };
                 match (v.trim().parse::<f64>(), value.trim().parse::<f64>()) {
@@ -228,14 +251,19 @@ impl Storyboard {
                 value,
                 freespace,
                 kind,
+                frame,
             } => {
                 let at = paracosm_openscenario::Pos {
                     file: String::new(),
                     line: 0,
                     col: 0,
                 };
-                self.resolve(position, &at).is_ok_and(|(p, _)| {
-                    let d = self.distance_to_point(e, [p.x, p.y], *freespace, kind);
+                self.resolve(position, &at).is_ok_and(|(p, lp)| {
+                    let d = if frame == "entity" {
+                        self.distance_to_point(e, [p.x, p.y], *freespace, kind)
+                    } else {
+                        self.road_distance_to(e, lp, *freespace, kind)
+                    };
                     rule.holds(d, *value)
                 })
             }
@@ -261,6 +289,7 @@ impl Storyboard {
             EntityTest::Standstill(d) => st.still_s >= *d - 1e-9,
             EntityTest::TraveledDistance(d) => st.travelled_m >= *d,
             EntityTest::EndOfRoad(d) => st.at_end_s > 0.0 && st.at_end_s >= *d - 1e-9,
+            EntityTest::Offroad(d) => st.offroad_s > 0.0 && st.offroad_s > *d + 1e-9,
             EntityTest::Collision(other) => match other {
                 Some(o) => st.collided && self.touching(e, *o),
                 None => st.collided,
@@ -272,6 +301,9 @@ impl Storyboard {
     /// (m; between bounding boxes with `freespace`, between reference points otherwise) and
     /// the speed at which `e` closes in on it along its heading (m/s).
     pub(in crate::xosc::story) fn gap(&self, e: usize, g: &Gap) -> (f64, f64, f64) {
+        if g.frame == "road" || g.frame == "lane" {
+            return self.road_gap(e, g);
+        }
         let (a, b) = (&self.actors[e], &self.actors[g.entity]);
         let h = a.state.pose.h;
         let (c, s) = (h.cos(), h.sin());
@@ -327,6 +359,155 @@ impl Storyboard {
         let (c, s) = (pose.h.cos(), pose.h.sin());
         let (dx, dy) = (p[0] - pose.x, p[1] - pose.y);
         let (mut long, mut lat) = (dx * c + dy * s, -dx * s + dy * c);
+        if freespace {
+            long = ((long - a.centre_m[0]).abs() - a.size_m[0] / 2.0).max(0.0);
+            lat = ((lat - a.centre_m[1]).abs() - a.size_m[1] / 2.0).max(0.0);
+        }
+        match kind {
+            "longitudinal" => long.abs(),
+            "lateral" => lat.abs(),
+            _ => long.hypot(lat),
+        }
+    }
+
+    /// As [`Storyboard::gap`], in road coordinates (`coordinateSystem="road"`, 1.0's
+    /// `alongRoute`; `lane` along its lanes, the same stations): `e`'s longitudinal distance
+    /// to the other entity is the roads' stations between them along the lanes, ahead in
+    /// `e`'s direction of travel (over the lanes' successors into other roads, behind when
+    /// the other entity leads to `e`), the lateral the difference of their `t` (left of `e`'s
+    /// direction), each between reference points or, with `freespace`, between the boxes
+    /// (half their lengths and widths off). NaN (every comparison false) when either entity
+    /// is on no lane or no lanes lead from one to the other.
+    fn road_gap(&self, e: usize, g: &Gap) -> (f64, f64, f64) {
+        let (a, b) = (&self.actors[e], &self.actors[g.entity]);
+        let nan = (f64::NAN, f64::NAN, f64::NAN);
+        let (Some(la), Some(lb)) = (a.state.lane, b.state.lane) else {
+            return nan;
+        };
+        let Some((mut long, mut lat)) = self.road_offsets(la, lb) else {
+            return nan;
+        };
+        if g.freespace {
+            // The gap between the boxes' extents in road coordinates, their corners each
+            // taken to the road (esmini's `FreeSpaceDistanceObjectRoadLane`); on different
+            // roads, the reference points' offsets less half the boxes.
+            let road = self.roads.ids(la.lane).1;
+            let dir = if la.along_s(&self.roads) { 1.0 } else { -1.0 };
+            match (
+                self.box_on_road(a, road, dir),
+                self.box_on_road(b, road, dir),
+            ) {
+                (Some((sa, ta)), Some((sb, tb))) => {
+                    let gap = |p: (f64, f64), q: (f64, f64)| {
+                        if q.0 > p.1 {
+                            q.0 - p.1
+                        } else if p.0 > q.1 {
+                            -(p.0 - q.1)
+                        } else {
+                            0.0
+                        }
+                    };
+                    long = gap(sa, sb);
+                    lat = gap(ta, tb);
+                }
+                _ => {
+                    long += b.centre_m[0] - a.centre_m[0];
+                    let shrink = |d: f64, half: f64| d.signum() * (d.abs() - half).max(0.0);
+                    long = shrink(long, (a.size_m[0] + b.size_m[0]) / 2.0);
+                    lat = shrink(lat, (a.size_m[1] + b.size_m[1]) / 2.0);
+                }
+            }
+        }
+        let vb = b.state.speed * (b.state.pose.h - a.state.pose.h).cos();
+        let closing = if long >= 0.0 {
+            a.state.speed - vb
+        } else {
+            vb - a.state.speed
+        };
+        (long, lat, closing)
+    }
+
+    /// The extent of entity `x`'s bounding box on road `road` (an index of the map's roads):
+    /// the least and greatest station and `t` of its corners, each times `dir` (so that they
+    /// grow in the direction of travel measured from); `None` when a corner is on no lane of
+    /// that road.
+    fn box_on_road(&self, x: &Actor, road: usize, dir: f64) -> Option<((f64, f64), (f64, f64))> {
+        let p = x.state.pose;
+        let (c, s) = (p.h.cos(), p.h.sin());
+        let (mut sr, mut tr) = (
+            (f64::INFINITY, f64::NEG_INFINITY),
+            (f64::INFINITY, f64::NEG_INFINITY),
+        );
+        for (u, v) in [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)] {
+            let lx = x.centre_m[0] + u * x.size_m[0] / 2.0;
+            let ly = x.centre_m[1] + v * x.size_m[1] / 2.0;
+            let (cx, cy) = (p.x + c * lx - s * ly, p.y + s * lx + c * ly);
+            let lp = self.roads.anchor(cx, cy)?;
+            if self.roads.ids(lp.lane).1 != road {
+                return None;
+            }
+            let (_, t) = self.roads.road_t(&lp).ok()?;
+            let (sv, tv) = (lp.s * dir, t * dir);
+            sr = (sr.0.min(sv), sr.1.max(sv));
+            tr = (tr.0.min(tv), tr.1.max(tv));
+        }
+        Some((sr, tr))
+    }
+
+    /// Where lane position `lb` is from `la` in road coordinates: the roads' stations
+    /// between them along the lanes (ahead in `la`'s direction of travel positive) and the
+    /// difference of their `t` (left of that direction positive); `None` when no lanes lead
+    /// from one to the other.
+    fn road_offsets(&self, la: LanePos, lb: LanePos) -> Option<(f64, f64)> {
+        let (Ok((_, ta)), Ok((_, tb))) = (self.roads.road_t(&la), self.roads.road_t(&lb)) else {
+            return None;
+        };
+        let dir = if la.along_s(&self.roads) { 1.0 } else { -1.0 };
+        let ahead = LanePos { d: 0.0, ..la };
+        let b0 = LanePos { d: 0.0, ..lb };
+        // The shortest way over the lanes, either way round: `b` ahead of `e`, or `e` ahead
+        // of `b` (then `b` is behind, the distance negative).
+        let shortest = |from: LanePos, to: LanePos, flip_from: bool| {
+            [false, true]
+                .into_iter()
+                .flat_map(|r1| [false, true].map(|r2| (r1, r2)))
+                .filter(|(r1, _)| flip_from || !*r1)
+                .filter_map(|(r1, r2)| {
+                    let f = LanePos {
+                        rev: from.rev != r1,
+                        ..from
+                    };
+                    let t = LanePos { rev: r2, ..to };
+                    self.roads.route_between(&f, &t).map(|(_, d)| d)
+                })
+                .filter(|d| *d >= 0.0)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let long = if self.roads.ids(la.lane).1 == self.roads.ids(lb.lane).1 {
+            (lb.s - la.s) * dir
+        } else {
+            let fwd = shortest(ahead, b0, false);
+            let bwd = shortest(b0, ahead, true);
+            match (fwd.is_finite(), bwd.is_finite()) {
+                (false, false) => return None,
+                _ if fwd <= bwd => fwd,
+                _ => -bwd,
+            }
+        };
+        Some((long, (tb - ta) * dir))
+    }
+
+    /// A `DistanceCondition`'s distance in road coordinates from entity `e` to lane position
+    /// `to` ([`Storyboard::road_offsets`]; with `freespace`, from its bounding box); NaN
+    /// when either is on no lane or no lanes lead between them.
+    fn road_distance_to(&self, e: usize, to: Option<LanePos>, freespace: bool, kind: &str) -> f64 {
+        let a = &self.actors[e];
+        let (Some(la), Some(lb)) = (a.state.lane, to) else {
+            return f64::NAN;
+        };
+        let Some((mut long, mut lat)) = self.road_offsets(la, lb) else {
+            return f64::NAN;
+        };
         if freespace {
             long = ((long - a.centre_m[0]).abs() - a.size_m[0] / 2.0).max(0.0);
             lat = ((lat - a.centre_m[1]).abs() - a.size_m[1] / 2.0).max(0.0);

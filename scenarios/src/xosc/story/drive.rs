@@ -28,6 +28,10 @@ pub(in crate::xosc::story) struct Drive {
     /// (esmini's relative heading): set where it is placed or where its trajectory ends,
     /// 0 after a lateral move.
     pub(in crate::xosc::story) rel_h: f64,
+    /// Teleported by an event in this step: it stands where it was put until the next step
+    /// (esmini's `TeleportAction` marks the entity's longitudinal motion as done for the
+    /// frame, so its default controller does not move it).
+    pub(in crate::xosc::story) teleported: bool,
 }
 
 impl Storyboard {
@@ -53,8 +57,9 @@ impl Storyboard {
         }
         v1 = v1.max(0.0);
         // At the new speed over the step (esmini's integration: the speed first, then the
-        // move).
-        let dist = v1 * dt;
+        // move); not at all in the step an event teleported it.
+        let held = std::mem::take(&mut self.drives[e].teleported);
+        let dist = if held { 0.0 } else { v1 * dt };
         let mut pose = st.pose;
         let mut lane = st.lane;
         let mut at_end = false;

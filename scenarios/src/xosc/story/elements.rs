@@ -44,6 +44,26 @@ pub(in crate::xosc::story) struct Moves {
     pub(in crate::xosc::story) skip: bool,
 }
 
+/// A transition of the standard's element state machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(in crate::xosc::story) enum Transition {
+    Start,
+    End,
+    Stop,
+    Skip,
+}
+
+/// A transition an element made: the storyboard's count of transitions made before it
+/// ([`Storyboard::seq`]), which one, and the phase it left the element in. A condition on an
+/// element's state reads the changes made since it was last evaluated, as esmini's
+/// `TrigByState` queues each state change for its conditions until they next evaluate.
+#[derive(Debug, Clone, Copy)]
+pub(in crate::xosc::story) struct Change {
+    pub(in crate::xosc::story) seq: u64,
+    pub(in crate::xosc::story) what: Transition,
+    pub(in crate::xosc::story) phase: Phase,
+}
+
 #[derive(Debug, Clone)]
 pub(in crate::xosc::story) struct Elem {
     pub(in crate::xosc::story) kind: Kind,
@@ -59,8 +79,10 @@ pub(in crate::xosc::story) struct Elem {
     pub(in crate::xosc::story) priority: Priority,
     /// An action's action and the entities it acts on.
     pub(in crate::xosc::story) action: Option<(m::NamedAction, Vec<usize>)>,
+    /// The transitions it made in this step (for the test's timeline).
     pub(in crate::xosc::story) moves: Moves,
-    pub(in crate::xosc::story) last: Moves,
+    /// Its transitions, in order.
+    pub(in crate::xosc::story) changes: Vec<Change>,
 }
 
 /// Whose trigger a trigger is, which says when it is evaluated: a start trigger while its
@@ -160,7 +182,7 @@ impl Storyboard {
             priority: Priority::Override,
             action: None,
             moves: Moves::default(),
-            last: Moves::default(),
+            changes: Vec::new(),
         });
         self.elems.len() - 1
     }
@@ -191,43 +213,108 @@ impl Storyboard {
     }
 
     pub(in crate::xosc::story) fn run_story(&mut self, s: usize, t: f64) -> Result<(), StoryError> {
+        // esmini's traversal (`StoryBoardElement::EvalTriggers`): each element's triggers
+        // are evaluated when it is visited, a running act's stop trigger first, and an act
+        // that starts has its events judged in the same visit, so that a condition sees what
+        // the elements visited before it did in this step (a parameter set, a transition).
         for a in self.elems[s].children.clone() {
-            match self.elems[a].phase {
-                Phase::Standby => {
-                    let go = self.elems[a].start.is_none_or(|k| self.trigger_now[k]);
-                    if go {
-                        self.start_elem(a, t)?;
-                        for g in self.elems[a].children.clone() {
-                            self.start_group(g, t)?;
-                            let maneuvers = self.elems[g].children.iter().copied();
-                            self.new_maneuvers.extend(maneuvers);
-                        }
-                    }
+            if self.elems[a].phase == Phase::Running
+                && self.elems[a].stop.is_some_and(|k| self.evaluate(k, t))
+            {
+                self.stop_elem(a);
+                continue;
+            }
+            if self.elems[a].phase == Phase::Standby {
+                if !self.elems[a].start.is_none_or(|k| self.evaluate(k, t)) {
+                    continue;
                 }
-                Phase::Running => {
-                    if self.elems[a].stop.is_some_and(|k| self.trigger_now[k]) {
-                        self.stop_elem(a);
-                        continue;
-                    }
-                    let mut all = true;
-                    for g in self.elems[a].children.clone() {
-                        self.run_group(g, t)?;
-                        all &= self.elems[g].phase == Phase::Complete;
-                    }
-                    if all {
-                        self.end_elem(a);
-                    }
+                self.start_elem(a, t)?;
+                for g in self.elems[a].children.clone() {
+                    self.start_group(g, t)?;
                 }
-                Phase::Complete => {}
+            }
+            if self.elems[a].phase == Phase::Running {
+                for g in self.elems[a].children.clone() {
+                    self.run_group(g, t)?;
+                }
+                self.settle(a);
             }
         }
-        if self.elems[s]
-            .children
-            .iter()
-            .all(|&a| self.elems[a].phase == Phase::Complete)
-            && self.elems[s].phase == Phase::Running
+        self.settle(s);
+        Ok(())
+    }
+
+    /// Ends element `i` (a maneuver, an act or a story) when it runs and every child of it
+    /// is complete.
+    pub(in crate::xosc::story) fn settle(&mut self, i: usize) {
+        if self.elems[i].phase == Phase::Running
+            && self.elems[i]
+                .children
+                .iter()
+                .all(|&c| self.elems[c].phase == Phase::Complete)
         {
-            self.end_elem(s);
+            self.end_elem(i);
+        }
+    }
+
+    /// Ends a running maneuver group `g` whose maneuvers are all complete, or starts it
+    /// again while it has runs left (`maximumExecutionCount`).
+    fn settle_group(&mut self, g: usize, t: f64) -> Result<(), StoryError> {
+        let e = &self.elems[g];
+        if e.phase != Phase::Running
+            || !e
+                .children
+                .iter()
+                .all(|&m| self.elems[m].phase == Phase::Complete)
+        {
+            return Ok(());
+        }
+        self.elems[g].runs += 1;
+        if self.elems[g].runs < self.elems[g].max_runs {
+            let runs = self.elems[g].runs;
+            self.start_group(g, t)?;
+            self.elems[g].runs = runs;
+            // Run again, its events' triggers start afresh (esmini resets the children of
+            // an element it runs again).
+            for m in self.elems[g].children.clone() {
+                for ev in self.elems[m].children.clone() {
+                    if let Some(k) = self.elems[ev].start {
+                        self.reset_trigger(k);
+                    }
+                }
+            }
+        } else {
+            self.end_elem(g);
+        }
+        Ok(())
+    }
+
+    /// Carries the ends of this step's events up the storyboard, as esmini's
+    /// `StoryBoardElement::End` ends a parent in the frame its last child ends
+    /// (`PropagateStateFromChildren`): a maneuver whose events are all complete ends, then
+    /// its group (or starts it again), its act and its story, so that a condition on their
+    /// end sees it in the next step.
+    pub(in crate::xosc::story) fn settle_all(&mut self, t: f64) -> Result<(), StoryError> {
+        for s in self.roots.clone() {
+            if self.elems[s].phase != Phase::Running {
+                continue;
+            }
+            for a in self.elems[s].children.clone() {
+                if self.elems[a].phase != Phase::Running {
+                    continue;
+                }
+                for g in self.elems[a].children.clone() {
+                    if self.elems[g].phase != Phase::Running {
+                        continue;
+                    }
+                    for m in self.elems[g].children.clone() {
+                        self.settle(m);
+                    }
+                    self.settle_group(g, t)?;
+                }
+                self.settle(a);
+            }
+            self.settle(s);
         }
         Ok(())
     }
@@ -253,22 +340,10 @@ impl Storyboard {
         if self.elems[g].phase != Phase::Running {
             return Ok(());
         }
-        let mut all = true;
         for man in self.elems[g].children.clone() {
             self.run_maneuver(man, t)?;
-            all &= self.elems[man].phase == Phase::Complete;
         }
-        if all {
-            self.elems[g].runs += 1;
-            if self.elems[g].runs < self.elems[g].max_runs {
-                let runs = self.elems[g].runs;
-                self.start_group(g, t)?;
-                self.elems[g].runs = runs;
-            } else {
-                self.end_elem(g);
-            }
-        }
-        Ok(())
+        self.settle_group(g, t)
     }
 
     pub(in crate::xosc::story) fn run_maneuver(
@@ -284,7 +359,7 @@ impl Storyboard {
             if self.elems[ev].phase != Phase::Standby {
                 continue;
             }
-            if !self.elems[ev].start.is_none_or(|k| self.trigger_now[k]) {
+            if !self.elems[ev].start.is_none_or(|k| self.evaluate(k, t)) {
                 continue;
             }
             let others: Vec<usize> = events
@@ -295,6 +370,7 @@ impl Storyboard {
             match self.elems[ev].priority {
                 Priority::Skip if !others.is_empty() => {
                     self.elems[ev].moves.skip = true;
+                    self.record(ev, Transition::Skip);
                     continue;
                 }
                 Priority::Override => {
@@ -319,16 +395,11 @@ impl Storyboard {
             {
                 self.end_elem(ev);
                 if self.elems[ev].runs < self.elems[ev].max_runs {
-                    self.elems[ev].phase = Phase::Standby;
+                    self.rearm(ev);
                 }
             }
         }
-        if events
-            .iter()
-            .all(|&ev| self.elems[ev].phase == Phase::Complete)
-        {
-            self.end_elem(man);
-        }
+        self.settle(man);
         Ok(())
     }
 
@@ -340,6 +411,7 @@ impl Storyboard {
         let e = &mut self.elems[i];
         e.phase = Phase::Running;
         e.moves.start = true;
+        self.record(i, Transition::Start);
         Ok(())
     }
 
@@ -348,6 +420,39 @@ impl Storyboard {
         if e.phase != Phase::Complete {
             e.phase = Phase::Complete;
             e.moves.end = true;
+            self.record(i, Transition::End);
+        }
+    }
+
+    /// Records that element `i` made transition `what` (in the phase it is in now).
+    pub(in crate::xosc::story) fn record(&mut self, i: usize, what: Transition) {
+        let phase = self.elems[i].phase;
+        self.elems[i].changes.push(Change {
+            seq: self.seq,
+            what,
+            phase,
+        });
+        self.seq += 1;
+    }
+
+    /// Event `ev`, ended with runs left, waits again: in standby (its end leaves it there),
+    /// its start trigger's conditions reset (esmini's `StoryBoardElement::End` resets the
+    /// trigger of an element it will run again).
+    pub(in crate::xosc::story) fn rearm(&mut self, ev: usize) {
+        self.elems[ev].phase = Phase::Standby;
+        if let Some(c) = self.elems[ev].changes.last_mut() {
+            c.phase = Phase::Standby;
+        }
+        if let Some(k) = self.elems[ev].start {
+            self.reset_trigger(k);
+        }
+    }
+
+    /// Forgets the transitions trigger `k`'s conditions have not read.
+    pub(in crate::xosc::story) fn reset_trigger(&mut self, k: usize) {
+        let now = self.seq;
+        for c in self.triggers[k].iter_mut().flatten() {
+            c.seen = now;
         }
     }
 
@@ -378,6 +483,7 @@ impl Storyboard {
         let e = &mut self.elems[i];
         e.phase = Phase::Complete;
         e.moves.stop = true;
+        self.record(i, Transition::Stop);
     }
 
     pub(in crate::xosc::story) fn start_action(
@@ -389,6 +495,13 @@ impl Storyboard {
         let Some((action, actors)) = self.elems[a].action.clone() else {
             return Ok(());
         };
+        if action.action.is_global() {
+            // On the world, once, whoever the maneuver group's actors are; it completes at
+            // once (esmini's global actions are atomic).
+            self.perform_global(&action, t)?;
+            self.end_elem(a);
+            return Ok(());
+        }
         for e in actors {
             // An action that cannot be performed names itself and its entity.
             self.start_task(e, &action, Some(a), t)

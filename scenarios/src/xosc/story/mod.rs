@@ -17,6 +17,7 @@ use drive::{Drive, ToLane, Track};
 use elements::{Elem, Kind, Owner, Phase};
 pub use tasks::DEFAULT_LATERAL_ACC_MPS2;
 use tasks::{Keep, Lateral, Path, SpeedTask};
+pub use tasks::{Stored, WorldEnv, MAP_FRICTION, NOMINAL_ILLUMINANCE_LX};
 
 use std::collections::VecDeque;
 
@@ -76,6 +77,9 @@ pub struct State {
     pub still_s: f64,
     /// How long it has stood at the end of its lanes, s.
     pub at_end_s: f64,
+    /// How long it has been off every lane of the map, s (kept only while an
+    /// `OffroadCondition` reads it).
+    pub offroad_s: f64,
     /// Whether it has touched anything solid.
     pub collided: bool,
 }
@@ -90,6 +94,7 @@ impl State {
             travelled_m: 0.0,
             still_s: 0.0,
             at_end_s: 0.0,
+            offroad_s: 0.0,
             collided: false,
         }
     }
@@ -116,9 +121,18 @@ pub struct Storyboard {
     roots: Vec<usize>,
     triggers: Vec<Vec<Vec<Cond>>>,
     owners: Vec<Owner>,
-    trigger_now: Vec<bool>,
     stop: Option<usize>,
-    params: Vec<(String, String)>,
+    /// The scenario's own parameters, their values changed by `ParameterAction`s.
+    params: Vec<tasks::Stored>,
+    /// The scenario's variables (`VariableDeclarations`), changed by `VariableAction`s.
+    variables: Vec<tasks::Stored>,
+    /// The world's environment as `EnvironmentAction`s set it.
+    env: tasks::WorldEnv,
+    /// How many transitions the storyboard's elements have made ([`elements::Change`]).
+    seq: u64,
+    /// Whether an `OffroadCondition` reads how long each entity has been off the road
+    /// ([`State::offroad_s`]).
+    watch_offroad: bool,
     /// Whether the storyboard's stop trigger has fired.
     pub ended: bool,
     started: bool,
@@ -132,9 +146,6 @@ pub struct Storyboard {
     /// A new route asked of the driven ego since the host last took one
     /// ([`Storyboard::take_route`]).
     route: Option<RouteAsk>,
-    /// The maneuvers that acts started in the current step's run of the stories, whose
-    /// events the step judges after it ([`Storyboard::judge_new_events`]).
-    new_maneuvers: Vec<usize>,
 }
 
 /// A route the storyboard asks of the ego the system under test drives (a `LaneChangeAction`
@@ -193,7 +204,15 @@ impl Storyboard {
                 sb.add_act(s, act)?;
             }
         }
-        sb.trigger_now = vec![false; sb.triggers.len()];
+        sb.watch_offroad = sb.triggers.iter().flatten().flatten().any(|c| {
+            matches!(
+                c.cond.kind,
+                ConditionKind::Entity {
+                    test: m::EntityTest::Offroad(_),
+                    ..
+                }
+            )
+        });
         sb.resolve_references();
         sb.perform_init(scenario)?;
         // Init's transitions run from the start.
@@ -231,19 +250,33 @@ impl Storyboard {
             roots: Vec::new(),
             triggers: Vec::new(),
             owners: Vec::new(),
-            trigger_now: Vec::new(),
             stop: None,
             params: scenario
                 .params
                 .iter()
-                .map(|(d, v)| (d.name.clone(), v.to_text()))
+                .map(|(d, v)| tasks::Stored {
+                    name: d.name.clone(),
+                    ty: d.ty,
+                    text: v.to_text(),
+                })
                 .collect(),
+            variables: scenario
+                .variables
+                .iter()
+                .map(|(name, ty, v)| tasks::Stored {
+                    name: name.clone(),
+                    ty: *ty,
+                    text: v.to_text(),
+                })
+                .collect(),
+            env: tasks::WorldEnv::default(),
+            seq: 0,
+            watch_offroad: false,
             ended: false,
             started: false,
             set_speed: None,
             hand_over: None,
             route: None,
-            new_maneuvers: Vec::new(),
         }
     }
 
@@ -342,7 +375,9 @@ impl Storyboard {
                         c.cond.kind,
                         m::ConditionKind::SimulationTime { .. }
                             | m::ConditionKind::Entity {
-                                test: m::EntityTest::Standstill(_) | m::EntityTest::EndOfRoad(_),
+                                test: m::EntityTest::Standstill(_)
+                                    | m::EntityTest::EndOfRoad(_)
+                                    | m::EntityTest::Offroad(_),
                                 ..
                             }
                     );
@@ -369,7 +404,7 @@ impl Storyboard {
     pub fn step(&mut self, t: f64, dt: f64) -> Result<(), StoryError> {
         // The transitions of the last step, for this step's conditions.
         for e in &mut self.elems {
-            e.last = std::mem::take(&mut e.moves);
+            e.moves = elements::Moves::default();
         }
         if !self.started {
             self.started = true;
@@ -377,29 +412,26 @@ impl Storyboard {
                 self.start_elem(r, t)?;
             }
         }
+        // A waiting trigger is evaluated when its element is visited (`run_story`).
         for k in 0..self.triggers.len() {
-            if self.waits(k) {
-                self.trigger_now[k] = self.evaluate(k, t);
-            } else {
+            if !self.waits(k) {
                 // Not waiting: its delays start afresh when it waits again; an edge is taken
                 // against the last value seen (esmini's `OSCCondition::Reset` clears only the
                 // delay history).
-                self.trigger_now[k] = false;
                 for c in self.triggers[k].iter_mut().flatten() {
                     c.forget_delay();
                 }
             }
         }
+        // The storyboard's stop trigger first, as esmini's traversal evaluates it.
         if let Some(k) = self.stop {
-            if self.trigger_now[k] {
+            if self.evaluate(k, t) {
                 self.ended = true;
             }
         }
-        self.new_maneuvers.clear();
         for r in self.roots.clone() {
             self.run_story(r, t)?;
         }
-        self.judge_new_events(t)?;
         self.keep_distances(t + dt)?;
         for e in 0..self.actors.len() {
             if self.actors[e].scripted {
@@ -407,6 +439,13 @@ impl Storyboard {
             } else {
                 self.ask_speed(e, t + dt);
                 self.ask_lane(e);
+            }
+        }
+        if self.watch_offroad {
+            for a in &mut self.actors {
+                let p = a.state.pose;
+                let off = self.roads.anchor(p.x, p.y).is_none();
+                a.state.offroad_s = if off { a.state.offroad_s + dt } else { 0.0 };
             }
         }
         // An event whose actions ended in this step's motion ends in this step.
@@ -420,39 +459,11 @@ impl Storyboard {
             {
                 self.end_elem(ev);
                 if self.elems[ev].runs < self.elems[ev].max_runs {
-                    self.elems[ev].phase = Phase::Standby;
+                    self.rearm(ev);
                 }
             }
         }
-        Ok(())
-    }
-
-    /// The events of each maneuver that its act started in this step's run of the stories
-    /// ([`Storyboard::new_maneuvers`]), judged in this step at time `t` (s): esmini's
-    /// traversal of the storyboard evaluates an element's children in the frame that starts
-    /// it (`StoryBoardElement::EvalTriggers`, `tests/data/xosc/third_party/ESMINI_NOTES.md`),
-    /// so such an event's start trigger is first evaluated now (it did not wait when this
-    /// step's triggers were evaluated: its maneuver did not run), and an event that fires (or
-    /// has no start trigger) starts now, its actions moving its actors over this step.
-    fn judge_new_events(&mut self, t: f64) -> Result<(), StoryError> {
-        if self.new_maneuvers.is_empty() {
-            return Ok(());
-        }
-        let started = std::mem::take(&mut self.new_maneuvers);
-        for &m in &started {
-            for ev in self.elems[m].children.clone() {
-                if let Some(k) = self.elems[ev].start {
-                    if self.waits(k) {
-                        self.trigger_now[k] = self.evaluate(k, t);
-                    }
-                }
-            }
-        }
-        for &m in &started {
-            self.run_maneuver(m, t)?;
-        }
-        self.new_maneuvers = started;
-        Ok(())
+        self.settle_all(t)
     }
 
     /// The transitions the acts, events and actions made in the last [`Storyboard::step`]:

@@ -97,18 +97,26 @@ impl Storyboard {
                 dt,
                 orientation,
             } => self.road_offset(*entity, (*ds, *dt), orientation, at)?,
+            Position::Route {
+                waypoints,
+                at: in_route,
+                orientation,
+            } => self.route_position(waypoints, in_route, orientation, at)?,
             Position::RelativeLane {
                 entity,
                 d_lane,
                 ds,
                 offset,
+                orientation,
             } => {
                 let lp = self.lane_of(*entity, "RelativeLanePosition", at)?;
                 let lp = self
                     .roads
                     .relative_lane(&lp, *d_lane, *ds, *offset)
                     .map_err(|e| bad(e.to_string()))?;
-                (self.roads.pose_of(&lp), Some(lp))
+                let mut pose = self.roads.pose_of(&lp);
+                pose.h = orient(orientation, pose.h);
+                (pose, Some(lp))
             }
         })
     }
@@ -216,5 +224,85 @@ impl Storyboard {
     /// Heading `h` relative to the travel of lane position `lp`, rad (0 off the lanes).
     pub(in crate::xosc::story) fn relative_heading(&self, h: f64, lp: Option<LanePos>) -> f64 {
         lp.map_or(0.0, |lp| wrap(h - self.roads.travel_heading(&lp)))
+    }
+}
+
+impl Storyboard {
+    /// A `RoutePosition`: on the route through `waypoints`, where `in_route` says: from its
+    /// first waypoint's lane, `path_s` m of the roads' stations along its lanes in their
+    /// direction of travel (into the successor on a road of the route where lanes fork),
+    /// then the lane of the `<lane id>` asked on the road there (or `t` across it); or where
+    /// an entity is. Its heading is the route's direction there, turned by `orientation`
+    /// (relative to it, or absolute).
+    ///
+    /// # Errors
+    /// [`StoryError`] at `at` for a first waypoint off the map's lanes, a route that ends
+    /// before `path_s`, a road with no such lane there.
+    pub(in crate::xosc::story) fn route_position(
+        &self,
+        waypoints: &[(Position, String)],
+        in_route: &m::InRoute,
+        orientation: &Option<m::Orientation>,
+        at: &paracosm_openscenario::Pos,
+    ) -> Result<(Pose, Option<LanePos>), StoryError> {
+        let bad = |message: String| StoryError {
+            at: site(at),
+            message,
+        };
+        if let m::InRoute::Entity(e) = in_route {
+            let st = &self.actors[*e].state;
+            return Ok((st.pose, st.lane));
+        }
+        let first = match waypoints.first() {
+            Some((p, _)) => self.resolve(p, at)?.1,
+            None => None,
+        };
+        let Some(mut lp) = first else {
+            return Err(bad(
+                "a route position's route starts off the map's lanes: its first waypoint is on no lane".into(),
+            ));
+        };
+        lp.d = 0.0;
+        lp.rev = false;
+        let mut roads = Vec::new();
+        for (p, _) in waypoints {
+            if let (_, Some(w)) = self.resolve(p, at)? {
+                roads.push(self.roads.ids(w.lane).1);
+            }
+        }
+        let prefer = |k: usize| {
+            roads.contains(&self.roads.ids(k).1) || roads.contains(&self.roads.exit_road(k))
+        };
+        let path_s = match in_route {
+            m::InRoute::Lane { path_s, .. } | m::InRoute::Road { path_s, .. } => *path_s,
+            m::InRoute::Entity(_) => 0.0,
+        };
+        if !self
+            .roads
+            .advance_stations(&mut lp, path_s.max(0.0), &prefer)
+        {
+            return Err(bad(format!("the route ends before {path_s} m along it")));
+        }
+        let travel = self.roads.travel_heading(&lp);
+        let h = orient(orientation, travel);
+        match in_route {
+            m::InRoute::Lane { lane, offset, .. } => {
+                let road = &self.roads.map().roads[self.roads.ids(lp.lane).1].od_id;
+                let to = self
+                    .roads
+                    .lane_pos(road, *lane, lp.s, *offset)
+                    .map_err(|e| bad(e.to_string()))?;
+                Ok(self.placed(to, h))
+            }
+            m::InRoute::Road { t, .. } => {
+                let road = &self.roads.map().roads[self.roads.ids(lp.lane).1].od_id;
+                let to = self
+                    .roads
+                    .road_pos(road, lp.s, *t)
+                    .map_err(|e| bad(e.to_string()))?;
+                Ok(self.placed(to, h))
+            }
+            m::InRoute::Entity(_) => unreachable!("returned above"),
+        }
     }
 }

@@ -4,6 +4,7 @@
 
 mod controller;
 mod distance;
+mod global;
 mod lateral;
 mod route;
 mod speed;
@@ -11,6 +12,7 @@ mod teleport;
 mod trajectory;
 
 pub(in crate::xosc::story) use distance::Keep;
+pub use global::{Stored, WorldEnv, MAP_FRICTION, NOMINAL_ILLUMINANCE_LX};
 pub(in crate::xosc::story) use lateral::Lateral;
 pub use lateral::DEFAULT_LATERAL_ACC_MPS2;
 pub(in crate::xosc::story) use speed::SpeedTask;
@@ -19,11 +21,14 @@ pub(in crate::xosc::story) use trajectory::Path;
 use super::*;
 
 impl Storyboard {
-    /// Performs `scenario`'s `Init`: positions first, in the file's order, then the rest (a
-    /// relative position may name an entity placed later in the file).
+    /// Performs `scenario`'s `Init`: positions first, each once the entities it is relative
+    /// to are placed (in the file's order otherwise: a position may name an entity placed
+    /// later in the file, as other readers accept), then the rest.
     ///
     /// # Errors
-    /// [`StoryError`] for an `Init` action that cannot be performed.
+    /// [`StoryError`] for an `Init` action that cannot be performed (a position relative to
+    /// an entity that `Init` never places, or a cycle of such positions, fails at the first
+    /// left).
     pub(in crate::xosc::story) fn perform_init(
         &mut self,
         scenario: &m::Scenario,
@@ -32,8 +37,30 @@ impl Storyboard {
             .init
             .iter()
             .partition(|(_, a)| matches!(a.action, Action::Teleport(_)));
-        for (e, a) in places.into_iter().chain(rest) {
+        // An entity is placed once its teleports are done; one Init never places stands
+        // where it is from the start.
+        let mut unplaced: Vec<bool> = vec![false; self.actors.len()];
+        for (e, _) in &places {
+            unplaced[*e] = true;
+        }
+        let mut left = places;
+        while !left.is_empty() {
+            let ready = left.iter().position(|(_, a)| match &a.action {
+                Action::Teleport(p) => relative_to(p).is_none_or(|r| !unplaced[r]),
+                _ => true,
+            });
+            // None ready: the first left fails on its reference (or is placed, if it can be).
+            let (e, a) = left.remove(ready.unwrap_or(0));
             self.start_task(*e, a, None, 0.0)?;
+            if !left.iter().any(|(o, _)| o == e) {
+                unplaced[*e] = false;
+            }
+        }
+        for (e, a) in rest {
+            self.start_task(*e, a, None, 0.0)?;
+        }
+        for a in &scenario.init_global {
+            self.perform_global(a, 0.0)?;
         }
         Ok(())
     }
@@ -70,7 +97,7 @@ impl Storyboard {
             }
         };
         match &na.action {
-            Action::Teleport(p) => position(p),
+            Action::Teleport(p) | Action::AcquirePosition(p) => position(p),
             Action::AssignRoute { waypoints } => {
                 waypoints.iter().try_for_each(|(p, _)| position(p))
             }
@@ -109,6 +136,8 @@ impl Storyboard {
                 if scripted || a.is_none() {
                     self.teleport(e, p, &action.pos)?;
                 }
+                // An event's teleport holds the entity for its step (`Drive::teleported`).
+                self.drives[e].teleported = scripted && a.is_some();
             }
             Action::Speed { target, dynamics } => {
                 return self.start_speed(e, (target, dynamics), a, t);
@@ -154,17 +183,49 @@ impl Storyboard {
                 self.start_distance(e, keep, *continuous)
                     .map_err(|e| bad(e.to_string()))?;
             }
-            Action::FollowTrajectory { shape, timing } => {
-                return self.start_trajectory(e, (shape, timing), (a, &action.pos), t);
+            Action::FollowTrajectory {
+                shape,
+                timing,
+                position_mode,
+            } => {
+                return self.start_trajectory(
+                    e,
+                    (shape, timing, *position_mode),
+                    (a, &action.pos),
+                    t,
+                );
             }
             Action::AssignRoute { waypoints } => {
                 self.assign_route(e, waypoints, &action.pos, scripted)?;
+            }
+            Action::AcquirePosition(p) => {
+                self.acquire_position(e, p, &action.pos, scripted)?;
             }
             Action::ActivateController {
                 lateral,
                 longitudinal,
             } => self.activate_controller(e, *lateral, *longitudinal),
+            // Performed once by their action, not per actor ([`Storyboard::start_action`]).
+            Action::Environment(_) | Action::SetValue { .. } | Action::ModifyValue { .. } => {}
+            // Nothing the storyboard moves reads lights or visibility: the front end refuses
+            // a visibility that a system under test would sense ([`crate::xosc::check`]).
+            Action::Appearance(_) | Action::Visibility { .. } => {}
         }
         Ok(())
+    }
+}
+
+/// The entity position `p` is relative to, if any.
+fn relative_to(p: &Position) -> Option<usize> {
+    match p {
+        Position::RelativeWorld { entity, .. }
+        | Position::RelativeObject { entity, .. }
+        | Position::RelativeRoad { entity, .. }
+        | Position::RelativeLane { entity, .. } => Some(*entity),
+        Position::Route {
+            at: m::InRoute::Entity(entity),
+            ..
+        } => Some(*entity),
+        _ => None,
     }
 }

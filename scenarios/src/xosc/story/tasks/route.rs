@@ -17,15 +17,22 @@ impl Storyboard {
         at: &paracosm_openscenario::Pos,
         scripted: bool,
     ) -> Result<(), StoryError> {
-        let mut roads = Vec::new();
+        let mut points = Vec::new();
         for (p, _) in waypoints {
             if let (_, Some(lp)) = self.resolve(p, at)? {
-                roads.push(self.roads.ids(lp.lane).1);
+                points.push(LanePos { rev: false, ..lp });
             }
         }
-        self.drives[e].prefer_roads = roads;
+        self.set_route(e, &points, scripted);
+        Ok(())
+    }
+
+    /// Gives entity `e` the route through `points` ([`Storyboard::route_through`]): the
+    /// roads it prefers where lanes fork; for the driven ego (not `scripted`), a route
+    /// planned again from where it is, which the host hands its system.
+    fn set_route(&mut self, e: usize, points: &[LanePos], scripted: bool) {
+        self.drives[e].prefer_roads = self.route_through(points);
         if !scripted {
-            // The driven ego's route, planned again from where it is.
             if let Some(lp) = self.actors[e].state.lane {
                 self.route = Some(RouteAsk {
                     join: lp,
@@ -33,7 +40,56 @@ impl Storyboard {
                 });
             }
         }
+    }
+
+    /// Performs an `AcquirePositionAction` (written at `at`) on entity `e`: a route from the
+    /// road it is on to the road of `target` (esmini's: a route of two waypoints, where the
+    /// entity is and the target), whose roads it prefers where lanes fork; for the driven ego,
+    /// the route handed to its system.
+    ///
+    /// # Errors
+    /// [`StoryError`] for a target off the map.
+    pub(in crate::xosc::story) fn acquire_position(
+        &mut self,
+        e: usize,
+        target: &Position,
+        at: &paracosm_openscenario::Pos,
+        scripted: bool,
+    ) -> Result<(), StoryError> {
+        let mut points = Vec::new();
+        if let Some(lp) = self.actors[e].state.lane {
+            points.push(lp);
+        }
+        if let (_, Some(lp)) = self.resolve(target, at)? {
+            points.push(LanePos { rev: false, ..lp });
+        }
+        self.set_route(e, &points, scripted);
         Ok(())
+    }
+
+    /// The roads of a route through `points` in order: the shortest way between each two
+    /// ([`Roads::route_roads`], as esmini plans a route between its waypoints), or where no
+    /// way leads from one to the next, their own roads.
+    fn route_through(&self, points: &[LanePos]) -> Vec<usize> {
+        let mut roads: Vec<usize> = Vec::new();
+        let mut add = |r: usize| {
+            if roads.last() != Some(&r) {
+                roads.push(r);
+            }
+        };
+        if let [only] = points {
+            add(self.roads.ids(only.lane).1);
+        }
+        for w in points.windows(2) {
+            match self.roads.route_roads(&w[0], &w[1]) {
+                Some(way) => way.into_iter().for_each(&mut add),
+                None => {
+                    add(self.roads.ids(w[0].lane).1);
+                    add(self.roads.ids(w[1].lane).1);
+                }
+            }
+        }
+        roads
     }
 
     /// Whether entity `e`'s route (its `AssignRouteAction`) takes lane `lane`: a lane of a

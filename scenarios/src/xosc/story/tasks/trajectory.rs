@@ -30,7 +30,7 @@ impl Storyboard {
     pub(in crate::xosc::story) fn start_trajectory(
         &mut self,
         e: usize,
-        (shape, timing): (&TrajectoryShape, &Option<(bool, f64, f64)>),
+        (shape, timing, position_mode): (&TrajectoryShape, &Option<(bool, f64, f64)>, bool),
         (a, pos): (Option<usize>, &paracosm_openscenario::Pos),
         t: f64,
     ) -> Result<(), StoryError> {
@@ -46,6 +46,13 @@ impl Storyboard {
         }
         let points = self.trajectory_points(e, shape, pos)?;
         let timed = points.iter().all(|(time, _)| time.is_some());
+        // esmini turns a polyline's heading at its corners in `position` mode, along each leg
+        // in `follow`; a sampled curve faces along itself at each sample.
+        let turn = match (shape, position_mode) {
+            (TrajectoryShape::Polyline(_), true) => crate::xosc::motion::Turn::Corner,
+            (TrajectoryShape::Polyline(_), false) => crate::xosc::motion::Turn::Segment,
+            _ => crate::xosc::motion::Turn::None,
+        };
         let path = match timing {
             Some((absolute, scale, offset)) if timed => {
                 let base = if *absolute { 0.0 } else { t };
@@ -54,11 +61,13 @@ impl Storyboard {
                         .iter()
                         .map(|(time, p)| (base + time.unwrap_or(0.0) * scale + offset, *p))
                         .collect(),
+                    turn,
                 })
             }
             _ => Path::Untimed(Untimed {
                 vertices: points.into_iter().map(|(_, p)| p).collect(),
                 gone_m: 0.0,
+                turn,
             }),
         };
         // On the trajectory from the start (esmini's reading): a timed one where it is at `t`,
@@ -109,7 +118,7 @@ impl Storyboard {
                     poses.push(self.resolve(p, pos)?.0);
                 }
                 for k in 0..poses.len() {
-                    if matches!(vertices[k].1, Position::World { h: None, .. }) {
+                    if !gives_heading(&vertices[k].1) {
                         let (a, b) = match (poses.get(k), poses.get(k + 1)) {
                             (Some(a), Some(b)) => (*a, *b),
                             _ if k > 0 => (poses[k - 1], poses[k]),
@@ -146,11 +155,27 @@ impl Storyboard {
                 let mut at = Vec::new();
                 for (time, weight, p) in points {
                     let q = self.resolve(p, pos)?.0;
-                    let given = !matches!(p, Position::World { h: None, .. });
+                    let given = gives_heading(p);
                     at.push((*time, *weight, [q.x, q.y], given.then_some(q.h)));
                 }
                 nurbs_poses(*order, &at, knots)
             }
         })
+    }
+}
+
+/// Whether position `p` gives a heading of its own (a world position's `h`, an
+/// `Orientation` with `h`): a trajectory's vertex without one faces along its leg, as esmini
+/// aligns a vertex whose position sets no heading mode.
+fn gives_heading(p: &Position) -> bool {
+    match p {
+        Position::World { h, .. } => h.is_some(),
+        Position::RelativeWorld { orientation, .. }
+        | Position::RelativeObject { orientation, .. }
+        | Position::Road { orientation, .. }
+        | Position::Lane { orientation, .. }
+        | Position::RelativeRoad { orientation, .. }
+        | Position::RelativeLane { orientation, .. }
+        | Position::Route { orientation, .. } => orientation.is_some(),
     }
 }

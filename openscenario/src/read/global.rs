@@ -1,0 +1,277 @@
+//! Global actions (OpenSCENARIO 1.3 User Guide, "Global actions"): `EnvironmentAction`
+//! (inline or from an environment catalog), `ParameterAction` and `VariableAction` (set or
+//! modify). Entity, infrastructure (traffic signal), traffic and monitor actions are refused,
+//! naming what is read.
+
+use roxmltree::Node;
+
+use super::Reader;
+use crate::error::XoscError;
+use crate::model::{Action, Environment};
+use crate::params::ParamType;
+use crate::xml::{child, choice, elements, need, only};
+use crate::Value;
+
+/// A `<GlobalAction>`.
+///
+/// # Errors
+/// [`XoscError::Unsupported`] for a global action paracosm does not read; Invalid for an
+/// undeclared parameter or variable, a value not of its type, a modification of one that is
+/// not a number, an environment value out of range.
+pub(super) fn global(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
+    let (a, tag) = choice(
+        r.text,
+        node,
+        &["EnvironmentAction", "ParameterAction", "VariableAction"],
+    )?;
+    match tag {
+        "EnvironmentAction" => {
+            let (e, tag) = choice(r.text, a, &["Environment", "CatalogReference"])?;
+            let env = if tag == "Environment" {
+                environment(&r.scoped(e)?, e)?
+            } else {
+                r.catalogs.read_entry(r, e, &["Environment"], environment)?
+            };
+            Ok(Action::Environment(env))
+        }
+        "ParameterAction" => value_action(r, a, false),
+        _ => value_action(r, a, true),
+    }
+}
+
+/// A `ParameterAction` (`parameterRef`) or `VariableAction` (`variableRef`): its
+/// `SetAction` or `ModifyAction` (1.0 and 1.1 name them so under `ParameterAction`; 1.2's
+/// `ParameterSetAction` and `VariableSetAction` are the same elements).
+fn value_action(r: &Reader<'_>, a: Node<'_, '_>, variable: bool) -> Result<Action, XoscError> {
+    let attr = if variable {
+        "variableRef"
+    } else {
+        "parameterRef"
+    };
+    // The name of a parameter, not a reference to its value: esmini's files may put a `$`
+    // before it.
+    let name = crate::params::required(r.text, a, attr)?
+        .trim()
+        .trim_start_matches('$')
+        .to_string();
+    let ty = declared_type(r, a, attr, &name, variable)?;
+    let (op, tag) = choice(r.text, a, &["SetAction", "ModifyAction"])?;
+    if tag == "SetAction" {
+        let text = r.scope.string(r.text, op, "value")?;
+        let value = ty
+            .coerce(Value::Str(text.clone()))
+            .map_err(|e| XoscError::Invalid {
+                pos: r.text.attr_pos(op, "value"),
+                reason: format!("{name} is of type {}: {}", ty.xsd_name(), e.0),
+            })?;
+        return Ok(Action::SetValue {
+            name,
+            variable,
+            value,
+        });
+    }
+    if !ty.is_numeric() {
+        return Err(r.text.invalid(
+            op,
+            format!(
+                "{name} is of type {}: only a number can be added to or multiplied",
+                ty.xsd_name()
+            ),
+        ));
+    }
+    let rule = need(r.text, op, "Rule")?;
+    let (v, tag) = choice(r.text, rule, &["AddValue", "MultiplyByValue"])?;
+    let by = r.scope.num(r.text, v, "value")?;
+    Ok(Action::ModifyValue {
+        name,
+        variable,
+        multiply: tag == "MultiplyByValue",
+        by,
+    })
+}
+
+/// The declared type of parameter or variable `name` (named by `node`'s attribute `attr`).
+fn declared_type(
+    r: &Reader<'_>,
+    node: Node<'_, '_>,
+    attr: &str,
+    name: &str,
+    variable: bool,
+) -> Result<ParamType, XoscError> {
+    let found = if variable {
+        r.variables
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, ty)| *ty)
+    } else {
+        r.globals.iter().find(|(n, _)| n == name).map(|(_, ty)| *ty)
+    };
+    found.ok_or_else(|| XoscError::Invalid {
+        pos: r.text.attr_pos(node, attr),
+        reason: if variable {
+            format!("variable {name:?} is not declared in the scenario's <VariableDeclarations>")
+        } else {
+            format!(
+                "parameter {name:?} is not declared in the scenario's own \
+                 <ParameterDeclarations> (a parameter a story, maneuver or catalog entry \
+                 declares is not set or read while a test runs)"
+            )
+        },
+    })
+}
+
+/// An `<Environment>` (inline, or a catalog entry read with its own scope): the parts it
+/// gives. What paracosm's world has no counterpart for (clouds, wind, temperature, pressure,
+/// the sun's azimuth) is noted.
+///
+/// # Errors
+/// Invalid for a `dateTime` that is not one, a visual range <= 0, a negative illuminance,
+/// precipitation intensity or friction scale factor, an unknown precipitation type.
+pub(super) fn environment(r: &Reader<'_>, e: Node<'_, '_>) -> Result<Environment, XoscError> {
+    if e.tag_name().name() != "Environment" {
+        return Err(r.text.invalid(
+            e,
+            format!(
+                "an environment catalog entry is an <Environment>, not <{}>",
+                e.tag_name().name()
+            ),
+        ));
+    }
+    only(
+        r.text,
+        e,
+        &[
+            "ParameterDeclarations",
+            "TimeOfDay",
+            "Weather",
+            "RoadCondition",
+        ],
+    )?;
+    let (sc, t) = (&r.scope, r.text);
+    let mut env = Environment::default();
+    if let Some(tod) = child(e, "TimeOfDay") {
+        let when = sc.string(t, tod, "dateTime")?;
+        let secs = seconds_of_day(&when).ok_or_else(|| XoscError::Invalid {
+            pos: t.attr_pos(tod, "dateTime"),
+            reason: format!("dateTime {when:?} is not a date and time (YYYY-MM-DDThh:mm:ss)"),
+        })?;
+        env.time_of_day = Some((secs, sc.bool(t, tod, "animation")?));
+    }
+    if let Some(w) = child(e, "Weather") {
+        only(t, w, &["Sun", "Fog", "Precipitation", "Wind", "DomeImage"])?;
+        for a in [
+            "cloudState",
+            "fractionalCloudCover",
+            "temperature",
+            "atmosphericPressure",
+        ] {
+            if w.attribute(a).is_some() {
+                r.note(w, format!("the weather's {a} is read but not modelled: paracosm's world has no counterpart"));
+            }
+        }
+        for c in ["Wind", "DomeImage"] {
+            if let Some(n) = child(w, c) {
+                r.note(
+                    n,
+                    format!("<{c}> is read but not modelled: paracosm's world has no counterpart"),
+                );
+            }
+        }
+        if let Some(sun) = child(w, "Sun") {
+            let lux = match sc.opt_num(t, sun, "illuminance")? {
+                Some(v) => v,
+                None => sc.num(t, sun, "intensity")?,
+            };
+            if !(0.0..=1e6).contains(&lux) {
+                return Err(t.invalid(
+                    sun,
+                    format!("a sun's illuminance is 0 to 1,000,000 lx, not {lux}"),
+                ));
+            }
+            let elevation = sc.num(t, sun, "elevation")?;
+            r.note(sun, "the sun's azimuth is not modelled: paracosm's light is the same from every direction");
+            env.sun = Some((lux, elevation));
+        }
+        if let Some(fog) = child(w, "Fog") {
+            let range = sc.num(t, fog, "visualRange")?;
+            if range.is_nan() || range <= 0.0 {
+                return Err(XoscError::Invalid {
+                    pos: t.attr_pos(fog, "visualRange"),
+                    reason: format!("a fog's visualRange is a distance > 0 m, not {range}"),
+                });
+            }
+            if child(fog, "BoundingBox").is_some() {
+                r.note(
+                    fog,
+                    "a fog's bounding box is not modelled: the fog fills the world",
+                );
+            }
+            env.fog_visual_range_m = Some(range);
+        }
+        if let Some(p) = child(w, "Precipitation") {
+            let kind = match sc.opt_string(t, p, "precipitationType")? {
+                Some(k) => k,
+                // 1.0 names it `type`.
+                None => sc.string(t, p, "type")?,
+            };
+            if !["dry", "rain", "snow"].contains(&kind.as_str()) {
+                return Err(t.invalid(
+                    p,
+                    format!("precipitationType is dry, rain or snow, not {kind:?}"),
+                ));
+            }
+            let intensity = match sc.opt_num(t, p, "precipitationIntensity")? {
+                Some(v) => v,
+                None => sc.opt_num(t, p, "intensity")?.unwrap_or(0.0),
+            };
+            if intensity.is_nan() || intensity < 0.0 {
+                return Err(t.invalid(
+                    p,
+                    format!("a precipitation's intensity is >= 0 mm/h, not {intensity}"),
+                ));
+            }
+            env.precipitation = Some((kind, intensity));
+        }
+    }
+    if let Some(rc) = child(e, "RoadCondition") {
+        let f = sc.num(t, rc, "frictionScaleFactor")?;
+        if !(0.0..=10.0).contains(&f) {
+            return Err(XoscError::Invalid {
+                pos: t.attr_pos(rc, "frictionScaleFactor"),
+                reason: format!("frictionScaleFactor is 0 to 10, not {f}"),
+            });
+        }
+        if elements(rc).next().is_some() || rc.attribute("wetness").is_some() {
+            r.note(rc, "a road condition's properties and wetness are not modelled: its friction scale factor is");
+        }
+        env.friction_scale = Some(f);
+    }
+    Ok(env)
+}
+
+/// The time of day of an XSD `dateTime` (`YYYY-MM-DDThh:mm:ss[.fff][zone]`), s after
+/// midnight as written (the zone is the place's own clock).
+fn seconds_of_day(when: &str) -> Option<f64> {
+    let (_, clock) = when.trim().split_once('T')?;
+    let mut parts = clock.splitn(3, ':');
+    let h: f64 = parts.next()?.parse().ok()?;
+    let m: f64 = parts.next()?.parse().ok()?;
+    let rest = parts.next()?;
+    let end = rest
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(rest.len());
+    let s: f64 = rest[..end].parse().ok()?;
+    ((0.0..24.0).contains(&h) && (0.0..60.0).contains(&m) && (0.0..61.0).contains(&s))
+        .then_some(h * 3600.0 + m * 60.0 + s)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_date_time_gives_its_time_of_day() {
+        let s = super::seconds_of_day("2025-06-13T06:30:15.500+02:00").unwrap();
+        assert!((s - (6.0 * 3600.0 + 30.0 * 60.0 + 15.5)).abs() < 1e-9);
+        assert_eq!(super::seconds_of_day("2025-06-13"), None);
+        assert_eq!(super::seconds_of_day("2025-06-13T25:00:00"), None);
+    }
+}
