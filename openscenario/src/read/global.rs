@@ -158,80 +158,7 @@ pub(super) fn environment(r: &Reader<'_>, e: Node<'_, '_>) -> Result<Environment
         env.time_of_day = Some((secs, sc.bool(t, tod, "animation")?));
     }
     if let Some(w) = child(e, "Weather") {
-        only(t, w, &["Sun", "Fog", "Precipitation", "Wind", "DomeImage"])?;
-        for a in [
-            "cloudState",
-            "fractionalCloudCover",
-            "temperature",
-            "atmosphericPressure",
-        ] {
-            if w.attribute(a).is_some() {
-                r.note(w, format!("the weather's {a} is read but not modelled: paracosm's world has no counterpart"));
-            }
-        }
-        for c in ["Wind", "DomeImage"] {
-            if let Some(n) = child(w, c) {
-                r.note(
-                    n,
-                    format!("<{c}> is read but not modelled: paracosm's world has no counterpart"),
-                );
-            }
-        }
-        if let Some(sun) = child(w, "Sun") {
-            let lux = match sc.opt_num(t, sun, "illuminance")? {
-                Some(v) => v,
-                None => sc.num(t, sun, "intensity")?,
-            };
-            if !(0.0..=1e6).contains(&lux) {
-                return Err(t.invalid(
-                    sun,
-                    format!("a sun's illuminance is 0 to 1,000,000 lx, not {lux}"),
-                ));
-            }
-            let elevation = sc.num(t, sun, "elevation")?;
-            r.note(sun, "the sun's azimuth is not modelled: paracosm's light is the same from every direction");
-            env.sun = Some((lux, elevation));
-        }
-        if let Some(fog) = child(w, "Fog") {
-            let range = sc.num(t, fog, "visualRange")?;
-            if range.is_nan() || range <= 0.0 {
-                return Err(XoscError::Invalid {
-                    pos: t.attr_pos(fog, "visualRange"),
-                    reason: format!("a fog's visualRange is a distance > 0 m, not {range}"),
-                });
-            }
-            if child(fog, "BoundingBox").is_some() {
-                r.note(
-                    fog,
-                    "a fog's bounding box is not modelled: the fog fills the world",
-                );
-            }
-            env.fog_visual_range_m = Some(range);
-        }
-        if let Some(p) = child(w, "Precipitation") {
-            let kind = match sc.opt_string(t, p, "precipitationType")? {
-                Some(k) => k,
-                // 1.0 names it `type`.
-                None => sc.string(t, p, "type")?,
-            };
-            if !["dry", "rain", "snow"].contains(&kind.as_str()) {
-                return Err(t.invalid(
-                    p,
-                    format!("precipitationType is dry, rain or snow, not {kind:?}"),
-                ));
-            }
-            let intensity = match sc.opt_num(t, p, "precipitationIntensity")? {
-                Some(v) => v,
-                None => sc.opt_num(t, p, "intensity")?.unwrap_or(0.0),
-            };
-            if intensity.is_nan() || intensity < 0.0 {
-                return Err(t.invalid(
-                    p,
-                    format!("a precipitation's intensity is >= 0 mm/h, not {intensity}"),
-                ));
-            }
-            env.precipitation = Some((kind, intensity));
-        }
+        weather(r, w, &mut env)?;
     }
     if let Some(rc) = child(e, "RoadCondition") {
         let f = sc.num(t, rc, "frictionScaleFactor")?;
@@ -247,6 +174,94 @@ pub(super) fn environment(r: &Reader<'_>, e: Node<'_, '_>) -> Result<Environment
         env.friction_scale = Some(f);
     }
     Ok(env)
+}
+
+/// An `<Environment>`'s `<Weather>`: its sun, fog and precipitation into `env`; clouds,
+/// temperature, pressure, wind and a dome image are noted.
+///
+/// # Errors
+/// As [`environment`].
+fn weather(r: &Reader<'_>, w: Node<'_, '_>, env: &mut Environment) -> Result<(), XoscError> {
+    let (sc, t) = (&r.scope, r.text);
+    only(t, w, &["Sun", "Fog", "Precipitation", "Wind", "DomeImage"])?;
+    for a in [
+        "cloudState",
+        "fractionalCloudCover",
+        "temperature",
+        "atmosphericPressure",
+    ] {
+        if w.attribute(a).is_some() {
+            r.note(w, format!("the weather's {a} is read but not modelled: paracosm's world has no counterpart"));
+        }
+    }
+    for c in ["Wind", "DomeImage"] {
+        if let Some(n) = child(w, c) {
+            r.note(
+                n,
+                format!("<{c}> is read but not modelled: paracosm's world has no counterpart"),
+            );
+        }
+    }
+    if let Some(sun) = child(w, "Sun") {
+        let lux = match sc.opt_num(t, sun, "illuminance")? {
+            Some(v) => v,
+            None => sc.num(t, sun, "intensity")?,
+        };
+        if !(0.0..=1e6).contains(&lux) {
+            return Err(t.invalid(
+                sun,
+                format!("a sun's illuminance is 0 to 1,000,000 lx, not {lux}"),
+            ));
+        }
+        let elevation = sc.num(t, sun, "elevation")?;
+        r.note(
+            sun,
+            "the sun's azimuth is not modelled: paracosm's light is the same from every direction",
+        );
+        env.sun = Some((lux, elevation));
+    }
+    if let Some(fog) = child(w, "Fog") {
+        let range = sc.num(t, fog, "visualRange")?;
+        if range.is_nan() || range <= 0.0 {
+            return Err(XoscError::Invalid {
+                pos: t.attr_pos(fog, "visualRange"),
+                reason: format!("a fog's visualRange is a distance > 0 m, not {range}"),
+            });
+        }
+        if child(fog, "BoundingBox").is_some() {
+            r.note(
+                fog,
+                "a fog's bounding box is not modelled: the fog fills the world",
+            );
+        }
+        env.fog_visual_range_m = Some(range);
+    }
+    if let Some(p) = child(w, "Precipitation") {
+        let kind = match sc.opt_string(t, p, "precipitationType")? {
+            Some(k) => k,
+            // 1.0 names it `type`.
+            None => sc.string(t, p, "type")?,
+        };
+        if !["dry", "rain", "snow"].contains(&kind.as_str()) {
+            return Err(t.invalid(
+                p,
+                format!("precipitationType is dry, rain or snow, not {kind:?}"),
+            ));
+        }
+        let intensity = match sc.opt_num(t, p, "precipitationIntensity")? {
+            Some(v) => v,
+            None => sc.opt_num(t, p, "intensity")?.unwrap_or(0.0),
+        };
+        if intensity.is_nan() || intensity < 0.0 {
+            return Err(t.invalid(
+                p,
+                format!("a precipitation's intensity is >= 0 mm/h, not {intensity}"),
+            ));
+        }
+        env.precipitation = Some((kind, intensity));
+    }
+
+    Ok(())
 }
 
 /// The time of day of an XSD `dateTime` (`YYYY-MM-DDThh:mm:ss[.fff][zone]`), s after
