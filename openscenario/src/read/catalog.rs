@@ -171,12 +171,8 @@ fn assignments(
         .into_iter()
         .flat_map(elements)
     {
-        // `parameterRef` names the entry's parameter; esmini and files written for it put a
-        // `$` before the name, which is not a reference to the scenario's parameter.
-        let name = match a.attribute("parameterRef") {
-            Some(n) => n.trim().trim_start_matches('$').to_string(),
-            None => r.scope.string(r.text, a, "parameterRef")?,
-        };
+        // `parameterRef` names the entry's parameter, not the scenario's.
+        let name = r.name_ref(a, "parameterRef")?;
         let value = r.scope.string(r.text, a, "value")?;
         out.push((name, value));
     }

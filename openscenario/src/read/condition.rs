@@ -173,12 +173,7 @@ fn by_value(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError
             } else {
                 "parameterRef"
             };
-            // The name of a parameter or variable, not a reference to its value: esmini's
-            // files may put a `$` before it.
-            let name = crate::params::required(r.text, v, attr)?
-                .trim()
-                .trim_start_matches('$')
-                .to_string();
+            let name = r.name_ref(v, attr)?;
             let declared = if variable { &r.variables } else { &r.globals };
             if !declared.iter().any(|(n, _)| *n == name) {
                 return Err(XoscError::Invalid {

@@ -48,12 +48,7 @@ fn value_action(r: &Reader<'_>, a: Node<'_, '_>, variable: bool) -> Result<Actio
     } else {
         "parameterRef"
     };
-    // The name of a parameter, not a reference to its value: esmini's files may put a `$`
-    // before it.
-    let name = crate::params::required(r.text, a, attr)?
-        .trim()
-        .trim_start_matches('$')
-        .to_string();
+    let name = r.name_ref(a, attr)?;
     let ty = declared_type(r, a, attr, &name, variable)?;
     let (op, tag) = choice(r.text, a, &["SetAction", "ModifyAction"])?;
     if tag == "SetAction" {

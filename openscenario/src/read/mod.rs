@@ -105,6 +105,19 @@ impl<'t> Reader<'t> {
         }
     }
 
+    /// `node`'s attribute `attr` read as the name of a parameter or variable (a
+    /// `parameterRef`, a `variableRef`): a name, not a reference to its value, so the `$`
+    /// that esmini's files put before it is dropped.
+    ///
+    /// # Errors
+    /// Invalid when the attribute is missing.
+    pub(crate) fn name_ref(&self, node: Node<'_, '_>, attr: &str) -> Result<String, XoscError> {
+        Ok(crate::params::required(self.text, node, attr)?
+            .trim()
+            .trim_start_matches('$')
+            .to_string())
+    }
+
     /// Notes that `node` is read but not honoured as written.
     pub(crate) fn note(&self, node: Node<'_, '_>, text: impl Into<String>) {
         self.notes.borrow_mut().push(Note {

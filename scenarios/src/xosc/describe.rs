@@ -97,6 +97,9 @@ fn write_entities(s: &Scenario, out: &mut String) {
     for (e, a) in &s.init {
         let _ = writeln!(out, "  {}: {}", s.entities[*e].name, action(s, &a.action));
     }
+    for a in &s.init_global {
+        let _ = writeln!(out, "  the world: {}", action(s, &a.action));
+    }
 }
 
 /// Writes the storyboard: each story's acts and events with their start triggers and
