@@ -1421,3 +1421,83 @@ fn an_init_position_relative_to_an_entity_placed_later_waits_for_it() {
         );
     }
 }
+
+/// CARLA's scenarios name their map as CARLA names its towns (`<LogicFile
+/// filepath="Town01"/>`): the town's OpenDRIVE file beside the scenario stands for it, with
+/// a note; without it the load is refused, saying where to put it.
+#[test]
+fn a_carla_town_named_without_its_extension_is_read_from_beside_the_scenario() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("follow.xosc");
+    std::fs::write(
+        &scenario,
+        r#"<OpenSCENARIO><FileHeader revMajor="1" revMinor="0" date="2026-11-29T00:00:00" description="CARLA town" author="x"/>
+<ParameterDeclarations/>
+<RoadNetwork><LogicFile filepath="Town01"/><SceneGraphFile filepath=""/></RoadNetwork>
+<Entities><ScenarioObject name="hero"><Vehicle name="vehicle.lincoln.mkz2017" vehicleCategory="car"><ParameterDeclarations/><Performance maxSpeed="69.444" maxAcceleration="200" maxDeceleration="10.0"/><BoundingBox><Center x="1.5" y="0.0" z="0.9"/><Dimensions width="2.1" length="4.5" height="1.8"/></BoundingBox><Axles><FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.8" positionX="3.1" positionZ="0.3"/><RearAxle maxSteering="0.0" wheelDiameter="0.6" trackWidth="1.8" positionX="0.0" positionZ="0.3"/></Axles><Properties/></Vehicle></ScenarioObject></Entities>
+<Storyboard><Init><Actions><Private entityRef="hero">
+<PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-1" s="20" offset="0"/></Position></TeleportAction></PrivateAction>
+<PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/><SpeedActionTarget><AbsoluteTargetSpeed value="5"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction>
+</Private></Actions></Init>
+<StopTrigger><ConditionGroup><Condition name="end" delay="0" conditionEdge="rising"><ByValueCondition><SimulationTimeCondition value="5" rule="greaterThan"/></ByValueCondition></Condition></ConditionGroup></StopTrigger>
+</Storyboard></OpenSCENARIO>"#,
+    )
+    .unwrap();
+    let file = scenario.to_str().unwrap();
+    let (code, _, err) = xosc(&[file]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("as CARLA names its towns"), "{err}");
+    std::fs::copy(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/maps/carla/Town01.xodr"),
+        dir.path().join("Town01.xodr"),
+    )
+    .unwrap();
+    let (code, out, err) = xosc(&[file]);
+    assert_eq!(code, 0, "{err}");
+    let text = format!("{out}{err}");
+    assert!(
+        text.contains("is named without its extension, as CARLA names its towns"),
+        "{text}"
+    );
+}
+
+/// An ego whose bounding box has a side of 0 m (which the schema allows, and which other
+/// entities may have) is refused at load, naming the box: its collisions could not be
+/// judged.
+#[test]
+fn an_ego_of_no_size_is_refused_at_its_box() {
+    let dir = tempfile::tempdir().unwrap();
+    let road = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/xosc/alks/concrete_scenarios/road_networks/alks_road_straight.xodr");
+    let scenario = dir.path().join("flat.xosc");
+    std::fs::write(
+        &scenario,
+        format!(
+            r#"<OpenSCENARIO><FileHeader revMajor="1" revMinor="2" date="2026-11-29T00:00:00" description="flat ego" author="x"/>
+<RoadNetwork><LogicFile filepath="{road}"/></RoadNetwork>
+<Entities><ScenarioObject name="Ego"><Vehicle name="flat" vehicleCategory="car"><BoundingBox><Center x="1.4" y="0" z="0.8"/><Dimensions width="2" length="4.5" height="0"/></BoundingBox><Performance maxSpeed="50" maxAcceleration="5" maxDeceleration="9"/><Axles><FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/><RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/></Axles><Properties/></Vehicle></ScenarioObject></Entities>
+<Storyboard><Init><Actions><Private entityRef="Ego">
+<PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction>
+<PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/><SpeedActionTarget><AbsoluteTargetSpeed value="10"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction>
+</Private></Actions></Init>
+<StopTrigger><ConditionGroup><Condition name="end" delay="0" conditionEdge="rising"><ByValueCondition><SimulationTimeCondition value="5" rule="greaterThan"/></ByValueCondition></Condition></ConditionGroup></StopTrigger>
+</Storyboard></OpenSCENARIO>"#,
+            road = road.display()
+        ),
+    )
+    .unwrap();
+    for scripted in [false, true] {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"));
+        cmd.arg(&scenario)
+            .args(["--budget", "1", "--out"])
+            .arg(dir.path().join("out"));
+        if scripted {
+            cmd.arg("--scripted-ego");
+        }
+        let o = cmd.output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains("flat.xosc:3:"), "{err}");
+        assert!(err.contains("cannot be the ego"), "{err}");
+    }
+}

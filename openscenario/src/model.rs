@@ -71,6 +71,23 @@ pub enum EntityKind {
     MiscObject(String),
 }
 
+/// The standard's `ObjectType`s of the scenario's own entities, as
+/// [`EntityKind::object_type`] names them (`external`, an object outside the scenario, is not
+/// one).
+pub const OBJECT_TYPES: [&str; 3] = ["vehicle", "pedestrian", "miscellaneous"];
+
+impl EntityKind {
+    /// The standard's `ObjectType` of an entity of this kind: `vehicle`, `pedestrian` or
+    /// `miscellaneous` (what a `CollisionCondition`'s `ByType` names).
+    pub fn object_type(&self) -> &'static str {
+        match self {
+            EntityKind::Vehicle(_) => "vehicle",
+            EntityKind::Pedestrian(_) => "pedestrian",
+            EntityKind::MiscObject(_) => "miscellaneous",
+        }
+    }
+}
+
 /// A scenario object.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Entity {
@@ -792,7 +809,59 @@ pub enum EntityTest {
     /// `OffroadCondition`: off every lane of the map (its reference point outside the
     /// road's width, as esmini's `Position::IsOffRoad`) for longer than this, s.
     Offroad(f64),
-    /// `CollisionCondition` with this entity (`ByType` is refused; `None` is kept for a
-    /// collision with anything).
+    /// `CollisionCondition` with this entity (`None` is kept for a collision with
+    /// anything).
     Collision(Option<usize>),
+    /// `CollisionCondition` `ByType`: with any other entity of this type (`vehicle`,
+    /// `pedestrian` or `miscellaneous`, [`EntityKind::object_type`]).
+    CollisionByType(String),
+    /// `AngleCondition` (1.3): the entity's heading, in `frame`, within `tolerance` of
+    /// `angle` (the absolute difference of the two, taken into `[0, π]`, below
+    /// `tolerance` + 1e-6 rad, as esmini has it).
+    Angle(AngleTest),
+    /// `RelativeClearanceCondition` (1.2): the lanes beside and around the entity are free
+    /// (esmini's `TrigByRelativeClearance`).
+    RelativeClearance(Clearance),
+    /// `RelativeAngleCondition` (1.3): the entity's heading less `entity`'s, each in
+    /// `test.frame`, within `test.tolerance` of `test.angle`.
+    RelativeAngle {
+        /// The other entity.
+        entity: usize,
+        /// The angle, its tolerance and the frame.
+        test: AngleTest,
+    },
+}
+
+/// What a `RelativeClearanceCondition` (1.2) asks: that no other entity (of `entities`,
+/// or any) stands in the lanes `ranges` counts from the entity's, from `backward_m` behind
+/// it to `forward_m` ahead along the road, and that such a lane exists where it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Clearance {
+    /// `distanceForward`, m, `>= 0`.
+    pub forward_m: f64,
+    /// `distanceBackward`, m, `>= 0`.
+    pub backward_m: f64,
+    /// `freeSpace`: between the boxes (else between reference points).
+    pub freespace: bool,
+    /// `oppositeLanes`: lanes of the other direction count too.
+    pub opposite_lanes: bool,
+    /// Each `RelativeLaneRange`'s `from` and `to` (lanes counted as `<lane id>`s differ,
+    /// the centre lane skipped; an absent bound is unbounded); none: every lane.
+    pub ranges: Vec<(i64, i64)>,
+    /// The entities that may stand there (`EntityRef`s); none: every other entity.
+    pub entities: Vec<usize>,
+}
+
+/// What an angle condition compares: a heading (rad) within a tolerance, in a frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AngleTest {
+    /// rad.
+    pub angle: f64,
+    /// rad, `>= 0`.
+    pub tolerance: f64,
+    /// `coordinateSystem`: `world` (the default of `AngleCondition`), `entity` (the default
+    /// of `RelativeAngleCondition`; an entity's own heading in its own frame is 0), `road`
+    /// (less the direction of increasing `s` where the entity is) or `lane` (less the
+    /// direction of travel of the entity's lane).
+    pub frame: String,
 }

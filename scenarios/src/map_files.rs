@@ -185,8 +185,15 @@ impl MapFiles {
             Base::Folder(dir) => {
                 let full = dir.join(path);
                 let shown = full.display().to_string();
-                let text = crate::text_file::read_text(&full, MAX_MAP_BYTES)
-                    .map_err(|e| files(format!("cannot read the OpenDRIVE map {shown}: {e}")))?;
+                let text = crate::text_file::read_text(&full, MAX_MAP_BYTES).map_err(|e| {
+                    let town = if full.extension().is_none() {
+                        " (a map named without its extension, as CARLA names its towns, is read \
+                         from NAME.xodr beside the scenario: put the town's OpenDRIVE file there)"
+                    } else {
+                        ""
+                    };
+                    files(format!("cannot read the OpenDRIVE map {shown}: {e}{town}"))
+                })?;
                 (shown, text)
             }
         };

@@ -162,7 +162,7 @@ fn check_all(files: &[PathBuf]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 21] = [
+const ESMINI_EXAMPLES: [&str; 22] = [
     "alks_cut-in",
     "alks_cut-out",
     "alks_decelerate",
@@ -184,6 +184,7 @@ const ESMINI_EXAMPLES: [&str; 21] = [
     "straight_500m",
     "straight_500m_pedestrian",
     "tunnels",
+    "two_plus_one_road",
 ];
 
 #[test]

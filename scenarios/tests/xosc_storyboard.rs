@@ -293,7 +293,7 @@ fn storyboard_of(tag: &str, text: &str) -> Result<Storyboard, StoryError> {
 #[test]
 fn a_delay_counts_from_when_the_element_waits_and_transitions_are_seen_next_step() {
     let init = r#"<Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>
-      <Private entityRef="B"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-3" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>"#;
+      <Private entityRef="B"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-3" s="60" offset="0"/></Position></TeleportAction></PrivateAction></Private>"#;
     let story = format!(
         r#"<Story name="S">
       <Act name="Late">
@@ -472,5 +472,66 @@ fn a_point_on_a_lane_anchors_at_its_own_station() {
         }
         assert!(worst < within, "{road}: anchored {worst} m off");
         println!("{road}: anchored within {worst:.2e} m");
+    }
+}
+
+/// A `RelativeAngleCondition` (OpenSCENARIO 1.3): B speeds up when A's heading, less B's,
+/// comes within 0.003 rad of 0.03 rad while A changes into B's lane behind it; in the road's frame
+/// (each heading less the road's direction where the entity is) as in B's own. The event
+/// starts at the step after the condition first holds on the poses the test reads, and not
+/// before A turns.
+#[test]
+fn a_relative_angle_condition_holds_when_one_heading_less_the_other_is_within_its_tolerance() {
+    for frame in ["entity", "road"] {
+        let init = format!(
+            r#"<Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction>{a}</Private>
+      <Private entityRef="B"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-3" s="60" offset="0"/></Position></TeleportAction></PrivateAction>{a}</Private>"#,
+            a = step_to(20.0)
+        );
+        let story = format!(
+            r#"<Story name="S"><Act name="Act">
+      <ManeuverGroup maximumExecutionCount="1" name="GA">
+        <Actors selectTriggeringEntities="false"><EntityRef entityRef="A"/></Actors>
+        <Maneuver name="MA"><Event name="Left" priority="parallel"><Action name="l"><PrivateAction><LateralAction><LaneChangeAction>
+          <LaneChangeActionDynamics dynamicsShape="sinusoidal" value="4" dynamicsDimension="time"/>
+          <LaneChangeTarget><RelativeTargetLane entityRef="A" value="1"/></LaneChangeTarget></LaneChangeAction></LateralAction></PrivateAction></Action>
+          <StartTrigger><ConditionGroup><Condition name="At2" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="2" rule="greaterThan"/></ByValueCondition></Condition></ConditionGroup></StartTrigger></Event></Maneuver>
+      </ManeuverGroup>
+      <ManeuverGroup maximumExecutionCount="1" name="GB">
+        <Actors selectTriggeringEntities="false"><EntityRef entityRef="B"/></Actors>
+        <Maneuver name="MB"><Event name="Faster" priority="parallel"><Action name="f">{faster}</Action>
+          <StartTrigger><ConditionGroup><Condition name="Turned" delay="0" conditionEdge="none"><ByEntityCondition>
+            <TriggeringEntities triggeringEntitiesRule="any"><EntityRef entityRef="A"/></TriggeringEntities>
+            <EntityCondition><RelativeAngleCondition entityRef="B" angleType="heading" angle="0.03" angleTolerance="0.003" coordinateSystem="{frame}"/></EntityCondition>
+          </ByEntityCondition></Condition></ConditionGroup></StartTrigger></Event></Maneuver>
+      </ManeuverGroup>
+      <StartTrigger><ConditionGroup><Condition name="T" delay="0" conditionEdge="none">
+        <ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition>
+      </Condition></ConditionGroup></StartTrigger>
+    </Act></Story>"#,
+            faster = step_to(25.0)
+        );
+        let entities = box_object("A") + &box_object("B");
+        let text = on_straight_road("relative angle", &entities, &init, &story, 8.0);
+        let text = text.replace(r#"revMinor="2""#, r#"revMinor="3""#);
+        let mut sb = storyboard_of("relative-angle", &text).expect("Init performs");
+        let (mut holds, mut faster) = (None, None);
+        run(&mut sb, 10.0, |t, sb| {
+            let (a, b) = (&sb.actors[0].state, &sb.actors[1].state);
+            let rel = paracosm_engine::network::roads::wrap(a.pose.h - b.pose.h);
+            if holds.is_none() && (rel - 0.03).abs() < 0.003 {
+                holds = Some(t);
+            }
+            if faster.is_none() && b.speed > 20.0 {
+                faster = Some(t);
+            }
+        });
+        let holds = holds.expect("A turns 0.03 rad from B's heading");
+        let faster = faster.unwrap_or_else(|| panic!("{frame}: B never sped up"));
+        assert!(holds > 2.0, "{frame}: A turned at {holds} s");
+        assert!(
+            (faster - holds - DT).abs() < 1e-9,
+            "{frame}: the condition held at {holds} s, B sped up at {faster} s"
+        );
     }
 }

@@ -469,20 +469,18 @@ impl RoadMap {
                 length_m: length,
             });
         }
-        let here: Vec<usize> = (0..self.lanes.len())
-            .filter(|&i| {
-                let l = &self.lanes[i];
-                let (a, b) = l.s_range();
-                l.road == r && a - 1e-9 <= s && s <= b + 1e-9
-            })
-            .collect();
-        here.iter()
-            .copied()
+        let here = |i: &usize| {
+            let l = &self.lanes[*i];
+            let (a, b) = l.s_range();
+            l.road == r && a - 1e-9 <= s && s <= b + 1e-9
+        };
+        (0..self.lanes.len())
+            .filter(here)
             .find(|&i| self.lanes[i].od_id == od_id)
             .ok_or_else(|| {
-                let lanes: Vec<String> = here
-                    .iter()
-                    .map(|&i| format!("{} ({})", self.lanes[i].od_id, self.lanes[i].kind))
+                let lanes: Vec<String> = (0..self.lanes.len())
+                    .filter(here)
+                    .map(|i| format!("{} ({})", self.lanes[i].od_id, self.lanes[i].kind))
                     .collect();
                 LaneAtError::NoLane {
                     map: self.source.clone(),
@@ -1096,6 +1094,18 @@ impl MapIndex {
         let mut seen = std::collections::BTreeSet::new();
         out.retain(|x| seen.insert(x.0));
         out
+    }
+
+    /// The first of [`MapIndex::lanes_at`]: the lane whose strip holds `[x, z]` (m) with the
+    /// nearest centre line (ties to the lower lane, then station), its station `i` and the
+    /// point's offset (m); `None` on no lane. Without gathering and sorting the others.
+    pub fn nearest_lane_at(&self, p: [f64; 2]) -> Option<(usize, usize, f64)> {
+        self.strips_at(p).min_by(|a, b| {
+            a.2.abs()
+                .total_cmp(&b.2.abs())
+                .then(a.0.cmp(&b.0))
+                .then(a.1.cmp(&b.1))
+        })
     }
 
     /// Whether the world point `[x, z]` lies on any lane of the map (driving or not).

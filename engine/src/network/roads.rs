@@ -198,25 +198,7 @@ impl Roads {
     /// # Errors
     /// When the road is unknown or has no lane at `s`.
     pub fn road_pos(&self, road: &str, s: f64, t: f64) -> Result<LanePos, RoadError> {
-        // The reference line lies on the inner border of lane −1 (or +1).
-        let inner = [-1, 1]
-            .into_iter()
-            .find_map(|id| self.lane_pos(road, id, s, 0.0).ok().map(|lp| (id, lp)));
-        let Some((id, lp)) = inner else {
-            // The map's own message for the road.
-            self.lane_pos(road, -1, s, 0.0)?;
-            return Err(RoadError(format!(
-                "road {road} has no lane −1 or 1 at s = {s} m"
-            )));
-        };
-        let (c, along) = self.frame(lp.lane, s);
-        let left = [-along.sin(), along.cos()];
-        let w = self.lane_width(lp.lane, s);
-        let sign = if id < 0 { 1.0 } else { -1.0 };
-        let reference = [
-            c[0] + left[0] * sign * w / 2.0,
-            c[1] + left[1] * sign * w / 2.0,
-        ];
+        let (reference, left, lp) = self.reference_at(road, s)?;
         let road_index = self.map.lanes[lp.lane].road;
         let mut best: Option<(f64, LanePos)> = None;
         for (k, l) in self.map.lanes.iter().enumerate() {
@@ -249,11 +231,49 @@ impl Roads {
     /// # Errors
     /// When the road has no lane −1 or 1 at the station.
     pub fn road_t(&self, lp: &LanePos) -> Result<(String, f64), RoadError> {
-        let road = self.map.roads[self.map.lanes[lp.lane].road].od_id.clone();
-        // The point at t = 0 on the same road and station, relative to its lane's centre.
-        let zero = self.road_pos(&road, lp.s, 0.0)?;
-        let t = self.lateral_between(zero.lane, lp.lane, lp.s) + lp.d - zero.d;
-        Ok((road, t))
+        let road = &self.map.roads[self.map.lanes[lp.lane].road].od_id;
+        Ok((road.clone(), self.t_of(lp)?))
+    }
+
+    /// The lateral coordinate `t` of `lp` (m, left of the reference line): the offset of
+    /// its lane's centre from the line across the normal of lane −1's (or 1's) direction
+    /// at that station, plus `lp.d`. [`Roads::road_t`] without the road's name.
+    ///
+    /// # Errors
+    /// When the road has no lane −1 or 1 at the station.
+    pub fn t_of(&self, lp: &LanePos) -> Result<f64, RoadError> {
+        let road = &self.map.roads[self.map.lanes[lp.lane].road].od_id;
+        let (reference, left, _) = self.reference_at(road, lp.s)?;
+        let (c, _) = self.frame(lp.lane, lp.s);
+        Ok((c[0] - reference[0]) * left[0] + (c[1] - reference[1]) * left[1] + lp.d)
+    }
+
+    /// The reference line's point at station `s` of road `road` (OpenDRIVE frame, m), the
+    /// unit vector to its left (towards increasing `t`), and lane −1's (or 1's) position
+    /// there: the line lies on the inner border of lane −1 (or +1).
+    ///
+    /// # Errors
+    /// When the road is unknown or has no lane −1 or 1 at `s`.
+    fn reference_at(&self, road: &str, s: f64) -> Result<([f64; 2], [f64; 2], LanePos), RoadError> {
+        let inner = [-1, 1]
+            .into_iter()
+            .find_map(|id| self.lane_pos(road, id, s, 0.0).ok().map(|lp| (id, lp)));
+        let Some((id, lp)) = inner else {
+            // The map's own message for the road.
+            self.lane_pos(road, -1, s, 0.0)?;
+            return Err(RoadError(format!(
+                "road {road} has no lane −1 or 1 at s = {s} m"
+            )));
+        };
+        let (c, along) = self.frame(lp.lane, s);
+        let left = [-along.sin(), along.cos()];
+        let w = self.lane_width(lp.lane, s);
+        let sign = if id < 0 { 1.0 } else { -1.0 };
+        let reference = [
+            c[0] + left[0] * sign * w / 2.0,
+            c[1] + left[1] * sign * w / 2.0,
+        ];
+        Ok((reference, left, lp))
     }
 
     /// The width of lane `k` at station `s`, m.
@@ -267,7 +287,7 @@ impl Roads {
     /// off every lane.
     pub fn anchor(&self, x: f64, y: f64) -> Option<LanePos> {
         let p = self.od_to_engine(x, y);
-        let (k, i, _) = *self.index.lanes_at(p).first()?;
+        let (k, i, _) = self.index.nearest_lane_at(p)?;
         let l = &self.map.lanes[k];
         let last = l.centre.len().saturating_sub(2);
         // The point's projection on segment `j`, as a share of it (unclamped), and the
@@ -359,6 +379,19 @@ impl Roads {
             }
         }
         road
+    }
+
+    /// The `<lane id>`s of the driving lanes of road `road` (an index of the map's roads)
+    /// at station `s` (m), in the map's order.
+    pub fn driving_ids_at(&self, road: usize, s: f64) -> Vec<i32> {
+        (self.map.lanes.iter())
+            .filter(|l| l.road == road && l.drivable)
+            .filter(|l| {
+                let (a, b) = l.s_range();
+                a - 1e-9 <= s && s <= b + 1e-9
+            })
+            .map(|l| l.od_id)
+            .collect()
     }
 
     /// The `<lane id>` and road of lane `k`.
@@ -573,6 +606,62 @@ impl Roads {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `t` of a point on a lane of CARLA's Town01 (roads of driving lanes each way with
+    /// 0.3 m lanes beside them) is the widths of the lanes between it and the reference line
+    /// plus half its own, positive to the left, plus its offset (to 1 cm: on a bend the lanes
+    /// are polylines of 0.5 m chords, which cut its corners); and `road_pos` takes
+    /// that `t` back to the same lane and offset.
+    #[test]
+    fn t_is_the_widths_between_the_lane_and_the_reference_line() {
+        let path = format!(
+            "{}/../tests/data/maps/carla/Town01.xodr",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let text = std::fs::read_to_string(&path).unwrap();
+        let map = crate::network::opendrive::import(&path, &text).unwrap().map;
+        let roads = Roads::new(&MapRef::new(map.clone()));
+        let mut checked = 0;
+        for (k, l) in map.lanes.iter().enumerate() {
+            if map.roads[l.road].junction.is_some() {
+                continue;
+            }
+            let (a, b) = l.s_range();
+            let s = (a + b) / 2.0;
+            let inner: f64 = (map.lanes.iter().enumerate())
+                .filter(|(_, m)| m.road == l.road && m.section == l.section)
+                .filter(|(_, m)| {
+                    m.od_id.signum() == l.od_id.signum() && m.od_id.abs() < l.od_id.abs()
+                })
+                .map(|(j, _)| roads.lane_width(j, s))
+                .sum();
+            let want = f64::from(l.od_id.signum()) * (inner + roads.lane_width(k, s) / 2.0);
+            for d in [0.0, 0.3, -0.4] {
+                let lp = LanePos {
+                    lane: k,
+                    s,
+                    d,
+                    rev: false,
+                };
+                let t = roads.t_of(&lp).unwrap();
+                assert!(
+                    (t - (want + d)).abs() < 0.01,
+                    "lane {} d {d}: t {t}, want {}",
+                    l.od_id,
+                    want + d
+                );
+                let road = &map.roads[l.road].od_id;
+                assert_eq!(roads.road_t(&lp).unwrap(), (road.clone(), t));
+                let back = roads.road_pos(road, s, t).unwrap();
+                if d.abs() < roads.lane_width(k, s) / 2.0 {
+                    assert_eq!(back.lane, k, "lane {} d {d}", l.od_id);
+                    assert!((back.d - d).abs() < 1e-9, "{} {d}", back.d);
+                }
+            }
+            checked += 1;
+        }
+        assert!(checked > 100, "{checked} lanes");
+    }
 
     #[test]
     fn wrap_keeps_angles_in_range() {

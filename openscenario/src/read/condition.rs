@@ -4,7 +4,9 @@ use roxmltree::Node;
 
 use super::{position, Reader};
 use crate::error::XoscError;
-use crate::model::{Condition, ConditionKind, Edge, EntityTest, Gap, Rule, Trigger};
+use crate::model::{
+    AngleTest, Clearance, Condition, ConditionKind, Edge, EntityTest, Gap, Rule, Trigger,
+};
 use crate::quantity::Quantity;
 use crate::xml::{choice, elements, need};
 
@@ -214,6 +216,9 @@ const ENTITY_CONDITIONS: &[&str] = &[
     "EndOfRoadCondition",
     "CollisionCondition",
     "OffroadCondition",
+    "AngleCondition",
+    "RelativeAngleCondition",
+    "RelativeClearanceCondition",
 ];
 
 fn by_entity(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError> {
@@ -239,7 +244,11 @@ fn by_entity(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscErro
                 .text
                 .unsupported(e, "triggering entities are <EntityRef> elements"));
         }
-        entities.push(r.entity(e, "entityRef")?);
+        for k in r.entities(e, "entityRef")? {
+            if !entities.contains(&k) {
+                entities.push(k);
+            }
+        }
     }
     if entities.is_empty() {
         return Err(r.text.invalid(t, "no triggering entity is named"));
@@ -303,6 +312,38 @@ fn measure(r: &Reader<'_>, c: Node<'_, '_>) -> Result<(String, String), XoscErro
     Ok((frame, kind))
 }
 
+/// Refuses a distance measured along a trajectory (`coordinateSystem="trajectory"`), and
+/// notes that a lateral or euclidean distance in lane coordinates is measured across the
+/// road in metres, as in road coordinates (esmini's reading: its lane and road coordinates
+/// give the same lateral distance).
+fn not_along_a_trajectory(
+    r: &Reader<'_>,
+    c: Node<'_, '_>,
+    frame: &str,
+    kind: &str,
+) -> Result<(), XoscError> {
+    if frame == "trajectory" {
+        return Err(XoscError::Unsupported {
+            pos: r.text.attr_pos(c, "coordinateSystem"),
+            reason: format!(
+                "a {kind} distance in the trajectory's coordinate system is not supported: \
+                 paracosm measures in the entity's, the road's and the lanes' coordinates"
+            ),
+        });
+    }
+    if frame == "lane" && kind != "longitudinal" {
+        r.note(
+            c,
+            format!(
+                "a {kind} distance in lane coordinates is measured across the road in metres \
+                 (the difference of the two positions' t), as in road coordinates, as esmini \
+                 measures it"
+            ),
+        );
+    }
+    Ok(())
+}
+
 /// Reads 1.2's `direction` on speed and acceleration conditions: `longitudinal` is the speed
 /// or acceleration along the entity's heading, which is what paracosm compares (its entities
 /// face the way they move, so the longitudinal part is the whole); `lateral` and `vertical`
@@ -326,17 +367,7 @@ fn gap(
     q: Quantity,
 ) -> Result<Gap, XoscError> {
     let (frame, kind) = measure(r, c)?;
-    // Along the road or its lanes, and across the road; not along a trajectory, and not
-    // across in lanes (counted in lanes, not metres).
-    if frame == "trajectory" || (frame == "lane" && kind != "longitudinal") {
-        return Err(XoscError::Unsupported {
-            pos: r.text.attr_pos(c, "coordinateSystem"),
-            reason: format!(
-                "a {kind} distance in the {frame:?} coordinate system is not supported: \
-                 paracosm measures in the entity's, the road's, and longitudinally along lanes"
-            ),
-        });
-    }
+    not_along_a_trajectory(r, c, &frame, &kind)?;
     Ok(Gap {
         entity: r.entity(target, "entityRef")?,
         rule: rule(r, c)?,
@@ -376,16 +407,7 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
         }
         "DistanceCondition" => {
             let (frame, kind) = measure(r, c)?;
-            if frame == "trajectory" || (frame == "lane" && kind != "longitudinal") {
-                return Err(XoscError::Unsupported {
-                    pos: t.attr_pos(c, "coordinateSystem"),
-                    reason: format!(
-                        "a {kind} distance condition in the {frame:?} coordinate system is not \
-                         supported: paracosm measures in the entity's, the road's, and \
-                         longitudinally along lanes"
-                    ),
-                });
-            }
+            not_along_a_trajectory(r, c, &frame, &kind)?;
             EntityTest::Distance {
                 position: position::read(r, need(t, c, "Position")?)?,
                 rule: rule(r, c)?,
@@ -424,9 +446,163 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
         "OffroadCondition" => {
             EntityTest::Offroad(s.num_in(t, c, "duration", Quantity::Duration)?)
         }
+        "AngleCondition" => EntityTest::Angle(angle_test(r, c, "world")?),
+        "RelativeClearanceCondition" => EntityTest::RelativeClearance(clearance(r, c)?),
+        "RelativeAngleCondition" => EntityTest::RelativeAngle {
+            entity: r.entity(c, "entityRef")?,
+            test: angle_test(r, c, "entity")?,
+        },
         _ => {
-            let (target, _) = choice(t, c, &["EntityRef"])?;
-            EntityTest::Collision(Some(r.entity(target, "entityRef")?))
+            let (target, tag) = choice(t, c, &["EntityRef", "ByType"])?;
+            if tag == "EntityRef" {
+                EntityTest::Collision(Some(r.entity(target, "entityRef")?))
+            } else {
+                EntityTest::CollisionByType(object_type(r, target)?)
+            }
         }
     })
+}
+
+/// The `type` of a collision condition's `ByType`: `vehicle`, `pedestrian` or
+/// `miscellaneous`; `external` (an object outside the scenario) is refused, as paracosm's
+/// world holds the file's entities only.
+fn object_type(r: &Reader<'_>, by: Node<'_, '_>) -> Result<String, XoscError> {
+    let kind = r.scope.string(r.text, by, "type")?;
+    match kind.as_str() {
+        k if crate::model::OBJECT_TYPES.contains(&k) => Ok(kind),
+        "external" => Err(XoscError::Unsupported {
+            pos: r.text.attr_pos(by, "type"),
+            reason: "a collision with an external object is not supported: paracosm's world \
+                     holds the scenario's own entities only"
+                .into(),
+        }),
+        other => Err(XoscError::Invalid {
+            pos: r.text.attr_pos(by, "type"),
+            reason: format!(
+                "type is one of {}, external, not {other:?}",
+                crate::model::OBJECT_TYPES.join(", ")
+            ),
+        }),
+    }
+}
+
+/// The [`AngleTest`] of an `AngleCondition` or `RelativeAngleCondition` `c`, whose
+/// `coordinateSystem` defaults to `default`. Only `angleType="heading"` is read: paracosm's
+/// storyboard moves its entities in the plane of the map, with no pitch or roll to compare;
+/// a trajectory's frame is refused as in distance conditions.
+fn angle_test(r: &Reader<'_>, c: Node<'_, '_>, default: &str) -> Result<AngleTest, XoscError> {
+    let (s, t) = (&r.scope, r.text);
+    let kind = s.string(t, c, "angleType")?;
+    if kind != "heading" {
+        let reason = if matches!(kind.as_str(), "pitch" | "roll") {
+            format!(
+                "an angle condition on the {kind} is not supported: paracosm's storyboard \
+                 moves its entities in the plane of the map, and compares headings only"
+            )
+        } else {
+            format!("angleType is heading, pitch or roll, not {kind:?}")
+        };
+        return Err(XoscError::Unsupported {
+            pos: t.attr_pos(c, "angleType"),
+            reason,
+        });
+    }
+    let frame = s
+        .opt_string(t, c, "coordinateSystem")?
+        .unwrap_or_else(|| default.to_owned());
+    if !matches!(frame.as_str(), "world" | "entity" | "road" | "lane") {
+        let reason = if frame == "trajectory" {
+            "an angle condition in the trajectory's coordinate system is not supported: \
+             paracosm compares headings in the world's, the entity's, the road's and the \
+             lane's"
+                .to_owned()
+        } else {
+            format!(
+                "coordinateSystem is one of world, entity, road, lane, trajectory, not {frame:?}"
+            )
+        };
+        return Err(XoscError::Unsupported {
+            pos: t.attr_pos(c, "coordinateSystem"),
+            reason,
+        });
+    }
+    let tolerance = s.num_in(t, c, "angleTolerance", Quantity::Angle)?;
+    if tolerance < 0.0 {
+        return Err(XoscError::Invalid {
+            pos: t.attr_pos(c, "angleTolerance"),
+            reason: format!("angleTolerance is an angle >= 0 rad, not {tolerance}"),
+        });
+    }
+    Ok(AngleTest {
+        angle: s.num_in(t, c, "angle", Quantity::Angle)?,
+        tolerance,
+        frame,
+    })
+}
+
+/// A `RelativeClearanceCondition` (1.2): its distances (`distanceForward`,
+/// `distanceBackward`, 0 m when absent), `freeSpace` (esmini's `freespace` spelling read
+/// too), `oppositeLanes`, its `RelativeLaneRange`s and its `EntityRef`s.
+///
+/// # Errors
+/// Invalid for a negative distance, a range whose `from` exceeds its `to`, a missing
+/// `freeSpace` or `oppositeLanes`; unsupported for another child.
+fn clearance(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Clearance, XoscError> {
+    let (s, t) = (&r.scope, r.text);
+    let distance = |attr: &str| -> Result<f64, XoscError> {
+        let d = s.opt_num_in(t, c, attr, Quantity::Distance)?.unwrap_or(0.0);
+        if d < 0.0 {
+            return Err(XoscError::Invalid {
+                pos: t.attr_pos(c, attr),
+                reason: format!("{attr} is a distance >= 0 m, not {d}"),
+            });
+        }
+        Ok(d)
+    };
+    let freespace = match s.opt_bool(t, c, "freeSpace")? {
+        Some(b) => b,
+        None => match s.opt_bool(t, c, "freespace")? {
+            Some(b) => b,
+            None => s.bool(t, c, "freeSpace")?,
+        },
+    };
+    let mut out = Clearance {
+        forward_m: distance("distanceForward")?,
+        backward_m: distance("distanceBackward")?,
+        freespace,
+        opposite_lanes: s.bool(t, c, "oppositeLanes")?,
+        ranges: Vec::new(),
+        entities: Vec::new(),
+    };
+    for e in elements(c) {
+        match e.tag_name().name() {
+            "RelativeLaneRange" => {
+                let bound = |attr: &str, unbounded: i64| -> Result<i64, XoscError> {
+                    Ok(match e.attribute(attr) {
+                        None => unbounded,
+                        Some(_) => i64::from(position::lane_id(r, e, attr)?),
+                    })
+                };
+                let (from, to) = (bound("from", i64::MIN / 4)?, bound("to", i64::MAX / 4)?);
+                if from > to {
+                    return Err(r.text.invalid(e, format!("a lane range from {from} to {to} is empty")));
+                }
+                out.ranges.push((from, to));
+            }
+            "EntityRef" => {
+                for k in r.entities(e, "entityRef")? {
+                    if !out.entities.contains(&k) {
+                        out.entities.push(k);
+                    }
+                }
+            }
+            other => {
+                return Err(r.text.unsupported(
+                    e,
+                    format!("<{other}> in <RelativeClearanceCondition>: paracosm reads <RelativeLaneRange> and <EntityRef>"),
+                ))
+            }
+        }
+    }
+    Ok(out)
 }

@@ -21,9 +21,26 @@ pub(super) fn road_network(
         match c.tag_name().name() {
             "LogicFile" => {
                 let path = r.scope.string(r.text, c, "filepath")?;
+                let mut file = super::join(&r.dir, &path);
+                // CARLA's scenarios name a town (`Town01`), which CARLA loads itself: its
+                // OpenDRIVE file beside the scenario stands for it.
+                if file.extension().is_none() && !file.exists() {
+                    let xodr = file.with_extension("xodr");
+                    if xodr.is_file() {
+                        r.note(
+                            c,
+                            format!(
+                                "the map {path:?} is named without its extension, as CARLA names \
+                                 its towns: read from {}",
+                                xodr.display()
+                            ),
+                        );
+                        file = xodr;
+                    }
+                }
                 out = Some(Located {
                     pos: r.text.pos(c),
-                    item: super::join(&r.dir, &path).display().to_string(),
+                    item: file.display().to_string(),
                 });
             }
             "SceneGraphFile" => r.note(c, "the 3D model (SceneGraphFile) is not drawn: paracosm draws the road from the OpenDRIVE file"),
@@ -37,7 +54,7 @@ pub(super) fn road_network(
     Ok(out)
 }
 
-/// `Entities`: every `ScenarioObject` (an `EntitySelection` is refused).
+/// `Entities`: every `ScenarioObject`, then every `EntitySelection` (into `r.selections`).
 pub(super) fn read(
     r: &mut Reader<'_>,
     catalogs: &Catalogs,
@@ -45,6 +62,9 @@ pub(super) fn read(
 ) -> Result<Vec<Entity>, XoscError> {
     let mut out: Vec<Entity> = Vec::new();
     for obj in node.into_iter().flat_map(elements) {
+        if obj.tag_name().name() == "EntitySelection" {
+            continue;
+        }
         if obj.tag_name().name() != "ScenarioObject" {
             return Err(r.text.unsupported(
                 obj,
@@ -108,7 +128,124 @@ pub(super) fn read(
         });
         std::rc::Rc::make_mut(&mut r.names).push(name);
     }
+    let selections = selections(r, &out, node)?;
+    r.selections = std::rc::Rc::new(selections);
     Ok(out)
+}
+
+/// Each `EntitySelection` of `Entities` (OpenSCENARIO 1.0+): its name and its members, the
+/// entities its `Members` name by `EntityRef` (an entity, or another selection, whose
+/// members it takes) or by `ByType` (every entity of that `objectType`), in the order of
+/// the entities, each once.
+///
+/// # Errors
+/// Invalid for a name taken by an entity or another selection, a member named nowhere, a
+/// selection that includes itself (through others), an unknown `objectType`, or a selection
+/// of no entity; unsupported for `objectType="external"`.
+fn selections(
+    r: &Reader<'_>,
+    entities: &[Entity],
+    node: Option<Node<'_, '_>>,
+) -> Result<Vec<(String, Vec<usize>)>, XoscError> {
+    let nodes: Vec<Node<'_, '_>> = node
+        .into_iter()
+        .flat_map(elements)
+        .filter(|n| n.has_tag_name("EntitySelection"))
+        .collect();
+    let mut named: Vec<(String, Node<'_, '_>)> = Vec::new();
+    for n in &nodes {
+        let name = r.scope.string(r.text, *n, "name")?;
+        if r.names.contains(&name) || named.iter().any(|(m, _)| *m == name) {
+            return Err(r.text.invalid(
+                *n,
+                format!("a second entity or selection is named {name:?}"),
+            ));
+        }
+        only(r.text, *n, &["Members"])?;
+        named.push((name, *n));
+    }
+    let mut out = Vec::new();
+    for k in 0..named.len() {
+        let mut members = vec![false; entities.len()];
+        select(r, entities, &named, k, &mut vec![k], &mut members)?;
+        let members: Vec<usize> = (0..entities.len()).filter(|&i| members[i]).collect();
+        if members.is_empty() {
+            return Err(r
+                .text
+                .invalid(named[k].1, "this entity selection selects no entity"));
+        }
+        out.push((named[k].0.clone(), members));
+    }
+    Ok(out)
+}
+
+/// Marks in `members` the entities selection `named[k]` selects; `path` holds the
+/// selections being expanded (a selection met again includes itself).
+fn select(
+    r: &Reader<'_>,
+    entities: &[Entity],
+    named: &[(String, Node<'_, '_>)],
+    k: usize,
+    path: &mut Vec<usize>,
+    members: &mut [bool],
+) -> Result<(), XoscError> {
+    let Some(list) = child(named[k].1, "Members") else {
+        return Ok(());
+    };
+    for m in elements(list) {
+        match m.tag_name().name() {
+            "EntityRef" => {
+                let name = r.scope.string(r.text, m, "entityRef")?;
+                if let Some(i) = r.names.iter().position(|n| *n == name) {
+                    members[i] = true;
+                } else if let Some(j) = named.iter().position(|(n, _)| *n == name) {
+                    if path.contains(&j) {
+                        return Err(XoscError::Invalid {
+                            pos: r.text.attr_pos(m, "entityRef"),
+                            reason: format!("selection {name:?} includes itself"),
+                        });
+                    }
+                    path.push(j);
+                    select(r, entities, named, j, path, members)?;
+                    path.pop();
+                } else {
+                    r.entity(m, "entityRef")?;
+                }
+            }
+            "ByType" => {
+                let kind = r.scope.string(r.text, m, "objectType")?;
+                if kind == "external" {
+                    return Err(XoscError::Unsupported {
+                        pos: r.text.attr_pos(m, "objectType"),
+                        reason: "a selection of external objects is not supported: paracosm's \
+                                 world holds the scenario's own entities only"
+                            .into(),
+                    });
+                }
+                if !crate::model::OBJECT_TYPES.contains(&kind.as_str()) {
+                    return Err(XoscError::Invalid {
+                        pos: r.text.attr_pos(m, "objectType"),
+                        reason: format!(
+                            "objectType is one of {}, external, not {kind:?}",
+                            crate::model::OBJECT_TYPES.join(", ")
+                        ),
+                    });
+                }
+                for (i, e) in entities.iter().enumerate() {
+                    members[i] |= e.kind.object_type() == kind;
+                }
+            }
+            other => {
+                return Err(r.text.unsupported(
+                    m,
+                    format!(
+                    "<{other}> in a selection's <Members>: paracosm reads <EntityRef> and <ByType>"
+                ),
+                ))
+            }
+        }
+    }
+    Ok(())
 }
 
 /// An object's kind, bounding box (dimensions, centre, where its dimensions are written) and
@@ -173,10 +310,10 @@ fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscErr
         scope.num_in(text, dims, "width", Quantity::Size)?,
         scope.num_in(text, dims, "height", Quantity::Size)?,
     ];
-    if dimensions_m.iter().any(|&d| !(d > 0.0 && d <= 100.0)) {
+    if dimensions_m.iter().any(|&d| !(0.0..=100.0).contains(&d)) {
         return Err(text.invalid(
             dims,
-            format!("a bounding box's sides must be in (0, 100] m, not {dimensions_m:?}"),
+            format!("a bounding box's sides must be in [0, 100] m, not {dimensions_m:?}"),
         ));
     }
     let centre_m = [
@@ -185,6 +322,16 @@ fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscErr
         scope.num_in(text, centre, "z", Quantity::Offset)?,
     ];
     let mut notes = Vec::new();
+    if dimensions_m.contains(&0.0) {
+        // The schema allows it (ASAM's and the generators' files write empty boxes).
+        notes.push(format!(
+            "{}'s bounding box has a side of 0 m ({dimensions_m:?}): the storyboard measures \
+             the box as written, as esmini does, and its body in the world is 0.1 m on that \
+             side so that what touches it is found (an ego needs a real size: its box is \
+             refused)",
+            scope.opt_string(text, e, "name")?.unwrap_or_default()
+        ));
+    }
     if child(e, "Performance").is_some() {
         notes.push(format!(
             "{}'s <Performance> limits are not applied: paracosm's vehicle model has its own",

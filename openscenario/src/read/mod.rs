@@ -30,6 +30,9 @@ pub(crate) struct Reader<'t> {
     pub(crate) scope: Scope,
     /// The entities' names, shared by the readers of nested scopes.
     pub(crate) names: std::rc::Rc<Vec<String>>,
+    /// Each `EntitySelection`'s name and members (indices into the entities, in the order
+    /// of the entities, each once).
+    pub(crate) selections: std::rc::Rc<Vec<(String, Vec<usize>)>>,
     pub(crate) notes: std::rc::Rc<std::cell::RefCell<Vec<Note>>>,
     pub(crate) dir: PathBuf,
     /// The scenario's catalog folders (read once its `CatalogLocations` are), shared by the
@@ -46,16 +49,39 @@ impl<'t> Reader<'t> {
     /// The entity named by `node`'s attribute `attr`.
     pub(crate) fn entity(&self, node: Node<'_, '_>, attr: &str) -> Result<usize, XoscError> {
         let name = self.scope.string(self.text, node, attr)?;
-        self.names
-            .iter()
-            .position(|n| *n == name)
-            .ok_or_else(|| XoscError::Invalid {
+        if let Some(k) = self.names.iter().position(|n| *n == name) {
+            return Ok(k);
+        }
+        if self.selections.iter().any(|(n, _)| *n == name) {
+            return Err(XoscError::Unsupported {
                 pos: self.text.attr_pos(node, attr),
                 reason: format!(
-                    "no entity is named {name:?}; the scenario's entities are {}",
-                    self.names.join(", ")
+                    "{name:?} is an entity selection: paracosm reads a selection among a \
+                     maneuver group's actors and a condition's triggering entities, not here, \
+                     where one entity is meant"
                 ),
-            })
+            });
+        }
+        Err(XoscError::Invalid {
+            pos: self.text.attr_pos(node, attr),
+            reason: format!(
+                "no entity is named {name:?}; the scenario's entities are {}",
+                self.names.join(", ")
+            ),
+        })
+    }
+
+    /// The entities named by `node`'s attribute `attr`: the entity of that name, or the
+    /// members of the `EntitySelection` of that name (actors and triggering entities).
+    ///
+    /// # Errors
+    /// Invalid when neither an entity nor a selection has the name.
+    pub(crate) fn entities(&self, node: Node<'_, '_>, attr: &str) -> Result<Vec<usize>, XoscError> {
+        let name = self.scope.string(self.text, node, attr)?;
+        match self.selections.iter().find(|(n, _)| *n == name) {
+            Some((_, members)) => Ok(members.clone()),
+            None => Ok(vec![self.entity(node, attr)?]),
+        }
     }
 
     /// A reader of the same file whose scope is this one's with `node`'s own
@@ -74,6 +100,7 @@ impl<'t> Reader<'t> {
             files: self.files,
             scope,
             names: std::rc::Rc::clone(&self.names),
+            selections: std::rc::Rc::clone(&self.selections),
             notes: self.notes.clone(),
             dir: self.dir.clone(),
             catalogs: std::rc::Rc::clone(&self.catalogs),
@@ -94,6 +121,7 @@ impl<'t> Reader<'t> {
             files: self.files,
             scope: scope.clone(),
             names: std::rc::Rc::clone(&self.names),
+            selections: std::rc::Rc::clone(&self.selections),
             notes: self.notes.clone(),
             dir: Path::new(&text.file)
                 .parent()
@@ -225,6 +253,7 @@ fn read_with(
         files,
         scope,
         names: std::rc::Rc::default(),
+        selections: std::rc::Rc::default(),
         notes: Default::default(),
         dir: dir.to_path_buf(),
         catalogs: std::rc::Rc::default(),

@@ -101,7 +101,7 @@ fn route(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
 }
 
 /// Attribute `attr` of `p` read as a lane id: a whole number of at most 1000 in size.
-fn lane_id(r: &Reader<'_>, p: Node<'_, '_>, attr: &str) -> Result<i32, XoscError> {
+pub(super) fn lane_id(r: &Reader<'_>, p: Node<'_, '_>, attr: &str) -> Result<i32, XoscError> {
     let (s, t) = (&r.scope, r.text);
     let v = s.num(t, p, attr)?;
     if v.fract() != 0.0 || v.abs() > 1000.0 {

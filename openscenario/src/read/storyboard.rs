@@ -111,7 +111,11 @@ fn act(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Act, XoscError> {
             if e.tag_name().name() != "EntityRef" {
                 return Err(r.text.unsupported(e, "actors are <EntityRef> elements"));
             }
-            actors.push(r.entity(e, "entityRef")?);
+            for k in r.entities(e, "entityRef")? {
+                if !actors.contains(&k) {
+                    actors.push(k);
+                }
+            }
         }
         if actors.is_empty()
             && !r

@@ -400,64 +400,104 @@ fn condition(s: &Scenario, c: &ConditionKind) -> String {
         }
         ConditionKind::Entity { entities, test, .. } => {
             let who: Vec<&str> = entities.iter().map(|&e| name(s, e)).collect();
-            let what = match test {
-                EntityTest::TimeHeadway(g) => {
-                    format!(
-                        "headway to {} {:?} {} s",
-                        name(s, g.entity),
-                        g.rule,
-                        g.value
-                    )
-                }
-                EntityTest::TimeToCollision(g) => format!(
-                    "time to collision with {} {:?} {} s",
-                    name(s, g.entity),
-                    g.rule,
-                    g.value
-                ),
-                EntityTest::RelativeDistance(g) => format!(
-                    "{} distance to {} {:?} {} m",
-                    g.kind,
-                    name(s, g.entity),
-                    g.rule,
-                    g.value
-                ),
-                EntityTest::ReachPosition {
-                    position: p,
-                    tolerance,
-                } => format!("within {tolerance} m of {}", position(s, p)),
-                EntityTest::Distance {
-                    position: p,
-                    rule,
-                    value,
-                    freespace,
-                    kind,
-                    frame,
-                } => format!(
-                    "{kind} distance{} to {} in {frame} coordinates {rule:?} {value} m",
-                    if *freespace { " from its box" } else { "" },
-                    position(s, p)
-                ),
-                EntityTest::Speed { rule, value } => format!("speed {rule:?} {value} m/s"),
-                EntityTest::RelativeSpeed {
-                    entity,
-                    rule,
-                    value,
-                } => format!(
-                    "speed relative to {} {rule:?} {value} m/s",
-                    name(s, *entity)
-                ),
-                EntityTest::Acceleration { rule, value } => {
-                    format!("acceleration {rule:?} {value} m/s2")
-                }
-                EntityTest::Standstill(d) => format!("still for {d} s"),
-                EntityTest::TraveledDistance(d) => format!("travelled {d} m"),
-                EntityTest::EndOfRoad(d) => format!("past the road's end for {d} s"),
-                EntityTest::Offroad(d) => format!("off the road for more than {d} s"),
-                EntityTest::Collision(Some(e)) => format!("touches {}", name(s, *e)),
-                EntityTest::Collision(None) => "touches anything".into(),
-            };
-            format!("{}: {what}", who.join("/"))
+            format!("{}: {}", who.join("/"), entity_test(s, test))
         }
+    }
+}
+
+/// What an entity condition's `test` asks, in words.
+fn entity_test(s: &Scenario, test: &EntityTest) -> String {
+    match test {
+        EntityTest::TimeHeadway(g) => {
+            format!(
+                "headway to {} {:?} {} s",
+                name(s, g.entity),
+                g.rule,
+                g.value
+            )
+        }
+        EntityTest::TimeToCollision(g) => format!(
+            "time to collision with {} {:?} {} s",
+            name(s, g.entity),
+            g.rule,
+            g.value
+        ),
+        EntityTest::RelativeDistance(g) => format!(
+            "{} distance to {} {:?} {} m",
+            g.kind,
+            name(s, g.entity),
+            g.rule,
+            g.value
+        ),
+        EntityTest::ReachPosition {
+            position: p,
+            tolerance,
+        } => format!("within {tolerance} m of {}", position(s, p)),
+        EntityTest::Distance {
+            position: p,
+            rule,
+            value,
+            freespace,
+            kind,
+            frame,
+        } => format!(
+            "{kind} distance{} to {} in {frame} coordinates {rule:?} {value} m",
+            if *freespace { " from its box" } else { "" },
+            position(s, p)
+        ),
+        EntityTest::Speed { rule, value } => format!("speed {rule:?} {value} m/s"),
+        EntityTest::RelativeSpeed {
+            entity,
+            rule,
+            value,
+        } => format!(
+            "speed relative to {} {rule:?} {value} m/s",
+            name(s, *entity)
+        ),
+        EntityTest::Acceleration { rule, value } => {
+            format!("acceleration {rule:?} {value} m/s2")
+        }
+        EntityTest::Standstill(d) => format!("still for {d} s"),
+        EntityTest::TraveledDistance(d) => format!("travelled {d} m"),
+        EntityTest::EndOfRoad(d) => format!("past the road's end for {d} s"),
+        EntityTest::Offroad(d) => format!("off the road for more than {d} s"),
+        EntityTest::Collision(Some(e)) => format!("touches {}", name(s, *e)),
+        EntityTest::Collision(None) => "touches anything".into(),
+        EntityTest::CollisionByType(kind) => format!("touches any {kind}"),
+        EntityTest::RelativeClearance(c) => format!(
+            "clear of {} from {} m behind to {} m ahead in lanes {}{}",
+            if c.entities.is_empty() {
+                "every entity".to_owned()
+            } else {
+                c.entities
+                    .iter()
+                    .map(|&e| name(s, e))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            },
+            c.backward_m,
+            c.forward_m,
+            if c.ranges.is_empty() {
+                "any".to_owned()
+            } else {
+                c.ranges
+                    .iter()
+                    .map(|(a, b)| format!("{a}..{b}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            },
+            if c.opposite_lanes { ", either way" } else { "" }
+        ),
+        EntityTest::Angle(a) => format!(
+            "heading in {} coordinates within {} rad of {} rad",
+            a.frame, a.tolerance, a.angle
+        ),
+        EntityTest::RelativeAngle { entity, test: a } => format!(
+            "heading less {}'s in {} coordinates within {} rad of {} rad",
+            name(s, *entity),
+            a.frame,
+            a.tolerance,
+            a.angle
+        ),
     }
 }

@@ -294,6 +294,107 @@ impl Storyboard {
                 Some(o) => st.collided && self.touching(e, *o),
                 None => st.collided,
             },
+            EntityTest::CollisionByType(kind) => {
+                st.collided
+                    && (0..self.actors.len()).any(|o| {
+                        o != e && self.actors[o].object_type == kind && self.touching(e, o)
+                    })
+            }
+            EntityTest::RelativeClearance(c) => self.clear(e, c),
+            EntityTest::Angle(a) => self
+                .heading_in(e, &a.frame)
+                .is_some_and(|h| within_angle(h, a)),
+            EntityTest::RelativeAngle { entity, test: a } => {
+                // In the other entity's frame: the difference of the two world headings.
+                let frame = if a.frame == "entity" {
+                    "world"
+                } else {
+                    &a.frame
+                };
+                match (self.heading_in(e, frame), self.heading_in(*entity, frame)) {
+                    (Some(h), Some(r)) => within_angle(h - r, a),
+                    _ => false,
+                }
+            }
+        }
+    }
+
+    /// Whether the lanes `c` names around entity `e` are clear (esmini's
+    /// `TrigByRelativeClearance`): no other entity (of `c.entities`, or any) stands from
+    /// `c.backward_m` behind to `c.forward_m` ahead along the road (between reference
+    /// points, or boxes with `freespace`) in a lane whose `<lane id>` differs from `e`'s
+    /// by a count in `c.ranges` (the centre lane skipped; one of the other direction only
+    /// with `opposite_lanes`), and a driving lane exists at `e`'s station with an id that
+    /// differs from `e`'s by such a count (of `e`'s side only without `opposite_lanes`).
+    /// False when `e` is on no lane.
+    fn clear(&self, e: usize, c: &paracosm_openscenario::model::Clearance) -> bool {
+        let Some(la) = self.actors[e].state.lane else {
+            return false;
+        };
+        let in_range =
+            |d: i64| c.ranges.is_empty() || c.ranges.iter().any(|&(a, b)| (a..=b).contains(&d));
+        let (ida, road) = self.roads.ids(la.lane);
+        let max_m = c.forward_m.max(c.backward_m);
+        for o in 0..self.actors.len() {
+            if o == e || (!c.entities.is_empty() && !c.entities.contains(&o)) {
+                continue;
+            }
+            let Some(lb) = self.actors[o].state.lane else {
+                continue;
+            };
+            let g = Gap {
+                entity: o,
+                rule: Rule::Lt,
+                value: 0.0,
+                freespace: c.freespace,
+                frame: "road".into(),
+                kind: "longitudinal".into(),
+            };
+            let (ds, _, _) = self.road_gap(e, &g);
+            if !ds.is_finite() || (!c.freespace && ds.abs() >= max_m) {
+                continue;
+            }
+            if ds < -c.backward_m || ds > c.forward_m {
+                continue;
+            }
+            let idb = self.roads.ids(lb.lane).0;
+            let opposite = idb.signum() != ida.signum();
+            let mut d = i64::from(idb) - i64::from(ida);
+            if opposite {
+                d = (d.abs() - 1) * d.signum();
+            }
+            if in_range(d) && (c.opposite_lanes || !opposite) {
+                return false;
+            }
+        }
+        // The lanes counted from e's own (by id, as esmini counts them) exist where it is.
+        self.roads.driving_ids_at(road, la.s).into_iter().any(|id| {
+            let d = i64::from(id) - i64::from(ida);
+            in_range(d) && (c.opposite_lanes || id.signum() == ida.signum())
+        })
+    }
+
+    /// Entity `e`'s heading in `frame` (rad): `world` its heading; `entity` 0; `road` its
+    /// heading less the direction of increasing `s` where it is; `lane` less its lane's
+    /// direction of travel there (esmini's `TrigByAngle`). `None` off every lane in the
+    /// road's and lane's frames.
+    fn heading_in(&self, e: usize, frame: &str) -> Option<f64> {
+        let st = &self.actors[e].state;
+        match frame {
+            "world" => Some(st.pose.h),
+            "entity" => Some(0.0),
+            _ => {
+                let lp = LanePos {
+                    rev: false,
+                    ..st.lane?
+                };
+                let reference = if frame == "road" {
+                    self.roads.along_heading(&lp)
+                } else {
+                    self.roads.travel_heading(&lp)
+                };
+                Some(st.pose.h - reference)
+            }
         }
     }
 
@@ -433,6 +534,32 @@ impl Storyboard {
     /// that road.
     fn box_on_road(&self, x: &Actor, road: usize, dir: f64) -> Option<((f64, f64), (f64, f64))> {
         let p = x.state.pose;
+        let key = (
+            [p.x.to_bits(), p.y.to_bits(), p.h.to_bits(), dir.to_bits()],
+            road,
+            x.size_m.map(f64::to_bits),
+            x.centre_m.map(f64::to_bits),
+        );
+        if let Some(b) = self.boxes.borrow().iter().find(|b| b.key == key) {
+            return b.extent;
+        }
+        let extent = self.box_on_road_now(x, road, dir);
+        let mut boxes = self.boxes.borrow_mut();
+        if boxes.len() == BOXES_KEPT {
+            boxes.remove(0);
+        }
+        boxes.push(BoxOnRoad { key, extent });
+        extent
+    }
+
+    /// [`Storyboard::box_on_road`], computed.
+    fn box_on_road_now(
+        &self,
+        x: &Actor,
+        road: usize,
+        dir: f64,
+    ) -> Option<((f64, f64), (f64, f64))> {
+        let p = x.state.pose;
         let (c, s) = (p.h.cos(), p.h.sin());
         let (mut sr, mut tr) = (
             (f64::INFINITY, f64::NEG_INFINITY),
@@ -446,7 +573,7 @@ impl Storyboard {
             if self.roads.ids(lp.lane).1 != road {
                 return None;
             }
-            let (_, t) = self.roads.road_t(&lp).ok()?;
+            let t = self.roads.t_of(&lp).ok()?;
             let (sv, tv) = (lp.s * dir, t * dir);
             sr = (sr.0.min(sv), sr.1.max(sv));
             tr = (tr.0.min(tv), tr.1.max(tv));
@@ -459,7 +586,7 @@ impl Storyboard {
     /// difference of their `t` (left of that direction positive); `None` when no lanes lead
     /// from one to the other.
     fn road_offsets(&self, la: LanePos, lb: LanePos) -> Option<(f64, f64)> {
-        let (Ok((_, ta)), Ok((_, tb))) = (self.roads.road_t(&la), self.roads.road_t(&lb)) else {
+        let (Ok(ta), Ok(tb)) = (self.roads.t_of(&la), self.roads.t_of(&lb)) else {
             return None;
         };
         let dir = if la.along_s(&self.roads) { 1.0 } else { -1.0 };
@@ -572,4 +699,28 @@ impl Storyboard {
         };
         (headway_s, gap_m, edge_m)
     }
+}
+
+/// Whether heading `h` (rad) lies within `a.tolerance` of `a.angle`: their difference taken
+/// into `[0, π]`, below the tolerance plus 1e-6 rad (esmini's `GetAbsAngleDifference` and
+/// `SMALL_NUMBER`).
+fn within_angle(h: f64, a: &paracosm_openscenario::model::AngleTest) -> bool {
+    let d = (h - a.angle).rem_euclid(std::f64::consts::TAU);
+    let d = if d > std::f64::consts::PI {
+        std::f64::consts::TAU - d
+    } else {
+        d
+    };
+    d < a.tolerance + 1e-6
+}
+
+/// How many box extents [`Storyboard::box_on_road`] keeps: the boxes of a step's entities.
+const BOXES_KEPT: usize = 16;
+
+/// The extent on a road of an entity's box at one pose ([`Storyboard::box_on_road`]): the
+/// key is the pose's and the direction's bits, the road, and the box's size and centre.
+#[derive(Debug, Clone)]
+pub(in crate::xosc::story) struct BoxOnRoad {
+    key: ([u64; 4], usize, [u64; 3], [u64; 3]),
+    extent: Option<((f64, f64), (f64, f64))>,
 }

@@ -52,6 +52,8 @@ pub struct Actor {
     /// The bounding box's centre relative to the entity's reference point, m (x forward, y
     /// left, z up).
     pub centre_m: [f64; 3],
+    /// Its `ObjectType`: `vehicle`, `pedestrian` or `miscellaneous`.
+    pub object_type: &'static str,
     /// Whether the storyboard moves it now: every entity but the ego the system under test
     /// drives, and that ego too until its controller is activated
     /// ([`Storyboard::hand_over_on_activation`]).
@@ -146,6 +148,10 @@ pub struct Storyboard {
     /// A new route asked of the driven ego since the host last took one
     /// ([`Storyboard::take_route`]).
     route: Option<RouteAsk>,
+    /// The extents on a road of the boxes the conditions measured lately
+    /// ([`conditions::BoxOnRoad`]): an entity's box is taken to the road once per pose, not
+    /// once per condition that reads it.
+    boxes: std::cell::RefCell<Vec<conditions::BoxOnRoad>>,
 }
 
 /// A route the storyboard asks of the ego the system under test drives (a `LaneChangeAction`
@@ -229,6 +235,7 @@ impl Storyboard {
             .enumerate()
             .map(|(i, e)| Actor {
                 name: e.name.clone(),
+                object_type: e.kind.object_type(),
                 size_m: e.dimensions_m,
                 centre_m: e.centre_m,
                 scripted: Some(i) != ego,
@@ -270,6 +277,7 @@ impl Storyboard {
                 })
                 .collect(),
             env: tasks::WorldEnv::default(),
+            boxes: std::cell::RefCell::default(),
             seq: 0,
             watch_offroad: false,
             ended: false,

@@ -62,9 +62,21 @@ impl Storyboard {
             self.ask_lane_change_route(e, (lp, to_lane, *offset_m), (by_distance, duration), a);
             return Ok(());
         }
+        // As esmini's `LatLaneChangeAction`: the entity is anchored on the lane it changes
+        // to from the start, its offset from that lane's centre moving to the offset asked,
+        // so that it follows where that lane runs (a lane that widens as it opens beside
+        // it, esmini's `two_plus_one_road`), not where it ran when the change started.
+        let from = lp.d - (target_d - offset_m);
+        let anchored = LanePos {
+            lane: to_lane,
+            d: from,
+            rev: self.roads.forward(to_lane) != lp.along_s(&self.roads),
+            ..lp
+        };
+        self.actors[e].state.lane = Some(anchored);
         let tr = Transition {
-            from: lp.d,
-            to: target_d,
+            from,
+            to: *offset_m,
             start_s: 0.0,
             duration_s: if dynamics.shape == m::Shape::Step {
                 0.0
