@@ -1424,7 +1424,8 @@ fn an_init_position_relative_to_an_entity_placed_later_waits_for_it() {
 
 /// CARLA's scenarios name their map as CARLA names its towns (`<LogicFile
 /// filepath="Town01"/>`): the town's OpenDRIVE file beside the scenario stands for it, with
-/// a note; without it the load is refused, saying where to put it.
+/// a note; without it the load is refused, saying where to put it. Their stop triggers hold
+/// CARLA's evaluation criteria (`criteria_...` on no parameter): notes, not conditions.
 #[test]
 fn a_carla_town_named_without_its_extension_is_read_from_beside_the_scenario() {
     let dir = tempfile::tempdir().unwrap();
@@ -1439,7 +1440,10 @@ fn a_carla_town_named_without_its_extension_is_read_from_beside_the_scenario() {
 <PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-1" s="20" offset="0"/></Position></TeleportAction></PrivateAction>
 <PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/><SpeedActionTarget><AbsoluteTargetSpeed value="5"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction>
 </Private></Actions></Init>
-<StopTrigger><ConditionGroup><Condition name="end" delay="0" conditionEdge="rising"><ByValueCondition><SimulationTimeCondition value="5" rule="greaterThan"/></ByValueCondition></Condition></ConditionGroup></StopTrigger>
+<StopTrigger><ConditionGroup>
+<Condition name="criteria_CollisionTest" delay="0" conditionEdge="rising"><ByValueCondition><ParameterCondition parameterRef="" value="" rule="lessThan"/></ByValueCondition></Condition>
+<Condition name="criteria_DrivenDistanceTest" delay="0" conditionEdge="rising"><ByValueCondition><ParameterCondition parameterRef="distance_success" value="100" rule="lessThan"/></ByValueCondition></Condition>
+</ConditionGroup></StopTrigger>
 </Storyboard></OpenSCENARIO>"#,
     )
     .unwrap();
@@ -1458,6 +1462,33 @@ fn a_carla_town_named_without_its_extension_is_read_from_beside_the_scenario() {
     assert!(
         text.contains("is named without its extension, as CARLA names its towns"),
         "{text}"
+    );
+    // Its stop trigger holds CARLA's evaluation criteria only: notes, not conditions, so
+    // nothing ends a test but the horizon asked for.
+    assert!(
+        text.contains("criteria_DrivenDistanceTest is one of CARLA's evaluation criteria"),
+        "{text}"
+    );
+    let campaign = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+            .arg(file)
+            .args(["--budget", "1", "--scripted-ego", "--out"])
+            .arg(dir.path().join("out"))
+            .arg("--force")
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = campaign(&[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("no stop trigger"), "{err}");
+    let o = campaign(&["--horizon", "3"]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
     );
 }
 

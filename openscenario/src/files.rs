@@ -42,7 +42,8 @@ impl FileSet {
         Ok(lock(&self.texts).entry(key).or_insert(text).clone())
     }
 
-    /// The `.xosc` files of the folder `dir` (extension compared without case), sorted:
+    /// The `.xosc` files of the folder `dir` (extension compared without case), sorted, or
+    /// `dir` alone when it is a `.xosc` file (openPASS's catalog locations name their file):
     /// listed the first time, from the set after. The first listing also reads each of them
     /// ([`FileSet::text`]; one that cannot be read is left to the read that needs it, which
     /// reports it), so that a test whose values choose another catalog entry reads the text
@@ -56,6 +57,16 @@ impl FileSet {
         let key = folded(dir);
         if let Some(files) = lock(&self.folders).get(&key) {
             return Ok(files.clone());
+        }
+        if dir.is_file()
+            && dir
+                .extension()
+                .is_some_and(|x| x.eq_ignore_ascii_case("xosc"))
+        {
+            // A location that names its one catalog file (openPASS's configurations).
+            let _ = self.text(dir);
+            let files: Arc<[PathBuf]> = vec![dir.to_path_buf()].into();
+            return Ok(lock(&self.folders).entry(key).or_insert(files).clone());
         }
         let mut files: Vec<PathBuf> = std::fs::read_dir(dir)?
             .filter_map(Result::ok)

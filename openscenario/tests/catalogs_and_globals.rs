@@ -149,3 +149,42 @@ fn a_set_value_not_of_its_type_is_refused_at_its_attribute() {
     assert!(e.contains("bad_set.xosc:"), "{e}");
     assert!(e.contains("Phase is of type int"), "{e}");
 }
+
+/// openPASS's configurations name a catalog's file as its location's `Directory`
+/// (`<Directory path="VehicleModelsCatalog.xosc"/>`): that file is the location's one
+/// catalog file, with a note; an entry of it is found as in a folder.
+#[test]
+fn a_catalog_location_naming_a_file_reads_that_file() {
+    let dir = std::env::temp_dir().join(format!("paracosm-openpass-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("VehicleModelsCatalog.xosc"),
+        r#"<OpenSCENARIO><FileHeader revMajor="1" revMinor="0" date="2026-11-29T00:00:00" description="c" author="x"/>
+<Catalog name="VehicleCatalog"><Vehicle name="car_one" vehicleCategory="car"><BoundingBox><Center x="1.3" y="0" z="0.7"/><Dimensions width="1.8" length="4.4" height="1.4"/></BoundingBox><Performance maxSpeed="50" maxAcceleration="5" maxDeceleration="9"/><Axles><FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/><RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/></Axles><Properties/></Vehicle></Catalog></OpenSCENARIO>"#,
+    )
+    .unwrap();
+    let scenario = dir.join("s.xosc");
+    std::fs::write(
+        &scenario,
+        r#"<OpenSCENARIO><FileHeader revMajor="1" revMinor="0" date="2026-11-29T00:00:00" description="openPASS" author="x"/>
+<ParameterDeclarations/>
+<CatalogLocations><VehicleCatalog><Directory path="VehicleModelsCatalog.xosc"/></VehicleCatalog></CatalogLocations>
+<RoadNetwork><LogicFile filepath="road.xodr"/></RoadNetwork>
+<Entities><ScenarioObject name="Ego"><CatalogReference catalogName="VehicleCatalog" entryName="car_one"/></ScenarioObject></Entities>
+<Storyboard><Init><Actions/></Init>
+<StopTrigger><ConditionGroup><Condition name="end" delay="0" conditionEdge="rising"><ByValueCondition><SimulationTimeCondition value="5" rule="greaterThan"/></ByValueCondition></Condition></ConditionGroup></StopTrigger>
+</Storyboard></OpenSCENARIO>"#,
+    )
+    .unwrap();
+    let s = read_scenario(&scenario, &[]);
+    std::fs::remove_dir_all(&dir).ok();
+    let s = s.unwrap();
+    assert_eq!(s.entities[0].dimensions_m, [4.4, 1.8, 1.4]);
+    assert!(
+        s.notes
+            .iter()
+            .any(|n| n.text.contains("names a file, as openPASS's")),
+        "{:?}",
+        s.notes
+    );
+}

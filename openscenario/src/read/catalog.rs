@@ -40,7 +40,17 @@ impl Catalogs {
                     .invalid(loc, format!("<{kind}Catalog> needs a <Directory>"))
             })?;
             let path = r.scope.string(r.text, dir, "path")?;
-            dirs.push((kind.to_string(), super::join(&r.dir, &path)));
+            let joined = super::join(&r.dir, &path);
+            if joined.is_file() {
+                r.note(
+                    dir,
+                    format!(
+                        "the {kind} catalog's directory {path:?} names a file, as openPASS's \
+                         configurations do: that file is the location's one catalog file"
+                    ),
+                );
+            }
+            dirs.push((kind.to_string(), joined));
         }
         Ok(Catalogs { dirs })
     }

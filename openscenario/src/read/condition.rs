@@ -20,22 +20,55 @@ pub(super) fn trigger(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Trigger, Xos
                 .unsupported(g, "a trigger holds <ConditionGroup> elements only"));
         }
         let mut conditions = Vec::new();
+        let mut criteria = 0;
         for c in elements(g) {
             if c.tag_name().name() != "Condition" {
                 return Err(r
                     .text
                     .unsupported(c, "a condition group holds <Condition> elements only"));
             }
+            if let Some(name) = carla_criterion(r, c) {
+                r.note(
+                    c,
+                    format!(
+                        "{name} is one of CARLA's evaluation criteria written as a condition on \
+                         no parameter: it is not a condition, and paracosm's monitors (collision, \
+                         off-road) judge the test, not it"
+                    ),
+                );
+                criteria += 1;
+                continue;
+            }
             conditions.push(condition(r, c)?);
         }
-        if conditions.is_empty() {
+        if conditions.is_empty() && criteria == 0 {
             return Err(r
                 .text
                 .invalid(g, "a condition group needs at least one condition"));
         }
-        groups.push(conditions);
+        if !conditions.is_empty() {
+            groups.push(conditions);
+        }
     }
     Ok(Trigger(groups))
+}
+
+/// The name of condition `c` when it is one of CARLA's evaluation criteria
+/// (scenario_runner's convention: a condition named `criteria_...` whose
+/// `ParameterCondition` names no declared parameter, `parameterRef=""` or CARLA's
+/// `distance_success`); `None` for any other condition.
+fn carla_criterion(r: &Reader<'_>, c: Node<'_, '_>) -> Option<String> {
+    let name = c.attribute("name")?;
+    if !name.starts_with("criteria_") {
+        return None;
+    }
+    let p = crate::xml::child(
+        crate::xml::child(c, "ByValueCondition")?,
+        "ParameterCondition",
+    )?;
+    let reference = p.attribute("parameterRef")?.trim_start_matches('$');
+    let declared = r.globals.iter().any(|(n, _)| n == reference);
+    (!declared).then(|| name.to_owned())
 }
 
 fn condition(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Condition, XoscError> {
