@@ -383,15 +383,14 @@ impl Roads {
 
     /// The `<lane id>`s of the driving lanes of road `road` (an index of the map's roads)
     /// at station `s` (m), in the map's order.
-    pub fn driving_ids_at(&self, road: usize, s: f64) -> Vec<i32> {
+    pub fn driving_ids_at(&self, road: usize, s: f64) -> impl Iterator<Item = i32> + '_ {
         (self.map.lanes.iter())
-            .filter(|l| l.road == road && l.drivable)
-            .filter(|l| {
+            .filter(move |l| l.road == road && l.drivable)
+            .filter(move |l| {
                 let (a, b) = l.s_range();
                 a - 1e-9 <= s && s <= b + 1e-9
             })
             .map(|l| l.od_id)
-            .collect()
     }
 
     /// The `<lane id>` and road of lane `k`.

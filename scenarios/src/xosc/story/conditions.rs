@@ -335,6 +335,15 @@ impl Storyboard {
             |d: i64| c.ranges.is_empty() || c.ranges.iter().any(|&(a, b)| (a..=b).contains(&d));
         let (ida, road) = self.roads.ids(la.lane);
         let max_m = c.forward_m.max(c.backward_m);
+        // One gap, its entity set for each other entity in turn.
+        let mut g = Gap {
+            entity: e,
+            rule: Rule::Lt,
+            value: 0.0,
+            freespace: c.freespace,
+            frame: "road".into(),
+            kind: "longitudinal".into(),
+        };
         for o in 0..self.actors.len() {
             if o == e || (!c.entities.is_empty() && !c.entities.contains(&o)) {
                 continue;
@@ -342,14 +351,7 @@ impl Storyboard {
             let Some(lb) = self.actors[o].state.lane else {
                 continue;
             };
-            let g = Gap {
-                entity: o,
-                rule: Rule::Lt,
-                value: 0.0,
-                freespace: c.freespace,
-                frame: "road".into(),
-                kind: "longitudinal".into(),
-            };
+            g.entity = o;
             let (ds, _, _) = self.road_gap(e, &g);
             if !ds.is_finite() || (!c.freespace && ds.abs() >= max_m) {
                 continue;
@@ -368,7 +370,7 @@ impl Storyboard {
             }
         }
         // The lanes counted from e's own (by id, as esmini counts them) exist where it is.
-        self.roads.driving_ids_at(road, la.s).into_iter().any(|id| {
+        self.roads.driving_ids_at(road, la.s).any(|id| {
             let d = i64::from(id) - i64::from(ida);
             in_range(d) && (c.opposite_lanes || id.signum() == ida.signum())
         })
@@ -705,13 +707,7 @@ impl Storyboard {
 /// into `[0, π]`, below the tolerance plus 1e-6 rad (esmini's `GetAbsAngleDifference` and
 /// `SMALL_NUMBER`).
 fn within_angle(h: f64, a: &paracosm_openscenario::model::AngleTest) -> bool {
-    let d = (h - a.angle).rem_euclid(std::f64::consts::TAU);
-    let d = if d > std::f64::consts::PI {
-        std::f64::consts::TAU - d
-    } else {
-        d
-    };
-    d < a.tolerance + 1e-6
+    paracosm_engine::network::roads::wrap(h - a.angle).abs() < a.tolerance + 1e-6
 }
 
 /// How many box extents [`Storyboard::box_on_road`] keeps: the boxes of a step's entities.
