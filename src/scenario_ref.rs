@@ -70,10 +70,15 @@ impl ScenarioRef {
             Ok(abs) if Path::new(p).is_file() => abs.display().to_string(),
             _ => p.to_owned(),
         };
+        let abs_dir = |p: &str| match std::fs::canonicalize(Path::new(p)) {
+            Ok(abs) if abs.is_dir() => abs.display().to_string(),
+            _ => p.to_owned(),
+        };
         match self {
             ScenarioRef::Program(p) => ScenarioRef::Program(abs(p)),
             ScenarioRef::OpenScenario(x) => ScenarioRef::OpenScenario(XoscRef {
                 xosc: abs(&x.xosc),
+                maps: x.maps.as_deref().map(abs_dir),
                 ..x.clone()
             }),
         }

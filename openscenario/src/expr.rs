@@ -63,6 +63,17 @@ fn err<T>(offset: usize, reason: impl Into<String>) -> Result<T, ExprError> {
     })
 }
 
+/// The constants an expression may name: `pi` and `e`, as esmini's expressions know them
+/// (its `simple_expr.c`). OpenSCENARIO 1.3's grammar has none; files written for esmini
+/// (Vector's Euro NCAP scenarios: `${65*pi/180}`) use `pi`, so it is read as a dialect.
+fn constant(name: &str) -> Option<f64> {
+    match name {
+        "pi" => Some(std::f64::consts::PI),
+        "e" => Some(std::f64::consts::E),
+        _ => None,
+    }
+}
+
 /// The functions an expression may call with their number of arguments (OpenSCENARIO 1.3 User
 /// Guide, 9.2.1 "Operators").
 const FUNCTIONS: [(&str, usize); 15] = [
@@ -429,7 +440,10 @@ impl<'t> Machine<'t, '_> {
                         self.open(t.at)?;
                         self.ops.push(Op::Paren(t.at));
                     }
-                    Tok::Word(w) if !matches!(w, "true" | "false" | "and" | "or") => {
+                    Tok::Word(w)
+                        if !matches!(w, "true" | "false" | "and" | "or")
+                            && constant(w).is_none() =>
+                    {
                         let open = toks.get(i).copied().unwrap_or(Token {
                             tok: Tok::End,
                             at: end,
@@ -479,6 +493,7 @@ impl<'t> Machine<'t, '_> {
             },
             Tok::Word("true") => Value::Bool(true),
             Tok::Word("false") => Value::Bool(false),
+            Tok::Word(w) if constant(w).is_some() => Value::Num(constant(w).unwrap_or(f64::NAN)),
             tok => {
                 return err(
                     t.at,
@@ -507,7 +522,8 @@ impl<'t> Machine<'t, '_> {
                 at,
                 format!(
                     "unknown name `{name}`: expressions know the functions {}, the operators \
-                     not, and, or and the literals true, false; parameters are written $name",
+                     not, and, or, the literals true, false and esmini's constants pi and e; \
+                     parameters are written $name",
                     known.join(", ")
                 ),
             );
@@ -740,6 +756,15 @@ mod tests {
         assert_eq!(num_of("-$x"), -3.0);
     }
 
+    /// esmini's constants, which Vector's Euro NCAP files use (`${65*pi/180}`).
+    #[test]
+    fn esminis_constants_pi_and_e() {
+        assert_eq!(num_of("65 * pi / 180"), 65.0 * std::f64::consts::PI / 180.0);
+        assert_eq!(num_of("-pi"), -std::f64::consts::PI);
+        assert_eq!(num_of("pow(e, 2)"), std::f64::consts::E.powi(2));
+        assert!(fails("pi(1)").reason.contains("expected an operator"));
+    }
+
     #[test]
     fn alks_expressions() {
         // From the ALKS templates (openMSL sl-3-1-osc-alks-scenarios).
@@ -812,8 +837,8 @@ mod tests {
         assert!(fails("asin(2)").reason.contains("not a finite number"));
         assert!(fails("1e308 * 10").reason.contains("not a finite number"));
         assert_eq!(fails("1e999").offset, 0);
-        assert_eq!(fails("pi / 2").offset, 0);
-        assert!(fails("pi / 2").reason.contains("unknown name `pi`"));
+        assert_eq!(fails("tau / 2").offset, 0);
+        assert!(fails("tau / 2").reason.contains("unknown name `tau`"));
         assert_eq!(fails("2 +").offset, 3);
         assert_eq!(fails("(1 + 2").offset, 6);
         assert_eq!(fails("1 + 2)").offset, 5);

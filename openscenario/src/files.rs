@@ -18,12 +18,39 @@ use crate::text::Text;
 pub struct FileSet {
     texts: Mutex<BTreeMap<PathBuf, Arc<Text>>>,
     folders: Mutex<BTreeMap<PathBuf, Arc<[PathBuf]>>>,
+    maps: Vec<PathBuf>,
+    carla: bool,
 }
 
 impl FileSet {
     /// An empty set: the first read of each file goes to disk.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// An empty set whose scenarios find a map their `LogicFile` names but that is not where
+    /// it says (a CARLA town, `Town01`) in the folder `maps` too (`--maps`).
+    pub fn with_maps(maps: Option<PathBuf>) -> Self {
+        Self {
+            maps: maps.into_iter().collect(),
+            ..Self::default()
+        }
+    }
+
+    /// The folders of maps ([`FileSet::with_maps`]): none, or the one given.
+    pub fn maps(&self) -> &[PathBuf] {
+        &self.maps
+    }
+
+    /// The same set, whose scenarios are read as CARLA's scenario_runner reads its own
+    /// (`--carla`; [`crate::model::Scenario::carla`]) whatever their `FileHeader` says.
+    pub fn as_carla(self, carla: bool) -> Self {
+        Self { carla, ..self }
+    }
+
+    /// Whether its scenarios are read as CARLA's ([`FileSet::as_carla`]).
+    pub fn carla(&self) -> bool {
+        self.carla
     }
 
     /// The text of `path`: read from disk ([`Text::read`]) the first time, from the set after.

@@ -35,6 +35,12 @@ pub struct Scenario {
     pub file: String,
     /// `FileHeader`'s `revMajor.revMinor` (1.0 to 1.3).
     pub version: (u32, u32),
+    /// Whether it is written for CARLA's scenario_runner: its `FileHeader` description
+    /// starts with `CARLA:`, as every scenario and catalog of scenario_runner's does, or the
+    /// reader is told so (`--carla`, [`crate::FileSet::as_carla`]). CARLA
+    /// reads some elements its own way (an `ActivateControllerAction` on a vehicle with no
+    /// controller starts CARLA's autopilot).
+    pub carla: bool,
     /// The declared parameters (in order) and the value each had.
     pub params: Vec<(ParamDecl, Value)>,
     /// The scope they were evaluated in (for checking other values against their
@@ -350,6 +356,24 @@ pub enum Action {
         /// Longitudinal control, when said.
         longitudinal: Option<bool>,
     },
+    /// `AssignControllerAction`: the entity is given controller `controller`, of kind
+    /// `kind` (its CARLA `module` or esmini `esminiController` property), which it obeys in
+    /// the domains activated here (`Some(true)`; in a file written for CARLA, whose
+    /// scenario_runner hands the entity over at once, both). On the ego a system under test
+    /// drives, the controller is that system.
+    AssignController {
+        /// The controller's name.
+        controller: String,
+        /// What kind of controller it is, when a property says.
+        kind: Option<String>,
+        /// `activateLateral`.
+        lateral: Option<bool>,
+        /// `activateLongitudinal`.
+        longitudinal: Option<bool>,
+    },
+    /// An `OverrideControllerValueAction` whose values are all inactive: it does nothing
+    /// (an active one is refused at load).
+    OverrideController,
     /// `AppearanceAction`: a vehicle's lights (`LightStateAction`) or an animation
     /// (`AnimationAction`), named here; paracosm draws neither, and nothing it models reads
     /// them.
@@ -422,6 +446,8 @@ impl Action {
             Action::AssignRoute { .. } => "AssignRouteAction",
             Action::AcquirePosition(_) => "AcquirePositionAction",
             Action::ActivateController { .. } => "ActivateControllerAction",
+            Action::AssignController { .. } => "AssignControllerAction",
+            Action::OverrideController => "OverrideControllerValueAction",
             Action::Appearance(_) => "AppearanceAction",
             Action::Visibility { .. } => "VisibilityAction",
             Action::Environment(_) => "EnvironmentAction",
@@ -433,6 +459,24 @@ impl Action {
                 variable: false, ..
             } => "ParameterModifyAction",
             Action::ModifyValue { variable: true, .. } => "VariableModifyAction",
+        }
+    }
+
+    /// Whether it activates a controller of its entity: an `ActivateControllerAction` that
+    /// activates a domain (one it leaves unsaid is activated), or an
+    /// `AssignControllerAction` that activates one.
+    pub fn hands_over(&self) -> bool {
+        match self {
+            Action::ActivateController {
+                lateral,
+                longitudinal,
+            } => *lateral != Some(false) || *longitudinal != Some(false),
+            Action::AssignController {
+                lateral,
+                longitudinal,
+                ..
+            } => *lateral == Some(true) || *longitudinal == Some(true),
+            _ => false,
         }
     }
 

@@ -288,7 +288,10 @@ class Scenario:
     """A scenario program: a built-in name (`paracosm.BUILTIN_SCENARIOS`) or the path of a
     `.star` file; or an OpenSCENARIO file (`.xosc`, a variation file or a scenario) read with
     `paracosm-fuzz`'s options: `open` (a list of `"Name=lo..hi"` or `"Name=a,b,c"`),
-    `continuous`, `scripted_ego`, `ego` (the vehicle's name) and `horizon` (s).
+    `continuous`, `scripted_ego`, `ego` (the vehicle's name), `horizon` (s), `ego_speed`
+    (m/s: the system under test's set speed where the file asks the ego none) and `maps` (a
+    folder where a map the file names is found, such as CARLA's towns) and `carla` (read the
+    file as CARLA's scenario_runner reads its own).
 
     Warnings of the program (LANGUAGE.md, "Warnings") are issued as `ScenarioWarning`.
     Raises ValueError naming the file, line and column when the program does not load.
@@ -296,12 +299,13 @@ class Scenario:
     """
 
     def __init__(self, name_or_path, *, sut=None, open=(), continuous=False, scripted_ego=False,
-                 ego=None, horizon=None):
+                 ego=None, horizon=None, ego_speed=None, maps=None, carla=False):
         if isinstance(open, str):
             raise TypeError("open is a list of 'Name=lo..hi' or 'Name=a,b,c' strings, not one string")
         self._native = _native.ScenarioHandle(
             os.fspath(name_or_path), open=list(open), continuous=continuous,
-            scripted_ego=scripted_ego, ego=ego, horizon=horizon)
+            scripted_ego=scripted_ego, ego=ego, horizon=horizon, ego_speed=ego_speed,
+            maps=None if maps is None else os.fspath(maps), carla=carla)
         self._sut = _sut_args(sut)
         # Checked now, as a run would check it: a bad name fails here, not at the first run.
         self._sut_name = self._native.sut_name(**self._sut)

@@ -218,10 +218,13 @@ impl ScenarioHandle {
 impl ScenarioHandle {
     /// Loads a built-in scenario by name, a `.star` program or an OpenSCENARIO `.xosc` file by
     /// path, the file read with `paracosm-fuzz`'s options (`open`: `Name=lo..hi` or
-    /// `Name=a,b,c` each; `continuous`, `scripted_ego`, `ego`, `horizon` in s), which only an
+    /// `Name=a,b,c` each; `continuous`, `scripted_ego`, `ego`, `horizon` in s, `ego_speed` in
+    /// m/s, `maps` a folder, `carla`), which only an
     /// OpenSCENARIO file takes ([`paracosm::ScenarioRef`]).
     #[new]
-    #[pyo3(signature = (name_or_path, *, open = Vec::new(), continuous = false, scripted_ego = false, ego = None, horizon = None))]
+    #[pyo3(signature = (name_or_path, *, open = Vec::new(), continuous = false, scripted_ego = false, ego = None, horizon = None, ego_speed = None, maps = None, carla = false))]
+    // One parameter per keyword argument of Python's `Scenario`, as pyo3 maps them.
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         name_or_path: &str,
@@ -230,6 +233,9 @@ impl ScenarioHandle {
         scripted_ego: bool,
         ego: Option<String>,
         horizon: Option<f64>,
+        ego_speed: Option<f64>,
+        maps: Option<String>,
+        carla: bool,
     ) -> PyResult<Self> {
         let reference = match paracosm::ScenarioRef::named(name_or_path) {
             paracosm::ScenarioRef::OpenScenario(x) => {
@@ -239,6 +245,9 @@ impl ScenarioHandle {
                     scripted_ego,
                     ego,
                     horizon_s: horizon,
+                    ego_speed_mps: ego_speed,
+                    maps,
+                    carla,
                     ..x
                 })
             }
@@ -247,13 +256,16 @@ impl ScenarioHandle {
                     && !continuous
                     && !scripted_ego
                     && ego.is_none()
-                    && horizon.is_none() =>
+                    && horizon.is_none()
+                    && ego_speed.is_none()
+                    && maps.is_none()
+                    && !carla =>
             {
                 program
             }
             _ => {
                 return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "{name_or_path}: open, continuous, scripted_ego, ego and horizon are for an \
+                    "{name_or_path}: open, continuous, scripted_ego, ego, horizon, ego_speed, maps and carla are for an \
                      OpenSCENARIO scenario (.xosc)"
                 )))
             }

@@ -425,3 +425,23 @@ def test_an_openscenario_file_loads_with_its_options_and_runs():
         paracosm.Scenario(str(path.parent / "no_such.xosc"))
     with pytest.raises(ValueError, match="are for an OpenSCENARIO scenario"):
         paracosm.Scenario("pedestrian-crossing", open=["walking_speed=1..2"])
+
+
+def test_a_carla_file_asks_for_the_ego_speed_it_leaves_to_the_agent(tmp_path):
+    """CARLA's FollowLeadingVehicle gives its hero no speed (scenario_runner leaves it to the
+    agent): without `ego_speed` the load refuses it, naming the hero's line; with it, a test
+    runs and the system under test drives the hero up behind the leading vehicle. Its town,
+    `Town01`, is found in the folder of CARLA's maps (`maps`)."""
+    import shutil
+    repo = Path(__file__).resolve().parents[2]
+    src = repo / "tests/data/xosc/third_party/carla/FollowLeadingVehicle.xosc"
+    shutil.copy(src, tmp_path / src.name)
+    towns = repo / "tests/data/maps/carla"
+    with pytest.raises(ValueError, match=r"FollowLeadingVehicle.xosc:13:5: .*--ego-speed"):
+        paracosm.Scenario(tmp_path / src.name, horizon=60, maps=towns)
+    with pytest.warns(paracosm.scenario.ScenarioWarning):
+        s = paracosm.Scenario(tmp_path / src.name, horizon=60, ego_speed=8.0, maps=towns)
+    assert len(s.space) == 0
+    records = s.run(np.zeros((1, 0)), jobs=1, output="records")
+    assert records[0]["status"] == "pass", records[0]
+    assert records[0]["metrics"]["simulated_s"] < 30.0, records[0]

@@ -146,7 +146,7 @@ fn xosc_chain(c: &mut Criterion) {
         continuous: false,
         scripted_ego: true,
         ego: None,
-        horizon_s: None,
+        ..paracosm_scenarios::xosc::XoscRef::default()
     };
     let s = paracosm_scenarios::xosc::campaign_scenario(&x).unwrap();
     let a = s

@@ -68,7 +68,7 @@ fn reference(xosc: &Path) -> XoscRef {
         continuous: false,
         scripted_ego: true,
         ego: None,
-        horizon_s: None,
+        ..XoscRef::default()
     }
 }
 

@@ -188,7 +188,8 @@ impl MapFiles {
                 let text = crate::text_file::read_text(&full, MAX_MAP_BYTES).map_err(|e| {
                     let town = if full.extension().is_none() {
                         " (a map named without its extension, as CARLA names its towns, is read \
-                         from NAME.xodr beside the scenario: put the town's OpenDRIVE file there)"
+                         from NAME.xodr beside the scenario or in the folder --maps DIR names: \
+                         CARLA's towns ship with CARLA, as CarlaUE4/Content/Carla/Maps/OpenDrive)"
                     } else {
                         ""
                     };

@@ -535,3 +535,142 @@ fn a_relative_angle_condition_holds_when_one_heading_less_the_other_is_within_it
         );
     }
 }
+
+/// A storyboard read as CARLA's scenario_runner reads its files (`CARLA:` in the
+/// description): the event's two conditions hold at different times (`time < 0.5` at the
+/// start, `time > 1` later), which fires a group once each has held (a latch), where the
+/// standard's reading never fires it; its `SpeedAction` to 2 m/s by a distance of 20 m holds
+/// the speed for those 20 m before the next event stops the box; and the storyboard ends
+/// with its story, long before its stop trigger at 100 s.
+#[test]
+fn carlas_reading_latches_conditions_holds_a_speed_for_its_distance_and_ends_with_its_story() {
+    let init = r#"<Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>"#;
+    let speed = |v: f64, dimension: &str, value: f64| {
+        format!(
+            r#"<PrivateAction><LongitudinalAction><SpeedAction>
+              <SpeedActionDynamics dynamicsShape="step" value="{value}" dynamicsDimension="{dimension}"/>
+              <SpeedActionTarget><AbsoluteTargetSpeed value="{v}"/></SpeedActionTarget>
+            </SpeedAction></LongitudinalAction></PrivateAction>"#
+        )
+    };
+    let time = |rule: &str, v: f64| {
+        format!(
+            r#"<Condition name="T{rule}" delay="0" conditionEdge="rising"><ByValueCondition><SimulationTimeCondition value="{v}" rule="{rule}"/></ByValueCondition></Condition>"#
+        )
+    };
+    let stories = format!(
+        r#"<Story name="S"><Act name="Act"><ManeuverGroup maximumExecutionCount="1" name="G">
+          <Actors selectTriggeringEntities="false"><EntityRef entityRef="A"/></Actors>
+          <Maneuver name="M">
+            <Event name="Go" priority="overwrite"><Action name="Go">{go}</Action>
+              <StartTrigger><ConditionGroup>{late}{early}</ConditionGroup></StartTrigger></Event>
+            <Event name="Stop" priority="overwrite"><Action name="Stop">{stop}</Action>
+              <StartTrigger><ConditionGroup><Condition name="AfterGo" delay="0" conditionEdge="none"><ByValueCondition>
+                <StoryboardElementStateCondition storyboardElementType="action" storyboardElementRef="Go" state="endTransition"/>
+              </ByValueCondition></Condition></ConditionGroup></StartTrigger></Event>
+          </Maneuver></ManeuverGroup>
+          <StartTrigger><ConditionGroup>{start}</ConditionGroup></StartTrigger></Act></Story>"#,
+        go = speed(2.0, "distance", 20.0),
+        stop = speed(0.0, "time", 0.0),
+        late = time("greaterThan", 1.0),
+        early = time("lessThan", 0.5),
+        start = time("greaterOrEqual", 0.0),
+    );
+    for (description, carla) in [("plain", false), ("CARLA:Latch", true)] {
+        let text = on_straight_road(description, &box_object("A"), init, &stories, 100.0);
+        let mut sb = storyboard_of("carla-latch", &text).unwrap();
+        let mut started = None;
+        let end = run(&mut sb, 100.0, |t, sb| {
+            if started.is_none() && sb.actors[0].state.speed > 1.0 {
+                started = Some(t);
+            }
+        });
+        let travelled = sb.actors[0].state.travelled_m;
+        if !carla {
+            assert_eq!(
+                started, None,
+                "the standard's reading never fires the group"
+            );
+            assert!(
+                (end - 100.0).abs() < 0.02,
+                "it runs to its stop trigger: {end}"
+            );
+            continue;
+        }
+        let started = started.expect("CARLA's reading fires the group");
+        assert!(
+            (started - 1.0).abs() < 0.05,
+            "fired once time > 1 also held: {started}"
+        );
+        assert!(
+            (travelled - 20.0).abs() < 0.05,
+            "2 m/s held for 20 m: {travelled}"
+        );
+        assert_eq!(sb.actors[0].state.speed, 0.0, "then stopped");
+        assert!(
+            (end - (started + 10.0)).abs() < 0.1,
+            "ended with its story: {end}"
+        );
+    }
+}
+
+/// A controller the storyboard assigns an entity that no system under test drives is the
+/// storyboard's motion only when it is of a kind that follows the storyboard (esmini's
+/// `DefaultController`, CARLA's `npc_vehicle_control`); an activated controller of another
+/// kind (esmini's ACC) is refused at load, naming it, whether the assignment or a later
+/// `ActivateControllerAction` activates it. An assignment that activates nothing is noted.
+#[test]
+fn an_activated_controller_the_storyboard_cannot_stand_for_is_refused() {
+    let init = r#"<Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>"#;
+    let story = |kind: &str, activate: &str, then: &str| {
+        format!(
+            r#"<Story name="S"><Act name="Act"><ManeuverGroup maximumExecutionCount="1" name="G">
+              <Actors selectTriggeringEntities="false"><EntityRef entityRef="A"/></Actors>
+              <Maneuver name="M"><Event name="E" priority="overwrite">
+                <Action name="Assign"><PrivateAction><ControllerAction><AssignControllerAction {activate}><Controller name="c"><Properties><Property name="esminiController" value="{kind}"/></Properties></Controller></AssignControllerAction></ControllerAction></PrivateAction></Action>
+                {then}
+                <StartTrigger><ConditionGroup><Condition name="T" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="1" rule="greaterThan"/></ByValueCondition></Condition></ConditionGroup></StartTrigger>
+              </Event></Maneuver></ManeuverGroup>
+              <StartTrigger><ConditionGroup><Condition name="S" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition></Condition></ConditionGroup></StartTrigger></Act></Story>"#
+        )
+    };
+    let activate = r#"<Action name="On"><PrivateAction><ControllerAction><ActivateControllerAction longitudinal="true" lateral="true"/></ControllerAction></PrivateAction></Action>"#;
+    let check = |tag: &str, stories: &str| {
+        let text = on_straight_road("plain", &box_object("A"), init, stories, 10.0);
+        let file =
+            std::env::temp_dir().join(format!("paracosm-ctl-{tag}-{}.xosc", std::process::id()));
+        std::fs::write(&file, text).unwrap();
+        let model = read_scenario(&file, &[]).expect("reads");
+        std::fs::remove_file(&file).ok();
+        paracosm_scenarios::xosc::check(&model, None).map_err(|e| e.to_string())
+    };
+    let err = check("acc-later", &story("ACCController", "", activate)).unwrap_err();
+    assert!(
+        err.contains("activates a controller of A that paracosm cannot run"),
+        "{err}"
+    );
+    assert!(err.contains("controller c (ACCController)"), "{err}");
+    let err = check(
+        "acc-now",
+        &story("ACCController", r#"activateLongitudinal="true""#, ""),
+    )
+    .unwrap_err();
+    assert!(
+        err.contains("has controller c (ACCController) drive A"),
+        "{err}"
+    );
+    let warnings = check("acc-idle", &story("ACCController", "", "")).unwrap();
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.message.contains("assigned to A but not activated")),
+        "{warnings:?}"
+    );
+    let warnings = check("default", &story("DefaultController", "", activate)).unwrap();
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.message.contains("ActivateControllerAction does nothing")),
+        "{warnings:?}"
+    );
+}

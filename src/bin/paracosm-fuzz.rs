@@ -58,11 +58,14 @@ fn main() -> ExitCode {
             .and_then(|s| say(&s.text()).map(|()| s.exit_code())),
         Some(Sub::Export(a)) => export(a),
         Some(Sub::Map(a)) => map(a),
-        Some(Sub::Xosc(a)) => {
-            paracosm_scenarios::xosc::inspect_with_map(&a.file, &a.open, a.continuous)
-                .map_err(|e| anyhow::Error::new(Error::from(e)))
-                .and_then(|i| say(&i.text()).map(|()| 0))
-        }
+        Some(Sub::Xosc(a)) => paracosm_scenarios::xosc::inspect_with_map(
+            &a.file,
+            &a.open,
+            a.continuous,
+            (a.maps.as_deref(), a.carla),
+        )
+        .map_err(|e| anyhow::Error::new(Error::from(e)))
+        .and_then(|i| say(&i.text()).map(|()| 0)),
         None => run(&cli),
     };
     let code = match result {

@@ -57,6 +57,20 @@ pub struct Cli {
     /// without a stop trigger, which is refused without it.
     #[arg(long, value_name = "SECONDS")]
     pub horizon: Option<f64>,
+    /// With an OpenSCENARIO scenario (.xosc): the set speed of the system under test, m/s,
+    /// where the file asks the ego none (CARLA's files leave it to the agent; such a file
+    /// is refused without it). A SpeedAction on the ego replaces it.
+    #[arg(long, value_name = "M/S")]
+    pub ego_speed: Option<f64>,
+    /// With an OpenSCENARIO scenario (.xosc): a folder of maps, where a map the file names
+    /// but that is not where it says (a CARLA town, `Town01`) is read from (`Town01.xodr`).
+    #[arg(long, value_name = "DIR")]
+    pub maps: Option<PathBuf>,
+    /// With an OpenSCENARIO scenario (.xosc): read it as CARLA's scenario_runner reads its
+    /// own (CARLA's left-handed frame, latching conditions, speed actions that last their
+    /// distance or time), also when its FileHeader does not say CARLA:.
+    #[arg(long)]
+    pub carla: bool,
     /// Write each test's trace to OUT/trace/test_N.csv: every entity's pose, speed and
     /// acceleration in the map's frame, laid out as esmini's CSV log (docs/cli.md, "Traces").
     #[arg(long)]
@@ -182,6 +196,15 @@ pub struct XoscArgs {
     /// A DistributionRange becomes an interval over its range instead of its levels.
     #[arg(long)]
     pub continuous: bool,
+    /// A folder of maps: a map the file names but that is not where it says (a CARLA town,
+    /// `Town01`) is read from this folder (`Town01.xodr`).
+    #[arg(long, value_name = "DIR")]
+    pub maps: Option<PathBuf>,
+    /// Read the file as CARLA's scenario_runner reads its own (CARLA's left-handed frame,
+    /// latching conditions, speed actions that last their distance or time), also when its
+    /// FileHeader's description does not start with CARLA: (docs/openscenario.md).
+    #[arg(long)]
+    pub carla: bool,
 }
 
 /// `paracosm-fuzz map`: an OpenDRIVE map listed and drawn.
@@ -393,6 +416,9 @@ impl Cli {
                     scripted_ego: self.scripted_ego,
                     ego: self.ego.clone(),
                     horizon_s: self.horizon,
+                    ego_speed_mps: self.ego_speed,
+                    maps: self.maps.as_ref().map(|d| d.display().to_string()),
+                    carla: self.carla,
                 }))
             }
             Some(_)
@@ -400,11 +426,14 @@ impl Cli {
                     || self.continuous
                     || self.scripted_ego
                     || self.ego.is_some()
-                    || self.horizon.is_some() =>
+                    || self.horizon.is_some()
+                    || self.ego_speed.is_some()
+                    || self.maps.is_some()
+                    || self.carla =>
             {
                 return Err(Error::BadInput(
-                    "--open, --continuous, --scripted-ego, --ego and --horizon are for an \
-                     OpenSCENARIO scenario (.xosc)"
+                    "--open, --continuous, --scripted-ego, --ego, --horizon, --ego-speed, \
+                     --maps and --carla are for an OpenSCENARIO scenario (.xosc)"
                         .into(),
                 ))
             }

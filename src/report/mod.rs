@@ -217,15 +217,35 @@ fn plan_plots(scenario: &Scenario, triage: Option<&Triage>) -> Vec<(&'static str
 }
 
 /// The failure map's axes: the two parameters `triage` ranks most relevant for a scenario
-/// that asks for them ([`Scenario::map_axes_by_relevance`]) when it ranks two, else the
-/// scenario's own.
+/// that asks for them ([`Scenario::map_axes_by_relevance`]) when it ranks two that vary
+/// (a parameter nothing reads, [`Scenario::unused_params`], or of one level, is no axis: on
+/// Euro NCAP's CCRs grid, all of whose tests pass, the ranking's ties put the unread
+/// `Scenario_ID` second), else the scenario's own.
 fn map_axes(scenario: &Scenario, triage: Option<&Triage>) -> Vec<String> {
-    match triage {
-        Some(t) if scenario.map_axes_by_relevance() && t.ranking.len() >= 2 => {
-            t.ranking.iter().take(2).map(|r| r.param.clone()).collect()
-        }
-        _ => scenario.map_axes().to_vec(),
+    let varies = |name: &str| {
+        !scenario.unused_params().iter().any(|u| u == name)
+            && scenario
+                .space()
+                .param(name)
+                .is_some_and(|p| match &p.domain {
+                    paracosm_generators::Domain::Levels(l) => l.len() > 1,
+                    paracosm_generators::Domain::Interval { .. } => true,
+                })
+    };
+    let ranked: Vec<String> = triage
+        .filter(|_| scenario.map_axes_by_relevance())
+        .map(|t| {
+            t.ranking
+                .iter()
+                .map(|r| r.param.clone())
+                .filter(|p| varies(p))
+                .collect()
+        })
+        .unwrap_or_default();
+    if ranked.len() >= 2 {
+        return ranked.into_iter().take(2).collect();
     }
+    scenario.map_axes().to_vec()
 }
 
 /// How a plot's title names a campaign's scenario: an OpenSCENARIO file by its file name,

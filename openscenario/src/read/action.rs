@@ -1,5 +1,6 @@
 //! Private actions (OpenSCENARIO 1.3 User Guide, "Actions"): speed, longitudinal distance,
-//! lane change, lane offset, teleport, follow trajectory (polyline) and activate controller.
+//! lane change, lane offset, teleport, follow trajectory (polyline), activate controller; controller actions in
+//! `controller.rs`.
 //! Every other action is refused with what is supported.
 
 use roxmltree::Node;
@@ -11,7 +12,7 @@ use crate::model::{
     TrajectoryShape,
 };
 use crate::quantity::Quantity;
-use crate::xml::{child, choice, elements, need, only};
+use crate::xml::{child, choice, elements, need};
 
 /// A `<PrivateAction>`.
 pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
@@ -97,17 +98,13 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
                 _ => follow_trajectory(r, f),
             }
         }
-        _ => {
-            only(r.text, a, &["ActivateControllerAction"])?;
-            let c = need(r.text, a, "ActivateControllerAction")?;
-            activate(r, c)
-        }
+        _ => super::controller::read(r, a),
     }
 }
 
 /// An `ActivateControllerAction`: 1.3's `animation` and `lighting` are refused when set;
 /// a named controller must be the entity's (paracosm reads one per entity).
-fn activate(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Action, XoscError> {
+pub(super) fn activate(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Action, XoscError> {
     for a in ["animation", "lighting"] {
         if r.scope.opt_bool(r.text, c, a)? == Some(true) {
             return Err(XoscError::Unsupported {
@@ -320,10 +317,11 @@ fn lane_change(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> 
     Ok(Action::LaneChange {
         target,
         dynamics,
-        offset_m: r
-            .scope
-            .opt_num_in(r.text, node, "targetLaneOffset", Quantity::Lateral)?
-            .unwrap_or(0.0),
+        offset_m: r.flip(
+            r.scope
+                .opt_num_in(r.text, node, "targetLaneOffset", Quantity::Lateral)?
+                .unwrap_or(0.0),
+        ),
     })
 }
 
@@ -335,11 +333,11 @@ fn lane_offset(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> 
         &["AbsoluteTargetLaneOffset", "RelativeTargetLaneOffset"],
     )?;
     let target = if tag == "AbsoluteTargetLaneOffset" {
-        OffsetTarget::Absolute(r.scope.num_in(r.text, t, "value", Quantity::Lateral)?)
+        OffsetTarget::Absolute(r.flip(r.scope.num_in(r.text, t, "value", Quantity::Lateral)?))
     } else {
         OffsetTarget::Relative {
             entity: r.entity(t, "entityRef")?,
-            value: r.scope.num_in(r.text, t, "value", Quantity::Lateral)?,
+            value: r.flip(r.scope.num_in(r.text, t, "value", Quantity::Lateral)?),
         }
     };
     Ok(Action::LaneOffset {

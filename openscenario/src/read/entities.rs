@@ -1,5 +1,7 @@
 //! `RoadNetwork` and `Entities`.
 
+use std::path::PathBuf;
+
 use roxmltree::Node;
 
 use super::{Catalogs, Reader};
@@ -22,20 +24,10 @@ pub(super) fn road_network(
             "LogicFile" => {
                 let path = r.scope.string(r.text, c, "filepath")?;
                 let mut file = super::join(&r.dir, &path);
-                // CARLA's scenarios name a town (`Town01`), which CARLA loads itself: its
-                // OpenDRIVE file beside the scenario stands for it.
-                if file.extension().is_none() && !file.exists() {
-                    let xodr = file.with_extension("xodr");
-                    if xodr.is_file() {
-                        r.note(
-                            c,
-                            format!(
-                                "the map {path:?} is named without its extension, as CARLA names \
-                                 its towns: read from {}",
-                                xodr.display()
-                            ),
-                        );
-                        file = xodr;
+                if !file.exists() {
+                    if let Some((found, why)) = map_elsewhere(r, &file) {
+                        r.note(c, format!("the map {path:?} {why}: read from {}", found.display()));
+                        file = found;
                     }
                 }
                 out = Some(Located {
@@ -52,6 +44,32 @@ pub(super) fn road_network(
         }
     }
     Ok(out)
+}
+
+/// Where a map that is not at `file` is found, and why there: CARLA's scenarios name a town
+/// (`Town01`), which CARLA loads itself, so its OpenDRIVE file beside the scenario
+/// (`Town01.xodr`) stands for it; else the file of that name (with `.xodr` when it has no
+/// extension) in the folder of maps (`--maps`, [`crate::FileSet::with_maps`]).
+fn map_elsewhere(r: &Reader<'_>, file: &std::path::Path) -> Option<(PathBuf, String)> {
+    let bare = file.extension().is_none();
+    if bare && file.with_extension("xodr").is_file() {
+        let why = "is named without its extension, as CARLA names its towns".to_string();
+        return Some((file.with_extension("xodr"), why));
+    }
+    let name = std::path::Path::new(file.file_name()?);
+    r.files.maps().iter().find_map(|dir| {
+        let at = dir.join(name);
+        let at = if bare { at.with_extension("xodr") } else { at };
+        at.is_file().then(|| {
+            (
+                at,
+                format!(
+                    "is not beside the scenario; found in --maps {}",
+                    dir.display()
+                ),
+            )
+        })
+    })
 }
 
 /// `Entities`: every `ScenarioObject`, then every `EntitySelection` (into `r.selections`).

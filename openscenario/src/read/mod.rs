@@ -3,6 +3,7 @@
 mod action;
 mod catalog;
 mod condition;
+mod controller;
 mod entities;
 mod global;
 mod position;
@@ -43,6 +44,9 @@ pub(crate) struct Reader<'t> {
     pub(crate) globals: std::rc::Rc<Vec<(String, crate::params::ParamType)>>,
     /// The scenario's variables (`VariableDeclarations`) and their types.
     pub(crate) variables: std::rc::Rc<Vec<(String, crate::params::ParamType)>>,
+    /// Whether the scenario is written for CARLA ([`crate::model::Scenario::carla`]): its
+    /// positions are in CARLA's left-handed frame ([`Reader::flip`]).
+    pub(crate) carla: bool,
 }
 
 impl<'t> Reader<'t> {
@@ -106,6 +110,7 @@ impl<'t> Reader<'t> {
             catalogs: std::rc::Rc::clone(&self.catalogs),
             globals: std::rc::Rc::clone(&self.globals),
             variables: std::rc::Rc::clone(&self.variables),
+            carla: self.carla,
         })
     }
 
@@ -130,6 +135,7 @@ impl<'t> Reader<'t> {
             catalogs: std::rc::Rc::clone(&self.catalogs),
             globals: std::rc::Rc::clone(&self.globals),
             variables: std::rc::Rc::clone(&self.variables),
+            carla: self.carla,
         }
     }
 
@@ -144,6 +150,18 @@ impl<'t> Reader<'t> {
             .trim()
             .trim_start_matches('$')
             .to_string())
+    }
+
+    /// A lateral value (a world `y`, a heading, an offset to the left) as the standard's
+    /// right-handed frame has it: `v`, or `-v` in a file written in CARLA's left-handed frame
+    /// (scenario_runner reverses these signs unless the file is CARLA's, and its lane offsets
+    /// count to the right); 0 stays +0.
+    pub(crate) fn flip(&self, v: f64) -> f64 {
+        if self.carla {
+            0.0 - v
+        } else {
+            v
+        }
     }
 
     /// Notes that `node` is read but not honoured as written.
@@ -233,6 +251,12 @@ fn read_with(
         ],
     )?;
     let version = read_version(text, root)?;
+    // scenario_runner's test of a file written in CARLA's frame (its
+    // `OpenScenarioConfiguration._set_scenario_name`).
+    let carla = files.carla()
+        || child(root, "FileHeader")
+            .and_then(|h| h.attribute("description"))
+            .is_some_and(|d| d.starts_with("CARLA:"));
     let storyboard = need(text, root, "Storyboard")?;
     let decls = read_declarations(text, child(root, "ParameterDeclarations"))?;
     let scope = Scope::with_values(text, &decls, overrides)?;
@@ -259,7 +283,19 @@ fn read_with(
         catalogs: std::rc::Rc::default(),
         globals: std::rc::Rc::new(decls.iter().map(|d| (d.name.clone(), d.ty)).collect()),
         variables: std::rc::Rc::default(),
+        carla,
     };
+    if carla {
+        r.note(
+            need(text, root, "FileHeader")?,
+            "read as CARLA's scenario_runner reads its files (the description starts with \
+             CARLA:, or --carla): in CARLA's \
+             left-handed frame: world y, headings and lateral offsets (t, dt, offset, dy, the \
+             offsets of lane offset and lane change actions) are read with their sign \
+             reversed, conditions latch, a SpeedAction lasts its dynamics' \
+             distance or time, and the scenario ends with its stories",
+        );
+    }
     let variables = read_variables(&r, child(root, "VariableDeclarations"))?;
     r.variables = std::rc::Rc::new(variables.iter().map(|(n, t, _)| (n.clone(), *t)).collect());
     r.catalogs = std::rc::Rc::new(Catalogs::read(&r, child(root, "CatalogLocations"))?);
@@ -270,6 +306,7 @@ fn read_with(
     Ok(Scenario {
         file: text.file.clone(),
         version,
+        carla,
         params,
         scope: r.scope.clone(),
         road_network,

@@ -31,22 +31,23 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscE
         "RoadPosition" => Position::Road {
             road: s.string(t, p, "roadId")?,
             s: s.num_in(t, p, "s", Quantity::Distance)?,
-            t: s.num_in(t, p, "t", Quantity::Lateral)?,
+            t: r.flip(s.num_in(t, p, "t", Quantity::Lateral)?),
             orientation: orientation(r, p)?,
         },
         "RelativeRoadPosition" => Position::RelativeRoad {
             entity: r.entity(p, "entityRef")?,
             ds: s.num_in(t, p, "ds", Quantity::Distance)?,
-            dt: s.num_in(t, p, "dt", Quantity::Lateral)?,
+            dt: r.flip(s.num_in(t, p, "dt", Quantity::Lateral)?),
             orientation: orientation(r, p)?,
         },
         "LanePosition" => Position::Lane {
             road: s.string(t, p, "roadId")?,
             lane: lane_id(r, p, "laneId")?,
             s: s.num_in(t, p, "s", Quantity::Distance)?,
-            offset: s
-                .opt_num_in(t, p, "offset", Quantity::Lateral)?
-                .unwrap_or(0.0),
+            offset: r.flip(
+                s.opt_num_in(t, p, "offset", Quantity::Lateral)?
+                    .unwrap_or(0.0),
+            ),
             orientation: orientation(r, p)?,
         },
         "RoutePosition" => route(r, p)?,
@@ -127,8 +128,8 @@ fn world(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
     }
     Ok(Position::World {
         x: s.num_in(t, p, "x", Quantity::Coordinate)?,
-        y: s.num_in(t, p, "y", Quantity::Coordinate)?,
-        h: s.opt_num_in(t, p, "h", Quantity::Angle)?,
+        y: r.flip(s.num_in(t, p, "y", Quantity::Coordinate)?),
+        h: s.opt_num_in(t, p, "h", Quantity::Angle)?.map(|h| r.flip(h)),
     })
 }
 
@@ -146,7 +147,7 @@ fn relative(r: &Reader<'_>, p: Node<'_, '_>, tag: &str) -> Result<Position, Xosc
     let (entity, dx, dy) = (
         r.entity(p, "entityRef")?,
         s.num_in(t, p, "dx", Quantity::Distance)?,
-        s.num_in(t, p, "dy", Quantity::Distance)?,
+        r.flip(s.num_in(t, p, "dy", Quantity::Distance)?),
     );
     let orientation = orientation(r, p)?;
     Ok(if tag == "RelativeWorldPosition" {
@@ -182,9 +183,10 @@ fn relative_lane(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError>
         entity: r.entity(p, "entityRef")?,
         d_lane: lane_id(r, p, "dLane")?,
         ds: ds.unwrap_or(0.0),
-        offset: s
-            .opt_num_in(t, p, "offset", Quantity::Lateral)?
-            .unwrap_or(0.0),
+        offset: r.flip(
+            s.opt_num_in(t, p, "offset", Quantity::Lateral)?
+                .unwrap_or(0.0),
+        ),
         orientation: orientation(r, p)?,
     })
 }
@@ -211,9 +213,11 @@ fn orientation(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Option<Orientation>, X
         }
     }
     Ok(Some(Orientation {
-        h: r.scope
-            .opt_num_in(r.text, o, "h", Quantity::Angle)?
-            .unwrap_or(0.0),
+        h: r.flip(
+            r.scope
+                .opt_num_in(r.text, o, "h", Quantity::Angle)?
+                .unwrap_or(0.0),
+        ),
         relative,
     }))
 }

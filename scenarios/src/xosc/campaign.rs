@@ -40,6 +40,18 @@ pub struct XoscRef {
     /// needs it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub horizon_s: Option<f64>,
+    /// `--ego-speed`: the system under test's set speed, m/s (finite, `> 0`), for a file that
+    /// asks its ego no speed (CARLA's leave it to the agent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ego_speed_mps: Option<f64>,
+    /// `--maps DIR`: a folder where a map the file names but that is not where it says (a
+    /// CARLA town, `Town01`) is found ([`paracosm_openscenario::FileSet::with_maps`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub maps: Option<String>,
+    /// `--carla`: read the file as CARLA's scenario_runner reads its own (its frame, its
+    /// conditions, its speed actions), also when its `FileHeader` does not say `CARLA:`.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub carla: bool,
 }
 
 impl std::fmt::Display for XoscRef {
@@ -61,6 +73,15 @@ impl std::fmt::Display for XoscRef {
         }
         if let Some(h) = self.horizon_s {
             write!(f, " --horizon {h}")?;
+        }
+        if let Some(v) = self.ego_speed_mps {
+            write!(f, " --ego-speed {v}")?;
+        }
+        if let Some(d) = &self.maps {
+            write!(f, " --maps {d}")?;
+        }
+        if self.carla {
+            f.write_str(" --carla")?;
         }
         Ok(())
     }
@@ -224,8 +245,10 @@ pub fn inspect_with_map(
     path: &Path,
     opens: &[String],
     continuous: bool,
+    (maps, carla): (Option<&Path>, bool),
 ) -> Result<Inspection, ScenarioError> {
-    let found = inspect(path, opens, continuous)?;
+    let files = FileSet::with_maps(maps.map(Path::to_path_buf)).as_carla(carla);
+    let found = inspect_in(&files, path, opens, continuous)?;
     super::load_map(&found.scenario)?;
     Ok(found)
 }
@@ -240,7 +263,8 @@ pub fn inspect_with_map(
 pub fn campaign_scenario(x: &XoscRef) -> Result<crate::Scenario, ScenarioError> {
     let path = x.xosc.as_str();
     let (opens, continuous) = (&x.open, x.continuous);
-    let files = std::sync::Arc::new(FileSet::new());
+    let files = FileSet::with_maps(x.maps.as_ref().map(PathBuf::from)).as_carla(x.carla);
+    let files = std::sync::Arc::new(files);
     let found = inspect_in(&files, Path::new(path), opens, continuous)?;
     let space = paracosm_generators::ParamSpace::new(found.space.clone()).map_err(|e| {
         ScenarioError::Input {
@@ -305,6 +329,7 @@ pub fn campaign_scenario(x: &XoscRef) -> Result<crate::Scenario, ScenarioError> 
         scripted_ego: x.scripted_ego,
         ego: x.ego.clone(),
         horizon_s: x.horizon_s,
+        ego_speed_mps: x.ego_speed_mps,
         warnings: found
             .limits
             .iter()

@@ -312,7 +312,9 @@ fn action(s: &Scenario, a: &Action) -> String {
                 .map_or(String::new(), |(p, _)| position(s, p))
         ),
         Action::ActivateController { .. } => "the system under test takes over".into(),
-        Action::Environment(_)
+        Action::AssignController { .. }
+        | Action::OverrideController
+        | Action::Environment(_)
         | Action::Appearance(_)
         | Action::Visibility { .. }
         | Action::SetValue { .. }
@@ -320,10 +322,18 @@ fn action(s: &Scenario, a: &Action) -> String {
     }
 }
 
-/// One line for an action that moves no entity (the environment, an entity's appearance or
-/// visibility, a parameter or variable).
+/// One line for an action that moves no entity (a controller's assignment or override, the
+/// environment, an entity's appearance or visibility, a parameter or variable).
 fn not_motion(a: &Action) -> String {
     match a {
+        Action::AssignController {
+            controller, kind, ..
+        } => format!(
+            "assign controller {controller}{}{}",
+            kind.as_ref().map_or(String::new(), |k| format!(" ({k})")),
+            if a.hands_over() { ", active" } else { "" }
+        ),
+        Action::OverrideController => "override nothing (every value inactive)".into(),
         Action::Environment(e) => environment(e),
         Action::Appearance(what) => format!("{what} (not modelled)"),
         Action::Visibility {

@@ -25,6 +25,7 @@ impl HostInputs for StoryInputs {
         let m::Scenario {
             file,
             version,
+            carla,
             params: _, // the values themselves
             scope: _,  // the same values, for constraint checks
             road_network,
@@ -45,6 +46,7 @@ impl HostInputs for StoryInputs {
         };
         *file == b.file
             && *version == b.version
+            && *carla == b.carla
             && *road_network == b.road_network
             && *entities == b.entities
             && *init == b.init

@@ -104,6 +104,9 @@ pub struct Source {
     /// `--horizon`: the longest test, s (finite, `> 0`); without it a test ends at the
     /// storyboard's stop trigger, and a storyboard without one is refused.
     pub horizon_s: Option<f64>,
+    /// `--ego-speed`: the set speed of the system under test, m/s, for a file that asks the
+    /// ego no speed ([`check_the_ego_is_asked_to_drive`]).
+    pub ego_speed_mps: Option<f64>,
 }
 
 /// An OpenSCENARIO error as a load error.
@@ -116,6 +119,7 @@ fn worlds_error(message: String) -> ScenarioError {
 }
 
 /// The entity the system under test drives: the vehicle `named` (`--ego NAME`), else the one
+/// given CARLA's `external_control` (its ego agent's controller), else the one
 /// whose controller the storyboard activates, else the one named `Ego` or `hero` (any
 /// case), else the scenario's only vehicle. With `any_vehicle` (the storyboard moves every
 /// entity, so nothing is tested of the ego) the first vehicle stands in when none is plainly
@@ -153,17 +157,36 @@ pub fn ego_of(
                 ))
             });
     }
+    // CARLA's controller of the ego's agent, assigned in Init or a story.
+    let agent = s
+        .init
+        .iter()
+        .map(|(e, na)| (*e, &na.action))
+        .chain(
+            s.stories
+                .iter()
+                .flat_map(|st| &st.acts)
+                .flat_map(|a| &a.groups)
+                .flat_map(|g| g.maneuvers.iter().map(move |mv| (g, mv)))
+                .flat_map(|(g, mv)| mv.events.iter().map(move |ev| (g, ev)))
+                .flat_map(|(g, ev)| ev.actions.iter().map(move |na| (g, na)))
+                .filter_map(|(g, na)| g.actors.first().map(|&e| (e, &na.action))),
+        )
+        .find_map(|(e, a)| match a {
+            Action::AssignController { kind: Some(k), .. } if k == "external_control" => Some(e),
+            _ => None,
+        });
     let activated = s
         .stories
         .iter()
         .flat_map(|st| &st.acts)
         .flat_map(|a| &a.groups)
         .find_map(|g| {
-            let activates = g.maneuvers.iter().flat_map(|mv| &mv.events).any(|ev| {
-                ev.actions
-                    .iter()
-                    .any(|na| matches!(na.action, Action::ActivateController { .. }))
-            });
+            let activates = g
+                .maneuvers
+                .iter()
+                .flat_map(|mv| &mv.events)
+                .any(|ev| ev.actions.iter().any(|na| na.action.hands_over()));
             activates.then(|| g.actors.first().copied()).flatten()
         });
     let by_name = || {
@@ -174,8 +197,9 @@ pub fn ego_of(
     };
     let only = || (vehicles.len() == 1).then(|| vehicles[0]);
     let first = || any_vehicle.then(|| vehicles.first().copied()).flatten();
-    activated
+    agent
         .filter(vehicle)
+        .or(activated.filter(vehicle))
         .or_else(by_name)
         .or_else(only)
         .or_else(first)
@@ -314,36 +338,10 @@ fn performed_otherwise(
     let name = &s.entities[e].name;
     let driven = Some(e) == ego;
     Ok(match &na.action {
-        Action::ActivateController {
-            lateral,
-            longitudinal,
-        } if driven => match (lateral, longitudinal) {
-            (Some(false), Some(false)) => {
-                return Err(worlds_error(format!(
-                    "{}: this ActivateControllerAction deactivates the controller of {name}, \
-                     handing it back to the storyboard, which paracosm cannot do: the system \
-                     under test drives the ego from its activation to the end. Run the file \
-                     with --scripted-ego to have the storyboard move the ego",
-                    na.pos
-                )));
-            }
-            (Some(false), _) | (_, Some(false)) => {
-                let (only, too) = if *lateral == Some(false) {
-                    ("longitudinal", "steering")
-                } else {
-                    ("lateral", "speed")
-                };
-                Some(format!(
-                    "this ActivateControllerAction activates only the {only} control of {name}: \
-                     paracosm hands the system under test the whole ego, its {too} too"
-                ))
-            }
-            _ => None,
-        },
-        Action::ActivateController { .. } => Some(format!(
-            "{name} has no controller in paracosm: the storyboard moves it, and its \
-             ActivateControllerAction does nothing"
-        )),
+        Action::ActivateController { .. } => return activated(s, na, (e, ego)),
+        Action::AssignController { .. } => return assigned(s, na, (e, ego), init),
+        // Every value inactive (noted where read; an active one is refused there).
+        Action::OverrideController => None,
         // The lights of a vehicle: noted where read.
         Action::Appearance(_) => None,
         // Hidden from the system under test's camera or sensors: paracosm cannot hide an
@@ -393,6 +391,189 @@ fn performed_otherwise(
     })
 }
 
+/// How paracosm performs `ActivateControllerAction` `na` on entity `e` ([`performed_otherwise`]):
+/// on the ego a system under test drives, the hand-over (of the whole ego, noted when only a
+/// domain is activated); on another entity nothing, since the storyboard moves it (noted).
+///
+/// # Errors
+/// [`ScenarioError::Load`] naming the action's line and column: a deactivation of the driven
+/// ego's controller; CARLA's autopilot; the activation of a controller the storyboard
+/// assigned that paracosm cannot run ([`assigned_driver`]).
+fn activated(
+    s: &m::Scenario,
+    na: &m::NamedAction,
+    (e, ego): (usize, Option<usize>),
+) -> Result<Option<String>, ScenarioError> {
+    let name = &s.entities[e].name;
+    let driven = Some(e) == ego;
+    Ok(match &na.action {
+        Action::ActivateController {
+            lateral,
+            longitudinal,
+        } if driven => match (lateral, longitudinal) {
+            (Some(false), Some(false)) => {
+                return Err(worlds_error(format!(
+                    "{}: this ActivateControllerAction deactivates the controller of {name}, \
+                     handing it back to the storyboard, which paracosm cannot do: the system \
+                     under test drives the ego from its activation to the end. Run the file \
+                     with --scripted-ego to have the storyboard move the ego",
+                    na.pos
+                )));
+            }
+            (Some(false), _) | (_, Some(false)) => {
+                let (only, too) = if *lateral == Some(false) {
+                    ("longitudinal", "steering")
+                } else {
+                    ("lateral", "speed")
+                };
+                Some(format!(
+                    "this ActivateControllerAction activates only the {only} control of {name}: \
+                     paracosm hands the system under test the whole ego, its {too} too"
+                ))
+            }
+            _ => None,
+        },
+        // CARLA's autopilot (its Traffic Manager) drives a vehicle activated so.
+        Action::ActivateController { .. } if s.carla && na.action.hands_over() => {
+            return Err(worlds_error(format!(
+                "{}: this ActivateControllerAction starts CARLA's autopilot on {name}, which \
+                 paracosm does not have: the storyboard would leave {name} at its speed \
+                 instead of driving it through the town",
+                na.pos
+            )));
+        }
+        // A controller the storyboard assigned it, which paracosm cannot run.
+        Action::ActivateController { .. } if na.action.hands_over() => {
+            if let Some(what) = assigned_driver(s, e, ego.is_none()) {
+                return Err(worlds_error(format!(
+                    "{}: this ActivateControllerAction activates a controller of {name} \
+                     that paracosm cannot run (the storyboard assigns it {what}): paracosm \
+                     moves an entity other than the ego a system under test drives only by \
+                     the storyboard. Have a system under test drive {name} (without \
+                     --scripted-ego, or --ego {name})",
+                    na.pos
+                )));
+            }
+            Some(format!(
+                "{name} has no controller in paracosm: the storyboard moves it, and its \
+                 ActivateControllerAction does nothing"
+            ))
+        }
+        Action::ActivateController { .. } => Some(format!(
+            "{name} has no controller in paracosm: the storyboard moves it, and its \
+             ActivateControllerAction does nothing"
+        )),
+        _ => None,
+    })
+}
+
+/// CARLA's controller of a vehicle that follows the storyboard's actions along its lane
+/// (scenario_runner's `NpcVehicleControl`), and esmini's (`DefaultController`): paracosm's
+/// storyboard moves an entity so.
+pub const STORYBOARD_CONTROLLERS: [&str; 2] = ["npc_vehicle_control", "DefaultController"];
+
+/// How paracosm performs `AssignControllerAction` `na` on entity `e` ([`performed_otherwise`]):
+/// on the ego a system under test drives, that system is its controller; on any other
+/// entity, a controller of [`STORYBOARD_CONTROLLERS`] is the storyboard's motion, one not
+/// activated does nothing yet, and under `--scripted-ego` CARLA's `external_control` (its
+/// ego's agent) is the storyboard's motion too.
+///
+/// # Errors
+/// [`ScenarioError::Load`] naming the action's line and column: an activated controller of
+/// another kind on an entity the storyboard moves.
+fn assigned(
+    s: &m::Scenario,
+    na: &m::NamedAction,
+    (e, ego): (usize, Option<usize>),
+    init: bool,
+) -> Result<Option<String>, ScenarioError> {
+    let Action::AssignController {
+        controller,
+        kind,
+        lateral,
+        longitudinal,
+    } = &na.action
+    else {
+        return Ok(None);
+    };
+    let name = &s.entities[e].name;
+    let what = controller_named(controller, kind.as_deref());
+    if Some(e) == ego {
+        let activated = (*lateral, *longitudinal);
+        let part = match activated {
+            (Some(true), Some(true)) => String::new(),
+            _ if !na.action.hands_over() => format!(
+                ", when an ActivateControllerAction activates it ({} does not)",
+                if init { "Init" } else { "this action" }
+            ),
+            (Some(true), _) => ", its speed too (this action activates only steering)".into(),
+            _ => ", its steering too (this action activates only speed)".into(),
+        };
+        return Ok(Some(format!(
+            "the system under test is the controller of {name}: it drives in place of {what}{part}"
+        )));
+    }
+    if !na.action.hands_over() {
+        return Ok(Some(format!(
+            "{what} is assigned to {name} but not activated: the storyboard moves {name}"
+        )));
+    }
+    let plain = kind
+        .as_deref()
+        .is_some_and(|k| STORYBOARD_CONTROLLERS.contains(&k));
+    // CARLA's controller of the ego: the system under test, which --scripted-ego replaces
+    // by the storyboard.
+    let scripted_ego = ego.is_none() && kind.as_deref() == Some("external_control");
+    if plain || scripted_ego {
+        return Ok(Some(format!(
+            "the storyboard moves {name} along its lane at the speeds its actions set, in \
+             place of {what}"
+        )));
+    }
+    Err(worlds_error(format!(
+        "{}: this AssignControllerAction has {what} drive {name}, which paracosm cannot run: \
+         it moves an entity other than the ego a system under test drives only by the \
+         storyboard (its actions along its lane, as a controller of kind {} does). Give the \
+         ego to a system under test (--ego {name}), or leave this entity to the storyboard",
+        na.pos,
+        STORYBOARD_CONTROLLERS.join(" or ")
+    )))
+}
+
+/// The first controller `s` assigns entity `e` (in `Init` or a story) that paracosm's
+/// storyboard cannot stand for: one of a kind other than [`STORYBOARD_CONTROLLERS`] (and, with
+/// `scripted` — no system under test — other than CARLA's `external_control`, the ego's agent
+/// the storyboard replaces), as `controller NAME (KIND)`.
+fn assigned_driver(s: &m::Scenario, e: usize, scripted: bool) -> Option<String> {
+    let stories = (s.stories.iter())
+        .flat_map(|st| &st.acts)
+        .flat_map(|a| &a.groups)
+        .filter(|g| g.actors.contains(&e))
+        .flat_map(|g| &g.maneuvers)
+        .flat_map(|mv| &mv.events)
+        .flat_map(|ev| &ev.actions);
+    let init = s.init.iter().filter(|(i, _)| *i == e).map(|(_, na)| na);
+    init.chain(stories).find_map(|na| match &na.action {
+        Action::AssignController {
+            controller, kind, ..
+        } => {
+            let k = kind.as_deref().unwrap_or("");
+            let plain =
+                STORYBOARD_CONTROLLERS.contains(&k) || (scripted && k == "external_control");
+            (!plain).then(|| controller_named(controller, kind.as_deref()))
+        }
+        _ => None,
+    })
+}
+
+/// `controller NAME (KIND)`, or `controller NAME` when its kind is not said.
+fn controller_named(controller: &str, kind: Option<&str>) -> String {
+    match kind {
+        Some(k) => format!("controller {controller} ({k})"),
+        None => format!("controller {controller}"),
+    }
+}
+
 /// The scenario of `source`: its space, the `aeb` system under test (which keeps the ego's
 /// initial speed as its set speed), a collision monitor and the off-road monitor, and a
 /// horizon of [`HORIZON_CAP_S`] that the storyboard's stop trigger cuts short.
@@ -405,6 +586,15 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
     let model = read_scenario_in(&source.files, &source.template, &[]).map_err(xosc_error)?;
     let ego = ego_of(&model, source.ego.as_deref(), source.scripted_ego)?;
     let mut warnings = check(&model, (!source.scripted_ego).then_some(ego))?;
+    if !source.scripted_ego {
+        check_the_ego_is_asked_to_drive(&model, ego, source.ego_speed_mps)?;
+    } else if source.ego_speed_mps.is_some() {
+        return Err(worlds_error(
+            "--ego-speed is the set speed of a system under test, and with --scripted-ego none \
+             drives: the storyboard moves the ego at the speeds the file asks"
+                .into(),
+        ));
+    }
     let horizon_s = horizon(&model, source.horizon_s)?;
     // The failure map's axes: the intervals first, then the parameters with most levels.
     let mut axes: Vec<&paracosm_generators::Param> = source.space.params().iter().collect();
@@ -421,6 +611,7 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
         maps: MapFiles::sharing(Base::Folder(dir), source.files.clone()),
         scripted_ego: source.scripted_ego,
         ego: source.ego.clone(),
+        ego_speed_mps: source.ego_speed_mps,
         horizon_s,
         map_axes,
         space: source.space,
@@ -507,6 +698,8 @@ struct XoscFrontEnd {
     scripted_ego: bool,
     /// [`Source::ego`].
     ego: Option<String>,
+    /// [`Source::ego_speed_mps`].
+    ego_speed_mps: Option<f64>,
     /// The longest test, s ([`horizon`]).
     horizon_s: f64,
     /// The failure map's axes (the intervals first, then the parameters with most levels).
@@ -517,6 +710,61 @@ struct XoscFrontEnd {
     source: crate::front_end::Source,
     /// What the load found.
     findings: crate::front_end::Findings,
+}
+
+/// Refuses a scenario that never asks the ego `ego`, which a system under test drives, to
+/// drive (no `SpeedAction` on it with a target above [`STILL_MPS`], in `Init` or a story)
+/// when no set speed is `given` (`--ego-speed`, finite and `> 0`): the system would hold
+/// the ego still, and a test whose ego never moves tests nothing the file describes.
+/// CARLA's files leave the ego's speed to the agent that drives it.
+///
+/// # Errors
+/// [`ScenarioError::Load`] naming the ego's `ScenarioObject`: no speed asked and none given;
+/// or `given` is not finite and `> 0`.
+pub fn check_the_ego_is_asked_to_drive(
+    model: &m::Scenario,
+    ego: usize,
+    given: Option<f64>,
+) -> Result<(), ScenarioError> {
+    let e = &model.entities[ego];
+    if let Some(v) = given {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(worlds_error(format!(
+                "--ego-speed must be a speed > 0 m/s, not {v}"
+            )));
+        }
+        return Ok(());
+    }
+    let drives = |a: &Action| match a {
+        Action::Speed { target, .. } => match target {
+            m::SpeedTarget::Absolute(v) => *v > STILL_MPS,
+            // Relative to another entity's speed: it may ask the ego to drive.
+            _ => true,
+        },
+        _ => false,
+    };
+    let in_init = model
+        .init
+        .iter()
+        .any(|(i, na)| *i == ego && drives(&na.action));
+    let in_stories = (model.stories.iter())
+        .flat_map(|st| &st.acts)
+        .flat_map(|a| &a.groups)
+        .filter(|g| g.actors.contains(&ego))
+        .flat_map(|g| &g.maneuvers)
+        .flat_map(|mv| &mv.events)
+        .flat_map(|ev| &ev.actions)
+        .any(|na| drives(&na.action));
+    if in_init || in_stories {
+        return Ok(());
+    }
+    Err(worlds_error(format!(
+        "{}: the file asks the ego {} no speed (no SpeedAction on it above {STILL_MPS} m/s): \
+         the system under test would have no set speed and hold it still, and a test whose \
+         ego never moves tests nothing the file describes. Give the system its set speed \
+         with --ego-speed M/S (CARLA's files leave it to the agent that drives the ego)",
+        e.pos, e.name
+    )))
 }
 
 /// The longest test of `model`, s: `given` (`--horizon`), else [`HORIZON_CAP_S`] when the
@@ -669,7 +917,10 @@ impl XoscFrontEnd {
         let light = (!sets.light).then(|| scene.push(Node::Const(Value::Num(DEFAULT_LIGHT))));
         let fog = (!sets.fog).then(|| scene.push(Node::Const(Value::Num(0.0))));
         let ego = ego_of(model, self.ego.as_deref(), self.scripted_ego)?;
-        let built = build_into(&mut scene, model, &self.maps, (ego, self.scripted_ego), 0)?;
+        let mut built = build_into(&mut scene, model, &self.maps, (ego, self.scripted_ego), 0)?;
+        if !self.scripted_ego {
+            built.host.ego_speed(self.ego_speed_mps);
+        }
         let mut from_storyboard = |f: u32| {
             let tick = scene.push(Node::Tick);
             scene.push(Node::Map {
@@ -821,6 +1072,7 @@ pub(crate) fn build_into(
         measures: (f64::INFINITY, f64::INFINITY, f64::NAN),
         asked: None,
         most_asked_mps: sb_init_speed,
+        ego_speed_mps: None,
         road_end: None,
         stuck_since: None,
         log: Vec::new(),
@@ -885,20 +1137,23 @@ fn ego_vehicle(entity: &m::Entity) -> Result<VehicleParams, ScenarioError> {
     })
 }
 
-/// Whether `model`'s storyboard activates a controller of entity `e`: then the storyboard
-/// moves it until the activation and the system under test drives it after
-/// ([`Storyboard::hand_over_on_activation`]).
+/// Whether `model`'s stories activate a controller of entity `e` and its `Init` does not:
+/// then the storyboard moves it until the activation and the system under test drives it
+/// after ([`Storyboard::hand_over_on_activation`]); activated in `Init`, the system drives
+/// it from the start (a later activation changes nothing).
 fn activates_controller_of(model: &m::Scenario, e: usize) -> bool {
-    model
-        .stories
-        .iter()
-        .flat_map(|st| &st.acts)
-        .flat_map(|a| &a.groups)
-        .filter(|g| g.actors.contains(&e))
-        .flat_map(|g| &g.maneuvers)
-        .flat_map(|mv| &mv.events)
-        .flat_map(|ev| &ev.actions)
-        .any(|na| matches!(na.action, Action::ActivateController { .. }))
+    let in_init = (model.init.iter()).any(|(i, na)| *i == e && na.action.hands_over());
+    !in_init
+        && model
+            .stories
+            .iter()
+            .flat_map(|st| &st.acts)
+            .flat_map(|a| &a.groups)
+            .filter(|g| g.actors.contains(&e))
+            .flat_map(|g| &g.maneuvers)
+            .flat_map(|mv| &mv.events)
+            .flat_map(|ev| &ev.actions)
+            .any(|na| na.action.hands_over())
 }
 
 /// The route of the ego `ego` from `from` (engine world `[x, z]`, m): it joins its lanes at
@@ -1014,6 +1269,9 @@ pub(crate) struct StoryHost {
     /// The highest speed the file asked of the driven ego so far (its `Init` speed, its
     /// `SpeedAction`s), m/s.
     most_asked_mps: f64,
+    /// `--ego-speed`: the set speed of the system under test where the file asks none, m/s
+    /// ([`StoryHost::ego_speed`]).
+    ego_speed_mps: Option<f64>,
     /// When the ego's road ended before the storyboard did, s.
     road_end: Option<f64>,
     /// Since when the world the system under test drives in stands still while the
@@ -1064,6 +1322,13 @@ impl StoryHost {
 }
 
 impl StoryHost {
+    /// Gives the system under test the set speed `v`, m/s, where the file asks none
+    /// (`--ego-speed`): from its first step with the ego, until a `SpeedAction` on the ego
+    /// sets another.
+    pub(crate) fn ego_speed(&mut self, v: Option<f64>) {
+        self.ego_speed_mps = v;
+    }
+
     /// Hands the ego to the system under test in the step (at `t`, s) whose
     /// `ActivateControllerAction` activated its controller: the storyboard stops placing it,
     /// the engine releases its chassis ([`Sink::ReleaseEgo`]) at the speed it had, which
@@ -1291,9 +1556,8 @@ impl Host for StoryHost {
                     ));
                 }
                 // A SpeedAction on the driven ego: the system under test's set speed.
-                let asked = self
-                    .sb
-                    .set_speed()
+                let asked = (self.sb.set_speed())
+                    .or(self.ego_speed_mps)
                     .filter(|_| !self.sb.actors[self.ego].scripted);
                 if asked.is_some() && asked != self.asked {
                     self.asked = asked;

@@ -27,6 +27,9 @@ pub(in crate::xosc::story) struct Cond {
     /// The storyboard's count of transitions when it was last evaluated: an element-state
     /// condition reads the transitions its elements made since ([`elements::Change`]).
     pub(in crate::xosc::story) seen: u64,
+    /// Whether it has been true since its element began to wait, for a storyboard whose
+    /// conditions latch ([`Storyboard::carla`]).
+    pub(in crate::xosc::story) latched: bool,
 }
 
 /// A run of evaluations of a delayed condition that gave one value: the first and last
@@ -48,6 +51,7 @@ impl Cond {
             taken: f64::NEG_INFINITY,
             refs: Vec::new(),
             seen: 0,
+            latched: false,
         }
     }
 
@@ -80,9 +84,10 @@ impl Cond {
         out
     }
 
-    /// Forgets its delayed values: its element no longer waits, and its delay starts afresh
-    /// when it waits again.
+    /// Forgets its delayed values and its latch: its element no longer waits, and its delay
+    /// starts afresh when it waits again.
     pub(in crate::xosc::story) fn forget_delay(&mut self) {
+        self.latched = false;
         self.history.clear();
         self.taken = f64::NEG_INFINITY;
     }
@@ -91,6 +96,7 @@ impl Cond {
 impl Storyboard {
     pub(in crate::xosc::story) fn evaluate(&mut self, k: usize, t: f64) -> bool {
         let mut any = false;
+        let latch = self.carla;
         for g in 0..self.triggers[k].len() {
             let mut all = true;
             for c in 0..self.triggers[k][g].len() {
@@ -99,6 +105,7 @@ impl Storyboard {
                 let cond = &mut self.triggers[k][g][c];
                 cond.seen = seq;
                 let edged = match cond.cond.edge {
+                    _ if latch => raw,
                     Edge::None => raw,
                     Edge::Rising => raw && cond.prev == Some(false),
                     Edge::Falling => !raw && cond.prev == Some(true),
@@ -111,7 +118,8 @@ impl Storyboard {
                 } else {
                     edged
                 };
-                all &= value;
+                cond.latched |= latch && value;
+                all &= value || cond.latched;
             }
             any |= all;
         }

@@ -50,7 +50,7 @@ impl Storyboard {
         if let Some(task) = self.drives[e].speed {
             let (v, over) = task.step(t1, |r| self.actors[r].state.speed);
             v1 = v;
-            if over && task.ends() {
+            if over && task.ends(t1, st.travelled_m) {
                 self.drives[e].speed = None;
                 done.push(task.action);
             }

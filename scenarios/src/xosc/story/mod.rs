@@ -132,6 +132,13 @@ pub struct Storyboard {
     env: tasks::WorldEnv,
     /// How many transitions the storyboard's elements have made ([`elements::Change`]).
     seq: u64,
+    /// Whether the storyboard is read as CARLA's scenario_runner reads its files
+    /// ([`m::Scenario::carla`]): a condition once true stays true while its element waits,
+    /// and its edge is not read (scenario_runner wraps each condition in a one-shot
+    /// behaviour and has no edges); the storyboard ends when its stories have; a `SpeedAction` sets its target at once and lasts its
+    /// dynamics' value, a distance travelled (m) or a time (s), as its
+    /// `ChangeActorTargetSpeed` does ([`speed::Hold`]).
+    carla: bool,
     /// Whether an `OffroadCondition` reads how long each entity has been off the road
     /// ([`State::offroad_s`]).
     watch_offroad: bool,
@@ -279,6 +286,7 @@ impl Storyboard {
             env: tasks::WorldEnv::default(),
             boxes: std::cell::RefCell::default(),
             seq: 0,
+            carla: scenario.carla,
             watch_offroad: false,
             ended: false,
             started: false,
@@ -423,9 +431,9 @@ impl Storyboard {
         // A waiting trigger is evaluated when its element is visited (`run_story`).
         for k in 0..self.triggers.len() {
             if !self.waits(k) {
-                // Not waiting: its delays start afresh when it waits again; an edge is taken
-                // against the last value seen (esmini's `OSCCondition::Reset` clears only the
-                // delay history).
+                // Not waiting: its delays start afresh when it waits again (and a latched
+                // condition is unlatched); an edge is taken against the last value seen
+                // (esmini's `OSCCondition::Reset` clears only the delay history).
                 for c in self.triggers[k].iter_mut().flatten() {
                     c.forget_delay();
                 }
@@ -471,7 +479,19 @@ impl Storyboard {
                 }
             }
         }
-        self.settle_all(t)
+        self.settle_all(t)?;
+        // CARLA's scenario ends with its stories (scenario_runner's behaviour tree succeeds
+        // when every story has).
+        let roots = &self.roots;
+        if self.carla
+            && !roots.is_empty()
+            && roots
+                .iter()
+                .all(|&r| self.elems[r].phase == Phase::Complete)
+        {
+            self.ended = true;
+        }
+        Ok(())
     }
 
     /// The transitions the acts, events and actions made in the last [`Storyboard::step`]:

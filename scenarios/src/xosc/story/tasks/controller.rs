@@ -1,8 +1,33 @@
-//! `ActivateControllerAction`: the hand-over of the ego to the system under test.
+//! Controller actions: `ActivateControllerAction` (and an `AssignControllerAction` that
+//! activates), the hand-over of the ego to the system under test.
 
 use super::super::*;
 
 impl Storyboard {
+    /// Performs controller action `action` on entity `e`: an activation, or an assignment
+    /// that activates ([`m::Action::hands_over`]), hands it over
+    /// ([`Storyboard::activate_controller`]); an assignment that activates nothing waits for
+    /// an `ActivateControllerAction`, and an override of inactive values does nothing (an
+    /// active one is refused at load).
+    pub(in crate::xosc::story) fn controller_action(&mut self, e: usize, action: &m::Action) {
+        match action {
+            m::Action::ActivateController {
+                lateral,
+                longitudinal,
+            } => self.activate_controller(e, *lateral, *longitudinal),
+            m::Action::AssignController {
+                lateral,
+                longitudinal,
+                ..
+            } if action.hands_over() => self.activate_controller(
+                e,
+                Some(*lateral == Some(true)),
+                Some(*longitudinal == Some(true)),
+            ),
+            _ => {}
+        }
+    }
+
     /// Performs an `ActivateControllerAction` on entity `e` with its `lateral` and
     /// `longitudinal` domains: the ego handed over on activation is then driven by the
     /// system under test, its lateral move and path ended.

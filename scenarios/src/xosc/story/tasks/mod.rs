@@ -201,10 +201,9 @@ impl Storyboard {
             Action::AcquirePosition(p) => {
                 self.acquire_position(e, p, &action.pos, scripted)?;
             }
-            Action::ActivateController {
-                lateral,
-                longitudinal,
-            } => self.activate_controller(e, *lateral, *longitudinal),
+            Action::ActivateController { .. }
+            | Action::AssignController { .. }
+            | Action::OverrideController => self.controller_action(e, &action.action),
             // Performed once by their action, not per actor ([`Storyboard::start_action`]).
             Action::Environment(_) | Action::SetValue { .. } | Action::ModifyValue { .. } => {}
             // Nothing the storyboard moves reads lights or visibility: the front end refuses

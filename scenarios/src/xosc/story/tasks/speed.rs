@@ -13,6 +13,19 @@ pub(in crate::xosc::story) struct SpeedTask {
     pub(in crate::xosc::story) track: Track,
     /// Its action.
     pub(in crate::xosc::story) action: usize,
+    /// How long it lasts past its transition, in CARLA's reading ([`Storyboard::carla`]).
+    pub(in crate::xosc::story) hold: Option<Hold>,
+}
+
+/// How long a `SpeedAction` lasts in CARLA's reading (scenario_runner's
+/// `ChangeActorTargetSpeed`): until its entity has travelled this far since the action
+/// started, or until this time.
+#[derive(Debug, Clone, Copy)]
+pub(in crate::xosc::story) enum Hold {
+    /// Until the entity's distance travelled ([`State::travelled_m`]) reaches this, m.
+    Travelled(f64),
+    /// Until this simulation time, s.
+    Until(f64),
 }
 
 impl SpeedTask {
@@ -34,10 +47,16 @@ impl SpeedTask {
         }
     }
 
-    /// Whether the task ends with its transition (a target that follows another entity
-    /// goes on).
-    pub(in crate::xosc::story) fn ends(&self) -> bool {
+    /// Whether the task ends at `t1` (s) with its entity's distance travelled `travelled_m`
+    /// (m), its transition over: a target that follows another entity goes on, and one
+    /// held (CARLA's reading) goes on until its hold ends.
+    pub(in crate::xosc::story) fn ends(&self, t1: f64, travelled_m: f64) -> bool {
         self.track.is_none()
+            && match self.hold {
+                None => true,
+                Some(Hold::Travelled(d)) => travelled_m >= d,
+                Some(Hold::Until(t)) => t1 >= t - 1e-9,
+            }
     }
 }
 
@@ -76,13 +95,23 @@ impl Storyboard {
             self.actors[e].state.speed = to.max(0.0);
             return Ok(());
         }
-        let tr = Transition {
+        let mut tr = Transition {
             from: v0,
             to: to.max(0.0),
             start_s: t,
             duration_s: duration_s(dynamics, to - v0, 0.5 * (v0 + to).abs()),
             shape: shape_of(dynamics.shape),
         };
+        // CARLA: the target at once, held for the dynamics' value (its distance or time).
+        let hold = (self.carla && a.is_some()).then(|| {
+            tr.duration_s = 0.0;
+            match dynamics.dimension {
+                m::Dimension::Distance => {
+                    Hold::Travelled(self.actors[e].state.travelled_m + dynamics.value)
+                }
+                _ => Hold::Until(t + dynamics.value),
+            }
+        });
         // A gap kept to another entity is the same longitudinal domain: it ends.
         let old = self.drives[e].keep.take().map(|k| k.action);
         self.override_task(old);
@@ -97,6 +126,7 @@ impl Storyboard {
             tr,
             track,
             action: a.unwrap_or(usize::MAX),
+            hold,
         });
 
         Ok(())
@@ -119,7 +149,7 @@ impl Storyboard {
             return;
         };
         let (v, over) = task.step(t1, |r| self.actors[r].state.speed);
-        if over && task.ends() {
+        if over && task.ends(t1, self.actors[e].state.travelled_m) {
             let reached = SET_SPEED_REACHED_MPS + SET_SPEED_REACHED_SHARE * task.tr.to.abs();
             if (self.actors[e].state.speed - task.tr.to).abs() <= reached {
                 self.drives[e].speed = None;

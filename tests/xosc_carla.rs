@@ -1,0 +1,220 @@
+//! CARLA scenario_runner's OpenSCENARIO examples (`tests/data/xosc/third_party/carla/`, MIT,
+//! provenance in `tests/data/xosc/third_party/PROVENANCE.md`), read as scenario_runner reads
+//! them: the ego is the vehicle given `external_control`, the system under test is its
+//! controller, positions are in CARLA's left-handed frame, conditions latch, a `SpeedAction`
+//! lasts its distance or time, and a scenario ends with its stories. Each of the 16 files
+//! runs as a campaign or is refused at load naming the element that blocks it, and a test
+//! keeps the count of those that run from falling.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The files that run as campaigns under `aeb` with `--ego-speed` (their ego's speed is left
+/// to CARLA's agent).
+const RUN: [&str; 3] = [
+    "FollowLeadingVehicle.xosc",
+    "LaneChangeSimple.xosc",
+    "OscControllerExample.xosc",
+];
+
+/// The files refused at load, each with what its error names.
+const REFUSED: [(&str, &str); 13] = [
+    ("CatalogExample.xosc", "CARLA's autopilot"),
+    (
+        "ChangingWeather.xosc",
+        "ChangingWeather.xosc:110:15: an <Action> holds one",
+    ),
+    (
+        "CyclistCrossing.xosc",
+        "(vehicle_longitudinal_control) drive adversary",
+    ),
+    (
+        "InitAddEntityAction.xosc",
+        "<EntityAction> in <GlobalAction>",
+    ),
+    (
+        "InitDeleteEntityAction.xosc",
+        "<EntityAction> in <GlobalAction>",
+    ),
+    ("IntersectionCollisionAvoidance.xosc", "<SynchronizeAction>"),
+    (
+        "LaneOffsetActionExample.xosc",
+        "cannot hand it this LaneOffsetAction",
+    ),
+    ("PedestrianCrossingFront.xosc", "brings rain (0.2 mm/h)"),
+    ("Slalom.xosc", "brings rain (0.2 mm/h)"),
+    (
+        "StoryAddEntityAction.xosc",
+        "<EntityAction> in <GlobalAction>",
+    ),
+    (
+        "StoryDeleteEntityAction.xosc",
+        "<EntityAction> in <GlobalAction>",
+    ),
+    ("SyncArrivalIntersection.xosc", "<SynchronizeAction>"),
+    ("VehicleLateralDistance.xosc", "<LateralDistanceAction>"),
+];
+
+/// The CARLA example `file`.
+fn carla(file: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/xosc/third_party/carla")
+        .join(file)
+}
+
+/// `--maps` and the folder of CARLA's towns (`Town01`, `Town04`: `tests/data/maps/carla/`),
+/// where a campaign finds the town a file names.
+fn maps() -> [String; 2] {
+    let towns = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/maps/carla");
+    ["--maps".into(), towns.display().to_string()]
+}
+
+/// Runs `paracosm-fuzz FILE ARGS --budget 1` in a fresh output folder: exit code, stderr,
+/// the record and the trace (when `--trace` was given).
+fn run(file: &Path, args: &[&str]) -> (i32, String, serde_json::Value, String) {
+    let out = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(file)
+        .args(args)
+        .args(maps())
+        .args(["--budget", "1", "--out"])
+        .arg(out.path().join("o"))
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    let o_dir = out.path().join("o");
+    let record = std::fs::read_to_string(o_dir.join("results.jsonl"))
+        .ok()
+        .and_then(|t| t.lines().next().map(|l| serde_json::from_str(l).unwrap()))
+        .unwrap_or(serde_json::Value::Null);
+    let trace = std::fs::read_to_string(o_dir.join("trace/test_0.csv")).unwrap_or_default();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+        record,
+        trace,
+    )
+}
+
+/// Each trace line's columns for entity `name` (esmini's CSV layout: name, id, speed, ...,
+/// then x and y eight and nine columns after the speed): `(t, speed, x, y)`.
+fn track(trace: &str, name: &str) -> Vec<(f64, f64, f64, f64)> {
+    trace
+        .lines()
+        .filter(|l| l.starts_with(|c: char| c.is_ascii_digit()))
+        .map(|l| {
+            let c: Vec<&str> = l.split(", ").collect();
+            let at = c.iter().position(|v| *v == name).unwrap();
+            let num = |k: usize| c[k].trim().parse::<f64>().unwrap();
+            (num(1), num(at + 2), num(at + 11), num(at + 12))
+        })
+        .collect()
+}
+
+#[test]
+fn every_carla_example_runs_as_a_campaign_or_is_refused_naming_its_blocker() {
+    let mut runs = 0;
+    for f in RUN {
+        let (code, err, r, _) = run(&carla(f), &["--ego-speed", "8", "--horizon", "60"]);
+        assert_eq!(code, 0, "{f}: {err}");
+        assert!(r["error"].is_null(), "{f}: {r}");
+        assert!(r["status"] == "pass" || r["status"] == "fail", "{f}: {r}");
+        runs += 1;
+    }
+    for (f, why) in REFUSED {
+        let (code, err, _, _) = run(&carla(f), &["--ego-speed", "8", "--horizon", "60"]);
+        assert_eq!(code, 2, "{f} is refused at load: {err}");
+        assert!(err.contains(why), "{f}: {why:?} not in {err}");
+        // Its file (or the catalog holding the element), line and column.
+        let at = [f, "ManeuverCatalog.xosc"]
+            .iter()
+            .filter_map(|name| err.split(&format!("{name}:")).nth(1))
+            .next();
+        assert!(
+            at.is_some_and(|rest| rest.starts_with(|c: char| c.is_ascii_digit())),
+            "{f} names its file, line and column: {err}"
+        );
+    }
+    // The counts: scenario_runner ships 16 examples; none ran before this reading.
+    assert_eq!(runs + REFUSED.len(), 16);
+    assert!(runs >= 3, "{runs} of 16 CARLA examples run");
+}
+
+/// `FollowLeadingVehicle`: the hero, at road 4 s 48.58 and t 2.75 in CARLA's frame (2.75 m to
+/// the right of the reference line: lane −1, as the file's own commented-out `LanePosition`
+/// says), drives at the set speed `--ego-speed` gives; once it is within 40 m (free space)
+/// of the adversary, 50 m ahead and 1 m to its left, the adversary keeps 2 m/s for 20 m and
+/// then stops for 10 s, and the scenario ends with its story. Before, the hero was refused
+/// (its `AssignControllerAction`), and read as the standard reads it, the act never started
+/// (its start conditions hold at different times) and the adversary stood still.
+#[test]
+fn carlas_follow_leading_vehicle_plays_as_scenario_runner_reads_it() {
+    let file = carla("FollowLeadingVehicle.xosc");
+    // Without --maps the town is nowhere: refused, saying where it is looked for.
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args([
+            "--ego-speed",
+            "8",
+            "--horizon",
+            "60",
+            "--budget",
+            "1",
+            "--out",
+        ])
+        .arg(tempfile::tempdir().unwrap().path().join("o"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("Town01") && err.contains("--maps DIR"),
+        "{err}"
+    );
+    let (code, err, _, _) = run(&file, &["--horizon", "60"]);
+    assert_eq!(code, 2, "no speed asked of the hero: {err}");
+    assert!(
+        err.contains("FollowLeadingVehicle.xosc:13:5") && err.contains("--ego-speed"),
+        "{err}"
+    );
+    let (code, err, r, trace) = run(
+        &file,
+        &[
+            "--ego-speed",
+            "8",
+            "--horizon",
+            "60",
+            "--trace",
+            "--trace-every",
+            "0.5",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(r["status"], "pass", "{r}");
+    let hero = track(&trace, "hero");
+    let adversary = track(&trace, "adversary");
+    // In CARLA's frame: the hero on the right lane (south of the road's reference line,
+    // which runs east at y ≈ −132.5), the adversary 1 m to its left.
+    let (_, _, hx, hy) = hero[0];
+    let (_, _, ax, ay) = adversary[0];
+    assert!((ax - hx - 50.0).abs() < 0.5, "50 m ahead: {hx} {ax}");
+    assert!(
+        (ay - hy - 1.0).abs() < 0.05,
+        "1 m to the hero's left: {hy} {ay}"
+    );
+    // The adversary moves 20 m at 2 m/s, then stands.
+    let moved = adversary.last().unwrap().2 - ax;
+    assert!(
+        (moved - 20.0).abs() < 0.2,
+        "the adversary kept 2 m/s for {moved} m"
+    );
+    assert!(adversary.iter().any(|a| (a.1 - 2.0).abs() < 1e-6));
+    // The hero drove up behind it and stopped; the test ended with the story (the 10 s
+    // wait), long before the horizon.
+    assert!(
+        hero.iter().any(|h| h.1 > 7.0),
+        "the hero reached its set speed"
+    );
+    let end = r["metrics"]["simulated_s"].as_f64().unwrap();
+    assert!(end > 15.0 && end < 30.0, "ended with its story at {end} s");
+}
