@@ -1532,3 +1532,69 @@ fn an_ego_of_no_size_is_refused_at_its_box() {
         assert!(err.contains("cannot be the ego"), "{err}");
     }
 }
+
+/// A speed parameter whose level is 0 asks the driven ego to stand: such a test, whose ego
+/// never moves, ends as an error when its storyboard ends, not as a pass; the level that
+/// asks it to drive runs as before. The file asks the ego a speed, so the load takes it.
+#[test]
+fn a_test_whose_values_ask_the_ego_no_speed_is_an_error_not_a_pass() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("stand.xosc");
+    let text = brake_scenario("false", 20.0, "leadingReferencedEntity").replacen(
+        r#"<AbsoluteTargetSpeed value="12"/>"#,
+        r#"<AbsoluteTargetSpeed value="$EgoSpeed"/>"#,
+        1,
+    );
+    let text = text.replace(
+        r#"<ParameterDeclaration name="LeadBrake""#,
+        r#"<ParameterDeclaration name="EgoSpeed" parameterType="double" value="12"/>
+<ParameterDeclaration name="LeadBrake""#,
+    );
+    std::fs::write(&file, text).unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args([
+            "--open",
+            "EgoSpeed=0,12",
+            "--strategy",
+            "variation",
+            "--budget",
+            "2",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    let records: Vec<serde_json::Value> = std::fs::read_to_string(out.join("results.jsonl"))
+        .unwrap_or_else(|e| panic!("{e}: {err}"))
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(records.len(), 2, "{err}");
+    for r in &records {
+        let v = r["params"]["EgoSpeed"].as_f64().unwrap();
+        if v == 0.0 {
+            assert_eq!(r["status"], "error", "{r}");
+            let e = r["error"].as_str().unwrap();
+            assert!(e.contains("asked it no speed above 0.1 m/s"), "{e}");
+        } else {
+            assert!(r["error"].is_null(), "{r}");
+        }
+    }
+    // And --ego-speed, meant for a file that asks the ego no speed, is refused with one
+    // that does, naming its SpeedAction.
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args(["--ego-speed", "9", "--budget", "1", "--out"])
+        .arg(dir.path().join("out2"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("stand.xosc:") && err.contains("--ego-speed is for a file that asks none"),
+        "{err}"
+    );
+}

@@ -218,3 +218,50 @@ fn carlas_follow_leading_vehicle_plays_as_scenario_runner_reads_it() {
     let end = r["metrics"]["simulated_s"].as_f64().unwrap();
     assert!(end > 15.0 && end < 30.0, "ended with its story at {end} s");
 }
+
+/// A campaign whose town is found with a relative `--maps` resumes bare from another folder:
+/// campaign.json keeps the folder absolute, and the fingerprint names the map by its place in
+/// the folder of maps, not by the path typed.
+#[test]
+fn a_campaign_with_maps_resumes_bare_from_another_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let run = |cwd: &Path, args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+            .args(args)
+            .current_dir(cwd)
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .output()
+            .unwrap();
+        (
+            o.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let file = carla("FollowLeadingVehicle.xosc");
+    let (code, err) = run(
+        root,
+        &[
+            file.to_str().unwrap(),
+            "--maps",
+            "tests/data/maps/carla",
+            "--ego-speed",
+            "8",
+            "--horizon",
+            "30",
+            "--budget",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("campaign.json")).unwrap()).unwrap();
+    let maps = json["scenario"]["maps"].as_str().unwrap();
+    assert!(Path::new(maps).is_absolute(), "{maps}");
+    let (code, err) = run(dir.path(), &["--resume", "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("refusing"), "{err}");
+}

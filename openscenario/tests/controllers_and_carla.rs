@@ -191,3 +191,24 @@ fn a_file_set_told_so_reads_any_file_as_carlas() {
         "CARLA's assignment takes over at once"
     );
 }
+
+/// scenario_runner adds a relative object position's offsets along the world's axes, as a
+/// relative world position's: in CARLA's reading it is one, its `dy` reversed.
+#[test]
+fn a_carla_relative_object_position_is_along_the_worlds_axes() {
+    let rel = r#"<RelativeObjectPosition entityRef="Ego" dx="5" dy="1"/>"#;
+    for (desc, world, dy) in [("plain", false, 1.0), ("CARLA:Rel", true, -1.0)] {
+        let s = read("rel", &scenario(0, desc, rel, CARLA_AGENT)).unwrap();
+        match &s.init[0].1.action {
+            Action::Teleport(Position::RelativeWorld { dx, dy: got, .. }) => {
+                assert!(world, "{desc}");
+                assert_eq!((*dx, *got), (5.0, dy));
+            }
+            Action::Teleport(Position::RelativeObject { dy: got, .. }) => {
+                assert!(!world, "{desc}");
+                assert_eq!(*got, dy);
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+}

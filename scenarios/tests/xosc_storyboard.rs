@@ -674,3 +674,35 @@ fn an_activated_controller_the_storyboard_cannot_stand_for_is_refused() {
         "{warnings:?}"
     );
 }
+
+/// In CARLA's reading a condition latches while its element waits, and only then: an event
+/// run again (`maximumExecutionCount` 3) waits afresh, so a condition that held once before
+/// its first run (`time < 0.05`) does not fire it again. Each run changes the box's speed at
+/// once, so the event ends in the step it starts and is rearmed within that step.
+#[test]
+fn a_latch_does_not_outlive_the_run_its_event_waited_for() {
+    let init = r#"<Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>"#;
+    let stories = format!(
+        r#"<Story name="S"><Act name="Act"><ManeuverGroup maximumExecutionCount="1" name="G">
+          <Actors selectTriggeringEntities="false"><EntityRef entityRef="A"/></Actors>
+          <Maneuver name="M"><Event name="Go" priority="overwrite" maximumExecutionCount="3">
+            <Action name="Go">{go}</Action>
+            <StartTrigger><ConditionGroup>
+              <Condition name="Early" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="0.05" rule="lessThan"/></ByValueCondition></Condition>
+              <Condition name="Late" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="1" rule="greaterThan"/></ByValueCondition></Condition>
+            </ConditionGroup></StartTrigger></Event></Maneuver></ManeuverGroup>
+          <StartTrigger><ConditionGroup><Condition name="S" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition></Condition></ConditionGroup></StartTrigger></Act></Story>"#,
+        go = step_to(2.0),
+    );
+    let text = on_straight_road("CARLA:Rearm", &box_object("A"), init, &stories, 5.0);
+    let mut sb = storyboard_of("carla-rearm", &text).unwrap();
+    let mut starts = 0;
+    run(&mut sb, 5.0, |_, sb| {
+        starts += sb
+            .transitions()
+            .iter()
+            .filter(|(kind, name, what)| *kind == "event" && *name == "Go" && *what == "start")
+            .count();
+    });
+    assert_eq!(starts, 1, "the event ran once: its rearm waits afresh");
+}

@@ -289,11 +289,11 @@ fn read_with(
         r.note(
             need(text, root, "FileHeader")?,
             "read as CARLA's scenario_runner reads its files (the description starts with \
-             CARLA:, or --carla): in CARLA's \
-             left-handed frame: world y, headings and lateral offsets (t, dt, offset, dy, the \
-             offsets of lane offset and lane change actions) are read with their sign \
-             reversed, conditions latch, a SpeedAction lasts its dynamics' \
-             distance or time, and the scenario ends with its stories",
+             CARLA:, or --carla): positions in CARLA's left-handed frame (world y, headings \
+             and lateral offsets, t, dt, offset, dy and the offsets of lane offset and lane \
+             change actions, with their sign reversed), conditions that latch, a SpeedAction \
+             that lasts its dynamics' distance or time, and a scenario that ends with its \
+             stories",
         );
     }
     let variables = read_variables(&r, child(root, "VariableDeclarations"))?;

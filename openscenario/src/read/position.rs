@@ -85,13 +85,14 @@ fn route(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
         "FromLaneCoordinates" => InRoute::Lane {
             path_s: s.num_in(t, w, "pathS", Quantity::Distance)?,
             lane: lane_id(r, w, "laneId")?,
-            offset: s
-                .opt_num_in(t, w, "laneOffset", Quantity::Lateral)?
-                .unwrap_or(0.0),
+            offset: r.flip(
+                s.opt_num_in(t, w, "laneOffset", Quantity::Lateral)?
+                    .unwrap_or(0.0),
+            ),
         },
         _ => InRoute::Road {
             path_s: s.num_in(t, w, "pathS", Quantity::Distance)?,
-            t: s.num_in(t, w, "t", Quantity::Lateral)?,
+            t: r.flip(s.num_in(t, w, "t", Quantity::Lateral)?),
         },
     };
     Ok(Position::Route {
@@ -135,7 +136,7 @@ fn world(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
 
 /// A `<RelativeWorldPosition>` or `<RelativeObjectPosition>` (as `tag` says): the entity and
 /// the offsets `dx`, `dy` (m) from it, with its orientation; a `dz` other than 0 is noted as
-/// not honoured.
+/// not honoured. In CARLA's reading both are offsets along the world's axes.
 fn relative(r: &Reader<'_>, p: Node<'_, '_>, tag: &str) -> Result<Position, XoscError> {
     let (s, t) = (&r.scope, r.text);
     if s.opt_num(t, p, "dz")?.is_some_and(|v| v != 0.0) {
@@ -150,7 +151,9 @@ fn relative(r: &Reader<'_>, p: Node<'_, '_>, tag: &str) -> Result<Position, Xosc
         r.flip(s.num_in(t, p, "dy", Quantity::Distance)?),
     );
     let orientation = orientation(r, p)?;
-    Ok(if tag == "RelativeWorldPosition" {
+    // scenario_runner adds a relative object position's offsets along the world's axes, as
+    // a relative world position's (its `convert_position_to_transform`).
+    Ok(if tag == "RelativeWorldPosition" || r.carla {
         Position::RelativeWorld {
             entity,
             dx,

@@ -317,8 +317,10 @@ pub fn campaign_scenario(x: &XoscRef) -> Result<crate::Scenario, ScenarioError> 
         files,
         // The file's name and options, not its folder: the fingerprint of a campaign is the
         // same from any folder and on any machine (shards on other mount points merge).
+        // `--maps` too: its maps are fingerprinted as input files, by their place in it.
         name: XoscRef {
             xosc: file_name(path),
+            maps: None,
             ..x.clone()
         }
         .to_string(),

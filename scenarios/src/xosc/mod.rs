@@ -186,7 +186,7 @@ pub fn ego_of(
                 .maneuvers
                 .iter()
                 .flat_map(|mv| &mv.events)
-                .any(|ev| ev.actions.iter().any(|na| na.action.hands_over()));
+                .any(|ev| ev.actions.iter().any(|na| hands_to_a_driver(&na.action)));
             activates.then(|| g.actors.first().copied()).flatten()
         });
     let by_name = || {
@@ -467,6 +467,21 @@ fn activated(
     })
 }
 
+/// Whether `a` hands its entity to a driver other than the storyboard: an activation, or an
+/// assignment that activates a controller of a kind other than [`STORYBOARD_CONTROLLERS`]
+/// (CARLA's NPC controller, assigned in a story, marks no ego).
+fn hands_to_a_driver(a: &Action) -> bool {
+    match a {
+        Action::AssignController { kind, .. } => {
+            a.hands_over()
+                && !kind
+                    .as_deref()
+                    .is_some_and(|k| STORYBOARD_CONTROLLERS.contains(&k))
+        }
+        _ => a.hands_over(),
+    }
+}
+
 /// CARLA's controller of a vehicle that follows the storyboard's actions along its lane
 /// (scenario_runner's `NpcVehicleControl`), and esmini's (`DefaultController`): paracosm's
 /// storyboard moves an entity so.
@@ -503,8 +518,9 @@ fn assigned(
         let part = match activated {
             (Some(true), Some(true)) => String::new(),
             _ if !na.action.hands_over() => format!(
-                ", when an ActivateControllerAction activates it ({} does not)",
-                if init { "Init" } else { "this action" }
+                " (this assignment{} activates nothing: the system drives {name} from an \
+                 ActivateControllerAction on it, or from the start without one)",
+                if init { " in Init" } else { "" }
             ),
             (Some(true), _) => ", its speed too (this action activates only steering)".into(),
             _ => ", its steering too (this action activates only speed)".into(),
@@ -656,7 +672,7 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
         ),
         files: (front_end.maps.inputs().into_iter())
             .map(|f| crate::InputFile {
-                path: relative_to(&source.files_base, &f.path),
+                path: input_name(&source.files_base, source.files.maps(), &f.path),
                 ..f
             })
             .collect(),
@@ -668,6 +684,20 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
         map_axes_by_relevance: true,
     };
     Scenario::new(Arc::new(front_end))
+}
+
+/// How a campaign names input file `path`: relative to the folder `base` ([`relative_to`]), or,
+/// when it lies outside it, relative to the folder of maps it was found in (`--maps`), as
+/// `--maps/NAME`: the same from any folder and for any `--maps` path to the same folder.
+fn input_name(base: &std::path::Path, maps: &[PathBuf], path: &str) -> String {
+    let named = relative_to(base, path);
+    if named != path {
+        return named;
+    }
+    (maps.iter())
+        .map(|d| relative_to(d, path))
+        .find(|r| r != path)
+        .map_or(named, |r| format!("--maps/{r}"))
 }
 
 /// `path` relative to the folder `base` when it lies inside it (both resolved by the file
@@ -712,41 +742,33 @@ struct XoscFrontEnd {
     findings: crate::front_end::Findings,
 }
 
-/// Refuses a scenario that never asks the ego `ego`, which a system under test drives, to
-/// drive (no `SpeedAction` on it with a target above [`STILL_MPS`], in `Init` or a story)
-/// when no set speed is `given` (`--ego-speed`, finite and `> 0`): the system would hold
-/// the ego still, and a test whose ego never moves tests nothing the file describes.
-/// CARLA's files leave the ego's speed to the agent that drives it.
+/// Refuses a scenario that never asks the ego `ego`, which a system under test drives, for a
+/// speed (no `SpeedAction` on it, in `Init` or a story) when no set speed is `given`
+/// (`--ego-speed`, finite and `> 0`): the system would hold the ego still, and a test whose
+/// ego never moves tests nothing the file describes. CARLA's files leave the ego's speed to
+/// the agent that drives it. A speed the file asks (whatever its value: a parameter's level
+/// may be 0, which the test's end judges, [`MOVED_M`]) and one given are refused together.
 ///
 /// # Errors
-/// [`ScenarioError::Load`] naming the ego's `ScenarioObject`: no speed asked and none given;
-/// or `given` is not finite and `> 0`.
+/// [`ScenarioError::Load`]: naming the ego's `ScenarioObject` when no speed is asked and none
+/// given; naming the file's `SpeedAction` when both are; `given` not finite and `> 0`.
 pub fn check_the_ego_is_asked_to_drive(
     model: &m::Scenario,
     ego: usize,
     given: Option<f64>,
 ) -> Result<(), ScenarioError> {
     let e = &model.entities[ego];
-    if let Some(v) = given {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(worlds_error(format!(
-                "--ego-speed must be a speed > 0 m/s, not {v}"
-            )));
-        }
-        return Ok(());
+    if given.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
+        return Err(worlds_error(format!(
+            "--ego-speed must be a speed > 0 m/s, not {}",
+            given.unwrap_or_default()
+        )));
     }
-    let drives = |a: &Action| match a {
-        Action::Speed { target, .. } => match target {
-            m::SpeedTarget::Absolute(v) => *v > STILL_MPS,
-            // Relative to another entity's speed: it may ask the ego to drive.
-            _ => true,
-        },
-        _ => false,
-    };
-    let in_init = model
-        .init
-        .iter()
-        .any(|(i, na)| *i == ego && drives(&na.action));
+    let speed = |na: &&m::NamedAction| matches!(na.action, Action::Speed { .. });
+    let in_init = (model.init.iter())
+        .filter(|(i, _)| *i == ego)
+        .map(|(_, na)| na)
+        .find(speed);
     let in_stories = (model.stories.iter())
         .flat_map(|st| &st.acts)
         .flat_map(|a| &a.groups)
@@ -754,17 +776,22 @@ pub fn check_the_ego_is_asked_to_drive(
         .flat_map(|g| &g.maneuvers)
         .flat_map(|mv| &mv.events)
         .flat_map(|ev| &ev.actions)
-        .any(|na| drives(&na.action));
-    if in_init || in_stories {
-        return Ok(());
+        .find(speed);
+    match (in_init.or(in_stories), given) {
+        (None, Some(_)) | (Some(_), None) => Ok(()),
+        (Some(na), Some(_)) => Err(worlds_error(format!(
+            "{}: the file asks the ego {} its speed here, and --ego-speed is for a file that \
+             asks none: leave it out, or open the file's speed parameter with --open",
+            na.pos, e.name
+        ))),
+        (None, None) => Err(worlds_error(format!(
+            "{}: the file asks the ego {} no speed (no SpeedAction on it): the system under \
+             test would have no set speed and hold it still, and a test whose ego never moves \
+             tests nothing the file describes. Give the system its set speed with --ego-speed \
+             M/S (CARLA's files leave it to the agent that drives the ego)",
+            e.pos, e.name
+        ))),
     }
-    Err(worlds_error(format!(
-        "{}: the file asks the ego {} no speed (no SpeedAction on it above {STILL_MPS} m/s): \
-         the system under test would have no set speed and hold it still, and a test whose \
-         ego never moves tests nothing the file describes. Give the system its set speed \
-         with --ego-speed M/S (CARLA's files leave it to the agent that drives the ego)",
-        e.pos, e.name
-    )))
 }
 
 /// The longest test of `model`, s: `given` (`--horizon`), else [`HORIZON_CAP_S`] when the
@@ -1289,9 +1316,10 @@ pub const MOVED_M: f64 = 0.5;
 pub const STILL_MPS: f64 = 0.1;
 
 impl StoryHost {
-    /// At the end of the storyboard (`t`, s): an error when the file asked the driven ego to
-    /// drive and it travelled less than [`MOVED_M`]: the test tested nothing the file
-    /// describes and must not read as a pass.
+    /// At the end of the storyboard (`t`, s): an error when the driven ego travelled less
+    /// than [`MOVED_M`], whether the file asked it to drive (the system under test never
+    /// did) or asked it no speed above [`STILL_MPS`] with this test's values: the test tested
+    /// nothing the file describes and must not read as a pass.
     ///
     /// # Errors
     /// A [`HostError`] that says so, with the speed asked and the distance travelled.
@@ -1309,12 +1337,22 @@ impl StoryHost {
             Some(Some((_, then))) => travelled -= then,
             None => {}
         }
+        let name = &self.sb.actors[self.ego].name;
         if self.most_asked_mps > STILL_MPS && travelled < MOVED_M {
             return Err(HostError(format!(
-                "t = {t:.2} s: the storyboard ended, and the ego {} travelled {travelled:.2} m \
-                 though the file asked it to drive at up to {:.2} m/s: the system under test \
-                 never drove it, so the test tested nothing the file describes",
-                self.sb.actors[self.ego].name, self.most_asked_mps
+                "t = {t:.2} s: the storyboard ended, and the ego {name} travelled \
+                 {travelled:.2} m though the file asked it to drive at up to {:.2} m/s: the \
+                 system under test never drove it, so the test tested nothing the file \
+                 describes",
+                self.most_asked_mps
+            )));
+        }
+        if travelled < MOVED_M {
+            return Err(HostError(format!(
+                "t = {t:.2} s: the storyboard ended, and the ego {name} travelled \
+                 {travelled:.2} m: with this test's values the file asked it no speed above \
+                 {STILL_MPS} m/s, so the system under test held it still, and a test whose ego \
+                 never moves tests nothing the file describes"
             )));
         }
         Ok(())

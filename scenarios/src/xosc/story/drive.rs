@@ -50,7 +50,8 @@ impl Storyboard {
         if let Some(task) = self.drives[e].speed {
             let (v, over) = task.step(t1, |r| self.actors[r].state.speed);
             v1 = v;
-            if over && task.ends(t1, st.travelled_m) {
+            // A hold by distance (CARLA's reading) counts this step's move.
+            if over && task.ends(t1, st.travelled_m + v.max(0.0) * dt) {
                 self.drives[e].speed = None;
                 done.push(task.action);
             }

@@ -448,11 +448,13 @@ impl Storyboard {
         }
     }
 
-    /// Forgets the transitions trigger `k`'s conditions have not read.
+    /// Forgets the transitions trigger `k`'s conditions have not read, and unlatches them
+    /// (CARLA's reading, [`Storyboard::carla`]): its element waits afresh.
     pub(in crate::xosc::story) fn reset_trigger(&mut self, k: usize) {
         let now = self.seq;
         for c in self.triggers[k].iter_mut().flatten() {
             c.seen = now;
+            c.latched = false;
         }
     }
 

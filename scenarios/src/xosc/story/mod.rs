@@ -135,9 +135,9 @@ pub struct Storyboard {
     /// Whether the storyboard is read as CARLA's scenario_runner reads its files
     /// ([`m::Scenario::carla`]): a condition once true stays true while its element waits,
     /// and its edge is not read (scenario_runner wraps each condition in a one-shot
-    /// behaviour and has no edges); the storyboard ends when its stories have; a `SpeedAction` sets its target at once and lasts its
-    /// dynamics' value, a distance travelled (m) or a time (s), as its
-    /// `ChangeActorTargetSpeed` does ([`speed::Hold`]).
+    /// behaviour and has no edges); the storyboard ends when its stories have; a
+    /// `SpeedAction` sets its target at once and lasts its dynamics' value, a distance
+    /// travelled (m) or a time (s), as its `ChangeActorTargetSpeed` does ([`speed::Hold`]).
     carla: bool,
     /// Whether an `OffroadCondition` reads how long each entity has been off the road
     /// ([`State::offroad_s`]).
