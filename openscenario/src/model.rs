@@ -111,8 +111,41 @@ pub struct Entity {
     pub box_pos: Pos,
     /// The name of the controller its `ObjectController` assigns, if any.
     pub controller: Option<String>,
+    /// Its `Performance`: the limits on the speed changes the storyboard makes it perform.
+    pub performance: Performance,
     /// Where it is declared.
     pub pos: Pos,
+}
+
+/// A vehicle's `Performance` (OpenSCENARIO 1.3, `Performance`), as esmini applies it to the
+/// `SpeedAction`s of the entities its storyboard moves: the target speed at most
+/// `max_speed_mps` in magnitude, and a transition's change of speed per step within
+/// `[−max_deceleration_mps2, max_acceleration_mps2]` (`LongSpeedAction::Step`). Pedestrians
+/// and miscellaneous objects have none (unbounded).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Performance {
+    /// `maxSpeed`, m/s (`> 0`).
+    pub max_speed_mps: f64,
+    /// `maxAcceleration`, m/s² (`> 0`).
+    pub max_acceleration_mps2: f64,
+    /// `maxDeceleration`, m/s² (`> 0`, a magnitude).
+    pub max_deceleration_mps2: f64,
+}
+
+impl Performance {
+    /// No limits: every value infinite.
+    pub const UNBOUNDED: Performance = Performance {
+        max_speed_mps: f64::INFINITY,
+        max_acceleration_mps2: f64::INFINITY,
+        max_deceleration_mps2: f64::INFINITY,
+    };
+    /// esmini's defaults for a vehicle whose `Performance` does not give a value: 100 m/s,
+    /// 10 m/s², 10 m/s² (`Vehicle::Vehicle` in esmini's `Entities.cpp`).
+    pub const VEHICLE_DEFAULT: Performance = Performance {
+        max_speed_mps: 100.0,
+        max_acceleration_mps2: 10.0,
+        max_deceleration_mps2: 10.0,
+    };
 }
 
 /// A story.
@@ -340,9 +373,15 @@ pub enum Action {
         /// corners only); else `follow`, also when the element is missing, as esmini reads
         /// it (the heading turns along each whole leg).
         position_mode: bool,
+        /// `initialDistanceOffset`, m (`>= 0`; 0 when absent): where along the trajectory the
+        /// entity starts, as esmini places it when the action starts (untimed only).
+        initial_offset_m: f64,
     },
     /// `AcquirePositionAction`: a route from where the entity is to this position.
     AcquirePosition(Position),
+    /// `SynchronizeAction`: the entity's speed is set each step so that it reaches its
+    /// target position when the master entity reaches the master's.
+    Synchronize(Box<Synchronize>),
     /// `AssignRouteAction`: a route through waypoints (the first is where the entity is
     /// routed from), each with its `routeStrategy`.
     AssignRoute {
@@ -415,6 +454,47 @@ pub enum Action {
     },
 }
 
+/// A `SynchronizeAction` (OpenSCENARIO 1.3 User Guide, "SynchronizeAction"): its entity
+/// arrives at `target` when `master` arrives at `master_target`, at the final speed if one
+/// is given.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Synchronize {
+    /// The master entity (`masterEntityRef`).
+    pub master: usize,
+    /// Where the master is headed (`TargetPositionMaster`).
+    pub master_target: Position,
+    /// Where the entity is headed (`TargetPosition`).
+    pub target: Position,
+    /// `targetToleranceMaster`, m (`>= 0`; 0 when absent, as esmini reads it).
+    pub master_tolerance_m: f64,
+    /// `targetTolerance`, m (`>= 0`; 0 when absent).
+    pub tolerance_m: f64,
+    /// `FinalSpeed`, if given.
+    pub final_speed: Option<FinalSpeed>,
+}
+
+/// A `SynchronizeAction`'s `FinalSpeed`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FinalSpeed {
+    /// `AbsoluteSpeed` (`None`: the value, m/s) or `RelativeSpeedToMaster` (`Some(factor)`:
+    /// the master's speed times (`factor`) or plus the value, as the master moves).
+    pub relative: Option<bool>,
+    /// The speed, m/s, or the factor, or the difference to the master's speed, m/s.
+    pub value: f64,
+    /// The steady state held before the target (`TargetDistanceSteadyState`: a distance,
+    /// m; `TargetTimeSteadyState`: a time, s), if given.
+    pub steady: Option<SteadyState>,
+}
+
+/// How long a `SynchronizeAction`'s entity holds its final speed before its target.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SteadyState {
+    /// `TargetDistanceSteadyState`: the last metres, m.
+    Distance(f64),
+    /// `TargetTimeSteadyState`: the last seconds, s (the final speed times this, m).
+    Time(f64),
+}
+
 /// An `Environment` (inline or from an environment catalog): what an `EnvironmentAction`
 /// sets. Each part is `None` where the element does not give it (the world keeps it).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -445,6 +525,7 @@ impl Action {
             Action::FollowTrajectory { .. } => "FollowTrajectoryAction",
             Action::AssignRoute { .. } => "AssignRouteAction",
             Action::AcquirePosition(_) => "AcquirePositionAction",
+            Action::Synchronize(_) => "SynchronizeAction",
             Action::ActivateController { .. } => "ActivateControllerAction",
             Action::AssignController { .. } => "AssignControllerAction",
             Action::OverrideController => "OverrideControllerValueAction",
@@ -510,6 +591,19 @@ pub enum TrajectoryShape {
         length: f64,
         /// `(startTime, stopTime)`, s.
         times: Option<(f64, f64)>,
+    },
+    /// `ClothoidSpline` (1.3): clothoid segments laid end to end from `start` (the entity's
+    /// pose when none), each `(curvature at its start, at its end, 1/m; length, m, > 0;
+    /// heading offset at its start, rad)`.
+    ClothoidSpline {
+        /// Where the first segment starts (its `PositionStart`), and the heading it starts
+        /// with.
+        start: Option<Position>,
+        /// `(curvatureStart, curvatureEnd, length, hOffset)` of each segment, in order.
+        segments: Vec<[f64; 4]>,
+        /// The segments after the first that give their own `PositionStart` (by index):
+        /// each starts there, not where the one before ends (as esmini lays them).
+        restarts: Vec<(usize, Position)>,
     },
     /// `Nurbs`: a rational B-spline of `order` (degree + 1, at least 2) over its control
     /// points `(time s, weight > 0, position)` and `knots` (control points + order of them,
@@ -617,6 +711,19 @@ pub enum Position {
         offset: f64,
         /// Orientation: relative to the lane's heading there (as the position faces without
         /// one), or absolute.
+        orientation: Option<Orientation>,
+    },
+    /// `TrajectoryPosition` (1.2+): `s` m along a trajectory's shape from its start, `t` m to
+    /// the left of it there, facing along it (turned by `orientation`, relative to that
+    /// direction, or absolute).
+    Trajectory {
+        /// The trajectory's shape (written in place or from a trajectory catalog).
+        shape: Box<TrajectoryShape>,
+        /// m along the shape (`>= 0`).
+        s: f64,
+        /// m to the left of the shape (`t`, 0 when absent).
+        t: f64,
+        /// Orientation, if given.
         orientation: Option<Orientation>,
     },
     /// `RoutePosition`: a place on a route (written in place or from a route catalog).
@@ -806,6 +913,23 @@ pub enum EntityTest {
         /// Comparison.
         rule: Rule,
         /// m.
+        value: f64,
+        /// From the entity's bounding box (its reference point otherwise).
+        freespace: bool,
+        /// `relativeDistanceType`: `longitudinal`, `lateral` or `euclidianDistance`.
+        kind: String,
+        /// `coordinateSystem`: `entity` or `road` (`lane` longitudinally).
+        frame: String,
+    },
+    /// `TimeToCollisionCondition` to a position: the distance to it (as a
+    /// `DistanceCondition` measures it) over the entity's speed, s; undefined (every rule
+    /// false) at no distance, standing, or moving away (esmini's `TrigByTimeToCollision`).
+    TimeToPosition {
+        /// The position.
+        position: Position,
+        /// Comparison.
+        rule: Rule,
+        /// s.
         value: f64,
         /// From the entity's bounding box (its reference point otherwise).
         freespace: bool,

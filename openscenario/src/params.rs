@@ -514,7 +514,7 @@ fn form(v: &str) -> Result<Form<'_>, (usize, String)> {
 }
 
 /// The names `v` refers to (for ordering a scope's declarations).
-fn refs_of(v: &str) -> Vec<String> {
+pub(crate) fn refs_of(v: &str) -> Vec<String> {
     match form(v) {
         Ok(Form::Ref(n)) => vec![n.to_string()],
         Ok(Form::Expr(inner, _)) => expr::params_in(inner),

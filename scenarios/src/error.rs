@@ -39,6 +39,17 @@ pub enum ScenarioError {
         /// The system's message.
         message: String,
     },
+    /// A test that reached its horizon but did not play as its scenario describes (an
+    /// OpenSCENARIO storyboard cut short while events still waited to start, an ego that
+    /// never moved): the message says what never happened and at what simulated time.
+    #[error("{message}")]
+    Unplayed {
+        /// The horizon's simulated time, s.
+        t_s: f64,
+        /// What did not happen, from `t = ... s:`, naming the elements and where they are
+        /// written.
+        message: String,
+    },
     /// An OpenSCENARIO file, or an option given with it, that a campaign cannot read: the
     /// message names the file (with the line and column) or the option.
     #[error("{message}")]

@@ -1,6 +1,6 @@
 use std::ops::ControlFlow;
 
-use paracosm_engine::rx::Host;
+use paracosm_engine::rx::{Host, HostError};
 use paracosm_engine::sut::SutConfig;
 use paracosm_engine::{
     CameraFrame, CameraSpec, Control, EgoState, Simulation, Snapshot, SnapshotParts, WorldSpec,
@@ -330,9 +330,7 @@ impl Scenario {
             .map(|m| m.build(judged.horizon_s))
             .collect();
         let mut watch = watch(spec, &judged.monitors, monitors);
-        // Whole steps covering the horizon: a horizon between two steps is rounded up (a
-        // horizon of 0.005 s is one step, not none), within 1e-9 of a step it is that step.
-        let ticks = ((judged.horizon_s / spec.dt_s - 1e-9).ceil() as u64).max(1);
+        let ticks = steps_covering(judged.horizon_s, spec.dt_s);
         // Streams are evaluated for the state a snapshot shows, so a published stream's value
         // and the runner's own signals describe the same moment.
         sim.evaluate(host)?;
@@ -385,8 +383,36 @@ impl Scenario {
             }
         }
 
+        if !stopped {
+            return at_horizon(watch, sim.t_s(), host);
+        }
         Ok(outcome(watch, tick < ticks, sim.t_s(), host.log()))
     }
+}
+
+/// The whole steps of `dt_s` (s) covering a horizon of `horizon_s` (s): a horizon between two
+/// steps is rounded up (a horizon of 0.005 s is one step, not none), within 1e-9 of a step it
+/// is that step.
+fn steps_covering(horizon_s: f64, dt_s: f64) -> u64 {
+    ((horizon_s / dt_s - 1e-9).ceil() as u64).max(1)
+}
+
+/// The outcome of a test that reached its horizon at `t_s` (s) before the scenario's own end:
+/// the monitors' verdicts, unless every monitor passed and the host says the test did not
+/// play (a storyboard still waiting to start its events, [`Host::finish`]).
+///
+/// # Errors
+/// [`ScenarioError::Unplayed`] with the host's reason.
+fn at_horizon(watch: Watch, t_s: f64, host: &mut dyn Host) -> Result<TestOutcome, ScenarioError> {
+    let end = outcome(watch, false, t_s, Vec::new());
+    if end.passed() {
+        host.finish(t_s)
+            .map_err(|HostError(message)| ScenarioError::Unplayed { t_s, message })?;
+    }
+    Ok(TestOutcome {
+        log: host.log(),
+        ..end
+    })
 }
 
 /// The monitors of one test and what they read: the published streams, and the runner's

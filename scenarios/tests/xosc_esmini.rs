@@ -162,12 +162,14 @@ fn check_all(files: &[PathBuf]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 22] = [
+const ESMINI_EXAMPLES: [&str; 28] = [
+    "acc-test",
     "alks_cut-in",
     "alks_cut-out",
     "alks_decelerate",
     "alks_pedestrian",
     "alks_r157_cut_in_quick_brake",
+    "alks-test",
     "cut-in",
     "cut-in_environment",
     "cut-in_simple",
@@ -178,11 +180,15 @@ const ESMINI_EXAMPLES: [&str; 22] = [
     "lane-change_trajectory_wp",
     "left-hand-traffic_by_heading",
     "left-hand-traffic_using_road_rule",
+    "ltap-od",
     "override_bb",
     "pedestrian",
+    "pedestrian_traj_synch",
     "slow-lead-vehicle",
     "straight_500m",
     "straight_500m_pedestrian",
+    "synch_with_steady_state",
+    "synchronize",
     "tunnels",
     "two_plus_one_road",
 ];
@@ -206,9 +212,14 @@ fn scenarios_written_here_move_as_in_esmini() {
 }
 
 /// Files nobody here wrote (`tests/data/xosc/third_party/`, PROVENANCE.md there): ASAM's
-/// examples and the Euro NCAP car-to-car rear files the `scenariogeneration` package writes,
-/// each as esmini moves it (CCRb keeps its target 12 m ahead of the ego by a continuous
-/// `LongitudinalDistanceAction` until the target brakes).
+/// examples, the Euro NCAP car-to-car rear files the `scenariogeneration` package writes
+/// (CCRb keeps its target 12 m ahead of the ego by a continuous `LongitudinalDistanceAction`
+/// until the target brakes) and Vector's Euro NCAP files whose entities move as esmini moves
+/// them (the cyclists of CBNA and CBNAO timed to the ego by a `SynchronizeAction` on route
+/// positions, CBLA's cyclist accelerating within its `Performance`, the pedestrians of CPNA
+/// and CPNCO timed to a `TrajectoryPosition`, the turning ego of CCFtap and CPTA and the
+/// oncoming car of CCFhol on clothoid splines, one with an `initialDistanceOffset`), each as
+/// esmini moves it.
 #[test]
 fn the_fields_files_move_as_in_esmini() {
     let files: Vec<PathBuf> = [
@@ -220,6 +231,7 @@ fn the_fields_files_move_as_in_esmini() {
         "asam_examples/SequentialEvents_0-100-0kph_Implicit.xosc",
         "asam_examples/SimpleOvertake.xosc",
         "asam_examples/SlowPrecedingVehicle.xosc",
+        "asam_examples/SynchronizedArrivalToIntersection.xosc",
         "asam_examples/TrafficJam.xosc",
         "scenariogeneration/CCRb_scenarios/xosc/CCRb0.xosc",
         "scenariogeneration/CCRb_scenarios/xosc/CCRb1.xosc",
@@ -228,6 +240,24 @@ fn the_fields_files_move_as_in_esmini() {
         "scenariogeneration/CCRm_scenarios/xosc/CCRm22.xosc",
         "scenariogeneration/CCRs_scenarios/xosc/CCRs42.xosc",
         "scenariogeneration/CCRs_scenarios/xosc/CCRs44.xosc",
+        "vector/OpenSCENARIO/NCAP/CA-FC_2026/CBNA.xosc",
+        "vector/OpenSCENARIO/NCAP/CA-FC_2026/CBNAO.xosc",
+        "vector/OpenSCENARIO/NCAP/CA-FC_2026/CBLA.xosc",
+        "vector/OpenSCENARIO/NCAP/CA-FC_2026/CCRs.xosc",
+        "vector/OpenSCENARIO/NCAP/CA-FC_2026/CCFhos.xosc",
+        "vector/OpenSCENARIO/NCAP/CA-FC_2026/CCFtap.xosc",
+        "vector/OpenSCENARIO/NCAP/CA-FC_2026/CPNA.xosc",
+        "vector/OpenSCENARIO/NCAP/CA-FC_2026/CPNCO.xosc",
+        "vector/OpenSCENARIO/NCAP/AEB_C2C_2023/NCAP_AEB_C2C_CCFtap_2023.xosc",
+        "vector/OpenSCENARIO/NCAP/AEB_C2C_2023/NCAP_AEB_C2C_CCFhol_2023.xosc",
+        "vector/OpenSCENARIO/NCAP/AEB_VRU_2023/NCAP_AEB_VRU_CPNA_2023.xosc",
+        "vector/OpenSCENARIO/NCAP/AEB_VRU_2023/NCAP_AEB_VRU_CPNCO_2023.xosc",
+        "vector/OpenSCENARIO/NCAP/AEB_VRU_2023/NCAP_AEB_VRU_CPTA_2023.xosc",
+        "vector/OpenSCENARIO/NCAP/AEB_VRU_2023/NCAP_AEB_VRU_CBNA_2023.xosc",
+        "vector/OpenSCENARIO/NCAP/AEB_VRU_2023/NCAP_AEB_VRU_CBNAO_2023.xosc",
+        "vector/OpenSCENARIO/NCAP/AEB_VRU_2023/NCAP_AEB_VRU_CBLA_2023.xosc",
+        "vector/OpenSCENARIO/NCAP/AEB_C2C_2023/NCAP_AEB_C2C_CCR_2023.xosc",
+        "vector/OpenSCENARIO/NCAP/AEB_C2C_2023/NCAP_AEB_C2C_CCFhos_2023.xosc",
     ]
     .iter()
     .map(|f| data("third_party").join(f))

@@ -706,3 +706,133 @@ fn a_latch_does_not_outlive_the_run_its_event_waited_for() {
     });
     assert_eq!(starts, 1, "the event ran once: its rearm waits afresh");
 }
+
+/// A car named `name` (4.6 × 1.9 × 1.5 m) whose `Performance` allows `max_acc` m/s², as a
+/// `ScenarioObject`.
+fn car_object(name: &str, max_acc: f64) -> String {
+    format!(
+        r#"<ScenarioObject name="{name}"><Vehicle name="car" vehicleCategory="car">
+        <BoundingBox><Center x="1.4" y="0" z="0.75"/><Dimensions width="1.9" length="4.6" height="1.5"/></BoundingBox>
+        <Performance maxSpeed="60" maxAcceleration="{max_acc}" maxDeceleration="9"/>
+        <Axles><FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/><RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/></Axles>
+        <Properties/></Vehicle></ScenarioObject>"#
+    )
+}
+
+/// `entity` placed on lane `lane` of the straight road at station `s` (m), with `Init`'s speed
+/// `v` (m/s).
+fn placed(entity: &str, lane: i32, s: f64, v: f64) -> String {
+    format!(
+        r#"<Private entityRef="{entity}"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="{lane}" s="{s}" offset="0"/></Position></TeleportAction></PrivateAction>{speed}</Private>"#,
+        speed = step_to(v)
+    )
+}
+
+/// One story in which `actor` performs `action` (a `PrivateAction`) from the start.
+fn story_of(actor: &str, action: &str) -> String {
+    format!(
+        r#"<Story name="S"><Act name="Act"><ManeuverGroup maximumExecutionCount="1" name="G">
+          <Actors selectTriggeringEntities="false"><EntityRef entityRef="{actor}"/></Actors>
+          <Maneuver name="M"><Event name="E" priority="overwrite"><Action name="A">{action}</Action>
+            <StartTrigger><ConditionGroup><Condition name="Now" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition></Condition></ConditionGroup></StartTrigger></Event>
+          </Maneuver></ManeuverGroup></Act></Story>"#
+    )
+}
+
+/// A `SynchronizeAction` times its entity to reach its target when the master reaches the
+/// master's (esmini's `SynchronizeAction::Step`): the master drives 200 m at 20 m/s, so the
+/// synchronized car, standing 100 m from its target, covers them in the same 10 s and arrives
+/// at the final speed asked (5 m/s), within a step; with a steady state of 2 s it drives its
+/// last 2 s at that speed. The action then ends and the speed stays.
+#[test]
+fn a_synchronized_entity_arrives_at_its_target_with_its_master_at_the_final_speed() {
+    for steady in ["", r#"<TargetTimeSteadyState time="2"/>"#] {
+        let sync = format!(
+            r#"<PrivateAction><SynchronizeAction masterEntityRef="Master">
+              <TargetPositionMaster><LanePosition roadId="0" laneId="-4" s="220" offset="0"/></TargetPositionMaster>
+              <TargetPosition><LanePosition roadId="0" laneId="-1" s="110" offset="0"/></TargetPosition>
+              <FinalSpeed><AbsoluteSpeed value="5">{steady}</AbsoluteSpeed></FinalSpeed>
+            </SynchronizeAction></PrivateAction>"#
+        );
+        let entities = format!("{}{}", box_object("Master"), box_object("Synced"));
+        let init = format!(
+            "{}{}",
+            placed("Master", -4, 20.0, 20.0),
+            placed("Synced", -1, 10.0, 0.0)
+        );
+        let text = on_straight_road("sync", &entities, &init, &story_of("Synced", &sync), 14.0);
+        let mut sb = storyboard_of("sync", &text).unwrap();
+        let (mut arrival, mut at_steady) = (None, None);
+        run(&mut sb, 14.0, |t, sb| {
+            let (m, y) = (&sb.actors[0].state, &sb.actors[1].state);
+            if arrival.is_none() && m.lane.unwrap().s >= 220.0 {
+                arrival = Some((t, y.lane.unwrap().s, y.speed));
+            }
+            if (t - 9.0).abs() < DT / 2.0 {
+                at_steady = Some(y.speed);
+            }
+        });
+        let (t, s, v) = arrival.expect("the master arrives");
+        assert!(
+            (t - 10.0).abs() < 2.0 * DT,
+            "{steady}: the master at 220 m at {t} s"
+        );
+        assert!(
+            (s - 110.0).abs() < 20.0 * DT,
+            "{steady}: the synchronized car at {s} m"
+        );
+        assert!((v - 5.0).abs() < 1e-9, "{steady}: at {v} m/s");
+        if !steady.is_empty() {
+            let v9 = at_steady.unwrap();
+            assert!(
+                (v9 - 5.0).abs() < 1e-9,
+                "in its steady state at 9 s: {v9} m/s"
+            );
+        }
+        assert_eq!(
+            sb.actors[1].state.speed, 5.0,
+            "{steady}: the final speed stays"
+        );
+    }
+}
+
+/// A vehicle's `Performance` limits the speed changes the storyboard makes it perform, as
+/// esmini's `LongSpeedAction` keeps them: asked from 0 to 20 m/s over 2 s, a car allowed 2 m/s²
+/// takes 10 s (10 m/s at 5 s), and its action ends once it is there; an object without limits
+/// follows the transition.
+#[test]
+fn a_vehicles_performance_limits_its_speed_changes() {
+    let speed = r#"<PrivateAction><LongitudinalAction><SpeedAction>
+        <SpeedActionDynamics dynamicsShape="linear" value="2" dynamicsDimension="time"/>
+        <SpeedActionTarget><AbsoluteTargetSpeed value="20"/></SpeedActionTarget>
+      </SpeedAction></LongitudinalAction></PrivateAction>"#;
+    for (object, at_5s, reached) in [
+        (car_object("A", 2.0), 10.0, 10.0),
+        (box_object("A"), 20.0, 2.0),
+    ] {
+        let text = on_straight_road(
+            "performance",
+            &object,
+            &placed("A", -4, 20.0, 0.0),
+            &story_of("A", speed),
+            12.0,
+        );
+        let mut sb = storyboard_of("performance", &text).unwrap();
+        let (mut v5, mut done) = (None, None);
+        run(&mut sb, 12.0, |t, sb| {
+            if (t - 5.0).abs() < DT / 2.0 {
+                v5 = Some(sb.actors[0].state.speed);
+            }
+            if done.is_none() && sb.transitions().contains(&("action", "A", "end")) {
+                done = Some(t);
+            }
+        });
+        let v5 = v5.unwrap();
+        assert!((v5 - at_5s).abs() < 0.05, "{v5} m/s at 5 s, not {at_5s}");
+        let done = done.expect("the action ends");
+        assert!(
+            (done - reached).abs() < 2.0 * DT,
+            "ended at {done} s, not {reached}"
+        );
+    }
+}

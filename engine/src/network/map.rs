@@ -84,9 +84,14 @@ impl MapLane {
         let (i, u) = self.locate(s);
         let (a, b) = (self.centre[i], self.centre[i + 1]);
         let p = [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])];
-        // The tangents at the two stations (central differences, exact on a circle),
-        // interpolated.
-        let (h0, h1) = (self.tangent(i), self.tangent(i + 1));
+        // The tangents at the two stations (central differences, exact on a circle; at the
+        // lane's ends carried on from the two nearest chords), interpolated.
+        let end = |j: usize| match j {
+            0 => self.end_tangent(false),
+            j if j + 1 == self.centre.len() => self.end_tangent(true),
+            j => self.tangent(j),
+        };
+        let (h0, h1) = (end(i), end(i + 1));
         let along = wrap(h0 + u * wrap(h1 - h0));
         let heading = if self.forward {
             along
@@ -123,9 +128,9 @@ impl MapLane {
     /// The direction of increasing `s` at the lane's last station (`last`) or its first, rad:
     /// the heading of the chord nearest that end, carried on to the end at the rate the
     /// headings of the two chords nearest it change (exact on a circle, where the heading is
-    /// linear in `s`). [`MapLane::pose`]'s one-sided difference there lags by half a sample,
-    /// `0.25 m / R` on a bend of radius `R` (1.4° at 10 m), which rounded a junction's 100°
-    /// turn to 99°.
+    /// linear in `s`), which [`MapLane::pose`] reads at the lane's ends. A one-sided
+    /// difference there lags by half a sample, `0.25 m / R` on a bend of radius `R` (1.4° at
+    /// 10 m), which rounded a junction's 100° turn to 99°.
     fn end_tangent(&self, last: bool) -> f64 {
         let n = self.centre.len();
         let chord = |i: usize| {
@@ -1277,9 +1282,10 @@ mod end_tangent_tests {
         MapLane::driving_for_tests(s, centre, 3.5)
     }
 
-    /// The heading at a bend's ends is its true tangent within 0.01°, where the one-sided
-    /// difference of `pose` lags by about 0.25 m / R (1.4° at R = 10 m): a 100° turn reads
-    /// +100°, not +99°.
+    /// The heading at a bend's ends is its true tangent within 0.01°, where a one-sided
+    /// difference would lag by about 0.25 m / R (1.4° at R = 10 m): a 100° turn reads +100°,
+    /// not +99°; `pose` reads the same there (it lagged until 2026-11-30: esmini's `ltap-od`
+    /// turned 0.0115 rad late at a junction's end).
     #[test]
     fn a_bends_end_heading_is_its_tangent() {
         for (r, deg) in [(10.0, 100.0_f64), (7.3, 90.0), (25.0, 45.0)] {
@@ -1289,9 +1295,13 @@ mod end_tangent_tests {
             assert!(start.abs() < 0.01, "r {r}: start {start}");
             assert!((end - deg).abs() < 0.01, "r {r}: end {end}, want {deg}");
             assert_eq!(format!("{:+.0}", end - start), format!("{deg:+.0}"));
-            // The old reading lagged.
-            let lagged = l.pose(l.s_range().1).1.to_degrees();
-            assert!((lagged - deg).abs() > 0.1, "r {r}: {lagged}");
+            let (s0, s1) = l.s_range();
+            let (at_start, at_end) = (l.pose(s0).1.to_degrees(), l.pose(s1).1.to_degrees());
+            assert!(at_start.abs() < 0.01, "r {r}: pose at the start {at_start}");
+            assert!(
+                (at_end - deg).abs() < 0.01,
+                "r {r}: pose at the end {at_end}"
+            );
         }
     }
 }

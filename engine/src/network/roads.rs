@@ -288,6 +288,23 @@ impl Roads {
     pub fn anchor(&self, x: f64, y: f64) -> Option<LanePos> {
         let p = self.od_to_engine(x, y);
         let (k, i, _) = self.index.nearest_lane_at(p)?;
+        Some(self.anchor_on(k, i, (x, y), p))
+    }
+
+    /// Every lane under the point `(x, y)` (OpenDRIVE frame, m) and where on each, nearest
+    /// centre line first: where roads overlap (a junction's connecting roads), each of them.
+    pub fn anchors(&self, x: f64, y: f64) -> Vec<LanePos> {
+        let p = self.od_to_engine(x, y);
+        self.index
+            .lanes_at(p)
+            .into_iter()
+            .map(|(k, i, _)| self.anchor_on(k, i, (x, y), p))
+            .collect()
+    }
+
+    /// The point `(x, y)` (OpenDRIVE frame; `p` in the engine's) on lane `k`, whose segment
+    /// at station `i` holds it.
+    fn anchor_on(&self, k: usize, i: usize, (x, y): (f64, f64), p: [f64; 2]) -> LanePos {
         let l = &self.map.lanes[k];
         let last = l.centre.len().saturating_sub(2);
         // The point's projection on segment `j`, as a share of it (unclamped), and the
@@ -332,12 +349,12 @@ impl Roads {
         let (c, along) = self.frame(k, s);
         let left = [-along.sin(), along.cos()];
         let d = (x - c[0]) * left[0] + (y - c[1]) * left[1];
-        Some(LanePos {
+        LanePos {
             lane: k,
             s,
             d,
             rev: false,
-        })
+        }
     }
 
     /// `lp` facing heading `h` (rad): against its lane's travel when `h` points against it.

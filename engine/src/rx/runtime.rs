@@ -58,6 +58,18 @@ pub trait Host {
     fn ended(&self) -> bool {
         false
     }
+
+    /// Called once when the test reaches its horizon at `t_s` (s) with no monitor failed and
+    /// the host not [`Host::ended`]: whether the test counts as played. The default host's
+    /// tests always count.
+    ///
+    /// # Errors
+    /// A [`HostError`] saying why the test cannot count (an OpenSCENARIO storyboard cut short
+    /// while its events still waited to start): the runner ends the test as an error.
+    fn finish(&mut self, t_s: f64) -> Result<(), HostError> {
+        let _ = t_s;
+        Ok(())
+    }
 }
 
 /// A [`Host`] without functions: every call is an error. For graphs built in Rust.

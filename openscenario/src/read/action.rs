@@ -1,6 +1,6 @@
 //! Private actions (OpenSCENARIO 1.3 User Guide, "Actions"): speed, longitudinal distance,
 //! lane change, lane offset, teleport, follow trajectory (polyline), activate controller; controller actions in
-//! `controller.rs`.
+//! `controller.rs`, synchronize in `synchronize.rs`.
 //! Every other action is refused with what is supported.
 
 use roxmltree::Node;
@@ -28,9 +28,11 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
             "ActivateControllerAction",
             "AppearanceAction",
             "VisibilityAction",
+            "SynchronizeAction",
         ],
     )?;
     match tag {
+        "SynchronizeAction" => super::synchronize::read(r, a),
         "AppearanceAction" => {
             let (kind, tag) = choice(r.text, a, &["LightStateAction", "AnimationAction"])?;
             let what = if tag == "LightStateAction" {
@@ -354,13 +356,14 @@ fn lane_offset(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> 
 /// `<Trajectory>`) or from a trajectory catalog (`<CatalogReference>` in either place), with
 /// its timing.
 fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
-    if r.scope
+    let initial_offset_m = r
+        .scope
         .opt_num_in(r.text, node, "initialDistanceOffset", Quantity::Distance)?
-        .is_some_and(|d| d != 0.0)
-    {
-        return Err(XoscError::Unsupported {
+        .unwrap_or(0.0);
+    if initial_offset_m < 0.0 {
+        return Err(XoscError::Invalid {
             pos: r.text.attr_pos(node, "initialDistanceOffset"),
-            reason: "a trajectory's initialDistanceOffset is not supported".into(),
+            reason: format!("initialDistanceOffset is a distance >= 0 m, not {initial_offset_m}"),
         });
     }
     let time_ref = need(r.text, node, "TimeReference")?;
@@ -399,20 +402,7 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
         }
     }
     let holder = child(node, "TrajectoryRef").unwrap_or(node);
-    let read = |r: &Reader<'_>, traj: Node<'_, '_>| trajectory(r, traj, timing.is_some());
-    let shape = match (
-        child(holder, "Trajectory"),
-        child(holder, "CatalogReference"),
-    ) {
-        (Some(traj), None) => read(&r.scoped(traj)?, traj)?,
-        (None, Some(c)) => r.catalogs.read_entry(r, c, &["Trajectory"], read)?,
-        _ => {
-            return Err(r.text.invalid(
-                holder,
-                "a trajectory is read from one <Trajectory> or one <CatalogReference> here",
-            ))
-        }
-    };
+    let shape = trajectory_of(r, holder, timing.is_some())?;
     let mut position_mode = false;
     if let Some(m) = child(node, "TrajectoryFollowingMode") {
         let mode = r.scope.string(r.text, m, "followingMode")?;
@@ -421,11 +411,46 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
             r.note(m, format!("followingMode {mode:?} places the entity on the trajectory as \"position\" does (its heading turns along each leg of a polyline, as esmini's does in this mode)"));
         }
     }
+    if initial_offset_m != 0.0 && timing.is_some() {
+        return Err(XoscError::Unsupported {
+            pos: r.text.attr_pos(node, "initialDistanceOffset"),
+            reason: "a timed trajectory's initialDistanceOffset is not supported: paracosm \
+                     starts part way along a trajectory only when it is followed at the \
+                     entity's speed"
+                .into(),
+        });
+    }
     Ok(Action::FollowTrajectory {
         shape,
         timing,
         position_mode,
+        initial_offset_m,
     })
+}
+
+/// The shape of the trajectory `holder` holds (a `TrajectoryRef`, or 1.0's action itself): one
+/// `<Trajectory>` or one trajectory catalog's `<CatalogReference>`; with `timed`, each of its
+/// points must have a time.
+///
+/// # Errors
+/// Invalid when `holder` holds neither or both; what reading the trajectory returns.
+pub(super) fn trajectory_of(
+    r: &Reader<'_>,
+    holder: Node<'_, '_>,
+    timed: bool,
+) -> Result<TrajectoryShape, XoscError> {
+    let read = |r: &Reader<'_>, traj: Node<'_, '_>| trajectory(r, traj, timed);
+    match (
+        child(holder, "Trajectory"),
+        child(holder, "CatalogReference"),
+    ) {
+        (Some(traj), None) => read(&r.scoped(traj)?, traj),
+        (None, Some(c)) => r.catalogs.read_entry(r, c, &["Trajectory"], read),
+        _ => Err(r.text.invalid(
+            holder,
+            "a trajectory is read from one <Trajectory> or one <CatalogReference> here",
+        )),
+    }
 }
 
 /// A `<Trajectory>`'s shape, read with `r`'s scope (the trajectory's own parameters in it);
@@ -452,11 +477,12 @@ fn trajectory(
     let (shape_node, kind) = choice(
         r.text,
         need(r.text, traj, "Shape")?,
-        &["Polyline", "Clothoid", "Nurbs"],
+        &["Polyline", "Clothoid", "ClothoidSpline", "Nurbs"],
     )?;
     let shape = match kind {
         "Polyline" => polyline(r, shape_node)?,
         "Clothoid" => clothoid(r, shape_node)?,
+        "ClothoidSpline" => clothoid_spline(r, shape_node)?,
         _ => nurbs(r, shape_node)?,
     };
     if timed_ {
@@ -526,6 +552,70 @@ fn clothoid(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, XoscErro
         curvature_prime: prime,
         length,
         times,
+    })
+}
+
+/// A `ClothoidSpline`: its `ClothoidSplineSegment`s (at least one; `curvatureStart`,
+/// `curvatureEnd`, `length` > 0, `hOffset` 0 when absent) and the first one's optional
+/// `PositionStart`.
+///
+/// A segment after the first with a `PositionStart` starts there (esmini's reading).
+///
+/// # Errors
+/// Invalid at a segment of no length, an empty spline; unsupported at times (`timeEnd`, a
+/// segment's `timeStart`: the spline is followed at the entity's speed).
+fn clothoid_spline(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, XoscError> {
+    let (sc, t) = (&r.scope, r.text);
+    crate::xml::only(t, c, &["ClothoidSplineSegment"])?;
+    if c.attribute("timeEnd").is_some() {
+        return Err(t.unsupported(
+            c,
+            "a clothoid spline's timeEnd is not supported: paracosm follows it at the entity's speed",
+        ));
+    }
+    let mut start = None;
+    let mut restarts = Vec::new();
+    let mut segments = Vec::new();
+    for (k, seg) in elements(c).enumerate() {
+        crate::xml::only(t, seg, &["PositionStart"])?;
+        if seg.attribute("timeStart").is_some() {
+            return Err(t.unsupported(
+                seg,
+                "a clothoid spline segment's timeStart is not supported: paracosm follows the spline at the entity's speed",
+            ));
+        }
+        if let Some(p) = child(seg, "PositionStart") {
+            let p = position::read(r, p)?;
+            if k == 0 {
+                start = Some(p);
+            } else {
+                restarts.push((k, p));
+            }
+        }
+        let length = sc.num_in(t, seg, "length", Quantity::Distance)?;
+        if !(length.is_finite() && length > 0.0) {
+            return Err(XoscError::Invalid {
+                pos: t.attr_pos(seg, "length"),
+                reason: format!("a clothoid spline segment's length must be > 0, not {length}"),
+            });
+        }
+        segments.push([
+            r.flip(sc.num_in(t, seg, "curvatureStart", Quantity::Curvature)?),
+            r.flip(sc.num_in(t, seg, "curvatureEnd", Quantity::Curvature)?),
+            length,
+            r.flip(sc.opt_num(t, seg, "hOffset")?.unwrap_or(0.0)),
+        ]);
+    }
+    if segments.is_empty() {
+        return Err(t.invalid(
+            c,
+            "a clothoid spline needs at least one <ClothoidSplineSegment>",
+        ));
+    }
+    Ok(TrajectoryShape::ClothoidSpline {
+        start,
+        segments,
+        restarts,
     })
 }
 
@@ -604,6 +694,7 @@ fn timed(r: &Reader<'_>, node: Node<'_, '_>, shape: &TrajectoryShape) -> Result<
     let times: Option<Vec<f64>> = match shape {
         TrajectoryShape::Polyline(v) => v.iter().map(|(t, _)| *t).collect(),
         TrajectoryShape::Clothoid { times, .. } => times.map(|(a, b)| vec![a, b]),
+        TrajectoryShape::ClothoidSpline { .. } => None,
         TrajectoryShape::Nurbs { points, .. } => points.iter().map(|(t, _, _)| *t).collect(),
     };
     match times {

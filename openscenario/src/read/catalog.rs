@@ -112,6 +112,21 @@ impl Catalogs {
                 {
                     let decls = read_declarations(&text, child(e, "ParameterDeclarations"))?;
                     let scope = Scope::new(&text, &decls, &assignments)?;
+                    let borrowed = borrowed_parameters(r, e, &scope);
+                    if borrowed.is_empty() {
+                        return read(&text, e, &scope);
+                    }
+                    // esmini resolves a name the entry does not declare in the scenario that
+                    // references it; the standard gives an entry its own declarations only.
+                    r.note(
+                        reference,
+                        format!(
+                            "catalog entry {entry:?} reads {}, which it does not declare: the \
+                             referencing scenario's value is used, as esmini reads it",
+                            borrowed.join(", ")
+                        ),
+                    );
+                    let scope = r.scope.child_with(&text, &decls, &assignments)?;
                     return read(&text, e, &scope);
                 }
                 missing.push(format!(
@@ -169,6 +184,24 @@ fn has_catalog_named(r: &Reader<'_>, dir: &Path, cat: &str) -> bool {
             })
         })
     })
+}
+
+/// The parameters (`$name`) that catalog entry `e`'s attributes read but that neither its own
+/// scope `own` nor the standard gives it, and that the referencing scope declares: each once,
+/// in the order first read.
+fn borrowed_parameters(r: &Reader<'_>, e: Node<'_, '_>, own: &Scope) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for n in e.descendants().filter(Node::is_element) {
+        for a in n.attributes() {
+            for name in crate::params::refs_of(a.value()) {
+                if own.get(&name).is_none() && r.scope.get(&name).is_some() && !out.contains(&name)
+                {
+                    out.push(name);
+                }
+            }
+        }
+    }
+    out.into_iter().map(|n| format!("${n}")).collect()
 }
 
 /// The reference's `ParameterAssignments`, each value resolved in the scenario's scope.

@@ -422,12 +422,25 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
     Ok(match tag {
         "TimeHeadwayCondition" => EntityTest::TimeHeadway(gap(r, c, c, Quantity::Duration)?),
         "TimeToCollisionCondition" => {
-            let (target, _) = choice(
+            let (target, tag) = choice(
                 t,
                 need(t, c, "TimeToCollisionConditionTarget")?,
-                &["EntityRef"],
+                &["EntityRef", "Position"],
             )?;
-            EntityTest::TimeToCollision(gap(r, c, target, Quantity::Duration)?)
+            if tag == "EntityRef" {
+                EntityTest::TimeToCollision(gap(r, c, target, Quantity::Duration)?)
+            } else {
+                let (frame, kind) = measure(r, c)?;
+                not_along_a_trajectory(r, c, &frame, &kind)?;
+                EntityTest::TimeToPosition {
+                    position: position::read(r, target)?,
+                    rule: rule(r, c)?,
+                    value: s.num_in(t, c, "value", Quantity::Duration)?,
+                    freespace: s.bool(t, c, "freespace")?,
+                    kind,
+                    frame,
+                }
+            }
         }
         "RelativeDistanceCondition" => {
             if c.attribute("relativeDistanceType").is_none() {

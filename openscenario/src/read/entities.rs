@@ -6,7 +6,7 @@ use roxmltree::Node;
 
 use super::{Catalogs, Reader};
 use crate::error::XoscError;
-use crate::model::{Entity, EntityKind, Located};
+use crate::model::{Entity, EntityKind, Located, Performance};
 use crate::params::Scope;
 use crate::quantity::Quantity;
 use crate::text::Text;
@@ -122,12 +122,13 @@ pub(super) fn read(
                 "more than one <ObjectController> per entity is not supported",
             ));
         }
-        let (kind, dimensions_m, centre_m, box_pos, notes) = if tag == "CatalogReference" {
-            catalogs.with_entry(r, body, &["Vehicle", "Pedestrian", "MiscObject"], object)?
-        } else {
-            let scope = r.scope.clone();
-            object(r.text, body, &scope)?
-        };
+        let (kind, dimensions_m, centre_m, box_pos, notes, performance) =
+            if tag == "CatalogReference" {
+                catalogs.with_entry(r, body, &["Vehicle", "Pedestrian", "MiscObject"], object)?
+            } else {
+                let scope = r.scope.clone();
+                object(r.text, body, &scope)?
+            };
         for n in notes {
             r.note(body, n);
         }
@@ -142,6 +143,7 @@ pub(super) fn read(
             centre_m,
             box_pos,
             controller,
+            performance,
             pos: r.text.pos(obj),
         });
         std::rc::Rc::make_mut(&mut r.names).push(name);
@@ -268,7 +270,14 @@ fn select(
 
 /// An object's kind, bounding box (dimensions, centre, where its dimensions are written) and
 /// notes.
-type Object = (EntityKind, [f64; 3], [f64; 3], crate::Pos, Vec<String>);
+type Object = (
+    EntityKind,
+    [f64; 3],
+    [f64; 3],
+    crate::Pos,
+    Vec<String>,
+    Performance,
+);
 
 /// A `Vehicle`, `Pedestrian` or `MiscObject` element: its kind, bounding box and notes.
 fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscError> {
@@ -350,19 +359,52 @@ fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscErr
             scope.opt_string(text, e, "name")?.unwrap_or_default()
         ));
     }
-    if child(e, "Performance").is_some() {
-        notes.push(format!(
-            "{}'s <Performance> limits are not applied: paracosm's vehicle model has its own",
-            scope.opt_string(text, e, "name")?.unwrap_or_default()
-        ));
-    }
+    let performance = match child(e, "Performance") {
+        Some(p) => performance(text, p, scope)?,
+        None if vehicle => {
+            notes.push(format!(
+                "{} has no <Performance> (the schema asks one): esmini's defaults limit the \
+                 speed changes the storyboard makes it perform (100 m/s, 10 m/s², 10 m/s²)",
+                scope.opt_string(text, e, "name")?.unwrap_or_default()
+            ));
+            Performance::VEHICLE_DEFAULT
+        }
+        None => Performance::UNBOUNDED,
+    };
     Ok((
         kind(category),
         dimensions_m,
         centre_m,
         text.pos(dims),
         notes,
+        performance,
     ))
+}
+
+/// A `Performance` element: `maxSpeed`, `maxAcceleration` and `maxDeceleration` (esmini's
+/// defaults for one not given), each `> 0`; files write large values (200 m/s²) for no
+/// limit, so no plausible range is asked.
+///
+/// # Errors
+/// Invalid at a value that is not a number `> 0`.
+fn performance(text: &Text, p: Node<'_, '_>, scope: &Scope) -> Result<Performance, XoscError> {
+    let d = Performance::VEHICLE_DEFAULT;
+    let value = |attr: &str, default: f64| -> Result<f64, XoscError> {
+        let v = scope.opt_num(text, p, attr)?.unwrap_or(default);
+        if v > 0.0 && v.is_finite() {
+            Ok(v)
+        } else {
+            Err(XoscError::Invalid {
+                pos: text.attr_pos(p, attr),
+                reason: format!("{attr} must be > 0, not {v}"),
+            })
+        }
+    };
+    Ok(Performance {
+        max_speed_mps: value("maxSpeed", d.max_speed_mps)?,
+        max_acceleration_mps2: value("maxAcceleration", d.max_acceleration_mps2)?,
+        max_deceleration_mps2: value("maxDeceleration", d.max_deceleration_mps2)?,
+    })
 }
 
 /// An `ObjectController`: the controller's name.

@@ -8,6 +8,7 @@ mod entities;
 mod global;
 mod position;
 mod storyboard;
+mod synchronize;
 
 use std::path::{Path, PathBuf};
 

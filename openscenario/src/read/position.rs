@@ -19,6 +19,7 @@ const POSITIONS: &[&str] = &[
     "LanePosition",
     "RelativeLanePosition",
     "RoutePosition",
+    "TrajectoryPosition",
 ];
 
 /// A `<Position>` element.
@@ -51,7 +52,33 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscE
             orientation: orientation(r, p)?,
         },
         "RoutePosition" => route(r, p)?,
+        "TrajectoryPosition" => trajectory(r, p)?,
         _ => relative_lane(r, p)?,
+    })
+}
+
+/// A `<TrajectoryPosition>`: `s` and `t` on its trajectory (`TrajectoryRef`: a `<Trajectory>`
+/// or a trajectory catalog's `<CatalogReference>`) and its orientation.
+///
+/// # Errors
+/// Invalid at a negative `s`, a `TrajectoryRef` that holds neither or both; what reading the
+/// trajectory returns.
+fn trajectory(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
+    let (sc, t) = (&r.scope, r.text);
+    let s = sc.num_in(t, p, "s", Quantity::Distance)?;
+    if s < 0.0 {
+        return Err(XoscError::Invalid {
+            pos: t.attr_pos(p, "s"),
+            reason: format!("a trajectory position's s is >= 0 m, not {s}"),
+        });
+    }
+    let holder = crate::xml::need(t, p, "TrajectoryRef")?;
+    let shape = super::action::trajectory_of(r, holder, false)?;
+    Ok(Position::Trajectory {
+        shape: Box::new(shape),
+        s,
+        t: r.flip(sc.opt_num_in(t, p, "t", Quantity::Lateral)?.unwrap_or(0.0)),
+        orientation: orientation(r, p)?,
     })
 }
 

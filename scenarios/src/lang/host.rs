@@ -369,4 +369,11 @@ impl<H: Host> Host for WithStory<'_, H> {
     fn ended(&self) -> bool {
         self.program.ended() || self.story.as_ref().is_some_and(|s| s.ended())
     }
+
+    fn finish(&mut self, t_s: f64) -> Result<(), HostError> {
+        match self.story.as_mut() {
+            Some(s) if !self.program.ended() => s.finish(t_s),
+            _ => Ok(()),
+        }
+    }
 }

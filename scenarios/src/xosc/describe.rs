@@ -194,6 +194,7 @@ fn position(s: &Scenario, p: &Position) -> String {
             format!("{dx} m ahead, {dy} m left of {}", name(s, *entity))
         }
         Position::Road { road, s: st, t, .. } => format!("road {road} s {st} t {t}"),
+        Position::Trajectory { s: st, t, .. } => format!("{st} m along a trajectory, {t} m left"),
         Position::Lane {
             road,
             lane,
@@ -220,6 +221,64 @@ fn position(s: &Scenario, p: &Position) -> String {
             )
         }
     }
+}
+
+/// A `FollowTrajectoryAction`'s trajectory `shape` as the listing says it.
+fn trajectory(s: &Scenario, shape: &TrajectoryShape) -> String {
+    match shape {
+        TrajectoryShape::Polyline(vertices) => format!(
+            "follow a polyline of {} vertices to {}",
+            vertices.len(),
+            vertices
+                .last()
+                .map_or(String::new(), |(_, p)| position(s, p))
+        ),
+        TrajectoryShape::Clothoid {
+            start,
+            curvature,
+            curvature_prime,
+            length,
+            ..
+        } => format!(
+            "follow a clothoid of {length} m, curvature {curvature} 1/m changing by \
+             {curvature_prime} 1/m2, from {}",
+            start
+                .as_ref()
+                .map_or("where it is".to_owned(), |p| position(s, p))
+        ),
+        TrajectoryShape::ClothoidSpline {
+            start, segments, ..
+        } => spline(s, start, segments),
+        TrajectoryShape::Nurbs { order, points, .. } => format!(
+            "follow a NURBS of order {order} over {} control points to {}",
+            points.len(),
+            points
+                .last()
+                .map_or(String::new(), |(_, _, p)| position(s, p))
+        ),
+    }
+}
+
+/// A clothoid spline from `start` (where the entity is when none) as the listing says it.
+fn spline(s: &Scenario, start: &Option<Position>, segments: &[[f64; 4]]) -> String {
+    format!(
+        "follow a clothoid spline of {} segments, {} m, from {}",
+        segments.len(),
+        segments.iter().map(|g| g[2]).sum::<f64>(),
+        start
+            .as_ref()
+            .map_or("where it is".to_owned(), |p| position(s, p))
+    )
+}
+
+/// A `SynchronizeAction` as the listing says it.
+fn synchronize(s: &Scenario, y: &paracosm_openscenario::model::Synchronize) -> String {
+    format!(
+        "arrive at {} when {} arrives at {}",
+        position(s, &y.target),
+        name(s, y.master),
+        position(s, &y.master_target)
+    )
 }
 
 /// One line for an action.
@@ -275,35 +334,8 @@ fn action(s: &Scenario, a: &Action) -> String {
         },
         Action::Teleport(p) => format!("at {}", position(s, p)),
         Action::AcquirePosition(p) => format!("route to {}", position(s, p)),
-        Action::FollowTrajectory { shape, .. } => match shape {
-            TrajectoryShape::Polyline(vertices) => format!(
-                "follow a polyline of {} vertices to {}",
-                vertices.len(),
-                vertices
-                    .last()
-                    .map_or(String::new(), |(_, p)| position(s, p))
-            ),
-            TrajectoryShape::Clothoid {
-                start,
-                curvature,
-                curvature_prime,
-                length,
-                ..
-            } => format!(
-                "follow a clothoid of {length} m, curvature {curvature} 1/m changing by \
-                 {curvature_prime} 1/m2, from {}",
-                start
-                    .as_ref()
-                    .map_or("where it is".to_owned(), |p| position(s, p))
-            ),
-            TrajectoryShape::Nurbs { order, points, .. } => format!(
-                "follow a NURBS of order {order} over {} control points to {}",
-                points.len(),
-                points
-                    .last()
-                    .map_or(String::new(), |(_, _, p)| position(s, p))
-            ),
-        },
+        Action::Synchronize(y) => synchronize(s, y),
+        Action::FollowTrajectory { shape, .. } => trajectory(s, shape),
         Action::AssignRoute { waypoints } => format!(
             "route through {} waypoints to {}",
             waypoints.len(),
@@ -418,14 +450,12 @@ fn condition(s: &Scenario, c: &ConditionKind) -> String {
 /// What an entity condition's `test` asks, in words.
 fn entity_test(s: &Scenario, test: &EntityTest) -> String {
     match test {
-        EntityTest::TimeHeadway(g) => {
-            format!(
-                "headway to {} {:?} {} s",
-                name(s, g.entity),
-                g.rule,
-                g.value
-            )
-        }
+        EntityTest::TimeHeadway(g) => format!(
+            "headway to {} {:?} {} s",
+            name(s, g.entity),
+            g.rule,
+            g.value
+        ),
         EntityTest::TimeToCollision(g) => format!(
             "time to collision with {} {:?} {} s",
             name(s, g.entity),
@@ -455,6 +485,12 @@ fn entity_test(s: &Scenario, test: &EntityTest) -> String {
             if *freespace { " from its box" } else { "" },
             position(s, p)
         ),
+        EntityTest::TimeToPosition {
+            position: p,
+            rule,
+            value,
+            ..
+        } => format!("time to {} {rule:?} {value} s", position(s, p)),
         EntityTest::Speed { rule, value } => format!("speed {rule:?} {value} m/s"),
         EntityTest::RelativeSpeed {
             entity,

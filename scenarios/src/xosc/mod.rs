@@ -38,7 +38,7 @@ use crate::scenario::Warning;
 use crate::scene::{LoadError, LoadErrorKind, Scene, Site, TestSettings};
 use crate::{MonitorSpec, Scenario, ScenarioError};
 
-use story::Storyboard;
+use story::{RouteAsk, Storyboard};
 
 /// The ego's time headway to the nearest entity ahead in its lane, s (`inf` with none).
 pub const HEADWAY_SIGNAL: &str = "ego_headway_s";
@@ -366,6 +366,9 @@ fn performed_otherwise(
         Action::Visibility { .. } if !driven => None,
         // Its place, its initial speed and its route (the lanes it plans through).
         Action::Teleport(_) | Action::AssignRoute { .. } if init && driven => None,
+        // An untimed trajectory: the system's route (a timed one asks a time the system
+        // under test would not keep).
+        Action::FollowTrajectory { timing: None, .. } if driven => None,
         // Its initial speed in Init; later, the set speed of the system under test.
         Action::Speed { .. } if driven => None,
         // Later, the route of the system under test: into the lane, or along the route's
@@ -379,7 +382,8 @@ fn performed_otherwise(
             return Err(worlds_error(format!(
                 "{}: the system under test drives {name}, and paracosm cannot hand it this {}: \
                  its storyboard asks it of the ego only as a SpeedAction (the system's set \
-                 speed), a LaneChangeAction or an AssignRouteAction (the system's route), an \
+                 speed), a LaneChangeAction, an AssignRouteAction or an untimed \
+                 FollowTrajectoryAction (the system's route), an \
                  ActivateControllerAction, or in Init a TeleportAction or an \
                  AssignRouteAction. Run the file with --scripted-ego to have the storyboard \
                  move the ego, or name another vehicle with --ego",
@@ -795,7 +799,8 @@ pub fn check_the_ego_is_asked_to_drive(
 }
 
 /// The longest test of `model`, s: `given` (`--horizon`), else [`HORIZON_CAP_S`] when the
-/// storyboard has a stop trigger that ends it sooner.
+/// storyboard has a stop trigger that ends it sooner, or is read as CARLA's (its stories'
+/// end ends it).
 ///
 /// # Errors
 /// [`ScenarioError::Load`]: `given` is not a finite number `> 0`, or the storyboard has no
@@ -808,11 +813,14 @@ pub fn horizon(model: &m::Scenario, given: Option<f64>) -> Result<f64, ScenarioE
             "{}: --horizon {h} s must be a finite number of seconds > 0",
             model.file
         ))),
-        None if model.stop.as_ref().is_none_or(|t| t.0.is_empty()) => Err(worlds_error(format!(
-            "{}: the storyboard has no stop trigger, so nothing ends a test: give \
+        // CARLA's scenario ends with its stories ([`m::Scenario::carla`]).
+        None if !model.carla && model.stop.as_ref().is_none_or(|t| t.0.is_empty()) => {
+            Err(worlds_error(format!(
+                "{}: the storyboard has no stop trigger, so nothing ends a test: give \
                  --horizon SECONDS (in a program, test(horizon = ...))",
-            model.file
-        ))),
+                model.file
+            )))
+        }
         None => Ok(HORIZON_CAP_S),
     }
 }
@@ -1083,6 +1091,8 @@ pub(crate) fn build_into(
         scene.publish(signal.to_owned(), id, None);
     }
     let sb_init_speed = sb.actors[ego].state.speed.max(0.0);
+    // The route `Init` asked of the driven ego is its route from the start (`place_ego`).
+    sb.take_route();
     let mut reads: Vec<StreamId> = probes.clone();
     reads.extend(ego_probes);
     let host = StoryHost {
@@ -1217,6 +1227,31 @@ fn lane_route(
     route
 }
 
+/// The route `ask` asks of the ego `ego` from `from` (engine world `[x, z]`, m): the path it
+/// gives (a trajectory handed to the system under test), its points at most 2 m apart, then
+/// the lanes on from its end; or the lanes from where it joins them ([`lane_route`]).
+fn route_of(sb: &Storyboard, ego: usize, from: [f64; 2], ask: &RouteAsk) -> Vec<[f64; 2]> {
+    if ask.path.is_empty() {
+        return lane_route(sb, ego, from, ask.join, ask.ahead_m);
+    }
+    let point = |p: &paracosm_engine::network::roads::Pose| {
+        let (q, _) = sb.roads().to_engine(*p);
+        [q[0], q[2]]
+    };
+    let mut route = vec![from];
+    for w in ask.path.windows(2) {
+        let (a, b) = (point(&w[0]), point(&w[1]));
+        let n = ((b[0] - a[0]).hypot(b[1] - a[1]) / 2.0).ceil().max(1.0) as usize;
+        route.extend((1..=n).map(|k| {
+            let u = k as f64 / n as f64;
+            [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])]
+        }));
+    }
+    let end = *route.last().expect("the route has a point");
+    route.extend(lane_route(sb, ego, end, ask.join, 0.0).into_iter().skip(1));
+    route
+}
+
 /// Places the ego where the storyboard's `Init` put it, at its initial speed, which the
 /// system under test keeps as its set speed, with a route along its lanes, with the body
 /// of its `BoundingBox` ([`ego_vehicle`]). With `hand_over` its chassis is placed by the
@@ -1247,7 +1282,10 @@ fn place_ego(
         through: None,
         map_lane: Some(lp.lane),
     };
-    let route = lane_route(sb, ego, [pos[0], pos[2]], lp, 0.0);
+    let route = match sb.init_route() {
+        Some(ask) if !scripted_ego => route_of(sb, ego, [pos[0], pos[2]], ask),
+        _ => lane_route(sb, ego, [pos[0], pos[2]], lp, 0.0),
+    };
     let speed = a.state.speed.max(0.0);
     let vehicle = ego_vehicle(entity)?;
     scene
@@ -1316,19 +1354,20 @@ pub const MOVED_M: f64 = 0.5;
 pub const STILL_MPS: f64 = 0.1;
 
 impl StoryHost {
-    /// At the end of the storyboard (`t`, s): an error when the driven ego travelled less
+    /// At the end of the storyboard or at the horizon (`t`, s; `end` says which, as the
+    /// message's words): an error when the driven ego travelled less
     /// than [`MOVED_M`], whether the file asked it to drive (the system under test never
     /// did) or asked it no speed above [`STILL_MPS`] with this test's values: the test tested
     /// nothing the file describes and must not read as a pass.
     ///
     /// # Errors
     /// A [`HostError`] that says so, with the speed asked and the distance travelled.
-    fn check_the_ego_moved(&self, t: f64) -> Result<(), HostError> {
+    fn check_the_ego_moved(&self, t: f64, end: &str) -> Result<(), HostError> {
         let mut travelled = self.sb.actors[self.ego].state.travelled_m;
         match self.hand_over {
             Some(None) => {
                 return Err(HostError(format!(
-                    "t = {t:.2} s: the storyboard ended before its ActivateControllerAction \
+                    "t = {t:.2} s: {end} before its ActivateControllerAction \
                      handed the ego {} to the system under test: the storyboard moved it \
                      throughout, so the test tested nothing of the system",
                     self.sb.actors[self.ego].name
@@ -1340,7 +1379,7 @@ impl StoryHost {
         let name = &self.sb.actors[self.ego].name;
         if self.most_asked_mps > STILL_MPS && travelled < MOVED_M {
             return Err(HostError(format!(
-                "t = {t:.2} s: the storyboard ended, and the ego {name} travelled \
+                "t = {t:.2} s: {end}, and the ego {name} travelled \
                  {travelled:.2} m though the file asked it to drive at up to {:.2} m/s: the \
                  system under test never drove it, so the test tested nothing the file \
                  describes",
@@ -1349,7 +1388,7 @@ impl StoryHost {
         }
         if travelled < MOVED_M {
             return Err(HostError(format!(
-                "t = {t:.2} s: the storyboard ended, and the ego {name} travelled \
+                "t = {t:.2} s: {end}, and the ego {name} travelled \
                  {travelled:.2} m: with this test's values the file asked it no speed above \
                  {STILL_MPS} m/s, so the system under test held it still, and a test whose ego \
                  never moves tests nothing the file describes"
@@ -1578,8 +1617,7 @@ impl Host for StoryHost {
                 self.hand_over_if_activated(t);
                 // A lane change or a route of the driven ego: the system's new route.
                 if let Some(ask) = self.sb.take_route() {
-                    let route =
-                        lane_route(&self.sb, self.ego, [pos[0], pos[2]], ask.join, ask.ahead_m);
+                    let route = route_of(&self.sb, self.ego, [pos[0], pos[2]], &ask);
                     let points = route
                         .iter()
                         .map(|p| Value::Vec3([p[0], 0.0, p[1]]))
@@ -1604,7 +1642,7 @@ impl Host for StoryHost {
                 }
                 self.most_asked_mps = self.most_asked_mps.max(asked.unwrap_or(0.0));
                 if self.sb.ended && !self.scripted_ego {
-                    self.check_the_ego_moved(t)?;
+                    self.check_the_ego_moved(t, "the storyboard ended")?;
                 }
                 if !self.scripted_ego {
                     self.check_the_storyboard_can_go_on(t)?;
@@ -1641,6 +1679,26 @@ impl Host for StoryHost {
 
     fn ended(&self) -> bool {
         self.sb.ended || self.road_end.is_some()
+    }
+
+    /// At the horizon, with the storyboard not ended: an error when an act or event still
+    /// waits to start (the horizon cut the test before it played what the file describes),
+    /// or when the driven ego never moved ([`StoryHost::check_the_ego_moved`]).
+    fn finish(&mut self, t_s: f64) -> Result<(), HostError> {
+        let waiting = self.sb.never_started();
+        if !waiting.is_empty() {
+            return Err(HostError(format!(
+                "t = {t_s:.2} s: the horizon came before the storyboard ended, and {} never \
+                 started: the test did not play what the file describes, so it cannot \
+                 count as a pass (give a longer --horizon, or let the storyboard's stop \
+                 trigger end it)",
+                waiting.join(", ")
+            )));
+        }
+        if self.scripted_ego || self.sb.actors[self.ego].scripted {
+            return Ok(());
+        }
+        self.check_the_ego_moved(t_s, "the horizon came")
     }
 
     fn log(&mut self) -> Vec<String> {

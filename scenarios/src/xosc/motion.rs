@@ -181,6 +181,28 @@ pub struct Untimed {
 }
 
 impl Untimed {
+    /// The distance along the path, m, of its point nearest `p` (`[x, y]`, m).
+    pub fn station_of(&self, p: [f64; 2]) -> f64 {
+        let (mut best, mut best_d2, mut along) = (0.0, f64::INFINITY, 0.0);
+        for w in self.vertices.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let (ux, uy) = (b.x - a.x, b.y - a.y);
+            let len2 = ux * ux + uy * uy;
+            let u = if len2 > 0.0 {
+                (((p[0] - a.x) * ux + (p[1] - a.y) * uy) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let (qx, qy) = (a.x + u * ux, a.y + u * uy);
+            let d2 = (p[0] - qx).powi(2) + (p[1] - qy).powi(2);
+            if d2 < best_d2 {
+                (best, best_d2) = (along + u * len2.sqrt(), d2);
+            }
+            along += len2.sqrt();
+        }
+        best
+    }
+
     /// Goes `dist` m further; the pose there and whether the end is reached.
     pub fn advance(&mut self, dist: f64) -> (Pose, bool) {
         self.gone_m += dist.max(0.0);

@@ -260,21 +260,21 @@ impl Storyboard {
                 freespace,
                 kind,
                 frame,
-            } => {
-                let at = paracosm_openscenario::Pos {
-                    file: String::new(),
-                    line: 0,
-                    col: 0,
-                };
-                self.resolve(position, &at).is_ok_and(|(p, lp)| {
-                    let d = if frame == "entity" {
-                        self.distance_to_point(e, [p.x, p.y], *freespace, kind)
-                    } else {
-                        self.road_distance_to(e, lp, *freespace, kind)
-                    };
-                    rule.holds(d, *value)
-                })
-            }
+            } => self
+                .distance_to_position(e, position, *freespace, (kind, frame))
+                .is_some_and(|d| rule.holds(d, *value)),
+            EntityTest::TimeToPosition {
+                position,
+                rule,
+                value,
+                freespace,
+                kind,
+                frame,
+            } => self
+                .distance_to_position(e, position, *freespace, (kind, frame))
+                .filter(|d| d.abs() >= 1e-6 && st.speed.abs() >= 1e-6)
+                .map(|d| d / st.speed)
+                .is_some_and(|ttc| ttc >= 0.0 && rule.holds(ttc, *value)),
             EntityTest::ReachPosition {
                 position,
                 tolerance,
@@ -455,6 +455,30 @@ impl Storyboard {
         (long, lat, closing)
     }
 
+    /// The distance from entity `e` to `position` where it is now, m, as a
+    /// `DistanceCondition` measures it (`kind` and `frame`, from its box with `freespace`):
+    /// in the entity's frame ([`Storyboard::distance_to_point`]) or along the roads
+    /// ([`Storyboard::road_distance_to`]); `None` for a position that does not resolve.
+    pub(in crate::xosc::story) fn distance_to_position(
+        &self,
+        e: usize,
+        position: &Position,
+        freespace: bool,
+        (kind, frame): (&str, &str),
+    ) -> Option<f64> {
+        let at = paracosm_openscenario::Pos {
+            file: String::new(),
+            line: 0,
+            col: 0,
+        };
+        let (p, lp) = self.resolve(position, &at).ok()?;
+        Some(if frame == "entity" {
+            self.distance_to_point(e, [p.x, p.y], freespace, kind)
+        } else {
+            self.road_distance_to(e, lp, freespace, kind)
+        })
+    }
+
     /// The distance from entity `e` to the point `p` (`[x, y]` m), as `kind` measures it in
     /// `e`'s frame (`longitudinal`, `lateral`, else euclidean): from its reference point, or
     /// with `freespace` from its bounding box (0 inside it). OpenSCENARIO `DistanceCondition`.
@@ -595,7 +619,11 @@ impl Storyboard {
     /// between them along the lanes (ahead in `la`'s direction of travel positive) and the
     /// difference of their `t` (left of that direction positive); `None` when no lanes lead
     /// from one to the other.
-    fn road_offsets(&self, la: LanePos, lb: LanePos) -> Option<(f64, f64)> {
+    pub(in crate::xosc::story) fn road_offsets(
+        &self,
+        la: LanePos,
+        lb: LanePos,
+    ) -> Option<(f64, f64)> {
         let (Ok(ta), Ok(tb)) = (self.roads.t_of(&la), self.roads.t_of(&lb)) else {
             return None;
         };

@@ -18,11 +18,16 @@ pub(in crate::xosc::story) struct Drive {
     pub(in crate::xosc::story) lateral: Option<Lateral>,
     /// The continuous `LongitudinalDistanceAction` in progress.
     pub(in crate::xosc::story) keep: Option<Keep>,
+    /// The `SynchronizeAction` in progress.
+    pub(in crate::xosc::story) sync: Option<Synchronizing>,
     /// The trajectory in progress and its action.
     pub(in crate::xosc::story) path: Option<(Path, usize)>,
     /// A driven ego's lane change in progress: the lane it changes to, the offset from its
     /// centre there (m), the action; it ends once the ego is there ([`LANE_REACHED_M`]).
     pub(in crate::xosc::story) lane_goal: Option<(usize, f64, usize)>,
+    /// A driven ego's trajectory in progress, handed to its system as its route: where it
+    /// ends and the action; it ends once the ego is there ([`PATH_END_REACHED_M`]).
+    pub(in crate::xosc::story) path_goal: Option<(Pose, usize)>,
     pub(in crate::xosc::story) prefer_roads: Vec<usize>,
     /// Its heading relative to its lane's travel, rad, kept as it moves along the lane
     /// (esmini's relative heading): set where it is placed or where its trajectory ends,
@@ -32,6 +37,44 @@ pub(in crate::xosc::story) struct Drive {
     /// (esmini's `TeleportAction` marks the entity's longitudinal motion as done for the
     /// frame, so its default controller does not move it).
     pub(in crate::xosc::story) teleported: bool,
+}
+
+/// The speed `v` (m/s) a `SpeedAction`'s `task` asks at the end of a step from `t` of `dt` s
+/// from the entity's speed `v0` (m/s), within the entity's `performance` as esmini keeps it
+/// (`LongSpeedAction::Step`): the speed at most `max_speed` in magnitude, and a change faster
+/// than `max_acceleration` (or `max_deceleration`) cut to it, the transition put back by the
+/// time the step did not cover; with whether the action is `over`, which it is only once its
+/// target is reached. A step shape jumps in the step it starts in (esmini sets its speed
+/// when the action starts); one that follows another entity's speed is limited after.
+fn limited(
+    task: &mut SpeedTask,
+    performance: m::Performance,
+    (v, over): (f64, bool),
+    (v0, t, dt): (f64, f64, f64),
+) -> (f64, bool) {
+    let v = v.clamp(-performance.max_speed_mps, performance.max_speed_mps);
+    let starts_now = task.tr.start_s >= t - 1e-9;
+    if task.tr.duration_s <= 0.0 && (task.track.is_none() || starts_now) || dt <= 0.0 {
+        return (v, over);
+    }
+    let required = (v - v0) / dt;
+    let (lo, hi) = (
+        -performance.max_deceleration_mps2,
+        performance.max_acceleration_mps2,
+    );
+    if required <= hi + 1e-6 && required >= lo - 1e-6 {
+        return (v, over);
+    }
+    let acc = required.clamp(lo, hi);
+    let cut = (v0 + acc * dt).clamp(-performance.max_speed_mps, performance.max_speed_mps);
+    // The share of the step the transition moved on.
+    let covered = (cut - v0) / required;
+    task.tr.start_s += dt - covered;
+    let target = task
+        .tr
+        .to
+        .clamp(-performance.max_speed_mps, performance.max_speed_mps);
+    (cut, over && (cut - target).abs() < 1e-6)
 }
 
 impl Storyboard {
@@ -47,9 +90,12 @@ impl Storyboard {
         // Speed.
         let mut v1 = st.speed;
         let mut done = Vec::new();
-        if let Some(task) = self.drives[e].speed {
+        if let Some(mut task) = self.drives[e].speed {
             let (v, over) = task.step(t1, |r| self.actors[r].state.speed);
+            let performance = self.actors[e].performance;
+            let (v, over) = limited(&mut task, performance, (v, over), (st.speed, t, dt));
             v1 = v;
+            self.drives[e].speed = Some(task);
             // A hold by distance (CARLA's reading) counts this step's move.
             if over && task.ends(t1, st.travelled_m + v.max(0.0) * dt) {
                 self.drives[e].speed = None;
@@ -98,9 +144,14 @@ impl Storyboard {
         let s = &mut self.actors[e].state;
         s.accel = (speed_now - s.speed) / dt;
         s.speed = speed_now;
-        s.pose = pose;
         s.lane = lane;
         s.travelled_m += moved;
+        s.vel = if held {
+            [speed_now * pose.h.cos(), speed_now * pose.h.sin()]
+        } else {
+            [(pose.x - s.pose.x) / dt, (pose.y - s.pose.y) / dt]
+        };
+        s.pose = pose;
         s.still_s = if speed_now.abs() < 1e-3 {
             s.still_s + dt
         } else {

@@ -479,6 +479,9 @@ impl Storyboard {
                 if d.keep.as_ref().is_some_and(|k| k.action == i) {
                     d.keep = None;
                 }
+                if d.sync.as_ref().is_some_and(|s| s.action == i) {
+                    d.sync = None;
+                }
             }
             self.elems[i].pending = 0;
         }

@@ -16,7 +16,7 @@ use conditions::Cond;
 use drive::{Drive, ToLane, Track};
 use elements::{Elem, Kind, Owner, Phase};
 pub use tasks::DEFAULT_LATERAL_ACC_MPS2;
-use tasks::{Keep, Lateral, Path, SpeedTask};
+use tasks::{Keep, Lateral, Path, SpeedTask, Synchronizing};
 pub use tasks::{Stored, WorldEnv, MAP_FRICTION, NOMINAL_ILLUMINANCE_LX};
 
 use std::collections::VecDeque;
@@ -54,6 +54,8 @@ pub struct Actor {
     pub centre_m: [f64; 3],
     /// Its `ObjectType`: `vehicle`, `pedestrian` or `miscellaneous`.
     pub object_type: &'static str,
+    /// The limits on the speed changes the storyboard makes it perform (its `Performance`).
+    pub performance: m::Performance,
     /// Whether the storyboard moves it now: every entity but the ego the system under test
     /// drives, and that ego too until its controller is activated
     /// ([`Storyboard::hand_over_on_activation`]).
@@ -75,6 +77,10 @@ pub struct State {
     pub lane: Option<LanePos>,
     /// Distance travelled since the start, m.
     pub travelled_m: f64,
+    /// Its velocity in the world, `[x, y]` m/s: its displacement over the last step divided
+    /// by the step, or, where it was placed (`Init`, a teleport), its speed along its heading
+    /// (esmini's `ScenarioEngine` derives velocities so).
+    pub vel: [f64; 2],
     /// How long it has stood still, s.
     pub still_s: f64,
     /// How long it has stood at the end of its lanes, s.
@@ -94,6 +100,7 @@ impl State {
             accel: 0.0,
             lane,
             travelled_m: 0.0,
+            vel: [0.0; 2],
             still_s: 0.0,
             at_end_s: 0.0,
             offroad_s: 0.0,
@@ -165,14 +172,23 @@ pub struct Storyboard {
 /// or an `AssignRouteAction` on it): from where the ego is, join `join` (a place on the lane
 /// to drive in, abeam the ego, at the offset asked) `ahead_m` metres further along, then
 /// follow the lanes from there, through junctions as the ego's route prefers.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RouteAsk {
     /// The lane position abeam the ego (its station) on the lane to drive in.
     pub join: LanePos,
     /// How far ahead the route joins that lane, m: the lane change's length (its distance, or
     /// its duration at the ego's speed); 0 for a route on the lane the ego is in.
     pub ahead_m: f64,
+    /// A path to drive first (a `FollowTrajectoryAction`'s trajectory, its points in the
+    /// OpenDRIVE frame): the route follows it, then the lanes on from its end (`join` is
+    /// there); empty for a route along the lanes.
+    pub path: Vec<Pose>,
 }
+
+/// How close the driven ego must come to the end of the trajectory its
+/// `FollowTrajectoryAction` hands the system under test as its route for the action to end,
+/// m.
+pub const PATH_END_REACHED_M: f64 = 1.0;
 
 /// How close to the target lane's centre (plus the offset asked) a driven ego must come for
 /// its `LaneChangeAction` to end, m.
@@ -228,6 +244,10 @@ impl Storyboard {
         });
         sb.resolve_references();
         sb.perform_init(scenario)?;
+        for a in &mut sb.actors {
+            let st = &mut a.state;
+            st.vel = [st.speed * st.pose.h.cos(), st.speed * st.pose.h.sin()];
+        }
         // Init's transitions run from the start.
         Ok(sb)
     }
@@ -243,6 +263,7 @@ impl Storyboard {
             .map(|(i, e)| Actor {
                 name: e.name.clone(),
                 object_type: e.kind.object_type(),
+                performance: e.performance,
                 size_m: e.dimensions_m,
                 centre_m: e.centre_m,
                 scripted: Some(i) != ego,
@@ -333,6 +354,9 @@ impl Storyboard {
         if self.started {
             st.accel = (speed - st.speed) / dt;
             st.travelled_m += moved;
+            st.vel = [(pose.x - st.pose.x) / dt, (pose.y - st.pose.y) / dt];
+        } else {
+            st.vel = [speed * heading.cos(), speed * heading.sin()];
         }
         st.speed = speed;
         st.pose = pose;
@@ -365,6 +389,32 @@ impl Storyboard {
             .any(|e| e.kind == Kind::Event && (e.runs > 0 || e.phase != Phase::Standby))
     }
 
+    /// The acts and events that have never started and wait on their start triggers now,
+    /// each as `act "NAME" (file:line:col)` with where its trigger's first condition is
+    /// written: what the file describes and a test cut short by its horizon never played.
+    pub fn never_started(&self) -> Vec<String> {
+        let mut waiting = Vec::new();
+        for k in (0..self.triggers.len()).filter(|&k| self.waits(k)) {
+            let elem = match self.owners[k] {
+                elements::Owner::ActStart(a) => a,
+                elements::Owner::EventStart { event, .. } => event,
+                elements::Owner::Storyboard | elements::Owner::ActStop(_) => continue,
+            };
+            let e = &self.elems[elem];
+            if e.runs > 0 {
+                continue;
+            }
+            let at = self.triggers[k]
+                .iter()
+                .flatten()
+                .next()
+                .map(|c| format!(" ({})", c.cond.pos))
+                .unwrap_or_default();
+            waiting.push(format!("{} {:?}{at}", e.kind.name(), e.name));
+        }
+        waiting
+    }
+
     /// What the storyboard waits on when it can wait no more: `None` while anything can still
     /// change a condition it waits on; else the conditions of the triggers it waits on
     /// (their names and kinds). Nothing can change when every entity stands still (at most
@@ -378,7 +428,11 @@ impl Storyboard {
         }
         let moving = self.actors.iter().zip(&self.drives).any(|(a, d)| {
             a.state.speed.abs() > still_mps
-                || (a.scripted && (d.speed.is_some() || d.lateral.is_some() || d.path.is_some()))
+                || (a.scripted
+                    && (d.speed.is_some()
+                        || d.lateral.is_some()
+                        || d.path.is_some()
+                        || d.sync.is_some()))
         });
         if moving {
             return None;
@@ -422,6 +476,7 @@ impl Storyboard {
         for e in &mut self.elems {
             e.moves = elements::Moves::default();
         }
+        let first = !self.started;
         if !self.started {
             self.started = true;
             for r in self.roots.clone() {
@@ -449,12 +504,14 @@ impl Storyboard {
             self.run_story(r, t)?;
         }
         self.keep_distances(t + dt)?;
+        self.synchronize(dt, first);
         for e in 0..self.actors.len() {
             if self.actors[e].scripted {
                 self.drive(e, t, dt)?;
             } else {
                 self.ask_speed(e, t + dt);
                 self.ask_lane(e);
+                self.ask_path(e);
             }
         }
         if self.watch_offroad {

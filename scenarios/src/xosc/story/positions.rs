@@ -102,6 +102,15 @@ impl Storyboard {
                 at: in_route,
                 orientation,
             } => self.route_position(waypoints, in_route, orientation, at)?,
+            Position::Trajectory {
+                shape,
+                s,
+                t,
+                orientation,
+            } => {
+                let pose = self.trajectory_position(shape, (*s, *t), orientation, at)?;
+                (pose, self.facing(self.roads.anchor(pose.x, pose.y), pose.h))
+            }
             Position::RelativeLane {
                 entity,
                 d_lane,
@@ -119,6 +128,62 @@ impl Storyboard {
                 (pose, Some(lp))
             }
         })
+    }
+
+    /// A `TrajectoryPosition` (written at `at`): `s` m along `shape` from its start (its
+    /// points as a `FollowTrajectoryAction` would sample them), `t` m to its left there,
+    /// facing along it, turned by `orientation`.
+    ///
+    /// # Errors
+    /// [`StoryError`] for a shape that starts where an entity is (a clothoid without its
+    /// start: a position names no entity), or an `s` past the shape's end.
+    pub(in crate::xosc::story) fn trajectory_position(
+        &self,
+        shape: &m::TrajectoryShape,
+        (s, t): (f64, f64),
+        orientation: &Option<m::Orientation>,
+        at: &paracosm_openscenario::Pos,
+    ) -> Result<Pose, StoryError> {
+        let bad = |message: String| StoryError {
+            at: site(at),
+            message,
+        };
+        if matches!(
+            shape,
+            m::TrajectoryShape::Clothoid { start: None, .. }
+                | m::TrajectoryShape::ClothoidSpline { start: None, .. }
+        ) {
+            return Err(bad(
+                "a trajectory position on a clothoid without a start position: it would start \
+                 where an entity is, and a position names none"
+                    .into(),
+            ));
+        }
+        let points: Vec<Pose> = self
+            // No entity: a shape that needs one is refused above.
+            .trajectory_points(0, shape, at)?
+            .into_iter()
+            .map(|(_, p)| p)
+            .collect();
+        let mut left = s;
+        for w in points.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let len = (b.x - a.x).hypot(b.y - a.y);
+            if left <= len + 1e-9 && len > 0.0 {
+                let u = (left / len).min(1.0);
+                let h = (b.y - a.y).atan2(b.x - a.x);
+                return Ok(Pose {
+                    x: a.x + u * (b.x - a.x) - t * h.sin(),
+                    y: a.y + u * (b.y - a.y) + t * h.cos(),
+                    h: orient(orientation, h),
+                });
+            }
+            left -= len;
+        }
+        Err(bad(format!(
+            "a trajectory position {s} m along a trajectory {:.2} m long",
+            s - left
+        )))
     }
 
     /// A `RelativeWorldPosition`: `dx`, `dy` (m, along the world's axes) from entity
@@ -283,8 +348,9 @@ impl Storyboard {
         {
             return Err(bad(format!("the route ends before {path_s} m along it")));
         }
-        let travel = self.roads.travel_heading(&lp);
-        let h = orient(orientation, travel);
+        // Facing as esmini's `OSCPositionRoute` faces it, not along the route's direction of
+        // travel: a lane position the driving direction of the lane it names, a road
+        // position the road's increasing `s`, each turned by the orientation given.
         match in_route {
             m::InRoute::Lane { lane, offset, .. } => {
                 let road = &self.roads.map().roads[self.roads.ids(lp.lane).1].od_id;
@@ -292,6 +358,7 @@ impl Storyboard {
                     .roads
                     .lane_pos(road, *lane, lp.s, *offset)
                     .map_err(|e| bad(e.to_string()))?;
+                let h = orient(orientation, self.roads.travel_heading(&to));
                 Ok(self.placed(to, h))
             }
             m::InRoute::Road { t, .. } => {
@@ -300,7 +367,7 @@ impl Storyboard {
                     .roads
                     .road_pos(road, lp.s, *t)
                     .map_err(|e| bad(e.to_string()))?;
-                Ok(self.placed(to, h))
+                Ok(self.placed(to, orient(orientation, self.roads.along_heading(&to))))
             }
             m::InRoute::Entity(_) => unreachable!("returned above"),
         }

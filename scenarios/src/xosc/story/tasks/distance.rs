@@ -39,6 +39,8 @@ impl Storyboard {
             self.override_task(old);
             let old = self.drives[e].keep.take().map(|k| k.action);
             self.override_task(old);
+            let old = self.drives[e].sync.take().map(|s| s.action);
+            self.override_task(old);
             if keep.action != usize::MAX {
                 self.elems[keep.action].pending += 1;
             }

@@ -176,7 +176,11 @@ impl Storyboard {
             d: offset_m,
             rev: lp.rev,
         };
-        self.route = Some(RouteAsk { join, ahead_m });
+        self.route = Some(RouteAsk {
+            join,
+            ahead_m,
+            path: Vec::new(),
+        });
         let old = self.drives[e].lane_goal.take().map(|g| g.2);
         self.override_task(old);
         if let Some(a) = a {

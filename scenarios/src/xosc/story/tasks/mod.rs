@@ -1,6 +1,6 @@
 //! The storyboard's actions: `Init` performed, references checked, and each running action's
 //! task started by its kind, one file per kind (speed, lateral, trajectory, teleport, route,
-//! controller, distance).
+//! controller, distance, synchronize).
 
 mod controller;
 mod distance;
@@ -8,6 +8,7 @@ mod global;
 mod lateral;
 mod route;
 mod speed;
+mod synchronize;
 mod teleport;
 mod trajectory;
 
@@ -16,6 +17,7 @@ pub use global::{Stored, WorldEnv, MAP_FRICTION, NOMINAL_ILLUMINANCE_LX};
 pub(in crate::xosc::story) use lateral::Lateral;
 pub use lateral::DEFAULT_LATERAL_ACC_MPS2;
 pub(in crate::xosc::story) use speed::SpeedTask;
+pub(in crate::xosc::story) use synchronize::Synchronizing;
 pub(in crate::xosc::story) use trajectory::Path;
 
 use super::*;
@@ -66,10 +68,11 @@ impl Storyboard {
     }
 
     /// Checks the roads and lanes that `na` names where they do not depend on where an
-    /// entity is when it starts: a teleport or a route's waypoint to a lane or road position
-    /// (the road, the lane at that station), and a lane change to an absolute lane id (some
-    /// road of the map has it). So a reference that cannot be met is refused when the file
-    /// loads, at the action's line and column, rather than failing every test.
+    /// entity is when it starts: a teleport, a synchronization's targets or a route's
+    /// waypoint to a lane or road position (the road, the lane at that station), and a lane
+    /// change to an absolute lane id (some road of the map has it). So a reference that
+    /// cannot be met is refused when the file loads, at the action's line and column, rather
+    /// than failing every test.
     ///
     /// # Errors
     /// [`StoryError`] at the action, naming the action and the map's refusal.
@@ -98,6 +101,10 @@ impl Storyboard {
         };
         match &na.action {
             Action::Teleport(p) | Action::AcquirePosition(p) => position(p),
+            Action::Synchronize(s) => {
+                position(&s.master_target)?;
+                position(&s.target)
+            }
             Action::AssignRoute { waypoints } => {
                 waypoints.iter().try_for_each(|(p, _)| position(p))
             }
@@ -139,6 +146,10 @@ impl Storyboard {
                 // An event's teleport holds the entity for its step (`Drive::teleported`).
                 self.drives[e].teleported = scripted && a.is_some();
             }
+            Action::Speed {
+                target: SpeedTarget::Absolute(v),
+                ..
+            } if *v < 0.0 => return Err(bad(backwards(action, *v, &self.actors[e].name))),
             Action::Speed { target, dynamics } => {
                 return self.start_speed(e, (target, dynamics), a, t);
             }
@@ -187,13 +198,10 @@ impl Storyboard {
                 shape,
                 timing,
                 position_mode,
+                initial_offset_m: offset,
             } => {
-                return self.start_trajectory(
-                    e,
-                    (shape, timing, *position_mode),
-                    (a, &action.pos),
-                    t,
-                );
+                let how = (shape, timing, *position_mode, *offset);
+                return self.start_trajectory(e, how, (a, &action.pos), t);
             }
             Action::AssignRoute { waypoints } => {
                 self.assign_route(e, waypoints, &action.pos, scripted)?;
@@ -201,6 +209,9 @@ impl Storyboard {
             Action::AcquirePosition(p) => {
                 self.acquire_position(e, p, &action.pos, scripted)?;
             }
+            // On the ego a system under test drives, refused at load.
+            Action::Synchronize(s) if scripted => self.start_sync(e, s, a, &action.pos)?,
+            Action::Synchronize(_) => {}
             Action::ActivateController { .. }
             | Action::AssignController { .. }
             | Action::OverrideController => self.controller_action(e, &action.action),
@@ -212,6 +223,15 @@ impl Storyboard {
         }
         Ok(())
     }
+}
+
+/// Why `SpeedAction` `action`, to `v` m/s (`< 0`), cannot be performed on entity `name`.
+fn backwards(action: &m::NamedAction, v: f64, name: &str) -> String {
+    format!(
+        "SpeedAction {:?} to {v} m/s asks {name} to drive backwards, which paracosm does not \
+         do: its storyboard and its systems under test move forward only (esmini reverses)",
+        action.name
+    )
 }
 
 /// The entity position `p` is relative to, if any.

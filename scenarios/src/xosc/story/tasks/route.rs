@@ -37,6 +37,7 @@ impl Storyboard {
                 self.route = Some(RouteAsk {
                     join: lp,
                     ahead_m: 0.0,
+                    path: Vec::new(),
                 });
             }
         }

@@ -112,8 +112,11 @@ impl Storyboard {
                 _ => Hold::Until(t + dynamics.value),
             }
         });
-        // A gap kept to another entity is the same longitudinal domain: it ends.
+        // A gap kept to another entity, or a synchronization, is the same longitudinal
+        // domain: it ends.
         let old = self.drives[e].keep.take().map(|k| k.action);
+        self.override_task(old);
+        let old = self.drives[e].sync.take().map(|s| s.action);
         self.override_task(old);
         if a.is_none() && tr.duration_s == 0.0 {
             self.actors[e].state.speed = tr.to;

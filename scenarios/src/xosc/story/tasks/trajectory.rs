@@ -25,12 +25,19 @@ impl Path {
 }
 
 impl Storyboard {
-    /// Starts a `FollowTrajectoryAction` on `e`.
+    /// Starts a `FollowTrajectoryAction` on `e`: its shape, timing, following mode and
+    /// `initialDistanceOffset` (m; untimed only, the entity placed there as esmini's
+    /// `SetTrajectoryS` places it).
     #[allow(clippy::type_complexity)]
     pub(in crate::xosc::story) fn start_trajectory(
         &mut self,
         e: usize,
-        (shape, timing, position_mode): (&TrajectoryShape, &Option<(bool, f64, f64)>, bool),
+        (shape, timing, position_mode, offset): (
+            &TrajectoryShape,
+            &Option<(bool, f64, f64)>,
+            bool,
+            f64,
+        ),
         (a, pos): (Option<usize>, &paracosm_openscenario::Pos),
         t: f64,
     ) -> Result<(), StoryError> {
@@ -42,7 +49,7 @@ impl Storyboard {
         };
 
         if !scripted {
-            return Ok(());
+            return self.hand_trajectory(e, (shape, offset), (a, pos));
         }
         let points = self.trajectory_points(e, shape, pos)?;
         let timed = points.iter().all(|(time, _)| time.is_some());
@@ -50,7 +57,9 @@ impl Storyboard {
         // in `follow`; a sampled curve faces along itself at each sample.
         let turn = match (shape, position_mode) {
             (TrajectoryShape::Polyline(_), true) => crate::xosc::motion::Turn::Corner,
-            (TrajectoryShape::Polyline(_), false) => crate::xosc::motion::Turn::Segment,
+            (TrajectoryShape::Polyline(_) | TrajectoryShape::ClothoidSpline { .. }, false) => {
+                crate::xosc::motion::Turn::Segment
+            }
             _ => crate::xosc::motion::Turn::None,
         };
         let path = match timing {
@@ -66,14 +75,15 @@ impl Storyboard {
             }
             _ => Path::Untimed(Untimed {
                 vertices: points.into_iter().map(|(_, p)| p).collect(),
-                gone_m: 0.0,
+                gone_m: offset,
                 turn,
             }),
         };
         // On the trajectory from the start (esmini's reading): a timed one where it is at `t`,
-        // one started in `Init` at its first vertex.
+        // one started in `Init` at its first vertex, one with an offset there.
         let here = match &path {
             Path::Timed(p) => Some(p.at(t).0),
+            Path::Untimed(u) if offset > 0.0 => Some(u.clone().advance(0.0).0),
             Path::Untimed(u) if a.is_none() => u.vertices.first().copied(),
             Path::Untimed(_) => None,
         };
@@ -95,6 +105,76 @@ impl Storyboard {
         self.drives[e].path = Some((path, a.unwrap_or(usize::MAX)));
 
         Ok(())
+    }
+
+    /// Hands the trajectory `shape` of a `FollowTrajectoryAction` (action `a`, written at
+    /// `pos`; `None` in `Init`) on the ego `e` a system under test drives to that system as
+    /// its route: the trajectory's points, then its lanes on from where the trajectory ends
+    /// (in `Init`, the ego starts at the trajectory's start). The speed stays the system's (a timed trajectory is refused at load); the action ends
+    /// once the ego is within [`PATH_END_REACHED_M`] of the trajectory's end.
+    ///
+    /// # Errors
+    /// [`StoryError`] for a point off the map, or a trajectory that ends on no lane.
+    fn hand_trajectory(
+        &mut self,
+        e: usize,
+        (shape, offset): (&TrajectoryShape, f64),
+        (a, pos): (Option<usize>, &paracosm_openscenario::Pos),
+    ) -> Result<(), StoryError> {
+        let points: Vec<Pose> = self
+            .trajectory_points(e, shape, pos)?
+            .into_iter()
+            .map(|(_, p)| p)
+            .collect();
+        let path = from_offset(&points, offset);
+        let end = *path.last().expect("a trajectory has points");
+        let Some(join) = self.facing(self.roads.anchor(end.x, end.y), end.h) else {
+            return Err(StoryError {
+                at: site(pos),
+                message: format!(
+                    "the trajectory handed to the system under test driving {} ends off the \
+                     map's lanes, at ({:.2}, {:.2}): its route could not go on from there",
+                    self.actors[e].name, end.x, end.y
+                ),
+            });
+        };
+        if a.is_none() {
+            // Started in `Init`: the ego starts where the trajectory does (esmini's reading).
+            let first = path[0];
+            let lane = self.facing(self.roads.anchor(first.x, first.y), first.h);
+            let st = &mut self.actors[e].state;
+            st.pose = first;
+            st.lane = lane;
+        }
+        self.route = Some(RouteAsk {
+            join,
+            ahead_m: 0.0,
+            path,
+        });
+        if let Some(a) = a {
+            self.elems[a].pending += 1;
+            self.drives[e].path_goal = Some((end, a));
+        }
+        Ok(())
+    }
+
+    /// Ends the driven ego `e`'s `FollowTrajectoryAction` once it is within
+    /// [`PATH_END_REACHED_M`] of its trajectory's end.
+    pub(in crate::xosc::story) fn ask_path(&mut self, e: usize) {
+        let Some((end, a)) = self.drives[e].path_goal else {
+            return;
+        };
+        let p = self.actors[e].state.pose;
+        if (p.x - end.x).hypot(p.y - end.y) <= PATH_END_REACHED_M {
+            self.drives[e].path_goal = None;
+            self.task_done(Some(a));
+        }
+    }
+
+    /// The route asked of the driven ego by its `Init` (a trajectory handed to it), which
+    /// the host gives its system from the start.
+    pub fn init_route(&self) -> Option<&RouteAsk> {
+        self.route.as_ref()
     }
 
     /// The points of trajectory `shape` for entity `e`, with their times in the file (none
@@ -147,6 +227,21 @@ impl Storyboard {
                     .map(|(d, p)| (times.map(|(a, b)| a + (b - a) * d / length), p))
                     .collect()
             }
+            TrajectoryShape::ClothoidSpline {
+                start,
+                segments,
+                restarts,
+            } => {
+                let from = match start {
+                    Some(p) => self.resolve(p, pos)?.0,
+                    None => self.actors[e].state.pose,
+                };
+                let mut starts = Vec::new();
+                for (k, p) in restarts {
+                    starts.push((*k, self.resolve(p, pos)?.0));
+                }
+                spline_poses(from, segments, &starts)
+            }
             TrajectoryShape::Nurbs {
                 order,
                 points,
@@ -164,6 +259,101 @@ impl Storyboard {
     }
 }
 
+/// The part of the path through `points` from `offset` m along it: the point there, then the
+/// points after it (the last point alone when the path is shorter).
+fn from_offset(points: &[Pose], offset: f64) -> Vec<Pose> {
+    if offset <= 0.0 {
+        return points.to_vec();
+    }
+    let mut left = offset;
+    for (k, w) in points.windows(2).enumerate() {
+        let len = (w[1].x - w[0].x).hypot(w[1].y - w[0].y);
+        if left < len {
+            let u = left / len;
+            let start = Pose {
+                x: w[0].x + u * (w[1].x - w[0].x),
+                y: w[0].y + u * (w[1].y - w[0].y),
+                h: w[0].h,
+            };
+            return std::iter::once(start)
+                .chain(points[k + 1..].iter().copied())
+                .collect();
+        }
+        left -= len;
+    }
+    points.last().copied().into_iter().collect()
+}
+
+/// The poses along clothoid spline `segments` (`[curvature at start, at end, length,
+/// heading offset]`) laid end to end from `from`, each segment from where the one before
+/// ends (or from its own start in `restarts`, by index), turned by its heading offset
+/// (OpenSCENARIO 1.3, `ClothoidSpline`; esmini's `ClothoidSplineShape::Freeze`); untimed. Sampled
+/// as esmini's `ClothoidSplineShape::CalculatePolyLine` samples it: every metre along the
+/// whole spline and its end, a vertex's heading the curve's there (followed with the heading
+/// turning along each leg, [`crate::xosc::motion::Turn::Segment`]).
+fn spline_poses(
+    from: Pose,
+    segments: &[[f64; 4]],
+    restarts: &[(usize, Pose)],
+) -> Vec<(Option<f64>, Pose)> {
+    use paracosm_engine::network::RefLine;
+    // Each segment's start pose and line.
+    let mut lines: Vec<(Pose, RefLine)> = Vec::new();
+    let mut at = from;
+    for (k, &[k0, k1, length, h_offset]) in segments.iter().enumerate() {
+        if let Some((_, p)) = restarts.iter().find(|(j, _)| *j == k) {
+            at = *p;
+        }
+        at.h = wrap(at.h + h_offset);
+        let line = RefLine {
+            length_m: length,
+            curv_start: k0,
+            curv_end: k1,
+        };
+        lines.push((at, line));
+        at = pose_on(at, &line, length);
+    }
+    let total: f64 = segments.iter().map(|g| g[2]).sum();
+    let steps = (total / SPLINE_STEP_M) as usize;
+    let mut out = Vec::with_capacity(steps + 1);
+    let (mut j, mut before) = (0usize, 0.0);
+    for i in 0..=steps {
+        let s = if i < steps {
+            i as f64 * SPLINE_STEP_M
+        } else {
+            total
+        };
+        if i < steps && s > before + lines[j].1.length_m - 1e-6 && j + 1 < lines.len() {
+            before += lines[j].1.length_m;
+            j += 1;
+        }
+        let k = if i < steps { j } else { lines.len() - 1 };
+        let local = if i < steps {
+            s - before
+        } else {
+            total - segments[..k].iter().map(|g| g[2]).sum::<f64>()
+        };
+        out.push((None, pose_on(lines[k].0, &lines[k].1, local)));
+    }
+    out
+}
+
+/// The distance between the vertices of a sampled clothoid spline, m (esmini's).
+const SPLINE_STEP_M: f64 = 1.0;
+
+/// The pose `d` m along `line` laid from `start` (its heading along the line's start).
+fn pose_on(start: Pose, line: &paracosm_engine::network::RefLine, d: f64) -> Pose {
+    let [x, z] = line.point(d);
+    // The engine's frame has +z to the right of travel; OpenSCENARIO's +y is left.
+    let (lx, ly) = (x, -z);
+    let (c, s) = (start.h.cos(), start.h.sin());
+    Pose {
+        x: start.x + c * lx - s * ly,
+        y: start.y + s * lx + c * ly,
+        h: wrap(start.h + line.heading(d)),
+    }
+}
+
 /// Whether position `p` gives a heading of its own (a world position's `h`, an
 /// `Orientation` with `h`): a trajectory's vertex without one faces along its leg, as esmini
 /// aligns a vertex whose position sets no heading mode.
@@ -176,6 +366,7 @@ fn gives_heading(p: &Position) -> bool {
         | Position::Lane { orientation, .. }
         | Position::RelativeRoad { orientation, .. }
         | Position::RelativeLane { orientation, .. }
-        | Position::Route { orientation, .. } => orientation.is_some(),
+        | Position::Route { orientation, .. }
+        | Position::Trajectory { orientation, .. } => orientation.is_some(),
     }
 }
