@@ -121,7 +121,8 @@ pub struct Entity {
 /// `SpeedAction`s of the entities its storyboard moves: the target speed at most
 /// `max_speed_mps` in magnitude, and a transition's change of speed per step within
 /// `[−max_deceleration_mps2, max_acceleration_mps2]` (`LongSpeedAction::Step`). Pedestrians
-/// and miscellaneous objects have none (unbounded).
+/// and miscellaneous objects have none (unbounded; esmini gives a miscellaneous object a
+/// `maxSpeed` of 0, so that its speed actions do not move it: paracosm moves it as they say).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Performance {
     /// `maxSpeed`, m/s (`> 0`).

@@ -151,7 +151,8 @@ fn a_synchronize_action_reads_its_targets_tolerances_and_final_speed() {
 
 /// What a synchronization cannot honour is refused at its line and column: a negative
 /// tolerance, a value type neither delta nor factor, a steady state at 0 m/s (it would never
-/// arrive), and esmini's `TargetPositionSteadyState`, which no published schema has.
+/// arrive), esmini's `TargetPositionSteadyState`, which no published schema has, a final
+/// speed backwards and a negative steady state.
 #[test]
 fn a_synchronization_that_cannot_be_honoured_is_refused_where_it_is_written() {
     let cases = [
@@ -179,6 +180,20 @@ fn a_synchronization_that_cannot_be_honoured_is_refused_where_it_is_written() {
                 r#"<FinalSpeed><AbsoluteSpeed value="3"><TargetPositionSteadyState><WorldPosition x="0" y="0"/></TargetPositionSteadyState></AbsoluteSpeed></FinalSpeed>"#,
             ),
             "<TargetPositionSteadyState> in <AbsoluteSpeed> is not supported",
+        ),
+        (
+            sync(
+                "",
+                r#"<FinalSpeed><AbsoluteSpeed value="-2"/></FinalSpeed>"#,
+            ),
+            "a final speed of -2 m/s drives backwards",
+        ),
+        (
+            sync(
+                "",
+                r#"<FinalSpeed><RelativeSpeedToMaster value="1" speedTargetValueType="factor"><TargetDistanceSteadyState distance="-5"/></RelativeSpeedToMaster></FinalSpeed>"#,
+            ),
+            "a steady state's distance is >= 0, not -5",
         ),
     ];
     for (i, (action, why)) in cases.iter().enumerate() {

@@ -798,8 +798,8 @@ fn a_synchronized_entity_arrives_at_its_target_with_its_master_at_the_final_spee
 
 /// A vehicle's `Performance` limits the speed changes the storyboard makes it perform, as
 /// esmini's `LongSpeedAction` keeps them: asked from 0 to 20 m/s over 2 s, a car allowed 2 m/s²
-/// takes 10 s (10 m/s at 5 s), and its action ends once it is there; an object without limits
-/// follows the transition.
+/// takes 10 s (10 m/s at 5 s), and its action ends once it is there; a pedestrian, without
+/// limits in esmini too, follows the transition.
 #[test]
 fn a_vehicles_performance_limits_its_speed_changes() {
     let speed = r#"<PrivateAction><LongitudinalAction><SpeedAction>
@@ -808,7 +808,11 @@ fn a_vehicles_performance_limits_its_speed_changes() {
       </SpeedAction></LongitudinalAction></PrivateAction>"#;
     for (object, at_5s, reached) in [
         (car_object("A", 2.0), 10.0, 10.0),
-        (box_object("A"), 20.0, 2.0),
+        (
+            r#"<ScenarioObject name="A"><Pedestrian name="p" pedestrianCategory="pedestrian" mass="80"><BoundingBox><Center x="0" y="0" z="0.9"/><Dimensions width="0.5" length="0.6" height="1.8"/></BoundingBox><Properties/></Pedestrian></ScenarioObject>"#.to_string(),
+            20.0,
+            2.0,
+        ),
     ] {
         let text = on_straight_road(
             "performance",

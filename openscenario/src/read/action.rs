@@ -555,6 +555,9 @@ fn clothoid(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, XoscErro
     })
 }
 
+/// The longest clothoid spline read, m (it is sampled every metre).
+const MAX_SPLINE_M: f64 = 100_000.0;
+
 /// A `ClothoidSpline`: its `ClothoidSplineSegment`s (at least one; `curvatureStart`,
 /// `curvatureEnd`, `length` > 0, `hOffset` 0 when absent) and the first one's optional
 /// `PositionStart`.
@@ -562,8 +565,9 @@ fn clothoid(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, XoscErro
 /// A segment after the first with a `PositionStart` starts there (esmini's reading).
 ///
 /// # Errors
-/// Invalid at a segment of no length, an empty spline; unsupported at times (`timeEnd`, a
-/// segment's `timeStart`: the spline is followed at the entity's speed).
+/// Invalid at a segment of no length, an empty spline, one longer than [`MAX_SPLINE_M`];
+/// unsupported at times (`timeEnd`, a segment's `timeStart`: the spline is followed at the
+/// entity's speed).
 fn clothoid_spline(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, XoscError> {
     let (sc, t) = (&r.scope, r.text);
     crate::xml::only(t, c, &["ClothoidSplineSegment"])?;
@@ -603,13 +607,26 @@ fn clothoid_spline(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, X
             r.flip(sc.num_in(t, seg, "curvatureStart", Quantity::Curvature)?),
             r.flip(sc.num_in(t, seg, "curvatureEnd", Quantity::Curvature)?),
             length,
-            r.flip(sc.opt_num(t, seg, "hOffset")?.unwrap_or(0.0)),
+            r.flip(
+                sc.opt_num_in(t, seg, "hOffset", Quantity::Angle)?
+                    .unwrap_or(0.0),
+            ),
         ]);
     }
     if segments.is_empty() {
         return Err(t.invalid(
             c,
             "a clothoid spline needs at least one <ClothoidSplineSegment>",
+        ));
+    }
+    let total: f64 = segments.iter().map(|g| g[2]).sum();
+    if total > MAX_SPLINE_M {
+        return Err(t.invalid(
+            c,
+            format!(
+                "a clothoid spline of {total} m: paracosm samples one every metre, up to \
+                 {MAX_SPLINE_M} m"
+            ),
         ));
     }
     Ok(TrajectoryShape::ClothoidSpline {

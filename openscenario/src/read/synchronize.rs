@@ -14,8 +14,9 @@ use crate::xml::{child, choice, need, only};
 ///
 /// # Errors
 /// Invalid at a missing target position, a negative tolerance, a relative final speed whose
-/// `speedTargetValueType` is neither `delta` nor `factor`, a steady state with a final speed
-/// of 0 m/s or less (no time at that speed reaches the target); unsupported at esmini's
+/// `speedTargetValueType` is neither `delta` nor `factor`, a negative absolute final speed
+/// (backwards), a negative steady state, a steady state with a final speed of 0 m/s or less
+/// (no time at that speed reaches the target); unsupported at esmini's
 /// `TargetPositionSteadyState`, which no published schema has.
 pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
     only(
@@ -91,16 +92,24 @@ fn final_speed(r: &Reader<'_>, node: Node<'_, '_>) -> Result<FinalSpeed, XoscErr
         s,
         &["TargetDistanceSteadyState", "TargetTimeSteadyState"],
     )?;
+    let not_negative = |node: Node<'_, '_>, attr: &str, q: Quantity| -> Result<f64, XoscError> {
+        let v = r.scope.num_in(r.text, node, attr, q)?;
+        if v < 0.0 {
+            return Err(XoscError::Invalid {
+                pos: r.text.attr_pos(node, attr),
+                reason: format!("a steady state's {attr} is >= 0, not {v}"),
+            });
+        }
+        Ok(v)
+    };
     let steady = if let Some(d) = child(s, "TargetDistanceSteadyState") {
-        Some(SteadyState::Distance(r.scope.num_in(
-            r.text,
+        Some(SteadyState::Distance(not_negative(
             d,
             "distance",
             Quantity::Distance,
         )?))
     } else if let Some(t) = child(s, "TargetTimeSteadyState") {
-        Some(SteadyState::Time(r.scope.num_in(
-            r.text,
+        Some(SteadyState::Time(not_negative(
             t,
             "time",
             Quantity::Duration,
@@ -108,6 +117,15 @@ fn final_speed(r: &Reader<'_>, node: Node<'_, '_>) -> Result<FinalSpeed, XoscErr
     } else {
         None
     };
+    if relative.is_none() && value < 0.0 {
+        return Err(XoscError::Invalid {
+            pos: r.text.attr_pos(s, "value"),
+            reason: format!(
+                "a final speed of {value} m/s drives backwards, which paracosm does not do \
+                 (its storyboard moves entities forward only)"
+            ),
+        });
+    }
     if steady.is_some() && relative.is_none() && value <= 0.0 {
         return Err(r.text.invalid(
             s,

@@ -20,6 +20,8 @@ pub(in crate::xosc::story) struct Drive {
     pub(in crate::xosc::story) keep: Option<Keep>,
     /// The `SynchronizeAction` in progress.
     pub(in crate::xosc::story) sync: Option<Synchronizing>,
+    /// Its speed before a synchronization set this step's (m/s), for its acceleration.
+    pub(in crate::xosc::story) speed_before: Option<f64>,
     /// The trajectory in progress and its action.
     pub(in crate::xosc::story) path: Option<(Path, usize)>,
     /// A driven ego's lane change in progress: the lane it changes to, the offset from its
@@ -141,8 +143,9 @@ impl Storyboard {
             pose.y += dist * pose.h.sin();
         }
         let moved = (pose.x - st.pose.x).hypot(pose.y - st.pose.y);
+        let before = self.drives[e].speed_before.take();
         let s = &mut self.actors[e].state;
-        s.accel = (speed_now - s.speed) / dt;
+        s.accel = (speed_now - before.unwrap_or(s.speed)) / dt;
         s.speed = speed_now;
         s.lane = lane;
         s.travelled_m += moved;

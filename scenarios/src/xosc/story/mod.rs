@@ -392,9 +392,27 @@ impl Storyboard {
     /// The acts and events that have never started and wait on their start triggers now,
     /// each as `act "NAME" (file:line:col)` with where its trigger's first condition is
     /// written: what the file describes and a test cut short by its horizon never played.
+    /// An element that waits on a reaction a good run never sees (a collision, leaving the
+    /// road, the end of the road, standing still) is not counted.
     pub fn never_started(&self) -> Vec<String> {
+        let reaction = |c: &Cond| {
+            matches!(
+                c.cond.kind,
+                m::ConditionKind::Entity {
+                    test: m::EntityTest::Collision(_)
+                        | m::EntityTest::CollisionByType(_)
+                        | m::EntityTest::Offroad(_)
+                        | m::EntityTest::EndOfRoad(_)
+                        | m::EntityTest::Standstill(_),
+                    ..
+                }
+            )
+        };
         let mut waiting = Vec::new();
         for k in (0..self.triggers.len()).filter(|&k| self.waits(k)) {
+            if self.triggers[k].iter().flatten().any(reaction) {
+                continue;
+            }
             let elem = match self.owners[k] {
                 elements::Owner::ActStart(a) => a,
                 elements::Owner::EventStart { event, .. } => event,

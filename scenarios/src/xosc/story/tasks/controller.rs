@@ -42,11 +42,13 @@ impl Storyboard {
         let on = lateral.unwrap_or(true) || longitudinal.unwrap_or(true);
         if on && Some(e) == self.hand_over && self.actors[e].scripted {
             self.actors[e].scripted = false;
-            // Its lateral move and path end with the script (and their actions); a
-            // running SpeedAction goes on as the system's set speed.
+            // Its lateral move, path, kept distance and synchronization end with the script
+            // (and their actions); a running SpeedAction goes on as the system's set speed.
             let old = [
                 self.drives[e].lateral.take().map(|l| l.action),
                 self.drives[e].path.take().map(|p| p.1),
+                self.drives[e].keep.take().map(|k| k.action),
+                self.drives[e].sync.take().map(|s| s.action),
             ];
             for o in old {
                 self.override_task(o);

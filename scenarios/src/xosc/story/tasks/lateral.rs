@@ -181,6 +181,9 @@ impl Storyboard {
             ahead_m,
             path: Vec::new(),
         });
+        // A trajectory handed before ends: the lane change's route replaces it.
+        let old_path = self.drives[e].path_goal.take().map(|g| g.1);
+        self.override_task(old_path);
         let old = self.drives[e].lane_goal.take().map(|g| g.2);
         self.override_task(old);
         if let Some(a) = a {

@@ -33,6 +33,9 @@ impl Storyboard {
     fn set_route(&mut self, e: usize, points: &[LanePos], scripted: bool) {
         self.drives[e].prefer_roads = self.route_through(points);
         if !scripted {
+            // A trajectory handed before ends: this route replaces it.
+            let old = self.drives[e].path_goal.take().map(|g| g.1);
+            self.override_task(old);
             if let Some(lp) = self.actors[e].state.lane {
                 self.route = Some(RouteAsk {
                     join: lp,

@@ -90,6 +90,10 @@ impl Storyboard {
                 (v, continuous.then_some((*entity, *value, *factor)))
             }
         };
+        // The target within the entity's `maxSpeed`, as esmini's `LongSpeedAction::Start`
+        // sets it (before its transition's length is taken).
+        let max = self.actors[e].performance.max_speed_mps;
+        let to = to.clamp(-max, max);
         if !scripted && a.is_none() {
             // The ego's initial speed; later, the system under test drives it.
             self.actors[e].state.speed = to.max(0.0);

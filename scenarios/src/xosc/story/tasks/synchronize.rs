@@ -92,7 +92,7 @@ impl Storyboard {
         sync.steady_m = s.final_speed.and_then(|f| {
             f.steady.map(|st| match st {
                 SteadyState::Distance(d) => d,
-                SteadyState::Time(t) => t * self.final_speed(&sync).unwrap_or(0.0),
+                SteadyState::Time(t) => t * self.final_speed(&sync).unwrap_or(0.0).max(0.0),
             })
         });
         let old = self.drives[e].speed.take().map(|s| s.action);
@@ -204,6 +204,7 @@ impl Storyboard {
             let Some(mut s) = self.drives[e].sync.take() else {
                 continue;
             };
+            self.drives[e].speed_before = Some(self.actors[e].state.speed);
             if first && self.sync_step(e, &mut s, (0.0, true)) {
                 self.task_done(Some(s.action).filter(|&a| a != usize::MAX));
                 continue;
@@ -257,7 +258,10 @@ impl Storyboard {
             }
             return false;
         };
-        if let (Some(steady_m), false) = (s.steady_m, s.mode == Mode::SteadyState) {
+        // A final speed relative to the master's may come to 0 or less: no steady state then
+        // (no time at it reaches the target).
+        let steady_m = s.steady_m.filter(|_| v1 > SMALL);
+        if let (Some(steady_m), false) = (steady_m, s.mode == Mode::SteadyState) {
             let steady_s = steady_m / v1;
             if dist - steady_m < SMALL || time_left - steady_s < SMALL {
                 s.mode = Mode::SteadyState;

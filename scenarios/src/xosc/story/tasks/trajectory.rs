@@ -151,6 +151,9 @@ impl Storyboard {
             ahead_m: 0.0,
             path,
         });
+        // A trajectory handed before ends: the new one is the route now.
+        let old = self.drives[e].path_goal.take().map(|g| g.1);
+        self.override_task(old);
         if let Some(a) = a {
             self.elems[a].pending += 1;
             self.drives[e].path_goal = Some((end, a));
@@ -323,7 +326,7 @@ fn spline_poses(
         } else {
             total
         };
-        if i < steps && s > before + lines[j].1.length_m - 1e-6 && j + 1 < lines.len() {
+        while i < steps && s > before + lines[j].1.length_m - 1e-6 && j + 1 < lines.len() {
             before += lines[j].1.length_m;
             j += 1;
         }
