@@ -1600,3 +1600,101 @@ fn a_test_whose_values_ask_the_ego_no_speed_is_an_error_not_a_pass() {
         "{err}"
     );
 }
+
+/// [`brake_scenario`]'s lead with the events `events` (whole `<Event>` elements) added to its
+/// maneuver, and a second box, `Late`, that `Init` does not place; run once with the ego
+/// scripted (nothing brakes it), its one record returned.
+fn entities_campaign(dir: &std::path::Path, tag: &str, events: &str) -> serde_json::Value {
+    let text = brake_scenario("false", 20.0, "leadingReferencedEntity")
+        .replace(
+            "</Entities>",
+            r#"<ScenarioObject name="Late">
+  <MiscObject name="box" miscObjectCategory="obstacle" mass="500">
+    <BoundingBox><Center x="0" y="0" z="0.75"/><Dimensions width="1.8" length="4" height="1.5"/></BoundingBox>
+    <Properties/>
+  </MiscObject>
+</ScenarioObject>
+  </Entities>"#,
+        )
+        .replace(
+            r#"<Event name="Brake" priority="override">"#,
+            &format!(r#"{events}<Event name="Brake" priority="override">"#),
+        );
+    let file = dir.join(format!("{tag}.xosc"));
+    std::fs::write(&file, text).unwrap();
+    let out = dir.join(tag);
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args(["--scripted-ego", "--budget", "1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    assert_eq!(
+        err.contains("Late is never in the scenario"),
+        !events.contains("AddEntityAction"),
+        "a box never placed nor added is named: {err}"
+    );
+    let results =
+        std::fs::read_to_string(out.join("results.jsonl")).unwrap_or_else(|e| panic!("{e}: {err}"));
+    serde_json::from_str(results.lines().next().unwrap()).unwrap()
+}
+
+/// A global `<Event>` named `name` that performs `action` (an `EntityAction`'s inside) on
+/// `entity` once the simulation time exceeds `t` s.
+fn entity_event(name: &str, entity: &str, action: &str, t: f64) -> String {
+    format!(
+        r#"<Event name="{name}" priority="parallel">
+          <Action name="{name}Action"><GlobalAction><EntityAction entityRef="{entity}">{action}</EntityAction></GlobalAction></Action>
+          <StartTrigger><ConditionGroup>
+            <Condition name="T{name}" delay="0" conditionEdge="rising">
+              <ByValueCondition><SimulationTimeCondition value="{t}" rule="greaterThan"/></ByValueCondition>
+            </Condition>
+          </ConditionGroup></StartTrigger>
+        </Event>"#
+    )
+}
+
+/// `AddEntityAction` and `DeleteEntityAction` (OpenSCENARIO 1.3, 7.7.3): the scripted ego
+/// at 12 m/s runs into its lead, which brakes hard after 3 s, unless the lead leaves the
+/// scenario first; then nothing touches it and the test passes. An entity `Init` does not
+/// place is out of the test's world (esmini's inactive entity, with a warning) until an
+/// `AddEntityAction` puts it in, where the ego then runs into it.
+#[test]
+fn an_entity_deleted_leaves_the_world_and_one_added_enters_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let collided = |r: &serde_json::Value| r["monitors"]["collision"]["passed"] == false;
+    let kept = entities_campaign(dir.path(), "kept", "");
+    assert_eq!(kept["status"], "fail", "the ego runs into the lead: {kept}");
+    assert!(collided(&kept), "{kept}");
+    let deleted = entities_campaign(
+        dir.path(),
+        "deleted",
+        &entity_event("Gone", "Lead", "<DeleteEntityAction/>", 2.0),
+    );
+    assert_eq!(deleted["status"], "pass", "the lead left at 2 s: {deleted}");
+    assert!(!collided(&deleted), "{deleted}");
+    // The lead gone, the box added 60 m ahead of the ego at 4 s stands in its lane.
+    let added = entities_campaign(
+        dir.path(),
+        "added",
+        &(entity_event("Gone", "Lead", "<DeleteEntityAction/>", 2.0)
+            + &entity_event(
+                "Enter",
+                "Late",
+                r#"<AddEntityAction><Position><RelativeLanePosition entityRef="Ego" dLane="0" ds="60"/></Position></AddEntityAction>"#,
+                4.0,
+            )),
+    );
+    assert_eq!(
+        added["status"], "fail",
+        "the ego runs into the added box: {added}"
+    );
+    assert!(collided(&added), "{added}");
+    // At 12 m/s, the ego's front (3.65 m ahead of its reference point) meets the box's back
+    // (2 m behind the box's, 60 m ahead) 4.53 s after the box enters at 4 s: it was in the
+    // world no sooner.
+    let t = added["metrics"]["simulated_s"].as_f64().unwrap();
+    assert!((8.3..8.8).contains(&t), "collided at {t} s: {added}");
+}

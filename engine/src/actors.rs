@@ -28,6 +28,9 @@ pub(crate) struct Actors {
     pub(crate) obstacles: Set<Obstacle, ObstacleSpec>,
     /// The actor each actor collider belongs to.
     owners: HashMap<ColliderHandle, ActorRef>,
+    /// The actors out of the test now ([`Action::SetPresent`]): [`Actors::all`] leaves them
+    /// out.
+    absent: Vec<ActorRef>,
 }
 
 impl Actors {
@@ -61,6 +64,7 @@ impl Actors {
             pedestrians: Set::default(),
             obstacles: Set::default(),
             owners: HashMap::new(),
+            absent: Vec::new(),
         };
         for (i, p) in spec.pedestrians.iter().enumerate() {
             let ped = Pedestrian::from_spec(i, p, &spec.streams, physics);
@@ -113,7 +117,10 @@ impl Actors {
             (self.pedestrians.iter()).map(|(h, a)| (ActorRef::Pedestrian(h), a as &dyn ActorKind));
         let obstacles =
             (self.obstacles.iter()).map(|(h, a)| (ActorRef::Obstacle(h), a as &dyn ActorKind));
-        cars.chain(pedestrians).chain(obstacles)
+        let absent = &self.absent;
+        cars.chain(pedestrians)
+            .chain(obstacles)
+            .filter(move |(r, _)| absent.is_empty() || !absent.contains(r))
     }
 
     /// Calls `f` on every actor, in [`Actors::all`]'s order.
@@ -144,6 +151,18 @@ impl Actors {
         value: &Value,
         world: &mut StepWorld,
     ) -> Result<(), EngineError> {
+        if let Action::SetPresent(r) = action {
+            let Value::Bool(present) = value else {
+                return Err(crate::behaviour::bad_input(
+                    world.t_s,
+                    "an actor's presence".into(),
+                    value,
+                    "a boolean (true: in the test)",
+                ));
+            };
+            self.set_present(r, *present, world.physics);
+            return Ok(());
+        }
         match action.actor() {
             ActorRef::Car(h) => match self.cars.get_mut(h) {
                 Some(car) => car.act(action, value, world),
@@ -154,6 +173,45 @@ impl Actors {
                 None => Ok(()),
             },
             ActorRef::Obstacle(_) | ActorRef::Ego => Ok(()),
+        }
+    }
+
+    /// Puts actor `r` into the test (`present`) or out of it ([`Action::SetPresent`]): its
+    /// body and collider enabled or disabled, its own flag set so that its moves leave them
+    /// so. Nothing changes for the ego, an obstacle, or an actor already so.
+    fn set_present(&mut self, r: ActorRef, present: bool, physics: &mut PhysicsWorld) {
+        let was = !self.absent.contains(&r);
+        if was == present {
+            return;
+        }
+        let parts = match r {
+            ActorRef::Car(h) => self.cars.get_mut(h).map(|c| {
+                c.absent = !present;
+                (c.body, Some(c.collider_pose()))
+            }),
+            ActorRef::Pedestrian(h) => self.pedestrians.get_mut(h).map(|p| {
+                p.absent = !present;
+                (Some((p.body, p.collider)), Some(p.collider_pose()))
+            }),
+            ActorRef::Obstacle(_) | ActorRef::Ego => None,
+        };
+        let Some((body, pose)) = parts else {
+            return;
+        };
+        if present {
+            self.absent.retain(|a| *a != r);
+        } else {
+            self.absent.push(r);
+        }
+        if let Some((body, collider)) = body {
+            let rb = &mut physics.bodies[body];
+            if present {
+                if let Some(pose) = pose {
+                    rb.set_position(pose, true);
+                }
+            }
+            rb.set_enabled(present);
+            physics.colliders[collider].set_enabled(present);
         }
     }
 
@@ -186,7 +244,7 @@ impl Actors {
             return Ok(());
         }
         let mut hits = Vec::new();
-        for (h, p) in self.pedestrians.iter_mut() {
+        for (h, p) in self.pedestrians.iter_mut().filter(|(_, p)| !p.absent) {
             if let Some(o) = p.walked_into(ActorRef::Pedestrian(h), solids) {
                 hits.push(o);
             }
@@ -246,7 +304,7 @@ impl Actors {
     pub(crate) fn asleep(&self, physics: &PhysicsWorld) -> Vec<(ColliderHandle, Pose)> {
         self.cars
             .values()
-            .filter(|c| c.is_asleep(physics))
+            .filter(|c| !c.absent && c.is_asleep(physics))
             .filter_map(|c| Some((c.body?.1, c.collider_pose())))
             .collect()
     }

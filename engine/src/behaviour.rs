@@ -136,6 +136,13 @@ pub enum Action {
     /// route its observation carries ([`crate::Observation::route`]), as an OpenSCENARIO
     /// storyboard's `LaneChangeAction` or `AssignRouteAction` on the ego it drives asks.
     SetEgoRoute,
+    /// The actor enters the test (the value `true`) or leaves it (`false`), as an
+    /// OpenSCENARIO storyboard's `AddEntityAction` and `DeleteEntityAction` ask. An actor out
+    /// of the test has its body and collider out of the physics step (nothing touches it,
+    /// no ray or sensor meets it, the camera does not draw it), its outputs have no events,
+    /// and what it would touch is not recorded; it keeps its pose, which its place actions
+    /// still move. An action on the ego does nothing (the ego is always in the test).
+    SetPresent(ActorRef),
 }
 
 impl Action {
@@ -150,6 +157,7 @@ impl Action {
             Action::PlaceEgo | Action::SetEgoSpeed | Action::ReleaseEgo | Action::SetEgoRoute => {
                 ActorRef::Ego
             }
+            Action::SetPresent(r) => r,
         }
     }
 }

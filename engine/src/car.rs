@@ -23,7 +23,9 @@ pub struct CarState {
     pub heading_rad: f64,
     /// Speed along the path in m/s.
     pub speed_mps: f64,
-    /// Whether it is in this test.
+    /// Whether it is in this test now: a car the world spec disables never is, and one an
+    /// OpenSCENARIO storyboard took out (`DeleteEntityAction`, [`crate::Action::SetPresent`])
+    /// is not until it is put back.
     pub enabled: bool,
 }
 
@@ -207,6 +209,9 @@ pub(crate) struct Car {
     /// crashed car stops for the rest of the test ([`Car::advance`]); a pedestrian it meets
     /// only stops it until the pedestrian has walked out of its path.
     pub(crate) wrecked: bool,
+    /// Whether it is out of the test ([`crate::Action::SetPresent`]): its body and collider
+    /// stay disabled, and what it would touch is not recorded.
+    pub(crate) absent: bool,
     /// The gap it keeps to whatever is ahead on its path, m (`Car(keep_distance=)`): it
     /// brakes, no harder than its tyres allow, to stop that far from it. `None`: it does not
     /// brake for anything (it still stops against what it meets).
@@ -448,6 +453,7 @@ impl Car {
             name: String::new(),
             lanes: Vec::new(),
             wrecked: false,
+            absent: false,
             keep_distance_m: None,
             lane_change: None,
             change_started_s: None,
@@ -792,7 +798,11 @@ impl Car {
             }
             s_new = (self.s + k * step).min(end);
         }
-        let hit = self.first_contact(solids, me, (self.s, s_new), next_t);
+        let hit = if self.absent {
+            None
+        } else {
+            self.first_contact(solids, me, (self.s, s_new), next_t)
+        };
         if let Some((free_s, o)) = hit {
             s_new = free_s;
             self.contact.collided = true;
@@ -833,6 +843,9 @@ impl Car {
             self.velocity = [v * pose.1.cos(), -v * pose.1.sin()];
         }
         self.body?;
+        if self.absent {
+            return None;
+        }
         let [x, z] = pose.0;
         let centre = [x, CLEARANCE_M + self.size.height_m / 2.0, z];
         if !solids.any_near(me, centre, self.radius_m(), false) {
@@ -861,7 +874,7 @@ impl Car {
             let [x, z] = self.here.0;
             let (dx, dz) = (x - zone.ego_m[0], z - zone.ego_m[1]);
             // A distance that is not a number keeps the car awake.
-            let asleep = dx * dx + dz * dz > zone.radius_m * zone.radius_m;
+            let asleep = self.absent || dx * dx + dz * dz > zone.radius_m * zone.radius_m;
             let rb = &mut physics.bodies[body];
             if asleep {
                 if rb.is_enabled() {
@@ -982,7 +995,7 @@ impl Car {
             pos_m: [x, 0.0, z],
             heading_rad,
             speed_mps: self.speed,
-            enabled: self.body.is_some(),
+            enabled: self.body.is_some() && !self.absent,
         }
     }
 }

@@ -38,6 +38,9 @@ pub struct PedestrianState {
     pub velocity_mps: [f64; 3],
     /// The way it faces, rad (counter-clockwise from `+x` seen from above).
     pub heading_rad: f64,
+    /// Whether it is in this test now: not while an OpenSCENARIO storyboard has it out
+    /// (`DeleteEntityAction`, [`crate::Action::SetPresent`]).
+    pub present: bool,
 }
 
 /// A kinematic pedestrian: a sensor capsule moved by position, not by forces. It never pushes
@@ -66,6 +69,9 @@ pub(crate) struct Pedestrian {
     velocity: [f64; 3],
     phase: PedestrianPhase,
     triggered_at_s: Option<f64>,
+    /// Whether it is out of the test ([`crate::Action::SetPresent`]): its body and collider
+    /// are disabled.
+    pub(crate) absent: bool,
 }
 
 impl Pedestrian {
@@ -177,6 +183,7 @@ impl Pedestrian {
             ],
             phase: PedestrianPhase::Waiting,
             triggered_at_s: None,
+            absent: false,
         }
     }
 
@@ -253,6 +260,7 @@ impl Pedestrian {
             triggered_at_s: self.triggered_at_s,
             velocity_mps: self.velocity,
             heading_rad: self.heading_rad,
+            present: !self.absent,
         }
     }
 }

@@ -88,6 +88,25 @@ pub struct Assignment {
     pub pos: Pos,
 }
 
+/// A `ParameterAssignment`'s value: as written, or an expression `${...}` (a dialect of
+/// Vector's Euro NCAP files, `${0.6/2-0.36}`, which esmini evaluates) evaluated to its value's
+/// text ([`Value::to_text`]); an expression reads no parameter (the assignment's own scope
+/// has none).
+///
+/// # Errors
+/// Invalid at the attribute for an expression that does not evaluate (naming why).
+fn assigned_value(text: &Text, a: Node<'_, '_>, value: &str) -> Result<String, XoscError> {
+    let Some(inner) = value.strip_prefix("${").and_then(|v| v.strip_suffix('}')) else {
+        return Ok(value.to_string());
+    };
+    expr::eval(inner, &|_| None)
+        .map(|v| v.to_text())
+        .map_err(|e| XoscError::Invalid {
+            pos: text.attr_pos(a, "value"),
+            reason: format!("the value {value:?} does not evaluate: {e}"),
+        })
+}
+
 /// A single parameter's distribution. Bounds are inclusive; numbers are finite.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Dist {
@@ -844,7 +863,7 @@ fn read_value_sets(text: &Text, node: Node<'_, '_>) -> Result<Vec<Vec<Assignment
                     format!("parameter {name} is assigned twice in one <ParameterValueSet>"),
                 ));
             }
-            let value = required(text, a, "value")?.to_string();
+            let value = assigned_value(text, a, required(text, a, "value")?)?;
             set.push(Assignment {
                 name,
                 value,
@@ -1036,6 +1055,18 @@ mod tests {
         assert!(error(dup).contains("assigned twice"));
         let empty = "<Deterministic><DeterministicMultiParameterDistribution><ValueSetDistribution/></DeterministicMultiParameterDistribution></Deterministic>";
         assert!(error(empty).contains("empty <ValueSetDistribution>"));
+        // Vector's CPRA_Cm variation: an assignment's value written as an expression.
+        let set = |value: &str| {
+            format!(
+                r#"<Deterministic><DeterministicMultiParameterDistribution><ValueSetDistribution>
+            <ParameterValueSet><ParameterAssignment parameterRef="a" value="{value}"/></ParameterValueSet>
+          </ValueSetDistribution></DeterministicMultiParameterDistribution></Deterministic>"#
+            )
+        };
+        let v = read(&set("${0.6/2-0.36}")).unwrap();
+        let got: f64 = v.multi[0].sets[0][0].value.parse().unwrap();
+        assert_eq!(got, 0.6 / 2.0 - 0.36);
+        assert!(error(&set("${$b + 1}")).contains("does not evaluate"));
     }
 
     #[test]

@@ -431,6 +431,24 @@ pub enum Action {
     /// `EnvironmentAction` (a global action): the parts of the world's environment it
     /// gives, the others kept.
     Environment(Environment),
+    /// `AddEntityAction` (a global `EntityAction`): entity `entity` (an index into
+    /// [`Scenario::entities`]) enters the scenario at `position`. An entity is in the
+    /// scenario from the start when `Init` places it (a `Private` block of its own, as
+    /// esmini activates it) or adds it; an `AddEntityAction` on an entity in the scenario
+    /// does nothing (esmini: "already active").
+    AddEntity {
+        /// The entity.
+        entity: usize,
+        /// Where it enters.
+        position: Position,
+    },
+    /// `DeleteEntityAction` (a global `EntityAction`): entity `entity` leaves the scenario:
+    /// nothing senses or touches it, and conditions leave it out, until an
+    /// `AddEntityAction` adds it again.
+    DeleteEntity {
+        /// The entity.
+        entity: usize,
+    },
     /// `ParameterSetAction` or `VariableSetAction` (global): the parameter or variable
     /// `name` takes `value` (of its declared type).
     SetValue {
@@ -533,6 +551,8 @@ impl Action {
             Action::Appearance(_) => "AppearanceAction",
             Action::Visibility { .. } => "VisibilityAction",
             Action::Environment(_) => "EnvironmentAction",
+            Action::AddEntity { .. } => "AddEntityAction",
+            Action::DeleteEntity { .. } => "DeleteEntityAction",
             Action::SetValue {
                 variable: false, ..
             } => "ParameterSetAction",
@@ -567,7 +587,11 @@ impl Action {
     pub fn is_global(&self) -> bool {
         matches!(
             self,
-            Action::Environment(_) | Action::SetValue { .. } | Action::ModifyValue { .. }
+            Action::Environment(_)
+                | Action::SetValue { .. }
+                | Action::ModifyValue { .. }
+                | Action::AddEntity { .. }
+                | Action::DeleteEntity { .. }
         )
     }
 }
@@ -897,6 +921,24 @@ pub struct Gap {
     pub kind: String,
 }
 
+/// A condition's gap from an entity to a position: a `DistanceCondition` (m) or a
+/// `TimeToCollisionCondition` with a position target (s).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PositionGap {
+    /// The position.
+    pub position: Position,
+    /// Comparison.
+    pub rule: Rule,
+    /// m (distance) or s (time to collision).
+    pub value: f64,
+    /// From the entity's bounding box (its reference point otherwise).
+    pub freespace: bool,
+    /// `relativeDistanceType`: `longitudinal`, `lateral` or `euclidianDistance`.
+    pub kind: String,
+    /// `coordinateSystem`: `entity` or `road` (`lane` longitudinally).
+    pub frame: String,
+}
+
 /// An entity condition's test (the standard's `EntityCondition` choices paracosm reads).
 #[derive(Debug, Clone, PartialEq)]
 pub enum EntityTest {
@@ -908,37 +950,11 @@ pub enum EntityTest {
     RelativeDistance(Gap),
     /// `DistanceCondition`: the distance from the entity to a position, m (in the entity's
     /// frame: `coordinateSystem` `entity`; from its bounding box with `freespace`).
-    Distance {
-        /// The position.
-        position: Position,
-        /// Comparison.
-        rule: Rule,
-        /// m.
-        value: f64,
-        /// From the entity's bounding box (its reference point otherwise).
-        freespace: bool,
-        /// `relativeDistanceType`: `longitudinal`, `lateral` or `euclidianDistance`.
-        kind: String,
-        /// `coordinateSystem`: `entity` or `road` (`lane` longitudinally).
-        frame: String,
-    },
+    Distance(PositionGap),
     /// `TimeToCollisionCondition` to a position: the distance to it (as a
     /// `DistanceCondition` measures it) over the entity's speed, s; undefined (every rule
     /// false) at no distance, standing, or moving away (esmini's `TrigByTimeToCollision`).
-    TimeToPosition {
-        /// The position.
-        position: Position,
-        /// Comparison.
-        rule: Rule,
-        /// s.
-        value: f64,
-        /// From the entity's bounding box (its reference point otherwise).
-        freespace: bool,
-        /// `relativeDistanceType`: `longitudinal`, `lateral` or `euclidianDistance`.
-        kind: String,
-        /// `coordinateSystem`: `entity` or `road` (`lane` longitudinally).
-        frame: String,
-    },
+    TimeToPosition(PositionGap),
     /// `ReachPositionCondition`.
     ReachPosition {
         /// The position.

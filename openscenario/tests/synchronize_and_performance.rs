@@ -3,7 +3,7 @@
 //! scenarios written here; and the refusals that name what paracosm cannot honour.
 
 use paracosm_openscenario::model::{
-    Action, ConditionKind, EntityTest, FinalSpeed, Performance, Position, SteadyState,
+    Action, ConditionKind, EntityTest, FinalSpeed, Performance, Position, PositionGap, SteadyState,
 };
 use paracosm_openscenario::read_scenario;
 
@@ -260,13 +260,13 @@ fn a_time_to_collision_to_a_position_is_read() {
     match &start.0[0][0].kind {
         ConditionKind::Entity {
             test:
-                EntityTest::TimeToPosition {
+                EntityTest::TimeToPosition(PositionGap {
                     position: Position::Lane { .. },
                     value,
                     kind,
                     frame,
                     ..
-                },
+                }),
             ..
         } => {
             assert_eq!(*value, 3.0);

@@ -55,14 +55,27 @@ struct Worst {
     heading_rad: f64,
     heading_at: String,
     samples: usize,
+    /// The first sample where an entity is in one simulator's scenario and not in the
+    /// other's (esmini's CSV leaves an inactive entity out), empty when none.
+    presence_at: String,
 }
 
-/// Steps the storyboard of `scenario` (every entity scripted) at esmini's step and compares
-/// it with esmini's track.
-fn compare(scenario: &Path, fixtures: &Path) -> Worst {
-    let stem = scenario.file_stem().unwrap().to_str().unwrap();
-    let track = fixture(&fixtures.join(format!("{stem}.csv")));
-    let model = read_scenario(scenario, &[]).expect("the scenario reads");
+/// Steps the storyboard of `scenario` (every entity scripted), its parameters `overrides`
+/// (name, value), at esmini's step and compares it with esmini's track `fixture_csv` (of the
+/// file as written, or of one permutation of a variation file, as esmini's `--param_dist`
+/// runs it).
+fn compare_with(scenario: &Path, fixture_csv: &Path, overrides: &[(&str, &str)]) -> Worst {
+    let track = fixture(fixture_csv);
+    let overrides: Vec<(String, paracosm_openscenario::Value)> = overrides
+        .iter()
+        .map(|(n, v)| {
+            (
+                n.to_string(),
+                paracosm_openscenario::Value::Str(v.to_string()),
+            )
+        })
+        .collect();
+    let model = read_scenario(scenario, &overrides).expect("the scenario reads");
     let road = model.road_network.as_ref().expect("a road network");
     let text = std::fs::read_to_string(&road.item).expect("the map reads");
     let map = MapRef::new(
@@ -76,6 +89,18 @@ fn compare(scenario: &Path, fixtures: &Path) -> Worst {
     let mut worst = Worst::default();
     let mut check = |k: usize, sb: &Storyboard| {
         for a in &sb.actors {
+            let in_esmini = track
+                .get(&a.name)
+                .and_then(|v| v.get(k))
+                .is_some_and(Option::is_some);
+            if in_esmini != a.present && worst.presence_at.is_empty() {
+                worst.presence_at = format!(
+                    "{} at {:.1} s: in paracosm's scenario {}, in esmini's {in_esmini}",
+                    a.name,
+                    k as f64 * EVERY_S,
+                    a.present
+                );
+            }
             let Some(Some([x, y, h])) = track.get(&a.name).and_then(|v| v.get(k)) else {
                 continue;
             };
@@ -134,24 +159,49 @@ fn files_ending(dir: &Path, suffix: &str) -> Vec<PathBuf> {
 }
 
 /// Compares every file of `files` with its fixture; fails naming each that differs.
+/// One comparison: a scenario, esmini's fixture of it, the parameters' values (name, value).
+type Run<'a> = (PathBuf, PathBuf, Vec<(&'a str, &'a str)>);
+
 fn check_all(files: &[PathBuf]) {
+    let runs: Vec<Run> = files
+        .iter()
+        .map(|f| {
+            let stem = f.file_stem().unwrap().to_str().unwrap();
+            let csv = data("esmini-trajectories").join(format!("{stem}.csv"));
+            (f.clone(), csv, vec![])
+        })
+        .collect();
+    check_runs(&runs);
+}
+
+/// Compares each run (a scenario, its fixture, its parameters' values) with its fixture;
+/// fails naming each that differs.
+fn check_runs(runs: &[Run]) {
     let mut report = Vec::new();
     let mut failed = 0;
-    for f in files {
-        let w = compare(f, &data("esmini-trajectories"));
-        let ok = w.pos_m <= POS_TOL_M && w.heading_rad <= HEADING_TOL_RAD && w.samples > 0;
+    for (f, csv, overrides) in runs {
+        let w = compare_with(f, csv, overrides);
+        let ok = w.pos_m <= POS_TOL_M
+            && w.heading_rad <= HEADING_TOL_RAD
+            && w.samples > 0
+            && w.presence_at.is_empty();
         if !ok {
             failed += 1;
         }
         report.push(format!(
-            "{} {}: {} samples, worst position {:.4} m ({}), worst heading {:.5} rad ({})",
+            "{} {}: {} samples, worst position {:.4} m ({}), worst heading {:.5} rad ({}){}",
             if ok { "ok  " } else { "FAIL" },
-            f.file_name().unwrap().to_string_lossy(),
+            csv.file_stem().unwrap().to_string_lossy(),
             w.samples,
             w.pos_m,
             w.pos_at,
             w.heading_rad,
-            w.heading_at
+            w.heading_at,
+            if w.presence_at.is_empty() {
+                String::new()
+            } else {
+                format!(", presence differs: {}", w.presence_at)
+            }
         ));
     }
     let report = report.join("\n");
@@ -162,7 +212,7 @@ fn check_all(files: &[PathBuf]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 28] = [
+const ESMINI_EXAMPLES: [&str; 33] = [
     "acc-test",
     "alks_cut-in",
     "alks_cut-out",
@@ -172,10 +222,15 @@ const ESMINI_EXAMPLES: [&str; 28] = [
     "alks-test",
     "cut-in",
     "cut-in_environment",
+    "cut-in_external",
+    "cut-in_interactive",
     "cut-in_simple",
+    "cut-in_sloppy",
+    "cut-in_visibility",
     "drive_when_close",
     "follow_reference",
     "highway_driver",
+    "lane_change_crest",
     "lane-change_clothoid_based_trajectory",
     "lane-change_trajectory_wp",
     "left-hand-traffic_by_heading",
@@ -258,9 +313,31 @@ fn the_fields_files_move_as_in_esmini() {
         "vector/OpenSCENARIO/NCAP/AEB_VRU_2023/NCAP_AEB_VRU_CBLA_2023.xosc",
         "vector/OpenSCENARIO/NCAP/AEB_C2C_2023/NCAP_AEB_C2C_CCR_2023.xosc",
         "vector/OpenSCENARIO/NCAP/AEB_C2C_2023/NCAP_AEB_C2C_CCFhos_2023.xosc",
+        "vector/OpenSCENARIO/NCAP/CA-FC_2026/CCCscp.xosc",
     ]
     .iter()
     .map(|f| data("third_party").join(f))
     .collect();
     check_all(&files);
+}
+
+/// Vector's CCCscp with the target at 70 km/h, the first permutation of its ExtendedRange
+/// variation as esmini runs it (`--param_dist`, `--param_permutation 0`): its storyboard
+/// deletes the three obstruction vehicles (`DeleteEntityAction`) when a speed exceeds
+/// 60 km/h, and they leave paracosm's scenario when they leave esmini's.
+#[test]
+fn an_entity_deleted_leaves_the_scenario_as_in_esmini() {
+    let file = data("third_party/vector/OpenSCENARIO/NCAP/CA-FC_2026/CCCscp.xosc");
+    let csv = data("esmini-trajectories/CCCscp_extended_0.csv");
+    let track = fixture(&csv);
+    assert_eq!(
+        track["ObstructionVehicle_Large"].iter().flatten().count(),
+        1,
+        "in esmini's first sample only"
+    );
+    check_runs(&[(
+        file,
+        csv,
+        vec![("Ego_speed_kph", "20"), ("Target_final_speed_kph", "70")],
+    )]);
 }

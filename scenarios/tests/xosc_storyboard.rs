@@ -840,3 +840,110 @@ fn a_vehicles_performance_limits_its_speed_changes() {
         );
     }
 }
+
+/// An entity out of the scenario is left out of conditions, as esmini's conditions skip an
+/// inactive one: `B`, which `Init` does not place, enters at 1 s (`AddEntityAction`) and
+/// leaves at 3 s (`DeleteEntityAction`); A speeds up when any of A and B stands still
+/// (`all`: B is left out, so A alone decides), and C stops when B travelled 0 m or more,
+/// which holds only once B is in the scenario.
+#[test]
+fn conditions_leave_out_an_entity_out_of_the_scenario() {
+    let init = format!(
+        r#"<Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="20" offset="0"/></Position></TeleportAction></PrivateAction></Private>
+      <Private entityRef="C"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-2" s="20" offset="0"/></Position></TeleportAction></PrivateAction>{v}</Private>"#,
+        v = step_to(5.0)
+    );
+    let global = |name: &str, inside: &str, t: f64| {
+        format!(
+            r#"<Event name="{name}" priority="parallel"><Action name="{name}"><GlobalAction><EntityAction entityRef="B">{inside}</EntityAction></GlobalAction></Action>
+          <StartTrigger><ConditionGroup><Condition name="T{name}" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="{t}" rule="greaterThan"/></ByValueCondition></Condition></ConditionGroup></StartTrigger></Event>"#
+        )
+    };
+    let when = |name: &str, who: &str, test: &str, action: String| {
+        let (rule, refs) = if who == "B" {
+            ("any", r#"<EntityRef entityRef="B"/>"#)
+        } else {
+            (
+                "all",
+                r#"<EntityRef entityRef="A"/><EntityRef entityRef="B"/>"#,
+            )
+        };
+        format!(
+            r#"<Event name="{name}" priority="parallel"><Action name="{name}">{action}</Action>
+          <StartTrigger><ConditionGroup><Condition name="C{name}" delay="0" conditionEdge="none"><ByEntityCondition>
+            <TriggeringEntities triggeringEntitiesRule="{rule}">{refs}</TriggeringEntities>
+            <EntityCondition>{test}</EntityCondition></ByEntityCondition></Condition></ConditionGroup></StartTrigger></Event>"#
+        )
+    };
+    let story = format!(
+        r#"<Story name="S"><Act name="Act">
+      <ManeuverGroup maximumExecutionCount="1" name="GA">
+        <Actors selectTriggeringEntities="false"><EntityRef entityRef="A"/></Actors>
+        <Maneuver name="MA">{enter}{leave}{a}</Maneuver>
+      </ManeuverGroup>
+      <ManeuverGroup maximumExecutionCount="1" name="GC">
+        <Actors selectTriggeringEntities="false"><EntityRef entityRef="C"/></Actors>
+        <Maneuver name="MC">{c}</Maneuver>
+      </ManeuverGroup>
+      <StartTrigger><ConditionGroup><Condition name="T" delay="0" conditionEdge="none">
+        <ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition>
+      </Condition></ConditionGroup></StartTrigger>
+    </Act></Story>"#,
+        enter = global(
+            "Enter",
+            r#"<AddEntityAction><Position><LanePosition roadId="0" laneId="-3" s="40" offset="0"/></Position></AddEntityAction>"#,
+            1.0
+        ),
+        leave = global("Leave", "<DeleteEntityAction/>", 3.0),
+        a = when(
+            "AStill",
+            "A and B",
+            r#"<StandStillCondition duration="0.5"/>"#,
+            step_to(7.0)
+        ),
+        c = when(
+            "BThere",
+            "B",
+            r#"<TraveledDistanceCondition value="0"/>"#,
+            step_to(0.0)
+        ),
+    );
+    let entities = box_object("A") + &box_object("B") + &box_object("C");
+    let text = on_straight_road("presence", &entities, &init, &story, 6.0);
+    let mut sb = storyboard_of("presence", &text).expect("Init performs");
+    assert_eq!(
+        sb.actors.iter().map(|a| a.present).collect::<Vec<_>>(),
+        [true, false, true],
+        "Init places A and C"
+    );
+    let (mut a_faster, mut c_stopped, mut b_in) = (None, None, Vec::new());
+    run(&mut sb, 6.0, |t, sb| {
+        if sb.actors[1].present {
+            b_in.push(t);
+        }
+        if a_faster.is_none() && sb.actors[0].state.speed > 6.0 {
+            a_faster = Some(t);
+        }
+        if c_stopped.is_none() && sb.actors[2].state.speed < 1.0 {
+            c_stopped = Some(t);
+        }
+    });
+    let (first, last) = (b_in[0], *b_in.last().unwrap());
+    assert!((first - 1.0).abs() <= 2.0 * DT, "B entered at {first} s");
+    assert!((last - 3.0).abs() <= 2.0 * DT, "B left at {last} s");
+    let p = sb.actors[1].state.pose;
+    assert!(
+        (p.x - 40.0).abs() < 1e-6,
+        "B entered where its action put it: {p:?}"
+    );
+    let a = a_faster.expect("A stood 0.5 s and sped up");
+    assert!(
+        (a - 0.5).abs() <= 2.0 * DT,
+        "A alone decided the `all` condition, at {a} s"
+    );
+    let c = c_stopped.expect("C stopped once B was in the scenario");
+    assert!(
+        (c - first).abs() <= 2.0 * DT,
+        "C's condition on B held only from B's entry: {c} s, B entered at {first} s"
+    );
+}

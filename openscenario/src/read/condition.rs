@@ -5,7 +5,8 @@ use roxmltree::Node;
 use super::{position, Reader};
 use crate::error::XoscError;
 use crate::model::{
-    AngleTest, Clearance, Condition, ConditionKind, Edge, EntityTest, Gap, Rule, Trigger,
+    AngleTest, Clearance, Condition, ConditionKind, Edge, EntityTest, Gap, PositionGap, Rule,
+    Trigger,
 };
 use crate::quantity::Quantity;
 use crate::xml::{choice, elements, need};
@@ -411,6 +412,25 @@ fn gap(
     })
 }
 
+/// A condition's gap to the position `target`, its value in `q` (a time or a distance).
+fn position_gap(
+    r: &Reader<'_>,
+    c: Node<'_, '_>,
+    target: Node<'_, '_>,
+    q: Quantity,
+) -> Result<PositionGap, XoscError> {
+    let (frame, kind) = measure(r, c)?;
+    not_along_a_trajectory(r, c, &frame, &kind)?;
+    Ok(PositionGap {
+        position: position::read(r, target)?,
+        rule: rule(r, c)?,
+        value: r.scope.num_in(r.text, c, "value", q)?,
+        freespace: r.scope.bool(r.text, c, "freespace")?,
+        frame,
+        kind,
+    })
+}
+
 fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest, XoscError> {
     let (s, t) = (&r.scope, r.text);
     if matches!(
@@ -430,16 +450,7 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
             if tag == "EntityRef" {
                 EntityTest::TimeToCollision(gap(r, c, target, Quantity::Duration)?)
             } else {
-                let (frame, kind) = measure(r, c)?;
-                not_along_a_trajectory(r, c, &frame, &kind)?;
-                EntityTest::TimeToPosition {
-                    position: position::read(r, target)?,
-                    rule: rule(r, c)?,
-                    value: s.num_in(t, c, "value", Quantity::Duration)?,
-                    freespace: s.bool(t, c, "freespace")?,
-                    kind,
-                    frame,
-                }
+                EntityTest::TimeToPosition(position_gap(r, c, target, Quantity::Duration)?)
             }
         }
         "RelativeDistanceCondition" => {
@@ -451,18 +462,12 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
             }
             EntityTest::RelativeDistance(gap(r, c, c, Quantity::Distance)?)
         }
-        "DistanceCondition" => {
-            let (frame, kind) = measure(r, c)?;
-            not_along_a_trajectory(r, c, &frame, &kind)?;
-            EntityTest::Distance {
-                position: position::read(r, need(t, c, "Position")?)?,
-                rule: rule(r, c)?,
-                value: s.num_in(t, c, "value", Quantity::Distance)?,
-                freespace: s.bool(t, c, "freespace")?,
-                kind,
-                frame,
-            }
-        }
+        "DistanceCondition" => EntityTest::Distance(position_gap(
+            r,
+            c,
+            need(t, c, "Position")?,
+            Quantity::Distance,
+        )?),
         "ReachPositionCondition" => EntityTest::ReachPosition {
             position: position::read(r, need(t, c, "Position")?)?,
             tolerance: s.num_in(t, c, "tolerance", Quantity::Size)?,

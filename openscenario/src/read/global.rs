@@ -1,7 +1,7 @@
 //! Global actions (OpenSCENARIO 1.3 User Guide, "Global actions"): `EnvironmentAction`
 //! (inline or from an environment catalog), `ParameterAction` and `VariableAction` (set or
-//! modify). Entity, infrastructure (traffic signal), traffic and monitor actions are refused,
-//! naming what is read.
+//! modify), `EntityAction` (add or delete an entity). Infrastructure (traffic signal),
+//! traffic and monitor actions are refused, naming what is read.
 
 use roxmltree::Node;
 
@@ -22,7 +22,12 @@ pub(super) fn global(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
     let (a, tag) = choice(
         r.text,
         node,
-        &["EnvironmentAction", "ParameterAction", "VariableAction"],
+        &[
+            "EnvironmentAction",
+            "EntityAction",
+            "ParameterAction",
+            "VariableAction",
+        ],
     )?;
     match tag {
         "EnvironmentAction" => {
@@ -34,9 +39,27 @@ pub(super) fn global(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
             };
             Ok(Action::Environment(env))
         }
+        "EntityAction" => entity_action(r, a),
         "ParameterAction" => value_action(r, a, false),
         _ => value_action(r, a, true),
     }
+}
+
+/// An `EntityAction`: its `AddEntityAction` (with its `Position`) or `DeleteEntityAction`
+/// on the entity `entityRef` names.
+///
+/// # Errors
+/// Invalid for an entity the file does not declare; Unsupported for an entity selection.
+fn entity_action(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Action, XoscError> {
+    let entity = r.entity(a, "entityRef")?;
+    let (op, tag) = choice(r.text, a, &["AddEntityAction", "DeleteEntityAction"])?;
+    if tag == "DeleteEntityAction" {
+        return Ok(Action::DeleteEntity { entity });
+    }
+    Ok(Action::AddEntity {
+        entity,
+        position: super::position::read(r, need(r.text, op, "Position")?)?,
+    })
 }
 
 /// A `ParameterAction` (`parameterRef`) or `VariableAction` (`variableRef`): its

@@ -344,6 +344,13 @@ fn action(s: &Scenario, a: &Action) -> String {
                 .map_or(String::new(), |(p, _)| position(s, p))
         ),
         Action::ActivateController { .. } => "the system under test takes over".into(),
+        Action::AddEntity {
+            entity,
+            position: p,
+        } => {
+            format!("{} enters at {}", name(s, *entity), position(s, p))
+        }
+        Action::DeleteEntity { entity } => format!("{} leaves the scenario", name(s, *entity)),
         Action::AssignController { .. }
         | Action::OverrideController
         | Action::Environment(_)
@@ -473,24 +480,21 @@ fn entity_test(s: &Scenario, test: &EntityTest) -> String {
             position: p,
             tolerance,
         } => format!("within {tolerance} m of {}", position(s, p)),
-        EntityTest::Distance {
-            position: p,
-            rule,
-            value,
-            freespace,
-            kind,
-            frame,
-        } => format!(
-            "{kind} distance{} to {} in {frame} coordinates {rule:?} {value} m",
-            if *freespace { " from its box" } else { "" },
-            position(s, p)
+        EntityTest::Distance(g) => format!(
+            "{} distance{} to {} in {} coordinates {:?} {} m",
+            g.kind,
+            if g.freespace { " from its box" } else { "" },
+            position(s, &g.position),
+            g.frame,
+            g.rule,
+            g.value
         ),
-        EntityTest::TimeToPosition {
-            position: p,
-            rule,
-            value,
-            ..
-        } => format!("time to {} {rule:?} {value} s", position(s, p)),
+        EntityTest::TimeToPosition(g) => format!(
+            "time to {} {:?} {} s",
+            position(s, &g.position),
+            g.rule,
+            g.value
+        ),
         EntityTest::Speed { rule, value } => format!("speed {rule:?} {value} m/s"),
         EntityTest::RelativeSpeed {
             entity,

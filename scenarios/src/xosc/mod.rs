@@ -284,6 +284,70 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
     Ok(warnings)
 }
 
+/// Who is in the scenario (`AddEntityAction`, `DeleteEntityAction`): an entity is in it
+/// from the start when `Init` places it (a `Private` block of its own) or adds it, as esmini
+/// activates entities. The ego vehicle `ego` is the test's vehicle under test, always in its
+/// world. A warning names each entity that is never in the scenario (esmini leaves it out
+/// too).
+///
+/// # Errors
+/// [`ScenarioError::Load`] naming the file, or the action's line and column: the ego not in
+/// the scenario from the start, or an `AddEntityAction` or `DeleteEntityAction` on it after
+/// `Init`.
+pub fn check_presence(s: &m::Scenario, ego: usize) -> Result<Vec<Warning>, ScenarioError> {
+    let mut present = vec![false; s.entities.len()];
+    for (e, _) in &s.init {
+        present[*e] = true;
+    }
+    for na in &s.init_global {
+        match na.action {
+            Action::AddEntity { entity, .. } => present[entity] = true,
+            Action::DeleteEntity { entity } if entity == ego => return Err(on_the_ego(na)),
+            Action::DeleteEntity { entity } => present[entity] = false,
+            _ => {}
+        }
+    }
+    if !present[ego] {
+        return Err(worlds_error(format!(
+            "{}: the ego {:?} is not in the scenario at the start: Init neither places it (a \
+             Private block of its own) nor adds it (AddEntityAction), and the ego is the \
+             vehicle under test, in the test's world from its start",
+            s.file, s.entities[ego].name
+        )));
+    }
+    let mut added = present;
+    for na in story_actions(s) {
+        match na.action {
+            Action::AddEntity { entity, .. } | Action::DeleteEntity { entity } if entity == ego => {
+                return Err(on_the_ego(na))
+            }
+            Action::AddEntity { entity, .. } => added[entity] = true,
+            _ => {}
+        }
+    }
+    Ok((0..s.entities.len())
+        .filter(|&e| !added[e])
+        .map(|e| Warning {
+            at: s.file.clone(),
+            message: format!(
+                "{} is never in the scenario: Init does not place it and no AddEntityAction \
+                 adds it, so it is left out of the test's world (as esmini leaves it out)",
+                s.entities[e].name
+            ),
+        })
+        .collect())
+}
+
+/// The refusal of an `AddEntityAction` or `DeleteEntityAction` `na` on the ego.
+fn on_the_ego(na: &m::NamedAction) -> ScenarioError {
+    worlds_error(format!(
+        "{}: this {} adds or deletes the ego, the vehicle under test, which is in the test's \
+         world throughout: paracosm cannot take it out",
+        na.pos,
+        na.action.kind_name()
+    ))
+}
+
 /// How paracosm performs global action `na` (`ego`: the entity a system under test drives,
 /// if one does): as written, or with a warning for what its world does not model.
 ///
@@ -606,6 +670,7 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
     let model = read_scenario_in(&source.files, &source.template, &[]).map_err(xosc_error)?;
     let ego = ego_of(&model, source.ego.as_deref(), source.scripted_ego)?;
     let mut warnings = check(&model, (!source.scripted_ego).then_some(ego))?;
+    warnings.extend(check_presence(&model, ego)?);
     if !source.scripted_ego {
         check_the_ego_is_asked_to_drive(&model, ego, source.ego_speed_mps)?;
     } else if source.ego_speed_mps.is_some() {
@@ -1112,6 +1177,7 @@ pub(crate) fn build_into(
         ego_speed_mps: None,
         road_end: None,
         stuck_since: None,
+        in_world: vec![true; model.entities.len()],
         log: Vec::new(),
     };
     let names = model.entities.iter().map(|e| e.name.clone());
@@ -1343,6 +1409,9 @@ pub(crate) struct StoryHost {
     /// storyboard waits on conditions that only motion could change, s
     /// ([`Storyboard::stuck`], [`STUCK_S`]).
     stuck_since: Option<f64>,
+    /// Whether each entity is in the test's world as the engine has it: every one at the
+    /// start, then as [`StoryHost::perform_presence`] has set it.
+    in_world: Vec<bool>,
     log: Vec<String>,
 }
 
@@ -1354,6 +1423,22 @@ pub const MOVED_M: f64 = 0.5;
 pub const STILL_MPS: f64 = 0.1;
 
 impl StoryHost {
+    /// Puts each entity that entered or left the scenario (`Init`, `AddEntityAction`,
+    /// `DeleteEntityAction`: [`story::Actor::present`]) into or out of the engine's world
+    /// ([`Sink::SetPresent`]); the first step takes out those `Init` did not place.
+    fn perform_presence(&mut self) {
+        for (e, sink) in self.sinks.iter().enumerate() {
+            let present = self.sb.actors[e].present;
+            let actor = match sink {
+                Some(s) if e != self.ego && present != self.in_world[e] => s.actor(),
+                _ => continue,
+            };
+            self.in_world[e] = present;
+            self.performed
+                .push((Sink::SetPresent(actor), Value::Bool(present)));
+        }
+    }
+
     /// At the end of the storyboard or at the horizon (`t`, s; `end` says which, as the
     /// message's words): an error when the driven ego travelled less
     /// than [`MOVED_M`], whether the file asked it to drive (the system under test never
@@ -1532,18 +1617,21 @@ pub(crate) struct EnvironmentSets {
     pub(crate) friction: bool,
 }
 
+/// Every action of `model`'s stories (its events' actions, not `Init`'s), in the file's order.
+fn story_actions(model: &m::Scenario) -> impl Iterator<Item = &m::NamedAction> {
+    model
+        .stories
+        .iter()
+        .flat_map(|st| &st.acts)
+        .flat_map(|a| &a.groups)
+        .flat_map(|g| &g.maneuvers)
+        .flat_map(|mv| &mv.events)
+        .flat_map(|e| &e.actions)
+}
+
 /// What the `EnvironmentAction`s of `model` set.
 pub(crate) fn environment_sets(model: &m::Scenario) -> EnvironmentSets {
-    let actions = model.init_global.iter().chain(
-        model
-            .stories
-            .iter()
-            .flat_map(|st| &st.acts)
-            .flat_map(|a| &a.groups)
-            .flat_map(|g| &g.maneuvers)
-            .flat_map(|mv| &mv.events)
-            .flat_map(|e| &e.actions),
-    );
+    let actions = model.init_global.iter().chain(story_actions(model));
     let mut sets = EnvironmentSets::default();
     for na in actions {
         if let Action::Environment(e) = &na.action {
@@ -1659,6 +1747,7 @@ impl Host for StoryHost {
                         ));
                     }
                 }
+                self.perform_presence();
                 Ok(Value::Unit)
             }
             1 => Ok(Value::Num(self.measures.0)),

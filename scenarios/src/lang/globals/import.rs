@@ -99,6 +99,8 @@ pub(super) fn register(builder: &mut GlobalsBuilder) {
         let ego = crate::xosc::ego_of(&model, ego, false).map_err(|e| anyhow!("{e}"))?;
         let warnings = crate::xosc::check(&model, Some(ego)).map_err(|e| anyhow!("{e}"))?;
         b.warnings.extend(warnings);
+        let warnings = crate::xosc::check_presence(&model, ego).map_err(|e| anyhow!("{e}"))?;
+        b.warnings.extend(warnings);
         let built = crate::xosc::build_into(
             &mut b.scene,
             &model,

@@ -1062,7 +1062,8 @@ fn action_kinds(
             | Action::PlaceEgo
             | Action::SetEgoSpeed
             | Action::ReleaseEgo
-            | Action::SetEgoRoute => continue,
+            | Action::SetEgoRoute
+            | Action::SetPresent(_) => continue,
             Action::SetSpeed(c) => (
                 format!("setSpeed of {}", car(c)),
                 matches!(v, Value::Num(_)),

@@ -220,8 +220,16 @@ impl Storyboard {
                 all,
                 test,
             } => {
-                let mut hits = entities.iter().map(|&e| self.entity_test(e, test));
-                if *all {
+                // An entity out of the scenario is left out, as esmini's conditions skip an
+                // inactive one; with none left the condition is false.
+                let mut hits = entities
+                    .iter()
+                    .filter(|&&e| self.actors[e].present)
+                    .map(|&e| self.entity_test(e, test))
+                    .peekable();
+                if hits.peek().is_none() {
+                    false
+                } else if *all {
                     hits.all(|h| h)
                 } else {
                     hits.any(|h| h)
@@ -232,49 +240,31 @@ impl Storyboard {
 
     pub(in crate::xosc::story) fn entity_test(&self, e: usize, test: &EntityTest) -> bool {
         let st = &self.actors[e].state;
+        // A test against an entity out of the scenario is false (esmini: "inactive").
+        if other_entity(test).is_some_and(|o| !self.actors[o].present) {
+            return false;
+        }
         match test {
             // Undefined (the reference behind, or the entity standing; not closing in) is
             // false whatever the rule, as esmini has it: an "infinite" headway must not
             // satisfy `greaterThan`.
             EntityTest::TimeHeadway(g) => {
-                let (long, _, _) = self.gap(e, g);
-                long >= 0.0 && st.speed > 1e-9 && g.rule.holds(long / st.speed, g.value)
+                let d = self.measured_gap(e, g);
+                d >= 0.0 && st.speed > 1e-9 && g.rule.holds(d / st.speed, g.value)
             }
             EntityTest::TimeToCollision(g) => {
                 let (long, _, closing) = self.gap(e, g);
                 long >= 0.0 && closing > 1e-9 && g.rule.holds(long / closing, g.value)
             }
-            EntityTest::RelativeDistance(g) => {
-                let (long, lat, _) = self.gap(e, g);
-                let d = match g.kind.as_str() {
-                    "longitudinal" => long.abs(),
-                    "lateral" => lat.abs(),
-                    _ => long.hypot(lat),
-                };
-                g.rule.holds(d, g.value)
-            }
-            EntityTest::Distance {
-                position,
-                rule,
-                value,
-                freespace,
-                kind,
-                frame,
-            } => self
-                .distance_to_position(e, position, *freespace, (kind, frame))
-                .is_some_and(|d| rule.holds(d, *value)),
-            EntityTest::TimeToPosition {
-                position,
-                rule,
-                value,
-                freespace,
-                kind,
-                frame,
-            } => self
-                .distance_to_position(e, position, *freespace, (kind, frame))
+            EntityTest::RelativeDistance(g) => g.rule.holds(self.measured_gap(e, g).abs(), g.value),
+            EntityTest::Distance(g) => self
+                .distance_to_position(e, &g.position, g.freespace, (&g.kind, &g.frame))
+                .is_some_and(|d| g.rule.holds(d, g.value)),
+            EntityTest::TimeToPosition(g) => self
+                .distance_to_position(e, &g.position, g.freespace, (&g.kind, &g.frame))
                 .filter(|d| d.abs() >= 1e-6 && st.speed.abs() >= 1e-6)
                 .map(|d| d / st.speed)
-                .is_some_and(|ttc| ttc >= 0.0 && rule.holds(ttc, *value)),
+                .is_some_and(|ttc| ttc >= 0.0 && g.rule.holds(ttc, g.value)),
             EntityTest::ReachPosition {
                 position,
                 tolerance,
@@ -305,7 +295,10 @@ impl Storyboard {
             EntityTest::CollisionByType(kind) => {
                 st.collided
                     && (0..self.actors.len()).any(|o| {
-                        o != e && self.actors[o].object_type == kind && self.touching(e, o)
+                        o != e
+                            && self.actors[o].present
+                            && self.actors[o].object_type == kind
+                            && self.touching(e, o)
                     })
             }
             EntityTest::RelativeClearance(c) => self.clear(e, c),
@@ -353,7 +346,10 @@ impl Storyboard {
             kind: "longitudinal".into(),
         };
         for o in 0..self.actors.len() {
-            if o == e || (!c.entities.is_empty() && !c.entities.contains(&o)) {
+            if o == e
+                || !self.actors[o].present
+                || (!c.entities.is_empty() && !c.entities.contains(&o))
+            {
                 continue;
             }
             let Some(lb) = self.actors[o].state.lane else {
@@ -453,6 +449,27 @@ impl Storyboard {
             vb - a.state.speed
         };
         (long, lat, closing)
+    }
+
+    /// The distance from entity `e` to the entity `g` names, m, as `g.kind` measures it (esmini's
+    /// `Object::Distance`): along (`longitudinal`) or across (`lateral`) in `g.frame`; the
+    /// euclidean distance in whatever frame (`euclidianDistance`, the default) is the straight
+    /// distance between the reference points (between the boxes with `freespace`), negative
+    /// when the other is not ahead along `e`'s heading (esmini's `getRelativeDistance`).
+    fn measured_gap(&self, e: usize, g: &Gap) -> f64 {
+        match g.kind.as_str() {
+            "longitudinal" => self.gap(e, g).0,
+            "lateral" => self.gap(e, g).1,
+            _ => {
+                let straight = Gap {
+                    frame: "entity".into(),
+                    ..g.clone()
+                };
+                let (long, lat, _) = self.gap(e, &straight);
+                let sign = if long > 0.0 { 1.0 } else { -1.0 };
+                sign * long.hypot(lat)
+            }
+        }
     }
 
     /// The distance from entity `e` to `position` where it is now, m, as a
@@ -706,7 +723,7 @@ impl Storyboard {
         let a = &self.actors[e];
         let mut gap_m = f64::INFINITY;
         for (j, b) in self.actors.iter().enumerate() {
-            if j == e {
+            if j == e || !b.present {
                 continue;
             }
             let g = Gap {
@@ -718,7 +735,6 @@ impl Storyboard {
                 kind: "longitudinal".into(),
             };
             let (long, lat, _) = self.gap(e, &g);
-            let _ = b;
             if long >= 0.0 && lat == 0.0 {
                 gap_m = gap_m.min(long);
             }
@@ -736,6 +752,20 @@ impl Storyboard {
             None => f64::NAN,
         };
         (headway_s, gap_m, edge_m)
+    }
+}
+
+/// The other entity a test measures against, if it names one.
+fn other_entity(test: &EntityTest) -> Option<usize> {
+    match test {
+        EntityTest::TimeHeadway(g)
+        | EntityTest::TimeToCollision(g)
+        | EntityTest::RelativeDistance(g) => Some(g.entity),
+        EntityTest::RelativeSpeed { entity, .. } | EntityTest::RelativeAngle { entity, .. } => {
+            Some(*entity)
+        }
+        EntityTest::Collision(other) => *other,
+        _ => None,
     }
 }
 

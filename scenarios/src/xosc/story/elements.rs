@@ -545,4 +545,15 @@ impl Storyboard {
             self.task_done(Some(a));
         }
     }
+
+    /// Entity `e`'s longitudinal tasks (a speed change, a kept distance, a synchronization)
+    /// end, overridden by a new one (OpenSCENARIO 1.3, 7.4.2: one action per domain).
+    pub(in crate::xosc::story) fn end_longitudinal(&mut self, e: usize) {
+        let old = self.drives[e].speed.take().map(|s| s.action);
+        self.override_task(old);
+        let old = self.drives[e].keep.take().map(|k| k.action);
+        self.override_task(old);
+        let old = self.drives[e].sync.take().map(|s| s.action);
+        self.override_task(old);
+    }
 }

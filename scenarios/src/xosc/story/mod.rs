@@ -60,6 +60,11 @@ pub struct Actor {
     /// drives, and that ego too until its controller is activated
     /// ([`Storyboard::hand_over_on_activation`]).
     pub scripted: bool,
+    /// Whether it is in the scenario now: placed by `Init` (a `Private` block of its own,
+    /// as esmini activates an entity) or added by an `AddEntityAction`, and not deleted
+    /// since (`DeleteEntityAction`). An entity out of it is out of the test's world, and
+    /// conditions leave it out (esmini's `IsActive`).
+    pub present: bool,
     /// Its state now.
     pub state: State,
 }
@@ -267,6 +272,7 @@ impl Storyboard {
                 size_m: e.dimensions_m,
                 centre_m: e.centre_m,
                 scripted: Some(i) != ego,
+                present: false,
                 state: State::at(
                     Pose {
                         x: 0.0,

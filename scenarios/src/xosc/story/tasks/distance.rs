@@ -35,12 +35,7 @@ impl Storyboard {
     ) -> Result<(), RoadError> {
         self.place_at_distance(e, keep.reference, keep.gap, &keep.displacement)?;
         if continuous {
-            let old = self.drives[e].speed.take().map(|s| s.action);
-            self.override_task(old);
-            let old = self.drives[e].keep.take().map(|k| k.action);
-            self.override_task(old);
-            let old = self.drives[e].sync.take().map(|s| s.action);
-            self.override_task(old);
+            self.end_longitudinal(e);
             if keep.action != usize::MAX {
                 self.elems[keep.action].pending += 1;
             }

@@ -1,5 +1,6 @@
 //! Global actions: `EnvironmentAction` sets the world's light, fog and road friction
-//! ([`WorldEnv`]); `ParameterSetAction`, `ParameterModifyAction`, `VariableSetAction` and
+//! ([`WorldEnv`]); `AddEntityAction` and `DeleteEntityAction` put an entity into the
+//! scenario or take it out ([`Actor::present`]); `ParameterSetAction`, `ParameterModifyAction`, `VariableSetAction` and
 //! `VariableModifyAction` change the values that `ParameterCondition` and
 //! `VariableCondition` read.
 
@@ -115,6 +116,21 @@ impl Storyboard {
         let (name, variable, new) = match &action.action {
             Action::Environment(env) => {
                 self.env.apply(env, t);
+                return Ok(());
+            }
+            // As esmini's `AddEntityAction::Start`: an entity in the scenario stays where it
+            // is ("already active").
+            Action::AddEntity { entity, position } => {
+                if !self.actors[*entity].present {
+                    self.teleport(*entity, position, &action.pos)?;
+                    let st = &mut self.actors[*entity].state;
+                    st.vel = [st.speed * st.pose.h.cos(), st.speed * st.pose.h.sin()];
+                    self.actors[*entity].present = true;
+                }
+                return Ok(());
+            }
+            Action::DeleteEntity { entity } => {
+                self.actors[*entity].present = false;
                 return Ok(());
             }
             Action::SetValue {

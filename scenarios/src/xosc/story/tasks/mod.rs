@@ -42,6 +42,9 @@ impl Storyboard {
         // An entity is placed once its teleports are done; one Init never places stands
         // where it is from the start.
         let mut unplaced: Vec<bool> = vec![false; self.actors.len()];
+        for (e, _) in &scenario.init {
+            self.actors[*e].present = true;
+        }
         for (e, _) in &places {
             unplaced[*e] = true;
         }
@@ -100,7 +103,9 @@ impl Storyboard {
             }
         };
         match &na.action {
-            Action::Teleport(p) | Action::AcquirePosition(p) => position(p),
+            Action::Teleport(p)
+            | Action::AcquirePosition(p)
+            | Action::AddEntity { position: p, .. } => position(p),
             Action::Synchronize(s) => {
                 position(&s.master_target)?;
                 position(&s.target)
@@ -172,28 +177,8 @@ impl Storyboard {
                     (a, &action.pos),
                 );
             }
-            Action::LongitudinalDistance {
-                entity,
-                distance_m,
-                time_gap_s,
-                freespace,
-                displacement,
-                continuous,
-                ..
-            } => {
-                if !scripted {
-                    return Ok(());
-                }
-                let keep = distance::Keep {
-                    reference: *entity,
-                    gap: (*distance_m, *time_gap_s, *freespace),
-                    displacement: displacement.clone(),
-                    action: a.unwrap_or(usize::MAX),
-                    at: site(&action.pos),
-                };
-                self.start_distance(e, keep, *continuous)
-                    .map_err(|e| bad(e.to_string()))?;
-            }
+            Action::LongitudinalDistance { .. } if scripted => self.start_keep(e, action, a)?,
+            Action::LongitudinalDistance { .. } => {}
             Action::FollowTrajectory {
                 shape,
                 timing,
@@ -216,12 +201,55 @@ impl Storyboard {
             | Action::AssignController { .. }
             | Action::OverrideController => self.controller_action(e, &action.action),
             // Performed once by their action, not per actor ([`Storyboard::start_action`]).
-            Action::Environment(_) | Action::SetValue { .. } | Action::ModifyValue { .. } => {}
+            Action::Environment(_)
+            | Action::SetValue { .. }
+            | Action::ModifyValue { .. }
+            | Action::AddEntity { .. }
+            | Action::DeleteEntity { .. } => {}
             // Nothing the storyboard moves reads lights or visibility: the front end refuses
             // a visibility that a system under test would sense ([`crate::xosc::check`]).
             Action::Appearance(_) | Action::Visibility { .. } => {}
         }
         Ok(())
+    }
+}
+
+impl Storyboard {
+    /// Starts the `LongitudinalDistanceAction` `action` on scripted entity `e`, for action
+    /// element `a` (`None` in `Init`).
+    ///
+    /// # Errors
+    /// [`StoryError`] at the action when the entity cannot be placed at its distance.
+    fn start_keep(
+        &mut self,
+        e: usize,
+        action: &m::NamedAction,
+        a: Option<usize>,
+    ) -> Result<(), StoryError> {
+        let Action::LongitudinalDistance {
+            entity,
+            distance_m,
+            time_gap_s,
+            freespace,
+            displacement,
+            continuous,
+            ..
+        } = &action.action
+        else {
+            return Ok(());
+        };
+        let keep = distance::Keep {
+            reference: *entity,
+            gap: (*distance_m, *time_gap_s, *freespace),
+            displacement: displacement.clone(),
+            action: a.unwrap_or(usize::MAX),
+            at: site(&action.pos),
+        };
+        self.start_distance(e, keep, *continuous)
+            .map_err(|err| StoryError {
+                at: site(&action.pos),
+                message: err.to_string(),
+            })
     }
 }
 

@@ -95,12 +95,7 @@ impl Storyboard {
                 SteadyState::Time(t) => t * self.final_speed(&sync).unwrap_or(0.0).max(0.0),
             })
         });
-        let old = self.drives[e].speed.take().map(|s| s.action);
-        self.override_task(old);
-        let old = self.drives[e].keep.take().map(|k| k.action);
-        self.override_task(old);
-        let old = self.drives[e].sync.take().map(|s| s.action);
-        self.override_task(old);
+        self.end_longitudinal(e);
         if let Some(a) = a {
             self.elems[a].pending += 1;
         }
