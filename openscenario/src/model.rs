@@ -149,6 +149,23 @@ impl Performance {
     };
 }
 
+/// A `LongitudinalDistanceAction`'s `DynamicConstraints` as written: each limit is `> 0`;
+/// one left out is the entity's [`Performance`] value (a rate: unbounded), and one above
+/// it is cut to it, as esmini's `parseDynamicConstraints` reads them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DistanceConstraints {
+    /// `maxAcceleration`, m/s².
+    pub max_acceleration_mps2: Option<f64>,
+    /// `maxDeceleration`, m/s² (a magnitude).
+    pub max_deceleration_mps2: Option<f64>,
+    /// `maxAccelerationRate`, m/s³.
+    pub max_acceleration_rate_mps3: Option<f64>,
+    /// `maxDecelerationRate`, m/s³ (a magnitude).
+    pub max_deceleration_rate_mps3: Option<f64>,
+    /// `maxSpeed`, m/s.
+    pub max_speed_mps: Option<f64>,
+}
+
 /// A story.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Story {
@@ -361,6 +378,9 @@ pub enum Action {
         displacement: String,
         /// `coordinateSystem`: `entity` (default), `lane`, `road` or `trajectory`.
         frame: String,
+        /// `DynamicConstraints`: the gap is approached within them (esmini's damped spring);
+        /// none, it is taken at once and held kinematically.
+        constraints: Option<DistanceConstraints>,
     },
     /// `TeleportAction`.
     Teleport(Position),

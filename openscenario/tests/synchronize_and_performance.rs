@@ -377,3 +377,61 @@ fn clothoid_splines_trajectory_positions_and_initial_offsets_are_read() {
         assert!(e.contains("s.xosc:"), "{e}");
     }
 }
+
+/// A `LongitudinalDistanceAction`'s `DynamicConstraints` are read as written, each limit
+/// left out `None` (the entity's `Performance` fills it when the storyboard runs); a limit
+/// of 0 or below is refused at its attribute.
+#[test]
+fn a_distance_actions_dynamic_constraints_are_read_and_a_limit_of_zero_refused() {
+    let keep = |constraints: &str| {
+        format!(
+            r#"<LongitudinalAction><LongitudinalDistanceAction entityRef="Ego" timeGap="2" freespace="true" continuous="true">{constraints}</LongitudinalDistanceAction></LongitudinalAction>"#
+        )
+    };
+    let s = read(
+        "dc",
+        &scenario(
+            PERFORMANCE,
+            false,
+            &keep(r#"<DynamicConstraints maxAcceleration="3" maxDeceleration="4" maxSpeed="30" maxDecelerationRate="1.5"/>"#),
+            SPEED,
+        ),
+    )
+    .unwrap();
+    let Action::LongitudinalDistance { constraints, .. } = action(&s) else {
+        panic!("not a distance action: {:?}", action(&s));
+    };
+    let c = constraints.expect("its constraints");
+    assert_eq!(
+        (
+            c.max_acceleration_mps2,
+            c.max_deceleration_mps2,
+            c.max_speed_mps,
+            c.max_acceleration_rate_mps3,
+            c.max_deceleration_rate_mps3
+        ),
+        (Some(3.0), Some(4.0), Some(30.0), None, Some(1.5))
+    );
+    let s = read("nodc", &scenario(PERFORMANCE, false, &keep(""), SPEED)).unwrap();
+    assert!(matches!(
+        action(&s),
+        Action::LongitudinalDistance {
+            constraints: None,
+            ..
+        }
+    ));
+    let e = read(
+        "dc0",
+        &scenario(
+            PERFORMANCE,
+            false,
+            &keep(r#"<DynamicConstraints maxAcceleration="0" maxDeceleration="4" maxSpeed="30"/>"#),
+            SPEED,
+        ),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("s.xosc:") && e.contains("maxAcceleration is a limit above 0, not 0"),
+        "{e}"
+    );
+}

@@ -212,7 +212,7 @@ fn check_runs(runs: &[Run]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 33] = [
+const ESMINI_EXAMPLES: [&str; 35] = [
     "acc-test",
     "alks_cut-in",
     "alks_cut-out",
@@ -227,6 +227,7 @@ const ESMINI_EXAMPLES: [&str; 33] = [
     "cut-in_simple",
     "cut-in_sloppy",
     "cut-in_visibility",
+    "distance_test",
     "drive_when_close",
     "follow_reference",
     "highway_driver",
@@ -235,6 +236,7 @@ const ESMINI_EXAMPLES: [&str; 33] = [
     "lane-change_trajectory_wp",
     "left-hand-traffic_by_heading",
     "left-hand-traffic_using_road_rule",
+    "long_dist_action_with_jerk",
     "ltap-od",
     "override_bb",
     "pedestrian",

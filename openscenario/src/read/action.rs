@@ -8,8 +8,8 @@ use roxmltree::Node;
 use super::{position, Reader};
 use crate::error::XoscError;
 use crate::model::{
-    Action, Dimension, Dynamics, LaneTarget, OffsetTarget, Position, Shape, SpeedTarget,
-    TrajectoryShape,
+    Action, Dimension, DistanceConstraints, Dynamics, LaneTarget, OffsetTarget, Position, Shape,
+    SpeedTarget, TrajectoryShape,
 };
 use crate::quantity::Quantity;
 use crate::xml::{child, choice, elements, need};
@@ -242,17 +242,9 @@ fn distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
         ));
     }
     let continuous = r.scope.bool(r.text, node, "continuous")?;
-    if let Some(c) = child(node, "DynamicConstraints") {
-        if continuous {
-            return Err(r.text.unsupported(
-                c,
-                "a continuous longitudinal distance action with <DynamicConstraints> is not \
-                 supported (esmini approaches the gap by a damped spring within them): paracosm \
-                 holds a continuous gap kinematically, without constraints",
-            ));
-        }
-        r.note(c, "a longitudinal distance action's dynamic constraints are not applied: the gap is held kinematically");
-    }
+    let constraints = child(node, "DynamicConstraints")
+        .map(|c| distance_constraints(r, c))
+        .transpose()?;
     Ok(Action::LongitudinalDistance {
         entity: r.entity(node, "entityRef")?,
         distance_m,
@@ -271,6 +263,28 @@ fn distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
             "coordinateSystem",
             &["entity", "lane", "road", "trajectory"],
         )?,
+        constraints,
+    })
+}
+
+/// A longitudinal distance action's `<DynamicConstraints>`: each limit given is `> 0`.
+fn distance_constraints(r: &Reader<'_>, c: Node<'_, '_>) -> Result<DistanceConstraints, XoscError> {
+    let limit = |attr: &str, q: Quantity| -> Result<Option<f64>, XoscError> {
+        let v = r.scope.opt_num_in(r.text, c, attr, q)?;
+        if let Some(v) = v.filter(|v| *v <= 0.0) {
+            return Err(XoscError::Invalid {
+                pos: r.text.attr_pos(c, attr),
+                reason: format!("{attr} is a limit above 0, not {v}"),
+            });
+        }
+        Ok(v)
+    };
+    Ok(DistanceConstraints {
+        max_acceleration_mps2: limit("maxAcceleration", Quantity::Acceleration)?,
+        max_deceleration_mps2: limit("maxDeceleration", Quantity::Acceleration)?,
+        max_acceleration_rate_mps3: limit("maxAccelerationRate", Quantity::Acceleration)?,
+        max_deceleration_rate_mps3: limit("maxDecelerationRate", Quantity::Acceleration)?,
+        max_speed_mps: limit("maxSpeed", Quantity::Speed)?,
     })
 }
 

@@ -527,7 +527,7 @@ impl Storyboard {
         for r in self.roots.clone() {
             self.run_story(r, t)?;
         }
-        self.keep_distances(t + dt)?;
+        self.keep_distances(t + dt, dt)?;
         self.synchronize(dt, first);
         for e in 0..self.actors.len() {
             if self.actors[e].scripted {

@@ -233,17 +233,21 @@ impl Storyboard {
             freespace,
             displacement,
             continuous,
-            ..
+            frame,
+            constraints,
         } = &action.action
         else {
             return Ok(());
         };
+        let spring = constraints
+            .map(|c| self.spring_for(e, *entity, &c, (displacement, frame, *continuous)));
         let keep = distance::Keep {
             reference: *entity,
             gap: (*distance_m, *time_gap_s, *freespace),
             displacement: displacement.clone(),
             action: a.unwrap_or(usize::MAX),
             at: site(&action.pos),
+            spring,
         };
         self.start_distance(e, keep, *continuous)
             .map_err(|err| StoryError {
