@@ -212,7 +212,7 @@ fn check_runs(runs: &[Run]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 35] = [
+const ESMINI_EXAMPLES: [&str; 37] = [
     "acc-test",
     "alks_cut-in",
     "alks_cut-out",
@@ -231,6 +231,8 @@ const ESMINI_EXAMPLES: [&str; 35] = [
     "drive_when_close",
     "follow_reference",
     "highway_driver",
+    "highway_merge",
+    "highway_merge_advanced",
     "lane_change_crest",
     "lane-change_clothoid_based_trajectory",
     "lane-change_trajectory_wp",

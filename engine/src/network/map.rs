@@ -49,6 +49,11 @@ pub struct MapLane {
     pub centre: Vec<[f64; 2]>,
     /// The lane's width at each station, m, `>= 0`.
     pub width: Vec<f64>,
+    /// The centre's offset from the road's reference line at each station (OpenDRIVE's `t`,
+    /// m, positive left: the `<laneOffset>` plus the widths between the centre and lane 0);
+    /// empty where not known (a map deserialized from before it was kept).
+    #[serde(default)]
+    pub t: Vec<f64>,
     /// The lanes (indices into [`RoadMap::lanes`]) that a car leaving this lane's travel end
     /// drives into.
     pub successors: Vec<usize>,
@@ -1183,6 +1188,7 @@ impl MapLane {
             drivable: true,
             forward: true,
             width: vec![width_m; s.len()],
+            t: vec![-width_m / 2.0; s.len()],
             s,
             centre,
             successors: Vec::new(),

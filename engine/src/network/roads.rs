@@ -551,7 +551,8 @@ impl Roads {
     }
 
     /// Moves `lp` `dist` metres (≥ 0, along the path at its offset from its lane's centre
-    /// line) in the lane's direction of travel, into a successor lane where the lane ends:
+    /// line, less the lane's drift across the road: [`super::MapLane::t`]) in the lane's direction
+    /// of travel, into a successor lane where the lane ends:
     /// the first that `prefer` accepts, else the first. Returns `false` when the lanes end before: `lp` then stands at the
     /// end.
     pub fn advance(&self, lp: &mut LanePos, mut dist: f64, prefer: &dyn Fn(usize) -> bool) -> bool {
@@ -561,8 +562,17 @@ impl Roads {
             // Metres of the centre line per metre of station, here.
             let i = l.s.partition_point(|&x| x <= lp.s).clamp(1, l.s.len() - 1) - 1;
             let span = l.s[i + 1] - l.s[i];
-            let chord =
+            let mut chord =
                 (l.centre[i + 1][0] - l.centre[i][0]).hypot(l.centre[i + 1][1] - l.centre[i][1]);
+            // A lane drifting across its road (a changing lane offset, or widths inside it
+            // that change) counts only its run along the road, as esmini's motion along `s`
+            // does (`DistanceToDS` scales by the curvature at the entity's `t` alone).
+            if let (Some(t0), Some(t1)) = (l.t.get(i), l.t.get(i + 1)) {
+                let drift = t1 - t0;
+                if drift != 0.0 {
+                    chord = (chord * chord - drift * drift).max(0.0).sqrt();
+                }
+            }
             // Off the centre line by `d` (left of increasing `s`), a path bends with the lane:
             // its length per metre of the centre line is `1 − κ·d`, `κ` the centre line's
             // curvature there (esmini's `DistanceToDS` at the entity's own offset).

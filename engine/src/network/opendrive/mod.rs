@@ -24,6 +24,7 @@ use super::map::{MapLane, MapRoad, RoadMap};
 
 mod links;
 mod numbers;
+mod offsets;
 mod overlaps;
 mod recentre;
 
@@ -307,6 +308,7 @@ pub fn import(file: &str, text: &str) -> Result<Imported, MapError> {
     check_self_links(&r, &net)?;
     check_gaps(&r, &net)?;
     let mut map = bake(&r, &net, &provenance)?;
+    offsets::centre_offsets(&r, &mut map);
     map.origin_m = shift.unwrap_or([0.0, 0.0]);
     warnings.extend(links::link_and_check(&r, &mut map)?);
     warnings.extend(overlaps::check(&r, &map)?);
@@ -754,6 +756,7 @@ fn bake(
             s: ss,
             centre,
             width,
+            t: Vec::new(),
             successors: Vec::new(),
         });
     }
