@@ -947,3 +947,64 @@ fn conditions_leave_out_an_entity_out_of_the_scenario() {
         "C's condition on B held only from B's entry: {c} s, B entered at {first} s"
     );
 }
+
+/// A scripted entity asked a negative speed reverses along its lane, as esmini's `MoveAlongS`
+/// by a negative distance moves it: `A`, standing at s = 100 m, is asked −3 m/s at 1 s and
+/// backs 3 m/s × 2 s = 6 m down its lane by 3 s, facing the way it faced, with its speed
+/// −3 m/s; `B` beside it, asked +3 m/s at the same time, moves 6 m the other way.
+#[test]
+fn a_scripted_entity_asked_a_negative_speed_reverses_along_its_lane() {
+    let place = |name: &str, lane: i32| {
+        format!(
+            r#"<Private entityRef="{name}"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="{lane}" s="100" offset="0"/></Position></TeleportAction></PrivateAction></Private>"#
+        )
+    };
+    let init = place("A", -2) + &place("B", -3);
+    let at_one = |name: &str, v: f64| {
+        format!(
+            r#"<ManeuverGroup maximumExecutionCount="1" name="G{name}">
+        <Actors selectTriggeringEntities="false"><EntityRef entityRef="{name}"/></Actors>
+        <Maneuver name="M{name}"><Event name="E{name}" priority="parallel"><Action name="V{name}">{action}</Action>
+          <StartTrigger><ConditionGroup><Condition name="T{name}" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="1" rule="greaterThan"/></ByValueCondition></Condition></ConditionGroup></StartTrigger></Event></Maneuver>
+      </ManeuverGroup>"#,
+            action = step_to(v)
+        )
+    };
+    let story = format!(
+        r#"<Story name="S"><Act name="Act">{a}{b}
+      <StartTrigger><ConditionGroup><Condition name="T" delay="0" conditionEdge="none">
+        <ByValueCondition><SimulationTimeCondition value="0" rule="greaterOrEqual"/></ByValueCondition>
+      </Condition></ConditionGroup></StartTrigger>
+    </Act></Story>"#,
+        a = at_one("A", -3.0),
+        b = at_one("B", 3.0),
+    );
+    let entities = box_object("A") + &box_object("B");
+    let text = on_straight_road("reverse", &entities, &init, &story, 3.0);
+    let mut sb = storyboard_of("reverse", &text).expect("Init performs");
+    let (h0, x0, xb0) = (
+        sb.actors[0].state.pose.h,
+        sb.actors[0].state.pose.x,
+        sb.actors[1].state.pose.x,
+    );
+    let end = run(&mut sb, 3.0, |_, _| {});
+    let (a, b) = (&sb.actors[0].state, &sb.actors[1].state);
+    // The event starts in the step after 1 s, and each step moves at the new speed.
+    let moving_s = end - 1.0;
+    assert!((a.speed + 3.0).abs() < 1e-9, "A's speed {}", a.speed);
+    assert!(
+        (a.pose.x - (x0 - 3.0 * moving_s)).abs() < 3.0 * 2.0 * DT,
+        "A backed from x {x0} to {} in {moving_s} s",
+        a.pose.x
+    );
+    assert!(
+        (b.pose.x - (xb0 + 3.0 * moving_s)).abs() < 3.0 * 2.0 * DT,
+        "B drove from x {xb0} to {}",
+        b.pose.x
+    );
+    assert!(
+        (a.pose.h - h0).abs() < 1e-9,
+        "A still faces {h0}: {}",
+        a.pose.h
+    );
+}

@@ -1740,7 +1740,7 @@ impl Host for StoryHost {
                         // Where the storyboard puts it, and its speed there (a teleport's
                         // step keeps the entity's speed, as esmini reports it).
                         let (p, h) = self.sb.engine_pose(e);
-                        let v = self.sb.actors[e].state.speed.max(0.0);
+                        let v = self.sb.actors[e].state.speed;
                         self.performed.push((
                             *sink,
                             Value::Tuple(vec![Value::Vec3(p), Value::Num(h), Value::Num(v)]),

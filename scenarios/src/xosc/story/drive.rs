@@ -24,6 +24,8 @@ pub(in crate::xosc::story) struct Drive {
     pub(in crate::xosc::story) speed_before: Option<f64>,
     /// The trajectory in progress and its action.
     pub(in crate::xosc::story) path: Option<(Path, usize)>,
+    /// Where that trajectory's action is written, `file:line:col`.
+    pub(in crate::xosc::story) path_at: String,
     /// A driven ego's lane change in progress: the lane it changes to, the offset from its
     /// centre there (m), the action; it ends once the ego is there ([`LANE_REACHED_M`]).
     pub(in crate::xosc::story) lane_goal: Option<(usize, f64, usize)>,
@@ -104,11 +106,23 @@ impl Storyboard {
                 done.push(task.action);
             }
         }
-        v1 = v1.max(0.0);
         // At the new speed over the step (esmini's integration: the speed first, then the
-        // move); not at all in the step an event teleported it.
+        // move), backwards at a negative one (esmini's `MoveAlongS` by a negative distance);
+        // not at all in the step an event teleported it.
         let held = std::mem::take(&mut self.drives[e].teleported);
         let dist = if held { 0.0 } else { v1 * dt };
+        // A timed trajectory's timing moves it, whatever its speed.
+        if dist < 0.0 && matches!(self.drives[e].path, Some((Path::Untimed(_), _))) {
+            return Err(StoryError {
+                at: self.drives[e].path_at.clone(),
+                message: format!(
+                    "{} is asked to reverse ({v1:.2} m/s) along a trajectory it follows at its \
+                     speed, which paracosm does not do (it reverses along its lane, and on a \
+                     timed trajectory as its timing says)",
+                    self.actors[e].name
+                ),
+            });
+        }
         let mut pose = st.pose;
         let mut lane = st.lane;
         let mut at_end = false;
@@ -181,11 +195,14 @@ impl Storyboard {
         (dist, dt, h0): (f64, f64, f64),
     ) -> (Pose, LanePos, bool, Option<usize>) {
         let mut ended = None;
-        let mut along = dist;
+        // Backwards, the same path the other way: the lateral move steps on the distance
+        // travelled, and the move along the lane is taken against its travel.
+        let back = dist < 0.0;
+        let mut along = dist.abs();
         // The heading relative to the lane's travel, as a slope against the travel.
         let mut slip = 0.0;
         if let Some(mut l) = self.drives[e].lateral {
-            let (d, over, a, s) = l.mv.step(lp.d, dist, dt);
+            let (d, over, a, s) = l.mv.step(lp.d, dist.abs(), dt);
             (along, slip) = (a, s);
             lp.d = d;
             self.drives[e].lateral = Some(l);
@@ -217,7 +234,9 @@ impl Storyboard {
                 || prefer_roads.contains(&self.roads.exit_road(n))
         };
         let up_before = lp.along_s(&self.roads);
+        lp.rev ^= back;
         let at_end = !self.roads.advance(&mut lp, along, &prefer);
+        lp.rev ^= back;
         if lp.along_s(&self.roads) != up_before {
             // Its lane runs on in a road of the other direction: a lateral move in
             // progress keeps its side of the motion.
@@ -232,7 +251,7 @@ impl Storyboard {
         let travel = self.roads.travel_heading(&lp);
         // `d` is left of increasing `s`: against `s`, the same move turns the other way.
         let side = if lp.along_s(&self.roads) { 1.0 } else { -1.0 };
-        let h = if dist > 1e-12 {
+        let h = if dist.abs() > 1e-12 {
             wrap(travel + side * slip + self.drives[e].rel_h)
         } else {
             h0

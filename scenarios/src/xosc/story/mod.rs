@@ -31,6 +31,7 @@ use super::motion::{
     Untimed,
 };
 use paracosm_engine::network::roads::{wrap, LanePos, Pose, RoadError, Roads};
+use paracosm_engine::transition;
 
 /// Orientation `o` against `base` (rad): a relative one added to it, an absolute one as
 /// written, `base` without one.

@@ -154,7 +154,9 @@ impl Storyboard {
             Action::Speed {
                 target: SpeedTarget::Absolute(v),
                 ..
-            } if *v < 0.0 => return Err(bad(backwards(action, *v, &self.actors[e].name))),
+            } if *v < 0.0 && !scripted => {
+                return Err(bad(backwards(action, *v, &self.actors[e].name)))
+            }
             Action::Speed { target, dynamics } => {
                 return self.start_speed(e, (target, dynamics), a, t);
             }
@@ -257,11 +259,13 @@ impl Storyboard {
     }
 }
 
-/// Why `SpeedAction` `action`, to `v` m/s (`< 0`), cannot be performed on entity `name`.
+/// Why `SpeedAction` `action`, to `v` m/s (`< 0`), cannot be performed on entity `name`,
+/// which a system under test drives.
 fn backwards(action: &m::NamedAction, v: f64, name: &str) -> String {
     format!(
-        "SpeedAction {:?} to {v} m/s asks {name} to drive backwards, which paracosm does not \
-         do: its storyboard and its systems under test move forward only (esmini reverses)",
+        "SpeedAction {:?} to {v} m/s asks {name} to drive backwards, which paracosm's systems \
+         under test do not do (they drive forward only; the storyboard reverses an entity it \
+         moves itself: --scripted-ego)",
         action.name
     )
 }

@@ -60,6 +60,27 @@ impl SpeedTask {
     }
 }
 
+/// How many times longer speed transition `tr` takes within `performance`: its peak rate of
+/// change over the maximum acceleration (deceleration for a slower target) when above it,
+/// else 1, as esmini's `TransitionDynamics::SetMaxRate` stretches a transition's parameter,
+/// uniformly, so that its shape stays and its peak is the maximum (a step is not stretched).
+fn stretch(tr: &Transition, performance: m::Performance) -> f64 {
+    if tr.duration_s <= 0.0 || matches!(tr.shape, transition::Shape::Step) {
+        return 1.0;
+    }
+    let peak = (tr.to - tr.from).abs() / tr.duration_s * transition::progress_slope(tr.shape, 0.5);
+    let most = if tr.to > tr.from {
+        performance.max_acceleration_mps2
+    } else {
+        performance.max_deceleration_mps2
+    };
+    if most > 0.0 && peak > most {
+        peak / most
+    } else {
+        1.0
+    }
+}
+
 impl Storyboard {
     /// Starts a `SpeedAction` on `e` (see [`Storyboard::start_task`]).
     pub(in crate::xosc::story) fn start_speed(
@@ -99,13 +120,19 @@ impl Storyboard {
             self.actors[e].state.speed = to.max(0.0);
             return Ok(());
         }
+        // A scripted entity reverses at a negative target (esmini's reading); the system
+        // under test is asked to stop there.
+        let to = if scripted { to } else { to.max(0.0) };
         let mut tr = Transition {
             from: v0,
-            to: to.max(0.0),
+            to,
             start_s: t,
             duration_s: duration_s(dynamics, to - v0, 0.5 * (v0 + to).abs()),
             shape: shape_of(dynamics.shape),
         };
+        if scripted {
+            tr.duration_s *= stretch(&tr, self.actors[e].performance);
+        }
         // CARLA: the target at once, held for the dynamics' value (its distance or time).
         let hold = (self.carla && a.is_some()).then(|| {
             tr.duration_s = 0.0;
@@ -164,5 +191,43 @@ impl Storyboard {
             }
         }
         self.set_speed = Some(v.max(0.0));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A transition from `from` to `to` m/s over `duration_s` s of `shape`.
+    fn tr(from: f64, to: f64, duration_s: f64, shape: transition::Shape) -> Transition {
+        Transition {
+            from,
+            to,
+            start_s: 0.0,
+            duration_s,
+            shape,
+        }
+    }
+
+    /// A sinusoidal 0 → 15 m/s over 3 s peaks at π/2 · 5 = 7.85 m/s²: within a maximum
+    /// acceleration of 5 m/s² it takes 3 · 7.85 / 5 = 4.71 s (esmini's light_state); a
+    /// cubic peaks at 1.5 times the mean rate, a linear one at it; a braking is held to the
+    /// maximum deceleration; one within the limits, and a step, keep their time.
+    #[test]
+    fn a_speed_transition_faster_than_the_performance_is_stretched_to_its_peak() {
+        use transition::Shape::{Cubic, Linear, Sinusoidal, Step};
+        let p = m::Performance {
+            max_speed_mps: 70.0,
+            max_acceleration_mps2: 5.0,
+            max_deceleration_mps2: 10.0,
+        };
+        let k = stretch(&tr(0.0, 15.0, 3.0, Sinusoidal), p);
+        assert!((3.0 * k - 1.5 * std::f64::consts::PI).abs() < 1e-12, "{k}");
+        assert!((stretch(&tr(0.0, 15.0, 3.0, Cubic), p) - 1.5).abs() < 1e-12);
+        assert!((stretch(&tr(0.0, 15.0, 1.0, Linear), p) - 3.0).abs() < 1e-12);
+        assert!((stretch(&tr(15.0, 0.0, 1.0, Linear), p) - 1.5).abs() < 1e-12);
+        assert_eq!(stretch(&tr(0.0, 15.0, 5.0, Sinusoidal), p), 1.0);
+        assert_eq!(stretch(&tr(0.0, 15.0, 0.0, Step), p), 1.0);
+        assert_eq!(stretch(&tr(0.0, -3.0, 0.1, Linear), p), 3.0);
     }
 }

@@ -103,6 +103,7 @@ impl Storyboard {
         }
         begin(self);
         self.drives[e].path = Some((path, a.unwrap_or(usize::MAX)));
+        self.drives[e].path_at = site(pos);
 
         Ok(())
     }
