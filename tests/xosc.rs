@@ -1698,3 +1698,76 @@ fn an_entity_deleted_leaves_the_world_and_one_added_enters_it() {
     let t = added["metrics"]["simulated_s"].as_f64().unwrap();
     assert!((8.3..8.8).contains(&t), "collided at {t} s: {added}");
 }
+
+/// A scripted ego asked a negative speed reverses along its lane through the engine too
+/// (`--scripted-ego`): the brake scenario's ego, asked −3 m/s at 6 m/s² after 3 s, stops and
+/// backs down its lane, its trace's speed −3 m/s and its position falling; the test passes.
+/// Driven by a system under test, the same ego is refused at that `SpeedAction`: the system
+/// drives forward only.
+#[test]
+fn a_scripted_ego_reverses_through_the_engine_and_a_driven_one_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = brake_scenario("false", 20.0, "leadingReferencedEntity")
+        .replace(
+            r#"<Actors selectTriggeringEntities="false"><EntityRef entityRef="Lead"/></Actors>"#,
+            r#"<Actors selectTriggeringEntities="false"><EntityRef entityRef="Ego"/></Actors>"#,
+        )
+        .replace(
+            r#"<AbsoluteTargetSpeed value="0"/></SpeedActionTarget>
+            </SpeedAction></LongitudinalAction></PrivateAction>
+          </Action>"#,
+            r#"<AbsoluteTargetSpeed value="-3"/></SpeedActionTarget>
+            </SpeedAction></LongitudinalAction></PrivateAction>
+          </Action>"#,
+        );
+    assert!(text.contains(r#"value="-3""#));
+    let file = dir.path().join("reverse.xosc");
+    std::fs::write(&file, &text).unwrap();
+    let out = dir.path().join("scripted");
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args(["--scripted-ego", "--budget", "1", "--trace", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    let results = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+    let record: serde_json::Value = serde_json::from_str(results.lines().next().unwrap()).unwrap();
+    assert_eq!(record["status"], "pass", "{record} {err}");
+    // The trace's rows: time, then per entity its name, id, speed, ... x at 11 columns on.
+    let trace = std::fs::read_to_string(out.join("trace/test_0.csv")).unwrap();
+    let ego: Vec<(f64, f64, f64)> = trace
+        .lines()
+        .skip(4)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').map(str::trim).collect();
+            let i = f.iter().position(|c| *c == "Ego").unwrap();
+            let num = |k: usize| f[k].parse::<f64>().unwrap();
+            (num(1), num(i + 2), num(i + 11))
+        })
+        .collect();
+    let (_, v_end, x_end) = *ego.last().unwrap();
+    let (_, _, x_10) = *ego.iter().find(|(t, _, _)| *t >= 10.0).unwrap();
+    assert!(
+        (v_end + 3.0).abs() < 0.01,
+        "the ego's speed at the end: {v_end}"
+    );
+    assert!(
+        x_end < x_10 - 10.0,
+        "it backed down its lane: x {x_10} at 10 s, {x_end} at the end"
+    );
+    // Driven by the system under test, the same ego cannot be asked to reverse.
+    let out = dir.path().join("driven");
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args(["--budget", "1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let results = std::fs::read_to_string(out.join("results.jsonl")).unwrap_or_default();
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(
+        results.contains("drive backwards") || err.contains("drive backwards"),
+        "{results} {err}"
+    );
+}

@@ -108,7 +108,8 @@ pub enum Action {
     /// The car is put at the value, `(Vec3 [x, y, z] m, heading rad)` or `(Vec3, heading,
     /// speed m/s)`, for this step, off its path: a scripted car (an OpenSCENARIO
     /// storyboard's) whose motion its script computes. Its reported velocity is the speed
-    /// given, along its heading, else the move it makes over the step (so a teleport with a
+    /// given, along its heading (backwards for a negative speed: a reversing car), else the
+    /// move it makes over the step (so a teleport with a
     /// speed given reports that speed, not the jump over one step). It stops for nothing, but
     /// what it touches at the new pose is recorded as a collision of both.
     PlaceCar(Handle<CarSpec>),
@@ -164,19 +165,18 @@ impl Action {
 
 /// What a place action's value must be ([`Action::PlaceCar`]), as its error says.
 pub(crate) const POSE_EXPECTED: &str =
-    "a (Vec3 [x, y, z] m, heading rad[, speed m/s >= 0]) tuple of finite numbers";
+    "a (Vec3 [x, y, z] m, heading rad[, speed m/s]) tuple of finite numbers";
 
 /// A placed actor's pose, `(Vec3 [x, y, z] m, heading rad)`, and the speed its script gives
-/// it when the tuple has a third number (m/s, finite and `>= 0`): see [`Action::PlaceCar`].
+/// it when the tuple has a third number (m/s, finite; negative backwards along its heading, a
+/// storyboard's reversing entity): see [`Action::PlaceCar`].
 /// `None` for anything else.
 pub(crate) fn placed_pose(value: &Value) -> Option<([f64; 3], f64, Option<f64>)> {
     let pose = |p: &[f64; 3], h: f64| p.iter().all(|x| x.is_finite()) && h.is_finite();
     match value {
         Value::Tuple(t) => match t.as_slice() {
             [Value::Vec3(p), Value::Num(h)] if pose(p, *h) => Some((*p, *h, None)),
-            [Value::Vec3(p), Value::Num(h), Value::Num(v)]
-                if pose(p, *h) && v.is_finite() && *v >= 0.0 =>
-            {
+            [Value::Vec3(p), Value::Num(h), Value::Num(v)] if pose(p, *h) && v.is_finite() => {
                 Some((*p, *h, Some(*v)))
             }
             _ => None,
