@@ -6,7 +6,7 @@
 //! - its velocity is its move over the last step: `|vel − Δpos/Δt| ≤ 1e-9 m/s` for NPC cars
 //!   and pedestrians (their velocity is measured so), `≤ 0.05 m/s` for the ego vehicle (a
 //!   rigid body integrated by rapier);
-//! - its speed is the size of its velocity (signed for the ego, negative backwards);
+//! - its speed is the size of its velocity (negative backwards: the ego, a reversed car);
 //! - its heading is continuous and turns no faster than the actor can: an NPC car at most
 //!   `v / MIN_PATH_RADIUS_M` (4 m, the tightest lane path) plus the turn of a lane change,
 //!   the ego at most `v / 5.3 m` (its steering limit), a pedestrian never (it walks a
@@ -132,7 +132,7 @@ fn check_program(path: &Path, tests: usize) -> Worst {
                         let norm = r.vel[0].hypot(r.vel[1]).hypot(r.vel[2]);
                         let speed_ok = match actor {
                             ActorRef::Ego => (r.speed.abs() - norm).abs() <= 1e-9 * norm.max(1.0),
-                            _ => (r.speed - norm).abs() <= 1e-9 * norm.max(1.0),
+                            _ => (r.speed.abs() - norm).abs() <= 1e-9 * norm.max(1.0),
                         };
                         assert!(speed_ok, "{}: speed {} but |vel| {norm}", at(), r.speed);
                         let Some(p) = last[j] else { continue };

@@ -1012,11 +1012,16 @@ impl ActorKind for Car {
     fn motion(&self) -> Option<Motion> {
         self.body?;
         let [vx, vz] = self.velocity;
+        // The size of its velocity, negative when it moves against its heading (a scripted
+        // car a storyboard reverses), as the ego's speed is.
+        let (sin, cos) = self.here.1.sin_cos();
+        let backwards = vx * cos - vz * sin < 0.0;
+        let size = vx.hypot(vz);
         Some(Motion {
             pos_m: self.centre_m(),
             vel_mps: [vx, 0.0, vz],
             heading_rad: half_open(self.here.1),
-            speed_mps: vx.hypot(vz),
+            speed_mps: if backwards { -size } else { size },
         })
     }
 

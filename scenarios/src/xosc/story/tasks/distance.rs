@@ -164,11 +164,10 @@ impl Storyboard {
             // which esmini has stepped by then (an action before this one). A reference the
             // system under test drives has the speed it drives at: its `SpeedAction` is
             // only the speed asked of that system.
-            if placed.is_ok() && self.actors[k.reference].scripted {
-                if let Some(task) = self.drives[k.reference].speed {
-                    let (v, _) = task.step(t1, |r| self.actors[r].state.speed);
-                    self.actors[e].state.speed = v.max(0.0);
-                }
+            let stepped =
+                self.actors[k.reference].scripted && self.drives[k.reference].speed.is_some();
+            if placed.is_ok() && stepped {
+                self.actors[e].state.speed = self.reference_speed(k.reference, t1).max(0.0);
             }
             let result = placed.map_err(|err| StoryError {
                 at: k.at.clone(),
