@@ -1771,3 +1771,124 @@ fn a_scripted_ego_reverses_through_the_engine_and_a_driven_one_is_refused() {
         "{results} {err}"
     );
 }
+
+/// A scenario on the ALKS suite's straight road: `Ego` at 10 m/s on lane -5, `Truck` (a car
+/// towing the trailer written in it; the ego too when `ego_tows`) 80 m ahead on lane -4 at
+/// 10 m/s, and an event that stops the ego if the truck collides with any vehicle; `init`
+/// is added to the truck's `Init`.
+fn truck_scenario(ego_tows: bool, init: &str) -> String {
+    let road = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/xosc/alks/concrete_scenarios/road_networks/alks_road_straight.xodr");
+    let axles = r#"<Axles><FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/><RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/></Axles>"#;
+    let trailer = format!(
+        r#"<TrailerHitch dx="-1.2"/><Trailer><Trailer name="t"><Vehicle name="trailer" vehicleCategory="trailer"><BoundingBox><Center x="1.4" y="0" z="0.75"/><Dimensions width="2" length="4.5" height="1.2"/></BoundingBox><Performance maxSpeed="60" maxAcceleration="10" maxDeceleration="10"/>{axles}<TrailerCoupler dx="3.25"/><Properties/></Vehicle></Trailer></Trailer>"#
+    );
+    let car = |tows: bool| {
+        format!(
+            r#"<Vehicle name="car" vehicleCategory="car"><BoundingBox><Center x="1.4" y="0" z="0.75"/><Dimensions width="1.9" length="4.6" height="1.5"/></BoundingBox><Performance maxSpeed="60" maxAcceleration="10" maxDeceleration="10"/>{axles}{}<Properties/></Vehicle>"#,
+            if tows { trailer.as_str() } else { "" }
+        )
+    };
+    let at = |name: &str, lane: i32, s: f64, extra: &str| {
+        format!(
+            r#"<Private entityRef="{name}"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="{lane}" s="{s}" offset="0"/></Position></TeleportAction></PrivateAction><PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/><SpeedActionTarget><AbsoluteTargetSpeed value="10"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction>{extra}</Private>"#
+        )
+    };
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<OpenSCENARIO>
+  <FileHeader revMajor="1" revMinor="3" date="2026-11-30T00:00:00" description="truck" author="paracosm"/>
+  <RoadNetwork><LogicFile filepath="{road}"/></RoadNetwork>
+  <Entities><ScenarioObject name="Ego">{ego}</ScenarioObject><ScenarioObject name="Truck">{truck}</ScenarioObject></Entities>
+  <Storyboard>
+    <Init><Actions>{ego_at}{truck_at}</Actions></Init>
+    <Story name="S"><Act name="Act"><ManeuverGroup maximumExecutionCount="1" name="G">
+      <Actors selectTriggeringEntities="false"><EntityRef entityRef="Ego"/></Actors>
+      <Maneuver name="M"><Event name="Crash" priority="parallel"><Action name="Stop"><PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" value="0" dynamicsDimension="time"/><SpeedActionTarget><AbsoluteTargetSpeed value="0"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction></Action>
+        <StartTrigger><ConditionGroup><Condition name="Hit" delay="0" conditionEdge="none"><ByEntityCondition><TriggeringEntities triggeringEntitiesRule="any"><EntityRef entityRef="Truck"/></TriggeringEntities><EntityCondition><CollisionCondition><ByType type="vehicle"/></CollisionCondition></EntityCondition></ByEntityCondition></Condition></ConditionGroup></StartTrigger></Event></Maneuver>
+    </ManeuverGroup></Act></Story>
+    <StopTrigger><ConditionGroup><Condition name="End" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="8" rule="greaterOrEqual"/></ByValueCondition></Condition></ConditionGroup></StopTrigger>
+  </Storyboard>
+</OpenSCENARIO>
+"#,
+        ego = car(ego_tows),
+        truck = car(true),
+        ego_at = at("Ego", -5, 20.0, ""),
+        truck_at = at("Truck", -4, 100.0, init),
+        road = road.display(),
+    )
+}
+
+/// A vehicle combination runs as a campaign: the trailer, an entity of its own (`Truck+`),
+/// follows its tow through the engine, and the two, overlapping at the hitch, do not collide
+/// (the storyboard's collision condition on the truck never fires). An ego towing a trailer,
+/// and a `TrailerAction`, are refused at load, naming them.
+#[test]
+fn a_trailer_runs_with_its_tow_and_an_ego_towing_one_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("truck.xosc");
+    std::fs::write(&file, truck_scenario(false, "")).unwrap();
+    let out = dir.path().join("run");
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg(&file)
+        .args(["--scripted-ego", "--budget", "1", "--trace", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    let results = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+    let record: serde_json::Value = serde_json::from_str(results.lines().next().unwrap()).unwrap();
+    assert_eq!(record["status"], "pass", "{record} {err}");
+    let log = record["log"].to_string();
+    assert!(
+        !log.contains("Crash"),
+        "the truck collided with its trailer: {log}"
+    );
+    let trace = std::fs::read_to_string(out.join("trace/test_0.csv")).unwrap();
+    let xs: Vec<f64> = trace
+        .lines()
+        .skip(4)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').map(str::trim).collect();
+            let i = f
+                .iter()
+                .position(|c| *c == "Truck+")
+                .expect("the trailer's columns");
+            f[i + 11].parse::<f64>().unwrap()
+        })
+        .collect();
+    let moved = (xs.last().unwrap() - xs[0]).abs();
+    assert!(
+        (moved - 80.0).abs() < 1.0,
+        "8 s at 10 m/s: the trailer moved {moved} m"
+    );
+
+    for (name, text, why) in [
+        (
+            "ego",
+            truck_scenario(true, ""),
+            "the ego \"Ego\" tows a trailer",
+        ),
+        (
+            "action",
+            truck_scenario(
+                false,
+                r#"<PrivateAction><TrailerAction><DisconnectTrailerAction/></TrailerAction></PrivateAction>"#,
+            ),
+            "couples or uncouples a trailer",
+        ),
+    ] {
+        let file = dir.path().join(format!("{name}.xosc"));
+        std::fs::write(&file, text).unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+            .arg(&file)
+            .args(["--budget", "1", "--out"])
+            .arg(dir.path().join(name))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(why), "{name}: {err}");
+        assert!(err.contains(&format!("{name}.xosc:")), "{name}: {err}");
+    }
+}

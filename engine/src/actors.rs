@@ -31,6 +31,8 @@ pub(crate) struct Actors {
     /// The actors out of the test now ([`Action::SetPresent`]): [`Actors::all`] leaves them
     /// out.
     absent: Vec<ActorRef>,
+    /// Each trailer and its tow ([`CarSpec::tow`]).
+    coupled: Vec<(ActorRef, ActorRef)>,
 }
 
 impl Actors {
@@ -65,6 +67,7 @@ impl Actors {
             obstacles: Set::default(),
             owners: HashMap::new(),
             absent: Vec::new(),
+            coupled: Vec::new(),
         };
         for (i, p) in spec.pedestrians.iter().enumerate() {
             let ped = Pedestrian::from_spec(i, p, &spec.streams, physics);
@@ -72,6 +75,7 @@ impl Actors {
             let h = actors.pedestrians.insert(ped);
             actors.owners.insert(collider, ActorRef::Pedestrian(h));
         }
+        let mut handles = Vec::new();
         for (i, c) in spec.cars.iter().enumerate() {
             let car = Car::from_spec(i, c, &spec.streams, physics)?;
             let collider = car.body.map(|(_, c)| c);
@@ -79,6 +83,25 @@ impl Actors {
             if let Some(collider) = collider {
                 actors.owners.insert(collider, ActorRef::Car(h));
             }
+            handles.push(h);
+        }
+        for (i, c) in spec.cars.iter().enumerate() {
+            let Some(tow) = c.tow else { continue };
+            if tow == i || tow >= handles.len() {
+                return Err(EngineError::InvalidWorld(format!(
+                    "car {i} is towed by car {tow}, which is {} (a trailer's tow is another car \
+                     of the world's {})",
+                    if tow == i {
+                        "itself"
+                    } else {
+                        "not in the world"
+                    },
+                    handles.len()
+                )));
+            }
+            actors
+                .coupled
+                .push((ActorRef::Car(handles[i]), ActorRef::Car(handles[tow])));
         }
         for (i, o) in spec.obstacles.iter().enumerate() {
             let obstacle = Obstacle::from_spec(i, o, physics)?;
@@ -285,6 +308,9 @@ impl Actors {
 
     /// Puts every actor in the test into `solids` where it is now.
     pub(crate) fn put_solids(&self, physics: &PhysicsWorld, solids: &mut Solids) {
+        for &(a, b) in &self.coupled {
+            solids.couple(a, b);
+        }
         for (r, a) in self.all() {
             if let Some((pose, shape)) = a.solid(physics) {
                 solids.put(r, pose, shape);

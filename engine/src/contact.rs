@@ -15,6 +15,9 @@ use rapier3d::prelude::*;
 /// than their radii together cannot touch, which most pairs are, so they skip parry's test.
 pub(crate) struct Solids {
     items: Vec<(ActorRef, Pose, SharedShape, f32)>,
+    /// Pairs coupled at a hitch (a trailer and its tow, [`crate::CarSpec::tow`]): their
+    /// contact is no collision, and neither is in the other's way.
+    coupled: Vec<(ActorRef, ActorRef)>,
 }
 
 /// The radius of `shape`'s bounding sphere about its frame's origin, m.
@@ -32,7 +35,26 @@ fn apart(a: &Pose, ra: f32, b: &Pose, rb: f32) -> bool {
 impl Solids {
     /// An empty set.
     pub(crate) fn new() -> Self {
-        Solids { items: Vec::new() }
+        Solids {
+            items: Vec::new(),
+            coupled: Vec::new(),
+        }
+    }
+
+    /// Couples `a` and `b` (a trailer and its tow): from now on neither meets the other.
+    pub(crate) fn couple(&mut self, a: ActorRef, b: ActorRef) {
+        self.coupled.push((a, b));
+    }
+
+    /// Whether `o` is another object than `me`, not coupled to it, and not the ego unless
+    /// `with_ego`: one `me` can meet.
+    fn other(&self, me: ActorRef, o: ActorRef, with_ego: bool) -> bool {
+        o != me
+            && (with_ego || o != ActorRef::Ego)
+            && !self
+                .coupled
+                .iter()
+                .any(|&(a, b)| (a, b) == (me, o) || (a, b) == (o, me))
     }
 
     /// Adds `who` with `shape` at `pose`, or moves it there when it is in the set.
@@ -63,7 +85,7 @@ impl Solids {
         let r = reach(shape);
         self.items
             .iter()
-            .filter(|(o, ..)| *o != me && (with_ego || *o != ActorRef::Ego))
+            .filter(|(o, ..)| self.other(me, *o, with_ego))
             .find(|(_, p, s, rs)| {
                 // A pair parry cannot test (no such pair among boxes and capsules) counts as
                 // touching: a contact is never assumed away.
@@ -86,7 +108,7 @@ impl Solids {
     ) -> bool {
         self.items
             .iter()
-            .filter(|(o, ..)| *o != me && (with_ego || *o != ActorRef::Ego))
+            .filter(|(o, ..)| self.other(me, *o, with_ego))
             .any(|(_, p, _, r)| {
                 let t = p.translation;
                 let d = [
@@ -99,16 +121,62 @@ impl Solids {
             })
     }
 
-    /// The smallest distance (m) from `shape` at `pose` to any object other than `me`, the
-    /// ego included; `inf` when there is none, `0` when touching.
+    /// The smallest distance (m) from `shape` at `pose` to any object other than `me` and
+    /// what is coupled to it, the ego included; `inf` when there is none, `0` when touching.
     pub(crate) fn clearance_m(&self, me: ActorRef, shape: &dyn Shape, pose: &Pose) -> f64 {
         self.items
             .iter()
-            .filter(|(o, ..)| *o != me)
+            .filter(|(o, ..)| self.other(me, *o, true))
             .map(|(_, p, s, _)| {
                 query::distance(pose, shape, p, s.as_ref())
                     .map_or(0.0, |d| f64::from(d.distance).max(0.0))
             })
             .fold(f64::INFINITY, f64::min)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::actor::Roster;
+    use crate::CarSpec;
+
+    /// A trailer and its tow overlap at the hitch: coupled, neither meets the other nor counts
+    /// it in its separation, while a third car in the same place still meets both.
+    #[test]
+    fn coupled_cars_do_not_meet_each_other_but_others_meet_them() {
+        let mut roster: Roster<CarSpec> = Roster::default();
+        let (tow, trailer, other) = (
+            ActorRef::Car(roster.add()),
+            ActorRef::Car(roster.add()),
+            ActorRef::Car(roster.add()),
+        );
+        let shape = SharedShape::cuboid(2.3, 0.75, 0.95);
+        let at = |x: f32| Pose::from_translation(Vector::new(x, 0.75, 0.0));
+        let mut solids = Solids::new();
+        solids.put(tow, at(0.0), shape.clone());
+        solids.put(trailer, at(-4.0), shape.clone());
+        // Overlapping by 0.6 m: uncoupled, they meet.
+        assert_eq!(
+            solids.first_hit(tow, shape.as_ref(), &at(0.0), true),
+            Some(trailer)
+        );
+        assert_eq!(solids.clearance_m(trailer, shape.as_ref(), &at(-4.0)), 0.0);
+        solids.couple(trailer, tow);
+        assert_eq!(solids.first_hit(tow, shape.as_ref(), &at(0.0), true), None);
+        assert_eq!(
+            solids.first_hit(trailer, shape.as_ref(), &at(-4.0), true),
+            None
+        );
+        assert!(!solids.any_near(tow, [0.0, 0.75, 0.0], 2.6, true));
+        assert_eq!(
+            solids.clearance_m(trailer, shape.as_ref(), &at(-4.0)),
+            f64::INFINITY
+        );
+        // A car that is not coupled to them meets either.
+        assert_eq!(
+            solids.first_hit(other, shape.as_ref(), &at(-2.0), true),
+            Some(tow)
+        );
     }
 }

@@ -987,6 +987,7 @@ mod tests {
                 lane_offsets_m: vec![],
                 name: String::new(),
                 keep_distance_m: None,
+                tow: None,
             }
         };
         s.cars = vec![

@@ -78,6 +78,11 @@ pub struct CarSpec {
     /// the ego), m, finite and `>= 0`: it brakes, at most `μ·g`, to stop that far short of
     /// it. `None`: it brakes for nothing, and stops only against what it meets.
     pub keep_distance_m: Option<f64>,
+    /// Its tow, when it is a trailer: the car (an index into [`WorldSpec::cars`], not its
+    /// own) whose hitch it is coupled to. The two touch at the hitch, so their contact is no
+    /// collision: neither records it, neither stops for the other, and neither's separation
+    /// counts the other. `None` for a car that no car tows.
+    pub tow: Option<usize>,
 }
 
 /// A static obstacle (`Obstacle(loc=, size=, color=)`): a box that never moves.

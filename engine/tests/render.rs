@@ -381,6 +381,7 @@ fn an_npc_cars_collider_and_its_drawing_agree() {
         lane_offsets_m: vec![],
         name: String::new(),
         keep_distance_m: None,
+        tow: None,
     }];
     let spec = standing_world(network, start, g, cars, vec![]);
     let mut sim = Simulation::new(&spec).unwrap();

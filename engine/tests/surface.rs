@@ -65,6 +65,7 @@ fn world(network: Network, at_m: f64, speed_mps: f64, cars: &[Npc]) -> WorldSpec
             lane_offsets_m: vec![],
             name: String::new(),
             keep_distance_m: None,
+            tow: None,
         });
     }
     WorldSpec {

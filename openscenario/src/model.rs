@@ -115,6 +115,18 @@ pub struct Entity {
     pub performance: Performance,
     /// Where it is declared.
     pub pos: Pos,
+    /// Its `TrailerHitch`'s `dx`: where a trailer is hitched to it, m ahead of its reference
+    /// point (negative behind it); `None` when it has no hitch and tows nothing.
+    pub hitch_dx_m: Option<f64>,
+    /// Its `TrailerCoupler`'s `dx`: where it is coupled to a vehicle that tows it, m ahead
+    /// of its reference point; `None` when it is no trailer.
+    pub coupler_dx_m: Option<f64>,
+    /// The entity it tows from the start (an index into [`Scenario::entities`]): its
+    /// `Trailer`, written in it (read as an entity of its own, named as esmini names it, the
+    /// tow's name and `+`) or a `TrailerRef` to another entity. The trailer is pulled by its
+    /// hitch as esmini pulls it ([`Entity::hitch_dx_m`], [`Entity::coupler_dx_m`]): its
+    /// coupler stays at the tow's hitch and it turns towards it.
+    pub trailer: Option<usize>,
 }
 
 /// A vehicle's `Performance` (OpenSCENARIO 1.3, `Performance`), as esmini applies it to the
@@ -400,6 +412,11 @@ pub enum Action {
     },
     /// `AcquirePositionAction`: a route from where the entity is to this position.
     AcquirePosition(Position),
+    /// `TrailerAction`: `ConnectTrailerAction` hitches entity `Some(trailer)` (an index into
+    /// [`Scenario::entities`]) to the entity, unhitching the one it tows;
+    /// `DisconnectTrailerAction` (`None`) unhitches it, the trailer then standing where it
+    /// is, at the speed it had.
+    Trailer(Option<usize>),
     /// `SynchronizeAction`: the entity's speed is set each step so that it reaches its
     /// target position when the master entity reaches the master's.
     Synchronize(Box<Synchronize>),
@@ -564,6 +581,8 @@ impl Action {
             Action::FollowTrajectory { .. } => "FollowTrajectoryAction",
             Action::AssignRoute { .. } => "AssignRouteAction",
             Action::AcquirePosition(_) => "AcquirePositionAction",
+            Action::Trailer(Some(_)) => "ConnectTrailerAction",
+            Action::Trailer(None) => "DisconnectTrailerAction",
             Action::Synchronize(_) => "SynchronizeAction",
             Action::ActivateController { .. } => "ActivateControllerAction",
             Action::AssignController { .. } => "AssignControllerAction",

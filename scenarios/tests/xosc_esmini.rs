@@ -212,7 +212,7 @@ fn check_runs(runs: &[Run]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 37] = [
+const ESMINI_EXAMPLES: [&str; 38] = [
     "acc-test",
     "alks_cut-in",
     "alks_cut-out",
@@ -221,6 +221,7 @@ const ESMINI_EXAMPLES: [&str; 37] = [
     "alks_r157_cut_in_quick_brake",
     "alks-test",
     "cut-in",
+    "cut-in_cr",
     "cut-in_environment",
     "cut-in_external",
     "cut-in_interactive",

@@ -1008,3 +1008,107 @@ fn a_scripted_entity_asked_a_negative_speed_reverses_along_its_lane() {
         a.pose.h
     );
 }
+
+/// A car named `name` with a hitch 1.2 m behind its reference point towing `trailer`
+/// (the elements inside its `<Trailer>`).
+fn tow_object(name: &str, trailer: &str) -> String {
+    format!(
+        r#"<ScenarioObject name="{name}"><Vehicle name="car" vehicleCategory="car">
+        <BoundingBox><Center x="1.4" y="0" z="0.75"/><Dimensions width="1.9" length="4.6" height="1.5"/></BoundingBox>
+        <Performance maxSpeed="60" maxAcceleration="10" maxDeceleration="10"/>
+        <Axles><FrontAxle maxSteering="0.5" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/><RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/></Axles>
+        <TrailerHitch dx="-1.2"/><Trailer>{trailer}</Trailer>
+        <Properties/></Vehicle></ScenarioObject>"#
+    )
+}
+
+/// A trailer whose coupler is 3.25 m ahead of its reference point, as a `Vehicle`.
+const BOX_TRAILER: &str = r#"<Vehicle name="trailer" vehicleCategory="trailer">
+        <BoundingBox><Center x="1.4" y="0" z="0.75"/><Dimensions width="2" length="4.5" height="1.2"/></BoundingBox>
+        <Performance maxSpeed="60" maxAcceleration="10" maxDeceleration="10"/>
+        <Axles><FrontAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="2.8" positionZ="0.3"/><RearAxle maxSteering="0" wheelDiameter="0.6" trackWidth="1.6" positionX="0" positionZ="0.3"/></Axles>
+        <TrailerCoupler dx="3.25"/><Properties/></Vehicle>"#;
+
+/// A trailer is pulled by its tow's hitch, as esmini pulls it: it enters the scenario with
+/// its tow, lined up straight behind it; at every step its coupler is at the hitch, it faces
+/// the hitch and it has its tow's speed, so through a lane change it swings out less than its
+/// tow and settles behind it in the new lane. A `DisconnectTrailerAction` leaves it at the
+/// speed it had, and its tow drives away from it.
+#[test]
+fn a_trailer_follows_its_tows_hitch_until_it_is_unhitched() {
+    let entities = tow_object(
+        "Tow",
+        &format!(r#"<Trailer name="t">{BOX_TRAILER}</Trailer>"#),
+    );
+    let init = placed("Tow", -2, 100.0, 10.0);
+    let lane_change = r#"<PrivateAction><LateralAction><LaneChangeAction>
+        <LaneChangeActionDynamics dynamicsShape="sinusoidal" value="3" dynamicsDimension="time"/>
+        <LaneChangeTarget><RelativeTargetLane entityRef="Tow" value="-1"/></LaneChangeTarget>
+      </LaneChangeAction></LateralAction></PrivateAction>"#;
+    let unhitch = format!(
+        r#"<Event name="Off" priority="parallel">
+          <Action name="Unhitch"><PrivateAction><TrailerAction><DisconnectTrailerAction/></TrailerAction></PrivateAction></Action>
+          <Action name="Faster">{}</Action>
+          <StartTrigger><ConditionGroup><Condition name="At8" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="8" rule="greaterOrEqual"/></ByValueCondition></Condition></ConditionGroup></StartTrigger></Event>"#,
+        step_to(15.0)
+    );
+    let story = format!(
+        r#"<Story name="S"><Act name="Act"><ManeuverGroup maximumExecutionCount="1" name="G">
+          <Actors selectTriggeringEntities="false"><EntityRef entityRef="Tow"/></Actors>
+          <Maneuver name="M"><Event name="E" priority="parallel"><Action name="A">{lane_change}</Action>
+            <StartTrigger><ConditionGroup><Condition name="At1" delay="0" conditionEdge="none"><ByValueCondition><SimulationTimeCondition value="1" rule="greaterOrEqual"/></ByValueCondition></Condition></ConditionGroup></StartTrigger></Event>{unhitch}
+          </Maneuver></ManeuverGroup></Act></Story>"#
+    );
+    let text = on_straight_road("trailer", &entities, &init, &story, 12.0);
+    let mut sb = storyboard_of("trailer", &text).expect("Init performs");
+    assert_eq!(sb.actors[1].name, "Tow+");
+    // Lined up behind its tow at Init: the coupler 3.25 m ahead of the trailer's reference
+    // point, at the hitch 1.2 m behind the tow's.
+    let (tow, trailer) = (sb.actors[0].state.pose, sb.actors[1].state.pose);
+    assert!(sb.actors[1].present);
+    assert!((tow.x - 1.2 - 3.25 - trailer.x).abs() < 1e-9 && (tow.y - trailer.y).abs() < 1e-9);
+    let hitch_gap = |sb: &Storyboard| {
+        let (t, r) = (sb.actors[0].state.pose, sb.actors[1].state.pose);
+        let hitch = [t.x - 1.2 * t.h.cos(), t.y - 1.2 * t.h.sin()];
+        let coupler = [r.x + 3.25 * r.h.cos(), r.y + 3.25 * r.h.sin()];
+        (hitch[0] - coupler[0]).hypot(hitch[1] - coupler[1])
+    };
+    let (mut tow_swing, mut trailer_swing) = (0.0_f64, 0.0_f64);
+    let y0 = tow.y;
+    let mut gap_after = 0.0;
+    run(&mut sb, 12.0, |t, sb| {
+        let (a, b) = (&sb.actors[0].state, &sb.actors[1].state);
+        if t < 8.0 - 1e-9 {
+            assert!(
+                hitch_gap(sb) < 1e-9,
+                "t = {t}: coupler {} m from the hitch",
+                hitch_gap(sb)
+            );
+            assert_eq!(a.speed, b.speed, "t = {t}");
+            tow_swing = tow_swing.max((a.pose.h).abs());
+            trailer_swing = trailer_swing.max((b.pose.h).abs());
+        } else {
+            gap_after = hitch_gap(sb);
+        }
+    });
+    let (a, b) = (&sb.actors[0].state, &sb.actors[1].state);
+    assert!(tow_swing > 0.05, "the tow turned {tow_swing} rad");
+    assert!(
+        trailer_swing < tow_swing && trailer_swing > 0.01,
+        "the trailer turned {trailer_swing} rad, its tow {tow_swing}"
+    );
+    // Settled in the new lane, a lane over, before it was unhitched; then left behind.
+    assert!(
+        (a.pose.y - y0).abs() > 1.5,
+        "tow from y {y0} to {}",
+        a.pose.y
+    );
+    assert!(
+        (b.pose.y - a.pose.y).abs() < 0.05,
+        "trailer at y {}, its tow at {}",
+        b.pose.y,
+        a.pose.y
+    );
+    assert!((b.speed - 10.0).abs() < 1e-9 && (a.speed - 15.0).abs() < 1e-9);
+    assert!(gap_after > 15.0, "4 s at 5 m/s more: {gap_after} m");
+}

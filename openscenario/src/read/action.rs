@@ -29,10 +29,22 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
             "AppearanceAction",
             "VisibilityAction",
             "SynchronizeAction",
+            "TrailerAction",
         ],
     )?;
     match tag {
         "SynchronizeAction" => super::synchronize::read(r, a),
+        "TrailerAction" => {
+            let (t, tag) = choice(
+                r.text,
+                a,
+                &["ConnectTrailerAction", "DisconnectTrailerAction"],
+            )?;
+            if tag == "DisconnectTrailerAction" {
+                return Ok(Action::Trailer(None));
+            }
+            Ok(Action::Trailer(Some(r.entity(t, "trailerRef")?)))
+        }
         "AppearanceAction" => {
             let (kind, tag) = choice(r.text, a, &["LightStateAction", "AnimationAction"])?;
             let what = if tag == "LightStateAction" {

@@ -79,6 +79,8 @@ pub(super) fn read(
     node: Option<Node<'_, '_>>,
 ) -> Result<Vec<Entity>, XoscError> {
     let mut out: Vec<Entity> = Vec::new();
+    // Trailers named by `TrailerRef`: (tow, the trailer's name, where it is named).
+    let mut refs: Vec<(usize, String, crate::Pos)> = Vec::new();
     for obj in node.into_iter().flat_map(elements) {
         if obj.tag_name().name() == "EntitySelection" {
             continue;
@@ -122,35 +124,149 @@ pub(super) fn read(
                 "more than one <ObjectController> per entity is not supported",
             ));
         }
-        let (kind, dimensions_m, centre_m, box_pos, notes, performance) =
-            if tag == "CatalogReference" {
-                catalogs.with_entry(r, body, &["Vehicle", "Pedestrian", "MiscObject"], object)?
-            } else {
-                let scope = r.scope.clone();
-                object(r.text, body, &scope)?
-            };
-        for n in notes {
-            r.note(body, n);
-        }
+        let read = if tag == "CatalogReference" {
+            catalogs.read_entry(r, body, &["Vehicle", "Pedestrian", "MiscObject"], object)?
+        } else {
+            object(r, body)?
+        };
         let controller = match child(obj, "ObjectController") {
             None => None,
             Some(oc) => Some(controller(r, catalogs, oc)?),
         };
-        out.push(Entity {
-            name: name.clone(),
-            kind,
-            dimensions_m,
-            centre_m,
-            box_pos,
-            controller,
-            performance,
-            pos: r.text.pos(obj),
-        });
-        std::rc::Rc::make_mut(&mut r.names).push(name);
+        push_combination(
+            r,
+            (&mut out, &mut refs),
+            (obj, body),
+            (name, read, controller),
+        )?;
     }
+    resolve_trailer_refs(&mut out, refs)?;
+    check_combinations(&out)?;
     let selections = selections(r, &out, node)?;
     r.selections = std::rc::Rc::new(selections);
     Ok(out)
+}
+
+/// Pushes entity `name` (its `ScenarioObject` and body elements `at`), read as `read`, with
+/// its controller, onto `out`; and each trailer written in it as an entity of its own, named
+/// as esmini names it (the tow's name and `+`), after its tow. A trailer named by a
+/// `TrailerRef` is recorded in `refs` (tow, name, where it is named).
+///
+/// # Errors
+/// Invalid for a name another entity has.
+fn push_combination(
+    r: &mut Reader<'_>,
+    (out, refs): (&mut Vec<Entity>, &mut Vec<(usize, String, crate::Pos)>),
+    (obj, body): (Node<'_, '_>, Node<'_, '_>),
+    (name, read, controller): (String, Body, Option<String>),
+) -> Result<(), XoscError> {
+    let mut pos = r.text.pos(obj);
+    let (mut name, mut read, mut controller) = (name, read, controller);
+    loop {
+        for n in std::mem::take(&mut read.notes) {
+            r.note(body, n);
+        }
+        if out.iter().any(|e| e.name == name) {
+            return Err(r
+                .text
+                .invalid(obj, format!("a second entity is named {name:?}")));
+        }
+        let towed = read.trailer.take();
+        let index = out.len();
+        out.push(Entity {
+            name: name.clone(),
+            kind: read.kind,
+            dimensions_m: read.dimensions_m,
+            centre_m: read.centre_m,
+            box_pos: read.box_pos,
+            controller: controller.take(),
+            performance: read.performance,
+            pos: pos.clone(),
+            hitch_dx_m: read.hitch_dx_m,
+            coupler_dx_m: read.coupler_dx_m,
+            trailer: None,
+        });
+        std::rc::Rc::make_mut(&mut r.names).push(name.clone());
+        match towed {
+            None => return Ok(()),
+            Some(Towed::Entity(other, at)) => {
+                refs.push((index, other, at));
+                return Ok(());
+            }
+            Some(Towed::Body(b)) => {
+                out[index].trailer = Some(index + 1);
+                name = format!("{name}+");
+                pos = b.pos.clone();
+                read = *b;
+            }
+        }
+    }
+}
+
+/// Hitches each trailer named by a `TrailerRef` (`refs`: tow, name, where it is named) to its
+/// tow, once every entity of `out` is read.
+///
+/// # Errors
+/// Invalid at the reference for a name no entity has, or an entity that is no trailer (no
+/// `TrailerCoupler`, or the tow itself).
+fn resolve_trailer_refs(
+    out: &mut [Entity],
+    refs: Vec<(usize, String, crate::Pos)>,
+) -> Result<(), XoscError> {
+    for (tow, other, at) in refs {
+        let Some(k) = out.iter().position(|e| e.name == other) else {
+            return Err(XoscError::Invalid {
+                pos: at,
+                reason: format!("no entity is named {other:?}"),
+            });
+        };
+        if out[k].coupler_dx_m.is_none() || k == tow {
+            return Err(XoscError::Invalid {
+                pos: at,
+                reason: format!(
+                    "{other:?} is no trailer of {:?}: a trailer is another vehicle with a <TrailerCoupler>",
+                    out[tow].name
+                ),
+            });
+        }
+        out[tow].trailer = Some(k);
+    }
+    Ok(())
+}
+
+/// Checks the vehicle combinations of `entities`: a trailer is towed by one vehicle at a
+/// time, and no combination tows itself round (a chain of trailers that comes back to its
+/// first vehicle).
+///
+/// # Errors
+/// Invalid at the second tow of a trailer, or at a vehicle whose chain comes back to it.
+fn check_combinations(entities: &[Entity]) -> Result<(), XoscError> {
+    for (i, e) in entities.iter().enumerate() {
+        let Some(t) = e.trailer else { continue };
+        if let Some(j) = (0..i).find(|&j| entities[j].trailer == Some(t)) {
+            return Err(XoscError::Invalid {
+                pos: e.pos.clone(),
+                reason: format!(
+                    "{:?} tows {:?}, which {:?} tows already: a trailer has one tow",
+                    e.name, entities[t].name, entities[j].name
+                ),
+            });
+        }
+        let mut at = Some(t);
+        for _ in 0..entities.len() {
+            match at {
+                Some(k) if k == i => {
+                    return Err(XoscError::Invalid {
+                        pos: e.pos.clone(),
+                        reason: format!("{:?}'s chain of trailers comes back to it", e.name),
+                    })
+                }
+                Some(k) => at = entities[k].trailer,
+                None => break,
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Each `EntitySelection` of `Entities` (OpenSCENARIO 1.0+): its name and its members, the
@@ -268,19 +384,37 @@ fn select(
     Ok(())
 }
 
-/// An object's kind, bounding box (dimensions, centre, where its dimensions are written) and
-/// notes.
-type Object = (
-    EntityKind,
-    [f64; 3],
-    [f64; 3],
-    crate::Pos,
-    Vec<String>,
-    Performance,
-);
+/// A `Vehicle`, `Pedestrian` or `MiscObject` as read: its kind, bounding box (dimensions,
+/// centre, where its dimensions are written), notes, `Performance`, and, for a vehicle, its
+/// hitch, coupler and the trailer it tows.
+struct Body {
+    kind: EntityKind,
+    dimensions_m: [f64; 3],
+    centre_m: [f64; 3],
+    box_pos: crate::Pos,
+    notes: Vec<String>,
+    performance: Performance,
+    /// `TrailerHitch dx`, m.
+    hitch_dx_m: Option<f64>,
+    /// `TrailerCoupler dx`, m.
+    coupler_dx_m: Option<f64>,
+    /// The trailer it tows from the start, if any.
+    trailer: Option<Towed>,
+    /// Where the object's element is written.
+    pos: crate::Pos,
+}
 
-/// A `Vehicle`, `Pedestrian` or `MiscObject` element: its kind, bounding box and notes.
-fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscError> {
+/// A vehicle's `Trailer`: a vehicle written in it (inline or from a catalog), or a
+/// `TrailerRef` to another entity (its name, where the reference is written).
+enum Towed {
+    Body(Box<Body>),
+    Entity(String, crate::Pos),
+}
+
+/// A `Vehicle`, `Pedestrian` or `MiscObject` element read with `r` (the scenario's reader,
+/// or a catalog entry's).
+fn object(r: &Reader<'_>, e: Node<'_, '_>) -> Result<Body, XoscError> {
+    let (text, scope) = (r.text, &r.scope);
     let tag = e.tag_name().name();
     let (category_attr, kind): (&str, fn(String) -> EntityKind) = match tag {
         "Vehicle" => ("vehicleCategory", EntityKind::Vehicle),
@@ -296,8 +430,6 @@ fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscErr
     let category = scope
         .opt_string(text, e, category_attr)?
         .unwrap_or_else(|| tag.to_lowercase());
-    // What the schema lets an object hold; a trailer hitched to a vehicle is refused (the
-    // storyboard would leave it standing while its tractor drives off).
     let vehicle = tag == "Vehicle";
     crate::xml::only(
         text,
@@ -317,18 +449,7 @@ fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscErr
             &["ParameterDeclarations", "BoundingBox", "Properties"]
         },
     )?;
-    if let Some(trailer) = child(e, "Trailer") {
-        let towed = match child(trailer, "TrailerRef") {
-            Some(r) => !scope.string(text, r, "entityRef")?.trim().is_empty(),
-            None => crate::xml::elements(trailer).next().is_some(),
-        };
-        if towed {
-            return Err(text.unsupported(
-                trailer,
-                "a vehicle towing a trailer is not supported: paracosm moves each entity on its own, so the trailer would be left standing",
-            ));
-        }
-    }
+    let (hitch_dx_m, coupler_dx_m, trailer) = combination(r, e)?;
     let bb = need(text, e, "BoundingBox")?;
     let dims = need(text, bb, "Dimensions")?;
     let centre = need(text, bb, "Center")?;
@@ -371,14 +492,86 @@ fn object(text: &Text, e: Node<'_, '_>, scope: &Scope) -> Result<Object, XoscErr
         }
         None => Performance::UNBOUNDED,
     };
-    Ok((
-        kind(category),
+    Ok(Body {
+        kind: kind(category),
         dimensions_m,
         centre_m,
-        text.pos(dims),
+        box_pos: text.pos(dims),
         notes,
         performance,
-    ))
+        hitch_dx_m,
+        coupler_dx_m,
+        trailer,
+        pos: text.pos(e),
+    })
+}
+
+/// A vehicle's `TrailerHitch dx` and `TrailerCoupler dx` (m) and its `Trailer`, each `None`
+/// when it has none.
+type Combination = (Option<f64>, Option<f64>, Option<Towed>);
+
+/// The [`Combination`] of object `e` (only a vehicle may have one).
+///
+/// # Errors
+/// Invalid for a trailer without a hitch to hitch it to, or a trailer written here without a
+/// coupler; what [`trailer`] returns.
+fn combination(
+    r: &Reader<'_>,
+    e: Node<'_, '_>,
+) -> Result<Combination, XoscError> {
+    let (text, scope) = (r.text, &r.scope);
+    let dx = |name: &str| -> Result<Option<f64>, XoscError> {
+        child(e, name)
+            .map(|n| scope.num_in(text, n, "dx", Quantity::Offset))
+            .transpose()
+    };
+    let (hitch_dx_m, coupler_dx_m) = (dx("TrailerHitch")?, dx("TrailerCoupler")?);
+    let towed = match child(e, "Trailer") {
+        None => None,
+        Some(t) => trailer(r, t)?,
+    };
+    if towed.is_some() && hitch_dx_m.is_none() {
+        return Err(text.invalid(
+            e,
+            "a vehicle that tows a <Trailer> needs a <TrailerHitch> (where the trailer is hitched)",
+        ));
+    }
+    if let Some(Towed::Body(b)) = &towed {
+        if b.coupler_dx_m.is_none() {
+            return Err(XoscError::Invalid {
+                pos: b.pos.clone(),
+                reason: "a trailer needs a <TrailerCoupler> (where it is coupled to its tow)"
+                    .into(),
+            });
+        }
+    }
+    Ok((hitch_dx_m, coupler_dx_m, towed))
+}
+
+/// A vehicle's `Trailer` element: a `Trailer` holding a vehicle (inline or a
+/// `CatalogReference`), or a `TrailerRef` (esmini's legacy `EntityRef`) naming another
+/// entity; `None` for a reference to no entity (`entityRef=""`).
+///
+/// # Errors
+/// Invalid for an element that holds none of these, or a trailer that is not a vehicle.
+fn trailer(r: &Reader<'_>, t: Node<'_, '_>) -> Result<Option<Towed>, XoscError> {
+    let (c, tag) = choice(r.text, t, &["Trailer", "TrailerRef", "EntityRef"])?;
+    if tag != "Trailer" {
+        let name = r.scope.string(r.text, c, "entityRef")?;
+        let name = name.trim();
+        return Ok((!name.is_empty())
+            .then(|| Towed::Entity(name.to_owned(), r.text.attr_pos(c, "entityRef"))));
+    }
+    let (v, tag) = choice(r.text, c, &["CatalogReference", "Vehicle"])?;
+    let body = if tag == "CatalogReference" {
+        r.catalogs.read_entry(r, v, &["Vehicle"], object)?
+    } else {
+        object(r, v)?
+    };
+    if !matches!(body.kind, EntityKind::Vehicle(_)) {
+        return Err(r.text.invalid(v, "a trailer is a <Vehicle>"));
+    }
+    Ok(Some(Towed::Body(Box::new(body))))
 }
 
 /// A `Performance` element: `maxSpeed`, `maxAcceleration` and `maxDeceleration` (esmini's

@@ -627,6 +627,7 @@ impl SceneBuilder {
                     lane_offsets_m,
                     name: car_name,
                     keep_distance_m,
+                    tow: None,
                 },
             )
             .map_err(|e| LoadError::new(LoadErrorKind::Worlds, format!("{}: {e}", o.name)))

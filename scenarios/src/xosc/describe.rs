@@ -334,6 +334,8 @@ fn action(s: &Scenario, a: &Action) -> String {
         },
         Action::Teleport(p) => format!("at {}", position(s, p)),
         Action::AcquirePosition(p) => format!("route to {}", position(s, p)),
+        Action::Trailer(Some(k)) => format!("hitch {}", name(s, *k)),
+        Action::Trailer(None) => "unhitch its trailer".to_string(),
         Action::Synchronize(y) => synchronize(s, y),
         Action::FollowTrajectory { shape, .. } => trajectory(s, shape),
         Action::AssignRoute { waypoints } => format!(

@@ -325,6 +325,15 @@ pub fn check_presence(s: &m::Scenario, ego: usize) -> Result<Vec<Warning>, Scena
             _ => {}
         }
     }
+    // A trailer is in the scenario with its tow (esmini activates a combination whole).
+    for e in 0..s.entities.len() {
+        let mut next = s.entities[e].trailer.filter(|_| added[e]);
+        for _ in 0..s.entities.len() {
+            let Some(k) = next else { break };
+            added[k] = true;
+            next = s.entities[k].trailer;
+        }
+    }
     Ok((0..s.entities.len())
         .filter(|&e| !added[e])
         .map(|e| Warning {
@@ -428,6 +437,16 @@ fn performed_otherwise(
              the world (--scripted-ego)"
         )),
         Action::Visibility { .. } if !driven => None,
+        // The engine couples a trailer to its tow for a whole test.
+        Action::Trailer(_) => {
+            return Err(worlds_error(format!(
+                "{}: this {} couples or uncouples a trailer while the test runs, which \
+                 paracosm's engine does not do: a trailer and its tow are coupled for a whole \
+                 test (a vehicle's <Trailer>), their contact no collision",
+                na.pos,
+                na.action.kind_name()
+            )))
+        }
         // Its place, its initial speed and its route (the lanes it plans through).
         Action::Teleport(_) | Action::AssignRoute { .. } if init && driven => None,
         // An untimed trajectory: the system's route (a timed one asks a time the system
@@ -1799,6 +1818,11 @@ impl Host for StoryHost {
 /// each entity's actor, in the file's order.
 type Placed = (Vec<Option<Sink>>, Vec<StreamId>, Vec<ActorRef>);
 
+/// The entity that tows entity `e` from the start ([`m::Entity::trailer`]), if any.
+fn tow_of(model: &m::Scenario, e: usize) -> Option<usize> {
+    model.entities.iter().position(|t| t.trailer == Some(e))
+}
+
 /// Declares every entity of `model` into `scene` where the storyboard's `Init` put it: the
 /// ego as the ego vehicle (placed later), pedestrians as pedestrians, other entities as cars,
 /// each standing still until the storyboard moves it.
@@ -1815,9 +1839,29 @@ fn place_entities(
     let mut sinks = Vec::new();
     let mut probes = Vec::new();
     let mut actors = Vec::new();
+    // Each entity's car in the world ([`paracosm_engine::WorldSpec::cars`]): cars are
+    // declared in the entities' order, after the ones already in the scene.
+    let base = (scene.actors().iter())
+        .filter(|a| matches!(a.actor, ActorRef::Car(_)))
+        .count();
+    let mut car_index = vec![None; model.entities.len()];
+    let cars = (0..model.entities.len())
+        .filter(|&i| i != ego && !matches!(model.entities[i].kind, EntityKind::Pedestrian(_)));
+    for (k, i) in cars.enumerate() {
+        car_index[i] = Some(base + k);
+    }
     for (i, ent) in model.entities.iter().enumerate() {
         let name = ent.name.clone();
         let at = here(&ent.pos, &name);
+        if i == ego && (ent.trailer.is_some() || tow_of(model, i).is_some()) {
+            return Err(worlds_error(format!(
+                "{}: the ego {name:?} {} a trailer, which paracosm does not test: its ego is \
+                 one vehicle, whose collisions, separation and time to collision would count \
+                 its own combination. Name a vehicle without a trailer with --ego",
+                ent.pos,
+                if ent.trailer.is_some() { "tows" } else { "is" }
+            )));
+        }
         let (pos, heading) = sb.engine_pose(i);
         let size = Size {
             length_m: ent.dimensions_m[0].max(0.1),
@@ -1867,6 +1911,7 @@ fn place_entities(
                         lane_offsets_m: vec![],
                         name: format!("Car {name} ({})", ent.pos),
                         keep_distance_m: None,
+                        tow: tow_of(model, i).and_then(|t| car_index[t]),
                     },
                 )
                 .map_err(|e| worlds_error(e.to_string()))?;

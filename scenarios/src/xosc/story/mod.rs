@@ -68,6 +68,15 @@ pub struct Actor {
     pub present: bool,
     /// Its state now.
     pub state: State,
+    /// Where a trailer is hitched to it, m ahead of its reference point (its
+    /// `TrailerHitch`), if it has a hitch.
+    pub hitch_dx_m: Option<f64>,
+    /// Where it is coupled to a tow, m ahead of its reference point (its `TrailerCoupler`),
+    /// if it is a trailer.
+    pub coupler_dx_m: Option<f64>,
+    /// The entity it tows now (its `Trailer`, or the one a `ConnectTrailerAction` hitched):
+    /// that trailer is pulled by its hitch, not moved by its own actions.
+    pub trailer: Option<usize>,
 }
 
 /// Where an entity is and how it moves.
@@ -274,6 +283,9 @@ impl Storyboard {
                 centre_m: e.centre_m,
                 scripted: Some(i) != ego,
                 present: false,
+                hitch_dx_m: e.hitch_dx_m,
+                coupler_dx_m: e.coupler_dx_m,
+                trailer: e.trailer,
                 state: State::at(
                     Pose {
                         x: 0.0,
@@ -531,6 +543,10 @@ impl Storyboard {
         self.keep_distances(t + dt, dt)?;
         self.synchronize(dt, first);
         for e in 0..self.actors.len() {
+            if self.tow_of(e).is_some() {
+                // A trailer goes where its tow pulls it (below).
+                continue;
+            }
             if self.actors[e].scripted {
                 self.drive(e, t, dt)?;
             } else {
@@ -539,6 +555,7 @@ impl Storyboard {
                 self.ask_path(e);
             }
         }
+        self.pull_trailers(dt);
         if self.watch_offroad {
             for a in &mut self.actors {
                 let p = a.state.pose;

@@ -1,6 +1,6 @@
 //! The storyboard's actions: `Init` performed, references checked, and each running action's
 //! task started by its kind, one file per kind (speed, lateral, trajectory, teleport, route,
-//! controller, distance, synchronize).
+//! controller, distance, synchronize, trailer).
 
 mod controller;
 mod distance;
@@ -10,6 +10,7 @@ mod route;
 mod speed;
 mod synchronize;
 mod teleport;
+mod trailer;
 mod trajectory;
 
 pub(in crate::xosc::story) use distance::Keep;
@@ -196,6 +197,7 @@ impl Storyboard {
             Action::AcquirePosition(p) => {
                 self.acquire_position(e, p, &action.pos, scripted)?;
             }
+            Action::Trailer(trailer) => self.hitch(e, *trailer, &action.pos)?,
             // On the ego a system under test drives, refused at load.
             Action::Synchronize(s) if scripted => self.start_sync(e, s, a, &action.pos)?,
             Action::Synchronize(_) => {}

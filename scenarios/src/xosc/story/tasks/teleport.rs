@@ -29,6 +29,9 @@ impl Storyboard {
         for o in old {
             self.override_task(o);
         }
+        // Its trailers are lined up behind it where it is put (esmini's
+        // `TeleportAction::Start`).
+        self.align_trailers(e);
         Ok(())
     }
 }
