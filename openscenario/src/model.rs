@@ -412,6 +412,10 @@ pub enum Action {
     },
     /// `AcquirePositionAction`: a route from where the entity is to this position.
     AcquirePosition(Position),
+    /// An empty `<Action/>` in a file read as CARLA's ([`Scenario::carla`]): scenario_runner
+    /// builds no behaviour for it, so it does nothing and completes at once (read as a global
+    /// action: on the world, once).
+    Nothing,
     /// `TrailerAction`: `ConnectTrailerAction` hitches entity `Some(trailer)` (an index into
     /// [`Scenario::entities`]) to the entity, unhitching the one it tows;
     /// `DisconnectTrailerAction` (`None`) unhitches it, the trailer then standing where it
@@ -583,6 +587,7 @@ impl Action {
             Action::AcquirePosition(_) => "AcquirePositionAction",
             Action::Trailer(Some(_)) => "ConnectTrailerAction",
             Action::Trailer(None) => "DisconnectTrailerAction",
+            Action::Nothing => "Action",
             Action::Synchronize(_) => "SynchronizeAction",
             Action::ActivateController { .. } => "ActivateControllerAction",
             Action::AssignController { .. } => "AssignControllerAction",
@@ -631,6 +636,7 @@ impl Action {
                 | Action::ModifyValue { .. }
                 | Action::AddEntity { .. }
                 | Action::DeleteEntity { .. }
+                | Action::Nothing
         )
     }
 }

@@ -22,7 +22,7 @@ pub enum Quantity {
     /// A duration or a time gap, s: `[0, 1e6]` (more than eleven days).
     Duration,
     /// A point in time or a time offset (a trajectory vertex's time, a timing's offset, a
-    /// simulation time to compare with), s: `[-1e6, 1e6]`.
+    /// simulation time to compare with), s: `[-1e8, 1e8]` (CARLA's files write 1e7 s for "never").
     Time,
     /// A distance along a road or between entities, m: `[-1e6, 1e6]` (1,000 km; a map is
     /// at most 131 km across, docs/limits.md).
@@ -51,7 +51,7 @@ impl Quantity {
             Quantity::Factor => (-100.0, 100.0),
             Quantity::Acceleration => (-100.0, 100.0),
             Quantity::Duration => (0.0, 1e6),
-            Quantity::Time => (-1e6, 1e6),
+            Quantity::Time => (-1e8, 1e8),
             Quantity::Curvature => (-100.0, 100.0),
             Quantity::Distance => (-1e6, 1e6),
             Quantity::Coordinate => (-1e7, 1e7),

@@ -212,3 +212,39 @@ fn a_carla_relative_object_position_is_along_the_worlds_axes() {
         }
     }
 }
+
+/// An empty `<Action/>` (CARLA's `ChangingWeather` writes one in an event that waits for
+/// 10^7 s): in a file read as CARLA's, an action that does nothing and completes at once, as
+/// scenario_runner builds no behaviour for it, noted where it is written; in any other file it
+/// is refused at its element (the schema asks one action).
+#[test]
+fn an_empty_action_does_nothing_only_in_carlas_reading() {
+    let empty = |description: &str| {
+        scenario(1, description, WORLD, "")
+            .replace(
+                r#"<Action name="a"><PrivateAction></PrivateAction></Action>"#,
+                r#"<Action name="a"/>"#,
+            )
+            .replace(
+                r#"value="1" rule="greaterThan""#,
+                r#"value="10000000" rule="greaterThan""#,
+            )
+    };
+    let text = empty("CARLA:empty");
+    assert!(text.contains(r#"<Action name="a"/>"#) && text.contains("10000000"));
+    let s = read("empty-carla", &text).expect("read as CARLA's");
+    assert_eq!(*action(&s), Action::Nothing);
+    assert!(action(&s).is_global());
+    assert!(
+        s.notes
+            .iter()
+            .any(|n| n.text.contains("an empty <Action>") && n.pos.to_string().contains("s.xosc:")),
+        "{:?}",
+        s.notes
+    );
+    let err = read("empty-other", &empty("plain")).expect_err("refused");
+    assert!(
+        err.contains("an <Action> holds one <PrivateAction> or <GlobalAction>, not nothing"),
+        "{err}"
+    );
+}

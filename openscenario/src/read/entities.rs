@@ -515,10 +515,7 @@ type Combination = (Option<f64>, Option<f64>, Option<Towed>);
 /// # Errors
 /// Invalid for a trailer without a hitch to hitch it to, or a trailer written here without a
 /// coupler; what [`trailer`] returns.
-fn combination(
-    r: &Reader<'_>,
-    e: Node<'_, '_>,
-) -> Result<Combination, XoscError> {
+fn combination(r: &Reader<'_>, e: Node<'_, '_>) -> Result<Combination, XoscError> {
     let (text, scope) = (r.text, &r.scope);
     let dx = |name: &str| -> Result<Option<f64>, XoscError> {
         child(e, name)

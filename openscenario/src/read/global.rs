@@ -255,32 +255,73 @@ fn weather(r: &Reader<'_>, w: Node<'_, '_>, env: &mut Environment) -> Result<(),
         env.fog_visual_range_m = Some(range);
     }
     if let Some(p) = child(w, "Precipitation") {
-        let kind = match sc.opt_string(t, p, "precipitationType")? {
-            Some(k) => k,
-            // 1.0 names it `type`.
-            None => sc.string(t, p, "type")?,
-        };
-        if !["dry", "rain", "snow"].contains(&kind.as_str()) {
-            return Err(t.invalid(
-                p,
-                format!("precipitationType is dry, rain or snow, not {kind:?}"),
-            ));
-        }
-        let intensity = match sc.opt_num(t, p, "precipitationIntensity")? {
-            Some(v) => v,
-            None => sc.opt_num(t, p, "intensity")?.unwrap_or(0.0),
-        };
-        if intensity.is_nan() || intensity < 0.0 {
-            return Err(t.invalid(
-                p,
-                format!("a precipitation's intensity is >= 0 mm/h, not {intensity}"),
-            ));
-        }
-        env.precipitation = Some((kind, intensity));
+        env.precipitation = Some(precipitation(r, p)?);
     }
 
     Ok(())
 }
+
+/// A `Precipitation`'s type (`dry`, `rain`, `snow`; 1.0's `type`) and intensity, mm/h (1.1's
+/// `precipitationIntensity`, or 1.0's `intensity` share in `[0, 1]` of
+/// [`FULL_PRECIPITATION_MM_PER_H`], noted).
+///
+/// # Errors
+/// Invalid for another type, a negative intensity or a share above 1.
+fn precipitation(r: &Reader<'_>, p: Node<'_, '_>) -> Result<(String, f64), XoscError> {
+    let (t, sc) = (r.text, &r.scope);
+    let kind = match sc.opt_string(t, p, "precipitationType")? {
+        Some(k) => k,
+        // 1.0 names it `type`.
+        None => sc.string(t, p, "type")?,
+    };
+    if !["dry", "rain", "snow"].contains(&kind.as_str()) {
+        return Err(t.invalid(
+            p,
+            format!("precipitationType is dry, rain or snow, not {kind:?}"),
+        ));
+    }
+    let intensity = match sc.opt_num(t, p, "precipitationIntensity")? {
+        Some(v) => v,
+        // 1.0's `intensity` is a share, [0, 1], of no stated rate.
+        None => match sc.opt_num(t, p, "intensity")? {
+            None => 0.0,
+            Some(share) if (0.0..=1.0).contains(&share) => {
+                if share > 0.0 {
+                    r.note(
+                        p,
+                        format!(
+                            "OpenSCENARIO 1.0's precipitation intensity {share} (a share in [0, 1], of \
+                             no stated rate) is read as {} mm/h: a share of {FULL_PRECIPITATION_MM_PER_H} mm/h, \
+                             the WMO's threshold of violent rain",
+                            share * FULL_PRECIPITATION_MM_PER_H
+                        ),
+                    );
+                }
+                share * FULL_PRECIPITATION_MM_PER_H
+            }
+            Some(share) => return Err(XoscError::Invalid {
+                pos: t.attr_pos(p, "intensity"),
+                reason: format!(
+                    "OpenSCENARIO 1.0's precipitation intensity is a share in [0, 1], not {share}"
+                ),
+            }),
+        },
+    };
+    if intensity.is_nan() || intensity < 0.0 {
+        return Err(t.invalid(
+            p,
+            format!("a precipitation's intensity is >= 0 mm/h, not {intensity}"),
+        ));
+    }
+    Ok((kind, intensity))
+}
+
+/// What OpenSCENARIO 1.0's precipitation `intensity` of 1 (a share in `[0, 1]`; 1.1 replaced
+/// it by `precipitationIntensity` in mm/h) is read as, mm/h: the World Meteorological
+/// Organization's threshold of violent rain (WMO Guide to Instruments and Methods of
+/// Observation, No. 8, rain intensity classes: light < 2.5, moderate to 10, heavy to 50,
+/// violent above, mm/h). The standard states no rate; this choice is noted where it is read.
+pub(crate) const FULL_PRECIPITATION_MM_PER_H: f64 = 50.0;
 
 /// The time of day of an XSD `dateTime` (`YYYY-MM-DDThh:mm:ss[.fff][zone]`), s after
 /// midnight as written (the zone is the place's own clock).

@@ -210,6 +210,20 @@ fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
         let mut actions = Vec::new();
         for a in elements(e).filter(|a| a.tag_name().name() == "Action") {
             let Some(p) = elements(a).next() else {
+                if r.carla {
+                    // scenario_runner builds no behaviour for it: it completes at once.
+                    r.note(
+                        a,
+                        "an empty <Action> (the schema asks one action) does nothing and \
+                         completes at once, as CARLA's scenario_runner reads it",
+                    );
+                    actions.push(NamedAction {
+                        name: name(r, a)?,
+                        pos: r.text.pos(a),
+                        action: crate::model::Action::Nothing,
+                    });
+                    continue;
+                }
                 return Err(r.text.invalid(
                     a,
                     "an <Action> holds one <PrivateAction> or <GlobalAction>, not nothing",

@@ -336,6 +336,7 @@ fn action(s: &Scenario, a: &Action) -> String {
         Action::AcquirePosition(p) => format!("route to {}", position(s, p)),
         Action::Trailer(Some(k)) => format!("hitch {}", name(s, *k)),
         Action::Trailer(None) => "unhitch its trailer".to_string(),
+        Action::Nothing => "nothing (an empty action)".to_string(),
         Action::Synchronize(y) => synchronize(s, y),
         Action::FollowTrajectory { shape, .. } => trajectory(s, shape),
         Action::AssignRoute { waypoints } => format!(

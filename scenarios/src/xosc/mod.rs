@@ -239,7 +239,7 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
     let mut each = |who: &[usize], na: &m::NamedAction, init: bool| -> Result<(), ScenarioError> {
         if na.action.is_global() {
             // On the world, not on the actors.
-            warnings.extend(global_otherwise(na, ego)?);
+            warnings.extend(global_otherwise(na));
             return Ok(());
         }
         for &e in who {
@@ -357,41 +357,29 @@ fn on_the_ego(na: &m::NamedAction) -> ScenarioError {
     ))
 }
 
-/// How paracosm performs global action `na` (`ego`: the entity a system under test drives,
-/// if one does): as written, or with a warning for what its world does not model.
-///
-/// # Errors
-/// [`ScenarioError::Load`] at the action: rain or snow while a system under test drives
-/// (paracosm's camera and range sensor do not model precipitation, so the system would sense a dry
-/// world).
-fn global_otherwise(
-    na: &m::NamedAction,
-    ego: Option<usize>,
-) -> Result<Option<Warning>, ScenarioError> {
+/// How paracosm performs global action `na`: as written, or with a warning for what its world
+/// does not model. Rain and snow are modelled by how far they let the camera and the range
+/// sensor see ([`story::precipitation_extinction_per_m`], added to the fog's extinction);
+/// the rest of what they do to an image (streaks, spray, a wet road's reflections) is named
+/// in a warning.
+fn global_otherwise(na: &m::NamedAction) -> Option<Warning> {
     let Action::Environment(env) = &na.action else {
-        return Ok(None);
+        return None;
     };
-    let Some((kind, mm)) = env
+    let (kind, mm) = env
         .precipitation
         .as_ref()
-        .filter(|(k, mm)| k != "dry" && *mm > 0.0)
-    else {
-        return Ok(None);
-    };
-    if ego.is_some() {
-        return Err(worlds_error(format!(
-            "{}: this EnvironmentAction brings {kind} ({mm} mm/h), which paracosm's camera and \
-             range sensor do not model: the system under test would sense a dry world. Run the file \
-             with --scripted-ego (no system senses it), or give the test its fog and light",
-            na.pos
-        )));
-    }
-    Ok(Some(Warning {
+        .filter(|(k, mm)| k != "dry" && *mm > 0.0)?;
+    let alone_m = 3.912 / story::precipitation_extinction_per_m(kind, *mm);
+    Some(Warning {
         at: na.pos.to_string(),
         message: format!(
-            "{kind} ({mm} mm/h) is not modelled: no system under test senses the world here"
+            "{kind} ({mm} mm/h) is modelled by its extinction (ITU-R P.1814): the camera and the \
+             range sensor see as through fog of a {alone_m:.0} m visual range, added to the \
+             fog's; its streaks, spray, drops on the lens and the wet road's reflections are not \
+             modelled"
         ),
-    }))
+    })
 }
 
 /// How paracosm performs action `na` on entity `e` (`ego`: the entity the system under test
@@ -1655,7 +1643,7 @@ pub(crate) fn environment_sets(model: &m::Scenario) -> EnvironmentSets {
     for na in actions {
         if let Action::Environment(e) = &na.action {
             sets.light |= e.time_of_day.is_some() || e.sun.is_some();
-            sets.fog |= e.fog_visual_range_m.is_some();
+            sets.fog |= e.fog_visual_range_m.is_some() || e.precipitation.is_some();
             sets.friction |= e.friction_scale.is_some();
         }
     }

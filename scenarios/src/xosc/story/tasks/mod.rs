@@ -14,7 +14,10 @@ mod trailer;
 mod trajectory;
 
 pub(in crate::xosc::story) use distance::Keep;
-pub use global::{Stored, WorldEnv, MAP_FRICTION, NOMINAL_ILLUMINANCE_LX};
+pub use global::{
+    precipitation_extinction_per_m, Stored, WorldEnv, MAP_FRICTION, NOMINAL_ILLUMINANCE_LX,
+    VISIBLE_WAVELENGTH_NM,
+};
 pub(in crate::xosc::story) use lateral::Lateral;
 pub use lateral::DEFAULT_LATERAL_ACC_MPS2;
 pub(in crate::xosc::story) use speed::SpeedTask;
@@ -209,7 +212,8 @@ impl Storyboard {
             | Action::SetValue { .. }
             | Action::ModifyValue { .. }
             | Action::AddEntity { .. }
-            | Action::DeleteEntity { .. } => {}
+            | Action::DeleteEntity { .. }
+            | Action::Nothing => {}
             // Nothing the storyboard moves reads lights or visibility: the front end refuses
             // a visibility that a system under test would sense ([`crate::xosc::check`]).
             Action::Appearance(_) | Action::Visibility { .. } => {}
