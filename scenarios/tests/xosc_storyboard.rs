@@ -1112,3 +1112,35 @@ fn a_trailer_follows_its_tows_hitch_until_it_is_unhitched() {
     assert!((b.speed - 10.0).abs() < 1e-9 && (a.speed - 15.0).abs() < 1e-9);
     assert!(gap_after > 15.0, "4 s at 5 m/s more: {gap_after} m");
 }
+
+/// CARLA's `vehicle_longitudinal_control` drives an entity's speed only, its steering left
+/// straight: the storyboard moves it straight along its heading, not along its lane. Placed
+/// 0.3 rad off its lane's direction, it leaves the lane's line (10 m/s for 5 s: 14.8 m
+/// across), where an entity the storyboard moves along its lane keeps to the lane.
+#[test]
+fn carlas_longitudinal_only_controller_moves_its_entity_straight_along_its_heading() {
+    let run_with = |module: &str| {
+        let assign = format!(
+            r#"<PrivateAction><ControllerAction><AssignControllerAction><Controller name="c"><Properties><Property name="module" value="{module}"/></Properties></Controller></AssignControllerAction></ControllerAction></PrivateAction>"#
+        );
+        let init = format!(
+            r#"<Private entityRef="A"><PrivateAction><TeleportAction><Position><LanePosition roadId="0" laneId="-4" s="100" offset="0"><Orientation type="relative" h="0.3"/></LanePosition></Position></TeleportAction></PrivateAction>{assign}{speed}</Private>"#,
+            speed = step_to(10.0)
+        );
+        let text = on_straight_road("CARLA:straight", &car_object("A", 10.0), &init, "", 5.0);
+        let mut sb = storyboard_of(&format!("straight-{module}"), &text).expect("Init performs");
+        let (y0, h0) = (sb.actors[0].state.pose.y, sb.actors[0].state.pose.h);
+        run(&mut sb, 5.0, |_, _| {});
+        let p = sb.actors[0].state.pose;
+        (p.y - y0, p.h - h0)
+    };
+    let (dy, dh) = run_with("vehicle_longitudinal_control");
+    // CARLA's frame: the file's relative heading 0.3 is read as -0.3 (left-handed).
+    assert!(
+        (dy.abs() - 5.0 * 10.0 * 0.3f64.sin()).abs() < 0.6,
+        "straight: {dy} m across"
+    );
+    assert!(dh.abs() < 1e-9, "its heading stays: {dh}");
+    let (dy, _) = run_with("npc_vehicle_control");
+    assert!(dy.abs() < 0.5, "along its lane: {dy} m across");
+}

@@ -299,12 +299,14 @@ fn precipitation(r: &Reader<'_>, p: Node<'_, '_>) -> Result<(String, f64), XoscE
                 }
                 share * FULL_PRECIPITATION_MM_PER_H
             }
-            Some(share) => return Err(XoscError::Invalid {
-                pos: t.attr_pos(p, "intensity"),
-                reason: format!(
+            Some(share) => {
+                return Err(XoscError::Invalid {
+                    pos: t.attr_pos(p, "intensity"),
+                    reason: format!(
                     "OpenSCENARIO 1.0's precipitation intensity is a share in [0, 1], not {share}"
                 ),
-            }),
+                })
+            }
         },
     };
     if intensity.is_nan() || intensity < 0.0 {

@@ -449,12 +449,14 @@ fn performed_otherwise(
         {
             None
         }
+        // A route along its lane at the offset (also in Init: where it starts to drive).
+        Action::LaneOffset { .. } if driven => None,
         _ if driven => {
             return Err(worlds_error(format!(
                 "{}: the system under test drives {name}, and paracosm cannot hand it this {}: \
                  its storyboard asks it of the ego only as a SpeedAction (the system's set \
-                 speed), a LaneChangeAction, an AssignRouteAction or an untimed \
-                 FollowTrajectoryAction (the system's route), an \
+                 speed), a LaneChangeAction, a LaneOffsetAction, an AssignRouteAction or an \
+                 untimed FollowTrajectoryAction (the system's route), an \
                  ActivateControllerAction, or in Init a TeleportAction or an \
                  AssignRouteAction. Run the file with --scripted-ego to have the storyboard \
                  move the ego, or name another vehicle with --ego",
@@ -549,9 +551,9 @@ fn hands_to_a_driver(a: &Action) -> bool {
     match a {
         Action::AssignController { kind, .. } => {
             a.hands_over()
-                && !kind
-                    .as_deref()
-                    .is_some_and(|k| STORYBOARD_CONTROLLERS.contains(&k))
+                && !kind.as_deref().is_some_and(|k| {
+                    STORYBOARD_CONTROLLERS.contains(&k) || story::STRAIGHT_CONTROLLERS.contains(&k)
+                })
         }
         _ => a.hands_over(),
     }
@@ -621,6 +623,16 @@ fn assigned(
              place of {what}"
         )));
     }
+    if kind
+        .as_deref()
+        .is_some_and(|k| story::STRAIGHT_CONTROLLERS.contains(&k))
+    {
+        return Ok(Some(format!(
+            "the storyboard moves {name} straight along its heading at the speeds its actions \
+             set, as {what} drives (its speed only, the steering left straight); its speed \
+             changes follow the actions' dynamics, not CARLA's full throttle"
+        )));
+    }
     Err(worlds_error(format!(
         "{}: this AssignControllerAction has {what} drive {name}, which paracosm cannot run: \
          it moves an entity other than the ego a system under test drives only by the \
@@ -649,8 +661,9 @@ fn assigned_driver(s: &m::Scenario, e: usize, scripted: bool) -> Option<String> 
             controller, kind, ..
         } => {
             let k = kind.as_deref().unwrap_or("");
-            let plain =
-                STORYBOARD_CONTROLLERS.contains(&k) || (scripted && k == "external_control");
+            let plain = STORYBOARD_CONTROLLERS.contains(&k)
+                || story::STRAIGHT_CONTROLLERS.contains(&k)
+                || (scripted && k == "external_control");
             (!plain).then(|| controller_named(controller, kind.as_deref()))
         }
         _ => None,
@@ -1670,6 +1683,23 @@ impl StoryHost {
     }
 }
 
+impl StoryHost {
+    /// Once the storyboard has ended (at `t`, s): the events the file describes that this
+    /// test did not play, in its record.
+    fn note_unplayed(&mut self, t: f64) {
+        if !self.sb.ended {
+            return;
+        }
+        let unplayed = self.sb.never_ran();
+        if !unplayed.is_empty() {
+            self.log.push(format!(
+                "t = {t:.3} s: the storyboard ended; {} never started",
+                unplayed.join(", ")
+            ));
+        }
+    }
+}
+
 impl Host for StoryHost {
     fn call(&mut self, f: u32, args: &[Value], streams: &Runtime) -> Result<Value, HostError> {
         match f.wrapping_sub(self.base) {
@@ -1739,6 +1769,7 @@ impl Host for StoryHost {
                 if self.sb.ended && !self.scripted_ego {
                     self.check_the_ego_moved(t, "the storyboard ended")?;
                 }
+                self.note_unplayed(t);
                 if !self.scripted_ego {
                     self.check_the_storyboard_can_go_on(t)?;
                 }

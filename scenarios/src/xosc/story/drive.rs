@@ -41,7 +41,17 @@ pub(in crate::xosc::story) struct Drive {
     /// (esmini's `TeleportAction` marks the entity's longitudinal motion as done for the
     /// frame, so its default controller does not move it).
     pub(in crate::xosc::story) teleported: bool,
+    /// It goes straight along its heading, not along its lanes: CARLA's
+    /// `vehicle_longitudinal_control` ([`STRAIGHT_CONTROLLERS`]) drives its speed and leaves
+    /// its steering as it is.
+    pub(in crate::xosc::story) straight: bool,
 }
+
+/// Controllers that drive an entity's speed only, leaving its steering straight (CARLA
+/// scenario_runner's `VehicleLongitudinalControl`: the throttle to its target speed, the
+/// steering untouched): the storyboard moves the entity straight along its heading at the
+/// speeds its actions ask, not along its lanes.
+pub const STRAIGHT_CONTROLLERS: [&str; 1] = ["vehicle_longitudinal_control"];
 
 /// The speed `v` (m/s) a `SpeedAction`'s `task` asks at the end of a step from `t` of `dt` s
 /// from the entity's speed `v0` (m/s), within the entity's `performance` as esmini keeps it
@@ -146,15 +156,14 @@ impl Storyboard {
                 self.drives[e].path = None;
                 done.push(a);
             }
-        } else if let Some(lp) = lane {
+        } else if let Some(lp) = lane.filter(|_| !self.drives[e].straight) {
             let (p, l, end, ended) = self.drive_on_lane(e, lp, (dist, dt, pose.h));
             pose = p;
             lane = Some(l);
             at_end = end;
             done.extend(ended);
         } else {
-            pose.x += dist * pose.h.cos();
-            pose.y += dist * pose.h.sin();
+            (pose, lane) = self.straight_on(e, pose, dist);
         }
         let moved = (pose.x - st.pose.x).hypot(pose.y - st.pose.y);
         let before = self.drives[e].speed_before.take();
@@ -179,6 +188,20 @@ impl Storyboard {
             self.override_task(Some(a));
         }
         Ok(())
+    }
+
+    /// Scripted entity `e` at `pose`, off its lanes or driven straight
+    /// ([`Drive::straight`]), moved `dist` m along its heading: its pose, and where it is on
+    /// the lanes when it is driven straight (for the conditions that read it), else none.
+    fn straight_on(&self, e: usize, mut pose: Pose, dist: f64) -> (Pose, Option<LanePos>) {
+        pose.x += dist * pose.h.cos();
+        pose.y += dist * pose.h.sin();
+        let lane = if self.drives[e].straight {
+            self.facing(self.roads.anchor(pose.x, pose.y), pose.h)
+        } else {
+            None
+        };
+        (pose, lane)
     }
 
     /// Moves scripted entity `e`, on lane position `lp` facing `h0`, a step of `dt` s in which

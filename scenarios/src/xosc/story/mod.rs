@@ -13,6 +13,7 @@ mod positions;
 mod tasks;
 
 use conditions::Cond;
+pub use drive::STRAIGHT_CONTROLLERS;
 use drive::{Drive, ToLane, Track};
 use elements::{Elem, Kind, Owner, Phase};
 pub use tasks::DEFAULT_LATERAL_ACC_MPS2;
@@ -468,6 +469,16 @@ impl Storyboard {
             waiting.push(format!("{} {:?}{at}", e.kind.name(), e.name));
         }
         waiting
+    }
+
+    /// The events that have never started, each as `event "NAME"`, in the storyboard's order:
+    /// what a test that ended (by its stop trigger, or its stories in CARLA's reading) did not
+    /// play, for its record.
+    pub fn never_ran(&self) -> Vec<String> {
+        (self.elems.iter())
+            .filter(|e| e.kind == Kind::Event && e.runs == 0 && e.phase != Phase::Running)
+            .map(|e| format!("{} {:?}", e.kind.name(), e.name))
+            .collect()
     }
 
     /// What the storyboard waits on when it can wait no more: `None` while anything can still

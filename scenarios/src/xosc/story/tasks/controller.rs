@@ -18,12 +18,21 @@ impl Storyboard {
             m::Action::AssignController {
                 lateral,
                 longitudinal,
+                kind,
                 ..
-            } if action.hands_over() => self.activate_controller(
-                e,
-                Some(*lateral == Some(true)),
-                Some(*longitudinal == Some(true)),
-            ),
+            } if action.hands_over() => {
+                if kind
+                    .as_deref()
+                    .is_some_and(|k| drive::STRAIGHT_CONTROLLERS.contains(&k))
+                {
+                    self.drives[e].straight = true;
+                }
+                self.activate_controller(
+                    e,
+                    Some(*lateral == Some(true)),
+                    Some(*longitudinal == Some(true)),
+                )
+            }
             _ => {}
         }
     }

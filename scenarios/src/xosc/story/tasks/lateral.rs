@@ -221,9 +221,6 @@ impl Storyboard {
             message,
         };
         let scripted = self.actors[e].scripted;
-        if !scripted {
-            return Ok(());
-        }
         let Some(lp) = self.actors[e].state.lane else {
             return Err(bad(format!(
                 "a LaneOffsetAction for {}, which is not on a lane",
@@ -237,6 +234,19 @@ impl Storyboard {
             }
         };
         let acc = max_lateral_acc.unwrap_or(DEFAULT_LATERAL_ACC_MPS2);
+        if !scripted {
+            // The system under test drives it: a route along its lane at the offset, over
+            // the move's time at its speed; a continuous offset is held until another
+            // lateral action replaces it (its goal is never reached).
+            let duration = offset_duration_s(*shape, to - lp.d, acc);
+            self.ask_lane_change_route(e, (lp, lp.lane, to), (false, duration), a);
+            if *continuous {
+                if let Some(goal) = &mut self.drives[e].lane_goal {
+                    goal.1 = f64::NAN;
+                }
+            }
+            return Ok(());
+        }
         let tr = Transition {
             from: lp.d,
             to,
