@@ -161,10 +161,12 @@ impl Performance {
     };
 }
 
-/// A `LongitudinalDistanceAction`'s `DynamicConstraints` as written: each limit is `> 0`;
-/// one left out is the entity's [`Performance`] value (a rate: unbounded), and one above
-/// it is cut to it, as esmini's `parseDynamicConstraints` reads them.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A distance action's `DynamicConstraints` as written: each limit is `> 0`. For a
+/// `LongitudinalDistanceAction`, one left out is the entity's [`Performance`] value (a rate:
+/// unbounded), and one above it is cut to it, as esmini's `parseDynamicConstraints` reads
+/// them; for a `LateralDistanceAction`, one left out is unbounded and one above the
+/// entity's `Performance` is taken as written (esmini warns and accepts it).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct DistanceConstraints {
     /// `maxAcceleration`, m/s².
     pub max_acceleration_mps2: Option<f64>,
@@ -394,6 +396,27 @@ pub enum Action {
         /// none, it is taken at once and held kinematically.
         constraints: Option<DistanceConstraints>,
     },
+    /// `LateralDistanceAction`: keep a lateral distance to an entity.
+    LateralDistance {
+        /// The entity kept at a distance.
+        entity: usize,
+        /// `distance`, m: from OpenSCENARIO 1.1 a magnitude (a negative one is read as its
+        /// magnitude, noted), its side given by `displacement`; in 1.0 signed, to the left of
+        /// the entity when positive. `None`: the distance at the action's start is kept.
+        distance_m: Option<f64>,
+        /// Whether the distance is between bounding boxes (the half widths added).
+        freespace: bool,
+        /// Whether it is kept after it is reached.
+        continuous: bool,
+        /// `displacement`: `leftToReferencedEntity`, `rightToReferencedEntity` or `any` (left,
+        /// as esmini resolves it; 1.0 has none: `any`).
+        displacement: String,
+        /// `coordinateSystem`: `entity` (default) or `road`.
+        frame: String,
+        /// `DynamicConstraints`: `maxAcceleration` (and `maxAccelerationRate`) and `maxSpeed`
+        /// of the lateral motion; none, the distance is taken at once.
+        constraints: Option<DistanceConstraints>,
+    },
     /// `TeleportAction`.
     Teleport(Position),
     /// `FollowTrajectoryAction`.
@@ -581,6 +604,7 @@ impl Action {
             Action::LaneChange { .. } => "LaneChangeAction",
             Action::LaneOffset { .. } => "LaneOffsetAction",
             Action::LongitudinalDistance { .. } => "LongitudinalDistanceAction",
+            Action::LateralDistance { .. } => "LateralDistanceAction",
             Action::Teleport(_) => "TeleportAction",
             Action::FollowTrajectory { .. } => "FollowTrajectoryAction",
             Action::AssignRoute { .. } => "AssignRouteAction",

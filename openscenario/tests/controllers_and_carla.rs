@@ -248,3 +248,87 @@ fn an_empty_action_does_nothing_only_in_carlas_reading() {
         "{err}"
     );
 }
+
+/// A `LateralDistanceAction`: from OpenSCENARIO 1.1 its side is `displacement`'s and a
+/// negative distance is read as its magnitude (noted, as esmini reads it); in 1.0 the
+/// distance is signed (no `displacement`), and in CARLA's frame reversed; without a distance
+/// the one at the start is kept; a distance in lane or trajectory coordinates is refused at
+/// its attribute.
+#[test]
+fn a_lateral_distance_reads_its_side_by_the_files_version_and_frame() {
+    let keep = |attrs: &str| {
+        format!(
+            r#"<LateralAction><LateralDistanceAction entityRef="Ego" freespace="false" continuous="true" {attrs}><DynamicConstraints maxAcceleration="2" maxSpeed="3"/></LateralDistanceAction></LateralAction>"#
+        )
+    };
+    let of = |s: &paracosm_openscenario::model::Scenario| match action(s) {
+        Action::LateralDistance {
+            distance_m,
+            displacement,
+            frame,
+            constraints,
+            ..
+        } => (
+            *distance_m,
+            displacement.clone(),
+            frame.clone(),
+            constraints.map(|c| (c.max_acceleration_mps2, c.max_speed_mps)),
+        ),
+        other => panic!("{other:?}"),
+    };
+    let s = read(
+        "lat-13",
+        &scenario(
+            3,
+            "plain",
+            WORLD,
+            &keep(
+                r#"distance="-2" displacement="rightToReferencedEntity" coordinateSystem="road""#,
+            ),
+        ),
+    )
+    .unwrap();
+    assert_eq!(
+        of(&s),
+        (
+            Some(2.0),
+            "rightToReferencedEntity".into(),
+            "road".into(),
+            Some((Some(2.0), Some(3.0)))
+        )
+    );
+    assert!(s
+        .notes
+        .iter()
+        .any(|n| n.text.contains("a lateral distance of -2 m is read as 2 m")));
+    let s = read(
+        "lat-10",
+        &scenario(0, "plain", WORLD, &keep(r#"distance="-2""#)),
+    )
+    .unwrap();
+    assert_eq!(of(&s).0, Some(-2.0));
+    assert_eq!((of(&s).1.as_str(), of(&s).2.as_str()), ("any", "entity"));
+    let s = read(
+        "lat-carla",
+        &scenario(0, "CARLA:lat", WORLD, &keep(r#"distance="-2""#)),
+    )
+    .unwrap();
+    assert_eq!(of(&s).0, Some(2.0), "CARLA's frame reverses the side");
+    let s = read("lat-none", &scenario(2, "plain", WORLD, &keep(""))).unwrap();
+    assert_eq!(of(&s).0, None);
+    let err = read(
+        "lat-lane",
+        &scenario(
+            2,
+            "plain",
+            WORLD,
+            &keep(r#"distance="1" coordinateSystem="lane""#),
+        ),
+    )
+    .unwrap_err();
+    assert!(
+        err.contains("a lateral distance in lane coordinates is not supported"),
+        "{err}"
+    );
+    assert!(err.contains("s.xosc:"), "{err}");
+}

@@ -45,32 +45,8 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
             }
             Ok(Action::Trailer(Some(r.entity(t, "trailerRef")?)))
         }
-        "AppearanceAction" => {
-            let (kind, tag) = choice(r.text, a, &["LightStateAction", "AnimationAction"])?;
-            let what = if tag == "LightStateAction" {
-                "a vehicle's lights"
-            } else {
-                "an animation"
-            };
-            r.note(
-                kind,
-                format!("<{tag}> is read but not modelled: paracosm draws no {}, and its sensors and monitors read none", if tag == "LightStateAction" { "vehicle lights" } else { "animations" }),
-            );
-            Ok(Action::Appearance(what.to_string()))
-        }
-        "VisibilityAction" => {
-            if child(a, "SensorReferenceSet").is_some() {
-                return Err(r.text.unsupported(
-                    a,
-                    "a visibility for some sensors only (<SensorReferenceSet>) is not supported: paracosm hides an entity from every sensor or none",
-                ));
-            }
-            Ok(Action::Visibility {
-                graphics: r.scope.bool(r.text, a, "graphics")?,
-                traffic: r.scope.bool(r.text, a, "traffic")?,
-                sensors: r.scope.bool(r.text, a, "sensors")?,
-            })
-        }
+        "AppearanceAction" => appearance(r, a),
+        "VisibilityAction" => visibility(r, a),
         // OpenSCENARIO 1.0 puts it directly under <PrivateAction>.
         "ActivateControllerAction" => activate(r, a),
         "LongitudinalAction" => {
@@ -82,11 +58,19 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
             }
         }
         "LateralAction" => {
-            let (l, tag) = choice(r.text, a, &["LaneChangeAction", "LaneOffsetAction"])?;
-            if tag == "LaneChangeAction" {
-                lane_change(r, l)
-            } else {
-                lane_offset(r, l)
+            let (l, tag) = choice(
+                r.text,
+                a,
+                &[
+                    "LaneChangeAction",
+                    "LaneOffsetAction",
+                    "LateralDistanceAction",
+                ],
+            )?;
+            match tag {
+                "LaneChangeAction" => lane_change(r, l),
+                "LaneOffsetAction" => lane_offset(r, l),
+                _ => lateral_distance(r, l),
             }
         }
         "TeleportAction" => Ok(Action::Teleport(position::read(
@@ -279,7 +263,110 @@ fn distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
     })
 }
 
-/// A longitudinal distance action's `<DynamicConstraints>`: each limit given is `> 0`.
+/// An `AppearanceAction`: a vehicle's lights or an animation, noted (paracosm draws neither).
+///
+/// # Errors
+/// What its choice's reader returns.
+fn appearance(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Action, XoscError> {
+    let (kind, tag) = choice(r.text, a, &["LightStateAction", "AnimationAction"])?;
+    let what = if tag == "LightStateAction" {
+        "a vehicle's lights"
+    } else {
+        "an animation"
+    };
+    let drawn = if tag == "LightStateAction" {
+        "vehicle lights"
+    } else {
+        "animations"
+    };
+    r.note(
+        kind,
+        format!("<{tag}> is read but not modelled: paracosm draws no {drawn}, and its sensors and monitors read none"),
+    );
+    Ok(Action::Appearance(what.to_string()))
+}
+
+/// A `VisibilityAction`.
+///
+/// # Errors
+/// Unsupported for a visibility for some sensors only (`SensorReferenceSet`).
+fn visibility(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Action, XoscError> {
+    if child(a, "SensorReferenceSet").is_some() {
+        return Err(r.text.unsupported(
+                a,
+                "a visibility for some sensors only (<SensorReferenceSet>) is not supported: paracosm hides an entity from every sensor or none",
+            ));
+    }
+    Ok(Action::Visibility {
+        graphics: r.scope.bool(r.text, a, "graphics")?,
+        traffic: r.scope.bool(r.text, a, "traffic")?,
+        sensors: r.scope.bool(r.text, a, "sensors")?,
+    })
+}
+
+/// A `LateralDistanceAction`: in OpenSCENARIO 1.1 and later a negative `distance` is read as
+/// its magnitude (its side is `displacement`'s), noted, as esmini reads it; in 1.0 it is signed
+/// (no `displacement`), and in CARLA's frame reversed ([`Reader::flip`]).
+///
+/// # Errors
+/// Unsupported for a `coordinateSystem` other than `entity` and `road` (esmini measures only
+/// those); what the attributes' readers return.
+fn lateral_distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
+    let frame = one_of(
+        r,
+        node,
+        "coordinateSystem",
+        &["entity", "road", "lane", "trajectory"],
+    )?;
+    if frame != "entity" && frame != "road" {
+        return Err(XoscError::Unsupported {
+            pos: r.text.attr_pos(node, "coordinateSystem"),
+            reason: format!(
+                "a lateral distance in {frame} coordinates is not supported: paracosm keeps it \
+                 in the entity's or the road's (as esmini does)"
+            ),
+        });
+    }
+    let since_1_1 = r.version >= (1, 1);
+    let mut distance_m = r
+        .scope
+        .opt_num_in(r.text, node, "distance", Quantity::Lateral)?
+        .map(|d| r.flip(d));
+    if let Some(d) = distance_m.filter(|d| since_1_1 && *d < 0.0) {
+        r.note(
+            node,
+            format!(
+                "a lateral distance of {d} m is read as {} m: from OpenSCENARIO 1.1 its side is \
+                 displacement's, as esmini reads it",
+                d.abs()
+            ),
+        );
+        distance_m = Some(d.abs());
+    }
+    let displacement = if since_1_1 {
+        one_of(
+            r,
+            node,
+            "displacement",
+            &["any", "leftToReferencedEntity", "rightToReferencedEntity"],
+        )?
+    } else {
+        "any".to_string()
+    };
+    Ok(Action::LateralDistance {
+        entity: r.entity(node, "entityRef")?,
+        distance_m,
+        freespace: r.scope.bool(r.text, node, "freespace")?,
+        continuous: r.scope.bool(r.text, node, "continuous")?,
+        displacement,
+        frame,
+        constraints: child(node, "DynamicConstraints")
+            .map(|c| distance_constraints(r, c))
+            .transpose()?,
+    })
+}
+
+/// A distance action's `<DynamicConstraints>`: each limit given is `> 0`.
 fn distance_constraints(r: &Reader<'_>, c: Node<'_, '_>) -> Result<DistanceConstraints, XoscError> {
     let limit = |attr: &str, q: Quantity| -> Result<Option<f64>, XoscError> {
         let v = r.scope.opt_num_in(r.text, c, attr, q)?;

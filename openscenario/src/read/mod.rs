@@ -48,6 +48,8 @@ pub(crate) struct Reader<'t> {
     /// Whether the scenario is written for CARLA ([`crate::model::Scenario::carla`]): its
     /// positions are in CARLA's left-handed frame ([`Reader::flip`]).
     pub(crate) carla: bool,
+    /// The scenario's `FileHeader` revision, `(major, minor)`.
+    pub(crate) version: (u32, u32),
 }
 
 impl<'t> Reader<'t> {
@@ -112,6 +114,7 @@ impl<'t> Reader<'t> {
             globals: std::rc::Rc::clone(&self.globals),
             variables: std::rc::Rc::clone(&self.variables),
             carla: self.carla,
+            version: self.version,
         })
     }
 
@@ -137,6 +140,7 @@ impl<'t> Reader<'t> {
             globals: std::rc::Rc::clone(&self.globals),
             variables: std::rc::Rc::clone(&self.variables),
             carla: self.carla,
+            version: self.version,
         }
     }
 
@@ -285,6 +289,7 @@ fn read_with(
         globals: std::rc::Rc::new(decls.iter().map(|d| (d.name.clone(), d.ty)).collect()),
         variables: std::rc::Rc::default(),
         carla,
+        version,
     };
     if carla {
         r.note(

@@ -332,6 +332,15 @@ fn action(s: &Scenario, a: &Action) -> String {
             (_, Some(t)) => format!("keep {t} s behind {}", name(s, *entity)),
             _ => String::new(),
         },
+        Action::LateralDistance {
+            entity,
+            distance_m,
+            displacement,
+            ..
+        } => match distance_m {
+            Some(d) => format!("keep {d} m beside {} ({displacement})", name(s, *entity)),
+            None => format!("keep its distance beside {}", name(s, *entity)),
+        },
         Action::Teleport(p) => format!("at {}", position(s, p)),
         Action::AcquirePosition(p) => format!("route to {}", position(s, p)),
         Action::Trailer(Some(k)) => format!("hitch {}", name(s, *k)),

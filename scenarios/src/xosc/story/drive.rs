@@ -41,6 +41,8 @@ pub(in crate::xosc::story) struct Drive {
     /// (esmini's `TeleportAction` marks the entity's longitudinal motion as done for the
     /// frame, so its default controller does not move it).
     pub(in crate::xosc::story) teleported: bool,
+    /// The `LateralDistanceAction` in progress.
+    pub(in crate::xosc::story) lat_keep: Option<LatKeep>,
     /// It goes straight along its heading, not along its lanes: CARLA's
     /// `vehicle_longitudinal_control` ([`STRAIGHT_CONTROLLERS`]) drives its speed and leaves
     /// its steering as it is.
@@ -133,6 +135,59 @@ impl Storyboard {
                 ),
             });
         }
+        // A kept lateral distance moves it itself, or places it on its lane to move on from.
+        let (lat, lat_ended) = self.lat_keep_step(e, v1, dt);
+        done.extend(lat_ended);
+        let (pose, lane, at_end, speed_now) = match lat {
+            LatStep::Moved(p, l) => (p, l, false, v1),
+            LatStep::Offset(lp, h) => {
+                self.drives[e].rel_h = self.relative_heading(h, Some(lp));
+                let from = State {
+                    pose: self.roads.pose_of(&lp),
+                    lane: Some(lp),
+                    ..st
+                };
+                self.move_on(e, &from, (dist, v1), (t1, dt), &mut done)
+            }
+            LatStep::Idle => self.move_on(e, &st, (dist, v1), (t1, dt), &mut done),
+        };
+        let moved = (pose.x - st.pose.x).hypot(pose.y - st.pose.y);
+        let before = self.drives[e].speed_before.take();
+        let s = &mut self.actors[e].state;
+        s.accel = (speed_now - before.unwrap_or(s.speed)) / dt;
+        s.speed = speed_now;
+        s.lane = lane;
+        s.travelled_m += moved;
+        s.vel = if held {
+            [speed_now * pose.h.cos(), speed_now * pose.h.sin()]
+        } else {
+            [(pose.x - s.pose.x) / dt, (pose.y - s.pose.y) / dt]
+        };
+        s.pose = pose;
+        s.still_s = if speed_now.abs() < 1e-3 {
+            s.still_s + dt
+        } else {
+            0.0
+        };
+        s.at_end_s = if at_end { s.at_end_s + dt } else { 0.0 };
+        for a in done {
+            self.override_task(Some(a));
+        }
+        Ok(())
+    }
+
+    /// Scripted entity `e` in state `st` moved a step of `dt` s ending at `t1` (s), in which
+    /// it travels `dist` m at speed `v1` (m/s): along its trajectory, its lanes, or its
+    /// heading. Its pose, lane position, whether its lanes ended, and its speed (a timed
+    /// trajectory's own); the actions whose motion ended are pushed on `done`.
+    fn move_on(
+        &mut self,
+        e: usize,
+        st: &State,
+        (dist, v1): (f64, f64),
+        (t1, dt): (f64, f64),
+        done: &mut Vec<usize>,
+    ) -> (Pose, Option<LanePos>, bool, f64) {
         let mut pose = st.pose;
         let mut lane = st.lane;
         let mut at_end = false;
@@ -165,29 +220,7 @@ impl Storyboard {
         } else {
             (pose, lane) = self.straight_on(e, pose, dist);
         }
-        let moved = (pose.x - st.pose.x).hypot(pose.y - st.pose.y);
-        let before = self.drives[e].speed_before.take();
-        let s = &mut self.actors[e].state;
-        s.accel = (speed_now - before.unwrap_or(s.speed)) / dt;
-        s.speed = speed_now;
-        s.lane = lane;
-        s.travelled_m += moved;
-        s.vel = if held {
-            [speed_now * pose.h.cos(), speed_now * pose.h.sin()]
-        } else {
-            [(pose.x - s.pose.x) / dt, (pose.y - s.pose.y) / dt]
-        };
-        s.pose = pose;
-        s.still_s = if speed_now.abs() < 1e-3 {
-            s.still_s + dt
-        } else {
-            0.0
-        };
-        s.at_end_s = if at_end { s.at_end_s + dt } else { 0.0 };
-        for a in done {
-            self.override_task(Some(a));
-        }
-        Ok(())
+        (pose, lane, at_end, speed_now)
     }
 
     /// Scripted entity `e` at `pose`, off its lanes or driven straight

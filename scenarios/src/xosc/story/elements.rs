@@ -482,6 +482,9 @@ impl Storyboard {
                 if d.sync.as_ref().is_some_and(|s| s.action == i) {
                     d.sync = None;
                 }
+                if d.lat_keep.as_ref().is_some_and(|k| k.action == i) {
+                    d.lat_keep = None;
+                }
             }
             self.elems[i].pending = 0;
         }

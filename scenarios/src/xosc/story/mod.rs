@@ -21,7 +21,7 @@ pub use tasks::{
     precipitation_extinction_per_m, Stored, WorldEnv, MAP_FRICTION, NOMINAL_ILLUMINANCE_LX,
     VISIBLE_WAVELENGTH_NM,
 };
-use tasks::{Keep, Lateral, Path, SpeedTask, Synchronizing};
+use tasks::{Keep, LatKeep, LatStep, Lateral, Path, SpeedTask, Synchronizing};
 
 use std::collections::VecDeque;
 
@@ -497,6 +497,7 @@ impl Storyboard {
                 || (a.scripted
                     && (d.speed.is_some()
                         || d.lateral.is_some()
+                        || d.lat_keep.is_some()
                         || d.path.is_some()
                         || d.sync.is_some()))
         });

@@ -55,6 +55,7 @@ impl Storyboard {
             // (and their actions); a running SpeedAction goes on as the system's set speed.
             let old = [
                 self.drives[e].lateral.take().map(|l| l.action),
+                self.drives[e].lat_keep.take().map(|k| k.action),
                 self.drives[e].path.take().map(|p| p.1),
                 self.drives[e].keep.take().map(|k| k.action),
                 self.drives[e].sync.take().map(|s| s.action),

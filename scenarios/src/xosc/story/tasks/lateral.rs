@@ -194,8 +194,13 @@ impl Storyboard {
 
     /// Starts lateral move `l` of `e` for action `a`, ending the one it replaces.
     pub(in crate::xosc::story) fn begin_lateral(&mut self, e: usize, l: Lateral, a: Option<usize>) {
-        let old = self.drives[e].lateral.take().map(|s| s.action);
-        self.override_task(old);
+        let old = [
+            self.drives[e].lateral.take().map(|s| s.action),
+            self.drives[e].lat_keep.take().map(|k| k.action),
+        ];
+        for o in old {
+            self.override_task(o);
+        }
         if let Some(a) = a {
             self.elems[a].pending += 1;
         }

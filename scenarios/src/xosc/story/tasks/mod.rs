@@ -1,11 +1,12 @@
 //! The storyboard's actions: `Init` performed, references checked, and each running action's
 //! task started by its kind, one file per kind (speed, lateral, trajectory, teleport, route,
-//! controller, distance, synchronize, trailer).
+//! controller, distance, lateral distance, synchronize, trailer).
 
 mod controller;
 mod distance;
 mod global;
 mod lateral;
+mod lateral_distance;
 mod route;
 mod speed;
 mod synchronize;
@@ -20,6 +21,7 @@ pub use global::{
 };
 pub(in crate::xosc::story) use lateral::Lateral;
 pub use lateral::DEFAULT_LATERAL_ACC_MPS2;
+pub(in crate::xosc::story) use lateral_distance::{LatKeep, LatStep};
 pub(in crate::xosc::story) use speed::SpeedTask;
 pub(in crate::xosc::story) use synchronize::Synchronizing;
 pub(in crate::xosc::story) use trajectory::Path;
@@ -184,6 +186,9 @@ impl Storyboard {
                 );
             }
             Action::LongitudinalDistance { .. } if scripted => self.start_keep(e, action, a)?,
+            // On the ego a system under test drives, refused at load.
+            Action::LateralDistance { .. } if scripted => self.start_lat_keep(e, action, a)?,
+            Action::LateralDistance { .. } => {}
             Action::LongitudinalDistance { .. } => {}
             Action::FollowTrajectory {
                 shape,
