@@ -1926,3 +1926,52 @@ fn a_trailer_runs_with_its_tow_and_an_ego_towing_one_is_refused() {
         assert!(err.contains(&format!("{name}.xosc:")), "{name}: {err}");
     }
 }
+
+/// esmini's `traffic_lights.xosc`: its storyboard sets and reads traffic signals of its
+/// map, so it runs with `--scripted-ego` (its pedestrians cross on their lights); under a
+/// system under test, which would neither see nor obey a signal, it is refused at the first
+/// signal action; and a signal the map does not have is refused at load, naming the map's.
+#[test]
+fn traffic_signals_run_scripted_and_are_refused_under_a_system_that_cannot_see_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xosc/esmini/xosc");
+    let run = |file: &std::path::Path, args: &[&str], out: &str| {
+        Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+            .arg(file)
+            .args(args)
+            .args(["--budget", "1", "--out"])
+            .arg(dir.path().join(out))
+            .output()
+            .unwrap()
+    };
+    let file = src.join("traffic_lights.xosc");
+    let o = run(&file, &["--scripted-ego", "--ego", "Ego"], "scripted");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    let o = run(&file, &["--ego", "Ego"], "driven");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("traffic_lights.xosc:42:13:") && err.contains("would neither see nor obey"),
+        "{err}"
+    );
+    // A signal the map does not have, in a copy whose relative paths (`../xodr`,
+    // `../xosc/Catalogs`) resolve to the originals.
+    let text = std::fs::read_to_string(&file).unwrap();
+    let bad = text.replacen(
+        r#"<TrafficSignalStateAction name="1""#,
+        r#"<TrafficSignalStateAction name="99""#,
+        1,
+    );
+    assert_ne!(bad, text);
+    let xosc = dir.path().join("xosc");
+    std::fs::create_dir_all(&xosc).unwrap();
+    std::os::unix::fs::symlink(src.join("Catalogs"), xosc.join("Catalogs")).unwrap();
+    std::os::unix::fs::symlink(src.join("../xodr"), dir.path().join("xodr")).unwrap();
+    let copy = xosc.join("bad_signal.xosc");
+    std::fs::write(&copy, bad).unwrap();
+    let o = run(&copy, &["--scripted-ego", "--ego", "Ego"], "bad");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("has no traffic signal \"99\""), "{err}");
+}

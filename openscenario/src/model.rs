@@ -435,6 +435,16 @@ pub enum Action {
     },
     /// `AcquirePositionAction`: a route from where the entity is to this position.
     AcquirePosition(Position),
+    /// `InfrastructureAction`'s `TrafficSignalStateAction` (a global action): the traffic
+    /// signal `signal` (an OpenDRIVE `<signal>`'s id, or its name) shows `state` (as written,
+    /// for example `off;off;on`), which `TrafficSignalCondition`s read; nothing paracosm
+    /// simulates draws or obeys a signal.
+    TrafficSignalState {
+        /// The signal's id or name.
+        signal: String,
+        /// Its state, as written.
+        state: String,
+    },
     /// An empty `<Action/>` in a file read as CARLA's ([`Scenario::carla`]): scenario_runner
     /// builds no behaviour for it, so it does nothing and completes at once (read as a global
     /// action: on the world, once).
@@ -612,6 +622,7 @@ impl Action {
             Action::Trailer(Some(_)) => "ConnectTrailerAction",
             Action::Trailer(None) => "DisconnectTrailerAction",
             Action::Nothing => "Action",
+            Action::TrafficSignalState { .. } => "TrafficSignalStateAction",
             Action::Synchronize(_) => "SynchronizeAction",
             Action::ActivateController { .. } => "ActivateControllerAction",
             Action::AssignController { .. } => "AssignControllerAction",
@@ -661,6 +672,7 @@ impl Action {
                 | Action::AddEntity { .. }
                 | Action::DeleteEntity { .. }
                 | Action::Nothing
+                | Action::TrafficSignalState { .. }
         )
     }
 }
@@ -948,6 +960,15 @@ pub enum ConditionKind {
         rule: Rule,
         /// The value as written.
         value: String,
+    },
+    /// `TrafficSignalCondition`: traffic signal `signal` (an OpenDRIVE `<signal>`'s id or
+    /// name) shows `state`, as the storyboard's `TrafficSignalStateAction`s last set it (no
+    /// state before one does).
+    TrafficSignal {
+        /// The signal's id or name.
+        signal: String,
+        /// The state, as written.
+        state: String,
     },
     /// `VariableCondition` (OpenSCENARIO 1.2): as [`ConditionKind::Parameter`], on a
     /// declared variable's current value.

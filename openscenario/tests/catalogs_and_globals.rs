@@ -188,3 +188,51 @@ fn a_catalog_location_naming_a_file_reads_that_file() {
         s.notes
     );
 }
+
+/// esmini's `traffic_lights.xosc` (MPL-2.0, `tests/data/xosc/esmini/`): its
+/// `InfrastructureAction`s set traffic signals by name to states as written, and its
+/// `TrafficSignalCondition`s read them; a signal controller's action is refused at its
+/// element (paracosm runs no signal controllers).
+#[test]
+fn traffic_signal_actions_and_conditions_are_read() {
+    let file = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/xosc/esmini/xosc/traffic_lights.xosc");
+    let s = read_scenario(&file, &[]).expect("reads");
+    let set: Vec<(&str, &str)> = s
+        .init_global
+        .iter()
+        .filter_map(|a| match &a.action {
+            Action::TrafficSignalState { signal, state } => Some((signal.as_str(), state.as_str())),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(set.len(), 3, "{set:?}");
+    assert_eq!(set[0].0, "1");
+    assert!(set[0].1.contains(';'), "a state as written: {set:?}");
+    let conditions: Vec<&ConditionKind> = s
+        .stories
+        .iter()
+        .flat_map(|st| &st.acts)
+        .flat_map(|a| &a.groups)
+        .flat_map(|g| &g.maneuvers)
+        .flat_map(|m| &m.events)
+        .filter_map(|e| e.start.as_ref())
+        .flat_map(|t| t.0.iter().flatten())
+        .map(|c| &c.kind)
+        .filter(|k| matches!(k, ConditionKind::TrafficSignal { .. }))
+        .collect();
+    assert!(!conditions.is_empty());
+    let text = std::fs::read_to_string(&file).unwrap();
+    let bad = text.replacen(
+        r#"<TrafficSignalStateAction name="1" state="$TrafficLightGreen"/>"#,
+        r#"<TrafficSignalControllerAction trafficSignalControllerRef="c" phase="go"/>"#,
+        1,
+    );
+    assert_ne!(bad, text);
+    let text = paracosm_openscenario::Text::new("bad_signal.xosc", bad);
+    let e = paracosm_openscenario::read_scenario_text(&text, file.parent().unwrap(), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bad_signal.xosc:45:"), "{e}");
+    assert!(e.contains("<TrafficSignalControllerAction>"), "{e}");
+}

@@ -263,6 +263,11 @@ pub struct RoadMap {
     pub roads: Vec<MapRoad>,
     /// Its lanes: every lane of every section with a positive width somewhere.
     pub lanes: Vec<MapLane>,
+    /// Its traffic signals (OpenDRIVE `<signal>`s): each one's `id` and `name` (empty when it
+    /// has none), in the file's order. paracosm draws and simulates none; an OpenSCENARIO
+    /// storyboard's signal actions and conditions name them, and a name not here is refused.
+    #[serde(default)]
+    pub signals: Vec<(String, String)>,
 }
 
 /// Where a route joins two lanes, how close the next lane's first station may lie to the last

@@ -156,9 +156,14 @@ fn by_value(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError
             "StoryboardElementStateCondition",
             "ParameterCondition",
             "VariableCondition",
+            "TrafficSignalCondition",
         ],
     )?;
     Ok(match tag {
+        "TrafficSignalCondition" => ConditionKind::TrafficSignal {
+            signal: r.scope.string(r.text, v, "name")?,
+            state: r.scope.string(r.text, v, "state")?,
+        },
         "SimulationTimeCondition" => ConditionKind::SimulationTime {
             rule: rule(r, v)?,
             value: r.scope.num_in(r.text, v, "value", Quantity::Time)?,

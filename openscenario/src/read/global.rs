@@ -27,9 +27,18 @@ pub(super) fn global(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
             "EntityAction",
             "ParameterAction",
             "VariableAction",
+            "InfrastructureAction",
         ],
     )?;
     match tag {
+        "InfrastructureAction" => {
+            let s = need(r.text, a, "TrafficSignalAction")?;
+            let (st, _) = choice(r.text, s, &["TrafficSignalStateAction"])?;
+            Ok(Action::TrafficSignalState {
+                signal: r.scope.string(r.text, st, "name")?,
+                state: r.scope.string(r.text, st, "state")?,
+            })
+        }
         "EnvironmentAction" => {
             let (e, tag) = choice(r.text, a, &["Environment", "CatalogReference"])?;
             let env = if tag == "Environment" {

@@ -346,6 +346,9 @@ fn action(s: &Scenario, a: &Action) -> String {
         Action::Trailer(Some(k)) => format!("hitch {}", name(s, *k)),
         Action::Trailer(None) => "unhitch its trailer".to_string(),
         Action::Nothing => "nothing (an empty action)".to_string(),
+        Action::TrafficSignalState { signal, state } => {
+            format!("traffic signal {signal:?} to {state:?}")
+        }
         Action::Synchronize(y) => synchronize(s, y),
         Action::FollowTrajectory { shape, .. } => trajectory(s, shape),
         Action::AssignRoute { waypoints } => format!(
@@ -456,6 +459,9 @@ fn condition(s: &Scenario, c: &ConditionKind) -> String {
             state,
         } => format!("{element_type} {element} {state}"),
         ConditionKind::Parameter { name, rule, value } => format!("${name} {rule:?} {value}"),
+        ConditionKind::TrafficSignal { signal, state } => {
+            format!("traffic signal {signal:?} shows {state:?}")
+        }
         ConditionKind::Variable { name, rule, value } => {
             format!("variable {name} {rule:?} {value}")
         }

@@ -238,7 +238,16 @@ pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, Scenar
         .collect();
     let mut each = |who: &[usize], na: &m::NamedAction, init: bool| -> Result<(), ScenarioError> {
         if na.action.is_global() {
-            // On the world, not on the actors.
+            // On the world, not on the actors. A traffic signal no system under test sees.
+            if let (Some(e), Action::TrafficSignalState { signal, .. }) = (ego, &na.action) {
+                return Err(worlds_error(format!(
+                    "{}: this TrafficSignalStateAction sets traffic signal {signal:?}, which the \
+                     system under test driving {} would neither see nor obey: paracosm draws no \
+                     traffic signals and its systems under test read none. Run the file with \
+                     --scripted-ego (the storyboard's conditions read the signals' states)",
+                    na.pos, s.entities[e].name
+                )));
+            }
             warnings.extend(global_otherwise(na));
             return Ok(());
         }

@@ -763,11 +763,21 @@ fn bake(
     if !lanes.iter().any(|l| l.drivable) {
         return Err(r.error(None, "the map has no driving lane".into()));
     }
+    let signals = r
+        .doc
+        .descendants()
+        .filter(|n| n.has_tag_name("signal"))
+        .map(|n| {
+            let text = |a: &str| n.attribute(a).unwrap_or("").to_owned();
+            (text("id"), text("name"))
+        })
+        .collect();
     Ok(RoadMap {
         source: r.file.to_owned(),
         origin_m: [0.0, 0.0],
         roads,
         lanes,
+        signals,
     })
 }
 

@@ -196,6 +196,9 @@ impl Storyboard {
                     _ => false,
                 }
             }),
+            ConditionKind::TrafficSignal { signal, state } => {
+                self.signal_state(signal) == Some(state.as_str())
+            }
             ConditionKind::Parameter { rule, value, .. }
             | ConditionKind::Variable { rule, value, .. } => {
                 let store = if matches!(cond.cond.kind, ConditionKind::Variable { .. }) {

@@ -168,6 +168,9 @@ pub struct Storyboard {
     /// Whether an `OffroadCondition` reads how long each entity has been off the road
     /// ([`State::offroad_s`]).
     watch_offroad: bool,
+    /// Each traffic signal's state as the storyboard's `TrafficSignalStateAction`s last set
+    /// it: (the signal's id or name as the file names it, its state).
+    signals: Vec<(String, String)>,
     /// Whether the storyboard's stop trigger has fired.
     pub ended: bool,
     started: bool,
@@ -262,6 +265,7 @@ impl Storyboard {
             )
         });
         sb.resolve_references();
+        sb.check_signals()?;
         sb.perform_init(scenario)?;
         for a in &mut sb.actors {
             let st = &mut a.state;
@@ -332,6 +336,7 @@ impl Storyboard {
             seq: 0,
             carla: scenario.carla,
             watch_offroad: false,
+            signals: Vec::new(),
             ended: false,
             started: false,
             set_speed: None,

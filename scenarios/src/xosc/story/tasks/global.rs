@@ -137,6 +137,55 @@ pub fn precipitation_extinction_per_m(kind: &str, mm_per_h: f64) -> f64 {
 }
 
 impl Storyboard {
+    /// The state traffic signal `signal` (an id or name) shows now, as the storyboard's
+    /// actions last set it; `None` before one does.
+    pub(in crate::xosc::story) fn signal_state(&self, signal: &str) -> Option<&str> {
+        (self.signals.iter())
+            .find(|(s, _)| s == signal)
+            .map(|(_, st)| st.as_str())
+    }
+
+    /// Checks that every traffic signal the storyboard's conditions name is a signal of the
+    /// map (by its id, or its name), as [`Storyboard::check_references`] checks the actions'.
+    ///
+    /// # Errors
+    /// [`StoryError`] at the first condition that names a signal the map does not have.
+    pub(in crate::xosc::story) fn check_signals(&self) -> Result<(), StoryError> {
+        for c in self.triggers.iter().flatten().flatten() {
+            if let ConditionKind::TrafficSignal { signal, .. } = &c.cond.kind {
+                if let Some(message) = self.signal_missing(signal) {
+                    return Err(StoryError {
+                        at: site(&c.cond.pos),
+                        message: format!("TrafficSignalCondition {:?}: {message}", c.cond.name),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Why the map does not have traffic signal `signal` (its `<signal>` id, or its name),
+    /// naming the signals it has; `None` when it has it.
+    pub(in crate::xosc::story) fn signal_missing(&self, signal: &str) -> Option<String> {
+        let signals = &self.roads.map().signals;
+        if signals
+            .iter()
+            .any(|(id, name)| id == signal || name == signal)
+        {
+            return None;
+        }
+        let ids: Vec<&str> = signals.iter().map(|(id, _)| id.as_str()).take(20).collect();
+        Some(format!(
+            "the map {} has no traffic signal {signal:?} (its signals' ids: {})",
+            self.roads.map().source,
+            if ids.is_empty() {
+                "none".to_string()
+            } else {
+                ids.join(", ")
+            }
+        ))
+    }
+
     /// Performs a global action (`action.action.is_global()`) at simulated time `t` (s).
     ///
     /// # Errors
@@ -150,6 +199,20 @@ impl Storyboard {
         let (name, variable, new) = match &action.action {
             Action::Environment(env) => {
                 self.env.apply(env, t);
+                return Ok(());
+            }
+            Action::TrafficSignalState { signal, state } => {
+                // `Init`'s are performed as the storyboard is built: checked here.
+                if let Some(message) = self.signal_missing(signal) {
+                    return Err(StoryError {
+                        at: site(&action.pos),
+                        message: format!("TrafficSignalStateAction {:?}: {message}", action.name),
+                    });
+                }
+                match self.signals.iter_mut().find(|(s, _)| s == signal) {
+                    Some(s) => s.1.clone_from(state),
+                    None => self.signals.push((signal.clone(), state.clone())),
+                }
                 return Ok(());
             }
             // As esmini's `AddEntityAction::Start`: an entity in the scenario stays where it

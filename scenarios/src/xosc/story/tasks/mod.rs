@@ -109,6 +109,10 @@ impl Storyboard {
             }
         };
         match &na.action {
+            Action::TrafficSignalState { signal, .. } => match self.signal_missing(signal) {
+                Some(why) => Err(refused(why)),
+                None => Ok(()),
+            },
             Action::Teleport(p)
             | Action::AcquirePosition(p)
             | Action::AddEntity { position: p, .. } => position(p),
@@ -218,7 +222,8 @@ impl Storyboard {
             | Action::ModifyValue { .. }
             | Action::AddEntity { .. }
             | Action::DeleteEntity { .. }
-            | Action::Nothing => {}
+            | Action::Nothing
+            | Action::TrafficSignalState { .. } => {}
             // Nothing the storyboard moves reads lights or visibility: the front end refuses
             // a visibility that a system under test would sense ([`crate::xosc::check`]).
             Action::Appearance(_) | Action::Visibility { .. } => {}
