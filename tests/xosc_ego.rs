@@ -273,7 +273,7 @@ test(horizon = 100)
     );
 }
 
-/// What paracosm cannot hand the system under test (here a lane change of the driven ego) is
+/// What paracosm cannot hand the system under test (here a teleport of the driven ego) is
 /// refused at load with the action's line and column, not dropped with a warning; the same
 /// file runs with `--scripted-ego`.
 #[test]
@@ -285,10 +285,7 @@ fn an_ego_action_the_system_cannot_take_is_refused_at_load() {
     <Actors selectTriggeringEntities="false"><EntityRef entityRef="Ego"/></Actors>
     <Maneuver name="M">
 <Event name="Change" priority="override">
-  <Action name="ChangeAction"><PrivateAction><LateralAction><LaneOffsetAction continuous="false">
-    <LaneOffsetActionDynamics maxLateralAcc="0.5" dynamicsShape="sinusoidal"/>
-    <LaneOffsetTarget><AbsoluteTargetLaneOffset value="0.5"/></LaneOffsetTarget>
-  </LaneOffsetAction></LateralAction></PrivateAction></Action>
+  <Action name="ChangeAction"><PrivateAction><TeleportAction><Position><RelativeLanePosition entityRef="Ego" dLane="0" ds="5"/></Position></TeleportAction></PrivateAction></Action>
   <StartTrigger><ConditionGroup>{}</ConditionGroup></StartTrigger>
 </Event>
     </Maneuver>
@@ -306,7 +303,7 @@ fn an_ego_action_the_system_cannot_take_is_refused_at_load() {
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("change.xosc:")
-            && err.contains("LaneOffsetAction")
+            && err.contains("TeleportAction")
             && err.contains("--scripted-ego"),
         "{err}"
     );
