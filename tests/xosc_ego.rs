@@ -273,6 +273,88 @@ test(horizon = 100)
     );
 }
 
+/// A `SpeedProfileAction` on the ego a system under test drives is its set speed over time:
+/// from parked at 1 s, 20 m/s 6 s later and 10 m/s 8 s after that (follow mode: corners
+/// rounded within 2 m/s³: its last corner, from −1.25 m/s² to none, takes 0.625 s about
+/// 15 s, so its last speed is planned for about 15.3 s). Under `aeb` the ego
+/// comes near 20 m/s, not over 21, and ends near 10 m/s; the stop trigger waits for the
+/// profile's end, which comes once the ego is within the set speed's tolerance of 10 m/s,
+/// after 15 s and before 25 s. A profile to a negative speed on it is refused
+/// when it starts, naming the action (its systems drive forward only).
+#[test]
+fn a_speed_profile_is_the_systems_set_speed_over_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let story = |entries: &str| {
+        format!(
+            r#"<Story name="S"><Act name="A">
+  <ManeuverGroup maximumExecutionCount="1" name="G">
+    <Actors selectTriggeringEntities="false"><EntityRef entityRef="Ego"/></Actors>
+    <Maneuver name="M"><Event name="Profile" priority="override">
+  <Action name="ProfileAction"><PrivateAction><LongitudinalAction><SpeedProfileAction followingMode="follow">
+    <DynamicConstraints maxAcceleration="4" maxDeceleration="4" maxAccelerationRate="2" maxDecelerationRate="2"/>
+    {entries}
+  </SpeedProfileAction></LongitudinalAction></PrivateAction></Action>
+  <StartTrigger><ConditionGroup>{}</ConditionGroup></StartTrigger>
+</Event></Maneuver>
+  </ManeuverGroup>
+</Act></Story>"#,
+            at_time("Go", 1.0, "rising")
+        )
+    };
+    let stop = format!(
+        r#"<Condition name="Done" delay="0" conditionEdge="rising">
+  <ByValueCondition><StoryboardElementStateCondition storyboardElementType="event" storyboardElementRef="Profile" state="endTransition"/></ByValueCondition>
+</Condition></ConditionGroup><ConditionGroup>{}"#,
+        at_time("Cap", 60.0, "rising")
+    );
+    let file = |entries: &str| {
+        scenario(
+            &vehicle("Ego", [5.0, 2.0, 1.5], 1.4),
+            &teleport("Ego", 50.0, 0.0),
+            &story(entries),
+            &stop,
+        )
+    };
+    std::fs::write(
+        dir.path().join("profile.xosc"),
+        file(r#"<SpeedProfileEntry time="6" speed="20"/><SpeedProfileEntry time="8" speed="10"/>"#),
+    )
+    .unwrap();
+    let program = r#"w = World()
+s = Import("profile.xosc")
+top = s.ego.speed.max()
+Monitor(top.map(lambda v: v - 17.0), over = "end", name = "near_20")
+Monitor(top.map(lambda v: 21.0 - v), over = "end", name = "not_over_21")
+Monitor(s.ego.speed.map(lambda v: 1.5 - max(v - 10.0, 10.0 - v)), over = "end", name = "ends_near_10")
+test(horizon = 100)
+"#;
+    let (code, err, records) = run(dir.path(), "prog.star", program, &[]);
+    assert_eq!(code, 0, "{err}\n{records:?}");
+    let r = &records[0];
+    for m in ["near_20", "not_over_21", "ends_near_10", "offroad"] {
+        assert_eq!(r["monitors"][m]["passed"], true, "{m}: {r}");
+    }
+    let end = r["metrics"]["simulated_s"].as_f64().unwrap();
+    assert!(
+        end > 15.0 && end < 25.0,
+        "the profile's end stops the test: {end} s"
+    );
+    std::fs::write(
+        dir.path().join("profile.xosc"),
+        file(r#"<SpeedProfileEntry time="6" speed="-2"/>"#),
+    )
+    .unwrap();
+    let (code, err, records) = run(dir.path(), "prog.star", program, &[]);
+    assert_ne!(code, 0, "{err}");
+    // The test is in error, its record naming the action.
+    assert_eq!(records.len(), 1, "{err}");
+    let r = records[0].to_string();
+    assert!(
+        r.contains(r#"SpeedProfileAction \"ProfileAction\" to -2 m/s asks Ego to drive backwards"#),
+        "{r}"
+    );
+}
+
 /// What paracosm cannot hand the system under test (here a teleport of the driven ego) is
 /// refused at load with the action's line and column, not dropped with a warning; the same
 /// file runs with `--scripted-ego`.

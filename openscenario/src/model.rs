@@ -457,6 +457,9 @@ pub enum Action {
     /// `SynchronizeAction`: the entity's speed is set each step so that it reaches its
     /// target position when the master entity reaches the master's.
     Synchronize(Box<Synchronize>),
+    /// `SpeedProfileAction` (OpenSCENARIO 1.2): the entity's speed through a sequence of
+    /// speeds, each reached a time after the one before.
+    SpeedProfile(Box<SpeedProfile>),
     /// `AssignRouteAction`: a route through waypoints (the first is where the entity is
     /// routed from), each with its `routeStrategy`.
     AssignRoute {
@@ -566,6 +569,25 @@ pub struct Synchronize {
     pub final_speed: Option<FinalSpeed>,
 }
 
+/// A `SpeedProfileAction` (OpenSCENARIO 1.2 User Guide, "SpeedProfileAction"): the entity's
+/// speed through `entries`, each speed reached `time` s after the entry before it (the first
+/// after the action's start).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpeedProfile {
+    /// `entityRef`: each entry's speed is relative to this entity's speed when the action
+    /// starts (an index into [`Scenario::entities`]); `None`: absolute.
+    pub entity: Option<usize>,
+    /// `followingMode` is `follow`: the speed changes within the constraints' acceleration
+    /// and its rate (jerk), rounding each corner of the profile; `position`: the speed is
+    /// linear between entries.
+    pub follow: bool,
+    /// `DynamicConstraints`, if given (none: unbounded, as esmini leaves them).
+    pub constraints: Option<DistanceConstraints>,
+    /// The `SpeedProfileEntry`s: `time` (s, `>= 0`; `None` when left out: reached at the
+    /// constraints' acceleration) and `speed` (m/s), at least one.
+    pub entries: Vec<(Option<f64>, f64)>,
+}
+
 /// A `SynchronizeAction`'s `FinalSpeed`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FinalSpeed {
@@ -624,6 +646,7 @@ impl Action {
             Action::Nothing => "Action",
             Action::TrafficSignalState { .. } => "TrafficSignalStateAction",
             Action::Synchronize(_) => "SynchronizeAction",
+            Action::SpeedProfile(_) => "SpeedProfileAction",
             Action::ActivateController { .. } => "ActivateControllerAction",
             Action::AssignController { .. } => "AssignControllerAction",
             Action::OverrideController => "OverrideControllerValueAction",

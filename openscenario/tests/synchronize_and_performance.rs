@@ -435,3 +435,81 @@ fn a_distance_actions_dynamic_constraints_are_read_and_a_limit_of_zero_refused()
         "{e}"
     );
 }
+
+/// A `SpeedProfileAction` reads its mode, its reference entity (the `entityRef` attribute),
+/// its constraints and its entries, a time left out as `None`; a negative time, a profile
+/// without entries, an unknown mode and esmini's `<EntityRef>` child (not in the schema) are
+/// refused at their line and column.
+#[test]
+fn a_speed_profile_reads_its_entries_and_refuses_what_it_cannot_honour() {
+    let profile = |attrs: &str, inner: &str| {
+        format!(
+            r#"<LongitudinalAction><SpeedProfileAction {attrs}>{inner}</SpeedProfileAction></LongitudinalAction>"#
+        )
+    };
+    let s = read(
+        "profile",
+        &scenario(
+            PERFORMANCE,
+            false,
+            &profile(
+                r#"followingMode="follow" entityRef="Ego""#,
+                r#"<DynamicConstraints maxAcceleration="3" maxAccelerationRate="2"/><SpeedProfileEntry time="0" speed="1"/><SpeedProfileEntry time="2.5" speed="-4"/><SpeedProfileEntry speed="6"/>"#,
+            ),
+            SPEED,
+        ),
+    )
+    .unwrap();
+    let Action::SpeedProfile(p) = action(&s) else {
+        panic!("{:?}", action(&s))
+    };
+    assert!(p.follow);
+    assert_eq!(p.entity, Some(0));
+    assert_eq!(
+        p.entries,
+        vec![(Some(0.0), 1.0), (Some(2.5), -4.0), (None, 6.0)]
+    );
+    let c = p.constraints.unwrap();
+    assert_eq!(
+        (
+            c.max_acceleration_mps2,
+            c.max_acceleration_rate_mps3,
+            c.max_speed_mps
+        ),
+        (Some(3.0), Some(2.0), None)
+    );
+    let refused = |tag: &str, attrs: &str, inner: &str| {
+        read(
+            tag,
+            &scenario(PERFORMANCE, false, &profile(attrs, inner), SPEED),
+        )
+        .unwrap_err()
+    };
+    let e = refused(
+        "negative",
+        r#"followingMode="position""#,
+        r#"<SpeedProfileEntry time="-1" speed="3"/>"#,
+    );
+    assert!(
+        e.contains(":17:") && e.contains("out of range for a duration"),
+        "{e}"
+    );
+    let e = refused("empty", r#"followingMode="position""#, "");
+    assert!(e.contains("needs a <SpeedProfileEntry>"), "{e}");
+    let e = refused(
+        "mode",
+        r#"followingMode="smooth""#,
+        r#"<SpeedProfileEntry time="1" speed="3"/>"#,
+    );
+    assert!(e.contains("followingMode is position or follow"), "{e}");
+    let e = refused(
+        "child",
+        r#"followingMode="follow""#,
+        r#"<EntityRef entityRef="Ego"/><SpeedProfileEntry time="1" speed="3"/>"#,
+    );
+    assert!(
+        e.contains("<EntityRef> in <SpeedProfileAction> is not supported")
+            && e.contains("entityRef attribute"),
+        "{e}"
+    );
+}

@@ -212,7 +212,7 @@ fn check_runs(runs: &[Run]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 40] = [
+const ESMINI_EXAMPLES: [&str; 41] = [
     "acc-test",
     "alks_cut-in",
     "alks_cut-out",
@@ -246,6 +246,7 @@ const ESMINI_EXAMPLES: [&str; 40] = [
     "pedestrian",
     "pedestrian_traj_synch",
     "slow-lead-vehicle",
+    "speed-profile",
     "straight_500m",
     "straight_500m_pedestrian",
     "synch_with_steady_state",

@@ -9,7 +9,7 @@ use super::{position, Reader};
 use crate::error::XoscError;
 use crate::model::{
     Action, Dimension, DistanceConstraints, Dynamics, LaneTarget, OffsetTarget, Position, Shape,
-    SpeedTarget, TrajectoryShape,
+    SpeedProfile, SpeedTarget, TrajectoryShape,
 };
 use crate::quantity::Quantity;
 use crate::xml::{child, choice, elements, need};
@@ -50,11 +50,19 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
         // OpenSCENARIO 1.0 puts it directly under <PrivateAction>.
         "ActivateControllerAction" => activate(r, a),
         "LongitudinalAction" => {
-            let (l, tag) = choice(r.text, a, &["SpeedAction", "LongitudinalDistanceAction"])?;
-            if tag == "SpeedAction" {
-                speed(r, l)
-            } else {
-                distance(r, l)
+            let (l, tag) = choice(
+                r.text,
+                a,
+                &[
+                    "SpeedAction",
+                    "LongitudinalDistanceAction",
+                    "SpeedProfileAction",
+                ],
+            )?;
+            match tag {
+                "SpeedAction" => speed(r, l),
+                "SpeedProfileAction" => speed_profile(r, l),
+                _ => distance(r, l),
             }
         }
         "LateralAction" => {
@@ -364,6 +372,59 @@ fn lateral_distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscEr
             .map(|c| distance_constraints(r, c))
             .transpose()?,
     })
+}
+
+/// A `<SpeedProfileAction>` (OpenSCENARIO 1.2): its `DynamicConstraints` (each limit `> 0`)
+/// and its entries, each `time` a duration (`>= 0`) when given.
+fn speed_profile(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
+    let follow = match r.scope.string(r.text, node, "followingMode")?.as_str() {
+        "follow" => true,
+        "position" => false,
+        other => {
+            return Err(XoscError::Invalid {
+                pos: r.text.attr_pos(node, "followingMode"),
+                reason: format!("followingMode is position or follow, not {other:?}"),
+            })
+        }
+    };
+    let mut entries = Vec::new();
+    for c in elements(node) {
+        match c.tag_name().name() {
+            "DynamicConstraints" => {}
+            "SpeedProfileEntry" => {
+                // A duration: within [0, 1e6] s.
+                let time = r.scope.opt_num_in(r.text, c, "time", Quantity::Duration)?;
+                entries.push((time, r.scope.num_in(r.text, c, "speed", Quantity::Speed)?));
+            }
+            other => {
+                return Err(XoscError::Unsupported {
+                    pos: r.text.pos(c),
+                    reason: format!(
+                        "<{other}> in <SpeedProfileAction> is not supported; paracosm reads \
+                         <DynamicConstraints> and <SpeedProfileEntry> (the entity whose speed \
+                         the entries are relative to is its entityRef attribute)"
+                    ),
+                })
+            }
+        }
+    }
+    if entries.is_empty() {
+        return Err(r
+            .text
+            .invalid(node, "<SpeedProfileAction> needs a <SpeedProfileEntry>"));
+    }
+    let entity = match node.attribute("entityRef") {
+        Some(_) => Some(r.entity(node, "entityRef")?),
+        None => None,
+    };
+    Ok(Action::SpeedProfile(Box::new(SpeedProfile {
+        entity,
+        follow,
+        constraints: child(node, "DynamicConstraints")
+            .map(|c| distance_constraints(r, c))
+            .transpose()?,
+        entries,
+    })))
 }
 
 /// A distance action's `<DynamicConstraints>`: each limit given is `> 0`.

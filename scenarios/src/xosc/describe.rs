@@ -350,6 +350,22 @@ fn action(s: &Scenario, a: &Action) -> String {
             format!("traffic signal {signal:?} to {state:?}")
         }
         Action::Synchronize(y) => synchronize(s, y),
+        Action::SpeedProfile(p) => format!(
+            "speed profile through {} ({}{})",
+            p.entries
+                .iter()
+                .map(|(t, v)| match t {
+                    Some(t) => format!("{v} m/s after {t} s"),
+                    None => format!("{v} m/s"),
+                })
+                .collect::<Vec<_>>()
+                .join(", "),
+            if p.follow { "follow" } else { "position" },
+            p.entity.map_or(String::new(), |r| format!(
+                ", relative to {}'s speed",
+                name(s, r)
+            ))
+        ),
         Action::FollowTrajectory { shape, .. } => trajectory(s, shape),
         Action::AssignRoute { waypoints } => format!(
             "route through {} waypoints to {}",

@@ -449,8 +449,9 @@ fn performed_otherwise(
         // An untimed trajectory: the system's route (a timed one asks a time the system
         // under test would not keep).
         Action::FollowTrajectory { timing: None, .. } if driven => None,
-        // Its initial speed in Init; later, the set speed of the system under test.
-        Action::Speed { .. } if driven => None,
+        // Its initial speed in Init; later, the set speed of the system under test (a
+        // profile: its set speed over time).
+        Action::Speed { .. } | Action::SpeedProfile(_) if driven => None,
         // Later, the route of the system under test: into the lane, or along the route's
         // roads.
         Action::LaneChange { .. } | Action::AssignRoute { .. } | Action::AcquirePosition(_)
@@ -463,8 +464,8 @@ fn performed_otherwise(
         _ if driven => {
             return Err(worlds_error(format!(
                 "{}: the system under test drives {name}, and paracosm cannot hand it this {}: \
-                 its storyboard asks it of the ego only as a SpeedAction (the system's set \
-                 speed), a LaneChangeAction, a LaneOffsetAction, an AssignRouteAction or an \
+                 its storyboard asks it of the ego only as a SpeedAction or a \
+                 SpeedProfileAction (the system's set speed), a LaneChangeAction, a LaneOffsetAction, an AssignRouteAction or an \
                  untimed FollowTrajectoryAction (the system's route), an \
                  ActivateControllerAction, or in Init a TeleportAction or an \
                  AssignRouteAction. Run the file with --scripted-ego to have the storyboard \

@@ -14,6 +14,9 @@ pub(in crate::xosc::story) type ToLane = Option<(usize, f64)>;
 pub(in crate::xosc::story) struct Drive {
     /// The `SpeedAction` in progress.
     pub(in crate::xosc::story) speed: Option<SpeedTask>,
+    /// The last `SpeedProfileAction`'s plan, which the speed task steps while it is
+    /// [`SpeedTask::profiled`].
+    pub(in crate::xosc::story) profile: Profile,
     /// The lateral move in progress.
     pub(in crate::xosc::story) lateral: Option<Lateral>,
     /// The continuous `LongitudinalDistanceAction` in progress.
@@ -107,9 +110,14 @@ impl Storyboard {
         let mut v1 = st.speed;
         let mut done = Vec::new();
         if let Some(mut task) = self.drives[e].speed {
-            let (v, over) = task.step(t1, |r| self.actors[r].state.speed);
+            let (v, over) = self.speed_task_at(e, &task, t1);
             let performance = self.actors[e].performance;
-            let (v, over) = limited(&mut task, performance, (v, over), (st.speed, t, dt));
+            // A profile keeps its own constraints (esmini's sets its speed as planned).
+            let (v, over) = if task.profiled {
+                (v, over)
+            } else {
+                limited(&mut task, performance, (v, over), (st.speed, t, dt))
+            };
             v1 = v;
             self.drives[e].speed = Some(task);
             // A hold by distance (CARLA's reading) counts this step's move.

@@ -21,7 +21,7 @@ pub use tasks::{
     precipitation_extinction_per_m, Stored, WorldEnv, MAP_FRICTION, NOMINAL_ILLUMINANCE_LX,
     VISIBLE_WAVELENGTH_NM,
 };
-use tasks::{Keep, LatKeep, LatStep, Lateral, Path, SpeedTask, Synchronizing};
+use tasks::{Keep, LatKeep, LatStep, Lateral, Path, Profile, SpeedTask, Synchronizing};
 
 use std::collections::VecDeque;
 

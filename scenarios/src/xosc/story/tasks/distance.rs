@@ -231,6 +231,9 @@ impl Storyboard {
     fn reference_speed(&self, reference: usize, t1: f64) -> f64 {
         let r = &self.actors[reference];
         match self.drives[reference].speed {
+            Some(task) if r.scripted && task.profiled => {
+                self.drives[reference].profile.clone().step(t1).0
+            }
             Some(task) if r.scripted => task.step(t1, |o| self.actors[o].state.speed).0,
             _ => r.state.speed,
         }

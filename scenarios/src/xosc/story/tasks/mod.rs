@@ -1,6 +1,6 @@
 //! The storyboard's actions: `Init` performed, references checked, and each running action's
-//! task started by its kind, one file per kind (speed, lateral, trajectory, teleport, route,
-//! controller, distance, lateral distance, synchronize, trailer).
+//! task started by its kind, one file per kind (speed, speed profile, lateral, trajectory,
+//! teleport, route, controller, distance, lateral distance, synchronize, trailer).
 
 mod controller;
 mod distance;
@@ -9,6 +9,7 @@ mod lateral;
 mod lateral_distance;
 mod route;
 mod speed;
+mod speed_profile;
 mod synchronize;
 mod teleport;
 mod trailer;
@@ -23,6 +24,7 @@ pub(in crate::xosc::story) use lateral::Lateral;
 pub use lateral::DEFAULT_LATERAL_ACC_MPS2;
 pub(in crate::xosc::story) use lateral_distance::{LatKeep, LatStep};
 pub(in crate::xosc::story) use speed::SpeedTask;
+pub(in crate::xosc::story) use speed_profile::Profile;
 pub(in crate::xosc::story) use synchronize::Synchronizing;
 pub(in crate::xosc::story) use trajectory::Path;
 
@@ -170,6 +172,13 @@ impl Storyboard {
             Action::Speed { target, dynamics } => {
                 return self.start_speed(e, (target, dynamics), a, t);
             }
+            Action::SpeedProfile(p) if !scripted && p.entity.is_none() => {
+                if let Some((_, v)) = p.entries.iter().find(|(_, v)| *v < 0.0) {
+                    return Err(bad(backwards(action, *v, &self.actors[e].name)));
+                }
+                self.start_speed_profile(e, p, a, t);
+            }
+            Action::SpeedProfile(p) => self.start_speed_profile(e, p, a, t),
             Action::LaneChange {
                 target,
                 dynamics,
@@ -275,13 +284,14 @@ impl Storyboard {
     }
 }
 
-/// Why `SpeedAction` `action`, to `v` m/s (`< 0`), cannot be performed on entity `name`,
+/// Why `SpeedAction` or `SpeedProfileAction` `action`, to `v` m/s (`< 0`), cannot be performed on entity `name`,
 /// which a system under test drives.
 fn backwards(action: &m::NamedAction, v: f64, name: &str) -> String {
     format!(
-        "SpeedAction {:?} to {v} m/s asks {name} to drive backwards, which paracosm's systems \
+        "{} {:?} to {v} m/s asks {name} to drive backwards, which paracosm's systems \
          under test do not do (they drive forward only; the storyboard reverses an entity it \
          moves itself: --scripted-ego)",
+        action.action.kind_name(),
         action.name
     )
 }

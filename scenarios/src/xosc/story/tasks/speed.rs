@@ -15,6 +15,9 @@ pub(in crate::xosc::story) struct SpeedTask {
     pub(in crate::xosc::story) action: usize,
     /// How long it lasts past its transition, in CARLA's reading ([`Storyboard::carla`]).
     pub(in crate::xosc::story) hold: Option<Hold>,
+    /// A `SpeedProfileAction`: the speed is its entity's [`Drive::profile`]'s (`tr` holds
+    /// only its start and last speeds).
+    pub(in crate::xosc::story) profiled: bool,
 }
 
 /// How long a `SpeedAction` lasts in CARLA's reading (scenario_runner's
@@ -161,6 +164,7 @@ impl Storyboard {
             track,
             action: a.unwrap_or(usize::MAX),
             hold,
+            profiled: false,
         });
 
         Ok(())
@@ -182,7 +186,7 @@ impl Storyboard {
         let Some(task) = self.drives[e].speed else {
             return;
         };
-        let (v, over) = task.step(t1, |r| self.actors[r].state.speed);
+        let (v, over) = self.speed_task_at(e, &task, t1);
         if over && task.ends(t1, self.actors[e].state.travelled_m) {
             let reached = SET_SPEED_REACHED_MPS + SET_SPEED_REACHED_SHARE * task.tr.to.abs();
             if (self.actors[e].state.speed - task.tr.to).abs() <= reached {
