@@ -17,6 +17,7 @@ pub mod model;
 pub mod params;
 pub mod quantity;
 pub mod read;
+pub mod support;
 pub mod text;
 mod xml;
 

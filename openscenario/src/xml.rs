@@ -3,6 +3,7 @@
 use roxmltree::Node;
 
 use crate::error::XoscError;
+use crate::support::Choice;
 use crate::text::Text;
 
 /// `node`'s element children.
@@ -32,17 +33,18 @@ pub fn need<'a, 'i>(
     })
 }
 
-/// `node`'s single element child, which must be one of `choices` (the standard's choice
-/// groups), with its name.
+/// `node`'s single element child, which must be one of what choice group `group` reads
+/// (the reader's table, [`crate::support`]), with its name.
 ///
 /// # Errors
 /// [`XoscError::Invalid`] when it has none or more than one; [`XoscError::Unsupported`] for
-/// another element, naming what is supported.
+/// another element, naming what is supported (and why, for a member the table refuses).
 pub fn choice<'a, 'i>(
     text: &Text,
     node: Node<'a, 'i>,
-    choices: &[&str],
+    group: &Choice,
 ) -> Result<(Node<'a, 'i>, &'a str), XoscError> {
+    let choices = group.read;
     let Some(c) = elements(node).next() else {
         return Err(text.invalid(
             node,
@@ -67,15 +69,27 @@ pub fn choice<'a, 'i>(
     let name = c.tag_name().name();
     match choices.iter().position(|&k| k == name) {
         Some(_) => Ok((c, name)),
-        None => Err(text.unsupported(
-            c,
-            format!(
-                "<{name}> in <{}> is not supported; paracosm reads {}",
-                node.tag_name().name(),
-                list(choices)
-            ),
-        )),
+        None => Err(refusal(text, node, c, group)),
     }
+}
+
+/// The refusal of element `c`, in `node`, which choice group `group` does not read: why, when
+/// the table refuses it, and what is read there.
+pub fn refusal(text: &Text, node: Node<'_, '_>, c: Node<'_, '_>, group: &Choice) -> XoscError {
+    let name = c.tag_name().name();
+    let why = group
+        .refused
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map_or(String::new(), |(_, why)| format!(": {why}"));
+    text.unsupported(
+        c,
+        format!(
+            "<{name}> in <{}> is not supported{why}; paracosm reads {}",
+            node.tag_name().name(),
+            list(group.read)
+        ),
+    )
 }
 
 /// `<A>, <B> or <C>`.

@@ -12,34 +12,16 @@ use crate::model::{
     SpeedProfile, SpeedTarget, TrajectoryShape,
 };
 use crate::quantity::Quantity;
+use crate::support;
 use crate::xml::{child, choice, elements, need};
 
 /// A `<PrivateAction>`.
 pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
-    let (a, tag) = choice(
-        r.text,
-        node,
-        &[
-            "LongitudinalAction",
-            "LateralAction",
-            "TeleportAction",
-            "RoutingAction",
-            "ControllerAction",
-            "ActivateControllerAction",
-            "AppearanceAction",
-            "VisibilityAction",
-            "SynchronizeAction",
-            "TrailerAction",
-        ],
-    )?;
+    let (a, tag) = choice(r.text, node, &support::PRIVATE_ACTION)?;
     match tag {
         "SynchronizeAction" => super::synchronize::read(r, a),
         "TrailerAction" => {
-            let (t, tag) = choice(
-                r.text,
-                a,
-                &["ConnectTrailerAction", "DisconnectTrailerAction"],
-            )?;
+            let (t, tag) = choice(r.text, a, &support::TRAILER_ACTION)?;
             if tag == "DisconnectTrailerAction" {
                 return Ok(Action::Trailer(None));
             }
@@ -50,15 +32,7 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
         // OpenSCENARIO 1.0 puts it directly under <PrivateAction>.
         "ActivateControllerAction" => activate(r, a),
         "LongitudinalAction" => {
-            let (l, tag) = choice(
-                r.text,
-                a,
-                &[
-                    "SpeedAction",
-                    "LongitudinalDistanceAction",
-                    "SpeedProfileAction",
-                ],
-            )?;
+            let (l, tag) = choice(r.text, a, &support::LONGITUDINAL_ACTION)?;
             match tag {
                 "SpeedAction" => speed(r, l),
                 "SpeedProfileAction" => speed_profile(r, l),
@@ -66,15 +40,7 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
             }
         }
         "LateralAction" => {
-            let (l, tag) = choice(
-                r.text,
-                a,
-                &[
-                    "LaneChangeAction",
-                    "LaneOffsetAction",
-                    "LateralDistanceAction",
-                ],
-            )?;
+            let (l, tag) = choice(r.text, a, &support::LATERAL_ACTION)?;
             match tag {
                 "LaneChangeAction" => lane_change(r, l),
                 "LaneOffsetAction" => lane_offset(r, l),
@@ -86,15 +52,7 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
             need(r.text, a, "Position")?,
         )?)),
         "RoutingAction" => {
-            let (f, tag) = choice(
-                r.text,
-                a,
-                &[
-                    "FollowTrajectoryAction",
-                    "AssignRouteAction",
-                    "AcquirePositionAction",
-                ],
-            )?;
+            let (f, tag) = choice(r.text, a, &support::ROUTING_ACTION)?;
             match tag {
                 "AssignRouteAction" => assign_route(r, f),
                 "AcquirePositionAction" => Ok(Action::AcquirePosition(position::read(
@@ -120,7 +78,7 @@ pub(super) fn activate(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Action, XoscEr
         }
     }
     if c.attribute("objectControllerRef").is_some() || c.attribute("controllerRef").is_some() {
-        r.note(c, "the controller named here is the entity's one controller: paracosm reads one per entity");
+        r.note(c, support::CONTROLLER_NAMED.note);
     }
     Ok(Action::ActivateController {
         lateral: r.scope.opt_bool(r.text, c, "lateral")?,
@@ -144,7 +102,13 @@ fn dynamics(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Dynamics, XoscError> {
     };
     if let Some(mode) = r.scope.opt_string(r.text, node, "followingMode")? {
         if mode != "position" {
-            r.note(node, format!("followingMode {mode:?} is followed as \"position\": the value follows the shape exactly"));
+            r.note(
+                node,
+                format!(
+                    "followingMode {mode:?} {}",
+                    support::DYNAMICS_FOLLOWING.note
+                ),
+            );
         }
     }
     let q = match dimension {
@@ -159,8 +123,9 @@ fn dynamics(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Dynamics, XoscError> {
         r.note(
             node,
             format!(
-                "a transition's rate of {value} is read as {}: the target gives the direction",
-                -value
+                "a transition's rate of {value} is read as {}: {}",
+                -value,
+                support::NEGATIVE_RATE.note
             ),
         );
         value = -value;
@@ -198,7 +163,7 @@ fn speed(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
     let (t, tag) = choice(
         r.text,
         need(r.text, node, "SpeedActionTarget")?,
-        &["AbsoluteTargetSpeed", "RelativeTargetSpeed"],
+        &support::SPEED_TARGET,
     )?;
     let target = if tag == "AbsoluteTargetSpeed" {
         SpeedTarget::Absolute(r.scope.num_in(r.text, t, "value", Quantity::Speed)?)
@@ -276,21 +241,13 @@ fn distance(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
 /// # Errors
 /// What its choice's reader returns.
 fn appearance(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Action, XoscError> {
-    let (kind, tag) = choice(r.text, a, &["LightStateAction", "AnimationAction"])?;
+    let (kind, tag) = choice(r.text, a, &support::APPEARANCE_ACTION)?;
     let what = if tag == "LightStateAction" {
         "a vehicle's lights"
     } else {
         "an animation"
     };
-    let drawn = if tag == "LightStateAction" {
-        "vehicle lights"
-    } else {
-        "animations"
-    };
-    r.note(
-        kind,
-        format!("<{tag}> is read but not modelled: paracosm draws no {drawn}, and its sensors and monitors read none"),
-    );
+    r.note(kind, format!("<{tag}> {}", support::APPEARANCE.note));
     Ok(Action::Appearance(what.to_string()))
 }
 
@@ -470,7 +427,7 @@ fn lane_change(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> 
     let (t, tag) = choice(
         r.text,
         need(r.text, node, "LaneChangeTarget")?,
-        &["AbsoluteTargetLane", "RelativeTargetLane"],
+        &support::LANE_CHANGE_TARGET,
     )?;
     let whole = |attr: &str| -> Result<i32, XoscError> {
         let v = r.scope.num(r.text, t, attr)?;
@@ -506,7 +463,7 @@ fn lane_offset(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> 
     let (t, tag) = choice(
         r.text,
         need(r.text, node, "LaneOffsetTarget")?,
-        &["AbsoluteTargetLaneOffset", "RelativeTargetLaneOffset"],
+        &support::LANE_OFFSET_TARGET,
     )?;
     let target = if tag == "AbsoluteTargetLaneOffset" {
         OffsetTarget::Absolute(r.flip(r.scope.num_in(r.text, t, "value", Quantity::Lateral)?))
@@ -582,7 +539,13 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
         let mode = r.scope.string(r.text, m, "followingMode")?;
         position_mode = mode == "position";
         if !position_mode {
-            r.note(m, format!("followingMode {mode:?} places the entity on the trajectory as \"position\" does (its heading turns along each leg of a polyline, as esmini's does in this mode)"));
+            r.note(
+                m,
+                format!(
+                    "followingMode {mode:?} {}",
+                    support::TRAJECTORY_FOLLOWING.note
+                ),
+            );
         }
     }
     if initial_offset_m != 0.0 && timing.is_some() {
@@ -648,11 +611,7 @@ fn trajectory(
             .text
             .unsupported(traj, "a closed trajectory is not supported"));
     }
-    let (shape_node, kind) = choice(
-        r.text,
-        need(r.text, traj, "Shape")?,
-        &["Polyline", "Clothoid", "ClothoidSpline", "Nurbs"],
-    )?;
+    let (shape_node, kind) = choice(r.text, need(r.text, traj, "Shape")?, &support::SHAPE)?;
     let shape = match kind {
         "Polyline" => polyline(r, shape_node)?,
         "Clothoid" => clothoid(r, shape_node)?,
@@ -903,7 +862,7 @@ fn timed(r: &Reader<'_>, node: Node<'_, '_>, shape: &TrajectoryShape) -> Result<
 /// An `AssignRouteAction`: its `<Route>`, inline (with its own parameter declarations) or
 /// from a route catalog (`<CatalogReference>`, with the reference's parameter assignments).
 fn assign_route(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
-    let (holder, tag) = choice(r.text, node, &["Route", "CatalogReference"])?;
+    let (holder, tag) = choice(r.text, node, &support::ROUTE_REF)?;
     let waypoints = if tag == "Route" {
         route(&r.scoped(holder)?, holder)?
     } else {

@@ -9,6 +9,7 @@ use crate::model::{
     Trigger,
 };
 use crate::quantity::Quantity;
+use crate::support;
 use crate::xml::{choice, elements, need};
 
 /// A `StartTrigger` or `StopTrigger`: its condition groups.
@@ -94,7 +95,7 @@ fn condition(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Condition, XoscError> {
             })
         }
     };
-    let (by, tag) = choice(r.text, c, &["ByValueCondition", "ByEntityCondition"])?;
+    let (by, tag) = choice(r.text, c, &support::CONDITION)?;
     let kind = if tag == "ByValueCondition" {
         by_value(r, by)?
     } else {
@@ -112,7 +113,10 @@ fn condition(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Condition, XoscError> {
             let raw = c.attribute("name").unwrap_or_default().to_string();
             r.note(
                 c,
-                format!("this condition's name {raw:?} is not an expression paracosm evaluates (esmini's concatenate texts); it is a label nothing refers to, kept as written"),
+                format!(
+                    "this condition's name {raw:?} {}",
+                    support::CONDITION_NAME.note
+                ),
             );
             raw
         }
@@ -148,17 +152,7 @@ pub(super) fn rule(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Rule, XoscError
 }
 
 fn by_value(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError> {
-    let (v, tag) = choice(
-        r.text,
-        by,
-        &[
-            "SimulationTimeCondition",
-            "StoryboardElementStateCondition",
-            "ParameterCondition",
-            "VariableCondition",
-            "TrafficSignalCondition",
-        ],
-    )?;
+    let (v, tag) = choice(r.text, by, &support::BY_VALUE_CONDITION)?;
     Ok(match tag {
         "TrafficSignalCondition" => ConditionKind::TrafficSignal {
             signal: r.scope.string(r.text, v, "name")?,
@@ -240,26 +234,6 @@ fn by_value(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError
     })
 }
 
-/// The entity conditions paracosm reads.
-const ENTITY_CONDITIONS: &[&str] = &[
-    "TimeHeadwayCondition",
-    "TimeToCollisionCondition",
-    "RelativeDistanceCondition",
-    "ReachPositionCondition",
-    "DistanceCondition",
-    "SpeedCondition",
-    "RelativeSpeedCondition",
-    "AccelerationCondition",
-    "StandStillCondition",
-    "TraveledDistanceCondition",
-    "EndOfRoadCondition",
-    "CollisionCondition",
-    "OffroadCondition",
-    "AngleCondition",
-    "RelativeAngleCondition",
-    "RelativeClearanceCondition",
-];
-
 fn by_entity(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscError> {
     let t = need(r.text, by, "TriggeringEntities")?;
     let all = match r
@@ -295,7 +269,7 @@ fn by_entity(r: &Reader<'_>, by: Node<'_, '_>) -> Result<ConditionKind, XoscErro
     let (c, tag) = choice(
         r.text,
         need(r.text, by, "EntityCondition")?,
-        ENTITY_CONDITIONS,
+        &support::ENTITY_CONDITION,
     )?;
     Ok(ConditionKind::Entity {
         entities,
@@ -450,7 +424,7 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
             let (target, tag) = choice(
                 t,
                 need(t, c, "TimeToCollisionConditionTarget")?,
-                &["EntityRef", "Position"],
+                &support::TTC_TARGET,
             )?;
             if tag == "EntityRef" {
                 EntityTest::TimeToCollision(gap(r, c, target, Quantity::Duration)?)
@@ -509,7 +483,7 @@ fn entity_test(r: &Reader<'_>, c: Node<'_, '_>, tag: &str) -> Result<EntityTest,
             test: angle_test(r, c, "entity")?,
         },
         _ => {
-            let (target, tag) = choice(t, c, &["EntityRef", "ByType"])?;
+            let (target, tag) = choice(t, c, &support::COLLISION_TARGET)?;
             if tag == "EntityRef" {
                 EntityTest::Collision(Some(r.entity(target, "entityRef")?))
             } else {

@@ -67,10 +67,7 @@ fn inactive_override(r: &Reader<'_>, o: Node<'_, '_>) -> Result<(), XoscError> {
             ));
         }
     }
-    r.note(
-        o,
-        "every value of this OverrideControllerValueAction is inactive: it overrides nothing",
-    );
+    r.note(o, crate::support::INACTIVE_OVERRIDE.note);
     Ok(())
 }
 
@@ -90,7 +87,7 @@ fn assign(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Action, XoscError> {
         }
     }
     let holder = child(c, "ObjectController").unwrap_or(c);
-    let (def, tag) = choice(r.text, holder, &["Controller", "CatalogReference"])?;
+    let (def, tag) = choice(r.text, holder, &crate::support::CONTROLLER)?;
     let (controller, kind) = if tag == "Controller" {
         name_and_kind(r, def)?
     } else {

@@ -26,7 +26,10 @@ pub(super) fn road_network(
                 let mut file = super::join(&r.dir, &path);
                 if !file.exists() {
                     if let Some((found, why)) = map_elsewhere(r, &file) {
-                        r.note(c, format!("the map {path:?} {why}: read from {}", found.display()));
+                        r.note(
+                            c,
+                            format!("the map {path:?} {why}: read from {}", found.display()),
+                        );
                         file = found;
                     }
                 }
@@ -35,11 +38,13 @@ pub(super) fn road_network(
                     item: file.display().to_string(),
                 });
             }
-            "SceneGraphFile" => r.note(c, "the 3D model (SceneGraphFile) is not drawn: paracosm draws the road from the OpenDRIVE file"),
-            "TrafficSignals" => r.note(c, "traffic signal controllers are not simulated"),
+            "SceneGraphFile" => r.note(c, crate::support::SCENE_GRAPH.note),
+            "TrafficSignals" => r.note(c, crate::support::SIGNAL_CONTROLLERS.note),
             "UsedArea" => {}
             other => {
-                return Err(r.text.unsupported(c, format!("<{other}> in <RoadNetwork> is not supported")))
+                return Err(r
+                    .text
+                    .unsupported(c, format!("<{other}> in <RoadNetwork> is not supported")))
             }
         }
     }
@@ -100,8 +105,14 @@ pub(super) fn read(
                 .text
                 .invalid(obj, format!("a second entity is named {name:?}")));
         }
-        const BODIES: [&str; 4] = ["CatalogReference", "Vehicle", "Pedestrian", "MiscObject"];
-        only(r.text, obj, &[&BODIES[..], &["ObjectController"]].concat())?;
+        let group = &crate::support::ENTITY_OBJECT;
+        const BODIES: &[&str] = crate::support::ENTITY_OBJECT.read;
+        if let Some(c) =
+            elements(obj).find(|c| group.refused.iter().any(|(n, _)| c.has_tag_name(*n)))
+        {
+            return Err(crate::xml::refusal(r.text, obj, c, group));
+        }
+        only(r.text, obj, &[BODIES, &["ObjectController"]].concat())?;
         let bodies: Vec<Node<'_, '_>> = elements(obj)
             .filter(|c| BODIES.contains(&c.tag_name().name()))
             .collect();
@@ -110,7 +121,7 @@ pub(super) fn read(
                 obj,
                 format!(
                     "a scenario object holds one of {}",
-                    crate::xml::list(&BODIES)
+                    crate::xml::list(BODIES)
                 ),
             ));
         };
@@ -552,14 +563,14 @@ fn combination(r: &Reader<'_>, e: Node<'_, '_>) -> Result<Combination, XoscError
 /// # Errors
 /// Invalid for an element that holds none of these, or a trailer that is not a vehicle.
 fn trailer(r: &Reader<'_>, t: Node<'_, '_>) -> Result<Option<Towed>, XoscError> {
-    let (c, tag) = choice(r.text, t, &["Trailer", "TrailerRef", "EntityRef"])?;
+    let (c, tag) = choice(r.text, t, &crate::support::TRAILER)?;
     if tag != "Trailer" {
         let name = r.scope.string(r.text, c, "entityRef")?;
         let name = name.trim();
         return Ok((!name.is_empty())
             .then(|| Towed::Entity(name.to_owned(), r.text.attr_pos(c, "entityRef"))));
     }
-    let (v, tag) = choice(r.text, c, &["CatalogReference", "Vehicle"])?;
+    let (v, tag) = choice(r.text, c, &crate::support::TRAILER_BODY)?;
     let body = if tag == "CatalogReference" {
         r.catalogs.read_entry(r, v, &["Vehicle"], object)?
     } else {
@@ -599,7 +610,7 @@ fn performance(text: &Text, p: Node<'_, '_>, scope: &Scope) -> Result<Performanc
 
 /// An `ObjectController`: the controller's name.
 fn controller(r: &Reader<'_>, catalogs: &Catalogs, oc: Node<'_, '_>) -> Result<String, XoscError> {
-    let (c, tag) = choice(r.text, oc, &["CatalogReference", "Controller"])?;
+    let (c, tag) = choice(r.text, oc, &crate::support::CONTROLLER)?;
     if tag == "CatalogReference" {
         catalogs.with_entry(r, c, &["Controller"], |text, e, scope| {
             scope.string(text, e, "name")

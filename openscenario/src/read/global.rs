@@ -9,6 +9,7 @@ use super::Reader;
 use crate::error::XoscError;
 use crate::model::{Action, Environment};
 use crate::params::ParamType;
+use crate::support;
 use crate::xml::{child, choice, elements, need, only};
 use crate::Value;
 
@@ -19,28 +20,18 @@ use crate::Value;
 /// undeclared parameter or variable, a value not of its type, a modification of one that is
 /// not a number, an environment value out of range.
 pub(super) fn global(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscError> {
-    let (a, tag) = choice(
-        r.text,
-        node,
-        &[
-            "EnvironmentAction",
-            "EntityAction",
-            "ParameterAction",
-            "VariableAction",
-            "InfrastructureAction",
-        ],
-    )?;
+    let (a, tag) = choice(r.text, node, &support::GLOBAL_ACTION)?;
     match tag {
         "InfrastructureAction" => {
             let s = need(r.text, a, "TrafficSignalAction")?;
-            let (st, _) = choice(r.text, s, &["TrafficSignalStateAction"])?;
+            let (st, _) = choice(r.text, s, &support::TRAFFIC_SIGNAL_ACTION)?;
             Ok(Action::TrafficSignalState {
                 signal: r.scope.string(r.text, st, "name")?,
                 state: r.scope.string(r.text, st, "state")?,
             })
         }
         "EnvironmentAction" => {
-            let (e, tag) = choice(r.text, a, &["Environment", "CatalogReference"])?;
+            let (e, tag) = choice(r.text, a, &support::ENVIRONMENT_ACTION)?;
             let env = if tag == "Environment" {
                 environment(&r.scoped(e)?, e)?
             } else {
@@ -61,7 +52,7 @@ pub(super) fn global(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
 /// Invalid for an entity the file does not declare; Unsupported for an entity selection.
 fn entity_action(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Action, XoscError> {
     let entity = r.entity(a, "entityRef")?;
-    let (op, tag) = choice(r.text, a, &["AddEntityAction", "DeleteEntityAction"])?;
+    let (op, tag) = choice(r.text, a, &support::ENTITY_ACTION)?;
     if tag == "DeleteEntityAction" {
         return Ok(Action::DeleteEntity { entity });
     }
@@ -82,7 +73,7 @@ fn value_action(r: &Reader<'_>, a: Node<'_, '_>, variable: bool) -> Result<Actio
     };
     let name = r.name_ref(a, attr)?;
     let ty = declared_type(r, a, attr, &name, variable)?;
-    let (op, tag) = choice(r.text, a, &["SetAction", "ModifyAction"])?;
+    let (op, tag) = choice(r.text, a, &support::VALUE_ACTION)?;
     if tag == "SetAction" {
         let text = r.scope.string(r.text, op, "value")?;
         let value = ty
@@ -107,7 +98,7 @@ fn value_action(r: &Reader<'_>, a: Node<'_, '_>, variable: bool) -> Result<Actio
         ));
     }
     let rule = need(r.text, op, "Rule")?;
-    let (v, tag) = choice(r.text, rule, &["AddValue", "MultiplyByValue"])?;
+    let (v, tag) = choice(r.text, rule, &support::MODIFY_RULE)?;
     let by = r.scope.num(r.text, v, "value")?;
     Ok(Action::ModifyValue {
         name,
@@ -196,7 +187,7 @@ pub(super) fn environment(r: &Reader<'_>, e: Node<'_, '_>) -> Result<Environment
             });
         }
         if elements(rc).next().is_some() || rc.attribute("wetness").is_some() {
-            r.note(rc, "a road condition's properties and wetness are not modelled: its friction scale factor is");
+            r.note(rc, support::ROAD_CONDITION.note);
         }
         env.friction_scale = Some(f);
     }
@@ -218,15 +209,15 @@ fn weather(r: &Reader<'_>, w: Node<'_, '_>, env: &mut Environment) -> Result<(),
         "atmosphericPressure",
     ] {
         if w.attribute(a).is_some() {
-            r.note(w, format!("the weather's {a} is read but not modelled: paracosm's world has no counterpart"));
+            r.note(
+                w,
+                format!("the weather's {a} {}", support::WEATHER_PART.note),
+            );
         }
     }
     for c in ["Wind", "DomeImage"] {
         if let Some(n) = child(w, c) {
-            r.note(
-                n,
-                format!("<{c}> is read but not modelled: paracosm's world has no counterpart"),
-            );
+            r.note(n, format!("<{c}> {}", support::WEATHER_PART.note));
         }
     }
     if let Some(sun) = child(w, "Sun") {
@@ -241,10 +232,7 @@ fn weather(r: &Reader<'_>, w: Node<'_, '_>, env: &mut Environment) -> Result<(),
             ));
         }
         let elevation = sc.num(t, sun, "elevation")?;
-        r.note(
-            sun,
-            "the sun's azimuth is not modelled: paracosm's light is the same from every direction",
-        );
+        r.note(sun, support::SUN_AZIMUTH.note);
         env.sun = Some((lux, elevation));
     }
     if let Some(fog) = child(w, "Fog") {
@@ -256,10 +244,7 @@ fn weather(r: &Reader<'_>, w: Node<'_, '_>, env: &mut Environment) -> Result<(),
             });
         }
         if child(fog, "BoundingBox").is_some() {
-            r.note(
-                fog,
-                "a fog's bounding box is not modelled: the fog fills the world",
-            );
+            r.note(fog, support::FOG_BOX.note);
         }
         env.fog_visual_range_m = Some(range);
     }

@@ -9,22 +9,9 @@ use crate::model::{Orientation, Position};
 use crate::quantity::Quantity;
 use crate::xml::{child, choice};
 
-/// The positions paracosm reads.
-const POSITIONS: &[&str] = &[
-    "WorldPosition",
-    "RelativeWorldPosition",
-    "RelativeObjectPosition",
-    "RoadPosition",
-    "RelativeRoadPosition",
-    "LanePosition",
-    "RelativeLanePosition",
-    "RoutePosition",
-    "TrajectoryPosition",
-];
-
 /// A `<Position>` element.
 pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Position, XoscError> {
-    let (p, tag) = choice(r.text, node, POSITIONS)?;
+    let (p, tag) = choice(r.text, node, &crate::support::POSITION)?;
     let (s, t) = (&r.scope, r.text);
     Ok(match tag {
         "WorldPosition" => world(r, p)?,
@@ -90,7 +77,7 @@ fn route(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
     let (holder, tag) = choice(
         t,
         crate::xml::need(t, p, "RouteRef")?,
-        &["Route", "CatalogReference"],
+        &crate::support::ROUTE_REF,
     )?;
     let waypoints = if tag == "Route" {
         super::action::route(&r.scoped(holder)?, holder)?
@@ -101,11 +88,7 @@ fn route(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
     let (w, tag) = choice(
         t,
         crate::xml::need(t, p, "InRoutePosition")?,
-        &[
-            "FromCurrentEntity",
-            "FromLaneCoordinates",
-            "FromRoadCoordinates",
-        ],
+        &crate::support::IN_ROUTE_POSITION,
     )?;
     let at = match tag {
         "FromCurrentEntity" => InRoute::Entity(r.entity(w, "entityRef")?),
@@ -150,7 +133,7 @@ fn world(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
         if s.opt_num(t, p, a)?.is_some_and(|v| v != 0.0) {
             r.note(
                 p,
-                format!("a world position's {a} is not honoured: paracosm's roads are flat"),
+                format!("a world position's {a} {}", crate::support::WORLD_Z.note),
             );
         }
     }
@@ -167,10 +150,7 @@ fn world(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
 fn relative(r: &Reader<'_>, p: Node<'_, '_>, tag: &str) -> Result<Position, XoscError> {
     let (s, t) = (&r.scope, r.text);
     if s.opt_num(t, p, "dz")?.is_some_and(|v| v != 0.0) {
-        r.note(
-            p,
-            "a relative position's dz is not honoured: paracosm's roads are flat",
-        );
+        r.note(p, crate::support::RELATIVE_DZ.note);
     }
     let (entity, dx, dy) = (
         r.entity(p, "entityRef")?,

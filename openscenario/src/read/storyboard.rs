@@ -122,10 +122,7 @@ fn act(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Act, XoscError> {
                 .scope
                 .bool(r.text, actors_node, "selectTriggeringEntities")?
         {
-            r.note(
-                actors_node,
-                "this maneuver group names no actor (and selectTriggeringEntities is false): its private actions act on nobody",
-            );
+            r.note(actors_node, crate::support::NO_ACTOR.note);
         }
         let mut maneuvers = Vec::new();
         for m in elements(g) {
@@ -161,10 +158,7 @@ fn act(r: &Reader<'_>, a: Node<'_, '_>) -> Result<Act, XoscError> {
     let start = match child(a, "StartTrigger") {
         Some(t) => Some(condition::trigger(r, t)?),
         None => {
-            r.note(
-                a,
-                "this act has no <StartTrigger>, which the standard requires: it starts at once",
-            );
+            r.note(a, crate::support::ACT_WITHOUT_START.note);
             None
         }
     };
@@ -247,15 +241,7 @@ fn maneuver(r: &Reader<'_>, m: Node<'_, '_>) -> Result<Maneuver, XoscError> {
                 action: match p.tag_name().name() {
                     "PrivateAction" => action::private(r, p)?,
                     "GlobalAction" => global::global(r, p)?,
-                    other => {
-                        return Err(r.text.unsupported(
-                            p,
-                            format!(
-                                "<{other}> in <Action> is not supported; paracosm reads \
-                                 <PrivateAction> or <GlobalAction>"
-                            ),
-                        ))
-                    }
+                    _ => return Err(crate::xml::refusal(r.text, a, p, &crate::support::ACTION)),
                 },
             });
         }

@@ -52,7 +52,7 @@ pub(super) fn read(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscErr
 /// A `<FinalSpeed>`: `AbsoluteSpeed` or `RelativeSpeedToMaster`, each with an optional
 /// steady state.
 fn final_speed(r: &Reader<'_>, node: Node<'_, '_>) -> Result<FinalSpeed, XoscError> {
-    let (s, tag) = choice(r.text, node, &["AbsoluteSpeed", "RelativeSpeedToMaster"])?;
+    let (s, tag) = choice(r.text, node, &crate::support::FINAL_SPEED)?;
     let relative = if tag == "AbsoluteSpeed" {
         None
     } else {
