@@ -64,6 +64,11 @@ pub struct Scenario {
     pub stop: Option<Trigger>,
     /// What was read but is not honoured as written.
     pub notes: Vec<Note>,
+    /// Each orientation with a pitch or roll other than 0 (a bicycle that falls over, a
+    /// pedestrian lying down): the storyboard moves its entity's position and heading as
+    /// written, and a campaign refuses it, since paracosm's bodies stand upright on flat
+    /// roads (their footprint would change).
+    pub tilts: Vec<Note>,
 }
 
 /// What kind of object an entity is.

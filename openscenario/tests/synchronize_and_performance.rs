@@ -513,3 +513,44 @@ fn a_speed_profile_reads_its_entries_and_refuses_what_it_cannot_honour() {
         "{e}"
     );
 }
+
+/// An orientation's pitch or roll (a bicycle falling over) is read: listed among the
+/// scenario's tilts at its attribute, and noted; a pitch and roll of 0 are no tilt.
+#[test]
+fn a_pitch_or_roll_is_read_as_a_tilt_at_its_attribute() {
+    let teleport = |o: &str| {
+        format!(
+            r#"<TeleportAction><Position><RelativeObjectPosition entityRef="Ego" dx="1" dy="0">{o}</RelativeObjectPosition></Position></TeleportAction>"#
+        )
+    };
+    let s = read(
+        "tilt",
+        &scenario(
+            PERFORMANCE,
+            false,
+            &teleport(r#"<Orientation type="relative" h="0" p="0" r="1.5"/>"#),
+            SPEED,
+        ),
+    )
+    .unwrap();
+    assert_eq!(s.tilts.len(), 1, "{:?}", s.tilts);
+    let t = &s.tilts[0];
+    assert!(t.pos.to_string().contains(":17:"), "{}", t.pos);
+    assert!(
+        t.text.contains("roll of 1.5 rad tilts its entity"),
+        "{}",
+        t.text
+    );
+    assert!(s.notes.iter().any(|n| n.text == t.text));
+    let s = read(
+        "flat",
+        &scenario(
+            PERFORMANCE,
+            false,
+            &teleport(r#"<Orientation type="relative" h="0.2" p="0" r="0"/>"#),
+            SPEED,
+        ),
+    )
+    .unwrap();
+    assert!(s.tilts.is_empty());
+}

@@ -443,6 +443,19 @@ impl<'de> Deserialize<'de> for MapRef {
 }
 
 impl RoadMap {
+    /// A map with no roads, named `source`: the ground of a scenario that names no road
+    /// network (esmini's examples of a parking lot, a combination of vehicles on open
+    /// ground). Every position on it is off the road; nothing can be placed on a lane.
+    pub fn empty(source: &str) -> RoadMap {
+        RoadMap {
+            source: source.to_string(),
+            origin_m: [0.0, 0.0],
+            roads: Vec::new(),
+            lanes: Vec::new(),
+            signals: Vec::new(),
+        }
+    }
+
     /// The bounding box of every lane's strip, world `([x_min, z_min], [x_max, z_max])` m.
     pub fn bounds_m(&self) -> ([f64; 2], [f64; 2]) {
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);

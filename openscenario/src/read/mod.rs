@@ -36,6 +36,8 @@ pub(crate) struct Reader<'t> {
     /// of the entities, each once).
     pub(crate) selections: std::rc::Rc<Vec<(String, Vec<usize>)>>,
     pub(crate) notes: std::rc::Rc<std::cell::RefCell<Vec<Note>>>,
+    /// Where an orientation tilts an entity ([`Scenario::tilts`]).
+    pub(crate) tilts: std::rc::Rc<std::cell::RefCell<Vec<Note>>>,
     pub(crate) dir: PathBuf,
     /// The scenario's catalog folders (read once its `CatalogLocations` are), shared by the
     /// readers of nested scopes and of catalog entries.
@@ -109,6 +111,7 @@ impl<'t> Reader<'t> {
             names: std::rc::Rc::clone(&self.names),
             selections: std::rc::Rc::clone(&self.selections),
             notes: self.notes.clone(),
+            tilts: self.tilts.clone(),
             dir: self.dir.clone(),
             catalogs: std::rc::Rc::clone(&self.catalogs),
             globals: std::rc::Rc::clone(&self.globals),
@@ -132,6 +135,7 @@ impl<'t> Reader<'t> {
             names: std::rc::Rc::clone(&self.names),
             selections: std::rc::Rc::clone(&self.selections),
             notes: self.notes.clone(),
+            tilts: self.tilts.clone(),
             dir: Path::new(&text.file)
                 .parent()
                 .map(Path::to_path_buf)
@@ -284,6 +288,7 @@ fn read_with(
         names: std::rc::Rc::default(),
         selections: std::rc::Rc::default(),
         notes: Default::default(),
+        tilts: Default::default(),
         dir: dir.to_path_buf(),
         catalogs: std::rc::Rc::default(),
         globals: std::rc::Rc::new(decls.iter().map(|d| (d.name.clone(), d.ty)).collect()),
@@ -323,6 +328,7 @@ fn read_with(
         stories,
         stop,
         notes: r.notes.take(),
+        tilts: r.tilts.take(),
     })
 }
 

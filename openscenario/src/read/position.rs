@@ -217,9 +217,22 @@ fn orientation(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Option<Orientation>, X
             })
         }
     };
-    for a in ["p", "r"] {
-        if r.scope.opt_num(r.text, o, a)?.is_some_and(|v| v != 0.0) {
-            return Err(r.text.unsupported(o, format!("an orientation's {a} (pitch or roll) is not supported: paracosm's roads are flat")));
+    for (a, what) in [("p", "pitch"), ("r", "roll")] {
+        if let Some(v) = r
+            .scope
+            .opt_num_in(r.text, o, a, Quantity::Angle)?
+            .filter(|v| *v != 0.0)
+        {
+            let text = format!(
+                "an orientation's {what} of {v} rad tilts its entity: the storyboard moves its \
+                 position and heading as written, and a campaign refuses it (paracosm's bodies \
+                 stand upright on flat roads)"
+            );
+            r.tilts.borrow_mut().push(crate::model::Note {
+                pos: r.text.attr_pos(o, a),
+                text: text.clone(),
+            });
+            r.note(o, text);
         }
     }
     Ok(Some(Orientation {

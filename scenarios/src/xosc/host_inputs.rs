@@ -36,6 +36,7 @@ impl HostInputs for StoryInputs {
             stories,
             stop,
             notes,
+            tilts,
         } = &*self.0;
         // A parameter that a condition reads while the test runs is read by the storyboard.
         let read_by_conditions = |a: &m::Scenario, b: &m::Scenario| {
@@ -56,6 +57,7 @@ impl HostInputs for StoryInputs {
             && *stories == b.stories
             && *stop == b.stop
             && *notes == b.notes
+            && *tilts == b.tilts
     }
 
     fn as_any(&self) -> &dyn std::any::Any {

@@ -228,6 +228,15 @@ pub fn ego_of(
 /// # Errors
 /// [`ScenarioError::Load`] naming the element's line and column.
 pub fn check(s: &m::Scenario, ego: Option<usize>) -> Result<Vec<Warning>, ScenarioError> {
+    if let Some(t) = s.tilts.first() {
+        return Err(worlds_error(format!(
+            "{}: {}. paracosm's engine cannot tilt a body: a tilted entity's footprint on the \
+             road (a bicycle lying on its side, a pedestrian lying down) is not its upright \
+             box, so its collisions would be misjudged. paracosm-fuzz xosc lists the file",
+            t.pos,
+            t.text.split(':').next().unwrap_or(&t.text)
+        )));
+    }
     let mut warnings: Vec<Warning> = s
         .notes
         .iter()

@@ -121,12 +121,80 @@ pub struct Timed {
     pub vertices: Vec<(f64, Pose)>,
     /// How the heading turns between vertices.
     pub turn: Turn,
+    /// In `followingMode="follow"`, each leg's motion at a constant acceleration
+    /// ([`Legs`]); `None`: at a constant speed (`position`).
+    pub legs: Option<Legs>,
+}
+
+/// A timed polyline followed in esmini's `follow` mode (`PolyLineShape::CalculatePolyLine`):
+/// each leg at a constant acceleration, from the speed the leg before ended at (the first
+/// from the entity's speed when the action starts), so that the leg's length is covered in
+/// its time; a leg that would end below 0 m/s ends at 0 m/s sooner, as esmini's does.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Legs {
+    /// Each vertex's distance along the polyline, m.
+    station_m: Vec<f64>,
+    /// The speed at each vertex, m/s.
+    speed_mps: Vec<f64>,
+    /// The acceleration on the leg from each vertex, m/s² (0 from the last).
+    acc_mps2: Vec<f64>,
+}
+
+impl Legs {
+    /// The legs of `vertices` (`(t, pose)`, increasing `t`) entered at `v0` m/s.
+    pub fn new(vertices: &[(f64, Pose)], v0: f64) -> Legs {
+        let n = vertices.len();
+        let mut station_m = vec![0.0; n];
+        for i in 1..n {
+            let (a, b) = (vertices[i - 1].1, vertices[i].1);
+            station_m[i] = station_m[i - 1] + (b.x - a.x).hypot(b.y - a.y);
+        }
+        let (mut speed_mps, mut acc_mps2) = (vec![v0; n], vec![0.0; n]);
+        let mut v = v0;
+        for i in 1..n {
+            let ds = station_m[i] - station_m[i - 1];
+            let dt = vertices[i].0 - vertices[i - 1].0;
+            let mut acc = 0.0;
+            if ds.abs() > 1e-6 && dt > TIME_EPS_S {
+                acc = 2.0 * (ds - v * dt) / (dt * dt);
+                // esmini's SIGN: 0 counts as positive.
+                if ((v + acc * dt) < 0.0) != (v < 0.0) {
+                    // Too long for a constant acceleration to 0 m/s: it arrives sooner.
+                    acc = -v * v / (2.0 * ds);
+                    v = 0.0;
+                } else {
+                    v += acc * dt;
+                }
+            } else if ds.abs() <= 1e-6 {
+                v = 0.0;
+            }
+            acc_mps2[i - 1] = acc;
+            speed_mps[i] = v;
+        }
+        Legs {
+            station_m,
+            speed_mps,
+            acc_mps2,
+        }
+    }
+
+    /// The distance along the polyline at `t` (s), m, on leg `i` (from vertex `i`, whose
+    /// time is `t_i`).
+    fn station(&self, i: usize, t_i: f64, t: f64) -> f64 {
+        let (v, a) = (self.speed_mps[i], self.acc_mps2[i]);
+        let mut dt = (t - t_i).max(0.0);
+        if a < 0.0 {
+            dt = dt.min(-v / a);
+        }
+        self.station_m[i] + v * dt + 0.5 * a * dt * dt
+    }
 }
 
 impl Timed {
-    /// The pose at `t` (s): the position linear between vertices, the heading turned as
-    /// [`Turn`] says (a vertex whose file gives no heading faces along its leg: the
-    /// storyboard fills it in), and whether `t` is past the last vertex.
+    /// The pose at `t` (s): the position linear between vertices (or, with [`Legs`], at the
+    /// distance each leg's acceleration gives), the heading turned as [`Turn`] says (a
+    /// vertex whose file gives no heading faces along its leg: the storyboard fills it in),
+    /// and whether `t` is past the last vertex.
     pub fn at(&self, t: f64) -> (Pose, bool) {
         let n = self.vertices.len();
         let last = self.vertices[n - 1];
@@ -136,6 +204,9 @@ impl Timed {
         let first = self.vertices[0];
         if t <= first.0 {
             return (first.1, false);
+        }
+        if let Some(legs) = &self.legs {
+            return (self.along(legs, t), false);
         }
         // A time within rounding of a vertex's is the vertex's (a step that adds `dt` to the
         // time lands a few ulps short of the vertex it means, and would face as the vertex
@@ -166,6 +237,37 @@ impl Timed {
             },
             false,
         )
+    }
+
+    /// The pose at `t` (s, within the vertices' times) with `legs`: on the leg whose end
+    /// time is the first at or after `t` (esmini's `PolyLineShape::Evaluate`), at the
+    /// distance its acceleration gives, in the leg that distance falls on.
+    fn along(&self, legs: &Legs, t: f64) -> Pose {
+        let n = self.vertices.len();
+        let i = (0..n - 1)
+            .find(|&i| self.vertices[i + 1].0 >= t)
+            .unwrap_or(n - 2);
+        let s = legs.station(i, self.vertices[i].0, t);
+        // The leg `s` falls on (a later one where the leg before is shorter).
+        let j = (i..n - 1)
+            .find(|&j| s <= legs.station_m[j + 1] + 1e-12)
+            .unwrap_or(n - 2);
+        let (a, b) = (self.vertices[j].1, self.vertices[j + 1].1);
+        let len = legs.station_m[j + 1] - legs.station_m[j];
+        let local = (s - legs.station_m[j]).clamp(0.0, len);
+        let u = if len > 0.0 { local / len } else { 1.0 };
+        let h = match self.turn {
+            Turn::None => a.h,
+            turn => {
+                let hs: Vec<f64> = self.vertices.iter().map(|v| v.1.h).collect();
+                turn.heading(&hs, j, local, len)
+            }
+        };
+        Pose {
+            x: a.x + u * (b.x - a.x),
+            y: a.y + u * (b.y - a.y),
+            h,
+        }
     }
 }
 
@@ -476,11 +578,56 @@ mod tests {
         assert!((acc - a).abs() < 1e-2, "{acc}");
     }
 
+    /// In `follow` mode each leg is covered at a constant acceleration from the speed the leg
+    /// before ended at (esmini's `bicycle_fall_over`: at 10 m/s, 20 m in 2 s and 5 m in
+    /// 0.5 s keep 10 m/s; 5 m in 1 s then brakes from 10 to 0 m/s, 128.75 m at its middle;
+    /// a leg of no length stands); in `position` mode each leg is at its own constant speed.
+    #[test]
+    fn a_timed_polyline_in_follow_mode_accelerates_along_each_leg() {
+        let p = |x: f64| Pose { x, y: 0.0, h: 0.0 };
+        let vertices = vec![
+            (0.0, p(100.0)),
+            (2.0, p(120.0)),
+            (2.5, p(125.0)),
+            (3.5, p(130.0)),
+            (4.0, p(130.0)),
+        ];
+        let follow = Timed {
+            turn: Turn::Segment,
+            legs: Some(Legs::new(&vertices, 10.0)),
+            vertices: vertices.clone(),
+        };
+        let position = Timed {
+            turn: Turn::Segment,
+            legs: None,
+            vertices,
+        };
+        for (t, x) in [
+            (1.0, 110.0),
+            (2.25, 122.5),
+            (3.0, 128.75),
+            (3.4, 129.95),
+            (3.8, 130.0),
+        ] {
+            let (q, done) = follow.at(t);
+            assert!(!done && (q.x - x).abs() < 1e-9, "{t}: {}", q.x);
+        }
+        assert!((position.at(3.0).0.x - 127.5).abs() < 1e-9);
+        // Entered at rest, the first leg accelerates: 20 m in 2 s at 10 m/s², 5 m at 1 s.
+        let from_rest = Legs::new(&follow.vertices, 0.0);
+        let at_rest = Timed {
+            legs: Some(from_rest),
+            ..follow.clone()
+        };
+        assert!((at_rest.at(1.0).0.x - 105.0).abs() < 1e-9);
+    }
+
     #[test]
     fn a_timed_polyline_is_linear_between_its_vertices_facing_as_each_leg_starts() {
         let p = |x: f64, y: f64| Pose { x, y, h: 0.3 };
         let path = Timed {
             turn: Turn::None,
+            legs: None,
             vertices: vec![
                 (1.0, p(0.0, 0.0)),
                 (

@@ -31,7 +31,7 @@ use paracosm_openscenario::model::{
 };
 
 use super::motion::{
-    clothoid_poses, duration_s, nurbs_poses, offset_duration_s, shape_of, Timed, Transition,
+    clothoid_poses, duration_s, nurbs_poses, offset_duration_s, shape_of, Legs, Timed, Transition,
     Untimed,
 };
 use paracosm_engine::network::roads::{wrap, LanePos, Pose, RoadError, Roads};

@@ -349,8 +349,12 @@ impl Storyboard {
                 }
             }
         }
+        // Facing as it faced its lane (esmini's motion along `s` keeps the heading relative
+        // to the road: a bicycle carried sideways on a rack stays sideways).
+        let mut pose = self.roads.pose_of(&lp);
+        pose.h = wrap(self.roads.travel_heading(&lp) + self.drives[e].rel_h);
         let st = &mut self.actors[e].state;
-        st.pose = self.roads.pose_of(&lp);
+        st.pose = pose;
         st.lane = Some(lp);
         // And it takes the reference's speed.
         st.speed = r.state.speed;

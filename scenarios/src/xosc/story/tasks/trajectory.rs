@@ -65,12 +65,18 @@ impl Storyboard {
         let path = match timing {
             Some((absolute, scale, offset)) if timed => {
                 let base = if *absolute { 0.0 } else { t };
+                let vertices: Vec<(f64, Pose)> = points
+                    .iter()
+                    .map(|(time, p)| (base + time.unwrap_or(0.0) * scale + offset, *p))
+                    .collect();
+                // A polyline in `follow` mode: each leg at a constant acceleration from the
+                // entity's speed now, as esmini's `PolyLineShape::CalculatePolyLine` plans it.
+                let legs = (matches!(shape, TrajectoryShape::Polyline(_)) && !position_mode)
+                    .then(|| Legs::new(&vertices, self.actors[e].state.speed));
                 Path::Timed(Timed {
-                    vertices: points
-                        .iter()
-                        .map(|(time, p)| (base + time.unwrap_or(0.0) * scale + offset, *p))
-                        .collect(),
+                    vertices,
                     turn,
+                    legs,
                 })
             }
             _ => Path::Untimed(Untimed {
