@@ -219,7 +219,7 @@ fn check_runs(runs: &[Run]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 45] = [
+const ESMINI_EXAMPLES: [&str; 47] = [
     "acc-test",
     "alks_cut-in",
     "alks_cut-out",
@@ -249,6 +249,7 @@ const ESMINI_EXAMPLES: [&str; 45] = [
     "lane-change_trajectory_wp",
     "left-hand-traffic_by_heading",
     "left-hand-traffic_using_road_rule",
+    "light_state",
     "long_dist_action_with_jerk",
     "ltap-od",
     "offroad_follower",
@@ -263,6 +264,7 @@ const ESMINI_EXAMPLES: [&str; 45] = [
     "synch_with_steady_state",
     "synchronize",
     "traffic_lights",
+    "trailer_connect",
     "tunnels",
     "two_plus_one_road",
 ];

@@ -280,9 +280,39 @@ pub struct Untimed {
     pub gone_m: f64,
     /// How the heading turns between vertices.
     pub turn: Turn,
+    /// How the entity faced the path's direction where it started on it (esmini's
+    /// `initialHeadingSign_`): `1.0` along it, `-1.0` against it (a car that reverses along
+    /// a path laid behind it). Its distance along the path changes by its own move times this,
+    /// and against the path it faces the other way, unless the path gives its headings
+    /// ([`Untimed::explicit`]).
+    pub facing: f64,
+    /// Every vertex gives its heading (a polyline whose vertices each have an orientation):
+    /// the entity takes them as they are, whichever way it moves.
+    pub explicit: bool,
 }
 
 impl Untimed {
+    /// The direction of travel along the path (rad) at distance `at` (m): the direction of
+    /// the leg there.
+    pub fn direction_at(&self, at: f64) -> f64 {
+        let mut left = at.max(0.0);
+        let legs: Vec<(Pose, Pose)> = self
+            .vertices
+            .windows(2)
+            .map(|w| (w[0], w[1]))
+            .filter(|(a, b)| (b.x - a.x).hypot(b.y - a.y) > 1e-9)
+            .collect();
+        for (a, b) in &legs {
+            let len = (b.x - a.x).hypot(b.y - a.y);
+            if left <= len {
+                return (b.y - a.y).atan2(b.x - a.x);
+            }
+            left -= len;
+        }
+        legs.last()
+            .map_or(self.vertices[0].h, |(a, b)| (b.y - a.y).atan2(b.x - a.x))
+    }
+
     /// The distance along the path, m, of its point nearest `p` (`[x, y]`, m).
     pub fn station_of(&self, p: [f64; 2]) -> f64 {
         let (mut best, mut best_d2, mut along) = (0.0, f64::INFINITY, 0.0);
@@ -307,8 +337,28 @@ impl Untimed {
 
     /// Goes `dist` m further; the pose there and whether the end is reached.
     pub fn advance(&mut self, dist: f64) -> (Pose, bool) {
-        self.gone_m += dist.max(0.0);
-        let mut left = self.gone_m;
+        let (pose, over) = self.advance_along(dist * self.facing);
+        if self.facing < 0.0 && !self.explicit {
+            return (
+                Pose {
+                    h: paracosm_engine::network::roads::wrap(pose.h + std::f64::consts::PI),
+                    ..pose
+                },
+                over,
+            );
+        }
+        (pose, over)
+    }
+
+    /// [`Untimed::advance`] by `along` m along the path's direction (backwards when
+    /// negative: it is over once back at the path's start).
+    fn advance_along(&mut self, along: f64) -> (Pose, bool) {
+        self.gone_m += along;
+        if along < 0.0 && self.gone_m <= 1e-6 {
+            self.gone_m = 0.0;
+            return (self.vertices[0], true);
+        }
+        let mut left = self.gone_m.max(0.0);
         for (i, w) in self.vertices.windows(2).enumerate() {
             let (a, b) = (w[0], w[1]);
             let len = (b.x - a.x).hypot(b.y - a.y);
@@ -435,6 +485,10 @@ const NURBS_SAMPLES: usize = 100_000;
 /// `NURBS_STEPLENGTH`).
 const NURBS_STEP_M: f64 = 1.0;
 
+/// The step of a NURBS curve's parameter over which a sample's tangent is taken (esmini's
+/// `NurbsShape::CalculatePolyLine`: 0.001, or the sampling step if smaller).
+const NURBS_TANGENT_STEP: f64 = 0.001;
+
 /// One control point of a NURBS trajectory: its time (s), weight (> 0), `[x, y]` (m) and the
 /// heading its position gives (rad), if it gives one.
 pub type ControlPoint = (Option<f64>, f64, [f64; 2], Option<f64>);
@@ -445,8 +499,8 @@ pub type ControlPoint = (Option<f64>, f64, [f64; 2], Option<f64>);
 /// the standard's optional times and headings (`roadmanager::NurbsShape`). Each control point's time belongs to the parameter
 /// where its basis function peaks, and times are linear in the parameter between those
 /// (when every control point has one). A point faces as the control points' headings blend
-/// by the same rational basis when every control point gives one, else along the curve (the
-/// next point; the last as the one before).
+/// by the same rational basis when every control point gives one, else along the curve (its
+/// tangent at each sample, the first as the second, as esmini faces them).
 pub fn nurbs_poses(
     order: usize,
     points: &[ControlPoint],
@@ -485,17 +539,41 @@ pub fn nurbs_poses(
         })
         .collect();
     if !headed {
-        for k in 0..out.len() {
-            let (a, b) = if k + 1 < out.len() {
-                (out[k].1, out[k + 1].1)
+        // Along the curve, as esmini's `NurbsShape::CalculatePolyLine` faces each sample: its
+        // tangent, from the point a small step of the parameter further (before, at the
+        // last); the first sample as the second (esmini resolves the first segment's heading
+        // from its successor); a sample where the curve does not move as the one before.
+        let at = |u: f64| {
+            let (first, b) = basis(order, knots, n, u);
+            let near = points.get(first..).unwrap_or(&[]);
+            let w: f64 = b.iter().zip(near).map(|(bi, p)| bi * p.1).sum();
+            let w = if w > 0.0 { w } else { 1.0 };
+            b.iter().zip(near).fold([0.0, 0.0], |[x, y], (bi, p)| {
+                [x + bi * p.1 / w * p.2[0], y + bi * p.1 / w * p.2[1]]
+            })
+        };
+        let step = ((u1 - u0) / (samples - 1) as f64).min(NURBS_TANGENT_STEP);
+        let m = out.len();
+        for k in 1..m {
+            let (u, p) = (out[k].0, out[k].1);
+            let [qx, qy] = if k + 1 < m {
+                at((u + step).min(u1))
             } else {
-                (out[k - 1].1, out[k].1)
+                at((u - step).max(u0))
             };
-            if (b.x - a.x).hypot(b.y - a.y) > 1e-12 {
-                out[k].1.h = (b.y - a.y).atan2(b.x - a.x);
-            } else if k > 0 {
-                out[k].1.h = out[k - 1].1.h;
-            }
+            let (dx, dy) = if k + 1 < m {
+                (qx - p.x, qy - p.y)
+            } else {
+                (p.x - qx, p.y - qy)
+            };
+            out[k].1.h = if dx.hypot(dy) > 1e-6 {
+                dy.atan2(dx)
+            } else {
+                out[k - 1].1.h
+            };
+        }
+        if m > 1 {
+            out[0].1.h = out[1].1.h;
         }
     }
     let times: Option<Vec<f64>> = points.iter().map(|p| p.0).collect();
@@ -622,6 +700,31 @@ mod tests {
         assert!((at_rest.at(1.0).0.x - 105.0).abs() < 1e-9);
     }
 
+    /// An entity that faces against a path it follows (esmini's `initialHeadingSign_` of
+    /// −1: a car reversing along a path laid behind it, as in esmini's `trailer_connect`) goes
+    /// along the path at a negative speed, facing away from the way it goes; the path's own
+    /// headings, when it gives them, are taken as they are; at a positive speed it goes back
+    /// along the path and the trajectory is over at its start.
+    #[test]
+    fn an_entity_facing_against_its_path_reverses_along_it() {
+        let p = |x: f64| Pose { x, y: 0.0, h: 0.0 };
+        let mut u = Untimed {
+            turn: Turn::Segment,
+            vertices: vec![p(0.0), p(10.0)],
+            gone_m: 0.0,
+            facing: -1.0,
+            explicit: false,
+        };
+        assert_eq!(u.direction_at(3.0), 0.0);
+        let (q, over) = u.advance(-4.0);
+        assert!(!over && (q.x - 4.0).abs() < 1e-12);
+        assert!((q.h - std::f64::consts::PI).abs() < 1e-12, "{}", q.h);
+        u.explicit = true;
+        assert_eq!(u.advance(-1.0).0.h, 0.0);
+        let (q, over) = u.advance(6.0);
+        assert!(over && q.x == 0.0, "{q:?}");
+    }
+
     #[test]
     fn a_timed_polyline_is_linear_between_its_vertices_facing_as_each_leg_starts() {
         let p = |x: f64, y: f64| Pose { x, y, h: 0.3 };
@@ -649,6 +752,8 @@ mod tests {
             turn: Turn::None,
             vertices: vec![p(0.0, 0.0), p(3.0, 0.0), p(3.0, 4.0)],
             gone_m: 0.0,
+            facing: 1.0,
+            explicit: false,
         };
         let (q, done) = u.advance(5.0);
         assert!(!done && (q.x - 3.0).abs() < 1e-12 && (q.y - 2.0).abs() < 1e-12);

@@ -131,18 +131,6 @@ impl Storyboard {
         // not at all in the step an event teleported it.
         let held = std::mem::take(&mut self.drives[e].teleported);
         let dist = if held { 0.0 } else { v1 * dt };
-        // A timed trajectory's timing moves it, whatever its speed.
-        if dist < 0.0 && matches!(self.drives[e].path, Some((Path::Untimed(_), _))) {
-            return Err(StoryError {
-                at: self.drives[e].path_at.clone(),
-                message: format!(
-                    "{} is asked to reverse ({v1:.2} m/s) along a trajectory it follows at its \
-                     speed, which paracosm does not do (it reverses along its lane, and on a \
-                     timed trajectory as its timing says)",
-                    self.actors[e].name
-                ),
-            });
-        }
         // A kept lateral distance moves it itself, or places it on its lane to move on from.
         let (lat, lat_ended) = self.lat_keep_step(e, v1, dt);
         done.extend(lat_ended);
@@ -225,6 +213,10 @@ impl Storyboard {
             lane = Some(l);
             at_end = end;
             done.extend(ended);
+        } else if self.roads.map().roads.is_empty() {
+            // On open ground (no road network) nothing but a trajectory moves it: esmini's
+            // default controller cannot move it along a road and stops it.
+            speed_now = 0.0;
         } else {
             (pose, lane) = self.straight_on(e, pose, dist);
         }

@@ -174,6 +174,10 @@ pub struct Storyboard {
     /// Whether the storyboard's stop trigger has fired.
     pub ended: bool,
     started: bool,
+    /// Actions that end in the next step's tasks: a `LightStateAction`, an
+    /// `AnimationAction` or a `VisibilityAction` (esmini ends them in their first `Step`,
+    /// the frame after they start).
+    ending_next: Vec<usize>,
     /// The speed the storyboard asks of the ego the system under test drives now, m/s: its
     /// `SpeedAction`s' transitions, which the host hands the system as its set speed
     /// ([`Storyboard::set_speed`]); `None` until one starts.
@@ -267,6 +271,9 @@ impl Storyboard {
         sb.resolve_references();
         sb.check_signals()?;
         sb.perform_init(scenario)?;
+        // Trailers Init did not line up (their tow placed by a trajectory) are pulled to
+        // their tows, as in esmini's initial frame.
+        sb.pull_trailers(0.0);
         for a in &mut sb.actors {
             let st = &mut a.state;
             st.vel = [st.speed * st.pose.h.cos(), st.speed * st.pose.h.sin()];
@@ -339,6 +346,7 @@ impl Storyboard {
             signals: Vec::new(),
             ended: false,
             started: false,
+            ending_next: Vec::new(),
             set_speed: None,
             hand_over: None,
             route: None,
@@ -571,6 +579,9 @@ impl Storyboard {
             if self.evaluate(k, t) {
                 self.ended = true;
             }
+        }
+        for a in std::mem::take(&mut self.ending_next) {
+            self.task_done(Some(a));
         }
         for r in self.roots.clone() {
             self.run_story(r, t)?;

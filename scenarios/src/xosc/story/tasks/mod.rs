@@ -52,6 +52,14 @@ impl Storyboard {
         let mut unplaced: Vec<bool> = vec![false; self.actors.len()];
         for (e, _) in &scenario.init {
             self.actors[*e].present = true;
+            // Its trailers with it (esmini activates a combination whole), where they are
+            // until a placement lines them up or their tow pulls them.
+            let mut next = self.actors[*e].trailer;
+            for _ in 0..self.actors.len() {
+                let Some(k) = next else { break };
+                self.actors[k].present = true;
+                next = self.actors[k].trailer;
+            }
         }
         for (e, _) in &places {
             unplaced[*e] = true;
@@ -235,7 +243,13 @@ impl Storyboard {
             | Action::TrafficSignalState { .. } => {}
             // Nothing the storyboard moves reads lights or visibility: the front end refuses
             // a visibility that a system under test would sense ([`crate::xosc::check`]).
-            Action::Appearance(_) | Action::Visibility { .. } => {}
+            // Each ends in the next step, as esmini's ends in its first `Step`.
+            Action::Appearance(_) | Action::Visibility { .. } => {
+                if let Some(a) = a {
+                    self.elems[a].pending += 1;
+                    self.ending_next.push(a);
+                }
+            }
         }
         Ok(())
     }

@@ -56,7 +56,8 @@ impl Storyboard {
     /// `ScenarioEngine::step` does: each trailer's coupler is put at its tow's hitch, on the
     /// line from the hitch to where the trailer was, and the trailer faces the hitch (a
     /// trailer follows its tow's path as a tractrix); it has its tow's speed, and is in the
-    /// scenario while its tow is.
+    /// scenario while its tow is. With `dt` 0 (after `Init`, as esmini's initial frame pulls
+    /// them) only their poses change.
     pub(in crate::xosc::story) fn pull_trailers(&mut self, dt: f64) {
         for e in 0..self.actors.len() {
             if self.actors[e].trailer.is_none() || self.tow_of(e).is_some() {
@@ -89,15 +90,18 @@ impl Storyboard {
                     .map(|lp| self.roads.facing(lp, pose.h));
                 let a = &mut self.actors[k];
                 let st = &mut a.state;
-                let moved = (pose.x - before.pose.x).hypot(pose.y - before.pose.y);
-                st.vel = [(pose.x - before.pose.x) / dt, (pose.y - before.pose.y) / dt];
-                st.accel = (speed - before.speed) / dt;
-                st.travelled_m += moved;
-                st.still_s = if speed.abs() < 1e-3 {
-                    st.still_s + dt
-                } else {
-                    0.0
-                };
+                // After `Init` (no time): only where it is.
+                if dt > 0.0 {
+                    let moved = (pose.x - before.pose.x).hypot(pose.y - before.pose.y);
+                    st.vel = [(pose.x - before.pose.x) / dt, (pose.y - before.pose.y) / dt];
+                    st.accel = (speed - before.speed) / dt;
+                    st.travelled_m += moved;
+                    st.still_s = if speed.abs() < 1e-3 {
+                        st.still_s + dt
+                    } else {
+                        0.0
+                    };
+                }
                 st.speed = speed;
                 st.pose = pose;
                 st.lane = lane;

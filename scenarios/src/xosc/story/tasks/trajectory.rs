@@ -54,12 +54,20 @@ impl Storyboard {
         let points = self.trajectory_points(e, shape, pos)?;
         let timed = points.iter().all(|(time, _)| time.is_some());
         // esmini turns a polyline's heading at its corners in `position` mode, along each leg
-        // in `follow`; a sampled curve faces along itself at each sample.
+        // in `follow`; a clothoid faces along the curve wherever it is evaluated (its samples'
+        // headings blended along each 0.25 m leg), in either mode; another sampled curve faces
+        // along itself at each sample.
         let turn = match (shape, position_mode) {
-            (TrajectoryShape::Polyline(_), true) => crate::xosc::motion::Turn::Corner,
-            (TrajectoryShape::Polyline(_) | TrajectoryShape::ClothoidSpline { .. }, false) => {
-                crate::xosc::motion::Turn::Segment
+            (TrajectoryShape::Polyline(_) | TrajectoryShape::Nurbs { .. }, true) => {
+                crate::xosc::motion::Turn::Corner
             }
+            (TrajectoryShape::Clothoid { .. }, _)
+            | (
+                TrajectoryShape::Polyline(_)
+                | TrajectoryShape::ClothoidSpline { .. }
+                | TrajectoryShape::Nurbs { .. },
+                false,
+            ) => crate::xosc::motion::Turn::Segment,
             _ => crate::xosc::motion::Turn::None,
         };
         let path = match timing {
@@ -79,11 +87,39 @@ impl Storyboard {
                     legs,
                 })
             }
-            _ => Path::Untimed(Untimed {
-                vertices: points.into_iter().map(|(_, p)| p).collect(),
-                gone_m: offset,
-                turn,
-            }),
+            _ => {
+                let mut u = Untimed {
+                    vertices: points.into_iter().map(|(_, p)| p).collect(),
+                    gone_m: offset,
+                    turn,
+                    facing: 1.0,
+                    explicit: match shape {
+                        TrajectoryShape::Polyline(v) => v.iter().all(|(_, p)| gives_heading(p)),
+                        _ => false,
+                    },
+                };
+                // How it faces the path (esmini's `FollowTrajectoryAction::Start`): a path
+                // that gives no headings is faced along, or against at a negative speed (a car
+                // reversing along a path laid behind it, facing away from the way it goes);
+                // one that gives its headings is faced as they say, and a heading against
+                // the path's direction moves it along the path at a negative speed.
+                let against = if u.explicit {
+                    let h = u.clone().advance(0.0).0.h;
+                    wrap(h - u.direction_at(offset)).abs() > std::f64::consts::FRAC_PI_2 + 1e-6
+                } else {
+                    // Its speed now: a step started before it in the same step is taken at
+                    // once (esmini sets a step's speed when the action starts).
+                    let v = match self.drives[e].speed {
+                        Some(s) if !s.profiled && s.tr.duration_s <= 0.0 => s.tr.to,
+                        _ => self.actors[e].state.speed,
+                    };
+                    v < 0.0
+                };
+                if against {
+                    u.facing = -1.0;
+                }
+                Path::Untimed(u)
+            }
         };
         // On the trajectory from the start (esmini's reading): a timed one where it is at `t`,
         // one started in `Init` at its first vertex, one with an offset there.
