@@ -514,7 +514,6 @@ pub fn nurbs_poses(
         .sum();
     let samples = ((polygon / NURBS_STEP_M) as usize + 2).clamp(2, NURBS_SAMPLES);
     let headed = points.iter().all(|p| p.3.is_some());
-    let mut peak = vec![(0.0f64, u0); n];
     let mut out: Vec<(f64, Pose)> = (0..samples)
         .map(|k| {
             let u = u0 + (u1 - u0) * k as f64 / (samples - 1) as f64;
@@ -523,21 +522,19 @@ pub fn nurbs_poses(
             let w: f64 = b.iter().zip(near).map(|(bi, p)| bi * p.1).sum();
             let w = if w > 0.0 { w } else { 1.0 };
             let (mut x, mut y, mut h) = (0.0, 0.0, 0.0);
-            for (j, (bi, p)) in b.iter().zip(near).enumerate() {
-                let j = first + j;
+            for (bi, p) in b.iter().zip(near) {
                 let f = bi * p.1 / w;
                 x += f * p.2[0];
                 y += f * p.2[1];
                 if *bi > 1e-12 {
                     h += f * wrap(p.3.unwrap_or(0.0) - h);
                 }
-                if *bi > peak[j].0 {
-                    peak[j] = (*bi, u);
-                }
             }
             (u, Pose { x, y, h: wrap(h) })
         })
         .collect();
+    // The parameter's step to where esmini reads a sample's tangent and its basis peaks.
+    let step = ((u1 - u0) / (samples - 1) as f64).min(NURBS_TANGENT_STEP);
     if !headed {
         // Along the curve, as esmini's `NurbsShape::CalculatePolyLine` faces each sample: its
         // tangent, from the point a small step of the parameter further (before, at the
@@ -552,7 +549,6 @@ pub fn nurbs_poses(
                 [x + bi * p.1 / w * p.2[0], y + bi * p.1 / w * p.2[1]]
             })
         };
-        let step = ((u1 - u0) / (samples - 1) as f64).min(NURBS_TANGENT_STEP);
         let m = out.len();
         for k in 1..m {
             let (u, p) = (out[k].0, out[k].1);
@@ -574,6 +570,25 @@ pub fn nurbs_poses(
         }
         if m > 1 {
             out[0].1.h = out[1].1.h;
+        }
+    }
+    // Where each control point's basis function peaks, as esmini finds it: over the samples,
+    // each read a small step of the parameter on (back, at the last), where esmini's
+    // `CalculatePolyLine` last evaluated the curve, and credited to the sample.
+    let mut peak = vec![(0.0f64, u0); n];
+    for (k, (u, _)) in out.iter().enumerate() {
+        let read = if k + 1 < out.len() {
+            (u + step).min(u1)
+        } else {
+            (u - step).max(u0)
+        };
+        let (first, b) = basis(order, knots, n, read);
+        for (j, bi) in b.iter().enumerate() {
+            if let Some(pk) = peak.get_mut(first + j) {
+                if *bi > pk.0 {
+                    *pk = (*bi, *u);
+                }
+            }
         }
     }
     let times: Option<Vec<f64>> = points.iter().map(|p| p.0).collect();
