@@ -738,6 +738,10 @@ pub enum TrajectoryShape {
         /// The segments after the first that give their own `PositionStart` (by index):
         /// each starts there, not where the one before ends (as esmini lays them).
         restarts: Vec<(usize, Position)>,
+        /// Its times (OpenSCENARIO 1.3): each segment's `timeStart` (s, increasing) and the
+        /// spline's `timeEnd`; along each segment the distance is linear in time, as esmini
+        /// reads them. `None`: followed at the entity's speed.
+        times: Option<(Vec<f64>, f64)>,
     },
     /// `Nurbs`: a rational B-spline of `order` (degree + 1, at least 2) over its control
     /// points `(time s, weight > 0, position)` and `knots` (control points + order of them,

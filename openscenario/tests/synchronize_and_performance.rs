@@ -310,6 +310,7 @@ fn clothoid_splines_trajectory_positions_and_initial_offsets_are_read() {
                     start,
                     segments,
                     restarts,
+                    times,
                 },
             initial_offset_m,
             ..
@@ -317,6 +318,7 @@ fn clothoid_splines_trajectory_positions_and_initial_offsets_are_read() {
             assert!(matches!(start, Some(Position::Lane { .. })));
             assert_eq!(segments, &vec![[0.0, 0.0, 10.0, 0.0], [0.0, 0.1, 7.0, 0.2]]);
             assert!(restarts.is_empty());
+            assert!(times.is_none());
             assert_eq!(*initial_offset_m, 3.0);
         }
         other => panic!("{other:?}"),
@@ -364,7 +366,7 @@ fn clothoid_splines_trajectory_positions_and_initial_offsets_are_read() {
         ),
         (
             follow("0", "<None/>", &spline(r#"timeEnd="4""#, "")),
-            "a clothoid spline's timeEnd is not supported",
+            "give all of them, or none",
         ),
     ];
     for (i, (action, why)) in cases.iter().enumerate() {
@@ -376,6 +378,56 @@ fn clothoid_splines_trajectory_positions_and_initial_offsets_are_read() {
         assert!(e.contains(why), "{why:?} not in {e}");
         assert!(e.contains("s.xosc:"), "{e}");
     }
+    // A timed spline (1.3): each segment's timeStart and the spline's timeEnd; a closed
+    // trajectory followed by its times is read (it ends at its last time, noted).
+    let timed_spline = r#"<Trajectory name="T" closed="true"><Shape><ClothoidSpline timeEnd="6"><ClothoidSplineSegment curvatureStart="0" curvatureEnd="0" length="10" timeStart="0"/><ClothoidSplineSegment curvatureStart="0" curvatureEnd="0.1" length="7" timeStart="2.5"/></ClothoidSpline></Shape></Trajectory>"#;
+    let s = read(
+        "timed",
+        &scenario(
+            PERFORMANCE,
+            false,
+            &follow("0", timing, timed_spline),
+            SPEED,
+        ),
+    )
+    .unwrap();
+    assert!(
+        matches!(action(&s), Action::FollowTrajectory {
+            shape: paracosm_openscenario::model::TrajectoryShape::ClothoidSpline { times: Some((starts, end)), .. },
+            ..
+        } if starts == &vec![0.0, 2.5] && *end == 6.0),
+        "{:?}",
+        action(&s)
+    );
+    assert!(s
+        .notes
+        .iter()
+        .any(|n| n.text.contains("closed changes nothing")));
+    let untimed_closed = timed_spline
+        .replace(r#" timeEnd="6""#, "")
+        .replace(r#" timeStart="0""#, "")
+        .replace(r#" timeStart="2.5""#, "");
+    let e = read(
+        "closed",
+        &scenario(
+            PERFORMANCE,
+            false,
+            &follow("0", "<None/>", &untimed_closed),
+            SPEED,
+        ),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("a closed trajectory followed at the entity's speed is not supported"),
+        "{e}"
+    );
+    let backwards = timed_spline.replace(r#"timeStart="2.5""#, r#"timeStart="7""#);
+    let e = read(
+        "backwards",
+        &scenario(PERFORMANCE, false, &follow("0", timing, &backwards), SPEED),
+    )
+    .unwrap_err();
+    assert!(e.contains("must increase"), "{e}");
 }
 
 /// A `LongitudinalDistanceAction`'s `DynamicConstraints` are read as written, each limit

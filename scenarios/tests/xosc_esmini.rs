@@ -219,7 +219,7 @@ fn check_runs(runs: &[Run]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 48] = [
+const ESMINI_EXAMPLES: [&str; 49] = [
     "acc-test",
     "alks_cut-in",
     "alks_cut-out",
@@ -266,6 +266,7 @@ const ESMINI_EXAMPLES: [&str; 48] = [
     "traffic_lights",
     "trailer_connect",
     "trajectory-test",
+    "truck_with_rotating_axle",
     "tunnels",
     "two_plus_one_road",
 ];

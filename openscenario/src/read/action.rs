@@ -607,9 +607,18 @@ fn trajectory(
         ));
     }
     if r.scope.bool(r.text, traj, "closed")? {
-        return Err(r
-            .text
-            .unsupported(traj, "a closed trajectory is not supported"));
+        if !timed_ {
+            return Err(r.text.unsupported(
+                traj,
+                "a closed trajectory followed at the entity's speed is not supported (a timed \
+                 one is: it ends at its last time)",
+            ));
+        }
+        r.note(
+            traj,
+            "a closed trajectory followed by its times ends at its last time, as esmini's \
+             does: closed changes nothing here",
+        );
     }
     let (shape_node, kind) = choice(r.text, need(r.text, traj, "Shape")?, &support::SHAPE)?;
     let shape = match kind {
@@ -699,28 +708,27 @@ const MAX_SPLINE_M: f64 = 100_000.0;
 ///
 /// # Errors
 /// Invalid at a segment of no length, an empty spline, one longer than [`MAX_SPLINE_M`];
-/// unsupported at times (`timeEnd`, a segment's `timeStart`: the spline is followed at the
-/// entity's speed).
+/// times given in part (a `timeEnd` needs every segment's `timeStart`, and they it), or
+/// that do not increase.
 fn clothoid_spline(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, XoscError> {
     let (sc, t) = (&r.scope, r.text);
     crate::xml::only(t, c, &["ClothoidSplineSegment"])?;
-    if c.attribute("timeEnd").is_some() {
-        return Err(t.unsupported(
-            c,
-            "a clothoid spline's timeEnd is not supported: paracosm follows it at the entity's speed",
-        ));
-    }
+    let time_end = sc.opt_num_in(t, c, "timeEnd", Quantity::Time)?;
+    let mut starts: Vec<Option<f64>> = Vec::new();
     let mut start = None;
     let mut restarts = Vec::new();
     let mut segments = Vec::new();
     for (k, seg) in elements(c).enumerate() {
         crate::xml::only(t, seg, &["PositionStart"])?;
-        if seg.attribute("timeStart").is_some() {
-            return Err(t.unsupported(
+        let time_start = sc.opt_num_in(t, seg, "timeStart", Quantity::Time)?;
+        if time_start.is_some() != time_end.is_some() {
+            return Err(t.invalid(
                 seg,
-                "a clothoid spline segment's timeStart is not supported: paracosm follows the spline at the entity's speed",
+                "a clothoid spline's times are its segments' timeStart and its timeEnd: give \
+                 all of them, or none (followed at the entity's speed)",
             ));
         }
+        starts.push(time_start);
         if let Some(p) = child(seg, "PositionStart") {
             let p = position::read(r, p)?;
             if k == 0 {
@@ -762,10 +770,27 @@ fn clothoid_spline(r: &Reader<'_>, c: Node<'_, '_>) -> Result<TrajectoryShape, X
             ),
         ));
     }
+    let times = match time_end {
+        Some(end) => {
+            let starts: Vec<f64> = starts.into_iter().flatten().collect();
+            let mut all = starts.clone();
+            all.push(end);
+            if all.windows(2).any(|w| w[1] <= w[0]) {
+                return Err(t.invalid(
+                    c,
+                    "a clothoid spline's times (each segment's timeStart, then its timeEnd) \
+                     must increase",
+                ));
+            }
+            Some((starts, end))
+        }
+        None => None,
+    };
     Ok(TrajectoryShape::ClothoidSpline {
         start,
         segments,
         restarts,
+        times,
     })
 }
 
@@ -844,7 +869,11 @@ fn timed(r: &Reader<'_>, node: Node<'_, '_>, shape: &TrajectoryShape) -> Result<
     let times: Option<Vec<f64>> = match shape {
         TrajectoryShape::Polyline(v) => v.iter().map(|(t, _)| *t).collect(),
         TrajectoryShape::Clothoid { times, .. } => times.map(|(a, b)| vec![a, b]),
-        TrajectoryShape::ClothoidSpline { .. } => None,
+        TrajectoryShape::ClothoidSpline { times, .. } => times.as_ref().map(|(s, end)| {
+            let mut all = s.clone();
+            all.push(*end);
+            all
+        }),
         TrajectoryShape::Nurbs { points, .. } => points.iter().map(|(t, _, _)| *t).collect(),
     };
     match times {

@@ -54,21 +54,12 @@ impl Storyboard {
         let points = self.trajectory_points(e, shape, pos)?;
         let timed = points.iter().all(|(time, _)| time.is_some());
         // esmini turns a polyline's heading at its corners in `position` mode, along each leg
-        // in `follow`; a clothoid faces along the curve wherever it is evaluated (its samples'
-        // headings blended along each 0.25 m leg), in either mode; another sampled curve faces
-        // along itself at each sample.
+        // in `follow`; a curve it samples (clothoid, clothoid spline, NURBS) turns along each
+        // leg between its samples' headings in either mode (esmini's `CalculatePolyLine` of
+        // those shapes sets the segment interpolation after the action has set its mode).
         let turn = match (shape, position_mode) {
-            (TrajectoryShape::Polyline(_) | TrajectoryShape::Nurbs { .. }, true) => {
-                crate::xosc::motion::Turn::Corner
-            }
-            (TrajectoryShape::Clothoid { .. }, _)
-            | (
-                TrajectoryShape::Polyline(_)
-                | TrajectoryShape::ClothoidSpline { .. }
-                | TrajectoryShape::Nurbs { .. },
-                false,
-            ) => crate::xosc::motion::Turn::Segment,
-            _ => crate::xosc::motion::Turn::None,
+            (TrajectoryShape::Polyline(_), true) => crate::xosc::motion::Turn::Corner,
+            _ => crate::xosc::motion::Turn::Segment,
         };
         let path = match timing {
             Some((absolute, scale, offset)) if timed => {
@@ -277,6 +268,7 @@ impl Storyboard {
                 start,
                 segments,
                 restarts,
+                times,
             } => {
                 let from = match start {
                     Some(p) => self.resolve(p, pos)?.0,
@@ -286,7 +278,11 @@ impl Storyboard {
                 for (k, p) in restarts {
                     starts.push((*k, self.resolve(p, pos)?.0));
                 }
-                spline_poses(from, segments, &starts)
+                let poses = spline_poses(from, segments, &starts);
+                match times {
+                    Some((begins, end)) => spline_times(poses, segments, begins, *end),
+                    None => poses,
+                }
             }
             TrajectoryShape::Nurbs {
                 order,
@@ -337,6 +333,40 @@ fn from_offset(points: &[Pose], offset: f64) -> Vec<Pose> {
 /// as esmini's `ClothoidSplineShape::CalculatePolyLine` samples it: every metre along the
 /// whole spline and its end, a vertex's heading the curve's there (followed with the heading
 /// turning along each leg, [`crate::xosc::motion::Turn::Segment`]).
+/// A clothoid spline's samples (`poses`, one every [`SPLINE_STEP_M`] along its `segments`)
+/// with their times, as esmini's `ClothoidSplineShape::Evaluate` reads a time: on each
+/// segment the distance is linear in time from its `timeStart` (`begins`) to the next
+/// one's (the last segment's: the spline's `end`), s.
+fn spline_times(
+    poses: Vec<(Option<f64>, Pose)>,
+    segments: &[[f64; 4]],
+    begins: &[f64],
+    end: f64,
+) -> Vec<(Option<f64>, Pose)> {
+    let total: f64 = segments.iter().map(|g| g[2]).sum();
+    let n = poses.len();
+    poses
+        .into_iter()
+        .enumerate()
+        .map(|(i, (_, p))| {
+            let s = if i + 1 < n {
+                i as f64 * SPLINE_STEP_M
+            } else {
+                total
+            };
+            // The segment holding `s` (the last one at the spline's end).
+            let (mut k, mut before) = (0usize, 0.0);
+            while k + 1 < segments.len() && s > before + segments[k][2] - 1e-6 {
+                before += segments[k][2];
+                k += 1;
+            }
+            let until = begins.get(k + 1).copied().unwrap_or(end);
+            let u = ((s - before) / segments[k][2]).clamp(0.0, 1.0);
+            (Some(begins[k] + u * (until - begins[k])), p)
+        })
+        .collect()
+}
+
 fn spline_poses(
     from: Pose,
     segments: &[[f64; 4]],
