@@ -291,7 +291,7 @@ mod tests {
         let s = read_catalog(&seed("catalog_entries.xosc")).unwrap();
         assert_eq!(s.entities.len(), 2);
         assert_eq!(s.entities[0].dimensions_m[0], 4.6);
-        assert!(s.entities[0].controller.is_some());
+        assert!(!s.entities[0].controllers.is_empty());
         // A broken entry fails the read, so the fuzzer's mutations reach the entry readers.
         let broken = seed("catalog_entries.xosc").replace("value=\"4.6\"", "value=\"x\"");
         assert!(read_catalog(&broken).is_err());

@@ -114,8 +114,11 @@ pub struct Entity {
     /// Where its bounding box's `Dimensions` are written (in a catalog file for a catalog
     /// entry).
     pub box_pos: Pos,
-    /// The name of the controller its `ObjectController` assigns, if any.
-    pub controller: Option<String>,
+    /// Its `ObjectController`s' names (their own `name`, else their controller's), in the
+    /// file's order
+    /// (OpenSCENARIO 1.2 allows several; an `ActivateControllerAction` names one by
+    /// `objectControllerRef`, else the first is meant). Empty: none.
+    pub controllers: Vec<String>,
     /// Its `Performance`: the limits on the speed changes the storyboard makes it perform.
     pub performance: Performance,
     /// Where it is declared.

@@ -401,13 +401,6 @@ pub const DYNAMICS_FOLLOWING: Noted = Noted {
     note: "is followed as \"position\": the value follows the shape exactly",
 };
 
-/// A trajectory's `followingMode` `follow`.
-pub const TRAJECTORY_FOLLOWING: Noted = Noted {
-    what: "a trajectory's following mode `follow`",
-    note: "places the entity on the trajectory as \"position\" does (its heading turns along \
-           each leg of a polyline, as esmini's does in this mode)",
-};
-
 /// A vehicle's lights or an animation.
 pub const APPEARANCE: Noted = Noted {
     what: "`LightStateAction` and `AnimationAction`",
@@ -417,9 +410,10 @@ pub const APPEARANCE: Noted = Noted {
 
 /// The controller an `ActivateControllerAction` names.
 pub const CONTROLLER_NAMED: Noted = Noted {
-    what: "the controller an `ActivateControllerAction` names",
-    note: "the controller named here is the entity's one controller: paracosm reads one per \
-           entity",
+    what: "the controller an `ActivateControllerAction` names (`objectControllerRef`, \
+           `controllerRef`)",
+    note: "which of the entity's controllers is named makes no difference to paracosm: the \
+           system under test drives the ego it hands over, and the storyboard moves the rest",
 };
 
 /// A negative transition rate.
@@ -502,7 +496,6 @@ pub const NOTED: &[&Noted] = &[
     &WORLD_Z,
     &RELATIVE_DZ,
     &DYNAMICS_FOLLOWING,
-    &TRAJECTORY_FOLLOWING,
     &APPEARANCE,
     &CONTROLLER_NAMED,
     &NEGATIVE_RATE,

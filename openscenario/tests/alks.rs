@@ -72,7 +72,7 @@ fn every_alks_template_reads_with_its_entities_events_and_actions() {
         // The ego is a car the ALKS controller drives; its road file exists.
         let ego = s.entities.iter().find(|e| e.name == "Ego").expect("an Ego");
         assert_eq!(ego.kind, EntityKind::Vehicle("car".into()));
-        assert_eq!(ego.controller.as_deref(), Some("ALKSController"));
+        assert_eq!(ego.controllers, vec!["ALKSController".to_string()]);
         assert_eq!(ego.dimensions_m, [5.0, 2.0, 1.8]);
         let road = s.road_network.as_ref().expect("a road network");
         assert!(Path::new(&road.item).is_file(), "{}", road.item);

@@ -219,7 +219,7 @@ fn check_runs(runs: &[Run]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 49] = [
+const ESMINI_EXAMPLES: [&str; 50] = [
     "acc-test",
     "alks_cut-in",
     "alks_cut-out",
@@ -240,6 +240,7 @@ const ESMINI_EXAMPLES: [&str; 49] = [
     "drive_when_close",
     "drop-bike",
     "follow_reference",
+    "follow_reference_interactive",
     "highway_driver",
     "highway_merge",
     "highway_merge_advanced",

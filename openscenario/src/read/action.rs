@@ -67,7 +67,7 @@ pub(super) fn private(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, Xosc
 }
 
 /// An `ActivateControllerAction`: 1.3's `animation` and `lighting` are refused when set;
-/// a named controller must be the entity's (paracosm reads one per entity).
+/// which controller it names is noted ([`crate::support::CONTROLLER_NAMED`]).
 pub(super) fn activate(r: &Reader<'_>, c: Node<'_, '_>) -> Result<Action, XoscError> {
     for a in ["animation", "lighting"] {
         if r.scope.opt_bool(r.text, c, a)? == Some(true) {
@@ -537,16 +537,9 @@ fn follow_trajectory(r: &Reader<'_>, node: Node<'_, '_>) -> Result<Action, XoscE
     let mut position_mode = false;
     if let Some(m) = child(node, "TrajectoryFollowingMode") {
         let mode = r.scope.string(r.text, m, "followingMode")?;
+        // `follow` is honoured as esmini honours it: a polyline's heading turned along each
+        // leg, a timed polyline's legs at constant accelerations.
         position_mode = mode == "position";
-        if !position_mode {
-            r.note(
-                m,
-                format!(
-                    "followingMode {mode:?} {}",
-                    support::TRAJECTORY_FOLLOWING.note
-                ),
-            );
-        }
     }
     if initial_offset_m != 0.0 && timing.is_some() {
         return Err(XoscError::Unsupported {

@@ -126,29 +126,35 @@ pub(super) fn read(
             ));
         };
         let tag = body.tag_name().name();
-        let controllers: Vec<Node<'_, '_>> = elements(obj)
-            .filter(|c| c.has_tag_name("ObjectController"))
-            .collect();
-        if controllers.len() > 1 {
-            return Err(r.text.unsupported(
-                controllers[1],
-                "more than one <ObjectController> per entity is not supported",
-            ));
-        }
         let read = if tag == "CatalogReference" {
             catalogs.read_entry(r, body, &["Vehicle", "Pedestrian", "MiscObject"], object)?
         } else {
             object(r, body)?
         };
-        let controller = match child(obj, "ObjectController") {
-            None => None,
-            Some(oc) => Some(controller(r, catalogs, oc)?),
-        };
+        let mut controllers = Vec::new();
+        for oc in elements(obj).filter(|c| c.has_tag_name("ObjectController")) {
+            // The ObjectController's own name (1.2+, what objectControllerRef names), else
+            // its controller's.
+            let name = match r.scope.opt_string(r.text, oc, "name")? {
+                Some(own) => {
+                    controller(r, catalogs, oc)?;
+                    own
+                }
+                None => controller(r, catalogs, oc)?,
+            };
+            if controllers.contains(&name) {
+                return Err(r.text.invalid(
+                    oc,
+                    format!("a second <ObjectController> of this entity is named {name:?}"),
+                ));
+            }
+            controllers.push(name);
+        }
         push_combination(
             r,
             (&mut out, &mut refs),
             (obj, body),
-            (name, read, controller),
+            (name, read, controllers),
         )?;
     }
     resolve_trailer_refs(&mut out, refs)?;
@@ -169,10 +175,10 @@ fn push_combination(
     r: &mut Reader<'_>,
     (out, refs): (&mut Vec<Entity>, &mut Vec<(usize, String, crate::Pos)>),
     (obj, body): (Node<'_, '_>, Node<'_, '_>),
-    (name, read, controller): (String, Body, Option<String>),
+    (name, read, controllers): (String, Body, Vec<String>),
 ) -> Result<(), XoscError> {
     let mut pos = r.text.pos(obj);
-    let (mut name, mut read, mut controller) = (name, read, controller);
+    let (mut name, mut read, mut controllers) = (name, read, controllers);
     loop {
         for n in std::mem::take(&mut read.notes) {
             r.note(body, n);
@@ -190,7 +196,7 @@ fn push_combination(
             dimensions_m: read.dimensions_m,
             centre_m: read.centre_m,
             box_pos: read.box_pos,
-            controller: controller.take(),
+            controllers: std::mem::take(&mut controllers),
             performance: read.performance,
             pos: pos.clone(),
             hitch_dx_m: read.hitch_dx_m,

@@ -88,9 +88,11 @@ fn write_entities(s: &Scenario, out: &mut String) {
             out,
             "  {}: {kind}, {l} x {w} x {h} m{}",
             e.name,
-            e.controller
-                .as_ref()
-                .map_or(String::new(), |c| format!(", controller {c}"))
+            match e.controllers.len() {
+                0 => String::new(),
+                1 => format!(", controller {}", e.controllers[0]),
+                _ => format!(", controllers {}", e.controllers.join(", ")),
+            }
         );
     }
     let _ = writeln!(out, "init:");
