@@ -273,6 +273,26 @@ fn spline(s: &Scenario, start: &Option<Position>, segments: &[[f64; 4]]) -> Stri
     )
 }
 
+/// A `SpeedProfileAction` as the listing says it.
+fn speed_profile(s: &Scenario, p: &paracosm_openscenario::model::SpeedProfile) -> String {
+    format!(
+        "speed profile through {} ({}{})",
+        p.entries
+            .iter()
+            .map(|(t, v)| match t {
+                Some(t) => format!("{v} m/s after {t} s"),
+                None => format!("{v} m/s"),
+            })
+            .collect::<Vec<_>>()
+            .join(", "),
+        if p.follow { "follow" } else { "position" },
+        p.entity.map_or(String::new(), |r| format!(
+            ", relative to {}'s speed",
+            name(s, r)
+        ))
+    )
+}
+
 /// A `SynchronizeAction` as the listing says it.
 fn synchronize(s: &Scenario, y: &paracosm_openscenario::model::Synchronize) -> String {
     format!(
@@ -352,22 +372,7 @@ fn action(s: &Scenario, a: &Action) -> String {
             format!("traffic signal {signal:?} to {state:?}")
         }
         Action::Synchronize(y) => synchronize(s, y),
-        Action::SpeedProfile(p) => format!(
-            "speed profile through {} ({}{})",
-            p.entries
-                .iter()
-                .map(|(t, v)| match t {
-                    Some(t) => format!("{v} m/s after {t} s"),
-                    None => format!("{v} m/s"),
-                })
-                .collect::<Vec<_>>()
-                .join(", "),
-            if p.follow { "follow" } else { "position" },
-            p.entity.map_or(String::new(), |r| format!(
-                ", relative to {}'s speed",
-                name(s, r)
-            ))
-        ),
+        Action::SpeedProfile(p) => speed_profile(s, p),
         Action::FollowTrajectory { shape, .. } => trajectory(s, shape),
         Action::AssignRoute { waypoints } => format!(
             "route through {} waypoints to {}",

@@ -485,6 +485,79 @@ const NURBS_SAMPLES: usize = 100_000;
 /// `NURBS_STEPLENGTH`).
 const NURBS_STEP_M: f64 = 1.0;
 
+/// Turns `out`'s samples (`(parameter, pose)`) of the NURBS `(order, points, knots)` to
+/// face along the curve, as esmini's `NurbsShape::CalculatePolyLine` faces each sample: its
+/// tangent, from the point a `step` of the parameter further (before, at the last), within
+/// `[u0, u1]`; the first sample as the second (esmini resolves the first segment's heading
+/// from its successor); a sample where the curve does not move as the one before.
+fn face_along(
+    out: &mut [(f64, Pose)],
+    (order, points, knots): (usize, &[ControlPoint], &[f64]),
+    (u0, u1, step): (f64, f64, f64),
+) {
+    let n = points.len();
+    let at = |u: f64| {
+        let (first, b) = basis(order, knots, n, u);
+        let near = points.get(first..).unwrap_or(&[]);
+        let w: f64 = b.iter().zip(near).map(|(bi, p)| bi * p.1).sum();
+        let w = if w > 0.0 { w } else { 1.0 };
+        b.iter().zip(near).fold([0.0, 0.0], |[x, y], (bi, p)| {
+            [x + bi * p.1 / w * p.2[0], y + bi * p.1 / w * p.2[1]]
+        })
+    };
+    let m = out.len();
+    for k in 1..m {
+        let (u, p) = (out[k].0, out[k].1);
+        let [qx, qy] = if k + 1 < m {
+            at((u + step).min(u1))
+        } else {
+            at((u - step).max(u0))
+        };
+        let (dx, dy) = if k + 1 < m {
+            (qx - p.x, qy - p.y)
+        } else {
+            (p.x - qx, p.y - qy)
+        };
+        out[k].1.h = if dx.hypot(dy) > 1e-6 {
+            dy.atan2(dx)
+        } else {
+            out[k - 1].1.h
+        };
+    }
+    if m > 1 {
+        out[0].1.h = out[1].1.h;
+    }
+}
+
+/// Where each control point's basis function peaks over `out`'s samples of the NURBS
+/// `(order, points, knots)`, `(value, parameter)`: as esmini finds it, each sample read a
+/// `step` of the parameter on (back, at the last), where esmini's `CalculatePolyLine` last
+/// evaluated the curve, and credited to the sample.
+fn peaks(
+    out: &[(f64, Pose)],
+    (order, points, knots): (usize, &[ControlPoint], &[f64]),
+    (u0, u1, step): (f64, f64, f64),
+) -> Vec<(f64, f64)> {
+    let n = points.len();
+    let mut peak = vec![(0.0f64, u0); n];
+    for (k, (u, _)) in out.iter().enumerate() {
+        let read = if k + 1 < out.len() {
+            (u + step).min(u1)
+        } else {
+            (u - step).max(u0)
+        };
+        let (first, b) = basis(order, knots, n, read);
+        for (j, bi) in b.iter().enumerate() {
+            if let Some(pk) = peak.get_mut(first + j) {
+                if *bi > pk.0 {
+                    *pk = (*bi, *u);
+                }
+            }
+        }
+    }
+    peak
+}
+
 /// The step of a NURBS curve's parameter over which a sample's tangent is taken (esmini's
 /// `NurbsShape::CalculatePolyLine`: 0.001, or the sampling step if smaller).
 const NURBS_TANGENT_STEP: f64 = 0.001;
@@ -536,61 +609,9 @@ pub fn nurbs_poses(
     // The parameter's step to where esmini reads a sample's tangent and its basis peaks.
     let step = ((u1 - u0) / (samples - 1) as f64).min(NURBS_TANGENT_STEP);
     if !headed {
-        // Along the curve, as esmini's `NurbsShape::CalculatePolyLine` faces each sample: its
-        // tangent, from the point a small step of the parameter further (before, at the
-        // last); the first sample as the second (esmini resolves the first segment's heading
-        // from its successor); a sample where the curve does not move as the one before.
-        let at = |u: f64| {
-            let (first, b) = basis(order, knots, n, u);
-            let near = points.get(first..).unwrap_or(&[]);
-            let w: f64 = b.iter().zip(near).map(|(bi, p)| bi * p.1).sum();
-            let w = if w > 0.0 { w } else { 1.0 };
-            b.iter().zip(near).fold([0.0, 0.0], |[x, y], (bi, p)| {
-                [x + bi * p.1 / w * p.2[0], y + bi * p.1 / w * p.2[1]]
-            })
-        };
-        let m = out.len();
-        for k in 1..m {
-            let (u, p) = (out[k].0, out[k].1);
-            let [qx, qy] = if k + 1 < m {
-                at((u + step).min(u1))
-            } else {
-                at((u - step).max(u0))
-            };
-            let (dx, dy) = if k + 1 < m {
-                (qx - p.x, qy - p.y)
-            } else {
-                (p.x - qx, p.y - qy)
-            };
-            out[k].1.h = if dx.hypot(dy) > 1e-6 {
-                dy.atan2(dx)
-            } else {
-                out[k - 1].1.h
-            };
-        }
-        if m > 1 {
-            out[0].1.h = out[1].1.h;
-        }
+        face_along(&mut out, (order, points, knots), (u0, u1, step));
     }
-    // Where each control point's basis function peaks, as esmini finds it: over the samples,
-    // each read a small step of the parameter on (back, at the last), where esmini's
-    // `CalculatePolyLine` last evaluated the curve, and credited to the sample.
-    let mut peak = vec![(0.0f64, u0); n];
-    for (k, (u, _)) in out.iter().enumerate() {
-        let read = if k + 1 < out.len() {
-            (u + step).min(u1)
-        } else {
-            (u - step).max(u0)
-        };
-        let (first, b) = basis(order, knots, n, read);
-        for (j, bi) in b.iter().enumerate() {
-            if let Some(pk) = peak.get_mut(first + j) {
-                if *bi > pk.0 {
-                    *pk = (*bi, *u);
-                }
-            }
-        }
-    }
+    let peak = peaks(&out, (order, points, knots), (u0, u1, step));
     let times: Option<Vec<f64>> = points.iter().map(|p| p.0).collect();
     let Some(times) = times else {
         return out.into_iter().map(|(_, p)| (None, p)).collect();

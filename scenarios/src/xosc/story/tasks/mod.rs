@@ -180,13 +180,7 @@ impl Storyboard {
             Action::Speed { target, dynamics } => {
                 return self.start_speed(e, (target, dynamics), a, t);
             }
-            Action::SpeedProfile(p) if !scripted && p.entity.is_none() => {
-                if let Some((_, v)) = p.entries.iter().find(|(_, v)| *v < 0.0) {
-                    return Err(bad(backwards(action, *v, &self.actors[e].name)));
-                }
-                self.start_speed_profile(e, p, a, t);
-            }
-            Action::SpeedProfile(p) => self.start_speed_profile(e, p, a, t),
+            Action::SpeedProfile(p) => self.start_profile_task(e, (p, action), a, t)?,
             Action::LaneChange {
                 target,
                 dynamics,
@@ -244,18 +238,46 @@ impl Storyboard {
             // Nothing the storyboard moves reads lights or visibility: the front end refuses
             // a visibility that a system under test would sense ([`crate::xosc::check`]).
             // Each ends in the next step, as esmini's ends in its first `Step`.
-            Action::Appearance(_) | Action::Visibility { .. } => {
-                if let Some(a) = a {
-                    self.elems[a].pending += 1;
-                    self.ending_next.push(a);
-                }
-            }
+            Action::Appearance(_) | Action::Visibility { .. } => self.end_next_step(a),
         }
         Ok(())
     }
 }
 
 impl Storyboard {
+    /// Starts `SpeedProfileAction` `p` (of action `action`) on `e`, for action element `a` at
+    /// `t` (s).
+    ///
+    /// # Errors
+    /// [`StoryError`] at the action when it asks the ego a system under test drives a
+    /// negative speed (its systems drive forward only).
+    fn start_profile_task(
+        &mut self,
+        e: usize,
+        (p, action): (&m::SpeedProfile, &m::NamedAction),
+        a: Option<usize>,
+        t: f64,
+    ) -> Result<(), StoryError> {
+        if !self.actors[e].scripted && p.entity.is_none() {
+            if let Some((_, v)) = p.entries.iter().find(|(_, v)| *v < 0.0) {
+                return Err(StoryError {
+                    at: site(&action.pos),
+                    message: backwards(action, *v, &self.actors[e].name),
+                });
+            }
+        }
+        self.start_speed_profile(e, p, a, t);
+        Ok(())
+    }
+
+    /// Has action element `a` (if any) end in the next step.
+    fn end_next_step(&mut self, a: Option<usize>) {
+        if let Some(a) = a {
+            self.elems[a].pending += 1;
+            self.ending_next.push(a);
+        }
+    }
+
     /// Starts the `LongitudinalDistanceAction` `action` on scripted entity `e`, for action
     /// element `a` (`None` in `Init`).
     ///

@@ -25,6 +25,48 @@ impl Path {
 }
 
 impl Storyboard {
+    /// The path of trajectory `shape` sampled into `points`, followed by entity `e` at its
+    /// speed from `offset` m along it, its heading turned as `turn` says; facing it as esmini's
+    /// `FollowTrajectoryAction::Start` has the entity face it: a path that gives no headings
+    /// is faced along, or against at a negative speed (a car reversing along a path laid
+    /// behind it, facing away from the way it goes); one that gives its headings is faced as
+    /// they say, and a heading against the path's direction moves it along the path at a
+    /// negative speed.
+    fn untimed(
+        &self,
+        e: usize,
+        (shape, points): (&TrajectoryShape, Vec<(Option<f64>, Pose)>),
+        offset: f64,
+        turn: crate::xosc::motion::Turn,
+    ) -> Untimed {
+        let mut u = Untimed {
+            vertices: points.into_iter().map(|(_, p)| p).collect(),
+            gone_m: offset,
+            turn,
+            facing: 1.0,
+            explicit: match shape {
+                TrajectoryShape::Polyline(v) => v.iter().all(|(_, p)| gives_heading(p)),
+                _ => false,
+            },
+        };
+        let against = if u.explicit {
+            let h = u.clone().advance(0.0).0.h;
+            wrap(h - u.direction_at(offset)).abs() > std::f64::consts::FRAC_PI_2 + 1e-6
+        } else {
+            // Its speed now: a step started before it in the same step is taken at once
+            // (esmini sets a step's speed when the action starts).
+            let v = match self.drives[e].speed {
+                Some(s) if !s.profiled && s.tr.duration_s <= 0.0 => s.tr.to,
+                _ => self.actors[e].state.speed,
+            };
+            v < 0.0
+        };
+        if against {
+            u.facing = -1.0;
+        }
+        u
+    }
+
     /// Starts a `FollowTrajectoryAction` on `e`: its shape, timing, following mode and
     /// `initialDistanceOffset` (m; untimed only, the entity placed there as esmini's
     /// `SetTrajectoryS` places it).
@@ -53,14 +95,7 @@ impl Storyboard {
         }
         let points = self.trajectory_points(e, shape, pos)?;
         let timed = points.iter().all(|(time, _)| time.is_some());
-        // esmini turns a polyline's heading at its corners in `position` mode, along each leg
-        // in `follow`; a curve it samples (clothoid, clothoid spline, NURBS) turns along each
-        // leg between its samples' headings in either mode (esmini's `CalculatePolyLine` of
-        // those shapes sets the segment interpolation after the action has set its mode).
-        let turn = match (shape, position_mode) {
-            (TrajectoryShape::Polyline(_), true) => crate::xosc::motion::Turn::Corner,
-            _ => crate::xosc::motion::Turn::Segment,
-        };
+        let turn = turn_of(shape, position_mode);
         let path = match timing {
             Some((absolute, scale, offset)) if timed => {
                 let base = if *absolute { 0.0 } else { t };
@@ -78,39 +113,7 @@ impl Storyboard {
                     legs,
                 })
             }
-            _ => {
-                let mut u = Untimed {
-                    vertices: points.into_iter().map(|(_, p)| p).collect(),
-                    gone_m: offset,
-                    turn,
-                    facing: 1.0,
-                    explicit: match shape {
-                        TrajectoryShape::Polyline(v) => v.iter().all(|(_, p)| gives_heading(p)),
-                        _ => false,
-                    },
-                };
-                // How it faces the path (esmini's `FollowTrajectoryAction::Start`): a path
-                // that gives no headings is faced along, or against at a negative speed (a car
-                // reversing along a path laid behind it, facing away from the way it goes);
-                // one that gives its headings is faced as they say, and a heading against
-                // the path's direction moves it along the path at a negative speed.
-                let against = if u.explicit {
-                    let h = u.clone().advance(0.0).0.h;
-                    wrap(h - u.direction_at(offset)).abs() > std::f64::consts::FRAC_PI_2 + 1e-6
-                } else {
-                    // Its speed now: a step started before it in the same step is taken at
-                    // once (esmini sets a step's speed when the action starts).
-                    let v = match self.drives[e].speed {
-                        Some(s) if !s.profiled && s.tr.duration_s <= 0.0 => s.tr.to,
-                        _ => self.actors[e].state.speed,
-                    };
-                    v < 0.0
-                };
-                if against {
-                    u.facing = -1.0;
-                }
-                Path::Untimed(u)
-            }
+            _ => Path::Untimed(self.untimed(e, (shape, points), offset, turn)),
         };
         // On the trajectory from the start (esmini's reading): a timed one where it is at `t`,
         // one started in `Init` at its first vertex, one with an offset there.
@@ -333,6 +336,18 @@ fn from_offset(points: &[Pose], offset: f64) -> Vec<Pose> {
 /// as esmini's `ClothoidSplineShape::CalculatePolyLine` samples it: every metre along the
 /// whole spline and its end, a vertex's heading the curve's there (followed with the heading
 /// turning along each leg, [`crate::xosc::motion::Turn::Segment`]).
+/// How a trajectory's heading turns between its points: esmini turns a polyline's heading at
+/// its corners in `position` mode, along each leg in `follow`; a curve it samples (clothoid,
+/// clothoid spline, NURBS) turns along each leg between its samples' headings in either mode
+/// (esmini's `CalculatePolyLine` of those shapes sets the segment interpolation after the
+/// action has set its mode).
+fn turn_of(shape: &TrajectoryShape, position_mode: bool) -> crate::xosc::motion::Turn {
+    match (shape, position_mode) {
+        (TrajectoryShape::Polyline(_), true) => crate::xosc::motion::Turn::Corner,
+        _ => crate::xosc::motion::Turn::Segment,
+    }
+}
+
 /// A clothoid spline's samples (`poses`, one every [`SPLINE_STEP_M`] along its `segments`)
 /// with their times, as esmini's `ClothoidSplineShape::Evaluate` reads a time: on each
 /// segment the distance is linear in time from its `timeStart` (`begins`) to the next
