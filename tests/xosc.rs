@@ -2023,3 +2023,33 @@ fn a_tilted_entity_or_a_world_without_roads_is_listed_and_refused_as_a_campaign(
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("has no RoadNetwork LogicFile"), "{err}");
 }
+
+/// A synchronization's target beyond its road's end (esmini's `ltap-od-relative-speed`: s =
+/// 455 m on a road of 304.19 m) is taken at the road's end, as esmini takes it, with a
+/// warning at load naming the action, the station asked and where the road ends; the test
+/// runs to its end (its two cars meet, as the file times them, so its collision monitor
+/// fails).
+#[test]
+fn a_synchronized_target_beyond_its_road_is_taken_at_its_end_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_paracosm-fuzz"))
+        .arg("tests/data/xosc/esmini/xosc/ltap-od-relative-speed.xosc")
+        .args(["--scripted-ego", "--budget", "1", "--out"])
+        .arg(dir.path().join("out"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(
+            "SynchronizeAction \"SyncActionNPC\": its target at s = 455 m lies beyond its road, \
+             which ends at 304.19 m: it is taken at the road's end"
+        ),
+        "{err}"
+    );
+    let records = std::fs::read_to_string(dir.path().join("out/results.jsonl")).unwrap();
+    assert_eq!(records.lines().count(), 1, "{err}");
+    // It ran to its end (the file times the two cars to meet: its collision monitor fails).
+    assert!(!records.contains("\"status\":\"error\""), "{records}");
+    assert!(records.contains("\"status\":\"fail\""), "{records}");
+}

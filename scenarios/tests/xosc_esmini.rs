@@ -219,7 +219,7 @@ fn check_runs(runs: &[Run]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 50] = [
+const ESMINI_EXAMPLES: [&str; 51] = [
     "acc-test",
     "alks_cut-in",
     "alks_cut-out",
@@ -253,6 +253,7 @@ const ESMINI_EXAMPLES: [&str; 50] = [
     "light_state",
     "long_dist_action_with_jerk",
     "ltap-od",
+    "ltap-od-relative-speed",
     "offroad_follower",
     "override_bb",
     "parking_lot",

@@ -744,8 +744,15 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
     };
     // The scene of the declared values: the map loads, the Init places every entity.
     let model = Arc::new(model);
-    let (scene, _) = front_end.build(model.clone())?;
+    let (scene, host) = front_end.build(model.clone())?;
     drop(scene);
+    // What the storyboard performs otherwise than written (a target at its road's end).
+    let story_notes: Vec<Warning> = (host.sb.notes().iter())
+        .map(|(at, message)| Warning {
+            at: at.clone(),
+            message: message.clone(),
+        })
+        .collect();
     // Every map a level can choose is read now, fingerprinted with the rest of the file set,
     // and shared by the tests: a campaign is one fixed scenario.
     front_end.read_every_map()?;
@@ -762,6 +769,7 @@ pub fn scenario(source: Source) -> Result<Scenario, ScenarioError> {
         message: w,
     }));
     warnings.extend(source.warnings);
+    warnings.extend(story_notes);
     findings.warnings = warnings;
     front_end.findings = findings;
     front_end.source = crate::front_end::Source {

@@ -178,6 +178,9 @@ pub struct Storyboard {
     /// `AnimationAction` or a `VisibilityAction` (esmini ends them in their first `Step`,
     /// the frame after they start).
     ending_next: Vec<usize>,
+    /// What the storyboard performs otherwise than written, found when it is built: `(where,
+    /// what)`, warnings at load ([`Storyboard::notes`]).
+    notes: Vec<(String, String)>,
     /// The speed the storyboard asks of the ego the system under test drives now, m/s: its
     /// `SpeedAction`s' transitions, which the host hands the system as its set speed
     /// ([`Storyboard::set_speed`]); `None` until one starts.
@@ -347,6 +350,7 @@ impl Storyboard {
             ended: false,
             started: false,
             ending_next: Vec::new(),
+            notes: Vec::new(),
             set_speed: None,
             hand_over: None,
             route: None,
@@ -482,6 +486,13 @@ impl Storyboard {
             waiting.push(format!("{} {:?}{at}", e.kind.name(), e.name));
         }
         waiting
+    }
+
+    /// What the storyboard performs otherwise than written, found when it was built:
+    /// `(file:line:col, what)` (a synchronization's target beyond its road's end, taken at
+    /// the end as esmini takes it).
+    pub fn notes(&self) -> &[(String, String)] {
+        &self.notes
     }
 
     /// The events that have never started, each as `event "NAME"`, in the storyboard's order:

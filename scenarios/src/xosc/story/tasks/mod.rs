@@ -93,12 +93,30 @@ impl Storyboard {
     /// cannot be met is refused when the file loads, at the action's line and column, rather
     /// than failing every test.
     ///
+    /// A synchronization's target beyond its road's end is taken at the end, as esmini takes
+    /// it, with a note ([`Storyboard::notes`]).
+    ///
     /// # Errors
     /// [`StoryError`] at the action, naming the action and the map's refusal.
     pub(in crate::xosc::story) fn check_references(
-        &self,
+        &mut self,
         na: &m::NamedAction,
     ) -> Result<(), StoryError> {
+        if let Action::Synchronize(s) = &na.action {
+            for p in [&s.master_target, &s.target] {
+                if let (_, Some((asked, at))) = self.within_road(p) {
+                    self.notes.push((
+                        site(&na.pos),
+                        format!(
+                            "SynchronizeAction {:?}: its target at s = {asked} m lies beyond its \
+                             road, which ends at {at:.2} m: it is taken at the road's end, as \
+                             esmini takes it",
+                            na.name
+                        ),
+                    ));
+                }
+            }
+        }
         let refused = |message: String| StoryError {
             at: site(&na.pos),
             message: format!("{} {:?}: {message}", na.action.kind_name(), na.name),
@@ -127,8 +145,8 @@ impl Storyboard {
             | Action::AcquirePosition(p)
             | Action::AddEntity { position: p, .. } => position(p),
             Action::Synchronize(s) => {
-                position(&s.master_target)?;
-                position(&s.target)
+                position(&self.within_road(&s.master_target).0)?;
+                position(&self.within_road(&s.target).0)
             }
             Action::AssignRoute { waypoints } => {
                 waypoints.iter().try_for_each(|(p, _)| position(p))

@@ -74,8 +74,8 @@ impl Storyboard {
         a: Option<usize>,
         at: &paracosm_openscenario::Pos,
     ) -> Result<(), StoryError> {
-        let master_target = self.place(&s.master_target, at)?;
-        let target = self.place(&s.target, at)?;
+        let master_target = self.place(&self.within_road(&s.master_target).0, at)?;
+        let target = self.place(&self.within_road(&s.target).0, at)?;
         let mut sync = Synchronizing {
             master: s.master,
             master_target,
@@ -101,6 +101,31 @@ impl Storyboard {
         }
         self.drives[e].sync = Some(sync);
         Ok(())
+    }
+
+    /// `p`, a lane or road position beyond its road's end (or before its start), taken at
+    /// the end (the start), as esmini's `Position::SetLanePos` takes it, with the station
+    /// asked and the one taken (m); any other position as it is.
+    pub(in crate::xosc::story) fn within_road(
+        &self,
+        p: &Position,
+    ) -> (Position, Option<(f64, f64)>) {
+        let (road, s) = match p {
+            Position::Lane { road, s, .. } | Position::Road { road, s, .. } => (road, *s),
+            _ => return (p.clone(), None),
+        };
+        let Some(r) = self.roads.map().roads.iter().find(|r| &r.od_id == road) else {
+            return (p.clone(), None);
+        };
+        let within = s.clamp(0.0, r.length_m);
+        if within == s {
+            return (p.clone(), None);
+        }
+        let mut q = p.clone();
+        if let Position::Lane { s, .. } | Position::Road { s, .. } = &mut q {
+            *s = within;
+        }
+        (q, Some((s, within)))
     }
 
     /// Where `p` (written at `at`) is now: its pose and its lanes ([`Place`]), facing its
