@@ -78,26 +78,34 @@ pub enum Turn {
 }
 
 impl Turn {
-    /// The heading on leg `i` (from vertex `i` to `i + 1` of headings `h`, rad) at `local`
-    /// m of its `len` m, as esmini's `PolyLineBase::EvaluateSegmentByLocalS` turns it.
-    pub fn heading(self, h: &[f64], i: usize, local: f64, len: f64) -> f64 {
-        let n = h.len();
+    /// The heading on leg `i` (from vertex `i` to `i + 1` of `n` vertices, `h(k)` the
+    /// heading of vertex `k`, rad) at `local` m of its `len` m, as esmini's
+    /// `PolyLineBase::EvaluateSegmentByLocalS` turns it. It reads at most the vertices
+    /// `i − 1` to `i + 1`, so a step costs no copy of a long path's headings.
+    pub fn heading(
+        self,
+        h: impl Fn(usize) -> f64,
+        n: usize,
+        i: usize,
+        local: f64,
+        len: f64,
+    ) -> f64 {
         if i + 1 >= n || len <= 0.0 {
-            return h[i.min(n - 1)];
+            return h(i.min(n - 1));
         }
         let diff = |a: f64, b: f64| wrap(a - b);
         let local = local.clamp(0.0, len);
         match self {
-            Turn::None => h[i],
-            Turn::Segment => wrap(h[i] + local / len * diff(h[i + 1], h[i])),
+            Turn::None => h(i),
+            Turn::Segment => wrap(h(i) + local / len * diff(h(i + 1), h(i))),
             Turn::Corner => {
                 let r = (len / 2.0).min(2.0);
                 if local < r {
                     if i > 0 {
                         let a = (r + local) / (2.0 * r);
-                        wrap(h[i - 1] + a * diff(h[i], h[i - 1]))
+                        wrap(h(i - 1) + a * diff(h(i), h(i - 1)))
                     } else {
-                        h[i]
+                        h(i)
                     }
                 } else if local > len - r {
                     let a = if i + 2 < n {
@@ -105,9 +113,9 @@ impl Turn {
                     } else {
                         (len - local) / r
                     };
-                    wrap(h[i] + (1.0 - a) * diff(h[i + 1], h[i]))
+                    wrap(h(i) + (1.0 - a) * diff(h(i + 1), h(i)))
                 } else {
-                    h[i]
+                    h(i)
                 }
             }
         }
@@ -224,9 +232,8 @@ impl Timed {
         let h = match self.turn {
             Turn::None => a.1.h,
             turn => {
-                let hs: Vec<f64> = self.vertices.iter().map(|v| v.1.h).collect();
                 let len = (b.1.x - a.1.x).hypot(b.1.y - a.1.y);
-                turn.heading(&hs, i - 1, u * len, len)
+                turn.heading(|k| self.vertices[k].1.h, n, i - 1, u * len, len)
             }
         };
         (
@@ -258,10 +265,7 @@ impl Timed {
         let u = if len > 0.0 { local / len } else { 1.0 };
         let h = match self.turn {
             Turn::None => a.h,
-            turn => {
-                let hs: Vec<f64> = self.vertices.iter().map(|v| v.1.h).collect();
-                turn.heading(&hs, j, local, len)
-            }
+            turn => turn.heading(|k| self.vertices[k].1.h, n, j, local, len),
         };
         Pose {
             x: a.x + u * (b.x - a.x),
@@ -367,8 +371,8 @@ impl Untimed {
                 let h = match self.turn {
                     Turn::None => a.h,
                     turn => {
-                        let hs: Vec<f64> = self.vertices.iter().map(|v| v.h).collect();
-                        turn.heading(&hs, i, left, len)
+                        let n = self.vertices.len();
+                        turn.heading(|k| self.vertices[k].h, n, i, left, len)
                     }
                 };
                 return (
