@@ -1766,6 +1766,9 @@ impl Host for StoryHost {
                     self.log
                         .push(format!("t = {t:.3} s: {kind} {name:?} {what}"));
                 }
+                for said in self.sb.take_said() {
+                    self.log.push(format!("t = {t:.3} s: {said}"));
+                }
                 self.hand_over_if_activated(t);
                 // A lane change or a route of the driven ego: the system's new route.
                 if let Some(ask) = self.sb.take_route() {

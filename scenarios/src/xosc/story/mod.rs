@@ -181,6 +181,9 @@ pub struct Storyboard {
     /// What the storyboard performs otherwise than written, found when it is built: `(where,
     /// what)`, warnings at load ([`Storyboard::notes`]).
     notes: Vec<(String, String)>,
+    /// What the storyboard found while it ran, for the test's record
+    /// ([`Storyboard::take_said`]).
+    said: Vec<String>,
     /// The speed the storyboard asks of the ego the system under test drives now, m/s: its
     /// `SpeedAction`s' transitions, which the host hands the system as its set speed
     /// ([`Storyboard::set_speed`]); `None` until one starts.
@@ -351,6 +354,7 @@ impl Storyboard {
             started: false,
             ending_next: Vec::new(),
             notes: Vec::new(),
+            said: Vec::new(),
             set_speed: None,
             hand_over: None,
             route: None,
@@ -493,6 +497,12 @@ impl Storyboard {
     /// the end as esmini takes it).
     pub fn notes(&self) -> &[(String, String)] {
         &self.notes
+    }
+
+    /// What the storyboard found in the last steps that the test's record should say (a
+    /// speed profile whose plan leaves its entries' speeds), each once.
+    pub fn take_said(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.said)
     }
 
     /// The events that have never started, each as `event "NAME"`, in the storyboard's order:

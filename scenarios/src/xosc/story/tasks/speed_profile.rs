@@ -388,6 +388,27 @@ impl Profile {
         }
     }
 
+    /// The speed furthest outside `[lo, hi]` (m/s) that the plan, from `t0` (s), reaches
+    /// before it ends (stepped every 0.01 s as the storyboard steps it), if it leaves that
+    /// range by more than 0.01 m/s.
+    pub(in crate::xosc::story) fn leaves(&self, (t0, lo, hi): (f64, f64, f64)) -> Option<f64> {
+        let mut p = self.clone();
+        let end = p.segments[p.segments.len() - 1].t + STEPPED_PAST_S;
+        let mut worst: Option<(f64, f64)> = None;
+        for k in 1.. {
+            let t = t0 + k as f64 * 0.01;
+            let (v, over) = p.step(t);
+            let out = (lo - v).max(v - hi);
+            if out > 0.01 && worst.is_none_or(|(o, _)| out > o) {
+                worst = Some((out, v));
+            }
+            if over || t > end {
+                break;
+            }
+        }
+        worst.map(|(_, v)| v)
+    }
+
     /// The speed at `t1` (s), m/s, and whether the action ends there (esmini's
     /// `LongSpeedProfileAction::Step`: in its last entry's segment or past, at the last
     /// segment's speed).
@@ -435,6 +456,22 @@ impl Storyboard {
             self.actors[e].performance,
         );
         let last = plan.segments[plan.segments.len() - 1].v;
+        // The entries' speeds (and the speed it starts from): a plan that leaves them (a
+        // corner its jerk limit cannot round in time) is said in the test's record.
+        let (lo, hi) = (profile.entries.iter().map(|(_, v)| v + offset))
+            .fold((st.speed, st.speed), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        if let Some(v) = plan.leaves((t, lo, hi)) {
+            let name = a.map_or(String::from("in Init"), |a| {
+                format!("{:?}", self.elems[a].name)
+            });
+            self.said.push(format!(
+                "SpeedProfileAction {name} on {}: its plan leaves its entries' speeds, \
+                 [{lo:.2}, {hi:.2}] m/s, reaching {v:.2} m/s (its constraints' rate of \
+                 acceleration cannot round a corner in time; esmini plans and runs it so, \
+                 warning that it falls back to linear)",
+                self.actors[e].name
+            ));
+        }
         for old in [
             self.drives[e].keep.take().map(|k| k.action),
             self.drives[e].sync.take().map(|s| s.action),
@@ -609,5 +646,29 @@ mod tests {
         assert!((at(1.0) - 11.5).abs() < 1e-9, "{}", at(1.0));
         let (_, v_end, over) = *out.last().unwrap();
         assert!(over && v_end == 13.0);
+    }
+
+    /// A jerk limit too low to round a corner in time (esmini's own planning of 22 → 0 m/s
+    /// in 2.5 s within 0.5 m/s³) overshoots below 0 m/s, reversing: the plan says so; with
+    /// a jerk of 30 m/s³ it stays within its entries' speeds.
+    #[test]
+    fn a_plan_that_leaves_its_entries_speeds_is_found() {
+        let sp = |jerk: f64| m::SpeedProfile {
+            entity: None,
+            follow: true,
+            constraints: Some(m::DistanceConstraints {
+                max_acceleration_mps2: Some(3.0),
+                max_deceleration_mps2: Some(8.0),
+                max_acceleration_rate_mps3: Some(jerk),
+                max_deceleration_rate_mps3: Some(jerk),
+                max_speed_mps: None,
+            }),
+            entries: vec![(Some(2.5), 0.0), (Some(2.0), 0.0), (None, 18.0)],
+        };
+        let low = Profile::plan(&sp(0.5), (3.0, 22.0, 0.0, 0.0), m::Performance::UNBOUNDED);
+        let v = low.leaves((3.0, 0.0, 22.0)).expect("it leaves [0, 22] m/s");
+        assert!(v < -30.0, "{v}");
+        let high = Profile::plan(&sp(30.0), (3.0, 22.0, 0.0, 0.0), m::Performance::UNBOUNDED);
+        assert_eq!(high.leaves((3.0, 0.0, 22.0)), None);
     }
 }
