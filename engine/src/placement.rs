@@ -111,3 +111,61 @@ pub fn check(objects: &[Placed], network: &Network) -> Result<(), EngineError> {
     }
     Ok(())
 }
+
+/// A box on the ground seen from above: its centre `[x, y]` (m, the OpenDRIVE frame: x east,
+/// y north), heading (rad, anticlockwise from x) and `[length, width]` (m, ≥ 0).
+pub type GroundBox = ([f64; 2], f64, [f64; 2]);
+
+/// Whether boxes `a` and `b` overlap seen from above (boxes that only touch overlap), as
+/// esmini's `Object::Collision` tests bounding boxes (separating axes in the ground plane):
+/// parry's intersection test of the two boxes, made 1 m high, taken relative to `a`'s centre
+/// so that single precision keeps millimetres far from the origin.
+#[must_use]
+pub fn boxes_overlap(a: GroundBox, b: GroundBox) -> bool {
+    // The engine's frame: x east, y up, z south; a heading turns about y.
+    let pose = |(c, h, _): GroundBox| {
+        Pose::from_parts(
+            Vector::new((c[0] - a.0[0]) as f32, 0.0, -(c[1] - a.0[1]) as f32),
+            Rotation::from_rotation_y(h as f32),
+        )
+    };
+    let cuboid = |(_, _, s): GroundBox| {
+        Cuboid::new(Vector::new((s[0] / 2.0) as f32, 0.5, (s[1] / 2.0) as f32))
+    };
+    intersection_test(&pose(a), &cuboid(a), &pose(b), &cuboid(b)).is_ok_and(|i| i.intersecting)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn boxes_overlap_by_their_sides_not_their_bounds() {
+        let car = ([1000.0, -2000.0], 0.0, [4.0, 2.0]);
+        // Side by side, 0.1 m apart, and just touching.
+        assert!(!boxes_overlap(car, ([1000.0, -1997.9], 0.0, [4.0, 2.0])));
+        assert!(boxes_overlap(car, ([1000.0, -1998.0], 0.0, [4.0, 2.0])));
+        // A 1 m square turned 45° off the car's front-left corner: their axis-aligned
+        // bounds overlap, the boxes do not (its nearest side is 0.066 m from the corner) ...
+        let diamond = |d: f64| {
+            (
+                [1002.0 + d, -1999.0 + d],
+                std::f64::consts::FRAC_PI_4,
+                [1.0, 1.0],
+            )
+        };
+        assert!(!boxes_overlap(car, diamond(0.4)));
+        // ... and 0.1 m nearer, they do.
+        assert!(boxes_overlap(car, diamond(0.3)));
+        // A long box turned 90° across the car's front overlaps it.
+        assert!(boxes_overlap(
+            car,
+            ([1002.5, -2000.0], std::f64::consts::FRAC_PI_2, [6.0, 1.2])
+        ));
+        // Headings are anticlockwise: a 10 m bar turned +30° from (1005, -2000) reaches
+        // (1009.3, -1997.5), clear of a box there turned the other way.
+        let bar = ([1005.0, -2000.0], std::f64::consts::FRAC_PI_6, [10.0, 0.2]);
+        assert!(boxes_overlap(bar, ([1009.3, -1997.5], 0.0, [0.4, 0.4])));
+        assert!(!boxes_overlap(bar, ([1009.3, -2002.5], 0.0, [0.4, 0.4])));
+    }
+}

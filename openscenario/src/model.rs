@@ -129,6 +129,13 @@ pub struct Entity {
     /// Its `TrailerCoupler`'s `dx`: where it is coupled to a vehicle that tows it, m ahead
     /// of its reference point; `None` when it is no trailer.
     pub coupler_dx_m: Option<f64>,
+    /// esmini's `refpoint_x_offset` property of a vehicle: its reference point is this far
+    /// ahead of its rear axle, m (a car driven by its front axle). Its body trails the
+    /// reference point as a rear axle trails its front one: each step it faces from where
+    /// its rear axle was to where its reference point is (esmini's `ScenarioEngine::step`).
+    /// [`Entity::centre_m`] is already taken from the reference point, as esmini moves the
+    /// box. `None`: the reference point is the rear axle, as the standard has it.
+    pub refpoint_dx_m: Option<f64>,
     /// The entity it tows from the start (an index into [`Scenario::entities`]): its
     /// `Trailer`, written in it (read as an entity of its own, named as esmini names it, the
     /// tow's name and `+`) or a `TrailerRef` to another entity. The trailer is pulled by its
@@ -764,6 +771,12 @@ pub enum TrajectoryShape {
 pub struct Orientation {
     /// Heading, rad.
     pub h: f64,
+    /// Pitch, rad (`p`): the storyboard carries it to rotate the offsets of a
+    /// [`Position::RelativeObject`] taken from the entity; a campaign refuses a tilt
+    /// ([`Scenario::tilts`]).
+    pub p: f64,
+    /// Roll, rad (`r`), carried as the pitch is.
+    pub r: f64,
     /// `type="relative"` (to the road's or lane's direction, or the entity's heading);
     /// a missing `type` is absolute.
     pub relative: bool,
@@ -800,6 +813,9 @@ pub enum Position {
         dx: f64,
         /// m, left.
         dy: f64,
+        /// m, up: the offsets are turned by the entity's heading, pitch and roll (esmini's
+        /// `RotateVec3d`), and the part along the ground is taken.
+        dz: f64,
         /// Orientation (relative: to the entity's heading).
         orientation: Option<Orientation>,
     },

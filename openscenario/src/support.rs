@@ -392,7 +392,9 @@ pub const WORLD_Z: Noted = Noted {
 /// A relative position's `dz`.
 pub const RELATIVE_DZ: Noted = Noted {
     what: "a relative position's `dz`",
-    note: "a relative position's dz is not honoured: paracosm's roads are flat",
+    note: "a relative position's dz is not honoured as a height: paracosm's roads are \
+           flat (in a relative object position it is turned with its entity's pitch and roll, \
+           as esmini turns it, and its part along the ground is taken)",
 };
 
 /// A `TransitionDynamics`' `followingMode` other than `position`.

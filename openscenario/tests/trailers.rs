@@ -226,3 +226,43 @@ fn a_combination_that_cannot_be_coupled_is_refused_where_it_is_written() {
         );
     }
 }
+
+/// esmini's `refpoint_x_offset` property puts a vehicle's reference point that far ahead of
+/// its rear axle: it is read, and the bounding box's centre is taken from the reference
+/// point; a value that is not a length is refused where it is written.
+#[test]
+fn a_reference_point_ahead_of_the_rear_axle_is_read_from_esminis_property() {
+    let with = |value: &str| {
+        vehicle("car", "").replace(
+            "<Properties/>",
+            &format!(r#"<Properties><Property name="model_id" value="0"/><Property name="refpoint_x_offset" value="{value}"/></Properties>"#),
+        )
+    };
+    let entities = format!(
+        r#"<ScenarioObject name="Tow">{}</ScenarioObject>"#,
+        with("2.8")
+    );
+    let s = read("refpoint", &scenario(&entities, WAIT)).unwrap();
+    let tow = &s.entities[0];
+    assert_eq!(tow.refpoint_dx_m, Some(2.8));
+    // The box's centre, 1.4 m ahead of the rear axle, is 1.4 m behind the reference point.
+    assert!(
+        (tow.centre_m[0] - (1.4 - 2.8)).abs() < 1e-12,
+        "{:?}",
+        tow.centre_m
+    );
+    // Without the property the reference point is the rear axle.
+    let plain = format!(
+        r#"<ScenarioObject name="Tow">{}</ScenarioObject>"#,
+        vehicle("car", "")
+    );
+    let s = read("refpoint-none", &scenario(&plain, WAIT)).unwrap();
+    assert_eq!(s.entities[0].refpoint_dx_m, None);
+    assert_eq!(s.entities[0].centre_m[0], 1.4);
+    let bad = format!(
+        r#"<ScenarioObject name="Tow">{}</ScenarioObject>"#,
+        with("front")
+    );
+    let err = read("refpoint-bad", &scenario(&bad, WAIT)).unwrap_err();
+    assert!(err.contains("s.xosc:") && err.contains("value"), "{err}");
+}

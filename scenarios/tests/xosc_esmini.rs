@@ -219,7 +219,7 @@ fn check_runs(runs: &[Run]) {
 /// esmini's own examples (`resources/xosc` of esmini, MPL-2.0, `tests/data/xosc/esmini`)
 /// that paracosm runs as esmini does. The others of that folder, each with what it lacks, are
 /// listed in `tests/data/xosc/esmini/PROVENANCE.md`.
-const ESMINI_EXAMPLES: [&str; 51] = [
+const ESMINI_EXAMPLES: [&str; 56] = [
     "acc-test",
     "alks_cut-in",
     "alks_cut-out",
@@ -241,12 +241,15 @@ const ESMINI_EXAMPLES: [&str; 51] = [
     "drop-bike",
     "follow_reference",
     "follow_reference_interactive",
+    "follow_trajectory_by_front_axle",
     "highway_driver",
     "highway_merge",
     "highway_merge_advanced",
     "keep_lateral_distance",
     "lane-change_clothoid_based_trajectory",
+    "lane_change",
     "lane_change_crest",
+    "lane_change_simple",
     "lane-change_trajectory_wp",
     "left-hand-traffic_by_heading",
     "left-hand-traffic_using_road_rule",
@@ -258,7 +261,9 @@ const ESMINI_EXAMPLES: [&str; 51] = [
     "override_bb",
     "parking_lot",
     "pedestrian",
+    "pedestrian_collision",
     "pedestrian_traj_synch",
+    "routing-test",
     "slow-lead-vehicle",
     "speed-profile",
     "straight_500m",

@@ -276,6 +276,25 @@ impl Roads {
         Ok((reference, left, lp))
     }
 
+    /// Whether `lp` lies across its road's lanes at its station, of any type but `none`
+    /// (its point within half a lane's width of some lane's centre, across that lane): off
+    /// its road otherwise, as esmini's `Position::IsOffRoad` takes `t` against the road's
+    /// width (`~LANE_TYPE_NONE`), whatever other road's lanes the point may fall on.
+    pub fn on_its_road(&self, lp: &LanePos) -> bool {
+        let p = self.pose_of(lp);
+        let road = self.map.lanes[lp.lane].road;
+        (0..self.map.lanes.len()).any(|j| {
+            let l = &self.map.lanes[j];
+            let (a, b) = l.s_range();
+            if l.road != road || l.kind == "none" || !(a - 1e-9 <= lp.s && lp.s <= b + 1e-9) {
+                return false;
+            }
+            let (c, along) = self.frame(j, lp.s);
+            let across = (p.x - c[0]) * -along.sin() + (p.y - c[1]) * along.cos();
+            across.abs() <= self.lane_width(j, lp.s) / 2.0 + 1e-9
+        })
+    }
+
     /// The width of lane `k` at station `s`, m.
     pub fn lane_width(&self, k: usize, s: f64) -> f64 {
         let l = &self.map.lanes[k];

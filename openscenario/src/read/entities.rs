@@ -201,6 +201,7 @@ fn push_combination(
             pos: pos.clone(),
             hitch_dx_m: read.hitch_dx_m,
             coupler_dx_m: read.coupler_dx_m,
+            refpoint_dx_m: read.refpoint_dx_m,
             trailer: None,
         });
         std::rc::Rc::make_mut(&mut r.names).push(name.clone());
@@ -415,6 +416,8 @@ struct Body {
     hitch_dx_m: Option<f64>,
     /// `TrailerCoupler dx`, m.
     coupler_dx_m: Option<f64>,
+    /// esmini's `refpoint_x_offset` property, m ([`crate::model::Entity::refpoint_dx_m`]).
+    refpoint_dx_m: Option<f64>,
     /// The trailer it tows from the start, if any.
     trailer: Option<Towed>,
     /// Where the object's element is written.
@@ -481,8 +484,14 @@ fn object(r: &Reader<'_>, e: Node<'_, '_>) -> Result<Body, XoscError> {
             format!("a bounding box's sides must be in [0, 100] m, not {dimensions_m:?}"),
         ));
     }
+    let refpoint_dx_m = if vehicle {
+        refpoint_offset(r, e)?
+    } else {
+        None
+    };
     let centre_m = [
-        scope.num_in(text, centre, "x", Quantity::Offset)?,
+        // Taken from the reference point, as esmini moves the box.
+        scope.num_in(text, centre, "x", Quantity::Offset)? - refpoint_dx_m.unwrap_or(0.0),
         scope.num_in(text, centre, "y", Quantity::Offset)?,
         scope.num_in(text, centre, "z", Quantity::Offset)?,
     ];
@@ -518,9 +527,29 @@ fn object(r: &Reader<'_>, e: Node<'_, '_>) -> Result<Body, XoscError> {
         performance,
         hitch_dx_m,
         coupler_dx_m,
+        refpoint_dx_m,
         trailer,
         pos: text.pos(e),
     })
+}
+
+/// A vehicle's esmini `refpoint_x_offset` property (`<Property name="refpoint_x_offset"
+/// value="…"/>` in its `Properties`), m; `None` without one.
+///
+/// # Errors
+/// What reading a number returns (a value that is not one, or out of an offset's range).
+fn refpoint_offset(r: &Reader<'_>, e: Node<'_, '_>) -> Result<Option<f64>, XoscError> {
+    let (text, scope) = (r.text, &r.scope);
+    let Some(props) = child(e, "Properties") else {
+        return Ok(None);
+    };
+    for p in elements(props).filter(|p| p.has_tag_name("Property")) {
+        if scope.opt_string(text, p, "name")?.as_deref() == Some("refpoint_x_offset") {
+            let dx = scope.num_in(text, p, "value", Quantity::Offset)?;
+            return Ok((dx != 0.0).then_some(dx));
+        }
+    }
+    Ok(None)
 }
 
 /// A vehicle's `TrailerHitch dx` and `TrailerCoupler dx` (m) and its `Trailer`, each `None`

@@ -145,11 +145,13 @@ fn world(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Position, XoscError> {
 }
 
 /// A `<RelativeWorldPosition>` or `<RelativeObjectPosition>` (as `tag` says): the entity and
-/// the offsets `dx`, `dy` (m) from it, with its orientation; a `dz` other than 0 is noted as
-/// not honoured. In CARLA's reading both are offsets along the world's axes.
+/// the offsets `dx`, `dy`, `dz` (m) from it, with its orientation; a `dz` other than 0 is
+/// noted (its height is not modelled). In CARLA's reading both are offsets along the world's
+/// axes.
 fn relative(r: &Reader<'_>, p: Node<'_, '_>, tag: &str) -> Result<Position, XoscError> {
     let (s, t) = (&r.scope, r.text);
-    if s.opt_num(t, p, "dz")?.is_some_and(|v| v != 0.0) {
+    let dz = s.opt_num_in(t, p, "dz", Quantity::Distance)?.unwrap_or(0.0);
+    if dz != 0.0 {
         r.note(p, crate::support::RELATIVE_DZ.note);
     }
     let (entity, dx, dy) = (
@@ -172,6 +174,7 @@ fn relative(r: &Reader<'_>, p: Node<'_, '_>, tag: &str) -> Result<Position, Xosc
             entity,
             dx,
             dy,
+            dz,
             orientation,
         }
     })
@@ -235,12 +238,16 @@ fn orientation(r: &Reader<'_>, p: Node<'_, '_>) -> Result<Option<Orientation>, X
             r.note(o, text);
         }
     }
+    let angle = |a: &str| -> Result<f64, XoscError> {
+        Ok(r.scope
+            .opt_num_in(r.text, o, a, Quantity::Angle)?
+            .unwrap_or(0.0))
+    };
     Ok(Some(Orientation {
-        h: r.flip(
-            r.scope
-                .opt_num_in(r.text, o, "h", Quantity::Angle)?
-                .unwrap_or(0.0),
-        ),
+        // CARLA's left-handed frame mirrors y: heading and roll change sign.
+        h: r.flip(angle("h")?),
+        p: angle("p")?,
+        r: r.flip(angle("r")?),
         relative,
     }))
 }

@@ -289,21 +289,25 @@ impl Storyboard {
             EntityTest::Acceleration { rule, value } => rule.holds(st.accel, *value),
             EntityTest::Standstill(d) => st.still_s >= *d - 1e-9,
             EntityTest::TraveledDistance(d) => st.travelled_m >= *d,
-            EntityTest::EndOfRoad(d) => st.at_end_s > 0.0 && st.at_end_s >= *d - 1e-9,
-            EntityTest::Offroad(d) => st.offroad_s > 0.0 && st.offroad_s > *d + 1e-9,
+            EntityTest::EndOfRoad(d) => st.at_end_s.is_some_and(|s| s >= *d - 1e-9),
+            EntityTest::Offroad(d) => st.offroad_s.is_some_and(|s| s > *d + 1e-9),
+            // Touching in the engine's world (a campaign's contacts), or bounding boxes that
+            // overlap, as esmini's `Object::Collision` finds it (scripted entities the
+            // engine does not collide, and the storyboard run alone).
             EntityTest::Collision(other) => match other {
-                Some(o) => st.collided && self.touching(e, *o),
-                None => st.collided,
+                Some(o) => (st.collided && self.touching(e, *o)) || self.overlapping(e, *o),
+                None => {
+                    st.collided
+                        || (0..self.actors.len())
+                            .any(|o| o != e && self.actors[o].present && self.overlapping(e, o))
+                }
             },
-            EntityTest::CollisionByType(kind) => {
-                st.collided
-                    && (0..self.actors.len()).any(|o| {
-                        o != e
-                            && self.actors[o].present
-                            && self.actors[o].object_type == kind
-                            && self.touching(e, o)
-                    })
-            }
+            EntityTest::CollisionByType(kind) => (0..self.actors.len()).any(|o| {
+                o != e
+                    && self.actors[o].present
+                    && self.actors[o].object_type == kind
+                    && ((st.collided && self.touching(e, o)) || self.overlapping(e, o))
+            }),
             EntityTest::RelativeClearance(c) => self.clear(e, c),
             EntityTest::Angle(a) => self
                 .heading_in(e, &a.frame)
@@ -716,6 +720,30 @@ impl Storyboard {
         };
         let (long, lat, _) = self.gap(a, &g);
         long.abs() <= 0.05 && lat.abs() <= 0.05
+    }
+
+    /// Whether the bounding boxes of entities `a` and `b` overlap seen from above (esmini's
+    /// `Object::Collision`: [`paracosm_engine::placement::boxes_overlap`]). A tow and the
+    /// trailer hitched to it never do: coupled, their boxes overlap at the hitch, and the
+    /// engine does not collide them either (esmini would find them colliding).
+    pub(in crate::xosc::story) fn overlapping(&self, a: usize, b: usize) -> bool {
+        if self.actors[a].trailer == Some(b) || self.actors[b].trailer == Some(a) {
+            return false;
+        }
+        let ground = |i: usize| {
+            let x = &self.actors[i];
+            let p = x.state.pose;
+            let (s, c) = p.h.sin_cos();
+            (
+                [
+                    p.x + c * x.centre_m[0] - s * x.centre_m[1],
+                    p.y + s * x.centre_m[0] + c * x.centre_m[1],
+                ],
+                p.h,
+                [x.size_m[0], x.size_m[1]],
+            )
+        };
+        paracosm_engine::placement::boxes_overlap(ground(a), ground(b))
     }
 
     /// The R157-style measures of entity `e`: its time headway (s) and following distance (m,

@@ -2,6 +2,7 @@
 //! trajectory, along the map's lanes.
 
 use super::*;
+use paracosm_engine::transition::LateralRule;
 
 /// A speed target that follows another entity: its index, the value, whether a factor.
 pub(in crate::xosc::story) type Track = Option<(usize, f64, bool)>;
@@ -35,7 +36,12 @@ pub(in crate::xosc::story) struct Drive {
     /// A driven ego's trajectory in progress, handed to its system as its route: where it
     /// ends and the action; it ends once the ego is there ([`PATH_END_REACHED_M`]).
     pub(in crate::xosc::story) path_goal: Option<(Pose, usize)>,
+    /// The roads of its route in order (its `AssignRouteAction` or `AcquirePositionAction`,
+    /// junctions' connecting roads included): where its lanes fork, it takes the way on.
     pub(in crate::xosc::story) prefer_roads: Vec<usize>,
+    /// How far along [`Drive::prefer_roads`] it has come: the index of the road it was last
+    /// seen on.
+    pub(in crate::xosc::story) route_at: usize,
     /// Its heading relative to its lane's travel, rad, kept as it moves along the lane
     /// (esmini's relative heading): set where it is placed or where its trajectory ends,
     /// 0 after a lateral move.
@@ -109,6 +115,7 @@ impl Storyboard {
         // Speed.
         let mut v1 = st.speed;
         let mut done = Vec::new();
+        let speed_action = self.drives[e].speed.map(|task| task.action);
         if let Some(mut task) = self.drives[e].speed {
             let (v, over) = self.speed_task_at(e, &task, t1);
             let performance = self.actors[e].performance;
@@ -130,7 +137,12 @@ impl Storyboard {
         // move), backwards at a negative one (esmini's `MoveAlongS` by a negative distance);
         // not at all in the step an event teleported it.
         let held = std::mem::take(&mut self.drives[e].teleported);
-        let dist = if held { 0.0 } else { v1 * dt };
+        let travel = if self.lane_change_first(e, speed_action) {
+            st.speed
+        } else {
+            v1
+        };
+        let dist = if held { 0.0 } else { travel * dt };
         // A kept lateral distance moves it itself, or places it on its lane to move on from.
         let (lat, lat_ended) = self.lat_keep_step(e, v1, dt);
         done.extend(lat_ended);
@@ -147,7 +159,15 @@ impl Storyboard {
             }
             LatStep::Idle => self.move_on(e, &st, (dist, v1), (t1, dt), &mut done),
         };
+        // Held at its road's end since the step before, where it did not move: it stands
+        // (esmini's `ScenarioEngine::step` sets such an entity's speed to 0, so an action
+        // started later begins from rest).
+        let stuck = at_end && st.at_end_s.is_some() && st.vel[0].hypot(st.vel[1]) < 1e-9;
+        let speed_now = if stuck { 0.0 } else { speed_now };
         let moved = (pose.x - st.pose.x).hypot(pose.y - st.pose.y);
+        // Standing where its road ended, it is still there (esmini's position keeps its
+        // end-of-road status while it does not move).
+        let at_end = at_end || (!held && moved < 1e-12 && st.at_end_s.is_some());
         let before = self.drives[e].speed_before.take();
         let s = &mut self.actors[e].state;
         s.accel = (speed_now - before.unwrap_or(s.speed)) / dt;
@@ -165,11 +185,46 @@ impl Storyboard {
         } else {
             0.0
         };
-        s.at_end_s = if at_end { s.at_end_s + dt } else { 0.0 };
+        s.at_end_s = at_end.then(|| s.at_end_s.map_or(0.0, |d| d + dt));
         for a in done {
             self.override_task(Some(a));
         }
         Ok(())
+    }
+
+    /// The roads of entity `e`'s route it may take next from lane `lane`: where that lane's
+    /// road is on the route at or after where it has come ([`Drive::route_at`], moved on to
+    /// it), that road and the two after it (a junction's connecting road and the road it
+    /// leads to), so that a road the route takes again later does not draw it off its way;
+    /// off the route, every road of it.
+    fn route_ahead(&mut self, e: usize, lane: usize) -> Vec<usize> {
+        let road = self.roads.ids(lane).1;
+        let d = &mut self.drives[e];
+        let from = d.route_at.min(d.prefer_roads.len());
+        match d.prefer_roads[from..].iter().position(|&r| r == road) {
+            Some(j) => {
+                d.route_at = from + j;
+                let end = (d.route_at + 3).min(d.prefer_roads.len());
+                d.prefer_roads[d.route_at..end].to_vec()
+            }
+            None => d.prefer_roads.clone(),
+        }
+    }
+
+    /// Whether entity `e`'s lane change is stepped before its speed's action
+    /// (`speed_action`) in esmini's order: `Init`'s actions first, then the stories' in the
+    /// order they are written. esmini's `LatLaneChangeAction` moves the entity along its
+    /// lane itself, at the speed it has when the lane change is stepped; a speed action
+    /// stepped later changes the speed for the next step.
+    fn lane_change_first(&self, e: usize, speed_action: Option<usize>) -> bool {
+        // `Init`'s actions (`usize::MAX`) come first.
+        let order = |a: usize| a.wrapping_add(1);
+        match (self.drives[e].lateral, speed_action) {
+            (Some(l), Some(s)) => {
+                !matches!(l.mv.rule, LateralRule::Offset) && order(l.action) < order(s)
+            }
+            _ => false,
+        }
     }
 
     /// Scripted entity `e` in state `st` moved a step of `dt` s ending at `t1` (s), in which
@@ -282,7 +337,7 @@ impl Storyboard {
                 }
             }
         }
-        let prefer_roads = self.drives[e].prefer_roads.clone();
+        let prefer_roads = self.route_ahead(e, lp.lane);
         // A route names the roads it takes; a junction's connecting road is preferred by
         // the road it leads to.
         let prefer = |n: usize| {

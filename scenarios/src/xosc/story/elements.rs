@@ -504,10 +504,11 @@ impl Storyboard {
             return Ok(());
         };
         if action.action.is_global() {
-            // On the world, once, whoever the maneuver group's actors are; it completes at
-            // once (esmini's global actions are atomic).
+            // On the world, once, whoever the maneuver group's actors are; it completes in
+            // this step, once every trigger has been read (esmini's global actions end in
+            // their first `Step`).
             self.perform_global(&action, t)?;
-            self.end_elem(a);
+            self.ending_now.push(a);
             return Ok(());
         }
         for e in actors {
@@ -525,9 +526,22 @@ impl Storyboard {
                 })?;
         }
         if self.elems[a].pending == 0 {
-            self.end_elem(a);
+            // Done at once (a teleport, a lane's assignment): it completes in this step, once
+            // every trigger has been read, as esmini's end in their first `Step`, after
+            // every trigger's evaluation; a trigger reads that it completed in the next step.
+            self.ending_now.push(a);
         }
         Ok(())
+    }
+
+    /// Completes the actions that were done when they started in this step
+    /// ([`Storyboard::ending_now`]), after every trigger of the step has been read.
+    pub(in crate::xosc::story) fn end_instant_actions(&mut self) {
+        for a in std::mem::take(&mut self.ending_now) {
+            if self.elems[a].phase == Phase::Running && self.elems[a].pending == 0 {
+                self.end_elem(a);
+            }
+        }
     }
 
     /// A task of action `a` (an element, `None` in `Init`) ended.

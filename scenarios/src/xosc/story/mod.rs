@@ -81,6 +81,10 @@ pub struct Actor {
     /// The entity it tows now (its `Trailer`, or the one a `ConnectTrailerAction` hitched):
     /// that trailer is pulled by its hitch, not moved by its own actions.
     pub trailer: Option<usize>,
+    /// A reference point ahead of its rear axle (esmini's `refpoint_x_offset`,
+    /// [`m::Entity::refpoint_dx_m`]): how far ahead, m, and where its rear axle is now
+    /// (`[x, y]`, m). Its body trails the reference point.
+    pub front_ref: Option<(f64, [f64; 2])>,
 }
 
 /// Where an entity is and how it moves.
@@ -102,13 +106,20 @@ pub struct State {
     pub vel: [f64; 2],
     /// How long it has stood still, s.
     pub still_s: f64,
-    /// How long it has stood at the end of its lanes, s.
-    pub at_end_s: f64,
-    /// How long it has been off every lane of the map, s (kept only while an
-    /// `OffroadCondition` reads it).
-    pub offroad_s: f64,
+    /// How long since it was found at the end of its lanes, s (0 in the step it got
+    /// there, as esmini times an `EndOfRoadCondition` from then); `None` when it is not
+    /// there.
+    pub at_end_s: Option<f64>,
+    /// How long since it was found off the road, s (0 in the step it left it, as esmini
+    /// times an `OffroadCondition` from then); `None` on the road. Kept only while an
+    /// `OffroadCondition` reads it.
+    pub offroad_s: Option<f64>,
     /// Whether it has touched anything solid.
     pub collided: bool,
+    /// Its pitch and roll, rad, from the orientation it was last placed with (0 on the
+    /// flat roads otherwise); they turn the offsets of a `RelativeObjectPosition` taken
+    /// from it.
+    pub tilt: [f64; 2],
 }
 
 impl State {
@@ -121,9 +132,10 @@ impl State {
             travelled_m: 0.0,
             vel: [0.0; 2],
             still_s: 0.0,
-            at_end_s: 0.0,
-            offroad_s: 0.0,
+            at_end_s: None,
+            offroad_s: None,
             collided: false,
+            tilt: [0.0; 2],
         }
     }
 }
@@ -178,6 +190,9 @@ pub struct Storyboard {
     /// `AnimationAction` or a `VisibilityAction` (esmini ends them in their first `Step`,
     /// the frame after they start).
     ending_next: Vec<usize>,
+    /// Actions done when they started in this step (a teleport, a global action): they
+    /// complete after the step's triggers have been read.
+    ending_now: Vec<usize>,
     /// What the storyboard performs otherwise than written, found when it is built: `(where,
     /// what)`, warnings at load ([`Storyboard::notes`]).
     notes: Vec<(String, String)>,
@@ -280,6 +295,7 @@ impl Storyboard {
         // Trailers Init did not line up (their tow placed by a trajectory) are pulled to
         // their tows, as in esmini's initial frame.
         sb.pull_trailers(0.0);
+        sb.trail_rear_axles();
         for a in &mut sb.actors {
             let st = &mut a.state;
             st.vel = [st.speed * st.pose.h.cos(), st.speed * st.pose.h.sin()];
@@ -307,6 +323,8 @@ impl Storyboard {
                 hitch_dx_m: e.hitch_dx_m,
                 coupler_dx_m: e.coupler_dx_m,
                 trailer: e.trailer,
+                // Its rear axle behind the origin, where it stands before `Init`.
+                front_ref: e.refpoint_dx_m.map(|dx| (dx, [-dx, 0.0])),
                 state: State::at(
                     Pose {
                         x: 0.0,
@@ -353,6 +371,7 @@ impl Storyboard {
             ended: false,
             started: false,
             ending_next: Vec::new(),
+            ending_now: Vec::new(),
             notes: Vec::new(),
             said: Vec::new(),
             set_speed: None,
@@ -607,6 +626,7 @@ impl Storyboard {
         for r in self.roots.clone() {
             self.run_story(r, t)?;
         }
+        self.end_instant_actions();
         self.keep_distances(t + dt, dt)?;
         self.synchronize(dt, first);
         for e in 0..self.actors.len() {
@@ -623,11 +643,18 @@ impl Storyboard {
             }
         }
         self.pull_trailers(dt);
+        self.trail_rear_axles();
         if self.watch_offroad {
             for a in &mut self.actors {
+                // Off its own road's lanes where it moves along one (esmini's
+                // `Position::IsOffRoad` reads `t` against its road's width), else off every
+                // lane of the map.
                 let p = a.state.pose;
-                let off = self.roads.anchor(p.x, p.y).is_none();
-                a.state.offroad_s = if off { a.state.offroad_s + dt } else { 0.0 };
+                let off = match a.state.lane {
+                    Some(lp) => !self.roads.on_its_road(&lp),
+                    None => self.roads.anchor(p.x, p.y).is_none(),
+                };
+                a.state.offroad_s = off.then(|| a.state.offroad_s.map_or(0.0, |s| s + dt));
             }
         }
         // An event whose actions ended in this step's motion ends in this step.

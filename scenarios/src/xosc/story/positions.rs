@@ -37,6 +37,37 @@ impl Storyboard {
         })
     }
 
+    /// The pitch and roll (rad) an entity placed at `p` has: a relative object or world
+    /// position's are its entity's, turned by a relative orientation or set by an absolute
+    /// one; any other position's are its orientation's (paracosm's roads are flat), 0
+    /// without one (esmini's `Position` modes).
+    pub(in crate::xosc::story) fn tilt_of(&self, p: &Position) -> [f64; 2] {
+        let (base, orientation) = match p {
+            Position::RelativeObject {
+                entity,
+                orientation,
+                ..
+            }
+            | Position::RelativeWorld {
+                entity,
+                orientation,
+                ..
+            } => (self.actors[*entity].state.tilt, orientation),
+            Position::Lane { orientation, .. }
+            | Position::Road { orientation, .. }
+            | Position::RelativeRoad { orientation, .. }
+            | Position::RelativeLane { orientation, .. }
+            | Position::Route { orientation, .. }
+            | Position::Trajectory { orientation, .. } => ([0.0; 2], orientation),
+            _ => return [0.0; 2],
+        };
+        match orientation {
+            Some(o) if o.relative => [wrap(base[0] + o.p), wrap(base[1] + o.r)],
+            Some(o) => [o.p, o.r],
+            None => base,
+        }
+    }
+
     /// Where `p` is now: its pose and its place on the lanes.
     ///
     /// # Errors
@@ -69,8 +100,9 @@ impl Storyboard {
                 entity,
                 dx,
                 dy,
+                dz,
                 orientation,
-            } => self.object_offset(*entity, *dx, *dy, orientation),
+            } => self.object_offset(*entity, [*dx, *dy, *dz], orientation),
             Position::Road {
                 road,
                 s,
@@ -206,19 +238,26 @@ impl Storyboard {
         (pose, self.facing(self.roads.anchor(x, y), pose.h))
     }
 
-    /// A `RelativeObjectPosition`: `dx` forward and `dy` left (m, in entity `entity`'s
-    /// frame) of the entity, heading `orientation` against the entity's (rad); its pose and
-    /// its place on the lanes.
+    /// A `RelativeObjectPosition`: `[dx, dy, dz]` forward, left and up (m, in entity
+    /// `entity`'s frame, turned by its heading, pitch and roll as esmini's `RotateVec3d`
+    /// turns them: `Rz(h)·Ry(p)·Rx(r)`) of the entity, its part along the ground taken, heading
+    /// `orientation` against the entity's (rad); its pose and its place on the lanes.
     pub(in crate::xosc::story) fn object_offset(
         &self,
         entity: usize,
-        dx: f64,
-        dy: f64,
+        [dx, dy, dz]: [f64; 3],
         orientation: &Option<m::Orientation>,
     ) -> (Pose, Option<LanePos>) {
-        let r = self.actors[entity].state.pose;
-        let (c, s) = (r.h.cos(), r.h.sin());
-        let (x, y) = (r.x + c * dx - s * dy, r.y + s * dx + c * dy);
+        let st = &self.actors[entity].state;
+        let r = st.pose;
+        let (sh, ch) = r.h.sin_cos();
+        let (sp, cp) = st.tilt[0].sin_cos();
+        let (sr, cr) = st.tilt[1].sin_cos();
+        // The offset in the entity's level frame (turned by roll, then pitch) ...
+        let fx = cp * dx + sp * sr * dy + sp * cr * dz;
+        let fy = cr * dy - sr * dz;
+        // ... then by the heading.
+        let (x, y) = (r.x + ch * fx - sh * fy, r.y + sh * fx + ch * fy);
         let pose = Pose {
             x,
             y,

@@ -1,12 +1,14 @@
 //! The storyboard's actions: `Init` performed, references checked, and each running action's
 //! task started by its kind, one file per kind (speed, speed profile, lateral, trajectory,
-//! teleport, route, controller, distance, lateral distance, synchronize, trailer).
+//! teleport, route, controller, distance, lateral distance, synchronize, trailer), and a
+//! body trailing a reference point ahead of its rear axle.
 
 mod controller;
 mod distance;
 mod global;
 mod lateral;
 mod lateral_distance;
+mod rear_axle;
 mod route;
 mod speed;
 mod speed_profile;

@@ -32,6 +32,7 @@ impl Storyboard {
     /// planned again from where it is, which the host hands its system.
     fn set_route(&mut self, e: usize, points: &[LanePos], scripted: bool) {
         self.drives[e].prefer_roads = self.route_through(points);
+        self.drives[e].route_at = 0;
         if !scripted {
             // A trajectory handed before ends: this route replaces it.
             let old = self.drives[e].path_goal.take().map(|g| g.1);

@@ -16,7 +16,9 @@ impl Storyboard {
         at: &paracosm_openscenario::Pos,
     ) -> Result<(), StoryError> {
         let (pose, lane) = self.resolve(p, at)?;
+        let tilt = self.tilt_of(p);
         let st = &mut self.actors[e].state;
+        st.tilt = tilt;
         st.pose = pose;
         st.lane = lane;
         self.drives[e].rel_h = self.relative_heading(pose.h, lane);
@@ -32,6 +34,7 @@ impl Storyboard {
         // Its trailers are lined up behind it where it is put (esmini's
         // `TeleportAction::Start`).
         self.align_trailers(e);
+        self.align_rear_axle(e);
         Ok(())
     }
 }
