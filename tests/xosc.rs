@@ -229,6 +229,23 @@ fn a_scenario_in_the_older_forms_reads() {
     assert!(!out.contains("<Performance>"), "{out}");
 }
 
+/// The listing reads an empty `<StartTrigger/>` as none (the act starts at once), and names
+/// a `CollisionCondition` between two scripted entities, which the storyboard finds by their
+/// boxes (`tests/data/xosc/written/contacts_and_road_edges.xosc`).
+#[test]
+fn an_empty_start_trigger_is_listed_as_starting_at_once() {
+    let (code, out, err) = xosc(&["tests/data/xosc/written/contacts_and_road_edges.xosc"]);
+    assert_eq!(code, 0, "{err}");
+    for want in [
+        "act a starts at once",
+        "event hit (chaser) starts when chaser: touches lead",
+        "stops when time Ge 14 s",
+    ] {
+        assert!(out.contains(want), "`{want}` not in\n{out}");
+    }
+    assert!(!out.contains("starts when \n"), "{out}");
+}
+
 /// A variation file in `dir` over ALKS 4.2.3 (the crossing pedestrian) whose `Deterministic`
 /// element holds `distributions`.
 fn crossing_variation(dir: &std::path::Path, distributions: &str) -> std::path::PathBuf {

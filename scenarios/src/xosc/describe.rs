@@ -110,9 +110,11 @@ fn write_storyboard(s: &Scenario, out: &mut String) {
     for story in &s.stories {
         let _ = writeln!(out, "story {}:", story.name);
         for act in &story.acts {
+            // An empty trigger (`<StartTrigger/>`) is none: the act starts at once.
             let start = act
                 .start
                 .as_ref()
+                .filter(|t| !t.0.is_empty())
                 .map_or("at once".to_string(), |t| trigger(s, t));
             let _ = writeln!(out, "  act {} starts {start}", act.name);
             for g in &act.groups {
@@ -126,6 +128,7 @@ fn write_storyboard(s: &Scenario, out: &mut String) {
                         let when = e
                             .start
                             .as_ref()
+                            .filter(|t| !t.0.is_empty())
                             .map_or("with its act".to_string(), |t| trigger(s, t));
                         let _ = writeln!(
                             out,
@@ -141,7 +144,8 @@ fn write_storyboard(s: &Scenario, out: &mut String) {
             }
         }
     }
-    if let Some(t) = &s.stop {
+    // An empty stop trigger never fires.
+    if let Some(t) = s.stop.as_ref().filter(|t| !t.0.is_empty()) {
         let _ = writeln!(out, "stops {}", trigger(s, t));
     }
 }
