@@ -316,6 +316,103 @@ fn cover_estimate_reads_fuzz_results_and_csv_and_decides_k_epsilon() {
     assert!((est2["dispersion"]["lower"].as_f64().unwrap() - d).abs() < 1e-12);
 }
 
+/// Past the default limits the star discrepancy and the dispersion are bracketed, and the
+/// bracket names `--exact`; with it both are exact, inside their brackets, with progress on
+/// stderr. A star discrepancy in d = 5, which paracosm has no exact algorithm for, stays a
+/// bracket that says so.
+#[test]
+fn cover_estimate_exact_computes_past_the_default_limits_with_progress() {
+    let dir = tempfile::tempdir().unwrap();
+    // 300 points in d = 4 (the star's default limit there is 256) and 130 in d = 5 (the
+    // dispersion's is 120): deterministic, spread by an additive recurrence.
+    let write = |name: &str, n: usize, d: usize| {
+        let alphas = [
+            0.7548776662,
+            0.5698402910,
+            0.4301597090,
+            0.3247179572,
+            0.2451223338,
+        ];
+        let mut text = (0..d)
+            .map(|k| format!("x{k}"))
+            .collect::<Vec<_>>()
+            .join(",");
+        text.push('\n');
+        for i in 1..=n {
+            let row: Vec<String> = (0..d)
+                .map(|k| format!("{:.6}", (0.5 + i as f64 * alphas[k]).fract()))
+                .collect();
+            text.push_str(&row.join(","));
+            text.push('\n');
+        }
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let four = write("four.csv", 300, 4);
+    let five = write("five.csv", 130, 5);
+    let run = |file: &std::path::Path, metric: &str, exact: bool| {
+        let mut args = vec!["estimate", file.to_str().unwrap(), "--metrics", metric];
+        if exact {
+            args.push("--exact");
+        }
+        let o = cover(&args);
+        expect_code(&o, 0);
+        (
+            String::from_utf8(o.stdout).unwrap(),
+            String::from_utf8(o.stderr).unwrap(),
+        )
+    };
+    let json = |file: &std::path::Path, metric: &str, exact: bool| {
+        let mut args = vec![
+            "estimate",
+            file.to_str().unwrap(),
+            "--metrics",
+            metric,
+            "--json",
+        ];
+        if exact {
+            args.push("--exact");
+        }
+        success_json(&cover(&args))
+    };
+    for (file, metric, key, name) in [
+        (&four, "star", "star", "star discrepancy"),
+        (&five, "dispersion", "dispersion", "dispersion"),
+    ] {
+        let (table, _) = run(file, metric, false);
+        assert!(table.contains("bracket (--exact computes it)"), "{table}");
+        let (table, progress) = run(file, metric, true);
+        assert!(
+            table.contains("exact") && !table.contains("bracket"),
+            "{table}"
+        );
+        assert!(
+            progress.contains(&format!("exact {name}: 100 %")),
+            "{progress}"
+        );
+        let bracket = json(file, metric, false);
+        let exact = json(file, metric, true);
+        let v = exact[key]["lower"].as_f64().unwrap();
+        assert_eq!(exact[key]["exact"], true, "{exact}");
+        assert_eq!(exact[key]["upper"].as_f64().unwrap(), v);
+        let (lo, hi) = (
+            bracket[key]["lower"].as_f64().unwrap(),
+            bracket[key]["upper"].as_f64().unwrap(),
+        );
+        assert!(
+            lo <= v + 1e-12 && v <= hi + 1e-12,
+            "{key}: {v} not in [{lo}, {hi}]"
+        );
+        assert!(lo < hi, "{key}: the default is a bracket: [{lo}, {hi}]");
+    }
+    let (table, _) = run(&five, "star", true);
+    assert!(
+        table.contains("bracket (no exact algorithm past d = 4: this is d = 5)"),
+        "{table}"
+    );
+}
+
 #[test]
 fn cover_bad_input_exits_2_naming_row_and_column() {
     let dir = tempfile::tempdir().unwrap();

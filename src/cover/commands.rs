@@ -69,6 +69,11 @@ pub struct EstimateArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Compute the dispersion (any dimension) and the star discrepancy (d <= 4) exactly,
+    /// past the default limits, whatever the time and memory (d = 3: about 45 s and 2 GB for
+    /// the star discrepancy of 10,000 points), with progress on stderr.
+    #[arg(long)]
+    pub exact: bool,
 }
 
 /// `paracosm-cover generate`.
@@ -197,12 +202,64 @@ pub fn run_estimate(a: &EstimateArgs, out: &mut dyn Write) -> Result<(), Error> 
         .transpose()
         .map_err(bad)?;
     let set = read_tests(&a.file, space.as_ref()).map_err(bad)?;
-    let report = estimate(&set, &metrics, a.strength, a.epsilon, a.missing).map_err(bad)?;
+    let tell = ExactTeller::new();
+    let report = estimate(
+        &set,
+        &metrics,
+        a.strength,
+        a.epsilon,
+        a.missing,
+        a.exact
+            .then_some(&|name: &str, done: u64, total: u64| tell.tell(name, done, total)),
+    )
+    .map_err(bad)?;
     if a.json {
         serde_json::to_writer_pretty(&mut *out, &report).map_err(|e| output(e.into()))?;
         writeln!(out).map_err(output)
     } else {
         write!(out, "{report}").map_err(output)
+    }
+}
+
+/// Tells an exact computation's progress on stderr, a line at each tenth of its work and at
+/// most every 5 s between (`exact star discrepancy: 40 % (12.3 s)`), so that a log shows it as
+/// a terminal does.
+struct ExactTeller {
+    /// When it started, and the last line's (tenths done, when).
+    state: std::sync::Mutex<(Instant, Option<(u64, Instant)>)>,
+}
+
+impl ExactTeller {
+    fn new() -> Self {
+        ExactTeller {
+            state: std::sync::Mutex::new((Instant::now(), None)),
+        }
+    }
+
+    /// `done` of `total` units of the exact `name` are done.
+    fn tell(&self, name: &str, done: u64, total: u64) {
+        let mut s = self
+            .state
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let now = Instant::now();
+        if done == 0 {
+            // A computation starts.
+            *s = (now, None);
+        }
+        let tenths = (done * 10).checked_div(total).unwrap_or(10);
+        let due = match s.1 {
+            None => true,
+            Some((t, at)) => tenths > t || now.duration_since(at).as_secs_f64() >= 5.0,
+        };
+        if due {
+            s.1 = Some((tenths, now));
+            let pct = (done * 100).checked_div(total).unwrap_or(100);
+            crate::cli::to_stderr(&format!(
+                "exact {name}: {pct} % ({:.1} s)",
+                now.duration_since(s.0).as_secs_f64()
+            ));
+        }
     }
 }
 

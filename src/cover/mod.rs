@@ -14,5 +14,5 @@ pub use plan::{
     halton_points_for, plan, plan_suites, suite_per_row, HaltonSize, Plan, PlanError, SuitePlan,
     MAX_MEASURED, MAX_PLANNED,
 };
-pub use report::{estimate, Estimate, Metric};
+pub use report::{estimate, Estimate, ExactProgress, Metric, STAR_EXACT_MAX_DIMS};
 pub use spec::{load_space, parse_space, SpecError};

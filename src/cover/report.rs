@@ -6,9 +6,9 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 
 use paracosm_generators::coverage::{
-    discrepancy, dispersion, k_epsilon_covering, kwise_coverage, star_discrepancy, CoverageError,
-    Discrepancy, Dispersion, DispersionOptions, KEpsilonCovering, KWiseCoverage, StarDiscrepancy,
-    StarOptions,
+    discrepancy, dispersion_with_progress, k_epsilon_covering, kwise_coverage,
+    star_discrepancy_with_progress, CoverageError, Discrepancy, Dispersion, DispersionOptions,
+    KEpsilonCovering, KWiseCoverage, StarDiscrepancy, StarOptions,
 };
 
 use super::TestSet;
@@ -73,9 +73,41 @@ pub struct Estimate {
 /// computed: 10^10, about 10 s each on one core.
 pub const MAX_L2_WORK: f64 = 1e10;
 
+/// Largest dimension in which paracosm computes the star discrepancy exactly (its sweeps are
+/// for d = 1 to 4; past it, a bracket).
+pub const STAR_EXACT_MAX_DIMS: usize = 4;
+
+/// How an exact computation's progress is told: the metric's name, then `(done, total)`
+/// units of its work ([`paracosm_generators::coverage::Progress`]).
+pub type ExactProgress<'a> = &'a (dyn Fn(&str, u64, u64) + Sync);
+
+/// The limits `paracosm-cover estimate` computes within: the defaults, or, with `--exact`,
+/// none, so that the dispersion (every `d`) and the star discrepancy (`d <= 4`) are exact
+/// whatever the time and memory.
+fn limits(exact: bool, d: usize) -> (DispersionOptions, StarOptions) {
+    if exact {
+        (
+            DispersionOptions {
+                exact_max_points: vec![usize::MAX; d.max(3) - 2],
+                ..DispersionOptions::default()
+            },
+            StarOptions {
+                exact_max_points: [usize::MAX; 4],
+                ..StarOptions::default()
+            },
+        )
+    } else {
+        (DispersionOptions::default(), StarOptions::default())
+    }
+}
+
 /// Computes the requested metrics over the continuous coordinates of `set`, k-wise coverage
 /// for strengths `1..=strength` over its discrete ones (listing up to `max_missing` uncovered
 /// tuples per strength), and the (k, ε) verdict with `k = strength` when `epsilon` is given.
+/// With `exact` (`--exact`) the dispersion and the star discrepancy are computed exactly
+/// wherever paracosm has an exact algorithm, past the default limits
+/// ([`DispersionOptions::exact_max_points`], [`StarOptions::exact_max_points`]), telling the
+/// hook how far each has come.
 ///
 /// # Errors
 /// [`CoverageError`] for a strength larger than the number of discrete parameters (or above
@@ -86,9 +118,18 @@ pub fn estimate(
     strength: Option<usize>,
     epsilon: Option<f64>,
     max_missing: usize,
+    exact: Option<ExactProgress<'_>>,
 ) -> Result<Estimate, CoverageError> {
     let nd = set.space.level_counts().len();
     let nc = set.space.continuous_dims();
+    let (dispersion_limits, star_limits) = limits(exact.is_some(), nc);
+    let hook = |name: &'static str| {
+        move |done: u64, total: u64| {
+            if let Some(tell) = exact {
+                tell(name, done, total);
+            }
+        }
+    };
     let strength = match strength {
         Some(t) => {
             if nd == 0 || t == 0 || t > nd.min(6) {
@@ -125,31 +166,21 @@ pub fn estimate(
         for m in metrics {
             match m {
                 Metric::Dispersion => {
-                    out.dispersion = Some(dispersion(&coords, nc, &DispersionOptions::default())?)
+                    out.dispersion = Some(dispersion_with_progress(
+                        &coords,
+                        nc,
+                        &dispersion_limits,
+                        &hook("dispersion"),
+                    )?)
                 }
-                Metric::L2(k) => {
-                    let n = set.points.len() as f64;
-                    if n * n * nc as f64 > MAX_L2_WORK {
-                        out.skipped.push(format!(
-                            "{}: skipped, n² · d = {:.1e} is past the limit of {MAX_L2_WORK:.0e}",
-                            k.name(),
-                            n * n * nc as f64
-                        ));
-                        continue;
-                    }
-                    let v = discrepancy(&coords, nc, *k)?;
-                    if v.is_finite() {
-                        out.discrepancy.push((k.name().to_owned(), v));
-                    } else {
-                        out.skipped.push(format!(
-                            "{}: not a finite number in d = {nc} (its product over the \
-                             dimensions overflows)",
-                            k.name()
-                        ));
-                    }
-                }
+                Metric::L2(k) => add_l2(&mut out, &coords, nc, *k)?,
                 Metric::Star => {
-                    out.star = Some(star_discrepancy(&coords, nc, &StarOptions::default())?)
+                    out.star = Some(star_discrepancy_with_progress(
+                        &coords,
+                        nc,
+                        &star_limits,
+                        &hook("star discrepancy"),
+                    )?)
                 }
             }
         }
@@ -160,10 +191,42 @@ pub fn estimate(
             &set.points,
             strength.max(1),
             eps,
-            &DispersionOptions::default(),
+            &dispersion_limits,
         )?);
     }
     Ok(out)
+}
+
+/// Adds the L2-type discrepancy `k` of `coords` (`n × nc`, row-major, in the unit cube) to
+/// `out`, or the reason it is skipped (past [`MAX_L2_WORK`], or not a finite number).
+///
+/// # Errors
+/// What [`discrepancy`] returns.
+fn add_l2(
+    out: &mut Estimate,
+    coords: &[f64],
+    nc: usize,
+    k: Discrepancy,
+) -> Result<(), CoverageError> {
+    let n = (coords.len() / nc) as f64;
+    if n * n * nc as f64 > MAX_L2_WORK {
+        out.skipped.push(format!(
+            "{}: skipped, n² · d = {:.1e} is past the limit of {MAX_L2_WORK:.0e}",
+            k.name(),
+            n * n * nc as f64
+        ));
+        return Ok(());
+    }
+    let v = discrepancy(coords, nc, k)?;
+    if v.is_finite() {
+        out.discrepancy.push((k.name().to_owned(), v));
+    } else {
+        out.skipped.push(format!(
+            "{}: not a finite number in d = {nc} (its product over the dimensions overflows)",
+            k.name()
+        ));
+    }
+    Ok(())
 }
 
 impl fmt::Display for Estimate {
@@ -192,7 +255,7 @@ impl fmt::Display for Estimate {
             } else {
                 writeln!(
                     f,
-                    "dispersion        [{:.6e}, {:.6e}]  bracket",
+                    "dispersion        [{:.6e}, {:.6e}]  bracket (--exact computes it)",
                     d.lower, d.upper
                 )?;
             }
@@ -218,9 +281,17 @@ impl fmt::Display for Estimate {
             if s.exact {
                 writeln!(f, "star discrepancy  {:.6e}  exact", s.lower)?;
             } else {
+                let how = if self.continuous.len() <= STAR_EXACT_MAX_DIMS {
+                    "--exact computes it".to_owned()
+                } else {
+                    format!(
+                        "no exact algorithm past d = {STAR_EXACT_MAX_DIMS}: this is d = {}",
+                        self.continuous.len()
+                    )
+                };
                 writeln!(
                     f,
-                    "star discrepancy  [{:.6e}, {:.6e}]  bracket",
+                    "star discrepancy  [{:.6e}, {:.6e}]  bracket ({how})",
                     s.lower, s.upper
                 )?;
             }

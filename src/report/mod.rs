@@ -427,7 +427,7 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
         if set.space.params().is_empty() {
             None
         } else {
-            crate::cover::estimate(&set, &metrics, strength, None, 10).ok()
+            crate::cover::estimate(&set, &metrics, strength, None, 10, None).ok()
         }
     };
     Summary {

@@ -17,14 +17,24 @@ mod star4d;
 mod wrap_around;
 
 pub use covering::{k_epsilon_covering, KEpsilonCovering};
+
+/// A hook an exact computation calls as it goes: `(done, total)` units of its work (the
+/// sweep's planes for the star discrepancy in d = 3, its prefixes in d = 4, the supporting
+/// points of the dispersion's sweep), from any of its threads; `done` only grows.
+pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
+
+/// A [`Progress`] that reports nothing.
+pub fn no_progress(_done: u64, _total: u64) {}
 pub use discrepancy::{discrepancy, Discrepancy};
-pub use dispersion::{dispersion, Dispersion, DispersionOptions, EmptyBox};
+pub use dispersion::{
+    dispersion, dispersion_with_progress, Dispersion, DispersionOptions, EmptyBox,
+};
 pub use error::CoverageError;
 pub use kwise::{
     kwise_coverage, kwise_coverage_rows, subset_products, subsets, KWiseCoverage, MissingTuple,
     RawKWise, MAX_STRENGTH,
 };
-pub use star::{star_discrepancy, StarDiscrepancy, StarOptions};
+pub use star::{star_discrepancy, star_discrepancy_with_progress, StarDiscrepancy, StarOptions};
 
 /// Checks an `n × d` row-major point set: `d >= 1`, length a multiple of `d`, every value
 /// finite and in `[0, 1]`. Returns `n`.

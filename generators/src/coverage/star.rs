@@ -96,6 +96,20 @@ pub fn star_discrepancy(
     d: usize,
     options: &StarOptions,
 ) -> Result<StarDiscrepancy, CoverageError> {
+    star_discrepancy_with_progress(points, d, options, &super::no_progress)
+}
+
+/// [`star_discrepancy`], telling `progress` how far an exact computation has come (the
+/// planes of the sweep in d = 3, the prefixes in d = 4; a bracket reports nothing).
+///
+/// # Errors
+/// As [`star_discrepancy`].
+pub fn star_discrepancy_with_progress(
+    points: &[f64],
+    d: usize,
+    options: &StarOptions,
+    progress: super::Progress<'_>,
+) -> Result<StarDiscrepancy, CoverageError> {
     let n = check_unit_points(points, d)?;
     if n == 0 {
         return Err(CoverageError::Shape("the point set is empty".into()));
@@ -107,8 +121,8 @@ pub fn star_discrepancy(
         let (value, witness) = match d {
             1 => exact_1d(points),
             2 => plane_terms(points, points, 1.0, n),
-            3 => super::star3d::exact_3d_sweep(points),
-            _ => super::star4d::exact_4d_prefixes(points),
+            3 => super::star3d::exact_3d_sweep(points, progress),
+            _ => super::star4d::exact_4d_prefixes(points, progress),
         };
         return Ok(StarDiscrepancy {
             lower: value,
@@ -485,6 +499,32 @@ mod tests {
         assert!(r.method.contains("at most 1.111 times"), "{}", r.method);
     }
 
+    /// The exact computations tell their progress, up to their whole work (the planes of the
+    /// sweep in d = 3, the prefixes in d = 4), and give what they give without it.
+    #[test]
+    fn the_exact_sweeps_report_their_progress_to_the_end() {
+        for d in [3, 4] {
+            let pts = crate::Halton::new(&crate::ParamSpace::unit_cube(d)).unit_points(0, 60);
+            let seen = std::sync::Mutex::new(Vec::new());
+            let with = star_discrepancy_with_progress(&pts, d, &StarOptions::default(), &|a, b| {
+                seen.lock().unwrap().push((a, b));
+            })
+            .unwrap();
+            let without = star_discrepancy(&pts, d, &StarOptions::default()).unwrap();
+            assert!(with.exact);
+            assert_eq!(with.lower, without.lower, "d = {d}");
+            let seen = seen.into_inner().unwrap();
+            let total = seen[0].1;
+            // 60 distinct first coordinates and the cube's end: 61 planes, or 61 prefixes.
+            assert_eq!(total, 61, "d = {d}");
+            assert!(
+                seen.iter().all(|&(a, b)| b == total && a <= total),
+                "d = {d}: {seen:?}"
+            );
+            assert_eq!(seen.iter().map(|s| s.0).max(), Some(total), "d = {d}");
+        }
+    }
+
     #[test]
     fn past_the_search_work_the_cover_still_bounds_and_the_bracket_says_how_far() {
         // 5,000 random points in d = 3 with no exact solve: n² · d = 7.5e7 is past the search,
@@ -618,7 +658,7 @@ mod tests {
                 .iter()
                 .map(|&v| if coarse { f64::from(v % 11) / 10.0 } else { f64::from(v) / 1000.0 })
                 .collect();
-            let (a, wa) = super::super::star3d::exact_3d_sweep(&pts);
+            let (a, wa) = super::super::star3d::exact_3d_sweep(&pts, &super::super::no_progress);
             let (b, _) = exact_3d(&pts);
             prop_assert!((a - b).abs() < 1e-12, "sweep {} vs enumeration {}", a, b);
             prop_assert!((local(&pts, 3, &wa) - a).abs() < 1e-12);

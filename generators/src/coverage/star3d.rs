@@ -267,9 +267,9 @@ impl Plane {
 /// its witness corner: `max over Γ of max(vol − open count/n, closed count/n − vol)`, the same
 /// quantity as the enumeration of the critical grid, in `O(n^{5/2})` time and `O(n²)` memory
 /// (about 1.6 GB at n = 10,000).
-pub(super) fn exact_3d_sweep(points: &[f64]) -> (f64, Vec<f64>) {
+pub(super) fn exact_3d_sweep(points: &[f64], progress: super::Progress<'_>) -> (f64, Vec<f64>) {
     let n = points.len() / 3;
-    let (value, witness, _) = scaled_3d_sweep(points, [1.0, 1.0], n as f64);
+    let (value, witness, _) = scaled_3d_sweep(points, [1.0, 1.0], n as f64, progress);
     (value, witness)
 }
 
@@ -277,8 +277,13 @@ pub(super) fn exact_3d_sweep(points: &[f64]) -> (f64, Vec<f64>) {
 /// of `points` (`m × 3`, row-major, in `[0, 1]`; `m` may be 0), with `σ = scale` and `n`
 /// (any positive divisor, usually the size of a larger set that `points` is part of): its
 /// value, the grid corner where it is reached and the term (0 open, 1 closed). With `σ = 1`
-/// and `n = m`, the star discrepancy of `points`.
-pub(super) fn scaled_3d_sweep(points: &[f64], scale: [f64; 2], n: f64) -> (f64, Vec<f64>, usize) {
+/// and `n = m`, the star discrepancy of `points`. `progress` hears of each plane swept.
+pub(super) fn scaled_3d_sweep(
+    points: &[f64],
+    scale: [f64; 2],
+    n: f64,
+    progress: super::Progress<'_>,
+) -> (f64, Vec<f64>, usize) {
     let m = points.len() / 3;
     let grid = |k: usize| {
         let mut g: Vec<f64> = points.chunks_exact(3).map(|p| p[k]).collect();
@@ -298,7 +303,8 @@ pub(super) fn scaled_3d_sweep(points: &[f64], scale: [f64; 2], n: f64) -> (f64, 
     let mut plane = Plane::new(&u, &v, n, scale);
     let mut best = (f64::NEG_INFINITY, vec![1.0; 3], 0);
     let mut next = 0;
-    for &z in &w {
+    for (k, &z) in w.iter().enumerate() {
+        progress(k as u64, w.len() as u64);
         // Open boxes at z: the points with a first coordinate below z are in.
         let (val, i, j) = plane.max_at(0, z, n);
         if val > best.0 {
@@ -316,5 +322,6 @@ pub(super) fn scaled_3d_sweep(points: &[f64], scale: [f64; 2], n: f64) -> (f64, 
             best = (val, vec![z, u[i], v[j]], 1);
         }
     }
+    progress(w.len() as u64, w.len() as u64);
     best
 }

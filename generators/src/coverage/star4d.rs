@@ -23,7 +23,7 @@ use super::star3d::scaled_3d_sweep;
 /// `O(n^{7/2})`, memory `O(n²)` per thread: on this project's 2-core machine, with another job
 /// beside it, 256 Halton points took 1.1 s, 384 took 4.1 s and 1,024 took 198 s
 /// (`cargo run --release -p paracosm-generators --example star3d -- 1024 halton 4`).
-pub(super) fn exact_4d_prefixes(points: &[f64]) -> (f64, Vec<f64>) {
+pub(super) fn exact_4d_prefixes(points: &[f64], progress: super::Progress<'_>) -> (f64, Vec<f64>) {
     let n = points.len() / 4;
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&a, &b| points[4 * a].total_cmp(&points[4 * b]));
@@ -35,6 +35,10 @@ pub(super) fn exact_4d_prefixes(points: &[f64]) -> (f64, Vec<f64>) {
             ends.push(k);
         }
     }
+    // Prefixes done, for `progress` (each prefix's own sweep reports nothing).
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let total = ends.len() as u64;
+    progress(0, total);
     let best = ends
         .par_iter()
         .map(|&end| {
@@ -47,7 +51,12 @@ pub(super) fn exact_4d_prefixes(points: &[f64]) -> (f64, Vec<f64>) {
                 .iter()
                 .flat_map(|&i| points[4 * i + 1..4 * i + 4].iter().copied())
                 .collect();
-            let (value, corner, term) = scaled_3d_sweep(&rest, [open_y0, closed_y0], n as f64);
+            let (value, corner, term) =
+                scaled_3d_sweep(&rest, [open_y0, closed_y0], n as f64, &super::no_progress);
+            progress(
+                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+                total,
+            );
             let y0 = if term == 0 { open_y0 } else { closed_y0 };
             (
                 value,

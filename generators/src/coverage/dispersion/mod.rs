@@ -132,6 +132,20 @@ pub fn dispersion(
     d: usize,
     options: &DispersionOptions,
 ) -> Result<Dispersion, CoverageError> {
+    dispersion_with_progress(points, d, options, &super::no_progress)
+}
+
+/// [`dispersion`], telling `progress` how far the exact sweep in `d >= 3` has come (its
+/// supporting points, each side; the plane's sweep and a bracket report nothing).
+///
+/// # Errors
+/// As [`dispersion`].
+pub fn dispersion_with_progress(
+    points: &[f64],
+    d: usize,
+    options: &DispersionOptions,
+    progress: super::Progress<'_>,
+) -> Result<Dispersion, CoverageError> {
     let n = check_unit_points(points, d)?;
     // Copies of the points and their columns, sorted.
     let per_point = d.saturating_mul(32).saturating_add(64);
@@ -164,7 +178,7 @@ pub fn dispersion(
             "exact: maximal-empty-rectangle sweep (d = 2)".to_owned(),
         ),
         _ if m <= limit => (
-            sweep::largest_empty_box(&inner, d),
+            sweep::largest_empty_box(&inner, d, progress),
             format!("exact: maximal-empty-box sweep (d = {d}, n = {n})"),
         ),
         _ => {

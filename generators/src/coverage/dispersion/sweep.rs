@@ -11,8 +11,13 @@ use super::{better, max_gap, plane, EmptyBox};
 /// Decomposition on axis 0: a maximal box's lower face on that axis holds a point (found by
 /// [`lower_supported`]), or lies on `0` with the upper face on a point (the same sweep on the
 /// mirrored set), or the box spans `[0, 1]` on axis 0 (the largest empty box of the points
-/// projected on the other axes, times 1).
-pub(super) fn largest_empty_box(points: &[f64], d: usize) -> EmptyBox {
+/// projected on the other axes, times 1). `progress` hears of each supporting point walked,
+/// `2n` in all (the projection's own sweep reports nothing).
+pub(super) fn largest_empty_box(
+    points: &[f64],
+    d: usize,
+    progress: super::super::Progress<'_>,
+) -> EmptyBox {
     let n = points.len() / d;
     let mirrored: Vec<f64> = points
         .chunks_exact(d)
@@ -25,7 +30,7 @@ pub(super) fn largest_empty_box(points: &[f64], d: usize) -> EmptyBox {
     let span = match d - 1 {
         1 => max_gap(&projected),
         2 => plane::largest_empty_rectangle(&projected),
-        _ => largest_empty_box(&projected, d - 1),
+        _ => largest_empty_box(&projected, d - 1, &super::super::no_progress),
     };
     let span = EmptyBox {
         lo: std::iter::once(0.0).chain(span.lo).collect(),
@@ -33,8 +38,12 @@ pub(super) fn largest_empty_box(points: &[f64], d: usize) -> EmptyBox {
     };
     let floor = AtomicU64::new(span.volume().to_bits());
     // Mirror by negation (exact in floating point); the mirrored axis ends at 0.
-    let right = lower_supported(points, d, n, 1.0, &floor, usize::MAX);
-    let left = lower_supported(&mirrored, d, n, 0.0, &floor, usize::MAX);
+    let walked = AtomicU64::new(0);
+    let total = 2 * n as u64;
+    progress(0, total);
+    let step = || progress(walked.fetch_add(1, Ordering::Relaxed) + 1, total);
+    let right = lower_supported(points, d, n, (1.0, &floor), usize::MAX, &step);
+    let left = lower_supported(&mirrored, d, n, (0.0, &floor), usize::MAX, &step);
     let left = left.map(|mut b| {
         let (lo, hi) = (-b.hi[0], -b.lo[0]);
         b.lo[0] = lo;
@@ -66,9 +75,9 @@ fn lower_supported(
     points: &[f64],
     d: usize,
     n: usize,
-    x_end: f64,
-    floor: &AtomicU64,
+    (x_end, floor): (f64, &AtomicU64),
     max_steps: usize,
+    walked: &(dyn Fn() + Sync),
 ) -> Option<EmptyBox> {
     // A capped walk also keeps only the largest boxes, so that high dimensions stay cheap.
     let max_boxes = if max_steps == usize::MAX {
@@ -143,6 +152,7 @@ fn lower_supported(
                         consider(x_end, boxes, b, &mut best);
                     }
                 }
+                walked();
                 best
             },
         )
@@ -328,5 +338,5 @@ fn split(boxes: &mut Boxes, spare: &mut Boxes, keep: &mut Vec<bool>, s: &[f64], 
 pub(super) fn capped_lower_bound(points: &[f64], d: usize, max_steps: usize) -> Option<EmptyBox> {
     let n = points.len() / d;
     let floor = AtomicU64::new(0f64.to_bits());
-    lower_supported(points, d, n, 1.0, &floor, max_steps)
+    lower_supported(points, d, n, (1.0, &floor), max_steps, &|| {})
 }

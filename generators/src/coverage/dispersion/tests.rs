@@ -193,3 +193,28 @@ fn past_the_search_limits_the_bracket_is_the_widest_empty_slab_and_one() {
         r.method
     );
 }
+
+/// The exact sweep tells its progress, up to its whole work, and gives what it gives without
+/// it.
+#[test]
+fn the_exact_sweep_reports_its_progress_to_the_end() {
+    let pts = crate::Halton::new(&crate::ParamSpace::unit_cube(3)).unit_points(0, 300);
+    let seen = std::sync::Mutex::new(Vec::new());
+    let with = dispersion_with_progress(&pts, 3, &DispersionOptions::default(), &|done, total| {
+        seen.lock().unwrap().push((done, total));
+    })
+    .unwrap();
+    let without = dispersion(&pts, 3, &DispersionOptions::default()).unwrap();
+    assert_eq!(with.lower, without.lower);
+    let seen = seen.into_inner().unwrap();
+    // Two sides of the supporting points (those strictly inside the cube: Halton's first is
+    // the origin), each reported once, from 0 to the total.
+    let inside = pts
+        .chunks_exact(3)
+        .filter(|p| p.iter().all(|&x| 0.0 < x && x < 1.0))
+        .count() as u64;
+    assert_eq!(inside, 299);
+    assert!(seen.iter().all(|&(_, t)| t == 2 * inside), "{seen:?}");
+    assert_eq!(seen.iter().map(|s| s.0).max(), Some(2 * inside));
+    assert_eq!(seen.len() as u64, 2 * inside + 1);
+}
