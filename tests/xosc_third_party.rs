@@ -242,3 +242,55 @@ fn an_ego_that_never_moves_when_the_file_asks_it_to_is_an_error() {
         "{why}"
     );
 }
+
+/// ASAM's ten example scenarios and the seven Euro NCAP files `scenariogeneration` writes run
+/// as campaigns of one test under `aeb` (a pass or a failure, never an error): all but ASAM's
+/// `SimpleOvertake`, whose vehicles are named neither Ego nor hero, so that the load asks
+/// which is the ego (`--ego`) and runs once told: 16 of 17 without an option, 17 with it
+/// (2026-11-30). Keeps those counts from falling.
+#[test]
+fn asams_and_the_generators_files_run_as_campaigns() {
+    let mut files: Vec<PathBuf> = Vec::new();
+    for dir in [data("asam_examples")] {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.extension().is_some_and(|x| x == "xosc") {
+                files.push(p);
+            }
+        }
+    }
+    for e in std::fs::read_dir(data("scenariogeneration")).unwrap() {
+        let x = e.unwrap().path().join("xosc");
+        for f in std::fs::read_dir(&x).into_iter().flatten() {
+            let p = f.unwrap().path();
+            if p.extension().is_some_and(|x| x == "xosc") {
+                files.push(p);
+            }
+        }
+    }
+    files.sort();
+    assert_eq!(files.len(), 17, "{files:?}");
+    let mut ran = 0;
+    for f in &files {
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        let (code, err, record) = run_one(&[f.to_str().unwrap()]);
+        if name == "SimpleOvertake.xosc" {
+            assert_eq!(code, 2, "{err}");
+            assert!(err.contains("--ego NAME"), "{err}");
+            let (code, err, record) = run_one(&[f.to_str().unwrap(), "--ego", "Vehicle 1"]);
+            assert!(matches!(code, 0 | 1), "{name} --ego: exit {code}: {err}");
+            assert!(
+                matches!(record["status"].as_str(), Some("pass" | "fail")),
+                "{record}"
+            );
+            continue;
+        }
+        assert!(matches!(code, 0 | 1), "{name}: exit {code}: {err}");
+        assert!(
+            matches!(record["status"].as_str(), Some("pass" | "fail")),
+            "{name}: {record}"
+        );
+        ran += 1;
+    }
+    assert_eq!(ran, 16);
+}

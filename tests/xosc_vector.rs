@@ -200,3 +200,42 @@ fn a_driven_egos_trajectory_is_its_systems_route() {
     );
     assert!((x1 - 263.19).abs() < 1.75, "on the crossing road: {x1}");
 }
+
+/// Each of Vector's 132 scenario and variation files runs as a campaign of one test under
+/// `aeb` (a pass or a failure, never an error), except the six CPRA files, refused at load at
+/// their ego's `SpeedAction` to −1.1 m/s (paracosm's systems under test drive forward only):
+/// 126 of 132 (2026-11-30; issue "The field's OpenSCENARIO files run as their authors meant",
+/// requirement 6, asks 90 %). Keeps that count from falling.
+#[test]
+fn every_vector_file_runs_as_a_campaign_but_the_reversing_cpra_files() {
+    let mut files = Vec::new();
+    scenario_files(&ncap(), &mut files);
+    let (mut ran, mut refused) = (0, Vec::new());
+    for f in &files {
+        let (code, err, records) = campaign(&[f.to_str().unwrap(), "--budget", "1"]);
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        match code {
+            0 | 1 => {
+                assert_eq!(records.len(), 1, "{name}: {err}");
+                let status = records[0]["status"].as_str().unwrap_or("").to_owned();
+                assert!(status == "pass" || status == "fail", "{name}: {status}");
+                ran += 1;
+            }
+            _ => {
+                assert!(
+                    name.contains("CPRA")
+                        && err.contains("drive backwards")
+                        && err.contains(".xosc:"),
+                    "{name}: exit {code}: {err}"
+                );
+                refused.push(name);
+            }
+        }
+    }
+    assert_eq!(files.len(), 132);
+    assert!(
+        ran >= 126,
+        "{ran} of {} ran; refused: {refused:?}",
+        files.len()
+    );
+}
