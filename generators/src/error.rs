@@ -42,4 +42,39 @@ pub enum GeneratorError {
     /// A strategy name that no generator answers to.
     #[error("unknown strategy `{0}` (expected one of: {names})", names = crate::Strategy::names())]
     UnknownStrategy(String),
+    /// A constraint could not be evaluated at a point.
+    #[error("constraint `{name}` cannot be evaluated: {reason}")]
+    ConstraintFailed {
+        /// The constraint's name.
+        name: String,
+        /// Why.
+        reason: String,
+    },
+    /// The constraints leave no valid point: the space is refused.
+    #[error("the constraints ({constraints}) leave no valid point: none of {tried} points tried is valid")]
+    NoValidPoint {
+        /// The constraints' names, comma-separated.
+        constraints: String,
+        /// How many points were tried.
+        tried: u64,
+    },
+    /// A given point breaks a constraint ([`crate::GivenPoints`]).
+    #[error("point {index} breaks {violation}: a test is never run on a forbidden point")]
+    Forbidden {
+        /// The point's index, from 0.
+        index: usize,
+        /// The constraint it breaks, and how.
+        violation: crate::Violation,
+    },
+    /// A constrained space has too many combinations of levels to enumerate for its
+    /// forbidden tuples (covering arrays and k-wise coverage of the valid space).
+    #[error(
+        "the space has more than {limit} combinations of discrete levels: too many to find \
+         those its constraints forbid (a covering suite over a constrained space needs them; \
+         use a sampler such as halton, which skips invalid points)"
+    )]
+    TooManyCombinations {
+        /// [`crate::MAX_ENUMERATED_COMBINATIONS`].
+        limit: u64,
+    },
 }

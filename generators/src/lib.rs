@@ -14,6 +14,7 @@
 //! This crate depends on nothing else of the workspace, so researchers can use it alone.
 #![warn(missing_docs)]
 
+mod constraint;
 pub mod coverage;
 pub mod covering;
 mod density;
@@ -28,7 +29,12 @@ mod random;
 mod sobol;
 mod space;
 mod strategy;
+mod valid;
 
+pub use constraint::{
+    wilson, Constraint, FnConstraint, ValidFraction, Violation, MAX_ENUMERATED_COMBINATIONS,
+    MAX_PROBES_PER_COMBINATION, VALID_FRACTION_SAMPLES,
+};
 pub use density::Density;
 pub use error::GeneratorError;
 pub use factorial::FullFactorial;
@@ -40,3 +46,4 @@ pub use random::UniformRandom;
 pub use sobol::{Sobol, SOBOL_MAX_DIMENSIONS, SOBOL_MAX_POINTS};
 pub use space::{Assignment, Domain, Param, ParamSpace, Value};
 pub use strategy::Strategy;
+pub use valid::ValidOnly;

@@ -127,9 +127,27 @@ impl Param {
 /// The space of open parameters of a scenario. Declaration order is the coordinate order:
 /// the `j`-th continuous parameter is `Point::continuous[j]`, the `j`-th discrete one is
 /// `Point::discrete[j]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+///
+/// A space may carry constraints ([`ParamSpace::with_constraints`]): its valid region is
+/// where they all hold. They are not serialised (a space read back from JSON has none), and
+/// two spaces are equal when their parameters and their constraints' names are.
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ParamSpace {
     params: Vec<Param>,
+    #[serde(skip)]
+    pub(crate) rules: std::sync::Arc<crate::constraint::Rules>,
+}
+
+impl PartialEq for ParamSpace {
+    fn eq(&self, other: &Self) -> bool {
+        let names = |s: &ParamSpace| -> Vec<String> {
+            s.constraints()
+                .iter()
+                .map(|c| c.name().to_owned())
+                .collect()
+        };
+        self.params == other.params && names(self) == names(other)
+    }
 }
 
 impl ParamSpace {
@@ -180,7 +198,10 @@ impl ParamSpace {
                 }
             }
         }
-        Ok(ParamSpace { params })
+        Ok(ParamSpace {
+            params,
+            rules: Default::default(),
+        })
     }
 
     /// The unit cube `[0, 1)^d` as a space: continuous parameters `x0 .. x{d-1}`, unit `1`.
@@ -190,6 +211,7 @@ impl ParamSpace {
             params: (0..d)
                 .map(|i| Param::interval(&format!("x{i}"), 0.0, 1.0, "1"))
                 .collect(),
+            rules: Default::default(),
         }
     }
 

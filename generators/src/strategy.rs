@@ -194,7 +194,8 @@ impl Strategy {
         }
     }
 
-    /// A generator of this strategy over `space`, seeded with `seed` where the strategy uses one.
+    /// A generator of this strategy over `space`, seeded with `seed` where the strategy uses one;
+    /// over a constrained space it draws valid points only ([`crate::ValidOnly`]).
     ///
     /// # Errors
     /// [`GeneratorError::CapacityExceeded`] when the space has more dimensions than the
@@ -203,6 +204,14 @@ impl Strategy {
     /// built by [`Strategy::build_sized`]; [`GeneratorError::NeedsPoints`] for
     /// [`Strategy::Points`], built by [`Strategy::build_given`].
     pub fn build(
+        self,
+        space: &ParamSpace,
+        seed: u64,
+    ) -> Result<Box<dyn Generator>, GeneratorError> {
+        Ok(valid_only(self.build_unconstrained(space, seed)?, space))
+    }
+
+    fn build_unconstrained(
         self,
         space: &ParamSpace,
         seed: u64,
@@ -263,9 +272,8 @@ impl Strategy {
         // The array's size decides the block size: build once to count rows.
         let probe = CoveringSuite::new(space, strength, kind, 1, seed).map_err(err)?;
         let per_row = CoveringSuite::per_row_for_budget(probe.rows(), budget);
-        Ok(Box::new(
-            CoveringSuite::new(space, strength, kind, per_row, seed).map_err(err)?,
-        ))
+        let suite = CoveringSuite::new(space, strength, kind, per_row, seed).map_err(err)?;
+        Ok(valid_only(Box::new(suite), space))
     }
 }
 
@@ -273,12 +281,28 @@ impl Strategy {
     /// The generator of [`Strategy::Points`]: `points`, in their order.
     ///
     /// # Errors
-    /// As [`GivenPoints::new`].
+    /// As [`GivenPoints::new`]; [`GeneratorError::Forbidden`] for the first point that breaks
+    /// a constraint of `space` (a given point is never skipped in silence).
     pub fn build_given(
         space: &ParamSpace,
         points: Vec<crate::Point>,
     ) -> Result<Box<dyn Generator>, GeneratorError> {
-        Ok(Box::new(GivenPoints::new(space, points)?))
+        let given = GivenPoints::new(space, points.clone())?;
+        for (index, p) in points.iter().enumerate() {
+            if let Some(violation) = space.violation(p)? {
+                return Err(GeneratorError::Forbidden { index, violation });
+            }
+        }
+        Ok(Box::new(given))
+    }
+}
+
+/// `g` as it is over an unconstrained space, else its valid points only.
+fn valid_only(g: Box<dyn Generator>, space: &ParamSpace) -> Box<dyn Generator> {
+    if space.is_constrained() {
+        Box::new(crate::ValidOnly::new(g, space))
+    } else {
+        g
     }
 }
 

@@ -656,6 +656,22 @@ impl Scope {
         Ok(scope)
     }
 
+    /// As [`Scope::with_values`] without the constraint check ([`Constrained::violation`]
+    /// checks them after).
+    ///
+    /// # Errors
+    /// As [`Scope::with_values`], except for broken constraints.
+    pub fn with_values_unconstrained(
+        text: &Text,
+        decls: &[ParamDecl],
+        values: &[(String, Value)],
+    ) -> Result<Scope, XoscError> {
+        let given: Vec<(&str, Given<'_>)> = (values.iter())
+            .map(|(n, v)| (n.as_str(), Given::Value(v)))
+            .collect();
+        Scope::build(None, text, decls, &given)
+    }
+
     /// As [`Scope::new`] without the constraint check, so that a campaign can tell the
     /// combinations of a variation that a template's constraints refuse (see
     /// [`Scope::check_all_constraints`]) from other errors.
@@ -1621,5 +1637,47 @@ mod tests {
         assert_eq!(eval_order(&[vec![], vec![2], vec![1]]), Err(vec![1, 2, 1]));
         assert!(approx_eq(0.1 + 0.2, 0.3));
         assert!(!approx_eq(1.0, 1.0001));
+    }
+}
+
+/// A scenario's global parameter declarations with their `ConstraintGroup`s, read once: what
+/// a campaign checks each combination of values against before it runs a test on it (the
+/// valid region of a logical scenario).
+#[derive(Debug, Clone)]
+pub struct Constrained {
+    text: std::sync::Arc<Text>,
+    decls: Vec<ParamDecl>,
+}
+
+impl Constrained {
+    /// The global `ParameterDeclarations` of the scenario `path`, read through `files`.
+    ///
+    /// # Errors
+    /// The file does not read or parse, or its declarations are malformed.
+    pub fn read(files: &crate::FileSet, path: &std::path::Path) -> Result<Self, XoscError> {
+        let text = files.text(path)?;
+        let decls = {
+            let doc = text.parse()?;
+            let root = text.open_root(doc)?;
+            read_declarations(&text, crate::xml::child(root, "ParameterDeclarations"))?
+        };
+        Ok(Constrained { text, decls })
+    }
+
+    /// Whether any declaration has a constraint group.
+    pub fn has_constraints(&self) -> bool {
+        self.decls.iter().any(|d| !d.constraint_groups.is_empty())
+    }
+
+    /// The first constraint group the scenario's values break with `values` (typed values by
+    /// name, as [`Scope::with_values`] takes them), as a message naming the declaration's
+    /// file, line and column; `None` when every declaration meets one of its groups, or when
+    /// the values fail otherwise (a test with them reports that error).
+    pub fn violation(&self, values: &[(String, Value)]) -> Option<String> {
+        let scope = Scope::with_values_unconstrained(&self.text, &self.decls, values).ok()?;
+        scope
+            .check_all_constraints(&self.decls)
+            .err()
+            .map(|e| e.to_string())
     }
 }

@@ -63,6 +63,14 @@ pub struct Estimate {
     pub star: Option<StarDiscrepancy>,
     /// The (k, ε)-covering verdict, when ε was given.
     pub k_epsilon: Option<KEpsilonCovering>,
+    /// Over a constrained space: the share of it the constraints leave valid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub valid: Option<paracosm_generators::ValidFraction>,
+    /// Over a constrained space with continuous parameters: the largest empty cube centred
+    /// in the valid region ([`paracosm_generators::coverage::valid_gap`]), the dispersion
+    /// of the valid region.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub valid_gap: Option<paracosm_generators::coverage::ValidGap>,
     /// Metrics asked for but not computed, each with the reason (too costly for this `n` and
     /// `d`, or a value that overflows). Empty when every metric was computed.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -160,8 +168,18 @@ pub fn estimate(
         discrepancy: Vec::new(),
         star: None,
         k_epsilon: None,
+        valid: None,
+        valid_gap: None,
         skipped: Vec::new(),
     };
+    if set.space.is_constrained() {
+        out.valid = Some(
+            set.space
+                .valid_fraction()
+                .map_err(|e| CoverageError::Constraints(e.to_string()))?,
+        );
+        out.valid_gap = paracosm_generators::coverage::valid_gap(&set.space, &set.points)?;
+    }
     if nc > 0 {
         for m in metrics {
             match m {
@@ -238,10 +256,18 @@ impl fmt::Display for Estimate {
             list(&self.continuous),
             list(&self.discrete)
         )?;
+        if let Some(v) = &self.valid {
+            writeln!(f, "valid space       {v}")?;
+        }
         for k in &self.kwise {
+            let forbidden = if k.forbidden > 0 {
+                format!(" valid tuples; {} forbidden", k.forbidden)
+            } else {
+                " tuples".to_owned()
+            };
             writeln!(
                 f,
-                "{}-wise coverage   {:>8.4}  ({} of {} tuples)",
+                "{}-wise coverage   {:>8.4}  ({} of {}{forbidden})",
                 k.strength, k.fraction, k.covered, k.total
             )?;
             for m in &k.missing {
@@ -265,6 +291,15 @@ impl fmt::Display for Estimate {
                 d.witness.lo, d.witness.hi
             )?;
             writeln!(f, "    method: {}", d.method)?;
+        }
+        if let Some(g) = &self.valid_gap {
+            writeln!(
+                f,
+                "valid-region gap  {:.6e}  lower bound (the largest empty cube centred in the \
+                 valid region, half side; {} valid probes)",
+                g.radius, g.probes
+            )?;
+            writeln!(f, "    centre (unit cube): {:?}", g.centre)?;
         }
         for (name, v) in &self.discrepancy {
             let note = if name == "l2star" {

@@ -36,6 +36,15 @@ pub enum SpecError {
 #[serde(deny_unknown_fields)]
 struct SpecFile {
     param: Vec<SpecParam>,
+    #[serde(default)]
+    constraint: Vec<SpecConstraint>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpecConstraint {
+    name: toml::Spanned<String>,
+    require: toml::Spanned<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -61,7 +70,16 @@ struct SpecParam {
 /// [[param]]
 /// name = "lanes"
 /// levels = [2, 4, 6]
+///
+/// [[constraint]]
+/// name = "slow_on_two_lanes"
+/// require = "lanes != 2 or walking_speed < 5"
 /// ```
+///
+/// Each `[[constraint]]` is a Starlark expression over the parameters' names that is `True`
+/// where a point is valid ([`paracosm_scenarios::lang::constraint::ExprConstraint`]); the
+/// space refuses constraints that leave no valid point
+/// ([`ParamSpace::valid_fraction`]).
 ///
 /// # Errors
 /// [`SpecError`] naming the file, and the line and column of a TOML error or of the program's
@@ -183,7 +201,35 @@ pub fn parse_space(file: &str, text: &str) -> Result<ParamSpace, SpecError> {
             density: None,
         });
     }
-    ParamSpace::new(params).map_err(|e| invalid(e.to_string()))
+    let space = ParamSpace::new(params).map_err(|e| invalid(e.to_string()))?;
+    let mut constraints: Vec<std::sync::Arc<dyn paracosm_generators::Constraint>> = Vec::new();
+    for c in parsed.constraint {
+        let here = at(c.require.span().start);
+        let name = c.name.into_inner();
+        if constraints.iter().any(|d| d.name() == name) {
+            return Err(invalid(format!(
+                "{}constraint `{name}` is declared twice",
+                at(c.require.span().start)
+            )));
+        }
+        let label = format!("{file}: [[constraint]] {name}");
+        let made = paracosm_scenarios::lang::constraint::ExprConstraint::new(
+            &name,
+            c.require.get_ref(),
+            &label,
+            &space,
+        )
+        .map_err(|e| invalid(format!("{here}{e}")))?;
+        constraints.push(std::sync::Arc::new(made));
+    }
+    if constraints.is_empty() {
+        return Ok(space);
+    }
+    let space = space.with_constraints(constraints);
+    space
+        .valid_fraction()
+        .map_err(|e| invalid(format!("{e}: no test could be run in this space")))?;
+    Ok(space)
 }
 
 #[cfg(test)]

@@ -354,6 +354,10 @@ fn write_summary(out: &Path, summary: &Summary) -> Result<(), crate::Error> {
 
 /// `space` and `points` without the parameters named in `unused` (coordinates by name).
 fn used_only(space: &ParamSpace, points: &[Point], unused: &[String]) -> (ParamSpace, Vec<Point>) {
+    if !space.params().iter().any(|p| unused.contains(&p.name)) {
+        // The space itself, with its constraints: coverage counts the valid space.
+        return (space.clone(), points.to_vec());
+    }
     // For each parameter: whether it is kept, and its index among the continuous or the
     // discrete coordinates of a point.
     let mut keep = Vec::new();
@@ -450,11 +454,30 @@ pub fn summarise(f: &Finished<'_>, outputs: Vec<String>) -> Summary {
         counts: Counts::of(f.records),
         first_failure: FirstFailure::of(f.records),
         coverage,
+        valid_space: valid_space(scenario.space()),
         triage: crate::report::triage::triage(scenario.space(), f.records),
         warnings: f.warnings.clone(),
         wall_s: f.wall_s,
         outputs,
     }
+}
+
+/// What the constraints of `space` leave valid, `None` for an unconstrained space (or one
+/// whose fraction cannot be computed: its campaign's load refused it already).
+fn valid_space(space: &ParamSpace) -> Option<crate::report::summary::ValidSpace> {
+    if !space.is_constrained() {
+        return None;
+    }
+    let fraction = space.valid_fraction().ok()?;
+    Some(crate::report::summary::ValidSpace {
+        constraints: space
+            .constraints()
+            .iter()
+            .map(|c| c.name().to_owned())
+            .collect::<Vec<_>>()
+            .join(", "),
+        fraction,
+    })
 }
 
 /// The human summary: counts and speed, the first failure, coverage, and the files.
@@ -510,6 +533,12 @@ pub fn human(
     if let Some(f) = &summary.first_failure {
         lines.push(first_failure_line(f, scenario));
         lines.push(format!("replay it: {}", replay_command(out, f.id)));
+    }
+    if let Some(v) = &summary.valid_space {
+        lines.push(format!(
+            "valid space: {} under {}; no test runs outside it",
+            v.fraction, v.constraints
+        ));
     }
     if let Some(cov) = &summary.coverage {
         lines.extend(coverage_line(cov));
@@ -582,10 +611,14 @@ fn coverage_line(cov: &crate::cover::Estimate) -> Option<String> {
         parts.push(note.clone());
     }
     for k in &cov.kwise {
-        parts.push(format!(
-            "{}-wise coverage {}/{}",
-            k.strength, k.covered, k.total
-        ));
+        parts.push(if k.forbidden > 0 {
+            format!(
+                "{}-wise coverage {}/{} valid tuples ({} forbidden)",
+                k.strength, k.covered, k.total, k.forbidden
+            )
+        } else {
+            format!("{}-wise coverage {}/{}", k.strength, k.covered, k.total)
+        });
     }
     (!parts.is_empty()).then(|| format!("coverage: {}", parts.join(", ")))
 }

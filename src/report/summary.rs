@@ -205,6 +205,10 @@ pub struct Summary {
     /// coverage of the discrete parameters, dispersion, discrepancies and star discrepancy of
     /// the continuous ones (unit cube); `null` without such parameters.
     pub coverage: Option<crate::cover::Estimate>,
+    /// What the scenario's constraints leave valid (its generators draw only there, and
+    /// `coverage` counts only the valid t-tuples); absent for an unconstrained space.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub valid_space: Option<ValidSpace>,
     /// Where failures are: rules from a shallow decision tree fitted on the records, and the
     /// parameters ranked by how much they explain the outcome ([`crate::report::triage`]); `null` with
     /// fewer than 10 tests that passed or failed, or no open parameter.
@@ -237,4 +241,13 @@ impl Summary {
             crate::Error::malformed(&path, message)
         })
     }
+}
+
+/// The valid part of a constrained space ([`Summary::valid_space`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ValidSpace {
+    /// The constraints' names, comma-separated.
+    pub constraints: String,
+    /// The share of the space they leave, exact or estimated with its 95 % interval.
+    pub fraction: paracosm_generators::ValidFraction,
 }

@@ -28,6 +28,10 @@ pub enum CoverageError {
         /// The parameter's number of levels.
         levels: u32,
     },
+    /// The forbidden combinations of a constrained space could not be found
+    /// ([`crate::ParamSpace::forbidden_levels`]).
+    #[error("{0}")]
+    Constraints(String),
     /// A strength `t` outside `1..=min(6, number of discrete parameters)`.
     #[error("strength t = {t} is not in 1..={max} (there are {discrete} discrete parameters)")]
     Strength {

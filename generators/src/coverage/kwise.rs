@@ -22,13 +22,22 @@ pub struct KWiseCoverage {
     pub strength: usize,
     /// t-tuples (a choice of `t` parameters and one level for each) that some test covers.
     pub covered: u64,
-    /// All t-tuples: `Σ over t-subsets S of Π_{i∈S} v_i`, with `v_i` the level counts.
+    /// All t-tuples: `Σ over t-subsets S of Π_{i∈S} v_i`, with `v_i` the level counts; over
+    /// a constrained space, those some valid point holds (`forbidden` left out).
     pub total: u64,
+    /// Over a constrained space, the t-tuples no valid point holds
+    /// ([`crate::ParamSpace::forbidden_levels`]): not counted in `total`, never missing.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub forbidden: u64,
     /// `covered / total` in `[0, 1]` (`1` when there are no tuples).
     pub fraction: f64,
     /// Up to the requested number of uncovered tuples, in lexicographic order of parameter
     /// subsets, then of levels.
     pub missing: Vec<MissingTuple>,
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }
 
 /// Every `t`-subset of `0..k`, in lexicographic order (empty unless `1 <= t <= k`).
@@ -81,9 +90,16 @@ pub struct RawKWise {
 /// filled in one pass over the rows. Time `O(C(k, t) · n · t)`, memory one bitset per worker;
 /// parallel over subsets with rayon, and deterministic whatever the thread count.
 ///
+/// Over a constrained space ([`ParamSpace::with_constraints`]) only the t-tuples that some
+/// valid point holds count: those the constraints forbid are left out of `total` and of the
+/// missing ones, and counted in `forbidden` (a `t`-tuple of levels is coverable when it
+/// extends to a combination of levels [`ParamSpace::forbidden_levels`] allows).
+///
 /// # Errors
 /// [`CoverageError::Strength`] unless `1 <= t <= min(6, k)` with `k` discrete parameters;
-/// [`CoverageError::LevelOutOfRange`] / [`CoverageError::Shape`] for points that do not fit.
+/// [`CoverageError::LevelOutOfRange`] / [`CoverageError::Shape`] for points that do not fit;
+/// [`CoverageError::Constraints`] when the forbidden combinations of a constrained space
+/// cannot be found.
 pub fn kwise_coverage(
     space: &ParamSpace,
     points: &[Point],
@@ -103,7 +119,14 @@ pub fn kwise_coverage(
         }
         rows.extend_from_slice(&p.discrete);
     }
-    let raw = kwise_coverage_rows(&levels, &rows, t, max_missing)?;
+    let mut raw = kwise_coverage_rows(&levels, &rows, t, max_missing)?;
+    let mut forbidden = 0;
+    let cons = space
+        .forbidden_levels()
+        .map_err(|e| CoverageError::Constraints(e.to_string()))?;
+    if let Some(cons) = cons.filter(|c| !c.is_empty()) {
+        (raw, forbidden) = valid_tuples(&levels, &rows, t, max_missing, &cons);
+    }
     let missing = raw
         .missing
         .into_iter()
@@ -125,6 +148,7 @@ pub fn kwise_coverage(
         strength: t,
         covered: raw.covered,
         total: raw.total,
+        forbidden,
         fraction: if raw.total == 0 {
             1.0
         } else {
@@ -213,6 +237,54 @@ pub fn kwise_coverage_rows(
         out.missing.extend(part.missing.into_iter().take(room));
     }
     Ok(out)
+}
+
+/// The t-wise coverage of `rows` (`n × k` row-major, levels already checked) counting only the
+/// tuples `cons` leaves coverable, and the number of forbidden tuples.
+fn valid_tuples(
+    levels: &[u32],
+    rows: &[u32],
+    t: usize,
+    max_missing: usize,
+    cons: &crate::covering::Constraints,
+) -> (RawKWise, u64) {
+    let k = levels.len();
+    let mut out = RawKWise {
+        covered: 0,
+        total: 0,
+        missing: Vec::new(),
+    };
+    let mut forbidden = 0;
+    for cols in subsets(k, t) {
+        let size: usize = cols.iter().map(|&c| levels[c] as usize).product();
+        let index = |row: &[u32]| {
+            cols.iter()
+                .fold(0usize, |a, &c| a * levels[c] as usize + row[c] as usize)
+        };
+        let mut seen = vec![false; size];
+        for row in rows.chunks_exact(k) {
+            seen[index(row)] = true;
+        }
+        for (idx, &s) in seen.iter().enumerate() {
+            let mut rest = idx;
+            let mut cells = vec![(0usize, 0u32); t];
+            for (slot, &c) in cells.iter_mut().zip(&cols).rev() {
+                *slot = (c, (rest % levels[c] as usize) as u32);
+                rest /= levels[c] as usize;
+            }
+            if !cons.completable(levels, &cells) {
+                forbidden += 1;
+                continue;
+            }
+            out.total += 1;
+            if s {
+                out.covered += 1;
+            } else if out.missing.len() < max_missing {
+                out.missing.push(cells);
+            }
+        }
+    }
+    (out, forbidden)
 }
 
 /// Advances `subset` (increasing indices below `k`) to the next subset in lexicographic order

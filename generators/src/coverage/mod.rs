@@ -14,6 +14,7 @@ mod ordered_sum;
 mod star;
 mod star3d;
 mod star4d;
+mod valid_gap;
 mod wrap_around;
 
 pub use covering::{k_epsilon_covering, KEpsilonCovering};
@@ -35,6 +36,7 @@ pub use kwise::{
     RawKWise, MAX_STRENGTH,
 };
 pub use star::{star_discrepancy, star_discrepancy_with_progress, StarDiscrepancy, StarOptions};
+pub use valid_gap::{valid_gap, ValidGap, VALID_GAP_PROBES};
 
 /// Checks an `n × d` row-major point set: `d >= 1`, length a multiple of `d`, every value
 /// finite and in `[0, 1]`. Returns `n`.

@@ -56,6 +56,10 @@ pub enum CoveringError {
     /// The constraints forbid every row.
     #[error("the constraints forbid every row: no test can be built")]
     Unsatisfiable,
+    /// The combinations a constrained space forbids could not be found
+    /// ([`crate::ParamSpace::forbidden_levels`]).
+    #[error("{0}")]
+    Forbidden(String),
     /// The array, or the table of `t`-tuples it must cover, is too large to build.
     #[error(
         "a covering array of strength {t} over these levels needs at least {rows} rows (the \

@@ -175,7 +175,7 @@ pub fn random_kwise_covering(
 
 /// The seed rows, then at least `min_rows` random rows and on until every coverable t-tuple
 /// is covered (at most `min_rows + max_rows` drawn).
-fn draw_until_covered(
+pub(crate) fn draw_until_covered(
     levels: &[u32],
     t: usize,
     seed: u64,

@@ -1,6 +1,7 @@
 use crate::{Generator, GeneratorError, Halton, ParamSpace, Point};
 
-use super::{ipog, random_kwise_covering, CoveringError};
+use super::{ipog_with, random_kwise_rows, CoveringError};
+use super::{random::draw_until_covered, Constraints};
 
 /// How the discrete half of a [`CoveringSuite`] is built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -20,6 +21,9 @@ pub enum ArrayKind {
 /// repeat each other) with `m` points per row. Points come out interleaved, block position
 /// major and row minor (row 0 point 0, row 1 point 0, ..., row 0 point 1, ...), so any prefix
 /// of at least `rows` points covers every t-tuple and spreads evenly over the rows.
+///
+/// Over a constrained space each row takes the next of its Halton points that is valid with
+/// its levels, so every round of `rows` points still gives each row a valid test.
 #[derive(Debug, Clone)]
 pub struct CoveringSuite {
     rows: Vec<Vec<u32>>,
@@ -28,15 +32,30 @@ pub struct CoveringSuite {
     halton: Halton,
     next: u64,
     name: &'static str,
+    /// The space when it is constrained: its invalid points are passed over.
+    constrained: Option<ParamSpace>,
+    /// Per row, how many of its Halton points it has used.
+    used: Vec<u64>,
 }
+
+/// The most of a row's Halton points a constrained suite tries for one valid test before it
+/// gives the last (which [`crate::ValidOnly`] then skips).
+const MAX_TRIES_PER_TEST: u64 = 10_000;
 
 impl CoveringSuite {
     /// A suite of strength `t` over `space` with `per_row` continuous points for each array
     /// row (use [`CoveringSuite::per_row_for_budget`] or a Halton budget for a target ε).
     ///
+    /// Over a constrained space the array covers every t-tuple of levels that some valid
+    /// point holds and holds no combination the constraints forbid
+    /// ([`ParamSpace::forbidden_levels`]), as PICT and ACTS do with constraints; the extra
+    /// rows of a space without continuous parameters are valid combinations too. (Its
+    /// continuous points may still break a constraint: [`crate::Strategy`] skips them.)
+    ///
     /// # Errors
     /// [`CoveringError::Strength`] for `t` outside `1..=min(6, N_D)` when the space has
-    /// discrete parameters.
+    /// discrete parameters; [`CoveringError::Forbidden`] when the forbidden combinations
+    /// cannot be found ([`ParamSpace::forbidden_levels`]'s errors).
     pub fn new(
         space: &ParamSpace,
         t: usize,
@@ -46,12 +65,19 @@ impl CoveringSuite {
     ) -> Result<Self, CoveringError> {
         let levels = space.level_counts();
         let k = levels.len();
+        let cons = space
+            .forbidden_levels()
+            .map_err(|e| CoveringError::Forbidden(e.to_string()))?
+            .unwrap_or_default();
         let rows: Vec<Vec<u32>> = if k == 0 {
             vec![Vec::new()]
         } else {
             let a = match kind {
-                ArrayKind::Ipog => ipog(&levels, t)?,
-                ArrayKind::RandomKWise => random_kwise_covering(&levels, t, 0.01, seed, 1 << 20)?,
+                ArrayKind::Ipog => ipog_with(&levels, t, &cons, &[])?,
+                ArrayKind::RandomKWise => {
+                    let m = random_kwise_rows(&levels, t, 0.01)?.rows as usize;
+                    draw_until_covered(&levels, t, seed, 1 << 20, &cons, &[], m)?
+                }
             };
             (0..a.len()).map(|r| a.row(r).to_vec()).collect()
         };
@@ -66,14 +92,16 @@ impl CoveringSuite {
             // A random array may draw a row twice: here that is one test run twice.
             let mut kept = std::collections::HashSet::new();
             rows.retain(|r| kept.insert(r.clone()));
-            extend_with_distinct_rows(&mut rows, &levels, target, seed);
+            extend_with_distinct_rows(&mut rows, &levels, target, seed, &cons);
             per_row = target.div_ceil(rows.len() as u64);
         }
         Ok(CoveringSuite {
+            used: vec![0; rows.len()],
             rows,
             per_row,
             halton: Halton::new(&continuous),
             next: 0,
+            constrained: space.is_constrained().then(|| space.clone()),
             name: match kind {
                 ArrayKind::Ipog => "ipog",
                 ArrayKind::RandomKWise => "kwise",
@@ -101,11 +129,23 @@ impl CoveringSuite {
         self.len() == 0
     }
 
-    /// Point `j` in the interleaved order.
+    /// Point `j` in the interleaved order. Past [`CoveringSuite::len`] (a constrained space
+    /// whose invalid points are skipped asks for more) the rows take turns again, each with
+    /// Halton points past every block: `len + (i - m) · rows + r` for row `r`'s `i`-th point.
     pub fn point(&self, j: u64) -> Point {
         let rows = self.rows.len() as u64;
-        let (r, i) = ((j % rows) as usize, j / rows);
-        let h = self.halton.point(r as u64 * self.per_row + i);
+        self.draw((j % rows) as usize, j / rows)
+    }
+
+    /// Row `r`'s `i`-th point.
+    fn draw(&self, r: usize, i: u64) -> Point {
+        let rows = self.rows.len() as u64;
+        let index = if i < self.per_row {
+            r as u64 * self.per_row + i
+        } else {
+            self.len() + (i - self.per_row) * rows + r as u64
+        };
+        let h = self.halton.point(index);
         Point {
             discrete: self.rows[r].clone(),
             continuous: h.continuous,
@@ -116,8 +156,14 @@ impl CoveringSuite {
 /// Appends to `rows` rows of `levels` that none of them repeats, drawn from
 /// `ChaCha8Rng::seed_from_u64(seed)`, until there are `target` rows or every combination of
 /// levels is there: all the others in a seeded random order when they are few (at most
-/// 2^20), else random rows not seen yet.
-fn extend_with_distinct_rows(rows: &mut Vec<Vec<u32>>, levels: &[u32], target: u64, seed: u64) {
+/// 2^20), else random rows not seen yet; none that `cons` forbids.
+fn extend_with_distinct_rows(
+    rows: &mut Vec<Vec<u32>>,
+    levels: &[u32],
+    target: u64,
+    seed: u64,
+    cons: &Constraints,
+) {
     use rand::seq::SliceRandom;
     use rand::{Rng, SeedableRng};
     let total = levels
@@ -147,15 +193,16 @@ fn extend_with_distinct_rows(rows: &mut Vec<Vec<u32>>, levels: &[u32], target: u
                     .rev()
                     .collect()
             })
-            .filter(|r: &Vec<u32>| !seen.contains(r))
+            .filter(|r: &Vec<u32>| !seen.contains(r) && !cons.violated_by(r))
             .collect();
         others.shuffle(&mut rng);
         rows.extend(others.into_iter().take(want as usize));
     } else {
+        // (A constrained space of this size is refused by `forbidden_levels`.)
         let goal = target.min(total);
         while (seen.len() as u64) < goal {
             let r: Vec<u32> = levels.iter().map(|&v| rng.random_range(0..v)).collect();
-            if seen.insert(r.clone()) {
+            if !cons.violated_by(&r) && seen.insert(r.clone()) {
                 rows.push(r);
             }
         }
@@ -167,17 +214,35 @@ impl Generator for CoveringSuite {
         self.name
     }
 
+    /// The next `n` points; past [`CoveringSuite::len`] as [`CoveringSuite::point`] says.
+    /// Over a constrained space, each row's next valid point.
     fn ask(&mut self, n: usize) -> Result<Vec<Point>, GeneratorError> {
         let end = self.next + n as u64;
-        if end > self.len() {
-            return Err(GeneratorError::CapacityExceeded {
-                generator: self.name,
-                what: "points",
-                limit: self.len(),
-                requested: end,
-            });
+        let Some(space) = self.constrained.clone() else {
+            let pts = (self.next..end).map(|j| self.point(j)).collect();
+            self.next = end;
+            return Ok(pts);
+        };
+        let rows = self.rows.len() as u64;
+        let tries = if space.continuous_dims() == 0 {
+            1
+        } else {
+            MAX_TRIES_PER_TEST
+        };
+        let mut pts = Vec::with_capacity(n);
+        for j in self.next..end {
+            let r = (j % rows) as usize;
+            let mut p = self.draw(r, self.used[r]);
+            self.used[r] += 1;
+            for _ in 1..tries {
+                if space.is_valid(&p)? {
+                    break;
+                }
+                p = self.draw(r, self.used[r]);
+                self.used[r] += 1;
+            }
+            pts.push(p);
         }
-        let pts = (self.next..end).map(|j| self.point(j)).collect();
         self.next = end;
         Ok(pts)
     }

@@ -9,6 +9,7 @@
 //! and the program may branch on it.
 
 mod builtins;
+pub mod constraint;
 mod globals;
 mod host;
 mod methods;

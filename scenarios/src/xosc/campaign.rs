@@ -312,6 +312,7 @@ pub fn campaign_scenario(x: &XoscRef) -> Result<crate::Scenario, ScenarioError> 
         Ok(out)
     });
     let template = PathBuf::from(&found.scenario.file);
+    let space = constrained_space(space, &files, &template, &overrides, path)?;
     let scenario = super::scenario(super::Source {
         template,
         files,
@@ -342,6 +343,76 @@ pub fn campaign_scenario(x: &XoscRef) -> Result<crate::Scenario, ScenarioError> 
             .collect(),
     })?;
     Ok(scenario)
+}
+
+/// The template's `ConstraintGroup`s as a constraint of the campaign's space: no test runs on
+/// a combination they refuse.
+#[derive(Debug)]
+struct TemplateConstraints {
+    constrained: paracosm_openscenario::params::Constrained,
+    overrides: OverridesDebug,
+}
+
+/// The campaign's overrides, which `Debug` shows by name only.
+struct OverridesDebug(super::Overrides);
+
+impl std::fmt::Debug for OverridesDebug {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Overrides")
+    }
+}
+
+/// The name the template's constraint groups go by in messages and summaries.
+pub const TEMPLATE_CONSTRAINTS: &str = "the template's constraint groups";
+
+impl paracosm_generators::Constraint for TemplateConstraints {
+    fn name(&self) -> &str {
+        TEMPLATE_CONSTRAINTS
+    }
+
+    fn violation(
+        &self,
+        values: &paracosm_generators::Assignment,
+    ) -> Result<Option<String>, String> {
+        let overrides = (self.overrides.0)(values).map_err(|e| e.0)?;
+        Ok(self.constrained.violation(&overrides))
+    }
+}
+
+/// `space` with the constraint groups of the template at `template` (read through `files`),
+/// when it has any, checked to leave some valid point.
+///
+/// # Errors
+/// [`ScenarioError::Input`] when the template does not read, or its constraint groups refuse
+/// every combination of the space.
+fn constrained_space(
+    space: paracosm_generators::ParamSpace,
+    files: &FileSet,
+    template: &Path,
+    overrides: &super::Overrides,
+    path: &str,
+) -> Result<paracosm_generators::ParamSpace, ScenarioError> {
+    let input = |message: String| ScenarioError::Input {
+        path: PathBuf::from(path),
+        message,
+    };
+    let constrained = paracosm_openscenario::params::Constrained::read(files, template)
+        .map_err(|e| input(e.to_string()))?;
+    if !constrained.has_constraints() || space.params().is_empty() {
+        return Ok(space);
+    }
+    let space = space.with_constraints(vec![std::sync::Arc::new(TemplateConstraints {
+        constrained,
+        overrides: OverridesDebug(overrides.clone()),
+    })]);
+    space.valid_fraction().map_err(|e| {
+        input(format!(
+            "{path}: {e}: no test of this logical scenario can run ({} refuse every \
+             combination of its parameters)",
+            TEMPLATE_CONSTRAINTS
+        ))
+    })?;
+    Ok(space)
 }
 
 /// A value set's parameter (`value_set_K`), its levels, and the assignments (name, value as
