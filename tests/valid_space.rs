@@ -219,3 +219,104 @@ require = "not (lane == 1 and kind == 'truck')"
     );
     assert!(err.contains("Variable `lanes` not found"), "{err}");
 }
+
+/// The pedestrian crossing with a `Require`: a fast walker is seen from far off. No test runs
+/// where the constraint is false, the summary gives the valid fraction (analytically
+/// 1 - (5/9.5)(15/55) = 85.6 %) inside its interval, and a `Require` that nothing meets, or
+/// that reads a stream, is refused at load.
+#[test]
+fn a_programs_require_keeps_every_test_valid_and_is_refused_when_it_cannot_hold() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/pedestrian_crossing.star"),
+    )
+    .unwrap();
+    let with = |require: &str| base.replace("w = World", &format!("{require}\n\nw = World"));
+    let write = |name: &str, text: String| {
+        let f = dir.path().join(name);
+        std::fs::write(&f, text).unwrap();
+        f
+    };
+    let ok = write(
+        "ok.star",
+        with("Require(lambda p: p.walking_speed < 5 or p.trigger_distance >= 20, name = \"seen_far\")"),
+    );
+    let out = dir.path().join("out");
+    let o = fuzz(
+        dir.path(),
+        &[
+            ok.to_str().unwrap(),
+            "--strategy",
+            "halton",
+            "--budget",
+            "200",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        matches!(o.status.code(), Some(0 | 1)),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["counts"]["error"], 0, "{said}");
+    let f = &summary["valid_space"]["fraction"];
+    let (lo, hi) = (f["lo"].as_f64().unwrap(), f["hi"].as_f64().unwrap());
+    let truth = 1.0 - (5.0 / 9.5) * (15.0 / 55.0);
+    assert!(lo <= truth && truth <= hi, "{f}");
+    for line in std::fs::read_to_string(out.join("results.jsonl"))
+        .unwrap()
+        .lines()
+    {
+        let r: serde_json::Value = serde_json::from_str(line).unwrap();
+        let (w, t) = (
+            r["params"]["walking_speed"].as_f64().unwrap(),
+            r["params"]["trigger_distance"].as_f64().unwrap(),
+        );
+        assert!(
+            w < 5.0 || t >= 20.0,
+            "test {} is forbidden: {w} m/s, {t} m",
+            r["id"]
+        );
+    }
+    for (name, require, needle) in [
+        (
+            "none.star",
+            "Require(lambda p: p.walking_speed > 20, name = \"impossible\")",
+            "leave no valid point",
+        ),
+        (
+            "stream.star",
+            "Require(lambda p: tick > 3)",
+            "Operation `compare` not supported",
+        ),
+        (
+            "typo.star",
+            "Require(lambda p: p.speed > 3)",
+            "p holds trigger_distance, walking_speed",
+        ),
+    ] {
+        let f = write(name, with(require));
+        let o = fuzz(
+            dir.path(),
+            &[
+                f.to_str().unwrap(),
+                "--budget",
+                "3",
+                "--out",
+                dir.path()
+                    .join(name)
+                    .with_extension("out")
+                    .to_str()
+                    .unwrap(),
+            ],
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(needle), "{name}: {err}");
+        assert!(err.contains(&format!("{name}:17:")), "{name}: {err}");
+    }
+}

@@ -607,6 +607,9 @@ fn coverage_line(cov: &crate::cover::Estimate) -> Option<String> {
             format!("star discrepancy in [{:.4}, {:.4}]", star.lower, star.upper)
         });
     }
+    if let Some(g) = &cov.valid_gap {
+        parts.push(format!("valid-region gap ≥ {:.4}", g.radius));
+    }
     for note in &cov.skipped {
         parts.push(note.clone());
     }

@@ -153,6 +153,7 @@ pub fn all() -> impl Iterator<Item = &'static Builtin> {
         super::globals::actors::SPECS,
         super::globals::monitors::SPECS,
         super::globals::settings::SPECS,
+        super::globals::constraints::SPECS,
         super::globals::import::SPECS,
         super::methods::SPECS,
     ]

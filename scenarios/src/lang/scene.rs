@@ -232,6 +232,10 @@ pub struct SceneBuilder {
     /// runs beside the program's lambdas (its host functions from
     /// [`crate::xosc::IMPORT_HOST_BASE`]).
     pub(crate) story: Option<ImportedStory>,
+    /// The `Require`s evaluated so far: name and where each stands.
+    pub requires: Vec<(String, Site)>,
+    /// The `Require` these values break (its message), which stopped the evaluation.
+    pub broken: Option<String>,
 }
 
 /// The host that runs an imported OpenSCENARIO storyboard ([`SceneBuilder::story`]).
@@ -259,6 +263,8 @@ impl SceneBuilder {
             loc_table: Default::default(),
             objects: Vec::new(),
             story: None,
+            requires: Vec::new(),
+            broken: None,
         }
     }
 

@@ -92,6 +92,9 @@ pub enum LoadErrorKind {
     Settings,
     /// A file the program reads (an OpenDRIVE map, an ONNX model) cannot be read.
     Files,
+    /// These values break a `Require` of the program: no test is run on them, and the
+    /// load's checks pass over them.
+    Constraint,
 }
 
 /// Why a program does not load, or a world of it cannot be built.

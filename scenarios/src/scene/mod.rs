@@ -276,6 +276,16 @@ impl Scene {
         self.given.is_some()
     }
 
+    /// The name of the parameter declared `k`-th: the one its values are given under, else
+    /// its declaration's own (`name=`), else the variable it is assigned to.
+    pub fn param_name(&self, k: usize) -> Option<String> {
+        let decl = self.params.get(k)?;
+        match &self.given {
+            Some(g) => g.name_of(decl, k).map(str::to_owned),
+            None => decl.name.clone().or_else(|| decl.site.variable.clone()),
+        }
+    }
+
     /// The value of the parameter declared `k`-th in this test.
     pub fn param_value(&self, k: usize) -> Option<ParamValue> {
         let decl = self.params.get(k)?;

@@ -3,6 +3,7 @@
 //! The global builtins of the scenario language (LANGUAGE.md documents each).
 
 pub(crate) mod actors;
+pub(crate) mod constraints;
 pub(crate) mod import;
 pub(crate) mod math;
 pub(crate) mod monitors;
@@ -270,5 +271,6 @@ pub(crate) fn paracosm_globals(builder: &mut GlobalsBuilder) {
     monitors::register_stream_monitors(builder);
     monitors::register_time_to_failure(builder);
     settings::register(builder);
+    constraints::register(builder);
     import::register(builder);
 }

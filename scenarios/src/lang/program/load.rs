@@ -78,11 +78,13 @@ pub fn load(
             .map_err(|e| LoadError::new(LoadErrorKind::Declarations, e.to_string()))?,
         maps: Arc::new(crate::map_files::MapFiles::new(base)),
         load_output_shown: false.into(),
+        requires: Vec::new(),
         combinations: std::sync::OnceLock::new(),
         load_steps: 0.into(),
         base_worlds: Default::default(),
     };
     let first = first_look(&mut program)?;
+    program.requires = first.world.requires.clone();
     name_parameters(&mut program, &first.world)?;
     settle_declarations(&mut program, &first.world)?;
     let space = parameter_space(&program)?;
@@ -141,6 +143,8 @@ pub fn load(
         unused_params,
         camera_only: found.camera_only,
     };
+    let program = Arc::new(program);
+    let space = required_space(&program, space)?;
     let loaded = Loaded {
         program,
         space,
@@ -150,9 +154,59 @@ pub fn load(
     Scenario::new(Arc::new(loaded))
 }
 
+/// The program's `Require`s as a constraint of its space: a point is valid when the
+/// program, evaluated with its values, passes every `Require`.
+struct Requires(Arc<Program>);
+
+impl std::fmt::Debug for Requires {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Requires({})", self.0.file)
+    }
+}
+
+impl paracosm_generators::Constraint for Requires {
+    fn name(&self) -> &str {
+        "the program's Require"
+    }
+
+    fn violation(&self, a: &Assignment) -> Result<Option<String>, String> {
+        let values = self.0.values(a).map_err(|e| e.to_string())?;
+        match self.0.evaluate(Some(values), |_, _| Ok(())) {
+            Err(e) if e.kind == LoadErrorKind::Constraint => Ok(Some(e.message)),
+            // Values that fail otherwise are that test's error.
+            _ => Ok(None),
+        }
+    }
+}
+
+/// `space` with the program's `Require`s, when it has any, checked to leave some valid point.
+///
+/// # Errors
+/// [`LoadErrorKind::Constraint`] when no point of the space meets them.
+fn required_space(program: &Arc<Program>, space: ParamSpace) -> Result<ParamSpace, LoadError> {
+    if program.requires.is_empty() {
+        return Ok(space);
+    }
+    let space = space.with_constraints(vec![Arc::new(Requires(program.clone()))]);
+    if let Err(e) = space.valid_fraction() {
+        let sites: Vec<String> = (program.requires.iter())
+            .map(|(n, at)| format!("`{n}` ({at})"))
+            .collect();
+        return Err(LoadError::new(
+            LoadErrorKind::Constraint,
+            format!(
+                "error: {e}: the constraints {} refuse every test\n --> {}",
+                sites.join(", "),
+                program.requires[0].1
+            ),
+        ));
+    }
+    Ok(space)
+}
+
 /// A loaded program as a front end: its space, what it read and what its load found.
 struct Loaded {
-    program: Program,
+    program: Arc<Program>,
     space: ParamSpace,
     source: crate::front_end::Source,
     findings: crate::front_end::Findings,
@@ -391,9 +445,11 @@ fn check_combinations(program: &Program) -> Result<Combinations, LoadError> {
                 stopped = Some((done, total, steps));
                 break;
             }
-            let (w, s) = program
-                .world_counted(values.clone())
-                .map_err(|e| for_values(label, e))?;
+            let (w, s) = match program.world_counted(values.clone()) {
+                // A combination the program's constraints forbid runs no test.
+                Err(e) if e.kind == LoadErrorKind::Constraint => continue,
+                r => r.map_err(|e| for_values(label, e))?,
+            };
             unread.push(usage::unread_streams(&w.world, &[]));
             steps += s;
         }
@@ -479,9 +535,10 @@ fn probe_parameter(
         }
         let mut values = base_values.to_vec();
         values[k] = v;
-        let other = program
-            .world_for(values)
-            .map_err(|e| for_values(&label, e))?;
+        let other = match program.world_for(values) {
+            Err(e) if e.kind == LoadErrorKind::Constraint => continue,
+            r => r.map_err(|e| for_values(&label, e))?,
+        };
         seen.extend(base.changes(&other, program.horizon_s));
         if !program.load_budget_left() {
             break;

@@ -90,6 +90,8 @@ pub struct Program {
     objects: Arc<std::collections::HashMap<String, String>>,
     /// The maps it reads, read once and shared with every evaluation.
     maps: Arc<crate::map_files::MapFiles>,
+    /// The `Require`s of the first evaluation: name and where each stands.
+    requires: Vec<(String, crate::scene::Site)>,
     /// Whether what the program prints at load has been shown (the load evaluates it more
     /// than once with the representative values; its output is shown once).
     load_output_shown: std::sync::atomic::AtomicBool,
@@ -291,6 +293,14 @@ impl Program {
                 if result.is_err() && state.scene.borrow().scene.has_values() {
                     // A parameter that only these values declare explains the failure first.
                     self.same_params_so_far(&state.scene.borrow())?;
+                }
+                if result.is_err() {
+                    if let Some(broken) = state.scene.borrow().broken.clone() {
+                        return Err(LoadError::new(
+                            LoadErrorKind::Constraint,
+                            format!("error: {broken}: no test is run on them"),
+                        ));
+                    }
                 }
                 result.map_err(|e| self.evaluation_error(e, again, &state.scene))?;
                 steps = eval.get_total_tick_count();
