@@ -22,6 +22,18 @@ use serde::{Deserialize, Serialize};
 use crate::covering::Constraints;
 use crate::{Assignment, GeneratorError, Halton, ParamSpace, Point, UniformRandom};
 
+/// Why a constraint cannot be evaluated at some values (or, for a constraint written as an
+/// expression, cannot be built): the message names the constraint.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct ConstraintError(pub String);
+
+impl From<String> for ConstraintError {
+    fn from(s: String) -> Self {
+        ConstraintError(s)
+    }
+}
+
 /// A constraint over the open parameters: a named predicate over a test's values.
 pub trait Constraint: Send + Sync + fmt::Debug {
     /// The constraint's name, as messages and summaries give it (e.g. `the template's
@@ -32,8 +44,8 @@ pub trait Constraint: Send + Sync + fmt::Debug {
     /// constraint; `Ok(Some(reason))` when they break it, `reason` saying how.
     ///
     /// # Errors
-    /// A message when the constraint cannot be evaluated for these values.
-    fn violation(&self, values: &Assignment) -> Result<Option<String>, String>;
+    /// [`ConstraintError`] when the constraint cannot be evaluated for these values.
+    fn violation(&self, values: &Assignment) -> Result<Option<String>, ConstraintError>;
 }
 
 /// A [`Constraint`] from a Rust function that tells whether values are valid.
@@ -69,7 +81,7 @@ where
         &self.name
     }
 
-    fn violation(&self, values: &Assignment) -> Result<Option<String>, String> {
+    fn violation(&self, values: &Assignment) -> Result<Option<String>, ConstraintError> {
         Ok((!(self.holds)(values)).then(|| format!("breaks {}", self.name)))
     }
 }
@@ -205,12 +217,12 @@ impl ParamSpace {
         }
         let values = self.decode(point)?;
         for c in &self.rules.list {
-            let broken =
-                c.violation(&values)
-                    .map_err(|reason| GeneratorError::ConstraintFailed {
-                        name: c.name().to_owned(),
-                        reason,
-                    })?;
+            let broken = c
+                .violation(&values)
+                .map_err(|e| GeneratorError::ConstraintFailed {
+                    name: c.name().to_owned(),
+                    reason: e.0,
+                })?;
             if let Some(reason) = broken {
                 return Ok(Some(Violation {
                     constraint: c.name().to_owned(),

@@ -32,8 +32,8 @@ mod strategy;
 mod valid;
 
 pub use constraint::{
-    wilson, Constraint, FnConstraint, ValidFraction, Violation, MAX_ENUMERATED_COMBINATIONS,
-    MAX_PROBES_PER_COMBINATION, VALID_FRACTION_SAMPLES,
+    wilson, Constraint, ConstraintError, FnConstraint, ValidFraction, Violation,
+    MAX_ENUMERATED_COMBINATIONS, MAX_PROBES_PER_COMBINATION, VALID_FRACTION_SAMPLES,
 };
 pub use density::Density;
 pub use error::GeneratorError;

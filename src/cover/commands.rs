@@ -97,6 +97,12 @@ pub struct GenerateArgs {
     /// for δ = 0.01), or random (random rows until every tuple is covered).
     #[arg(long, value_enum, default_value = "ipog")]
     pub algorithm: Algorithm,
+    /// Post-optimise the covering array (--model) by simulated annealing for about this many
+    /// seconds of the reference machine (a budget of moves, so the array is the same on any
+    /// machine); 0 turns it off. Default: 2 s for a model of at most 100,000 t-tuples, else
+    /// off.
+    #[arg(long, value_name = "SECONDS")]
+    pub optimise: Option<f64>,
     /// How points are chosen.
     #[arg(long, value_parser = crate::cli::strategy_parser(), default_value = "halton")]
     pub strategy: Strategy,
@@ -518,6 +524,48 @@ fn read_user_file(path: &Path) -> Result<String, Error> {
     std::fs::read_to_string(path).map_err(|e| bad(format!("cannot read `{}`: {e}", path.display())))
 }
 
+/// The t-tuples a model of `levels` has at strength `t` under which `generate --model`
+/// post-optimises its array by default.
+pub const DEFAULT_OPTIMISE_MAX_TUPLES: f64 = 100_000.0;
+
+/// Seconds of post-optimisation a small model gets by default.
+pub const DEFAULT_OPTIMISE_S: f64 = 2.0;
+
+/// `array` post-optimised as `--optimise` asks (by default for a small model).
+///
+/// # Errors
+/// [`Error::BadInput`] for a negative or non-finite number of seconds.
+fn optimised(
+    array: &paracosm_generators::covering::CoveringArray,
+    a: &GenerateArgs,
+    constraints: &paracosm_generators::covering::Constraints,
+    frozen: usize,
+) -> Result<paracosm_generators::covering::CoveringArray, Error> {
+    use paracosm_generators::covering::{optimise, Optimise};
+    let t = array.strength;
+    // Σ over t-subsets of the level products: the elementary symmetric polynomial e_t.
+    let mut e = vec![0.0f64; t + 1];
+    e[0] = 1.0;
+    for &v in &array.levels {
+        for j in (1..=t).rev() {
+            e[j] += e[j - 1] * f64::from(v);
+        }
+    }
+    let tuples = e[t];
+    let seconds = match a.optimise {
+        Some(s) if s.is_finite() && s >= 0.0 => s,
+        Some(s) => {
+            return Err(bad(format!(
+                "--optimise {s}: give a number of seconds >= 0"
+            )))
+        }
+        None if tuples <= DEFAULT_OPTIMISE_MAX_TUPLES => DEFAULT_OPTIMISE_S,
+        None => 0.0,
+    };
+    let how = Optimise::seconds(seconds, &array.levels, t, a.seed);
+    Ok(optimise(array, constraints, frozen, how))
+}
+
 /// `generate --model`: a covering array for a PICT model, written as CSV of value names.
 fn generate_array(a: &GenerateArgs, model: &Path, out: &mut dyn Write) -> Result<(), Error> {
     use paracosm_generators::covering::{ipog_with, random_kwise_with, random_until_covered_with};
@@ -540,6 +588,7 @@ fn generate_array(a: &GenerateArgs, model: &Path, out: &mut dyn Write) -> Result
         }
     }
     .map_err(bad)?;
+    let array = optimised(&array, a, constraints, seed_rows.len())?;
     let mut buffer = Vec::new();
     {
         let sink: &mut dyn Write = match a.output {

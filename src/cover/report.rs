@@ -247,15 +247,9 @@ fn add_l2(
     Ok(())
 }
 
-impl fmt::Display for Estimate {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(
-            f,
-            "{} tests; continuous: {}; discrete: {}",
-            self.tests,
-            list(&self.continuous),
-            list(&self.discrete)
-        )?;
+impl Estimate {
+    /// The valid fraction and the k-wise lines of [`Estimate`]'s table.
+    fn fmt_kwise(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         if let Some(v) = &self.valid {
             writeln!(f, "valid space       {v}")?;
         }
@@ -275,6 +269,20 @@ impl fmt::Display for Estimate {
                 writeln!(f, "    missing: {}", t.join(", "))?;
             }
         }
+        Ok(())
+    }
+}
+
+impl fmt::Display for Estimate {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{} tests; continuous: {}; discrete: {}",
+            self.tests,
+            list(&self.continuous),
+            list(&self.discrete)
+        )?;
+        self.fmt_kwise(f)?;
         if let Some(d) = &self.dispersion {
             if d.exact {
                 writeln!(f, "dispersion        {:.6e}  exact", d.lower)?;

@@ -202,14 +202,33 @@ pub fn parse_space(file: &str, text: &str) -> Result<ParamSpace, SpecError> {
         });
     }
     let space = ParamSpace::new(params).map_err(|e| invalid(e.to_string()))?;
+    with_constraints(file, space, parsed.constraint, &at)
+}
+
+/// `space` with the file's `[[constraint]]`s, checked to leave some valid point; `at` gives
+/// the "line L, column C: " of a byte offset of the file.
+///
+/// # Errors
+/// [`SpecError::Invalid`]: a constraint named twice, one that does not build
+/// ([`paracosm_scenarios::lang::constraint::ExprConstraint::new`]), or constraints no point
+/// meets.
+fn with_constraints(
+    file: &str,
+    space: ParamSpace,
+    specs: Vec<SpecConstraint>,
+    at: &dyn Fn(usize) -> String,
+) -> Result<ParamSpace, SpecError> {
+    let invalid = |reason: String| SpecError::Invalid {
+        file: file.to_owned(),
+        reason,
+    };
     let mut constraints: Vec<std::sync::Arc<dyn paracosm_generators::Constraint>> = Vec::new();
-    for c in parsed.constraint {
+    for c in specs {
         let here = at(c.require.span().start);
         let name = c.name.into_inner();
         if constraints.iter().any(|d| d.name() == name) {
             return Err(invalid(format!(
-                "{}constraint `{name}` is declared twice",
-                at(c.require.span().start)
+                "{here}constraint `{name}` is declared twice"
             )));
         }
         let label = format!("{file}: [[constraint]] {name}");

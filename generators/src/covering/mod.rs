@@ -7,11 +7,13 @@
 
 mod constraints;
 mod ipog;
+mod optimise;
 mod random;
 mod suite;
 
 pub use constraints::Constraints;
 pub use ipog::{ipog, ipog_with};
+pub use optimise::{optimise, Optimise, MOVE_BASE_S, MOVE_UNIT_S};
 pub use random::{
     random_kwise, random_kwise_covering, random_kwise_rows, random_kwise_with,
     random_until_covered, random_until_covered_with, RandomKWiseSize,

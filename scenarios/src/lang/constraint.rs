@@ -6,7 +6,7 @@ use starlark::eval::Evaluator;
 use starlark::syntax::{AstModule, Dialect};
 use starlark::values::Value as StarValue;
 
-use paracosm_generators::{Assignment, Constraint, ParamSpace, Point, Value};
+use paracosm_generators::{Assignment, Constraint, ConstraintError, ParamSpace, Point, Value};
 
 /// The most Starlark steps one evaluation of a constraint's expression may take.
 pub const MAX_CONSTRAINT_STEPS: u64 = 100_000;
@@ -36,7 +36,12 @@ impl ExprConstraint {
     /// A message naming `label` when the expression does not parse, names a variable that is
     /// no parameter, or is not `True` or `False` at the space's first point (every level
     /// first, every interval at its lower end).
-    pub fn new(name: &str, expr: &str, label: &str, space: &ParamSpace) -> Result<Self, String> {
+    pub fn new(
+        name: &str,
+        expr: &str,
+        label: &str,
+        space: &ParamSpace,
+    ) -> Result<Self, ConstraintError> {
         let dialect = Dialect {
             enable_load: false,
             enable_def: false,
@@ -45,7 +50,7 @@ impl ExprConstraint {
             ..Dialect::Standard
         };
         let ast = AstModule::parse(label, expr.to_owned(), &dialect)
-            .map_err(|e| format!("constraint `{name}`: {e}"))?;
+            .map_err(|e| ConstraintError(format!("constraint `{name}`: {e}")))?;
         let c = ExprConstraint {
             name: name.to_owned(),
             expr: expr.to_owned(),
@@ -56,13 +61,15 @@ impl ExprConstraint {
             discrete: vec![0; space.level_counts().len()],
             continuous: vec![0.0; space.continuous_dims()],
         };
-        let values = space.decode(&first).map_err(|e| e.to_string())?;
+        let values = space
+            .decode(&first)
+            .map_err(|e| ConstraintError(e.to_string()))?;
         c.holds(&values)?;
         Ok(c)
     }
 
     /// Whether the expression is true at `values`.
-    fn holds(&self, values: &Assignment) -> Result<bool, String> {
+    fn holds(&self, values: &Assignment) -> Result<bool, ConstraintError> {
         Module::with_temp_heap(|module| {
             let heap = module.heap();
             for (n, v) in values.iter() {
@@ -76,24 +83,24 @@ impl ExprConstraint {
             }
             let mut eval = Evaluator::new(&module);
             eval.set_max_callstack_size(50)
-                .map_err(|e| format!("constraint `{}`: {e}", self.name))?;
+                .map_err(|e| ConstraintError(format!("constraint `{}`: {e}", self.name)))?;
             let got = eval
                 .eval_module(self.ast.clone(), &self.globals)
-                .map_err(|e| format!("constraint `{}`: {e}", self.name))?;
+                .map_err(|e| ConstraintError(format!("constraint `{}`: {e}", self.name)))?;
             if eval.get_total_tick_count() > MAX_CONSTRAINT_STEPS {
-                return Err(format!(
+                return Err(ConstraintError(format!(
                     "constraint `{}` took more than {MAX_CONSTRAINT_STEPS} steps",
                     self.name
-                ));
+                )));
             }
             got.unpack_bool().ok_or_else(|| {
-                format!(
+                ConstraintError(format!(
                     "constraint `{}`: `{}` is {} ({}), not True or False",
                     self.name,
                     self.expr,
                     got,
                     got.get_type()
-                )
+                ))
             })
         })
     }
@@ -104,7 +111,7 @@ impl Constraint for ExprConstraint {
         &self.name
     }
 
-    fn violation(&self, values: &Assignment) -> Result<Option<String>, String> {
+    fn violation(&self, values: &Assignment) -> Result<Option<String>, ConstraintError> {
         Ok((!self.holds(values)?).then(|| format!("`{}` is False", self.expr)))
     }
 }
@@ -157,7 +164,7 @@ mod tests {
             ("speed <", "Parse error"),
         ] {
             let e = ExprConstraint::new("c", expr, "space.toml:3:11", &space()).unwrap_err();
-            assert!(e.contains(needle), "{expr}: {e}");
+            assert!(e.0.contains(needle), "{expr}: {e}");
         }
     }
 }

@@ -373,8 +373,9 @@ impl paracosm_generators::Constraint for TemplateConstraints {
     fn violation(
         &self,
         values: &paracosm_generators::Assignment,
-    ) -> Result<Option<String>, String> {
-        let overrides = (self.overrides.0)(values).map_err(|e| e.0)?;
+    ) -> Result<Option<String>, paracosm_generators::ConstraintError> {
+        let overrides =
+            (self.overrides.0)(values).map_err(|e| paracosm_generators::ConstraintError(e.0))?;
         Ok(self.constrained.violation(&overrides))
     }
 }

@@ -169,8 +169,12 @@ impl paracosm_generators::Constraint for Requires {
         "the program's Require"
     }
 
-    fn violation(&self, a: &Assignment) -> Result<Option<String>, String> {
-        let values = self.0.values(a).map_err(|e| e.to_string())?;
+    fn violation(
+        &self,
+        a: &Assignment,
+    ) -> Result<Option<String>, paracosm_generators::ConstraintError> {
+        let values =
+            (self.0.values(a)).map_err(|e| paracosm_generators::ConstraintError(e.to_string()))?;
         match self.0.evaluate(Some(values), |_, _| Ok(())) {
             Err(e) if e.kind == LoadErrorKind::Constraint => Ok(Some(e.message)),
             // Values that fail otherwise are that test's error.
