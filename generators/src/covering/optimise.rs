@@ -355,7 +355,7 @@ impl<'a> Chain<'a> {
                 } else {
                     stalled += 1;
                 }
-                if left % 1024 == 0 {
+                if left.is_multiple_of(1024) {
                     temperature = (temperature * 0.97).max(0.05);
                 }
                 if stalled > 20_000 {
