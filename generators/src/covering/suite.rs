@@ -284,7 +284,11 @@ mod tests {
         // Each row's block is the Halton points r·m .. (r+1)·m.
         let h = Halton::new(&ParamSpace::unit_cube(2));
         assert_eq!(pts[1].continuous, h.point(16).continuous);
-        assert!(suite.ask(1).is_err());
+        // Past the blocks (a constrained space's skipped points ask for more), row 0 takes
+        // the first Halton point after every block.
+        let next = suite.ask(1).unwrap();
+        assert_eq!(next[0].continuous, h.point(suite.len()).continuous);
+        assert_eq!(next[0].discrete, pts[0].discrete);
     }
 
     /// Without continuous parameters, the budget past the array runs other combinations of
