@@ -374,3 +374,45 @@ fn the_post_optimisation_shrinks_a_pict_models_array() {
         }
     }
 }
+
+/// A `Require` that forbids the representative values' neighbours (a speed tied to a kind)
+/// does not make the load call a parameter unused: `speed` feeds the pedestrian, and
+/// coverage keeps it.
+#[test]
+fn a_parameter_a_require_ties_to_another_is_not_called_unused() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/pedestrian_crossing.star"),
+    )
+    .unwrap();
+    let program = base.replace(
+        "w = World",
+        "kind = VarEnum([\"slow\", \"fast\"], name = \"kind\")\n\
+         def matched(p):\n    if p.kind == \"fast\":\n        return p.walking_speed >= 3\n    \
+         return p.walking_speed < 3\nRequire(matched)\n\nw = World",
+    );
+    let file = dir.path().join("tied.star");
+    std::fs::write(&file, program).unwrap();
+    let out = dir.path().join("out");
+    let o = fuzz(
+        dir.path(),
+        &[
+            file.to_str().unwrap(),
+            "--budget",
+            "64",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    assert!(
+        !err.contains("`walking_speed` is sampled but no object uses it"),
+        "{err}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let unused = summary["unused_params"].as_array().unwrap();
+    assert!(!unused.iter().any(|u| u == "walking_speed"), "{unused:?}");
+    assert_eq!(summary["counts"]["error"], 0);
+}

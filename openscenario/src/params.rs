@@ -648,10 +648,7 @@ impl Scope {
         decls: &[ParamDecl],
         values: &[(String, Value)],
     ) -> Result<Scope, XoscError> {
-        let given: Vec<(&str, Given<'_>)> = (values.iter())
-            .map(|(n, v)| (n.as_str(), Given::Value(v)))
-            .collect();
-        let scope = Scope::build(None, text, decls, &given)?;
+        let scope = Scope::with_values_unconstrained(text, decls, values)?;
         scope.check_all_constraints(decls)?;
         Ok(scope)
     }

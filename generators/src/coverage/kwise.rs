@@ -241,7 +241,7 @@ pub fn kwise_coverage_rows(
 
 /// The t-wise coverage of `rows` (`n × k` row-major, levels already checked) counting only the
 /// tuples `cons` leaves coverable, and the number of forbidden tuples.
-fn valid_tuples(
+pub(crate) fn valid_tuples(
     levels: &[u32],
     rows: &[u32],
     t: usize,

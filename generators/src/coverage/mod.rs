@@ -31,6 +31,7 @@ pub use dispersion::{
     dispersion, dispersion_with_progress, Dispersion, DispersionOptions, EmptyBox,
 };
 pub use error::CoverageError;
+pub(crate) use kwise::valid_tuples;
 pub use kwise::{
     kwise_coverage, kwise_coverage_rows, subset_products, subsets, KWiseCoverage, MissingTuple,
     RawKWise, MAX_STRENGTH,

@@ -226,32 +226,8 @@ pub fn coverage_with_constraints(
     t: usize,
     constraints: &Constraints,
 ) -> (u64, u64) {
-    let k = levels.len();
-    let (mut covered, mut total) = (0, 0);
-    for cols in crate::coverage::subsets(k, t) {
-        let size: usize = cols.iter().map(|&c| levels[c] as usize).product();
-        let index = |row: &[u32]| {
-            cols.iter()
-                .fold(0usize, |a, &c| a * levels[c] as usize + row[c] as usize)
-        };
-        let mut seen = vec![false; size];
-        for row in rows.chunks_exact(k) {
-            seen[index(row)] = true;
-        }
-        for (idx, &s) in seen.iter().enumerate() {
-            let mut rest = idx;
-            let mut cells = vec![(0usize, 0u32); t];
-            for (slot, &c) in cells.iter_mut().zip(&cols).rev() {
-                *slot = (c, (rest % levels[c] as usize) as u32);
-                rest /= levels[c] as usize;
-            }
-            if constraints.completable(levels, &cells) {
-                total += 1;
-                covered += u64::from(s);
-            }
-        }
-    }
-    (covered, total)
+    let (raw, _) = crate::coverage::valid_tuples(levels, rows, t, 0, constraints);
+    (raw.covered, raw.total)
 }
 
 /// Test helper: constraints forbidding the pairs `(column, level, column, level)` drawn by a

@@ -493,7 +493,13 @@ fn probe_effects(
             changes.push(Vec::new());
             continue;
         }
-        changes.push(probe_parameter(program, k, &base, &base_values)?);
+        let (seen, forbidden) = probe_parameter(program, k, &base, &base_values)?;
+        if seen.is_empty() && forbidden {
+            // A `Require` forbade some of its values beside the others' first ones: what it
+            // changes is unknown there, so it counts as used rather than called unused.
+            unprobed.push(k);
+        }
+        changes.push(seen);
     }
     Ok(Effects {
         base_values,
@@ -503,14 +509,16 @@ fn probe_effects(
     })
 }
 
-/// What parameter `k`'s other values change against the world `base` of `base_values`.
+/// What parameter `k`'s other values change against the world `base` of `base_values`, and
+/// whether a `Require` forbade some of those values.
 fn probe_parameter(
     program: &Program,
     k: usize,
     base: &Evaluated,
     base_values: &[ParamValue],
-) -> Result<Vec<usage::Change>, LoadError> {
+) -> Result<(Vec<usage::Change>, bool), LoadError> {
     let mut seen = Vec::new();
+    let mut forbidden = false;
     // At most MAX_PROBED_VALUES of its values, spread over them (a VarEnum may have
     // thousands of levels, each one evaluation of the program).
     let mut all = program.checked_values(k);
@@ -540,7 +548,10 @@ fn probe_parameter(
         let mut values = base_values.to_vec();
         values[k] = v;
         let other = match program.world_for(values) {
-            Err(e) if e.kind == LoadErrorKind::Constraint => continue,
+            Err(e) if e.kind == LoadErrorKind::Constraint => {
+                forbidden = true;
+                continue;
+            }
             r => r.map_err(|e| for_values(&label, e))?,
         };
         seen.extend(base.changes(&other, program.horizon_s));
@@ -548,7 +559,7 @@ fn probe_parameter(
             break;
         }
     }
-    Ok(seen)
+    Ok((seen, forbidden))
 }
 
 /// Phase 7: the monitors, with the default `OffRoadMonitor` unless the program opts out or
@@ -800,7 +811,8 @@ fn second_looks(
     read_in_code
 }
 
-/// The warning that the budget left parameters `unprobed` (by declaration index).
+/// The warning that the budget, or a `Require` that forbids their other values beside the
+/// others' representative ones, left parameters `unprobed` (by declaration index).
 fn unprobed_warning(program: &Program, unprobed: &[usize], file: &str) -> Warning {
     let names: Vec<&str> = unprobed
         .iter()
@@ -810,8 +822,9 @@ fn unprobed_warning(program: &Program, unprobed: &[usize], file: &str) -> Warnin
     Warning {
         at: format!("{file}:1:1"),
         message: format!(
-            "loading stopped probing what parameters change at its budget of \
-             {MAX_LOAD_CHECK_STEPS} evaluation steps: {} parameter{} ({}{}) count as used, \
+            "loading could not probe what {} parameter{} ({}{}) change (its budget of \
+             {MAX_LOAD_CHECK_STEPS} evaluation steps ran out, or a Require forbids their \
+             other values beside the others' representative ones): they count as used, \
              unprobed (no warning says whether an object uses them, and coverage includes \
              them)",
             unprobed.len(),
