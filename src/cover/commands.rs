@@ -562,7 +562,7 @@ fn optimised(
         None if tuples <= DEFAULT_OPTIMISE_MAX_TUPLES => DEFAULT_OPTIMISE_S,
         None => 0.0,
     };
-    let how = Optimise::seconds(seconds, &array.levels, t, a.seed);
+    let how = Optimise::seconds(seconds, a.seed);
     Ok(optimise(array, constraints, frozen, how))
 }
 

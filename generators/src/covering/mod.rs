@@ -6,14 +6,16 @@
 //!   its union bound, or grown until the coverage checker is satisfied.
 
 mod constraints;
+mod construct;
 mod ipog;
 mod optimise;
 mod random;
 mod suite;
 
 pub use constraints::Constraints;
+pub use construct::{construct, doubling, orthogonal_array, product};
 pub use ipog::{ipog, ipog_with};
-pub use optimise::{optimise, Optimise, MOVE_BASE_S, MOVE_UNIT_S};
+pub use optimise::{optimise, Optimise, WORK_UNIT_S};
 pub use random::{
     random_kwise, random_kwise_covering, random_kwise_rows, random_kwise_with,
     random_until_covered, random_until_covered_with, RandomKWiseSize,
