@@ -36,6 +36,20 @@ pub struct CoveringSuite {
     constrained: Option<ParamSpace>,
     /// Per row, how many of its Halton points it has used.
     used: Vec<u64>,
+    /// The stride of a row's points past the blocks: the least prime at least the number of
+    /// rows that is no Halton base, so that the leaped sequence still fills the cube (a stride
+    /// sharing a factor with a base fixes that coordinate's first digits; Kocis and Whiten,
+    /// "Computational investigations of low-discrepancy sequences", ACM TOMS 23, 1997).
+    leap: u64,
+}
+
+/// The least prime `p ≥ at_least` that is not among the first `bases` primes.
+fn leap_prime(at_least: u64, bases: usize) -> u64 {
+    let is_prime = |n: u64| n >= 2 && (2..).take_while(|d| d * d <= n).all(|d| n % d != 0);
+    let first: Vec<u64> = (2..).filter(|&n| is_prime(n)).take(bases).collect();
+    (at_least.max(2)..)
+        .find(|&n| is_prime(n) && !first.contains(&n))
+        .expect("a prime")
 }
 
 /// The most of a row's Halton points a constrained suite tries for one valid test before it
@@ -95,12 +109,14 @@ impl CoveringSuite {
             extend_with_distinct_rows(&mut rows, &levels, target, seed, &cons);
             per_row = target.div_ceil(rows.len() as u64);
         }
+        let leap = leap_prime(rows.len() as u64, space.continuous_dims());
         Ok(CoveringSuite {
             used: vec![0; rows.len()],
             rows,
             per_row,
             halton: Halton::new(&continuous),
             next: 0,
+            leap,
             constrained: space.is_constrained().then(|| space.clone()),
             name: match kind {
                 ArrayKind::Ipog => "ipog",
@@ -131,7 +147,8 @@ impl CoveringSuite {
 
     /// Point `j` in the interleaved order. Past [`CoveringSuite::len`] (a constrained space
     /// whose invalid points are skipped asks for more) the rows take turns again, each with
-    /// Halton points past every block: `len + (i - m) · rows + r` for row `r`'s `i`-th point.
+    /// Halton points past every block: `len + (i - m) · L + r` for row `r`'s `i`-th point, `L`
+    /// the least prime at least the number of rows that is no Halton base.
     pub fn point(&self, j: u64) -> Point {
         let rows = self.rows.len() as u64;
         self.draw((j % rows) as usize, j / rows)
@@ -139,11 +156,10 @@ impl CoveringSuite {
 
     /// Row `r`'s `i`-th point.
     fn draw(&self, r: usize, i: u64) -> Point {
-        let rows = self.rows.len() as u64;
         let index = if i < self.per_row {
             r as u64 * self.per_row + i
         } else {
-            self.len() + (i - self.per_row) * rows + r as u64
+            self.len() + (i - self.per_row) * self.leap + r as u64
         };
         let h = self.halton.point(index);
         Point {
