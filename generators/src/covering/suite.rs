@@ -45,7 +45,12 @@ pub struct CoveringSuite {
 
 /// The least prime `p ≥ at_least` that is not among the first `bases` primes.
 fn leap_prime(at_least: u64, bases: usize) -> u64 {
-    let is_prime = |n: u64| n >= 2 && (2..).take_while(|d| d * d <= n).all(|d| n % d != 0);
+    let is_prime = |n: u64| {
+        n >= 2
+            && (2..)
+                .take_while(|d| d * d <= n)
+                .all(|d| !n.is_multiple_of(d))
+    };
     let first: Vec<u64> = (2..).filter(|&n| is_prime(n)).take(bases).collect();
     (at_least.max(2)..)
         .find(|&n| is_prime(n) && !first.contains(&n))
